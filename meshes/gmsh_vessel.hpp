@@ -1,0 +1,22 @@
+#pragma once
+/// Vessel meshes generated with the gmsh C++ API (built-in kernel: the annular cross-section, made
+/// of four quarter patches, is extruded along the tube or revolved around the arch's axis).
+#include "meshes/tet_mesh.hpp"
+#include "meshes/vessel_geometry.hpp"
+
+namespace vessel {
+
+struct MeshingOptions {
+  bool verbose = false;  ///< let gmsh print its own log
+  int threads = 1;       ///< gmsh threads (the 3D Delaunay of large levels uses them)
+};
+
+/// Generates the tetrahedral wall mesh with the groups of kVesselGroups, tets positively oriented
+/// and boundary triangles outward. Throws InputError for invalid params (see validate) and
+/// std::runtime_error if gmsh fails.
+TetMesh generate_vessel_mesh(const VesselParams& params, const MeshingOptions& options = {});
+
+/// The gmsh API version string ("4.8.0"), part of the mesh cache key.
+std::string gmsh_version();
+
+}  // namespace vessel

@@ -1,0 +1,98 @@
+#include "meshes/mesh_cache.hpp"
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+
+#include "meshes/errors.hpp"
+#include "meshes/msh_io.hpp"
+
+namespace vessel {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Bumped whenever the generator's output for the same params changes.
+constexpr int kGeneratorVersion = 1;
+
+std::uint64_t fnv1a(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+std::string exact(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+fs::path default_cache_dir() {
+  if (const char* dir = std::getenv("VESSELVERIFY_CACHE_DIR"); dir && *dir) return dir;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) {
+    return fs::path(xdg) / "vesselverify";
+  }
+  if (const char* home = std::getenv("HOME"); home && *home) {
+    return fs::path(home) / ".cache" / "vesselverify";
+  }
+  return ".vesselverify-cache";
+}
+
+std::string mesh_cache_key(const VesselParams& p) {
+  std::string key = "vesselverify-mesh generator=" + std::to_string(kGeneratorVersion) +
+                    " gmsh=" + gmsh_version() + " kind=" + to_string(p.kind) +
+                    " style=" + to_string(p.style) + " level=" + std::to_string(p.level) +
+                    " a=" + exact(p.inner_radius) + " t=" + exact(p.wall_thickness);
+  key += p.kind == VesselKind::straight ? " L=" + exact(p.length) : " R=" + exact(p.bend_radius);
+  return key;
+}
+
+std::string mesh_cache_file_name(const VesselParams& p) {
+  char hash[17];
+  std::snprintf(hash, sizeof hash, "%016llx",
+                static_cast<unsigned long long>(fnv1a(mesh_cache_key(p))));
+  return to_string(p.kind) + "-" + to_string(p.style) + "-L" + std::to_string(p.level) + "-" +
+         hash + ".msh";
+}
+
+TetMesh load_or_generate_vessel(const VesselParams& params, const fs::path& cache_dir,
+                                const MeshingOptions& options, MeshSource* source) {
+  validate(params);
+  MeshSource info;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!cache_dir.empty()) {
+    info.path = cache_dir / mesh_cache_file_name(params);
+    if (fs::exists(info.path)) {
+      try {
+        TetMesh mesh = read_msh(info.path);
+        require_vessel_groups(mesh, info.path.string());
+        info.cache_hit = true;
+        info.seconds = seconds_since(t0);
+        if (source) *source = info;
+        return mesh;
+      } catch (const InputError& e) {
+        std::cerr << "warning: ignoring unreadable cached mesh (" << e.what()
+                  << "); generating it again\n";
+      }
+    }
+  }
+  TetMesh mesh = generate_vessel_mesh(params, options);
+  info.seconds = seconds_since(t0);
+  if (!cache_dir.empty()) write_msh(info.path, mesh);
+  if (source) *source = info;
+  return mesh;
+}
+
+}  // namespace vessel

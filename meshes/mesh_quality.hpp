@@ -1,0 +1,45 @@
+#pragma once
+/// Tetrahedral mesh quality: dihedral angles, radius ratio, edge lengths, volumes.
+#include <string>
+
+#include "meshes/tet_mesh.hpp"
+
+namespace vessel {
+
+/// min / max / mean / standard deviation of a quantity over elements or edges.
+struct Stats {
+  double min = 0.0;
+  double max = 0.0;
+  double mean = 0.0;
+  double stddev = 0.0;
+  std::size_t count = 0;
+};
+
+struct MeshQuality {
+  Stats dihedral_deg;    ///< all six dihedral angles of every tet, degrees (regular tet: 70.53°)
+  Stats radius_ratio;    ///< 3·inradius/circumradius per tet (1 regular, → 0 degenerate)
+  Stats edge_length;     ///< unique edges, m
+  Stats volume;          ///< signed tet volumes, m³
+  double total_volume = 0.0;
+  std::size_t inverted = 0;    ///< tets with negative signed volume
+  std::size_t degenerate = 0;  ///< tets with |V| < 1e-8 × (mean edge)³ (zero volume)
+};
+
+/// Per-tet quality values (for VTU output).
+struct TetQuality {
+  double volume = 0.0;
+  double radius_ratio = 0.0;
+  double min_dihedral_deg = 0.0;
+  double max_dihedral_deg = 0.0;
+};
+/// The six interior dihedral angles of a tet, degrees.
+std::array<double, 6> dihedral_angles_deg(const Vec3& a, const Vec3& b, const Vec3& c,
+                                          const Vec3& d);
+TetQuality tet_quality(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+
+MeshQuality compute_quality(const TetMesh& mesh);
+
+/// Multi-line human-readable summary in mm, mm³ and degrees.
+std::string format_quality(const MeshQuality& q);
+
+}  // namespace vessel

@@ -1,0 +1,24 @@
+#pragma once
+/// Reading and writing gmsh `.msh` files (ASCII formats 2.2 and 4.1) without the gmsh library, so
+/// every parse error can name the file and line. Linear tetrahedra (type 4) and triangles (type 2)
+/// are kept; points and lines are skipped; any other element type is an error.
+#include <filesystem>
+
+#include "meshes/tet_mesh.hpp"
+
+namespace vessel {
+
+enum class MshVersion { v22, v41 };
+
+/// Reads an ASCII `.msh` 2.2 or 4.1 file. Node indices are renumbered 0.. in file order, unused
+/// nodes dropped, tets flipped if the file's convention makes them all negative, and group triangles that are tet faces oriented
+/// outward. Throws InputError naming the file and line for a missing, truncated, binary or
+/// malformed file, a non-finite coordinate or an unknown node tag. Does not require any group:
+/// call require_vessel_groups for that.
+TetMesh read_msh(const std::filesystem::path& path);
+
+/// Writes the mesh atomically as ASCII `.msh` (one entity per physical group).
+void write_msh(const std::filesystem::path& path, const TetMesh& mesh,
+               MshVersion version = MshVersion::v41);
+
+}  // namespace vessel

@@ -1,0 +1,220 @@
+#include "meshes/tet_mesh.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <map>
+#include <unordered_map>
+
+#include "meshes/errors.hpp"
+
+namespace vessel {
+
+namespace {
+
+/// The four faces of a tet, each listed so that its normal points away from the opposite vertex
+/// when the tet is positively oriented.
+constexpr std::array<std::array<int, 3>, 4> kTetFaces{{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+
+std::array<int, 3> sorted(Triangle t) {
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+struct TriangleKeyHash {
+  std::size_t operator()(const std::array<int, 3>& k) const {
+    std::size_t h = static_cast<std::size_t>(k[0]);
+    h = h * 1000003u ^ static_cast<std::size_t>(k[1]);
+    h = h * 1000003u ^ static_cast<std::size_t>(k[2]);
+    return h;
+  }
+};
+
+}  // namespace
+
+const PhysicalGroup* TetMesh::find_group(std::string_view name, int dim) const {
+  for (const auto& g : groups) {
+    if (g.name == name && g.dim == dim) return &g;
+  }
+  return nullptr;
+}
+
+const PhysicalGroup& TetMesh::require_group(std::string_view name, int dim,
+                                            std::string_view source) const {
+  if (const auto* g = find_group(name, dim)) {
+    if (g->elements.empty()) {
+      throw InputError(std::string(source) + ": physical group '" + std::string(name) +
+                       "' is empty; expected at least one " +
+                       (dim == 3 ? "tetrahedron" : "triangle"));
+    }
+    return *g;
+  }
+  std::string present;
+  for (const auto& g : groups) {
+    present += (present.empty() ? "" : ", ") + g.name + " (dim " + std::to_string(g.dim) + ")";
+  }
+  throw InputError(std::string(source) + ": missing physical group '" + std::string(name) +
+                   "' of dimension " + std::to_string(dim) + "; the mesh has " +
+                   (present.empty() ? std::string("no physical groups") : present) +
+                   ". A vessel mesh needs inlet, outlet, inner_wall, outer_wall (surfaces) and "
+                   "wall (volume)");
+}
+
+void require_vessel_groups(const TetMesh& mesh, std::string_view source) {
+  for (const auto& spec : kVesselGroups) (void)mesh.require_group(spec.name, spec.dim, source);
+}
+
+std::vector<int> TetMesh::group_nodes(const PhysicalGroup& group) const {
+  std::vector<int> out;
+  for (int e : group.elements) {
+    if (group.dim == 3) {
+      out.insert(out.end(), tets[e].begin(), tets[e].end());
+    } else {
+      out.insert(out.end(), triangles[e].begin(), triangles[e].end());
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+std::vector<Triangle> TetMesh::group_triangles(const PhysicalGroup& group) const {
+  if (group.dim != 2) {
+    throw std::invalid_argument("group_triangles: group '" + group.name + "' has dimension " +
+                                std::to_string(group.dim) + ", expected 2");
+  }
+  std::vector<Triangle> out;
+  out.reserve(group.elements.size());
+  for (int e : group.elements) out.push_back(triangles[e]);
+  return out;
+}
+
+double signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return (b - a).dot((c - a).cross(d - a)) / 6.0;
+}
+
+double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return 0.5 * (b - a).cross(c - a).norm();
+}
+
+double mesh_volume(const TetMesh& mesh) {
+  double v = 0.0;
+  for (const auto& t : mesh.tets) {
+    v += signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
+  }
+  return v;
+}
+
+double group_area(const TetMesh& mesh, const PhysicalGroup& group) {
+  double a = 0.0;
+  for (const auto& t : mesh.group_triangles(group)) {
+    a += triangle_area(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]]);
+  }
+  return a;
+}
+
+namespace {
+/// Maps each sorted face to (count, the outward-oriented face of the last tet that had it).
+std::unordered_map<std::array<int, 3>, std::pair<int, Triangle>, TriangleKeyHash> face_map(
+    const TetMesh& mesh) {
+  std::unordered_map<std::array<int, 3>, std::pair<int, Triangle>, TriangleKeyHash> faces;
+  faces.reserve(mesh.tets.size() * 3);
+  for (const auto& t : mesh.tets) {
+    const bool positive =
+        signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]) >= 0;
+    for (const auto& f : kTetFaces) {
+      Triangle tri{t[f[0]], t[f[1]], t[f[2]]};
+      if (!positive) std::swap(tri[1], tri[2]);
+      auto& entry = faces[sorted(tri)];
+      ++entry.first;
+      entry.second = tri;
+    }
+  }
+  return faces;
+}
+}  // namespace
+
+std::vector<Triangle> boundary_faces(const TetMesh& mesh) {
+  std::vector<Triangle> out;
+  for (const auto& [key, entry] : face_map(mesh)) {
+    if (entry.first == 1) out.push_back(entry.second);
+  }
+  return out;
+}
+
+void orient_tets(TetMesh& mesh) {
+  const bool all_negative = std::all_of(mesh.tets.begin(), mesh.tets.end(), [&](const Tet& t) {
+    return signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]) <=
+           0;
+  });
+  if (!all_negative) return;
+  for (auto& t : mesh.tets) std::swap(t[2], t[3]);
+}
+
+void orient_boundary_outward(TetMesh& mesh) {
+  const auto faces = face_map(mesh);
+  for (auto& tri : mesh.triangles) {
+    const auto it = faces.find(sorted(tri));
+    if (it != faces.end() && it->second.first == 1) tri = it->second.second;
+  }
+}
+
+void remove_unused_nodes(TetMesh& mesh) {
+  std::vector<int> new_index(mesh.nodes.size(), -1);
+  for (const auto& t : mesh.tets) {
+    for (int n : t) new_index[n] = 0;
+  }
+  for (const auto& t : mesh.triangles) {
+    for (int n : t) new_index[n] = 0;
+  }
+  std::vector<Vec3> nodes;
+  nodes.reserve(mesh.nodes.size());
+  for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
+    if (new_index[i] == 0) {
+      new_index[i] = static_cast<int>(nodes.size());
+      nodes.push_back(mesh.nodes[i]);
+    }
+  }
+  for (auto& t : mesh.tets) {
+    for (int& n : t) n = new_index[n];
+  }
+  for (auto& t : mesh.triangles) {
+    for (int& n : t) n = new_index[n];
+  }
+  mesh.nodes = std::move(nodes);
+}
+
+SurfaceTopology surface_topology(const std::vector<Triangle>& triangles) {
+  // For each undirected edge: how many triangles use it, and how many traverse it low→high.
+  std::map<std::pair<int, int>, std::pair<int, int>> edges;
+  for (const auto& t : triangles) {
+    for (int i = 0; i < 3; ++i) {
+      const int a = t[i];
+      const int b = t[(i + 1) % 3];
+      auto& e = edges[{std::min(a, b), std::max(a, b)}];
+      ++e.first;
+      if (a < b) ++e.second;
+    }
+  }
+  SurfaceTopology topo;
+  for (const auto& [edge, use] : edges) {
+    if (use.first == 1) {
+      ++topo.boundary_edges;
+    } else if (use.first > 2) {
+      ++topo.non_manifold_edges;
+    } else if (use.second != 1) {
+      ++topo.inconsistent_edges;
+    }
+  }
+  return topo;
+}
+
+double enclosed_volume(const std::vector<Vec3>& nodes, const std::vector<Triangle>& triangles) {
+  // Divergence theorem: V = Σ (a · (b × c)) / 6 over outward triangles.
+  double v = 0.0;
+  for (const auto& t : triangles) {
+    v += nodes[t[0]].dot(nodes[t[1]].cross(nodes[t[2]])) / 6.0;
+  }
+  return v;
+}
+
+}  // namespace vessel

@@ -1,0 +1,66 @@
+#pragma once
+/// Parametric vessels: a straight thick-walled tube and a 180° arch of the same cross-section.
+/// Lengths in metres.
+#include <string>
+
+#include "meshes/tet_mesh.hpp"
+
+namespace vessel {
+
+enum class VesselKind { straight, arch };
+
+/// How the wall is meshed: unstructured Delaunay tets of size h0/2^level, or a structured
+/// (transfinite, extruded) grid of circumferential × axial × radial layers doubled per level.
+enum class MeshStyle { unstructured, structured };
+
+struct VesselParams {
+  VesselKind kind = VesselKind::straight;
+  double inner_radius = 3e-3;    ///< a, m
+  double wall_thickness = 1e-3;  ///< t = b − a, m
+  double length = 40e-3;         ///< straight tube length, m
+  double bend_radius = 15e-3;    ///< arch centreline radius R, m (the arch spans 180°)
+  MeshStyle style = MeshStyle::unstructured;
+  int level = 0;  ///< refinement level 0..4; each level halves the element size
+
+  [[nodiscard]] double outer_radius() const { return inner_radius + wall_thickness; }
+  /// Length of the centreline, m: L for the tube, πR for the arch.
+  [[nodiscard]] double centreline_length() const;
+};
+
+inline constexpr int kMaxMeshLevel = 4;
+
+/// Throws InputError naming the parameter, the value and the allowed range when the vessel cannot
+/// be built (non-positive or non-finite sizes, a wall reaching the bend's axis, a bad level).
+void validate(const VesselParams& params);
+
+/// Closed-form wall volume, m³: π(b²−a²)L for the tube; for the arch, Pappus' theorem gives the
+/// torus segment π(b²−a²)·πR.
+double analytic_wall_volume(const VesselParams& params);
+/// Closed-form area of the lateral wall of radius r (a or b), m²: 2πr·L, or 2πr·πR for the arch.
+double analytic_lateral_area(const VesselParams& params, double radius);
+/// Closed-form area of one end face, m²: π(b²−a²).
+double analytic_end_area(const VesselParams& params);
+
+/// Distance of a point from the vessel centreline, m (the local radius ρ of the cross-section).
+double distance_from_centreline(const VesselParams& params, const Vec3& p);
+
+/// Structured grid counts at the params' level.
+struct StructuredCounts {
+  int circumferential = 0;  ///< divisions around the circumference (multiple of 4)
+  int axial = 0;            ///< divisions along the centreline
+  int radial = 0;           ///< divisions through the wall
+  [[nodiscard]] long expected_nodes() const {
+    return static_cast<long>(circumferential) * (axial + 1) * (radial + 1);
+  }
+};
+StructuredCounts structured_counts(const VesselParams& params);
+
+/// Target element size of the unstructured mesh at the params' level, m: t / 2^level.
+double unstructured_mesh_size(const VesselParams& params);
+
+std::string to_string(VesselKind kind);
+std::string to_string(MeshStyle style);
+/// One line describing the vessel in mm, for logs and reports.
+std::string describe(const VesselParams& params);
+
+}  // namespace vessel

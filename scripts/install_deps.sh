@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs the Debian packages vesselverify needs, only those that are missing (idempotent).
+# Fast when everything is already there: one dpkg-query, no network.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libeigen3-dev libsuitesparse-dev        # msm: Eigen, CHOLMOD
+  libgmsh-dev                             # meshes: gmsh C++ API
+  libdeal.ii-dev                          # fem_reference
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
+  libspectra-dev
+  python3-matplotlib python3-numpy        # reports (use /usr/bin/python3)
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
+  [ "$status" = "installed" ] || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "install_deps: installing ${#missing[@]} missing Debian package(s): ${missing[*]}"
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install_deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  sudo_cmd=(sudo)
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,294 @@
+// .msh, STL and VTU input/output: round trips, files written by gmsh itself, and bad input.
+#include <gmsh.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "../test_helpers.hpp"
+#include "meshes/atomic_file.hpp"
+#include "meshes/errors.hpp"
+#include "meshes/gmsh_vessel.hpp"
+#include "meshes/msh_io.hpp"
+#include "meshes/stl_io.hpp"
+#include "meshes/vtu_io.hpp"
+
+using namespace vessel;
+using vessel::test::TempDir;
+using vessel::test::read_text;
+using vessel::test::write_text;
+
+namespace {
+
+/// The message of the InputError that `f` throws ("" if none).
+template <class F>
+std::string input_error(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const TetMesh& level0_tube() {
+  static const TetMesh mesh = generate_vessel_mesh(VesselParams{});
+  return mesh;
+}
+
+void expect_same_mesh(const TetMesh& a, const TetMesh& b) {
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  for (std::size_t i = 0; i < a.nodes.size(); ++i) ASSERT_EQ(a.nodes[i], b.nodes[i]) << i;
+  ASSERT_EQ(a.tets, b.tets);
+  ASSERT_EQ(a.groups.size(), b.groups.size());
+  for (const auto& g : a.groups) {
+    const auto* h = b.find_group(g.name, g.dim);
+    ASSERT_NE(h, nullptr) << g.name;
+    EXPECT_EQ(g.tag, h->tag);
+    if (g.dim == 2) EXPECT_EQ(a.group_triangles(g), b.group_triangles(*h)) << g.name;
+    EXPECT_EQ(g.elements.size(), h->elements.size()) << g.name;
+  }
+}
+
+/// A single tet with two named groups, in msh 2.2.
+const char* kOneTet22 = R"($MeshFormat
+2.2 0 8
+$EndMeshFormat
+$PhysicalNames
+2
+2 1 "inlet"
+3 10 "wall"
+$EndPhysicalNames
+$Nodes
+4
+1 0 0 0
+2 1 0 0
+3 0 1 0
+4 0 0 1
+$EndNodes
+$Elements
+2
+1 2 2 1 1 1 3 2
+2 4 2 10 10 1 2 3 4
+$EndElements
+)";
+
+}  // namespace
+
+TEST(MshIo, RoundTripV41IsExact) {
+  TempDir dir;
+  write_msh(dir / "tube.msh", level0_tube(), MshVersion::v41);
+  expect_same_mesh(level0_tube(), read_msh(dir / "tube.msh"));
+}
+
+TEST(MshIo, RoundTripV22IsExact) {
+  TempDir dir;
+  write_msh(dir / "tube.msh", level0_tube(), MshVersion::v22);
+  expect_same_mesh(level0_tube(), read_msh(dir / "tube.msh"));
+}
+
+TEST(MshIo, ReadsFilesWrittenByGmshInBothFormats) {
+  // gmsh writes the files; our reader must recover gmsh's own element counts and the box volume.
+  TempDir dir;
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::model::add("box");
+  const int box = gmsh::model::occ::addBox(0, 0, 0, 1, 2, 3);
+  gmsh::model::occ::synchronize();
+  gmsh::vectorpair faces;
+  gmsh::model::getBoundary({{3, box}}, faces, false, false);
+  std::vector<int> face_tags;
+  for (const auto& f : faces) face_tags.push_back(f.second);
+  gmsh::model::addPhysicalGroup(2, face_tags, 7);
+  gmsh::model::setPhysicalName(2, 7, "skin");
+  gmsh::model::addPhysicalGroup(3, {box}, 3);
+  gmsh::model::setPhysicalName(3, 3, "wall");
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 0.5);
+  gmsh::model::mesh::generate(3);
+  std::vector<int> types;
+  std::vector<std::vector<std::size_t>> tags, nodes;
+  gmsh::model::mesh::getElements(types, tags, nodes, 3);
+  const std::size_t gmsh_tets = tags.at(0).size();
+  gmsh::model::mesh::getElements(types, tags, nodes, 2);
+  std::size_t gmsh_triangles = 0;
+  for (const auto& t : tags) gmsh_triangles += t.size();
+  gmsh::option::setNumber("Mesh.MshFileVersion", 2.2);
+  gmsh::write((dir / "box22.msh").string());
+  gmsh::option::setNumber("Mesh.MshFileVersion", 4.1);
+  gmsh::write((dir / "box41.msh").string());
+  gmsh::finalize();
+
+  for (const char* file : {"box22.msh", "box41.msh"}) {
+    SCOPED_TRACE(file);
+    const TetMesh mesh = read_msh(dir / file);
+    EXPECT_EQ(mesh.tets.size(), gmsh_tets);
+    EXPECT_EQ(mesh.triangles.size(), gmsh_triangles);
+    EXPECT_NEAR(mesh_volume(mesh), 6.0, 1e-12);
+    const auto* skin = mesh.find_group("skin", 2);
+    ASSERT_NE(skin, nullptr);
+    EXPECT_EQ(skin->tag, 7);
+    EXPECT_NEAR(group_area(mesh, *skin), 2.0 * (1 * 2 + 2 * 3 + 1 * 3), 1e-12);
+    EXPECT_TRUE(surface_topology(mesh.group_triangles(*skin)).closed_and_oriented());
+    EXPECT_NEAR(enclosed_volume(mesh.nodes, mesh.group_triangles(*skin)), 6.0, 1e-12);
+  }
+}
+
+TEST(MshIo, HandWrittenTetHasVolumeOneSixthAndOutwardFace) {
+  TempDir dir;
+  write_text(dir / "tet.msh", kOneTet22);
+  const TetMesh mesh = read_msh(dir / "tet.msh");
+  ASSERT_EQ(mesh.tets.size(), 1u);
+  EXPECT_DOUBLE_EQ(mesh_volume(mesh), 1.0 / 6.0);
+  // The inlet triangle lies in z = 0; outward from the tet is −z.
+  const auto& t = mesh.triangles.at(0);
+  const Vec3 n = (mesh.nodes[t[1]] - mesh.nodes[t[0]]).cross(mesh.nodes[t[2]] - mesh.nodes[t[0]]);
+  EXPECT_LT(n.z(), 0.0);
+}
+
+TEST(MshIo, MissingFileIsAClearError) {
+  const auto msg = input_error([] { (void)read_msh("/nonexistent/vessel.msh"); });
+  EXPECT_NE(msg.find("/nonexistent/vessel.msh"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("not found"), std::string::npos) << msg;
+}
+
+TEST(MshIo, EmptyAndNonMshFilesAreRefused) {
+  TempDir dir;
+  write_text(dir / "empty.msh", "");
+  EXPECT_NE(input_error([&] { (void)read_msh(dir / "empty.msh"); }).find("empty"),
+            std::string::npos);
+  write_text(dir / "text.msh", "hello\n");
+  EXPECT_NE(input_error([&] { (void)read_msh(dir / "text.msh"); }).find("$MeshFormat"),
+            std::string::npos);
+}
+
+TEST(MshIo, TruncatedFilesAreRefusedInEveryFormat) {
+  TempDir dir;
+  for (auto version : {MshVersion::v22, MshVersion::v41}) {
+    write_msh(dir / "full.msh", level0_tube(), version);
+    const std::string text = read_text(dir / "full.msh");
+    for (double fraction : {0.05, 0.3, 0.6, 0.99}) {
+      write_text(dir / "cut.msh", text.substr(0, static_cast<std::size_t>(fraction * text.size())));
+      const auto msg = input_error([&] { (void)read_msh(dir / "cut.msh"); });
+      EXPECT_FALSE(msg.empty()) << "fraction " << fraction;
+      EXPECT_NE(msg.find("cut.msh"), std::string::npos) << msg;
+    }
+  }
+}
+
+TEST(MshIo, MalformedValuesNameTheLine) {
+  TempDir dir;
+  std::string text = kOneTet22;
+  text.replace(text.find("2 1 0 0"), 7, "2 1 zero 0");
+  write_text(dir / "bad.msh", text);
+  const auto msg = input_error([&] { (void)read_msh(dir / "bad.msh"); });
+  EXPECT_NE(msg.find("bad.msh:12:"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("zero"), std::string::npos) << msg;
+}
+
+TEST(MshIo, NonFiniteCoordinatesAreRefused) {
+  TempDir dir;
+  std::string text = kOneTet22;
+  text.replace(text.find("4 0 0 1"), 7, "4 0 nan 1");
+  write_text(dir / "nan.msh", text);
+  EXPECT_NE(input_error([&] { (void)read_msh(dir / "nan.msh"); }).find("non-finite"),
+            std::string::npos);
+}
+
+TEST(MshIo, UnknownNodeTagsAndBinaryFilesAreRefused) {
+  TempDir dir;
+  std::string text = kOneTet22;
+  text.replace(text.find("10 10 1 2 3 4"), 13, "10 10 1 2 3 9");
+  write_text(dir / "tag.msh", text);
+  EXPECT_NE(input_error([&] { (void)read_msh(dir / "tag.msh"); }).find("node tag 9"),
+            std::string::npos);
+  text = kOneTet22;
+  text.replace(text.find("2.2 0 8"), 7, "2.2 1 8");
+  write_text(dir / "bin.msh", text);
+  EXPECT_NE(input_error([&] { (void)read_msh(dir / "bin.msh"); }).find("binary"),
+            std::string::npos);
+}
+
+TEST(MshIo, MeshWithoutVesselGroupsIsRefusedNamingTheGroup) {
+  TempDir dir;
+  write_text(dir / "tet.msh", kOneTet22);
+  const TetMesh mesh = read_msh(dir / "tet.msh");
+  const auto msg = input_error([&] { require_vessel_groups(mesh, (dir / "tet.msh").string()); });
+  EXPECT_NE(msg.find("tet.msh"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'outlet'"), std::string::npos) << msg;
+}
+
+TEST(StlIo, AsciiRoundTripIsExactAndBinaryWithinFloatPrecision) {
+  TempDir dir;
+  const TriangleSurface inner =
+      extract_surface(level0_tube(), {std::string(group_names::inner_wall)}, "test");
+  write_stl(dir / "inner.stl", inner, StlFormat::ascii);
+  const TriangleSurface ascii = read_stl(dir / "inner.stl");
+  EXPECT_EQ(ascii.nodes, inner.nodes);
+  EXPECT_EQ(ascii.triangles, inner.triangles);
+  write_stl(dir / "inner_bin.stl", inner, StlFormat::binary);
+  const TriangleSurface binary = read_stl(dir / "inner_bin.stl");
+  EXPECT_EQ(binary.nodes.size(), inner.nodes.size());
+  EXPECT_EQ(binary.triangles.size(), inner.triangles.size());
+  EXPECT_NEAR(surface_area(binary) / surface_area(inner), 1.0, 1e-6);
+  // The inner wall is an open tube: its only open edges are the two rims.
+  const SurfaceTopology topo = surface_topology(binary.triangles);
+  EXPECT_EQ(topo.inconsistent_edges, 0u);
+  EXPECT_EQ(topo.non_manifold_edges, 0u);
+  EXPECT_GT(topo.boundary_edges, 0u);
+}
+
+TEST(StlIo, BadFilesAreClearErrors) {
+  TempDir dir;
+  EXPECT_NE(input_error([&] { (void)read_stl(dir / "missing.stl"); }).find("not found"),
+            std::string::npos);
+  write_text(dir / "empty.stl", "");
+  EXPECT_NE(input_error([&] { (void)read_stl(dir / "empty.stl"); }).find("empty"),
+            std::string::npos);
+  write_text(dir / "cut.stl",
+             "solid x\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n");
+  const auto cut = input_error([&] { (void)read_stl(dir / "cut.stl"); });
+  EXPECT_NE(cut.find("cut.stl:5: file is truncated"), std::string::npos) << cut;
+  write_text(dir / "flat.stl",
+             "solid x\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 0 0 0\n"
+             "   vertex 1 0 0\n  endloop\n endfacet\nendsolid x\n");
+  EXPECT_NE(input_error([&] { (void)read_stl(dir / "flat.stl"); }).find("degenerate"),
+            std::string::npos);
+}
+
+TEST(VtuIo, WritesPointsCellsAndFieldsAndRefusesWrongSizes) {
+  TempDir dir;
+  const TetMesh& mesh = level0_tube();
+  VtuField u{"u", 3, std::vector<double>(3 * mesh.nodes.size(), 0.5)};
+  write_vtu(dir / "tube.vtu", mesh, {u});
+  const std::string text = read_text(dir / "tube.vtu");
+  EXPECT_NE(text.find("NumberOfPoints=\"" + std::to_string(mesh.nodes.size()) + "\""),
+            std::string::npos);
+  EXPECT_NE(text.find("NumberOfCells=\"" + std::to_string(mesh.tets.size()) + "\""),
+            std::string::npos);
+  EXPECT_NE(text.find("Name=\"u\" NumberOfComponents=\"3\""), std::string::npos);
+  VtuField wrong{"w", 1, {1.0}};
+  EXPECT_THROW(write_vtu(dir / "bad.vtu", mesh, {wrong}), std::invalid_argument);
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.vtu"));
+}
+
+TEST(AtomicFile, AFailedWriteLeavesTheEarlierFileAndNoTemporary) {
+  TempDir dir;
+  write_file_atomically(dir / "out.txt", [](std::ostream& out) { out << "good"; });
+  EXPECT_THROW(write_file_atomically(dir / "out.txt",
+                                     [](std::ostream& out) {
+                                       out << "half";
+                                       throw std::runtime_error("boom");
+                                     }),
+               std::runtime_error);
+  EXPECT_EQ(read_text(dir / "out.txt"), "good");
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
+                          std::filesystem::directory_iterator()),
+            1);
+}
+
+TEST(AtomicFile, UnwritableDirectoryIsAnInputError) {
+  const auto msg = input_error([] {
+    write_file_atomically("/proc/vesselverify/out.txt", [](std::ostream& out) { out << "x"; });
+  });
+  EXPECT_NE(msg.find("/proc/vesselverify"), std::string::npos) << msg;
+}

@@ -1,0 +1,10 @@
+#pragma once
+/// Subcommands of the vesselverify program. Each adds itself to the app; its callback throws
+/// vessel::InputError for bad input, which main() reports with a non-zero exit.
+#include <CLI/CLI.hpp>
+
+namespace vessel::cli {
+
+void add_mesh_command(CLI::App& app);
+
+}  // namespace vessel::cli

@@ -1,0 +1,29 @@
+#pragma once
+/// Command-line options shared by every subcommand that builds a vessel mesh.
+#include <CLI/CLI.hpp>
+#include <filesystem>
+
+#include "meshes/mesh_cache.hpp"
+
+namespace vessel::cli {
+
+struct VesselOptions {
+  VesselParams params;
+  std::string vessel = "straight";
+  bool structured = false;
+  std::filesystem::path cache_dir = default_cache_dir();
+  bool no_cache = false;
+  MeshingOptions meshing;
+};
+
+/// Adds --vessel, --structured, --level, --inner-radius, --wall-thickness, --length,
+/// --bend-radius, --cache-dir, --no-cache, --threads, --gmsh-log to `cmd`.
+void add_vessel_options(CLI::App& cmd, VesselOptions& options);
+
+/// Completes params from the parsed strings and validates them (InputError if out of range).
+VesselParams resolve(VesselOptions& options);
+
+/// Meshes (or loads from the cache) the vessel, printing progress and timing to `log`.
+TetMesh mesh_vessel(VesselOptions& options, std::ostream& log, MeshSource* source = nullptr);
+
+}  // namespace vessel::cli
