@@ -1,0 +1,52 @@
+#pragma once
+/// Loads defined once on the mesh's own surface triangles and tets, shared by the FEM reference
+/// (which integrates the same tractions) and the mass-spring models (which receive the consistent
+/// nodal loads), so both see the same total force over the same area. Free of deal.II. SI units.
+#include <string>
+#include <vector>
+
+#include "meshes/tet_mesh.hpp"
+
+namespace vessel {
+
+/// A catheter-tip contact: normal force `force` (N) spread uniformly over the triangles of
+/// `surface_group` whose centroid lies within `radius` (m) of `point`. A point force would give
+/// infinite displacement in the continuum (Kelvin's solution ~ 1/r); a patch does not.
+struct ContactPatchSpec {
+  Vec3 point = Vec3::Zero();
+  double radius = 0.5e-3;
+  double force = 0.0;  ///< N, pushing into the wall (positive) along the patch's inward normal
+  std::string surface_group = "inner_wall";
+};
+
+/// A uniform traction (Pa, a vector) on a set of boundary triangles.
+struct TractionPatch {
+  std::vector<int> triangles;  ///< indices into TetMesh::triangles
+  Vec3 traction = Vec3::Zero();
+  double area = 0.0;           ///< m², sum of the triangles' areas
+  Vec3 outward_normal = Vec3::Zero();  ///< area-weighted mean outward unit normal of the patch
+};
+
+/// Selects the contact patch and its traction t = −F n̂ / A (n̂ the patch's mean outward normal),
+/// so ∫ t dA = −F n̂ exactly. Throws InputError naming the group if it is missing or if no triangle
+/// lies within the radius (a contact point off the wall), or if radius or force is not finite or
+/// radius ≤ 0.
+TractionPatch contact_patch(const TetMesh& mesh, const ContactPatchSpec& spec);
+
+/// The triangles a pressure acts on (the group's, InputError if missing). Pressure p (Pa) gives
+/// traction −p n on each, n the outward normal, pushing the inner wall away from the lumen for
+/// p > 0; the FEM integrates that, the nodal version is pressure_nodal_loads.
+std::vector<int> pressure_triangles(const TetMesh& mesh, const std::string& group);
+
+/// Consistent nodal loads (N per node, indexed like mesh.nodes) of linear triangles under uniform
+/// traction: each triangle gives t·A/3 to each of its three nodes.
+std::vector<Vec3> traction_nodal_loads(const TetMesh& mesh, const TractionPatch& patch);
+/// Consistent nodal loads of pressure p on the group's triangles: −p n A/3 per triangle node.
+std::vector<Vec3> pressure_nodal_loads(const TetMesh& mesh, const std::string& group, double p);
+/// Consistent nodal loads of a uniform body force density ρg (N/m³): ρg V/4 per tet node.
+std::vector<Vec3> body_force_nodal_loads(const TetMesh& mesh, const Vec3& force_density);
+
+/// Sum of nodal loads (N).
+Vec3 total_load(const std::vector<Vec3>& loads);
+
+}  // namespace vessel
