@@ -20,7 +20,7 @@ class GmshSession {
   explicit GmshSession(const MeshingOptions& options) {
     gmsh::initialize(0, nullptr, /*readConfigFiles=*/false);
     gmsh::option::setNumber("General.Terminal", options.verbose ? 1 : 0);
-    gmsh::option::setNumber("General.NumThreads", options.threads);
+    gmsh::option::setNumber("General.NumThreads", 1);
     gmsh::model::add("vessel");
   }
   ~GmshSession() { gmsh::finalize(); }
@@ -242,10 +242,15 @@ TetMesh generate_vessel_mesh(const VesselParams& params, const MeshingOptions& o
     gmsh::option::setNumber("Mesh.MeshSizeMin", 0.5 * h);
     gmsh::option::setNumber("Mesh.MeshSizeMax", h);
     gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+    // HXT (algorithm 10) on one thread: deterministic, 3× faster than the default Delaunay at
+    // level 2 here (3.3 s vs 10.5 s) and better shaped (min dihedral 14° vs 6°). More threads make
+    // the node count vary from run to run, which the mesh cache must not allow.
+    gmsh::option::setNumber("Mesh.Algorithm3D", 10);
   }
   gmsh::model::mesh::generate(3);
   TetMesh mesh = extract_mesh();
   remove_unused_nodes(mesh);
+  sort_elements(mesh);  // HXT's element order varies between calls; the mesh itself does not
   orient_tets(mesh);
   orient_boundary_outward(mesh);
   require_vessel_groups(mesh, "generated " + describe(params));

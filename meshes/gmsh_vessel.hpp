@@ -8,11 +8,12 @@ namespace vessel {
 
 struct MeshingOptions {
   bool verbose = false;  ///< let gmsh print its own log
-  int threads = 1;       ///< gmsh threads (the 3D Delaunay of large levels uses them)
 };
 
 /// Generates the tetrahedral wall mesh with the groups of kVesselGroups, tets positively oriented
-/// and boundary triangles outward. Throws InputError for invalid params (see validate) and
+/// and boundary triangles outward, elements in canonical order. The same params give the same
+/// mesh in every fresh process; a repeat call in the same process may differ in a few tets of the
+/// unstructured mesh (gmsh's HXT keeps state between calls), which is why meshes are cached. Throws InputError for invalid params (see validate) and
 /// std::runtime_error if gmsh fails.
 TetMesh generate_vessel_mesh(const VesselParams& params, const MeshingOptions& options = {});
 

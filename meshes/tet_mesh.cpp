@@ -158,6 +158,60 @@ void orient_boundary_outward(TetMesh& mesh) {
   }
 }
 
+namespace {
+/// The element's nodes in ascending order up to an even permutation (so orientation is kept):
+/// sorted, with the last two swapped if sorting took an odd number of transpositions.
+template <std::size_t N>
+std::array<int, N> canonical_nodes(std::array<int, N> e) {
+  bool odd = false;
+  for (std::size_t i = 0; i < N; ++i) {  // selection sort, counting swaps
+    std::size_t m = i;
+    for (std::size_t j = i + 1; j < N; ++j) {
+      if (e[j] < e[m]) m = j;
+    }
+    if (m != i) {
+      std::swap(e[i], e[m]);
+      odd = !odd;
+    }
+  }
+  if (odd) std::swap(e[N - 2], e[N - 1]);
+  return e;
+}
+
+/// Puts each element in canonical node order and reorders `elements` by sorted node indices;
+/// returns new_index[old] for the remap.
+template <std::size_t N>
+std::vector<int> sort_by_sorted_nodes(std::vector<std::array<int, N>>& elements) {
+  std::vector<std::pair<std::array<int, N>, int>> keyed;
+  keyed.reserve(elements.size());
+  for (std::size_t i = 0; i < elements.size(); ++i) {
+    elements[i] = canonical_nodes(elements[i]);
+    auto key = elements[i];
+    std::sort(key.begin(), key.end());
+    keyed.emplace_back(key, static_cast<int>(i));
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::array<int, N>> sorted_elements;
+  sorted_elements.reserve(elements.size());
+  std::vector<int> new_index(elements.size());
+  for (std::size_t i = 0; i < keyed.size(); ++i) {
+    new_index[keyed[i].second] = static_cast<int>(i);
+    sorted_elements.push_back(elements[keyed[i].second]);
+  }
+  elements = std::move(sorted_elements);
+  return new_index;
+}
+}  // namespace
+
+void sort_elements(TetMesh& mesh) {
+  const auto tet_index = sort_by_sorted_nodes(mesh.tets);
+  const auto tri_index = sort_by_sorted_nodes(mesh.triangles);
+  for (auto& g : mesh.groups) {
+    for (int& e : g.elements) e = (g.dim == 3 ? tet_index : tri_index)[e];
+    std::sort(g.elements.begin(), g.elements.end());
+  }
+}
+
 void remove_unused_nodes(TetMesh& mesh) {
   std::vector<int> new_index(mesh.nodes.size(), -1);
   for (const auto& t : mesh.tets) {

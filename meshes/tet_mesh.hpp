@@ -86,6 +86,9 @@ std::vector<Triangle> boundary_faces(const TetMesh& mesh);
 void orient_tets(TetMesh& mesh);
 /// Orients each group triangle that is a face of a tet so its normal points out of that tet.
 void orient_boundary_outward(TetMesh& mesh);
+/// Canonical element order independent of the mesher's: each element's nodes ascending up to an
+/// even permutation (orientation kept), elements sorted by their nodes, groups remapped.
+void sort_elements(TetMesh& mesh);
 /// Drops nodes not used by any element and renumbers the rest, keeping their order.
 void remove_unused_nodes(TetMesh& mesh);
 

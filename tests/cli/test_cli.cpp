@@ -71,6 +71,15 @@ TEST(Cli, CacheIsWrittenOnceAndHitAfterwards) {
   EXPECT_TRUE(contains(second.output, "read from cache")) << second.output;
 }
 
+TEST(Cli, GenerationIsDeterministicAcrossRunsSoTheCacheIsSound) {
+  TempDir dir;
+  for (const char* name : {"a.msh", "b.msh"}) {
+    const auto r = vv("mesh --no-cache --vessel arch -o " + (dir / name).string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  EXPECT_EQ(vessel::test::read_text(dir / "a.msh"), vessel::test::read_text(dir / "b.msh"));
+}
+
 TEST(Cli, NegativeRadiusIsAClearErrorAndNonZeroExit) {
   TempDir dir;
   const auto r = vv("mesh --no-cache --inner-radius -0.003 -o " + (dir / "x.msh").string());

@@ -11,7 +11,7 @@ TEST(SlowStructuredVessel, NodeCountsGrowTowards8xUpToLevel3) {
   long previous = 0;
   for (int level = 0; level <= 3; ++level) {
     p.level = level;
-    const TetMesh mesh = generate_vessel_mesh(p, {false, 2});
+    const TetMesh mesh = generate_vessel_mesh(p);
     const long n = static_cast<long>(mesh.nodes.size());
     EXPECT_EQ(n, structured_counts(p).expected_nodes());
     if (previous > 0) {
@@ -30,7 +30,7 @@ TEST(SlowVesselMesh, Level2VolumeErrorKeepsFalling) {
       VesselParams p;
       p.kind = kind;
       p.level = level;
-      const double err = std::abs(mesh_volume(generate_vessel_mesh(p, {false, 2})) /
+      const double err = std::abs(mesh_volume(generate_vessel_mesh(p)) /
                                       analytic_wall_volume(p) - 1.0);
       EXPECT_LT(err, previous / 2.0) << to_string(kind) << " level " << level;
       previous = err;

@@ -11,7 +11,7 @@ void add_vessel_options(CLI::App& cmd, VesselOptions& o) {
       ->capture_default_str();
   cmd.add_flag("--structured", o.structured,
                "Structured (transfinite, extruded) mesh: circumferential × axial × radial layers "
-               "doubled per level. Default: unstructured Delaunay tets of size t/2^level");
+               "doubled per level. Default: unstructured tets (gmsh HXT) of size t/2^level");
   cmd.add_option("--level", p.level, "Refinement level 0..4 (each level halves the element size)")
       ->capture_default_str();
   cmd.add_option("--inner-radius", p.inner_radius, "Inner radius a, metres")->capture_default_str();
@@ -24,7 +24,6 @@ void add_vessel_options(CLI::App& cmd, VesselOptions& o) {
                  "Directory of cached generated meshes (env VESSELVERIFY_CACHE_DIR)")
       ->capture_default_str();
   cmd.add_flag("--no-cache", o.no_cache, "Always generate; neither read nor write the cache");
-  cmd.add_option("--threads", o.meshing.threads, "Threads gmsh may use")->capture_default_str();
   cmd.add_flag("--gmsh-log", o.meshing.verbose, "Show gmsh's own log");
 }
 

@@ -17,7 +17,7 @@ struct VesselOptions {
 };
 
 /// Adds --vessel, --structured, --level, --inner-radius, --wall-thickness, --length,
-/// --bend-radius, --cache-dir, --no-cache, --threads, --gmsh-log to `cmd`.
+/// --bend-radius, --cache-dir, --no-cache, --gmsh-log to `cmd`.
 void add_vessel_options(CLI::App& cmd, VesselOptions& options);
 
 /// Completes params from the parsed strings and validates them (InputError if out of range).
