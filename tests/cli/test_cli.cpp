@@ -120,3 +120,15 @@ TEST(Cli, UnwritableOutputIsAClearError) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "/proc/vesselverify")) << r.output;
 }
+
+TEST(Cli, SceneValidatesShippedScenesAndRefusesBadOnes) {
+  const std::string scenes = std::string(VESSEL_SCENES_DIR);
+  const auto ok = vv("scene " + scenes + "/contact_straight.toml " + scenes + "/pressure_lame.toml");
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_TRUE(contains(ok.output, "scene 'pressure_lame' is valid")) << ok.output;
+  TempDir dir;
+  write_text(dir / "bad.toml", "name = \"b\"\n[vessel]\nkind = \"straight\"\nradius = 1\n");
+  const auto bad = vv("scene " + (dir / "bad.toml").string());
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "bad.toml:4: key 'vessel.radius': unknown key")) << bad.output;
+}

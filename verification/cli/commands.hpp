@@ -6,5 +6,6 @@
 namespace vessel::cli {
 
 void add_mesh_command(CLI::App& app);
+void add_scene_command(CLI::App& app);
 
 }  // namespace vessel::cli

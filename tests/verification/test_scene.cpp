@@ -1,0 +1,136 @@
+// Scene files: every shipped scene parses and validates; bad scenes are refused naming file, line
+// and key.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "../test_helpers.hpp"
+#include "meshes/errors.hpp"
+#include "verification/scene.hpp"
+
+using namespace vessel;
+
+namespace {
+
+const char* kMinimal = R"(name = "t"
+[vessel]
+kind = "straight"
+level = 0
+[load]
+type = "contact"
+magnitudes = [0.01, 0.02]
+point = [3e-3, 0, 20e-3]
+[[models]]
+kind = "fem"
+degree = 1
+)";
+
+std::string error_of(const std::string& text) {
+  try {
+    (void)parse_scene(text, "scene.toml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+/// `kMinimal` with the first `from` replaced by `to`.
+std::string replaced(const std::string& from, const std::string& to) {
+  std::string text = kMinimal;
+  return text.replace(text.find(from), from.size(), to);
+}
+
+/// `kMinimal` with `line` inserted after the first line that starts with `after`.
+std::string with(const std::string& after, const std::string& line) {
+  std::string text = kMinimal;
+  const auto at = text.find('\n', text.find(after)) + 1;
+  return text.insert(at, line + "\n");
+}
+
+}  // namespace
+
+TEST(Scene, EveryShippedSceneParsesAndValidates) {
+  const std::filesystem::path dir = VESSEL_SCENES_DIR;
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".toml") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Scene s = read_scene(entry.path());
+    EXPECT_EQ(s.name, entry.path().stem().string());
+    EXPECT_FALSE(s.models.empty());
+    EXPECT_FALSE(s.load.magnitudes.empty());
+    ++count;
+  }
+  EXPECT_GE(count, 5);
+}
+
+TEST(Scene, DefaultsAndValuesAreRead) {
+  const Scene s = parse_scene(kMinimal, "scene.toml");
+  EXPECT_EQ(s.vessel.kind, VesselKind::straight);
+  EXPECT_EQ(s.vessel.style, MeshStyle::structured);
+  EXPECT_DOUBLE_EQ(s.youngs_modulus, 14.24e3);  // seed 000's E
+  EXPECT_EQ(s.load.magnitudes, (std::vector<double>{0.01, 0.02}));
+  EXPECT_DOUBLE_EQ(s.load.contact.radius, 0.5e-3);
+  EXPECT_EQ(s.models.at(0).degree, 1);
+  EXPECT_EQ(s.models.at(0).name, "fem_1");
+  EXPECT_EQ(s.boundary.at("inlet"), BoundaryCondition::clamped);
+}
+
+TEST(Scene, UnknownKeyIsRefusedWithLineAndKnownKeys) {
+  const auto msg = error_of(with("[vessel]", "lenght = 0.04"));
+  EXPECT_NE(msg.find("scene.toml:3: key 'vessel.lenght': unknown key"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("length"), std::string::npos) << msg;
+  EXPECT_NE(error_of(with("name", "colour = \"red\"")).find("key 'colour'"), std::string::npos);
+}
+
+TEST(Scene, WrongTypesAndRangesAreRefusedNamingTheKey) {
+  auto msg = error_of(with("[vessel]", "inner_radius = \"3mm\""));
+  EXPECT_NE(msg.find("key 'vessel.inner_radius': found \"3mm\", expected a number"),
+            std::string::npos) << msg;
+  msg = error_of(with("[vessel]", "inner_radius = -3e-3"));
+  EXPECT_NE(msg.find("vessel.inner_radius"), std::string::npos) << msg;
+  msg = error_of(replaced("level = 0", "level = 7"));
+  EXPECT_NE(msg.find("key 'vessel.level': found 7, expected an integer in [0, 4]"),
+            std::string::npos) << msg;
+  msg = error_of(with("name", "[material]\nnu = 0.6"));
+  EXPECT_NE(msg.find("key 'material.nu': found 0.6, expected a number in [0, 0.5]"),
+            std::string::npos) << msg;
+  msg = error_of(with("name", "[material]\nE = 0"));
+  EXPECT_NE(msg.find("material.E"), std::string::npos) << msg;
+}
+
+TEST(Scene, IntegratorsNeedAPositiveTimeStep) {
+  const std::string model = "[[models]]\nkind = \"volume_msm\"\nsolver = \"verlet\"\nsteps = 10\n";
+  auto msg = error_of(std::string(kMinimal) + model + "dt = 0.0\n");
+  EXPECT_NE(msg.find("dt"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("> 0"), std::string::npos) << msg;
+  msg = error_of(std::string(kMinimal) + model + "dt = -1e-4\n");
+  EXPECT_NE(msg.find("models[1].dt"), std::string::npos) << msg;
+  msg = error_of(std::string(kMinimal) + model);
+  EXPECT_NE(msg.find("missing; solver \"verlet\" needs a time step"), std::string::npos) << msg;
+}
+
+TEST(Scene, UnknownRuleNamesAndDuplicateModelsAreRefused) {
+  auto msg = error_of(std::string(kMinimal) + "[[models]]\nkind = \"volume_msm\"\nstiffness = \"magic\"\n");
+  EXPECT_NE(msg.find("found \"magic\", expected one of seed000"), std::string::npos) << msg;
+  msg = error_of(std::string(kMinimal) + "[[models]]\nkind = \"fem\"\nname = \"fem_1\"\n");
+  EXPECT_NE(msg.find("used twice"), std::string::npos) << msg;
+}
+
+TEST(Scene, MissingSectionsSyntaxErrorsAndMissingFilesAreClear) {
+  EXPECT_NE(error_of("name = \"x\"\n").find("[vessel]"), std::string::npos);
+  const auto msg = error_of("name = \"x\"\n[vessel\n");
+  EXPECT_NE(msg.find("scene.toml:2: TOML syntax error"), std::string::npos) << msg;
+  try {
+    (void)read_scene("/nonexistent/scene.toml");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not found"), std::string::npos);
+  }
+}
+
+TEST(Scene, ArchTooTightForItsWallIsRefused) {
+  const auto msg =
+      error_of(replaced("kind = \"straight\"", "kind = \"arch\"\nbend_radius = 3.5e-3"));
+  EXPECT_NE(msg.find("too thick"), std::string::npos) << msg;
+}

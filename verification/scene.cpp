@@ -1,0 +1,356 @@
+#include "verification/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "meshes/errors.hpp"
+
+namespace vessel {
+
+namespace {
+
+// Names the scene accepts for mass-spring options (the msm library's named rules).
+const std::vector<std::string> kStiffnessRules{"seed000", "mollemans", "van_gelder", "lloyd",
+                                               "uniform"};
+const std::vector<std::string> kMassRules{"uniform", "tet_volume", "density"};
+const std::vector<std::string> kSolvers{"static",           "linear", "explicit_euler",
+                                        "symplectic_euler", "verlet", "implicit_euler",
+                                        "dynamic_relaxation"};
+const std::vector<std::string> kSurfaces{"inner", "outer", "mid"};
+
+std::string join(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+std::string show(const toml::node& node) {
+  std::ostringstream s;
+  node.visit([&](auto&& v) {
+    using T = std::remove_cvref_t<decltype(v)>;
+    if constexpr (toml::is_string<T>) {
+      s << '"' << *v << '"';
+    } else if constexpr (toml::is_table<T>) {
+      s << "a table";
+    } else if constexpr (toml::is_array<T>) {
+      s << "an array";
+    } else if constexpr (toml::is_boolean<T>) {
+      s << (*v ? "true" : "false");
+    } else {
+      s << *v;  // numbers, dates and times
+    }
+  });
+  return s.str();
+}
+
+/// Reads one TOML table strictly: every key must be asked for, every value must have the asked
+/// type and range; messages say "file:line: key 'a.b': found X, expected Y".
+class TableReader {
+ public:
+  TableReader(const toml::table& table, std::string prefix, const std::string& file)
+      : table_(table), prefix_(std::move(prefix)), file_(file) {}
+
+  [[noreturn]] void fail(const toml::node* node, const std::string& key,
+                         const std::string& what) const {
+    const auto line = node ? node->source().begin.line : table_.source().begin.line;
+    const std::string where = key.empty() ? "[" + prefix_.substr(0, prefix_.size() - 1) + "]"
+                                          : "key '" + prefix_ + key + "'";
+    throw InputError(file_ + ":" + std::to_string(line) + ": " + where + ": " + what);
+  }
+
+  const toml::node* get(const std::string& key) {
+    known_.push_back(key);
+    return table_.get(key);
+  }
+
+  const toml::node& require(const std::string& key, const std::string& expected) {
+    const toml::node* n = get(key);
+    if (!n) fail(nullptr, key, "missing; expected " + expected);
+    return *n;
+  }
+
+  /// A number (integer or float), finite, within [lo, hi].
+  double number(const toml::node& n, const std::string& key, double lo, double hi,
+                const std::string& unit) const {
+    std::optional<double> v;
+    if (n.is_floating_point() || n.is_integer()) v = n.value<double>();
+    std::ostringstream range;
+    range << "a number in [" << lo << ", " << hi << "]" << (unit.empty() ? "" : " " + unit);
+    if (!v) fail(&n, key, "found " + show(n) + ", expected " + range.str());
+    if (!std::isfinite(*v) || *v < lo || *v > hi) {
+      std::ostringstream found;
+      found << *v;
+      fail(&n, key, "found " + found.str() + ", expected " + range.str());
+    }
+    return *v;
+  }
+
+  double number_or(const std::string& key, double fallback, double lo, double hi,
+                   const std::string& unit = "") {
+    const toml::node* n = get(key);
+    return n ? number(*n, key, lo, hi, unit) : fallback;
+  }
+
+  double positive(const std::string& key, double fallback, const std::string& unit) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    const double v = number(*n, key, 0.0, HUGE_VAL, unit);
+    if (v <= 0.0) fail(n, key, "found 0, expected a number > 0 " + unit);
+    return v;
+  }
+
+  long integer_or(const std::string& key, long fallback, long lo, long hi) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    const auto v = n->value_exact<int64_t>();
+    if (!v || *v < lo || *v > hi) {
+      fail(n, key, "found " + show(*n) + ", expected an integer in [" + std::to_string(lo) + ", " +
+                       std::to_string(hi) + "]");
+    }
+    return static_cast<long>(*v);
+  }
+
+  std::string string_or(const std::string& key, const std::string& fallback,
+                        const std::vector<std::string>& allowed = {}) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    const auto v = n->value_exact<std::string>();
+    const std::string expected =
+        allowed.empty() ? "a string" : "one of " + join(allowed);
+    if (!v) fail(n, key, "found " + show(*n) + ", expected " + expected);
+    if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), *v) == allowed.end()) {
+      fail(n, key, "found \"" + *v + "\", expected " + expected);
+    }
+    return *v;
+  }
+
+  /// A number or an array of numbers, each within [lo, hi]; at least one.
+  std::vector<double> numbers(const toml::node& n, const std::string& key, double lo, double hi,
+                              const std::string& unit) const {
+    std::vector<double> out;
+    if (const auto* arr = n.as_array()) {
+      if (arr->empty()) fail(&n, key, "found an empty array, expected at least one number");
+      for (const auto& item : *arr) out.push_back(number(item, key, lo, hi, unit));
+    } else {
+      out.push_back(number(n, key, lo, hi, unit));
+    }
+    return out;
+  }
+
+  Vec3 vector3(const toml::node& n, const std::string& key) const {
+    const auto* arr = n.as_array();
+    if (!arr || arr->size() != 3) fail(&n, key, "found " + show(n) + ", expected [x, y, z]");
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) v[i] = number(*arr->get(i), key, -HUGE_VAL, HUGE_VAL, "");
+    return v;
+  }
+
+  TableReader sub(const std::string& key, bool required) {
+    const toml::node* n = get(key);
+    if (!n) {
+      if (required) fail(nullptr, key, "missing; expected a [" + prefix_ + key + "] table");
+      return TableReader(empty_, prefix_ + key + ".", file_);
+    }
+    if (!n->is_table()) fail(n, key, "found " + show(*n) + ", expected a table");
+    return TableReader(*n->as_table(), prefix_ + key + ".", file_);
+  }
+
+  /// Fails on the first key that was never asked for.
+  void finish() const {
+    for (const auto& [key, node] : table_) {
+      const std::string k(key.str());
+      if (std::find(known_.begin(), known_.end(), k) == known_.end()) {
+        fail(&node, k, "unknown key; expected one of: " + join(known_));
+      }
+    }
+  }
+
+  const toml::table& table() const { return table_; }
+  const std::string& prefix() const { return prefix_; }
+
+ private:
+  inline static const toml::table empty_{};
+  const toml::table& table_;
+  std::string prefix_;
+  std::string file_;
+  std::vector<std::string> known_;
+};
+
+VesselParams read_vessel(TableReader r, int& reference_level) {
+  VesselParams p;
+  const std::string kind = r.string_or("kind", "straight", {"straight", "arch"});
+  p.kind = kind == "arch" ? VesselKind::arch : VesselKind::straight;
+  p.inner_radius = r.positive("inner_radius", p.inner_radius, "m");
+  p.wall_thickness = r.positive("wall_thickness", p.wall_thickness, "m");
+  p.length = r.positive("length", p.length, "m");
+  p.bend_radius = r.positive("bend_radius", p.bend_radius, "m");
+  const std::string mesh = r.string_or("mesh", "structured", {"structured", "unstructured"});
+  p.style = mesh == "structured" ? MeshStyle::structured : MeshStyle::unstructured;
+  p.level = static_cast<int>(r.integer_or("level", 0, 0, kMaxMeshLevel));
+  reference_level = static_cast<int>(r.integer_or("reference_level", p.level, 0, kMaxMeshLevel));
+  r.finish();
+  try {
+    validate(p);
+  } catch (const InputError& e) {
+    r.fail(nullptr, "", e.what());
+  }
+  return p;
+}
+
+ModelSpec read_model(TableReader r, std::size_t index) {
+  ModelSpec m;
+  const std::string kind = r.string_or("kind", "", {"fem", "surface_msm", "volume_msm"});
+  if (kind.empty()) r.fail(nullptr, "kind", "missing; expected one of fem, surface_msm, volume_msm");
+  m.kind = kind == "fem" ? ModelKind::fem
+                         : (kind == "surface_msm" ? ModelKind::surface_msm : ModelKind::volume_msm);
+  m.name = r.string_or("name", kind + "_" + std::to_string(index + 1));
+  if (m.kind == ModelKind::fem) {
+    m.degree = static_cast<int>(r.integer_or("degree", 2, 1, 2));
+  } else {
+    if (m.kind == ModelKind::surface_msm) m.surface = r.string_or("surface", m.surface, kSurfaces);
+    m.stiffness = r.string_or("stiffness", m.kind == ModelKind::volume_msm ? "mollemans" : "seed000",
+                              kStiffnessRules);
+    m.mass = r.string_or("mass", m.mass, kMassRules);
+    m.solver = r.string_or("solver", m.solver, kSolvers);
+    m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "1/s");
+    const bool integrator = m.solver != "static" && m.solver != "linear";
+    if (integrator) {
+      const toml::node* dt = r.get("dt");
+      if (!dt) r.fail(nullptr, "dt", "missing; solver \"" + m.solver + "\" needs a time step > 0 s");
+      m.dt = r.number(*dt, "dt", 0.0, HUGE_VAL, "s");
+      if (m.dt <= 0.0) r.fail(dt, "dt", "found 0, expected a time step > 0 s");
+      m.steps = r.integer_or("steps", 0, 1, 1'000'000'000L);
+      if (m.steps == 0) r.fail(nullptr, "steps", "missing; expected the number of steps (> 0)");
+    }
+  }
+  r.finish();
+  return m;
+}
+
+LoadSpec read_load(TableReader r) {
+  LoadSpec load;
+  const std::string type = r.string_or("type", "", {"contact", "pressure", "gravity"});
+  if (type.empty()) r.fail(nullptr, "type", "missing; expected one of contact, pressure, gravity");
+  load.kind = type == "contact" ? LoadKind::contact
+                                : (type == "pressure" ? LoadKind::pressure : LoadKind::gravity);
+  const char* unit = load.kind == LoadKind::contact ? "N" : (load.kind == LoadKind::pressure ? "Pa" : "g");
+  load.magnitudes = r.numbers(r.require("magnitudes", std::string("a number or array of numbers (") + unit + ")"),
+                              "magnitudes", 0.0, HUGE_VAL, unit);
+  if (load.kind == LoadKind::contact) {
+    load.contact.point = r.vector3(r.require("point", "[x, y, z] in m on the wall"), "point");
+    load.contact.radius = r.positive("patch_radius", load.contact.radius, "m");
+    load.contact.surface_group =
+        r.string_or("surface", load.contact.surface_group, {"inner_wall", "outer_wall"});
+  } else if (load.kind == LoadKind::pressure) {
+    load.contact.surface_group = r.string_or("surface", "inner_wall", {"inner_wall", "outer_wall"});
+  } else {
+    if (const toml::node* d = r.get("direction")) {
+      load.gravity_direction = r.vector3(*d, "direction");
+      if (load.gravity_direction.norm() == 0.0) r.fail(d, "direction", "found [0, 0, 0], expected a non-zero vector");
+      load.gravity_direction.normalize();
+    }
+  }
+  r.finish();
+  return load;
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view text, const std::string& source_name) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    throw InputError(source_name + ":" + std::to_string(e.source().begin.line) +
+                     ": TOML syntax error: " + std::string(e.description()));
+  }
+  Scene scene;
+  scene.source = source_name;
+  TableReader r(root, "", source_name);
+  scene.name = r.string_or("name", "");
+  if (scene.name.empty()) r.fail(nullptr, "name", "missing; expected the scene's name");
+  scene.description = r.string_or("description", "");
+  scene.vessel = read_vessel(r.sub("vessel", true), scene.reference_level);
+
+  TableReader material = r.sub("material", false);
+  scene.youngs_modulus = material.positive("E", scene.youngs_modulus, "Pa");
+  if (const toml::node* nu = material.get("nu")) {
+    scene.poisson_ratios = material.numbers(*nu, "nu", 0.0, 0.5, "");
+  }
+  scene.density = material.positive("density", scene.density, "kg/m³");
+  material.finish();
+
+  TableReader boundary = r.sub("boundary", false);
+  for (const auto& group : {std::string(group_names::inlet), std::string(group_names::outlet)}) {
+    const std::string bc = boundary.string_or(group, "clamped", {"clamped", "roller", "free"});
+    scene.boundary[group] = bc == "clamped" ? BoundaryCondition::clamped
+                                            : (bc == "roller" ? BoundaryCondition::axial_roller
+                                                              : BoundaryCondition::free);
+  }
+  boundary.finish();
+
+  scene.load = read_load(r.sub("load", true));
+
+  const toml::node* models = r.get("models");
+  if (!models) r.fail(nullptr, "models", "missing; expected at least one [[models]] table");
+  const auto* list = models->as_array();
+  if (!list || list->empty()) r.fail(models, "models", "expected at least one [[models]] table");
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const auto* t = list->get(i)->as_table();
+    if (!t) r.fail(list->get(i), "models", "expected [[models]] tables");
+    ModelSpec m = read_model(TableReader(*t, "models[" + std::to_string(i) + "].", source_name), i);
+    if (!names.insert(m.name).second) {
+      r.fail(list->get(i), "models", "model name \"" + m.name + "\" is used twice; names must be unique");
+    }
+    scene.models.push_back(std::move(m));
+  }
+
+  TableReader tol = r.sub("tolerances", false);
+  scene.tolerances.max_error_mm = tol.positive("max_error_mm", scene.tolerances.max_error_mm, "mm");
+  tol.finish();
+  r.finish();
+  return scene;
+}
+
+Scene read_scene(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!std::filesystem::exists(path)) throw InputError(path.string() + ": scene file not found");
+  if (!in) throw InputError(path.string() + ": cannot open scene file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), path.string());
+}
+
+std::string to_string(BoundaryCondition bc) {
+  switch (bc) {
+    case BoundaryCondition::clamped: return "clamped";
+    case BoundaryCondition::axial_roller: return "roller";
+    case BoundaryCondition::free: return "free";
+  }
+  return "?";
+}
+
+std::string to_string(LoadKind kind) {
+  switch (kind) {
+    case LoadKind::contact: return "contact";
+    case LoadKind::pressure: return "pressure";
+    case LoadKind::gravity: return "gravity";
+  }
+  return "?";
+}
+
+std::string to_string(ModelKind kind) {
+  switch (kind) {
+    case ModelKind::fem: return "fem";
+    case ModelKind::surface_msm: return "surface_msm";
+    case ModelKind::volume_msm: return "volume_msm";
+  }
+  return "?";
+}
+
+}  // namespace vessel
