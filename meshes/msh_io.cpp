@@ -35,12 +35,7 @@ int nodes_per_element(int type) {
 /// Line-oriented reader that knows the file name and line number of everything it reports.
 class MshReader {
  public:
-  explicit MshReader(const std::filesystem::path& path) : path_(path.string()), in_(path) {
-    if (!std::filesystem::exists(path)) {
-      throw InputError(path_ + ": mesh file not found");
-    }
-    if (!in_) throw InputError(path_ + ": cannot open mesh file for reading");
-  }
+  MshReader(std::istream& in, std::string source) : path_(std::move(source)), in_(in) {}
 
   /// Reads the next line into line(); false at end of file.
   bool next() {
@@ -55,7 +50,7 @@ class MshReader {
     if (!next()) {
       throw InputError(path_ + ":" + std::to_string(line_no_) +
                        ": file is truncated: it ends inside " + section + " (expected $End" +
-                       section.substr(1) + ")");
+                       (section.empty() ? section : section.substr(1)) + ")");
     }
     return line_;
   }
@@ -110,7 +105,7 @@ class MshReader {
 
  private:
   std::string path_;
-  mutable std::ifstream in_;
+  std::istream& in_;
   std::string line_;
   long line_no_ = 0;
 };
@@ -241,10 +236,11 @@ void read_elements_v22(MshReader& r, MeshBuilder& b) {
     const auto t = r.tokens_at_least(3, "'tag type ntags ...'");
     const int type = r.number<int>(t[1], "element type");
     const int ntags = r.number<int>(t[2], "number of element tags");
+    if (ntags < 0) r.fail("negative number of element tags " + std::to_string(ntags));
     const int nn = nodes_per_element(type);
-    const std::size_t expected = 3 + static_cast<std::size_t>(std::max(ntags, 0)) +
-                                 static_cast<std::size_t>(std::max(nn, 0));
-    if (nn > 0 && t.size() < expected) {
+    if (nn < 0) b.add_element(type, {}, {});  // refuses the unsupported type, naming it
+    const std::size_t expected = 3 + static_cast<std::size_t>(ntags) + static_cast<std::size_t>(nn);
+    if (t.size() < expected) {
       r.fail("element line has " + std::to_string(t.size()) + " values, expected " +
              std::to_string(expected));
     }
@@ -254,8 +250,8 @@ void read_elements_v22(MshReader& r, MeshBuilder& b) {
       if (tag != 0) physical.push_back(tag);  // 0: the element is in no physical group
     }
     nodes.clear();
-    for (int k = 0; k < std::max(nn, 0); ++k) {
-      nodes.push_back(r.number<std::size_t>(t[3 + ntags + k], "node tag"));
+    for (int k = 0; k < nn; ++k) {
+      nodes.push_back(r.number<std::size_t>(t[3 + static_cast<std::size_t>(ntags + k)], "node tag"));
     }
     b.add_element(type, nodes, physical);
   }
@@ -354,9 +350,16 @@ void read_elements_v41(MshReader& r, MeshBuilder& b, const EntityPhysicals& phys
 }  // namespace
 
 TetMesh read_msh(const std::filesystem::path& path) {
-  MshReader r(path);
+  if (!std::filesystem::exists(path)) throw InputError(path.string() + ": mesh file not found");
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string() + ": cannot open mesh file for reading");
+  return parse_msh(in, path.string());
+}
+
+TetMesh parse_msh(std::istream& in, const std::string& source) {
+  MshReader r(in, source);
   MeshBuilder builder(r);
-  if (!r.next()) throw InputError(path.string() + ": mesh file is empty");
+  if (!r.next()) throw InputError(source + ": mesh file is empty");
   if (r.line() != "$MeshFormat") {
     r.fail("not a gmsh .msh file: expected '$MeshFormat', found '" + r.line().substr(0, 40) + "'");
   }
@@ -377,7 +380,7 @@ TetMesh read_msh(const std::filesystem::path& path) {
   bool have_nodes = false;
   bool have_elements = false;
   while (r.next()) {
-    const std::string& section = r.line();
+    const std::string section = r.line();  // a copy: next_in() overwrites the line
     if (section.empty()) continue;
     if (section == "$PhysicalNames") {
       read_physical_names(r, builder);
@@ -399,7 +402,7 @@ TetMesh read_msh(const std::filesystem::path& path) {
     }
   }
   if (!have_nodes || !have_elements) {
-    throw InputError(path.string() + ": file is truncated or incomplete: " +
+    throw InputError(source + ": file is truncated or incomplete: " +
                      (!have_nodes ? "no $Nodes section" : "no $Elements section"));
   }
   return builder.finish();

@@ -3,6 +3,8 @@
 /// every parse error can name the file and line. Linear tetrahedra (type 4) and triangles (type 2)
 /// are kept; points and lines are skipped; any other element type is an error.
 #include <filesystem>
+#include <istream>
+#include <string>
 
 #include "meshes/tet_mesh.hpp"
 
@@ -16,6 +18,8 @@ enum class MshVersion { v22, v41 };
 /// malformed file, a non-finite coordinate or an unknown node tag. Does not require any group:
 /// call require_vessel_groups for that.
 TetMesh read_msh(const std::filesystem::path& path);
+/// Same, from a stream; `source` names it in messages.
+TetMesh parse_msh(std::istream& in, const std::string& source);
 
 /// Writes the mesh atomically as ASCII `.msh` (one entity per physical group).
 void write_msh(const std::filesystem::path& path, const TetMesh& mesh,

@@ -46,53 +46,50 @@ class SurfaceBuilder {
   std::map<std::array<double, 3>, int> index_;
 };
 
-bool looks_binary(const fs::path& path, std::uintmax_t size) {
-  if (size < kBinaryHeader + 4) return false;
-  std::ifstream in(path, std::ios::binary);
-  char header[kBinaryHeader + 4];
-  in.read(header, sizeof header);
+/// Binary STL: 80-byte header, facet count, 50 bytes per facet; the size must match exactly.
+bool looks_binary(std::string_view data) {
+  if (data.size() < kBinaryHeader + 4) return false;
   std::uint32_t count = 0;
-  std::memcpy(&count, header + kBinaryHeader, 4);
-  return size == kBinaryHeader + 4 + static_cast<std::uintmax_t>(count) * kBinaryFacet;
+  std::memcpy(&count, data.data() + kBinaryHeader, 4);
+  return data.size() == kBinaryHeader + 4 + static_cast<std::uintmax_t>(count) * kBinaryFacet;
 }
 
-TriangleSurface read_binary(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  in.seekg(static_cast<std::streamoff>(kBinaryHeader));
+TriangleSurface read_binary(std::string_view data, const std::string& source) {
+  std::istringstream in{std::string(data.substr(kBinaryHeader)), std::ios::binary};
   std::uint32_t count = 0;
   in.read(reinterpret_cast<char*>(&count), 4);
   SurfaceBuilder builder;
   for (std::uint32_t f = 0; f < count; ++f) {
-    float data[12];
+    float values[12];  // normal, then the three corners
     char attribute[2];
-    in.read(reinterpret_cast<char*>(data), sizeof data);
+    in.read(reinterpret_cast<char*>(values), sizeof values);
     in.read(attribute, 2);
     if (!in) {
-      throw InputError(path.string() + ": binary STL is truncated at facet " + std::to_string(f) +
+      throw InputError(source + ": binary STL is truncated at facet " + std::to_string(f) +
                        " of " + std::to_string(count));
     }
     std::array<Vec3, 3> corners;
     for (int k = 0; k < 3; ++k) {
-      corners[k] = Vec3(data[3 + 3 * k], data[4 + 3 * k], data[5 + 3 * k]);
+      corners[k] = Vec3(values[3 + 3 * k], values[4 + 3 * k], values[5 + 3 * k]);
       if (!corners[k].allFinite()) {
-        throw InputError(path.string() + ": binary STL facet " + std::to_string(f) +
+        throw InputError(source + ": binary STL facet " + std::to_string(f) +
                          " has a non-finite coordinate; expected finite numbers");
       }
     }
     if (!builder.add_facet(corners)) {
-      throw InputError(path.string() + ": binary STL facet " + std::to_string(f) +
+      throw InputError(source + ": binary STL facet " + std::to_string(f) +
                        " is degenerate (two corners coincide)");
     }
   }
   return builder.finish();
 }
 
-TriangleSurface read_ascii(const fs::path& path) {
-  std::ifstream in(path);
+TriangleSurface read_ascii(std::string_view data, const std::string& source) {
+  std::istringstream in{std::string(data)};
   std::string line;
   long line_no = 0;
   auto fail = [&](const std::string& what) {
-    throw InputError(path.string() + ":" + std::to_string(line_no) + ": " + what);
+    throw InputError(source + ":" + std::to_string(line_no) + ": " + what);
   };
   auto next_tokens = [&](std::vector<std::string>& tok) {
     while (std::getline(in, line)) {
@@ -152,10 +149,17 @@ TriangleSurface read_ascii(const fs::path& path) {
 
 TriangleSurface read_stl(const fs::path& path) {
   if (!fs::exists(path)) throw InputError(path.string() + ": STL file not found");
-  const auto size = fs::file_size(path);
-  if (size == 0) throw InputError(path.string() + ": STL file is empty");
-  TriangleSurface s = looks_binary(path, size) ? read_binary(path) : read_ascii(path);
-  if (s.triangles.empty()) throw InputError(path.string() + ": STL file has no facets");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open STL file for reading");
+  std::ostringstream data;
+  data << in.rdbuf();
+  return parse_stl(data.str(), path.string());
+}
+
+TriangleSurface parse_stl(std::string_view data, const std::string& source) {
+  if (data.empty()) throw InputError(source + ": STL file is empty");
+  TriangleSurface s = looks_binary(data) ? read_binary(data, source) : read_ascii(data, source);
+  if (s.triangles.empty()) throw InputError(source + ": STL file has no facets");
   return s;
 }
 

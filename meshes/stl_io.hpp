@@ -1,6 +1,8 @@
 #pragma once
 /// Triangulated STL surfaces (seed 000 reads its vessel from STL) for the surface models.
 #include <filesystem>
+#include <string>
+#include <string_view>
 
 #include "meshes/tet_mesh.hpp"
 
@@ -19,6 +21,8 @@ struct TriangleSurface {
 /// (binary) for a missing, empty, truncated or malformed file, a non-finite coordinate or a
 /// degenerate facet. Coordinates are taken as metres.
 TriangleSurface read_stl(const std::filesystem::path& path);
+/// Same, from the file's bytes; `source` names it in messages.
+TriangleSurface parse_stl(std::string_view data, const std::string& source);
 
 enum class StlFormat { ascii, binary };
 /// Writes the surface atomically. Binary STL stores float32: coordinates round to ~1e-7 relative.

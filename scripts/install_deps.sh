@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages vesselverify needs, only those that are missing (idempotent).
-# Fast when everything is already there: one dpkg-query, no network.
+# Fast when everything is already there: one dpkg-query per package, no network.
+# Usage: scripts/install_deps.sh [extra-package ...]   (e.g. scripts/fuzz.sh adds clang)
 set -euo pipefail
 
 packages=(
@@ -12,6 +13,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libspectra-dev
   python3-matplotlib python3-numpy        # reports (use /usr/bin/python3)
+  "$@"
 )
 
 missing=()
