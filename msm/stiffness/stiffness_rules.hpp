@@ -55,7 +55,8 @@ double van_gelder_stiffness(double E, double measure_around_edge, double L);
 /// spring network's linear stiffness matrix Σ_e k_e g_e g_eᵀ matches the element's linear FEM
 /// stiffness matrix K (isotropic, E and ν; triangles in plane stress with thickness t), here in
 /// the least-squares (Frobenius) sense: Σ_f (g_eᵀg_f)² k_f = g_eᵀ K g_e. For the equilateral
-/// triangle at ν = 1/3 and the regular tetrahedron at ν = 1/4 the match is exact.
+/// triangle at ν = 1/3 the match is exact (k = √3/4·E·t); for the regular tetrahedron at ν = 1/4
+/// it gives Lloyd et al.'s k = (2√2/25)·E·l, not an exact match (six springs cannot be).
 /// Returns the k of the 6 edges (0-1, 0-2, 0-3, 1-2, 1-3, 2-3) of a tetrahedron, N/m.
 std::array<double, 6> lloyd_tet_stiffness(const std::array<Vec3, 4>& x, double E, double nu);
 /// The k of the 3 edges (0-1, 0-2, 1-2) of a triangle of thickness t, N/m.
