@@ -205,21 +205,27 @@ RelaxationResult dynamic_relaxation(const Problem& p, const RelaxationOptions& o
   VectorXd v = VectorXd::Zero(n), f(n), scratch(n), g(n);
   const VectorXd inv_mass = p.mass.cwiseInverse();
   const double limit = 1e3 * std::max(p.external_force.norm() * bbox_diagonal(p.rest), 1e-300);
-  double ke_prev = 0.0;
   double energy = 0.0;
+  double c = 0.0;  // mass-proportional damping coefficient, 1/s
+  SparseMatrix K;
   for (r.steps = 1; r.steps <= o.max_steps; ++r.steps) {
     total_force(p, r.x, v, f, scratch);
     r.residual = f.norm();  // undamped model: f = −∇Π on free dofs (plus its damping, if any)
     if (r.residual <= target) break;
-    v += h * inv_mass.cwiseProduct(f);
-    r.x += h * v;
-    const double ke = 0.5 * v.dot(p.mass.cwiseProduct(v));
-    if (ke < ke_prev) {
-      v.setZero();  // kinetic damping: the kinetic energy peaked, restart from rest here
-      ke_prev = 0.0;
-    } else {
-      ke_prev = ke;
+    if (r.steps % 20 == 1) {
+      // Underwood (1983) adaptive damping: c = 2ω₀ with ω₀² the Rayleigh quotient
+      // uᵀKu / uᵀMu of the current displacement u (K the stiffness, refreshed every 200 steps).
+      if (r.steps % 200 == 1) {
+        p.form->hessian(r.x, K, true);
+        apply_dirichlet(K, p.fixed);
+      }
+      const VectorXd u = r.x - p.rest;
+      const double uMu = u.dot(p.mass.cwiseProduct(u));
+      if (uMu > 0) c = 2.0 * std::sqrt(std::max(u.dot(K * u) / uMu, 0.0));
     }
+    // Damped leapfrog: v_{n+½} = ((1 − ch/2) v_{n−½} + h M⁻¹ f) / (1 + ch/2).
+    v = ((1.0 - 0.5 * c * h) * v + h * inv_mass.cwiseProduct(f)) / (1.0 + 0.5 * c * h);
+    r.x += h * v;
     if (r.steps % 64 == 0) check(p, r.steps, r.x, v, limit, energy);
   }
   r.seconds = now() - t0;

@@ -72,8 +72,9 @@ struct RelaxationResult {
   double dt = 0.0;
   double seconds = 0.0;
 };
-/// Dynamic relaxation: symplectic Euler with kinetic damping (velocities zeroed at each peak of
-/// the kinetic energy) until the residual tolerance. Throws std::runtime_error if it does not
+/// Dynamic relaxation: damped leapfrog (symplectic Euler) with Underwood's (1983) adaptive
+/// mass-proportional damping c = 2ω₀ (ω₀ from the Rayleigh quotient of the current displacement)
+/// at dt = safety·2/ω_max, until the residual tolerance. Throws std::runtime_error if it does not
 /// get there, DivergenceError if it blows up.
 RelaxationResult dynamic_relaxation(const Problem& problem, const RelaxationOptions& options = {});
 
