@@ -4,10 +4,12 @@
 
 namespace vessel::msm {
 
-CholmodSolver::CholmodSolver() = default;
+CholmodSolver::CholmodSolver() {
+  llt_.cholmod().print = 0;  // a failed (indefinite) attempt is handled here, not printed
+}
 CholmodSolver::~CholmodSolver() = default;
 
-void CholmodSolver::factorize(const SparseMatrix& A) {
+bool CholmodSolver::try_factorize(const SparseMatrix& A) {
   if (A.rows() != pattern_rows_ || A.nonZeros() != pattern_nonzeros_) {
     llt_.analyzePattern(A);
     pattern_rows_ = A.rows();
@@ -17,7 +19,11 @@ void CholmodSolver::factorize(const SparseMatrix& A) {
   mu_ = 0.0;
   llt_.factorize(A);
   ++factorisations_;
-  if (llt_.info() == Eigen::Success) return;
+  return llt_.info() == Eigen::Success;
+}
+
+void CholmodSolver::factorize(const SparseMatrix& A) {
+  if (try_factorize(A)) return;
   // Not positive definite (e.g. a surface membrane without transverse stiffness): regularise.
   VectorXd diag = A.diagonal();
   for (double mu = 1e-10; mu <= 1e-2; mu *= 10.0) {

@@ -19,6 +19,8 @@ class CholmodSolver {
   /// A + μ·diag(A) for growing μ (1e-10 … 1e-2) and records μ; throws std::runtime_error if even
   /// that fails.
   void factorize(const SparseMatrix& A);
+  /// Factorises A without regularisation; false if A is not positive definite.
+  [[nodiscard]] bool try_factorize(const SparseMatrix& A);
   [[nodiscard]] VectorXd solve(const VectorXd& b) const;
   [[nodiscard]] int symbolic_analyses() const { return analyses_; }
   [[nodiscard]] int numeric_factorisations() const { return factorisations_; }

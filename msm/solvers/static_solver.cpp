@@ -36,32 +36,52 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
       break;
     }
     if (r.iterations == o.max_iterations) break;
-    p.form->hessian(r.x, H, o.project_psd);
+    // The exact Hessian where it is positive definite (quadratic convergence); where compression
+    // makes it indefinite, the per-spring PSD projection (then regularised if still singular).
+    p.form->hessian(r.x, H, false);
     apply_dirichlet(H, p.fixed);
-    solver.factorize(H);
+    bool exact = solver.try_factorize(H);
+    if (!exact) {
+      if (o.project_psd) {
+        p.form->hessian(r.x, H, true);
+        apply_dirichlet(H, p.fixed);
+      }
+      solver.factorize(H);
+    }
     const VectorXd dx = -solver.solve(g);
-    // Backtracking (Armijo) line search on Π.
+    // Backtracking (Armijo) line search on Π. Near the solution the energy change drops below
+    // round-off (|ΔΠ| ≲ 1e-12 |Π|): there a step is accepted if it reduces the residual instead.
     const double slope = g.dot(dx);
     double alpha = 1.0;
-    VectorXd trial;
+    VectorXd trial, gt;
     double trial_energy = energy;
     bool accepted = false;
     for (int ls = 0; ls < 40; ++ls) {
       trial = r.x + alpha * dx;
       trial_energy = p.potential(trial);
-      if (std::isfinite(trial_energy) && trial_energy <= energy + 1e-4 * alpha * slope) {
+      if (!std::isfinite(trial_energy)) {
+        alpha *= 0.5;
+        continue;
+      }
+      if (trial_energy <= energy + 1e-4 * alpha * slope) {
         accepted = true;
         break;
       }
+      if (std::abs(trial_energy - energy) <= 1e-12 * std::abs(energy)) {
+        p.potential_gradient(trial, gt);
+        if (gt.norm() < r.residual) {
+          accepted = true;
+          break;
+        }
+      }
       alpha *= 0.5;
     }
-    if (!accepted) {
-      // Energy differences below round-off: accept the full step if it reduces the residual.
-      trial = r.x + dx;
-      VectorXd gt;
-      p.potential_gradient(trial, gt);
-      if (!(gt.norm() < r.residual)) break;
-      trial_energy = p.potential(trial);
+    if (!accepted) break;
+    if (o.log) {
+      *o.log << "  newton " << r.iterations << ": residual " << r.residual << " N, step " << alpha
+             << (exact ? ", exact Hessian" : ", projected Hessian") << ", regularisation "
+             << solver.last_regularisation()
+             << ", energy " << trial_energy << " J\n";
     }
     r.x = trial;
     energy = trial_energy;

@@ -2,16 +2,19 @@
 /// Static equilibrium of a Problem: Newton on the total potential with a backtracking line search,
 /// the analytic (PSD-projected) Hessian and CHOLMOD; and the linearised model (stiffness at the
 /// rest state) for small-displacement comparisons.
+#include <ostream>
+
 #include "msm/model/form.hpp"
 
 namespace vessel::msm {
 
 struct StaticOptions {
   /// Converged when ‖∇Π‖ on the free dofs ≤ tolerance·max(‖f_ext‖, force_scale).
-  double tolerance = 1e-10;
+  double tolerance = 1e-8;
   double force_scale = 1e-12;  ///< N, for unloaded problems
-  int max_iterations = 100;
+  int max_iterations = 200;
   bool project_psd = true;
+  std::ostream* log = nullptr;  ///< per-iteration residual, step length, regularisation
 };
 
 struct StaticResult {
