@@ -1,5 +1,6 @@
 #include "msm/model/spring_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -12,16 +13,6 @@ void apply_dirichlet(SparseMatrix& A, const std::vector<char>& fixed) {
     for (SparseMatrix::InnerIterator it(A, k); it; ++it) {
       if (fixed[it.row()] || fixed[it.col()]) it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
     }
-  }
-}
-
-SpringModel::SpringModel(const SpringNetwork& network, double point_damping)
-    : num_nodes_(static_cast<int>(network.nodes.size())),
-      springs_(network.springs),
-      point_damping_(point_damping) {
-  if (!(point_damping >= 0)) {
-    throw InputError("point_damping k_v: expected a value ≥ 0 N·s/m, got " +
-                     std::to_string(point_damping));
   }
 }
 
@@ -42,6 +33,58 @@ void add_block(std::vector<Eigen::Triplet<double>>& t, const Spring& s, const Ma
 }
 }  // namespace
 
+SpringModel::SpringModel(const SpringNetwork& network, double point_damping)
+    : num_nodes_(static_cast<int>(network.nodes.size())),
+      springs_(network.springs),
+      point_damping_(point_damping) {
+  if (!(point_damping >= 0)) {
+    throw InputError("point_damping k_v: expected a value ≥ 0 N·s/m, got " +
+                     std::to_string(point_damping));
+  }
+  // The pattern: the full diagonal plus the four 3×3 blocks of every spring.
+  const int n = num_dofs();
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(springs_.size() * 36 + static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 0.0);
+  for (const Spring& s : springs_) add_block(t, s, Mat6::Zero());
+  pattern_.resize(n, n);
+  pattern_.setFromTriplets(t.begin(), t.end());
+  pattern_.makeCompressed();
+  auto slot = [&](int row, int col) {
+    const int* inner = pattern_.innerIndexPtr();
+    const int begin = pattern_.outerIndexPtr()[col];
+    const int end = pattern_.outerIndexPtr()[col + 1];
+    return static_cast<int>(std::lower_bound(inner + begin, inner + end, row) - inner);
+  };
+  diagonal_slots_.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) diagonal_slots_[i] = slot(i, i);
+  slots_.reserve(springs_.size() * 36);
+  for (const Spring& s : springs_) {
+    const int idx[2] = {s.a, s.b};
+    for (int p = 0; p < 2; ++p)
+      for (int q = 0; q < 2; ++q)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) slots_.push_back(slot(3 * idx[p] + i, 3 * idx[q] + j));
+  }
+}
+
+template <class BlockFn>
+void SpringModel::assemble(SparseMatrix& H, double diagonal, BlockFn block) const {
+  H = pattern_;
+  double* values = H.valuePtr();
+  std::fill(values, values + H.nonZeros(), 0.0);
+  for (int slot : diagonal_slots_) values[slot] = diagonal;
+  const int* slot = slots_.data();
+  for (const Spring& s : springs_) {
+    const Mat6 B = block(s);
+    for (int p = 0; p < 2; ++p)
+      for (int q = 0; q < 2; ++q)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) values[*slot++] += B(3 * p + i, 3 * q + j);
+  }
+}
+
+
 double SpringModel::energy(const VectorXd& x) const {
   double e = 0.0;
   for (const Spring& s : springs_) e += spring_energy(node(x, s.a), node(x, s.b), s.rest_length, s.law);
@@ -58,14 +101,9 @@ void SpringModel::gradient(const VectorXd& x, VectorXd& g) const {
 }
 
 void SpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(springs_.size() * 36 + static_cast<std::size_t>(num_dofs()));
-  for (int i = 0; i < num_dofs(); ++i) t.emplace_back(i, i, 0.0);  // full diagonal in the pattern
-  for (const Spring& s : springs_) {
-    add_block(t, s, spring_hessian(node(x, s.a), node(x, s.b), s.rest_length, s.law, project_psd));
-  }
-  H.resize(num_dofs(), num_dofs());
-  H.setFromTriplets(t.begin(), t.end());
+  assemble(H, 0.0, [&](const Spring& s) {
+    return spring_hessian(node(x, s.a), node(x, s.b), s.rest_length, s.law, project_psd);
+  });
 }
 
 void SpringModel::damping_force(const VectorXd& x, const VectorXd& v, VectorXd& f) const {
@@ -80,14 +118,9 @@ void SpringModel::damping_force(const VectorXd& x, const VectorXd& v, VectorXd& 
 }
 
 void SpringModel::damping_jacobian(const VectorXd& x, SparseMatrix& D) const {
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(springs_.size() * 36 + static_cast<std::size_t>(num_dofs()));
-  for (int i = 0; i < num_dofs(); ++i) t.emplace_back(i, i, point_damping_);
-  for (const Spring& s : springs_) {
-    add_block(t, s, axial_damping_jacobian(node(x, s.a), node(x, s.b), s.damping));
-  }
-  D.resize(num_dofs(), num_dofs());
-  D.setFromTriplets(t.begin(), t.end());
+  assemble(D, point_damping_, [&](const Spring& s) {
+    return axial_damping_jacobian(node(x, s.a), node(x, s.b), s.damping);
+  });
 }
 
 double SpringModel::max_strain(const VectorXd& x) const {

@@ -26,9 +26,16 @@ class SpringModel : public Form {
   [[nodiscard]] double max_strain(const VectorXd& x) const;
 
  private:
+  /// Adds each spring's 6×6 block (from `block(spring)`) into H, whose pattern is fixed once.
+  template <class BlockFn>
+  void assemble(SparseMatrix& H, double diagonal, BlockFn block) const;
+
   int num_nodes_ = 0;
   std::vector<Spring> springs_;
   double point_damping_ = 0.0;
+  SparseMatrix pattern_;           ///< the Hessian's sparsity pattern (values zero)
+  std::vector<int> slots_;         ///< per spring, 36 indices into pattern_'s value array
+  std::vector<int> diagonal_slots_;  ///< per dof, its diagonal entry
 };
 
 /// Flattens node positions to (x0, y0, z0, x1, ...).
