@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -90,10 +91,10 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
   r.numeric_factorisations = solver.numeric_factorisations();
   r.seconds = now() - t0;
   if (!r.converged) {
-    throw std::runtime_error("static Newton did not converge: iteration " +
-                             std::to_string(r.iterations) + ", residual " +
-                             std::to_string(r.residual) + " N (target " + std::to_string(target) +
-                             " N)");
+    std::ostringstream msg;
+    msg << "static Newton did not converge: iteration " << r.iterations << ", residual "
+        << r.residual << " N (target " << target << " N)";
+    throw std::runtime_error(msg.str());
   }
   return r;
 }
