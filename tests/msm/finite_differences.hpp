@@ -16,21 +16,39 @@ struct DerivativeCheck {
   double hessian_asymmetry = 0.0;  ///< ‖H − Hᵀ‖_F / max(‖H‖_F, floor)
 };
 
+/// Central differences of a scalar function: the gradient.
+inline VectorXd fd_gradient(const std::function<double(const VectorXd&)>& f, const VectorXd& x,
+                            double h) {
+  VectorXd g(x.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    VectorXd xp = x, xm = x;
+    xp[i] += h;
+    xm[i] -= h;
+    g[i] = (f(xp) - f(xm)) / (2 * h);
+  }
+  return g;
+}
+
+/// Central differences of a vector function: its Jacobian (column i = ∂g/∂x_i).
+inline MatrixXd fd_jacobian(const std::function<VectorXd(const VectorXd&)>& g, const VectorXd& x,
+                            double h) {
+  MatrixXd J(g(x).size(), x.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    VectorXd xp = x, xm = x;
+    xp[i] += h;
+    xm[i] -= h;
+    J.col(i) = (g(xp) - g(xm)) / (2 * h);
+  }
+  return J;
+}
+
 /// Central-difference check at x with step h (relative to the scale of x's entries).
 inline DerivativeCheck check_derivatives(const std::function<double(const VectorXd&)>& energy,
                                          const std::function<VectorXd(const VectorXd&)>& gradient,
                                          const std::function<MatrixXd(const VectorXd&)>& hessian,
                                          const VectorXd& x, double h) {
-  const Eigen::Index n = x.size();
-  VectorXd g_fd(n);
-  MatrixXd H_fd(n, n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    VectorXd xp = x, xm = x;
-    xp[i] += h;
-    xm[i] -= h;
-    g_fd[i] = (energy(xp) - energy(xm)) / (2 * h);
-    H_fd.col(i) = (gradient(xp) - gradient(xm)) / (2 * h);
-  }
+  const VectorXd g_fd = fd_gradient(energy, x, h);
+  const MatrixXd H_fd = fd_jacobian(gradient, x, h);
   const VectorXd g = gradient(x);
   const MatrixXd H = hessian(x);
   DerivativeCheck c;
