@@ -12,6 +12,7 @@
 #include "meshes/surface_loads.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/model/spring_model.hpp"
+#include "msm/pbd/constraints.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
@@ -46,6 +47,11 @@ struct MsmOptions {
   std::vector<std::string> fixed_groups{"inlet", "outlet"};
   fs::path json;
   bool verbose = false;
+  int pbd_iterations = 10;
+  double bending_compliance = 0.0;
+  bool angle_constraints = false;
+  bool no_dihedral = false;
+  double pbd_damping = 0.01;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -71,7 +77,11 @@ void run(MsmOptions& o) {
   msm::validate(o.stiffness_params);
   const bool is_static = o.solver == "static" || o.solver == "linear" || o.solver == "relaxation";
   msm::Integrator integrator = msm::Integrator::symplectic_euler;
-  if (!is_static) integrator = msm::parse_integrator(o.solver);
+  if (!is_static && o.solver != "pbd") integrator = msm::parse_integrator(o.solver);
+  if (o.solver == "pbd" && o.model != "surface") {
+    throw InputError("--solver pbd: the position-based constraints of seed 002 are for the surface "
+                     "model (--model surface)");
+  }
   if (o.dt < 0 || !std::isfinite(o.dt)) {
     throw InputError("--dt: expected a time step > 0 s (or 0 for automatic), got " +
                      std::to_string(o.dt));
@@ -185,6 +195,39 @@ void run(MsmOptions& o) {
               << " µs per step)\n";
     result["solver"] = {{"name", o.solver}, {"steps", r.steps}, {"dt", r.dt},
                         {"residual_N", r.residual}, {"seconds", r.seconds}};
+  } else if (o.solver == "pbd") {
+    // Seed 002: stretching (compliance 1/k of each structural spring), dihedral bending and,
+    // optionally, the simplified angle constraint, solved with XPBD.
+    std::vector<Vec3> net_loads(net.nodes.size(), Vec3::Zero());
+    for (std::size_t i = 0; i < net.nodes.size(); ++i) {
+      net_loads[i] = problem.external_force.segment<3>(3 * static_cast<Eigen::Index>(i));
+    }
+    msm::PbdConstraintOptions co;
+    co.dihedral = !o.no_dihedral;
+    co.angle = o.angle_constraints;
+    co.bending_compliance = o.bending_compliance;
+    co.angle_compliance = o.bending_compliance;
+    const auto constraints = msm::build_pbd_constraints(net, net_loads, co);
+    std::size_t counts_by_type[3] = {0, 0, 0};
+    for (const auto& c : constraints) ++counts_by_type[static_cast<int>(c.type)];
+    msm::PbdOptions po;
+    po.dt = o.dt > 0 ? o.dt : 1e-3;
+    po.steps = o.steps;
+    po.iterations = o.pbd_iterations;
+    po.velocity_damping = o.pbd_damping;
+    std::cout << "XPBD: " << counts_by_type[0] << " stretching, " << counts_by_type[1]
+              << " dihedral, " << counts_by_type[2] << " angle constraints; " << po.steps
+              << " steps of " << po.dt << " s, " << po.iterations << " iterations each ...\n";
+    const msm::PbdResult r = msm::run_pbd(problem, constraints, po);
+    x = r.x;
+    std::cout << "  " << r.seconds << " s, " << r.seconds / r.steps * 1e6
+              << " µs per step, largest stretch violation " << r.max_violation * 1e3 << " mm\n";
+    result["solver"] = {{"name", "pbd"}, {"steps", r.steps}, {"dt", po.dt},
+                        {"iterations", po.iterations}, {"seconds", r.seconds},
+                        {"seconds_per_step", r.seconds / r.steps},
+                        {"constraints", {{"stretch", counts_by_type[0]},
+                                         {"dihedral", counts_by_type[1]},
+                                         {"angle", counts_by_type[2]}}}};
   } else {
     msm::DynamicOptions d;
     d.integrator = integrator;
@@ -279,9 +322,9 @@ void add_msm_command(CLI::App& app) {
   cmd->add_option("--density", o->density, "kg/m³")->capture_default_str();
   cmd->add_option("--solver", o->solver,
                   "static, linear, relaxation, explicit-euler, symplectic-euler, verlet, "
-                  "implicit-euler")
+                  "implicit-euler, pbd (XPBD constraints of seed 002, surface model)")
       ->check(CLI::IsMember({"static", "linear", "relaxation", "explicit-euler",
-                             "symplectic-euler", "verlet", "implicit-euler"}))
+                             "symplectic-euler", "verlet", "implicit-euler", "pbd"}))
       ->capture_default_str();
   cmd->add_option("--dt", o->dt,
                   "Time step, s (default: 0.5 × the critical-step bound; implicit: 10 ×)");
@@ -297,6 +340,16 @@ void add_msm_command(CLI::App& app) {
   cmd->add_option("--patch-radius", o->patch_radius, "Contact patch radius, m")
       ->capture_default_str();
   cmd->add_option("--fixed", o->fixed_groups, "Surface groups whose nodes are fixed")
+      ->capture_default_str();
+  cmd->add_option("--pbd-iterations", o->pbd_iterations, "XPBD iterations per step")
+      ->capture_default_str();
+  cmd->add_option("--bending-compliance", o->bending_compliance,
+                  "XPBD compliance of the dihedral/angle constraints, 1/(N·m) (0: rigid)")
+      ->capture_default_str();
+  cmd->add_flag("--angle-constraints", o->angle_constraints,
+                "Add seed 002's simplified angle constraints at loaded nodes");
+  cmd->add_flag("--no-dihedral", o->no_dihedral, "Leave out the dihedral-angle constraints");
+  cmd->add_option("--pbd-damping", o->pbd_damping, "Fraction of velocity removed per PBD step")
       ->capture_default_str();
   cmd->add_flag("-v,--verbose", o->verbose, "Print the Newton iterations");
   cmd->add_option("--json", o->json, "Write the results as JSON (atomically)");
