@@ -90,3 +90,11 @@ TEST_F(MsmCli, DivergenceStopsWithStepNodeEnergyAndWritesNothing) {
   EXPECT_TRUE(contains(r.output, "energy")) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "diverged.json"));
 }
+
+TEST_F(MsmCli, PressureAndGravityFromTheSharedLoadDefinitionsRun) {
+  const auto r = vv("--model volume --force 0 --pressure 5 --gravity --solver linear");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "linearised model")) << r.output;
+  const auto bad = vv("--pressure nan");
+  EXPECT_NE(bad.exit_code, 0) << bad.output;
+}

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 #include <numeric>
 
@@ -236,4 +237,26 @@ TEST(MassRules, SumToTheMaterialMassAndMatchHandValues) {
   EXPECT_NEAR(mu[2], rho * 2 * A * 2e-3 / 4, 1e-18);
   EXPECT_THROW((void)nodal_masses(pair, MassRule::seed001, rho), InputError);
   EXPECT_THROW((void)nodal_masses(pair, MassRule::uniform, 0.0), InputError);
+}
+
+TEST(Topology, TriangleNetworkFromAnStlFileEqualsTheOneFromTheMesh) {
+  // The surface model on an STL (seed 000 reads its vessel from STL): same springs, same lengths
+  // to float32 precision.
+  VesselParams p;
+  p.style = MeshStyle::structured;
+  const TriangleSurface inner = wall_surface(structured_tube(), p, WallSurface::inner);
+  const auto path = std::filesystem::temp_directory_path() / "msm_topology_inner.stl";
+  write_stl(path, inner, StlFormat::binary);
+  const TriangleSurface read = read_stl(path);
+  std::filesystem::remove(path);
+  const SpringNetwork a = build_triangle_network(inner, 1e-3);
+  const SpringNetwork b = build_triangle_network(read, 1e-3);
+  EXPECT_EQ(a.count(SpringFamily::structural), b.count(SpringFamily::structural));
+  EXPECT_EQ(a.count(SpringFamily::bend), b.count(SpringFamily::bend));
+  double total_a = 0, total_b = 0;
+  for (const auto& s : a.springs) total_a += s.rest_length;
+  for (const auto& s : b.springs) total_b += s.rest_length;
+  EXPECT_NEAR(total_b / total_a, 1.0, 1e-6);
+  // Euler: a tube (open cylinder) has V − E + F = 0, so structural springs = nodes + triangles.
+  EXPECT_EQ(a.count(SpringFamily::structural), inner.nodes.size() + inner.triangles.size());
 }

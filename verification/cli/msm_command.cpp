@@ -52,6 +52,8 @@ struct MsmOptions {
   bool angle_constraints = false;
   bool no_dihedral = false;
   double pbd_damping = 0.01;
+  double pressure = 0.0;
+  bool gravity = false;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -105,7 +107,13 @@ void run(MsmOptions& o) {
   spec.radius = o.patch_radius;
   spec.force = o.force;
   const TractionPatch patch = contact_patch(mesh, spec);
-  const std::vector<Vec3> loads = traction_nodal_loads(mesh, patch);
+  std::vector<Vec3> loads = traction_nodal_loads(mesh, patch);
+  if (o.pressure != 0.0) {
+    if (!std::isfinite(o.pressure)) throw InputError("--pressure: expected a finite value in Pa");
+    // Shared definition: −p n A/3 per inner-wall triangle node, the FEM's consistent load.
+    const auto pl = pressure_nodal_loads(mesh, std::string(group_names::inner_wall), o.pressure);
+    for (std::size_t i = 0; i < loads.size(); ++i) loads[i] += pl[i];
+  }
 
   const auto t_build = std::chrono::steady_clock::now();
   msm::SpringNetwork net;
@@ -132,7 +140,15 @@ void run(MsmOptions& o) {
   for (auto& s : net.springs) s.damping = o.axial_damping;
   const std::vector<double> masses = msm::nodal_masses(net, mass_rule, o.density);
   const msm::SpringModel model(net, o.point_damping);
-  const msm::Problem problem = msm::make_problem(model, net, masses, mesh, loads, o.fixed_groups);
+  msm::Problem problem = msm::make_problem(model, net, masses, mesh, loads, o.fixed_groups);
+  if (o.gravity) {
+    // Gravity −9.81 m/s² along y on the nodal masses: for the volume model with consistent masses
+    // this is exactly the shared body_force_nodal_loads (ρV/4 per tet vertex); a surface model
+    // carries its own (shell) mass ρ·t·A/3 per triangle vertex.
+    for (Eigen::Index i = 0; i < problem.num_dofs(); i += 3) {
+      problem.external_force[i + 1] -= 9.81 * problem.mass[i];
+    }
+  }
   const double build_seconds = seconds_since(t_build);
 
   std::cout << "model: " << o.model << (o.model == "surface" ? " (" + o.surface + " wall)" : "")
@@ -337,6 +353,9 @@ void add_msm_command(CLI::App& app) {
   cmd->add_option("--contact-point", o->contact_point,
                   "Contact point x y z, m (default: inner wall at mid-length)")
       ->expected(3);
+  cmd->add_option("--pressure", o->pressure, "Internal pressure on the inner wall, Pa")
+      ->capture_default_str();
+  cmd->add_flag("--gravity", o->gravity, "Add gravity (9.81 m/s² along −y) on the nodal masses");
   cmd->add_option("--patch-radius", o->patch_radius, "Contact patch radius, m")
       ->capture_default_str();
   cmd->add_option("--fixed", o->fixed_groups, "Surface groups whose nodes are fixed")
