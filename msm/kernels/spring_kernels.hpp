@@ -25,8 +25,8 @@ struct LengthProfile {
 /// k2 beyond it. Compression (negative elongation) always uses k1, as in the seed, whose
 /// threshold is on the elongation.
 struct SpringLaw {
-  double k1 = 0.0;  ///< N/m
-  double k2 = 0.0;  ///< N/m, used beyond the threshold
+  double k1 = 0.0;                                             ///< N/m
+  double k2 = 0.0;                                             ///< N/m, used beyond the threshold
   double threshold = std::numeric_limits<double>::infinity();  ///< Δx_c, m
 };
 
@@ -58,8 +58,7 @@ Mat6 spring_hessian(const Vec3& xa, const Vec3& xb, double rest_length, const Sp
 /// d = (xa − xb)/|xa − xb|. The seed prints (v_b − v_a)·d, which with its d = (xa − xb)/|…| would
 /// push a moving node further along and inject energy; the dissipative sign is used here (the
 /// damping power is −k_d ((va − vb)·d)² ≤ 0). Returns (f_a, f_b) stacked, N.
-Vec6 axial_damping_force(const Vec3& xa, const Vec3& xb, const Vec3& va, const Vec3& vb,
-                         double kd);
+Vec6 axial_damping_force(const Vec3& xa, const Vec3& xb, const Vec3& va, const Vec3& vb, double kd);
 /// −∂f/∂v of the axial damping force (6×6, PSD), N·s/m: k_d [[D, −D], [−D, D]], D = d dᵀ.
 Mat6 axial_damping_jacobian(const Vec3& xa, const Vec3& xb, double kd);
 

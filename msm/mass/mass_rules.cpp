@@ -16,16 +16,20 @@ MassRule parse_mass_rule(const std::string& name) {
 
 std::string to_string(MassRule rule) {
   switch (rule) {
-    case MassRule::uniform: return "uniform";
-    case MassRule::seed001: return "seed001";
-    case MassRule::consistent: return "consistent";
+    case MassRule::uniform:
+      return "uniform";
+    case MassRule::seed001:
+      return "seed001";
+    case MassRule::consistent:
+      return "consistent";
   }
   return "unknown";
 }
 
 namespace {
 double tet_volume(const SpringNetwork& net, const Tet& t) {
-  return std::abs(signed_volume(net.nodes[t[0]], net.nodes[t[1]], net.nodes[t[2]], net.nodes[t[3]]));
+  return std::abs(
+      signed_volume(net.nodes[t[0]], net.nodes[t[1]], net.nodes[t[2]], net.nodes[t[3]]));
 }
 }  // namespace
 

@@ -8,9 +8,9 @@
 namespace vessel::msm {
 
 enum class MassRule {
-  uniform,        ///< total mass spread evenly over the nodes (seed 000 §III.A)
-  seed001,        ///< tet-volume lumping, seed 001 eq. (2), rescaled to the total mass
-  consistent,     ///< density-consistent lumping: ρV/4 per tet vertex, ρ·A·t/3 per triangle vertex
+  uniform,     ///< total mass spread evenly over the nodes (seed 000 §III.A)
+  seed001,     ///< tet-volume lumping, seed 001 eq. (2), rescaled to the total mass
+  consistent,  ///< density-consistent lumping: ρV/4 per tet vertex, ρ·A·t/3 per triangle vertex
 };
 MassRule parse_mass_rule(const std::string& name);
 std::string to_string(MassRule rule);

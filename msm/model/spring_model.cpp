@@ -84,10 +84,10 @@ void SpringModel::assemble(SparseMatrix& H, double diagonal, BlockFn block) cons
   }
 }
 
-
 double SpringModel::energy(const VectorXd& x) const {
   double e = 0.0;
-  for (const Spring& s : springs_) e += spring_energy(node(x, s.a), node(x, s.b), s.rest_length, s.law);
+  for (const Spring& s : springs_)
+    e += spring_energy(node(x, s.a), node(x, s.b), s.rest_length, s.law);
   return e;
 }
 
@@ -133,7 +133,8 @@ double SpringModel::max_strain(const VectorXd& x) const {
 
 VectorXd flatten(const std::vector<Vec3>& nodes) {
   VectorXd x(3 * static_cast<Eigen::Index>(nodes.size()));
-  for (std::size_t i = 0; i < nodes.size(); ++i) x.segment<3>(3 * static_cast<Eigen::Index>(i)) = nodes[i];
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    x.segment<3>(3 * static_cast<Eigen::Index>(i)) = nodes[i];
   return x;
 }
 

@@ -33,8 +33,8 @@ class SpringModel : public Form {
   int num_nodes_ = 0;
   std::vector<Spring> springs_;
   double point_damping_ = 0.0;
-  SparseMatrix pattern_;           ///< the Hessian's sparsity pattern (values zero)
-  std::vector<int> slots_;         ///< per spring, 36 indices into pattern_'s value array
+  SparseMatrix pattern_;             ///< the Hessian's sparsity pattern (values zero)
+  std::vector<int> slots_;           ///< per spring, 36 indices into pattern_'s value array
   std::vector<int> diagonal_slots_;  ///< per dof, its diagonal entry
 };
 

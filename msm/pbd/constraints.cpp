@@ -72,7 +72,8 @@ ConstraintValue evaluate(const Constraint& c, const VectorXd& x) {
       }
       const Vec3 q3 = (p2.cross(n2) + n1.cross(p2) * d) / l23;
       const Vec3 q4 = (p2.cross(n1) + n2.cross(p2) * d) / l24;
-      const Vec3 q2 = -(p3.cross(n2) + n1.cross(p3) * d) / l23 - (p4.cross(n1) + n2.cross(p4) * d) / l24;
+      const Vec3 q2 =
+          -(p3.cross(n2) + n1.cross(p3) * d) / l23 - (p4.cross(n1) + n2.cross(p4) * d) / l24;
       const Vec3 q1 = -q2 - q3 - q4;
       v.grad = {q1 / s, q2 / s, q3 / s, q4 / s};
       return v;
@@ -119,7 +120,8 @@ std::vector<Constraint> build_pbd_constraints(const SpringNetwork& net,
   std::vector<Constraint> out;
   const VectorXd x0 = [&] {
     VectorXd x(3 * static_cast<Eigen::Index>(net.nodes.size()));
-    for (std::size_t i = 0; i < net.nodes.size(); ++i) x.segment<3>(3 * static_cast<Eigen::Index>(i)) = net.nodes[i];
+    for (std::size_t i = 0; i < net.nodes.size(); ++i)
+      x.segment<3>(3 * static_cast<Eigen::Index>(i)) = net.nodes[i];
     return x;
   }();
   if (o.stretch) {
@@ -173,8 +175,8 @@ std::vector<Constraint> build_pbd_constraints(const SpringNetwork& net,
   return out;
 }
 
-PbdResult run_pbd(const Problem& p, const std::vector<Constraint>& constraints,
-                  const PbdOptions& o, const VectorXd& x0) {
+PbdResult run_pbd(const Problem& p, const std::vector<Constraint>& constraints, const PbdOptions& o,
+                  const VectorXd& x0) {
   if (!(o.dt > 0) || !std::isfinite(o.dt)) {
     throw InputError("dt: expected a finite time step > 0 s, got " + std::to_string(o.dt));
   }
@@ -211,7 +213,8 @@ PbdResult run_pbd(const Problem& p, const std::vector<Constraint>& constraints,
         const double dl = (-cv.C - alpha * lambda[ci]) / (denom + alpha);
         lambda[ci] += dl;
         for (int k = 0; k < cv.count; ++k) {
-          xp.segment<3>(3 * c.nodes[k]) += dl * w.segment<3>(3 * c.nodes[k]).cwiseProduct(cv.grad[k]);
+          xp.segment<3>(3 * c.nodes[k]) +=
+              dl * w.segment<3>(3 * c.nodes[k]).cwiseProduct(cv.grad[k]);
         }
       }
     }
@@ -225,7 +228,8 @@ PbdResult run_pbd(const Problem& p, const std::vector<Constraint>& constraints,
     r.steps = step;
   }
   for (const Constraint& c : constraints) {
-    if (c.type == ConstraintType::stretch) r.max_violation = std::max(r.max_violation, std::abs(evaluate(c, r.x).C));
+    if (c.type == ConstraintType::stretch)
+      r.max_violation = std::max(r.max_violation, std::abs(evaluate(c, r.x).C));
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

@@ -46,8 +46,8 @@ Vec3 seed002_angle_correction(const Vec3& pi, const Vec3& pj, const Vec3& f, dou
 
 struct PbdConstraintOptions {
   bool stretch = true;
-  bool dihedral = true;       ///< bending by the dihedral angle (one per interior edge)
-  bool angle = false;         ///< the seed's simplified angle constraint instead/in addition
+  bool dihedral = true;             ///< bending by the dihedral angle (one per interior edge)
+  bool angle = false;               ///< the seed's simplified angle constraint instead/in addition
   double bending_compliance = 0.0;  ///< 1/(N·m)
   double angle_compliance = 0.0;    ///< 1/(N·m)
 };
@@ -60,9 +60,9 @@ std::vector<Constraint> build_pbd_constraints(const SpringNetwork& net,
                                               const PbdConstraintOptions& options);
 
 struct PbdOptions {
-  double dt = 1e-3;     ///< s
+  double dt = 1e-3;  ///< s
   int steps = 100;
-  int iterations = 10;  ///< Gauss–Seidel sweeps per step
+  int iterations = 10;            ///< Gauss–Seidel sweeps per step
   double velocity_damping = 0.0;  ///< fraction of the velocity removed per step, [0, 1)
 };
 

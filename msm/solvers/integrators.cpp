@@ -13,16 +13,22 @@ Integrator parse_integrator(const std::string& name) {
   if (name == "symplectic-euler") return Integrator::symplectic_euler;
   if (name == "verlet") return Integrator::verlet;
   if (name == "implicit-euler") return Integrator::implicit_euler;
-  throw InputError("integrator: expected explicit-euler, symplectic-euler, verlet or "
-                   "implicit-euler; got '" + name + "'");
+  throw InputError(
+      "integrator: expected explicit-euler, symplectic-euler, verlet or "
+      "implicit-euler; got '" +
+      name + "'");
 }
 
 std::string to_string(Integrator i) {
   switch (i) {
-    case Integrator::explicit_euler: return "explicit-euler";
-    case Integrator::symplectic_euler: return "symplectic-euler";
-    case Integrator::verlet: return "verlet";
-    case Integrator::implicit_euler: return "implicit-euler";
+    case Integrator::explicit_euler:
+      return "explicit-euler";
+    case Integrator::symplectic_euler:
+      return "symplectic-euler";
+    case Integrator::verlet:
+      return "verlet";
+    case Integrator::implicit_euler:
+      return "implicit-euler";
   }
   return "unknown";
 }

@@ -63,7 +63,7 @@ double max_frequency_bound(const Problem& problem);
 struct RelaxationOptions {
   double tolerance = 1e-8;  ///< stop when ‖∇Π‖ ≤ tolerance·‖f_ext‖ on free dofs
   int max_steps = 2'000'000;
-  double safety = 0.9;      ///< dt = safety·2/ω_max bound
+  double safety = 0.9;  ///< dt = safety·2/ω_max bound
 };
 struct RelaxationResult {
   VectorXd x;

@@ -81,8 +81,7 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
     if (o.log) {
       *o.log << "  newton " << r.iterations << ": residual " << r.residual << " N, step " << alpha
              << (exact ? ", exact Hessian" : ", projected Hessian") << ", regularisation "
-             << solver.last_regularisation()
-             << ", energy " << trial_energy << " J\n";
+             << solver.last_regularisation() << ", energy " << trial_energy << " J\n";
     }
     r.x = trial;
     energy = trial_energy;

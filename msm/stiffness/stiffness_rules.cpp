@@ -14,17 +14,24 @@ StiffnessRule parse_stiffness_rule(const std::string& name) {
   if (name == "van-gelder" || name == "van_gelder") return StiffnessRule::van_gelder;
   if (name == "lloyd") return StiffnessRule::lloyd;
   if (name == "uniform") return StiffnessRule::uniform;
-  throw InputError("stiffness rule: expected one of seed000, seed001, van-gelder, lloyd, uniform; "
-                   "got '" + name + "'");
+  throw InputError(
+      "stiffness rule: expected one of seed000, seed001, van-gelder, lloyd, uniform; "
+      "got '" +
+      name + "'");
 }
 
 std::string to_string(StiffnessRule rule) {
   switch (rule) {
-    case StiffnessRule::seed000: return "seed000";
-    case StiffnessRule::seed001: return "seed001";
-    case StiffnessRule::van_gelder: return "van-gelder";
-    case StiffnessRule::lloyd: return "lloyd";
-    case StiffnessRule::uniform: return "uniform";
+    case StiffnessRule::seed000:
+      return "seed000";
+    case StiffnessRule::seed001:
+      return "seed001";
+    case StiffnessRule::van_gelder:
+      return "van-gelder";
+    case StiffnessRule::lloyd:
+      return "lloyd";
+    case StiffnessRule::uniform:
+      return "uniform";
   }
   return "unknown";
 }
@@ -33,22 +40,23 @@ void validate(const StiffnessParams& p) {
   auto require = [](bool ok, const std::string& what) {
     if (!ok) throw InputError(what);
   };
-  require(std::isfinite(p.youngs_modulus) && p.youngs_modulus > 0,
-          "youngs_modulus E: expected a finite value > 0 Pa, got " + std::to_string(p.youngs_modulus));
+  require(
+      std::isfinite(p.youngs_modulus) && p.youngs_modulus > 0,
+      "youngs_modulus E: expected a finite value > 0 Pa, got " + std::to_string(p.youngs_modulus));
   require(p.poisson_ratio >= 0.0 && p.poisson_ratio <= 0.5,
           "poisson_ratio ν: expected a value in [0, 0.5], got " + std::to_string(p.poisson_ratio));
   require(std::isfinite(p.uniform_k) && p.uniform_k > 0,
           "uniform_k: expected a finite value > 0 N/m, got " + std::to_string(p.uniform_k));
-  for (double f : {p.structural_factor, p.shear_factor, p.bend_factor, p.two_ring_factor,
-                   p.volume_factor}) {
-    require(std::isfinite(f) && f >= 0, "family factor: expected a finite value ≥ 0, got " +
-                                            std::to_string(f));
+  for (double f :
+       {p.structural_factor, p.shear_factor, p.bend_factor, p.two_ring_factor, p.volume_factor}) {
+    require(std::isfinite(f) && f >= 0,
+            "family factor: expected a finite value ≥ 0, got " + std::to_string(f));
   }
-  require(std::isfinite(p.bilinear_ratio) && p.bilinear_ratio > 0,
-          "bilinear_ratio k2/k1: expected a finite value > 0, got " + std::to_string(p.bilinear_ratio));
-  require(p.bilinear_threshold_strain > 0,
-          "bilinear_threshold_strain: expected a value > 0, got " +
-              std::to_string(p.bilinear_threshold_strain));
+  require(
+      std::isfinite(p.bilinear_ratio) && p.bilinear_ratio > 0,
+      "bilinear_ratio k2/k1: expected a finite value > 0, got " + std::to_string(p.bilinear_ratio));
+  require(p.bilinear_threshold_strain > 0, "bilinear_threshold_strain: expected a value > 0, got " +
+                                               std::to_string(p.bilinear_threshold_strain));
 }
 
 double seed000_stiffness(double E, double area, double h0) {
@@ -211,20 +219,36 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
       case StiffnessRule::seed000:
         k = seed000_stiffness(E, volume ? L * L : t * L, L);
         break;
-      case StiffnessRule::seed001: k = seed001_stiffness(E, m, L); break;
-      case StiffnessRule::van_gelder: k = van_gelder_stiffness(E, m, L); break;
+      case StiffnessRule::seed001:
+        k = seed001_stiffness(E, m, L);
+        break;
+      case StiffnessRule::van_gelder:
+        k = van_gelder_stiffness(E, m, L);
+        break;
       case StiffnessRule::lloyd:
         k = is_edge ? lloyd.at(key(s.a, s.b)) : van_gelder_stiffness(E, m, L);
         break;
-      case StiffnessRule::uniform: k = p.uniform_k; break;
+      case StiffnessRule::uniform:
+        k = p.uniform_k;
+        break;
     }
     double factor = 1.0;
     switch (s.family) {
-      case SpringFamily::structural: factor = p.structural_factor; break;
-      case SpringFamily::shear: factor = p.shear_factor; break;
-      case SpringFamily::bend: factor = p.bend_factor; break;
-      case SpringFamily::two_ring: factor = p.two_ring_factor; break;
-      case SpringFamily::volume: factor = p.volume_factor; break;
+      case SpringFamily::structural:
+        factor = p.structural_factor;
+        break;
+      case SpringFamily::shear:
+        factor = p.shear_factor;
+        break;
+      case SpringFamily::bend:
+        factor = p.bend_factor;
+        break;
+      case SpringFamily::two_ring:
+        factor = p.two_ring_factor;
+        break;
+      case SpringFamily::volume:
+        factor = p.volume_factor;
+        break;
     }
     s.law.k1 = factor * k;
     s.law.k2 = k2_ratio * s.law.k1;

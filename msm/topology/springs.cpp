@@ -13,11 +13,16 @@ namespace vessel::msm {
 
 std::string to_string(SpringFamily family) {
   switch (family) {
-    case SpringFamily::structural: return "structural";
-    case SpringFamily::shear: return "shear";
-    case SpringFamily::bend: return "bend";
-    case SpringFamily::two_ring: return "two_ring";
-    case SpringFamily::volume: return "volume";
+    case SpringFamily::structural:
+      return "structural";
+    case SpringFamily::shear:
+      return "shear";
+    case SpringFamily::bend:
+      return "bend";
+    case SpringFamily::two_ring:
+      return "two_ring";
+    case SpringFamily::volume:
+      return "volume";
   }
   return "unknown";
 }
@@ -148,7 +153,8 @@ std::vector<GridIndex> recover_tube_grid(const std::vector<Vec3>& nodes, const V
     const double fj = c.axial / ds;
     const long i = std::lround(fi);
     const long j = std::lround(fj);
-    if (std::abs(fi - static_cast<double>(i)) > 0.25 || std::abs(fj - static_cast<double>(j)) > 0.25 || j < 0 || j > n_axial) {
+    if (std::abs(fi - static_cast<double>(i)) > 0.25 ||
+        std::abs(fj - static_cast<double>(j)) > 0.25 || j < 0 || j > n_axial) {
       throw InputError("structured tube grid: node " + std::to_string(n) +
                        " is not on the expected " + std::to_string(n_circ) + " × " +
                        std::to_string(n_axial + 1) +
@@ -157,13 +163,13 @@ std::vector<GridIndex> recover_tube_grid(const std::vector<Vec3>& nodes, const V
     GridIndex g{static_cast<int>(((i % n_circ) + n_circ) % n_circ), static_cast<int>(j)};
     grid[n] = g;
     if (seen[static_cast<std::size_t>(g.j) * n_circ + g.i]++) {
-      throw InputError("structured tube grid: two nodes at grid position (" +
-                       std::to_string(g.i) + ", " + std::to_string(g.j) + ")");
+      throw InputError("structured tube grid: two nodes at grid position (" + std::to_string(g.i) +
+                       ", " + std::to_string(g.j) + ")");
     }
   }
   if (nodes.size() != seen.size()) {
-    throw InputError("structured tube grid: " + std::to_string(nodes.size()) +
-                     " nodes, expected " + std::to_string(seen.size()));
+    throw InputError("structured tube grid: " + std::to_string(nodes.size()) + " nodes, expected " +
+                     std::to_string(seen.size()));
   }
   return grid;
 }

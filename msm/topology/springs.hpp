@@ -18,10 +18,9 @@ namespace vessel::msm {
 /// triangle mesh the two opposite vertices of two triangles sharing an edge), optional two-ring.
 /// Volume model (seed 001, Mollemans): one spring per tetrahedron edge.
 enum class SpringFamily { structural, shear, bend, two_ring, volume };
-inline constexpr std::array<SpringFamily, 5> kAllFamilies{SpringFamily::structural,
-                                                          SpringFamily::shear, SpringFamily::bend,
-                                                          SpringFamily::two_ring,
-                                                          SpringFamily::volume};
+inline constexpr std::array<SpringFamily, 5> kAllFamilies{
+    SpringFamily::structural, SpringFamily::shear, SpringFamily::bend, SpringFamily::two_ring,
+    SpringFamily::volume};
 std::string to_string(SpringFamily family);
 
 struct Spring {
@@ -29,20 +28,20 @@ struct Spring {
   int b = 0;
   double rest_length = 0.0;  ///< m
   SpringFamily family = SpringFamily::structural;
-  SpringLaw law;             ///< stiffness (set by a stiffness rule)
-  double damping = 0.0;      ///< axial damping k_d, N·s/m (seed 000 eq. 3.4)
+  SpringLaw law;         ///< stiffness (set by a stiffness rule)
+  double damping = 0.0;  ///< axial damping k_d, N·s/m (seed 000 eq. 3.4)
 };
 
 /// A spring network on its own node array (the mesh's nodes for the volume model, the surface's
 /// nodes for a surface model). `source_node[i]` is node i's index in the TetMesh (−1 if none).
 struct SpringNetwork {
-  std::vector<Vec3> nodes;        ///< rest positions, m
+  std::vector<Vec3> nodes;  ///< rest positions, m
   std::vector<int> source_node;
   std::vector<Spring> springs;
   /// Triangles of the surface model (empty for the volume model), for masses and PBD bending.
   std::vector<Triangle> triangles;
-  std::vector<Tet> tets;          ///< tets of the volume model (empty for surfaces)
-  double thickness = 0.0;         ///< wall thickness t carried by a surface model, m
+  std::vector<Tet> tets;   ///< tets of the volume model (empty for surfaces)
+  double thickness = 0.0;  ///< wall thickness t carried by a surface model, m
   [[nodiscard]] std::size_t count(SpringFamily family) const;
 };
 

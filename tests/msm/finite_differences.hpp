@@ -11,8 +11,8 @@ using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
 struct DerivativeCheck {
-  double gradient_error = 0.0;  ///< ‖g − g_fd‖ / max(‖g_fd‖, floor)
-  double hessian_error = 0.0;   ///< ‖H − H_fd‖_F / max(‖H_fd‖_F, floor)
+  double gradient_error = 0.0;     ///< ‖g − g_fd‖ / max(‖g_fd‖, floor)
+  double hessian_error = 0.0;      ///< ‖H − H_fd‖_F / max(‖H_fd‖_F, floor)
   double hessian_asymmetry = 0.0;  ///< ‖H − Hᵀ‖_F / max(‖H‖_F, floor)
 };
 

@@ -100,9 +100,9 @@ TEST(EffectiveModuli, VolumeModelOfACubeObeysTheCauchyRelation) {
   ASSERT_GT(mesh.tets.size(), 1000u);
   const double E = 14.24e3;
   std::map<std::string, Moduli> m;
-  for (StiffnessRule rule : {StiffnessRule::seed000, StiffnessRule::seed001,
-                             StiffnessRule::van_gelder, StiffnessRule::lloyd,
-                             StiffnessRule::uniform}) {
+  for (StiffnessRule rule :
+       {StiffnessRule::seed000, StiffnessRule::seed001, StiffnessRule::van_gelder,
+        StiffnessRule::lloyd, StiffnessRule::uniform}) {
     for (double nu : {0.0, 0.25, 0.45}) {
       if (rule != StiffnessRule::lloyd && nu != 0.25) continue;  // only lloyd reads ν
       SpringNetwork net = build_volume_network(mesh);
@@ -114,9 +114,9 @@ TEST(EffectiveModuli, VolumeModelOfACubeObeysTheCauchyRelation) {
       if (rule == StiffnessRule::lloyd) std::snprintf(suffix, sizeof suffix, "(nu=%.2f)", nu);
       const std::string key = to_string(rule) + suffix;
       m[key] = measure(net, 1e-4);
-      std::printf("cube %zu nodes %zu tets, rule %-16s E_eff = %8.1f Pa (E_eff/E = %.3f), nu_eff = %.3f\n",
-                  mesh.nodes.size(), mesh.tets.size(), key.c_str(), m[key].E, m[key].E / E,
-                  m[key].nu);
+      std::printf(
+          "cube %zu nodes %zu tets, rule %-16s E_eff = %8.1f Pa (E_eff/E = %.3f), nu_eff = %.3f\n",
+          mesh.nodes.size(), mesh.tets.size(), key.c_str(), m[key].E, m[key].E / E, m[key].nu);
     }
   }
   // Linearity: seed001's k is exactly a third of van_gelder's, so is its modulus; ν unchanged.
@@ -125,8 +125,8 @@ TEST(EffectiveModuli, VolumeModelOfACubeObeysTheCauchyRelation) {
   // Cauchy relation: networks whose k depends on geometry only (not on ν) sit near ν = 1/4,
   // whatever ν is asked for (the unstructured cube is nearly, not exactly, isotropic and has
   // free faces, hence the tolerance).
-  for (const auto& key : {"seed001", "van-gelder", "lloyd(nu=0.25)", "lloyd(nu=0.45)",
-                          "lloyd(nu=0.00)"}) {
+  for (const auto& key :
+       {"seed001", "van-gelder", "lloyd(nu=0.25)", "lloyd(nu=0.45)", "lloyd(nu=0.00)"}) {
     ASSERT_TRUE(m.count(key)) << key;
     EXPECT_NEAR(m[key].nu, 0.25, 0.06) << key;
   }

@@ -49,8 +49,8 @@ TEST_F(MsmCli, SurfaceAndVolumeModelsSolveStaticallyAndWriteJson) {
 }
 
 TEST_F(MsmCli, StructuredGridHasSeed000FamiliesAndEveryDynamicSolverRuns) {
-  // Level 0 structured: 24 × 22 cells (structural 24·23 + 24·22, shear 2·24·22, bend 24·23 + 24·21);
-  // the coarse grid needs a patch wider than its 0.8 mm × 1.8 mm cells.
+  // Level 0 structured: 24 × 22 cells (structural 24·23 + 24·22, shear 2·24·22, bend 24·23 +
+  // 24·21); the coarse grid needs a patch wider than its 0.8 mm × 1.8 mm cells.
   const auto g = vv("--structured --surface mid --solver linear --patch-radius 1.5e-3");
   ASSERT_EQ(g.exit_code, 0) << g.output;
   EXPECT_TRUE(contains(g.output, "structural 1080 shear 1056 bend 1056")) << g.output;

@@ -90,8 +90,7 @@ TEST(Pbd, XpbdUpdateReproducesTheSeedsClosedFormCorrections) {
 TEST(Pbd, DihedralConstraintIsZeroAtRestAndRestoresABentPair) {
   // Two triangles hinged on the edge 0-1 at 120°.
   SpringNetwork net;
-  net.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 1, 0),
-               Vec3(0.5, -0.5, std::sqrt(3.0) / 2)};
+  net.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 1, 0), Vec3(0.5, -0.5, std::sqrt(3.0) / 2)};
   net.triangles = {{0, 1, 2}, {1, 0, 3}};
   const auto cs = build_pbd_constraints(net, {}, {false, true, false, 0.0, 0.0});
   ASSERT_EQ(cs.size(), 1u);

@@ -146,11 +146,12 @@ TEST(Integrators, UndampedEnergyBoundedForSymplecticAndVerletGrowingForExplicitE
     for (double e : r.energy) d = std::max(d, std::abs(e - E0) / E0);
     return d;
   };
-  std::printf("undamped oscillator, dt = %.2f x critical: max |E-E0|/E0 symplectic Euler %.4f "
-              "(%d steps), Verlet %.4f; explicit Euler E/E0 after 40 steps %.1f; implicit Euler "
-              "E/E0 after %d steps %.3g\n",
-              ratio, max_dev(sym), steps, max_dev(ver), exp.energy.back() / E0, steps,
-              imp.energy.back() / E0);
+  std::printf(
+      "undamped oscillator, dt = %.2f x critical: max |E-E0|/E0 symplectic Euler %.4f "
+      "(%d steps), Verlet %.4f; explicit Euler E/E0 after 40 steps %.1f; implicit Euler "
+      "E/E0 after %d steps %.3g\n",
+      ratio, max_dev(sym), steps, max_dev(ver), exp.energy.back() / E0, steps,
+      imp.energy.back() / E0);
   // Symplectic Euler conserves a modified energy: the true one oscillates by O(ωh) (25 % here)
   // here and does not drift; Verlet by O((ωh)²) = ±4 %.
   EXPECT_LT(max_dev(sym), 0.3);
@@ -164,7 +165,8 @@ TEST(Integrators, UndampedEnergyBoundedForSymplecticAndVerletGrowingForExplicitE
   // Run on, it trips the divergence detection (energy beyond 1000 × its start).
   EXPECT_THROW((void)run_oscillator(Integrator::explicit_euler, ratio, 100), DivergenceError);
   // Implicit Euler dissipates: monotone decrease.
-  for (std::size_t i = 1; i < imp.energy.size(); ++i) EXPECT_LE(imp.energy[i], imp.energy[i - 1] + 1e-15 * E0);
+  for (std::size_t i = 1; i < imp.energy.size(); ++i)
+    EXPECT_LE(imp.energy[i], imp.energy[i - 1] + 1e-15 * E0);
   EXPECT_LT(imp.energy.back() / E0, 0.01);
 }
 
@@ -197,7 +199,7 @@ TEST(Integrators, BlowUpStopsWithStepNodeAndEnergy) {
 
 TEST(Integrators, DampedImplicitEulerSettlesOnTheStaticAnswer) {
   Chain c = make_chain({41.106, 20.0}, 0.1, 1e-4);
-  c.net.springs[0].damping = 0.05;  // axial damping, seed 000 eq. (3.4)
+  c.net.springs[0].damping = 0.05;                       // axial damping, seed 000 eq. (3.4)
   c.model = std::make_unique<SpringModel>(c.net, 0.01);  // point damping, eq. (3.3)
   c.problem.form = c.model.get();
   DynamicOptions o;

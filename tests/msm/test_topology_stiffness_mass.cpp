@@ -79,7 +79,8 @@ TEST(Topology, TriangleNetworkEdgesPlusOneBendPerInteriorEdge) {
     if (s.family == SpringFamily::bend) EXPECT_NEAR(s.rest_length, std::sqrt(3.0) * 1e-3, 1e-15);
   }
   // Two-ring on the rhombus: every pair is already connected → none.
-  EXPECT_EQ(build_triangle_network(triangle_pair(1e-3), 1e-3, true).count(SpringFamily::two_ring), 0u);
+  EXPECT_EQ(build_triangle_network(triangle_pair(1e-3), 1e-3, true).count(SpringFamily::two_ring),
+            0u);
 }
 
 TEST(Topology, TwoRingSpringsOnAStrip) {
@@ -259,4 +260,23 @@ TEST(Topology, TriangleNetworkFromAnStlFileEqualsTheOneFromTheMesh) {
   EXPECT_NEAR(total_b / total_a, 1.0, 1e-6);
   // Euler: a tube (open cylinder) has V − E + F = 0, so structural springs = nodes + triangles.
   EXPECT_EQ(a.count(SpringFamily::structural), inner.nodes.size() + inner.triangles.size());
+}
+
+TEST(Topology, StructuredArchGridAndMidSurface) {
+  VesselParams p;
+  p.kind = VesselKind::arch;
+  p.style = MeshStyle::structured;
+  const TetMesh mesh = generate_vessel_mesh(p);
+  const StructuredCounts c = structured_counts(p);
+  const TriangleSurface mid = wall_surface(mesh, p, WallSurface::mid);
+  const SpringNetwork net = build_tube_grid_network(mid, p, p.wall_thickness);
+  const std::size_t nc = c.circumferential, na = c.axial;
+  EXPECT_EQ(net.count(SpringFamily::structural), nc * (na + 1) + nc * na);
+  EXPECT_EQ(net.count(SpringFamily::shear), 2 * nc * na);
+  EXPECT_EQ(net.count(SpringFamily::bend), nc * (na + 1) + nc * (na - 1));
+  // Every mid-surface node at distance a + t/2 from the arch's centreline circle of radius R.
+  for (const Vec3& x : mid.nodes) {
+    const double rho = std::hypot(std::hypot(x.x(), x.y()) - p.bend_radius, x.z());
+    EXPECT_NEAR(rho, p.inner_radius + 0.5 * p.wall_thickness, 1e-12);
+  }
 }

@@ -81,8 +81,9 @@ void run(MsmOptions& o) {
   msm::Integrator integrator = msm::Integrator::symplectic_euler;
   if (!is_static && o.solver != "pbd") integrator = msm::parse_integrator(o.solver);
   if (o.solver == "pbd" && o.model != "surface") {
-    throw InputError("--solver pbd: the position-based constraints of seed 002 are for the surface "
-                     "model (--model surface)");
+    throw InputError(
+        "--solver pbd: the position-based constraints of seed 002 are for the surface "
+        "model (--model surface)");
   }
   if (o.dt < 0 || !std::isfinite(o.dt)) {
     throw InputError("--dt: expected a time step > 0 s (or 0 for automatic), got " +
@@ -169,8 +170,8 @@ void run(MsmOptions& o) {
   }
   double total_mass = problem.mass.sum() / 3.0;
   std::cout << "stiffness rule " << msm::to_string(rule) << ": k from " << kmin << " to " << kmax
-            << " N/m; mass rule " << msm::to_string(mass_rule) << ": total "
-            << total_mass * 1e3 << " g\n";
+            << " N/m; mass rule " << msm::to_string(mass_rule) << ": total " << total_mass * 1e3
+            << " g\n";
   std::cout << "contact: " << o.force * 1e3 << " mN over " << patch.triangles.size()
             << " triangles (" << patch.area * 1e6 << " mm²) at (" << spec.point.x() * 1e3 << ", "
             << spec.point.y() * 1e3 << ", " << spec.point.z() * 1e3 << ") mm\n";
@@ -193,24 +194,29 @@ void run(MsmOptions& o) {
   if (o.solver == "static" || o.solver == "linear") {
     msm::StaticOptions static_options;
     if (o.verbose) static_options.log = &std::cout;
-    const msm::StaticResult r =
-        o.solver == "static" ? msm::solve_static(problem, static_options) : msm::solve_linear(problem);
+    const msm::StaticResult r = o.solver == "static" ? msm::solve_static(problem, static_options)
+                                                     : msm::solve_linear(problem);
     x = r.x;
     std::cout << (o.solver == "static" ? "static Newton" : "linearised model") << ": "
               << r.iterations << " iteration(s), residual " << r.residual << " N, "
               << std::setprecision(4) << r.seconds << " s per static solve (" << r.symbolic_analyses
               << " symbolic, " << r.numeric_factorisations << " numeric CHOLMOD factorisations)\n"
               << std::setprecision(6);
-    result["solver"] = {{"name", o.solver}, {"iterations", r.iterations},
-                        {"residual_N", r.residual}, {"seconds", r.seconds}};
+    result["solver"] = {{"name", o.solver},
+                        {"iterations", r.iterations},
+                        {"residual_N", r.residual},
+                        {"seconds", r.seconds}};
   } else if (o.solver == "relaxation") {
     const msm::RelaxationResult r = msm::dynamic_relaxation(problem);
     x = r.x;
     std::cout << "dynamic relaxation: " << r.steps << " steps of " << r.dt << " s, residual "
               << r.residual << " N, " << r.seconds << " s (" << r.seconds / r.steps * 1e6
               << " µs per step)\n";
-    result["solver"] = {{"name", o.solver}, {"steps", r.steps}, {"dt", r.dt},
-                        {"residual_N", r.residual}, {"seconds", r.seconds}};
+    result["solver"] = {{"name", o.solver},
+                        {"steps", r.steps},
+                        {"dt", r.dt},
+                        {"residual_N", r.residual},
+                        {"seconds", r.seconds}};
   } else if (o.solver == "pbd") {
     // Seed 002: stretching (compliance 1/k of each structural spring), dihedral bending and,
     // optionally, the simplified angle constraint, solved with XPBD.
@@ -238,18 +244,22 @@ void run(MsmOptions& o) {
     x = r.x;
     std::cout << "  " << r.seconds << " s, " << r.seconds / r.steps * 1e6
               << " µs per step, largest stretch violation " << r.max_violation * 1e3 << " mm\n";
-    result["solver"] = {{"name", "pbd"}, {"steps", r.steps}, {"dt", po.dt},
-                        {"iterations", po.iterations}, {"seconds", r.seconds},
+    result["solver"] = {{"name", "pbd"},
+                        {"steps", r.steps},
+                        {"dt", po.dt},
+                        {"iterations", po.iterations},
+                        {"seconds", r.seconds},
                         {"seconds_per_step", r.seconds / r.steps},
-                        {"constraints", {{"stretch", counts_by_type[0]},
-                                         {"dihedral", counts_by_type[1]},
-                                         {"angle", counts_by_type[2]}}}};
+                        {"constraints",
+                         {{"stretch", counts_by_type[0]},
+                          {"dihedral", counts_by_type[1]},
+                          {"angle", counts_by_type[2]}}}};
   } else {
     msm::DynamicOptions d;
     d.integrator = integrator;
     const double critical = 2.0 / msm::max_frequency_bound(problem);
-    d.dt = o.dt > 0 ? o.dt
-                    : (integrator == msm::Integrator::implicit_euler ? 10.0 : 0.5) * critical;
+    d.dt =
+        o.dt > 0 ? o.dt : (integrator == msm::Integrator::implicit_euler ? 10.0 : 0.5) * critical;
     d.steps = o.steps;
     std::cout << msm::to_string(integrator) << ": " << d.steps << " steps of " << d.dt
               << " s (critical step bound 2/ω_max = " << critical << " s) ...\n";
@@ -257,9 +267,10 @@ void run(MsmOptions& o) {
     x = r.x;
     std::cout << "  " << r.seconds << " s, " << r.seconds / r.steps * 1e6
               << " µs per step, final energy " << r.energy << " J\n";
-    result["solver"] = {{"name", o.solver}, {"steps", r.steps}, {"dt", d.dt},
-                        {"critical_dt_bound", critical}, {"seconds", r.seconds},
-                        {"seconds_per_step", r.seconds / r.steps}, {"energy_J", r.energy}};
+    result["solver"] = {{"name", o.solver},     {"steps", r.steps},
+                        {"dt", d.dt},           {"critical_dt_bound", critical},
+                        {"seconds", r.seconds}, {"seconds_per_step", r.seconds / r.steps},
+                        {"energy_J", r.energy}};
   }
 
   // Displacement at the network node nearest the contact point, and the largest.
@@ -278,11 +289,11 @@ void run(MsmOptions& o) {
   const Vec3 inward = -patch.outward_normal;
   const double strain = model.max_strain(x);
   std::cout << "contact-point displacement: " << u.norm() * 1e3 << " mm (along the load "
-            << u.dot(inward) * 1e3 << " mm) at node " << nearest << ", "
-            << std::sqrt(best) * 1e3 << " mm from the contact point\n"
+            << u.dot(inward) * 1e3 << " mm) at node " << nearest << ", " << std::sqrt(best) * 1e3
+            << " mm from the contact point\n"
             << "largest nodal displacement " << max_u * 1e3 << " mm, largest spring strain "
-            << strain * 100 << " %" << (strain > 0.05 ? " (beyond 5 %: outside the linear regime)" : "")
-            << "\n";
+            << strain * 100 << " %"
+            << (strain > 0.05 ? " (beyond 5 %: outside the linear regime)" : "") << "\n";
   result["contact_displacement_mm"] = u.norm() * 1e3;
   result["contact_displacement_along_load_mm"] = u.dot(inward) * 1e3;
   result["max_displacement_mm"] = max_u * 1e3;
@@ -326,7 +337,8 @@ void add_msm_command(CLI::App& app) {
   cmd->add_option("--youngs-modulus", sp.youngs_modulus, "E, Pa")->capture_default_str();
   cmd->add_option("--poisson-ratio", sp.poisson_ratio, "ν (lloyd rule)")->capture_default_str();
   cmd->add_option("--uniform-k", sp.uniform_k, "k of the uniform rule, N/m")->capture_default_str();
-  cmd->add_option("--shear-factor", sp.shear_factor, "Factor on shear springs")->capture_default_str();
+  cmd->add_option("--shear-factor", sp.shear_factor, "Factor on shear springs")
+      ->capture_default_str();
   cmd->add_option("--bend-factor", sp.bend_factor, "Factor on bend springs")->capture_default_str();
   cmd->add_option("--two-ring-factor", sp.two_ring_factor, "Factor on two-ring springs")
       ->capture_default_str();
@@ -334,13 +346,14 @@ void add_msm_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--bilinear-threshold", sp.bilinear_threshold_strain,
                   "Threshold strain of the bilinear spring (default: none, Hooke)");
-  cmd->add_option("--mass", o->mass, "Mass rule: uniform, seed001, consistent")->capture_default_str();
+  cmd->add_option("--mass", o->mass, "Mass rule: uniform, seed001, consistent")
+      ->capture_default_str();
   cmd->add_option("--density", o->density, "kg/m³")->capture_default_str();
   cmd->add_option("--solver", o->solver,
                   "static, linear, relaxation, explicit-euler, symplectic-euler, verlet, "
                   "implicit-euler, pbd (XPBD constraints of seed 002, surface model)")
-      ->check(CLI::IsMember({"static", "linear", "relaxation", "explicit-euler",
-                             "symplectic-euler", "verlet", "implicit-euler", "pbd"}))
+      ->check(CLI::IsMember({"static", "linear", "relaxation", "explicit-euler", "symplectic-euler",
+                             "verlet", "implicit-euler", "pbd"}))
       ->capture_default_str();
   cmd->add_option("--dt", o->dt,
                   "Time step, s (default: 0.5 × the critical-step bound; implicit: 10 ×)");
