@@ -7,5 +7,7 @@ namespace vessel::cli {
 
 void add_mesh_command(CLI::App& app);
 void add_scene_command(CLI::App& app);
+/// `vesselverify msm`: run a mass-spring model on a vessel mesh under a contact load.
+void add_msm_command(CLI::App& app);
 
 }  // namespace vessel::cli

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   vessel::cli::add_mesh_command(app);
   vessel::cli::add_scene_command(app);
+  vessel::cli::add_msm_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

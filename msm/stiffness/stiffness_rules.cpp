@@ -1,0 +1,259 @@
+#include "msm/stiffness/stiffness_rules.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <map>
+
+#include "meshes/errors.hpp"
+
+namespace vessel::msm {
+
+StiffnessRule parse_stiffness_rule(const std::string& name) {
+  if (name == "seed000") return StiffnessRule::seed000;
+  if (name == "seed001") return StiffnessRule::seed001;
+  if (name == "van-gelder" || name == "van_gelder") return StiffnessRule::van_gelder;
+  if (name == "lloyd") return StiffnessRule::lloyd;
+  if (name == "uniform") return StiffnessRule::uniform;
+  throw InputError(
+      "stiffness rule: expected one of seed000, seed001, van-gelder, lloyd, uniform; "
+      "got '" +
+      name + "'");
+}
+
+std::string to_string(StiffnessRule rule) {
+  switch (rule) {
+    case StiffnessRule::seed000:
+      return "seed000";
+    case StiffnessRule::seed001:
+      return "seed001";
+    case StiffnessRule::van_gelder:
+      return "van-gelder";
+    case StiffnessRule::lloyd:
+      return "lloyd";
+    case StiffnessRule::uniform:
+      return "uniform";
+  }
+  return "unknown";
+}
+
+void validate(const StiffnessParams& p) {
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw InputError(what);
+  };
+  require(
+      std::isfinite(p.youngs_modulus) && p.youngs_modulus > 0,
+      "youngs_modulus E: expected a finite value > 0 Pa, got " + std::to_string(p.youngs_modulus));
+  require(p.poisson_ratio >= 0.0 && p.poisson_ratio <= 0.5,
+          "poisson_ratio ν: expected a value in [0, 0.5], got " + std::to_string(p.poisson_ratio));
+  require(std::isfinite(p.uniform_k) && p.uniform_k > 0,
+          "uniform_k: expected a finite value > 0 N/m, got " + std::to_string(p.uniform_k));
+  for (double f :
+       {p.structural_factor, p.shear_factor, p.bend_factor, p.two_ring_factor, p.volume_factor}) {
+    require(std::isfinite(f) && f >= 0,
+            "family factor: expected a finite value ≥ 0, got " + std::to_string(f));
+  }
+  require(
+      std::isfinite(p.bilinear_ratio) && p.bilinear_ratio > 0,
+      "bilinear_ratio k2/k1: expected a finite value > 0, got " + std::to_string(p.bilinear_ratio));
+  require(p.bilinear_threshold_strain > 0, "bilinear_threshold_strain: expected a value > 0, got " +
+                                               std::to_string(p.bilinear_threshold_strain));
+}
+
+double seed000_stiffness(double E, double area, double h0) {
+  return E * area / h0;  // seed 000 eq. (4.2): k = E·A/h0
+}
+
+double seed001_stiffness(double E, double volume_around_edge, double L) {
+  // seed 001 §2.2: k = E·V_T/L², V_T "the third of total volume of tetrahedrons".
+  return E * (volume_around_edge / 3.0) / (L * L);
+}
+
+double van_gelder_stiffness(double E, double measure_around_edge, double L) {
+  // Van Gelder (1998): k_c = E·Σ_e |T_e| / |c|² (|T_e| volume, or t × area in 2D).
+  return E * measure_around_edge / (L * L);
+}
+
+namespace {
+
+/// Block (a, b) of an isotropic P1 element's stiffness: m·[λ ga gbᵀ + μ gb gaᵀ + μ (ga·gb) P].
+void add_isotropic_blocks(Eigen::MatrixXd& K, const std::vector<Vec3>& grads, double measure,
+                          double lambda, double mu, const Eigen::Matrix3d& P) {
+  const int n = static_cast<int>(grads.size());
+  for (int a = 0; a < n; ++a) {
+    for (int b = 0; b < n; ++b) {
+      const Vec3& ga = grads[a];
+      const Vec3& gb = grads[b];
+      K.block<3, 3>(3 * a, 3 * b) +=
+          measure * (lambda * ga * gb.transpose() + mu * gb * ga.transpose() + mu * ga.dot(gb) * P);
+    }
+  }
+}
+
+/// Least-squares spring constants: Σ_f (g_eᵀ g_f)² k_f = g_eᵀ K g_e.
+template <int NE>
+std::array<double, NE> lsq_springs(const Eigen::MatrixXd& K, const std::vector<Vec3>& x,
+                                   const std::array<std::pair<int, int>, NE>& edges) {
+  const int n = static_cast<int>(x.size());
+  std::array<Eigen::VectorXd, NE> g;
+  for (int e = 0; e < NE; ++e) {
+    g[e] = Eigen::VectorXd::Zero(3 * n);
+    const auto [a, b] = edges[e];
+    const Vec3 d = (x[a] - x[b]).normalized();
+    g[e].template segment<3>(3 * a) = d;
+    g[e].template segment<3>(3 * b) = -d;
+  }
+  Eigen::Matrix<double, NE, NE> A;
+  Eigen::Matrix<double, NE, 1> rhs;
+  for (int e = 0; e < NE; ++e) {
+    rhs(e) = g[e].dot(K * g[e]);
+    for (int f = 0; f < NE; ++f) {
+      const double c = g[e].dot(g[f]);
+      A(e, f) = c * c;
+    }
+  }
+  const Eigen::Matrix<double, NE, 1> k = A.colPivHouseholderQr().solve(rhs);
+  std::array<double, NE> out{};
+  for (int e = 0; e < NE; ++e) out[e] = k(e);
+  return out;
+}
+
+constexpr std::array<std::pair<int, int>, 6> kTetEdges{
+    {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+constexpr std::array<std::pair<int, int>, 3> kTriEdges{{{0, 1}, {0, 2}, {1, 2}}};
+
+}  // namespace
+
+Eigen::MatrixXd fem_tet_stiffness(const std::array<Vec3, 4>& x, double E, double nu) {
+  Eigen::Matrix3d J;
+  J.col(0) = x[1] - x[0];
+  J.col(1) = x[2] - x[0];
+  J.col(2) = x[3] - x[0];
+  const double volume = std::abs(J.determinant()) / 6.0;
+  const Eigen::Matrix3d Jinv = J.inverse();
+  std::vector<Vec3> grads(4);
+  for (int i = 0; i < 3; ++i) grads[i + 1] = Jinv.row(i).transpose();
+  grads[0] = -(grads[1] + grads[2] + grads[3]);
+  const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+  const double mu = E / (2 * (1 + nu));
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(12, 12);
+  add_isotropic_blocks(K, grads, volume, lambda, mu, Eigen::Matrix3d::Identity());
+  return K;
+}
+
+Eigen::MatrixXd fem_triangle_stiffness(const std::array<Vec3, 3>& x, double E, double nu,
+                                       double t) {
+  const Vec3 c = (x[1] - x[0]).cross(x[2] - x[0]);
+  const double two_area = c.norm();
+  const Vec3 n = c / two_area;
+  std::vector<Vec3> grads(3);
+  for (int a = 0; a < 3; ++a) {
+    // ∇N_a = n × (x_c − x_b) / (2A), (a, b, c) counter-clockwise about n.
+    grads[a] = n.cross(x[(a + 2) % 3] - x[(a + 1) % 3]) / two_area;
+  }
+  // Plane stress: λ* = Eν/(1 − ν²), μ = E/(2(1 + ν)).
+  const double lambda = E * nu / (1 - nu * nu);
+  const double mu = E / (2 * (1 + nu));
+  const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - n * n.transpose();
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(9, 9);
+  add_isotropic_blocks(K, grads, t * 0.5 * two_area, lambda, mu, P);
+  return K;
+}
+
+std::array<double, 6> lloyd_tet_stiffness(const std::array<Vec3, 4>& x, double E, double nu) {
+  return lsq_springs<6>(fem_tet_stiffness(x, E, nu), {x.begin(), x.end()}, kTetEdges);
+}
+
+std::array<double, 3> lloyd_triangle_stiffness(const std::array<Vec3, 3>& x, double E, double nu,
+                                               double t) {
+  return lsq_springs<3>(fem_triangle_stiffness(x, E, nu, t), {x.begin(), x.end()}, kTriEdges);
+}
+
+void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessParams& p) {
+  validate(p);
+  const double E = p.youngs_modulus;
+  const bool volume = !net.tets.empty();
+  const double t = net.thickness;
+  if (!volume && rule != StiffnessRule::uniform && !(t > 0)) {
+    throw InputError("assign_stiffness: a surface network needs a wall thickness t > 0");
+  }
+  using Edge = std::pair<int, int>;
+  auto key = [](int a, int b) { return a < b ? Edge{a, b} : Edge{b, a}; };
+  // Element measure around each edge (Σ V, or t·Σ A) and the lloyd sums.
+  std::map<Edge, double> measure;
+  std::map<Edge, double> lloyd;
+  if (volume) {
+    for (const Tet& tet : net.tets) {
+      std::array<Vec3, 4> x{net.nodes[tet[0]], net.nodes[tet[1]], net.nodes[tet[2]],
+                            net.nodes[tet[3]]};
+      const double V = std::abs(signed_volume(x[0], x[1], x[2], x[3]));
+      std::array<double, 6> kl{};
+      if (rule == StiffnessRule::lloyd) kl = lloyd_tet_stiffness(x, E, p.poisson_ratio);
+      for (int e = 0; e < 6; ++e) {
+        const Edge k = key(tet[kTetEdges[e].first], tet[kTetEdges[e].second]);
+        measure[k] += V;
+        lloyd[k] += kl[e];
+      }
+    }
+  } else {
+    for (const Triangle& tri : net.triangles) {
+      std::array<Vec3, 3> x{net.nodes[tri[0]], net.nodes[tri[1]], net.nodes[tri[2]]};
+      const double A = triangle_area(x[0], x[1], x[2]);
+      std::array<double, 3> kl{};
+      if (rule == StiffnessRule::lloyd) kl = lloyd_triangle_stiffness(x, E, p.poisson_ratio, t);
+      for (int e = 0; e < 3; ++e) {
+        const Edge k = key(tri[kTriEdges[e].first], tri[kTriEdges[e].second]);
+        measure[k] += t * A;
+        lloyd[k] += kl[e];
+      }
+    }
+  }
+  const double k2_ratio = p.bilinear_ratio;
+  for (Spring& s : net.springs) {
+    const double L = s.rest_length;
+    const auto it = measure.find(key(s.a, s.b));
+    const bool is_edge = it != measure.end();
+    // Surrogate measure of a non-edge spring: one equilateral triangle on it (see header).
+    const double m = is_edge ? it->second : t * std::sqrt(3.0) / 4.0 * L * L;
+    double k = 0.0;
+    switch (rule) {
+      case StiffnessRule::seed000:
+        k = seed000_stiffness(E, volume ? L * L : t * L, L);
+        break;
+      case StiffnessRule::seed001:
+        k = seed001_stiffness(E, m, L);
+        break;
+      case StiffnessRule::van_gelder:
+        k = van_gelder_stiffness(E, m, L);
+        break;
+      case StiffnessRule::lloyd:
+        k = is_edge ? lloyd.at(key(s.a, s.b)) : van_gelder_stiffness(E, m, L);
+        break;
+      case StiffnessRule::uniform:
+        k = p.uniform_k;
+        break;
+    }
+    double factor = 1.0;
+    switch (s.family) {
+      case SpringFamily::structural:
+        factor = p.structural_factor;
+        break;
+      case SpringFamily::shear:
+        factor = p.shear_factor;
+        break;
+      case SpringFamily::bend:
+        factor = p.bend_factor;
+        break;
+      case SpringFamily::two_ring:
+        factor = p.two_ring_factor;
+        break;
+      case SpringFamily::volume:
+        factor = p.volume_factor;
+        break;
+    }
+    s.law.k1 = factor * k;
+    s.law.k2 = k2_ratio * s.law.k1;
+    s.law.threshold = p.bilinear_threshold_strain * L;  // infinite → Hooke
+  }
+}
+
+}  // namespace vessel::msm

@@ -1,0 +1,79 @@
+#pragma once
+/// Stiffness rules: named functions from (E, ν, geometry) to spring constants. Each rule is
+/// documented with its source; `assign_stiffness` applies one to a whole network.
+/// Units: E in Pa, lengths in m, areas m², volumes m³, stiffness N/m.
+#include <array>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "msm/topology/springs.hpp"
+
+namespace vessel::msm {
+
+enum class StiffnessRule {
+  seed000,     ///< k = E·A/h0 (seed 000 eq. 4.2)
+  seed001,     ///< k = E·V_T/L², V_T one third of the volume around the edge (seed 001 §2.2)
+  van_gelder,  ///< k = E·Σ V_e/L² (3D) or E·t·Σ A_e/L² (2D), Van Gelder (1998)
+  lloyd,       ///< least-squares match of the element's FEM stiffness, Lloyd et al. (2007)
+  uniform,     ///< one k for every spring (comparison; seed 000 quotes k = 41.106)
+};
+StiffnessRule parse_stiffness_rule(const std::string& name);
+std::string to_string(StiffnessRule rule);
+
+/// Material and per-family settings for assign_stiffness.
+struct StiffnessParams {
+  double youngs_modulus = 14.24e3;  ///< E, Pa (seed 000 §IV: 14.24 kPa)
+  double poisson_ratio = 0.25;      ///< ν, used by the lloyd rule
+  double uniform_k = 41.106;        ///< N/m, the uniform rule (seed 000 §IV: k = 41.106)
+  /// Multipliers per family (surface springs: structural, shear, bend, two-ring; volume).
+  double structural_factor = 1.0;
+  double shear_factor = 1.0;
+  double bend_factor = 1.0;
+  double two_ring_factor = 1.0;
+  double volume_factor = 1.0;
+  /// Bilinear law (seed 001 eq. 1): k2 = bilinear_ratio·k1 beyond `bilinear_threshold` strain
+  /// (elongation/rest length). Infinite threshold: Hooke springs.
+  double bilinear_ratio = 1.0;
+  double bilinear_threshold_strain = std::numeric_limits<double>::infinity();
+};
+/// Throws InputError naming the parameter: E ≤ 0 or not finite, ν outside [0, 0.5], negative
+/// factor, uniform_k ≤ 0, bilinear ratio ≤ 0 or threshold ≤ 0.
+void validate(const StiffnessParams& params);
+
+/// seed 000 eq. (4.2): k = E·A/h0 (A the loaded cross-section, h0 the rest height).
+double seed000_stiffness(double E, double area, double h0);
+/// seed 001 §2.2: k = E·V_T/L² with V_T = (Σ volumes of the tets containing the edge)/3.
+double seed001_stiffness(double E, double volume_around_edge, double L);
+/// Van Gelder (1998), "Approximate simulation of elastic membranes by triangulated spring
+/// meshes": k = E·Σ_e V_e/|c|² for tetrahedra; for triangles k = E·t·Σ_e A_e/|c|² (the measure
+/// argument is then t·Σ A_e).
+double van_gelder_stiffness(double E, double measure_around_edge, double L);
+
+/// Lloyd, Székely & Harders (2007), "Identification of spring parameters for deformable object
+/// simulation" (IEEE TVCG 13(5)): spring constants of one element's edges chosen so that the
+/// spring network's linear stiffness matrix Σ_e k_e g_e g_eᵀ matches the element's linear FEM
+/// stiffness matrix K (isotropic, E and ν; triangles in plane stress with thickness t), here in
+/// the least-squares (Frobenius) sense: Σ_f (g_eᵀg_f)² k_f = g_eᵀ K g_e. For the equilateral
+/// triangle at ν = 1/3 the match is exact (k = √3/4·E·t); for the regular tetrahedron at ν = 1/4
+/// it gives Lloyd et al.'s k = (2√2/25)·E·l, not an exact match (six springs cannot be).
+/// Returns the k of the 6 edges (0-1, 0-2, 0-3, 1-2, 1-3, 2-3) of a tetrahedron, N/m.
+std::array<double, 6> lloyd_tet_stiffness(const std::array<Vec3, 4>& x, double E, double nu);
+/// The k of the 3 edges (0-1, 0-2, 1-2) of a triangle of thickness t, N/m.
+std::array<double, 3> lloyd_triangle_stiffness(const std::array<Vec3, 3>& x, double E, double nu,
+                                               double t);
+/// Linear FEM stiffness matrix of a P1 tetrahedron (12×12) and of a plane-stress triangle of
+/// thickness t (9×9, in-plane), N/m. Used by the lloyd rule and by tests.
+Eigen::MatrixXd fem_tet_stiffness(const std::array<Vec3, 4>& x, double E, double nu);
+Eigen::MatrixXd fem_triangle_stiffness(const std::array<Vec3, 3>& x, double E, double nu, double t);
+
+/// Sets law.k1 (and the bilinear k2, threshold) of every spring of the network by the rule and
+/// the family factors. Volume networks use their tets; surface networks their triangles with the
+/// network's thickness t. Springs that are not an element edge (bend, shear, two-ring) have no
+/// element measure of their own: the seed000 rule gives them k = E·t·h0/h0 = E·t (A = t·h0, the
+/// square patch a surface spring spans; k = E·h0 for volume springs, A = h0²); seed001, van_gelder
+/// and lloyd use the measure of one equilateral triangle on the spring, t·(√3/4)·L² (seed001
+/// takes a third of it), i.e. k = (√3/4)·E·t for van_gelder and lloyd.
+void assign_stiffness(SpringNetwork& network, StiffnessRule rule, const StiffnessParams& params);
+
+}  // namespace vessel::msm

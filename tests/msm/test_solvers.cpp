@@ -1,0 +1,211 @@
+// Static Newton, the linearised model, dynamic relaxation and the integrators on problems with
+// closed-form answers: Hooke's law on a spring and a chain (seed 000 Fig. 5: 0–140 mN), and the
+// energy of an undamped linear oscillator.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "meshes/errors.hpp"
+#include "msm/model/spring_model.hpp"
+#include "msm/solvers/integrators.hpp"
+#include "msm/solvers/static_solver.hpp"
+
+using namespace vessel;
+using namespace vessel::msm;
+
+namespace {
+
+/// A chain of springs along x (node 0 fixed; y and z of every node fixed: Hooke's 1D setting),
+/// stiffness k[i] between nodes i and i+1, rest length 1 mm, mass m per node, force F on the end.
+struct Chain {
+  SpringNetwork net;
+  std::unique_ptr<SpringModel> model;
+  Problem problem;
+};
+
+Chain make_chain(const std::vector<double>& k, double F, double mass = 1e-4) {
+  Chain c;
+  const int n = static_cast<int>(k.size()) + 1;
+  for (int i = 0; i < n; ++i) c.net.nodes.push_back(Vec3(1e-3 * i, 0, 0));
+  for (int i = 0; i + 1 < n; ++i) {
+    Spring s;
+    s.a = i;
+    s.b = i + 1;
+    s.rest_length = 1e-3;
+    s.law = {k[i], k[i]};
+    c.net.springs.push_back(s);
+  }
+  c.model = std::make_unique<SpringModel>(c.net);
+  Problem& p = c.problem;
+  p.form = c.model.get();
+  p.rest = flatten(c.net.nodes);
+  p.mass = Eigen::VectorXd::Constant(3 * n, mass);
+  p.external_force = Eigen::VectorXd::Zero(3 * n);
+  p.external_force[3 * (n - 1)] = F;
+  p.fixed.assign(3 * n, 0);
+  for (int i = 0; i < n; ++i) p.fixed[3 * i + 1] = p.fixed[3 * i + 2] = 1;
+  p.fixed[0] = 1;
+  return c;
+}
+
+double end_displacement(const Problem& p, const Eigen::VectorXd& x) {
+  const Eigen::Index e = x.size() - 3;
+  return x[e] - p.rest[e];
+}
+
+}  // namespace
+
+TEST(StaticSolver, OneSpringFollowsHookesLawFrom0To140mN) {
+  // Seed 000 Fig. 5: k = 41.106 N/m, F = 0 … 140 mN → δ = F/k (3.41 mm at 140 mN).
+  for (double F = 0.0; F <= 0.140 + 1e-12; F += 0.010) {
+    Chain c = make_chain({41.106}, F);
+    const StaticResult r = solve_static(c.problem);
+    EXPECT_NEAR(end_displacement(c.problem, r.x), F / 41.106, 1e-12) << F;
+    const StaticResult l = solve_linear(c.problem);
+    EXPECT_NEAR(end_displacement(c.problem, l.x), F / 41.106, 1e-12) << F;
+  }
+}
+
+TEST(StaticSolver, ChainIsSpringsInSeriesAndReusesTheSymbolicFactorisation) {
+  const std::vector<double> k{10.0, 41.106, 25.0, 80.0, 15.0};
+  double compliance = 0.0;
+  for (double ki : k) compliance += 1.0 / ki;
+  for (double F : {0.0, 0.035, 0.070, 0.140}) {
+    Chain c = make_chain(k, F);
+    const StaticResult r = solve_static(c.problem);
+    EXPECT_NEAR(end_displacement(c.problem, r.x), F * compliance, 1e-12);
+    // Every spring carries F.
+    for (std::size_t i = 0; i < k.size(); ++i) {
+      const double L = r.x[3 * (i + 1)] - r.x[3 * i];
+      EXPECT_NEAR(k[i] * (L - 1e-3), F, 1e-10);
+    }
+    EXPECT_LE(r.symbolic_analyses, 1);
+  }
+}
+
+TEST(StaticSolver, BilinearChainBeyondTheThreshold) {
+  // One bilinear spring (seed 001 eq. 1): k1 = 20, k2 = 60 N/m, Δx_c = 1 mm. F = 0.05 N:
+  // F = k1 Δx_c + k2 (δ − Δx_c) → δ = Δx_c + (F − k1 Δx_c)/k2.
+  Chain c = make_chain({20.0}, 0.05);
+  c.net.springs[0].law = {20.0, 60.0, 1e-3};
+  c.model = std::make_unique<SpringModel>(c.net);
+  c.problem.form = c.model.get();
+  const StaticResult r = solve_static(c.problem);
+  EXPECT_NEAR(end_displacement(c.problem, r.x), 1e-3 + (0.05 - 0.02) / 60.0, 1e-12);
+}
+
+TEST(DynamicRelaxation, ReachesHookesLawOnTheChain) {
+  const std::vector<double> k{10.0, 41.106, 25.0};
+  double compliance = 0.0;
+  for (double ki : k) compliance += 1.0 / ki;
+  for (double F : {0.010, 0.070, 0.140}) {
+    Chain c = make_chain(k, F);
+    RelaxationOptions o;
+    o.tolerance = 1e-10;
+    const RelaxationResult r = dynamic_relaxation(c.problem, o);
+    EXPECT_NEAR(end_displacement(c.problem, r.x), F * compliance, 1e-8 * F * compliance);
+    EXPECT_GT(r.steps, 1);
+  }
+}
+
+namespace {
+/// Undamped oscillator: one spring k, free node mass m, released from 0.01 mm stretch.
+struct EnergyRun {
+  std::vector<double> energy;
+};
+EnergyRun run_oscillator(Integrator integrator, double dt_over_critical, int steps) {
+  const double k = 41.106, m = 1e-3;
+  Chain c = make_chain({k}, 0.0, m);
+  DynamicOptions o;
+  o.integrator = integrator;
+  o.dt = dt_over_critical * 2.0 / std::sqrt(k / m);
+  o.steps = steps;
+  EnergyRun run;
+  o.on_step = [&](int, const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
+    run.energy.push_back(total_energy(c.problem, x, v));
+  };
+  Eigen::VectorXd x0 = c.problem.rest;
+  x0[3] += 1e-5;  // small enough that the spring never passes through zero length
+  run.energy.push_back(total_energy(c.problem, x0, Eigen::VectorXd::Zero(x0.size())));
+  (void)integrate(c.problem, o, x0);
+  return run;
+}
+}  // namespace
+
+TEST(Integrators, UndampedEnergyBoundedForSymplecticAndVerletGrowingForExplicitEuler) {
+  const int steps = 2000;
+  const double ratio = 0.2;  // dt = 0.2 × critical step 2/ω, so ωh = 0.4
+  const auto sym = run_oscillator(Integrator::symplectic_euler, ratio, steps);
+  const auto ver = run_oscillator(Integrator::verlet, ratio, steps);
+  const auto exp = run_oscillator(Integrator::explicit_euler, ratio, 40);
+  const auto imp = run_oscillator(Integrator::implicit_euler, ratio, steps);
+  const double E0 = sym.energy.front();
+  auto max_dev = [&](const EnergyRun& r) {
+    double d = 0;
+    for (double e : r.energy) d = std::max(d, std::abs(e - E0) / E0);
+    return d;
+  };
+  std::printf(
+      "undamped oscillator, dt = %.2f x critical: max |E-E0|/E0 symplectic Euler %.4f "
+      "(%d steps), Verlet %.4f; explicit Euler E/E0 after 40 steps %.1f; implicit Euler "
+      "E/E0 after %d steps %.3g\n",
+      ratio, max_dev(sym), steps, max_dev(ver), exp.energy.back() / E0, steps,
+      imp.energy.back() / E0);
+  // Symplectic Euler conserves a modified energy: the true one oscillates by O(ωh) (25 % here)
+  // here and does not drift; Verlet by O((ωh)²) = ±4 %.
+  EXPECT_LT(max_dev(sym), 0.3);
+  EXPECT_LT(max_dev(ver), 0.05);
+  EXPECT_NEAR(sym.energy.back() / E0, 1.0, 0.3);
+  // Explicit Euler (seed 000 eq. 3.7) on a linear oscillator multiplies the energy by exactly
+  // 1 + (ωh)² each step.
+  const double wh = 2.0 * ratio;
+  EXPECT_NEAR(exp.energy.back() / E0, std::pow(1 + wh * wh, 40), 1e-8 * std::pow(1 + wh * wh, 40));
+  EXPECT_GT(exp.energy.back() / E0, 300.0);
+  // Run on, it trips the divergence detection (energy beyond 1000 × its start).
+  EXPECT_THROW((void)run_oscillator(Integrator::explicit_euler, ratio, 100), DivergenceError);
+  // Implicit Euler dissipates: monotone decrease.
+  for (std::size_t i = 1; i < imp.energy.size(); ++i)
+    EXPECT_LE(imp.energy[i], imp.energy[i - 1] + 1e-15 * E0);
+  EXPECT_LT(imp.energy.back() / E0, 0.01);
+}
+
+TEST(Integrators, BlowUpStopsWithStepNodeAndEnergy) {
+  const double k = 41.106, m = 1e-3;
+  Chain c = make_chain({k}, 0.0, m);
+  DynamicOptions o;
+  o.integrator = Integrator::symplectic_euler;
+  o.dt = 1.2 * 2.0 / std::sqrt(k / m);  // beyond the critical step
+  o.steps = 10000;
+  Eigen::VectorXd x0 = c.problem.rest;
+  x0[3] += 1e-4;
+  try {
+    (void)integrate(c.problem, o, x0);
+    FAIL() << "expected DivergenceError";
+  } catch (const DivergenceError& e) {
+    EXPECT_EQ(e.node, 1);
+    EXPECT_GT(e.step, 1);
+    EXPECT_LT(e.step, 10000);
+    EXPECT_NE(std::string(e.what()).find("step"), std::string::npos);
+  }
+  // The bound on ω is an upper bound: at 0.99 × 2/bound symplectic Euler is stable.
+  const double w = max_frequency_bound(c.problem);
+  EXPECT_GE(w, std::sqrt(k / m) * (1 - 1e-12));
+  o.dt = 0.99 * 2.0 / w;
+  EXPECT_NO_THROW((void)integrate(c.problem, o, x0));
+  o.dt = 0.0;
+  EXPECT_THROW((void)integrate(c.problem, o, x0), InputError);
+}
+
+TEST(Integrators, DampedImplicitEulerSettlesOnTheStaticAnswer) {
+  Chain c = make_chain({41.106, 20.0}, 0.1, 1e-4);
+  c.net.springs[0].damping = 0.05;                       // axial damping, seed 000 eq. (3.4)
+  c.model = std::make_unique<SpringModel>(c.net, 0.01);  // point damping, eq. (3.3)
+  c.problem.form = c.model.get();
+  DynamicOptions o;
+  o.integrator = Integrator::implicit_euler;
+  o.dt = 1e-3;
+  o.steps = 3000;
+  const DynamicResult r = integrate(c.problem, o);
+  EXPECT_NEAR(end_displacement(c.problem, r.x), 0.1 * (1 / 41.106 + 1 / 20.0), 1e-9);
+}
