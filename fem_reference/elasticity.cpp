@@ -414,12 +414,17 @@ void ElasticitySolver::Impl::local_system(const dl::DoFHandler<kDim>::active_cel
   fev.reinit(cell);
   std::vector<dl::SymmetricTensor<2, kDim>> eps(n);
   std::vector<double> div(n), psi(n);
-  const dl::Tensor<1, kDim> body{{problem.material.density * problem.gravity.x(),
-                                  problem.material.density * problem.gravity.y(),
-                                  problem.material.density * problem.gravity.z()}};
+  const Vec3 rho_g = problem.material.density * problem.gravity;
+  dl::Tensor<1, kDim> body;
   const double inv_lambda = mixed ? (std::isinf(lambda) ? 0.0 : 1.0 / lambda) : 0.0;
   for (unsigned q = 0; q < fev.n_quadrature_points; ++q) {
     const double jxw = fev.JxW(q);
+    Vec3 b = rho_g;
+    if (problem.body_force) {
+      const auto& x = fev.quadrature_point(q);
+      b += problem.body_force(Vec3(x[0], x[1], x[2]));
+    }
+    for (unsigned c = 0; c < 3; ++c) body[c] = b[c];
     for (unsigned i = 0; i < n; ++i) {
       eps[i] = fev[disp].symmetric_gradient(i, q);
       div[i] = fev[disp].divergence(i, q);
@@ -489,7 +494,8 @@ dl::Quadrature<kDim - 1> face_quadrature(int degree) {
 void ElasticitySolver::Impl::assemble() {
   const int q_degree = mixed ? 2 : degree;
   dl::FEValues<kDim> fev(*mapping, *fe, cell_quadrature(q_degree),
-                         dl::update_values | dl::update_gradients | dl::update_JxW_values);
+                         dl::update_values | dl::update_gradients | dl::update_JxW_values |
+                             dl::update_quadrature_points);
   dl::FEFaceValues<kDim> fefv(*mapping, *fe, face_quadrature(q_degree),
                               dl::update_values | dl::update_normal_vectors | dl::update_JxW_values);
   const unsigned n = fe->n_dofs_per_cell();
@@ -564,7 +570,8 @@ void ElasticitySolver::Impl::postprocess() {
   const dl::FEValuesExtractors::Vector disp(0);
   const dl::FEValuesExtractors::Scalar pres(kDim);
   dl::FEValues<kDim> fev(*mapping, *fe, cell_quadrature(q_degree),
-                         dl::update_values | dl::update_gradients | dl::update_JxW_values);
+                         dl::update_values | dl::update_gradients | dl::update_JxW_values |
+                             dl::update_quadrature_points);
   dl::FEValues<kDim> centre(*mapping, *fe, dl::Quadrature<kDim>(dl::Point<kDim>(0.25, 0.25, 0.25)),
                             dl::update_values | dl::update_gradients);
   dl::FEFaceValues<kDim> fefv(*mapping, *fe, face_quadrature(q_degree),
@@ -652,7 +659,7 @@ ElasticitySolver::ElasticitySolver(const TetMesh& mesh, ElasticityProblem proble
   const auto& o = im.problem.options;
   const double nu = im.problem.material.poisson_ratio;
   im.mixed = o.formulation == Formulation::mixed ||
-             (o.formulation == Formulation::automatic && nu >= o.mixed_threshold);
+             (o.formulation == Formulation::automatic && (nu >= o.mixed_threshold || nu == 0.5));
   im.degree = im.mixed ? 2 : o.degree;
   im.lambda = im.problem.material.lambda();
   im.mu = im.problem.material.mu();

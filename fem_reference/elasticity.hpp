@@ -58,7 +58,7 @@ struct PressureLoad {
 struct SolverOptions {
   int degree = 1;  ///< displacement element degree, 1 or 2 (the mixed element is always P2–P1)
   Formulation formulation = Formulation::automatic;
-  double mixed_threshold = 0.45;  ///< automatic: mixed when ν ≥ this
+  double mixed_threshold = 0.45;  ///< automatic: mixed when ν ≥ this (and always at ν = 0.5)
   LinearSolver solver = LinearSolver::automatic;
   std::size_t direct_max_dofs = 60000;  ///< automatic: direct at or below this many DoFs
   double cg_relative_tolerance = 1e-10;  ///< ‖r‖ ≤ tol·‖b‖ for CG
@@ -72,6 +72,8 @@ struct ElasticityProblem {
   std::vector<PressureLoad> pressures;
   std::vector<TractionPatch> patches;  ///< from vessel::contact_patch (shared with mass-spring)
   Vec3 gravity = Vec3::Zero();         ///< m/s²; body force ρg
+  /// Optional extra body force density b(x), N/m³ (manufactured solutions); added to ρg.
+  std::function<Vec3(const Vec3&)> body_force;
   SolverOptions options;
 };
 

@@ -14,10 +14,10 @@ inline VesselParams short_tube(int level) {
   return p;
 }
 
-/// The mesh of short_tube(level), generated on first use.
+/// The mesh of short_tube(level), level 0..3, generated on first use.
 inline const TetMesh& short_tube_mesh(int level) {
-  static TetMesh meshes[3];
-  static bool made[3] = {false, false, false};
+  static TetMesh meshes[4];
+  static bool made[4] = {false, false, false, false};
   if (!made[level]) {
     meshes[level] = generate_vessel_mesh(short_tube(level));
     made[level] = true;
