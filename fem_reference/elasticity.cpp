@@ -97,8 +97,8 @@ void ensure_mpi_initialized() {
 /// three are u; any further, the mixed element's pressure, are zero).
 class VectorFunction : public dl::Function<kDim> {
  public:
-  VectorFunction(std::function<Vec3(const Vec3&)> f, unsigned n_components)
-      : dl::Function<kDim>(n_components), f_(std::move(f)) {}
+  VectorFunction(std::function<Vec3(const Vec3&)> f, unsigned components)
+      : dl::Function<kDim>(components), f_(std::move(f)) {}
   double value(const dl::Point<kDim>& p, unsigned component) const override {
     if (component >= 3 || !f_) return 0.0;
     return f_(Vec3(p[0], p[1], p[2]))[component];
@@ -639,13 +639,13 @@ void ElasticitySolver::Impl::postprocess() {
     if (std::find(seen.begin(), seen.end(), bc.group) != seen.end()) continue;
     seen.push_back(bc.group);
     const auto tag = static_cast<dl::types::boundary_id>(mesh.require_group(bc.group, 2, "FEM").tag);
-    std::vector<bool> on_group(dof.n_dofs(), false);
     std::vector<bool> mask(n_components, false);
     mask[0] = mask[1] = mask[2] = true;
-    dl::DoFTools::extract_boundary_dofs(dof, dl::ComponentMask(mask), on_group, {tag});
+    const dl::IndexSet on_group =
+        dl::DoFTools::extract_boundary_dofs(dof, dl::ComponentMask(mask), {tag});
     GroupReaction r{bc.group, Vec3::Zero()};
-    for (std::size_t d = 0; d < on_group.size(); ++d) {
-      if (on_group[d] && constraints.is_constrained(d)) r.force[dof_component[d]] += residual(d);
+    for (const auto d : on_group) {
+      if (constraints.is_constrained(d)) r.force[dof_component[d]] += residual(d);
     }
     result.reactions.push_back(r);
   }

@@ -40,6 +40,15 @@ struct DirichletCondition {
   Kind kind = Kind::clamped;
   int component = 2;                                ///< roller: 0, 1, 2 for x, y, z
   std::function<Vec3(const Vec3&)> value;           ///< clamped: prescribed u(x), m
+
+  /// All components held: u = value(x) on the group (u = 0 without a value).
+  static DirichletCondition clamped(std::string group, std::function<Vec3(const Vec3&)> value = {}) {
+    return {std::move(group), Kind::clamped, 0, std::move(value)};
+  }
+  /// u[component] = 0 on the group, the other components free.
+  static DirichletCondition roller(std::string group, int component) {
+    return {std::move(group), Kind::roller, component, {}};
+  }
 };
 
 /// u[component] = 0 at the mesh node at `point` (within 1e-9 of the mesh size; InputError

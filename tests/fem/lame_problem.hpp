@@ -14,9 +14,8 @@ inline fem::ElasticityProblem lame_problem(double nu, int degree, fem::Formulati
   p.options.degree = degree;
   p.options.formulation = f;
   p.options.solver = fem::LinearSolver::direct;
-  using Kind = fem::DirichletCondition::Kind;
-  p.dirichlet = {{.group = "inlet", .kind = Kind::roller, .component = 2},
-                 {.group = "outlet", .kind = Kind::roller, .component = 2}};
+  p.dirichlet = {fem::DirichletCondition::roller("inlet", 2),
+                 fem::DirichletCondition::roller("outlet", 2)};
   p.point_constraints = fem::tube_in_plane_pins(3e-3, 0.0);
   p.pressures = {{"inner_wall", kLamePressure}};
   return p;

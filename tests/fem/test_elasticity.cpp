@@ -13,7 +13,6 @@
 
 using namespace vessel;
 using namespace vessel::fem;
-using Kind = DirichletCondition::Kind;
 
 namespace {
 
@@ -34,7 +33,7 @@ ElasticityProblem all_boundary_prescribed(std::function<Vec3(const Vec3&)> g, in
   ElasticityProblem p;
   p.options.degree = degree;
   for (const char* grp : {"inlet", "outlet", "inner_wall", "outer_wall"}) {
-    p.dirichlet.push_back({.group = grp, .kind = Kind::clamped, .component = 0, .value = g});
+    p.dirichlet.push_back(fem::DirichletCondition::clamped(grp, g));
   }
   return p;
 }
@@ -64,7 +63,7 @@ TEST(ElasticityInput, RejectsBadMaterialAndGroupsWithClearMessages) {
   p.options.degree = 3;
   EXPECT_NE(input_error(p).find("degree"), std::string::npos);
   p = {};
-  p.dirichlet = {{.group = "no_such_group"}};
+  p.dirichlet = {fem::DirichletCondition::clamped("no_such_group")};
   EXPECT_NE(input_error(p).find("no_such_group"), std::string::npos);
   p = {};
   p.pressures = {{"lumen", 1.0}};
@@ -78,7 +77,7 @@ TEST(ElasticityRigidBody, NoLoadGivesNoDisplacement) {
   for (int degree : {1, 2}) {
     ElasticityProblem p;
     p.options.degree = degree;
-    p.dirichlet = {{.group = "inlet"}};
+    p.dirichlet = {fem::DirichletCondition::clamped("inlet")};
     const auto r = solve_elasticity(mesh0(), p);
     EXPECT_EQ(max_norm(r.nodal_displacement), 0.0);
     EXPECT_EQ(r.strain_energy, 0.0);
@@ -156,7 +155,7 @@ TEST(ElasticityEquilibrium, ReactionsBalanceAContactPatch) {
   for (int degree : {1, 2}) {
     ElasticityProblem p;
     p.options.degree = degree;
-    p.dirichlet = {{.group = "inlet"}, {.group = "outlet"}};
+    p.dirichlet = {fem::DirichletCondition::clamped("inlet"), fem::DirichletCondition::clamped("outlet")};
     p.patches = {patch};
     const auto r = solve_elasticity(m, p);
     // The integrated traction equals the patch's total force −F n̂ (exact quadrature of a
@@ -177,7 +176,7 @@ TEST(ElasticityEquilibrium, ReactionBalancesGravity) {
   const auto& m = mesh0();
   ElasticityProblem p;
   p.options.degree = 1;
-  p.dirichlet = {{.group = "inlet"}};
+  p.dirichlet = {fem::DirichletCondition::clamped("inlet")};
   p.gravity = Vec3(0, -9.81, 0);
   const auto r = solve_elasticity(m, p);
   const Vec3 weight = p.material.density * p.gravity * mesh_volume(m);  // ρ g V
@@ -189,7 +188,7 @@ TEST(ElasticityPointEvaluation, MatchesNodalValuesAndRefusesOutsidePoints) {
   const auto& m = mesh0();
   ElasticityProblem p;
   p.options.degree = 2;
-  p.dirichlet = {{.group = "inlet"}};
+  p.dirichlet = {fem::DirichletCondition::clamped("inlet")};
   p.pressures = {{"inner_wall", 5.0}};
   ElasticitySolver s(m, p);
   const auto& r = s.solve();

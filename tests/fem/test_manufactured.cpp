@@ -41,7 +41,7 @@ double error_on_level(int degree, int level, double nu) {
   const double lambda = p.material.lambda(), mu = p.material.mu();
   p.body_force = [=](const Vec3& x) { return body_force(x, lambda, mu); };
   for (const char* g : {"inlet", "outlet", "inner_wall", "outer_wall"}) {
-    p.dirichlet.push_back({.group = g, .kind = DirichletCondition::Kind::clamped, .value = u_exact});
+    p.dirichlet.push_back(fem::DirichletCondition::clamped(g, u_exact));
   }
   ElasticitySolver s(test::short_tube_mesh(level), p);
   const auto& r = s.solve();

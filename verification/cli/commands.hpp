@@ -6,5 +6,7 @@
 namespace vessel::cli {
 
 void add_mesh_command(CLI::App& app);
+/// `vesselverify fem`: the deal.II linear-elastic reference (fem_command.cpp).
+void add_fem_command(CLI::App& app);
 
 }  // namespace vessel::cli

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
       "Run 'vesselverify <command> --help' for a command's options."};
   app.require_subcommand(1);
   vessel::cli::add_mesh_command(app);
+  vessel::cli::add_fem_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
