@@ -9,5 +9,7 @@ void add_mesh_command(CLI::App& app);
 void add_scene_command(CLI::App& app);
 /// `vesselverify msm`: run a mass-spring model on a vessel mesh under a contact load.
 void add_msm_command(CLI::App& app);
+/// `vesselverify fem`: the deal.II linear-elastic reference (fem_command.cpp).
+void add_fem_command(CLI::App& app);
 
 }  // namespace vessel::cli

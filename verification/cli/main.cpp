@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   vessel::cli::add_mesh_command(app);
   vessel::cli::add_scene_command(app);
   vessel::cli::add_msm_command(app);
+  vessel::cli::add_fem_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,31 @@
+#pragma once
+/// Grid-convergence arithmetic: observed order from errors on refined meshes, Richardson
+/// extrapolation and Roache's grid convergence index (GCI), so every report can print the
+/// reference's own discretisation uncertainty next to a model error.
+#include <vector>
+
+namespace vessel::fem {
+
+/// Observed order p = ln(e_coarse / e_fine) / ln(ratio) of an error that falls from e_coarse to
+/// e_fine when h shrinks by `ratio` (> 1). std::invalid_argument for non-positive inputs.
+double observed_order(double e_coarse, double e_fine, double ratio = 2.0);
+
+/// Observed order from three solutions on meshes refined by a constant ratio (Roache 1998,
+/// eq. 5.10.6.1): p = ln((f3 − f2)/(f2 − f1)) / ln(r), f1 the finest. std::domain_error when the
+/// differences have opposite signs (oscillatory convergence) or are zero.
+double observed_order_three(double f_coarse, double f_medium, double f_fine, double ratio = 2.0);
+
+struct RichardsonEstimate {
+  double extrapolated = 0.0;  ///< f_exact ≈ f1 + (f1 − f2)/(r^p − 1)
+  double error_fine = 0.0;    ///< |f_exact − f1|, the estimated error of the finest solution
+  double gci_fine = 0.0;      ///< GCI_fine = Fs |f1 − f2| / (|f1| (r^p − 1)), relative
+};
+
+/// Richardson extrapolation (Richardson 1911; Roache, Verification and Validation in
+/// Computational Science and Engineering, 1998, §5.6) from the two finest solutions f_medium,
+/// f_fine with order p, and the grid convergence index with safety factor Fs (1.25 with an
+/// observed order from three grids, 3 with an assumed one).
+RichardsonEstimate richardson(double f_medium, double f_fine, double order, double ratio = 2.0,
+                              double safety_factor = 1.25);
+
+}  // namespace vessel::fem

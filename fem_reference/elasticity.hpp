@@ -1,0 +1,162 @@
+#pragma once
+/// The FEM reference: small-strain isotropic linear elasticity on a vessel TetMesh with deal.II
+/// simplex elements (P1, P2, Taylor–Hood P2–P1 for ν → 0.5). Plain data only: deal.II stays inside
+/// elasticity.cpp (pimpl), so including this header compiles no deal.II. SI units throughout.
+#include <array>
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "meshes/surface_loads.hpp"
+#include "meshes/tet_mesh.hpp"
+
+namespace vessel::fem {
+
+/// Isotropic linear-elastic material.
+struct Material {
+  double youngs_modulus = 14.24e3;  ///< E, Pa (vessel wall, Wang Bin et al. via seed 000)
+  double poisson_ratio = 0.3;       ///< ν, dimensionless, in [0, 0.5]
+  double density = 1060.0;          ///< ρ, kg/m³
+  /// Lamé's first parameter λ = Eν / ((1+ν)(1−2ν)), Pa (infinite at ν = 0.5).
+  [[nodiscard]] double lambda() const;
+  /// Shear modulus μ = E / (2(1+ν)), Pa.
+  [[nodiscard]] double mu() const;
+};
+
+/// Displacement-only (P1 or P2) or mixed displacement–pressure (Taylor–Hood P2–P1).
+enum class Formulation { automatic, displacement, mixed };
+enum class LinearSolver { automatic, direct, cg_amg };
+
+/// A Dirichlet condition on the nodes of a boundary group (a dim-2 physical group).
+struct DirichletCondition {
+  enum class Kind {
+    clamped,  ///< all three components prescribed: u = value(x) (zero when value is empty)
+    roller    ///< only u[component] = 0, the others free (the plane-strain end of a straight tube)
+  };
+  std::string group;
+  Kind kind = Kind::clamped;
+  int component = 2;                                ///< roller: 0, 1, 2 for x, y, z
+  std::function<Vec3(const Vec3&)> value;           ///< clamped: prescribed u(x), m
+
+  /// All components held: u = value(x) on the group (u = 0 without a value).
+  static DirichletCondition clamped(std::string group, std::function<Vec3(const Vec3&)> value = {}) {
+    return {std::move(group), Kind::clamped, 0, std::move(value)};
+  }
+  /// u[component] = 0 on the group, the other components free.
+  static DirichletCondition roller(std::string group, int component) {
+    return {std::move(group), Kind::roller, component, {}};
+  }
+};
+
+/// u[component] = 0 at the mesh node at `point` (within 1e-9 of the mesh size; InputError
+/// otherwise). Used to remove the rigid-body modes that rollers leave free.
+struct PointConstraint {
+  Vec3 point = Vec3::Zero();
+  int component = 0;
+};
+
+/// Uniform pressure p (Pa) on a boundary group: traction −p n (n outward).
+struct PressureLoad {
+  std::string group;
+  double pressure = 0.0;
+};
+
+struct SolverOptions {
+  int degree = 1;  ///< displacement element degree, 1 or 2 (the mixed element is always P2–P1)
+  Formulation formulation = Formulation::automatic;
+  double mixed_threshold = 0.45;  ///< automatic: mixed when ν ≥ this (and always at ν = 0.5)
+  LinearSolver solver = LinearSolver::automatic;
+  std::size_t direct_max_dofs = 60000;  ///< automatic: direct at or below this many DoFs
+  double cg_relative_tolerance = 1e-10;  ///< ‖r‖ ≤ tol·‖b‖ for CG
+  unsigned max_iterations = 5000;
+};
+
+struct ElasticityProblem {
+  Material material;
+  std::vector<DirichletCondition> dirichlet;
+  std::vector<PointConstraint> point_constraints;
+  std::vector<PressureLoad> pressures;
+  std::vector<TractionPatch> patches;  ///< from vessel::contact_patch (shared with mass-spring)
+  Vec3 gravity = Vec3::Zero();         ///< m/s²; body force ρg
+  /// Optional extra body force density b(x), N/m³ (manufactured solutions); added to ρg.
+  std::function<Vec3(const Vec3&)> body_force;
+  SolverOptions options;
+};
+
+/// Reaction force (N) exerted by the supports of one constrained group on the body.
+struct GroupReaction {
+  std::string group;
+  Vec3 force = Vec3::Zero();
+};
+
+/// Wall-clock seconds per phase.
+struct PhaseTimings {
+  double setup = 0.0;     ///< triangulation, DoFs, constraints, sparsity
+  double assembly = 0.0;
+  double solve = 0.0;
+  double postprocess = 0.0;  ///< nodal values, energy, strains, reactions
+};
+
+struct ElasticityResult {
+  std::string element;          ///< "P1", "P2" or "P2-P1 (Taylor-Hood)"
+  Formulation formulation = Formulation::displacement;  ///< the one used
+  LinearSolver solver = LinearSolver::direct;            ///< the one used
+  unsigned iterations = 0;      ///< CG iterations (0 for direct)
+  std::size_t n_dofs = 0;
+  std::size_t n_pressure_dofs = 0;  ///< mixed only
+  std::vector<Vec3> nodal_displacement;  ///< at every TetMesh node, m
+  std::vector<GroupReaction> reactions;  ///< one per Dirichlet group, in order of first mention
+  Vec3 applied_load = Vec3::Zero();      ///< ∫ traction dA + ∫ ρg dV, N
+  double strain_energy = 0.0;            ///< ½∫σ:ε dV, J
+  double max_principal_strain = 0.0;     ///< largest eigenvalue of ε over the mesh (quadrature points)
+  double max_abs_principal_strain = 0.0; ///< largest |eigenvalue| of ε: the linear-regime flag
+  /// Per tet, at its centroid: ε and σ as (xx, yy, zz, xy, yz, xz), dimensionless and Pa.
+  std::vector<std::array<double, 6>> tet_strain;
+  std::vector<std::array<double, 6>> tet_stress;
+  PhaseTimings timings;
+};
+
+/// Solves a linear-elastic problem on one mesh and keeps the solution for point evaluation.
+class ElasticitySolver {
+ public:
+  /// Validates the problem (InputError naming the parameter or group: E ≤ 0, ν ∉ [0, 0.5],
+  /// ν = 0.5 with the displacement formulation, degree ∉ {1, 2}, a missing group, a point
+  /// constraint off the mesh's nodes) and builds the deal.II triangulation from the mesh.
+  ElasticitySolver(const TetMesh& mesh, ElasticityProblem problem);
+  ~ElasticitySolver();
+  ElasticitySolver(const ElasticitySolver&) = delete;
+  ElasticitySolver& operator=(const ElasticitySolver&) = delete;
+
+  /// Assembles and solves; returns the result (also kept in result()).
+  const ElasticityResult& solve();
+  [[nodiscard]] const ElasticityResult& result() const;
+
+  /// The FE displacement (m) at arbitrary points inside the mesh (within a relative tolerance of
+  /// 1e-9 of the element size). Throws InputError naming the first point outside. Requires solve().
+  [[nodiscard]] std::vector<Vec3> displacement_at(const std::vector<Vec3>& points) const;
+
+  /// ‖u_h − u‖_L2 / ‖u‖_L2 over the mesh, integrated with a quadrature two orders above the
+  /// element's. Requires solve().
+  [[nodiscard]] double relative_l2_error(const std::function<Vec3(const Vec3&)>& exact) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Convenience: ElasticitySolver(mesh, problem).solve().
+ElasticityResult solve_elasticity(const TetMesh& mesh, const ElasticityProblem& problem);
+
+/// Three point constraints that remove the in-plane rigid motions (x, y translation, rotation
+/// about z) of a straight tube along z whose ends are on rollers, without restraining radial
+/// expansion: u_y = 0 at (±a, 0, z), u_x = 0 at (0, a, z). The mesh must have nodes there (the
+/// generated tube has, on its end faces).
+std::vector<PointConstraint> tube_in_plane_pins(double inner_radius, double z);
+
+std::string to_string(Formulation f);
+std::string to_string(LinearSolver s);
+
+}  // namespace vessel::fem

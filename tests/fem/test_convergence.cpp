@@ -1,0 +1,32 @@
+#include "fem_reference/convergence.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+using namespace vessel::fem;
+
+TEST(ObservedOrder, RecoversThePowerOfAPowerLaw) {
+  // e = C h^p with h halved: e_coarse / e_fine = 2^p.
+  EXPECT_NEAR(observed_order(3.0 * std::pow(0.2, 2.0), 3.0 * std::pow(0.1, 2.0)), 2.0, 1e-12);
+  EXPECT_NEAR(observed_order(std::pow(0.3, 3.0), std::pow(0.1, 3.0), 3.0), 3.0, 1e-12);
+  EXPECT_THROW(observed_order(0.0, 1.0), std::invalid_argument);
+  EXPECT_THROW(observed_order(1.0, 0.5, 1.0), std::invalid_argument);
+}
+
+TEST(ObservedOrder, FromThreeSolutions) {
+  // f(h) = 5 + 0.7 h² on h = 0.4, 0.2, 0.1.
+  auto f = [](double h) { return 5.0 + 0.7 * h * h; };
+  EXPECT_NEAR(observed_order_three(f(0.4), f(0.2), f(0.1)), 2.0, 1e-10);
+  EXPECT_THROW(observed_order_three(1.0, 2.0, 1.5), std::domain_error);  // oscillating
+}
+
+TEST(Richardson, ExtrapolatesAPowerLawExactly) {
+  auto f = [](double h) { return 2.5 - 0.3 * h * h * h; };
+  const auto e = richardson(f(0.2), f(0.1), 3.0);
+  EXPECT_NEAR(e.extrapolated, 2.5, 1e-12);
+  EXPECT_NEAR(e.error_fine, 0.3e-3, 1e-12);
+  // Hand-computed GCI: 1.25 · |(f2 − f1)/f1| / (2³ − 1), f2 − f1 = −0.3(0.008 − 0.001) = −0.0021.
+  EXPECT_NEAR(e.gci_fine, 1.25 * (0.0021 / f(0.1)) / 7.0, 1e-14);
+}

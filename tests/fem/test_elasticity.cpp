@@ -1,0 +1,202 @@
+/// The FEM reference against independent truth: input validation, rigid-body motion, the
+/// constant-strain patch test, equilibrium of reactions and applied loads, point evaluation.
+#include "fem_reference/elasticity.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "fem_test_meshes.hpp"
+#include "meshes/errors.hpp"
+#include "meshes/surface_loads.hpp"
+
+using namespace vessel;
+using namespace vessel::fem;
+
+namespace {
+
+const TetMesh& mesh0() { return test::short_tube_mesh(0); }
+
+/// Message of the InputError the constructor throws, or "" if it throws none.
+std::string input_error(const ElasticityProblem& p) {
+  try {
+    ElasticitySolver s(mesh0(), p);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+/// All four surface groups clamped to u = g(x).
+ElasticityProblem all_boundary_prescribed(std::function<Vec3(const Vec3&)> g, int degree) {
+  ElasticityProblem p;
+  p.options.degree = degree;
+  for (const char* grp : {"inlet", "outlet", "inner_wall", "outer_wall"}) {
+    p.dirichlet.push_back(fem::DirichletCondition::clamped(grp, g));
+  }
+  return p;
+}
+
+double max_norm(const std::vector<Vec3>& v) {
+  double m = 0;
+  for (const auto& x : v) m = std::max(m, x.norm());
+  return m;
+}
+
+}  // namespace
+
+TEST(ElasticityInput, RejectsBadMaterialAndGroupsWithClearMessages) {
+  ElasticityProblem p;
+  p.material.youngs_modulus = 0.0;
+  EXPECT_NE(input_error(p).find("Young's modulus"), std::string::npos);
+  p = {};
+  p.material.poisson_ratio = 0.51;
+  EXPECT_NE(input_error(p).find("0 <= nu <= 0.5"), std::string::npos);
+  p.material.poisson_ratio = -0.1;
+  EXPECT_NE(input_error(p).find("Poisson"), std::string::npos);
+  p = {};
+  p.material.poisson_ratio = 0.5;
+  p.options.formulation = Formulation::displacement;
+  EXPECT_NE(input_error(p).find("mixed formulation"), std::string::npos);
+  p = {};
+  p.options.degree = 3;
+  EXPECT_NE(input_error(p).find("degree"), std::string::npos);
+  p = {};
+  p.dirichlet = {fem::DirichletCondition::clamped("no_such_group")};
+  EXPECT_NE(input_error(p).find("no_such_group"), std::string::npos);
+  p = {};
+  p.pressures = {{"lumen", 1.0}};
+  EXPECT_NE(input_error(p).find("lumen"), std::string::npos);
+  p = {};
+  p.point_constraints = {{Vec3(0, 0, 0), 0}};  // the tube's axis: no node there
+  EXPECT_NE(input_error(p).find("no mesh node"), std::string::npos);
+}
+
+TEST(ElasticityRigidBody, NoLoadGivesNoDisplacement) {
+  for (int degree : {1, 2}) {
+    ElasticityProblem p;
+    p.options.degree = degree;
+    p.dirichlet = {fem::DirichletCondition::clamped("inlet")};
+    const auto r = solve_elasticity(mesh0(), p);
+    EXPECT_EQ(max_norm(r.nodal_displacement), 0.0);
+    EXPECT_EQ(r.strain_energy, 0.0);
+  }
+}
+
+TEST(ElasticityRigidBody, ImposedRigidMotionIsReproducedWithoutStrain) {
+  // u = c + ω × x, small rotation: a rigid motion has ε = 0 exactly (linear kinematics).
+  const Vec3 c(1e-6, -2e-6, 0.5e-6);
+  const Vec3 w(1e-4, 2e-4, -3e-4);
+  auto g = [&](const Vec3& x) -> Vec3 { return c + w.cross(x); };
+  for (int degree : {1, 2}) {
+    const auto r = solve_elasticity(mesh0(), all_boundary_prescribed(g, degree));
+    const auto& m = mesh0();
+    double err = 0, ref = 0;
+    for (std::size_t n = 0; n < m.nodes.size(); ++n) {
+      err = std::max(err, (r.nodal_displacement[n] - g(m.nodes[n])).norm());
+      ref = std::max(ref, g(m.nodes[n]).norm());
+    }
+    EXPECT_LT(err, 1e-10 * ref) << "P" << degree;
+    EXPECT_LT(r.max_abs_principal_strain, 1e-10) << "P" << degree;
+    // Energy scale of a strain of 1e-4 over the wall: ½ E ε² V ≈ 1e-10 J; a rigid motion is 0.
+    EXPECT_LT(r.strain_energy, 1e-20) << "P" << degree;
+    for (const auto& rx : r.reactions) EXPECT_LT(rx.force.norm(), 1e-12) << rx.group;
+  }
+}
+
+TEST(ElasticityPatchTest, P1ReproducesAConstantStrainFieldExactly) {
+  // u = A x + c on the whole boundary: the exact solution has ε = sym(A) everywhere and
+  // σ = λ tr(ε) I + 2μ ε (hand-computed below), with no body force.
+  Eigen::Matrix3d a;
+  a << 1e-3, 2e-4, -3e-4, -1e-4, -2e-3, 5e-4, 4e-4, 1e-4, 1.5e-3;
+  const Vec3 c(2e-6, 0, -1e-6);
+  auto g = [&](const Vec3& x) -> Vec3 { return a * x + c; };
+  const Eigen::Matrix3d eps = 0.5 * (a + a.transpose());
+  for (int degree : {1, 2}) {
+    auto p = all_boundary_prescribed(g, degree);
+    p.material.poisson_ratio = 0.3;
+    ElasticitySolver solver(mesh0(), p);
+    const auto& r = solver.solve();
+    const auto& m = mesh0();
+    double err = 0;
+    for (std::size_t n = 0; n < m.nodes.size(); ++n) {
+      err = std::max(err, (r.nodal_displacement[n] - g(m.nodes[n])).norm());
+    }
+    EXPECT_LT(err, 1e-9 * 4e-3 * 2e-3) << "P" << degree;  // |A x| ≈ 2e-3 · 4 mm
+    const double e = p.material.youngs_modulus, nu = 0.3;
+    const double lambda = e * nu / ((1 + nu) * (1 - 2 * nu)), mu = e / (2 * (1 + nu));
+    const Eigen::Matrix3d sigma = lambda * eps.trace() * Eigen::Matrix3d::Identity() + 2 * mu * eps;
+    const int ij[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+    for (std::size_t t = 0; t < m.tets.size(); t += 37) {
+      for (int v = 0; v < 6; ++v) {
+        EXPECT_NEAR(r.tet_strain[t][v], eps(ij[v][0], ij[v][1]), 1e-12);
+        EXPECT_NEAR(r.tet_stress[t][v], sigma(ij[v][0], ij[v][1]), 1e-7 * sigma.norm());
+      }
+    }
+    // Strain energy density ½ σ:ε times the mesh volume.
+    const double w = 0.5 * (sigma.array() * eps.array()).sum() * mesh_volume(m);
+    EXPECT_NEAR(r.strain_energy, w, 1e-9 * w);
+    // Point evaluation anywhere inside reproduces the linear field.
+    const Vec3 inside(0.0, 3.4e-3, 0.37e-3), inside2(-2.5e-3, -2.2e-3, 0.81e-3);
+    const auto u = solver.displacement_at({inside, inside2});
+    EXPECT_LT((u[0] - g(inside)).norm(), 1e-9 * g(inside).norm());
+    EXPECT_LT((u[1] - g(inside2)).norm(), 1e-9 * g(inside2).norm());
+  }
+}
+
+TEST(ElasticityEquilibrium, ReactionsBalanceAContactPatch) {
+  const auto& m = mesh0();
+  ContactPatchSpec spec;
+  spec.point = Vec3(3e-3, 0, 0.5e-3);
+  spec.radius = 0.5e-3;
+  spec.force = 1e-3;  // 1 mN
+  const TractionPatch patch = contact_patch(m, spec);
+  for (int degree : {1, 2}) {
+    ElasticityProblem p;
+    p.options.degree = degree;
+    p.dirichlet = {fem::DirichletCondition::clamped("inlet"), fem::DirichletCondition::clamped("outlet")};
+    p.patches = {patch};
+    const auto r = solve_elasticity(m, p);
+    // The integrated traction equals the patch's total force −F n̂ (exact quadrature of a
+    // constant traction over the same flat triangles).
+    const Vec3 total = -spec.force * patch.outward_normal;
+    EXPECT_LT((r.applied_load - total).norm(), 1e-12 * spec.force);
+    ASSERT_EQ(r.reactions.size(), 2u);
+    const Vec3 sum = r.reactions[0].force + r.reactions[1].force;
+    EXPECT_LT((sum + total).norm(), 1e-8 * spec.force) << "P" << degree;
+    // The patch pushes the inner wall outward (+x at (a, 0, z)).
+    const auto u = ElasticitySolver(m, p).solve().nodal_displacement;
+    EXPECT_GT(max_norm(u), 0.0);
+    EXPECT_GT(r.strain_energy, 0.0);
+  }
+}
+
+TEST(ElasticityEquilibrium, ReactionBalancesGravity) {
+  const auto& m = mesh0();
+  ElasticityProblem p;
+  p.options.degree = 1;
+  p.dirichlet = {fem::DirichletCondition::clamped("inlet")};
+  p.gravity = Vec3(0, -9.81, 0);
+  const auto r = solve_elasticity(m, p);
+  const Vec3 weight = p.material.density * p.gravity * mesh_volume(m);  // ρ g V
+  EXPECT_LT((r.applied_load - weight).norm(), 1e-10 * weight.norm());
+  EXPECT_LT((r.reactions[0].force + weight).norm(), 1e-8 * weight.norm());
+}
+
+TEST(ElasticityPointEvaluation, MatchesNodalValuesAndRefusesOutsidePoints) {
+  const auto& m = mesh0();
+  ElasticityProblem p;
+  p.options.degree = 2;
+  p.dirichlet = {fem::DirichletCondition::clamped("inlet")};
+  p.pressures = {{"inner_wall", 5.0}};
+  ElasticitySolver s(m, p);
+  const auto& r = s.solve();
+  std::vector<Vec3> pts;
+  for (std::size_t n = 0; n < m.nodes.size(); n += 7) pts.push_back(m.nodes[n]);
+  const auto u = s.displacement_at(pts);
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    EXPECT_LT((u[k] - r.nodal_displacement[k * 7]).norm(), 1e-9 * max_norm(r.nodal_displacement));
+  }
+  EXPECT_THROW((void)s.displacement_at({Vec3(0, 0, 0.5e-3)}), InputError);  // in the lumen
+}

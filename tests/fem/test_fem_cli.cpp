@@ -1,0 +1,80 @@
+// `vesselverify fem` end to end: a pressure run against Lamé, a contact run writing JSON and VTU,
+// and bad input giving a clear message, exit code 1 and no output file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "../test_helpers.hpp"
+
+using vessel::test::CommandResult;
+using vessel::test::run_command;
+using vessel::test::TempDir;
+
+namespace {
+
+CommandResult vv(const std::string& args) {
+  return run_command(std::string(VESSELVERIFY_EXE) + " " + args);
+}
+bool contains(const std::string& s, const std::string& what) {
+  return s.find(what) != std::string::npos;
+}
+// A short structured tube keeps each run well under a second.
+const std::string kTube = "--structured --length 0.002 --no-cache ";
+
+}  // namespace
+
+TEST(FemCli, HelpHasExamples) {
+  const auto r = vv("fem --help");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "Examples")) << r.output;
+  EXPECT_TRUE(contains(r.output, "--solver")) << r.output;
+}
+
+TEST(FemCli, PressureRunComparesWithLameAndBalancesReactions) {
+  TempDir dir;
+  const auto r = vv("fem " + kTube + "--degree 2 --json " + (dir / "f.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "DoFs")) << r.output;
+  EXPECT_TRUE(contains(r.output, "Lamé closed form")) << r.output;
+  const auto j = nlohmann::json::parse(vessel::test::read_text(dir / "f.json"));
+  EXPECT_EQ(j["schema"], "vesselverify.fem");
+  EXPECT_EQ(j["element"], "P2");
+  EXPECT_LT(j["lame_relative_l2_error"].get<double>(), 0.02);  // level 0, P2: about 1 %
+  EXPECT_GT(j["dofs"].get<int>(), 0);
+}
+
+TEST(FemCli, ContactRunWritesVtuAndJson) {
+  TempDir dir;
+  const auto r = vv("fem " + kTube + "--load contact --force 1e-4 --contact-point 0.003 0 0.001 --vtu " +
+                    (dir / "c.vtu").string() + " --json " + (dir / "c.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "c.vtu"));
+  const std::string vtu = vessel::test::read_text(dir / "c.vtu");
+  EXPECT_TRUE(contains(vtu, "displacement") && contains(vtu, "stress")) << vtu.substr(0, 400);
+  const auto j = nlohmann::json::parse(vessel::test::read_text(dir / "c.json"));
+  // The two clamped ends hold the whole 0.1 mN push in +x: their reactions sum to −0.1 mN.
+  const auto& rx = j["reactions"];
+  ASSERT_EQ(rx.size(), 2u);
+  EXPECT_NEAR(rx[0]["force_mN"][0].get<double>() + rx[1]["force_mN"][0].get<double>(), -0.1, 1e-9);
+  // The patch pushes the inner wall outward at +x.
+  EXPECT_GT(j["contact"]["displacement_mm"][0].get<double>(), 0.0);
+}
+
+TEST(FemCli, BadInputExitsOneWithAClearMessageAndWritesNothing) {
+  TempDir dir;
+  const std::string json = " --json " + (dir / "x.json").string();
+  auto r = vv("fem " + kTube + "--nu 0.6" + json);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "Poisson")) << r.output;
+  r = vv("fem " + kTube + "--nu 0.5 --formulation displacement" + json);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "mixed formulation")) << r.output;
+  r = vv("fem " + kTube + "--E -1" + json);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "Young's modulus")) << r.output;
+  r = vv("fem " + kTube + "--load contact --contact-point 0 0 0.001" + json);  // in the lumen
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "off the wall")) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.json"));
+}

@@ -1,0 +1,314 @@
+/// `vesselverify fem`: solve the linear-elastic FEM reference on a vessel mesh under pressure, a
+/// contact patch or gravity; print DoFs, phase timings, displacements, energy, strain, reactions;
+/// write VTU and JSON.
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <numbers>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "fem_reference/elasticity.hpp"
+#include "fem_reference/lame.hpp"
+#include "meshes/atomic_file.hpp"
+#include "meshes/errors.hpp"
+#include "meshes/surface_loads.hpp"
+#include "meshes/vtu_io.hpp"
+#include "verification/cli/commands.hpp"
+#include "verification/cli/vessel_options.hpp"
+
+namespace vessel::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct FemCommandOptions {
+  VesselOptions vessel;
+  int degree = 1;
+  double youngs_modulus = fem::Material{}.youngs_modulus;
+  double poisson_ratio = fem::Material{}.poisson_ratio;
+  double density = fem::Material{}.density;
+  std::string formulation = "auto";
+  double mixed_threshold = fem::SolverOptions{}.mixed_threshold;
+  std::vector<std::string> loads{"pressure"};
+  double pressure = 10.0;
+  double force = 1e-4;
+  std::vector<double> contact_point;  // empty: (a, 0, L/2) on the inner wall
+  double contact_radius = 0.5e-3;
+  std::string contact_surface = std::string(group_names::inner_wall);
+  std::vector<double> gravity{0.0, -9.81, 0.0};
+  std::string bc = "auto";
+  std::string solver = "auto";
+  std::size_t direct_max_dofs = fem::SolverOptions{}.direct_max_dofs;
+  double tolerance = fem::SolverOptions{}.cg_relative_tolerance;
+  unsigned max_iterations = fem::SolverOptions{}.max_iterations;
+  fs::path vtu;
+  fs::path json;
+};
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+Vec3 to_vec3(const std::vector<double>& v, const char* name) {
+  if (v.size() != 3) throw InputError(std::string(name) + " expects three numbers x y z");
+  return {v[0], v[1], v[2]};
+}
+
+std::string mm(const Vec3& v, int precision = 6) {
+  std::ostringstream s;
+  s << std::setprecision(precision) << "(" << v.x() * 1e3 << ", " << v.y() * 1e3 << ", "
+    << v.z() * 1e3 << ")";
+  return s.str();
+}
+
+nlohmann::json json_vec(const Vec3& v, double scale) {
+  return nlohmann::json::array({v.x() * scale, v.y() * scale, v.z() * scale});
+}
+
+void run(FemCommandOptions& o) {
+  auto t0 = Clock::now();
+  MeshSource source;
+  const TetMesh mesh = mesh_vessel(o.vessel, std::cout, &source);
+  const VesselParams& params = o.vessel.params;
+  const double mesh_seconds = since(t0);
+  std::cout << "mesh: " << mesh.nodes.size() << " nodes, " << mesh.tets.size() << " tets\n";
+
+  fem::ElasticityProblem problem;
+  problem.material = {o.youngs_modulus, o.poisson_ratio, o.density};
+  auto& opt = problem.options;
+  opt.degree = o.degree;
+  opt.formulation = o.formulation == "mixed"          ? fem::Formulation::mixed
+                    : o.formulation == "displacement" ? fem::Formulation::displacement
+                                                      : fem::Formulation::automatic;
+  opt.mixed_threshold = o.mixed_threshold;
+  opt.solver = o.solver == "direct"   ? fem::LinearSolver::direct
+               : o.solver == "cg-amg" ? fem::LinearSolver::cg_amg
+                                      : fem::LinearSolver::automatic;
+  opt.direct_max_dofs = o.direct_max_dofs;
+  opt.cg_relative_tolerance = o.tolerance;
+  opt.max_iterations = o.max_iterations;
+
+  bool has_pressure = false, has_contact = false, has_gravity = false;
+  for (const auto& l : o.loads) {
+    has_pressure |= l == "pressure";
+    has_contact |= l == "contact";
+    has_gravity |= l == "gravity";
+  }
+  Vec3 contact_point(params.inner_radius, 0.0, 0.5 * params.length);
+  if (params.kind == VesselKind::arch) {
+    // The arch's crown: centreline point (0, R, 0); the inner wall on the side of the bend's centre.
+    contact_point = Vec3(0.0, params.bend_radius - params.inner_radius, 0.0);
+  }
+  if (!o.contact_point.empty()) contact_point = to_vec3(o.contact_point, "--contact-point");
+  if (o.contact_point.empty() && o.contact_surface == group_names::outer_wall) {
+    contact_point = params.kind == VesselKind::straight
+                        ? Vec3(params.outer_radius(), 0.0, 0.5 * params.length)
+                        : Vec3(0.0, params.bend_radius + params.outer_radius(), 0.0);
+  }
+  TractionPatch patch;
+  if (has_pressure) problem.pressures.push_back({std::string(group_names::inner_wall), o.pressure});
+  if (has_contact) {
+    ContactPatchSpec spec;
+    spec.point = contact_point;
+    spec.radius = o.contact_radius;
+    spec.force = o.force;
+    spec.surface_group = o.contact_surface;
+    patch = contact_patch(mesh, spec);
+    problem.patches.push_back(patch);
+    std::cout << "contact patch: " << patch.triangles.size() << " triangles of '"
+              << o.contact_surface << "', area " << patch.area * 1e6 << " mm² (disc "
+              << std::numbers::pi * o.contact_radius * o.contact_radius * 1e6 << " mm²), traction "
+              << patch.traction.norm() << " Pa\n";
+  }
+  if (has_gravity) problem.gravity = to_vec3(o.gravity, "--gravity");
+
+  // Ends: roller (u_z = 0, plane strain, plus three in-plane pins) or clamped.
+  std::string bc = o.bc;
+  if (bc == "auto") bc = (has_pressure && !has_contact && !has_gravity) ? "roller" : "clamped";
+  if (bc == "roller") {
+    if (params.kind != VesselKind::straight) {
+      throw InputError("--bc roller (u_z = 0 on the end faces) needs the straight tube; the arch's "
+                       "ends are not normal to z: use --bc clamped");
+    }
+    problem.dirichlet = {fem::DirichletCondition::roller("inlet", 2),
+                         fem::DirichletCondition::roller("outlet", 2)};
+    problem.point_constraints = fem::tube_in_plane_pins(params.inner_radius, 0.0);
+  } else if (bc == "clamped") {
+    problem.dirichlet = {fem::DirichletCondition::clamped("inlet"), fem::DirichletCondition::clamped("outlet")};
+  } else if (bc == "clamped-inlet") {
+    problem.dirichlet = {fem::DirichletCondition::clamped("inlet")};
+  }
+  std::cout << std::setprecision(6) << "material: E " << o.youngs_modulus << " Pa, nu " << o.poisson_ratio << ", rho "
+            << o.density << " kg/m³; ends: " << bc << "\n";
+
+  fem::ElasticitySolver solver(mesh, problem);
+  const auto& pre = solver.result();
+  std::cout << "element " << pre.element << ": " << pre.n_dofs << " DoFs";
+  if (pre.n_pressure_dofs) std::cout << " (" << pre.n_pressure_dofs << " pressure)";
+  std::cout << "\nsolving ..." << std::flush;
+  const auto& r = solver.solve();
+  std::cout << " " << fem::to_string(r.solver);
+  if (r.solver == fem::LinearSolver::cg_amg) std::cout << ", " << r.iterations << " CG iterations";
+  std::cout << "\n";
+
+  Vec3 u_contact = Vec3::Zero();
+  const bool have_contact_u = has_contact;
+  if (have_contact_u) u_contact = solver.displacement_at({contact_point})[0];
+  double max_u = 0.0;
+  for (const auto& u : r.nodal_displacement) max_u = std::max(max_u, u.norm());
+
+  t0 = Clock::now();
+  if (!o.vtu.empty()) {
+    VtuField disp{"displacement", 3, {}}, strain{"strain", 6, {}}, stress{"stress", 6, {}};
+    for (const auto& u : r.nodal_displacement) disp.values.insert(disp.values.end(), {u.x(), u.y(), u.z()});
+    for (const auto& e : r.tet_strain) strain.values.insert(strain.values.end(), e.begin(), e.end());
+    for (const auto& s : r.tet_stress) stress.values.insert(stress.values.end(), s.begin(), s.end());
+    write_vtu(o.vtu, mesh, {disp}, {strain, stress});
+  }
+  const double output_seconds = since(t0);
+
+  std::cout << std::setprecision(6);
+  std::cout << "results (mm, mN, mJ):\n";
+  std::cout << "  max |u|                 " << max_u * 1e3 << " mm\n";
+  if (have_contact_u) {
+    std::cout << "  u at contact point      " << mm(u_contact) << " mm, along the patch normal "
+              << u_contact.dot(-patch.outward_normal) * 1e3 << " mm\n";
+  }
+  std::cout << "  strain energy           " << r.strain_energy * 1e3 << " mJ\n";
+  std::cout << "  max principal strain    " << r.max_principal_strain << " (max |eigenvalue| "
+            << r.max_abs_principal_strain << ")\n";
+  if (r.max_abs_principal_strain > 0.05) {
+    std::cout << "  WARNING: strain above 5 %: outside the linear reference's validity\n";
+  }
+  double lame_error = -1.0;
+  if (bc == "roller" && has_pressure && !has_contact && !has_gravity) {
+    // The Lamé set-up: compare with the closed form (plane strain is exact with roller ends).
+    const fem::LameCylinder lame{params.inner_radius, params.outer_radius(), o.pressure,
+                                 o.youngs_modulus, o.poisson_ratio};
+    lame_error = solver.relative_l2_error([&](const Vec3& x) { return lame.displacement(x); });
+    std::cout << "  Lamé closed form        u_r(a) " << lame.radial_displacement(params.inner_radius) * 1e3
+              << " mm, u_r(b) " << lame.radial_displacement(params.outer_radius()) * 1e3
+              << " mm; FEM relative L2 error " << lame_error << "\n";
+  }
+  std::cout << "  applied load            " << mm(r.applied_load) << " mN\n";
+  Vec3 reaction_sum = Vec3::Zero();
+  for (const auto& g : r.reactions) {
+    std::cout << "  reaction on " << std::left << std::setw(12) << g.group << std::right
+              << mm(g.force) << " mN\n";
+    reaction_sum += g.force;
+  }
+  std::cout << "  |applied + reactions|   " << (r.applied_load + reaction_sum).norm() * 1e3
+            << " mN (equilibrium)\n";
+  std::cout << std::fixed << std::setprecision(3) << "timings (s): mesh " << mesh_seconds
+            << ", setup " << r.timings.setup << ", assembly " << r.timings.assembly << ", solve "
+            << r.timings.solve << ", postprocess " << r.timings.postprocess << ", output "
+            << output_seconds << std::defaultfloat << "\n";
+  if (!o.vtu.empty()) std::cout << "wrote " << o.vtu.string() << "\n";
+
+  if (!o.json.empty()) {
+    nlohmann::json reactions = nlohmann::json::array();
+    for (const auto& g : r.reactions) reactions.push_back({{"group", g.group}, {"force_mN", json_vec(g.force, 1e3)}});
+    nlohmann::json j{
+        {"schema", "vesselverify.fem"},
+        {"schema_version", 1},
+        {"units", {{"length", "mm"}, {"force", "mN"}, {"energy", "mJ"}, {"time", "s"}}},
+        {"vessel", describe(params)},
+        {"mesh", {{"nodes", mesh.nodes.size()}, {"tets", mesh.tets.size()}, {"cache_hit", source.cache_hit}}},
+        {"material", {{"E_Pa", o.youngs_modulus}, {"nu", o.poisson_ratio}, {"density_kg_m3", o.density}}},
+        {"loads", o.loads},
+        {"ends", bc},
+        {"element", r.element},
+        {"formulation", fem::to_string(r.formulation)},
+        {"solver", fem::to_string(r.solver)},
+        {"cg_iterations", r.iterations},
+        {"dofs", r.n_dofs},
+        {"pressure_dofs", r.n_pressure_dofs},
+        {"max_displacement_mm", max_u * 1e3},
+        {"strain_energy_mJ", r.strain_energy * 1e3},
+        {"max_principal_strain", r.max_principal_strain},
+        {"max_abs_principal_strain", r.max_abs_principal_strain},
+        {"applied_load_mN", json_vec(r.applied_load, 1e3)},
+        {"reactions", reactions},
+        {"timings_s",
+         {{"mesh", mesh_seconds}, {"setup", r.timings.setup}, {"assembly", r.timings.assembly},
+          {"solve", r.timings.solve}, {"postprocess", r.timings.postprocess}, {"output", output_seconds}}}};
+    if (lame_error >= 0.0) j["lame_relative_l2_error"] = lame_error;
+    if (have_contact_u) {
+      j["contact"] = {{"point_mm", json_vec(contact_point, 1e3)}, {"radius_mm", o.contact_radius * 1e3},
+                      {"force_mN", o.force * 1e3}, {"patch_area_mm2", patch.area * 1e6},
+                      {"patch_triangles", patch.triangles.size()},
+                      {"displacement_mm", json_vec(u_contact, 1e3)}};
+    }
+    write_file_atomically(o.json, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+    std::cout << "wrote " << o.json.string() << "\n";
+  }
+}
+
+}  // namespace
+
+void add_fem_command(CLI::App& app) {
+  auto o = std::make_shared<FemCommandOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "fem",
+      "Solve the linear-elastic FEM reference (deal.II, P1/P2 tets, Taylor-Hood P2-P1 for nu near "
+      "0.5) on a vessel mesh and print DoFs, phase timings, displacement (mm), strain energy, "
+      "largest principal strain and reaction forces (mN).\n"
+      "Ends: 'roller' holds u_z = 0 on both end faces (plane strain, the Lamé set-up; three pins "
+      "remove the in-plane rigid motion), 'clamped' holds both ends, 'clamped-inlet' only the "
+      "inlet; 'auto' is roller for pressure alone and clamped otherwise.\n"
+      "Examples:\n"
+      "  vesselverify fem                                   # P1, 10 Pa internal pressure\n"
+      "  vesselverify fem --degree 2 --level 1 --structured --vtu tube.vtu\n"
+      "  vesselverify fem --load contact --force 1e-4 --contact-radius 5e-4 --json fem.json\n"
+      "  vesselverify fem --load gravity --bc clamped-inlet\n"
+      "  vesselverify fem --nu 0.5                          # Taylor-Hood P2-P1 (automatic)\n"
+      "  vesselverify fem --degree 2 --level 2 --solver cg-amg");
+  add_vessel_options(*cmd, o->vessel);
+  cmd->add_option("--degree", o->degree, "Displacement element degree (1 or 2)")
+      ->check(CLI::IsMember({1, 2}))
+      ->capture_default_str();
+  cmd->add_option("--E", o->youngs_modulus, "Young's modulus, Pa")->capture_default_str();
+  cmd->add_option("--nu", o->poisson_ratio, "Poisson's ratio, 0..0.5")->capture_default_str();
+  cmd->add_option("--density", o->density, "Density, kg/m³")->capture_default_str();
+  cmd->add_option("--formulation", o->formulation,
+                  "auto (mixed when nu >= --mixed-threshold), displacement, or mixed (P2-P1)")
+      ->check(CLI::IsMember({"auto", "displacement", "mixed"}))
+      ->capture_default_str();
+  cmd->add_option("--mixed-threshold", o->mixed_threshold, "auto: mixed formulation when nu >= this")
+      ->capture_default_str();
+  cmd->add_option("--load", o->loads, "Load(s): pressure, contact, gravity (repeatable)")
+      ->check(CLI::IsMember({"pressure", "contact", "gravity"}))
+      ->capture_default_str();
+  cmd->add_option("--pressure", o->pressure, "Internal pressure on inner_wall, Pa")->capture_default_str();
+  cmd->add_option("--force", o->force, "Contact force, N (pushes into the wall)")->capture_default_str();
+  cmd->add_option("--contact-point", o->contact_point,
+                  "Contact point x y z, metres (default: mid-length on the chosen wall at +x)")
+      ->expected(3);
+  cmd->add_option("--contact-radius", o->contact_radius, "Contact patch radius, metres")
+      ->capture_default_str();
+  cmd->add_option("--contact-surface", o->contact_surface, "Surface group the contact acts on")
+      ->check(CLI::IsMember({"inner_wall", "outer_wall"}))
+      ->capture_default_str();
+  cmd->add_option("--gravity", o->gravity, "Gravity vector gx gy gz, m/s²")->expected(3)->capture_default_str();
+  cmd->add_option("--bc", o->bc, "End conditions: auto, roller, clamped, clamped-inlet")
+      ->check(CLI::IsMember({"auto", "roller", "clamped", "clamped-inlet"}))
+      ->capture_default_str();
+  cmd->add_option("--solver", o->solver,
+                  "Linear solver: auto (direct up to --direct-max-dofs, else CG with algebraic "
+                  "multigrid), direct (UMFPACK), cg-amg (Trilinos ML)")
+      ->check(CLI::IsMember({"auto", "direct", "cg-amg"}))
+      ->capture_default_str();
+  cmd->add_option("--direct-max-dofs", o->direct_max_dofs, "auto: direct solver up to this many DoFs")
+      ->capture_default_str();
+  cmd->add_option("--tolerance", o->tolerance, "CG relative residual tolerance")->capture_default_str();
+  cmd->add_option("--max-iterations", o->max_iterations, "CG iteration limit")->capture_default_str();
+  cmd->add_option("--vtu", o->vtu, "Write displacement (nodes), strain and stress (tets) as VTU");
+  cmd->add_option("--json", o->json, "Write a JSON summary");
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace vessel::cli
