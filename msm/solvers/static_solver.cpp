@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -28,11 +29,14 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
   VectorXd g;
   SparseMatrix H;
   double energy = p.potential(r.x);
+  // Round-off floor of the residual: ε·(largest stiffness)·(model size)·√n, set at the first
+  // Hessian; below it the residual cannot be reduced, whatever the load.
+  double roundoff = 0.0;
   for (r.iterations = 0; r.iterations <= o.max_iterations; ++r.iterations) {
     p.potential_gradient(r.x, g);
     r.residual = g.norm();
     if (!std::isfinite(r.residual)) break;
-    if (r.residual <= target) {
+    if (r.residual <= std::max(target, roundoff)) {
       r.converged = true;
       break;
     }
@@ -40,6 +44,11 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
     // The exact Hessian where it is positive definite (quadratic convergence); where compression
     // makes it indefinite, the per-spring PSD projection (then regularised if still singular).
     p.form->hessian(r.x, H, false);
+    if (roundoff == 0.0) {
+      const double size = (p.rest.maxCoeff() - p.rest.minCoeff());
+      roundoff = std::numeric_limits<double>::epsilon() * H.diagonal().cwiseAbs().maxCoeff() *
+                 size * std::sqrt(static_cast<double>(p.num_dofs()));
+    }
     apply_dirichlet(H, p.fixed);
     bool exact = solver.try_factorize(H);
     if (!exact) {
