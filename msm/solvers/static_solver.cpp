@@ -17,7 +17,9 @@ double now() {
 }
 }  // namespace
 
-StaticResult solve_static(const Problem& p, const StaticOptions& o, const VectorXd& start) {
+namespace {
+
+StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& start) {
   const double t0 = now();
   StaticResult r;
   r.x = start.size() == p.num_dofs() ? start : p.rest;
@@ -105,6 +107,29 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
     throw std::runtime_error(msg.str());
   }
   return r;
+}
+
+}  // namespace
+
+StaticResult solve_static(const Problem& p, const StaticOptions& o, const VectorXd& start) {
+  if (o.load_steps <= 1) return newton(p, o, start);
+  // Load stepping: Newton on f_ext·s/N for s = 1..N, each from the previous equilibrium.
+  const double t0 = now();
+  Problem step = p;
+  StaticResult total;
+  total.x = start;
+  for (int s = 1; s <= o.load_steps; ++s) {
+    step.external_force = p.external_force * (static_cast<double>(s) / o.load_steps);
+    const StaticResult r = newton(step, o, total.x);
+    total.x = r.x;
+    total.iterations += r.iterations;
+    total.residual = r.residual;
+    total.converged = r.converged;
+    total.symbolic_analyses += r.symbolic_analyses;
+    total.numeric_factorisations += r.numeric_factorisations;
+  }
+  total.seconds = now() - t0;
+  return total;
 }
 
 StaticResult solve_linear(const Problem& p) {

@@ -15,6 +15,7 @@ struct StaticOptions {
   double force_scale = 1e-12;  ///< N, for unloaded problems
   int max_iterations = 200;
   bool project_psd = true;
+  int load_steps = 1;           ///< load increments (Newton from each previous equilibrium)
   std::ostream* log = nullptr;  ///< per-iteration residual, step length, regularisation
 };
 
