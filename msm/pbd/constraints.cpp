@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "meshes/errors.hpp"
@@ -196,6 +197,17 @@ PbdResult run_pbd(const Problem& p, const std::vector<Constraint>& constraints, 
   r.x = x0.size() == n ? x0 : p.rest;
   r.v = VectorXd::Zero(n);
   std::vector<double> lambda(constraints.size());
+  double extent = 0.0;
+  for (Eigen::Index i = 0; i < 3; ++i) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (Eigen::Index k = i; k < n; k += 3) {
+      lo = std::min(lo, p.rest[k]);
+      hi = std::max(hi, p.rest[k]);
+    }
+    if (n > 0) extent += (hi - lo) * (hi - lo);
+  }
+  double ke_limit = o.blowup_factor * std::max({p.external_force.norm() * std::sqrt(extent),
+                                                0.5 * r.v.dot(p.mass.cwiseProduct(r.v)), 1e-300});
   for (int step = 1; step <= o.steps; ++step) {
     VectorXd xp = r.x + h * r.v + h * h * w.cwiseProduct(p.external_force);
     std::fill(lambda.begin(), lambda.end(), 0.0);
@@ -221,9 +233,21 @@ PbdResult run_pbd(const Problem& p, const std::vector<Constraint>& constraints, 
     r.v = (1.0 - o.velocity_damping) * (xp - r.x) / h;
     r.x = xp;
     for (int i = 0; i < n; ++i) {
-      if (!std::isfinite(r.x[i])) {
-        throw DivergenceError(step, i / 3, total_energy(p, r.x, r.v), "non-finite PBD position");
+      if (!std::isfinite(r.x[i]) || !std::isfinite(r.v[i])) {
+        throw DivergenceError(step, i / 3, std::numeric_limits<double>::quiet_NaN(),
+                              "non-finite PBD position or velocity");
       }
+    }
+    // Energy blow-up: the kinetic energy beyond what the loads could ever supply.
+    const double kinetic = 0.5 * r.v.dot(p.mass.cwiseProduct(r.v));
+    // The first step may release the energy of initially violated constraints: it sets the scale.
+    if (step == 1) ke_limit = std::max(ke_limit, o.blowup_factor * kinetic);
+    if (kinetic > ke_limit) {
+      Eigen::Index worst = 0;
+      r.v.cwiseAbs().maxCoeff(&worst);
+      throw DivergenceError(
+          step, static_cast<int>(worst / 3), kinetic,
+          "PBD kinetic energy above the blow-up limit " + std::to_string(ke_limit) + " J");
     }
     r.steps = step;
   }

@@ -64,6 +64,10 @@ struct PbdOptions {
   int steps = 100;
   int iterations = 10;            ///< Gauss–Seidel sweeps per step
   double velocity_damping = 0.0;  ///< fraction of the velocity removed per step, [0, 1)
+  /// Divergence when the kinetic energy exceeds blowup_factor × ‖f_ext‖·(model diagonal), an
+  /// upper bound of what the loads can supply over the model's size, or × the kinetic energy
+  /// after the first step (which releases any initially violated constraint).
+  double blowup_factor = 1e3;
 };
 
 struct PbdResult {
@@ -77,7 +81,7 @@ struct PbdResult {
 /// XPBD time stepping (Macklin et al. 2016): predict x* = x + h v + h² M⁻¹ f_ext, then per
 /// iteration and constraint Δλ = (−C − α̃λ)/(Σ w|∇C|² + α̃), α̃ = α/h², Δx = w ∇C Δλ; v = Δx/h.
 /// Fixed dofs (problem.fixed) have zero inverse mass. Throws InputError for dt ≤ 0, iterations
-/// < 1, damping outside [0, 1); DivergenceError on a non-finite position.
+/// < 1, damping outside [0, 1); DivergenceError on a non-finite value or a kinetic-energy blow-up.
 PbdResult run_pbd(const Problem& problem, const std::vector<Constraint>& constraints,
                   const PbdOptions& options, const VectorXd& x0 = VectorXd());
 

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -16,7 +17,9 @@ double now() {
 }
 }  // namespace
 
-StaticResult solve_static(const Problem& p, const StaticOptions& o, const VectorXd& start) {
+namespace {
+
+StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& start) {
   const double t0 = now();
   StaticResult r;
   r.x = start.size() == p.num_dofs() ? start : p.rest;
@@ -28,11 +31,14 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
   VectorXd g;
   SparseMatrix H;
   double energy = p.potential(r.x);
+  // Round-off floor of the residual: ε·(largest stiffness)·(model size)·√n, set at the first
+  // Hessian; below it the residual cannot be reduced, whatever the load.
+  double roundoff = 0.0;
   for (r.iterations = 0; r.iterations <= o.max_iterations; ++r.iterations) {
     p.potential_gradient(r.x, g);
     r.residual = g.norm();
     if (!std::isfinite(r.residual)) break;
-    if (r.residual <= target) {
+    if (r.residual <= std::max(target, roundoff)) {
       r.converged = true;
       break;
     }
@@ -40,6 +46,11 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
     // The exact Hessian where it is positive definite (quadratic convergence); where compression
     // makes it indefinite, the per-spring PSD projection (then regularised if still singular).
     p.form->hessian(r.x, H, false);
+    if (roundoff == 0.0) {
+      const double size = (p.rest.maxCoeff() - p.rest.minCoeff());
+      roundoff = std::numeric_limits<double>::epsilon() * H.diagonal().cwiseAbs().maxCoeff() *
+                 size * std::sqrt(static_cast<double>(p.num_dofs()));
+    }
     apply_dirichlet(H, p.fixed);
     bool exact = solver.try_factorize(H);
     if (!exact) {
@@ -96,6 +107,29 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
     throw std::runtime_error(msg.str());
   }
   return r;
+}
+
+}  // namespace
+
+StaticResult solve_static(const Problem& p, const StaticOptions& o, const VectorXd& start) {
+  if (o.load_steps <= 1) return newton(p, o, start);
+  // Load stepping: Newton on f_ext·s/N for s = 1..N, each from the previous equilibrium.
+  const double t0 = now();
+  Problem step = p;
+  StaticResult total;
+  total.x = start;
+  for (int s = 1; s <= o.load_steps; ++s) {
+    step.external_force = p.external_force * (static_cast<double>(s) / o.load_steps);
+    const StaticResult r = newton(step, o, total.x);
+    total.x = r.x;
+    total.iterations += r.iterations;
+    total.residual = r.residual;
+    total.converged = r.converged;
+    total.symbolic_analyses += r.symbolic_analyses;
+    total.numeric_factorisations += r.numeric_factorisations;
+  }
+  total.seconds = now() - t0;
+  return total;
 }
 
 StaticResult solve_linear(const Problem& p) {

@@ -9,11 +9,13 @@
 namespace vessel::msm {
 
 struct StaticOptions {
-  /// Converged when ‖∇Π‖ on the free dofs ≤ tolerance·max(‖f_ext‖, force_scale).
+  /// Converged when ‖∇Π‖ on the free dofs ≤ tolerance·max(‖f_ext‖, force_scale), or below the
+  /// round-off floor ε·max|K_ii|·(model size)·√n.
   double tolerance = 1e-8;
   double force_scale = 1e-12;  ///< N, for unloaded problems
   int max_iterations = 200;
   bool project_psd = true;
+  int load_steps = 1;           ///< load increments (Newton from each previous equilibrium)
   std::ostream* log = nullptr;  ///< per-iteration residual, step length, regularisation
 };
 

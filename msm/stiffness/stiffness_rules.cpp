@@ -211,7 +211,11 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
   for (Spring& s : net.springs) {
     const double L = s.rest_length;
     const auto it = measure.find(key(s.a, s.b));
-    const bool is_edge = it != measure.end();
+    // Only structural and volume springs take their element measure: a shear spring on a grid
+    // cell may or may not coincide with the diagonal the mesher cut the cell along, and both
+    // diagonals must be treated alike.
+    const bool is_edge = it != measure.end() &&
+                         (s.family == SpringFamily::structural || s.family == SpringFamily::volume);
     // Surrogate measure of a non-edge spring: one equilateral triangle on it (see header).
     const double m = is_edge ? it->second : t * std::sqrt(3.0) / 4.0 * L * L;
     double k = 0.0;

@@ -69,11 +69,12 @@ Eigen::MatrixXd fem_triangle_stiffness(const std::array<Vec3, 3>& x, double E, d
 
 /// Sets law.k1 (and the bilinear k2, threshold) of every spring of the network by the rule and
 /// the family factors. Volume networks use their tets; surface networks their triangles with the
-/// network's thickness t. Springs that are not an element edge (bend, shear, two-ring) have no
-/// element measure of their own: the seed000 rule gives them k = E·t·h0/h0 = E·t (A = t·h0, the
-/// square patch a surface spring spans; k = E·h0 for volume springs, A = h0²); seed001, van_gelder
-/// and lloyd use the measure of one equilateral triangle on the spring, t·(√3/4)·L² (seed001
-/// takes a third of it), i.e. k = (√3/4)·E·t for van_gelder and lloyd.
+/// network's thickness t. Springs other than structural and volume ones (bend, shear, two-ring)
+/// are not taken as element edges, even where one coincides with a cut diagonal: the seed000 rule
+/// gives them k = E·t·h0/h0 = E·t (A = t·h0, the square patch a surface spring spans; k = E·h0 for
+/// volume springs, A = h0²); seed001, van_gelder and lloyd use the measure of one equilateral
+/// triangle on the spring, t·(√3/4)·L² (seed001 takes a third of it), i.e. k = (√3/4)·E·t for
+/// van_gelder and lloyd.
 void assign_stiffness(SpringNetwork& network, StiffnessRule rule, const StiffnessParams& params);
 
 }  // namespace vessel::msm

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -12,6 +13,7 @@
 #include "meshes/errors.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/pbd/constraints.hpp"
+#include "msm/solvers/integrators.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;
@@ -148,4 +150,23 @@ TEST(Pbd, XpbdStiffnessIsPhysicalAndIndependentOfTheIterationCount) {
   PbdOptions bad;
   bad.dt = -1;
   EXPECT_THROW((void)run_pbd(p, cs, bad), InputError);
+}
+
+TEST(Pbd, NonFiniteStateStopsWithStepAndNode) {
+  SpringNetwork net;
+  net.nodes = {Vec3::Zero(), Vec3(1e-3, 0, 0)};
+  const SpringModel model(net);
+  Problem p = free_problem(model, flatten(net.nodes), 1e-4);
+  p.external_force[3] = std::numeric_limits<double>::infinity();
+  const std::vector<Constraint> cs{
+      {ConstraintType::stretch, {0, 1, 0, 0}, 1e-3, 0.1, Vec3::Zero()}};
+  PbdOptions o;
+  o.steps = 10;
+  try {
+    (void)run_pbd(p, cs, o);
+    FAIL() << "expected DivergenceError";
+  } catch (const DivergenceError& e) {
+    EXPECT_EQ(e.step, 1);
+    EXPECT_TRUE(e.node == 0 || e.node == 1);
+  }
 }

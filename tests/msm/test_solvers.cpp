@@ -7,9 +7,13 @@
 #include <cstdio>
 
 #include "meshes/errors.hpp"
+#include "meshes/gmsh_vessel.hpp"
+#include "meshes/surface_loads.hpp"
+#include "msm/mass/mass_rules.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/static_solver.hpp"
+#include "msm/stiffness/stiffness_rules.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;
@@ -208,4 +212,35 @@ TEST(Integrators, DampedImplicitEulerSettlesOnTheStaticAnswer) {
   o.steps = 3000;
   const DynamicResult r = integrate(c.problem, o);
   EXPECT_NEAR(end_displacement(c.problem, r.x), 0.1 * (1 / 41.106 + 1 / 20.0), 1e-9);
+}
+
+TEST(Solvers, NewtonRelaxationAndLinearisedModelAgreeOnTheVesselVolumeModel) {
+  // Three independent routes to the static answer of the volume model under the shared contact
+  // patch: Newton/CHOLMOD, dynamic relaxation (explicit), and — at a load small enough to be
+  // linear — the stiffness at rest.
+  const VesselParams params;
+  const TetMesh mesh = generate_vessel_mesh(params);
+  SpringNetwork net = build_volume_network(mesh);
+  assign_stiffness(net, StiffnessRule::seed001, StiffnessParams{});
+  const SpringModel model(net);
+  const auto masses = nodal_masses(net, MassRule::consistent, kVesselDensity);
+  ContactPatchSpec spec;
+  spec.point = Vec3(3e-3, 0, 20e-3);
+  spec.radius = 1e-3;
+  for (double force : {1e-3, 1e-7}) {
+    spec.force = force;
+    const auto loads = traction_nodal_loads(mesh, contact_patch(mesh, spec));
+    const Problem p = make_problem(model, net, masses, mesh, loads, {"inlet", "outlet"});
+    const StaticResult newton = solve_static(p);
+    const Eigen::VectorXd u = newton.x - p.rest;
+    if (force > 1e-5) {
+      RelaxationOptions o;
+      o.tolerance = 1e-9;
+      const RelaxationResult dr = dynamic_relaxation(p, o);
+      EXPECT_LT((dr.x - newton.x).norm(), 1e-6 * u.norm());
+    } else {
+      const StaticResult lin = solve_linear(p);
+      EXPECT_LT((lin.x - newton.x).norm(), 1e-4 * u.norm());
+    }
+  }
 }

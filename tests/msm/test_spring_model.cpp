@@ -175,3 +175,17 @@ TEST(SpringModel, ProblemOnTheVesselCarriesTheSharedContactLoadAndFixesTheEnds) 
   EXPECT_NEAR(p.external_force.sum(), total.sum(), 1e-15);
   EXPECT_NEAR(p.mass.sum() / 3, 1060.0 * mesh_volume(mesh), 1e-12);
 }
+
+TEST(SpringModel, ConsistentMassesTimesGravityEqualTheSharedBodyForceLoads) {
+  // The CLI's --gravity applies m_i·g; for the volume model with consistent masses this must be
+  // the shared body_force_nodal_loads (ρV/4 per tet vertex) node by node.
+  const TetMesh mesh = generate_vessel_mesh(VesselParams{});
+  const SpringNetwork net = build_volume_network(mesh);
+  const double rho = kVesselDensity;
+  const auto m = nodal_masses(net, MassRule::consistent, rho);
+  const Vec3 g(0, -9.81, 0);
+  const auto shared = body_force_nodal_loads(mesh, rho * g);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < m.size(); ++i) worst = std::max(worst, (m[i] * g - shared[i]).norm());
+  EXPECT_LT(worst, 1e-18);
+}

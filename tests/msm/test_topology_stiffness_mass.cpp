@@ -280,3 +280,22 @@ TEST(Topology, StructuredArchGridAndMidSurface) {
     EXPECT_NEAR(rho, p.inner_radius + 0.5 * p.wall_thickness, 1e-12);
   }
 }
+
+TEST(StiffnessRules, BothShearDiagonalsOfAGridCellGetTheSameStiffness) {
+  VesselParams p;
+  p.style = MeshStyle::structured;
+  SpringNetwork net =
+      build_tube_grid_network(wall_surface(structured_tube(), p, WallSurface::inner), p, 1e-3);
+  for (StiffnessRule rule :
+       {StiffnessRule::seed001, StiffnessRule::van_gelder, StiffnessRule::lloyd}) {
+    assign_stiffness(net, rule, StiffnessParams{});
+    double lo = 1e300, hi = 0;
+    for (const Spring& s : net.springs) {
+      if (s.family != SpringFamily::shear) continue;
+      // All shear springs of the straight tube have the same length, so the same k.
+      lo = std::min(lo, s.law.k1);
+      hi = std::max(hi, s.law.k1);
+    }
+    EXPECT_NEAR(hi / lo, 1.0, 1e-9) << to_string(rule);
+  }
+}

@@ -54,6 +54,7 @@ struct MsmOptions {
   double pbd_damping = 0.01;
   double pressure = 0.0;
   bool gravity = false;
+  int load_steps = 1;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -194,6 +195,7 @@ void run(MsmOptions& o) {
   if (o.solver == "static" || o.solver == "linear") {
     msm::StaticOptions static_options;
     if (o.verbose) static_options.log = &std::cout;
+    static_options.load_steps = o.load_steps;
     const msm::StaticResult r = o.solver == "static" ? msm::solve_static(problem, static_options)
                                                      : msm::solve_linear(problem);
     x = r.x;
@@ -382,6 +384,8 @@ void add_msm_command(CLI::App& app) {
                 "Add seed 002's simplified angle constraints at loaded nodes");
   cmd->add_flag("--no-dihedral", o->no_dihedral, "Leave out the dihedral-angle constraints");
   cmd->add_option("--pbd-damping", o->pbd_damping, "Fraction of velocity removed per PBD step")
+      ->capture_default_str();
+  cmd->add_option("--load-steps", o->load_steps, "Static Newton: load increments")
       ->capture_default_str();
   cmd->add_flag("-v,--verbose", o->verbose, "Print the Newton iterations");
   cmd->add_option("--json", o->json, "Write the results as JSON (atomically)");
