@@ -11,6 +11,7 @@
 #include "meshes/errors.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/mass/mass_rules.hpp"
+#include "msm/model/build_network.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/pbd/constraints.hpp"
 #include "msm/solvers/integrators.hpp"
@@ -118,29 +119,20 @@ void run(MsmOptions& o) {
   }
 
   const auto t_build = std::chrono::steady_clock::now();
-  msm::SpringNetwork net;
-  std::string topology = "tetrahedral edges (seed 001)";
-  if (o.model == "volume") {
-    net = msm::build_volume_network(mesh);
-  } else {
-    const msm::WallSurface which = msm::parse_wall_surface(o.surface);
-    const TriangleSurface surface = msm::wall_surface(mesh, params, which);
-    std::string topo = o.topology;
-    if (topo == "auto") topo = params.style == MeshStyle::structured ? "grid" : "triangles";
-    if (topo == "grid") {
-      net = msm::build_tube_grid_network(surface, params, params.wall_thickness);
-      topology = "structured tube grid (seed 000 families)";
-    } else if (topo == "triangles") {
-      net = msm::build_triangle_network(surface, params.wall_thickness, o.two_ring);
-      topology = std::string("triangle mesh (edges + bend across edges") +
-                 (o.two_ring ? " + two-ring)" : ")");
-    } else {
-      throw InputError("--topology: expected auto, grid or triangles, got '" + o.topology + "'");
-    }
-  }
-  msm::assign_stiffness(net, rule, o.stiffness_params);
-  for (auto& s : net.springs) s.damping = o.axial_damping;
-  const std::vector<double> masses = msm::nodal_masses(net, mass_rule, o.density);
+  msm::NetworkOptions network_options;
+  network_options.model = o.model;
+  network_options.surface = o.surface;
+  network_options.topology = o.topology;
+  network_options.two_ring = o.two_ring;
+  network_options.stiffness = rule;
+  network_options.stiffness_params = o.stiffness_params;
+  network_options.mass = mass_rule;
+  network_options.density = o.density;
+  network_options.axial_damping = o.axial_damping;
+  msm::BuiltNetwork built = msm::build_network(mesh, params, network_options);
+  const msm::SpringNetwork& net = built.network;
+  const std::string& topology = built.topology;
+  const std::vector<double>& masses = built.masses;
   const msm::SpringModel model(net, o.point_damping);
   msm::Problem problem = msm::make_problem(model, net, masses, mesh, loads, o.fixed_groups);
   if (o.gravity) {

@@ -1,0 +1,40 @@
+#pragma once
+/// One place that turns a model description (volume or surface, which wall, which topology,
+/// stiffness and mass rules) into a spring network with stiffness and masses, for the command
+/// line and the verification harness alike.
+#include <string>
+#include <vector>
+
+#include "meshes/tet_mesh.hpp"
+#include "meshes/vessel_geometry.hpp"
+#include "msm/mass/mass_rules.hpp"
+#include "msm/stiffness/stiffness_rules.hpp"
+#include "msm/topology/springs.hpp"
+
+namespace vessel::msm {
+
+struct NetworkOptions {
+  std::string model = "surface";   ///< "surface" (seeds 000/002) or "volume" (seed 001)
+  std::string surface = "inner";   ///< surface model: inner | outer | mid wall
+  std::string topology = "auto";   ///< surface model: auto | grid | triangles
+  bool two_ring = false;           ///< triangle topology: add two-ring springs
+  StiffnessRule stiffness = StiffnessRule::seed000;
+  StiffnessParams stiffness_params;
+  MassRule mass = MassRule::consistent;
+  double density = kVesselDensity;  ///< kg/m³
+  double axial_damping = 0.0;       ///< k_d of seed 000 eq. (3.4), N·s/m, every spring
+};
+
+struct BuiltNetwork {
+  SpringNetwork network;      ///< springs with stiffness and damping assigned
+  std::vector<double> masses;  ///< kg per network node
+  std::string topology;        ///< human-readable description
+};
+
+/// Builds the network on the mesh: "auto" topology is seed 000's grid on a structured vessel and
+/// the triangle topology otherwise. Throws InputError for an unknown model, surface or topology
+/// name, or invalid stiffness parameters.
+BuiltNetwork build_network(const TetMesh& mesh, const VesselParams& params,
+                           const NetworkOptions& options);
+
+}  // namespace vessel::msm
