@@ -32,6 +32,12 @@
 #include <map>
 #include <sstream>
 
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <Spectra/MatOp/SparseSymMatProd.h>
+#include <Spectra/SymGEigsShiftSolver.h>
+#include <numbers>
+
 #include "meshes/errors.hpp"
 
 namespace vessel::fem {
@@ -743,6 +749,130 @@ double ElasticitySolver::relative_l2_error(const std::function<Vec3(const Vec3&)
   const double norm =
       dl::VectorTools::compute_global_error(im.tria, cellwise, dl::VectorTools::L2_norm);
   return err / norm;
+}
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double>;
+
+/// (K − σM)⁻¹ for Spectra's shift-invert mode, by a sparse LDLᵀ factorisation.
+class ShiftInvertLdlt {
+ public:
+  using Scalar = double;
+  ShiftInvertLdlt(const SpMat& k, const SpMat& m) : k_(k), m_(m) {}
+  [[nodiscard]] Eigen::Index rows() const { return k_.rows(); }
+  [[nodiscard]] Eigen::Index cols() const { return k_.cols(); }
+  void set_shift(const double& sigma) {
+    const SpMat a = k_ - sigma * m_;
+    ldlt_.compute(a);
+    if (ldlt_.info() != Eigen::Success) {
+      throw std::runtime_error("modal analysis: factorisation of K - sigma M failed");
+    }
+  }
+  void perform_op(const double* x_in, double* y_out) const {
+    Eigen::Map<const Eigen::VectorXd> x(x_in, rows());
+    Eigen::Map<Eigen::VectorXd> y(y_out, rows());
+    y = ldlt_.solve(x);
+  }
+
+ private:
+  const SpMat& k_;
+  const SpMat& m_;
+  Eigen::SimplicialLDLT<SpMat> ldlt_;
+};
+
+}  // namespace
+
+ModalResult ElasticitySolver::modes(int count) const {
+  const auto& im = *impl_;
+  if (im.mixed) {
+    throw InputError("modal analysis needs the displacement formulation (P1 or P2); the mixed "
+                     "Taylor-Hood system has no pressure mass: use nu below the mixed threshold");
+  }
+  if (count < 1) throw InputError("modal analysis: number of modes must be >= 1");
+  if (!(im.problem.material.density > 0.0)) {
+    throw InputError("modal analysis needs density > 0 (the mass matrix)");
+  }
+  const auto t0 = Clock::now();
+  // Free DoFs (not Dirichlet or point constrained) → eigenproblem index.
+  std::vector<int> free_index(im.dof.n_dofs(), -1);
+  int n_free = 0;
+  for (dl::types::global_dof_index d = 0; d < im.dof.n_dofs(); ++d) {
+    if (!im.constraints.is_constrained(d)) free_index[d] = n_free++;
+  }
+  if (n_free <= count) throw InputError("modal analysis: fewer free DoFs than modes requested");
+  const dl::FEValuesExtractors::Vector disp(0);
+  dl::FEValues<kDim> fev(*im.mapping, *im.fe, dl::QGaussSimplex<kDim>(static_cast<unsigned>(im.degree + 1)),
+                         dl::update_values | dl::update_gradients | dl::update_JxW_values);
+  const unsigned n = im.fe->n_dofs_per_cell();
+  std::vector<dl::types::global_dof_index> dofs(n);
+  std::vector<Eigen::Triplet<double>> kt, mt;
+  const double rho = im.problem.material.density;
+  for (const auto& cell : im.dof.active_cell_iterators()) {
+    fev.reinit(cell);
+    cell->get_dof_indices(dofs);
+    for (unsigned q = 0; q < fev.n_quadrature_points; ++q) {
+      const double jxw = fev.JxW(q);
+      for (unsigned i = 0; i < n; ++i) {
+        const int fi = free_index[dofs[i]];
+        if (fi < 0) continue;
+        const auto ei = fev[disp].symmetric_gradient(i, q);
+        const double di = fev[disp].divergence(i, q);
+        const auto vi = fev[disp].value(i, q);
+        for (unsigned j = 0; j < n; ++j) {
+          const int fj = free_index[dofs[j]];
+          if (fj < 0) continue;
+          // K: step-8's bilinear form; M_ij = ∫ ρ φ_i·φ_j (consistent mass).
+          const double kij = im.lambda * di * fev[disp].divergence(j, q) +
+                             2.0 * im.mu * (ei * fev[disp].symmetric_gradient(j, q));
+          kt.emplace_back(fi, fj, kij * jxw);
+          mt.emplace_back(fi, fj, rho * (vi * fev[disp].value(j, q)) * jxw);
+        }
+      }
+    }
+  }
+  SpMat k(n_free, n_free), m(n_free, n_free);
+  k.setFromTriplets(kt.begin(), kt.end());
+  m.setFromTriplets(mt.begin(), mt.end());
+  kt.clear();
+  mt.clear();
+
+  ShiftInvertLdlt op(k, m);
+  Spectra::SparseSymMatProd<double> bop(m);
+  const int ncv = std::min(n_free, std::max(2 * count + 1, 30));
+  // σ slightly below zero keeps K − σM positive definite even without constraints (rigid modes).
+  const double sigma = -1.0;  // (rad/s)²
+  Spectra::SymGEigsShiftSolver<ShiftInvertLdlt, Spectra::SparseSymMatProd<double>,
+                               Spectra::GEigsMode::ShiftInvert>
+      eigs(op, bop, count, ncv, sigma);
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10, Spectra::SortRule::SmallestAlge);
+  if (eigs.info() != Spectra::CompInfo::Successful) {
+    throw std::runtime_error("modal analysis: the Lanczos iteration did not converge");
+  }
+  const Eigen::VectorXd lambda = eigs.eigenvalues();
+  const Eigen::MatrixXd vectors = eigs.eigenvectors();
+  ModalResult out;
+  out.n_dofs = static_cast<std::size_t>(n_free);
+  for (int e = 0; e < lambda.size(); ++e) {
+    out.frequencies_hz.push_back(std::sqrt(std::max(lambda[e], 0.0)) / (2.0 * std::numbers::pi));
+    std::vector<Vec3> shape(im.mesh.nodes.size(), Vec3::Zero());
+    for (const auto& cell : im.dof.active_cell_iterators()) {
+      for (unsigned v = 0; v < 4; ++v) {
+        for (unsigned c = 0; c < 3; ++c) {
+          const int fi = free_index[cell->vertex_dof_index(v, c)];
+          shape[cell->vertex_index(v)][c] = fi < 0 ? 0.0 : vectors(fi, e);
+        }
+      }
+    }
+    double mx = 0.0;
+    for (const auto& u : shape) mx = std::max(mx, u.norm());
+    if (mx > 0.0)
+      for (auto& u : shape) u /= mx;
+    out.mode_shapes.push_back(std::move(shape));
+  }
+  out.seconds = seconds_since(t0);
+  return out;
 }
 
 ElasticityResult solve_elasticity(const TetMesh& mesh, const ElasticityProblem& problem) {
