@@ -44,6 +44,7 @@ struct FemCommandOptions {
   std::size_t direct_max_dofs = fem::SolverOptions{}.direct_max_dofs;
   double tolerance = fem::SolverOptions{}.cg_relative_tolerance;
   unsigned max_iterations = fem::SolverOptions{}.max_iterations;
+  int modes = 0;
   fs::path vtu;
   fs::path json;
 };
@@ -161,13 +162,29 @@ void run(FemCommandOptions& o) {
   double max_u = 0.0;
   for (const auto& u : r.nodal_displacement) max_u = std::max(max_u, u.norm());
 
+  fem::ModalResult modal;
+  if (o.modes > 0) {
+    std::cout << "modal analysis: lowest " << o.modes << " natural frequencies ..." << std::flush;
+    modal = solver.modes(o.modes);
+    std::cout << " " << std::fixed << std::setprecision(3) << modal.seconds << " s" << std::defaultfloat
+              << "\n  f (Hz):" << std::setprecision(6);
+    for (double f : modal.frequencies_hz) std::cout << " " << f;
+    std::cout << "\n";
+  }
+
   t0 = Clock::now();
   if (!o.vtu.empty()) {
     VtuField disp{"displacement", 3, {}}, strain{"strain", 6, {}}, stress{"stress", 6, {}};
     for (const auto& u : r.nodal_displacement) disp.values.insert(disp.values.end(), {u.x(), u.y(), u.z()});
     for (const auto& e : r.tet_strain) strain.values.insert(strain.values.end(), e.begin(), e.end());
     for (const auto& s : r.tet_stress) stress.values.insert(stress.values.end(), s.begin(), s.end());
-    write_vtu(o.vtu, mesh, {disp}, {strain, stress});
+    std::vector<VtuField> point_fields{disp};
+    for (std::size_t k = 0; k < modal.mode_shapes.size(); ++k) {
+      VtuField mode{"mode_" + std::to_string(k + 1), 3, {}};
+      for (const auto& u : modal.mode_shapes[k]) mode.values.insert(mode.values.end(), {u.x(), u.y(), u.z()});
+      point_fields.push_back(std::move(mode));
+    }
+    write_vtu(o.vtu, mesh, point_fields, {strain, stress});
   }
   const double output_seconds = since(t0);
 
@@ -237,6 +254,10 @@ void run(FemCommandOptions& o) {
          {{"mesh", mesh_seconds}, {"setup", r.timings.setup}, {"assembly", r.timings.assembly},
           {"solve", r.timings.solve}, {"postprocess", r.timings.postprocess}, {"output", output_seconds}}}};
     if (lame_error >= 0.0) j["lame_relative_l2_error"] = lame_error;
+    if (o.modes > 0) {
+      j["modal"] = {{"frequencies_hz", modal.frequencies_hz}, {"dofs", modal.n_dofs},
+                    {"seconds", modal.seconds}};
+    }
     if (have_contact_u) {
       j["contact"] = {{"point_mm", json_vec(contact_point, 1e3)}, {"radius_mm", o.contact_radius * 1e3},
                       {"force_mN", o.force * 1e3}, {"patch_area_mm2", patch.area * 1e6},
@@ -266,6 +287,7 @@ void add_fem_command(CLI::App& app) {
       "  vesselverify fem --load contact --force 1e-4 --contact-radius 5e-4 --json fem.json\n"
       "  vesselverify fem --load gravity --bc clamped-inlet\n"
       "  vesselverify fem --nu 0.5                          # Taylor-Hood P2-P1 (automatic)\n"
+      "  vesselverify fem --degree 2 --bc clamped-inlet --modes 10   # natural frequencies\n"
       "  vesselverify fem --degree 2 --level 2 --solver cg-amg");
   add_vessel_options(*cmd, o->vessel);
   cmd->add_option("--degree", o->degree, "Displacement element degree (1 or 2)")
@@ -306,7 +328,12 @@ void add_fem_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--tolerance", o->tolerance, "CG relative residual tolerance")->capture_default_str();
   cmd->add_option("--max-iterations", o->max_iterations, "CG iteration limit")->capture_default_str();
-  cmd->add_option("--vtu", o->vtu, "Write displacement (nodes), strain and stress (tets) as VTU");
+  cmd->add_option("--modes", o->modes,
+                  "Also compute this many lowest natural frequencies and mode shapes (consistent "
+                  "mass, on the same end conditions; e.g. 10)")
+      ->check(CLI::Range(0, 100));
+  cmd->add_option("--vtu", o->vtu,
+                  "Write displacement and mode shapes (nodes), strain and stress (tets) as VTU");
   cmd->add_option("--json", o->json, "Write a JSON summary");
   cmd->callback([o] { run(*o); });
 }
