@@ -18,6 +18,7 @@
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_fe.h>
+#include <deal.II/fe/mapping_fe_field.h>
 #include <deal.II/grid/tria.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
@@ -69,6 +70,16 @@ std::string to_string(LinearSolver s) {
     case LinearSolver::cg_amg: return "cg-amg";
   }
   return "?";
+}
+
+std::vector<CurvedSurface> tube_curved_walls(double a, double b) {
+  auto cylinder = [](double r) {
+    return [r](const Vec3& x) {
+      const double rho = std::hypot(x.x(), x.y());
+      return Vec3(x.x() * r / rho, x.y() * r / rho, x.z());
+    };
+  };
+  return {{"inner_wall", cylinder(a)}, {"outer_wall", cylinder(b)}};
 }
 
 std::vector<PointConstraint> tube_in_plane_pins(double a, double z) {
@@ -259,7 +270,11 @@ struct ElasticitySolver::Impl {
 
   dl::Triangulation<kDim> tria;
   std::unique_ptr<dl::FiniteElement<kDim>> fe;
-  std::unique_ptr<dl::MappingFE<kDim>> mapping;
+  std::unique_ptr<dl::MappingFE<kDim>> linear_mapping;
+  std::unique_ptr<dl::Mapping<kDim>> mapping;  // linear_mapping's copy, or the curved one
+  std::unique_ptr<dl::FiniteElement<kDim>> geometry_fe;
+  dl::DoFHandler<kDim> geometry_dof;
+  dl::Vector<double> geometry_positions;  // absolute positions of the P2 geometry nodes
   dl::DoFHandler<kDim> dof;
   dl::AffineConstraints<double> constraints;
   dl::SparsityPattern sparsity;
@@ -280,6 +295,7 @@ struct ElasticitySolver::Impl {
 
   void build_triangulation();
   void setup_dofs();
+  void setup_curved_mapping();
   void local_system(const dl::DoFHandler<kDim>::active_cell_iterator& cell,
                     dl::FEValues<kDim>& fev, dl::FEFaceValues<kDim>& fefv,
                     dl::FullMatrix<double>& k, dl::Vector<double>& f, Vec3* applied) const;
@@ -341,7 +357,9 @@ void ElasticitySolver::Impl::build_triangulation() {
 
 void ElasticitySolver::Impl::setup_dofs() {
   const dl::FE_SimplexP<kDim> linear(1);
-  mapping = std::make_unique<dl::MappingFE<kDim>>(linear);
+  linear_mapping = std::make_unique<dl::MappingFE<kDim>>(linear);
+  mapping = linear_mapping->clone();
+  if (degree == 2 && !problem.curved_surfaces.empty()) setup_curved_mapping();
   if (mixed) {
     // Taylor–Hood P2–P1 (step-22's u–p pattern on simplices).
     fe = std::make_unique<dl::FESystem<kDim>>(dl::FE_SimplexP<kDim>(2), kDim,
@@ -406,6 +424,55 @@ void ElasticitySolver::Impl::setup_dofs() {
   matrix.reinit(sparsity);
   rhs.reinit(dof.n_dofs());
   solution.reinit(dof.n_dofs());
+}
+
+void ElasticitySolver::Impl::setup_curved_mapping() {
+  geometry_fe = std::make_unique<dl::FESystem<kDim>>(dl::FE_SimplexP<kDim>(2), kDim);
+  geometry_dof.reinit(tria);
+  geometry_dof.distribute_dofs(*geometry_fe);
+  geometry_positions.reinit(geometry_dof.n_dofs());
+  std::map<int, const CurvedSurface*> by_tag;
+  for (const auto& cs : problem.curved_surfaces) {
+    by_tag[mesh.require_group(cs.group, 2, "curved surface").tag] = &cs;
+  }
+  const auto& unit = geometry_fe->get_unit_support_points();
+  const unsigned n = geometry_fe->n_dofs_per_cell();
+  std::vector<dl::types::global_dof_index> dofs(n);
+  // A node on a curved face is shared with cells that touch the surface only along an edge: once
+  // projected (from a cell that has the face), it must not be overwritten from such a cell.
+  std::vector<bool> projected(geometry_dof.n_dofs(), false);
+  for (const auto& cell : geometry_dof.active_cell_iterators()) {
+    cell->get_dof_indices(dofs);
+    for (unsigned i = 0; i < n; ++i) {
+      if (projected[dofs[i]]) continue;
+      const auto x = linear_mapping->transform_unit_to_real_cell(cell, unit[i]);
+      Vec3 y(x[0], x[1], x[2]);
+      // A P2 node lies on a face iff it is one of the face's vertices or edge midpoints.
+      for (unsigned f = 0; f < cell->n_faces(); ++f) {
+        if (!cell->face(f)->at_boundary()) continue;
+        const auto it = by_tag.find(static_cast<int>(cell->face(f)->boundary_id()));
+        if (it == by_tag.end()) continue;
+        const auto face = cell->face(f);
+        const double h = face->diameter();
+        bool on_face = false;
+        for (unsigned a = 0; a < 3 && !on_face; ++a) {
+          for (unsigned b = a; b < 3 && !on_face; ++b) {
+            const auto m = 0.5 * (face->vertex(a) + face->vertex(b));
+            on_face = x.distance(m) < 1e-9 * h;
+          }
+        }
+        if (on_face) {
+          y = it->second->project(y);
+          projected[dofs[i]] = true;
+          break;
+        }
+      }
+      geometry_positions(dofs[i]) = y[geometry_fe->system_to_component_index(i).first];
+    }
+  }
+  mapping = std::make_unique<dl::MappingFEField<kDim, kDim, dl::Vector<double>>>(
+      geometry_dof, geometry_positions);
+  result.curved = true;
 }
 
 void ElasticitySolver::Impl::local_system(const dl::DoFHandler<kDim>::active_cell_iterator& cell,
@@ -719,8 +786,16 @@ std::vector<Vec3> ElasticitySolver::displacement_at(const std::vector<Vec3>& poi
       throw InputError(m.str());
     }
     const auto& cell = im.cells[static_cast<std::size_t>(t)];
-    const dl::Point<kDim> ref =
-        im.mapping->transform_real_to_unit_cell(cell, dl::Point<kDim>(x.x(), x.y(), x.z()));
+    const dl::Point<kDim> px(x.x(), x.y(), x.z());
+    dl::Point<kDim> ref = im.linear_mapping->transform_real_to_unit_cell(cell, px);
+    if (im.result.curved) {
+      // The curved cell differs from the straight one only near the curved faces (O(h²)); use
+      // the curved inverse where deal.II provides it, else the straight one.
+      try {
+        ref = im.mapping->transform_real_to_unit_cell(cell, px);
+      } catch (...) {
+      }
+    }
     cell->get_dof_indices(dofs);
     Vec3 u = Vec3::Zero();
     for (unsigned i = 0; i < n; ++i) {
@@ -735,20 +810,63 @@ std::vector<Vec3> ElasticitySolver::displacement_at(const std::vector<Vec3>& poi
 double ElasticitySolver::relative_l2_error(const std::function<Vec3(const Vec3&)>& exact) const {
   const auto& im = *impl_;
   if (!im.solved) throw std::logic_error("relative_l2_error called before solve()");
-  const VectorFunction u_exact(exact, im.n_components);
+  // Own loop rather than VectorTools::integrate_difference: with the curved MappingFEField on
+  // simplices deal.II 9.4 returns NaN there, so the quadrature points are computed from the
+  // geometry field itself (x_q = Σ x_i φ_i(ξ_q)) and only JxW comes from the mapping.
   const dl::QWitherdenVincentSimplex<kDim> quad(static_cast<unsigned>(im.degree + 2));
-  const dl::ComponentSelectFunction<kDim> select(std::make_pair(0U, 3U), im.n_components);
-  dl::Vector<double> cellwise(im.tria.n_active_cells());
-  dl::VectorTools::integrate_difference(*im.mapping, im.dof, im.solution, u_exact, cellwise, quad,
-                                        dl::VectorTools::L2_norm, &select);
-  const double err =
-      dl::VectorTools::compute_global_error(im.tria, cellwise, dl::VectorTools::L2_norm);
-  dl::Vector<double> zero(im.dof.n_dofs());
-  dl::VectorTools::integrate_difference(*im.mapping, im.dof, zero, u_exact, cellwise, quad,
-                                        dl::VectorTools::L2_norm, &select);
-  const double norm =
-      dl::VectorTools::compute_global_error(im.tria, cellwise, dl::VectorTools::L2_norm);
-  return err / norm;
+  const dl::FEValuesExtractors::Vector disp(0);
+  dl::FEValues<kDim> fev(*im.mapping, *im.fe, quad, dl::update_values | dl::update_JxW_values);
+  dl::FEValues<kDim> lin(*im.linear_mapping, *im.fe, quad, dl::update_quadrature_points);
+  std::unique_ptr<dl::FEValues<kDim>> geo;
+  if (im.result.curved) {
+    geo = std::make_unique<dl::FEValues<kDim>>(*im.linear_mapping, *im.geometry_fe, quad,
+                                               dl::update_values);
+  }
+  std::vector<dl::Tensor<1, kDim>> uh(quad.size());
+  std::vector<dl::types::global_dof_index> gdofs(im.geometry_fe ? im.geometry_fe->n_dofs_per_cell() : 0);
+  double err2 = 0.0, norm2 = 0.0;
+  for (const auto& cell : im.dof.active_cell_iterators()) {
+    fev.reinit(cell);
+    lin.reinit(cell);
+    fev[disp].get_function_values(im.solution, uh);
+    std::vector<Vec3> xq(quad.size());
+    for (unsigned q = 0; q < quad.size(); ++q) {
+      const auto& p = lin.quadrature_point(q);
+      xq[q] = Vec3(p[0], p[1], p[2]);
+    }
+    if (geo) {
+      const typename dl::DoFHandler<kDim>::active_cell_iterator gcell(&im.tria, cell->level(),
+                                                                     cell->index(), &im.geometry_dof);
+      geo->reinit(gcell);
+      gcell->get_dof_indices(gdofs);
+      for (unsigned q = 0; q < quad.size(); ++q) {
+        Vec3 x = Vec3::Zero();
+        for (unsigned i = 0; i < gdofs.size(); ++i) {
+          x[im.geometry_fe->system_to_component_index(i).first] +=
+              im.geometry_positions(gdofs[i]) * geo->shape_value(i, q);
+        }
+        xq[q] = x;
+      }
+    }
+    for (unsigned q = 0; q < quad.size(); ++q) {
+      const Vec3 u = exact(xq[q]);
+      const Vec3 d = Vec3(uh[q][0], uh[q][1], uh[q][2]) - u;
+      err2 += d.squaredNorm() * fev.JxW(q);
+      norm2 += u.squaredNorm() * fev.JxW(q);
+    }
+  }
+  return std::sqrt(err2 / norm2);
+}
+
+double ElasticitySolver::domain_volume() const {
+  const auto& im = *impl_;
+  dl::FEValues<kDim> fev(*im.mapping, *im.fe, cell_quadrature(2), dl::update_JxW_values);
+  double v = 0.0;
+  for (const auto& cell : im.dof.active_cell_iterators()) {
+    fev.reinit(cell);
+    for (unsigned q = 0; q < fev.n_quadrature_points; ++q) v += fev.JxW(q);
+  }
+  return v;
 }
 
 namespace {

@@ -64,6 +64,17 @@ struct PressureLoad {
   double pressure = 0.0;
 };
 
+/// A boundary group whose exact surface is known: with a quadratic element its P2 geometry nodes
+/// (edge midpoints) are moved onto the surface by `project` (isoparametric MappingFEField), so the
+/// curved wall is represented to O(h³) instead of the straight-sided tets' O(h²).
+struct CurvedSurface {
+  std::string group;
+  std::function<Vec3(const Vec3&)> project;  ///< closest point on the exact surface, m
+};
+
+/// The straight tube's walls: cylinders r = a (inner_wall) and r = b (outer_wall) about the z axis.
+std::vector<CurvedSurface> tube_curved_walls(double inner_radius, double outer_radius);
+
 struct SolverOptions {
   int degree = 1;  ///< displacement element degree, 1 or 2 (the mixed element is always P2–P1)
   Formulation formulation = Formulation::automatic;
@@ -83,6 +94,9 @@ struct ElasticityProblem {
   std::vector<PointConstraint> point_constraints;
   std::vector<PressureLoad> pressures;
   std::vector<TractionPatch> patches;  ///< from vessel::contact_patch (shared with mass-spring)
+  /// Curved geometry for degree 2 (ignored for P1). Note: a traction patch is then integrated over
+  /// the curved faces, whose area differs from the flat triangles' by O(h²).
+  std::vector<CurvedSurface> curved_surfaces;
   Vec3 gravity = Vec3::Zero();         ///< m/s²; body force ρg
   /// Optional extra body force density b(x), N/m³ (manufactured solutions); added to ρg.
   std::function<Vec3(const Vec3&)> body_force;
@@ -105,6 +119,7 @@ struct PhaseTimings {
 
 struct ElasticityResult {
   std::string element;          ///< "P1", "P2" or "P2-P1 (Taylor-Hood)"
+  bool curved = false;          ///< quadratic geometry on the curved surfaces
   Formulation formulation = Formulation::displacement;  ///< the one used
   LinearSolver solver = LinearSolver::direct;            ///< the one used
   unsigned iterations = 0;      ///< CG iterations (0 for direct)
@@ -159,6 +174,9 @@ class ElasticitySolver {
   /// ‖u_h − u‖_L2 / ‖u‖_L2 over the mesh, integrated with a quadrature two orders above the
   /// element's. Requires solve().
   [[nodiscard]] double relative_l2_error(const std::function<Vec3(const Vec3&)>& exact) const;
+
+  /// Volume of the discrete domain, m³ (the tets', or the curved cells' with curved surfaces).
+  [[nodiscard]] double domain_volume() const;
 
  private:
   struct Impl;

@@ -45,6 +45,7 @@ struct FemCommandOptions {
   double tolerance = fem::SolverOptions{}.cg_relative_tolerance;
   unsigned max_iterations = fem::SolverOptions{}.max_iterations;
   int modes = 0;
+  bool curved = false;
   fs::path vtu;
   fs::path json;
 };
@@ -126,6 +127,12 @@ void run(FemCommandOptions& o) {
               << patch.traction.norm() << " Pa\n";
   }
   if (has_gravity) problem.gravity = to_vec3(o.gravity, "--gravity");
+  if (o.curved) {
+    if (params.kind != VesselKind::straight) {
+      throw InputError("--curved is available for the straight tube only (its walls are cylinders)");
+    }
+    problem.curved_surfaces = fem::tube_curved_walls(params.inner_radius, params.outer_radius());
+  }
 
   // Ends: roller (u_z = 0, plane strain, plus three in-plane pins) or clamped.
   std::string bc = o.bc;
@@ -148,7 +155,8 @@ void run(FemCommandOptions& o) {
 
   fem::ElasticitySolver solver(mesh, problem);
   const auto& pre = solver.result();
-  std::cout << "element " << pre.element << ": " << pre.n_dofs << " DoFs";
+  std::cout << "element " << pre.element << (pre.curved ? " on curved walls" : "") << ": "
+            << pre.n_dofs << " DoFs";
   if (pre.n_pressure_dofs) std::cout << " (" << pre.n_pressure_dofs << " pressure)";
   std::cout << "\nsolving ..." << std::flush;
   const auto& r = solver.solve();
@@ -239,6 +247,7 @@ void run(FemCommandOptions& o) {
         {"loads", o.loads},
         {"ends", bc},
         {"element", r.element},
+        {"curved", r.curved},
         {"formulation", fem::to_string(r.formulation)},
         {"solver", fem::to_string(r.solver)},
         {"cg_iterations", r.iterations},
@@ -328,6 +337,9 @@ void add_fem_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--tolerance", o->tolerance, "CG relative residual tolerance")->capture_default_str();
   cmd->add_option("--max-iterations", o->max_iterations, "CG iteration limit")->capture_default_str();
+  cmd->add_flag("--curved", o->curved,
+                "Quadratic elements: put the P2 geometry nodes on the exact cylinders (straight "
+                "tube), so the wall is curved (O(h³) geometry instead of straight-sided O(h²))");
   cmd->add_option("--modes", o->modes,
                   "Also compute this many lowest natural frequencies and mode shapes (consistent "
                   "mass, on the same end conditions; e.g. 10)")
