@@ -23,7 +23,8 @@ double observed_order_three(double f3, double f2, double f1, double ratio) {
 }
 
 RichardsonEstimate richardson(double f2, double f1, double p, double r, double fs) {
-  if (!(r > 1.0) || !(p > 0.0)) throw std::invalid_argument("richardson: need ratio > 1, order > 0");
+  if (!(r > 1.0) || !(p > 0.0))
+    throw std::invalid_argument("richardson: need ratio > 1, order > 0");
   const double rp1 = std::pow(r, p) - 1.0;
   RichardsonEstimate e;
   e.extrapolated = f1 + (f1 - f2) / rp1;  // Richardson extrapolation

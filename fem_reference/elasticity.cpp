@@ -3,12 +3,8 @@
 /// postprocess.
 #include "fem_reference/elasticity.hpp"
 
-#include <mpi.h>
-
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <cstdlib>
+#include <Spectra/MatOp/SparseSymMatProd.h>
+#include <Spectra/SymGEigsShiftSolver.h>
 #include <deal.II/base/function.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/base/symmetric_tensor.h>
@@ -29,15 +25,18 @@
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/vector.h>
 #include <deal.II/numerics/vector_tools.h>
-#include <limits>
-#include <map>
-#include <sstream>
+#include <mpi.h>
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
-#include <Spectra/MatOp/SparseSymMatProd.h>
-#include <Spectra/SymGEigsShiftSolver.h>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <map>
 #include <numbers>
+#include <sstream>
 
 #include "meshes/errors.hpp"
 
@@ -56,18 +55,24 @@ double Material::mu() const { return youngs_modulus / (2.0 * (1.0 + poisson_rati
 
 std::string to_string(Formulation f) {
   switch (f) {
-    case Formulation::automatic: return "auto";
-    case Formulation::displacement: return "displacement";
-    case Formulation::mixed: return "mixed";
+    case Formulation::automatic:
+      return "auto";
+    case Formulation::displacement:
+      return "displacement";
+    case Formulation::mixed:
+      return "mixed";
   }
   return "?";
 }
 
 std::string to_string(LinearSolver s) {
   switch (s) {
-    case LinearSolver::automatic: return "auto";
-    case LinearSolver::direct: return "direct";
-    case LinearSolver::cg_amg: return "cg-amg";
+    case LinearSolver::automatic:
+      return "auto";
+    case LinearSolver::direct:
+      return "direct";
+    case LinearSolver::cg_amg:
+      return "cg-amg";
   }
   return "?";
 }
@@ -150,7 +155,8 @@ class TetLocator {
     const double extent = (hi_ - lo_).maxCoeff();
     lo_ -= Vec3::Constant(1e-9 * extent);
     hi_ += Vec3::Constant(1e-9 * extent);
-    const double per_axis = std::cbrt(static_cast<double>(std::max<std::size_t>(mesh.tets.size(), 1)));
+    const double per_axis =
+        std::cbrt(static_cast<double>(std::max<std::size_t>(mesh.tets.size(), 1)));
     for (int d = 0; d < 3; ++d) {
       n_[d] = std::max(1, static_cast<int>(per_axis * (hi_[d] - lo_[d]) / extent) + 1);
     }
@@ -164,11 +170,13 @@ class TetLocator {
       const auto ia = bucket_of(a), ib = bucket_of(b);
       for (int i = ia[0]; i <= ib[0]; ++i)
         for (int j = ia[1]; j <= ib[1]; ++j)
-          for (int k = ia[2]; k <= ib[2]; ++k) buckets_[index(i, j, k)].push_back(static_cast<int>(t));
+          for (int k = ia[2]; k <= ib[2]; ++k)
+            buckets_[index(i, j, k)].push_back(static_cast<int>(t));
     }
   }
 
-  /// The tet containing x (the one with the largest smallest barycentric coordinate, ≥ −tol), or −1.
+  /// The tet containing x (the one with the largest smallest barycentric coordinate, ≥ −tol), or
+  /// −1.
   [[nodiscard]] int find(const Vec3& x, double tol = 1e-9) const {
     for (int d = 0; d < 3; ++d) {
       if (x[d] < lo_[d] || x[d] > hi_[d]) return -1;
@@ -240,7 +248,8 @@ void validate(const TetMesh& mesh, const ElasticityProblem& p) {
   }
   for (const auto& pr : p.pressures) {
     (void)mesh.require_group(pr.group, 2, "FEM pressure load");
-    if (!std::isfinite(pr.pressure)) throw InputError("pressure on '" + pr.group + "' is not finite");
+    if (!std::isfinite(pr.pressure))
+      throw InputError("pressure on '" + pr.group + "' is not finite");
   }
   for (const auto& patch : p.patches) {
     for (int t : patch.triangles) {
@@ -282,9 +291,9 @@ struct ElasticitySolver::Impl {
   dl::Vector<double> rhs, solution;
 
   std::vector<dl::DoFHandler<kDim>::active_cell_iterator> cells;  // by tet index
-  std::vector<std::array<int, 4>> face_triangle;  // per cell and face: TetMesh triangle or −1
-  std::vector<int> triangle_tag;                   // gmsh tag of each triangle's group (0: none)
-  std::vector<std::vector<int>> triangle_patches;  // patches acting on each triangle
+  std::vector<std::array<int, 4>> face_triangle;      // per cell and face: TetMesh triangle or −1
+  std::vector<int> triangle_tag;                      // gmsh tag of each triangle's group (0: none)
+  std::vector<std::vector<int>> triangle_patches;     // patches acting on each triangle
   std::vector<std::pair<int, double>> pressure_tags;  // (group tag, p) of each pressure load
   std::unique_ptr<TetLocator> locator;
   ElasticityResult result;
@@ -296,9 +305,9 @@ struct ElasticitySolver::Impl {
   void build_triangulation();
   void setup_dofs();
   void setup_curved_mapping();
-  void local_system(const dl::DoFHandler<kDim>::active_cell_iterator& cell,
-                    dl::FEValues<kDim>& fev, dl::FEFaceValues<kDim>& fefv,
-                    dl::FullMatrix<double>& k, dl::Vector<double>& f, Vec3* applied) const;
+  void local_system(const dl::DoFHandler<kDim>::active_cell_iterator& cell, dl::FEValues<kDim>& fev,
+                    dl::FEFaceValues<kDim>& fefv, dl::FullMatrix<double>& k, dl::Vector<double>& f,
+                    Vec3* applied) const;
   void assemble();
   void solve_linear();
   void postprocess();
@@ -310,7 +319,8 @@ void ElasticitySolver::Impl::build_triangulation() {
   for (const auto& x : mesh.nodes) vertices.emplace_back(x.x(), x.y(), x.z());
   std::vector<dl::CellData<kDim>> cell_data(mesh.tets.size(), dl::CellData<kDim>(4));
   for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
-    for (unsigned v = 0; v < 4; ++v) cell_data[t].vertices[v] = static_cast<unsigned>(mesh.tets[t][v]);
+    for (unsigned v = 0; v < 4; ++v)
+      cell_data[t].vertices[v] = static_cast<unsigned>(mesh.tets[t][v]);
     cell_data[t].material_id = 0;
   }
   tria.create_triangulation(vertices, cell_data, dl::SubCellData());
@@ -322,7 +332,8 @@ void ElasticitySolver::Impl::build_triangulation() {
     for (int e : g.elements) triangle_tag[e] = g.tag;
   }
   for (const auto& pr : problem.pressures) {
-    pressure_tags.emplace_back(mesh.require_group(pr.group, 2, "FEM pressure load").tag, pr.pressure);
+    pressure_tags.emplace_back(mesh.require_group(pr.group, 2, "FEM pressure load").tag,
+                               pr.pressure);
   }
   triangle_patches.assign(mesh.triangles.size(), {});
   for (std::size_t i = 0; i < problem.patches.size(); ++i) {
@@ -377,7 +388,8 @@ void ElasticitySolver::Impl::setup_dofs() {
   if (!problem.point_constraints.empty()) {
     // Tolerance: 1e-6 of a typical element length (cube root of the mean tet volume).
     const double tol =
-        1e-6 * std::cbrt(mesh_volume(mesh) / static_cast<double>(std::max<std::size_t>(mesh.tets.size(), 1)));
+        1e-6 * std::cbrt(mesh_volume(mesh) /
+                         static_cast<double>(std::max<std::size_t>(mesh.tets.size(), 1)));
     std::vector<std::pair<dl::DoFHandler<kDim>::active_cell_iterator, unsigned>> vertex_cell(
         mesh.nodes.size(), {dof.end(), 0});
     for (const auto& cell : dof.active_cell_iterators())
@@ -402,7 +414,8 @@ void ElasticitySolver::Impl::setup_dofs() {
     }
   }
   for (const auto& bc : problem.dirichlet) {
-    const auto tag = static_cast<dl::types::boundary_id>(mesh.require_group(bc.group, 2, "FEM").tag);
+    const auto tag =
+        static_cast<dl::types::boundary_id>(mesh.require_group(bc.group, 2, "FEM").tag);
     std::vector<bool> mask(n_components, false);
     if (bc.kind == DirichletCondition::Kind::clamped) {
       mask[0] = mask[1] = mask[2] = true;
@@ -569,8 +582,9 @@ void ElasticitySolver::Impl::assemble() {
   dl::FEValues<kDim> fev(*mapping, *fe, cell_quadrature(q_degree),
                          dl::update_values | dl::update_gradients | dl::update_JxW_values |
                              dl::update_quadrature_points);
-  dl::FEFaceValues<kDim> fefv(*mapping, *fe, face_quadrature(q_degree),
-                              dl::update_values | dl::update_normal_vectors | dl::update_JxW_values);
+  dl::FEFaceValues<kDim> fefv(
+      *mapping, *fe, face_quadrature(q_degree),
+      dl::update_values | dl::update_normal_vectors | dl::update_JxW_values);
   const unsigned n = fe->n_dofs_per_cell();
   dl::FullMatrix<double> k(n, n);
   dl::Vector<double> f(n);
@@ -647,8 +661,9 @@ void ElasticitySolver::Impl::postprocess() {
                              dl::update_quadrature_points);
   dl::FEValues<kDim> centre(*mapping, *fe, dl::Quadrature<kDim>(dl::Point<kDim>(0.25, 0.25, 0.25)),
                             dl::update_values | dl::update_gradients);
-  dl::FEFaceValues<kDim> fefv(*mapping, *fe, face_quadrature(q_degree),
-                              dl::update_values | dl::update_normal_vectors | dl::update_JxW_values);
+  dl::FEFaceValues<kDim> fefv(
+      *mapping, *fe, face_quadrature(q_degree),
+      dl::update_values | dl::update_normal_vectors | dl::update_JxW_values);
   std::vector<dl::SymmetricTensor<2, kDim>> eps(fev.n_quadrature_points);
   std::vector<double> p(fev.n_quadrature_points);
   const double inv_lambda = std::isinf(lambda) ? 0.0 : 1.0 / lambda;
@@ -686,7 +701,8 @@ void ElasticitySolver::Impl::postprocess() {
     const dl::SymmetricTensor<2, kDim> sigma =
         2.0 * mu * e1[0] - pc * dl::unit_symmetric_tensor<kDim>();
     const auto idx = cell->active_cell_index();
-    constexpr std::array<std::array<unsigned, 2>, 6> kVoigt{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}}};
+    constexpr std::array<std::array<unsigned, 2>, 6> kVoigt{
+        {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}}};
     for (unsigned v = 0; v < 6; ++v) {
       result.tet_strain[idx][v] = e1[0][kVoigt[v][0]][kVoigt[v][1]];
       result.tet_stress[idx][v] = sigma[kVoigt[v][0]][kVoigt[v][1]];
@@ -711,7 +727,8 @@ void ElasticitySolver::Impl::postprocess() {
   for (const auto& bc : problem.dirichlet) {
     if (std::find(seen.begin(), seen.end(), bc.group) != seen.end()) continue;
     seen.push_back(bc.group);
-    const auto tag = static_cast<dl::types::boundary_id>(mesh.require_group(bc.group, 2, "FEM").tag);
+    const auto tag =
+        static_cast<dl::types::boundary_id>(mesh.require_group(bc.group, 2, "FEM").tag);
     std::vector<bool> mask(n_components, false);
     mask[0] = mask[1] = mask[2] = true;
     const dl::IndexSet on_group =
@@ -823,7 +840,8 @@ double ElasticitySolver::relative_l2_error(const std::function<Vec3(const Vec3&)
                                                dl::update_values);
   }
   std::vector<dl::Tensor<1, kDim>> uh(quad.size());
-  std::vector<dl::types::global_dof_index> gdofs(im.geometry_fe ? im.geometry_fe->n_dofs_per_cell() : 0);
+  std::vector<dl::types::global_dof_index> gdofs(im.geometry_fe ? im.geometry_fe->n_dofs_per_cell()
+                                                                : 0);
   double err2 = 0.0, norm2 = 0.0;
   for (const auto& cell : im.dof.active_cell_iterators()) {
     fev.reinit(cell);
@@ -835,8 +853,8 @@ double ElasticitySolver::relative_l2_error(const std::function<Vec3(const Vec3&)
       xq[q] = Vec3(p[0], p[1], p[2]);
     }
     if (geo) {
-      const typename dl::DoFHandler<kDim>::active_cell_iterator gcell(&im.tria, cell->level(),
-                                                                     cell->index(), &im.geometry_dof);
+      const typename dl::DoFHandler<kDim>::active_cell_iterator gcell(
+          &im.tria, cell->level(), cell->index(), &im.geometry_dof);
       geo->reinit(gcell);
       gcell->get_dof_indices(gdofs);
       for (unsigned q = 0; q < quad.size(); ++q) {
@@ -904,8 +922,9 @@ class ShiftInvertLdlt {
 ModalResult ElasticitySolver::modes(int count) const {
   const auto& im = *impl_;
   if (im.mixed) {
-    throw InputError("modal analysis needs the displacement formulation (P1 or P2); the mixed "
-                     "Taylor-Hood system has no pressure mass: use nu below the mixed threshold");
+    throw InputError(
+        "modal analysis needs the displacement formulation (P1 or P2); the mixed "
+        "Taylor-Hood system has no pressure mass: use nu below the mixed threshold");
   }
   if (count < 1) throw InputError("modal analysis: number of modes must be >= 1");
   if (!(im.problem.material.density > 0.0)) {
@@ -920,7 +939,8 @@ ModalResult ElasticitySolver::modes(int count) const {
   }
   if (n_free <= count) throw InputError("modal analysis: fewer free DoFs than modes requested");
   const dl::FEValuesExtractors::Vector disp(0);
-  dl::FEValues<kDim> fev(*im.mapping, *im.fe, dl::QGaussSimplex<kDim>(static_cast<unsigned>(im.degree + 1)),
+  dl::FEValues<kDim> fev(*im.mapping, *im.fe,
+                         dl::QGaussSimplex<kDim>(static_cast<unsigned>(im.degree + 1)),
                          dl::update_values | dl::update_gradients | dl::update_JxW_values);
   const unsigned n = im.fe->n_dofs_per_cell();
   std::vector<dl::types::global_dof_index> dofs(n);

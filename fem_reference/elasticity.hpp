@@ -38,11 +38,12 @@ struct DirichletCondition {
   };
   std::string group;
   Kind kind = Kind::clamped;
-  int component = 2;                                ///< roller: 0, 1, 2 for x, y, z
-  std::function<Vec3(const Vec3&)> value;           ///< clamped: prescribed u(x), m
+  int component = 2;                       ///< roller: 0, 1, 2 for x, y, z
+  std::function<Vec3(const Vec3&)> value;  ///< clamped: prescribed u(x), m
 
   /// All components held: u = value(x) on the group (u = 0 without a value).
-  static DirichletCondition clamped(std::string group, std::function<Vec3(const Vec3&)> value = {}) {
+  static DirichletCondition clamped(std::string group,
+                                    std::function<Vec3(const Vec3&)> value = {}) {
     return {std::move(group), Kind::clamped, 0, std::move(value)};
   }
   /// u[component] = 0 on the group, the other components free.
@@ -97,7 +98,7 @@ struct ElasticityProblem {
   /// Curved geometry for degree 2 (ignored for P1). Note: a traction patch is then integrated over
   /// the curved faces, whose area differs from the flat triangles' by O(h²).
   std::vector<CurvedSurface> curved_surfaces;
-  Vec3 gravity = Vec3::Zero();         ///< m/s²; body force ρg
+  Vec3 gravity = Vec3::Zero();  ///< m/s²; body force ρg
   /// Optional extra body force density b(x), N/m³ (manufactured solutions); added to ρg.
   std::function<Vec3(const Vec3&)> body_force;
   SolverOptions options;
@@ -111,26 +112,26 @@ struct GroupReaction {
 
 /// Wall-clock seconds per phase.
 struct PhaseTimings {
-  double setup = 0.0;     ///< triangulation, DoFs, constraints, sparsity
+  double setup = 0.0;  ///< triangulation, DoFs, constraints, sparsity
   double assembly = 0.0;
   double solve = 0.0;
   double postprocess = 0.0;  ///< nodal values, energy, strains, reactions
 };
 
 struct ElasticityResult {
-  std::string element;          ///< "P1", "P2" or "P2-P1 (Taylor-Hood)"
-  bool curved = false;          ///< quadratic geometry on the curved surfaces
+  std::string element;  ///< "P1", "P2" or "P2-P1 (Taylor-Hood)"
+  bool curved = false;  ///< quadratic geometry on the curved surfaces
   Formulation formulation = Formulation::displacement;  ///< the one used
-  LinearSolver solver = LinearSolver::direct;            ///< the one used
-  unsigned iterations = 0;      ///< CG iterations (0 for direct)
+  LinearSolver solver = LinearSolver::direct;           ///< the one used
+  unsigned iterations = 0;                              ///< CG iterations (0 for direct)
   std::size_t n_dofs = 0;
-  std::size_t n_pressure_dofs = 0;  ///< mixed only
+  std::size_t n_pressure_dofs = 0;       ///< mixed only
   std::vector<Vec3> nodal_displacement;  ///< at every TetMesh node, m
   std::vector<GroupReaction> reactions;  ///< one per Dirichlet group, in order of first mention
   Vec3 applied_load = Vec3::Zero();      ///< ∫ traction dA + ∫ ρg dV, N
   double strain_energy = 0.0;            ///< ½∫σ:ε dV, J
-  double max_principal_strain = 0.0;     ///< largest eigenvalue of ε over the mesh (quadrature points)
-  double max_abs_principal_strain = 0.0; ///< largest |eigenvalue| of ε: the linear-regime flag
+  double max_principal_strain = 0.0;  ///< largest eigenvalue of ε over the mesh (quadrature points)
+  double max_abs_principal_strain = 0.0;  ///< largest |eigenvalue| of ε: the linear-regime flag
   /// Per tet, at its centroid: ε and σ as (xx, yy, zz, xy, yz, xz), dimensionless and Pa.
   std::vector<std::array<double, 6>> tet_strain;
   std::vector<std::array<double, 6>> tet_stress;

@@ -22,8 +22,11 @@ inline fem::ElasticityProblem lame_problem(double nu, int degree, fem::Formulati
 }
 
 inline fem::LameCylinder lame_exact(double nu) {
-  return {.inner_radius = 3e-3, .outer_radius = 4e-3, .pressure = kLamePressure,
-          .youngs_modulus = 14.24e3, .poisson_ratio = nu};
+  return {.inner_radius = 3e-3,
+          .outer_radius = 4e-3,
+          .pressure = kLamePressure,
+          .youngs_modulus = 14.24e3,
+          .poisson_ratio = nu};
 }
 
 }  // namespace vessel::test

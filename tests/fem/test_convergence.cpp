@@ -1,9 +1,9 @@
-#include "fem_reference/convergence.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
+
+#include "fem_reference/convergence.hpp"
 
 using namespace vessel::fem;
 

@@ -1,12 +1,11 @@
 /// The FEM reference against independent truth: input validation, rigid-body motion, the
 /// constant-strain patch test, equilibrium of reactions and applied loads, point evaluation.
-#include "fem_reference/elasticity.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
+#include "fem_reference/elasticity.hpp"
 #include "fem_test_meshes.hpp"
 #include "meshes/errors.hpp"
 #include "meshes/surface_loads.hpp"
@@ -155,7 +154,8 @@ TEST(ElasticityEquilibrium, ReactionsBalanceAContactPatch) {
   for (int degree : {1, 2}) {
     ElasticityProblem p;
     p.options.degree = degree;
-    p.dirichlet = {fem::DirichletCondition::clamped("inlet"), fem::DirichletCondition::clamped("outlet")};
+    p.dirichlet = {fem::DirichletCondition::clamped("inlet"),
+                   fem::DirichletCondition::clamped("outlet")};
     p.patches = {patch};
     const auto r = solve_elasticity(m, p);
     // The integrated traction equals the patch's total force −F n̂ (exact quadrature of a

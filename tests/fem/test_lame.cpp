@@ -1,6 +1,4 @@
 /// Lamé's thick-walled cylinder: the closed form itself, then the FEM against it (P1, P2, mixed).
-#include "fem_reference/lame.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +8,7 @@
 
 #include "fem_reference/convergence.hpp"
 #include "fem_reference/elasticity.hpp"
+#include "fem_reference/lame.hpp"
 #include "fem_test_meshes.hpp"
 #include "lame_problem.hpp"
 
@@ -34,8 +33,11 @@ double sigma_rr(const LameCylinder& c, double r) {
 
 TEST(LameClosedForm, SatisfiesTheTractionBoundaryConditions) {
   for (double nu : {0.0, 0.3, 0.45, 0.49}) {
-    LameCylinder c{.inner_radius = 3e-3, .outer_radius = 4e-3, .pressure = 7.0,
-                   .youngs_modulus = 14.24e3, .poisson_ratio = nu};
+    LameCylinder c{.inner_radius = 3e-3,
+                   .outer_radius = 4e-3,
+                   .pressure = 7.0,
+                   .youngs_modulus = 14.24e3,
+                   .poisson_ratio = nu};
     EXPECT_NEAR(sigma_rr(c, 3e-3), -7.0, 1e-5) << "nu " << nu;
     EXPECT_NEAR(sigma_rr(c, 4e-3), 0.0, 1e-5) << "nu " << nu;
   }
@@ -167,7 +169,8 @@ TEST(LameFem, AutomaticFormulationSwitchesToMixedAtTheThreshold) {
 // P2 reaches its own order 3 (Ciarlet & Raviart's isoparametric theory); Taylor–Hood at ν = 0.5
 // gains the same way (its displacement is P2).
 TEST(LameFem, CurvedP2ReachesOrderThree) {
-  for (auto [nu, f] : {std::pair{0.3, Formulation::displacement}, std::pair{0.5, Formulation::mixed}}) {
+  for (auto [nu, f] :
+       {std::pair{0.3, Formulation::displacement}, std::pair{0.5, Formulation::mixed}}) {
     std::vector<double> e;
     for (int level : {0, 1}) {
       auto problem = test::lame_problem(nu, 2, f);
@@ -179,8 +182,8 @@ TEST(LameFem, CurvedP2ReachesOrderThree) {
       // each circular segment, the chord O(θ³).
       const double exact_volume = std::numbers::pi * (16e-6 - 9e-6) * 1e-3;
       const double polygon_volume = mesh_volume(test::short_tube_mesh(level));
-      std::cout << "  volume: curved " << solver.domain_volume() / exact_volume - 1
-                << ", straight " << polygon_volume / exact_volume - 1 << " (relative)\n";
+      std::cout << "  volume: curved " << solver.domain_volume() / exact_volume - 1 << ", straight "
+                << polygon_volume / exact_volume - 1 << " (relative)\n";
       EXPECT_LT(std::abs(solver.domain_volume() / exact_volume - 1),
                 0.02 * std::abs(polygon_volume / exact_volume - 1));
       const auto exact = test::lame_exact(nu);
