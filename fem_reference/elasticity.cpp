@@ -3,6 +3,7 @@
 /// postprocess.
 #include "fem_reference/elasticity.hpp"
 
+#include <Epetra_MultiVector.h>
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymGEigsShiftSolver.h>
 #include <deal.II/base/function.h>
@@ -23,12 +24,14 @@
 #include <deal.II/lac/sparse_direct.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/trilinos_precondition.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 #include <deal.II/numerics/vector_tools.h>
 #include <mpi.h>
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <Teuchos_ParameterList.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -624,10 +627,46 @@ void ElasticitySolver::Impl::solve_linear() {
     data.higher_order_elements = degree > 1;
     data.smoother_sweeps = 2;
     data.aggregation_threshold = 0.02;
-    // Near-null space: deal.II 9.4's interface takes the three translations only.
-    dl::DoFTools::extract_constant_modes(dof, fe->component_mask(dl::FEValuesExtractors::Vector(0)),
-                                         data.constant_modes);
-    amg.initialize(matrix, data);
+    dl::TrilinosWrappers::SparseMatrix trilinos_matrix;
+    std::vector<double> rigid_modes;  // must outlive amg.initialize
+    if (o.amg_rigid_body_modes) {
+      // All six rigid-body modes as ML's near-null space (smoothed aggregation for elasticity,
+      // Vaněk, Mandel & Brezina 1996): AdditionalData only passes constant modes, so the ML
+      // parameter list is filled first and the rotations are added as pre-computed vectors.
+      trilinos_matrix.reinit(matrix);
+      Teuchos::ParameterList ml;
+      std::unique_ptr<Epetra_MultiVector> unused;
+      data.set_parameters(ml, unused, trilinos_matrix);
+      const std::size_t n = dof.n_dofs();
+      std::vector<dl::Point<kDim>> x(n);
+      dl::DoFTools::map_dofs_to_support_points(*mapping, dof, x);
+      dl::Point<kDim> centre;
+      for (const auto& p : x) centre += p / static_cast<double>(n);
+      std::vector<unsigned> component(n, 0);
+      std::vector<dl::types::global_dof_index> dofs(fe->n_dofs_per_cell());
+      for (const auto& cell : dof.active_cell_iterators()) {
+        cell->get_dof_indices(dofs);
+        for (unsigned i = 0; i < dofs.size(); ++i)
+          component[dofs[i]] = fe->system_to_component_index(i).first;
+      }
+      rigid_modes.assign(6 * n, 0.0);
+      for (std::size_t d = 0; d < n; ++d) {
+        const auto r = x[d] - centre;
+        const unsigned c = component[d];
+        rigid_modes[c * n + d] = 1.0;  // translation along c
+        // rotations ω × r about x, y, z: (0, −z, y), (z, 0, −x), (−y, x, 0)
+        const double rot[3][3] = {{0, -r[2], r[1]}, {r[2], 0, -r[0]}, {-r[1], r[0], 0}};
+        for (unsigned k = 0; k < 3; ++k) rigid_modes[(3 + k) * n + d] = rot[k][c];
+      }
+      ml.set("null space: type", "pre-computed");
+      ml.set("null space: dimension", 6);
+      ml.set("null space: vectors", rigid_modes.data());
+      amg.initialize(trilinos_matrix, ml);
+    } else {
+      dl::DoFTools::extract_constant_modes(
+          dof, fe->component_mask(dl::FEValuesExtractors::Vector(0)), data.constant_modes);
+      amg.initialize(matrix, data);
+    }
     dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs.l2_norm());
     dl::SolverCG<dl::Vector<double>> cg(control);
     try {

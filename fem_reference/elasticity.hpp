@@ -85,6 +85,9 @@ struct SolverOptions {
   /// this machine (2 cores, reference BLAS): P1 7k DoFs direct 0.15 s vs AMG 0.49 s; P1 33k
   /// direct 3.4 s vs AMG 1.2 s; P2 44k direct 5.9 s vs AMG 2.9 s.
   std::size_t direct_max_dofs = 20000;
+  /// CG-AMG: give ML all six rigid-body modes (translations and rotations) as near-null space;
+  /// false: only the three translations (deal.II's AdditionalData::constant_modes).
+  bool amg_rigid_body_modes = true;
   double cg_relative_tolerance = 1e-10;  ///< ‖r‖ ≤ tol·‖b‖ for CG
   unsigned max_iterations = 5000;
 };
