@@ -1,5 +1,6 @@
 #include "fem_reference/convergence.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -23,7 +24,8 @@ double observed_order_three(double f3, double f2, double f1, double ratio) {
 }
 
 RichardsonEstimate richardson(double f2, double f1, double p, double r, double fs) {
-  if (!(r > 1.0) || !(p > 0.0)) throw std::invalid_argument("richardson: need ratio > 1, order > 0");
+  if (!(r > 1.0) || !(p > 0.0))
+    throw std::invalid_argument("richardson: need ratio > 1, order > 0");
   const double rp1 = std::pow(r, p) - 1.0;
   RichardsonEstimate e;
   e.extrapolated = f1 + (f1 - f2) / rp1;  // Richardson extrapolation
@@ -31,6 +33,29 @@ RichardsonEstimate richardson(double f2, double f1, double p, double r, double f
   // Roache's GCI for the fine grid: Fs |ε| / (r^p − 1), ε = (f2 − f1)/f1.
   e.gci_fine = f1 != 0.0 ? fs * std::abs((f2 - f1) / f1) / rp1 : 0.0;
   return e;
+}
+
+FieldUncertainty richardson_field(const std::vector<Vec3>& medium, const std::vector<Vec3>& fine,
+                                  double order, double ratio) {
+  if (medium.size() != fine.size()) {
+    throw std::invalid_argument("richardson_field: the two levels have different point counts");
+  }
+  if (!(ratio > 1.0) || !(order > 0.0)) {
+    throw std::invalid_argument("richardson_field: need ratio > 1, order > 0");
+  }
+  const double rp1 = std::pow(ratio, order) - 1.0;
+  FieldUncertainty u;
+  double e2 = 0.0, f2 = 0.0;
+  for (std::size_t i = 0; i < fine.size(); ++i) {
+    const double e = (fine[i] - medium[i]).norm() / rp1;  // |u_ext − u_fine|, Richardson
+    u.error_fine.push_back(e);
+    u.max_error = std::max(u.max_error, e);
+    e2 += e * e;
+    f2 += fine[i].squaredNorm();
+  }
+  if (!fine.empty()) u.rms_error = std::sqrt(e2 / static_cast<double>(fine.size()));
+  u.relative_l2 = f2 > 0.0 ? std::sqrt(e2 / f2) : 0.0;
+  return u;
 }
 
 }  // namespace vessel::fem

@@ -4,6 +4,8 @@
 /// reference's own discretisation uncertainty next to a model error.
 #include <vector>
 
+#include "meshes/tet_mesh.hpp"
+
 namespace vessel::fem {
 
 /// Observed order p = ln(e_coarse / e_fine) / ln(ratio) of an error that falls from e_coarse to
@@ -27,5 +29,20 @@ struct RichardsonEstimate {
 /// observed order from three grids, 3 with an assumed one).
 RichardsonEstimate richardson(double f_medium, double f_fine, double order, double ratio = 2.0,
                               double safety_factor = 1.25);
+
+/// The reference's discretisation uncertainty at a set of points (e.g. mass-spring nodes), from
+/// its displacement there on the two finest levels.
+struct FieldUncertainty {
+  std::vector<double> error_fine;  ///< |u_ext − u_fine| per point, m (Richardson estimate)
+  double max_error = 0.0;          ///< m
+  double rms_error = 0.0;          ///< m
+  double relative_l2 = 0.0;        ///< ‖u_ext − u_fine‖ / ‖u_fine‖ over the points
+};
+
+/// Pointwise Richardson extrapolation u_ext = u_fine + (u_fine − u_medium)/(r^p − 1) of a
+/// displacement field sampled at the same points on two levels (refinement ratio r, order p, e.g.
+/// the observed order of the Lamé verification). std::invalid_argument for unequal sizes.
+FieldUncertainty richardson_field(const std::vector<Vec3>& medium, const std::vector<Vec3>& fine,
+                                  double order, double ratio = 2.0);
 
 }  // namespace vessel::fem

@@ -3,12 +3,9 @@
 /// postprocess.
 #include "fem_reference/elasticity.hpp"
 
-#include <mpi.h>
-
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <cstdlib>
+#include <Epetra_MultiVector.h>
+#include <Spectra/MatOp/SparseSymMatProd.h>
+#include <Spectra/SymGEigsShiftSolver.h>
 #include <deal.II/base/function.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/base/symmetric_tensor.h>
@@ -18,6 +15,7 @@
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_fe.h>
+#include <deal.II/fe/mapping_fe_field.h>
 #include <deal.II/grid/tria.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
@@ -26,10 +24,21 @@
 #include <deal.II/lac/sparse_direct.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/trilinos_precondition.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 #include <deal.II/numerics/vector_tools.h>
+#include <mpi.h>
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <Teuchos_ParameterList.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <sstream>
 
 #include "meshes/errors.hpp"
@@ -49,20 +58,36 @@ double Material::mu() const { return youngs_modulus / (2.0 * (1.0 + poisson_rati
 
 std::string to_string(Formulation f) {
   switch (f) {
-    case Formulation::automatic: return "auto";
-    case Formulation::displacement: return "displacement";
-    case Formulation::mixed: return "mixed";
+    case Formulation::automatic:
+      return "auto";
+    case Formulation::displacement:
+      return "displacement";
+    case Formulation::mixed:
+      return "mixed";
   }
   return "?";
 }
 
 std::string to_string(LinearSolver s) {
   switch (s) {
-    case LinearSolver::automatic: return "auto";
-    case LinearSolver::direct: return "direct";
-    case LinearSolver::cg_amg: return "cg-amg";
+    case LinearSolver::automatic:
+      return "auto";
+    case LinearSolver::direct:
+      return "direct";
+    case LinearSolver::cg_amg:
+      return "cg-amg";
   }
   return "?";
+}
+
+std::vector<CurvedSurface> tube_curved_walls(double a, double b) {
+  auto cylinder = [](double r) {
+    return [r](const Vec3& x) {
+      const double rho = std::hypot(x.x(), x.y());
+      return Vec3(x.x() * r / rho, x.y() * r / rho, x.z());
+    };
+  };
+  return {{"inner_wall", cylinder(a)}, {"outer_wall", cylinder(b)}};
 }
 
 std::vector<PointConstraint> tube_in_plane_pins(double a, double z) {
@@ -133,7 +158,8 @@ class TetLocator {
     const double extent = (hi_ - lo_).maxCoeff();
     lo_ -= Vec3::Constant(1e-9 * extent);
     hi_ += Vec3::Constant(1e-9 * extent);
-    const double per_axis = std::cbrt(static_cast<double>(std::max<std::size_t>(mesh.tets.size(), 1)));
+    const double per_axis =
+        std::cbrt(static_cast<double>(std::max<std::size_t>(mesh.tets.size(), 1)));
     for (int d = 0; d < 3; ++d) {
       n_[d] = std::max(1, static_cast<int>(per_axis * (hi_[d] - lo_[d]) / extent) + 1);
     }
@@ -147,11 +173,13 @@ class TetLocator {
       const auto ia = bucket_of(a), ib = bucket_of(b);
       for (int i = ia[0]; i <= ib[0]; ++i)
         for (int j = ia[1]; j <= ib[1]; ++j)
-          for (int k = ia[2]; k <= ib[2]; ++k) buckets_[index(i, j, k)].push_back(static_cast<int>(t));
+          for (int k = ia[2]; k <= ib[2]; ++k)
+            buckets_[index(i, j, k)].push_back(static_cast<int>(t));
     }
   }
 
-  /// The tet containing x (the one with the largest smallest barycentric coordinate, ≥ −tol), or −1.
+  /// The tet containing x (the one with the largest smallest barycentric coordinate, ≥ −tol), or
+  /// −1.
   [[nodiscard]] int find(const Vec3& x, double tol = 1e-9) const {
     for (int d = 0; d < 3; ++d) {
       if (x[d] < lo_[d] || x[d] > hi_[d]) return -1;
@@ -223,7 +251,8 @@ void validate(const TetMesh& mesh, const ElasticityProblem& p) {
   }
   for (const auto& pr : p.pressures) {
     (void)mesh.require_group(pr.group, 2, "FEM pressure load");
-    if (!std::isfinite(pr.pressure)) throw InputError("pressure on '" + pr.group + "' is not finite");
+    if (!std::isfinite(pr.pressure))
+      throw InputError("pressure on '" + pr.group + "' is not finite");
   }
   for (const auto& patch : p.patches) {
     for (int t : patch.triangles) {
@@ -253,7 +282,11 @@ struct ElasticitySolver::Impl {
 
   dl::Triangulation<kDim> tria;
   std::unique_ptr<dl::FiniteElement<kDim>> fe;
-  std::unique_ptr<dl::MappingFE<kDim>> mapping;
+  std::unique_ptr<dl::MappingFE<kDim>> linear_mapping;
+  std::unique_ptr<dl::Mapping<kDim>> mapping;  // linear_mapping's copy, or the curved one
+  std::unique_ptr<dl::FiniteElement<kDim>> geometry_fe;
+  dl::DoFHandler<kDim> geometry_dof;
+  dl::Vector<double> geometry_positions;  // absolute positions of the P2 geometry nodes
   dl::DoFHandler<kDim> dof;
   dl::AffineConstraints<double> constraints;
   dl::SparsityPattern sparsity;
@@ -261,9 +294,9 @@ struct ElasticitySolver::Impl {
   dl::Vector<double> rhs, solution;
 
   std::vector<dl::DoFHandler<kDim>::active_cell_iterator> cells;  // by tet index
-  std::vector<std::array<int, 4>> face_triangle;  // per cell and face: TetMesh triangle or −1
-  std::vector<int> triangle_tag;                   // gmsh tag of each triangle's group (0: none)
-  std::vector<std::vector<int>> triangle_patches;  // patches acting on each triangle
+  std::vector<std::array<int, 4>> face_triangle;      // per cell and face: TetMesh triangle or −1
+  std::vector<int> triangle_tag;                      // gmsh tag of each triangle's group (0: none)
+  std::vector<std::vector<int>> triangle_patches;     // patches acting on each triangle
   std::vector<std::pair<int, double>> pressure_tags;  // (group tag, p) of each pressure load
   std::unique_ptr<TetLocator> locator;
   ElasticityResult result;
@@ -274,9 +307,10 @@ struct ElasticitySolver::Impl {
 
   void build_triangulation();
   void setup_dofs();
-  void local_system(const dl::DoFHandler<kDim>::active_cell_iterator& cell,
-                    dl::FEValues<kDim>& fev, dl::FEFaceValues<kDim>& fefv,
-                    dl::FullMatrix<double>& k, dl::Vector<double>& f, Vec3* applied) const;
+  void setup_curved_mapping();
+  void local_system(const dl::DoFHandler<kDim>::active_cell_iterator& cell, dl::FEValues<kDim>& fev,
+                    dl::FEFaceValues<kDim>& fefv, dl::FullMatrix<double>& k, dl::Vector<double>& f,
+                    Vec3* applied) const;
   void assemble();
   void solve_linear();
   void postprocess();
@@ -288,7 +322,8 @@ void ElasticitySolver::Impl::build_triangulation() {
   for (const auto& x : mesh.nodes) vertices.emplace_back(x.x(), x.y(), x.z());
   std::vector<dl::CellData<kDim>> cell_data(mesh.tets.size(), dl::CellData<kDim>(4));
   for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
-    for (unsigned v = 0; v < 4; ++v) cell_data[t].vertices[v] = static_cast<unsigned>(mesh.tets[t][v]);
+    for (unsigned v = 0; v < 4; ++v)
+      cell_data[t].vertices[v] = static_cast<unsigned>(mesh.tets[t][v]);
     cell_data[t].material_id = 0;
   }
   tria.create_triangulation(vertices, cell_data, dl::SubCellData());
@@ -300,7 +335,8 @@ void ElasticitySolver::Impl::build_triangulation() {
     for (int e : g.elements) triangle_tag[e] = g.tag;
   }
   for (const auto& pr : problem.pressures) {
-    pressure_tags.emplace_back(mesh.require_group(pr.group, 2, "FEM pressure load").tag, pr.pressure);
+    pressure_tags.emplace_back(mesh.require_group(pr.group, 2, "FEM pressure load").tag,
+                               pr.pressure);
   }
   triangle_patches.assign(mesh.triangles.size(), {});
   for (std::size_t i = 0; i < problem.patches.size(); ++i) {
@@ -335,7 +371,9 @@ void ElasticitySolver::Impl::build_triangulation() {
 
 void ElasticitySolver::Impl::setup_dofs() {
   const dl::FE_SimplexP<kDim> linear(1);
-  mapping = std::make_unique<dl::MappingFE<kDim>>(linear);
+  linear_mapping = std::make_unique<dl::MappingFE<kDim>>(linear);
+  mapping = linear_mapping->clone();
+  if (degree == 2 && !problem.curved_surfaces.empty()) setup_curved_mapping();
   if (mixed) {
     // Taylor–Hood P2–P1 (step-22's u–p pattern on simplices).
     fe = std::make_unique<dl::FESystem<kDim>>(dl::FE_SimplexP<kDim>(2), kDim,
@@ -353,7 +391,8 @@ void ElasticitySolver::Impl::setup_dofs() {
   if (!problem.point_constraints.empty()) {
     // Tolerance: 1e-6 of a typical element length (cube root of the mean tet volume).
     const double tol =
-        1e-6 * std::cbrt(mesh_volume(mesh) / static_cast<double>(std::max<std::size_t>(mesh.tets.size(), 1)));
+        1e-6 * std::cbrt(mesh_volume(mesh) /
+                         static_cast<double>(std::max<std::size_t>(mesh.tets.size(), 1)));
     std::vector<std::pair<dl::DoFHandler<kDim>::active_cell_iterator, unsigned>> vertex_cell(
         mesh.nodes.size(), {dof.end(), 0});
     for (const auto& cell : dof.active_cell_iterators())
@@ -378,7 +417,8 @@ void ElasticitySolver::Impl::setup_dofs() {
     }
   }
   for (const auto& bc : problem.dirichlet) {
-    const auto tag = static_cast<dl::types::boundary_id>(mesh.require_group(bc.group, 2, "FEM").tag);
+    const auto tag =
+        static_cast<dl::types::boundary_id>(mesh.require_group(bc.group, 2, "FEM").tag);
     std::vector<bool> mask(n_components, false);
     if (bc.kind == DirichletCondition::Kind::clamped) {
       mask[0] = mask[1] = mask[2] = true;
@@ -400,6 +440,55 @@ void ElasticitySolver::Impl::setup_dofs() {
   matrix.reinit(sparsity);
   rhs.reinit(dof.n_dofs());
   solution.reinit(dof.n_dofs());
+}
+
+void ElasticitySolver::Impl::setup_curved_mapping() {
+  geometry_fe = std::make_unique<dl::FESystem<kDim>>(dl::FE_SimplexP<kDim>(2), kDim);
+  geometry_dof.reinit(tria);
+  geometry_dof.distribute_dofs(*geometry_fe);
+  geometry_positions.reinit(geometry_dof.n_dofs());
+  std::map<int, const CurvedSurface*> by_tag;
+  for (const auto& cs : problem.curved_surfaces) {
+    by_tag[mesh.require_group(cs.group, 2, "curved surface").tag] = &cs;
+  }
+  const auto& unit = geometry_fe->get_unit_support_points();
+  const unsigned n = geometry_fe->n_dofs_per_cell();
+  std::vector<dl::types::global_dof_index> dofs(n);
+  // A node on a curved face is shared with cells that touch the surface only along an edge: once
+  // projected (from a cell that has the face), it must not be overwritten from such a cell.
+  std::vector<bool> projected(geometry_dof.n_dofs(), false);
+  for (const auto& cell : geometry_dof.active_cell_iterators()) {
+    cell->get_dof_indices(dofs);
+    for (unsigned i = 0; i < n; ++i) {
+      if (projected[dofs[i]]) continue;
+      const auto x = linear_mapping->transform_unit_to_real_cell(cell, unit[i]);
+      Vec3 y(x[0], x[1], x[2]);
+      // A P2 node lies on a face iff it is one of the face's vertices or edge midpoints.
+      for (unsigned f = 0; f < cell->n_faces(); ++f) {
+        if (!cell->face(f)->at_boundary()) continue;
+        const auto it = by_tag.find(static_cast<int>(cell->face(f)->boundary_id()));
+        if (it == by_tag.end()) continue;
+        const auto face = cell->face(f);
+        const double h = face->diameter();
+        bool on_face = false;
+        for (unsigned a = 0; a < 3 && !on_face; ++a) {
+          for (unsigned b = a; b < 3 && !on_face; ++b) {
+            const auto m = 0.5 * (face->vertex(a) + face->vertex(b));
+            on_face = x.distance(m) < 1e-9 * h;
+          }
+        }
+        if (on_face) {
+          y = it->second->project(y);
+          projected[dofs[i]] = true;
+          break;
+        }
+      }
+      geometry_positions(dofs[i]) = y[geometry_fe->system_to_component_index(i).first];
+    }
+  }
+  mapping = std::make_unique<dl::MappingFEField<kDim, kDim, dl::Vector<double>>>(
+      geometry_dof, geometry_positions);
+  result.curved = true;
 }
 
 void ElasticitySolver::Impl::local_system(const dl::DoFHandler<kDim>::active_cell_iterator& cell,
@@ -496,8 +585,9 @@ void ElasticitySolver::Impl::assemble() {
   dl::FEValues<kDim> fev(*mapping, *fe, cell_quadrature(q_degree),
                          dl::update_values | dl::update_gradients | dl::update_JxW_values |
                              dl::update_quadrature_points);
-  dl::FEFaceValues<kDim> fefv(*mapping, *fe, face_quadrature(q_degree),
-                              dl::update_values | dl::update_normal_vectors | dl::update_JxW_values);
+  dl::FEFaceValues<kDim> fefv(
+      *mapping, *fe, face_quadrature(q_degree),
+      dl::update_values | dl::update_normal_vectors | dl::update_JxW_values);
   const unsigned n = fe->n_dofs_per_cell();
   dl::FullMatrix<double> k(n, n);
   dl::Vector<double> f(n);
@@ -537,10 +627,46 @@ void ElasticitySolver::Impl::solve_linear() {
     data.higher_order_elements = degree > 1;
     data.smoother_sweeps = 2;
     data.aggregation_threshold = 0.02;
-    // Near-null space: deal.II 9.4's interface takes the three translations only.
-    dl::DoFTools::extract_constant_modes(dof, fe->component_mask(dl::FEValuesExtractors::Vector(0)),
-                                         data.constant_modes);
-    amg.initialize(matrix, data);
+    dl::TrilinosWrappers::SparseMatrix trilinos_matrix;
+    std::vector<double> rigid_modes;  // must outlive amg.initialize
+    if (o.amg_rigid_body_modes) {
+      // All six rigid-body modes as ML's near-null space (smoothed aggregation for elasticity,
+      // Vaněk, Mandel & Brezina 1996): AdditionalData only passes constant modes, so the ML
+      // parameter list is filled first and the rotations are added as pre-computed vectors.
+      trilinos_matrix.reinit(matrix);
+      Teuchos::ParameterList ml;
+      std::unique_ptr<Epetra_MultiVector> unused;
+      data.set_parameters(ml, unused, trilinos_matrix);
+      const std::size_t n = dof.n_dofs();
+      std::vector<dl::Point<kDim>> x(n);
+      dl::DoFTools::map_dofs_to_support_points(*mapping, dof, x);
+      dl::Point<kDim> centre;
+      for (const auto& p : x) centre += p / static_cast<double>(n);
+      std::vector<unsigned> component(n, 0);
+      std::vector<dl::types::global_dof_index> dofs(fe->n_dofs_per_cell());
+      for (const auto& cell : dof.active_cell_iterators()) {
+        cell->get_dof_indices(dofs);
+        for (unsigned i = 0; i < dofs.size(); ++i)
+          component[dofs[i]] = fe->system_to_component_index(i).first;
+      }
+      rigid_modes.assign(6 * n, 0.0);
+      for (std::size_t d = 0; d < n; ++d) {
+        const auto r = x[d] - centre;
+        const unsigned c = component[d];
+        rigid_modes[c * n + d] = 1.0;  // translation along c
+        // rotations ω × r about x, y, z: (0, −z, y), (z, 0, −x), (−y, x, 0)
+        const double rot[3][3] = {{0, -r[2], r[1]}, {r[2], 0, -r[0]}, {-r[1], r[0], 0}};
+        for (unsigned k = 0; k < 3; ++k) rigid_modes[(3 + k) * n + d] = rot[k][c];
+      }
+      ml.set("null space: type", "pre-computed");
+      ml.set("null space: dimension", 6);
+      ml.set("null space: vectors", rigid_modes.data());
+      amg.initialize(trilinos_matrix, ml);
+    } else {
+      dl::DoFTools::extract_constant_modes(
+          dof, fe->component_mask(dl::FEValuesExtractors::Vector(0)), data.constant_modes);
+      amg.initialize(matrix, data);
+    }
     dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs.l2_norm());
     dl::SolverCG<dl::Vector<double>> cg(control);
     try {
@@ -574,8 +700,9 @@ void ElasticitySolver::Impl::postprocess() {
                              dl::update_quadrature_points);
   dl::FEValues<kDim> centre(*mapping, *fe, dl::Quadrature<kDim>(dl::Point<kDim>(0.25, 0.25, 0.25)),
                             dl::update_values | dl::update_gradients);
-  dl::FEFaceValues<kDim> fefv(*mapping, *fe, face_quadrature(q_degree),
-                              dl::update_values | dl::update_normal_vectors | dl::update_JxW_values);
+  dl::FEFaceValues<kDim> fefv(
+      *mapping, *fe, face_quadrature(q_degree),
+      dl::update_values | dl::update_normal_vectors | dl::update_JxW_values);
   std::vector<dl::SymmetricTensor<2, kDim>> eps(fev.n_quadrature_points);
   std::vector<double> p(fev.n_quadrature_points);
   const double inv_lambda = std::isinf(lambda) ? 0.0 : 1.0 / lambda;
@@ -613,7 +740,8 @@ void ElasticitySolver::Impl::postprocess() {
     const dl::SymmetricTensor<2, kDim> sigma =
         2.0 * mu * e1[0] - pc * dl::unit_symmetric_tensor<kDim>();
     const auto idx = cell->active_cell_index();
-    constexpr std::array<std::array<unsigned, 2>, 6> kVoigt{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}}};
+    constexpr std::array<std::array<unsigned, 2>, 6> kVoigt{
+        {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}}};
     for (unsigned v = 0; v < 6; ++v) {
       result.tet_strain[idx][v] = e1[0][kVoigt[v][0]][kVoigt[v][1]];
       result.tet_stress[idx][v] = sigma[kVoigt[v][0]][kVoigt[v][1]];
@@ -638,7 +766,8 @@ void ElasticitySolver::Impl::postprocess() {
   for (const auto& bc : problem.dirichlet) {
     if (std::find(seen.begin(), seen.end(), bc.group) != seen.end()) continue;
     seen.push_back(bc.group);
-    const auto tag = static_cast<dl::types::boundary_id>(mesh.require_group(bc.group, 2, "FEM").tag);
+    const auto tag =
+        static_cast<dl::types::boundary_id>(mesh.require_group(bc.group, 2, "FEM").tag);
     std::vector<bool> mask(n_components, false);
     mask[0] = mask[1] = mask[2] = true;
     const dl::IndexSet on_group =
@@ -713,8 +842,16 @@ std::vector<Vec3> ElasticitySolver::displacement_at(const std::vector<Vec3>& poi
       throw InputError(m.str());
     }
     const auto& cell = im.cells[static_cast<std::size_t>(t)];
-    const dl::Point<kDim> ref =
-        im.mapping->transform_real_to_unit_cell(cell, dl::Point<kDim>(x.x(), x.y(), x.z()));
+    const dl::Point<kDim> px(x.x(), x.y(), x.z());
+    dl::Point<kDim> ref = im.linear_mapping->transform_real_to_unit_cell(cell, px);
+    if (im.result.curved) {
+      // The curved cell differs from the straight one only near the curved faces (O(h²)); use
+      // the curved inverse where deal.II provides it, else the straight one.
+      try {
+        ref = im.mapping->transform_real_to_unit_cell(cell, px);
+      } catch (...) {
+      }
+    }
     cell->get_dof_indices(dofs);
     Vec3 u = Vec3::Zero();
     for (unsigned i = 0; i < n; ++i) {
@@ -729,20 +866,190 @@ std::vector<Vec3> ElasticitySolver::displacement_at(const std::vector<Vec3>& poi
 double ElasticitySolver::relative_l2_error(const std::function<Vec3(const Vec3&)>& exact) const {
   const auto& im = *impl_;
   if (!im.solved) throw std::logic_error("relative_l2_error called before solve()");
-  const VectorFunction u_exact(exact, im.n_components);
+  // Own loop rather than VectorTools::integrate_difference: with the curved MappingFEField on
+  // simplices deal.II 9.4 returns NaN there, so the quadrature points are computed from the
+  // geometry field itself (x_q = Σ x_i φ_i(ξ_q)) and only JxW comes from the mapping.
   const dl::QWitherdenVincentSimplex<kDim> quad(static_cast<unsigned>(im.degree + 2));
-  const dl::ComponentSelectFunction<kDim> select(std::make_pair(0U, 3U), im.n_components);
-  dl::Vector<double> cellwise(im.tria.n_active_cells());
-  dl::VectorTools::integrate_difference(*im.mapping, im.dof, im.solution, u_exact, cellwise, quad,
-                                        dl::VectorTools::L2_norm, &select);
-  const double err =
-      dl::VectorTools::compute_global_error(im.tria, cellwise, dl::VectorTools::L2_norm);
-  dl::Vector<double> zero(im.dof.n_dofs());
-  dl::VectorTools::integrate_difference(*im.mapping, im.dof, zero, u_exact, cellwise, quad,
-                                        dl::VectorTools::L2_norm, &select);
-  const double norm =
-      dl::VectorTools::compute_global_error(im.tria, cellwise, dl::VectorTools::L2_norm);
-  return err / norm;
+  const dl::FEValuesExtractors::Vector disp(0);
+  dl::FEValues<kDim> fev(*im.mapping, *im.fe, quad, dl::update_values | dl::update_JxW_values);
+  dl::FEValues<kDim> lin(*im.linear_mapping, *im.fe, quad, dl::update_quadrature_points);
+  std::unique_ptr<dl::FEValues<kDim>> geo;
+  if (im.result.curved) {
+    geo = std::make_unique<dl::FEValues<kDim>>(*im.linear_mapping, *im.geometry_fe, quad,
+                                               dl::update_values);
+  }
+  std::vector<dl::Tensor<1, kDim>> uh(quad.size());
+  std::vector<dl::types::global_dof_index> gdofs(im.geometry_fe ? im.geometry_fe->n_dofs_per_cell()
+                                                                : 0);
+  double err2 = 0.0, norm2 = 0.0;
+  for (const auto& cell : im.dof.active_cell_iterators()) {
+    fev.reinit(cell);
+    lin.reinit(cell);
+    fev[disp].get_function_values(im.solution, uh);
+    std::vector<Vec3> xq(quad.size());
+    for (unsigned q = 0; q < quad.size(); ++q) {
+      const auto& p = lin.quadrature_point(q);
+      xq[q] = Vec3(p[0], p[1], p[2]);
+    }
+    if (geo) {
+      const typename dl::DoFHandler<kDim>::active_cell_iterator gcell(
+          &im.tria, cell->level(), cell->index(), &im.geometry_dof);
+      geo->reinit(gcell);
+      gcell->get_dof_indices(gdofs);
+      for (unsigned q = 0; q < quad.size(); ++q) {
+        Vec3 x = Vec3::Zero();
+        for (unsigned i = 0; i < gdofs.size(); ++i) {
+          x[im.geometry_fe->system_to_component_index(i).first] +=
+              im.geometry_positions(gdofs[i]) * geo->shape_value(i, q);
+        }
+        xq[q] = x;
+      }
+    }
+    for (unsigned q = 0; q < quad.size(); ++q) {
+      const Vec3 u = exact(xq[q]);
+      const Vec3 d = Vec3(uh[q][0], uh[q][1], uh[q][2]) - u;
+      err2 += d.squaredNorm() * fev.JxW(q);
+      norm2 += u.squaredNorm() * fev.JxW(q);
+    }
+  }
+  return std::sqrt(err2 / norm2);
+}
+
+double ElasticitySolver::domain_volume() const {
+  const auto& im = *impl_;
+  dl::FEValues<kDim> fev(*im.mapping, *im.fe, cell_quadrature(2), dl::update_JxW_values);
+  double v = 0.0;
+  for (const auto& cell : im.dof.active_cell_iterators()) {
+    fev.reinit(cell);
+    for (unsigned q = 0; q < fev.n_quadrature_points; ++q) v += fev.JxW(q);
+  }
+  return v;
+}
+
+namespace {
+
+using SpMat = Eigen::SparseMatrix<double>;
+
+/// (K − σM)⁻¹ for Spectra's shift-invert mode, by a sparse LDLᵀ factorisation.
+class ShiftInvertLdlt {
+ public:
+  using Scalar = double;
+  ShiftInvertLdlt(const SpMat& k, const SpMat& m) : k_(k), m_(m) {}
+  [[nodiscard]] Eigen::Index rows() const { return k_.rows(); }
+  [[nodiscard]] Eigen::Index cols() const { return k_.cols(); }
+  void set_shift(const double& sigma) {
+    const SpMat a = k_ - sigma * m_;
+    ldlt_.compute(a);
+    if (ldlt_.info() != Eigen::Success) {
+      throw std::runtime_error("modal analysis: factorisation of K - sigma M failed");
+    }
+  }
+  void perform_op(const double* x_in, double* y_out) const {
+    Eigen::Map<const Eigen::VectorXd> x(x_in, rows());
+    Eigen::Map<Eigen::VectorXd> y(y_out, rows());
+    y = ldlt_.solve(x);
+  }
+
+ private:
+  const SpMat& k_;
+  const SpMat& m_;
+  Eigen::SimplicialLDLT<SpMat> ldlt_;
+};
+
+}  // namespace
+
+ModalResult ElasticitySolver::modes(int count) const {
+  const auto& im = *impl_;
+  if (im.mixed) {
+    throw InputError(
+        "modal analysis needs the displacement formulation (P1 or P2); the mixed "
+        "Taylor-Hood system has no pressure mass: use nu below the mixed threshold");
+  }
+  if (count < 1) throw InputError("modal analysis: number of modes must be >= 1");
+  if (!(im.problem.material.density > 0.0)) {
+    throw InputError("modal analysis needs density > 0 (the mass matrix)");
+  }
+  const auto t0 = Clock::now();
+  // Free DoFs (not Dirichlet or point constrained) → eigenproblem index.
+  std::vector<int> free_index(im.dof.n_dofs(), -1);
+  int n_free = 0;
+  for (dl::types::global_dof_index d = 0; d < im.dof.n_dofs(); ++d) {
+    if (!im.constraints.is_constrained(d)) free_index[d] = n_free++;
+  }
+  if (n_free <= count) throw InputError("modal analysis: fewer free DoFs than modes requested");
+  const dl::FEValuesExtractors::Vector disp(0);
+  dl::FEValues<kDim> fev(*im.mapping, *im.fe,
+                         dl::QGaussSimplex<kDim>(static_cast<unsigned>(im.degree + 1)),
+                         dl::update_values | dl::update_gradients | dl::update_JxW_values);
+  const unsigned n = im.fe->n_dofs_per_cell();
+  std::vector<dl::types::global_dof_index> dofs(n);
+  std::vector<Eigen::Triplet<double>> kt, mt;
+  const double rho = im.problem.material.density;
+  for (const auto& cell : im.dof.active_cell_iterators()) {
+    fev.reinit(cell);
+    cell->get_dof_indices(dofs);
+    for (unsigned q = 0; q < fev.n_quadrature_points; ++q) {
+      const double jxw = fev.JxW(q);
+      for (unsigned i = 0; i < n; ++i) {
+        const int fi = free_index[dofs[i]];
+        if (fi < 0) continue;
+        const auto ei = fev[disp].symmetric_gradient(i, q);
+        const double di = fev[disp].divergence(i, q);
+        const auto vi = fev[disp].value(i, q);
+        for (unsigned j = 0; j < n; ++j) {
+          const int fj = free_index[dofs[j]];
+          if (fj < 0) continue;
+          // K: step-8's bilinear form; M_ij = ∫ ρ φ_i·φ_j (consistent mass).
+          const double kij = im.lambda * di * fev[disp].divergence(j, q) +
+                             2.0 * im.mu * (ei * fev[disp].symmetric_gradient(j, q));
+          kt.emplace_back(fi, fj, kij * jxw);
+          mt.emplace_back(fi, fj, rho * (vi * fev[disp].value(j, q)) * jxw);
+        }
+      }
+    }
+  }
+  SpMat k(n_free, n_free), m(n_free, n_free);
+  k.setFromTriplets(kt.begin(), kt.end());
+  m.setFromTriplets(mt.begin(), mt.end());
+  kt.clear();
+  mt.clear();
+
+  ShiftInvertLdlt op(k, m);
+  Spectra::SparseSymMatProd<double> bop(m);
+  const int ncv = std::min(n_free, std::max(2 * count + 1, 30));
+  // σ slightly below zero keeps K − σM positive definite even without constraints (rigid modes).
+  const double sigma = -1.0;  // (rad/s)²
+  Spectra::SymGEigsShiftSolver<ShiftInvertLdlt, Spectra::SparseSymMatProd<double>,
+                               Spectra::GEigsMode::ShiftInvert>
+      eigs(op, bop, count, ncv, sigma);
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10, Spectra::SortRule::SmallestAlge);
+  if (eigs.info() != Spectra::CompInfo::Successful) {
+    throw std::runtime_error("modal analysis: the Lanczos iteration did not converge");
+  }
+  const Eigen::VectorXd lambda = eigs.eigenvalues();
+  const Eigen::MatrixXd vectors = eigs.eigenvectors();
+  ModalResult out;
+  out.n_dofs = static_cast<std::size_t>(n_free);
+  for (int e = 0; e < lambda.size(); ++e) {
+    out.frequencies_hz.push_back(std::sqrt(std::max(lambda[e], 0.0)) / (2.0 * std::numbers::pi));
+    std::vector<Vec3> shape(im.mesh.nodes.size(), Vec3::Zero());
+    for (const auto& cell : im.dof.active_cell_iterators()) {
+      for (unsigned v = 0; v < 4; ++v) {
+        for (unsigned c = 0; c < 3; ++c) {
+          const int fi = free_index[cell->vertex_dof_index(v, c)];
+          shape[cell->vertex_index(v)][c] = fi < 0 ? 0.0 : vectors(fi, e);
+        }
+      }
+    }
+    double mx = 0.0;
+    for (const auto& u : shape) mx = std::max(mx, u.norm());
+    if (mx > 0.0)
+      for (auto& u : shape) u /= mx;
+    out.mode_shapes.push_back(std::move(shape));
+  }
+  out.seconds = seconds_since(t0);
+  return out;
 }
 
 ElasticityResult solve_elasticity(const TetMesh& mesh, const ElasticityProblem& problem) {

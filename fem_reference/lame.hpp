@@ -6,9 +6,9 @@
 namespace vessel::fem {
 
 struct LameCylinder {
-  double inner_radius = 3e-3;  ///< a, m
-  double outer_radius = 4e-3;  ///< b, m
-  double pressure = 1.0;       ///< p on r = a, Pa (outer surface traction-free)
+  double inner_radius = 3e-3;       ///< a, m
+  double outer_radius = 4e-3;       ///< b, m
+  double pressure = 1.0;            ///< p on r = a, Pa (outer surface traction-free)
   double youngs_modulus = 14.24e3;  ///< E, Pa
   double poisson_ratio = 0.3;       ///< ν
 

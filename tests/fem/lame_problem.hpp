@@ -13,7 +13,7 @@ inline fem::ElasticityProblem lame_problem(double nu, int degree, fem::Formulati
   p.material.poisson_ratio = nu;
   p.options.degree = degree;
   p.options.formulation = f;
-  p.options.solver = fem::LinearSolver::direct;
+  p.options.solver = fem::LinearSolver::automatic;  // direct up to 20k DoFs, then AMG-CG (1e-10)
   p.dirichlet = {fem::DirichletCondition::roller("inlet", 2),
                  fem::DirichletCondition::roller("outlet", 2)};
   p.point_constraints = fem::tube_in_plane_pins(3e-3, 0.0);
@@ -22,8 +22,11 @@ inline fem::ElasticityProblem lame_problem(double nu, int degree, fem::Formulati
 }
 
 inline fem::LameCylinder lame_exact(double nu) {
-  return {.inner_radius = 3e-3, .outer_radius = 4e-3, .pressure = kLamePressure,
-          .youngs_modulus = 14.24e3, .poisson_ratio = nu};
+  return {.inner_radius = 3e-3,
+          .outer_radius = 4e-3,
+          .pressure = kLamePressure,
+          .youngs_modulus = 14.24e3,
+          .poisson_ratio = nu};
 }
 
 }  // namespace vessel::test

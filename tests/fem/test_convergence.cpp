@@ -1,9 +1,9 @@
-#include "fem_reference/convergence.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
+
+#include "fem_reference/convergence.hpp"
 
 using namespace vessel::fem;
 
@@ -29,4 +29,23 @@ TEST(Richardson, ExtrapolatesAPowerLawExactly) {
   EXPECT_NEAR(e.error_fine, 0.3e-3, 1e-12);
   // Hand-computed GCI: 1.25 · |(f2 − f1)/f1| / (2³ − 1), f2 − f1 = −0.3(0.008 − 0.001) = −0.0021.
   EXPECT_NEAR(e.gci_fine, 1.25 * (0.0021 / f(0.1)) / 7.0, 1e-14);
+}
+
+TEST(RichardsonField, RecoversThePointwiseErrorOfAPowerLaw) {
+  // u_h(x) = u(x) + c(x) h²: the fine level's error is c(x) h_fine² exactly.
+  using vessel::Vec3;
+  const std::vector<Vec3> exact{{1e-3, 0, 0}, {0, 2e-3, 1e-3}};
+  const std::vector<Vec3> c{{0.5, -1, 0}, {0, 0, 2}};
+  auto level = [&](double h) {
+    std::vector<Vec3> u;
+    for (std::size_t i = 0; i < exact.size(); ++i) u.push_back(exact[i] + c[i] * h * h);
+    return u;
+  };
+  const double h = 1e-2;
+  const auto est = richardson_field(level(2 * h), level(h), 2.0);
+  ASSERT_EQ(est.error_fine.size(), 2u);
+  EXPECT_NEAR(est.error_fine[0], c[0].norm() * h * h, 1e-15);
+  EXPECT_NEAR(est.error_fine[1], c[1].norm() * h * h, 1e-15);
+  EXPECT_NEAR(est.max_error, 2 * h * h, 1e-15);
+  EXPECT_THROW(richardson_field(level(h), {}, 2.0), std::invalid_argument);
 }

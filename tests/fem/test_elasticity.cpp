@@ -1,12 +1,11 @@
 /// The FEM reference against independent truth: input validation, rigid-body motion, the
 /// constant-strain patch test, equilibrium of reactions and applied loads, point evaluation.
-#include "fem_reference/elasticity.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
+#include "fem_reference/elasticity.hpp"
 #include "fem_test_meshes.hpp"
 #include "meshes/errors.hpp"
 #include "meshes/surface_loads.hpp"
@@ -155,7 +154,8 @@ TEST(ElasticityEquilibrium, ReactionsBalanceAContactPatch) {
   for (int degree : {1, 2}) {
     ElasticityProblem p;
     p.options.degree = degree;
-    p.dirichlet = {fem::DirichletCondition::clamped("inlet"), fem::DirichletCondition::clamped("outlet")};
+    p.dirichlet = {fem::DirichletCondition::clamped("inlet"),
+                   fem::DirichletCondition::clamped("outlet")};
     p.patches = {patch};
     const auto r = solve_elasticity(m, p);
     // The integrated traction equals the patch's total force −F n̂ (exact quadrature of a
@@ -199,4 +199,37 @@ TEST(ElasticityPointEvaluation, MatchesNodalValuesAndRefusesOutsidePoints) {
     EXPECT_LT((u[k] - r.nodal_displacement[k * 7]).norm(), 1e-9 * max_norm(r.nodal_displacement));
   }
   EXPECT_THROW((void)s.displacement_at({Vec3(0, 0, 0.5e-3)}), InputError);  // in the lumen
+}
+
+TEST(ElasticitySolvers, AmgCgAgreesWithTheDirectSolver) {
+  // A second solver as independent check: UMFPACK vs CG with ML AMG (translations only, and all
+  // six rigid-body modes), on a contact patch with clamped ends, P1 and P2.
+  const auto& m = test::short_tube_mesh(1);
+  ContactPatchSpec spec;
+  spec.point = Vec3(3e-3, 0, 0.5e-3);
+  spec.force = 1e-4;
+  for (int degree : {1, 2}) {
+    ElasticityProblem p;
+    p.options.degree = degree;
+    p.dirichlet = {DirichletCondition::clamped("inlet"), DirichletCondition::clamped("outlet")};
+    p.patches = {contact_patch(m, spec)};
+    p.options.solver = LinearSolver::direct;
+    const auto direct = solve_elasticity(m, p);
+    const double scale = max_norm(direct.nodal_displacement);
+    for (bool rigid : {false, true}) {
+      p.options.solver = LinearSolver::cg_amg;
+      p.options.amg_rigid_body_modes = rigid;
+      const auto cg = solve_elasticity(m, p);
+      EXPECT_EQ(cg.solver, LinearSolver::cg_amg);
+      EXPECT_GT(cg.iterations, 0u);
+      double diff = 0;
+      for (std::size_t n = 0; n < m.nodes.size(); ++n) {
+        diff = std::max(diff, (cg.nodal_displacement[n] - direct.nodal_displacement[n]).norm());
+      }
+      std::cout << "  P" << degree << " AMG-CG (" << (rigid ? "6 rigid modes" : "3 translations")
+                << "): " << cg.iterations << " iterations, max |u_cg - u_direct| / max |u| "
+                << diff / scale << "\n";
+      EXPECT_LT(diff, 1e-7 * scale) << "P" << degree << " rigid " << rigid;
+    }
+  }
 }

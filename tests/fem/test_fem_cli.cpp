@@ -46,8 +46,9 @@ TEST(FemCli, PressureRunComparesWithLameAndBalancesReactions) {
 
 TEST(FemCli, ContactRunWritesVtuAndJson) {
   TempDir dir;
-  const auto r = vv("fem " + kTube + "--load contact --force 1e-4 --contact-point 0.003 0 0.001 --vtu " +
-                    (dir / "c.vtu").string() + " --json " + (dir / "c.json").string());
+  const auto r =
+      vv("fem " + kTube + "--load contact --force 1e-4 --contact-point 0.003 0 0.001 --vtu " +
+         (dir / "c.vtu").string() + " --json " + (dir / "c.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "c.vtu"));
   const std::string vtu = vessel::test::read_text(dir / "c.vtu");
@@ -77,4 +78,15 @@ TEST(FemCli, BadInputExitsOneWithAClearMessageAndWritesNothing) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "off the wall")) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "x.json"));
+}
+
+TEST(FemCli, ModesArePrintedAndWritten) {
+  TempDir dir;
+  const auto r =
+      vv("fem " + kTube + "--bc clamped-inlet --modes 4 --json " + (dir / "m.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "f (Hz):")) << r.output;
+  const auto j = nlohmann::json::parse(vessel::test::read_text(dir / "m.json"));
+  ASSERT_EQ(j["modal"]["frequencies_hz"].size(), 4u);
+  EXPECT_GT(j["modal"]["frequencies_hz"][0].get<double>(), 0.0);
 }

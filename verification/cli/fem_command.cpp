@@ -5,8 +5,8 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
-#include <numbers>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 
 #include "fem_reference/elasticity.hpp"
@@ -44,6 +44,8 @@ struct FemCommandOptions {
   std::size_t direct_max_dofs = fem::SolverOptions{}.direct_max_dofs;
   double tolerance = fem::SolverOptions{}.cg_relative_tolerance;
   unsigned max_iterations = fem::SolverOptions{}.max_iterations;
+  int modes = 0;
+  bool curved = false;
   fs::path vtu;
   fs::path json;
 };
@@ -100,7 +102,8 @@ void run(FemCommandOptions& o) {
   }
   Vec3 contact_point(params.inner_radius, 0.0, 0.5 * params.length);
   if (params.kind == VesselKind::arch) {
-    // The arch's crown: centreline point (0, R, 0); the inner wall on the side of the bend's centre.
+    // The arch's crown: centreline point (0, R, 0); the inner wall on the side of the bend's
+    // centre.
     contact_point = Vec3(0.0, params.bend_radius - params.inner_radius, 0.0);
   }
   if (!o.contact_point.empty()) contact_point = to_vec3(o.contact_point, "--contact-point");
@@ -125,29 +128,39 @@ void run(FemCommandOptions& o) {
               << patch.traction.norm() << " Pa\n";
   }
   if (has_gravity) problem.gravity = to_vec3(o.gravity, "--gravity");
+  if (o.curved) {
+    if (params.kind != VesselKind::straight) {
+      throw InputError(
+          "--curved is available for the straight tube only (its walls are cylinders)");
+    }
+    problem.curved_surfaces = fem::tube_curved_walls(params.inner_radius, params.outer_radius());
+  }
 
   // Ends: roller (u_z = 0, plane strain, plus three in-plane pins) or clamped.
   std::string bc = o.bc;
   if (bc == "auto") bc = (has_pressure && !has_contact && !has_gravity) ? "roller" : "clamped";
   if (bc == "roller") {
     if (params.kind != VesselKind::straight) {
-      throw InputError("--bc roller (u_z = 0 on the end faces) needs the straight tube; the arch's "
-                       "ends are not normal to z: use --bc clamped");
+      throw InputError(
+          "--bc roller (u_z = 0 on the end faces) needs the straight tube; the arch's "
+          "ends are not normal to z: use --bc clamped");
     }
     problem.dirichlet = {fem::DirichletCondition::roller("inlet", 2),
                          fem::DirichletCondition::roller("outlet", 2)};
     problem.point_constraints = fem::tube_in_plane_pins(params.inner_radius, 0.0);
   } else if (bc == "clamped") {
-    problem.dirichlet = {fem::DirichletCondition::clamped("inlet"), fem::DirichletCondition::clamped("outlet")};
+    problem.dirichlet = {fem::DirichletCondition::clamped("inlet"),
+                         fem::DirichletCondition::clamped("outlet")};
   } else if (bc == "clamped-inlet") {
     problem.dirichlet = {fem::DirichletCondition::clamped("inlet")};
   }
-  std::cout << std::setprecision(6) << "material: E " << o.youngs_modulus << " Pa, nu " << o.poisson_ratio << ", rho "
-            << o.density << " kg/m³; ends: " << bc << "\n";
+  std::cout << std::setprecision(6) << "material: E " << o.youngs_modulus << " Pa, nu "
+            << o.poisson_ratio << ", rho " << o.density << " kg/m³; ends: " << bc << "\n";
 
   fem::ElasticitySolver solver(mesh, problem);
   const auto& pre = solver.result();
-  std::cout << "element " << pre.element << ": " << pre.n_dofs << " DoFs";
+  std::cout << "element " << pre.element << (pre.curved ? " on curved walls" : "") << ": "
+            << pre.n_dofs << " DoFs";
   if (pre.n_pressure_dofs) std::cout << " (" << pre.n_pressure_dofs << " pressure)";
   std::cout << "\nsolving ..." << std::flush;
   const auto& r = solver.solve();
@@ -161,13 +174,33 @@ void run(FemCommandOptions& o) {
   double max_u = 0.0;
   for (const auto& u : r.nodal_displacement) max_u = std::max(max_u, u.norm());
 
+  fem::ModalResult modal;
+  if (o.modes > 0) {
+    std::cout << "modal analysis: lowest " << o.modes << " natural frequencies ..." << std::flush;
+    modal = solver.modes(o.modes);
+    std::cout << " " << std::fixed << std::setprecision(3) << modal.seconds << " s"
+              << std::defaultfloat << "\n  f (Hz):" << std::setprecision(6);
+    for (double f : modal.frequencies_hz) std::cout << " " << f;
+    std::cout << "\n";
+  }
+
   t0 = Clock::now();
   if (!o.vtu.empty()) {
     VtuField disp{"displacement", 3, {}}, strain{"strain", 6, {}}, stress{"stress", 6, {}};
-    for (const auto& u : r.nodal_displacement) disp.values.insert(disp.values.end(), {u.x(), u.y(), u.z()});
-    for (const auto& e : r.tet_strain) strain.values.insert(strain.values.end(), e.begin(), e.end());
-    for (const auto& s : r.tet_stress) stress.values.insert(stress.values.end(), s.begin(), s.end());
-    write_vtu(o.vtu, mesh, {disp}, {strain, stress});
+    for (const auto& u : r.nodal_displacement)
+      disp.values.insert(disp.values.end(), {u.x(), u.y(), u.z()});
+    for (const auto& e : r.tet_strain)
+      strain.values.insert(strain.values.end(), e.begin(), e.end());
+    for (const auto& s : r.tet_stress)
+      stress.values.insert(stress.values.end(), s.begin(), s.end());
+    std::vector<VtuField> point_fields{disp};
+    for (std::size_t k = 0; k < modal.mode_shapes.size(); ++k) {
+      VtuField mode{"mode_" + std::to_string(k + 1), 3, {}};
+      for (const auto& u : modal.mode_shapes[k])
+        mode.values.insert(mode.values.end(), {u.x(), u.y(), u.z()});
+      point_fields.push_back(std::move(mode));
+    }
+    write_vtu(o.vtu, mesh, point_fields, {strain, stress});
   }
   const double output_seconds = since(t0);
 
@@ -190,8 +223,9 @@ void run(FemCommandOptions& o) {
     const fem::LameCylinder lame{params.inner_radius, params.outer_radius(), o.pressure,
                                  o.youngs_modulus, o.poisson_ratio};
     lame_error = solver.relative_l2_error([&](const Vec3& x) { return lame.displacement(x); });
-    std::cout << "  Lamé closed form        u_r(a) " << lame.radial_displacement(params.inner_radius) * 1e3
-              << " mm, u_r(b) " << lame.radial_displacement(params.outer_radius()) * 1e3
+    std::cout << "  Lamé closed form        u_r(a) "
+              << lame.radial_displacement(params.inner_radius) * 1e3 << " mm, u_r(b) "
+              << lame.radial_displacement(params.outer_radius()) * 1e3
               << " mm; FEM relative L2 error " << lame_error << "\n";
   }
   std::cout << "  applied load            " << mm(r.applied_load) << " mN\n";
@@ -211,17 +245,23 @@ void run(FemCommandOptions& o) {
 
   if (!o.json.empty()) {
     nlohmann::json reactions = nlohmann::json::array();
-    for (const auto& g : r.reactions) reactions.push_back({{"group", g.group}, {"force_mN", json_vec(g.force, 1e3)}});
+    for (const auto& g : r.reactions)
+      reactions.push_back({{"group", g.group}, {"force_mN", json_vec(g.force, 1e3)}});
     nlohmann::json j{
         {"schema", "vesselverify.fem"},
         {"schema_version", 1},
         {"units", {{"length", "mm"}, {"force", "mN"}, {"energy", "mJ"}, {"time", "s"}}},
         {"vessel", describe(params)},
-        {"mesh", {{"nodes", mesh.nodes.size()}, {"tets", mesh.tets.size()}, {"cache_hit", source.cache_hit}}},
-        {"material", {{"E_Pa", o.youngs_modulus}, {"nu", o.poisson_ratio}, {"density_kg_m3", o.density}}},
+        {"mesh",
+         {{"nodes", mesh.nodes.size()},
+          {"tets", mesh.tets.size()},
+          {"cache_hit", source.cache_hit}}},
+        {"material",
+         {{"E_Pa", o.youngs_modulus}, {"nu", o.poisson_ratio}, {"density_kg_m3", o.density}}},
         {"loads", o.loads},
         {"ends", bc},
         {"element", r.element},
+        {"curved", r.curved},
         {"formulation", fem::to_string(r.formulation)},
         {"solver", fem::to_string(r.solver)},
         {"cg_iterations", r.iterations},
@@ -234,12 +274,23 @@ void run(FemCommandOptions& o) {
         {"applied_load_mN", json_vec(r.applied_load, 1e3)},
         {"reactions", reactions},
         {"timings_s",
-         {{"mesh", mesh_seconds}, {"setup", r.timings.setup}, {"assembly", r.timings.assembly},
-          {"solve", r.timings.solve}, {"postprocess", r.timings.postprocess}, {"output", output_seconds}}}};
+         {{"mesh", mesh_seconds},
+          {"setup", r.timings.setup},
+          {"assembly", r.timings.assembly},
+          {"solve", r.timings.solve},
+          {"postprocess", r.timings.postprocess},
+          {"output", output_seconds}}}};
     if (lame_error >= 0.0) j["lame_relative_l2_error"] = lame_error;
+    if (o.modes > 0) {
+      j["modal"] = {{"frequencies_hz", modal.frequencies_hz},
+                    {"dofs", modal.n_dofs},
+                    {"seconds", modal.seconds}};
+    }
     if (have_contact_u) {
-      j["contact"] = {{"point_mm", json_vec(contact_point, 1e3)}, {"radius_mm", o.contact_radius * 1e3},
-                      {"force_mN", o.force * 1e3}, {"patch_area_mm2", patch.area * 1e6},
+      j["contact"] = {{"point_mm", json_vec(contact_point, 1e3)},
+                      {"radius_mm", o.contact_radius * 1e3},
+                      {"force_mN", o.force * 1e3},
+                      {"patch_area_mm2", patch.area * 1e6},
                       {"patch_triangles", patch.triangles.size()},
                       {"displacement_mm", json_vec(u_contact, 1e3)}};
     }
@@ -266,6 +317,7 @@ void add_fem_command(CLI::App& app) {
       "  vesselverify fem --load contact --force 1e-4 --contact-radius 5e-4 --json fem.json\n"
       "  vesselverify fem --load gravity --bc clamped-inlet\n"
       "  vesselverify fem --nu 0.5                          # Taylor-Hood P2-P1 (automatic)\n"
+      "  vesselverify fem --degree 2 --bc clamped-inlet --modes 10   # natural frequencies\n"
       "  vesselverify fem --degree 2 --level 2 --solver cg-amg");
   add_vessel_options(*cmd, o->vessel);
   cmd->add_option("--degree", o->degree, "Displacement element degree (1 or 2)")
@@ -278,13 +330,16 @@ void add_fem_command(CLI::App& app) {
                   "auto (mixed when nu >= --mixed-threshold), displacement, or mixed (P2-P1)")
       ->check(CLI::IsMember({"auto", "displacement", "mixed"}))
       ->capture_default_str();
-  cmd->add_option("--mixed-threshold", o->mixed_threshold, "auto: mixed formulation when nu >= this")
+  cmd->add_option("--mixed-threshold", o->mixed_threshold,
+                  "auto: mixed formulation when nu >= this")
       ->capture_default_str();
   cmd->add_option("--load", o->loads, "Load(s): pressure, contact, gravity (repeatable)")
       ->check(CLI::IsMember({"pressure", "contact", "gravity"}))
       ->capture_default_str();
-  cmd->add_option("--pressure", o->pressure, "Internal pressure on inner_wall, Pa")->capture_default_str();
-  cmd->add_option("--force", o->force, "Contact force, N (pushes into the wall)")->capture_default_str();
+  cmd->add_option("--pressure", o->pressure, "Internal pressure on inner_wall, Pa")
+      ->capture_default_str();
+  cmd->add_option("--force", o->force, "Contact force, N (pushes into the wall)")
+      ->capture_default_str();
   cmd->add_option("--contact-point", o->contact_point,
                   "Contact point x y z, metres (default: mid-length on the chosen wall at +x)")
       ->expected(3);
@@ -293,7 +348,9 @@ void add_fem_command(CLI::App& app) {
   cmd->add_option("--contact-surface", o->contact_surface, "Surface group the contact acts on")
       ->check(CLI::IsMember({"inner_wall", "outer_wall"}))
       ->capture_default_str();
-  cmd->add_option("--gravity", o->gravity, "Gravity vector gx gy gz, m/s²")->expected(3)->capture_default_str();
+  cmd->add_option("--gravity", o->gravity, "Gravity vector gx gy gz, m/s²")
+      ->expected(3)
+      ->capture_default_str();
   cmd->add_option("--bc", o->bc, "End conditions: auto, roller, clamped, clamped-inlet")
       ->check(CLI::IsMember({"auto", "roller", "clamped", "clamped-inlet"}))
       ->capture_default_str();
@@ -302,11 +359,22 @@ void add_fem_command(CLI::App& app) {
                   "multigrid), direct (UMFPACK), cg-amg (Trilinos ML)")
       ->check(CLI::IsMember({"auto", "direct", "cg-amg"}))
       ->capture_default_str();
-  cmd->add_option("--direct-max-dofs", o->direct_max_dofs, "auto: direct solver up to this many DoFs")
+  cmd->add_option("--direct-max-dofs", o->direct_max_dofs,
+                  "auto: direct solver up to this many DoFs")
       ->capture_default_str();
-  cmd->add_option("--tolerance", o->tolerance, "CG relative residual tolerance")->capture_default_str();
-  cmd->add_option("--max-iterations", o->max_iterations, "CG iteration limit")->capture_default_str();
-  cmd->add_option("--vtu", o->vtu, "Write displacement (nodes), strain and stress (tets) as VTU");
+  cmd->add_option("--tolerance", o->tolerance, "CG relative residual tolerance")
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", o->max_iterations, "CG iteration limit")
+      ->capture_default_str();
+  cmd->add_flag("--curved", o->curved,
+                "Quadratic elements: put the P2 geometry nodes on the exact cylinders (straight "
+                "tube), so the wall is curved (O(h³) geometry instead of straight-sided O(h²))");
+  cmd->add_option("--modes", o->modes,
+                  "Also compute this many lowest natural frequencies and mode shapes (consistent "
+                  "mass, on the same end conditions; e.g. 10)")
+      ->check(CLI::Range(0, 100));
+  cmd->add_option("--vtu", o->vtu,
+                  "Write displacement and mode shapes (nodes), strain and stress (tets) as VTU");
   cmd->add_option("--json", o->json, "Write a JSON summary");
   cmd->callback([o] { run(*o); });
 }
