@@ -149,6 +149,7 @@ Face sorted_face(unsigned a, unsigned b, unsigned c) {
 /// Uniform bucket grid over the tets' bounding boxes for point location.
 class TetLocator {
  public:
+  static constexpr double kBoxPadding = 0.1;  ///< of a tet's box diagonal
   explicit TetLocator(const TetMesh& mesh) : mesh_(&mesh) {
     lo_ = hi_ = mesh.nodes.empty() ? Vec3::Zero() : mesh.nodes[0];
     for (const auto& x : mesh.nodes) {
@@ -156,8 +157,12 @@ class TetLocator {
       hi_ = hi_.cwiseMax(x);
     }
     const double extent = (hi_ - lo_).maxCoeff();
-    lo_ -= Vec3::Constant(1e-9 * extent);
-    hi_ += Vec3::Constant(1e-9 * extent);
+    double largest_tet = 0.0;
+    for (const auto& tet : mesh.tets) {
+      largest_tet = std::max(largest_tet, (mesh.nodes[tet[1]] - mesh.nodes[tet[0]]).norm());
+    }
+    lo_ -= Vec3::Constant(1e-9 * extent + kBoxPadding * largest_tet);
+    hi_ += Vec3::Constant(1e-9 * extent + kBoxPadding * largest_tet);
     const double per_axis =
         std::cbrt(static_cast<double>(std::max<std::size_t>(mesh.tets.size(), 1)));
     for (int d = 0; d < 3; ++d) {
@@ -170,6 +175,11 @@ class TetLocator {
         a = a.cwiseMin(mesh.nodes[v]);
         b = b.cwiseMax(mesh.nodes[v]);
       }
+      // Listed also in the buckets just outside its box, so that points slightly outside the
+      // mesh (a curved wall's chord error) still find their tet when a tolerance allows it.
+      const Vec3 pad = Vec3::Constant(kBoxPadding * (b - a).norm());
+      a -= pad;
+      b += pad;
       const auto ia = bucket_of(a), ib = bucket_of(b);
       for (int i = ia[0]; i <= ib[0]; ++i)
         for (int j = ia[1]; j <= ib[1]; ++j)
@@ -826,7 +836,8 @@ const ElasticityResult& ElasticitySolver::solve() {
 
 const ElasticityResult& ElasticitySolver::result() const { return impl_->result; }
 
-std::vector<Vec3> ElasticitySolver::displacement_at(const std::vector<Vec3>& points) const {
+std::vector<Vec3> ElasticitySolver::displacement_at(const std::vector<Vec3>& points,
+                                                    double outside_tolerance) const {
   const auto& im = *impl_;
   if (!im.solved) throw std::logic_error("displacement_at called before solve()");
   std::vector<Vec3> out;
@@ -834,7 +845,7 @@ std::vector<Vec3> ElasticitySolver::displacement_at(const std::vector<Vec3>& poi
   const unsigned n = im.fe->n_dofs_per_cell();
   std::vector<dl::types::global_dof_index> dofs(n);
   for (const auto& x : points) {
-    const int t = im.locator->find(x);
+    const int t = im.locator->find(x, outside_tolerance);
     if (t < 0) {
       std::ostringstream m;
       m << "point (" << x.x() * 1e3 << ", " << x.y() * 1e3 << ", " << x.z() * 1e3

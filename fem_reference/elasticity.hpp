@@ -168,7 +168,11 @@ class ElasticitySolver {
 
   /// The FE displacement (m) at arbitrary points inside the mesh (within a relative tolerance of
   /// 1e-9 of the element size). Throws InputError naming the first point outside. Requires solve().
-  [[nodiscard]] std::vector<Vec3> displacement_at(const std::vector<Vec3>& points) const;
+  /// `outside_tolerance` (barycentric, dimensionless) also accepts points that far outside the
+  /// nearest tet, evaluated by extending its polynomial: a node on an exact curved wall lies outside
+  /// the straight-sided tets by up to the chord's sagitta (a few % of a tet's height).
+  [[nodiscard]] std::vector<Vec3> displacement_at(const std::vector<Vec3>& points,
+                                                  double outside_tolerance = 1e-9) const;
 
   /// The `count` lowest natural frequencies (shift-invert Lanczos, Spectra, on the displacement
   /// formulation; InputError for the mixed one). Does not need solve(). Without constraints the

@@ -13,14 +13,16 @@ namespace vessel {
 
 namespace {
 
-// Names the scene accepts for mass-spring options (the msm library's named rules).
-const std::vector<std::string> kStiffnessRules{"seed000", "mollemans", "van_gelder", "lloyd",
+// Names the scene accepts for mass-spring options: the msm library's own names (its parse_*
+// functions accept exactly these; a test checks that they agree).
+const std::vector<std::string> kStiffnessRules{"seed000", "seed001", "van-gelder", "lloyd",
                                                "uniform"};
-const std::vector<std::string> kMassRules{"uniform", "tet_volume", "density"};
-const std::vector<std::string> kSolvers{"static",           "linear", "explicit_euler",
-                                        "symplectic_euler", "verlet", "implicit_euler",
-                                        "dynamic_relaxation"};
+const std::vector<std::string> kMassRules{"uniform", "seed001", "consistent"};
+const std::vector<std::string> kSolvers{"static",           "linear", "relaxation",
+                                        "explicit-euler",   "symplectic-euler",
+                                        "verlet",           "implicit-euler"};
 const std::vector<std::string> kSurfaces{"inner", "outer", "mid"};
+const std::vector<std::string> kTopologies{"auto", "grid", "triangles"};
 
 std::string join(const std::vector<std::string>& names) {
   std::string s;
@@ -212,12 +214,14 @@ ModelSpec read_model(TableReader r, std::size_t index) {
     m.degree = static_cast<int>(r.integer_or("degree", 2, 1, 2));
   } else {
     if (m.kind == ModelKind::surface_msm) m.surface = r.string_or("surface", m.surface, kSurfaces);
-    m.stiffness = r.string_or("stiffness", m.kind == ModelKind::volume_msm ? "mollemans" : "seed000",
+    if (m.kind == ModelKind::surface_msm) m.topology = r.string_or("topology", m.topology, kTopologies);
+    m.stiffness = r.string_or("stiffness", m.kind == ModelKind::volume_msm ? "seed001" : "seed000",
                               kStiffnessRules);
     m.mass = r.string_or("mass", m.mass, kMassRules);
     m.solver = r.string_or("solver", m.solver, kSolvers);
-    m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "1/s");
-    const bool integrator = m.solver != "static" && m.solver != "linear";
+    m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
+    const bool integrator =
+        m.solver != "static" && m.solver != "linear" && m.solver != "relaxation";
     if (integrator) {
       const toml::node* dt = r.get("dt");
       if (!dt) r.fail(nullptr, "dt", "missing; solver \"" + m.solver + "\" needs a time step > 0 s");

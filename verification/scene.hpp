@@ -23,11 +23,12 @@ struct ModelSpec {
   ModelKind kind = ModelKind::fem;
   int degree = 2;                      ///< FEM: 1 or 2
   std::string surface = "mid";         ///< surface msm: inner | outer | mid
-  std::string stiffness;               ///< msm stiffness rule
-  std::string mass = "density";        ///< msm mass rule
-  std::string solver = "static";       ///< static | linear | an integrator
+  std::string topology = "auto";       ///< surface msm: auto | grid | triangles
+  std::string stiffness;               ///< msm stiffness rule (msm::parse_stiffness_rule names)
+  std::string mass = "consistent";     ///< msm mass rule (msm::parse_mass_rule names)
+  std::string solver = "static";       ///< static | linear | relaxation | an integrator
   double dt = 0.0;                     ///< s, integrators only (> 0)
-  double damping = 0.0;                ///< point damping, 1/s (mass-proportional)
+  double damping = 0.0;                ///< point damping k_v of seed 000 eq. (3.3), N·s/m per node
   long steps = 0;                      ///< integrators: number of steps (> 0)
 };
 

@@ -201,6 +201,28 @@ TEST(ElasticityPointEvaluation, MatchesNodalValuesAndRefusesOutsidePoints) {
   EXPECT_THROW((void)s.displacement_at({Vec3(0, 0, 0.5e-3)}), InputError);  // in the lumen
 }
 
+TEST(ElasticityPointEvaluation, ToleranceAcceptsPointsJustOutsideACurvedWall) {
+  // A point 5 µm outside an outer-wall node (the chord error of a curved wall is of that order):
+  // refused by default, evaluated with a tolerance, and then close to the node's value (the
+  // field's gradient times 5 µm).
+  const auto& m = mesh0();
+  ElasticityProblem p;
+  p.options.degree = 2;
+  p.dirichlet = {fem::DirichletCondition::clamped("inlet")};
+  p.pressures = {{"inner_wall", 5.0}};
+  ElasticitySolver s(m, p);
+  const auto& r = s.solve();
+  int node = -1;  // the outer-wall node that moves most
+  for (int n : m.group_nodes(*m.find_group("outer_wall", 2))) {
+    if (node < 0 || r.nodal_displacement[n].norm() > r.nodal_displacement[node].norm()) node = n;
+  }
+  const Vec3 x = m.nodes[node];
+  const Vec3 outside = x + 5e-6 * Vec3(x.x(), x.y(), 0.0).normalized();
+  EXPECT_THROW((void)s.displacement_at({outside}), InputError);
+  const Vec3 u = s.displacement_at({outside}, 0.25)[0];
+  EXPECT_LT((u - r.nodal_displacement[node]).norm(), 0.02 * r.nodal_displacement[node].norm());
+}
+
 TEST(ElasticitySolvers, AmgCgAgreesWithTheDirectSolver) {
   // A second solver as independent check: UMFPACK vs CG with ML AMG (translations only, and all
   // six rigid-body modes), on a contact patch with clamped ends, P1 and P2.

@@ -13,6 +13,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   vessel::cli::add_mesh_command(app);
   vessel::cli::add_scene_command(app);
+  std::string command_line;
+  for (int i = 0; i < argc; ++i) command_line += (i ? " " : "") + std::string(argv[i]);
+  vessel::cli::add_run_command(app, command_line);
   vessel::cli::add_msm_command(app);
   vessel::cli::add_fem_command(app);
   try {

@@ -1,0 +1,147 @@
+// The harness end to end on small scenes, against independent truth: Lamé's closed form for the
+// reference's contact-point value, zero error for a model identical to the reference, exact
+// linear scaling, and a diverging model recorded as failed while the others still run.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "../test_helpers.hpp"
+
+#include "verification/harness.hpp"
+
+using namespace vessel;
+
+namespace {
+
+/// Straight structured tube, level 0, internal pressure 10 Pa, roller ends (plane strain).
+const char* kLame = R"(name = "lame_test"
+[vessel]
+kind = "straight"
+mesh = "structured"
+level = 0
+reference_level = 0
+[material]
+E = 14.24e3
+nu = 0.3
+[boundary]
+inlet = "roller"
+outlet = "roller"
+[load]
+type = "pressure"
+magnitudes = [10.0, 20.0]
+[[models]]
+name = "p2_same_as_reference"
+kind = "fem"
+degree = 2
+[[models]]
+name = "p1"
+kind = "fem"
+degree = 1
+[[models]]
+name = "volume_linear"
+kind = "volume_msm"
+stiffness = "seed001"
+solver = "linear"
+[[models]]
+name = "volume_explicit_euler_too_big_a_step"
+kind = "volume_msm"
+stiffness = "seed001"
+solver = "explicit-euler"
+dt = 1.0
+steps = 50
+)";
+
+const ModelOutcome& find(const SceneResult& r, const std::string& model, double magnitude) {
+  for (const auto& o : r.outcomes) {
+    if (o.model == model && o.magnitude == magnitude) return o;
+  }
+  throw std::runtime_error("no outcome for " + model);
+}
+
+/// Lamé, plane strain: u_r(r) = p a² / (E (b² − a²)) ((1+ν)(1−2ν) r + (1+ν) b²/r).
+double lame_radial(double p, double a, double b, double E, double nu, double r) {
+  return p * a * a / (E * (b * b - a * a)) * ((1 + nu) * (1 - 2 * nu) * r + (1 + nu) * b * b / r);
+}
+
+class HarnessLame : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    result_ = new SceneResult(run_scene(parse_scene(kLame, "lame_test.toml"), HarnessOptions{}));
+  }
+  static void TearDownTestSuite() { delete result_; }
+  static SceneResult* result_;
+};
+SceneResult* HarnessLame::result_ = nullptr;
+
+}  // namespace
+
+TEST_F(HarnessLame, ReferenceAtTheQoiPointMatchesLame) {
+  // The QoI point of a pressure scene is the inner wall at mid-length, θ = 0: u_r(a).
+  const ModelOutcome& o = find(*result_, "p2_same_as_reference", 10.0);
+  const double exact_mm = lame_radial(10.0, 3e-3, 4e-3, 14.24e3, 0.3, 3e-3) * 1e3;
+  EXPECT_NEAR(o.qoi_reference_mm / exact_mm, 1.0, 0.03);  // straight-sided P2 at level 0
+}
+
+TEST_F(HarnessLame, AModelIdenticalToTheReferenceHasZeroError) {
+  const ModelOutcome& o = find(*result_, "p2_same_as_reference", 10.0);
+  ASSERT_TRUE(o.ok);
+  EXPECT_LT(o.error.relative_l2, 1e-8);
+  EXPECT_LT(o.error.max_mm, 1e-9);
+}
+
+TEST_F(HarnessLame, P1IsLessAccurateThanTheReferenceButClose) {
+  const ModelOutcome& o = find(*result_, "p1", 10.0);
+  ASSERT_TRUE(o.ok);
+  EXPECT_GT(o.error.relative_l2, 1e-4);
+  EXPECT_LT(o.error.relative_l2, 0.3);
+}
+
+TEST_F(HarnessLame, LinearModelsScaleExactlyWithTheLoad) {
+  for (const char* model : {"p1", "volume_linear"}) {
+    const ModelOutcome& a = find(*result_, model, 10.0);
+    const ModelOutcome& b = find(*result_, model, 20.0);
+    ASSERT_TRUE(a.ok && b.ok) << model;
+    EXPECT_NEAR(b.error.max_mm / a.error.max_mm, 2.0, 1e-6) << model;
+    EXPECT_NEAR(b.qoi_displacement_mm / a.qoi_displacement_mm, 2.0, 1e-6) << model;
+    EXPECT_NEAR(a.error.relative_l2, b.error.relative_l2, 1e-9) << model;
+  }
+}
+
+TEST_F(HarnessLame, ADivergingModelIsRecordedAsFailedAndTheOthersStillRun) {
+  const ModelOutcome& o = find(*result_, "volume_explicit_euler_too_big_a_step", 10.0);
+  EXPECT_FALSE(o.ok);
+  EXPECT_NE(o.failure.find("step"), std::string::npos) << o.failure;
+  EXPECT_TRUE(find(*result_, "volume_linear", 20.0).ok);
+  EXPECT_EQ(result_->references.size(), 1u);
+  EXPECT_EQ(result_->outcomes.size(), 8u);
+}
+
+TEST_F(HarnessLame, ResultsJsonHasEveryFieldItsSchemaRequires) {
+  test::TempDir dir;
+  write_results_json(dir / "results.json", {*result_}, "test");
+  write_results_csv(dir / "results.csv", {*result_});
+  write_summary_markdown(dir / "summary.md", {*result_}, "test");
+  const auto results = nlohmann::json::parse(test::read_text(dir / "results.json"));
+  const auto schema = nlohmann::json::parse(test::read_text(VESSEL_RESULTS_SCHEMA));
+  for (const auto& key : schema["required"]) EXPECT_TRUE(results.contains(key)) << key;
+  const auto& scene_schema = schema["properties"]["scenes"]["items"];
+  const auto& scene = results["scenes"].at(0);
+  for (const auto& key : scene_schema["required"]) EXPECT_TRUE(scene.contains(key)) << key;
+  const auto& outcome_schema = scene_schema["properties"]["outcomes"]["items"];
+  for (const auto& outcome : scene["outcomes"]) {
+    for (const auto& key : outcome_schema["required"]) EXPECT_TRUE(outcome.contains(key)) << key;
+    if (outcome["ok"]) {
+      for (const auto& key : outcome_schema["properties"]["error"]["required"]) {
+        EXPECT_TRUE(outcome["error"].contains(key)) << key;
+      }
+    } else {
+      EXPECT_TRUE(outcome.contains("failure"));
+    }
+  }
+  // One CSV row per outcome plus the header.
+  const std::string csv = test::read_text(dir / "results.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 8);
+  EXPECT_NE(test::read_text(dir / "summary.md").find("| p1 | 0.3 | 10 |"), std::string::npos);
+}

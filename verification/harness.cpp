@@ -1,0 +1,394 @@
+#include "verification/harness.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "fem_reference/convergence.hpp"
+#include "fem_reference/elasticity.hpp"
+#include "meshes/errors.hpp"
+#include "meshes/mesh_cache.hpp"
+#include "msm/model/build_network.hpp"
+#include "msm/model/spring_model.hpp"
+#include "msm/solvers/integrators.hpp"
+#include "msm/solvers/static_solver.hpp"
+#include "verification/progress.hpp"
+#include "verification/timing.hpp"
+
+namespace vessel {
+
+namespace {
+
+constexpr double kStandardGravity = 9.81;  ///< m/s²; gravity magnitudes are multiples of g
+constexpr double kLinearRegimeStrain = 0.05;
+/// Straight-sided tets cap the reference's observed order near 2 on the curved walls (the
+/// reference's own Lamé verification), so Richardson uses p = 2 between its two levels.
+constexpr double kReferenceOrder = 2.0;
+constexpr double kMixedThreshold = 0.49;
+
+TetMesh mesh_at_level(const Scene& s, int level, const HarnessOptions& o) {
+  VesselParams p = s.vessel;
+  p.level = level;
+  return load_or_generate_vessel(p, o.cache_dir, {});
+}
+
+/// Where the "contact-point displacement" is read: the contact point, or for distributed loads the
+/// inner wall at mid-length (tube: θ = 0 side; arch: the outer bend's apex).
+Vec3 qoi_point(const Scene& s) {
+  if (s.load.kind == LoadKind::contact) return s.load.contact.point;
+  const VesselParams& p = s.vessel;
+  if (p.kind == VesselKind::straight) return {p.inner_radius, 0.0, 0.5 * p.length};
+  return {0.0, p.bend_radius + p.inner_radius, 0.0};
+}
+
+/// Barycentric tolerance for evaluating the reference at model nodes: a node on the exact curved
+/// wall lies outside the reference's straight-sided tets by up to the chord's sagitta ℓ²/(8r),
+/// a few per cent of a tet's height at the levels used; the FE polynomial is extended there.
+constexpr double kOutsideTolerance = 0.25;
+
+std::vector<Vec3> scaled(const std::vector<Vec3>& u, double factor) {
+  std::vector<Vec3> out(u.size());
+  for (std::size_t i = 0; i < u.size(); ++i) out[i] = factor * u[i];
+  return out;
+}
+
+std::vector<std::string> groups_with(const Scene& s, BoundaryCondition bc) {
+  std::vector<std::string> out;
+  for (const auto& [group, condition] : s.boundary) {
+    if (condition == bc) out.push_back(group);
+  }
+  return out;
+}
+
+/// The FEM problem of the scene at unit load.
+fem::ElasticityProblem fem_problem(const Scene& s, const TetMesh& mesh, double nu, int degree) {
+  fem::ElasticityProblem prob;
+  prob.material.youngs_modulus = s.youngs_modulus;
+  prob.material.poisson_ratio = nu;
+  prob.material.density = s.density;
+  prob.options.degree = degree;
+  // Taylor–Hood only from ν = 0.49: its saddle-point system goes to the direct solver (minutes and
+  // gigabytes at reference levels), while P2 displacement elements do not lock appreciably below
+  // 0.49 and scale with AMG-CG.
+  prob.options.mixed_threshold = kMixedThreshold;
+  for (const auto& g : groups_with(s, BoundaryCondition::clamped)) {
+    prob.dirichlet.push_back(fem::DirichletCondition::clamped(g));
+  }
+  const auto rollers = groups_with(s, BoundaryCondition::axial_roller);
+  if (!rollers.empty()) {
+    if (s.vessel.kind != VesselKind::straight) {
+      throw InputError(s.source.string() + ": roller ends are supported on the straight tube only");
+    }
+    for (const auto& g : rollers) {
+      prob.dirichlet.push_back(fem::DirichletCondition::roller(g, 2));
+    }
+    if (groups_with(s, BoundaryCondition::clamped).empty()) {
+      prob.point_constraints = fem::tube_in_plane_pins(s.vessel.inner_radius, 0.0);
+    }
+  }
+  if (prob.dirichlet.empty()) {
+    throw InputError(s.source.string() +
+                     ": [boundary] leaves both ends free; expected at least one clamped or roller "
+                     "end (a free body has rigid motions and no static answer)");
+  }
+  switch (s.load.kind) {
+    case LoadKind::contact: {
+      ContactPatchSpec spec = s.load.contact;
+      spec.force = 1.0;
+      prob.patches.push_back(contact_patch(mesh, spec));
+      break;
+    }
+    case LoadKind::pressure:
+      prob.pressures.push_back({s.load.contact.surface_group, 1.0});
+      break;
+    case LoadKind::gravity:
+      prob.gravity = kStandardGravity * s.load.gravity_direction;
+      break;
+  }
+  return prob;
+}
+
+/// The mass-spring problem of the scene at load `magnitude`.
+msm::Problem msm_problem(const Scene& s, const msm::Form& form, const msm::BuiltNetwork& built,
+                         const TetMesh& mesh, double magnitude) {
+  std::vector<Vec3> loads(mesh.nodes.size(), Vec3::Zero());
+  if (s.load.kind == LoadKind::contact) {
+    ContactPatchSpec spec = s.load.contact;
+    spec.force = magnitude;
+    loads = traction_nodal_loads(mesh, contact_patch(mesh, spec));
+  } else if (s.load.kind == LoadKind::pressure) {
+    loads = pressure_nodal_loads(mesh, s.load.contact.surface_group, magnitude);
+  }
+  msm::Problem problem = msm::make_problem(form, built.network, built.masses, mesh, loads,
+                                           groups_with(s, BoundaryCondition::clamped));
+  if (s.load.kind == LoadKind::gravity) {
+    // The network's own masses carry gravity (for the volume model with consistent masses this is
+    // exactly the FEM's ρg V/4 per tet vertex).
+    const Vec3 g = magnitude * kStandardGravity * s.load.gravity_direction;
+    for (Eigen::Index i = 0; i < problem.num_dofs(); i += 3) {
+      for (int c = 0; c < 3; ++c) problem.external_force[i + c] += problem.mass[i] * g[c];
+    }
+  }
+  const auto rollers = groups_with(s, BoundaryCondition::axial_roller);
+  if (!rollers.empty()) {
+    // Straight tube: u_z = 0 on the end planes, plus the FEM's three in-plane pins at the nodes
+    // nearest (±ρ, 0, 0) and (0, ρ, 0) of the inlet plane.
+    const double tol = 1e-9 + 1e-6 * s.vessel.length;
+    const auto& nodes = built.network.nodes;
+    std::array<int, 3> pin{-1, -1, -1};
+    std::array<double, 3> best{};
+    best.fill(std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      const Vec3& x = nodes[i];
+      const bool at_inlet = std::abs(x.z()) < tol;
+      const bool at_outlet = std::abs(x.z() - s.vessel.length) < tol;
+      if ((at_inlet && s.boundary.at("inlet") == BoundaryCondition::axial_roller) ||
+          (at_outlet && s.boundary.at("outlet") == BoundaryCondition::axial_roller)) {
+        problem.fixed[3 * i + 2] = 1;
+      }
+      if (!at_inlet) continue;
+      // Pin candidates: (ρ, 0) and (−ρ, 0) for u_y, (0, ρ) for u_x.
+      const auto consider = [&](int k, bool right_side, double off_axis) {
+        if (right_side && off_axis < best[k]) {
+          best[k] = off_axis;
+          pin[k] = static_cast<int>(i);
+        }
+      };
+      consider(0, x.x() > 0, std::abs(x.y()));
+      consider(1, x.x() < 0, std::abs(x.y()));
+      consider(2, x.y() > 0, std::abs(x.x()));
+    }
+    if (groups_with(s, BoundaryCondition::clamped).empty()) {
+      for (int k = 0; k < 3; ++k) {
+        if (pin[k] < 0) throw InputError("no mass-spring node on the inlet plane to pin");
+        problem.fixed[3 * pin[k] + (k < 2 ? 1 : 0)] = 1;  // u_y at (±ρ,0), u_x at (0,ρ)
+      }
+    }
+  }
+  return problem;
+}
+
+std::size_t free_unknowns(const msm::Problem& p) {
+  return static_cast<std::size_t>(std::count(p.fixed.begin(), p.fixed.end(), 0));
+}
+
+std::size_t nearest(const std::vector<Vec3>& points, const Vec3& x) {
+  std::size_t best = 0;
+  double d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double di = (points[i] - x).squaredNorm();
+    if (di < d) {
+      d = di;
+      best = i;
+    }
+  }
+  return best;
+}
+
+/// Reference displacement at unit load and its Richardson uncertainty at a model's points.
+struct ReferenceAtPoints {
+  std::vector<Vec3> u;  ///< fine level, unit load
+  fem::FieldUncertainty uncertainty;  ///< unit load; zero if there is no coarser level
+  bool has_uncertainty = false;
+};
+
+struct ReferenceSolvers {
+  std::unique_ptr<fem::ElasticitySolver> fine;
+  std::unique_ptr<fem::ElasticitySolver> coarse;
+};
+
+ReferenceAtPoints reference_at(const ReferenceSolvers& ref, const std::vector<Vec3>& points) {
+  ReferenceAtPoints r;
+  r.u = ref.fine->displacement_at(points, kOutsideTolerance);
+  if (ref.coarse) {
+    r.uncertainty = fem::richardson_field(ref.coarse->displacement_at(points, kOutsideTolerance),
+                                          r.u, kReferenceOrder);
+    r.has_uncertainty = true;
+  }
+  return r;
+}
+
+void finish_outcome(ModelOutcome& out, const std::vector<Vec3>& u_model,
+                    const ReferenceAtPoints& ref, double magnitude, std::size_t qoi,
+                    double ref_max_strain_unit) {
+  const std::vector<Vec3> u_ref = scaled(ref.u, magnitude);
+  out.error = compare_displacements(u_model, u_ref);
+  out.has_reference_uncertainty = ref.has_uncertainty;
+  if (ref.has_uncertainty) {
+    out.reference_uncertainty.max_mm = ref.uncertainty.max_error * magnitude * 1e3;
+    out.reference_uncertainty.rms_mm = ref.uncertainty.rms_error * magnitude * 1e3;
+    out.reference_uncertainty.relative_l2 = ref.uncertainty.relative_l2;
+  }
+  out.qoi_displacement_mm = u_model[qoi].norm() * 1e3;
+  out.qoi_reference_mm = u_ref[qoi].norm() * 1e3;
+  out.beyond_linear_regime = ref_max_strain_unit * magnitude > kLinearRegimeStrain;
+  out.ok = true;
+}
+
+/// A FEM model: always the displacement formulation of its degree, so that P1's locking near
+/// ν = 0.5 shows; at ν = 0.5, where that element cannot be used, it is recorded as failed.
+void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
+                   const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
+                   const HarnessOptions& o, ModelOutcome base, SceneResult& result) {
+  try {
+    Stopwatch setup;
+    fem::ElasticityProblem problem = fem_problem(s, mesh, nu, spec.degree);
+    problem.options.formulation = fem::Formulation::displacement;
+    fem::ElasticitySolver solver(mesh, problem);
+    base.setup_seconds = setup.seconds();
+    std::vector<double> times;
+    fem::ElasticityResult r;
+    for (int k = 0; k < std::max(1, o.repeats); ++k) {
+      r = solver.solve();
+      times.push_back(r.timings.assembly + r.timings.solve);
+    }
+    base.solve_seconds = median(times);
+    base.detail = r.element + ", " + fem::to_string(r.solver);
+    base.nodes = mesh.nodes.size();
+    base.unknowns = r.n_dofs;
+    const ReferenceAtPoints at = reference_at(ref, mesh.nodes);
+    const std::size_t qoi = nearest(mesh.nodes, result.qoi_point);
+    for (const double mag : s.load.magnitudes) {
+      ModelOutcome out = base;
+      out.magnitude = mag;
+      out.max_strain = r.max_abs_principal_strain * mag;
+      finish_outcome(out, scaled(r.nodal_displacement, mag), at, mag, qoi,
+                     fine.max_abs_principal_strain);
+      result.outcomes.push_back(out);
+    }
+  } catch (const std::exception& e) {
+    for (const double mag : s.load.magnitudes) {
+      ModelOutcome out = base;
+      out.magnitude = mag;
+      out.failure = e.what();
+      result.outcomes.push_back(out);
+    }
+    if (o.log) *o.log << "      FAILED: " << e.what() << "\n";
+  }
+}
+
+}  // namespace
+
+SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
+  std::ostream null_stream(nullptr);
+  std::ostream& log = o.log ? *o.log : null_stream;
+  Stopwatch total;
+  SceneResult result;
+  result.scene = s;
+  result.qoi_point = qoi_point(s);
+
+  log << "scene " << s.name << ": " << describe(s.vessel) << "\n";
+  const TetMesh model_mesh = mesh_at_level(s, s.vessel.level, o);
+  const TetMesh fine_mesh = mesh_at_level(s, s.reference_level, o);
+  std::unique_ptr<TetMesh> coarse_mesh;
+  if (s.reference_level > 0) {
+    coarse_mesh = std::make_unique<TetMesh>(mesh_at_level(s, s.reference_level - 1, o));
+  }
+
+  std::size_t cases = 0;
+  for (const auto& m : s.models) cases += m.kind == ModelKind::fem ? 1 : s.load.magnitudes.size();
+  Progress progress(log, s.poisson_ratios.size() * (1 + cases));
+
+  for (const double nu : s.poisson_ratios) {
+    progress.begin("reference P2 (level " + std::to_string(s.reference_level) + ", ν = " +
+                   std::to_string(nu) + ")");
+    ReferenceSolvers ref;
+    ref.fine = std::make_unique<fem::ElasticitySolver>(fine_mesh, fem_problem(s, fine_mesh, nu, 2));
+    const fem::ElasticityResult& fine = ref.fine->solve();
+    if (coarse_mesh) {
+      ref.coarse =
+          std::make_unique<fem::ElasticitySolver>(*coarse_mesh, fem_problem(s, *coarse_mesh, nu, 2));
+      ref.coarse->solve();
+    }
+    ReferenceInfo info;
+    info.poisson_ratio = nu;
+    info.element = fine.element;
+    info.level = s.reference_level;
+    info.dofs = fine.n_dofs + fine.n_pressure_dofs;
+    info.solve_seconds = fine.timings.assembly + fine.timings.solve;
+    info.max_abs_strain_unit = fine.max_abs_principal_strain;
+    result.references.push_back(info);
+    progress.end();
+
+    for (const auto& spec : s.models) {
+      ModelOutcome base;
+      base.model = spec.name;
+      base.kind = to_string(spec.kind);
+      base.poisson_ratio = nu;
+      if (spec.kind == ModelKind::fem) {
+        progress.begin(spec.name + " (FEM P" + std::to_string(spec.degree) + ")");
+        run_fem_model(s, spec, nu, model_mesh, ref, fine, o, base, result);
+        progress.end();
+        continue;
+      }
+      // Mass-spring model.
+      msm::NetworkOptions net_options;
+      net_options.model = spec.kind == ModelKind::volume_msm ? "volume" : "surface";
+      net_options.surface = spec.surface;
+      net_options.topology = spec.topology;
+      net_options.stiffness = msm::parse_stiffness_rule(spec.stiffness);
+      net_options.stiffness_params.youngs_modulus = s.youngs_modulus;
+      net_options.stiffness_params.poisson_ratio = nu;
+      net_options.mass = msm::parse_mass_rule(spec.mass);
+      net_options.density = s.density;
+      Stopwatch setup;
+      const msm::BuiltNetwork built = msm::build_network(model_mesh, s.vessel, net_options);
+      const msm::SpringModel model(built.network, spec.damping);
+      base.setup_seconds = setup.seconds();
+      base.detail = built.topology + ", " + spec.stiffness + " stiffness, " + spec.mass +
+                    " masses, " + spec.solver;
+      base.nodes = built.network.nodes.size();
+      const ReferenceAtPoints at = reference_at(ref, built.network.nodes);
+      const std::size_t qoi = nearest(built.network.nodes, result.qoi_point);
+      for (const double mag : s.load.magnitudes) {
+        progress.begin(spec.name + " at " + std::to_string(mag) + " (" + to_string(s.load.kind) +
+                       ")");
+        ModelOutcome out = base;
+        out.magnitude = mag;
+        try {
+          const msm::Problem problem = msm_problem(s, model, built, model_mesh, mag);
+          out.unknowns = free_unknowns(problem);
+          std::vector<double> times;
+          Eigen::VectorXd x;
+          for (int k = 0; k < std::max(1, o.repeats); ++k) {
+            Stopwatch solve;
+            if (spec.solver == "static") {
+              x = msm::solve_static(problem).x;
+            } else if (spec.solver == "linear") {
+              x = msm::solve_linear(problem).x;
+            } else if (spec.solver == "relaxation") {
+              x = msm::dynamic_relaxation(problem).x;
+            } else {
+              msm::DynamicOptions d;
+              d.integrator = msm::parse_integrator(spec.solver);
+              d.dt = spec.dt;
+              d.steps = static_cast<int>(spec.steps);
+              x = msm::integrate(problem, d).x;
+            }
+            times.push_back(solve.seconds());
+          }
+          out.solve_seconds = median(times);
+          out.max_strain = model.max_strain(x);
+          std::vector<Vec3> u(built.network.nodes.size());
+          for (std::size_t i = 0; i < u.size(); ++i) {
+            u[i] = x.segment<3>(3 * static_cast<Eigen::Index>(i)) - built.network.nodes[i];
+          }
+          finish_outcome(out, u, at, mag, qoi, fine.max_abs_principal_strain);
+        } catch (const InputError&) {
+          throw;
+        } catch (const std::exception& e) {
+          out.ok = false;
+          out.failure = e.what();
+          log << "      FAILED: " << e.what() << "\n";
+        }
+        result.outcomes.push_back(out);
+        progress.end();
+      }
+    }
+  }
+  result.seconds = total.seconds();
+  return result;
+}
+
+}  // namespace vessel

@@ -1,0 +1,80 @@
+#pragma once
+/// The verification harness: runs a scene's models against the FEM reference and measures the
+/// displacement error and the time of each, for every Poisson's ratio and load magnitude.
+///
+/// The reference is P2 (Taylor–Hood P2–P1 where ν calls for it) on the scene's reference level,
+/// evaluated at each model node's rest position; the same reference on the level below gives its
+/// own discretisation uncertainty (pointwise Richardson, order 2 for straight-sided geometry), which
+/// is reported next to every model error. Linear FEM responses are solved once per ν for a unit
+/// load and scaled; mass-spring models are solved for every magnitude (they are nonlinear).
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "verification/metrics.hpp"
+#include "verification/scene.hpp"
+
+namespace vessel {
+
+struct HarnessOptions {
+  std::filesystem::path cache_dir;  ///< generated meshes (empty: no cache)
+  std::ostream* log = nullptr;      ///< progress; nullptr for none
+  int repeats = 1;                  ///< timed repeats of each model solve (median reported)
+};
+
+/// The reference's answer for one ν (at unit load; scale by the magnitude).
+struct ReferenceInfo {
+  double poisson_ratio = 0.0;
+  std::string element;
+  int level = 0;
+  std::size_t dofs = 0;
+  double solve_seconds = 0.0;  ///< fine level, assembly + solve
+  double max_abs_strain_unit = 0.0;  ///< largest |principal strain| at unit load
+};
+
+/// One model at one (ν, magnitude).
+struct ModelOutcome {
+  std::string model;
+  std::string kind;       ///< fem | surface_msm | volume_msm
+  std::string detail;     ///< element or topology, rules, solver
+  double poisson_ratio = 0.0;
+  double magnitude = 0.0;  ///< N, Pa or g
+  bool ok = false;
+  std::string failure;     ///< why it did not finish (divergence, no convergence, ...)
+  std::size_t nodes = 0;
+  std::size_t unknowns = 0;  ///< DoFs or 3 × free nodes
+  double setup_seconds = 0.0;
+  double solve_seconds = 0.0;  ///< median over repeats
+  ErrorStatistics error;       ///< against the reference at the model's nodes
+  ErrorStatistics reference_uncertainty;  ///< the reference's own estimated error there (max, rms)
+  bool has_reference_uncertainty = false;  ///< false when the reference has no coarser level
+  double qoi_displacement_mm = 0.0;  ///< model displacement magnitude at the node nearest the QoI point
+  double qoi_reference_mm = 0.0;     ///< reference there
+  double max_strain = 0.0;           ///< largest strain of the model (springs or FEM)
+  bool beyond_linear_regime = false;  ///< max strain of the reference > 5 %
+};
+
+struct SceneResult {
+  Scene scene;
+  Vec3 qoi_point = Vec3::Zero();  ///< where the "contact-point displacement" is read
+  std::vector<ReferenceInfo> references;
+  std::vector<ModelOutcome> outcomes;
+  double seconds = 0.0;
+};
+
+/// Runs the scene. Throws InputError for inputs the scene validation cannot see (a contact point
+/// off the generated wall, roller ends on the arch); a model that fails (diverges, does not
+/// converge) is recorded as failed with its reason, and the others still run.
+SceneResult run_scene(const Scene& scene, const HarnessOptions& options);
+
+/// Results as versioned JSON (schema "vesselverify.results", version 1; see
+/// verification/results.schema.json), CSV (one row per model, ν and magnitude) and a Markdown
+/// summary table; each written atomically.
+void write_results_json(const std::filesystem::path& path, const std::vector<SceneResult>& results,
+                        const std::string& command);
+void write_results_csv(const std::filesystem::path& path, const std::vector<SceneResult>& results);
+void write_summary_markdown(const std::filesystem::path& path,
+                            const std::vector<SceneResult>& results, const std::string& command);
+
+}  // namespace vessel

@@ -1,0 +1,183 @@
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+#include <unistd.h>
+
+#include "meshes/atomic_file.hpp"
+#include "verification/harness.hpp"
+
+namespace vessel {
+
+namespace {
+
+std::string now_utc() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+std::string host_name() {
+  char buf[256] = {};
+  gethostname(buf, sizeof buf - 1);
+  return buf;
+}
+
+nlohmann::json error_json(const ErrorStatistics& e) {
+  return {{"max_mm", e.max_mm},     {"mean_mm", e.mean_mm},         {"stddev_mm", e.stddev_mm},
+          {"rms_mm", e.rms_mm},     {"relative_l2", e.relative_l2}, {"points", e.points}};
+}
+
+nlohmann::json scene_json(const SceneResult& r) {
+  nlohmann::json refs = nlohmann::json::array();
+  for (const auto& ref : r.references) {
+    refs.push_back({{"poisson_ratio", ref.poisson_ratio},
+                    {"element", ref.element},
+                    {"level", ref.level},
+                    {"dofs", ref.dofs},
+                    {"solve_seconds", ref.solve_seconds},
+                    {"max_abs_strain_at_unit_load", ref.max_abs_strain_unit}});
+  }
+  nlohmann::json outcomes = nlohmann::json::array();
+  for (const auto& o : r.outcomes) {
+    nlohmann::json j{{"model", o.model},
+                     {"kind", o.kind},
+                     {"detail", o.detail},
+                     {"poisson_ratio", o.poisson_ratio},
+                     {"magnitude", o.magnitude},
+                     {"ok", o.ok},
+                     {"nodes", o.nodes},
+                     {"unknowns", o.unknowns},
+                     {"setup_seconds", o.setup_seconds},
+                     {"solve_seconds", o.solve_seconds}};
+    if (o.ok) {
+      j["error"] = error_json(o.error);
+      if (o.has_reference_uncertainty) {
+        j["reference_uncertainty"] = {{"max_mm", o.reference_uncertainty.max_mm},
+                                      {"rms_mm", o.reference_uncertainty.rms_mm}};
+      } else {
+        j["reference_uncertainty"] = nullptr;  // the reference had no coarser level
+      }
+      j["qoi_displacement_mm"] = o.qoi_displacement_mm;
+      j["qoi_reference_mm"] = o.qoi_reference_mm;
+      j["max_strain"] = o.max_strain;
+      j["beyond_linear_regime"] = o.beyond_linear_regime;
+    } else {
+      j["failure"] = o.failure;
+    }
+    outcomes.push_back(j);
+  }
+  const Scene& s = r.scene;
+  return {{"name", s.name},
+          {"source", s.source.string()},
+          {"description", s.description},
+          {"vessel", describe(s.vessel)},
+          {"model_level", s.vessel.level},
+          {"reference_level", s.reference_level},
+          {"youngs_modulus_pa", s.youngs_modulus},
+          {"load", to_string(s.load.kind)},
+          {"load_unit", s.load.kind == LoadKind::contact
+                            ? "N"
+                            : (s.load.kind == LoadKind::pressure ? "Pa" : "g")},
+          {"qoi_point_mm",
+           {r.qoi_point.x() * 1e3, r.qoi_point.y() * 1e3, r.qoi_point.z() * 1e3}},
+          {"seconds", r.seconds},
+          {"references", refs},
+          {"outcomes", outcomes}};
+}
+
+const char* load_unit(LoadKind k) {
+  return k == LoadKind::contact ? "N" : (k == LoadKind::pressure ? "Pa" : "g");
+}
+
+}  // namespace
+
+void write_results_json(const std::filesystem::path& path, const std::vector<SceneResult>& results,
+                        const std::string& command) {
+  nlohmann::json scenes = nlohmann::json::array();
+  for (const auto& r : results) scenes.push_back(scene_json(r));
+  const nlohmann::json j{{"schema", "vesselverify.results"},
+                         {"schema_version", 1},
+                         {"units", {{"displacement", "mm"}, {"time", "s"}, {"strain", "1"}}},
+                         {"date", now_utc()},
+                         {"command", command},
+                         {"machine",
+                          {{"host", host_name()},
+                           {"hardware_threads", std::thread::hardware_concurrency()}}},
+                         {"build", {{"compiler", __VERSION__}, {"cxx_standard", __cplusplus}}},
+                         {"scenes", scenes}};
+  write_file_atomically(path, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+}
+
+void write_results_csv(const std::filesystem::path& path, const std::vector<SceneResult>& results) {
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << "scene,model,kind,poisson_ratio,magnitude,load_unit,ok,nodes,unknowns,setup_s,solve_s,"
+           "max_mm,mean_mm,stddev_mm,rms_mm,relative_l2,ref_uncertainty_max_mm,qoi_mm,"
+           "qoi_reference_mm,max_strain,beyond_linear_regime\n";
+    out << std::setprecision(8);
+    for (const auto& r : results) {
+      for (const auto& o : r.outcomes) {
+        out << r.scene.name << ',' << o.model << ',' << o.kind << ',' << o.poisson_ratio << ','
+            << o.magnitude << ',' << load_unit(r.scene.load.kind) << ',' << (o.ok ? 1 : 0) << ','
+            << o.nodes << ',' << o.unknowns << ',' << o.setup_seconds << ',' << o.solve_seconds;
+        if (o.ok) {
+          out << ',' << o.error.max_mm << ',' << o.error.mean_mm << ',' << o.error.stddev_mm << ','
+              << o.error.rms_mm << ',' << o.error.relative_l2 << ',';
+          if (o.has_reference_uncertainty) out << o.reference_uncertainty.max_mm;
+          out << ',' << o.qoi_displacement_mm << ','
+              << o.qoi_reference_mm << ',' << o.max_strain << ','
+              << (o.beyond_linear_regime ? 1 : 0);
+        } else {
+          out << ",,,,,,,,,,";
+        }
+        out << '\n';
+      }
+    }
+  });
+}
+
+void write_summary_markdown(const std::filesystem::path& path,
+                            const std::vector<SceneResult>& results, const std::string& command) {
+  write_file_atomically(path, [&](std::ostream& out) {
+    out << "# vesselverify summary\n\n"
+        << "Produced " << now_utc() << " on " << host_name() << " ("
+        << std::thread::hardware_concurrency() << " hardware threads) by\n\n    " << command
+        << "\n\nDisplacement errors against the FEM reference (P2, or Taylor–Hood P2–P1 for ν ≥ "
+           "0.49) evaluated at each model node's rest position, in mm, with seed 000's "
+           "statistics. *ref. unc.* is the reference's own estimated error there (Richardson "
+           "between its two finest levels, order 2): errors below it are not resolved. Rows marked "
+           "⚠ strain the reference beyond 5 %, outside linear elasticity's validity.\n\n";
+    out << std::setprecision(3);
+    for (const auto& r : results) {
+      const char* unit = load_unit(r.scene.load.kind);
+      out << "## " << r.scene.name << "\n\n" << r.scene.description << ". " << describe(r.scene.vessel)
+          << "; reference level " << r.scene.reference_level << " (" << std::fixed
+          << std::setprecision(1) << r.seconds << " s in all)." << std::defaultfloat
+          << std::setprecision(3) << "\n\n";
+      out << "| model | ν | load (" << unit
+          << ") | max | mean | std | RMS | rel. L2 | ref. unc. (max) | QoI model / ref. | solve s | "
+             "unknowns |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+      for (const auto& o : r.outcomes) {
+        out << "| " << o.model << " | " << o.poisson_ratio << " | " << o.magnitude
+            << (o.beyond_linear_regime ? " ⚠" : "") << " | ";
+        if (!o.ok) {
+          out << "FAILED: " << o.failure << " | | | | | | | | |\n";
+          continue;
+        }
+        out << o.error.max_mm << " | " << o.error.mean_mm << " | " << o.error.stddev_mm << " | "
+            << o.error.rms_mm << " | " << o.error.relative_l2 << " | ";
+        if (o.has_reference_uncertainty) {
+          out << o.reference_uncertainty.max_mm;
+        } else {
+          out << "–";
+        }
+        out << " | " << o.qoi_displacement_mm << " / "
+            << o.qoi_reference_mm << " | " << o.solve_seconds << " | " << o.unknowns << " |\n";
+      }
+      out << "\n";
+    }
+  });
+}
+
+}  // namespace vessel
