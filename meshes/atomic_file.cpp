@@ -19,7 +19,11 @@ void write_file_atomically(const fs::path& path, const std::function<void(std::o
     throw InputError("cannot create output directory '" + dir.string() + "': " + ec.message());
   }
   std::random_device rd;
-  const fs::path tmp = dir / ("." + path.filename().string() + ".tmp" + std::to_string(rd()));
+  std::string tmp_name = ".";
+  tmp_name += path.filename().string();
+  tmp_name += ".tmp";
+  tmp_name += std::to_string(rd());
+  const fs::path tmp = dir / tmp_name;
   try {
     {
       std::ofstream out(tmp, binary ? std::ios::binary : std::ios::out);
