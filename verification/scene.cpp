@@ -8,20 +8,18 @@
 #include <toml++/toml.h>
 
 #include "meshes/errors.hpp"
+#include "msm/mass/mass_rules.hpp"
+#include "msm/solvers/integrators.hpp"
+#include "msm/stiffness/stiffness_rules.hpp"
 
 namespace vessel {
 
 namespace {
 
-// Names the scene accepts for mass-spring options: the msm library's own names (its parse_*
-// functions accept exactly these; a test checks that they agree).
-const std::vector<std::string> kStiffnessRules{"seed000", "seed001", "van-gelder", "lloyd",
-                                               "uniform"};
-const std::vector<std::string> kMassRules{"uniform", "seed001", "consistent"};
-const std::vector<std::string> kSolvers{"static",           "linear", "relaxation",
-                                        "explicit-euler",   "symplectic-euler",
-                                        "verlet",           "implicit-euler"};
+// Stiffness and mass rules and integrators are checked by the msm library's own parsers (one list
+// of names, theirs); these are the scene's other choices.
 const std::vector<std::string> kSurfaces{"inner", "outer", "mid"};
+const std::vector<std::string> kStaticSolvers{"static", "linear", "relaxation"};
 const std::vector<std::string> kTopologies{"auto", "grid", "triangles"};
 
 std::string join(const std::vector<std::string>& names) {
@@ -114,6 +112,21 @@ class TableReader {
                        std::to_string(hi) + "]");
     }
     return static_cast<long>(*v);
+  }
+
+  /// A string that `parse` (an msm parse_* function) accepts; its InputError becomes this key's.
+  template <class Parse>
+  std::string name_or(const std::string& key, const std::string& fallback, Parse&& parse) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    const auto v = n->value_exact<std::string>();
+    if (!v) fail(n, key, "found " + show(*n) + ", expected a string");
+    try {
+      (void)parse(*v);
+    } catch (const InputError& e) {
+      fail(n, key, e.what());
+    }
+    return *v;
   }
 
   std::string string_or(const std::string& key, const std::string& fallback,
@@ -215,13 +228,24 @@ ModelSpec read_model(TableReader r, std::size_t index) {
   } else {
     if (m.kind == ModelKind::surface_msm) m.surface = r.string_or("surface", m.surface, kSurfaces);
     if (m.kind == ModelKind::surface_msm) m.topology = r.string_or("topology", m.topology, kTopologies);
-    m.stiffness = r.string_or("stiffness", m.kind == ModelKind::volume_msm ? "seed001" : "seed000",
-                              kStiffnessRules);
-    m.mass = r.string_or("mass", m.mass, kMassRules);
-    m.solver = r.string_or("solver", m.solver, kSolvers);
+    m.stiffness = r.name_or("stiffness", m.kind == ModelKind::volume_msm ? "seed001" : "seed000",
+                            msm::parse_stiffness_rule);
+    m.mass = r.name_or("mass", m.mass, msm::parse_mass_rule);
+    m.solver = r.name_or("solver", m.solver, [](const std::string& name) {
+      if (std::find(kStaticSolvers.begin(), kStaticSolvers.end(), name) != kStaticSolvers.end()) {
+        return 0;
+      }
+      try {
+        (void)msm::parse_integrator(name);
+      } catch (const InputError& e) {
+        throw InputError("expected static, linear, relaxation or an integrator (" +
+                         std::string(e.what()) + ")");
+      }
+      return 0;
+    });
     m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
     const bool integrator =
-        m.solver != "static" && m.solver != "linear" && m.solver != "relaxation";
+        std::find(kStaticSolvers.begin(), kStaticSolvers.end(), m.solver) == kStaticSolvers.end();
     if (integrator) {
       const toml::node* dt = r.get("dt");
       if (!dt) r.fail(nullptr, "dt", "missing; solver \"" + m.solver + "\" needs a time step > 0 s");

@@ -69,14 +69,22 @@ SpringNetwork build_volume_network(const TetMesh& mesh) {
   return net;
 }
 
-SpringNetwork build_triangle_network(const TriangleSurface& surface, double thickness,
-                                     bool two_ring) {
+namespace {
+/// A surface network's nodes, source nodes, triangles and thickness, without springs yet.
+SpringNetwork surface_network(const TriangleSurface& surface, double thickness) {
   SpringNetwork net;
   net.nodes = surface.nodes;
   net.source_node = surface.source_node;
   if (net.source_node.size() != net.nodes.size()) net.source_node.assign(net.nodes.size(), -1);
   net.triangles = surface.triangles;
   net.thickness = thickness;
+  return net;
+}
+}  // namespace
+
+SpringNetwork build_triangle_network(const TriangleSurface& surface, double thickness,
+                                     bool two_ring) {
+  SpringNetwork net = surface_network(surface, thickness);
   // Edge → opposite vertices of the triangles sharing it.
   std::map<Edge, std::vector<int>> opposite;
   for (const Triangle& t : surface.triangles) {
@@ -188,12 +196,7 @@ SpringNetwork build_tube_grid_network(const TriangleSurface& surface, const Vess
     if (j < 0 || j > na) return -1;
     return at[static_cast<std::size_t>(j) * nc + ((i % nc) + nc) % nc];
   };
-  SpringNetwork net;
-  net.nodes = surface.nodes;
-  net.source_node = surface.source_node;
-  if (net.source_node.size() != net.nodes.size()) net.source_node.assign(net.nodes.size(), -1);
-  net.triangles = surface.triangles;
-  net.thickness = thickness;
+  SpringNetwork net = surface_network(surface, thickness);
   auto add = [&](int a, int b, SpringFamily f) {
     if (a >= 0 && b >= 0 && a != b) net.springs.push_back(make_spring(net.nodes, a, b, f));
   };
