@@ -7,6 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libsuitesparse-dev        # msm: Eigen, CHOLMOD
+  libopenblas0-pthread                    # BLAS for CHOLMOD, UMFPACK, eigen-solves (4x faster)
   libgmsh-dev                             # meshes: gmsh C++ API
   libdeal.ii-dev                          # fem_reference
   libgtest-dev libgmock-dev libbenchmark-dev
