@@ -30,6 +30,7 @@
 #include <mpi.h>
 
 #include <Eigen/SparseCholesky>
+#include "fem_reference/cholmod_solve.hpp"
 #include <Eigen/SparseCore>
 #include <Teuchos_ParameterList.hpp>
 #include <algorithm>
@@ -625,7 +626,26 @@ void ElasticitySolver::Impl::solve_linear() {
   result.solver = s;
   if (rhs.l2_norm() == 0.0) {
     solution = 0.0;  // no load and homogeneous constraints: u = 0
+  } else if (s == LinearSolver::direct && !mixed) {
+    // CHOLMOD (supernodal Cholesky) for the SPD displacement system: the constraints keep K
+    // symmetric with positive diagonal entries on constrained rows.
+    const std::size_t n = dof.n_dofs();
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(matrix.n_nonzero_elements());
+    for (std::size_t row = 0; row < n; ++row) {
+      for (auto it = matrix.begin(row); it != matrix.end(row); ++it) {
+        if (it->value() != 0.0) {
+          entries.emplace_back(static_cast<int>(row), static_cast<int>(it->column()), it->value());
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> K(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+    K.setFromTriplets(entries.begin(), entries.end());
+    const Eigen::VectorXd x = solve_spd_cholmod(
+        K, Eigen::Map<const Eigen::VectorXd>(rhs.begin(), static_cast<Eigen::Index>(n)));
+    std::copy(x.data(), x.data() + x.size(), solution.begin());
   } else if (s == LinearSolver::direct) {
+    // UMFPACK for the indefinite mixed (Taylor–Hood) system.
     dl::SparseDirectUMFPACK direct;
     direct.initialize(matrix);
     direct.vmult(solution, rhs);

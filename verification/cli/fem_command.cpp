@@ -356,7 +356,7 @@ void add_fem_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--solver", o->solver,
                   "Linear solver: auto (direct up to --direct-max-dofs, else CG with algebraic "
-                  "multigrid), direct (UMFPACK), cg-amg (Trilinos ML)")
+                  "multigrid), direct (CHOLMOD; UMFPACK for the mixed system), cg-amg (Trilinos ML)")
       ->check(CLI::IsMember({"auto", "direct", "cg-amg"}))
       ->capture_default_str();
   cmd->add_option("--direct-max-dofs", o->direct_max_dofs,
