@@ -2,6 +2,8 @@
 /// constant-strain patch test, equilibrium of reactions and applied loads, point evaluation.
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include <cmath>
 #include <string>
 
@@ -184,14 +186,24 @@ TEST(ElasticityEquilibrium, ReactionBalancesGravity) {
   EXPECT_LT((r.reactions[0].force + weight).norm(), 1e-8 * weight.norm());
 }
 
-TEST(ElasticityPointEvaluation, MatchesNodalValuesAndRefusesOutsidePoints) {
-  const auto& m = mesh0();
+namespace {
+/// P2 on `m`, inlet clamped, 5 Pa on the inner wall, solved: the point-evaluation tests' problem.
+std::unique_ptr<ElasticitySolver> solved_inlet_clamped_under_pressure(const TetMesh& m) {
   ElasticityProblem p;
   p.options.degree = 2;
   p.dirichlet = {fem::DirichletCondition::clamped("inlet")};
   p.pressures = {{"inner_wall", 5.0}};
-  ElasticitySolver s(m, p);
-  const auto& r = s.solve();
+  auto s = std::make_unique<ElasticitySolver>(m, p);
+  s->solve();
+  return s;
+}
+}  // namespace
+
+TEST(ElasticityPointEvaluation, MatchesNodalValuesAndRefusesOutsidePoints) {
+  const auto& m = mesh0();
+  const auto solver = solved_inlet_clamped_under_pressure(m);
+  const ElasticitySolver& s = *solver;
+  const auto& r = s.result();
   std::vector<Vec3> pts;
   for (std::size_t n = 0; n < m.nodes.size(); n += 7) pts.push_back(m.nodes[n]);
   const auto u = s.displacement_at(pts);
@@ -206,12 +218,9 @@ TEST(ElasticityPointEvaluation, ToleranceAcceptsPointsJustOutsideACurvedWall) {
   // refused by default, evaluated with a tolerance, and then close to the node's value (the
   // field's gradient times 5 µm).
   const auto& m = mesh0();
-  ElasticityProblem p;
-  p.options.degree = 2;
-  p.dirichlet = {fem::DirichletCondition::clamped("inlet")};
-  p.pressures = {{"inner_wall", 5.0}};
-  ElasticitySolver s(m, p);
-  const auto& r = s.solve();
+  const auto solver = solved_inlet_clamped_under_pressure(m);
+  const ElasticitySolver& s = *solver;
+  const auto& r = s.result();
   int node = -1;  // the outer-wall node that moves most
   for (int n : m.group_nodes(*m.find_group("outer_wall", 2))) {
     if (node < 0 || r.nodal_displacement[n].norm() > r.nodal_displacement[node].norm()) node = n;
