@@ -33,19 +33,36 @@ struct ReferenceInfo {
   double max_abs_strain_unit = 0.0;  ///< largest |principal strain| at unit load
 };
 
-/// One model at one (ν, magnitude).
+/// Radial displacement u·e_ρ along the wall line through the QoI point (the model's nodes at the
+/// QoI's angle around the centreline and nearest its radius), sorted by arc length s.
+struct WallProfile {
+  std::vector<double> s_mm;
+  std::vector<double> model_mm;
+  std::vector<double> reference_mm;
+};
+
+/// The QoI displacement magnitude over time (dynamic models), sampled.
+struct History {
+  std::vector<double> time_s;
+  std::vector<double> model_mm;
+  std::vector<double> reference_mm;  ///< the FEM transient (Newmark), empty if none
+};
+
+/// One model at one (ν, level, magnitude).
 struct ModelOutcome {
   std::string model;
   std::string kind;       ///< fem | surface_msm | volume_msm
   std::string detail;     ///< element or topology, rules, solver
   double poisson_ratio = 0.0;
   double magnitude = 0.0;  ///< N, Pa or g
+  int level = 0;           ///< mesh level of the model
   bool ok = false;
   std::string failure;     ///< why it did not finish (divergence, no convergence, ...)
   std::size_t nodes = 0;
   std::size_t unknowns = 0;  ///< DoFs or 3 × free nodes
   double setup_seconds = 0.0;
   double solve_seconds = 0.0;  ///< median over repeats
+  double memory_mib = 0.0;  ///< peak resident memory added by set-up and solve
   ErrorStatistics error;       ///< against the reference at the model's nodes
   ErrorStatistics reference_uncertainty;  ///< the reference's own estimated error there (max, rms)
   bool has_reference_uncertainty = false;  ///< false when the reference has no coarser level
@@ -53,6 +70,8 @@ struct ModelOutcome {
   double qoi_reference_mm = 0.0;     ///< reference there
   double max_strain = 0.0;           ///< largest strain of the model (springs or FEM)
   bool beyond_linear_regime = false;  ///< max strain of the reference > 5 %
+  WallProfile wall_profile;
+  History history;  ///< dynamic models only
 };
 
 struct SceneResult {

@@ -46,11 +46,13 @@ nlohmann::json scene_json(const SceneResult& r) {
                      {"detail", o.detail},
                      {"poisson_ratio", o.poisson_ratio},
                      {"magnitude", o.magnitude},
+                     {"level", o.level},
                      {"ok", o.ok},
                      {"nodes", o.nodes},
                      {"unknowns", o.unknowns},
                      {"setup_seconds", o.setup_seconds},
-                     {"solve_seconds", o.solve_seconds}};
+                     {"solve_seconds", o.solve_seconds},
+                     {"memory_mib", o.memory_mib}};
     if (o.ok) {
       j["error"] = error_json(o.error);
       if (o.has_reference_uncertainty) {
@@ -63,6 +65,14 @@ nlohmann::json scene_json(const SceneResult& r) {
       j["qoi_reference_mm"] = o.qoi_reference_mm;
       j["max_strain"] = o.max_strain;
       j["beyond_linear_regime"] = o.beyond_linear_regime;
+      j["wall_profile"] = {{"s_mm", o.wall_profile.s_mm},
+                           {"model_mm", o.wall_profile.model_mm},
+                           {"reference_mm", o.wall_profile.reference_mm}};
+      if (!o.history.time_s.empty()) {
+        j["history"] = {{"time_s", o.history.time_s},
+                        {"model_mm", o.history.model_mm},
+                        {"reference_mm", o.history.reference_mm}};
+      }
     } else {
       j["failure"] = o.failure;
     }
@@ -73,7 +83,7 @@ nlohmann::json scene_json(const SceneResult& r) {
           {"source", s.source.string()},
           {"description", s.description},
           {"vessel", describe(s.vessel)},
-          {"model_level", s.vessel.level},
+          {"model_levels", s.model_levels},
           {"reference_level", s.reference_level},
           {"youngs_modulus_pa", s.youngs_modulus},
           {"load", to_string(s.load.kind)},
@@ -98,7 +108,7 @@ void write_results_json(const std::filesystem::path& path, const std::vector<Sce
   nlohmann::json scenes = nlohmann::json::array();
   for (const auto& r : results) scenes.push_back(scene_json(r));
   const nlohmann::json j{{"schema", "vesselverify.results"},
-                         {"schema_version", 1},
+                         {"schema_version", 2},
                          {"units", {{"displacement", "mm"}, {"time", "s"}, {"strain", "1"}}},
                          {"date", now_utc()},
                          {"command", command},
@@ -112,15 +122,17 @@ void write_results_json(const std::filesystem::path& path, const std::vector<Sce
 
 void write_results_csv(const std::filesystem::path& path, const std::vector<SceneResult>& results) {
   write_file_atomically(path, [&](std::ostream& out) {
-    out << "scene,model,kind,poisson_ratio,magnitude,load_unit,ok,nodes,unknowns,setup_s,solve_s,"
+    out << "scene,model,kind,poisson_ratio,level,magnitude,load_unit,ok,nodes,unknowns,setup_s,"
+           "solve_s,memory_mib,"
            "max_mm,mean_mm,stddev_mm,rms_mm,relative_l2,ref_uncertainty_max_mm,qoi_mm,"
            "qoi_reference_mm,max_strain,beyond_linear_regime\n";
     out << std::setprecision(8);
     for (const auto& r : results) {
       for (const auto& o : r.outcomes) {
         out << r.scene.name << ',' << o.model << ',' << o.kind << ',' << o.poisson_ratio << ','
-            << o.magnitude << ',' << load_unit(r.scene.load.kind) << ',' << (o.ok ? 1 : 0) << ','
-            << o.nodes << ',' << o.unknowns << ',' << o.setup_seconds << ',' << o.solve_seconds;
+            << o.level << ',' << o.magnitude << ',' << load_unit(r.scene.load.kind) << ','
+            << (o.ok ? 1 : 0) << ',' << o.nodes << ',' << o.unknowns << ',' << o.setup_seconds
+            << ',' << o.solve_seconds << ',' << o.memory_mib;
         if (o.ok) {
           out << ',' << o.error.max_mm << ',' << o.error.mean_mm << ',' << o.error.stddev_mm << ','
               << o.error.rms_mm << ',' << o.error.relative_l2 << ',';
@@ -155,11 +167,11 @@ void write_summary_markdown(const std::filesystem::path& path,
           << "; reference level " << r.scene.reference_level << " (" << std::fixed
           << std::setprecision(1) << r.seconds << " s in all)." << std::defaultfloat
           << std::setprecision(3) << "\n\n";
-      out << "| model | ν | load (" << unit
+      out << "| model | ν | level | load (" << unit
           << ") | max | mean | std | RMS | rel. L2 | ref. unc. (max) | QoI model / ref. | solve s | "
-             "unknowns |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+             "unknowns |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
       for (const auto& o : r.outcomes) {
-        out << "| " << o.model << " | " << o.poisson_ratio << " | " << o.magnitude
+        out << "| " << o.model << " | " << o.poisson_ratio << " | " << o.level << " | " << o.magnitude
             << (o.beyond_linear_regime ? " ⚠" : "") << " | ";
         if (!o.ok) {
           out << "FAILED: " << o.failure << " | | | | | | | | |\n";

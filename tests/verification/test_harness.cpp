@@ -143,5 +143,5 @@ TEST_F(HarnessLame, ResultsJsonHasEveryFieldItsSchemaRequires) {
   // One CSV row per outcome plus the header.
   const std::string csv = test::read_text(dir / "results.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 8);
-  EXPECT_NE(test::read_text(dir / "summary.md").find("| p1 | 0.3 | 10 |"), std::string::npos);
+  EXPECT_NE(test::read_text(dir / "summary.md").find("| p1 | 0.3 | 0 | 10 |"), std::string::npos);
 }
