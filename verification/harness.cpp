@@ -407,6 +407,18 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
 
 }  // namespace
 
+Scene quick_variant(Scene s) {
+  s.model_levels = {0};
+  s.vessel.level = 0;
+  const bool mixed = std::any_of(s.poisson_ratios.begin(), s.poisson_ratios.end(),
+                                 [](double nu) { return nu >= kMixedThreshold; });
+  s.reference_level = std::min(s.reference_level, mixed ? 0 : 1);
+  if (s.load.magnitudes.size() > 2) {
+    s.load.magnitudes = {s.load.magnitudes.front(), s.load.magnitudes.back()};
+  }
+  return s;
+}
+
 SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
   std::ostream null_stream(nullptr);
   std::ostream& log = o.log ? *o.log : null_stream;

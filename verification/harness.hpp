@@ -82,16 +82,32 @@ struct SceneResult {
   double seconds = 0.0;
 };
 
+/// The --quick variant of a scene: the coarsest useful levels (models at 0, reference at 1 so that
+/// level 0 gives its uncertainty) and only the smallest and largest load. Taylor–Hood (ν ≥ 0.49)
+/// goes to a direct solver that needs minutes and gigabytes at level 1, so scenes with such a ν
+/// keep their reference at level 0 (then without an uncertainty estimate).
+Scene quick_variant(Scene scene);
+
 /// Runs the scene. Throws InputError for inputs the scene validation cannot see (a contact point
 /// off the generated wall, roller ends on the arch); a model that fails (diverges, does not
 /// converge) is recorded as failed with its reason, and the others still run.
 SceneResult run_scene(const Scene& scene, const HarnessOptions& options);
 
+/// Runs the scenes one after another (a header line per scene on options.log) and writes
+/// results.json (with reference_kernel_seconds() timed first), results.csv and summary.md into
+/// `output_dir`, which is created and checked writable before anything runs (InputError).
+std::vector<SceneResult> run_and_write(const std::vector<Scene>& scenes,
+                                       const HarnessOptions& options,
+                                       const std::filesystem::path& output_dir,
+                                       const std::string& command);
+
 /// Results as versioned JSON (schema "vesselverify.results", version 1; see
 /// verification/results.schema.json), CSV (one row per model, ν and magnitude) and a Markdown
 /// summary table; each written atomically.
+/// `reference_kernel_seconds` (reference_kernel_seconds() of the same run, for the gate's
+/// normalised timings) is written when positive.
 void write_results_json(const std::filesystem::path& path, const std::vector<SceneResult>& results,
-                        const std::string& command);
+                        const std::string& command, double reference_kernel_seconds = 0.0);
 void write_results_csv(const std::filesystem::path& path, const std::vector<SceneResult>& results);
 void write_summary_markdown(const std::filesystem::path& path,
                             const std::vector<SceneResult>& results, const std::string& command);

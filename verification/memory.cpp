@@ -1,6 +1,9 @@
 #include "verification/memory.hpp"
 
 #include <fstream>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <sstream>
 #include <string>
 
@@ -28,6 +31,9 @@ double resident_memory_mib() { return status_field_mib("VmRSS"); }
 double peak_resident_memory_mib() { return status_field_mib("VmHWM"); }
 
 void reset_peak_memory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
   std::ofstream out("/proc/self/clear_refs");
   out << "5";  // resets VmHWM to VmRSS (proc(5), "clear_refs")
 }

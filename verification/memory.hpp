@@ -9,21 +9,26 @@ namespace vessel {
 double resident_memory_mib();
 /// Peak resident set size since the last reset_peak_memory() (or the start), MiB.
 double peak_resident_memory_mib();
-/// Resets the peak to the current resident size (no-op where unsupported).
+/// Resets the peak to the current resident size (no-op where unsupported). Returns the heap's
+/// free pages to the system first (glibc's malloc_trim): otherwise a model reusing memory freed
+/// by an earlier one would not raise the resident size and its memory would read as zero.
 void reset_peak_memory();
 
 /// Peak memory a piece of work added on top of what was resident when it started: construct
 /// before, call added_mib() after.
 class MemoryProbe {
  public:
-  MemoryProbe() : before_(resident_memory_mib()) { reset_peak_memory(); }
+  MemoryProbe() {
+    reset_peak_memory();
+    before_ = resident_memory_mib();
+  }
   [[nodiscard]] double added_mib() const {
     const double peak = peak_resident_memory_mib();
     return peak > before_ ? peak - before_ : 0.0;
   }
 
  private:
-  double before_;
+  double before_ = 0.0;
 };
 
 }  // namespace vessel

@@ -1,3 +1,4 @@
+#include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -5,6 +6,8 @@
 #include <unistd.h>
 
 #include "meshes/atomic_file.hpp"
+#include "meshes/errors.hpp"
+#include "verification/timing.hpp"
 #include "verification/harness.hpp"
 
 namespace vessel {
@@ -92,6 +95,7 @@ nlohmann::json scene_json(const SceneResult& r) {
                             : (s.load.kind == LoadKind::pressure ? "Pa" : "g")},
           {"qoi_point_mm",
            {r.qoi_point.x() * 1e3, r.qoi_point.y() * 1e3, r.qoi_point.z() * 1e3}},
+          {"tolerance_max_error_mm", s.tolerances.max_error_mm},
           {"seconds", r.seconds},
           {"references", refs},
           {"outcomes", outcomes}};
@@ -104,10 +108,10 @@ const char* load_unit(LoadKind k) {
 }  // namespace
 
 void write_results_json(const std::filesystem::path& path, const std::vector<SceneResult>& results,
-                        const std::string& command) {
+                        const std::string& command, double reference_kernel_seconds) {
   nlohmann::json scenes = nlohmann::json::array();
   for (const auto& r : results) scenes.push_back(scene_json(r));
-  const nlohmann::json j{{"schema", "vesselverify.results"},
+  nlohmann::json j{{"schema", "vesselverify.results"},
                          {"schema_version", 2},
                          {"units", {{"displacement", "mm"}, {"time", "s"}, {"strain", "1"}}},
                          {"date", now_utc()},
@@ -117,7 +121,45 @@ void write_results_json(const std::filesystem::path& path, const std::vector<Sce
                            {"hardware_threads", std::thread::hardware_concurrency()}}},
                          {"build", {{"compiler", __VERSION__}, {"cxx_standard", __cplusplus}}},
                          {"scenes", scenes}};
+  if (reference_kernel_seconds > 0.0) j["reference_kernel_seconds"] = reference_kernel_seconds;
   write_file_atomically(path, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+}
+
+std::vector<SceneResult> run_and_write(const std::vector<Scene>& scenes,
+                                       const HarnessOptions& options,
+                                       const std::filesystem::path& output_dir,
+                                       const std::string& command) {
+  std::error_code ec;
+  std::filesystem::create_directories(output_dir, ec);
+  bool writable = !ec;
+  if (writable) {
+    const std::filesystem::path probe = output_dir / ".vesselverify-write-test";
+    writable = static_cast<bool>(std::ofstream(probe));
+    std::error_code ignored;
+    std::filesystem::remove(probe, ignored);
+  }
+  if (!writable) {
+    throw InputError(output_dir.string() + ": output directory cannot be " +
+                     (ec ? "created (" + ec.message() + ")" : std::string("written")) +
+                     "; expected a writable directory");
+  }
+  const double kernel = reference_kernel_seconds();
+  std::vector<SceneResult> results;
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    if (options.log) {
+      *options.log << "== scene " << i + 1 << "/" << scenes.size() << ": " << scenes[i].name
+                   << " ==\n";
+    }
+    results.push_back(run_scene(scenes[i], options));
+  }
+  write_results_json(output_dir / "results.json", results, command, kernel);
+  write_results_csv(output_dir / "results.csv", results);
+  write_summary_markdown(output_dir / "summary.md", results, command);
+  if (options.log) {
+    *options.log << "wrote " << (output_dir / "results.json").string()
+                 << ", results.csv and summary.md\n";
+  }
+  return results;
 }
 
 void write_results_csv(const std::filesystem::path& path, const std::vector<SceneResult>& results) {

@@ -24,19 +24,6 @@ struct RunOptions {
   std::string command;
 };
 
-/// --quick: the coarsest useful levels (models at 0, reference at 1 with 0 for its uncertainty)
-/// and only the smallest and largest load, so every shipped scene runs in seconds to minutes.
-/// Taylor–Hood (ν ≥ 0.49) goes to the direct solver, which needs minutes and gigabytes at level 1:
-/// scenes with such a ν keep their reference at level 0 (then without an uncertainty estimate).
-void make_quick(Scene& s) {
-  s.model_levels = {0};
-  s.vessel.level = 0;
-  const bool mixed = std::any_of(s.poisson_ratios.begin(), s.poisson_ratios.end(),
-                                 [](double nu) { return nu >= 0.49; });
-  s.reference_level = std::min(s.reference_level, mixed ? 0 : 1);
-  if (s.load.magnitudes.size() > 2) s.load.magnitudes = {s.load.magnitudes.front(), s.load.magnitudes.back()};
-}
-
 /// The command line's sweeps replace the scene's values (after --quick, so they win).
 void apply_sweeps(const RunOptions& o, Scene& s) {
   if (!o.poisson_ratios.empty()) s.poisson_ratios = o.poisson_ratios;
@@ -60,22 +47,14 @@ void run(const RunOptions& o) {
   std::vector<Scene> scenes;
   for (const auto& f : o.scenes) scenes.push_back(read_scene(f));  // validate all before running
   for (Scene& s : scenes) {
-    if (o.quick) make_quick(s);
+    if (o.quick) s = quick_variant(std::move(s));
     apply_sweeps(o, s);
   }
   HarnessOptions h;
   h.cache_dir = o.cache_dir;
   h.log = &std::cout;
   h.repeats = o.repeats;
-  std::vector<SceneResult> results;
-  for (std::size_t i = 0; i < scenes.size(); ++i) {
-    std::cout << "== scene " << i + 1 << "/" << scenes.size() << ": " << scenes[i].name << " ==\n";
-    results.push_back(run_scene(scenes[i], h));
-  }
-  write_results_json(o.output_dir / "results.json", results, o.command);
-  write_results_csv(o.output_dir / "results.csv", results);
-  write_summary_markdown(o.output_dir / "summary.md", results, o.command);
-  std::cout << "wrote " << (o.output_dir / "results.json").string() << ", results.csv and summary.md\n";
+  run_and_write(scenes, h, o.output_dir, o.command);
 }
 
 }  // namespace
