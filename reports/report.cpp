@@ -318,12 +318,26 @@ void history_figure(const FigureContext& c) {
     m.y = o->history_model_mm;
     plot.series.push_back(m);
   }
+  Table t;
+  t.header = {"model", "load", "steps", "simulated s", "solve s", "steps/s", "real-time factor",
+              "max error over time mm", "final max error mm", "FEM damping α 1/s"};
+  for (const OutcomeRow* o : rows) {
+    t.rows.push_back({o->model, load_text(o->magnitude, c.scene), std::to_string(o->steps),
+                      fmt(o->simulated_s), fmt(o->solve_seconds),
+                      fmt(static_cast<double>(o->steps) / o->solve_seconds),
+                      fmt(o->simulated_s / o->solve_seconds),
+                      reference_drawn ? fmt(o->history_max_error_mm) : "–", fmt(o->max_mm),
+                      fmt(o->mass_damping_per_s)});
+  }
   c.doc.figure(file_safe(c.scene.name) + "_history.svg", render_svg(plot),
                "The contact force applied as a step at t = 0: displacement of the QoI point over "
                "time for each integrator" +
                    std::string(reference_drawn ? ", against the FEM transient (Newmark, average "
                                                  "acceleration)."
-                                               : " (no FEM transient in these results)."));
+                                               : " (no FEM transient in these results).") +
+                   " Real-time factor: simulated time over wall-clock time (≥ 1 runs in real "
+                   "time). The final error is against the static reference.");
+  c.doc.table(t);
 }
 
 Table statistics_table(const SceneRows& s) {

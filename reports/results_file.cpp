@@ -72,6 +72,10 @@ OutcomeRow read_outcome(const json& j, const std::string& where) {
     o.history_time_s = field<std::vector<double>>(*h, "time_s", where + ".history");
     o.history_model_mm = field<std::vector<double>>(*h, "model_mm", where + ".history");
     o.history_reference_mm = field<std::vector<double>>(*h, "reference_mm", where + ".history");
+    o.history_max_error_mm = field<double>(*h, "max_error_mm", where + ".history");
+    o.steps = field<long>(*h, "steps", where + ".history");
+    o.simulated_s = field<double>(*h, "simulated_s", where + ".history");
+    o.mass_damping_per_s = field<double>(*h, "mass_damping_per_s", where + ".history");
   }
   return o;
 }

@@ -24,6 +24,8 @@ struct OutcomeRow {
   bool beyond_linear_regime = false;
   std::vector<double> profile_s_mm, profile_model_mm, profile_reference_mm;
   std::vector<double> history_time_s, history_model_mm, history_reference_mm;
+  double history_max_error_mm = 0.0, simulated_s = 0.0, mass_damping_per_s = 0.0;
+  long steps = 0;
 };
 
 struct ReferenceRow {

@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <tuple>
 
 #include "fem_reference/convergence.hpp"
 #include "fem_reference/elasticity.hpp"
@@ -236,7 +237,42 @@ struct ReferenceAtPoints {
 struct ReferenceSolvers {
   std::unique_ptr<fem::ElasticitySolver> fine;
   std::unique_ptr<fem::ElasticitySolver> coarse;
+  /// FEM transients already run, by (probe point, simulated time, α): |u(t)| at unit load, m.
+  mutable std::map<std::tuple<double, double, double, double, double>,
+                   std::pair<std::vector<double>, std::vector<double>>>
+      transients;
 };
+
+/// Newmark steps of the FEM transient: average acceleration is unconditionally stable, and 400
+/// steps over the run resolve the low modes that a contact step excites.
+constexpr int kTransientSteps = 400;
+
+/// The FEM transient at `probe` for a step unit load over `duration` (cached): times and |u|.
+const std::pair<std::vector<double>, std::vector<double>>& transient_at(
+    const ReferenceSolvers& ref, const Vec3& probe, double duration, double alpha) {
+  const auto key = std::make_tuple(probe.x(), probe.y(), probe.z(), duration, alpha);
+  const auto it = ref.transients.find(key);
+  if (it != ref.transients.end()) return it->second;
+  fem::TransientOptions t;
+  t.dt = duration / kTransientSteps;
+  t.steps = kTransientSteps;
+  t.mass_damping = alpha;
+  t.probe_points = {probe};
+  t.outside_tolerance = kOutsideTolerance;
+  const fem::TransientResult r = ref.fine->transient(t);
+  std::vector<double> u(r.time.size());
+  for (std::size_t k = 0; k < u.size(); ++k) u[k] = r.probe_displacement[k][0].norm();
+  return ref.transients.emplace(key, std::make_pair(r.time, u)).first->second;
+}
+
+/// Linear interpolation of (t, v) at time x (clamped to the ends).
+double interpolate(const std::vector<double>& t, const std::vector<double>& v, double x) {
+  if (x <= t.front()) return v.front();
+  if (x >= t.back()) return v.back();
+  const auto hi = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin());
+  const double w = (x - t[hi - 1]) / (t[hi] - t[hi - 1]);
+  return (1.0 - w) * v[hi - 1] + w * v[hi];
+}
 
 ReferenceAtPoints reference_at(const ReferenceSolvers& ref, const std::vector<Vec3>& points) {
   ReferenceAtPoints r;
@@ -322,6 +358,24 @@ void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
   }
 }
 
+/// The FEM transient next to a dynamic model's history. The model's point damping c (force −c v
+/// per node, seed 000 eq. 3.3) becomes mass-proportional damping α = c / m̄ with m̄ the model's
+/// mean nodal mass: exact for uniform masses, an average otherwise.
+void add_reference_history(History& h, const ReferenceSolvers& ref, const Vec3& probe,
+                           const ModelSpec& spec, const msm::Problem& problem, double magnitude) {
+  h.steps = spec.steps;
+  h.simulated_s = spec.dt * static_cast<double>(spec.steps);
+  const double mean_mass = problem.mass.sum() / static_cast<double>(problem.mass.size());
+  h.mass_damping = spec.damping > 0.0 ? spec.damping / mean_mass : 0.0;
+  const auto& [t, u] = transient_at(ref, probe, h.simulated_s, h.mass_damping);
+  h.reference_mm.clear();
+  h.max_error_mm = 0.0;
+  for (std::size_t k = 0; k < h.time_s.size(); ++k) {
+    h.reference_mm.push_back(interpolate(t, u, h.time_s[k]) * magnitude * 1e3);
+    h.max_error_mm = std::max(h.max_error_mm, std::abs(h.model_mm[k] - h.reference_mm[k]));
+  }
+}
+
 /// A mass-spring model at every load magnitude.
 void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
                    const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
@@ -374,6 +428,8 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
           d.dt = spec.dt;
           d.steps = static_cast<int>(spec.steps);
           out.history = {};
+          out.history.time_s.push_back(0.0);  // at rest
+          out.history.model_mm.push_back(0.0);
           const int every = std::max(1, d.steps / kHistorySamples);
           const auto q = static_cast<Eigen::Index>(3 * at.qoi);
           d.on_step = [&](int step, const Eigen::VectorXd& xs, const Eigen::VectorXd&) {
@@ -382,6 +438,7 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
             out.history.model_mm.push_back((xs.segment<3>(q) - nodes[at.qoi]).norm() * 1e3);
           };
           x = msm::integrate(problem, d).x;
+          add_reference_history(out.history, ref, nodes[at.qoi], spec, problem, mag);
         }
         times.push_back(solve.seconds());
       }

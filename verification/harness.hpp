@@ -41,11 +41,18 @@ struct WallProfile {
   std::vector<double> reference_mm;
 };
 
-/// The QoI displacement magnitude over time (dynamic models), sampled.
+/// The QoI displacement magnitude over time (dynamic models), sampled. The reference is the FEM
+/// transient (Newmark, average acceleration) of the same step load on the reference mesh, at the
+/// model's QoI node, with the model's point damping mapped to mass-proportional damping,
+/// interpolated linearly to the model's sample times.
 struct History {
   std::vector<double> time_s;
   std::vector<double> model_mm;
-  std::vector<double> reference_mm;  ///< the FEM transient (Newmark), empty if none
+  std::vector<double> reference_mm;
+  double max_error_mm = 0.0;  ///< max over the samples of |model − reference|
+  long steps = 0;
+  double simulated_s = 0.0;   ///< dt × steps
+  double mass_damping = 0.0;  ///< α of the FEM transient, 1/s
 };
 
 /// One model at one (ν, level, magnitude).

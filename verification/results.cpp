@@ -74,7 +74,11 @@ nlohmann::json scene_json(const SceneResult& r) {
       if (!o.history.time_s.empty()) {
         j["history"] = {{"time_s", o.history.time_s},
                         {"model_mm", o.history.model_mm},
-                        {"reference_mm", o.history.reference_mm}};
+                        {"reference_mm", o.history.reference_mm},
+                        {"max_error_mm", o.history.max_error_mm},
+                        {"steps", o.history.steps},
+                        {"simulated_s", o.history.simulated_s},
+                        {"mass_damping_per_s", o.history.mass_damping}};
       }
     } else {
       j["failure"] = o.failure;
