@@ -17,5 +17,7 @@ void add_gate_command(CLI::App& app, const std::string& command_line);
 void add_msm_command(CLI::App& app);
 /// `vesselverify fem`: the deal.II linear-elastic reference (fem_command.cpp).
 void add_fem_command(CLI::App& app);
+/// `vesselverify stability`: critical time steps and hard cases (stability_command.cpp).
+void add_stability_command(CLI::App& app, const std::string& command_line);
 
 }  // namespace vessel::cli
