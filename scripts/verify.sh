@@ -1,20 +1,23 @@
 #!/usr/bin/env bash
-# The main command: installs what is missing, builds in Release and runs the default verification:
-# the shipped static scenes (contact on the straight tube and on the arch, Lamé pressure, gravity
-# sag) with every model against the FEM reference, and the default vessels' mesh statistics.
-# Writes results.json (schema verification/results.schema.json), results.csv, summary.md and the
-# meshes' statistics under the output directory.
+# The main command: installs what is missing, builds in Release and runs the default verification
+# of the shipped scenes, then writes the report.
+#   1. the default vessels' mesh statistics;
+#   2. `vesselverify run`: every model of every shipped scene (contact on the straight tube and
+#      on the arch, Lamé pressure, gravity sag, the dynamic step contact) against the FEM
+#      reference → results.json, results.csv, summary.md;
+#   3. `vesselverify stability`: predicted vs found critical time steps and the hard cases →
+#      stability.json, stability.md;
+#   4. `vesselverify report` → report.md, report.html (self-contained) and figures/.
 #
-# Usage: scripts/verify.sh [--full] [output-dir]   (default: results)
-#   default  the --quick variant: models at level 0, reference at level 1 (0 for scenes with
-#            ν ≥ 0.49), smallest and largest load; a few minutes on 2 cores
-#   --full   the scenes' own levels and every load: much longer (Taylor–Hood references at level
-#            ≥ 1 go to a direct solver and need many minutes and gigabytes)
+# Usage: scripts/verify.sh [--quick] [output-dir]   (default output: results/)
+#   default  the scenes' own levels, loads and sweeps: well under 30 minutes on 2 cores
+#   --quick  models at level 0, reference at level 1, smallest and largest load, the quick
+#            stability study: a few minutes
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-mode=(--quick)
-if [ "${1:-}" = "--full" ]; then
-  mode=()
+mode=()
+if [ "${1:-}" = "--quick" ]; then
+  mode=(--quick)
   shift
 fi
 out="${1:-$root/results}"
@@ -23,11 +26,15 @@ build="$root/build"
 "$root/scripts/build.sh" "$build"
 vv="$build/verification/vesselverify"
 mkdir -p "$out"
+start=$SECONDS
 for vessel in straight arch; do
   echo "== default $vessel vessel =="
   "$vv" mesh --vessel "$vessel" --level 0 --stats-json "$out/${vessel}_vessel_stats.json"
 done
 scenes="$root/verification/scenes"
 "$vv" run "${mode[@]}" --output-dir "$out" "$scenes/contact_straight.toml" \
-  "$scenes/pressure_lame.toml" "$scenes/contact_arch.toml" "$scenes/gravity_sag.toml"
-echo "results written to $out (summary: $out/summary.md)"
+  "$scenes/pressure_lame.toml" "$scenes/contact_arch.toml" "$scenes/gravity_sag.toml" \
+  "$scenes/dynamic_contact.toml"
+"$vv" stability "${mode[@]}" --output-dir "$out"
+"$vv" report "$out/results.json" --stability "$out/stability.md" --output-dir "$out"
+echo "verification finished in $((SECONDS - start)) s; report: $out/report.html (and report.md)"
