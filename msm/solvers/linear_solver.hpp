@@ -25,6 +25,8 @@ class CholmodSolver {
   [[nodiscard]] int symbolic_analyses() const { return analyses_; }
   [[nodiscard]] int numeric_factorisations() const { return factorisations_; }
   [[nodiscard]] double last_regularisation() const { return mu_; }
+  /// Wall-clock seconds spent in numeric factorisations (and symbolic analyses) so far.
+  [[nodiscard]] double factorisation_seconds() const { return seconds_; }
 
  private:
   Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower> llt_;
@@ -33,6 +35,7 @@ class CholmodSolver {
   int analyses_ = 0;
   int factorisations_ = 0;
   double mu_ = 0.0;
+  double seconds_ = 0.0;
 };
 
 }  // namespace vessel::msm
