@@ -39,9 +39,12 @@ void CholmodSolver::factorize(const SparseMatrix& A) {
   if (try_factorize(A)) return;
   // Not positive definite (e.g. a surface membrane without transverse stiffness): regularise.
   VectorXd diag = A.diagonal();
+  // A dof without stiffness (zero diagonal: e.g. a node between compressed springs, whose
+  // transverse stiffness the projection removed) gets a shift relative to the mean diagonal.
+  const double floor = 1e-3 * diag.cwiseAbs().mean() + 1e-300;
   for (double mu = 1e-10; mu <= 1e-2; mu *= 10.0) {
     SparseMatrix R = A;
-    for (Eigen::Index i = 0; i < R.rows(); ++i) R.coeffRef(i, i) += mu * std::max(diag[i], 1e-30);
+    for (Eigen::Index i = 0; i < R.rows(); ++i) R.coeffRef(i, i) += mu * std::max(diag[i], floor);
     const double t0 = now();
     llt_.factorize(R);
     ++factorisations_;

@@ -16,7 +16,7 @@ class CholmodSolver {
   CholmodSolver& operator=(const CholmodSolver&) = delete;
   /// Factorises A (symmetric, lower triangle read). The symbolic analysis is done once per
   /// pattern (nonzero count and dimension). If A is not positive definite, retries with
-  /// A + μ·diag(A) for growing μ (1e-10 … 1e-2) and records μ; throws std::runtime_error if even
+  /// A + μ·max(diag(A), 1e-3·mean|diag(A)|) for growing μ (1e-10 … 1e-2) and records μ; throws std::runtime_error if even
   /// that fails.
   void factorize(const SparseMatrix& A);
   /// Factorises A without regularisation; false if A is not positive definite.

@@ -65,6 +65,7 @@ StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& st
   // Round-off floor of the residual: ε·(largest stiffness)·(model size)·√n, set at the first
   // Hessian; below it the residual cannot be reduced, whatever the load.
   double roundoff = 0.0;
+  int backoff = 0, skip_exact = 0;
   for (r.iterations = 0; r.iterations <= o.max_iterations; ++r.iterations) {
     p.potential_gradient(r.x, g);
     r.residual = g.norm();
@@ -85,7 +86,17 @@ StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& st
                  size * std::sqrt(static_cast<double>(p.num_dofs()));
     }
     apply_dirichlet(H, p.fixed);
-    const bool exact = solver.try_factorize(H);
+    // A failed (indefinite) factorisation costs as much as a good one. After a failure, skip the
+    // exact attempt for 1, 2, 4 (at most `exact_backoff`) iterations while it keeps failing.
+    const bool try_exact = skip_exact == 0;
+    if (skip_exact > 0) --skip_exact;
+    const bool exact = try_exact && solver.try_factorize(H);
+    if (exact) {
+      backoff = 0;
+    } else if (try_exact && o.exact_backoff > 0) {
+      backoff = std::min(std::max(1, 2 * backoff), o.exact_backoff);
+      skip_exact = backoff;
+    }
     if (!exact) {
       ++r.indefinite_iterations;
       ta = now();
@@ -164,7 +175,7 @@ StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& st
       VectorXd& v = curvature_direction;
       p.potential_gradient(r.x, gt);
       const double sign = gt.dot(v) > 0.0 ? -1.0 : 1.0;
-      double b = std::max({alpha * dx.cwiseAbs().maxCoeff(),
+      double b = std::max({accepted ? alpha * dx.cwiseAbs().maxCoeff() : 0.0,
                            1e-3 * (r.x - p.rest).cwiseAbs().maxCoeff(),
                            1e-9 * (p.rest.maxCoeff() - p.rest.minCoeff())}) /
                  v.cwiseAbs().maxCoeff();

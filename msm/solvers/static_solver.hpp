@@ -17,8 +17,12 @@ struct StaticOptions {
   bool project_psd = true;
   int load_steps = 1;           ///< load increments (Newton from each previous equilibrium)
   /// Where the exact Hessian is indefinite: power iterations for a direction of negative
-  /// curvature (0: off, plain projected Newton). See static_solver.cpp.
-  int curvature_iterations = 20;
+  /// curvature (0: off, plain projected Newton). Off by default: fewer iterations on the level
+  /// 0–1 surface models, but more (and more time) on the level-2 grid; docs/msm_measurements.md.
+  int curvature_iterations = 0;
+  /// After the exact Hessian fails to factorise (indefinite), skip the attempt for 1, 2, 4 …
+  /// iterations, at most this many (0: try every iteration).
+  int exact_backoff = 0;
   /// With a negative-curvature direction found (generalised eigenvalue λ < 0 of H v = λ Hp v):
   /// the Newton step uses (1 − τ)H + τHp, τ the smallest blend whose eigenvalues are ≥ this
   /// (relative to Hp), instead of Hp alone. 1 or more: off.

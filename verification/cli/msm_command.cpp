@@ -72,6 +72,7 @@ struct MsmOptions {
   bool fixed_given = false;  ///< --fixed on the command line
   int curvature_iterations = msm::StaticOptions{}.curvature_iterations;
   double curvature_shift = msm::StaticOptions{}.curvature_shift;
+  int exact_backoff = msm::StaticOptions{}.exact_backoff;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -354,6 +355,7 @@ void run(MsmOptions& o) {
     static_options.load_steps = o.load_steps;
     static_options.curvature_iterations = o.curvature_iterations;
     static_options.curvature_shift = o.curvature_shift;
+    static_options.exact_backoff = o.exact_backoff;
     const msm::StaticResult r = o.solver == "static" ? msm::solve_static(problem, static_options)
                                                      : msm::solve_linear(problem);
     x = r.x;
@@ -573,6 +575,11 @@ void add_msm_command(CLI::App& app) {
   cmd->add_option("--curvature-shift", o->curvature_shift,
                   "Static Newton: smallest relative eigenvalue δ of the blended Hessian "
                   "(1 − τ)H + τHp where H is indefinite (≥ 1: projected Hessian only)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--exact-backoff", o->exact_backoff,
+                  "Static Newton: after an indefinite exact Hessian, skip trying it for up to this "
+                  "many iterations (doubling while it keeps failing; 0: try every iteration)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_flag("-v,--verbose", o->verbose, "Print the Newton iterations");
