@@ -37,4 +37,11 @@ struct BuiltNetwork {
 BuiltNetwork build_network(const TetMesh& mesh, const VesselParams& params,
                            const NetworkOptions& options);
 
+/// Surface model on any triangle surface (an STL file, or a user mesh's wall): the triangle
+/// topology (options.topology must be auto or triangles: the seed 000 grid needs the generated
+/// structured tube), stiffness, damping and masses as in build_network, wall thickness t (m).
+/// Throws InputError for a grid topology, a non-surface model or invalid parameters.
+BuiltNetwork build_surface_network(const TriangleSurface& surface, double thickness,
+                                   const NetworkOptions& options);
+
 }  // namespace vessel::msm

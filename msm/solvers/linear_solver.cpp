@@ -1,5 +1,6 @@
 #include "msm/solvers/linear_solver.hpp"
 
+#include <chrono>
 #include <stdexcept>
 
 namespace vessel::msm {
@@ -9,11 +10,19 @@ CholmodSolver::CholmodSolver() {
 }
 CholmodSolver::~CholmodSolver() = default;
 
+namespace {
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
 bool CholmodSolver::try_factorize(const SparseMatrix& A) {
+  const double t0 = now();
   if (A.rows() != pattern_rows_ || A.nonZeros() != pattern_nonzeros_) {
-    // Simplicial below 10k unknowns, supernodal above (measured here with Debian's reference
-    // BLAS: 3k-unknown surface model 72 vs 94 ms; 33k-unknown volume model 3.6 vs 2.1 s).
-    llt_.setMode(A.rows() < 10'000 ? Eigen::CholmodSimplicialLLt : Eigen::CholmodSupernodalLLt);
+    // Supernodal from 1000 unknowns (measured here with OpenBLAS, CPU time of whole static
+    // solves: 6.5k-unknown surface model 2.9 vs 8.3 s simplicial, 1.6k: 0.63 vs 0.85 s; with
+    // Debian's reference BLAS the crossing was near 10k). Simplicial for the tiny test problems.
+    llt_.setMode(A.rows() < 1000 ? Eigen::CholmodSimplicialLLt : Eigen::CholmodSupernodalLLt);
     llt_.analyzePattern(A);
     pattern_rows_ = A.rows();
     pattern_nonzeros_ = A.nonZeros();
@@ -22,6 +31,7 @@ bool CholmodSolver::try_factorize(const SparseMatrix& A) {
   mu_ = 0.0;
   llt_.factorize(A);
   ++factorisations_;
+  seconds_ += now() - t0;
   return llt_.info() == Eigen::Success;
 }
 
@@ -29,11 +39,16 @@ void CholmodSolver::factorize(const SparseMatrix& A) {
   if (try_factorize(A)) return;
   // Not positive definite (e.g. a surface membrane without transverse stiffness): regularise.
   VectorXd diag = A.diagonal();
+  // A dof without stiffness (zero diagonal: e.g. a node between compressed springs, whose
+  // transverse stiffness the projection removed) gets a shift relative to the mean diagonal.
+  const double floor = 1e-3 * diag.cwiseAbs().mean() + 1e-300;
   for (double mu = 1e-10; mu <= 1e-2; mu *= 10.0) {
     SparseMatrix R = A;
-    for (Eigen::Index i = 0; i < R.rows(); ++i) R.coeffRef(i, i) += mu * std::max(diag[i], 1e-30);
+    for (Eigen::Index i = 0; i < R.rows(); ++i) R.coeffRef(i, i) += mu * std::max(diag[i], floor);
+    const double t0 = now();
     llt_.factorize(R);
     ++factorisations_;
+    seconds_ += now() - t0;
     if (llt_.info() == Eigen::Success) {
       mu_ = mu;
       return;

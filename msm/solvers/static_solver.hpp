@@ -16,6 +16,17 @@ struct StaticOptions {
   int max_iterations = 200;
   bool project_psd = true;
   int load_steps = 1;           ///< load increments (Newton from each previous equilibrium)
+  /// Where the exact Hessian is indefinite: power iterations for a direction of negative
+  /// curvature (0: off, plain projected Newton). Off by default: fewer iterations on the level
+  /// 0–1 surface models, but more (and more time) on the level-2 grid; docs/msm_measurements.md.
+  int curvature_iterations = 0;
+  /// After the exact Hessian fails to factorise (indefinite), skip the attempt for 1, 2, 4 …
+  /// iterations, at most this many (0: try every iteration).
+  int exact_backoff = 0;
+  /// With a negative-curvature direction found (generalised eigenvalue λ < 0 of H v = λ Hp v):
+  /// the Newton step uses (1 − τ)H + τHp, τ the smallest blend whose eigenvalues are ≥ this
+  /// (relative to Hp), instead of Hp alone. 1 or more: off.
+  double curvature_shift = 0.3;
   std::ostream* log = nullptr;  ///< per-iteration residual, step length, regularisation
 };
 
@@ -27,10 +38,18 @@ struct StaticResult {
   double seconds = 0.0;
   int symbolic_analyses = 0;
   int numeric_factorisations = 0;
+  int indefinite_iterations = 0;     ///< iterations whose exact Hessian was not positive definite
+  int negative_curvature_steps = 0;  ///< of those, steps taken along a negative-curvature direction
+  double factorisation_seconds = 0.0;  ///< of `seconds`: CHOLMOD symbolic + numeric factorisations
+  double assembly_seconds = 0.0;       ///< of `seconds`: Hessian assembly
+  double curvature_seconds = 0.0;      ///< of `seconds`: power iterations for negative curvature
 };
 
-/// Newton with Armijo backtracking from `start` (rest positions if empty). Throws
-/// std::runtime_error naming the iteration and residual if it does not converge.
+/// Newton with Armijo backtracking from `start` (rest positions if empty): the exact Hessian
+/// where it is positive definite; elsewhere the per-spring PSD-projected Hessian for a descent
+/// direction plus a step along a direction of negative curvature of the exact Hessian (escaping
+/// saddles and buckling points). Throws std::runtime_error naming the iteration and residual if it
+/// does not converge.
 StaticResult solve_static(const Problem& problem, const StaticOptions& options = {},
                           const VectorXd& start = VectorXd());
 

@@ -69,7 +69,8 @@ double seed001_stiffness(double E, double volume_around_edge, double L) {
 }
 
 double van_gelder_stiffness(double E, double measure_around_edge, double L) {
-  // Van Gelder (1998): k_c = E·Σ_e |T_e| / |c|² (|T_e| volume, or t × area in 2D).
+  // Van Gelder (1998), abstract: k ∝ area/|c|²; k_c = E·Σ_e |T_e| / |c|² (|T_e| volume, or
+  // t × area in 2D). Constant and 3D form not verified against the paper's text (see header).
   return E * measure_around_edge / (L * L);
 }
 

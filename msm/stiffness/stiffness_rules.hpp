@@ -46,17 +46,28 @@ double seed000_stiffness(double E, double area, double h0);
 /// seed 001 §2.2: k = E·V_T/L² with V_T = (Σ volumes of the tets containing the edge)/3.
 double seed001_stiffness(double E, double volume_around_edge, double L);
 /// Van Gelder (1998), "Approximate simulation of elastic membranes by triangulated spring
-/// meshes": k = E·Σ_e V_e/|c|² for tetrahedra; for triangles k = E·t·Σ_e A_e/|c|² (the measure
-/// argument is then t·Σ A_e).
+/// meshes", J. Graphics Tools 3(2): k_c = E·t·Σ_e A_e/|c|² for triangles (the sum over the
+/// triangles e sharing edge c), k_c = E·Σ_e V_e/|c|² for tetrahedra. Source check (2026-11): the
+/// paper's full text could not be retrieved with the project's search corpora (docs, pages, code);
+/// only its abstract was, which states the rule's "simplest form: stiffness varies as triangle
+/// area over edge length squared" and that "extensions ... to three dimensions are discussed".
+/// The proportionality constant E·t (so that an equilateral triangle reproduces the plane-stress
+/// continuum at ν = 1/3) and the 3D form are therefore NOT checked against the paper's equations,
+/// whose numbers cannot be cited here; any ν-dependence the paper may give is not implemented.
+/// Tests check the properties that hold for this form (tests/msm/test_stiffness_papers.cpp).
 double van_gelder_stiffness(double E, double measure_around_edge, double L);
 
 /// Lloyd, Székely & Harders (2007), "Identification of spring parameters for deformable object
-/// simulation" (IEEE TVCG 13(5)): spring constants of one element's edges chosen so that the
+/// simulation", IEEE TVCG 13(5): spring constants of one element's edges chosen so that the
 /// spring network's linear stiffness matrix Σ_e k_e g_e g_eᵀ matches the element's linear FEM
 /// stiffness matrix K (isotropic, E and ν; triangles in plane stress with thickness t), here in
-/// the least-squares (Frobenius) sense: Σ_f (g_eᵀg_f)² k_f = g_eᵀ K g_e. For the equilateral
-/// triangle at ν = 1/3 the match is exact (k = √3/4·E·t); for the regular tetrahedron at ν = 1/4
-/// it gives Lloyd et al.'s k = (2√2/25)·E·l, not an exact match (six springs cannot be).
+/// the least-squares (Frobenius) sense: Σ_f (g_eᵀg_f)² k_f = g_eᵀ K g_e. Equilateral triangle at
+/// ν = 1/3: exact, k = (√3/4)·E·t; regular tetrahedron at ν = 1/4: k = (2√2/25)·E·l, not exact (six
+/// springs cannot match a tet: 24/25 of the continuum's dilation energy). Source check (2026-11):
+/// the paper's text could not be retrieved with the project's search corpora, so these closed
+/// forms, the least-squares reading and the paper's load case are as remembered, not verified
+/// against its equations (no equation numbers cited). What the tests verify independently: the
+/// element energies under uniform strain against the continuum's closed form.
 /// Returns the k of the 6 edges (0-1, 0-2, 0-3, 1-2, 1-3, 2-3) of a tetrahedron, N/m.
 std::array<double, 6> lloyd_tet_stiffness(const std::array<Vec3, 4>& x, double E, double nu);
 /// The k of the 3 edges (0-1, 0-2, 1-2) of a triangle of thickness t, N/m.

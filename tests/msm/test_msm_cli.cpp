@@ -98,3 +98,65 @@ TEST_F(MsmCli, PressureAndGravityFromTheSharedLoadDefinitionsRun) {
   const auto bad = vv("--pressure nan");
   EXPECT_NE(bad.exit_code, 0) << bad.output;
 }
+
+TEST_F(MsmCli, InputMshAndStlGiveTheSameModelAsTheGeneratedMesh) {
+  // The generated level-0 vessel written once as .msh and its inner wall as STL: the surface
+  // model read back from either (fixed ends: the groups, or the STL's open boundary) has the
+  // generated model's springs and equilibrium. STL stores float32, hence the 1e-5 tolerance.
+  const auto m = run_command(std::string(VESSELVERIFY_EXE) + " mesh --cache-dir " +
+                             (dir / "cache").string() + " -o " + (dir / "v.msh").string() +
+                             " --stl " + (dir / "inner.stl").string() + " --stl-group inner_wall");
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  auto solve = [&](const std::string& args, const std::string& name) {
+    const auto r = vv(args + " --json " + (dir / name).string());
+    EXPECT_EQ(r.exit_code, 0) << args << "\n" << r.output;
+    return nlohmann::json::parse(read_text(dir / name));
+  };
+  const std::string stl_in = "--input " + (dir / "inner.stl").string();
+  const std::string stl_fix = stl_in + " --contact-point 0.003 0 0.02 --fix-boundary";
+  // Static Newton on the STL surface and on the generated wall.
+  const auto gen = solve("", "gen.json");
+  const auto stl = solve(stl_fix, "stl.json");
+  EXPECT_EQ(stl["springs"], gen["springs"]);
+  EXPECT_NEAR(stl["contact_displacement_mm"].get<double>(),
+              gen["contact_displacement_mm"].get<double>(),
+              1e-5 * gen["contact_displacement_mm"].get<double>());
+  EXPECT_EQ(stl["input"], (dir / "inner.stl").string());
+  // The .msh file (both models, linearised: cheap and deterministic) equals the generated mesh.
+  for (const std::string model : {"surface", "volume"}) {
+    const std::string args = "--solver linear --model " + model;
+    const auto a = solve(args, "a.json");
+    const auto b = solve(args + " --input " + (dir / "v.msh").string(), "b.json");
+    EXPECT_EQ(b["springs"], a["springs"]) << model;
+    EXPECT_DOUBLE_EQ(b["contact_displacement_mm"].get<double>(),
+                     a["contact_displacement_mm"].get<double>())
+        << model;
+  }
+  // z-planes fix the same ends as the STL's boundary: the tube spans z = 0 … 40 mm.
+  const auto boundary = solve(stl_fix + " --solver linear", "boundary.json");
+  const auto planes = solve(stl_in +
+                                " --solver linear --contact-point 0.003 0 0.02 --fix-below-z 1e-9 "
+                                "--fix-above-z 0.039999999",
+                            "planes.json");
+  EXPECT_DOUBLE_EQ(planes["contact_displacement_mm"].get<double>(),
+                   boundary["contact_displacement_mm"].get<double>());
+
+  const std::pair<std::string, std::string> bad[] = {
+      {stl_in + " --model volume --contact-point 0.003 0 0.02 --fix-boundary", "needs tetrahedra"},
+      {stl_in + " --fix-boundary", "--contact-point"},
+      {stl_in + " --contact-point 0.003 0 0.02", "--fix-below-z"},
+      {stl_in + " --contact-point 0.003 0 0.02 --fixed inlet", "physical groups"},
+      {stl_in + " --contact-point 0.003 0 0.02 --fix-below-z -1", "fixes no node"},
+      {stl_in + " --contact-point 0.003 0 0.02 --fix-below-z 5", "every node"},
+      {stl_in + " --contact-point 0.003 0 0.02 --fix-boundary --surface mid", "--surface mid"},
+      {"--input " + (dir / "v.obj").string(), ".obj"},
+      {"--input " + (dir / "missing.msh").string(), "missing.msh"},
+      {"--input " + (dir / "v.msh").string() + " --structured", "grid topology"},
+  };
+  for (const auto& [args, what] : bad) {
+    const auto r = vv(args + " --json " + (dir / "bad.json").string());
+    EXPECT_EQ(r.exit_code, 1) << args << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, what)) << args << "\n" << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.json"));
+  }
+}

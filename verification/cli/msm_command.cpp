@@ -1,14 +1,23 @@
 /// `vesselverify msm`: build a surface or volume mass-spring model on a vessel mesh, load it with
 /// the shared contact patch, solve statically or dynamically, print and optionally write results.
+#include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <map>
+#include <numeric>
+#include <set>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
+#include "meshes/msh_io.hpp"
+#include "meshes/stl_io.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/model/build_network.hpp"
@@ -56,6 +65,14 @@ struct MsmOptions {
   double pressure = 0.0;
   bool gravity = false;
   int load_steps = 1;
+  fs::path input;                                            ///< .msh or .stl instead of --vessel
+  double fix_below_z = std::numeric_limits<double>::quiet_NaN();  ///< m
+  double fix_above_z = std::numeric_limits<double>::quiet_NaN();  ///< m
+  bool fix_boundary = false;
+  bool fixed_given = false;  ///< --fixed on the command line
+  int curvature_iterations = msm::StaticOptions{}.curvature_iterations;
+  double curvature_shift = msm::StaticOptions{}.curvature_shift;
+  int exact_backoff = msm::StaticOptions{}.exact_backoff;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -68,6 +85,65 @@ Vec3 default_contact_point(const VesselParams& p) {
   const double alpha = std::numbers::pi / 2;  // arch mid-length
   const Vec3 er(std::cos(alpha), std::sin(alpha), 0.0);
   return (p.bend_radius + p.inner_radius) * er;
+}
+
+/// Fixes the network nodes selected by --fix-below-z, --fix-above-z and --fix-boundary (the nodes
+/// on edges of a single triangle: the open ends of a tube). InputError if an option fixes nothing.
+void fix_by_options(const MsmOptions& o, const msm::SpringNetwork& net, msm::Problem& p) {
+  auto fix = [&](std::size_t i) {
+    for (int k = 0; k < 3; ++k) p.fixed[3 * i + k] = 1;
+  };
+  double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
+  for (const Vec3& x : net.nodes) {
+    zmin = std::min(zmin, x.z());
+    zmax = std::max(zmax, x.z());
+  }
+  auto by_z = [&](double z, bool below, const std::string& name) {
+    if (std::isnan(z)) return;
+    if (!std::isfinite(z)) throw InputError(name + ": expected a finite z in metres");
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < net.nodes.size(); ++i) {
+      if (below ? net.nodes[i].z() <= z : net.nodes[i].z() >= z) {
+        fix(i);
+        ++n;
+      }
+    }
+    if (n == 0) {
+      std::ostringstream m;
+      m << name << " " << z << ": fixes no node; the model spans z from " << zmin * 1e3 << " to "
+        << zmax * 1e3 << " mm (the option is in metres)";
+      throw InputError(m.str());
+    }
+    std::cout << name << " " << z * 1e3 << " mm: " << n << " nodes fixed\n";
+  };
+  by_z(o.fix_below_z, true, "--fix-below-z");
+  by_z(o.fix_above_z, false, "--fix-above-z");
+  if (o.fix_boundary) {
+    std::map<std::pair<int, int>, int> edges;
+    for (const Triangle& t : net.triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const int a = t[k], b = t[(k + 1) % 3];
+        ++edges[{std::min(a, b), std::max(a, b)}];
+      }
+    }
+    std::set<int> nodes;
+    for (const auto& [e, count] : edges) {
+      if (count == 1) nodes.insert({e.first, e.second});
+    }
+    if (nodes.empty()) {
+      throw InputError("--fix-boundary: the surface is closed (every edge has two triangles); "
+                       "fix nodes with --fix-below-z or --fix-above-z");
+    }
+    for (int i : nodes) fix(static_cast<std::size_t>(i));
+    std::cout << "--fix-boundary: " << nodes.size() << " nodes on the open boundary fixed\n";
+  }
+  if (std::find(p.fixed.begin(), p.fixed.end(), 0) == p.fixed.end()) {
+    throw InputError("fixed nodes: every node of the model is fixed; nothing can move (check the "
+                     "--fix-below-z/--fix-above-z values, in metres)");
+  }
+  if (std::find(p.fixed.begin(), p.fixed.end(), 1) == p.fixed.end()) {
+    std::cout << "warning: no node is fixed; the static solvers need supports\n";
+  }
 }
 
 void run(MsmOptions& o) {
@@ -99,7 +175,91 @@ void run(MsmOptions& o) {
     throw InputError("--contact-point: expected three coordinates x y z in metres");
   }
 
-  const TetMesh mesh = mesh_vessel(o.vessel, std::cout);
+  // The mesh: generated (--vessel ...), a user .msh (both models, physical groups) or an STL
+  // surface (surface model only; no groups: fixed nodes and contact point from options).
+  std::string ext = o.input.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const bool from_file = !o.input.empty();
+  const bool is_stl = from_file && ext == ".stl";
+  if (from_file && ext != ".msh" && !is_stl) {
+    throw InputError("--input " + o.input.string() + ": expected a .msh mesh or an .stl surface, got '" +
+                     ext + "'");
+  }
+  if (from_file) {
+    const std::string in = "--input " + o.input.string();
+    if (o.vessel.structured || o.topology == "grid") {
+      throw InputError(in + ": seed 000's grid topology needs the generated --structured tube; " +
+                       "a file gives the triangle topology");
+    }
+    if (o.model == "surface" && o.surface == "mid") {
+      throw InputError(in + ": --surface mid needs the generated vessel's centreline; use inner or outer");
+    }
+  }
+  if (is_stl) {
+    const std::string in = "--input " + o.input.string();
+    if (o.model == "volume") {
+      throw InputError(in + " is an STL surface: the volume model (--model volume) needs " +
+                       "tetrahedra; give a .msh mesh, or use --model surface");
+    }
+    if (o.contact_point.empty() && o.force != 0.0) {
+      throw InputError(in + ": --contact-point x y z (m) is required with an STL surface (no " +
+                       "vessel geometry to place the default contact point on)");
+    }
+    if (o.fixed_given) {
+      throw InputError(in + ": --fixed names physical groups, which an STL file does not have; " +
+                       "fix nodes with --fix-below-z, --fix-above-z or --fix-boundary");
+    }
+    if (std::isnan(o.fix_below_z) && std::isnan(o.fix_above_z) && !o.fix_boundary) {
+      throw InputError(in + ": an STL surface has no physical groups to fix; fix nodes with " +
+                       "--fix-below-z Z, --fix-above-z Z (m) or --fix-boundary (the open ends)");
+    }
+    if (o.pressure != 0.0) {
+      throw InputError(in + ": --pressure acts on the 'inner_wall' group, which an STL file has not");
+    }
+    o.fixed_groups.clear();
+  }
+  if (o.fix_boundary && o.model != "surface") {
+    throw InputError("--fix-boundary: fixes the open boundary of a surface model; for the volume "
+                     "model use --fixed groups or --fix-below-z/--fix-above-z");
+  }
+
+  TetMesh mesh;
+  TriangleSurface stl_surface;
+  const std::string surface_group = is_stl ? "surface" : std::string(group_names::inner_wall);
+  if (!from_file) {
+    mesh = mesh_vessel(o.vessel, std::cout);
+  } else {
+    (void)resolve(o.vessel);  // wall thickness, default contact point
+    if (is_stl) {
+      stl_surface = read_stl(o.input);
+      // A TetMesh without tets holding the surface as one group, so the shared contact-patch
+      // loads (meshes/surface_loads.hpp) work on it unchanged; network node i = mesh node i.
+      mesh.nodes = stl_surface.nodes;
+      mesh.triangles = stl_surface.triangles;
+      PhysicalGroup g{surface_group, 2, 1, {}};
+      g.elements.resize(mesh.triangles.size());
+      std::iota(g.elements.begin(), g.elements.end(), 0);
+      mesh.groups.push_back(g);
+      stl_surface.source_node.resize(stl_surface.nodes.size());
+      std::iota(stl_surface.source_node.begin(), stl_surface.source_node.end(), 0);
+      std::cout << "surface " << o.input.string() << ": " << stl_surface.nodes.size()
+                << " nodes, " << stl_surface.triangles.size() << " triangles\n";
+    } else {
+      mesh = read_msh(o.input);
+      const std::string in = o.input.string();
+      if (o.model == "volume" && mesh.tets.empty()) {
+        throw InputError(in + ": the volume model needs tetrahedra, the file has none");
+      }
+      if (o.model == "surface") {
+        (void)mesh.require_group(o.surface == "outer" ? group_names::outer_wall
+                                                      : group_names::inner_wall,
+                                 2, in);
+      }
+      for (const auto& name : o.fixed_groups) (void)mesh.require_group(name, 2, in);
+      std::cout << "mesh " << in << ": " << mesh.nodes.size() << " nodes, " << mesh.tets.size()
+                << " tets, " << mesh.triangles.size() << " boundary triangles\n";
+    }
+  }
   std::cout << std::defaultfloat << std::setprecision(6);
   const VesselParams& params = o.vessel.params;
   // Shared load definition: the same patch and consistent nodal loads the FEM gets.
@@ -108,6 +268,7 @@ void run(MsmOptions& o) {
                    ? default_contact_point(params)
                    : Vec3(o.contact_point[0], o.contact_point[1], o.contact_point[2]);
   spec.radius = o.patch_radius;
+  spec.surface_group = surface_group;
   spec.force = o.force;
   const TractionPatch patch = contact_patch(mesh, spec);
   std::vector<Vec3> loads = traction_nodal_loads(mesh, patch);
@@ -129,12 +290,15 @@ void run(MsmOptions& o) {
   network_options.mass = mass_rule;
   network_options.density = o.density;
   network_options.axial_damping = o.axial_damping;
-  msm::BuiltNetwork built = msm::build_network(mesh, params, network_options);
+  msm::BuiltNetwork built =
+      is_stl ? msm::build_surface_network(stl_surface, params.wall_thickness, network_options)
+             : msm::build_network(mesh, params, network_options);
   const msm::SpringNetwork& net = built.network;
   const std::string& topology = built.topology;
   const std::vector<double>& masses = built.masses;
   const msm::SpringModel model(net, o.point_damping);
   msm::Problem problem = msm::make_problem(model, net, masses, mesh, loads, o.fixed_groups);
+  fix_by_options(o, net, problem);
   if (o.gravity) {
     // Gravity −9.81 m/s² along y on the nodal masses: for the volume model with consistent masses
     // this is exactly the shared body_force_nodal_loads (ρV/4 per tet vertex); a surface model
@@ -182,24 +346,39 @@ void run(MsmOptions& o) {
                         {"force_mN", o.force * 1e3},
                         {"build_seconds", build_seconds}};
   if (o.model == "surface") result["surface"] = o.surface;
+  if (from_file) result["input"] = o.input.string();
 
   Eigen::VectorXd x;
   if (o.solver == "static" || o.solver == "linear") {
     msm::StaticOptions static_options;
     if (o.verbose) static_options.log = &std::cout;
     static_options.load_steps = o.load_steps;
+    static_options.curvature_iterations = o.curvature_iterations;
+    static_options.curvature_shift = o.curvature_shift;
+    static_options.exact_backoff = o.exact_backoff;
     const msm::StaticResult r = o.solver == "static" ? msm::solve_static(problem, static_options)
                                                      : msm::solve_linear(problem);
     x = r.x;
     std::cout << (o.solver == "static" ? "static Newton" : "linearised model") << ": "
               << r.iterations << " iteration(s), residual " << r.residual << " N, "
               << std::setprecision(4) << r.seconds << " s per static solve (" << r.symbolic_analyses
-              << " symbolic, " << r.numeric_factorisations << " numeric CHOLMOD factorisations)\n"
-              << std::setprecision(6);
+              << " symbolic, " << r.numeric_factorisations << " numeric CHOLMOD factorisations, "
+              << r.factorisation_seconds << " s)\n";
+    if (o.solver == "static") {
+      std::cout << "  " << r.indefinite_iterations << " iteration(s) with an indefinite Hessian, "
+                << r.negative_curvature_steps << " negative-curvature step(s); assembly "
+                << r.assembly_seconds << " s, negative-curvature search " << r.curvature_seconds
+                << " s\n";
+    }
+    std::cout << std::setprecision(6);
     result["solver"] = {{"name", o.solver},
                         {"iterations", r.iterations},
                         {"residual_N", r.residual},
-                        {"seconds", r.seconds}};
+                        {"seconds", r.seconds},
+                        {"numeric_factorisations", r.numeric_factorisations},
+                        {"factorisation_seconds", r.factorisation_seconds},
+                        {"indefinite_iterations", r.indefinite_iterations},
+                        {"negative_curvature_steps", r.negative_curvature_steps}};
   } else if (o.solver == "relaxation") {
     const msm::RelaxationResult r = msm::dynamic_relaxation(problem);
     x = r.x;
@@ -365,8 +544,17 @@ void add_msm_command(CLI::App& app) {
   cmd->add_flag("--gravity", o->gravity, "Add gravity (9.81 m/s² along −y) on the nodal masses");
   cmd->add_option("--patch-radius", o->patch_radius, "Contact patch radius, m")
       ->capture_default_str();
-  cmd->add_option("--fixed", o->fixed_groups, "Surface groups whose nodes are fixed")
-      ->capture_default_str();
+  CLI::Option* fixed =
+      cmd->add_option("--fixed", o->fixed_groups, "Surface groups whose nodes are fixed")
+          ->capture_default_str();
+  cmd->add_option("--input", o->input,
+                  "Mesh file instead of a generated vessel: .msh (both models, with the vessel's "
+                  "physical groups) or .stl (surface model; needs --contact-point and a --fix-* "
+                  "option)");
+  cmd->add_option("--fix-below-z", o->fix_below_z, "Also fix the nodes with z ≤ this, m");
+  cmd->add_option("--fix-above-z", o->fix_above_z, "Also fix the nodes with z ≥ this, m");
+  cmd->add_flag("--fix-boundary", o->fix_boundary,
+                "Also fix the nodes on the surface's open boundary (the ends of a tube)");
   cmd->add_option("--pbd-iterations", o->pbd_iterations, "XPBD iterations per step")
       ->capture_default_str();
   cmd->add_option("--bending-compliance", o->bending_compliance,
@@ -379,9 +567,27 @@ void add_msm_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--load-steps", o->load_steps, "Static Newton: load increments")
       ->capture_default_str();
+  cmd->add_option("--curvature-iterations", o->curvature_iterations,
+                  "Static Newton: power iterations for a negative-curvature direction where the "
+                  "Hessian is indefinite (0: plain projected Newton)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--curvature-shift", o->curvature_shift,
+                  "Static Newton: smallest relative eigenvalue δ of the blended Hessian "
+                  "(1 − τ)H + τHp where H is indefinite (≥ 1: projected Hessian only)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--exact-backoff", o->exact_backoff,
+                  "Static Newton: after an indefinite exact Hessian, skip trying it for up to this "
+                  "many iterations (doubling while it keeps failing; 0: try every iteration)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_flag("-v,--verbose", o->verbose, "Print the Newton iterations");
   cmd->add_option("--json", o->json, "Write the results as JSON (atomically)");
-  cmd->callback([o] { run(*o); });
+  cmd->callback([o, fixed] {
+    o->fixed_given = fixed->count() > 0;
+    run(*o);
+  });
 }
 
 }  // namespace vessel::cli
