@@ -46,7 +46,15 @@ Mat6 spring_hessian(const Vec3& xa, const Vec3& xb, double rest_length, const Sp
   const Vec3 e = xa - xb;
   const double L = e.norm();
   Mat6 H = Mat6::Zero();
-  if (L <= 0.0) return H;
+  if (L <= 0.0) {
+    // Coincident ends. A zero-rest-length spring is ½k|e|² there, Hessian k[I −I; −I I]; with a
+    // positive rest length the energy has a cone point and no Hessian: zero is returned.
+    if (rest_length > 0.0) return H;
+    const double k = spring_profile(0.0, 0.0, law).ddpsi;
+    const Eigen::Matrix3d K = k * Eigen::Matrix3d::Identity();
+    H << K, -K, -K, K;
+    return H;
+  }
   const Vec3 d = e / L;
   const LengthProfile p = spring_profile(L, rest_length, law);
   double axial = p.ddpsi;

@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include "meshes/errors.hpp"
 #include "msm/solvers/linear_solver.hpp"
@@ -18,6 +20,15 @@ Integrator parse_integrator(const std::string& name) {
       "implicit-euler; got '" +
       name + "'");
 }
+
+namespace {
+/// "3.5e-07" rather than std::to_string's "0.000000": energies and residuals span many decades.
+std::string sci(double v) {
+  std::ostringstream s;
+  s << std::setprecision(4) << v;
+  return s.str();
+}
+}  // namespace
 
 std::string to_string(Integrator i) {
   switch (i) {
@@ -92,7 +103,7 @@ void check(const Problem& p, int step, const VectorXd& x, const VectorXd& v, dou
       }
     }
     throw DivergenceError(step, worst, energy,
-                          "energy above the blow-up limit " + std::to_string(limit) + " J");
+                          "energy above the blow-up limit " + sci(limit) + " J");
   }
 }
 
@@ -105,7 +116,7 @@ double total_energy(const Problem& p, const VectorXd& x, const VectorXd& v) {
 DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorXd& x0,
                         const VectorXd& v0) {
   if (!(o.dt > 0) || !std::isfinite(o.dt)) {
-    throw InputError("dt: expected a finite time step > 0 s, got " + std::to_string(o.dt));
+    throw InputError("dt: expected a finite time step > 0 s, got " + sci(o.dt));
   }
   if (o.steps < 0) throw InputError("steps: expected ≥ 0, got " + std::to_string(o.steps));
   const int n = p.num_dofs();

@@ -173,6 +173,11 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
   validate(p);
   const double E = p.youngs_modulus;
   const bool volume = !net.tets.empty();
+  if (rule == StiffnessRule::lloyd && volume && p.poisson_ratio >= 0.5) {
+    // λ = Eν/((1+ν)(1−2ν)) is infinite at ν = 0.5: the FEM element matrix Lloyd fits does not exist.
+    throw InputError("stiffness rule lloyd on tetrahedra: poisson_ratio ν = 0.5 makes λ infinite; "
+                     "expected ν < 0.5");
+  }
   const double t = net.thickness;
   if (!volume && rule != StiffnessRule::uniform && !(t > 0)) {
     throw InputError("assign_stiffness: a surface network needs a wall thickness t > 0");
@@ -211,6 +216,12 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
   const double k2_ratio = p.bilinear_ratio;
   for (Spring& s : net.springs) {
     const double L = s.rest_length;
+    if (rule != StiffnessRule::uniform && !(L > 0.0)) {
+      // Every rule but the uniform one divides by the rest length (k ∝ 1/L or 1/L²).
+      throw InputError("stiffness rule " + to_string(rule) + ": the spring between nodes " +
+                       std::to_string(s.a) + " and " + std::to_string(s.b) +
+                       " has zero rest length (coincident nodes); expected distinct nodes");
+    }
     const auto it = measure.find(key(s.a, s.b));
     // Only structural and volume springs take their element measure: a shear spring on a grid
     // cell may or may not coincide with the diagonal the mesher cut the cell along, and both

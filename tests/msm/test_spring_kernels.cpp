@@ -120,3 +120,18 @@ TEST(SpringKernels, AxialDampingIsSeed000Eq34AndDissipates) {
   }
   EXPECT_LT((point_damping_force(Vec3(1, 2, 3), 0.5) - Vec3(-0.5, -1, -1.5)).norm(), 1e-15);
 }
+
+TEST(SpringKernels, ZeroRestLengthSpringAtCoincidentEndsHasHessianKTimesIdentityBlocks) {
+  // ½k|xa − xb|² has Hessian k[I −I; −I I] everywhere, including where xa = xb.
+  SpringLaw law;
+  law.k1 = 7.0;
+  const Vec3 x(0.1, -0.2, 0.3);
+  const Mat6 H = spring_hessian(x, x, 0.0, law, false);
+  Mat6 expected;
+  const Eigen::Matrix3d K = 7.0 * Eigen::Matrix3d::Identity();
+  expected << K, -K, -K, K;
+  EXPECT_LT((H - expected).norm(), 1e-12);
+  // Away from coincidence the general formula gives the same (transverse dψ/L = k).
+  const Mat6 H1 = spring_hessian(x, x + Vec3(1e-3, 2e-3, -1e-3), 0.0, law, false);
+  EXPECT_LT((H1 - expected).norm(), 1e-9);
+}

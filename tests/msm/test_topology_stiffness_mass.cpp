@@ -299,3 +299,27 @@ TEST(StiffnessRules, BothShearDiagonalsOfAGridCellGetTheSameStiffness) {
     EXPECT_NEAR(hi / lo, 1.0, 1e-9) << to_string(rule);
   }
 }
+
+TEST(StiffnessRules, CoincidentNodesAndLloydAtNuOneHalfAreRefusedNotNan) {
+  using namespace vessel::msm;
+  SpringNetwork net;
+  net.nodes = {Vec3(0, 0, 0), Vec3(1e-3, 0, 0), Vec3(0, 1e-3, 0), Vec3(0, 0, 1e-3)};
+  net.tets = {{0, 1, 2, 3}};
+  Spring s;
+  s.a = 0;
+  s.b = 1;
+  s.rest_length = 1e-3;
+  s.family = SpringFamily::volume;
+  net.springs = {s};
+  StiffnessParams p;
+  p.poisson_ratio = 0.5;
+  EXPECT_THROW(assign_stiffness(net, StiffnessRule::lloyd, p), vessel::InputError);
+  p.poisson_ratio = 0.3;
+  net.springs[0].rest_length = 0.0;
+  try {
+    assign_stiffness(net, StiffnessRule::seed001, p);
+    FAIL() << "a zero-length spring was accepted";
+  } catch (const vessel::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("zero rest length"), std::string::npos) << e.what();
+  }
+}
