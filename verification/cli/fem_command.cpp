@@ -42,8 +42,10 @@ struct FemCommandOptions {
   std::string bc = "auto";
   std::string solver = "auto";
   std::size_t direct_max_dofs = fem::SolverOptions{}.direct_max_dofs;
+  std::size_t direct_max_mixed_dofs = fem::SolverOptions{}.direct_max_mixed_dofs;
   double tolerance = fem::SolverOptions{}.cg_relative_tolerance;
   unsigned max_iterations = fem::SolverOptions{}.max_iterations;
+  unsigned gmres_restart = fem::SolverOptions{}.gmres_restart;
   int modes = 0;
   bool curved = false;
   bool transient = false;  // Newmark step response after the static solve
@@ -92,12 +94,15 @@ void run(FemCommandOptions& o) {
                     : o.formulation == "displacement" ? fem::Formulation::displacement
                                                       : fem::Formulation::automatic;
   opt.mixed_threshold = o.mixed_threshold;
-  opt.solver = o.solver == "direct"   ? fem::LinearSolver::direct
-               : o.solver == "cg-amg" ? fem::LinearSolver::cg_amg
-                                      : fem::LinearSolver::automatic;
+  opt.solver = o.solver == "direct"        ? fem::LinearSolver::direct
+               : o.solver == "cg-amg"      ? fem::LinearSolver::cg_amg
+               : o.solver == "gmres-block" ? fem::LinearSolver::gmres_block
+                                           : fem::LinearSolver::automatic;
   opt.direct_max_dofs = o.direct_max_dofs;
+  opt.direct_max_mixed_dofs = o.direct_max_mixed_dofs;
   opt.cg_relative_tolerance = o.tolerance;
   opt.max_iterations = o.max_iterations;
+  opt.gmres_restart = o.gmres_restart;
 
   bool has_pressure = false, has_contact = false, has_gravity = false;
   for (const auto& l : o.loads) {
@@ -171,6 +176,11 @@ void run(FemCommandOptions& o) {
   const auto& r = solver.solve();
   std::cout << " " << fem::to_string(r.solver);
   if (r.solver == fem::LinearSolver::cg_amg) std::cout << ", " << r.iterations << " CG iterations";
+  if (r.solver == fem::LinearSolver::gmres_block) {
+    std::cout << ", " << r.iterations << " FGMRES iterations (" << std::setprecision(3)
+              << r.inner_iterations << " CG iterations per pressure-mass solve)"
+              << std::setprecision(6);
+  }
   std::cout << "\n";
 
   Vec3 u_contact = Vec3::Zero();
@@ -324,7 +334,8 @@ void run(FemCommandOptions& o) {
         {"curved", r.curved},
         {"formulation", fem::to_string(r.formulation)},
         {"solver", fem::to_string(r.solver)},
-        {"cg_iterations", r.iterations},
+        {"cg_iterations", r.iterations},  // CG or FGMRES, by "solver"
+        {"inner_iterations", r.inner_iterations},
         {"dofs", r.n_dofs},
         {"pressure_dofs", r.n_pressure_dofs},
         {"max_displacement_mm", max_u * 1e3},
@@ -427,16 +438,26 @@ void add_fem_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "roller", "clamped", "clamped-inlet"}))
       ->capture_default_str();
   cmd->add_option("--solver", o->solver,
-                  "Linear solver: auto (direct up to --direct-max-dofs, else CG with algebraic "
-                  "multigrid), direct (CHOLMOD; UMFPACK for the mixed system), cg-amg (Trilinos ML)")
-      ->check(CLI::IsMember({"auto", "direct", "cg-amg"}))
+                  "Linear solver: auto (direct up to --direct-max-dofs / --direct-max-mixed-dofs, "
+                  "else iterative), direct (CHOLMOD; UMFPACK for the mixed system), cg-amg (CG "
+                  "with Trilinos ML AMG, displacement system), gmres-block (FGMRES with a "
+                  "block-triangular preconditioner: AMG on the displacement block, scaled "
+                  "pressure mass for the Schur complement; mixed system)")
+      ->check(CLI::IsMember({"auto", "direct", "cg-amg", "gmres-block"}))
       ->capture_default_str();
   cmd->add_option("--direct-max-dofs", o->direct_max_dofs,
                   "auto: direct solver up to this many DoFs")
       ->capture_default_str();
-  cmd->add_option("--tolerance", o->tolerance, "CG relative residual tolerance")
+  cmd->add_option("--direct-max-mixed-dofs", o->direct_max_mixed_dofs,
+                  "auto: direct solver (UMFPACK) for the mixed system up to this many DoFs")
       ->capture_default_str();
-  cmd->add_option("--max-iterations", o->max_iterations, "CG iteration limit")
+  cmd->add_option("--tolerance", o->tolerance, "CG / FGMRES relative residual tolerance")
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", o->max_iterations, "CG / FGMRES iteration limit")
+      ->capture_default_str();
+  cmd->add_option("--gmres-restart", o->gmres_restart,
+                  "gmres-block: Krylov basis size before FGMRES restarts (2 vectors each)")
+      ->check(CLI::Range(2u, 2000u))
       ->capture_default_str();
   cmd->add_flag("--curved", o->curved,
                 "Quadratic elements: put the P2 geometry nodes on the exact cylinders (straight "
