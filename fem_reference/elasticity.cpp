@@ -19,7 +19,9 @@
 #include <deal.II/grid/tria.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/precondition.h>
 #include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/solver_gmres.h>
 #include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/sparse_direct.h>
 #include <deal.II/lac/sparse_matrix.h>
@@ -76,6 +78,8 @@ std::string to_string(LinearSolver s) {
       return "direct";
     case LinearSolver::cg_amg:
       return "cg-amg";
+    case LinearSolver::gmres_block:
+      return "gmres-block";
   }
   return "?";
 }
@@ -323,6 +327,7 @@ struct ElasticitySolver::Impl {
                     Vec3* applied) const;
   void assemble();
   void solve_linear();
+  void solve_mixed_iterative();
   void postprocess();
 
   /// The FE displacement at x as Σ w · u[dof]: the element's shape functions at x, per DoF and
@@ -631,16 +636,294 @@ void ElasticitySolver::Impl::assemble() {
   result.applied_load = applied;
 }
 
+namespace {
+
+/// Trilinos ML smoothed-aggregation AMG for an elasticity matrix whose rows are the DoFs with
+/// support points `x` and displacement components `component`. All six rigid-body modes as ML's
+/// near-null space (smoothed aggregation for elasticity, Vaněk, Mandel & Brezina 1996):
+/// AdditionalData only passes constant modes, so the ML parameter list is filled first and the
+/// rotations are added as pre-computed vectors (`storage` must outlive `amg`). Without
+/// `rigid_body_modes`, only the three translations.
+void initialize_elasticity_amg(dl::TrilinosWrappers::PreconditionAMG& amg,
+                               const dl::TrilinosWrappers::SparseMatrix& matrix,
+                               const std::vector<dl::Point<kDim>>& x,
+                               const std::vector<unsigned>& component, bool higher_order,
+                               bool rigid_body_modes, std::vector<double>& storage) {
+  ensure_mpi_initialized();
+  dl::TrilinosWrappers::PreconditionAMG::AdditionalData data;
+  data.elliptic = true;
+  data.higher_order_elements = higher_order;
+  data.smoother_sweeps = 2;
+  data.aggregation_threshold = 0.02;
+  const std::size_t n = x.size();
+  if (!rigid_body_modes) {
+    data.constant_modes.assign(3, std::vector<bool>(n, false));
+    for (std::size_t d = 0; d < n; ++d) data.constant_modes[component[d]][d] = true;
+    amg.initialize(matrix, data);
+    return;
+  }
+  Teuchos::ParameterList ml;
+  std::unique_ptr<Epetra_MultiVector> unused;
+  data.set_parameters(ml, unused, matrix);
+  dl::Point<kDim> centre;
+  for (const auto& p : x) centre += p / static_cast<double>(n);
+  storage.assign(6 * n, 0.0);
+  for (std::size_t d = 0; d < n; ++d) {
+    const auto r = x[d] - centre;
+    const unsigned c = component[d];
+    storage[c * n + d] = 1.0;  // translation along c
+    // rotations ω × r about x, y, z: (0, −z, y), (z, 0, −x), (−y, x, 0)
+    const double rot[3][3] = {{0, -r[2], r[1]}, {r[2], 0, -r[0]}, {-r[1], r[0], 0}};
+    for (unsigned k = 0; k < 3; ++k) storage[(3 + k) * n + d] = rot[k][c];
+  }
+  ml.set("null space: type", "pre-computed");
+  ml.set("null space: dimension", 6);
+  ml.set("null space: vectors", storage.data());
+  amg.initialize(matrix, ml);
+}
+
+using Index = dl::types::global_dof_index;
+
+/// The rows and columns `rows` of `a` (renumbered 0..rows.size()−1 by `local`, −1 elsewhere).
+void extract_block(const dl::SparseMatrix<double>& a, const std::vector<Index>& rows,
+                   const std::vector<int>& local, dl::SparsityPattern& pattern,
+                   dl::SparseMatrix<double>& out) {
+  const auto m = static_cast<Index>(rows.size());
+  dl::DynamicSparsityPattern dsp(m, m);
+  for (Index i = 0; i < m; ++i) {
+    for (auto it = a.begin(rows[i]); it != a.end(rows[i]); ++it) {
+      const int j = local[it->column()];
+      if (j >= 0) dsp.add(i, static_cast<Index>(j));
+    }
+  }
+  pattern.copy_from(dsp);
+  out.reinit(pattern);
+  for (Index i = 0; i < m; ++i) {
+    for (auto it = a.begin(rows[i]); it != a.end(rows[i]); ++it) {
+      const int j = local[it->column()];
+      if (j >= 0) out.set(i, static_cast<Index>(j), it->value());
+    }
+  }
+}
+
+/// The mixed matrix with its pressure rows and columns scaled by ω (D K D, D = diag(1, ω)), so
+/// that the residual's displacement and pressure parts weigh alike in GMRES.
+class ScaledMixedOperator {
+ public:
+  ScaledMixedOperator(const dl::SparseMatrix<double>& k, const std::vector<bool>& is_pressure,
+                      double omega)
+      : k_(k), is_pressure_(is_pressure), omega_(omega), tmp_(k.m()) {}
+  void vmult(dl::Vector<double>& dst, const dl::Vector<double>& src) const {
+    tmp_ = src;
+    scale(tmp_);
+    k_.vmult(dst, tmp_);
+    scale(dst);
+  }
+  void scale(dl::Vector<double>& v) const {
+    for (Index i = 0; i < v.size(); ++i)
+      if (is_pressure_[i]) v(i) *= omega_;
+  }
+
+ private:
+  const dl::SparseMatrix<double>& k_;
+  const std::vector<bool>& is_pressure_;
+  double omega_;
+  mutable dl::Vector<double> tmp_;
+};
+
+/// Block upper-triangular preconditioner P = [Â  ωBᵀ; 0  −ω²Ŝ] for the scaled Taylor–Hood
+/// system [A  ωBᵀ; ωB  −ω²C] (step-22 / step-56 pattern): Â⁻¹ one AMG V-cycle on the
+/// displacement block, Ŝ⁻¹ a Jacobi-CG solve with Ŝ = (1/(2μ) + 1/λ) M_p. Inexact inner solves
+/// make P vary between applications: used with FGMRES.
+class BlockTriangularPreconditioner {
+ public:
+  BlockTriangularPreconditioner(const ScaledMixedOperator& op,
+                                const dl::TrilinosWrappers::PreconditionAMG& amg,
+                                const dl::SparseMatrix<double>& schur,
+                                const std::vector<Index>& u_dofs,
+                                const std::vector<Index>& p_dofs, double omega)
+      : op_(op), amg_(amg), schur_(schur), u_dofs_(u_dofs), p_dofs_(p_dofs), omega_(omega) {
+    jacobi_.initialize(schur_);
+    ru_.reinit(static_cast<Index>(u_dofs.size()));
+    xu_.reinit(static_cast<Index>(u_dofs.size()));
+    rp_.reinit(static_cast<Index>(p_dofs.size()));
+    xp_.reinit(static_cast<Index>(p_dofs.size()));
+  }
+  void vmult(dl::Vector<double>& dst, const dl::Vector<double>& src) const {
+    // p̃ = −(ω²Ŝ)⁻¹ r_p
+    for (Index i = 0; i < p_dofs_.size(); ++i) rp_(i) = src(p_dofs_[i]);
+    xp_ = 0.0;
+    if (rp_.l2_norm() > 0.0) {
+      dl::ReductionControl control(1000, 1e-300, 1e-6);
+      dl::SolverCG<dl::Vector<double>> cg(control);
+      cg.solve(schur_, xp_, rp_, jacobi_);
+      inner_iterations_ += control.last_step();
+    }
+    xp_ *= -1.0 / (omega_ * omega_);
+    // u = Â⁻¹ (r_u − ωBᵀ p̃): ωBᵀ p̃ is the displacement part of (D K D)[0; p̃].
+    full_.reinit(src.size());
+    for (Index i = 0; i < p_dofs_.size(); ++i) full_(p_dofs_[i]) = xp_(i);
+    product_.reinit(src.size());
+    op_.vmult(product_, full_);
+    for (Index i = 0; i < u_dofs_.size(); ++i) ru_(i) = src(u_dofs_[i]) - product_(u_dofs_[i]);
+    amg_.vmult(xu_, ru_);
+    for (Index i = 0; i < u_dofs_.size(); ++i) dst(u_dofs_[i]) = xu_(i);
+    for (Index i = 0; i < p_dofs_.size(); ++i) dst(p_dofs_[i]) = xp_(i);
+    ++applications_;
+  }
+  [[nodiscard]] double mean_inner_iterations() const {
+    return applications_ ? static_cast<double>(inner_iterations_) / static_cast<double>(applications_)
+                        : 0.0;
+  }
+
+ private:
+  const ScaledMixedOperator& op_;
+  const dl::TrilinosWrappers::PreconditionAMG& amg_;
+  const dl::SparseMatrix<double>& schur_;
+  const std::vector<Index>& u_dofs_;
+  const std::vector<Index>& p_dofs_;
+  double omega_;
+  dl::PreconditionJacobi<dl::SparseMatrix<double>> jacobi_;
+  mutable dl::Vector<double> ru_, xu_, rp_, xp_, full_, product_;
+  mutable unsigned long inner_iterations_ = 0;
+  mutable unsigned long applications_ = 0;
+};
+
+}  // namespace
+
+void ElasticitySolver::Impl::solve_mixed_iterative() {
+  const auto& o = problem.options;
+  const Index n = dof.n_dofs();
+  // DoF → component and support point; the displacement and pressure index lists.
+  std::vector<unsigned> component(n, 0);
+  {
+    std::vector<dl::types::global_dof_index> dofs(fe->n_dofs_per_cell());
+    for (const auto& cell : dof.active_cell_iterators()) {
+      cell->get_dof_indices(dofs);
+      for (unsigned i = 0; i < dofs.size(); ++i)
+        component[dofs[i]] = fe->system_to_component_index(i).first;
+    }
+  }
+  std::vector<Index> u_dofs, p_dofs;
+  std::vector<int> u_local(n, -1), p_local(n, -1);
+  std::vector<bool> is_pressure(n, false);
+  for (Index d = 0; d < n; ++d) {
+    if (component[d] < 3) {
+      u_local[d] = static_cast<int>(u_dofs.size());
+      u_dofs.push_back(d);
+    } else {
+      p_local[d] = static_cast<int>(p_dofs.size());
+      p_dofs.push_back(d);
+      is_pressure[d] = true;
+    }
+  }
+
+  // Displacement block A = ∫ 2μ ε:ε (with the constrained rows' diagonal) and its AMG.
+  dl::SparsityPattern a_pattern;
+  dl::SparseMatrix<double> a_block;
+  extract_block(matrix, u_dofs, u_local, a_pattern, a_block);
+  ensure_mpi_initialized();  // before any Trilinos object is made
+  dl::TrilinosWrappers::SparseMatrix a_trilinos;
+  a_trilinos.reinit(a_block);
+  std::vector<dl::Point<kDim>> x_all(n), x_u(u_dofs.size());
+  dl::DoFTools::map_dofs_to_support_points(*mapping, dof, x_all);
+  std::vector<unsigned> comp_u(u_dofs.size());
+  for (Index i = 0; i < u_dofs.size(); ++i) {
+    x_u[i] = x_all[u_dofs[i]];
+    comp_u[i] = component[u_dofs[i]];
+  }
+  dl::TrilinosWrappers::PreconditionAMG amg;
+  std::vector<double> modes_storage;
+  initialize_elasticity_amg(amg, a_trilinos, x_u, comp_u, true, o.amg_rigid_body_modes,
+                            modes_storage);
+
+  // Schur complement S = C + B A⁻¹ Bᵀ of [A Bᵀ; B −C] (C = M_p/λ, B = −∫ q div v): B A⁻¹ Bᵀ is
+  // spectrally equivalent to M_p/(2μ) for an inf-sup stable pair (Taylor–Hood), so
+  // Ŝ = (1/(2μ) + 1/λ) M_p is uniformly equivalent to S in λ and h (Klawonn 1998, SIAM J. Sci.
+  // Comput. 19:172, "Block-triangular preconditioners for saddle point problems with a penalty
+  // term"; Elman, Silvester & Wathen 2014, §4.2 for the Stokes limit λ → ∞).
+  const double inv_lambda = std::isinf(lambda) ? 0.0 : 1.0 / lambda;
+  const double schur_scale = 1.0 / (2.0 * mu) + inv_lambda;
+  const auto n_p = static_cast<Index>(p_dofs.size());
+  dl::DynamicSparsityPattern p_dsp(n_p, n_p);
+  const dl::FEValuesExtractors::Scalar pres(kDim);
+  dl::FEValues<kDim> fev(*mapping, *fe, cell_quadrature(2),
+                         dl::update_values | dl::update_JxW_values);
+  std::vector<dl::types::global_dof_index> dofs(fe->n_dofs_per_cell());
+  std::vector<unsigned> local_p;
+  for (const auto& cell : dof.active_cell_iterators()) {
+    cell->get_dof_indices(dofs);
+    for (auto i : dofs)
+      for (auto j : dofs)
+        if (p_local[i] >= 0 && p_local[j] >= 0) p_dsp.add(static_cast<Index>(p_local[i]), static_cast<Index>(p_local[j]));
+  }
+  dl::SparsityPattern p_pattern;
+  p_pattern.copy_from(p_dsp);
+  dl::SparseMatrix<double> schur(p_pattern);
+  for (const auto& cell : dof.active_cell_iterators()) {
+    fev.reinit(cell);
+    cell->get_dof_indices(dofs);
+    local_p.clear();
+    for (unsigned i = 0; i < dofs.size(); ++i)
+      if (p_local[dofs[i]] >= 0) local_p.push_back(i);
+    for (unsigned q = 0; q < fev.n_quadrature_points; ++q) {
+      const double w = schur_scale * fev.JxW(q);
+      for (unsigned i : local_p)
+        for (unsigned j : local_p)
+          schur.add(static_cast<Index>(p_local[dofs[i]]), static_cast<Index>(p_local[dofs[j]]),
+                    w * fev[pres].value(i, q) * fev[pres].value(j, q));
+    }
+  }
+
+  // ω² = mean diag(A) / mean diag(Ŝ): balances the two blocks of the scaled system.
+  double diag_a = 0.0, diag_s = 0.0;
+  for (Index i = 0; i < u_dofs.size(); ++i) diag_a += a_block.diag_element(i);
+  for (Index i = 0; i < p_dofs.size(); ++i) diag_s += schur.diag_element(i);
+  const double omega = std::sqrt((diag_a / static_cast<double>(u_dofs.size())) /
+                                 (diag_s / static_cast<double>(p_dofs.size())));
+  a_block.clear();
+
+  const ScaledMixedOperator op(matrix, is_pressure, omega);
+  const BlockTriangularPreconditioner prec(op, amg, schur, u_dofs, p_dofs, omega);
+  dl::Vector<double> b = rhs;
+  op.scale(b);
+  dl::Vector<double> y(n);
+  dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * b.l2_norm());
+  dl::SolverFGMRES<dl::Vector<double>> gmres(
+      control, dl::SolverFGMRES<dl::Vector<double>>::AdditionalData(o.gmres_restart));
+  try {
+    gmres.solve(op, y, b, prec);
+  } catch (const dl::SolverControl::NoConvergence& e) {
+    std::ostringstream m;
+    m << "FGMRES with the block preconditioner did not converge in " << e.last_step
+      << " iterations (residual " << e.last_residual << " of " << b.l2_norm()
+      << "); try --solver direct or more --max-iterations";
+    throw std::runtime_error(m.str());
+  }
+  op.scale(y);  // p = ω p̃
+  solution = y;
+  result.iterations = control.last_step();
+  result.inner_iterations = prec.mean_inner_iterations();
+}
+
 void ElasticitySolver::Impl::solve_linear() {
   const auto& o = problem.options;
   LinearSolver s = o.solver;
   if (s == LinearSolver::automatic) {
-    s = (mixed || dof.n_dofs() <= o.direct_max_dofs) ? LinearSolver::direct : LinearSolver::cg_amg;
+    const std::size_t limit = mixed ? o.direct_max_mixed_dofs : o.direct_max_dofs;
+    s = dof.n_dofs() <= limit ? LinearSolver::direct
+                              : (mixed ? LinearSolver::gmres_block : LinearSolver::cg_amg);
   }
   if (s == LinearSolver::cg_amg && mixed) {
     throw InputError(
         "solver cg-amg is for the symmetric positive definite displacement system; the mixed "
-        "(Taylor-Hood) system is indefinite: use the direct solver");
+        "(Taylor-Hood) system is indefinite: use gmres-block (block-preconditioned FGMRES) or "
+        "direct");
+  }
+  if (s == LinearSolver::gmres_block && !mixed) {
+    throw InputError(
+        "solver gmres-block is for the mixed (Taylor-Hood) system; the displacement system is "
+        "symmetric positive definite: use cg-amg or direct");
   }
   result.solver = s;
   if (rhs.l2_norm() == 0.0) {
@@ -648,10 +931,10 @@ void ElasticitySolver::Impl::solve_linear() {
   } else if (s == LinearSolver::direct && !mixed) {
     // CHOLMOD (supernodal Cholesky) for the SPD displacement system: the constraints keep K
     // symmetric with positive diagonal entries on constrained rows.
-    const std::size_t n = dof.n_dofs();
+    const Index n = dof.n_dofs();
     std::vector<Eigen::Triplet<double>> entries;
     entries.reserve(matrix.n_nonzero_elements());
-    for (std::size_t row = 0; row < n; ++row) {
+    for (Index row = 0; row < n; ++row) {
       for (auto it = matrix.begin(row); it != matrix.end(row); ++it) {
         if (it->value() != 0.0) {
           entries.emplace_back(static_cast<int>(row), static_cast<int>(it->column()), it->value());
@@ -668,54 +951,26 @@ void ElasticitySolver::Impl::solve_linear() {
     dl::SparseDirectUMFPACK direct;
     direct.initialize(matrix);
     direct.vmult(solution, rhs);
+  } else if (s == LinearSolver::gmres_block) {
+    solve_mixed_iterative();
   } else {
-    ensure_mpi_initialized();
+    ensure_mpi_initialized();  // before any Trilinos object is made
     dl::TrilinosWrappers::PreconditionAMG amg;
-    dl::TrilinosWrappers::PreconditionAMG::AdditionalData data;
-    data.elliptic = true;
-    data.higher_order_elements = degree > 1;
-    data.smoother_sweeps = 2;
-    data.aggregation_threshold = 0.02;
     dl::TrilinosWrappers::SparseMatrix trilinos_matrix;
-    std::vector<double> rigid_modes;  // must outlive amg.initialize
-    if (o.amg_rigid_body_modes) {
-      // All six rigid-body modes as ML's near-null space (smoothed aggregation for elasticity,
-      // Vaněk, Mandel & Brezina 1996): AdditionalData only passes constant modes, so the ML
-      // parameter list is filled first and the rotations are added as pre-computed vectors.
-      trilinos_matrix.reinit(matrix);
-      Teuchos::ParameterList ml;
-      std::unique_ptr<Epetra_MultiVector> unused;
-      data.set_parameters(ml, unused, trilinos_matrix);
-      const std::size_t n = dof.n_dofs();
-      std::vector<dl::Point<kDim>> x(n);
-      dl::DoFTools::map_dofs_to_support_points(*mapping, dof, x);
-      dl::Point<kDim> centre;
-      for (const auto& p : x) centre += p / static_cast<double>(n);
-      std::vector<unsigned> component(n, 0);
-      std::vector<dl::types::global_dof_index> dofs(fe->n_dofs_per_cell());
-      for (const auto& cell : dof.active_cell_iterators()) {
-        cell->get_dof_indices(dofs);
-        for (unsigned i = 0; i < dofs.size(); ++i)
-          component[dofs[i]] = fe->system_to_component_index(i).first;
-      }
-      rigid_modes.assign(6 * n, 0.0);
-      for (std::size_t d = 0; d < n; ++d) {
-        const auto r = x[d] - centre;
-        const unsigned c = component[d];
-        rigid_modes[c * n + d] = 1.0;  // translation along c
-        // rotations ω × r about x, y, z: (0, −z, y), (z, 0, −x), (−y, x, 0)
-        const double rot[3][3] = {{0, -r[2], r[1]}, {r[2], 0, -r[0]}, {-r[1], r[0], 0}};
-        for (unsigned k = 0; k < 3; ++k) rigid_modes[(3 + k) * n + d] = rot[k][c];
-      }
-      ml.set("null space: type", "pre-computed");
-      ml.set("null space: dimension", 6);
-      ml.set("null space: vectors", rigid_modes.data());
-      amg.initialize(trilinos_matrix, ml);
-    } else {
-      dl::DoFTools::extract_constant_modes(
-          dof, fe->component_mask(dl::FEValuesExtractors::Vector(0)), data.constant_modes);
-      amg.initialize(matrix, data);
+    trilinos_matrix.reinit(matrix);
+    const std::size_t n = dof.n_dofs();
+    std::vector<dl::Point<kDim>> x(n);
+    dl::DoFTools::map_dofs_to_support_points(*mapping, dof, x);
+    std::vector<unsigned> component(n, 0);
+    std::vector<dl::types::global_dof_index> dofs(fe->n_dofs_per_cell());
+    for (const auto& cell : dof.active_cell_iterators()) {
+      cell->get_dof_indices(dofs);
+      for (unsigned i = 0; i < dofs.size(); ++i)
+        component[dofs[i]] = fe->system_to_component_index(i).first;
     }
+    std::vector<double> modes_storage;  // must outlive amg
+    initialize_elasticity_amg(amg, trilinos_matrix, x, component, degree > 1,
+                              o.amg_rigid_body_modes, modes_storage);
     dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs.l2_norm());
     dl::SolverCG<dl::Vector<double>> cg(control);
     try {
@@ -1062,11 +1317,11 @@ ElasticitySolver::Impl::FreeSystem ElasticitySolver::Impl::assemble_free_system(
     constraints.distribute_local_to_global(m, dofs, md);
   }
   FreeSystem out;
-  const std::size_t n_all = dof.n_dofs();
+  const Index n_all = dof.n_dofs();
   out.free_index.assign(n_all, -1);
   out.constrained_value.assign(n_all, 0.0);
   int n_free = 0;
-  for (std::size_t d = 0; d < n_all; ++d) {
+  for (Index d = 0; d < n_all; ++d) {
     if (!constraints.is_constrained(d)) {
       out.free_index[d] = n_free++;
       continue;
@@ -1081,7 +1336,7 @@ ElasticitySolver::Impl::FreeSystem ElasticitySolver::Impl::assemble_free_system(
   auto to_eigen = [&](const dl::SparseMatrix<double>& a) {
     std::vector<Eigen::Triplet<double>> t;
     t.reserve(a.n_nonzero_elements());
-    for (std::size_t row = 0; row < n_all; ++row) {
+    for (Index row = 0; row < n_all; ++row) {
       const int fr = out.free_index[row];
       if (fr < 0) continue;
       for (auto it = a.begin(row); it != a.end(row); ++it) {
@@ -1097,7 +1352,7 @@ ElasticitySolver::Impl::FreeSystem ElasticitySolver::Impl::assemble_free_system(
   kd.clear();
   if (with_mass) out.M = to_eigen(md);
   out.f.resize(n_free);
-  for (std::size_t d = 0; d < n_all; ++d) {
+  for (Index d = 0; d < n_all; ++d) {
     if (out.free_index[d] >= 0) out.f[out.free_index[d]] = fd(d);
   }
   return out;

@@ -28,7 +28,9 @@ struct Material {
 
 /// Displacement-only (P1 or P2) or mixed displacement–pressure (Taylor–Hood P2–P1).
 enum class Formulation { automatic, displacement, mixed };
-enum class LinearSolver { automatic, direct, cg_amg };
+/// direct: CHOLMOD (displacement) or UMFPACK (mixed); cg_amg: CG with AMG (displacement only);
+/// gmres_block: FGMRES with a block-triangular AMG / pressure-mass preconditioner (mixed only).
+enum class LinearSolver { automatic, direct, cg_amg, gmres_block };
 
 /// A Dirichlet condition on the nodes of a boundary group (a dim-2 physical group).
 struct DirichletCondition {
@@ -87,10 +89,14 @@ struct SolverOptions {
   /// 11.3 s vs AMG 18.3 s (91 iterations). Above ~250k DoFs the factor's memory grows faster
   /// than AMG's.
   std::size_t direct_max_dofs = 250000;
+  /// automatic, mixed system: UMFPACK at or below this many DoFs, else gmres_block.
+  std::size_t direct_max_mixed_dofs = 100000;
   /// CG-AMG: give ML all six rigid-body modes (translations and rotations) as near-null space;
   /// false: only the three translations (deal.II's AdditionalData::constant_modes).
   bool amg_rigid_body_modes = true;
-  double cg_relative_tolerance = 1e-10;  ///< ‖r‖ ≤ tol·‖b‖ for CG
+  double cg_relative_tolerance = 1e-10;  ///< ‖r‖ ≤ tol·‖b‖ for CG and FGMRES
+  /// gmres_block: Krylov basis size before FGMRES restarts (memory: 2 × this many vectors).
+  unsigned gmres_restart = 100;
   unsigned max_iterations = 5000;
 };
 
@@ -128,7 +134,8 @@ struct ElasticityResult {
   bool curved = false;  ///< quadratic geometry on the curved surfaces
   Formulation formulation = Formulation::displacement;  ///< the one used
   LinearSolver solver = LinearSolver::direct;           ///< the one used
-  unsigned iterations = 0;                              ///< CG iterations (0 for direct)
+  unsigned iterations = 0;  ///< CG or FGMRES iterations (0 for direct)
+  double inner_iterations = 0.0;  ///< gmres_block: mean CG iterations per pressure-mass solve
   std::size_t n_dofs = 0;
   std::size_t n_pressure_dofs = 0;       ///< mixed only
   std::vector<Vec3> nodal_displacement;  ///< at every TetMesh node, m

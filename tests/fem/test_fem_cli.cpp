@@ -116,3 +116,22 @@ TEST(FemCli, TransientRefusesABadTimeStepAndWritesNothing) {
   EXPECT_TRUE(contains(r.output, "time step")) << r.output;
   EXPECT_FALSE(std::filesystem::exists(csv));
 }
+
+TEST(FemCli, RichardsonSolvesOneLevelCoarserAndExtrapolates) {
+  TempDir dir;
+  const auto r = vv("fem " + kTube + "--level 1 --richardson --json " + (dir / "r.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "GCI")) << r.output;
+  const auto j = nlohmann::json::parse(vessel::test::read_text(dir / "r.json"))["richardson"];
+  EXPECT_EQ(j["coarse_level"], 0);
+  // u_ext = u1 + (u1 − u2)/(2^p − 1) with p = 2 (Richardson 1911), recomputed by hand.
+  const double u1 = j["u_fine_mm"], u2 = j["u_coarse_mm"];
+  EXPECT_NEAR(j["extrapolated_mm"].get<double>(), u1 + (u1 - u2) / 3.0, 1e-12 * std::abs(u1));
+  EXPECT_NEAR(j["error_fine_mm"].get<double>(), std::abs(u1 - u2) / 3.0, 1e-12 * std::abs(u1));
+}
+
+TEST(FemCli, RichardsonNeedsALevelToCoarsen) {
+  const auto r = vv("fem " + kTube + "--level 0 --richardson");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "--level >= 1")) << r.output;
+}

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "fem_reference/convergence.hpp"
 #include "fem_reference/elasticity.hpp"
 #include "fem_reference/lame.hpp"
 #include "meshes/atomic_file.hpp"
@@ -42,8 +43,10 @@ struct FemCommandOptions {
   std::string bc = "auto";
   std::string solver = "auto";
   std::size_t direct_max_dofs = fem::SolverOptions{}.direct_max_dofs;
+  std::size_t direct_max_mixed_dofs = fem::SolverOptions{}.direct_max_mixed_dofs;
   double tolerance = fem::SolverOptions{}.cg_relative_tolerance;
   unsigned max_iterations = fem::SolverOptions{}.max_iterations;
+  unsigned gmres_restart = fem::SolverOptions{}.gmres_restart;
   int modes = 0;
   bool curved = false;
   bool transient = false;  // Newmark step response after the static solve
@@ -51,6 +54,8 @@ struct FemCommandOptions {
   int steps = fem::TransientOptions{}.steps;
   double mass_damping = 0.0;
   fs::path history_csv;
+  bool richardson = false;  // also solve level − 1: Richardson / GCI of the contact-point u
+  double richardson_order = 2.0;
   fs::path vtu;
   fs::path json;
 };
@@ -77,6 +82,10 @@ nlohmann::json json_vec(const Vec3& v, double scale) {
 }
 
 void run(FemCommandOptions& o) {
+  if (o.richardson && o.vessel.params.level < 1) {
+    throw InputError("--richardson also solves one level coarser: it needs --level >= 1, found " +
+                     std::to_string(o.vessel.params.level));
+  }
   auto t0 = Clock::now();
   MeshSource source;
   const TetMesh mesh = mesh_vessel(o.vessel, std::cout, &source);
@@ -92,12 +101,15 @@ void run(FemCommandOptions& o) {
                     : o.formulation == "displacement" ? fem::Formulation::displacement
                                                       : fem::Formulation::automatic;
   opt.mixed_threshold = o.mixed_threshold;
-  opt.solver = o.solver == "direct"   ? fem::LinearSolver::direct
-               : o.solver == "cg-amg" ? fem::LinearSolver::cg_amg
-                                      : fem::LinearSolver::automatic;
+  opt.solver = o.solver == "direct"        ? fem::LinearSolver::direct
+               : o.solver == "cg-amg"      ? fem::LinearSolver::cg_amg
+               : o.solver == "gmres-block" ? fem::LinearSolver::gmres_block
+                                           : fem::LinearSolver::automatic;
   opt.direct_max_dofs = o.direct_max_dofs;
+  opt.direct_max_mixed_dofs = o.direct_max_mixed_dofs;
   opt.cg_relative_tolerance = o.tolerance;
   opt.max_iterations = o.max_iterations;
+  opt.gmres_restart = o.gmres_restart;
 
   bool has_pressure = false, has_contact = false, has_gravity = false;
   for (const auto& l : o.loads) {
@@ -118,13 +130,13 @@ void run(FemCommandOptions& o) {
                         : Vec3(0.0, params.bend_radius + params.outer_radius(), 0.0);
   }
   TractionPatch patch;
+  ContactPatchSpec spec;
+  spec.point = contact_point;
+  spec.radius = o.contact_radius;
+  spec.force = o.force;
+  spec.surface_group = o.contact_surface;
   if (has_pressure) problem.pressures.push_back({std::string(group_names::inner_wall), o.pressure});
   if (has_contact) {
-    ContactPatchSpec spec;
-    spec.point = contact_point;
-    spec.radius = o.contact_radius;
-    spec.force = o.force;
-    spec.surface_group = o.contact_surface;
     patch = contact_patch(mesh, spec);
     problem.patches.push_back(patch);
     std::cout << "contact patch: " << patch.triangles.size() << " triangles of '"
@@ -171,6 +183,11 @@ void run(FemCommandOptions& o) {
   const auto& r = solver.solve();
   std::cout << " " << fem::to_string(r.solver);
   if (r.solver == fem::LinearSolver::cg_amg) std::cout << ", " << r.iterations << " CG iterations";
+  if (r.solver == fem::LinearSolver::gmres_block) {
+    std::cout << ", " << r.iterations << " FGMRES iterations (" << std::setprecision(3)
+              << r.inner_iterations << " CG iterations per pressure-mass solve)"
+              << std::setprecision(6);
+  }
   std::cout << "\n";
 
   Vec3 u_contact = Vec3::Zero();
@@ -178,6 +195,55 @@ void run(FemCommandOptions& o) {
   if (have_contact_u) u_contact = solver.displacement_at({contact_point})[0];
   double max_u = 0.0;
   for (const auto& u : r.nodal_displacement) max_u = std::max(max_u, u.norm());
+
+  // The reference's own uncertainty at the contact point: the same problem one level coarser,
+  // Richardson extrapolation and GCI (fem_reference/convergence.hpp; Roache 1998, §5.6).
+  nlohmann::json richardson_json;
+  if (o.richardson) {
+    VesselOptions coarse_options = o.vessel;
+    coarse_options.params.level -= 1;
+    std::cout << "richardson: the same problem on level " << coarse_options.params.level << "\n";
+    const TetMesh coarse_mesh = mesh_vessel(coarse_options, std::cout);
+    fem::ElasticityProblem coarse_problem = problem;
+    if (has_contact) {
+      // The patch is the triangles whose centroids lie within the radius: on another mesh it
+      // covers a different area (same total force), part of what the estimate measures.
+      coarse_problem.patches = {contact_patch(coarse_mesh, spec)};
+      std::cout << "  coarse contact patch: " << coarse_problem.patches[0].triangles.size()
+                << " triangles, area " << coarse_problem.patches[0].area * 1e6 << " mm² (fine "
+                << patch.area * 1e6 << " mm²)\n";
+    }
+    fem::ElasticitySolver coarse(coarse_mesh, coarse_problem);
+    const auto& rc = coarse.solve();
+    // The contact point lies on the exact inner cylinder: allow the chord's sagitta.
+    constexpr double kTolerance = 0.25;
+    const Vec3 u_fine = solver.displacement_at({contact_point}, kTolerance)[0];
+    const Vec3 u_coarse = coarse.displacement_at({contact_point}, kTolerance)[0];
+    const Vec3 dir = has_contact ? Vec3(-patch.outward_normal)
+                                 : Vec3(Vec3(contact_point.x(), contact_point.y(), 0).normalized());
+    const double f1 = u_fine.dot(dir), f2 = u_coarse.dot(dir);
+    // Assumed (not observed) order: Roache's safety factor 3.
+    const auto est = fem::richardson(f2, f1, o.richardson_order, 2.0, 3.0);
+    std::cout << std::setprecision(6) << "  u at contact point along (" << dir.x() << ", "
+              << dir.y() << ", " << dir.z() << "): level " << coarse_options.params.level << " ("
+              << rc.n_dofs << " DoFs, " << fem::to_string(rc.solver) << ", solve "
+              << rc.timings.solve << " s) " << f2 * 1e3 << " mm, level " << o.vessel.params.level
+              << " " << f1 * 1e3 << " mm\n"
+              << "  Richardson (order " << o.richardson_order << ", ratio 2): extrapolated "
+              << est.extrapolated * 1e3 << " mm, estimated error of level "
+              << o.vessel.params.level << " " << est.error_fine * 1e3 << " mm ("
+              << 100.0 * est.error_fine / std::abs(f1) << " %), GCI " << 100.0 * est.gci_fine
+              << " % (safety factor 3)\n";
+    richardson_json = {{"coarse_level", coarse_options.params.level},
+                       {"coarse_dofs", rc.n_dofs},
+                       {"order", o.richardson_order},
+                       {"direction", json_vec(dir, 1.0)},
+                       {"u_coarse_mm", f2 * 1e3},
+                       {"u_fine_mm", f1 * 1e3},
+                       {"extrapolated_mm", est.extrapolated * 1e3},
+                       {"error_fine_mm", est.error_fine * 1e3},
+                       {"gci_fine", est.gci_fine}};
+  }
 
   fem::ModalResult modal;
   if (o.modes > 0) {
@@ -324,7 +390,8 @@ void run(FemCommandOptions& o) {
         {"curved", r.curved},
         {"formulation", fem::to_string(r.formulation)},
         {"solver", fem::to_string(r.solver)},
-        {"cg_iterations", r.iterations},
+        {"cg_iterations", r.iterations},  // CG or FGMRES, by "solver"
+        {"inner_iterations", r.inner_iterations},
         {"dofs", r.n_dofs},
         {"pressure_dofs", r.n_pressure_dofs},
         {"max_displacement_mm", max_u * 1e3},
@@ -346,6 +413,7 @@ void run(FemCommandOptions& o) {
                     {"dofs", modal.n_dofs},
                     {"seconds", modal.seconds}};
     }
+    if (o.richardson) j["richardson"] = richardson_json;
     if (o.transient) {
       j["transient"] = {{"dt_s", o.dt},
                         {"steps", o.steps},
@@ -427,16 +495,26 @@ void add_fem_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "roller", "clamped", "clamped-inlet"}))
       ->capture_default_str();
   cmd->add_option("--solver", o->solver,
-                  "Linear solver: auto (direct up to --direct-max-dofs, else CG with algebraic "
-                  "multigrid), direct (CHOLMOD; UMFPACK for the mixed system), cg-amg (Trilinos ML)")
-      ->check(CLI::IsMember({"auto", "direct", "cg-amg"}))
+                  "Linear solver: auto (direct up to --direct-max-dofs / --direct-max-mixed-dofs, "
+                  "else iterative), direct (CHOLMOD; UMFPACK for the mixed system), cg-amg (CG "
+                  "with Trilinos ML AMG, displacement system), gmres-block (FGMRES with a "
+                  "block-triangular preconditioner: AMG on the displacement block, scaled "
+                  "pressure mass for the Schur complement; mixed system)")
+      ->check(CLI::IsMember({"auto", "direct", "cg-amg", "gmres-block"}))
       ->capture_default_str();
   cmd->add_option("--direct-max-dofs", o->direct_max_dofs,
                   "auto: direct solver up to this many DoFs")
       ->capture_default_str();
-  cmd->add_option("--tolerance", o->tolerance, "CG relative residual tolerance")
+  cmd->add_option("--direct-max-mixed-dofs", o->direct_max_mixed_dofs,
+                  "auto: direct solver (UMFPACK) for the mixed system up to this many DoFs")
       ->capture_default_str();
-  cmd->add_option("--max-iterations", o->max_iterations, "CG iteration limit")
+  cmd->add_option("--tolerance", o->tolerance, "CG / FGMRES relative residual tolerance")
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", o->max_iterations, "CG / FGMRES iteration limit")
+      ->capture_default_str();
+  cmd->add_option("--gmres-restart", o->gmres_restart,
+                  "gmres-block: Krylov basis size before FGMRES restarts (2 vectors each)")
+      ->check(CLI::Range(2u, 2000u))
       ->capture_default_str();
   cmd->add_flag("--curved", o->curved,
                 "Quadratic elements: put the P2 geometry nodes on the exact cylinders (straight "
@@ -445,6 +523,14 @@ void add_fem_command(CLI::App& app) {
                   "Also compute this many lowest natural frequencies and mode shapes (consistent "
                   "mass, on the same end conditions; e.g. 10)")
       ->check(CLI::Range(0, 100));
+  cmd->add_flag("--richardson", o->richardson,
+                "Also solve one level coarser (--level >= 1) and print the Richardson "
+                "extrapolation and grid convergence index of the contact point's displacement "
+                "(the reference's own discretisation uncertainty)");
+  cmd->add_option("--richardson-order", o->richardson_order,
+                  "Assumed convergence order for --richardson (2 is conservative for P1 and P2)")
+      ->check(CLI::Range(0.5, 6.0))
+      ->capture_default_str();
   cmd->add_flag("--transient", o->transient,
                 "Also run the step response: the loads applied at t = 0 to the body at rest, "
                 "Newmark average acceleration with the consistent mass; prints the contact "
