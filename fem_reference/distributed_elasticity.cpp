@@ -69,8 +69,7 @@ MpiSession::MpiSession() : impl_(std::make_unique<Impl>()) {
     throw std::logic_error("MpiSession: MPI is already initialised in this process");
   }
   // One thread per rank: the ranks are the parallelism (the machines have few cores).
-  impl_->mpi =
-      std::make_unique<dl::Utilities::MPI::MPI_InitFinalize>(impl_->argc, impl_->argv, 1);
+  impl_->mpi = std::make_unique<dl::Utilities::MPI::MPI_InitFinalize>(impl_->argc, impl_->argv, 1);
 }
 
 MpiSession::~MpiSession() = default;
@@ -339,9 +338,7 @@ class Distributed {
   void solve_linear();
   void postprocess();
   std::vector<Vec3> evaluate(const std::vector<Vec3>& points) const;
-  [[nodiscard]] double max_over_ranks(double v) const {
-    return dl::Utilities::MPI::max(v, comm_);
-  }
+  [[nodiscard]] double max_over_ranks(double v) const { return dl::Utilities::MPI::max(v, comm_); }
 
   const TetMesh& mesh_;
   const ElasticityProblem& problem_;
@@ -382,7 +379,8 @@ void Distributed::build_triangulation() {
     for (const auto& x : mesh_.nodes) vertices.emplace_back(x.x(), x.y(), x.z());
     std::vector<dl::CellData<kDim>> cells(mesh_.tets.size(), dl::CellData<kDim>(4));
     for (std::size_t t = 0; t < mesh_.tets.size(); ++t) {
-      for (unsigned v = 0; v < 4; ++v) cells[t].vertices[v] = static_cast<unsigned>(mesh_.tets[t][v]);
+      for (unsigned v = 0; v < 4; ++v)
+        cells[t].vertices[v] = static_cast<unsigned>(mesh_.tets[t][v]);
     }
     serial.create_triangulation(vertices, cells, dl::SubCellData());
     dl::GridTools::partition_triangulation(n_ranks_, serial);
@@ -676,9 +674,9 @@ void Distributed::solve_linear() {
       cg.solve(matrix_, solution_, rhs_, amg);
     } catch (const dl::SolverControl::NoConvergence& e) {
       std::ostringstream m;
-      m << "distributed CG with AMG did not converge in " << e.last_step
-        << " iterations (residual " << e.last_residual << ", target "
-        << o.cg_relative_tolerance * rhs_norm << "): raise --max-iterations or --tolerance";
+      m << "distributed CG with AMG did not converge in " << e.last_step << " iterations (residual "
+        << e.last_residual << ", target " << o.cg_relative_tolerance * rhs_norm
+        << "): raise --max-iterations or --tolerance";
       throw std::runtime_error(m.str());
     }
     out_.fem.iterations = control.last_step();
@@ -715,7 +713,8 @@ void Distributed::postprocess() {
   if (rank_ == 0) {
     r.nodal_displacement.assign(mesh_.nodes.size(), Vec3::Zero());
     for (std::size_t i = 0; i + 4 <= all.size(); i += 4) {
-      r.nodal_displacement[static_cast<std::size_t>(all[i])] = Vec3(all[i + 1], all[i + 2], all[i + 3]);
+      r.nodal_displacement[static_cast<std::size_t>(all[i])] =
+          Vec3(all[i + 1], all[i + 2], all[i + 3]);
     }
   }
 
@@ -824,7 +823,8 @@ std::vector<Vec3> Distributed::evaluate(const std::vector<Vec3>& points) const {
     }
     Vec3 u = Vec3::Zero();
     if (global.rank == static_cast<int>(rank_)) {
-      const auto ref = mapping_.transform_real_to_unit_cell(best_cell, dl::Point<kDim>(x.x(), x.y(), x.z()));
+      const auto ref =
+          mapping_.transform_real_to_unit_cell(best_cell, dl::Point<kDim>(x.x(), x.y(), x.z()));
       best_cell->get_dof_indices(dofs);
       for (unsigned i = 0; i < n; ++i) {
         const unsigned c = fe_->system_to_component_index(i).first;
@@ -851,7 +851,8 @@ DistributedResult Distributed::run(const std::vector<Vec3>& points) {
   std::size_t owned_cells = 0;
   for (const auto& cell : tria_.active_cell_iterators()) owned_cells += cell->is_locally_owned();
   const auto cells = dl::Utilities::MPI::all_gather(comm_, owned_cells);
-  const auto dofs = dl::Utilities::MPI::all_gather(comm_, static_cast<std::size_t>(owned_.n_elements()));
+  const auto dofs =
+      dl::Utilities::MPI::all_gather(comm_, static_cast<std::size_t>(owned_.n_elements()));
   out_.cells_per_rank.assign(cells.begin(), cells.end());
   out_.dofs_per_rank.assign(dofs.begin(), dofs.end());
 
@@ -876,7 +877,8 @@ DistributedResult solve_elasticity_distributed(const TetMesh& mesh,
   int initialized = 0;
   MPI_Initialized(&initialized);
   if (!initialized) {
-    throw std::logic_error("solve_elasticity_distributed needs MPI: create a fem::MpiSession first");
+    throw std::logic_error(
+        "solve_elasticity_distributed needs MPI: create a fem::MpiSession first");
   }
   validate(mesh, problem);
   Distributed solver(mesh, problem, options.self_only ? MPI_COMM_SELF : MPI_COMM_WORLD);

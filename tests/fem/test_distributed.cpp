@@ -126,8 +126,8 @@ void check_against_serial(Load load, int degree) {
   // Force scale: the net load, or the pressure's |p|·A when it cancels over the closed wall.
   double load_scale = s.applied_load.norm();
   for (const auto& pr : problem.pressures) {
-    load_scale = std::max(load_scale, std::abs(pr.pressure) *
-                                          group_area(mesh, mesh.require_group(pr.group, 2, "")));
+    load_scale = std::max(
+        load_scale, std::abs(pr.pressure) * group_area(mesh, mesh.require_group(pr.group, 2, "")));
   }
   for (const DistributedResult* d : {&all, &one}) {
     SCOPED_TRACE(std::to_string(d->n_ranks) + " rank(s)");
@@ -147,13 +147,13 @@ void check_against_serial(Load load, int degree) {
     ASSERT_EQ(r.reactions.size(), s.reactions.size());
     for (std::size_t g = 0; g < s.reactions.size(); ++g) {
       EXPECT_EQ(r.reactions[g].group, s.reactions[g].group);
-      EXPECT_LT((r.reactions[g].force - s.reactions[g].force).norm(),
-                kAgreement * load_scale)
+      EXPECT_LT((r.reactions[g].force - s.reactions[g].force).norm(), kAgreement * load_scale)
           << r.reactions[g].group;
     }
   }
   // One rank against all ranks: the same field to solver tolerance.
-  const double diff = max_relative_difference(all.fem.nodal_displacement, one.fem.nodal_displacement);
+  const double diff =
+      max_relative_difference(all.fem.nodal_displacement, one.fem.nodal_displacement);
   std::printf("1 vs %d ranks: max |u_1 - u_n| / max |u_1| = %.3g\n", all.n_ranks, diff);
   EXPECT_LT(diff, kAgreement);
 }

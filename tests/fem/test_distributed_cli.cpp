@@ -44,11 +44,11 @@ const std::string kTube = "--structured --length 0.004 --no-cache ";
 TEST(FemDistributedCli, TwoRanksMatchTheSerialDirectSolveAndPrintOnce) {
   TempDir dir;
   const std::string load = "--degree 2 --load contact --contact-radius 1e-3 --tolerance 1e-13 ";
-  const auto serial = vv("fem " + kTube + load + "--solver direct --json " +
-                         (dir / "serial.json").string());
+  const auto serial =
+      vv("fem " + kTube + load + "--solver direct --json " + (dir / "serial.json").string());
   ASSERT_EQ(serial.exit_code, 0) << serial.output;
-  const auto mpi = mpi_vv(2, "fem " + kTube + load + "--distributed --json " +
-                                 (dir / "mpi.json").string());
+  const auto mpi =
+      mpi_vv(2, "fem " + kTube + load + "--distributed --json " + (dir / "mpi.json").string());
   ASSERT_EQ(mpi.exit_code, 0) << mpi.output;
   EXPECT_EQ(count(mpi.output, "element P2:"), 1u) << mpi.output;  // rank 0 alone prints
   EXPECT_TRUE(contains(mpi.output, "2 MPI rank(s)")) << mpi.output;

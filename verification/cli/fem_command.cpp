@@ -382,10 +382,9 @@ void run_distributed(const FemCommandOptions& o, const TetMesh& mesh,
   std::cout << "  |applied + reactions|   " << (r.applied_load + reaction_sum).norm() * 1e3
             << " mN (equilibrium)\n";
   std::cout << std::fixed << std::setprecision(3) << "timings (s, slowest rank): mesh "
-            << mesh_seconds << ", setup " << r.timings.setup << ", assembly "
-            << r.timings.assembly << ", solve " << r.timings.solve << ", postprocess "
-            << r.timings.postprocess << ", output " << output_seconds << std::defaultfloat
-            << "\n";
+            << mesh_seconds << ", setup " << r.timings.setup << ", assembly " << r.timings.assembly
+            << ", solve " << r.timings.solve << ", postprocess " << r.timings.postprocess
+            << ", output " << output_seconds << std::defaultfloat << "\n";
   if (!o.vtu.empty()) std::cout << "wrote " << o.vtu.string() << "\n";
 
   if (!o.json.empty() && !r.nodal_displacement.empty()) {  // rank 0 only
@@ -397,7 +396,8 @@ void run_distributed(const FemCommandOptions& o, const TetMesh& mesh,
         {"schema_version", 1},
         {"units", {{"length", "mm"}, {"force", "mN"}, {"energy", "mJ"}, {"time", "s"}}},
         {"vessel", describe(o.vessel.params)},
-        {"mesh", {{"nodes", mesh.nodes.size()}, {"tets", mesh.tets.size()}, {"cache_hit", cache_hit}}},
+        {"mesh",
+         {{"nodes", mesh.nodes.size()}, {"tets", mesh.tets.size()}, {"cache_hit", cache_hit}}},
         {"material",
          {{"E_Pa", o.youngs_modulus}, {"nu", o.poisson_ratio}, {"density_kg_m3", o.density}}},
         {"loads", o.loads},
@@ -514,11 +514,12 @@ void add_fem_command(CLI::App& app) {
                   "Also compute this many lowest natural frequencies and mode shapes (consistent "
                   "mass, on the same end conditions; e.g. 10)")
       ->check(CLI::Range(0, 100));
-  cmd->add_flag("--distributed", o->distributed,
-                "Solve in parallel over the MPI ranks (run under 'mpirun -np N'): fully distributed "
-                "mesh, Trilinos CG with ML AMG; P1/P2 displacement formulation only (no mixed, "
-                "--curved or --modes). Rank 0 prints and writes the files; --vtu gets the nodal "
-                "displacement only");
+  cmd->add_flag(
+      "--distributed", o->distributed,
+      "Solve in parallel over the MPI ranks (run under 'mpirun -np N'): fully distributed "
+      "mesh, Trilinos CG with ML AMG; P1/P2 displacement formulation only (no mixed, "
+      "--curved or --modes). Rank 0 prints and writes the files; --vtu gets the nodal "
+      "displacement only");
   cmd->add_option("--vtu", o->vtu,
                   "Write displacement and mode shapes (nodes), strain and stress (tets) as VTU");
   cmd->add_option("--json", o->json, "Write a JSON summary");
