@@ -13,6 +13,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libspectra-dev
+  openmpi-bin                             # mpirun: fem --distributed and its tests
   python3-matplotlib python3-numpy        # reports (use /usr/bin/python3)
   "$@"
 )

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "fem_reference/convergence.hpp"
+#include "fem_reference/distributed_elasticity.hpp"
 #include "fem_reference/elasticity.hpp"
 #include "fem_reference/lame.hpp"
 #include "meshes/atomic_file.hpp"
@@ -56,6 +57,7 @@ struct FemCommandOptions {
   fs::path history_csv;
   bool richardson = false;  // also solve level − 1: Richardson / GCI of the contact-point u
   double richardson_order = 2.0;
+  bool distributed = false;
   fs::path vtu;
   fs::path json;
 };
@@ -81,14 +83,37 @@ nlohmann::json json_vec(const Vec3& v, double scale) {
   return nlohmann::json::array({v.x() * scale, v.y() * scale, v.z() * scale});
 }
 
+void run_distributed(const FemCommandOptions& o, const TetMesh& mesh,
+                     const fem::ElasticityProblem& problem, const std::string& bc,
+                     const TractionPatch* patch, const Vec3& contact_point, double mesh_seconds,
+                     bool cache_hit);
+
+/// Discards what is written to it: the non-root ranks' std::cout in a --distributed run.
+struct NullBuffer : std::streambuf {
+  int overflow(int c) override { return c; }
+};
+
 void run(FemCommandOptions& o) {
   if (o.richardson && o.vessel.params.level < 1) {
     throw InputError("--richardson also solves one level coarser: it needs --level >= 1, found " +
                      std::to_string(o.vessel.params.level));
+  // --distributed: MPI lives for this command only (the serial program never initialises it
+  // unless CG-AMG needs Trilinos); rank 0 meshes and prints, every rank solves its part.
+  std::unique_ptr<fem::MpiSession> mpi;
+  static NullBuffer null_buffer;
+  if (o.distributed) {
+    if (o.modes > 0) throw InputError("--modes is serial only: drop it or --distributed");
+    if (o.transient) throw InputError("--transient is serial only: drop it or --distributed");
+    if (o.richardson) throw InputError("--richardson is serial only: drop it or --distributed");
+    mpi = std::make_unique<fem::MpiSession>();
+    if (mpi->rank() != 0) std::cout.rdbuf(&null_buffer);
   }
   auto t0 = Clock::now();
   MeshSource source;
-  const TetMesh mesh = mesh_vessel(o.vessel, std::cout, &source);
+  const TetMesh mesh =
+      o.distributed
+          ? fem::make_mesh_on_rank0([&] { return mesh_vessel(o.vessel, std::cout, &source); })
+          : mesh_vessel(o.vessel, std::cout, &source);
   const VesselParams& params = o.vessel.params;
   const double mesh_seconds = since(t0);
   std::cout << "mesh: " << mesh.nodes.size() << " nodes, " << mesh.tets.size() << " tets\n";
@@ -173,6 +198,11 @@ void run(FemCommandOptions& o) {
   }
   std::cout << std::setprecision(6) << "material: E " << o.youngs_modulus << " Pa, nu "
             << o.poisson_ratio << ", rho " << o.density << " kg/m³; ends: " << bc << "\n";
+  if (o.distributed) {
+    run_distributed(o, mesh, problem, bc, has_contact ? &patch : nullptr, contact_point,
+                    mesh_seconds, source.cache_hit);
+    return;
+  }
 
   fem::ElasticitySolver solver(mesh, problem);
   const auto& pre = solver.result();
@@ -437,6 +467,117 @@ void run(FemCommandOptions& o) {
   }
 }
 
+/// The --distributed path: the same problem solved over the MPI ranks (fem::
+/// solve_elasticity_distributed); every rank solves, rank 0 prints and writes the files.
+void run_distributed(const FemCommandOptions& o, const TetMesh& mesh,
+                     const fem::ElasticityProblem& problem, const std::string& bc,
+                     const TractionPatch* patch, const Vec3& contact_point, double mesh_seconds,
+                     bool cache_hit) {
+  fem::DistributedOptions dopt;
+  if (patch) dopt.evaluation_points = {contact_point};
+  std::cout << "solving distributed ..." << std::flush;
+  const auto d = fem::solve_elasticity_distributed(mesh, problem, dopt);
+  const auto& r = d.fem;
+  std::cout << " " << d.n_ranks << " MPI rank(s)\n";
+  std::cout << "element " << r.element << ": " << r.n_dofs << " DoFs; cg-amg, " << r.iterations
+            << " CG iterations\n  per rank: tets";
+  for (auto c : d.cells_per_rank) std::cout << " " << c;
+  std::cout << "; DoFs";
+  for (auto c : d.dofs_per_rank) std::cout << " " << c;
+  std::cout << "\n";
+  double max_u = 0.0;
+  for (const auto& u : r.nodal_displacement) max_u = std::max(max_u, u.norm());
+  const Vec3 u_contact = patch ? d.point_displacement.at(0) : Vec3::Zero();
+
+  auto t0 = Clock::now();
+  if (!o.vtu.empty() && !r.nodal_displacement.empty()) {
+    // Nodal displacement only: the per-tet strain and stress stay on their ranks.
+    VtuField disp{"displacement", 3, {}};
+    for (const auto& u : r.nodal_displacement)
+      disp.values.insert(disp.values.end(), {u.x(), u.y(), u.z()});
+    write_vtu(o.vtu, mesh, {disp}, {});
+  }
+  const double output_seconds = since(t0);
+
+  std::cout << std::setprecision(6) << "results (mm, mN, mJ):\n";
+  std::cout << "  max |u|                 " << max_u * 1e3 << " mm (at the mesh nodes)\n";
+  if (patch) {
+    std::cout << "  u at contact point      " << mm(u_contact) << " mm, along the patch normal "
+              << u_contact.dot(-patch->outward_normal) * 1e3 << " mm\n";
+  }
+  std::cout << "  strain energy           " << r.strain_energy * 1e3 << " mJ\n";
+  std::cout << "  max principal strain    " << r.max_principal_strain << " (max |eigenvalue| "
+            << r.max_abs_principal_strain << ")\n";
+  if (r.max_abs_principal_strain > 0.05) {
+    std::cout << "  WARNING: strain above 5 %: outside the linear reference's validity\n";
+  }
+  std::cout << "  applied load            " << mm(r.applied_load) << " mN\n";
+  Vec3 reaction_sum = Vec3::Zero();
+  for (const auto& g : r.reactions) {
+    std::cout << "  reaction on " << std::left << std::setw(12) << g.group << std::right
+              << mm(g.force) << " mN\n";
+    reaction_sum += g.force;
+  }
+  std::cout << "  |applied + reactions|   " << (r.applied_load + reaction_sum).norm() * 1e3
+            << " mN (equilibrium)\n";
+  std::cout << std::fixed << std::setprecision(3) << "timings (s, slowest rank): mesh "
+            << mesh_seconds << ", setup " << r.timings.setup << ", assembly " << r.timings.assembly
+            << ", solve " << r.timings.solve << ", postprocess " << r.timings.postprocess
+            << ", output " << output_seconds << std::defaultfloat << "\n";
+  if (!o.vtu.empty()) std::cout << "wrote " << o.vtu.string() << "\n";
+
+  if (!o.json.empty() && !r.nodal_displacement.empty()) {  // rank 0 only
+    nlohmann::json reactions = nlohmann::json::array();
+    for (const auto& g : r.reactions)
+      reactions.push_back({{"group", g.group}, {"force_mN", json_vec(g.force, 1e3)}});
+    nlohmann::json j{
+        {"schema", "vesselverify.fem"},
+        {"schema_version", 1},
+        {"units", {{"length", "mm"}, {"force", "mN"}, {"energy", "mJ"}, {"time", "s"}}},
+        {"vessel", describe(o.vessel.params)},
+        {"mesh",
+         {{"nodes", mesh.nodes.size()}, {"tets", mesh.tets.size()}, {"cache_hit", cache_hit}}},
+        {"material",
+         {{"E_Pa", o.youngs_modulus}, {"nu", o.poisson_ratio}, {"density_kg_m3", o.density}}},
+        {"loads", o.loads},
+        {"ends", bc},
+        {"element", r.element},
+        {"curved", false},
+        {"formulation", fem::to_string(r.formulation)},
+        {"solver", fem::to_string(r.solver)},
+        {"cg_iterations", r.iterations},
+        {"dofs", r.n_dofs},
+        {"pressure_dofs", 0},
+        {"distributed",
+         {{"mpi_ranks", d.n_ranks},
+          {"tets_per_rank", d.cells_per_rank},
+          {"dofs_per_rank", d.dofs_per_rank}}},
+        {"max_displacement_mm", max_u * 1e3},
+        {"strain_energy_mJ", r.strain_energy * 1e3},
+        {"max_principal_strain", r.max_principal_strain},
+        {"max_abs_principal_strain", r.max_abs_principal_strain},
+        {"applied_load_mN", json_vec(r.applied_load, 1e3)},
+        {"reactions", reactions},
+        {"timings_s",
+         {{"mesh", mesh_seconds},
+          {"setup", r.timings.setup},
+          {"assembly", r.timings.assembly},
+          {"solve", r.timings.solve},
+          {"postprocess", r.timings.postprocess},
+          {"output", output_seconds}}}};
+    if (patch) {
+      j["contact"] = {{"point_mm", json_vec(contact_point, 1e3)},
+                      {"radius_mm", o.contact_radius * 1e3},
+                      {"force_mN", o.force * 1e3},
+                      {"patch_area_mm2", patch->area * 1e6},
+                      {"patch_triangles", patch->triangles.size()},
+                      {"displacement_mm", json_vec(u_contact, 1e3)}};
+    }
+    write_file_atomically(o.json, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+    std::cout << "wrote " << o.json.string() << "\n";
+  }
+}
+
 }  // namespace
 
 void add_fem_command(CLI::App& app) {
@@ -459,6 +600,7 @@ void add_fem_command(CLI::App& app) {
       "  vesselverify fem --degree 2 --level 2 --solver cg-amg\n"
       "  vesselverify fem --load contact --degree 2 --transient --dt 1e-4 --steps 200 "
       "--history-csv h.csv");
+      "  mpirun -np 2 vesselverify fem --distributed --degree 2 --level 1 --load contact");
   add_vessel_options(*cmd, o->vessel);
   cmd->add_option("--degree", o->degree, "Displacement element degree (1 or 2)")
       ->check(CLI::IsMember({1, 2}))
@@ -543,6 +685,12 @@ void add_fem_command(CLI::App& app) {
   cmd->add_option("--history-csv", o->history_csv,
                   "Transient: write the contact point's displacement (mm) and the energies (mJ) "
                   "at every step as CSV");
+  cmd->add_flag(
+      "--distributed", o->distributed,
+      "Solve in parallel over the MPI ranks (run under 'mpirun -np N'): fully distributed "
+      "mesh, Trilinos CG with ML AMG; P1/P2 displacement formulation only (no mixed, "
+      "--curved or --modes). Rank 0 prints and writes the files; --vtu gets the nodal "
+      "displacement only");
   cmd->add_option("--vtu", o->vtu,
                   "Write displacement and mode shapes (nodes), strain and stress (tets) as VTU");
   cmd->add_option("--json", o->json, "Write a JSON summary");

@@ -1,0 +1,78 @@
+#pragma once
+/// The FEM reference in parallel with MPI (issue #3): the displacement formulation (P1, P2) on
+/// deal.II's fully distributed triangulation, Trilinos matrices and vectors, CG with ML AMG (all
+/// six rigid-body modes as near-null space). Plain data only: deal.II and mpi.h stay inside
+/// distributed_elasticity.cpp. SI units throughout.
+///
+/// Every function here is collective over MPI_COMM_WORLD (or over the single calling rank with
+/// DistributedOptions::self_only): every rank must call it with the same mesh and problem.
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "fem_reference/elasticity.hpp"
+#include "meshes/tet_mesh.hpp"
+
+namespace vessel::fem {
+
+/// MPI for the lifetime of the object (deal.II's MPI_InitFinalize: also p4est, PETSc, Zoltan),
+/// one thread per rank. Create it once, before any distributed call; not needed by the serial
+/// ElasticitySolver. Throws std::logic_error if MPI is already initialised (it can be once per
+/// process only).
+class MpiSession {
+ public:
+  MpiSession();
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+  /// This process's rank in MPI_COMM_WORLD and the number of ranks.
+  [[nodiscard]] int rank() const;
+  [[nodiscard]] int size() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Collective: calls `make` on rank 0 only and sends its mesh to every rank, so all ranks solve
+/// the same mesh (a generated mesh is read from the cache or meshed once, not once per rank). If
+/// `make` throws on rank 0, rank 0 rethrows its exception and every other rank throws InputError
+/// with the same message, so no rank is left waiting.
+TetMesh make_mesh_on_rank0(const std::function<TetMesh()>& make);
+
+struct DistributedOptions {
+  /// Solve on MPI_COMM_SELF (this rank alone) instead of MPI_COMM_WORLD: a one-rank reference
+  /// inside a multi-rank run (the 1-vs-2-rank test). Not collective over the world then.
+  bool self_only = false;
+  /// Points (m) at which the FE displacement is evaluated (e.g. the contact point), within a
+  /// barycentric tolerance of 1e-9 of a tet; InputError naming the first point outside the mesh.
+  std::vector<Vec3> evaluation_points;
+};
+
+struct DistributedResult {
+  /// Same meaning as the serial result's fields, with these differences: nodal_displacement (every
+  /// TetMesh node, m) is filled on rank 0 only (gathered there; empty on other ranks);
+  /// tet_strain and tet_stress are empty (not gathered); solver is always cg_amg; timings are
+  /// the slowest rank's per phase; applied_load, reactions, strain_energy and the principal
+  /// strains are global (reduced over the ranks) on every rank.
+  ElasticityResult fem;
+  int n_ranks = 1;
+  std::vector<std::size_t> cells_per_rank;  ///< locally owned tets of each rank (every rank)
+  std::vector<std::size_t> dofs_per_rank;   ///< locally owned DoFs of each rank (every rank)
+  std::vector<Vec3> point_displacement;     ///< at DistributedOptions::evaluation_points, m
+};
+
+/// Solves `problem` on `mesh` distributed over the ranks: the mesh is partitioned with METIS
+/// (GridTools::partition_triangulation) and each rank keeps only its cells and one layer of ghosts
+/// (parallel::fullydistributed::Triangulation); CG with Trilinos ML AMG to
+/// options.cg_relative_tolerance. Supports P1 and P2 displacement elements, clamped and roller
+/// Dirichlet groups, point constraints, pressures, traction patches, gravity and body forces.
+/// InputError (the same on every rank) for invalid parameters, a missing group, and what is not
+/// distributed: the mixed (Taylor–Hood) formulation (also ν ≥ the automatic mixed threshold),
+/// curved surfaces, and the direct solver. std::runtime_error if CG does not converge.
+DistributedResult solve_elasticity_distributed(const TetMesh& mesh,
+                                               const ElasticityProblem& problem,
+                                               const DistributedOptions& options = {});
+
+}  // namespace vessel::fem

@@ -1,0 +1,296 @@
+/// The distributed (MPI) FEM reference against a second solver: the serial ElasticitySolver with
+/// CHOLMOD's direct factorisation, on the same mesh and problem; and the solve on one rank
+/// (MPI_COMM_SELF) against the solve on every rank. Run by ctest under `mpirun -np 2` (see
+/// CMakeLists.txt); every comparison is made on rank 0, and any rank's failure fails the run.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "fem_reference/distributed_elasticity.hpp"
+#include "fem_reference/elasticity.hpp"
+#include "meshes/errors.hpp"
+#include "meshes/gmsh_vessel.hpp"
+#include "meshes/surface_loads.hpp"
+
+using namespace vessel;
+using namespace vessel::fem;
+
+namespace {
+
+int world_rank() {
+  int r = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r;
+}
+int world_size() {
+  int s = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &s);
+  return s;
+}
+
+/// A short unstructured tube (a = 3 mm, t = 1 mm, L = 6 mm, gmsh HXT level 0), meshed on rank 0
+/// and sent to the others.
+constexpr double kLength = 6e-3;
+const TetMesh& tube() {
+  static const TetMesh mesh = make_mesh_on_rank0([] {
+    VesselParams p;
+    p.length = kLength;
+    p.level = 0;
+    return generate_vessel_mesh(p);
+  });
+  return mesh;
+}
+
+/// Solved to well below the 1e-8 comparison tolerance: CG's relative residual 1e-13.
+constexpr double kCgTolerance = 1e-13;
+constexpr double kAgreement = 1e-8;
+
+double max_norm(const std::vector<Vec3>& v) {
+  double m = 0.0;
+  for (const auto& x : v) m = std::max(m, x.norm());
+  return m;
+}
+/// max_i |a_i − b_i| / max_i |b_i|
+double max_relative_difference(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double d = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, (a[i] - b[i]).norm());
+  return d / max_norm(b);
+}
+
+enum class Load { contact, pressure_rollers, pressure_gravity };
+
+ElasticityProblem make_problem(Load load, int degree) {
+  const TetMesh& mesh = tube();
+  ElasticityProblem p;
+  p.options.degree = degree;
+  p.options.cg_relative_tolerance = kCgTolerance;
+  if (load == Load::contact) {
+    // The shared catheter patch at mid-length on the inner wall; both ends clamped.
+    ContactPatchSpec spec;
+    spec.point = Vec3(3e-3, 0.0, 0.5 * kLength);
+    spec.radius = 1e-3;
+    spec.force = 1e-4;
+    p.patches.push_back(contact_patch(mesh, spec));
+    p.dirichlet = {DirichletCondition::clamped("inlet"), DirichletCondition::clamped("outlet")};
+  } else if (load == Load::pressure_rollers) {
+    // The Lamé set-up: rollers on both ends and three point pins.
+    p.pressures.push_back({"inner_wall", 10.0});
+    p.dirichlet = {DirichletCondition::roller("inlet", 2), DirichletCondition::roller("outlet", 2)};
+    p.point_constraints = tube_in_plane_pins(3e-3, 0.0);
+  } else {
+    p.pressures.push_back({"inner_wall", 5.0});
+    p.gravity = Vec3(0.0, -9.81, 0.0);
+    p.dirichlet = {DirichletCondition::clamped("inlet")};
+  }
+  return p;
+}
+
+/// The distributed solve over every rank and over rank 0 alone, checked against CHOLMOD (serial
+/// ElasticitySolver, direct) on rank 0: nodal displacement, contact-point displacement, applied
+/// load, reactions and strain energy.
+void check_against_serial(Load load, int degree) {
+  const TetMesh& mesh = tube();
+  const ElasticityProblem problem = make_problem(load, degree);
+  DistributedOptions opt;
+  const Vec3 point(3.2e-3, 0.1e-3, 0.5 * kLength);  // inside the wall, off the nodes
+  opt.evaluation_points = {point};
+  const DistributedResult all = solve_elasticity_distributed(mesh, problem, opt);
+  EXPECT_EQ(all.n_ranks, world_size());
+  ASSERT_EQ(all.cells_per_rank.size(), static_cast<std::size_t>(world_size()));
+  std::size_t cells = 0;
+  for (auto c : all.cells_per_rank) cells += c;
+  EXPECT_EQ(cells, mesh.tets.size());
+  if (world_size() > 1) {
+    for (auto c : all.cells_per_rank) EXPECT_GT(c, 0u) << "a rank got no cells";
+  }
+  if (world_rank() != 0) {
+    EXPECT_TRUE(all.fem.nodal_displacement.empty());
+    return;
+  }
+
+  ElasticityProblem direct = problem;
+  direct.options.solver = LinearSolver::direct;
+  ElasticitySolver serial(mesh, direct);
+  const ElasticityResult& s = serial.solve();
+  ASSERT_EQ(s.solver, LinearSolver::direct);
+  const Vec3 s_point = serial.displacement_at({point})[0];
+
+  DistributedOptions self = opt;
+  self.self_only = true;
+  const DistributedResult one = solve_elasticity_distributed(mesh, problem, self);
+  EXPECT_EQ(one.n_ranks, 1);
+
+  // Force scale: the net load, or the pressure's |p|·A when it cancels over the closed wall.
+  double load_scale = s.applied_load.norm();
+  for (const auto& pr : problem.pressures) {
+    load_scale = std::max(
+        load_scale, std::abs(pr.pressure) * group_area(mesh, mesh.require_group(pr.group, 2, "")));
+  }
+  for (const DistributedResult* d : {&all, &one}) {
+    SCOPED_TRACE(std::to_string(d->n_ranks) + " rank(s)");
+    const auto& r = d->fem;
+    EXPECT_EQ(r.n_dofs, s.n_dofs);
+    EXPECT_EQ(r.element, degree == 1 ? "P1" : "P2");
+    EXPECT_GT(r.iterations, 0u);
+    ASSERT_EQ(r.nodal_displacement.size(), mesh.nodes.size());
+    const double diff = max_relative_difference(r.nodal_displacement, s.nodal_displacement);
+    std::printf("%d rank(s): %zu DoFs, %u CG iterations, max |u - u_cholmod| / max |u| = %.3g\n",
+                d->n_ranks, r.n_dofs, r.iterations, diff);
+    EXPECT_LT(diff, kAgreement);
+    EXPECT_LT((d->point_displacement.at(0) - s_point).norm() / max_norm(s.nodal_displacement),
+              kAgreement);
+    EXPECT_LT((r.applied_load - s.applied_load).norm(), 1e-12 * load_scale);
+    EXPECT_NEAR(r.strain_energy, s.strain_energy, kAgreement * s.strain_energy);
+    ASSERT_EQ(r.reactions.size(), s.reactions.size());
+    for (std::size_t g = 0; g < s.reactions.size(); ++g) {
+      EXPECT_EQ(r.reactions[g].group, s.reactions[g].group);
+      EXPECT_LT((r.reactions[g].force - s.reactions[g].force).norm(), kAgreement * load_scale)
+          << r.reactions[g].group;
+    }
+  }
+  // One rank against all ranks: the same field to solver tolerance.
+  const double diff =
+      max_relative_difference(all.fem.nodal_displacement, one.fem.nodal_displacement);
+  std::printf("1 vs %d ranks: max |u_1 - u_n| / max |u_1| = %.3g\n", all.n_ranks, diff);
+  EXPECT_LT(diff, kAgreement);
+}
+
+/// The InputError every rank throws (they all validate the same input), or "".
+std::string input_error(const ElasticityProblem& p) {
+  try {
+    (void)solve_elasticity_distributed(tube(), p);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(DistributedElasticity, P1ContactMatchesCholmodOnOneAndAllRanks) {
+  check_against_serial(Load::contact, 1);
+}
+TEST(DistributedElasticity, P2ContactMatchesCholmodOnOneAndAllRanks) {
+  check_against_serial(Load::contact, 2);
+}
+TEST(DistributedElasticity, P1PressureRollersAndPinsMatchCholmod) {
+  check_against_serial(Load::pressure_rollers, 1);
+}
+TEST(DistributedElasticity, P2PressureRollersAndPinsMatchCholmod) {
+  check_against_serial(Load::pressure_rollers, 2);
+}
+TEST(DistributedElasticity, P2PressureAndGravityClampedInletMatchCholmod) {
+  check_against_serial(Load::pressure_gravity, 2);
+}
+
+TEST(DistributedElasticity, GravityLoadIsTheWeightAndReactionsBalanceIt) {
+  // Independent of any solver: the applied load of gravity is ρ g V (V the tets' volume), and the
+  // one clamped end carries all of it.
+  ElasticityProblem p;
+  p.options.cg_relative_tolerance = kCgTolerance;
+  p.gravity = Vec3(0.0, -9.81, 0.0);
+  p.dirichlet = {DirichletCondition::clamped("inlet")};
+  const auto d = solve_elasticity_distributed(tube(), p);
+  const Vec3 weight = p.material.density * mesh_volume(tube()) * p.gravity;
+  EXPECT_LT((d.fem.applied_load - weight).norm(), 1e-12 * weight.norm());
+  ASSERT_EQ(d.fem.reactions.size(), 1u);
+  EXPECT_LT((d.fem.reactions[0].force + weight).norm(), 1e-8 * weight.norm());
+}
+
+TEST(DistributedElasticity, RefusesWhatIsNotDistributedWithClearMessages) {
+  ElasticityProblem p = make_problem(Load::contact, 2);
+  p.material.poisson_ratio = 0.49;  // automatic: mixed Taylor–Hood
+  EXPECT_NE(input_error(p).find("displacement formulation (P1, P2) only"), std::string::npos);
+  p = make_problem(Load::contact, 2);
+  p.options.formulation = Formulation::mixed;
+  EXPECT_NE(input_error(p).find("mixed"), std::string::npos);
+  p = make_problem(Load::contact, 2);
+  p.curved_surfaces = tube_curved_walls(3e-3, 4e-3);
+  EXPECT_NE(input_error(p).find("curved"), std::string::npos);
+  p = make_problem(Load::contact, 1);
+  p.options.solver = LinearSolver::direct;
+  EXPECT_NE(input_error(p).find("solver 'direct' is serial only"), std::string::npos);
+  p = make_problem(Load::contact, 1);
+  p.material.youngs_modulus = -1.0;
+  EXPECT_NE(input_error(p).find("Young's modulus"), std::string::npos);
+  p = make_problem(Load::contact, 3);
+  EXPECT_NE(input_error(p).find("degree = 3"), std::string::npos);
+  p = make_problem(Load::contact, 1);
+  p.dirichlet.push_back(DirichletCondition::clamped("no_such_group"));
+  EXPECT_NE(input_error(p).find("no_such_group"), std::string::npos);
+  p = make_problem(Load::pressure_rollers, 1);
+  p.point_constraints.push_back({Vec3(3.5e-3, 0.0, 1.0), 0});  // far beyond the tube's end
+  EXPECT_NE(input_error(p).find("no mesh node there"), std::string::npos);
+}
+
+TEST(DistributedElasticity, EvaluationPointOutsideTheWallIsAnInputError) {
+  ElasticityProblem p = make_problem(Load::contact, 1);
+  DistributedOptions opt;
+  opt.evaluation_points = {Vec3(0.0, 0.0, 0.5 * kLength)};  // on the axis, in the lumen
+  std::string msg;
+  try {
+    (void)solve_elasticity_distributed(tube(), p, opt);
+  } catch (const InputError& e) {
+    msg = e.what();
+  }
+  EXPECT_NE(msg.find("outside the FEM mesh"), std::string::npos) << msg;
+}
+
+TEST(DistributedMesh, RankZeroMeshReachesEveryRankAndItsErrorsToo) {
+  // A hand-built mesh (one tet, one triangle group) made on rank 0 only.
+  TetMesh made;
+  made.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  made.tets = {{0, 1, 2, 3}};
+  made.triangles = {{0, 2, 1}};
+  made.groups = {{"bottom", 2, 7, {0}}, {"wall", 3, 10, {0}}};
+  int calls = 0;
+  const TetMesh got = make_mesh_on_rank0([&] {
+    ++calls;
+    return made;
+  });
+  EXPECT_EQ(calls, world_rank() == 0 ? 1 : 0);
+  EXPECT_EQ(got.nodes, made.nodes);
+  EXPECT_EQ(got.tets, made.tets);
+  EXPECT_EQ(got.triangles, made.triangles);
+  ASSERT_EQ(got.groups.size(), 2u);
+  EXPECT_EQ(got.groups[0].name, "bottom");
+  EXPECT_EQ(got.groups[0].tag, 7);
+  EXPECT_EQ(got.groups[1].dim, 3);
+  EXPECT_EQ(got.groups[1].elements, std::vector<int>{0});
+
+  std::string msg;
+  try {
+    (void)make_mesh_on_rank0([]() -> TetMesh { throw InputError("mesh.msh line 3: bad node"); });
+  } catch (const InputError& e) {
+    msg = e.what();
+  }
+  EXPECT_EQ(msg, "mesh.msh line 3: bad node");
+}
+
+int main(int argc, char** argv) {
+  MpiSession mpi;
+  bool listing = false;  // before InitGoogleTest, which removes the flags it knows from argv
+  for (int i = 1; i < argc; ++i) listing |= std::strcmp(argv[i], "--gtest_list_tests") == 0;
+  ::testing::InitGoogleTest(&argc, argv);
+  if (mpi.rank() != 0) {
+    // One test list for ctest's discovery; the other ranks report failures only (to stderr).
+    if (listing) (void)std::freopen("/dev/null", "w", stdout);
+    auto& listeners = ::testing::UnitTest::GetInstance()->listeners();
+    delete listeners.Release(listeners.default_result_printer());
+    struct FailurePrinter : ::testing::EmptyTestEventListener {
+      int rank;
+      explicit FailurePrinter(int r) : rank(r) {}
+      void OnTestPartResult(const ::testing::TestPartResult& r) override {
+        if (r.failed()) {
+          std::fprintf(stderr, "[rank %d] %s:%d: Failure\n%s\n", rank,
+                       r.file_name() ? r.file_name() : "?", r.line_number(), r.summary());
+        }
+      }
+    };
+    listeners.Append(new FailurePrinter(mpi.rank()));
+  }
+  return RUN_ALL_TESTS();
+}
