@@ -50,6 +50,7 @@ struct FemCommandOptions {
   unsigned gmres_restart = fem::SolverOptions{}.gmres_restart;
   int modes = 0;
   bool curved = false;
+  bool distributed = false;
   bool transient = false;  // Newmark step response after the static solve
   double dt = fem::TransientOptions{}.dt;
   int steps = fem::TransientOptions{}.steps;
@@ -57,7 +58,6 @@ struct FemCommandOptions {
   fs::path history_csv;
   bool richardson = false;  // also solve level − 1: Richardson / GCI of the contact-point u
   double richardson_order = 2.0;
-  bool distributed = false;
   fs::path vtu;
   fs::path json;
 };
@@ -97,6 +97,7 @@ void run(FemCommandOptions& o) {
   if (o.richardson && o.vessel.params.level < 1) {
     throw InputError("--richardson also solves one level coarser: it needs --level >= 1, found " +
                      std::to_string(o.vessel.params.level));
+  }
   // --distributed: MPI lives for this command only (the serial program never initialises it
   // unless CG-AMG needs Trilinos); rank 0 meshes and prints, every rank solves its part.
   std::unique_ptr<fem::MpiSession> mpi;
@@ -599,7 +600,7 @@ void add_fem_command(CLI::App& app) {
       "  vesselverify fem --degree 2 --bc clamped-inlet --modes 10   # natural frequencies\n"
       "  vesselverify fem --degree 2 --level 2 --solver cg-amg\n"
       "  vesselverify fem --load contact --degree 2 --transient --dt 1e-4 --steps 200 "
-      "--history-csv h.csv");
+      "--history-csv h.csv\n"
       "  mpirun -np 2 vesselverify fem --distributed --degree 2 --level 1 --load contact");
   add_vessel_options(*cmd, o->vessel);
   cmd->add_option("--degree", o->degree, "Displacement element degree (1 or 2)")
@@ -673,6 +674,12 @@ void add_fem_command(CLI::App& app) {
                   "Assumed convergence order for --richardson (2 is conservative for P1 and P2)")
       ->check(CLI::Range(0.5, 6.0))
       ->capture_default_str();
+  cmd->add_flag(
+      "--distributed", o->distributed,
+      "Solve in parallel over the MPI ranks (run under 'mpirun -np N'): fully distributed "
+      "mesh, Trilinos CG with ML AMG; P1/P2 displacement formulation only (no mixed, "
+      "--curved, --modes or --transient). Rank 0 prints and writes the files; --vtu gets the "
+      "nodal displacement only");
   cmd->add_flag("--transient", o->transient,
                 "Also run the step response: the loads applied at t = 0 to the body at rest, "
                 "Newmark average acceleration with the consistent mass; prints the contact "
@@ -685,12 +692,6 @@ void add_fem_command(CLI::App& app) {
   cmd->add_option("--history-csv", o->history_csv,
                   "Transient: write the contact point's displacement (mm) and the energies (mJ) "
                   "at every step as CSV");
-  cmd->add_flag(
-      "--distributed", o->distributed,
-      "Solve in parallel over the MPI ranks (run under 'mpirun -np N'): fully distributed "
-      "mesh, Trilinos CG with ML AMG; P1/P2 displacement formulation only (no mixed, "
-      "--curved or --modes). Rank 0 prints and writes the files; --vtu gets the nodal "
-      "displacement only");
   cmd->add_option("--vtu", o->vtu,
                   "Write displacement and mode shapes (nodes), strain and stress (tets) as VTU");
   cmd->add_option("--json", o->json, "Write a JSON summary");
