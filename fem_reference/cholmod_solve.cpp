@@ -6,14 +6,28 @@
 namespace vessel::fem {
 
 Eigen::VectorXd solve_spd_cholmod(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& b) {
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt(K);
-  if (llt.info() != Eigen::Success) {
+  return CholmodFactor(K).solve(b);
+}
+
+struct CholmodFactor::Impl {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+};
+
+CholmodFactor::CholmodFactor(const Eigen::SparseMatrix<double>& K)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->llt.compute(K);
+  if (impl_->llt.info() != Eigen::Success) {
     throw std::runtime_error(
         "CHOLMOD could not factorise the displacement system: it is not positive definite "
         "(an unconstrained rigid-body motion?)");
   }
-  Eigen::VectorXd x = llt.solve(b);
-  if (llt.info() != Eigen::Success) throw std::runtime_error("CHOLMOD solve failed");
+}
+
+CholmodFactor::~CholmodFactor() = default;
+
+Eigen::VectorXd CholmodFactor::solve(const Eigen::VectorXd& b) const {
+  Eigen::VectorXd x = impl_->llt.solve(b);
+  if (impl_->llt.info() != Eigen::Success) throw std::runtime_error("CHOLMOD solve failed");
   return x;
 }
 

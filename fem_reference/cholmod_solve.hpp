@@ -3,11 +3,28 @@
 /// own translation unit (no deal.II), fed through Eigen's CHOLMOD interface.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
 
 namespace vessel::fem {
 
 /// Solves K x = b for a symmetric positive definite K given in full (both triangles). Throws
 /// std::runtime_error if the factorisation fails (K not positive definite).
 Eigen::VectorXd solve_spd_cholmod(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& b);
+
+/// A CHOLMOD supernodal Cholesky factor kept for repeated solves (the Newmark transient factorises
+/// K + 4/dt² M once and reuses it every step).
+class CholmodFactor {
+ public:
+  /// Factorises the SPD matrix K (both triangles stored); std::runtime_error if not SPD.
+  explicit CholmodFactor(const Eigen::SparseMatrix<double>& K);
+  ~CholmodFactor();
+  CholmodFactor(const CholmodFactor&) = delete;
+  CholmodFactor& operator=(const CholmodFactor&) = delete;
+  [[nodiscard]] Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace vessel::fem

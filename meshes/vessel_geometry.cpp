@@ -74,10 +74,32 @@ double analytic_end_area(const VesselParams& p) {
   return std::numbers::pi * (b * b - a * a);
 }
 
+
+CentrelineCoordinates centreline_coordinates(const VesselParams& p, const Vec3& x) {
+  CentrelineCoordinates c;
+  Vec3 offset;  // from the centreline to x
+  Vec3 outward;  // θ = 0 direction in the cross-section
+  Vec3 binormal;  // θ = π/2 direction
+  if (p.kind == VesselKind::straight) {
+    c.s = x.z();
+    offset = Vec3(x.x(), x.y(), 0.0);
+    outward = Vec3::UnitX();
+    binormal = Vec3::UnitY();
+  } else {
+    const double phi = std::atan2(x.y(), x.x());
+    c.s = p.bend_radius * phi;
+    outward = Vec3(std::cos(phi), std::sin(phi), 0.0);
+    offset = x - p.bend_radius * outward;
+    binormal = Vec3::UnitZ();
+  }
+  c.rho = offset.norm();
+  c.theta = std::atan2(offset.dot(binormal), offset.dot(outward));
+  if (c.rho > 0.0) c.e_rho = offset / c.rho;
+  return c;
+}
+
 double distance_from_centreline(const VesselParams& p, const Vec3& x) {
-  if (p.kind == VesselKind::straight) return std::hypot(x.x(), x.y());
-  // Arch: centreline is the circle of radius R about the z axis in the z = 0 plane.
-  return std::hypot(std::hypot(x.x(), x.y()) - p.bend_radius, x.z());
+  return centreline_coordinates(p, x).rho;
 }
 
 StructuredCounts structured_counts(const VesselParams& p) {

@@ -44,6 +44,18 @@ double analytic_end_area(const VesselParams& params);
 /// Distance of a point from the vessel centreline, m (the local radius ρ of the cross-section).
 double distance_from_centreline(const VesselParams& params, const Vec3& p);
 
+/// A point's position relative to the vessel's centreline: arc length s along it (m; z for the
+/// tube, Rφ for the arch with φ = atan2(y, x)), distance ρ from it (m), the angle θ around it
+/// (rad, in (−π, π]; θ = 0 at +x for the tube and on the outer bend, away from the arch's centre)
+/// and the unit vector e_ρ from the centreline to the point.
+struct CentrelineCoordinates {
+  double s = 0.0;
+  double rho = 0.0;
+  double theta = 0.0;
+  Vec3 e_rho = Vec3::UnitX();
+};
+CentrelineCoordinates centreline_coordinates(const VesselParams& params, const Vec3& p);
+
 /// Structured grid counts at the params' level.
 struct StructuredCounts {
   int circumferential = 0;  ///< divisions around the circumference (multiple of 4)

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
+#include <numbers>
+#include <tuple>
 
 #include "fem_reference/convergence.hpp"
 #include "fem_reference/elasticity.hpp"
@@ -13,6 +16,7 @@
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/static_solver.hpp"
+#include "verification/memory.hpp"
 #include "verification/progress.hpp"
 #include "verification/timing.hpp"
 
@@ -26,6 +30,7 @@ constexpr double kLinearRegimeStrain = 0.05;
 /// reference's own Lamé verification), so Richardson uses p = 2 between its two levels.
 constexpr double kReferenceOrder = 2.0;
 constexpr double kMixedThreshold = 0.49;
+constexpr int kHistorySamples = 200;  ///< points kept of a dynamic model's QoI history
 
 TetMesh mesh_at_level(const Scene& s, int level, const HarnessOptions& o) {
   VesselParams p = s.vessel;
@@ -186,6 +191,42 @@ std::size_t nearest(const std::vector<Vec3>& points, const Vec3& x) {
   return best;
 }
 
+/// The model nodes on the wall line through the QoI point: within a third of the level's cell size
+/// of the QoI's angle around the centreline, at the radius nearest the QoI's; sorted by arc length.
+std::vector<std::size_t> wall_line(const VesselParams& v, int level,
+                                   const std::vector<Vec3>& nodes, const Vec3& qoi) {
+  const CentrelineCoordinates q = centreline_coordinates(v, qoi);
+  const double cell = v.wall_thickness / static_cast<double>(1 << level);
+  std::vector<std::size_t> on_line;
+  std::vector<CentrelineCoordinates> c(nodes.size());
+  double nearest_radius = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    c[i] = centreline_coordinates(v, nodes[i]);
+    const double dtheta = std::remainder(c[i].theta - q.theta, 2.0 * std::numbers::pi);
+    if (std::abs(dtheta) * q.rho > cell / 3.0) continue;
+    on_line.push_back(i);
+    nearest_radius = std::min(nearest_radius, std::abs(c[i].rho - q.rho));
+  }
+  std::erase_if(on_line, [&](std::size_t i) {
+    return std::abs(c[i].rho - q.rho) > nearest_radius + 0.1 * cell;
+  });
+  std::sort(on_line.begin(), on_line.end(), [&](std::size_t a, std::size_t b) { return c[a].s < c[b].s; });
+  return on_line;
+}
+
+WallProfile wall_profile(const VesselParams& v, const std::vector<Vec3>& nodes,
+                         const std::vector<std::size_t>& line, const std::vector<Vec3>& u_model,
+                         const std::vector<Vec3>& u_ref) {
+  WallProfile p;
+  for (const std::size_t i : line) {
+    const CentrelineCoordinates c = centreline_coordinates(v, nodes[i]);
+    p.s_mm.push_back(c.s * 1e3);
+    p.model_mm.push_back(u_model[i].dot(c.e_rho) * 1e3);
+    p.reference_mm.push_back(u_ref[i].dot(c.e_rho) * 1e3);
+  }
+  return p;
+}
+
 /// Reference displacement at unit load and its Richardson uncertainty at a model's points.
 struct ReferenceAtPoints {
   std::vector<Vec3> u;  ///< fine level, unit load
@@ -196,7 +237,42 @@ struct ReferenceAtPoints {
 struct ReferenceSolvers {
   std::unique_ptr<fem::ElasticitySolver> fine;
   std::unique_ptr<fem::ElasticitySolver> coarse;
+  /// FEM transients already run, by (probe point, simulated time, α): |u(t)| at unit load, m.
+  mutable std::map<std::tuple<double, double, double, double, double>,
+                   std::pair<std::vector<double>, std::vector<double>>>
+      transients;
 };
+
+/// Newmark steps of the FEM transient: average acceleration is unconditionally stable, and 400
+/// steps over the run resolve the low modes that a contact step excites.
+constexpr int kTransientSteps = 400;
+
+/// The FEM transient at `probe` for a step unit load over `duration` (cached): times and |u|.
+const std::pair<std::vector<double>, std::vector<double>>& transient_at(
+    const ReferenceSolvers& ref, const Vec3& probe, double duration, double alpha) {
+  const auto key = std::make_tuple(probe.x(), probe.y(), probe.z(), duration, alpha);
+  const auto it = ref.transients.find(key);
+  if (it != ref.transients.end()) return it->second;
+  fem::TransientOptions t;
+  t.dt = duration / kTransientSteps;
+  t.steps = kTransientSteps;
+  t.mass_damping = alpha;
+  t.probe_points = {probe};
+  t.outside_tolerance = kOutsideTolerance;
+  const fem::TransientResult r = ref.fine->transient(t);
+  std::vector<double> u(r.time.size());
+  for (std::size_t k = 0; k < u.size(); ++k) u[k] = r.probe_displacement[k][0].norm();
+  return ref.transients.emplace(key, std::make_pair(r.time, u)).first->second;
+}
+
+/// Linear interpolation of (t, v) at time x (clamped to the ends).
+double interpolate(const std::vector<double>& t, const std::vector<double>& v, double x) {
+  if (x <= t.front()) return v.front();
+  if (x >= t.back()) return v.back();
+  const auto hi = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin());
+  const double w = (x - t[hi - 1]) / (t[hi] - t[hi - 1]);
+  return (1.0 - w) * v[hi - 1] + w * v[hi];
+}
 
 ReferenceAtPoints reference_at(const ReferenceSolvers& ref, const std::vector<Vec3>& points) {
   ReferenceAtPoints r;
@@ -209,10 +285,22 @@ ReferenceAtPoints reference_at(const ReferenceSolvers& ref, const std::vector<Ve
   return r;
 }
 
-void finish_outcome(ModelOutcome& out, const std::vector<Vec3>& u_model,
-                    const ReferenceAtPoints& ref, double magnitude, std::size_t qoi,
-                    double ref_max_strain_unit) {
+/// Where a model's results are read: the QoI node and the wall line.
+struct ReadOut {
+  std::size_t qoi = 0;
+  std::vector<std::size_t> wall_line;
+};
+
+ReadOut read_out(const Scene& s, int level, const std::vector<Vec3>& nodes, const Vec3& qoi) {
+  return {nearest(nodes, qoi), wall_line(s.vessel, level, nodes, qoi)};
+}
+
+void finish_outcome(ModelOutcome& out, const Scene& s, const std::vector<Vec3>& nodes,
+                    const std::vector<Vec3>& u_model, const ReferenceAtPoints& ref,
+                    double magnitude, const ReadOut& at, double ref_max_strain_unit) {
   const std::vector<Vec3> u_ref = scaled(ref.u, magnitude);
+  const std::size_t qoi = at.qoi;
+  out.wall_profile = wall_profile(s.vessel, nodes, at.wall_line, u_model, u_ref);
   out.error = compare_displacements(u_model, u_ref);
   out.has_reference_uncertainty = ref.has_uncertainty;
   if (ref.has_uncertainty) {
@@ -232,6 +320,7 @@ void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
                    const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
                    const HarnessOptions& o, ModelOutcome base, SceneResult& result) {
   try {
+    const MemoryProbe memory;
     Stopwatch setup;
     fem::ElasticityProblem problem = fem_problem(s, mesh, nu, spec.degree);
     problem.options.formulation = fem::Formulation::displacement;
@@ -244,16 +333,17 @@ void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
       times.push_back(r.timings.assembly + r.timings.solve);
     }
     base.solve_seconds = median(times);
+    base.memory_mib = memory.added_mib();
     base.detail = r.element + ", " + fem::to_string(r.solver);
     base.nodes = mesh.nodes.size();
     base.unknowns = r.n_dofs;
-    const ReferenceAtPoints at = reference_at(ref, mesh.nodes);
-    const std::size_t qoi = nearest(mesh.nodes, result.qoi_point);
+    const ReferenceAtPoints ref_here = reference_at(ref, mesh.nodes);
+    const ReadOut at = read_out(s, base.level, mesh.nodes, result.qoi_point);
     for (const double mag : s.load.magnitudes) {
       ModelOutcome out = base;
       out.magnitude = mag;
       out.max_strain = r.max_abs_principal_strain * mag;
-      finish_outcome(out, scaled(r.nodal_displacement, mag), at, mag, qoi,
+      finish_outcome(out, s, mesh.nodes, scaled(r.nodal_displacement, mag), ref_here, mag, at,
                      fine.max_abs_principal_strain);
       result.outcomes.push_back(out);
     }
@@ -268,7 +358,123 @@ void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
   }
 }
 
+/// The FEM transient next to a dynamic model's history. The model's point damping c (force −c v
+/// per node, seed 000 eq. 3.3) becomes mass-proportional damping α = c / m̄ with m̄ the model's
+/// mean nodal mass: exact for uniform masses, an average otherwise.
+void add_reference_history(History& h, const ReferenceSolvers& ref, const Vec3& probe,
+                           const ModelSpec& spec, const msm::Problem& problem, double magnitude) {
+  h.steps = spec.steps;
+  h.simulated_s = spec.dt * static_cast<double>(spec.steps);
+  const double mean_mass = problem.mass.sum() / static_cast<double>(problem.mass.size());
+  h.mass_damping = spec.damping > 0.0 ? spec.damping / mean_mass : 0.0;
+  const auto& [t, u] = transient_at(ref, probe, h.simulated_s, h.mass_damping);
+  h.reference_mm.clear();
+  h.max_error_mm = 0.0;
+  for (std::size_t k = 0; k < h.time_s.size(); ++k) {
+    h.reference_mm.push_back(interpolate(t, u, h.time_s[k]) * magnitude * 1e3);
+    h.max_error_mm = std::max(h.max_error_mm, std::abs(h.model_mm[k] - h.reference_mm[k]));
+  }
+}
+
+/// A mass-spring model at every load magnitude.
+void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
+                   const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
+                   const HarnessOptions& o, Progress& progress, ModelOutcome base,
+                   SceneResult& result) {
+  msm::NetworkOptions net_options;
+  net_options.model = spec.kind == ModelKind::volume_msm ? "volume" : "surface";
+  net_options.surface = spec.surface;
+  net_options.topology = spec.topology;
+  net_options.stiffness = msm::parse_stiffness_rule(spec.stiffness);
+  net_options.stiffness_params.youngs_modulus = s.youngs_modulus;
+  net_options.stiffness_params.poisson_ratio = nu;
+  net_options.mass = msm::parse_mass_rule(spec.mass);
+  net_options.density = s.density;
+  const MemoryProbe setup_memory;
+  Stopwatch setup;
+  VesselParams vessel = s.vessel;
+  vessel.level = base.level;
+  const msm::BuiltNetwork built = msm::build_network(mesh, vessel, net_options);
+  const msm::SpringModel model(built.network, spec.damping);
+  base.setup_seconds = setup.seconds();
+  base.memory_mib = setup_memory.added_mib();
+  base.detail = built.topology + ", " + spec.stiffness + " stiffness, " + spec.mass + " masses, " +
+                spec.solver;
+  base.nodes = built.network.nodes.size();
+  const std::vector<Vec3>& nodes = built.network.nodes;
+  const ReferenceAtPoints ref_here = reference_at(ref, nodes);
+  const ReadOut at = read_out(s, base.level, nodes, result.qoi_point);
+  for (const double mag : s.load.magnitudes) {
+    progress.begin(spec.name + " at " + std::to_string(mag) + " (" + to_string(s.load.kind) + ")");
+    ModelOutcome out = base;
+    out.magnitude = mag;
+    try {
+      const msm::Problem problem = msm_problem(s, model, built, mesh, mag);
+      out.unknowns = free_unknowns(problem);
+      std::vector<double> times;
+      Eigen::VectorXd x;
+      const MemoryProbe solve_memory;
+      for (int k = 0; k < std::max(1, o.repeats); ++k) {
+        Stopwatch solve;
+        if (spec.solver == "static") {
+          x = msm::solve_static(problem).x;
+        } else if (spec.solver == "linear") {
+          x = msm::solve_linear(problem).x;
+        } else if (spec.solver == "relaxation") {
+          x = msm::dynamic_relaxation(problem).x;
+        } else {
+          msm::DynamicOptions d;
+          d.integrator = msm::parse_integrator(spec.solver);
+          d.dt = spec.dt;
+          d.steps = static_cast<int>(spec.steps);
+          out.history = {};
+          out.history.time_s.push_back(0.0);  // at rest
+          out.history.model_mm.push_back(0.0);
+          const int every = std::max(1, d.steps / kHistorySamples);
+          const auto q = static_cast<Eigen::Index>(3 * at.qoi);
+          d.on_step = [&](int step, const Eigen::VectorXd& xs, const Eigen::VectorXd&) {
+            if (step % every != 0 && step != d.steps) return;
+            out.history.time_s.push_back(step * d.dt);
+            out.history.model_mm.push_back((xs.segment<3>(q) - nodes[at.qoi]).norm() * 1e3);
+          };
+          x = msm::integrate(problem, d).x;
+          add_reference_history(out.history, ref, nodes[at.qoi], spec, problem, mag);
+        }
+        times.push_back(solve.seconds());
+      }
+      out.solve_seconds = median(times);
+      out.memory_mib = std::max(out.memory_mib, solve_memory.added_mib());
+      out.max_strain = model.max_strain(x);
+      std::vector<Vec3> u(nodes.size());
+      for (std::size_t i = 0; i < u.size(); ++i) {
+        u[i] = x.segment<3>(3 * static_cast<Eigen::Index>(i)) - nodes[i];
+      }
+      finish_outcome(out, s, nodes, u, ref_here, mag, at, fine.max_abs_principal_strain);
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::exception& e) {
+      out.ok = false;
+      out.failure = e.what();
+      if (o.log) *o.log << "      FAILED: " << e.what() << "\n";
+    }
+    result.outcomes.push_back(out);
+    progress.end();
+  }
+}
+
 }  // namespace
+
+Scene quick_variant(Scene s) {
+  s.model_levels = {0};
+  s.vessel.level = 0;
+  const bool mixed = std::any_of(s.poisson_ratios.begin(), s.poisson_ratios.end(),
+                                 [](double nu) { return nu >= kMixedThreshold; });
+  s.reference_level = std::min(s.reference_level, mixed ? 0 : 1);
+  if (s.load.magnitudes.size() > 2) {
+    s.load.magnitudes = {s.load.magnitudes.front(), s.load.magnitudes.back()};
+  }
+  return s;
+}
 
 SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
   std::ostream null_stream(nullptr);
@@ -279,7 +485,8 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
   result.qoi_point = qoi_point(s);
 
   log << "scene " << s.name << ": " << describe(s.vessel) << "\n";
-  const TetMesh model_mesh = mesh_at_level(s, s.vessel.level, o);
+  std::map<int, TetMesh> model_meshes;
+  for (const int level : s.model_levels) model_meshes.emplace(level, mesh_at_level(s, level, o));
   const TetMesh fine_mesh = mesh_at_level(s, s.reference_level, o);
   std::unique_ptr<TetMesh> coarse_mesh;
   if (s.reference_level > 0) {
@@ -288,7 +495,7 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
 
   std::size_t cases = 0;
   for (const auto& m : s.models) cases += m.kind == ModelKind::fem ? 1 : s.load.magnitudes.size();
-  Progress progress(log, s.poisson_ratios.size() * (1 + cases));
+  Progress progress(log, s.poisson_ratios.size() * (1 + s.model_levels.size() * cases));
 
   for (const double nu : s.poisson_ratios) {
     progress.begin("reference P2 (level " + std::to_string(s.reference_level) + ", ν = " +
@@ -311,79 +518,21 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
     result.references.push_back(info);
     progress.end();
 
-    for (const auto& spec : s.models) {
-      ModelOutcome base;
-      base.model = spec.name;
-      base.kind = to_string(spec.kind);
-      base.poisson_ratio = nu;
-      if (spec.kind == ModelKind::fem) {
-        progress.begin(spec.name + " (FEM P" + std::to_string(spec.degree) + ")");
-        run_fem_model(s, spec, nu, model_mesh, ref, fine, o, base, result);
-        progress.end();
-        continue;
-      }
-      // Mass-spring model.
-      msm::NetworkOptions net_options;
-      net_options.model = spec.kind == ModelKind::volume_msm ? "volume" : "surface";
-      net_options.surface = spec.surface;
-      net_options.topology = spec.topology;
-      net_options.stiffness = msm::parse_stiffness_rule(spec.stiffness);
-      net_options.stiffness_params.youngs_modulus = s.youngs_modulus;
-      net_options.stiffness_params.poisson_ratio = nu;
-      net_options.mass = msm::parse_mass_rule(spec.mass);
-      net_options.density = s.density;
-      Stopwatch setup;
-      const msm::BuiltNetwork built = msm::build_network(model_mesh, s.vessel, net_options);
-      const msm::SpringModel model(built.network, spec.damping);
-      base.setup_seconds = setup.seconds();
-      base.detail = built.topology + ", " + spec.stiffness + " stiffness, " + spec.mass +
-                    " masses, " + spec.solver;
-      base.nodes = built.network.nodes.size();
-      const ReferenceAtPoints at = reference_at(ref, built.network.nodes);
-      const std::size_t qoi = nearest(built.network.nodes, result.qoi_point);
-      for (const double mag : s.load.magnitudes) {
-        progress.begin(spec.name + " at " + std::to_string(mag) + " (" + to_string(s.load.kind) +
-                       ")");
-        ModelOutcome out = base;
-        out.magnitude = mag;
-        try {
-          const msm::Problem problem = msm_problem(s, model, built, model_mesh, mag);
-          out.unknowns = free_unknowns(problem);
-          std::vector<double> times;
-          Eigen::VectorXd x;
-          for (int k = 0; k < std::max(1, o.repeats); ++k) {
-            Stopwatch solve;
-            if (spec.solver == "static") {
-              x = msm::solve_static(problem).x;
-            } else if (spec.solver == "linear") {
-              x = msm::solve_linear(problem).x;
-            } else if (spec.solver == "relaxation") {
-              x = msm::dynamic_relaxation(problem).x;
-            } else {
-              msm::DynamicOptions d;
-              d.integrator = msm::parse_integrator(spec.solver);
-              d.dt = spec.dt;
-              d.steps = static_cast<int>(spec.steps);
-              x = msm::integrate(problem, d).x;
-            }
-            times.push_back(solve.seconds());
-          }
-          out.solve_seconds = median(times);
-          out.max_strain = model.max_strain(x);
-          std::vector<Vec3> u(built.network.nodes.size());
-          for (std::size_t i = 0; i < u.size(); ++i) {
-            u[i] = x.segment<3>(3 * static_cast<Eigen::Index>(i)) - built.network.nodes[i];
-          }
-          finish_outcome(out, u, at, mag, qoi, fine.max_abs_principal_strain);
-        } catch (const InputError&) {
-          throw;
-        } catch (const std::exception& e) {
-          out.ok = false;
-          out.failure = e.what();
-          log << "      FAILED: " << e.what() << "\n";
+    for (const auto& [level, mesh] : model_meshes) {
+      for (const auto& spec : s.models) {
+        ModelOutcome base;
+        base.model = spec.name;
+        base.kind = to_string(spec.kind);
+        base.poisson_ratio = nu;
+        base.level = level;
+        if (spec.kind == ModelKind::fem) {
+          progress.begin(spec.name + " (FEM P" + std::to_string(spec.degree) + ", level " +
+                         std::to_string(level) + ")");
+          run_fem_model(s, spec, nu, mesh, ref, fine, o, base, result);
+          progress.end();
+        } else {
+          run_msm_model(s, spec, nu, mesh, ref, fine, o, progress, base, result);
         }
-        result.outcomes.push_back(out);
-        progress.end();
       }
     }
   }

@@ -33,19 +33,43 @@ struct ReferenceInfo {
   double max_abs_strain_unit = 0.0;  ///< largest |principal strain| at unit load
 };
 
-/// One model at one (ν, magnitude).
+/// Radial displacement u·e_ρ along the wall line through the QoI point (the model's nodes at the
+/// QoI's angle around the centreline and nearest its radius), sorted by arc length s.
+struct WallProfile {
+  std::vector<double> s_mm;
+  std::vector<double> model_mm;
+  std::vector<double> reference_mm;
+};
+
+/// The QoI displacement magnitude over time (dynamic models), sampled. The reference is the FEM
+/// transient (Newmark, average acceleration) of the same step load on the reference mesh, at the
+/// model's QoI node, with the model's point damping mapped to mass-proportional damping,
+/// interpolated linearly to the model's sample times.
+struct History {
+  std::vector<double> time_s;
+  std::vector<double> model_mm;
+  std::vector<double> reference_mm;
+  double max_error_mm = 0.0;  ///< max over the samples of |model − reference|
+  long steps = 0;
+  double simulated_s = 0.0;   ///< dt × steps
+  double mass_damping = 0.0;  ///< α of the FEM transient, 1/s
+};
+
+/// One model at one (ν, level, magnitude).
 struct ModelOutcome {
   std::string model;
   std::string kind;       ///< fem | surface_msm | volume_msm
   std::string detail;     ///< element or topology, rules, solver
   double poisson_ratio = 0.0;
   double magnitude = 0.0;  ///< N, Pa or g
+  int level = 0;           ///< mesh level of the model
   bool ok = false;
   std::string failure;     ///< why it did not finish (divergence, no convergence, ...)
   std::size_t nodes = 0;
   std::size_t unknowns = 0;  ///< DoFs or 3 × free nodes
   double setup_seconds = 0.0;
   double solve_seconds = 0.0;  ///< median over repeats
+  double memory_mib = 0.0;  ///< peak resident memory added by set-up and solve
   ErrorStatistics error;       ///< against the reference at the model's nodes
   ErrorStatistics reference_uncertainty;  ///< the reference's own estimated error there (max, rms)
   bool has_reference_uncertainty = false;  ///< false when the reference has no coarser level
@@ -53,6 +77,8 @@ struct ModelOutcome {
   double qoi_reference_mm = 0.0;     ///< reference there
   double max_strain = 0.0;           ///< largest strain of the model (springs or FEM)
   bool beyond_linear_regime = false;  ///< max strain of the reference > 5 %
+  WallProfile wall_profile;
+  History history;  ///< dynamic models only
 };
 
 struct SceneResult {
@@ -63,16 +89,32 @@ struct SceneResult {
   double seconds = 0.0;
 };
 
+/// The --quick variant of a scene: the coarsest useful levels (models at 0, reference at 1 so that
+/// level 0 gives its uncertainty) and only the smallest and largest load. Taylor–Hood (ν ≥ 0.49)
+/// goes to a direct solver that needs minutes and gigabytes at level 1, so scenes with such a ν
+/// keep their reference at level 0 (then without an uncertainty estimate).
+Scene quick_variant(Scene scene);
+
 /// Runs the scene. Throws InputError for inputs the scene validation cannot see (a contact point
 /// off the generated wall, roller ends on the arch); a model that fails (diverges, does not
 /// converge) is recorded as failed with its reason, and the others still run.
 SceneResult run_scene(const Scene& scene, const HarnessOptions& options);
 
+/// Runs the scenes one after another (a header line per scene on options.log) and writes
+/// results.json (with reference_kernel_seconds() timed first), results.csv and summary.md into
+/// `output_dir`, which is created and checked writable before anything runs (InputError).
+std::vector<SceneResult> run_and_write(const std::vector<Scene>& scenes,
+                                       const HarnessOptions& options,
+                                       const std::filesystem::path& output_dir,
+                                       const std::string& command);
+
 /// Results as versioned JSON (schema "vesselverify.results", version 1; see
 /// verification/results.schema.json), CSV (one row per model, ν and magnitude) and a Markdown
 /// summary table; each written atomically.
+/// `reference_kernel_seconds` (reference_kernel_seconds() of the same run, for the gate's
+/// normalised timings) is written when positive.
 void write_results_json(const std::filesystem::path& path, const std::vector<SceneResult>& results,
-                        const std::string& command);
+                        const std::string& command, double reference_kernel_seconds = 0.0);
 void write_results_csv(const std::filesystem::path& path, const std::vector<SceneResult>& results);
 void write_summary_markdown(const std::filesystem::path& path,
                             const std::vector<SceneResult>& results, const std::string& command);

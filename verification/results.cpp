@@ -1,3 +1,4 @@
+#include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -5,6 +6,8 @@
 #include <unistd.h>
 
 #include "meshes/atomic_file.hpp"
+#include "meshes/errors.hpp"
+#include "verification/timing.hpp"
 #include "verification/harness.hpp"
 
 namespace vessel {
@@ -46,11 +49,13 @@ nlohmann::json scene_json(const SceneResult& r) {
                      {"detail", o.detail},
                      {"poisson_ratio", o.poisson_ratio},
                      {"magnitude", o.magnitude},
+                     {"level", o.level},
                      {"ok", o.ok},
                      {"nodes", o.nodes},
                      {"unknowns", o.unknowns},
                      {"setup_seconds", o.setup_seconds},
-                     {"solve_seconds", o.solve_seconds}};
+                     {"solve_seconds", o.solve_seconds},
+                     {"memory_mib", o.memory_mib}};
     if (o.ok) {
       j["error"] = error_json(o.error);
       if (o.has_reference_uncertainty) {
@@ -63,6 +68,18 @@ nlohmann::json scene_json(const SceneResult& r) {
       j["qoi_reference_mm"] = o.qoi_reference_mm;
       j["max_strain"] = o.max_strain;
       j["beyond_linear_regime"] = o.beyond_linear_regime;
+      j["wall_profile"] = {{"s_mm", o.wall_profile.s_mm},
+                           {"model_mm", o.wall_profile.model_mm},
+                           {"reference_mm", o.wall_profile.reference_mm}};
+      if (!o.history.time_s.empty()) {
+        j["history"] = {{"time_s", o.history.time_s},
+                        {"model_mm", o.history.model_mm},
+                        {"reference_mm", o.history.reference_mm},
+                        {"max_error_mm", o.history.max_error_mm},
+                        {"steps", o.history.steps},
+                        {"simulated_s", o.history.simulated_s},
+                        {"mass_damping_per_s", o.history.mass_damping}};
+      }
     } else {
       j["failure"] = o.failure;
     }
@@ -73,7 +90,7 @@ nlohmann::json scene_json(const SceneResult& r) {
           {"source", s.source.string()},
           {"description", s.description},
           {"vessel", describe(s.vessel)},
-          {"model_level", s.vessel.level},
+          {"model_levels", s.model_levels},
           {"reference_level", s.reference_level},
           {"youngs_modulus_pa", s.youngs_modulus},
           {"load", to_string(s.load.kind)},
@@ -82,6 +99,7 @@ nlohmann::json scene_json(const SceneResult& r) {
                             : (s.load.kind == LoadKind::pressure ? "Pa" : "g")},
           {"qoi_point_mm",
            {r.qoi_point.x() * 1e3, r.qoi_point.y() * 1e3, r.qoi_point.z() * 1e3}},
+          {"tolerance_max_error_mm", s.tolerances.max_error_mm},
           {"seconds", r.seconds},
           {"references", refs},
           {"outcomes", outcomes}};
@@ -94,11 +112,11 @@ const char* load_unit(LoadKind k) {
 }  // namespace
 
 void write_results_json(const std::filesystem::path& path, const std::vector<SceneResult>& results,
-                        const std::string& command) {
+                        const std::string& command, double reference_kernel_seconds) {
   nlohmann::json scenes = nlohmann::json::array();
   for (const auto& r : results) scenes.push_back(scene_json(r));
-  const nlohmann::json j{{"schema", "vesselverify.results"},
-                         {"schema_version", 1},
+  nlohmann::json j{{"schema", "vesselverify.results"},
+                         {"schema_version", 2},
                          {"units", {{"displacement", "mm"}, {"time", "s"}, {"strain", "1"}}},
                          {"date", now_utc()},
                          {"command", command},
@@ -107,20 +125,60 @@ void write_results_json(const std::filesystem::path& path, const std::vector<Sce
                            {"hardware_threads", std::thread::hardware_concurrency()}}},
                          {"build", {{"compiler", __VERSION__}, {"cxx_standard", __cplusplus}}},
                          {"scenes", scenes}};
+  if (reference_kernel_seconds > 0.0) j["reference_kernel_seconds"] = reference_kernel_seconds;
   write_file_atomically(path, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+}
+
+std::vector<SceneResult> run_and_write(const std::vector<Scene>& scenes,
+                                       const HarnessOptions& options,
+                                       const std::filesystem::path& output_dir,
+                                       const std::string& command) {
+  std::error_code ec;
+  std::filesystem::create_directories(output_dir, ec);
+  bool writable = !ec;
+  if (writable) {
+    const std::filesystem::path probe = output_dir / ".vesselverify-write-test";
+    writable = static_cast<bool>(std::ofstream(probe));
+    std::error_code ignored;
+    std::filesystem::remove(probe, ignored);
+  }
+  if (!writable) {
+    throw InputError(output_dir.string() + ": output directory cannot be " +
+                     (ec ? "created (" + ec.message() + ")" : std::string("written")) +
+                     "; expected a writable directory");
+  }
+  const double kernel = reference_kernel_seconds();
+  std::vector<SceneResult> results;
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    if (options.log) {
+      *options.log << "== scene " << i + 1 << "/" << scenes.size() << ": " << scenes[i].name
+                   << " ==\n";
+    }
+    results.push_back(run_scene(scenes[i], options));
+  }
+  write_results_json(output_dir / "results.json", results, command, kernel);
+  write_results_csv(output_dir / "results.csv", results);
+  write_summary_markdown(output_dir / "summary.md", results, command);
+  if (options.log) {
+    *options.log << "wrote " << (output_dir / "results.json").string()
+                 << ", results.csv and summary.md\n";
+  }
+  return results;
 }
 
 void write_results_csv(const std::filesystem::path& path, const std::vector<SceneResult>& results) {
   write_file_atomically(path, [&](std::ostream& out) {
-    out << "scene,model,kind,poisson_ratio,magnitude,load_unit,ok,nodes,unknowns,setup_s,solve_s,"
+    out << "scene,model,kind,poisson_ratio,level,magnitude,load_unit,ok,nodes,unknowns,setup_s,"
+           "solve_s,memory_mib,"
            "max_mm,mean_mm,stddev_mm,rms_mm,relative_l2,ref_uncertainty_max_mm,qoi_mm,"
            "qoi_reference_mm,max_strain,beyond_linear_regime\n";
     out << std::setprecision(8);
     for (const auto& r : results) {
       for (const auto& o : r.outcomes) {
         out << r.scene.name << ',' << o.model << ',' << o.kind << ',' << o.poisson_ratio << ','
-            << o.magnitude << ',' << load_unit(r.scene.load.kind) << ',' << (o.ok ? 1 : 0) << ','
-            << o.nodes << ',' << o.unknowns << ',' << o.setup_seconds << ',' << o.solve_seconds;
+            << o.level << ',' << o.magnitude << ',' << load_unit(r.scene.load.kind) << ','
+            << (o.ok ? 1 : 0) << ',' << o.nodes << ',' << o.unknowns << ',' << o.setup_seconds
+            << ',' << o.solve_seconds << ',' << o.memory_mib;
         if (o.ok) {
           out << ',' << o.error.max_mm << ',' << o.error.mean_mm << ',' << o.error.stddev_mm << ','
               << o.error.rms_mm << ',' << o.error.relative_l2 << ',';
@@ -155,11 +213,11 @@ void write_summary_markdown(const std::filesystem::path& path,
           << "; reference level " << r.scene.reference_level << " (" << std::fixed
           << std::setprecision(1) << r.seconds << " s in all)." << std::defaultfloat
           << std::setprecision(3) << "\n\n";
-      out << "| model | ν | load (" << unit
+      out << "| model | ν | level | load (" << unit
           << ") | max | mean | std | RMS | rel. L2 | ref. unc. (max) | QoI model / ref. | solve s | "
-             "unknowns |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+             "unknowns |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
       for (const auto& o : r.outcomes) {
-        out << "| " << o.model << " | " << o.poisson_ratio << " | " << o.magnitude
+        out << "| " << o.model << " | " << o.poisson_ratio << " | " << o.level << " | " << o.magnitude
             << (o.beyond_linear_regime ? " ⚠" : "") << " | ";
         if (!o.ok) {
           out << "FAILED: " << o.failure << " | | | | | | | | |\n";

@@ -114,21 +114,55 @@ class TableReader {
     return static_cast<long>(*v);
   }
 
-  /// A string that `parse` (an msm parse_* function) accepts; its InputError becomes this key's.
-  template <class Parse>
-  std::string name_or(const std::string& key, const std::string& fallback, Parse&& parse) {
+  /// An integer or an array of integers, each within [lo, hi]; at least one.
+  std::vector<int> integers_or(const std::string& key, std::vector<int> fallback, long lo, long hi) {
     const toml::node* n = get(key);
     if (!n) return fallback;
-    const auto v = n->value_exact<std::string>();
-    if (!v) fail(n, key, "found " + show(*n) + ", expected a string");
-    try {
-      (void)parse(*v);
-    } catch (const InputError& e) {
-      fail(n, key, e.what());
+    std::vector<const toml::node*> items;
+    if (const auto* arr = n->as_array()) {
+      if (arr->empty()) fail(n, key, "found an empty array, expected at least one integer");
+      for (const auto& item : *arr) items.push_back(&item);
+    } else {
+      items.push_back(n);
     }
-    return *v;
+    std::vector<int> out;
+    for (const toml::node* item : items) {
+      const auto v = item->value_exact<int64_t>();
+      if (!v || *v < lo || *v > hi) {
+        fail(item, key, "found " + show(*item) + ", expected an integer in [" + std::to_string(lo) +
+                            ", " + std::to_string(hi) + "] or an array of them");
+      }
+      out.push_back(static_cast<int>(*v));
+    }
+    return out;
   }
-
+  /// A string, or an array of strings, each accepted by `parse` (an msm parse_* function); its
+  /// InputError becomes this key's.
+  template <class Parse>
+  std::vector<std::string> names_or(const std::string& key, const std::string& fallback,
+                                    Parse&& parse) {
+    const toml::node* n = get(key);
+    if (!n) return {fallback};
+    std::vector<const toml::node*> items;
+    if (const auto* arr = n->as_array()) {
+      if (arr->empty()) fail(n, key, "found an empty array, expected at least one name");
+      for (const auto& item : *arr) items.push_back(&item);
+    } else {
+      items.push_back(n);
+    }
+    std::vector<std::string> out;
+    for (const toml::node* item : items) {
+      const auto v = item->value_exact<std::string>();
+      if (!v) fail(item, key, "found " + show(*item) + ", expected a string or an array of strings");
+      try {
+        (void)parse(*v);
+      } catch (const InputError& e) {
+        fail(item, key, e.what());
+      }
+      out.push_back(*v);
+    }
+    return out;
+  }
   std::string string_or(const std::string& key, const std::string& fallback,
                         const std::vector<std::string>& allowed = {}) {
     const toml::node* n = get(key);
@@ -195,7 +229,7 @@ class TableReader {
   std::vector<std::string> known_;
 };
 
-VesselParams read_vessel(TableReader r, int& reference_level) {
+VesselParams read_vessel(TableReader r, std::vector<int>& levels, int& reference_level) {
   VesselParams p;
   const std::string kind = r.string_or("kind", "straight", {"straight", "arch"});
   p.kind = kind == "arch" ? VesselKind::arch : VesselKind::straight;
@@ -205,8 +239,12 @@ VesselParams read_vessel(TableReader r, int& reference_level) {
   p.bend_radius = r.positive("bend_radius", p.bend_radius, "m");
   const std::string mesh = r.string_or("mesh", "structured", {"structured", "unstructured"});
   p.style = mesh == "structured" ? MeshStyle::structured : MeshStyle::unstructured;
-  p.level = static_cast<int>(r.integer_or("level", 0, 0, kMaxMeshLevel));
-  reference_level = static_cast<int>(r.integer_or("reference_level", p.level, 0, kMaxMeshLevel));
+  levels = r.integers_or("level", {0}, 0, kMaxMeshLevel);
+  std::sort(levels.begin(), levels.end());
+  levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+  p.level = levels.front();
+  reference_level =
+      static_cast<int>(r.integer_or("reference_level", levels.back(), 0, kMaxMeshLevel));
   r.finish();
   try {
     validate(p);
@@ -216,7 +254,21 @@ VesselParams read_vessel(TableReader r, int& reference_level) {
   return p;
 }
 
-ModelSpec read_model(TableReader r, std::size_t index) {
+bool is_integrator(const std::string& solver) {
+  return std::find(kStaticSolvers.begin(), kStaticSolvers.end(), solver) == kStaticSolvers.end();
+}
+
+/// "5e-05" rather than "0.000050".
+std::string short_number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+/// One [[models]] table. `stiffness`, `mass`, `solver` and `dt` (and `degree` for FEM) may be
+/// arrays: the table then stands for every combination (a sweep), each named after the table's
+/// name plus the swept values, e.g. "volume[stiffness=lloyd;dt=2e-05]".
+std::vector<ModelSpec> read_model(TableReader r, std::size_t index) {
   ModelSpec m;
   const std::string kind = r.string_or("kind", "", {"fem", "surface_msm", "volume_msm"});
   if (kind.empty()) r.fail(nullptr, "kind", "missing; expected one of fem, surface_msm, volume_msm");
@@ -224,39 +276,73 @@ ModelSpec read_model(TableReader r, std::size_t index) {
                          : (kind == "surface_msm" ? ModelKind::surface_msm : ModelKind::volume_msm);
   m.name = r.string_or("name", kind + "_" + std::to_string(index + 1));
   if (m.kind == ModelKind::fem) {
-    m.degree = static_cast<int>(r.integer_or("degree", 2, 1, 2));
-  } else {
-    if (m.kind == ModelKind::surface_msm) m.surface = r.string_or("surface", m.surface, kSurfaces);
-    if (m.kind == ModelKind::surface_msm) m.topology = r.string_or("topology", m.topology, kTopologies);
-    m.stiffness = r.name_or("stiffness", m.kind == ModelKind::volume_msm ? "seed001" : "seed000",
-                            msm::parse_stiffness_rule);
-    m.mass = r.name_or("mass", m.mass, msm::parse_mass_rule);
-    m.solver = r.name_or("solver", m.solver, [](const std::string& name) {
-      if (std::find(kStaticSolvers.begin(), kStaticSolvers.end(), name) != kStaticSolvers.end()) {
-        return 0;
-      }
-      try {
-        (void)msm::parse_integrator(name);
-      } catch (const InputError& e) {
-        throw InputError("expected static, linear, relaxation or an integrator (" +
-                         std::string(e.what()) + ")");
-      }
-      return 0;
-    });
-    m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
-    const bool integrator =
-        std::find(kStaticSolvers.begin(), kStaticSolvers.end(), m.solver) == kStaticSolvers.end();
-    if (integrator) {
-      const toml::node* dt = r.get("dt");
-      if (!dt) r.fail(nullptr, "dt", "missing; solver \"" + m.solver + "\" needs a time step > 0 s");
-      m.dt = r.number(*dt, "dt", 0.0, HUGE_VAL, "s");
-      if (m.dt <= 0.0) r.fail(dt, "dt", "found 0, expected a time step > 0 s");
-      m.steps = r.integer_or("steps", 0, 1, 1'000'000'000L);
-      if (m.steps == 0) r.fail(nullptr, "steps", "missing; expected the number of steps (> 0)");
+    const std::vector<int> degrees = r.integers_or("degree", {2}, 1, 2);
+    r.finish();
+    std::vector<ModelSpec> out;
+    for (const int d : degrees) {
+      ModelSpec c = m;
+      c.degree = d;
+      if (degrees.size() > 1) c.name += "[degree=" + std::to_string(d) + "]";
+      out.push_back(c);
     }
+    return out;
+  }
+  if (m.kind == ModelKind::surface_msm) m.surface = r.string_or("surface", m.surface, kSurfaces);
+  if (m.kind == ModelKind::surface_msm) m.topology = r.string_or("topology", m.topology, kTopologies);
+  const auto stiffness = r.names_or(
+      "stiffness", m.kind == ModelKind::volume_msm ? "seed001" : "seed000", msm::parse_stiffness_rule);
+  const auto mass = r.names_or("mass", m.mass, msm::parse_mass_rule);
+  const auto solvers = r.names_or("solver", m.solver, [](const std::string& name) {
+    if (!is_integrator(name)) return 0;
+    try {
+      (void)msm::parse_integrator(name);
+    } catch (const InputError& e) {
+      throw InputError("expected static, linear, relaxation or an integrator (" +
+                       std::string(e.what()) + ")");
+    }
+    return 0;
+  });
+  m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
+  const bool any_integrator = std::any_of(solvers.begin(), solvers.end(), is_integrator);
+  std::vector<double> dts{0.0};
+  if (any_integrator) {
+    const toml::node* dt = r.get("dt");
+    const std::string integrator = *std::find_if(solvers.begin(), solvers.end(), is_integrator);
+    if (!dt) r.fail(nullptr, "dt", "missing; solver \"" + integrator + "\" needs a time step > 0 s");
+    dts = r.numbers(*dt, "dt", 0.0, HUGE_VAL, "s");
+    for (const double v : dts) {
+      if (v <= 0.0) r.fail(dt, "dt", "found 0, expected a time step > 0 s");
+    }
+    m.steps = r.integer_or("steps", 0, 1, 1'000'000'000L);
+    if (m.steps == 0) r.fail(nullptr, "steps", "missing; expected the number of steps (> 0)");
   }
   r.finish();
-  return m;
+  std::vector<ModelSpec> out;
+  for (const auto& k : stiffness) {
+    for (const auto& ms : mass) {
+      for (const auto& solver : solvers) {
+        for (const double dt : is_integrator(solver) ? dts : std::vector<double>{0.0}) {
+          ModelSpec c = m;
+          c.stiffness = k;
+          c.mass = ms;
+          c.solver = solver;
+          c.dt = dt;
+          if (!is_integrator(solver)) c.steps = 0;
+          std::string swept;
+          const auto add = [&](bool varies, const std::string& key, const std::string& value) {
+            if (varies) swept += (swept.empty() ? "" : ";") + key + "=" + value;
+          };
+          add(stiffness.size() > 1, "stiffness", k);
+          add(mass.size() > 1, "mass", ms);
+          add(solvers.size() > 1, "solver", solver);
+          add(dts.size() > 1 && is_integrator(solver), "dt", short_number(dt));
+          if (!swept.empty()) c.name += "[" + swept + "]";
+          out.push_back(c);
+        }
+      }
+    }
+  }
+  return out;
 }
 
 LoadSpec read_load(TableReader r) {
@@ -302,7 +388,7 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
   scene.name = r.string_or("name", "");
   if (scene.name.empty()) r.fail(nullptr, "name", "missing; expected the scene's name");
   scene.description = r.string_or("description", "");
-  scene.vessel = read_vessel(r.sub("vessel", true), scene.reference_level);
+  scene.vessel = read_vessel(r.sub("vessel", true), scene.model_levels, scene.reference_level);
 
   TableReader material = r.sub("material", false);
   scene.youngs_modulus = material.positive("E", scene.youngs_modulus, "Pa");
@@ -331,11 +417,14 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
   for (std::size_t i = 0; i < list->size(); ++i) {
     const auto* t = list->get(i)->as_table();
     if (!t) r.fail(list->get(i), "models", "expected [[models]] tables");
-    ModelSpec m = read_model(TableReader(*t, "models[" + std::to_string(i) + "].", source_name), i);
-    if (!names.insert(m.name).second) {
-      r.fail(list->get(i), "models", "model name \"" + m.name + "\" is used twice; names must be unique");
+    for (ModelSpec& m :
+         read_model(TableReader(*t, "models[" + std::to_string(i) + "].", source_name), i)) {
+      if (!names.insert(m.name).second) {
+        r.fail(list->get(i), "models",
+               "model name \"" + m.name + "\" is used twice; names must be unique");
+      }
+      scene.models.push_back(std::move(m));
     }
-    scene.models.push_back(std::move(m));
   }
 
   TableReader tol = r.sub("tolerances", false);

@@ -17,7 +17,9 @@ enum class LoadKind { contact, pressure, gravity };
 enum class ModelKind { fem, surface_msm, volume_msm };
 
 /// One model to run against the reference. FEM models use `degree`; mass-spring models use the
-/// rest (names as the msm library defines them; checked against the lists in scene.cpp).
+/// rest (names as the msm library defines them; checked against the lists in scene.cpp). A
+/// [[models]] table whose stiffness, mass, solver, dt or degree is an array expands into one
+/// ModelSpec per combination (a sweep from the scene file).
 struct ModelSpec {
   std::string name;  ///< unique within the scene, used in results and reports
   ModelKind kind = ModelKind::fem;
@@ -47,8 +49,10 @@ struct Scene {
   std::string name;
   std::string description;
   std::filesystem::path source;  ///< the file it was read from
-  VesselParams vessel;           ///< vessel.level is the mass-spring models' level
-  int reference_level = 1;       ///< finest FEM level of the reference
+  VesselParams vessel;           ///< vessel.level is model_levels.front()
+  /// Levels the models run at (`level = 1` or `level = [0, 1, 2]`: a convergence sweep), ascending.
+  std::vector<int> model_levels{0};
+  int reference_level = 1;       ///< finest FEM level of the reference (default: the finest model level)
   double youngs_modulus = 14.24e3;  ///< Pa
   std::vector<double> poisson_ratios{0.45};
   double density = 1060.0;  ///< kg/m³

@@ -29,6 +29,12 @@ struct TimingSample {
 /// Runs `fn` `warmup` times untimed, then `repeats` times timed (repeats ≥ 1).
 TimingSample time_median(const std::function<void()>& fn, int repeats = 5, int warmup = 1);
 
+/// Seconds of a fixed computation shaped like the models' work (a sparse Cholesky factorisation
+/// and solve of a 3-D Laplacian, and a pass of spring forces over a fixed network), median of 5
+/// after a warm-up. The gate divides solve times by it, so baselines recorded on one machine
+/// remain comparable on another (Google Benchmark's practice of comparing ratios within one run).
+double reference_kernel_seconds();
+
 /// Median of a non-empty sample (std::invalid_argument if empty).
 double median(std::vector<double> values);
 

@@ -2,6 +2,7 @@
 // and bad input giving a clear message, exit code 1 and no output file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -89,4 +90,29 @@ TEST(FemCli, ModesArePrintedAndWritten) {
   const auto j = nlohmann::json::parse(vessel::test::read_text(dir / "m.json"));
   ASSERT_EQ(j["modal"]["frequencies_hz"].size(), 4u);
   EXPECT_GT(j["modal"]["frequencies_hz"][0].get<double>(), 0.0);
+}
+
+TEST(FemCli, TransientPrintsTheHistoryAndWritesTheCsv) {
+  TempDir dir;
+  const auto csv = dir / "h.csv";
+  const auto r = vv("fem " + kTube +
+                    "--load contact --contact-point 0.003 0 0.001 --transient --dt 2e-4 --steps "
+                    "30 --mass-damping 50 --history-csv " +
+                    csv.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "Newmark")) << r.output;
+  EXPECT_TRUE(contains(r.output, "ms/step")) << r.output;
+  const std::string text = vessel::test::read_text(csv);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 32);  // header + steps + 1 rows
+  EXPECT_EQ(text.rfind("t_s,ux_mm", 0), 0u) << text.substr(0, 80);
+}
+
+TEST(FemCli, TransientRefusesABadTimeStepAndWritesNothing) {
+  TempDir dir;
+  const auto csv = dir / "h.csv";
+  const auto r = vv("fem " + kTube + "--load contact --contact-point 0.003 0 0.001 --transient " +
+                    "--dt -1 --history-csv " + csv.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "time step")) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(csv));
 }

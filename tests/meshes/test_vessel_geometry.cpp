@@ -104,3 +104,26 @@ TEST(VesselGeometry, StructuredCountsDoublePerLevel) {
   EXPECT_GE(c0.expected_nodes(), 1000);
   EXPECT_LE(c0.expected_nodes(), 3000);
 }
+
+TEST(VesselGeometry, CentrelineCoordinatesOfHandPlacedPoints) {
+  const VesselParams tube;
+  const auto t = centreline_coordinates(tube, Vec3(0.0, 3e-3, 7e-3));
+  EXPECT_DOUBLE_EQ(t.s, 7e-3);
+  EXPECT_DOUBLE_EQ(t.rho, 3e-3);
+  EXPECT_NEAR(t.theta, std::numbers::pi / 2.0, 1e-15);
+  EXPECT_NEAR((t.e_rho - Vec3::UnitY()).norm(), 0.0, 1e-15);
+
+  VesselParams arch;
+  arch.kind = VesselKind::arch;  // centreline: radius R about z, φ from 0 to π
+  const double R = arch.bend_radius;
+  // The outer bend's apex at φ = π/2: θ = 0, e_ρ away from the arch's centre.
+  const auto apex = centreline_coordinates(arch, Vec3(0.0, R + 3e-3, 0.0));
+  EXPECT_NEAR(apex.s, R * std::numbers::pi / 2.0, 1e-15);
+  EXPECT_NEAR(apex.rho, 3e-3, 1e-15);
+  EXPECT_NEAR(apex.theta, 0.0, 1e-12);
+  EXPECT_NEAR((apex.e_rho - Vec3::UnitY()).norm(), 0.0, 1e-12);
+  // Above the centreline at φ = 0: θ = π/2; the inner bend: θ = π.
+  EXPECT_NEAR(centreline_coordinates(arch, Vec3(R, 0.0, 2e-3)).theta, std::numbers::pi / 2.0, 1e-12);
+  EXPECT_NEAR(std::abs(centreline_coordinates(arch, Vec3(R - 2e-3, 0.0, 0.0)).theta),
+              std::numbers::pi, 1e-12);
+}

@@ -143,5 +143,72 @@ TEST_F(HarnessLame, ResultsJsonHasEveryFieldItsSchemaRequires) {
   // One CSV row per outcome plus the header.
   const std::string csv = test::read_text(dir / "results.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 8);
-  EXPECT_NE(test::read_text(dir / "summary.md").find("| p1 | 0.3 | 10 |"), std::string::npos);
+  EXPECT_NE(test::read_text(dir / "summary.md").find("| p1 | 0.3 | 0 | 10 |"), std::string::npos);
+}
+
+TEST_F(HarnessLame, WallProfileIsLamesUniformRadialDisplacementAlongTheTube) {
+  // Plane strain holds along the whole tube, so the radial displacement of the inner wall line is
+  // u_r(a) from end to end, for the reference and for P2 (identical to it).
+  const ModelOutcome& o = find(*result_, "p2_same_as_reference", 10.0);
+  const double exact_mm = lame_radial(10.0, 3e-3, 4e-3, 14.24e3, 0.3, 3e-3) * 1e3;
+  ASSERT_GE(o.wall_profile.s_mm.size(), 20u);  // every axial grid line at level 0
+  EXPECT_NEAR(o.wall_profile.s_mm.front(), 0.0, 1e-9);
+  EXPECT_NEAR(o.wall_profile.s_mm.back(), 40.0, 1e-9);
+  for (std::size_t i = 0; i < o.wall_profile.s_mm.size(); ++i) {
+    EXPECT_NEAR(o.wall_profile.reference_mm[i] / exact_mm, 1.0, 0.03) << "s = " << o.wall_profile.s_mm[i];
+    EXPECT_NEAR(o.wall_profile.model_mm[i], o.wall_profile.reference_mm[i], 1e-9);
+  }
+}
+
+namespace {
+
+/// A damped step contact on the smallest tube: the volume model with implicit Euler.
+const char* kDynamic = R"(name = "dynamic_test"
+[vessel]
+kind = "straight"
+mesh = "structured"
+level = 0
+reference_level = 0
+[material]
+E = 14.24e3
+nu = 0.3
+[load]
+type = "contact"
+magnitudes = [1e-4]
+point = [3.0e-3, 0.0, 20.0e-3]
+patch_radius = 1.0e-3
+[[models]]
+name = "volume_implicit"
+kind = "volume_msm"
+stiffness = "seed001"
+solver = "implicit-euler"
+dt = 2e-3
+steps = 250
+damping = 1.5e-4  # N·s/m per node: about critical for the lowest modes
+)";
+
+}  // namespace
+
+TEST(HarnessDynamic, FemTransientSettlesOnTheStaticReferenceAndTheHistoryIsSampled) {
+  const SceneResult r = run_scene(parse_scene(kDynamic, "dynamic_test.toml"), HarnessOptions{});
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  const ModelOutcome& o = r.outcomes[0];
+  ASSERT_TRUE(o.ok) << o.failure;
+  const History& h = o.history;
+  ASSERT_EQ(h.time_s.size(), h.model_mm.size());
+  ASSERT_EQ(h.time_s.size(), h.reference_mm.size());
+  EXPECT_GE(h.time_s.size(), 100u);
+  EXPECT_NEAR(h.time_s.back(), 0.5, 1e-12);
+  EXPECT_NEAR(h.simulated_s, 0.5, 1e-12);
+  EXPECT_EQ(h.reference_mm.front(), 0.0);  // at rest at t = 0
+  // Heavy damping: after 0.5 s the FEM transient (Newmark) has settled on the static P2 solve —
+  // two different computations — and the model's history ends where its final state is.
+  EXPECT_NEAR(h.reference_mm.back() / o.qoi_reference_mm, 1.0, 0.02);
+  EXPECT_NEAR(h.model_mm.back(), o.qoi_displacement_mm, 1e-9);
+  EXPECT_GT(h.mass_damping, 0.0);
+  double max_diff = 0.0;
+  for (std::size_t k = 0; k < h.time_s.size(); ++k) {
+    max_diff = std::max(max_diff, std::abs(h.model_mm[k] - h.reference_mm[k]));
+  }
+  EXPECT_DOUBLE_EQ(h.max_error_mm, max_diff);
 }

@@ -136,3 +136,38 @@ TEST(Scene, ArchTooTightForItsWallIsRefused) {
       error_of(replaced("kind = \"straight\"", "kind = \"arch\"\nbend_radius = 3.5e-3"));
   EXPECT_NE(msg.find("too thick"), std::string::npos) << msg;
 }
+
+TEST(Scene, LevelMayBeAListForAConvergenceSweep) {
+  const Scene s = parse_scene(replaced("level = 0", "level = [2, 0, 1]"), "scene.toml");
+  EXPECT_EQ(s.model_levels, (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(s.vessel.level, 0);
+  EXPECT_EQ(s.reference_level, 2);  // default: the finest model level
+  const auto msg = error_of(replaced("level = 0", "level = [0, 9]"));
+  EXPECT_NE(msg.find("key 'vessel.level': found 9"), std::string::npos) << msg;
+}
+
+TEST(Scene, ArraysInAModelTableExpandIntoOneModelPerCombination) {
+  const std::string model =
+      "[[models]]\nname = \"vol\"\nkind = \"volume_msm\"\nstiffness = [\"seed001\", \"lloyd\"]\n"
+      "solver = [\"static\", \"verlet\"]\ndt = [1e-5, 2e-5]\nsteps = 10\n";
+  const Scene s = parse_scene(std::string(kMinimal) + model, "scene.toml");
+  // 2 rules × (static + verlet at 2 steps) = 6 mass-spring models after the FEM one.
+  ASSERT_EQ(s.models.size(), 7u);
+  std::vector<std::string> names;
+  for (std::size_t i = 1; i < s.models.size(); ++i) names.push_back(s.models[i].name);
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "vol[stiffness=seed001;solver=static]",
+                       "vol[stiffness=seed001;solver=verlet;dt=1e-05]",
+                       "vol[stiffness=seed001;solver=verlet;dt=2e-05]",
+                       "vol[stiffness=lloyd;solver=static]",
+                       "vol[stiffness=lloyd;solver=verlet;dt=1e-05]",
+                       "vol[stiffness=lloyd;solver=verlet;dt=2e-05]"}));
+  EXPECT_EQ(s.models[3].stiffness, "seed001");
+  EXPECT_EQ(s.models[3].solver, "verlet");
+  EXPECT_DOUBLE_EQ(s.models[3].dt, 2e-5);
+  EXPECT_EQ(s.models[4].steps, 0);  // static: no steps
+  const auto msg = error_of(std::string(kMinimal) +
+                            "[[models]]\nkind = \"volume_msm\"\nstiffness = [\"seed001\", 3]\n");
+  EXPECT_NE(msg.find("key 'models[1].stiffness': found 3, expected a string"), std::string::npos)
+      << msg;
+}

@@ -9,9 +9,15 @@ void add_mesh_command(CLI::App& app);
 void add_scene_command(CLI::App& app);
 /// `vesselverify run`; `command_line` is recorded in the results.
 void add_run_command(CLI::App& app, const std::string& command_line);
+/// `vesselverify report`: results → Markdown and HTML report; `command_line` is recorded in it.
+void add_report_command(CLI::App& app, const std::string& command_line);
+/// `vesselverify gate`: the CI gate against a committed baseline.
+void add_gate_command(CLI::App& app, const std::string& command_line);
 /// `vesselverify msm`: run a mass-spring model on a vessel mesh under a contact load.
 void add_msm_command(CLI::App& app);
 /// `vesselverify fem`: the deal.II linear-elastic reference (fem_command.cpp).
 void add_fem_command(CLI::App& app);
+/// `vesselverify stability`: critical time steps and hard cases (stability_command.cpp).
+void add_stability_command(CLI::App& app, const std::string& command_line);
 
 }  // namespace vessel::cli

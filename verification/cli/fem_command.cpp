@@ -48,6 +48,11 @@ struct FemCommandOptions {
   int modes = 0;
   bool curved = false;
   bool distributed = false;
+  bool transient = false;  // Newmark step response after the static solve
+  double dt = fem::TransientOptions{}.dt;
+  int steps = fem::TransientOptions{}.steps;
+  double mass_damping = 0.0;
+  fs::path history_csv;
   fs::path vtu;
   fs::path json;
 };
@@ -90,6 +95,7 @@ void run(FemCommandOptions& o) {
   static NullBuffer null_buffer;
   if (o.distributed) {
     if (o.modes > 0) throw InputError("--modes is serial only: drop it or --distributed");
+    if (o.transient) throw InputError("--transient is serial only: drop it or --distributed");
     mpi = std::make_unique<fem::MpiSession>();
     if (mpi->rank() != 0) std::cout.rdbuf(&null_buffer);
   }
@@ -213,6 +219,61 @@ void run(FemCommandOptions& o) {
     std::cout << "\n";
   }
 
+  // The step response at the contact point (the probe): Newmark average acceleration.
+  fem::TransientResult tr;
+  if (o.transient) {
+    fem::TransientOptions to;
+    to.dt = o.dt;
+    to.steps = o.steps;
+    to.mass_damping = o.mass_damping;
+    to.probe_points = {contact_point};
+    std::cout << "transient (Newmark average acceleration, step load at t = 0): " << o.steps
+              << " steps of " << o.dt << " s, mass damping " << o.mass_damping << " 1/s ..."
+              << std::flush;
+    tr = solver.transient(to);
+    const Vec3 u_static = solver.displacement_at({contact_point})[0];
+    const Vec3 dir = has_contact ? Vec3(-patch.outward_normal)
+                                 : (u_static.norm() > 0 ? Vec3(u_static.normalized())
+                                                        : Vec3(1.0, 0.0, 0.0));
+    std::cout << std::fixed << std::setprecision(3) << " setup " << tr.setup_seconds << " s, "
+              << tr.seconds_per_step * 1e3 << " ms/step" << std::defaultfloat << "\n";
+    std::cout << std::setprecision(3) << "  probe " << mm(contact_point) << " mm, displacement along ("
+              << dir.x() << ", " << dir.y() << ", " << dir.z() << "), static "
+              << u_static.dot(dir) * 1e3 << " mm:\n"
+              << std::setprecision(6);
+    const std::size_t rows = std::min<std::size_t>(20, tr.time.size() - 1);
+    double peak = 0.0, sum = 0.0;
+    for (std::size_t n = 0; n < tr.time.size(); ++n) {
+      const double u = tr.probe_displacement[n][0].dot(dir);
+      peak = std::max(peak, std::abs(u));
+      if (n > 0) sum += u;
+    }
+    std::cout << "    t (ms)      u (mm)        |u| (mm)\n";
+    for (std::size_t k = 0; k <= rows; ++k) {
+      const std::size_t n = rows == 0 ? 0 : k * (tr.time.size() - 1) / rows;
+      const Vec3& u = tr.probe_displacement[n][0];
+      std::cout << "    " << std::setw(10) << tr.time[n] * 1e3 << "  " << std::setw(12)
+                << u.dot(dir) * 1e3 << "  " << std::setw(12) << u.norm() * 1e3 << "\n";
+    }
+    const double mean = sum / static_cast<double>(tr.time.size() - 1);
+    std::cout << "  peak |u| " << peak * 1e3 << " mm (" << peak / std::abs(u_static.dot(dir))
+              << " x static), time mean " << mean * 1e3 << " mm, final "
+              << tr.probe_displacement.back()[0].dot(dir) * 1e3 << " mm\n";
+    if (!o.history_csv.empty()) {
+      write_file_atomically(o.history_csv, [&](std::ostream& out) {
+        out << "t_s,ux_mm,uy_mm,uz_mm,kinetic_energy_mJ,strain_energy_mJ,load_work_mJ\n";
+        out << std::setprecision(12);
+        for (std::size_t n = 0; n < tr.time.size(); ++n) {
+          const Vec3& u = tr.probe_displacement[n][0];
+          out << tr.time[n] << "," << u.x() * 1e3 << "," << u.y() * 1e3 << "," << u.z() * 1e3
+              << "," << tr.kinetic_energy[n] * 1e3 << "," << tr.strain_energy[n] * 1e3 << ","
+              << tr.load_work[n] * 1e3 << "\n";
+        }
+      });
+      std::cout << "wrote " << o.history_csv.string() << "\n";
+    }
+  }
+
   t0 = Clock::now();
   if (!o.vtu.empty()) {
     VtuField disp{"displacement", 3, {}}, strain{"strain", 6, {}}, stress{"stress", 6, {}};
@@ -314,6 +375,16 @@ void run(FemCommandOptions& o) {
       j["modal"] = {{"frequencies_hz", modal.frequencies_hz},
                     {"dofs", modal.n_dofs},
                     {"seconds", modal.seconds}};
+    }
+    if (o.transient) {
+      j["transient"] = {{"dt_s", o.dt},
+                        {"steps", o.steps},
+                        {"mass_damping_per_s", o.mass_damping},
+                        {"probe_mm", json_vec(contact_point, 1e3)},
+                        {"final_probe_displacement_mm",
+                         json_vec(tr.probe_displacement.back()[0], 1e3)},
+                        {"setup_seconds", tr.setup_seconds},
+                        {"seconds_per_step", tr.seconds_per_step}};
     }
     if (have_contact_u) {
       j["contact"] = {{"point_mm", json_vec(contact_point, 1e3)},
@@ -459,6 +530,8 @@ void add_fem_command(CLI::App& app) {
       "  vesselverify fem --nu 0.5                          # Taylor-Hood P2-P1 (automatic)\n"
       "  vesselverify fem --degree 2 --bc clamped-inlet --modes 10   # natural frequencies\n"
       "  vesselverify fem --degree 2 --level 2 --solver cg-amg\n"
+      "  vesselverify fem --load contact --degree 2 --transient --dt 1e-4 --steps 200 "
+      "--history-csv h.csv\n"
       "  mpirun -np 2 vesselverify fem --distributed --degree 2 --level 1 --load contact");
   add_vessel_options(*cmd, o->vessel);
   cmd->add_option("--degree", o->degree, "Displacement element degree (1 or 2)")
@@ -518,8 +591,20 @@ void add_fem_command(CLI::App& app) {
       "--distributed", o->distributed,
       "Solve in parallel over the MPI ranks (run under 'mpirun -np N'): fully distributed "
       "mesh, Trilinos CG with ML AMG; P1/P2 displacement formulation only (no mixed, "
-      "--curved or --modes). Rank 0 prints and writes the files; --vtu gets the nodal "
-      "displacement only");
+      "--curved, --modes or --transient). Rank 0 prints and writes the files; --vtu gets the "
+      "nodal displacement only");
+  cmd->add_flag("--transient", o->transient,
+                "Also run the step response: the loads applied at t = 0 to the body at rest, "
+                "Newmark average acceleration with the consistent mass; prints the contact "
+                "point's displacement over time (sampled) and the timings");
+  cmd->add_option("--dt", o->dt, "Transient time step, s")->capture_default_str();
+  cmd->add_option("--steps", o->steps, "Transient number of steps")->capture_default_str();
+  cmd->add_option("--mass-damping", o->mass_damping,
+                  "Transient mass-proportional damping alpha (C = alpha M), 1/s")
+      ->capture_default_str();
+  cmd->add_option("--history-csv", o->history_csv,
+                  "Transient: write the contact point's displacement (mm) and the energies (mJ) "
+                  "at every step as CSV");
   cmd->add_option("--vtu", o->vtu,
                   "Write displacement and mode shapes (nodes), strain and stress (tets) as VTU");
   cmd->add_option("--json", o->json, "Write a JSON summary");

@@ -16,8 +16,11 @@ int main(int argc, char** argv) {
   std::string command_line;
   for (int i = 0; i < argc; ++i) command_line += (i ? " " : "") + std::string(argv[i]);
   vessel::cli::add_run_command(app, command_line);
+  vessel::cli::add_report_command(app, command_line);
+  vessel::cli::add_gate_command(app, command_line);
   vessel::cli::add_msm_command(app);
   vessel::cli::add_fem_command(app);
+  vessel::cli::add_stability_command(app, command_line);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -17,38 +17,44 @@ struct RunOptions {
   std::filesystem::path cache_dir = default_cache_dir();
   bool quick = false;
   int repeats = 1;
+  std::vector<double> poisson_ratios;  ///< sweeps overriding the scenes' own (empty: keep)
+  std::vector<int> levels;
+  std::vector<double> magnitudes;
+  int reference_level = -1;
   std::string command;
 };
 
-/// --quick: the coarsest useful levels (models at 0, reference at 1 with 0 for its uncertainty)
-/// and only the smallest and largest load, so every shipped scene runs in seconds to minutes.
-/// Taylor–Hood (ν ≥ 0.49) goes to the direct solver, which needs minutes and gigabytes at level 1:
-/// scenes with such a ν keep their reference at level 0 (then without an uncertainty estimate).
-void make_quick(Scene& s) {
-  s.vessel.level = 0;
-  const bool mixed = std::any_of(s.poisson_ratios.begin(), s.poisson_ratios.end(),
-                                 [](double nu) { return nu >= 0.49; });
-  s.reference_level = std::min(s.reference_level, mixed ? 0 : 1);
-  if (s.load.magnitudes.size() > 2) s.load.magnitudes = {s.load.magnitudes.front(), s.load.magnitudes.back()};
+/// The command line's sweeps replace the scene's values (after --quick, so they win).
+void apply_sweeps(const RunOptions& o, Scene& s) {
+  if (!o.poisson_ratios.empty()) s.poisson_ratios = o.poisson_ratios;
+  if (!o.magnitudes.empty()) s.load.magnitudes = o.magnitudes;
+  if (!o.levels.empty()) {
+    s.model_levels = o.levels;
+    std::sort(s.model_levels.begin(), s.model_levels.end());
+    s.model_levels.erase(std::unique(s.model_levels.begin(), s.model_levels.end()),
+                         s.model_levels.end());
+    s.vessel.level = s.model_levels.front();
+  }
+  if (o.reference_level >= 0) s.reference_level = o.reference_level;
+  if (s.reference_level < s.model_levels.back()) {
+    std::cerr << "warning: " << s.name << ": the reference (level " << s.reference_level
+              << ") is coarser than the finest model level (" << s.model_levels.back()
+              << "); its error may exceed the models'\n";
+  }
 }
 
 void run(const RunOptions& o) {
   std::vector<Scene> scenes;
   for (const auto& f : o.scenes) scenes.push_back(read_scene(f));  // validate all before running
+  for (Scene& s : scenes) {
+    if (o.quick) s = quick_variant(std::move(s));
+    apply_sweeps(o, s);
+  }
   HarnessOptions h;
   h.cache_dir = o.cache_dir;
   h.log = &std::cout;
   h.repeats = o.repeats;
-  std::vector<SceneResult> results;
-  for (std::size_t i = 0; i < scenes.size(); ++i) {
-    if (o.quick) make_quick(scenes[i]);
-    std::cout << "== scene " << i + 1 << "/" << scenes.size() << ": " << scenes[i].name << " ==\n";
-    results.push_back(run_scene(scenes[i], h));
-  }
-  write_results_json(o.output_dir / "results.json", results, o.command);
-  write_results_csv(o.output_dir / "results.csv", results);
-  write_summary_markdown(o.output_dir / "summary.md", results, o.command);
-  std::cout << "wrote " << (o.output_dir / "results.json").string() << ", results.csv and summary.md\n";
+  run_and_write(scenes, h, o.output_dir, o.command);
 }
 
 }  // namespace
@@ -73,6 +79,24 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--repeats", o->repeats, "Timed repeats per model solve (median reported)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
+  cmd->add_option("--nu", o->poisson_ratios,
+                  "Sweep Poisson's ratio over these values instead of the scenes' (e.g. "
+                  "--nu 0,0.25,0.45,0.49,0.5)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 0.5));
+  cmd->add_option("--levels", o->levels,
+                  "Run the models at these mesh levels instead of the scenes' (a convergence "
+                  "sweep, e.g. --levels 0,1,2)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, kMaxMeshLevel));
+  cmd->add_option("--magnitudes", o->magnitudes,
+                  "Load magnitudes instead of the scenes' (N, Pa or g as the scene's load)")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--reference-level", o->reference_level,
+                  "Level of the P2 reference instead of the scene's (its uncertainty comes from "
+                  "the level below)")
+      ->check(CLI::Range(0, kMaxMeshLevel));
   cmd->callback([o] { run(*o); });
 }
 

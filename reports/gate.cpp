@@ -1,0 +1,112 @@
+#include "reports/gate.hpp"
+
+#include <algorithm>
+#include <map>
+#include <sstream>
+#include <tuple>
+
+namespace vessel::reports {
+
+namespace {
+
+using Key = std::tuple<std::string, std::string, double, int, double>;
+
+Key key_of(const SceneRows& s, const OutcomeRow& o) {
+  return {s.name, o.model, o.poisson_ratio, o.level, o.magnitude};
+}
+
+std::map<Key, const OutcomeRow*> index(const ResultsFile& r) {
+  std::map<Key, const OutcomeRow*> out;
+  for (const auto& s : r.scenes) {
+    for (const auto& o : s.outcomes) out[key_of(s, o)] = &o;
+  }
+  return out;
+}
+
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(4);
+  s << v;
+  return s.str();
+}
+
+GateFinding finding(const Key& k, std::string what, std::string baseline, std::string current,
+                    bool failure) {
+  return {std::get<0>(k), std::get<1>(k), std::get<2>(k), std::get<3>(k), std::get<4>(k),
+          std::move(what), std::move(baseline), std::move(current), failure};
+}
+
+}  // namespace
+
+bool GateOutcome::passed() const {
+  return std::none_of(findings.begin(), findings.end(), [](const auto& f) { return f.failure; });
+}
+
+GateOutcome compare_with_baseline(const ResultsFile& baseline, const ResultsFile& current,
+                                  const GateTolerances& tol) {
+  GateOutcome out;
+  const auto base = index(baseline);
+  const auto now = index(current);
+  const bool timed = baseline.reference_kernel_seconds && current.reference_kernel_seconds &&
+                     *baseline.reference_kernel_seconds > 0 && *current.reference_kernel_seconds > 0;
+  for (const auto& [k, b] : base) {
+    const auto it = now.find(k);
+    if (it == now.end()) {
+      out.findings.push_back(finding(k, "missing from this run", "present", "absent", true));
+      continue;
+    }
+    const OutcomeRow& c = *it->second;
+    ++out.compared;
+    if (b->ok && !c.ok) {
+      out.findings.push_back(finding(k, "now fails", "finished", c.failure, true));
+      continue;
+    }
+    if (!b->ok) {
+      if (c.ok) out.findings.push_back(finding(k, "now finishes (was failing)", b->failure, "finished", false));
+      continue;
+    }
+    const auto grew = [&](double was, double is) {
+      return is > was * (1.0 + tol.error_relative) + tol.error_absolute_mm;
+    };
+    const auto shrank = [&](double was, double is) {
+      return is < was * (1.0 - tol.error_relative) - tol.error_absolute_mm;
+    };
+    if (grew(b->max_mm, c.max_mm)) {
+      out.findings.push_back(finding(k, "max error grew", num(b->max_mm) + " mm", num(c.max_mm) + " mm", true));
+    } else if (grew(b->rms_mm, c.rms_mm)) {
+      out.findings.push_back(finding(k, "RMS error grew", num(b->rms_mm) + " mm", num(c.rms_mm) + " mm", true));
+    } else if (shrank(b->max_mm, c.max_mm)) {
+      out.findings.push_back(finding(k, "max error fell (update the baseline to keep it)",
+                                     num(b->max_mm) + " mm", num(c.max_mm) + " mm", false));
+    }
+    if (timed && b->solve_seconds >= tol.timing_floor_s) {
+      const double was = b->solve_seconds / *baseline.reference_kernel_seconds;
+      const double is = c.solve_seconds / *current.reference_kernel_seconds;
+      if (is > tol.timing_ratio * was) {
+        out.findings.push_back(finding(k, "slower (normalised solve time)", num(was) + " kernels",
+                                       num(is) + " kernels", true));
+      } else if (is * tol.timing_ratio < was) {
+        out.findings.push_back(finding(k, "faster (normalised solve time)", num(was) + " kernels",
+                                       num(is) + " kernels", false));
+      }
+    }
+  }
+  for (const auto& [k, c] : now) {
+    if (!base.count(k)) out.findings.push_back(finding(k, "new, not in the baseline", "", c->ok ? "finished" : c->failure, false));
+  }
+  std::stable_sort(out.findings.begin(), out.findings.end(),
+                   [](const auto& a, const auto& b) { return a.failure && !b.failure; });
+  return out;
+}
+
+Table gate_table(const GateOutcome& outcome) {
+  Table t;
+  t.header = {"", "scene", "model", "ν", "level", "load", "what", "baseline", "this run"};
+  for (const auto& f : outcome.findings) {
+    t.rows.push_back({f.failure ? "FAIL" : "note", f.scene, f.model, num(f.poisson_ratio),
+                      std::to_string(f.level), num(f.magnitude), f.what, f.baseline, f.current});
+  }
+  return t;
+}
+
+}  // namespace vessel::reports

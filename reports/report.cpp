@@ -1,0 +1,501 @@
+#include "reports/report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "meshes/atomic_file.hpp"
+#include "meshes/errors.hpp"
+#include "reports/svg_plot.hpp"
+
+namespace vessel::reports {
+
+namespace {
+
+std::string fmt(double v, int digits = 3) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << v;
+  return s.str();
+}
+
+std::string file_safe(const std::string& name) {
+  std::string out;
+  for (const char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return out;
+}
+
+std::string now_utc() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", std::gmtime(&t));
+  return buf;
+}
+
+/// A model variant as plotted: its name, plus the level when the scene sweeps levels.
+std::string variant(const OutcomeRow& o, const SceneRows& s) {
+  return s.model_levels.size() > 1 ? o.model + " (L" + std::to_string(o.level) + ")" : o.model;
+}
+
+double first_nu(const SceneRows& s) {
+  return s.references.empty() ? (s.outcomes.empty() ? 0.0 : s.outcomes.front().poisson_ratio)
+                              : s.references.front().poisson_ratio;
+}
+
+int finest_level(const SceneRows& s) {
+  return s.model_levels.empty() ? 0 : s.model_levels.back();
+}
+
+/// Outcomes selected by a predicate, in file order.
+template <class Pred>
+std::vector<const OutcomeRow*> select(const SceneRows& s, Pred&& pred) {
+  std::vector<const OutcomeRow*> out;
+  for (const auto& o : s.outcomes) {
+    if (pred(o)) out.push_back(&o);
+  }
+  return out;
+}
+
+/// Model names in order of first appearance.
+std::vector<std::string> model_names(const SceneRows& s) {
+  std::vector<std::string> names;
+  for (const auto& o : s.outcomes) {
+    if (std::find(names.begin(), names.end(), o.model) == names.end()) names.push_back(o.model);
+  }
+  return names;
+}
+
+std::string load_text(double magnitude, const SceneRows& s) {
+  if (s.load_unit == "N") return fmt(magnitude * 1e3) + " mN";
+  return fmt(magnitude) + " " + s.load_unit;
+}
+
+std::string reference_uncertainty_text(const OutcomeRow& o) {
+  return o.reference_uncertainty_max_mm ? fmt(*o.reference_uncertainty_max_mm) : "–";
+}
+
+Series series(std::string label, bool lines, bool markers = true) {
+  Series s;
+  s.label = std::move(label);
+  s.lines = lines;
+  s.markers = markers;
+  return s;
+}
+
+/// The reference (or the Pareto front): a thick black line.
+Series black_line(std::string label, std::vector<double> x = {}, std::vector<double> y = {}) {
+  Series s = series(std::move(label), true, false);
+  s.x = std::move(x);
+  s.y = std::move(y);
+  s.emphasis = true;
+  s.colour = "#000000";
+  return s;
+}
+
+/// A guide (tolerance, uncertainty, seed 000's line): dashed grey.
+Series grey_dashed(std::string label, bool markers = false) {
+  Series s = series(std::move(label), true, markers);
+  s.dashed = true;
+  s.colour = "#888888";
+  return s;
+}
+
+struct FigureContext {
+  Document& doc;
+  const SceneRows& scene;
+  double magnitude;
+  double nu;
+};
+
+void speed_error_figure(const FigureContext& c) {
+  const auto rows = select(c.scene, [&](const OutcomeRow& o) {
+    return o.ok && o.magnitude == c.magnitude;
+  });
+  if (rows.empty()) return;
+  Plot plot;
+  plot.title = c.scene.name + ": speed against error at " + load_text(c.magnitude, c.scene);
+  plot.x = {"solve time per load case (s)", Scale::log};
+  plot.y = {"max nodal error (mm)", Scale::log};
+  std::map<std::string, std::size_t> series_of;
+  std::vector<double> xs, ys;
+  std::vector<std::string> labels;
+  for (const OutcomeRow* o : rows) {
+    const std::string label = variant(*o, c.scene);
+    if (!series_of.count(label)) {
+      series_of[label] = plot.series.size();
+      plot.series.push_back(series(label, false));
+    }
+    Series& s = plot.series[series_of[label]];
+    s.x.push_back(std::max(o->solve_seconds, 1e-6));
+    s.y.push_back(o->max_mm);
+    xs.push_back(std::max(o->solve_seconds, 1e-6));
+    ys.push_back(o->max_mm);
+    labels.push_back(label + (c.scene.references.size() > 1 ? " ν=" + fmt(o->poisson_ratio) : ""));
+  }
+  const auto front = pareto_front(xs, ys);
+  Series pareto = black_line("Pareto front");
+  std::string names;
+  for (const std::size_t i : front) {
+    pareto.x.push_back(xs[i]);
+    pareto.y.push_back(ys[i]);
+    names += (names.empty() ? "" : ", ") + labels[i];
+  }
+  plot.series.push_back(pareto);
+  const auto [xmin, xmax] = std::minmax_element(xs.begin(), xs.end());
+  Series tolerance = grey_dashed("tolerance " + fmt(c.scene.tolerance_mm) + " mm");
+  tolerance.x = {*xmin, *xmax};
+  tolerance.y = {c.scene.tolerance_mm, c.scene.tolerance_mm};
+  plot.series.push_back(tolerance);
+  c.doc.figure(file_safe(c.scene.name) + "_speed_error.svg", render_svg(plot),
+               "Speed against error, " + c.scene.name + ", load " +
+                   load_text(c.magnitude, c.scene) +
+                   ": one point per model, Poisson's ratio and level. The black line joins the "
+                   "Pareto front (no other point is both faster and more accurate): " + names +
+                   ". Dashed: the scene's tolerance.");
+}
+
+void error_vs_nu_figure(const FigureContext& c) {
+  if (c.scene.references.size() < 2) return;
+  Plot plot;
+  plot.title = c.scene.name + ": error against Poisson's ratio";
+  plot.x = {"Poisson's ratio ν", Scale::linear};
+  plot.y = {"relative L2 error", Scale::log};
+  for (const auto& name : model_names(c.scene)) {
+    Series s = series(name, true);
+    for (const OutcomeRow* o : select(c.scene, [&](const OutcomeRow& r) {
+           return r.ok && r.model == name && r.magnitude == c.magnitude &&
+                  r.level == finest_level(c.scene);
+         })) {
+      s.x.push_back(o->poisson_ratio);
+      s.y.push_back(o->relative_l2);
+    }
+    plot.series.push_back(s);
+  }
+  c.doc.figure(file_safe(c.scene.name) + "_error_vs_nu.svg", render_svg(plot),
+               "Relative L2 error of the nodal displacement against ν, load " +
+                   load_text(c.magnitude, c.scene) + ", level " +
+                   std::to_string(finest_level(c.scene)) +
+                   ". Spring networks obey the Cauchy relations (an isotropic one has ν = 1/4 "
+                   "whatever is asked), and P1 locks as ν → 0.5: both show here.");
+}
+
+void error_vs_level_figure(const FigureContext& c) {
+  if (c.scene.model_levels.size() < 2) return;
+  Plot plot;
+  plot.title = c.scene.name + ": error against mesh level";
+  plot.x = {"mesh level (cell size halves per level)", Scale::linear};
+  plot.y = {"max nodal error (mm)", Scale::log};
+  Series unc = grey_dashed("reference uncertainty (max)", true);
+  for (const auto& name : model_names(c.scene)) {
+    Series s = series(name, true);
+    for (const OutcomeRow* o : select(c.scene, [&](const OutcomeRow& r) {
+           return r.ok && r.model == name && r.magnitude == c.magnitude &&
+                  r.poisson_ratio == c.nu;
+         })) {
+      s.x.push_back(o->level);
+      s.y.push_back(o->max_mm);
+      if (o->reference_uncertainty_max_mm && name == model_names(c.scene).front()) {
+        unc.x.push_back(o->level);
+        unc.y.push_back(*o->reference_uncertainty_max_mm);
+      }
+    }
+    plot.series.push_back(s);
+  }
+  if (!unc.x.empty()) plot.series.push_back(unc);
+  c.doc.figure(file_safe(c.scene.name) + "_error_vs_level.svg", render_svg(plot),
+               "Convergence: max nodal error against mesh level, ν = " + fmt(c.nu) + ", load " +
+                   load_text(c.magnitude, c.scene) +
+                   ". FEM errors fall with refinement; a mass-spring error that does not fall is "
+                   "the model's own, not the mesh's. Grey: the reference's own uncertainty, "
+                   "below which no error is resolved.");
+}
+
+void load_displacement_figure(const FigureContext& c) {
+  Plot plot;
+  plot.title = c.scene.name + ": load against QoI displacement";
+  plot.x = {"load (" + std::string(c.scene.load_unit == "N" ? "mN" : c.scene.load_unit) + ")",
+            Scale::log};
+  plot.y = {"displacement at the QoI point (mm)", Scale::log};
+  const double unit = c.scene.load_unit == "N" ? 1e3 : 1.0;
+  Series reference = black_line("FEM reference");
+  std::set<double> magnitudes;
+  for (const auto& name : model_names(c.scene)) {
+    Series s = series(name, true);
+    for (const OutcomeRow* o : select(c.scene, [&](const OutcomeRow& r) {
+           return r.ok && r.model == name && r.poisson_ratio == c.nu &&
+                  r.level == finest_level(c.scene);
+         })) {
+      s.x.push_back(o->magnitude * unit);
+      s.y.push_back(o->qoi_mm);
+      if (magnitudes.insert(o->magnitude).second) {
+        reference.x.push_back(o->magnitude * unit);
+        reference.y.push_back(o->qoi_reference_mm);
+      }
+    }
+    plot.series.push_back(s);
+  }
+  if (magnitudes.size() < 2) return;  // one load: nothing to draw a line through
+  std::vector<std::size_t> order(reference.x.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](auto a, auto b) { return reference.x[a] < reference.x[b]; });
+  Series sorted = reference;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    sorted.x[i] = reference.x[order[i]];
+    sorted.y[i] = reference.y[order[i]];
+  }
+  plot.series.insert(plot.series.begin(), sorted);
+  std::string caption = "Load against the displacement at the QoI point (" + c.scene.name +
+                        ", ν = " + fmt(c.nu) + ", level " + std::to_string(finest_level(c.scene)) +
+                        "). The FEM reference is linear, so it is only valid up to about 5 % strain.";
+  if (c.scene.load_unit == "N") {
+    Series hooke = grey_dashed("seed 000 Hooke line, F/k, k = 41.106 N/m");
+    for (const double m : magnitudes) {
+      hooke.x.push_back(m * 1e3);
+      hooke.y.push_back(m / kSeed000HookeStiffness * 1e3);
+    }
+    plot.series.push_back(hooke);
+    caption += " Dashed grey: the line seed 000 compared its model against (x = F/k with its "
+               "k = E·A/h₀ = 41.106 N/m, eq. 4.2), which is not the vessel's contact stiffness.";
+  }
+  c.doc.figure(file_safe(c.scene.name) + "_load_displacement.svg", render_svg(plot), caption);
+}
+
+void wall_profile_figure(const FigureContext& c) {
+  const auto rows = select(c.scene, [&](const OutcomeRow& r) {
+    return r.ok && r.magnitude == c.magnitude && r.poisson_ratio == c.nu &&
+           r.level == finest_level(c.scene) && !r.profile_s_mm.empty();
+  });
+  if (rows.empty()) return;
+  Plot plot;
+  plot.title = c.scene.name + ": radial displacement along the wall";
+  plot.x = {"arc length along the centreline s (mm)", Scale::linear};
+  plot.y = {"radial displacement u·e_ρ (mm)", Scale::linear};
+  const OutcomeRow* densest = *std::max_element(rows.begin(), rows.end(), [](auto a, auto b) {
+    return a->profile_s_mm.size() < b->profile_s_mm.size();
+  });
+  plot.series.push_back(
+      black_line("FEM reference", densest->profile_s_mm, densest->profile_reference_mm));
+  std::set<std::string> seen;
+  for (const OutcomeRow* o : rows) {
+    if (!seen.insert(o->model).second) continue;
+    Series m = series(o->model, true);
+    m.x = o->profile_s_mm;
+    m.y = o->profile_model_mm;
+    plot.series.push_back(m);
+  }
+  c.doc.figure(file_safe(c.scene.name) + "_wall_profile.svg", render_svg(plot),
+               "Radial displacement along the wall line through the QoI point (each model's "
+               "nodes at its angle around the centreline), load " +
+                   load_text(c.magnitude, c.scene) + ", ν = " + fmt(c.nu) +
+                   ". Where the curves part is where each model's error lives.");
+}
+
+void history_figure(const FigureContext& c) {
+  const auto rows = select(c.scene, [&](const OutcomeRow& r) {
+    return r.ok && !r.history_time_s.empty() && r.poisson_ratio == c.nu &&
+           r.level == finest_level(c.scene);
+  });
+  if (rows.empty()) return;
+  Plot plot;
+  plot.title = c.scene.name + ": QoI displacement over time";
+  plot.x = {"time (s)", Scale::linear};
+  plot.y = {"displacement at the QoI point (mm)", Scale::linear};
+  bool reference_drawn = false;
+  for (const OutcomeRow* o : rows) {
+    if (o->magnitude != rows.front()->magnitude) continue;
+    if (!reference_drawn && o->history_reference_mm.size() == o->history_time_s.size()) {
+      plot.series.insert(plot.series.begin(),
+                         black_line("FEM transient (Newmark)", o->history_time_s,
+                                    o->history_reference_mm));
+      reference_drawn = true;
+    }
+    Series m = series(o->model, true, false);
+    m.x = o->history_time_s;
+    m.y = o->history_model_mm;
+    plot.series.push_back(m);
+  }
+  Table t;
+  t.header = {"model", "load", "steps", "simulated s", "solve s", "steps/s", "real-time factor",
+              "max error over time mm", "final max error mm", "FEM damping α 1/s"};
+  for (const OutcomeRow* o : rows) {
+    t.rows.push_back({o->model, load_text(o->magnitude, c.scene), std::to_string(o->steps),
+                      fmt(o->simulated_s), fmt(o->solve_seconds),
+                      fmt(static_cast<double>(o->steps) / o->solve_seconds),
+                      fmt(o->simulated_s / o->solve_seconds),
+                      reference_drawn ? fmt(o->history_max_error_mm) : "–", fmt(o->max_mm),
+                      fmt(o->mass_damping_per_s)});
+  }
+  c.doc.figure(file_safe(c.scene.name) + "_history.svg", render_svg(plot),
+               "The contact force applied as a step at t = 0: displacement of the QoI point over "
+               "time for each integrator" +
+                   std::string(reference_drawn ? ", against the FEM transient (Newmark, average "
+                                                 "acceleration)."
+                                               : " (no FEM transient in these results).") +
+                   " Real-time factor: simulated time over wall-clock time (≥ 1 runs in real "
+                   "time). The final error is against the static reference.");
+  c.doc.table(t);
+}
+
+Table statistics_table(const SceneRows& s) {
+  Table t;
+  t.header = {"model", "ν", "level", "load", "max mm", "mean mm", "std mm", "RMS mm", "rel. L2",
+              "ref. unc. mm", "QoI model / ref. mm", "max strain", "solve s", "set-up s",
+              "memory MiB", "unknowns"};
+  for (const auto& o : s.outcomes) {
+    std::vector<std::string> row{o.model, fmt(o.poisson_ratio), std::to_string(o.level),
+                                 load_text(o.magnitude, s) + (o.beyond_linear_regime ? " ⚠" : "")};
+    if (!o.ok) {
+      row.push_back("**failed**: " + o.failure);
+      row.resize(t.header.size());
+      row[12] = fmt(o.solve_seconds);
+      row[13] = fmt(o.setup_seconds);
+      t.rows.push_back(row);
+      continue;
+    }
+    for (const std::string& v :
+         {fmt(o.max_mm), fmt(o.mean_mm), fmt(o.stddev_mm), fmt(o.rms_mm), fmt(o.relative_l2),
+          reference_uncertainty_text(o), fmt(o.qoi_mm) + " / " + fmt(o.qoi_reference_mm),
+          fmt(o.max_strain, 2), fmt(o.solve_seconds), fmt(o.setup_seconds), fmt(o.memory_mib, 3),
+          std::to_string(o.unknowns)}) {
+      row.push_back(v);
+    }
+    t.rows.push_back(row);
+  }
+  return t;
+}
+
+void scene_section(Document& doc, const SceneRows& s) {
+  doc.heading(2, "Scene `" + s.name + "`");
+  doc.paragraph(s.description + (s.description.empty() ? "" : ". ") + s.vessel + ". Load: " +
+                s.load + ". Models at level(s) " + [&] {
+                  std::string l;
+                  for (const int v : s.model_levels) l += (l.empty() ? "" : ", ") + std::to_string(v);
+                  return l;
+                }() + "; " + fmt(s.seconds, 3) + " s for the whole scene.");
+  Table refs;
+  refs.header = {"ν", "reference element", "level", "DoFs", "solve s", "max strain per unit load"};
+  for (const auto& r : s.references) {
+    refs.rows.push_back({fmt(r.poisson_ratio), r.element, std::to_string(r.level),
+                         std::to_string(r.dofs), fmt(r.solve_seconds),
+                         fmt(r.max_abs_strain_at_unit_load)});
+  }
+  doc.table(refs);
+  const FigureContext c{doc, s, representative_magnitude(s), first_nu(s)};
+  speed_error_figure(c);
+  error_vs_nu_figure(c);
+  error_vs_level_figure(c);
+  load_displacement_figure(c);
+  wall_profile_figure(c);
+  history_figure(c);
+  doc.paragraph("Seed 000's statistics of the nodal displacement error for every model, Poisson's "
+                "ratio, level and load (⚠: the reference strains beyond 5 % there):");
+  doc.table(statistics_table(s));
+}
+
+/// One row per (scene, model, level) at the scene's representative load and first ν.
+Table summary_table(const ResultsFile& r) {
+  Table t;
+  t.header = {"scene", "model", "level", "load", "max mm", "RMS mm", "rel. L2", "ref. unc. mm",
+              "within tol.", "solve s", "set-up s", "memory MiB"};
+  for (const auto& s : r.scenes) {
+    const double mag = representative_magnitude(s);
+    const double nu = first_nu(s);
+    for (const auto& o : s.outcomes) {
+      if (o.magnitude != mag || o.poisson_ratio != nu) continue;
+      if (!o.ok) {
+        t.rows.push_back({s.name, o.model, std::to_string(o.level), load_text(mag, s),
+                          "**failed**", "", "", "", "no", "", fmt(o.setup_seconds), ""});
+        continue;
+      }
+      t.rows.push_back({s.name, o.model, std::to_string(o.level),
+                        load_text(mag, s) + (o.beyond_linear_regime ? " ⚠" : ""), fmt(o.max_mm),
+                        fmt(o.rms_mm), fmt(o.relative_l2), reference_uncertainty_text(o),
+                        o.max_mm <= s.tolerance_mm ? "yes" : "no", fmt(o.solve_seconds),
+                        fmt(o.setup_seconds), fmt(o.memory_mib, 3)});
+    }
+  }
+  return t;
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string() + ": cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+double representative_magnitude(const SceneRows& s) {
+  double best = -1.0;
+  double smallest = HUGE_VAL;
+  for (const auto& o : s.outcomes) {
+    smallest = std::min(smallest, o.magnitude);
+    if (o.ok && !o.beyond_linear_regime) best = std::max(best, o.magnitude);
+  }
+  return best > 0.0 ? best : smallest;
+}
+
+Document build_report(const ResultsFile& r, const std::string& stability_markdown,
+                      const std::string& command) {
+  Document doc;
+  doc.heading(1, "vesselverify report");
+  doc.paragraph("How wrong, and how fast, is each mass-spring vessel model against linear-elastic "
+                "FEM? Results `" + r.path.filename().string() + "` were produced " + r.date +
+                " on `" + r.host + "` (" + std::to_string(r.hardware_threads) +
+                " hardware threads), built with " + r.compiler + ", by\n\n    " + r.command +
+                "\n\nThis report was generated " + now_utc() + " by\n\n    " + command);
+  doc.paragraph("Errors are the model's nodal displacement minus the FEM reference's (P2, or "
+                "Taylor–Hood P2–P1 for ν ≥ 0.49) evaluated at each model node's rest position, in "
+                "mm, with seed 000's statistics (max, mean, standard deviation, RMS). *ref. unc.* "
+                "is the reference's own estimated error there (Richardson between its two finest "
+                "levels): an error below it is not resolved. ⚠ marks loads that strain the "
+                "reference beyond 5 %, outside linear elasticity's validity. Times are wall-clock "
+                "seconds of a Release build (median of the repeats); memory is the peak resident "
+                "memory a model's set-up and solve added.");
+  doc.heading(2, "Summary");
+  doc.paragraph("Each scene at its representative load (the largest within the linear regime) "
+                "and its first Poisson's ratio; *within tol.* compares the max error with the "
+                "scene's tolerance (seed 000's visual threshold, 0.1 mm, unless the scene says "
+                "otherwise).");
+  doc.table(summary_table(r));
+  for (const auto& s : r.scenes) scene_section(doc, s);
+  if (stability_markdown.empty()) {
+    doc.heading(2, "Numerical stability");
+    doc.paragraph("Not part of these results: `vesselverify stability` writes `stability.md`, "
+                  "which `vesselverify report --stability` embeds here.");
+  } else {
+    doc.markdown(stability_markdown);
+  }
+  return doc;
+}
+
+void write_report(const ReportOptions& o) {
+  const ResultsFile results = read_results(o.results);
+  std::string stability;
+  if (!o.stability_markdown.empty()) stability = read_text(o.stability_markdown);
+  const Document doc = build_report(results, stability, o.command);
+  std::error_code ec;
+  std::filesystem::create_directories(o.output_dir / "figures", ec);
+  if (ec) {
+    throw InputError((o.output_dir / "figures").string() + ": cannot create the output "
+                     "directory (" + ec.message() + ")");
+  }
+  for (const Block& b : doc.blocks()) {
+    if (b.kind != Block::Kind::figure) continue;
+    write_file_atomically(o.output_dir / "figures" / b.file_name,
+                          [&](std::ostream& out) { out << b.svg; });
+  }
+  write_file_atomically(o.output_dir / "report.md",
+                        [&](std::ostream& out) { out << doc.markdown_text("figures"); });
+  write_file_atomically(o.output_dir / "report.html", [&](std::ostream& out) {
+    out << doc.html_text("vesselverify report");
+  });
+}
+
+}  // namespace vessel::reports

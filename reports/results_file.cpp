@@ -1,0 +1,155 @@
+#include "reports/results_file.hpp"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "meshes/errors.hpp"
+
+namespace vessel::reports {
+
+namespace {
+
+using nlohmann::json;
+
+/// j[key] as T, or an InputError naming the file and the JSON path.
+template <class T>
+T field(const json& j, const char* key, const std::string& where) {
+  const auto it = j.find(key);
+  if (it == j.end() || it->is_null()) {
+    throw InputError(where + ": missing field '" + key + "'");
+  }
+  try {
+    return it->get<T>();
+  } catch (const json::exception&) {
+    throw InputError(where + ": field '" + key + "' has the wrong type (" + it->type_name() + ")");
+  }
+}
+
+template <class T>
+T field_or(const json& j, const char* key, T fallback, const std::string& where) {
+  const auto it = j.find(key);
+  return it == j.end() || it->is_null() ? fallback : field<T>(j, key, where);
+}
+
+OutcomeRow read_outcome(const json& j, const std::string& where) {
+  OutcomeRow o;
+  o.model = field<std::string>(j, "model", where);
+  o.kind = field<std::string>(j, "kind", where);
+  o.detail = field<std::string>(j, "detail", where);
+  o.poisson_ratio = field<double>(j, "poisson_ratio", where);
+  o.magnitude = field<double>(j, "magnitude", where);
+  o.level = field<int>(j, "level", where);
+  o.ok = field<bool>(j, "ok", where);
+  o.nodes = field<std::size_t>(j, "nodes", where);
+  o.unknowns = field<std::size_t>(j, "unknowns", where);
+  o.setup_seconds = field<double>(j, "setup_seconds", where);
+  o.solve_seconds = field<double>(j, "solve_seconds", where);
+  o.memory_mib = field_or<double>(j, "memory_mib", 0.0, where);
+  if (!o.ok) {
+    o.failure = field<std::string>(j, "failure", where);
+    return o;
+  }
+  const json e = field<json>(j, "error", where);
+  o.max_mm = field<double>(e, "max_mm", where + ".error");
+  o.mean_mm = field<double>(e, "mean_mm", where + ".error");
+  o.stddev_mm = field<double>(e, "stddev_mm", where + ".error");
+  o.rms_mm = field<double>(e, "rms_mm", where + ".error");
+  o.relative_l2 = field<double>(e, "relative_l2", where + ".error");
+  if (const auto u = j.find("reference_uncertainty"); u != j.end() && !u->is_null()) {
+    o.reference_uncertainty_max_mm = field<double>(*u, "max_mm", where + ".reference_uncertainty");
+  }
+  o.qoi_mm = field<double>(j, "qoi_displacement_mm", where);
+  o.qoi_reference_mm = field<double>(j, "qoi_reference_mm", where);
+  o.max_strain = field<double>(j, "max_strain", where);
+  o.beyond_linear_regime = field<bool>(j, "beyond_linear_regime", where);
+  if (const auto p = j.find("wall_profile"); p != j.end()) {
+    o.profile_s_mm = field<std::vector<double>>(*p, "s_mm", where + ".wall_profile");
+    o.profile_model_mm = field<std::vector<double>>(*p, "model_mm", where + ".wall_profile");
+    o.profile_reference_mm = field<std::vector<double>>(*p, "reference_mm", where + ".wall_profile");
+  }
+  if (const auto h = j.find("history"); h != j.end()) {
+    o.history_time_s = field<std::vector<double>>(*h, "time_s", where + ".history");
+    o.history_model_mm = field<std::vector<double>>(*h, "model_mm", where + ".history");
+    o.history_reference_mm = field<std::vector<double>>(*h, "reference_mm", where + ".history");
+    o.history_max_error_mm = field<double>(*h, "max_error_mm", where + ".history");
+    o.steps = field<long>(*h, "steps", where + ".history");
+    o.simulated_s = field<double>(*h, "simulated_s", where + ".history");
+    o.mass_damping_per_s = field<double>(*h, "mass_damping_per_s", where + ".history");
+  }
+  return o;
+}
+
+}  // namespace
+
+ResultsFile parse_results(const std::string& text, const std::filesystem::path& source) {
+  const std::string file = source.string();
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw InputError(file + ": not valid JSON (" + e.what() + ")");
+  }
+  if (!j.is_object() || j.value("schema", "") != "vesselverify.results") {
+    throw InputError(file + ": not a vesselverify results file (expected \"schema\": "
+                            "\"vesselverify.results\")");
+  }
+  ResultsFile r;
+  r.path = source;
+  r.schema_version = field<int>(j, "schema_version", file);
+  if (r.schema_version != 2) {
+    throw InputError(file + ": schema_version " + std::to_string(r.schema_version) +
+                     ", expected 2 (rerun `vesselverify run` with this build)");
+  }
+  r.date = field<std::string>(j, "date", file);
+  r.command = field<std::string>(j, "command", file);
+  r.host = field<std::string>(field<json>(j, "machine", file), "host", file + ": machine");
+  r.hardware_threads = field<unsigned>(field<json>(j, "machine", file), "hardware_threads", file + ": machine");
+  r.compiler = field<std::string>(field<json>(j, "build", file), "compiler", file + ": build");
+  if (const auto k = j.find("reference_kernel_seconds"); k != j.end() && !k->is_null()) {
+    r.reference_kernel_seconds = k->get<double>();
+  }
+  const auto scenes = field<json>(j, "scenes", file);
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    const json& s = scenes[i];
+    const std::string where = file + ": scenes[" + std::to_string(i) + "]";
+    SceneRows sr;
+    sr.name = field<std::string>(s, "name", where);
+    sr.description = field_or<std::string>(s, "description", "", where);
+    sr.vessel = field<std::string>(s, "vessel", where);
+    sr.load = field<std::string>(s, "load", where);
+    sr.load_unit = field<std::string>(s, "load_unit", where);
+    sr.model_levels = field<std::vector<int>>(s, "model_levels", where);
+    sr.reference_level = field<int>(s, "reference_level", where);
+    sr.tolerance_mm = field_or<double>(s, "tolerance_max_error_mm", 0.1, where);
+    sr.seconds = field<double>(s, "seconds", where);
+    for (const json& ref : field<json>(s, "references", where)) {
+      ReferenceRow rr;
+      rr.poisson_ratio = field<double>(ref, "poisson_ratio", where + ".references");
+      rr.element = field<std::string>(ref, "element", where + ".references");
+      rr.level = field<int>(ref, "level", where + ".references");
+      rr.dofs = field<std::size_t>(ref, "dofs", where + ".references");
+      rr.solve_seconds = field<double>(ref, "solve_seconds", where + ".references");
+      rr.max_abs_strain_at_unit_load =
+          field<double>(ref, "max_abs_strain_at_unit_load", where + ".references");
+      sr.references.push_back(rr);
+    }
+    const auto outcomes = field<json>(s, "outcomes", where);
+    for (std::size_t k = 0; k < outcomes.size(); ++k) {
+      sr.outcomes.push_back(
+          read_outcome(outcomes[k], where + ".outcomes[" + std::to_string(k) + "]"));
+    }
+    r.scenes.push_back(std::move(sr));
+  }
+  return r;
+}
+
+ResultsFile read_results(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string() + ": cannot open results file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_results(text.str(), path);
+}
+
+}  // namespace vessel::reports

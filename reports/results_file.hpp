@@ -1,0 +1,65 @@
+#pragma once
+/// results.json (schema "vesselverify.results", version 2; verification/results.schema.json) read
+/// back into plain structs, for the report generator and the gate. Only what they use is read.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace vessel::reports {
+
+struct OutcomeRow {
+  std::string model, kind, detail;
+  double poisson_ratio = 0.0;
+  double magnitude = 0.0;
+  int level = 0;
+  bool ok = false;
+  std::string failure;
+  std::size_t nodes = 0, unknowns = 0;
+  double setup_seconds = 0.0, solve_seconds = 0.0, memory_mib = 0.0;
+  // Present when ok:
+  double max_mm = 0.0, mean_mm = 0.0, stddev_mm = 0.0, rms_mm = 0.0, relative_l2 = 0.0;
+  std::optional<double> reference_uncertainty_max_mm;
+  double qoi_mm = 0.0, qoi_reference_mm = 0.0, max_strain = 0.0;
+  bool beyond_linear_regime = false;
+  std::vector<double> profile_s_mm, profile_model_mm, profile_reference_mm;
+  std::vector<double> history_time_s, history_model_mm, history_reference_mm;
+  double history_max_error_mm = 0.0, simulated_s = 0.0, mass_damping_per_s = 0.0;
+  long steps = 0;
+};
+
+struct ReferenceRow {
+  double poisson_ratio = 0.0;
+  std::string element;
+  int level = 0;
+  std::size_t dofs = 0;
+  double solve_seconds = 0.0;
+  double max_abs_strain_at_unit_load = 0.0;
+};
+
+struct SceneRows {
+  std::string name, description, vessel, load, load_unit;
+  std::vector<int> model_levels;
+  int reference_level = 0;
+  double tolerance_mm = 0.1;
+  double seconds = 0.0;
+  std::vector<ReferenceRow> references;
+  std::vector<OutcomeRow> outcomes;
+};
+
+struct ResultsFile {
+  std::filesystem::path path;
+  int schema_version = 0;
+  std::string date, command, host, compiler;
+  unsigned hardware_threads = 0;
+  std::optional<double> reference_kernel_seconds;
+  std::vector<SceneRows> scenes;
+};
+
+/// Reads and checks a results file; InputError naming the file and what is wrong (missing file,
+/// not JSON, another schema or version, a missing field).
+ResultsFile read_results(const std::filesystem::path& path);
+/// Same from text; `source` names it in messages.
+ResultsFile parse_results(const std::string& text, const std::filesystem::path& source);
+
+}  // namespace vessel::reports

@@ -1,0 +1,128 @@
+// `vesselverify report` and `vesselverify gate` end to end on the committed baseline (a real
+// results file of the gate scenes): the report's files, and the gate's verdict when the baseline
+// is doctored to make this run look like a regression.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "../test_helpers.hpp"
+
+using vessel::test::CommandResult;
+using vessel::test::read_text;
+using vessel::test::run_command;
+using vessel::test::TempDir;
+using vessel::test::write_text;
+
+namespace {
+
+const std::string kBaseline = VESSEL_BASELINE;
+
+CommandResult vv(const std::string& args) {
+  return run_command(std::string(VESSELVERIFY_EXE) + " " + args);
+}
+
+bool contains(const std::string& s, const std::string& what) {
+  return s.find(what) != std::string::npos;
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+/// The baseline with `edit` applied to every outcome of `model`, written to `path`.
+template <class Edit>
+void doctored_baseline(const std::filesystem::path& path, const std::string& model, Edit&& edit) {
+  nlohmann::json j = nlohmann::json::parse(read_text(kBaseline));
+  int edited = 0;
+  for (auto& scene : j["scenes"]) {
+    for (auto& o : scene["outcomes"]) {
+      if (o["model"] == model && o["ok"] == true) {
+        edit(o);
+        ++edited;
+      }
+    }
+  }
+  ASSERT_GT(edited, 0) << "no finished outcome of " << model << " in the baseline";
+  write_text(path, j.dump(1));
+}
+
+}  // namespace
+
+TEST(ReportCli, WritesMarkdownHtmlAndEveryFigure) {
+  TempDir dir;
+  const auto r = vv("report " + kBaseline + " -o " + dir.path().string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string md = read_text(dir / "report.md");
+  const std::string html = read_text(dir / "report.html");
+  EXPECT_TRUE(contains(md, "## Summary"));
+  EXPECT_TRUE(contains(md, "## Scene `contact_straight`"));
+  EXPECT_TRUE(contains(md, "## Numerical stability"));
+  std::size_t figures = 0;
+  for (const auto& f : std::filesystem::directory_iterator(dir / "figures")) {
+    EXPECT_EQ(f.path().extension(), ".svg");
+    EXPECT_TRUE(contains(md, "figures/" + f.path().filename().string())) << f.path();
+    ++figures;
+  }
+  EXPECT_GE(figures, 6u);  // at least speed-error and wall profile per scene
+  EXPECT_EQ(count(html, "<svg"), figures);  // self-contained: every figure inline
+  EXPECT_FALSE(contains(html, "src=\""));    // and nothing linked
+}
+
+TEST(ReportCli, ANonResultsFileIsAClearError) {
+  TempDir dir;
+  write_text(dir / "x.json", "{\"schema\": \"something else\"}");
+  const auto r = vv("report " + (dir / "x.json").string() + " -o " + dir.path().string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "x.json: not a vesselverify results file")) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "report.md"));
+}
+
+TEST(GateCli, TheBaselineAgainstItselfPasses) {
+  TempDir dir;
+  const auto r = vv("gate --baseline " + kBaseline + " --current " + kBaseline + " --output-dir " +
+                    dir.path().string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "Gate passed")) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "gate.md"));
+}
+
+TEST(GateCli, AModelWhoseErrorGrewFailsWithATable) {
+  // A baseline where the volume model was 2x more accurate: this run's error "grew".
+  TempDir dir;
+  doctored_baseline(dir / "baseline.json", "volume_mollemans", [](nlohmann::json& o) {
+    o["error"]["max_mm"] = o["error"]["max_mm"].get<double>() / 2;
+  });
+  const auto r = vv("gate --baseline " + (dir / "baseline.json").string() + " --current " +
+                    kBaseline + " --output-dir " + dir.path().string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "Gate FAILED")) << r.output;
+  EXPECT_TRUE(contains(r.output, "| FAIL | contact_straight | volume_mollemans |")) << r.output;
+  EXPECT_TRUE(contains(r.output, "max error grew")) << r.output;
+}
+
+TEST(GateCli, AModelThatFinishedAndNowFailsFailsTheGate) {
+  // Here the baseline is this run and the "current" results have the surface model diverging.
+  TempDir dir;
+  doctored_baseline(dir / "current.json", "surface_seed000", [](nlohmann::json& o) {
+    o["ok"] = false;
+    o["failure"] = "diverged at step 7 (node 3, energy 1e9 J)";
+  });
+  const auto r = vv("gate --baseline " + kBaseline + " --current " +
+                    (dir / "current.json").string() + " --output-dir " + dir.path().string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "now fails")) << r.output;
+  EXPECT_TRUE(contains(r.output, "diverged at step 7")) << r.output;
+}
+
+TEST(GateCli, AMissingBaselineSaysHowToCreateIt) {
+  TempDir dir;
+  const auto r = vv("gate --baseline " + (dir / "none.json").string() + " --current " + kBaseline +
+                    " --output-dir " + dir.path().string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "none.json: baseline not found")) << r.output;
+  EXPECT_TRUE(contains(r.output, "--update-baseline")) << r.output;
+}

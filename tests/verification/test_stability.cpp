@@ -1,0 +1,112 @@
+// The stability study's pieces: the refinement-exponent fit on exact power laws, the graded
+// contact-patch mesh against the tube's closed-form volume, the JSON against its schema, and the
+// Markdown section's title.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "../test_helpers.hpp"
+#include "meshes/errors.hpp"
+#include "meshes/mesh_quality.hpp"
+#include "verification/stability.hpp"
+
+using namespace vessel;
+
+TEST(Stability, LogLogSlopeRecoversTheExponentOfAPowerLaw) {
+  const std::vector<double> h{1e-3, 5e-4, 2.5e-4};
+  for (double p : {1.0, 0.5, 2.0}) {
+    std::vector<double> y;
+    for (double x : h) y.push_back(3e-4 * std::pow(x, p));
+    EXPECT_NEAR(loglog_slope(h, y), p, 1e-12);
+  }
+  EXPECT_THROW((void)loglog_slope({1e-3}, {1.0}), InputError);
+  EXPECT_THROW((void)loglog_slope({1e-3, 1e-3}, {1.0, 2.0}), InputError);
+}
+
+TEST(Stability, RefinedPatchMeshIsFineAtThePointCoarseElsewhereAndHasTheTubesVolume) {
+  VesselParams params;
+  const Vec3 point(params.inner_radius, 0.0, 0.5 * params.length);
+  const double fine = 0.15e-3;
+  const TetMesh mesh = refined_patch_mesh(params, point, fine, 0.5e-3);
+  EXPECT_NO_THROW(require_vessel_groups(mesh, "refined"));
+  const MeshQuality q = compute_quality(mesh);
+  EXPECT_EQ(q.inverted, 0u);
+  // Closed form π(b² − a²)L; the straight-sided tets miss the circular segments (O(h²)).
+  const double exact = analytic_wall_volume(params);
+  EXPECT_NEAR(q.total_volume, exact, 0.02 * exact);
+  // Edges touching the point's neighbourhood are near `fine`; far away near the nominal 1 mm.
+  double near_max = 0.0, far_min = 1.0;
+  for (const Tet& t : mesh.tets) {
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        const Vec3 a = mesh.nodes[t[i]], b = mesh.nodes[t[j]];
+        const double len = (a - b).norm();
+        if ((0.5 * (a + b) - point).norm() < 0.3e-3) near_max = std::max(near_max, len);
+        if ((0.5 * (a + b) - point).norm() > 8e-3) far_min = std::min(far_min, len);
+      }
+  }
+  EXPECT_LT(near_max, 2.5 * fine);
+  EXPECT_GT(far_min, 0.3e-3);
+  EXPECT_THROW((void)refined_patch_mesh(VesselParams{.kind = VesselKind::arch}, point, fine, 1e-3),
+               InputError);
+}
+
+namespace {
+StabilityReport sample_report() {
+  StabilityReport r;
+  r.command_line = "vesselverify stability --quick";
+  r.trial_steps = 500;
+  CriticalStepRow row;
+  row.model = "volume / seed001";
+  row.integrator = "verlet";
+  row.predicted_dt = 2e-4;
+  row.found_dt = 1.99e-4;
+  r.rows = {row, row};
+  r.rows[1].level = 1;
+  r.fits.push_back({"volume / seed001", "verlet", 0.0, {0, 1}, 1.0, 1.0});
+  HardCase hc{"x", "A case", "setup", {}, 1.0};
+  hc.outcomes.push_back({"FEM | P1", true, true, std::nullopt, "fine | ok", {{"u_contact_mm", 0.1}}});
+  hc.outcomes.push_back({"msm", false, std::nullopt, false, "stopped", {{"nan", NAN}}});
+  r.hard_cases.push_back(hc);
+  return r;
+}
+}  // namespace
+
+TEST(Stability, JsonHasEveryFieldItsSchemaRequires) {
+  const auto j = nlohmann::json::parse(stability_json(sample_report()));
+  const auto schema = nlohmann::json::parse(test::read_text(VESSEL_STABILITY_SCHEMA));
+  EXPECT_EQ(j["schema"], schema["properties"]["schema"]["const"]);
+  for (const auto& key : schema["required"]) EXPECT_TRUE(j.contains(key)) << key;
+  const auto& props = schema["properties"];
+  for (const auto& key : props["critical_steps"]["items"]["required"])
+    EXPECT_TRUE(j["critical_steps"][0].contains(key)) << key;
+  for (const auto& key : props["refinement"]["items"]["required"])
+    EXPECT_TRUE(j["refinement"][0].contains(key)) << key;
+  const auto& hc = props["hard_cases"]["items"];
+  for (const auto& key : hc["required"]) EXPECT_TRUE(j["hard_cases"][0].contains(key)) << key;
+  for (const auto& key : hc["properties"]["outcomes"]["items"]["required"])
+    EXPECT_TRUE(j["hard_cases"][0]["outcomes"][1].contains(key)) << key;
+  EXPECT_TRUE(j["hard_cases"][0]["outcomes"][1]["converged"].is_null());
+  EXPECT_TRUE(j["hard_cases"][0]["outcomes"][1]["values"]["nan"].is_null());  // NaN → null
+  EXPECT_NEAR(j["critical_steps"][0]["found_over_predicted"].get<double>(), 0.995, 1e-12);
+}
+
+TEST(Stability, MarkdownIsOneSelfContainedSectionWithTheCommandAndEscapedCells) {
+  const std::string md = stability_markdown(sample_report());
+  EXPECT_EQ(md.rfind("## Numerical stability\n", 0), 0u);
+  EXPECT_EQ(md.find("\n## "), std::string::npos);  // no second top-level section
+  EXPECT_NE(md.find("`vesselverify stability --quick`"), std::string::npos);
+  EXPECT_NE(md.find("fine \\| ok"), std::string::npos);
+  EXPECT_NE(md.find("| volume / seed001 | verlet | 0 | 0,1 | 1 | 1 |"), std::string::npos) << md;
+}
+
+TEST(Stability, WritesBothFilesAtomicallyAndRefusesAnUnwritableDirectory) {
+  test::TempDir dir;
+  write_stability(dir.path(), sample_report());
+  EXPECT_TRUE(std::filesystem::exists(dir / "stability.json"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "stability.md"));
+  test::write_text(dir / "file", "x");
+  EXPECT_THROW(write_stability(dir / "file" / "sub", sample_report()), InputError);
+}

@@ -1,0 +1,125 @@
+/// `vesselverify gate`: the CI gate of model changes. Runs the gate scenes (quick variants: coarse
+/// levels, smallest and largest load) and compares with a committed baseline; fails with a table
+/// of what changed when a model's error grows, a model that finished now fails, or a normalised
+/// solve time regresses.
+#include <fstream>
+#include <iostream>
+
+#include "meshes/atomic_file.hpp"
+#include "meshes/errors.hpp"
+#include "meshes/mesh_cache.hpp"
+#include "reports/gate.hpp"
+#include "verification/cli/commands.hpp"
+#include "verification/harness.hpp"
+
+namespace vessel::cli {
+
+namespace {
+
+/// The shipped scenes the gate runs (quick variants), resolved in --scenes-dir.
+const std::vector<std::string> kGateScenes{"contact_straight.toml", "pressure_lame.toml",
+                                           "gravity_sag.toml"};
+
+struct GateOptions {
+  std::filesystem::path baseline;
+  std::filesystem::path current;  ///< compare this results file instead of running the scenes
+  std::filesystem::path scenes_dir = VESSELVERIFY_SCENES_DIR;
+  std::filesystem::path output_dir = "gate-results";
+  std::filesystem::path cache_dir = default_cache_dir();
+  bool update_baseline = false;
+  reports::GateTolerances tolerances;
+  std::string command;
+};
+
+/// Thrown when the gate finds a regression: main() prints it and exits 1.
+class GateFailed : public std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+void gate(const GateOptions& o) {
+  std::filesystem::path results_path = o.current;
+  if (results_path.empty()) {
+    std::vector<Scene> scenes;
+    for (const auto& name : kGateScenes) {
+      scenes.push_back(quick_variant(read_scene(o.scenes_dir / name)));
+    }
+    HarnessOptions h;
+    h.cache_dir = o.cache_dir;
+    h.log = &std::cout;
+    h.repeats = 3;  // medians: the gate compares times
+    run_and_write(scenes, h, o.output_dir, o.command);
+    results_path = o.output_dir / "results.json";
+  }
+  const reports::ResultsFile current = reports::read_results(results_path);
+  if (o.update_baseline) {
+    std::ifstream in(results_path);
+    write_file_atomically(o.baseline, [&](std::ostream& out) { out << in.rdbuf(); });
+    std::cout << "baseline updated: " << o.baseline.string() << " (from "
+              << results_path.string() << ")\n";
+    return;
+  }
+  if (!std::filesystem::exists(o.baseline)) {
+    throw InputError(o.baseline.string() +
+                     ": baseline not found; create it with `vesselverify gate --baseline " +
+                     o.baseline.string() + " --update-baseline`");
+  }
+  const reports::ResultsFile baseline = reports::read_results(o.baseline);
+  const reports::GateOutcome outcome = reports::compare_with_baseline(baseline, current, o.tolerances);
+  reports::Document doc;
+  doc.heading(1, std::string("Gate ") + (outcome.passed() ? "passed" : "FAILED"));
+  doc.paragraph("Compared " + std::to_string(outcome.compared) + " cases of `" +
+                results_path.string() + "` with the baseline `" + o.baseline.string() +
+                "` (error tolerance +" + std::to_string(o.tolerances.error_relative * 100.0) +
+                " %, timing ratio " + std::to_string(o.tolerances.timing_ratio) +
+                " on times normalised by the reference kernel).");
+  if (!outcome.findings.empty()) doc.table(reports::gate_table(outcome));
+  const std::string text = doc.markdown_text(".");
+  std::cout << text;
+  std::error_code ec;
+  std::filesystem::create_directories(o.output_dir, ec);
+  if (!ec) write_file_atomically(o.output_dir / "gate.md", [&](std::ostream& out) { out << text; });
+  if (!outcome.passed()) {
+    throw GateFailed("gate failed: a model's error, stability or speed regressed (table above); "
+                     "if the change is intended, rerun with --update-baseline and commit the "
+                     "baseline");
+  }
+}
+
+}  // namespace
+
+void add_gate_command(CLI::App& app, const std::string& command_line) {
+  auto o = std::make_shared<GateOptions>();
+  o->command = command_line;
+  CLI::App* cmd = app.add_subcommand(
+      "gate",
+      "CI gate of model changes: run the gate scenes (quick variants of contact_straight, "
+      "pressure_lame and gravity_sag) and compare with a committed baseline. Fails (exit 1) with "
+      "a table of what changed if any model's error grows beyond the tolerance, a model that "
+      "finished now fails, or a solve time normalised by a reference kernel grows beyond the "
+      "timing ratio.\n"
+      "Examples:\n"
+      "  vesselverify gate --baseline reports/baseline.json\n"
+      "  vesselverify gate --baseline reports/baseline.json --update-baseline\n"
+      "  vesselverify gate --baseline reports/baseline.json --current results/results.json");
+  cmd->add_option("--baseline", o->baseline, "Baseline results file (committed)")->required();
+  cmd->add_flag("--update-baseline", o->update_baseline,
+                "Rewrite the baseline with this run's results instead of comparing");
+  cmd->add_option("--current", o->current,
+                  "Compare this results file (same gate scenes) instead of running the scenes")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--scenes-dir", o->scenes_dir, "Where the gate scenes are")->capture_default_str();
+  cmd->add_option("--output-dir", o->output_dir, "Where this run's results and gate.md go")
+      ->capture_default_str();
+  cmd->add_option("--cache-dir", o->cache_dir, "Mesh cache directory")->capture_default_str();
+  cmd->add_option("--error-tolerance", o->tolerances.error_relative,
+                  "Relative growth of a max or RMS error that fails the gate")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
+  cmd->add_option("--timing-ratio", o->tolerances.timing_ratio,
+                  "Growth factor of a normalised solve time that fails the gate")
+      ->check(CLI::Range(1.0, 1000.0))
+      ->capture_default_str();
+  cmd->callback([o] { gate(*o); });
+}
+
+}  // namespace vessel::cli

@@ -1,0 +1,39 @@
+/// `vesselverify report`: results.json (+ stability.md) → report.md, report.html, figures/.
+#include <iostream>
+
+#include "reports/report.hpp"
+#include "verification/cli/commands.hpp"
+
+namespace vessel::cli {
+
+void add_report_command(CLI::App& app, const std::string& command_line) {
+  auto o = std::make_shared<reports::ReportOptions>();
+  o->command = command_line;
+  CLI::App* cmd = app.add_subcommand(
+      "report",
+      "Turn results into a report: report.md (figures as .svg files under figures/) and "
+      "report.html (self-contained, figures inline): a summary table, and per scene speed "
+      "against error with the Pareto front, error against nu and against mesh level, load "
+      "against contact displacement beside the FEM and seed 000's Hooke line, the radial "
+      "displacement along the wall, dynamic histories, and seed 000's statistics for every "
+      "model; plus the numerical-stability section when given.\n"
+      "Examples:\n"
+      "  vesselverify report results/results.json\n"
+      "  vesselverify report results/results.json --stability results/stability.md -o report");
+  cmd->add_option("results", o->results, "results.json written by `vesselverify run`")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--stability", o->stability_markdown,
+                  "stability.md written by `vesselverify stability`, embedded as a section")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output-dir", o->output_dir,
+                  "Where report.md, report.html and figures/ go (default: beside the results)");
+  cmd->callback([o] {
+    if (o->output_dir.empty()) o->output_dir = o->results.parent_path();
+    if (o->output_dir.empty()) o->output_dir = ".";
+    reports::write_report(*o);
+    std::cout << "wrote " << (o->output_dir / "report.md").string() << " and report.html\n";
+  });
+}
+
+}  // namespace vessel::cli

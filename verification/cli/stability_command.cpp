@@ -1,0 +1,99 @@
+/// `vesselverify stability`: predicted vs found critical time steps of the explicit integrators
+/// and the hard cases of issue 6; writes stability.json and stability.md.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "meshes/errors.hpp"
+#include "meshes/mesh_cache.hpp"
+#include "verification/cli/commands.hpp"
+#include "verification/stability.hpp"
+
+namespace vessel::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct StabilityCli {
+  bool quick = false;
+  fs::path output_dir = "results";
+  fs::path cache_dir = default_cache_dir();
+  bool no_cache = false;
+  int trial_steps = 0;
+  long long long_run_steps = 0;
+  int max_level = -1;
+  bool no_hard_cases = false;
+};
+
+/// Fails early (before minutes of work) when the output directory cannot be written: creates it
+/// if missing and creates and removes a probe file in it.
+void require_writable_dir(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) {
+    throw InputError("--output-dir " + dir.string() + ": cannot create the directory (" +
+                     (ec ? ec.message() : "not a directory") + "); expected a writable directory");
+  }
+  const fs::path probe = dir / ".vesselverify-write-probe";
+  {
+    std::ofstream out(probe);
+    if (!out) {
+      throw InputError("--output-dir " + dir.string() +
+                       ": cannot write into the directory; expected a writable directory");
+    }
+  }
+  fs::remove(probe, ec);
+}
+
+}  // namespace
+
+void add_stability_command(CLI::App& app, const std::string& command_line) {
+  auto o = std::make_shared<StabilityCli>();
+  CLI::App* cmd = app.add_subcommand(
+      "stability",
+      "Numerical stability: critical time step of each explicit integrator predicted from the "
+      "largest eigenvalue of M^-1 K (Lanczos) vs found by bisection on dt, per model, "
+      "integrator and mesh level, and the hard cases (nu -> 0.5, E from 1 kPa to 1 MPa, sliver "
+      "tets, a refined contact patch, an inverting load, a long run, a tight arch bend, "
+      "zero-length springs). Writes stability.json and stability.md (times in s, lengths in mm "
+      "in the text).\n"
+      "Examples:\n  vesselverify stability --quick --output-dir results\n"
+      "  vesselverify stability            # levels 0..2 and a 10^6-step long run");
+  cmd->add_flag("--quick", o->quick,
+                "Levels 0..1, 500 steps per trial, a 2e4-step long run (a few minutes)");
+  cmd->add_option("--output-dir", o->output_dir, "Where stability.json and stability.md go")
+      ->capture_default_str();
+  cmd->add_option("--cache-dir", o->cache_dir, "Mesh cache directory")->capture_default_str();
+  cmd->add_flag("--no-cache", o->no_cache, "Do not read or write the mesh cache");
+  cmd->add_option("--trial-steps", o->trial_steps,
+                  "Steps per stability trial (default 500 quick, 1000 full)");
+  cmd->add_option("--long-run-steps", o->long_run_steps,
+                  "Steps of the long run (default 2e4 quick, 1e6 full)");
+  cmd->add_option("--max-level", o->max_level, "Highest mesh level of the step table");
+  cmd->add_flag("--no-hard-cases", o->no_hard_cases, "Only the critical-step table");
+  cmd->callback([o, command_line] {
+    if (o->trial_steps < 0) {
+      throw InputError("--trial-steps: expected ≥ 1, got " + std::to_string(o->trial_steps));
+    }
+    if (o->long_run_steps < 0 || o->long_run_steps > 2'000'000'000LL) {
+      throw InputError("--long-run-steps: expected 1..2e9, got " +
+                       std::to_string(o->long_run_steps));
+    }
+    require_writable_dir(o->output_dir);
+    StabilityOptions so;
+    so.quick = o->quick;
+    so.cache_dir = o->no_cache ? fs::path() : o->cache_dir;
+    so.log = &std::cout;
+    so.command_line = command_line;
+    so.trial_steps = o->trial_steps;
+    so.long_run_steps = o->long_run_steps;
+    so.max_level = o->max_level;
+    so.hard_cases = !o->no_hard_cases;
+    const StabilityReport report = run_stability(so);
+    write_stability(o->output_dir, report);
+    std::cout << "wrote " << (o->output_dir / "stability.json").string() << " and stability.md\n";
+  });
+}
+
+}  // namespace vessel::cli

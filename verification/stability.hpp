@@ -1,0 +1,112 @@
+#pragma once
+/// Numerical stability study (`vesselverify stability`, issue 6): predicted vs found critical
+/// time steps of the explicit integrators per model, integrator and mesh level, their shrinking
+/// with refinement, and the hard cases (near-incompressible ν, stiff and soft E at a fixed step,
+/// sliver tets, a refined contact patch, an inverting load, a long run, a tight arch bend,
+/// zero-length springs and coincident nodes), each with what every model did.
+/// Results: stability.json (schema verification/stability.schema.json) and stability.md.
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "meshes/tet_mesh.hpp"
+#include "meshes/vessel_geometry.hpp"
+
+namespace vessel {
+
+struct StabilityOptions {
+  bool quick = true;  ///< levels 0..1 and a scaled-down long run; else levels 0..2 and 10⁶ steps
+  std::filesystem::path cache_dir;  ///< mesh cache ("" disables it)
+  std::ostream* log = nullptr;      ///< progress
+  std::string command_line;         ///< recorded in the results
+  /// Overrides (0: the mode's default): steps per stability trial, steps of the long run,
+  /// highest mesh level of the step table.
+  int trial_steps = 0;
+  long long long_run_steps = 0;
+  int max_level = -1;
+  bool hard_cases = true;  ///< false: only the critical-step table
+};
+
+/// One row of the critical-step table.
+struct CriticalStepRow {
+  std::string model;       ///< e.g. "volume / seed001"
+  std::string integrator;  ///< explicit-euler | symplectic-euler | verlet
+  double zeta = 0.0;       ///< target damping ratio of the top mode (c = 2ζω_max·mean mass)
+  double point_damping = 0.0;  ///< c, N·s/m per node (seed 000 eq. 3.3)
+  int level = 0;
+  int nodes = 0;
+  int springs = 0;
+  double h_nominal = 0.0;  ///< the mesh's nominal element size, m
+  double omega_max = 0.0;  ///< rad/s (Lanczos)
+  double omega_gershgorin = 0.0;
+  double omega_min = 0.0;
+  double gamma_max = 0.0;  ///< damping rate of the top mode, 1/s
+  double predicted_dt = 0.0;
+  double found_dt = 0.0;     ///< largest step found stable, s
+  double unstable_dt = 0.0;  ///< smallest step found unstable, s
+  int trials = 0;
+  int steps_per_trial = 0;
+  double seconds = 0.0;
+};
+
+/// How the found step shrinks with refinement: dt ∝ h^exponent (least squares over the levels).
+struct RefinementFit {
+  std::string model;
+  std::string integrator;
+  double zeta = 0.0;
+  std::vector<int> levels;
+  double exponent = 0.0;  ///< of the found step
+  double predicted_exponent = 0.0;
+};
+
+/// What one model did on a hard case.
+struct HardCaseOutcome {
+  std::string model;
+  bool finished = false;           ///< returned a result (no exception)
+  std::optional<bool> converged;   ///< solver converged (static / linear solve), if applicable
+  std::optional<bool> bounded;     ///< energy stayed bounded (dynamic runs), if applicable
+  std::string reported;            ///< what it reported (numbers in mm, mN, s), or its error
+  std::map<std::string, double> values;  ///< the main figures, SI unless the key says mm
+};
+
+struct HardCase {
+  std::string id;
+  std::string title;
+  std::string setup;  ///< what was run
+  std::vector<HardCaseOutcome> outcomes;
+  double seconds = 0.0;
+};
+
+struct StabilityReport {
+  bool quick = true;
+  std::string command_line;
+  int trial_steps = 0;
+  std::vector<CriticalStepRow> rows;
+  std::vector<RefinementFit> fits;
+  std::vector<HardCase> hard_cases;
+  double seconds = 0.0;
+};
+
+/// Runs the study. Throws InputError for bad options.
+StabilityReport run_stability(const StabilityOptions& options);
+
+/// The versioned JSON (schema "vesselverify.stability", version 1) as text.
+std::string stability_json(const StabilityReport& report);
+/// The self-contained Markdown section "## Numerical stability".
+std::string stability_markdown(const StabilityReport& report);
+/// Writes stability.json and stability.md into `dir` atomically (InputError if it cannot).
+void write_stability(const std::filesystem::path& dir, const StabilityReport& report);
+
+/// Least-squares slope of log(y) against log(x) (InputError unless ≥ 2 positive pairs).
+double loglog_slope(const std::vector<double>& x, const std::vector<double>& y);
+
+/// A straight tube meshed with gmsh (OpenCASCADE) with the element size graded from `fine` (m)
+/// at `point` up to the vessel's nominal size (level 0) beyond `radius` + a transition: the
+/// finely refined contact patch. Groups as in kVesselGroups.
+TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
+                           double radius);
+
+}  // namespace vessel
