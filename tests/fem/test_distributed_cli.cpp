@@ -99,6 +99,9 @@ TEST(FemDistributedCli, RefusesWhatIsNotDistributedAndWritesNothing) {
   r = vv("fem " + kTube + "--distributed --modes 3" + json);
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "--modes is serial only")) << r.output;
+  r = vv("fem " + kTube + "--distributed --transient" + json);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "--transient is serial only")) << r.output;
   r = vv("fem " + kTube + "--distributed --load contact --contact-point 0 0 0.002" + json);
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "off the wall")) << r.output;
