@@ -300,11 +300,11 @@ ReadOut read_out(const Scene& s, int level, const std::vector<Vec3>& nodes, cons
 void finish_outcome(ModelOutcome& out, const Scene& s, const std::vector<Vec3>& nodes,
                     const std::vector<Vec3>& u_model, const ReferenceAtPoints& ref,
                     double magnitude, const ReadOut& at, double ref_max_strain_unit,
-                    const Vec3& qoi_point, const std::vector<Vec3>& loads, long steps,
-                    double dt) {
+                    const Vec3& qoi_point, const std::vector<Vec3>& loads, long steps, double dt) {
   const std::vector<Vec3> u_ref = scaled(ref.u, magnitude);
   const std::size_t qoi = at.qoi;
-  out.quantities = quantity_errors(s.budget, nodes, u_model, u_ref, qoi, qoi_point, loads, out.history);
+  out.quantities =
+      quantity_errors(s.budget, nodes, u_model, u_ref, qoi, qoi_point, loads, out.history);
   if (s.budget.stated) {
     out.budget_error = budget_quantity_error(out.quantities, s.budget.quantity);
     std::tie(out.update_seconds, out.steps_per_update) =
@@ -442,15 +442,15 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
         held = held_nodes(full, result.qoi_point, spec.roi_radius);
         roi = std::make_unique<RoiNetwork>(restrict_network(built.network, held));
         roi_model = std::make_unique<msm::SpringModel>(roi->network, spec.damping);
-        roi_problem = std::make_unique<msm::Problem>(
-            restrict_problem(full, *roi, held, *roi_model));
+        roi_problem =
+            std::make_unique<msm::Problem>(restrict_problem(full, *roi, held, *roi_model));
       }
       const msm::Problem& problem = roi ? *roi_problem : full;
       // The QoI node in the solved problem (−1 if the region holds it).
       Eigen::Index qoi_solved = static_cast<Eigen::Index>(at.qoi);
       if (roi) {
-        const auto it = std::find(roi->full_index.begin(), roi->full_index.end(),
-                                  static_cast<int>(at.qoi));
+        const auto it =
+            std::find(roi->full_index.begin(), roi->full_index.end(), static_cast<int>(at.qoi));
         qoi_solved = it == roi->full_index.end() ? -1 : it - roi->full_index.begin();
       }
       out.unknowns = free_unknowns(problem);
@@ -530,7 +530,8 @@ QuantityErrors quantity_errors(const Budget& budget, const std::vector<Vec3>& no
                                const std::vector<Vec3>& loads, const History& history) {
   QuantityErrors q;
   q.contact_point_mm = (u_model[qoi] - u_ref[qoi]).norm() * 1e3;
-  if (!history.time_s.empty()) q.contact_point_mm = std::max(q.contact_point_mm, history.max_error_mm);
+  if (!history.time_s.empty())
+    q.contact_point_mm = std::max(q.contact_point_mm, history.max_error_mm);
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     q.field_mm = std::max(q.field_mm, (u_model[i] - u_ref[i]).norm() * 1e3);
   }
@@ -580,10 +581,14 @@ double budget_magnitude(const Scene& s, double max_abs_strain_unit) {
 double budget_quantity_error(const QuantityErrors& q, BudgetQuantity quantity) {
   constexpr double nan = std::numeric_limits<double>::quiet_NaN();
   switch (quantity) {
-    case BudgetQuantity::contact_point: return q.contact_point_mm;
-    case BudgetQuantity::field: return q.field_mm;
-    case BudgetQuantity::patch: return q.patch_mm.value_or(nan);
-    case BudgetQuantity::reaction: return q.reaction_mN.value_or(nan);
+    case BudgetQuantity::contact_point:
+      return q.contact_point_mm;
+    case BudgetQuantity::field:
+      return q.field_mm;
+    case BudgetQuantity::patch:
+      return q.patch_mm.value_or(nan);
+    case BudgetQuantity::reaction:
+      return q.reaction_mN.value_or(nan);
   }
   return nan;
 }

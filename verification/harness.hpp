@@ -36,7 +36,7 @@ struct ReferenceInfo {
   std::size_t dofs = 0;
   double solve_seconds = 0.0;  ///< fine level, assembly + solve
   double max_abs_strain_unit = 0.0;  ///< largest |principal strain| at unit load
-  double budget_magnitude = 0.0;  ///< the load the budget applies at for this ν (scene's unit)
+  double budget_magnitude = 0.0;     ///< the load the budget applies at for this ν (scene's unit)
 };
 
 /// The error on each quantity a budget may name (issue #7), against the reference at the model's
@@ -47,8 +47,8 @@ struct QuantityErrors {
   /// state against the static reference) and the history's largest difference from the FEM
   /// transient there.
   double contact_point_mm = 0.0;
-  double field_mm = 0.0;              ///< max |u_model − u_ref| over all model nodes, mm
-  std::optional<double> patch_mm;     ///< max within the budget's radius of the QoI point, mm
+  double field_mm = 0.0;           ///< max |u_model − u_ref| over all model nodes, mm
+  std::optional<double> patch_mm;  ///< max within the budget's radius of the QoI point, mm
   /// Contact loads: the indentation d = Σ f_i·u_i / |Σ f_i| (work-conjugate to the total contact
   /// force, over the model's loaded nodes, the same nodal loads for model and reference), mm.
   std::optional<double> indentation_mm, indentation_reference_mm;
@@ -148,8 +148,7 @@ double budget_quantity_error(const QuantityErrors& q, BudgetQuantity quantity);
 
 /// Time per update (s) and steps per update of a run that took `solve_seconds`: static solvers
 /// (steps = 0) one solve; integrators `steps` steps of `dt` → per step × ⌈period/dt⌉ (at least 1).
-std::pair<double, long> time_per_update(double solve_seconds, long steps, double dt,
-                                        double period);
+std::pair<double, long> time_per_update(double solve_seconds, long steps, double dt, double period);
 
 /// Runs the scene. Throws InputError for inputs the scene validation cannot see (a contact point
 /// off the generated wall, roller ends on the arch); a model that fails (diverges, does not

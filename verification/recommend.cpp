@@ -40,12 +40,18 @@ bool meets(const Candidate& c, double tolerance, double budget) {
 
 std::string to_string(Verdict v) {
   switch (v) {
-    case Verdict::recommended: return "recommended";
-    case Verdict::meets_budget: return "meets the budget, costlier";
-    case Verdict::too_slow: return "too slow";
-    case Verdict::too_inaccurate: return "too inaccurate";
-    case Verdict::too_slow_and_inaccurate: return "too slow and too inaccurate";
-    case Verdict::failed: return "failed";
+    case Verdict::recommended:
+      return "recommended";
+    case Verdict::meets_budget:
+      return "meets the budget, costlier";
+    case Verdict::too_slow:
+      return "too slow";
+    case Verdict::too_inaccurate:
+      return "too inaccurate";
+    case Verdict::too_slow_and_inaccurate:
+      return "too slow and too inaccurate";
+    case Verdict::failed:
+      return "failed";
   }
   return "?";
 }
@@ -92,8 +98,9 @@ Selection select_model(const std::vector<Candidate>& c, double tolerance, double
     }
     if (!std::isfinite(c[i].error)) {
       sel.verdicts[i] = Verdict::failed;
-      sel.reasons[i] = "failed: its error on the budget's quantity is not finite (the model does "
-                       "not move the contact)";
+      sel.reasons[i] =
+          "failed: its error on the budget's quantity is not finite (the model does "
+          "not move the contact)";
       continue;
     }
     const bool accurate = c[i].error <= tolerance;
@@ -108,10 +115,9 @@ Selection select_model(const std::vector<Candidate>& c, double tolerance, double
       sel.verdicts[i] = Verdict::meets_budget;
       const Candidate& best = c[*sel.recommended];
       const bool tied = c[i].update_seconds <= fastest * (1.0 + kTimingTie);
-      sel.reasons[i] = "meets both, but " + time + " per update against " +
-                       ms(best.update_seconds) +
-                       (tied ? " (a tie within " + fmt(kTimingTie * 100) + " %) with a larger error"
-                             : "");
+      sel.reasons[i] =
+          "meets both, but " + time + " per update against " + ms(best.update_seconds) +
+          (tied ? " (a tie within " + fmt(kTimingTie * 100) + " %) with a larger error" : "");
     } else if (!accurate && !fast) {
       sel.verdicts[i] = Verdict::too_slow_and_inaccurate;
       sel.reasons[i] = err + " > " + tol_text + " and " + time + " > " + ms(budget) + " per update";
@@ -232,8 +238,8 @@ std::vector<Candidate> collect_candidates(const SceneResult& r) {
       continue;
     }
     // NaN (not computable) wins over any number: std::max would drop it.
-    c.error = std::isnan(c.error) || std::isnan(o.budget_error) ? NAN
-                                                                : std::max(c.error, o.budget_error);
+    c.error =
+        std::isnan(c.error) || std::isnan(o.budget_error) ? NAN : std::max(c.error, o.budget_error);
     c.update_seconds = std::max(c.update_seconds, o.update_seconds);
   }
   return out;
@@ -254,14 +260,16 @@ Recommendation recommend(const Scene& scene, const RecommendOptions& o,
     s = quick_variant(std::move(s));
     s.load.magnitudes = magnitudes;  // the budget picks its own load
   }
-  s.model_levels = o.levels.empty() ? (o.quick ? std::vector<int>{0} : std::vector<int>{0, 1})
-                                    : o.levels;
+  s.model_levels =
+      o.levels.empty() ? (o.quick ? std::vector<int>{0} : std::vector<int>{0, 1}) : o.levels;
   std::sort(s.model_levels.begin(), s.model_levels.end());
   s.vessel.level = s.model_levels.front();
+  if (o.reference_level >= 0) s.reference_level = o.reference_level;
   s.reference_level = std::max(s.reference_level, s.model_levels.back());
   std::vector<double> radii = o.roi_radii;
   if (radii.empty()) {
-    radii = o.quick ? std::vector<double>{4e-3, 8e-3} : std::vector<double>{2e-3, 4e-3, 8e-3, 16e-3};
+    radii =
+        o.quick ? std::vector<double>{4e-3, 8e-3} : std::vector<double>{2e-3, 4e-3, 8e-3, 16e-3};
   }
   s.models = candidate_models(s, radii);
   HarnessOptions h = o.harness;
@@ -275,12 +283,10 @@ Recommendation recommend(const Scene& scene, const RecommendOptions& o,
   rec.candidates = collect_candidates(rec.result);
   rec.selection = select_model(rec.candidates, s.budget.tolerance, s.budget.seconds_per_update(),
                                budget_unit(s.budget.quantity));
-  write_file_atomically(output_dir / "recommend.md", [&](std::ostream& out) {
-    out << recommendation_markdown(rec, command);
-  });
-  write_file_atomically(output_dir / "recommend.json", [&](std::ostream& out) {
-    out << recommendation_json(rec, command);
-  });
+  write_file_atomically(output_dir / "recommend.md",
+                        [&](std::ostream& out) { out << recommendation_markdown(rec, command); });
+  write_file_atomically(output_dir / "recommend.json",
+                        [&](std::ostream& out) { out << recommendation_json(rec, command); });
   return rec;
 }
 
@@ -294,7 +300,8 @@ std::string budget_text(const Scene& s, const SceneResult& r) {
   t << " error ≤ " << fmt(b.tolerance) << " " << budget_unit(b.quantity) << ", and ≤ "
     << ms(b.seconds_per_update()) << " of computation per update";
   if (b.rate_hz > 0.0) t << " (" << fmt(b.rate_hz) << " Hz)";
-  const char* unit = s.load.kind == LoadKind::contact ? "N" : (s.load.kind == LoadKind::pressure ? "Pa" : "g");
+  const char* unit =
+      s.load.kind == LoadKind::contact ? "N" : (s.load.kind == LoadKind::pressure ? "Pa" : "g");
   for (const ReferenceInfo& ref : r.references) {
     t << "; at ν = " << ref.poisson_ratio << " the load is ";
     if (s.load.kind == LoadKind::contact) {
@@ -324,16 +331,30 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
      << "    " << command << "\n\n";
   if (sel.recommended) {
     const Candidate& best = c[*sel.recommended];
-    md << "**Recommended: `" << best.name << "`** (" << best.detail << "): error " << fmt(best.error)
-       << " " << unit << ", " << ms(best.update_seconds) << " per update, " << best.unknowns
-       << " unknowns.\n\n";
+    md << "**Recommended: `" << best.name << "`** (" << best.detail << "): error "
+       << fmt(best.error) << " " << unit << ", " << ms(best.update_seconds) << " per update, "
+       << best.unknowns << " unknowns.\n\n";
   } else if (sel.closest) {
     const Candidate& near = c[*sel.closest];
-    md << "**No candidate meets the budget.** The closest is `" << near.name << "` ("
-       << near.detail << "): error " << fmt(near.error) << " " << unit << ", "
-       << ms(near.update_seconds) << " per update; " << sel.reasons[*sel.closest] << ".\n\n";
+    md << "**No candidate meets the budget.** The closest is `" << near.name << "` (" << near.detail
+       << "): error " << fmt(near.error) << " " << unit << ", " << ms(near.update_seconds)
+       << " per update; " << sel.reasons[*sel.closest] << ".\n\n";
   } else {
     md << "**No candidate meets the budget**, and none finished.\n\n";
+  }
+  // A tolerance at or above the reference's own contact displacement is met by a model that does
+  // not move at all: say so, the answer then says nothing about accuracy.
+  double reference_qoi_mm = 0.0;
+  for (const ModelOutcome& o : rec.result.outcomes) {
+    if (o.ok) reference_qoi_mm = std::max(reference_qoi_mm, o.qoi_reference_mm);
+  }
+  if (s.budget.quantity != BudgetQuantity::reaction && reference_qoi_mm > 0.0 &&
+      s.budget.tolerance >= reference_qoi_mm) {
+    md << "⚠ **The tolerance does not discriminate**: at this load the reference's contact point "
+          "moves "
+       << fmt(reference_qoi_mm) << " mm, no more than the " << fmt(s.budget.tolerance)
+       << " mm tolerance, so a model that does not move at all would meet it. State a tighter "
+          "tolerance or a larger load (`magnitude`) for an answer about accuracy.\n\n";
   }
   md << "Time per update: one static solve from rest for static solvers (set-up excluded: it is "
         "done once); for integrators the time per step × the steps one update period needs. "
@@ -341,13 +362,16 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
         "model node; region-of-interest models (R) hold every node farther than R from the "
         "contact and are compared on the whole vessel. ★ marks the Pareto front (no other "
         "candidate is both faster and more accurate).\n\n";
-  md << "| candidate | unknowns | error (" << unit << ") | time per update (ms) | Pareto | verdict | "
+  md << "| candidate | unknowns | error (" << unit
+     << ") | time per update (ms) | Pareto | verdict | "
         "why |\n|---|---|---|---|---|---|---|\n";
   // Winners first, then by time per update; failures last.
   std::vector<std::size_t> order(c.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    const auto rank = [&](std::size_t i) { return static_cast<int>(sel.verdicts[i]) > 1 ? 2 : static_cast<int>(sel.verdicts[i]); };
+    const auto rank = [&](std::size_t i) {
+      return static_cast<int>(sel.verdicts[i]) > 1 ? 2 : static_cast<int>(sel.verdicts[i]);
+    };
     const bool fa = sel.verdicts[a] == Verdict::failed, fb = sel.verdicts[b] == Verdict::failed;
     if (fa != fb) return fb;
     if (rank(a) != rank(b)) return rank(a) < rank(b);
@@ -370,16 +394,16 @@ std::string recommendation_json(const Recommendation& rec, const std::string& co
   nlohmann::json candidates = nlohmann::json::array();
   for (std::size_t i = 0; i < rec.candidates.size(); ++i) {
     const Candidate& c = rec.candidates[i];
-    nlohmann::json j{{"name", c.name},
-                     {"model", c.model},
-                     {"detail", c.detail},
-                     {"level", c.level},
-                     {"unknowns", c.unknowns},
-                     {"ok", c.ok},
-                     {"pareto", std::find(sel.pareto.begin(), sel.pareto.end(), i) !=
-                                    sel.pareto.end()},
-                     {"verdict", to_string(sel.verdicts[i])},
-                     {"reason", sel.reasons[i]}};
+    nlohmann::json j{
+        {"name", c.name},
+        {"model", c.model},
+        {"detail", c.detail},
+        {"level", c.level},
+        {"unknowns", c.unknowns},
+        {"ok", c.ok},
+        {"pareto", std::find(sel.pareto.begin(), sel.pareto.end(), i) != sel.pareto.end()},
+        {"verdict", to_string(sel.verdicts[i])},
+        {"reason", sel.reasons[i]}};
     if (c.roi_radius > 0.0) j["roi_radius_mm"] = c.roi_radius * 1e3;
     if (c.ok) {
       j["error"] = std::isfinite(c.error) ? nlohmann::json(c.error) : nlohmann::json(nullptr);
@@ -403,7 +427,12 @@ std::string recommendation_json(const Recommendation& rec, const std::string& co
   for (const ReferenceInfo& ref : rec.result.references) {
     loads.push_back({{"poisson_ratio", ref.poisson_ratio}, {"magnitude", ref.budget_magnitude}});
   }
+  double reference_qoi_mm = 0.0;
+  for (const ModelOutcome& o : rec.result.outcomes) {
+    if (o.ok) reference_qoi_mm = std::max(reference_qoi_mm, o.qoi_reference_mm);
+  }
   const nlohmann::json j{{"schema", "vesselverify.recommend"},
+                         {"reference_contact_point_mm", reference_qoi_mm},
                          {"schema_version", 1},
                          {"command", command},
                          {"scene", s.name},

@@ -30,12 +30,12 @@ struct Candidate {
 };
 
 enum class Verdict {
-  recommended,    ///< meets both, and the cheapest that does
-  meets_budget,   ///< meets both, but costs more time per update than the recommended one
+  recommended,   ///< meets both, and the cheapest that does
+  meets_budget,  ///< meets both, but costs more time per update than the recommended one
   too_slow,
   too_inaccurate,
   too_slow_and_inaccurate,
-  failed,         ///< diverged, did not converge, or its error is not computable
+  failed,  ///< diverged, did not converge, or its error is not computable
 };
 std::string to_string(Verdict verdict);
 
@@ -54,15 +54,16 @@ inline constexpr double kTimingTie = 0.05;
 
 /// Judges the candidates against `tolerance` (the quantity's unit, named by `unit`) and
 /// `seconds_per_update`. The cheapest is the least time per update; ties (times within
-/// kTimingTie of the least) go to the smaller error, then to the earlier candidate. A candidate that failed or whose error is not finite can win
-/// nothing.
+/// kTimingTie of the least) go to the smaller error, then to the earlier candidate. A candidate
+/// that failed or whose error is not finite can win nothing.
 Selection select_model(const std::vector<Candidate>& candidates, double tolerance,
                        double seconds_per_update, const std::string& unit = "mm");
 
 struct RecommendOptions {
-  bool quick = false;               ///< models at level 0 only, reference at level ≤ 1
-  std::vector<int> levels;          ///< model levels (empty: 0 and 1; quick: 0)
-  std::vector<double> roi_radii;    ///< m (empty: 2, 4, 8, 16 mm; quick: 4, 8 mm)
+  bool quick = false;             ///< models at level 0 only, reference at level ≤ 1
+  std::vector<int> levels;        ///< model levels (empty: 0 and 1; quick: 0)
+  int reference_level = -1;       ///< the reference's level (−1: the scene's)
+  std::vector<double> roi_radii;  ///< m (empty: 2, 4, 8, 16 mm; quick: 4, 8 mm)
   HarnessOptions harness;
 };
 

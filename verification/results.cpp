@@ -1,15 +1,16 @@
+#include <unistd.h>
+
 #include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
-#include <unistd.h>
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
-#include "verification/timing.hpp"
 #include "verification/harness.hpp"
+#include "verification/timing.hpp"
 
 namespace vessel {
 
@@ -118,24 +119,23 @@ nlohmann::json scene_json(const SceneResult& r) {
     outcomes.push_back(j);
   }
   const Scene& s = r.scene;
-  return {{"name", s.name},
-          {"source", s.source.string()},
-          {"description", s.description},
-          {"vessel", describe(s.vessel)},
-          {"model_levels", s.model_levels},
-          {"reference_level", s.reference_level},
-          {"youngs_modulus_pa", s.youngs_modulus},
-          {"load", to_string(s.load.kind)},
-          {"load_unit", s.load.kind == LoadKind::contact
-                            ? "N"
-                            : (s.load.kind == LoadKind::pressure ? "Pa" : "g")},
-          {"qoi_point_mm",
-           {r.qoi_point.x() * 1e3, r.qoi_point.y() * 1e3, r.qoi_point.z() * 1e3}},
-          {"tolerance_max_error_mm", s.tolerances.max_error_mm},
-          {"budget", s.budget.stated ? budget_json(s.budget) : nlohmann::json(nullptr)},
-          {"seconds", r.seconds},
-          {"references", refs},
-          {"outcomes", outcomes}};
+  return {
+      {"name", s.name},
+      {"source", s.source.string()},
+      {"description", s.description},
+      {"vessel", describe(s.vessel)},
+      {"model_levels", s.model_levels},
+      {"reference_level", s.reference_level},
+      {"youngs_modulus_pa", s.youngs_modulus},
+      {"load", to_string(s.load.kind)},
+      {"load_unit",
+       s.load.kind == LoadKind::contact ? "N" : (s.load.kind == LoadKind::pressure ? "Pa" : "g")},
+      {"qoi_point_mm", {r.qoi_point.x() * 1e3, r.qoi_point.y() * 1e3, r.qoi_point.z() * 1e3}},
+      {"tolerance_max_error_mm", s.tolerances.max_error_mm},
+      {"budget", s.budget.stated ? budget_json(s.budget) : nlohmann::json(nullptr)},
+      {"seconds", r.seconds},
+      {"references", refs},
+      {"outcomes", outcomes}};
 }
 
 const char* load_unit(LoadKind k) {

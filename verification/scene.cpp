@@ -307,9 +307,10 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
   std::vector<double> radii{0.0};
   if (const toml::node* roi = r.get("roi_radius")) {
     if (load != LoadKind::contact) {
-      r.fail(roi, "roi_radius", "found a region-of-interest radius on a " + to_string(load) +
-                                    " load; expected it only with a contact load (the region is "
-                                    "centred on the contact point)");
+      r.fail(roi, "roi_radius",
+             "found a region-of-interest radius on a " + to_string(load) +
+                 " load; expected it only with a contact load (the region is "
+                 "centred on the contact point)");
     }
     radii = r.numbers(*roi, "roi_radius", 0.0, HUGE_VAL, "m");
     for (const double v : radii) {
@@ -335,26 +336,26 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
     for (const auto& ms : mass) {
       for (const auto& solver : solvers) {
         for (const double dt : is_integrator(solver) ? dts : std::vector<double>{0.0}) {
-         for (const double roi : radii) {
-          ModelSpec c = m;
-          c.roi_radius = roi;
-          c.stiffness = k;
-          c.mass = ms;
-          c.solver = solver;
-          c.dt = dt;
-          if (!is_integrator(solver)) c.steps = 0;
-          std::string swept;
-          const auto add = [&](bool varies, const std::string& key, const std::string& value) {
-            if (varies) swept += (swept.empty() ? "" : ";") + key + "=" + value;
-          };
-          add(stiffness.size() > 1, "stiffness", k);
-          add(mass.size() > 1, "mass", ms);
-          add(solvers.size() > 1, "solver", solver);
-          add(dts.size() > 1 && is_integrator(solver), "dt", short_number(dt));
-          add(radii.size() > 1, "roi_radius", short_number(roi));
-          if (!swept.empty()) c.name += "[" + swept + "]";
-          out.push_back(c);
-         }
+          for (const double roi : radii) {
+            ModelSpec c = m;
+            c.roi_radius = roi;
+            c.stiffness = k;
+            c.mass = ms;
+            c.solver = solver;
+            c.dt = dt;
+            if (!is_integrator(solver)) c.steps = 0;
+            std::string swept;
+            const auto add = [&](bool varies, const std::string& key, const std::string& value) {
+              if (varies) swept += (swept.empty() ? "" : ";") + key + "=" + value;
+            };
+            add(stiffness.size() > 1, "stiffness", k);
+            add(mass.size() > 1, "mass", ms);
+            add(solvers.size() > 1, "solver", solver);
+            add(dts.size() > 1 && is_integrator(solver), "dt", short_number(dt));
+            add(radii.size() > 1, "roi_radius", short_number(roi));
+            if (!swept.empty()) c.name += "[" + swept + "]";
+            out.push_back(c);
+          }
         }
       }
     }
@@ -406,8 +407,9 @@ Budget read_budget(TableReader r, const Scene& scene) {
   }
   const bool contact = scene.load.kind == LoadKind::contact;
   if (b.quantity == BudgetQuantity::reaction && !contact) {
-    r.fail(q, "quantity", "found \"reaction\" with a " + to_string(scene.load.kind) +
-                              " load; expected a contact load (the instrument's force)");
+    r.fail(q, "quantity",
+           "found \"reaction\" with a " + to_string(scene.load.kind) +
+               " load; expected a contact load (the instrument's force)");
   }
   const toml::node* radius = r.get("radius");
   if (b.quantity == BudgetQuantity::patch) {
@@ -415,21 +417,28 @@ Budget read_budget(TableReader r, const Scene& scene) {
     b.radius = r.number(*radius, "radius", 0.0, HUGE_VAL, "m");
     if (b.radius <= 0.0) r.fail(radius, "radius", "found 0, expected a radius > 0 m");
   } else if (radius) {
-    r.fail(radius, "radius", "found a radius with quantity \"" + to_string(b.quantity) +
-                                 "\"; expected it only with quantity \"patch\"");
+    r.fail(radius, "radius",
+           "found a radius with quantity \"" + to_string(b.quantity) +
+               "\"; expected it only with quantity \"patch\"");
   }
   const toml::node* mm = r.get("tolerance_mm");
   const toml::node* mn = r.get("tolerance_mN");
   if (b.quantity == BudgetQuantity::reaction) {
-    if (mm) r.fail(mm, "tolerance_mm", "found a displacement tolerance; quantity \"reaction\" "
-                                       "expected tolerance_mN (a force, mN)");
-    if (!mn) r.fail(nullptr, "tolerance_mN", "missing; quantity \"reaction\" needs a force "
-                                             "tolerance > 0 mN");
+    if (mm)
+      r.fail(mm, "tolerance_mm",
+             "found a displacement tolerance; quantity \"reaction\" "
+             "expected tolerance_mN (a force, mN)");
+    if (!mn)
+      r.fail(nullptr, "tolerance_mN",
+             "missing; quantity \"reaction\" needs a force "
+             "tolerance > 0 mN");
     b.tolerance = r.number(*mn, "tolerance_mN", 0.0, HUGE_VAL, "mN");
     if (b.tolerance <= 0.0) r.fail(mn, "tolerance_mN", "found 0, expected a tolerance > 0 mN");
   } else {
-    if (mn) r.fail(mn, "tolerance_mN", "found a force tolerance with quantity \"" +
-                                           to_string(b.quantity) + "\"; expected tolerance_mm");
+    if (mn)
+      r.fail(mn, "tolerance_mN",
+             "found a force tolerance with quantity \"" + to_string(b.quantity) +
+                 "\"; expected tolerance_mm");
     b.tolerance = scene.tolerances.max_error_mm;  // [tolerances], itself 0.1 mm by default
     if (mm) {
       b.tolerance = r.number(*mm, "tolerance_mm", 0.0, HUGE_VAL, "mm");
@@ -550,10 +559,14 @@ std::string to_string(LoadKind kind) {
 
 std::string to_string(BudgetQuantity q) {
   switch (q) {
-    case BudgetQuantity::contact_point: return "contact_point";
-    case BudgetQuantity::patch: return "patch";
-    case BudgetQuantity::field: return "field";
-    case BudgetQuantity::reaction: return "reaction";
+    case BudgetQuantity::contact_point:
+      return "contact_point";
+    case BudgetQuantity::patch:
+      return "patch";
+    case BudgetQuantity::field:
+      return "field";
+    case BudgetQuantity::reaction:
+      return "reaction";
   }
   return "?";
 }

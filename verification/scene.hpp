@@ -51,9 +51,9 @@ struct Tolerances {
 /// What the scene's error budget is measured on (the `[budget]` table's `quantity`).
 enum class BudgetQuantity {
   contact_point,  ///< |u_model − u_ref| at the QoI (contact) node, mm
-  patch,          ///< max |u_model − u_ref| over the model nodes within `radius` of the QoI point, mm
-  field,          ///< max |u_model − u_ref| over all model nodes, mm
-  reaction,       ///< the force the instrument feels at the reference's indentation, mN
+  patch,     ///< max |u_model − u_ref| over the model nodes within `radius` of the QoI point, mm
+  field,     ///< max |u_model − u_ref| over all model nodes, mm
+  reaction,  ///< the force the instrument feels at the reference's indentation, mN
 };
 
 /// An accuracy and rate budget: what the scene needs (issue #7). Rate: `rate_hz` sets the update
@@ -62,11 +62,11 @@ enum class BudgetQuantity {
 struct Budget {
   bool stated = false;  ///< the scene has a [budget] table
   BudgetQuantity quantity = BudgetQuantity::contact_point;
-  double radius = 0.0;        ///< m, quantity patch only
-  double tolerance = 0.1;     ///< mm (mN for reaction); seed 000's 0.1 mm visual threshold
-  double rate_hz = 0.0;       ///< 0: not given
-  double time_budget_s = 0.0; ///< 0: not given
-  double magnitude = 0.0;     ///< load the budget applies at (scene's unit); 0: representative
+  double radius = 0.0;         ///< m, quantity patch only
+  double tolerance = 0.1;      ///< mm (mN for reaction); seed 000's 0.1 mm visual threshold
+  double rate_hz = 0.0;        ///< 0: not given
+  double time_budget_s = 0.0;  ///< 0: not given
+  double magnitude = 0.0;      ///< load the budget applies at (scene's unit); 0: representative
   /// Compute time allowed per update, s (time_budget_s, else 1/rate_hz; 0 if neither).
   [[nodiscard]] double seconds_per_update() const {
     return time_budget_s > 0.0 ? time_budget_s : (rate_hz > 0.0 ? 1.0 / rate_hz : 0.0);

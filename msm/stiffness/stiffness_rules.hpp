@@ -20,8 +20,8 @@ enum class StiffnessRule {
 };
 /// Every rule, in declaration order (for sweeps over all of them, e.g. `vesselverify recommend`).
 inline constexpr std::array<StiffnessRule, 5> kAllStiffnessRules{
-    StiffnessRule::seed000, StiffnessRule::seed001, StiffnessRule::van_gelder,
-    StiffnessRule::lloyd, StiffnessRule::uniform};
+    StiffnessRule::seed000, StiffnessRule::seed001, StiffnessRule::van_gelder, StiffnessRule::lloyd,
+    StiffnessRule::uniform};
 StiffnessRule parse_stiffness_rule(const std::string& name);
 std::string to_string(StiffnessRule rule);
 

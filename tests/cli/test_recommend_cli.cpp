@@ -1,5 +1,5 @@
-// `vesselverify recommend` end to end on a small level-0 contact scene (slow: it runs every
-// generated candidate against the FEM reference). The answer is checked against the budget's
+// `vesselverify recommend` end to end on a small level-0 contact scene (every generated candidate
+// against a level-0 reference: a few seconds). The answer is checked against the budget's
 // definition from the written evidence: the recommended candidate meets the tolerance and the
 // time per update, and every candidate faster than it (beyond the 5 % timing tie) misses one;
 // the report embeds the section.

@@ -36,10 +36,9 @@ struct Fixture {
     spec.point = kContact;
     spec.radius = 1e-3;
     spec.force = 1e-4;
-    problem = msm::make_problem(*model, net, msm::nodal_masses(net, msm::MassRule::consistent,
-                                                               kVesselDensity),
-                                mesh, traction_nodal_loads(mesh, contact_patch(mesh, spec)),
-                                {"inlet", "outlet"});
+    problem = msm::make_problem(
+        *model, net, msm::nodal_masses(net, msm::MassRule::consistent, msm::kVesselDensity), mesh,
+        traction_nodal_loads(mesh, contact_patch(mesh, spec)), {"inlet", "outlet"});
   }
 };
 
@@ -69,13 +68,18 @@ void BM_Eliminated(benchmark::State& state) {
   const RoiNetwork roi = restrict_network(f.net, held);
   const msm::SpringModel model(roi.network);
   const msm::Problem p = restrict_problem(f.problem, roi, held, model);
-  state.counters["unknowns"] = static_cast<double>(
-      std::count(p.fixed.begin(), p.fixed.end(), 0));
+  state.counters["unknowns"] = static_cast<double>(std::count(p.fixed.begin(), p.fixed.end(), 0));
   for (auto _ : state) benchmark::DoNotOptimize(msm::solve_static(p).x.data());
 }
 
 }  // namespace
 
-BENCHMARK(BM_HeldByIdentityRows)->Arg(0)->Arg(2)->Arg(4)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_HeldByIdentityRows)
+    ->Arg(0)
+    ->Arg(2)
+    ->Arg(4)
+    ->Arg(8)
+    ->Arg(16)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Eliminated)->Arg(2)->Arg(4)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -49,7 +49,9 @@ std::string error_of(const std::string& text) {
 }
 
 /// kContact plus a [budget] table with these lines.
-std::string budget(const std::string& lines) { return std::string(kContact) + "[budget]\n" + lines + "\n"; }
+std::string budget(const std::string& lines) {
+  return std::string(kContact) + "[budget]\n" + lines + "\n";
+}
 
 }  // namespace
 
@@ -72,8 +74,8 @@ TEST(Budget, DefaultsAreTheContactPointAtSeed000sThreshold) {
 }
 
 TEST(Budget, ToleranceDefaultsToTheScenesTolerancesTable) {
-  const Scene s = parse_scene(
-      budget("rate_hz = 1000") + "[tolerances]\nmax_error_mm = 0.05\n", "scene.toml");
+  const Scene s =
+      parse_scene(budget("rate_hz = 1000") + "[tolerances]\nmax_error_mm = 0.05\n", "scene.toml");
   EXPECT_DOUBLE_EQ(s.budget.tolerance, 0.05);
 }
 
@@ -129,8 +131,9 @@ TEST(Budget, RefusalsNameTheKeyWhatWasFoundAndWhatWasExpected) {
           {"budget.magnitude", "found 0.5", "one of the load's magnitudes"});
   refused(budget("rate = 30"), {"budget.rate", "unknown key"});
   refused("budget = 3\n" + std::string(kContact), {"key 'budget'", "expected a table"});
-  refused(std::string(kPressure) + "[budget]\nquantity = \"reaction\"\ntolerance_mN = 1\n"
-                                   "rate_hz = 30\n",
+  refused(std::string(kPressure) +
+              "[budget]\nquantity = \"reaction\"\ntolerance_mN = 1\n"
+              "rate_hz = 30\n",
           {"budget.quantity", "pressure", "contact load"});
 }
 
@@ -155,8 +158,9 @@ TEST(Roi, RefusedWhereItMeansNothing) {
   pressure.insert(pressure.find("solver"), "roi_radius = 0.004\n");
   EXPECT_NE(error_of(pressure).find("expected it only with a contact load"), std::string::npos)
       << error_of(pressure);
-  std::string fem = std::string(kContact) + "[[models]]\nname = \"f\"\nkind = \"fem\"\n"
-                                            "roi_radius = 0.004\n";
+  std::string fem = std::string(kContact) +
+                    "[[models]]\nname = \"f\"\nkind = \"fem\"\n"
+                    "roi_radius = 0.004\n";
   EXPECT_NE(error_of(fem).find("models[1].roi_radius': unknown key"), std::string::npos)
       << error_of(fem);
 }

@@ -29,12 +29,12 @@ Candidate candidate(const std::string& name, double error, double seconds, bool 
 TEST(Selection, TheCheapestMeetingBothWinsAndEveryOtherSaysWhy) {
   // Tolerance 0.1 mm, 10 ms per update.
   const std::vector<Candidate> c{
-      candidate("accurate_slow", 0.01, 0.050),   // too slow
-      candidate("fast_wrong", 0.50, 0.001),      // too inaccurate
-      candidate("good", 0.08, 0.004),            // meets both, cheapest of those
-      candidate("good_costlier", 0.02, 0.008),   // meets both, costs more
-      candidate("bad_both", 0.3, 0.02),          // both
-      candidate("broken", 0.0, 0.0, false),      // failed
+      candidate("accurate_slow", 0.01, 0.050),  // too slow
+      candidate("fast_wrong", 0.50, 0.001),     // too inaccurate
+      candidate("good", 0.08, 0.004),           // meets both, cheapest of those
+      candidate("good_costlier", 0.02, 0.008),  // meets both, costs more
+      candidate("bad_both", 0.3, 0.02),         // both
+      candidate("broken", 0.0, 0.0, false),     // failed
   };
   const Selection s = select_model(c, 0.1, 0.010);
   ASSERT_TRUE(s.recommended.has_value());
@@ -76,12 +76,12 @@ TEST(Selection, NoneMeetsTheBudgetNamesTheClosest) {
 }
 
 TEST(Selection, TiesGoToTheSmallerErrorThenTheEarlierCandidate) {
-  const Selection by_error = select_model(
-      {candidate("first", 0.05, 0.002), candidate("second", 0.01, 0.002)}, 0.1, 0.01);
+  const Selection by_error =
+      select_model({candidate("first", 0.05, 0.002), candidate("second", 0.01, 0.002)}, 0.1, 0.01);
   EXPECT_EQ(*by_error.recommended, 1u);
   EXPECT_NE(by_error.reasons[0].find("larger error"), std::string::npos) << by_error.reasons[0];
-  const Selection exact = select_model(
-      {candidate("first", 0.05, 0.002), candidate("second", 0.05, 0.002)}, 0.1, 0.01);
+  const Selection exact =
+      select_model({candidate("first", 0.05, 0.002), candidate("second", 0.05, 0.002)}, 0.1, 0.01);
   EXPECT_EQ(*exact.recommended, 0u);
   // Times within 5 % of the fastest are a tie; beyond, the faster wins whatever its error.
   const Selection near = select_model(
@@ -91,14 +91,14 @@ TEST(Selection, TiesGoToTheSmallerErrorThenTheEarlierCandidate) {
       {candidate("fastest", 0.08, 0.00200), candidate("beyond", 0.01, 0.00211)}, 0.1, 0.01);
   EXPECT_EQ(*apart.recommended, 0u);
   // Closest ties (same factor) go to the faster.
-  const Selection closest = select_model(
-      {candidate("slow", 0.2, 0.0019), candidate("fast", 0.2, 0.0001)}, 0.1, 0.001);
+  const Selection closest =
+      select_model({candidate("slow", 0.2, 0.0019), candidate("fast", 0.2, 0.0001)}, 0.1, 0.001);
   EXPECT_EQ(*closest.closest, 1u);
 }
 
 TEST(Selection, NothingFinishedNamesNothing) {
-  const Selection s = select_model({candidate("x", 0, 0, false), candidate("nan", NAN, 0.001)},
-                                   0.1, 0.01);
+  const Selection s =
+      select_model({candidate("x", 0, 0, false), candidate("nan", NAN, 0.001)}, 0.1, 0.01);
   EXPECT_FALSE(s.recommended.has_value());
   EXPECT_FALSE(s.closest.has_value());
   EXPECT_EQ(s.verdicts[1], Verdict::failed);
@@ -168,7 +168,8 @@ TEST(Quantities, HandComputedValues) {
   EXPECT_NEAR(r.contact_point_mm, 0.3, 1e-12);
   // A model that does not indent feels an infinite force error.
   const std::vector<Vec3> still(4, Vec3::Zero());
-  const QuantityErrors s = quantity_errors(Budget{}, nodes, still, u_ref, 0, Vec3::Zero(), loads, {});
+  const QuantityErrors s =
+      quantity_errors(Budget{}, nodes, still, u_ref, 0, Vec3::Zero(), loads, {});
   EXPECT_TRUE(std::isinf(*s.reaction_mN));
 }
 

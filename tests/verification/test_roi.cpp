@@ -115,8 +115,8 @@ TEST(Roi, RestrictedSolveMatchesTheClosedFormAndTheFullProblemWithTheSameNodesFi
   const Eigen::VectorXd xf = msm::solve_static(fixed).x;
   for (std::size_t k = 0; k < roi.full_index.size(); ++k) {
     const auto i = static_cast<Eigen::Index>(roi.full_index[k]);
-    EXPECT_NEAR((x.segment<3>(3 * static_cast<Eigen::Index>(k)) - xf.segment<3>(3 * i)).norm(),
-                0.0, 1e-14);
+    EXPECT_NEAR((x.segment<3>(3 * static_cast<Eigen::Index>(k)) - xf.segment<3>(3 * i)).norm(), 0.0,
+                1e-14);
   }
 }
 

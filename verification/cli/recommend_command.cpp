@@ -19,6 +19,7 @@ struct Options {
   bool quick = false;
   int repeats = 3;
   std::vector<int> levels;
+  int reference_level = -1;
   std::vector<double> roi_radii;
   std::string command;
 };
@@ -44,6 +45,7 @@ void run(const Options& o) {
   RecommendOptions r;
   r.quick = o.quick;
   r.levels = o.levels;
+  r.reference_level = o.reference_level;
   r.roi_radii = o.roi_radii;
   r.harness.cache_dir = o.cache_dir;
   r.harness.log = &std::cout;
@@ -102,6 +104,10 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
       ->capture_default_str();
   cmd->add_option("--levels", o->levels, "Model levels instead of 0,1 (quick: 0)")
       ->delimiter(',')
+      ->check(CLI::Range(0, kMaxMeshLevel));
+  cmd->add_option("--reference-level", o->reference_level,
+                  "Level of the P2 reference instead of the scene's (at least the finest model "
+                  "level)")
       ->check(CLI::Range(0, kMaxMeshLevel));
   cmd->add_option("--roi-radii", o->roi_radii,
                   "Region-of-interest radii, m, instead of 0.002,0.004,0.008,0.016 (quick: "
