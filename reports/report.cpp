@@ -442,7 +442,7 @@ double representative_magnitude(const SceneRows& s) {
 }
 
 Document build_report(const ResultsFile& r, const std::string& stability_markdown,
-                      const std::string& command) {
+                      const std::string& command, const std::vector<std::string>& recommendations) {
   Document doc;
   doc.heading(1, "vesselverify report");
   doc.paragraph("How wrong, and how fast, is each mass-spring vessel model against linear-elastic "
@@ -465,6 +465,7 @@ Document build_report(const ResultsFile& r, const std::string& stability_markdow
                 "otherwise).");
   doc.table(summary_table(r));
   for (const auto& s : r.scenes) scene_section(doc, s);
+  for (const auto& section : recommendations) doc.markdown(section);
   if (stability_markdown.empty()) {
     doc.heading(2, "Numerical stability");
     doc.paragraph("Not part of these results: `vesselverify stability` writes `stability.md`, "
@@ -479,7 +480,9 @@ void write_report(const ReportOptions& o) {
   const ResultsFile results = read_results(o.results);
   std::string stability;
   if (!o.stability_markdown.empty()) stability = read_text(o.stability_markdown);
-  const Document doc = build_report(results, stability, o.command);
+  std::vector<std::string> recommendations;
+  for (const auto& f : o.recommend_markdown) recommendations.push_back(read_text(f));
+  const Document doc = build_report(results, stability, o.command, recommendations);
   std::error_code ec;
   std::filesystem::create_directories(o.output_dir / "figures", ec);
   if (ec) {

@@ -3,6 +3,7 @@
 /// figures as .svg files, and report.html, self-contained with the same figures inline.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "reports/document.hpp"
 #include "reports/results_file.hpp"
@@ -16,14 +17,17 @@ inline constexpr double kSeed000HookeStiffness = 41.106;  // N/m
 struct ReportOptions {
   std::filesystem::path results;           ///< results.json of `vesselverify run`
   std::filesystem::path stability_markdown;  ///< stability.md of `vesselverify stability` (optional)
+  /// recommend.md files of `vesselverify recommend`, each embedded as a section (optional).
+  std::vector<std::filesystem::path> recommend_markdown;
   std::filesystem::path output_dir;        ///< report.md, report.html, figures/
   std::string command;                     ///< the command line that makes the report
 };
 
 /// The report's content. `stability_markdown` is embedded verbatim (empty: a note says it was
-/// not run).
+/// not run), and so is each of `recommendations` (recommend.md sections), after the scenes.
 Document build_report(const ResultsFile& results, const std::string& stability_markdown,
-                      const std::string& command);
+                      const std::string& command,
+                      const std::vector<std::string>& recommendations = {});
 
 /// Reads the inputs, builds the report and writes report.md, report.html and figures/*.svg, each
 /// atomically. InputError for a missing or malformed input or an unwritable output directory.

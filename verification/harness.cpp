@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <sstream>
 #include <tuple>
 
 #include "fem_reference/convergence.hpp"
@@ -18,6 +19,7 @@
 #include "msm/solvers/static_solver.hpp"
 #include "verification/memory.hpp"
 #include "verification/progress.hpp"
+#include "verification/roi.hpp"
 #include "verification/timing.hpp"
 
 namespace vessel {
@@ -297,9 +299,17 @@ ReadOut read_out(const Scene& s, int level, const std::vector<Vec3>& nodes, cons
 
 void finish_outcome(ModelOutcome& out, const Scene& s, const std::vector<Vec3>& nodes,
                     const std::vector<Vec3>& u_model, const ReferenceAtPoints& ref,
-                    double magnitude, const ReadOut& at, double ref_max_strain_unit) {
+                    double magnitude, const ReadOut& at, double ref_max_strain_unit,
+                    const Vec3& qoi_point, const std::vector<Vec3>& loads, long steps, double dt) {
   const std::vector<Vec3> u_ref = scaled(ref.u, magnitude);
   const std::size_t qoi = at.qoi;
+  out.quantities =
+      quantity_errors(s.budget, nodes, u_model, u_ref, qoi, qoi_point, loads, out.history);
+  if (s.budget.stated) {
+    out.budget_error = budget_quantity_error(out.quantities, s.budget.quantity);
+    std::tie(out.update_seconds, out.steps_per_update) =
+        time_per_update(out.solve_seconds, steps, dt, s.budget.update_period());
+  }
   out.wall_profile = wall_profile(s.vessel, nodes, at.wall_line, u_model, u_ref);
   out.error = compare_displacements(u_model, u_ref);
   out.has_reference_uncertainty = ref.has_uncertainty;
@@ -339,12 +349,19 @@ void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
     base.unknowns = r.n_dofs;
     const ReferenceAtPoints ref_here = reference_at(ref, mesh.nodes);
     const ReadOut at = read_out(s, base.level, mesh.nodes, result.qoi_point);
+    std::vector<Vec3> unit_loads;
+    if (s.load.kind == LoadKind::contact) {
+      ContactPatchSpec spec_unit = s.load.contact;
+      spec_unit.force = 1.0;
+      unit_loads = traction_nodal_loads(mesh, contact_patch(mesh, spec_unit));
+    }
     for (const double mag : s.load.magnitudes) {
       ModelOutcome out = base;
       out.magnitude = mag;
       out.max_strain = r.max_abs_principal_strain * mag;
       finish_outcome(out, s, mesh.nodes, scaled(r.nodal_displacement, mag), ref_here, mag, at,
-                     fine.max_abs_principal_strain);
+                     fine.max_abs_principal_strain, result.qoi_point, scaled(unit_loads, mag), 0,
+                     0.0);
       result.outcomes.push_back(out);
     }
   } catch (const std::exception& e) {
@@ -400,6 +417,12 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
   base.memory_mib = setup_memory.added_mib();
   base.detail = built.topology + ", " + spec.stiffness + " stiffness, " + spec.mass + " masses, " +
                 spec.solver;
+  base.roi_radius = spec.roi_radius;
+  if (spec.roi_radius > 0.0) {
+    std::ostringstream r;
+    r << ", region of interest R = " << spec.roi_radius * 1e3 << " mm";
+    base.detail += r.str();
+  }
   base.nodes = built.network.nodes.size();
   const std::vector<Vec3>& nodes = built.network.nodes;
   const ReferenceAtPoints ref_here = reference_at(ref, nodes);
@@ -409,7 +432,27 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
     ModelOutcome out = base;
     out.magnitude = mag;
     try {
-      const msm::Problem problem = msm_problem(s, model, built, mesh, mag);
+      const msm::Problem full = msm_problem(s, model, built, mesh, mag);
+      // Region of interest: the nodes beyond R held and removed from the solve (verification/roi).
+      std::unique_ptr<RoiNetwork> roi;
+      std::unique_ptr<msm::SpringModel> roi_model;
+      std::unique_ptr<msm::Problem> roi_problem;
+      std::vector<char> held;
+      if (spec.roi_radius > 0.0) {
+        held = held_nodes(full, result.qoi_point, spec.roi_radius);
+        roi = std::make_unique<RoiNetwork>(restrict_network(built.network, held));
+        roi_model = std::make_unique<msm::SpringModel>(roi->network, spec.damping);
+        roi_problem =
+            std::make_unique<msm::Problem>(restrict_problem(full, *roi, held, *roi_model));
+      }
+      const msm::Problem& problem = roi ? *roi_problem : full;
+      // The QoI node in the solved problem (−1 if the region holds it).
+      Eigen::Index qoi_solved = static_cast<Eigen::Index>(at.qoi);
+      if (roi) {
+        const auto it =
+            std::find(roi->full_index.begin(), roi->full_index.end(), static_cast<int>(at.qoi));
+        qoi_solved = it == roi->full_index.end() ? -1 : it - roi->full_index.begin();
+      }
       out.unknowns = free_unknowns(problem);
       std::vector<double> times;
       Eigen::VectorXd x;
@@ -431,11 +474,12 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
           out.history.time_s.push_back(0.0);  // at rest
           out.history.model_mm.push_back(0.0);
           const int every = std::max(1, d.steps / kHistorySamples);
-          const auto q = static_cast<Eigen::Index>(3 * at.qoi);
           d.on_step = [&](int step, const Eigen::VectorXd& xs, const Eigen::VectorXd&) {
             if (step % every != 0 && step != d.steps) return;
             out.history.time_s.push_back(step * d.dt);
-            out.history.model_mm.push_back((xs.segment<3>(q) - nodes[at.qoi]).norm() * 1e3);
+            out.history.model_mm.push_back(
+                qoi_solved < 0 ? 0.0
+                               : (xs.segment<3>(3 * qoi_solved) - nodes[at.qoi]).norm() * 1e3);
           };
           x = msm::integrate(problem, d).x;
           add_reference_history(out.history, ref, nodes[at.qoi], spec, problem, mag);
@@ -444,12 +488,28 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
       }
       out.solve_seconds = median(times);
       out.memory_mib = std::max(out.memory_mib, solve_memory.added_mib());
-      out.max_strain = model.max_strain(x);
+      out.max_strain = roi ? roi_model->max_strain(x) : model.max_strain(x);
+      if (roi) {  // back to the full model: the held nodes stay at rest
+        Eigen::VectorXd x_full = full.rest;
+        for (std::size_t k = 0; k < roi->full_index.size(); ++k) {
+          x_full.segment<3>(3 * static_cast<Eigen::Index>(roi->full_index[k])) =
+              x.segment<3>(3 * static_cast<Eigen::Index>(k));
+        }
+        x = std::move(x_full);
+      }
       std::vector<Vec3> u(nodes.size());
+      std::vector<Vec3> loads;
       for (std::size_t i = 0; i < u.size(); ++i) {
         u[i] = x.segment<3>(3 * static_cast<Eigen::Index>(i)) - nodes[i];
       }
-      finish_outcome(out, s, nodes, u, ref_here, mag, at, fine.max_abs_principal_strain);
+      if (s.load.kind == LoadKind::contact) {
+        loads.resize(nodes.size());
+        for (std::size_t i = 0; i < u.size(); ++i) {
+          loads[i] = full.external_force.segment<3>(3 * static_cast<Eigen::Index>(i));
+        }
+      }
+      finish_outcome(out, s, nodes, u, ref_here, mag, at, fine.max_abs_principal_strain,
+                     result.qoi_point, loads, spec.steps, spec.dt);
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {
@@ -463,6 +523,85 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
 }
 
 }  // namespace
+
+QuantityErrors quantity_errors(const Budget& budget, const std::vector<Vec3>& nodes,
+                               const std::vector<Vec3>& u_model, const std::vector<Vec3>& u_ref,
+                               std::size_t qoi, const Vec3& qoi_point,
+                               const std::vector<Vec3>& loads, const History& history) {
+  QuantityErrors q;
+  q.contact_point_mm = (u_model[qoi] - u_ref[qoi]).norm() * 1e3;
+  if (!history.time_s.empty())
+    q.contact_point_mm = std::max(q.contact_point_mm, history.max_error_mm);
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    q.field_mm = std::max(q.field_mm, (u_model[i] - u_ref[i]).norm() * 1e3);
+  }
+  if (budget.quantity == BudgetQuantity::patch && budget.radius > 0.0) {
+    double worst = 0.0;
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      if ((nodes[i] - qoi_point).norm() <= budget.radius) {
+        worst = std::max(worst, (u_model[i] - u_ref[i]).norm());
+      }
+    }
+    q.patch_mm = worst * 1e3;
+  }
+  if (!loads.empty()) {
+    // Work-conjugate indentation: the total contact force F does work F·d on the wall.
+    Vec3 total = Vec3::Zero();
+    double work_model = 0.0;
+    double work_ref = 0.0;
+    for (std::size_t i = 0; i < loads.size(); ++i) {
+      total += loads[i];
+      work_model += loads[i].dot(u_model[i]);
+      work_ref += loads[i].dot(u_ref[i]);
+    }
+    const double force = total.norm();
+    if (force > 0.0) {
+      const double d_model = work_model / force;
+      const double d_ref = work_ref / force;
+      q.indentation_mm = d_model * 1e3;
+      q.indentation_reference_mm = d_ref * 1e3;
+      q.reaction_mN = d_model > 0.0 ? force * std::abs(d_ref - d_model) / d_model * 1e3
+                                    : std::numeric_limits<double>::infinity();
+    }
+  }
+  return q;
+}
+
+double budget_magnitude(const Scene& s, double max_abs_strain_unit) {
+  if (s.budget.magnitude > 0.0) return s.budget.magnitude;
+  double best = -1.0;
+  double smallest = HUGE_VAL;
+  for (const double m : s.load.magnitudes) {
+    smallest = std::min(smallest, m);
+    if (max_abs_strain_unit * m <= kLinearRegimeStrain) best = std::max(best, m);
+  }
+  return best > 0.0 ? best : smallest;
+}
+
+double budget_quantity_error(const QuantityErrors& q, BudgetQuantity quantity) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  switch (quantity) {
+    case BudgetQuantity::contact_point:
+      return q.contact_point_mm;
+    case BudgetQuantity::field:
+      return q.field_mm;
+    case BudgetQuantity::patch:
+      return q.patch_mm.value_or(nan);
+    case BudgetQuantity::reaction:
+      return q.reaction_mN.value_or(nan);
+  }
+  return nan;
+}
+
+std::pair<double, long> time_per_update(double solve_seconds, long steps, double dt,
+                                        double period) {
+  if (period <= 0.0) return {0.0, 0};
+  if (steps <= 0 || dt <= 0.0) return {solve_seconds, 0};
+  // One update advances the simulation by the period: ⌈period/dt⌉ steps (a relative 1e-9 keeps
+  // 1 ms / 1e-5 s at 100 steps despite round-off), at least one.
+  const long per_update = std::max(1L, static_cast<long>(std::ceil(period / dt * (1.0 - 1e-9))));
+  return {solve_seconds / static_cast<double>(steps) * static_cast<double>(per_update), per_update};
+}
 
 Scene quick_variant(Scene s) {
   s.model_levels = {0};
@@ -494,7 +633,8 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
   }
 
   std::size_t cases = 0;
-  for (const auto& m : s.models) cases += m.kind == ModelKind::fem ? 1 : s.load.magnitudes.size();
+  const std::size_t loads = o.budget_load_only ? 1 : s.load.magnitudes.size();
+  for (const auto& m : s.models) cases += m.kind == ModelKind::fem ? 1 : loads;
   Progress progress(log, s.poisson_ratios.size() * (1 + s.model_levels.size() * cases));
 
   for (const double nu : s.poisson_ratios) {
@@ -515,8 +655,11 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
     info.dofs = fine.n_dofs + fine.n_pressure_dofs;
     info.solve_seconds = fine.timings.assembly + fine.timings.solve;
     info.max_abs_strain_unit = fine.max_abs_principal_strain;
+    info.budget_magnitude = budget_magnitude(s, fine.max_abs_principal_strain);
     result.references.push_back(info);
     progress.end();
+    Scene at_nu = s;  // the scene's loads for this ν (only the budget's, if asked)
+    if (o.budget_load_only) at_nu.load.magnitudes = {info.budget_magnitude};
 
     for (const auto& [level, mesh] : model_meshes) {
       for (const auto& spec : s.models) {
@@ -528,10 +671,10 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
         if (spec.kind == ModelKind::fem) {
           progress.begin(spec.name + " (FEM P" + std::to_string(spec.degree) + ", level " +
                          std::to_string(level) + ")");
-          run_fem_model(s, spec, nu, mesh, ref, fine, o, base, result);
+          run_fem_model(at_nu, spec, nu, mesh, ref, fine, o, base, result);
           progress.end();
         } else {
-          run_msm_model(s, spec, nu, mesh, ref, fine, o, progress, base, result);
+          run_msm_model(at_nu, spec, nu, mesh, ref, fine, o, progress, base, result);
         }
       }
     }

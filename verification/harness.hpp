@@ -8,6 +8,8 @@
 /// is reported next to every model error. Linear FEM responses are solved once per ν for a unit
 /// load and scaled; mass-spring models are solved for every magnitude (they are nonlinear).
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -21,6 +23,9 @@ struct HarnessOptions {
   std::filesystem::path cache_dir;  ///< generated meshes (empty: no cache)
   std::ostream* log = nullptr;      ///< progress; nullptr for none
   int repeats = 1;                  ///< timed repeats of each model solve (median reported)
+  /// Run the models only at the budget's load (Budget::magnitude, else the representative load:
+  /// the largest magnitude within the reference's linear regime, else the smallest), per ν.
+  bool budget_load_only = false;
 };
 
 /// The reference's answer for one ν (at unit load; scale by the magnitude).
@@ -31,6 +36,26 @@ struct ReferenceInfo {
   std::size_t dofs = 0;
   double solve_seconds = 0.0;  ///< fine level, assembly + solve
   double max_abs_strain_unit = 0.0;  ///< largest |principal strain| at unit load
+  double budget_magnitude = 0.0;     ///< the load the budget applies at for this ν (scene's unit)
+};
+
+/// The error on each quantity a budget may name (issue #7), against the reference at the model's
+/// own nodes. Unset optionals: not computable for this scene (reaction: contact loads only; patch:
+/// the budget names no patch radius).
+struct QuantityErrors {
+  /// |u_model − u_ref| at the QoI (contact) node, mm; for integrators the larger of that (final
+  /// state against the static reference) and the history's largest difference from the FEM
+  /// transient there.
+  double contact_point_mm = 0.0;
+  double field_mm = 0.0;           ///< max |u_model − u_ref| over all model nodes, mm
+  std::optional<double> patch_mm;  ///< max within the budget's radius of the QoI point, mm
+  /// Contact loads: the indentation d = Σ f_i·u_i / |Σ f_i| (work-conjugate to the total contact
+  /// force, over the model's loaded nodes, the same nodal loads for model and reference), mm.
+  std::optional<double> indentation_mm, indentation_reference_mm;
+  /// Contact loads: the force the instrument feels when it imposes the reference's indentation,
+  /// F·d_ref/d_model (secant contact stiffness), minus the true force F, |·| in mN; infinite if
+  /// the model does not indent.
+  std::optional<double> reaction_mN;
 };
 
 /// Radial displacement u·e_ρ along the wall line through the QoI point (the model's nodes at the
@@ -79,6 +104,15 @@ struct ModelOutcome {
   bool beyond_linear_regime = false;  ///< max strain of the reference > 5 %
   WallProfile wall_profile;
   History history;  ///< dynamic models only
+  double roi_radius = 0.0;  ///< m; 0: the whole vessel
+  QuantityErrors quantities;
+  /// The scene's budget quantity's error (mm, or mN for reaction); NaN without a [budget].
+  double budget_error = std::numeric_limits<double>::quiet_NaN();
+  /// Compute time per update at the budget's rate, s: one solve for static solvers; for
+  /// integrators the time per step × the steps one update period needs (at least 1). 0 without a
+  /// budget rate.
+  double update_seconds = 0.0;
+  long steps_per_update = 0;  ///< integrators with a budget rate
 };
 
 struct SceneResult {
@@ -94,6 +128,27 @@ struct SceneResult {
 /// goes to a direct solver that needs minutes and gigabytes at level 1, so scenes with such a ν
 /// keep their reference at level 0 (then without an uncertainty estimate).
 Scene quick_variant(Scene scene);
+
+/// The load the budget applies at: Budget::magnitude if set, else the largest of the scene's
+/// magnitudes whose reference strain (max_abs_strain_unit × magnitude) stays within 5 %, else the
+/// smallest.
+double budget_magnitude(const Scene& scene, double max_abs_strain_unit);
+
+/// The budget quantities of a model state: displacements u_model and u_ref (m) at the model's
+/// nodes, its QoI node index and point, `loads` the model's nodal loads (N, per node; empty
+/// unless the load is a contact: no indentation or reaction then), `history` the dynamic history
+/// (empty for static models). The patch error is computed when budget.quantity is patch.
+QuantityErrors quantity_errors(const Budget& budget, const std::vector<Vec3>& nodes,
+                               const std::vector<Vec3>& u_model, const std::vector<Vec3>& u_ref,
+                               std::size_t qoi, const Vec3& qoi_point,
+                               const std::vector<Vec3>& loads, const History& history);
+
+/// The budget quantity's value among the quantity errors (NaN if not computable).
+double budget_quantity_error(const QuantityErrors& q, BudgetQuantity quantity);
+
+/// Time per update (s) and steps per update of a run that took `solve_seconds`: static solvers
+/// (steps = 0) one solve; integrators `steps` steps of `dt` → per step × ⌈period/dt⌉ (at least 1).
+std::pair<double, long> time_per_update(double solve_seconds, long steps, double dt, double period);
 
 /// Runs the scene. Throws InputError for inputs the scene validation cannot see (a contact point
 /// off the generated wall, roller ends on the arch); a model that fails (diverges, does not

@@ -1,14 +1,16 @@
+#include <unistd.h>
+
+#include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
-#include <unistd.h>
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
-#include "verification/timing.hpp"
 #include "verification/harness.hpp"
+#include "verification/timing.hpp"
 
 namespace vessel {
 
@@ -32,6 +34,23 @@ nlohmann::json error_json(const ErrorStatistics& e) {
           {"rms_mm", e.rms_mm},     {"relative_l2", e.relative_l2}, {"points", e.points}};
 }
 
+/// A number, or null where it is not finite (JSON has no infinity) or not computable.
+nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nullptr; }
+nlohmann::json number_or_null(const std::optional<double>& v) {
+  return v ? number_or_null(*v) : nlohmann::json(nullptr);
+}
+
+nlohmann::json budget_json(const Budget& b) {
+  nlohmann::json j{{"quantity", to_string(b.quantity)},
+                   {"unit", budget_unit(b.quantity)},
+                   {"tolerance", b.tolerance},
+                   {"rate_hz", number_or_null(b.rate_hz > 0.0 ? b.rate_hz : NAN)},
+                   {"seconds_per_update", b.seconds_per_update()},
+                   {"update_period_s", b.update_period()}};
+  if (b.quantity == BudgetQuantity::patch) j["radius_mm"] = b.radius * 1e3;
+  return j;
+}
+
 nlohmann::json scene_json(const SceneResult& r) {
   nlohmann::json refs = nlohmann::json::array();
   for (const auto& ref : r.references) {
@@ -40,7 +59,8 @@ nlohmann::json scene_json(const SceneResult& r) {
                     {"level", ref.level},
                     {"dofs", ref.dofs},
                     {"solve_seconds", ref.solve_seconds},
-                    {"max_abs_strain_at_unit_load", ref.max_abs_strain_unit}});
+                    {"max_abs_strain_at_unit_load", ref.max_abs_strain_unit},
+                    {"budget_magnitude", ref.budget_magnitude}});
   }
   nlohmann::json outcomes = nlohmann::json::array();
   for (const auto& o : r.outcomes) {
@@ -56,6 +76,7 @@ nlohmann::json scene_json(const SceneResult& r) {
                      {"setup_seconds", o.setup_seconds},
                      {"solve_seconds", o.solve_seconds},
                      {"memory_mib", o.memory_mib}};
+    if (o.roi_radius > 0.0) j["roi_radius_mm"] = o.roi_radius * 1e3;
     if (o.ok) {
       j["error"] = error_json(o.error);
       if (o.has_reference_uncertainty) {
@@ -68,6 +89,18 @@ nlohmann::json scene_json(const SceneResult& r) {
       j["qoi_reference_mm"] = o.qoi_reference_mm;
       j["max_strain"] = o.max_strain;
       j["beyond_linear_regime"] = o.beyond_linear_regime;
+      const QuantityErrors& q = o.quantities;
+      j["quantities"] = {{"contact_point_mm", q.contact_point_mm},
+                         {"field_mm", q.field_mm},
+                         {"patch_mm", number_or_null(q.patch_mm)},
+                         {"indentation_mm", number_or_null(q.indentation_mm)},
+                         {"indentation_reference_mm", number_or_null(q.indentation_reference_mm)},
+                         {"reaction_mN", number_or_null(q.reaction_mN)}};
+      if (r.scene.budget.stated) {
+        j["budget_error"] = number_or_null(o.budget_error);
+        j["update_seconds"] = o.update_seconds;
+        if (o.steps_per_update > 0) j["steps_per_update"] = o.steps_per_update;
+      }
       j["wall_profile"] = {{"s_mm", o.wall_profile.s_mm},
                            {"model_mm", o.wall_profile.model_mm},
                            {"reference_mm", o.wall_profile.reference_mm}};
@@ -86,23 +119,23 @@ nlohmann::json scene_json(const SceneResult& r) {
     outcomes.push_back(j);
   }
   const Scene& s = r.scene;
-  return {{"name", s.name},
-          {"source", s.source.string()},
-          {"description", s.description},
-          {"vessel", describe(s.vessel)},
-          {"model_levels", s.model_levels},
-          {"reference_level", s.reference_level},
-          {"youngs_modulus_pa", s.youngs_modulus},
-          {"load", to_string(s.load.kind)},
-          {"load_unit", s.load.kind == LoadKind::contact
-                            ? "N"
-                            : (s.load.kind == LoadKind::pressure ? "Pa" : "g")},
-          {"qoi_point_mm",
-           {r.qoi_point.x() * 1e3, r.qoi_point.y() * 1e3, r.qoi_point.z() * 1e3}},
-          {"tolerance_max_error_mm", s.tolerances.max_error_mm},
-          {"seconds", r.seconds},
-          {"references", refs},
-          {"outcomes", outcomes}};
+  return {
+      {"name", s.name},
+      {"source", s.source.string()},
+      {"description", s.description},
+      {"vessel", describe(s.vessel)},
+      {"model_levels", s.model_levels},
+      {"reference_level", s.reference_level},
+      {"youngs_modulus_pa", s.youngs_modulus},
+      {"load", to_string(s.load.kind)},
+      {"load_unit",
+       s.load.kind == LoadKind::contact ? "N" : (s.load.kind == LoadKind::pressure ? "Pa" : "g")},
+      {"qoi_point_mm", {r.qoi_point.x() * 1e3, r.qoi_point.y() * 1e3, r.qoi_point.z() * 1e3}},
+      {"tolerance_max_error_mm", s.tolerances.max_error_mm},
+      {"budget", s.budget.stated ? budget_json(s.budget) : nlohmann::json(nullptr)},
+      {"seconds", r.seconds},
+      {"references", refs},
+      {"outcomes", outcomes}};
 }
 
 const char* load_unit(LoadKind k) {

@@ -268,7 +268,7 @@ std::string short_number(double v) {
 /// One [[models]] table. `stiffness`, `mass`, `solver` and `dt` (and `degree` for FEM) may be
 /// arrays: the table then stands for every combination (a sweep), each named after the table's
 /// name plus the swept values, e.g. "volume[stiffness=lloyd;dt=2e-05]".
-std::vector<ModelSpec> read_model(TableReader r, std::size_t index) {
+std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind load) {
   ModelSpec m;
   const std::string kind = r.string_or("kind", "", {"fem", "surface_msm", "volume_msm"});
   if (kind.empty()) r.fail(nullptr, "kind", "missing; expected one of fem, surface_msm, volume_msm");
@@ -303,6 +303,20 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index) {
     return 0;
   });
   m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
+  // Region of interest: a radius or an array of radii (a sweep), each > 0 m.
+  std::vector<double> radii{0.0};
+  if (const toml::node* roi = r.get("roi_radius")) {
+    if (load != LoadKind::contact) {
+      r.fail(roi, "roi_radius",
+             "found a region-of-interest radius on a " + to_string(load) +
+                 " load; expected it only with a contact load (the region is "
+                 "centred on the contact point)");
+    }
+    radii = r.numbers(*roi, "roi_radius", 0.0, HUGE_VAL, "m");
+    for (const double v : radii) {
+      if (v <= 0.0) r.fail(roi, "roi_radius", "found 0, expected a radius > 0 m");
+    }
+  }
   const bool any_integrator = std::any_of(solvers.begin(), solvers.end(), is_integrator);
   std::vector<double> dts{0.0};
   if (any_integrator) {
@@ -322,22 +336,26 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index) {
     for (const auto& ms : mass) {
       for (const auto& solver : solvers) {
         for (const double dt : is_integrator(solver) ? dts : std::vector<double>{0.0}) {
-          ModelSpec c = m;
-          c.stiffness = k;
-          c.mass = ms;
-          c.solver = solver;
-          c.dt = dt;
-          if (!is_integrator(solver)) c.steps = 0;
-          std::string swept;
-          const auto add = [&](bool varies, const std::string& key, const std::string& value) {
-            if (varies) swept += (swept.empty() ? "" : ";") + key + "=" + value;
-          };
-          add(stiffness.size() > 1, "stiffness", k);
-          add(mass.size() > 1, "mass", ms);
-          add(solvers.size() > 1, "solver", solver);
-          add(dts.size() > 1 && is_integrator(solver), "dt", short_number(dt));
-          if (!swept.empty()) c.name += "[" + swept + "]";
-          out.push_back(c);
+          for (const double roi : radii) {
+            ModelSpec c = m;
+            c.roi_radius = roi;
+            c.stiffness = k;
+            c.mass = ms;
+            c.solver = solver;
+            c.dt = dt;
+            if (!is_integrator(solver)) c.steps = 0;
+            std::string swept;
+            const auto add = [&](bool varies, const std::string& key, const std::string& value) {
+              if (varies) swept += (swept.empty() ? "" : ";") + key + "=" + value;
+            };
+            add(stiffness.size() > 1, "stiffness", k);
+            add(mass.size() > 1, "mass", ms);
+            add(solvers.size() > 1, "solver", solver);
+            add(dts.size() > 1 && is_integrator(solver), "dt", short_number(dt));
+            add(radii.size() > 1, "roi_radius", short_number(roi));
+            if (!swept.empty()) c.name += "[" + swept + "]";
+            out.push_back(c);
+          }
         }
       }
     }
@@ -370,6 +388,82 @@ LoadSpec read_load(TableReader r) {
   }
   r.finish();
   return load;
+}
+
+/// The [budget] table (issue #7): quantity, its tolerance, a rate or time budget, the load.
+Budget read_budget(TableReader r, const Scene& scene) {
+  Budget b;
+  b.stated = true;
+  const toml::node* q = r.get("quantity");
+  if (q) {
+    const auto name = q->value_exact<std::string>();
+    try {
+      if (!name) throw InputError("");
+      b.quantity = parse_budget_quantity(*name);
+    } catch (const InputError&) {
+      r.fail(q, "quantity",
+             "found " + show(*q) + ", expected one of contact_point, patch, field, reaction");
+    }
+  }
+  const bool contact = scene.load.kind == LoadKind::contact;
+  if (b.quantity == BudgetQuantity::reaction && !contact) {
+    r.fail(q, "quantity",
+           "found \"reaction\" with a " + to_string(scene.load.kind) +
+               " load; expected a contact load (the instrument's force)");
+  }
+  const toml::node* radius = r.get("radius");
+  if (b.quantity == BudgetQuantity::patch) {
+    if (!radius) r.fail(nullptr, "radius", "missing; quantity \"patch\" needs a radius > 0 m");
+    b.radius = r.number(*radius, "radius", 0.0, HUGE_VAL, "m");
+    if (b.radius <= 0.0) r.fail(radius, "radius", "found 0, expected a radius > 0 m");
+  } else if (radius) {
+    r.fail(radius, "radius",
+           "found a radius with quantity \"" + to_string(b.quantity) +
+               "\"; expected it only with quantity \"patch\"");
+  }
+  const toml::node* mm = r.get("tolerance_mm");
+  const toml::node* mn = r.get("tolerance_mN");
+  if (b.quantity == BudgetQuantity::reaction) {
+    if (mm)
+      r.fail(mm, "tolerance_mm",
+             "found a displacement tolerance; quantity \"reaction\" "
+             "expected tolerance_mN (a force, mN)");
+    if (!mn)
+      r.fail(nullptr, "tolerance_mN",
+             "missing; quantity \"reaction\" needs a force "
+             "tolerance > 0 mN");
+    b.tolerance = r.number(*mn, "tolerance_mN", 0.0, HUGE_VAL, "mN");
+    if (b.tolerance <= 0.0) r.fail(mn, "tolerance_mN", "found 0, expected a tolerance > 0 mN");
+  } else {
+    if (mn)
+      r.fail(mn, "tolerance_mN",
+             "found a force tolerance with quantity \"" + to_string(b.quantity) +
+                 "\"; expected tolerance_mm");
+    b.tolerance = scene.tolerances.max_error_mm;  // [tolerances], itself 0.1 mm by default
+    if (mm) {
+      b.tolerance = r.number(*mm, "tolerance_mm", 0.0, HUGE_VAL, "mm");
+      if (b.tolerance <= 0.0) r.fail(mm, "tolerance_mm", "found 0, expected a tolerance > 0 mm");
+    }
+  }
+  b.rate_hz = r.positive("rate_hz", 0.0, "Hz");
+  b.time_budget_s = r.positive("time_budget_s", 0.0, "s");
+  if (const toml::node* m = r.get("magnitude")) {
+    b.magnitude = r.number(*m, "magnitude", 0.0, HUGE_VAL, "");
+    const auto& mags = scene.load.magnitudes;
+    if (std::none_of(mags.begin(), mags.end(), [&](double v) {
+          return std::abs(v - b.magnitude) <= 1e-12 * std::max(std::abs(v), 1e-300);
+        })) {
+      std::ostringstream found;
+      found << "found " << b.magnitude << ", expected one of the load's magnitudes";
+      r.fail(m, "magnitude", found.str());
+    }
+  }
+  r.finish();  // unknown keys (a misspelt rate) first
+  if (b.rate_hz == 0.0 && b.time_budget_s == 0.0) {
+    r.fail(nullptr, "rate_hz",
+           "missing; expected rate_hz (30 visual, 1000 haptic) or time_budget_s per update");
+  }
+  return b;
 }
 
 }  // namespace
@@ -418,7 +512,8 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
     const auto* t = list->get(i)->as_table();
     if (!t) r.fail(list->get(i), "models", "expected [[models]] tables");
     for (ModelSpec& m :
-         read_model(TableReader(*t, "models[" + std::to_string(i) + "].", source_name), i)) {
+         read_model(TableReader(*t, "models[" + std::to_string(i) + "].", source_name), i,
+                    scene.load.kind)) {
       if (!names.insert(m.name).second) {
         r.fail(list->get(i), "models",
                "model name \"" + m.name + "\" is used twice; names must be unique");
@@ -430,6 +525,7 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
   TableReader tol = r.sub("tolerances", false);
   scene.tolerances.max_error_mm = tol.positive("max_error_mm", scene.tolerances.max_error_mm, "mm");
   tol.finish();
+  if (r.get("budget")) scene.budget = read_budget(r.sub("budget", false), scene);
   r.finish();
   return scene;
 }
@@ -460,6 +556,31 @@ std::string to_string(LoadKind kind) {
   }
   return "?";
 }
+
+std::string to_string(BudgetQuantity q) {
+  switch (q) {
+    case BudgetQuantity::contact_point:
+      return "contact_point";
+    case BudgetQuantity::patch:
+      return "patch";
+    case BudgetQuantity::field:
+      return "field";
+    case BudgetQuantity::reaction:
+      return "reaction";
+  }
+  return "?";
+}
+
+BudgetQuantity parse_budget_quantity(const std::string& name) {
+  for (const auto q : {BudgetQuantity::contact_point, BudgetQuantity::patch, BudgetQuantity::field,
+                       BudgetQuantity::reaction}) {
+    if (name == to_string(q)) return q;
+  }
+  throw InputError("budget quantity: expected one of contact_point, patch, field, reaction; got '" +
+                   name + "'");
+}
+
+const char* budget_unit(BudgetQuantity q) { return q == BudgetQuantity::reaction ? "mN" : "mm"; }
 
 std::string to_string(ModelKind kind) {
   switch (kind) {

@@ -32,6 +32,9 @@ struct ModelSpec {
   double dt = 0.0;                     ///< s, integrators only (> 0)
   double damping = 0.0;                ///< point damping k_v of seed 000 eq. (3.3), N·s/m per node
   long steps = 0;                      ///< integrators: number of steps (> 0)
+  /// Region of interest (mass-spring, contact loads): nodes farther than this from the contact
+  /// point are fixed and their unknowns removed from the solve, m; 0 = the whole vessel.
+  double roi_radius = 0.0;
 };
 
 struct LoadSpec {
@@ -43,6 +46,35 @@ struct LoadSpec {
 
 struct Tolerances {
   double max_error_mm = 0.1;  ///< seed 000's visual threshold
+};
+
+/// What the scene's error budget is measured on (the `[budget]` table's `quantity`).
+enum class BudgetQuantity {
+  contact_point,  ///< |u_model − u_ref| at the QoI (contact) node, mm
+  patch,     ///< max |u_model − u_ref| over the model nodes within `radius` of the QoI point, mm
+  field,     ///< max |u_model − u_ref| over all model nodes, mm
+  reaction,  ///< the force the instrument feels at the reference's indentation, mN
+};
+
+/// An accuracy and rate budget: what the scene needs (issue #7). Rate: `rate_hz` sets the update
+/// period 1/rate; `time_budget_s` the compute time allowed per update (default the period); given
+/// alone it is also the period.
+struct Budget {
+  bool stated = false;  ///< the scene has a [budget] table
+  BudgetQuantity quantity = BudgetQuantity::contact_point;
+  double radius = 0.0;         ///< m, quantity patch only
+  double tolerance = 0.1;      ///< mm (mN for reaction); seed 000's 0.1 mm visual threshold
+  double rate_hz = 0.0;        ///< 0: not given
+  double time_budget_s = 0.0;  ///< 0: not given
+  double magnitude = 0.0;      ///< load the budget applies at (scene's unit); 0: representative
+  /// Compute time allowed per update, s (time_budget_s, else 1/rate_hz; 0 if neither).
+  [[nodiscard]] double seconds_per_update() const {
+    return time_budget_s > 0.0 ? time_budget_s : (rate_hz > 0.0 ? 1.0 / rate_hz : 0.0);
+  }
+  /// Simulated time one update advances, s (1/rate_hz, else time_budget_s; 0 if neither).
+  [[nodiscard]] double update_period() const {
+    return rate_hz > 0.0 ? 1.0 / rate_hz : time_budget_s;
+  }
 };
 
 struct Scene {
@@ -60,6 +92,7 @@ struct Scene {
   LoadSpec load;
   std::vector<ModelSpec> models;
   Tolerances tolerances;
+  Budget budget;
 };
 
 /// Reads and validates a scene file. Throws InputError ("file:line: key: what was found, what was
@@ -72,5 +105,9 @@ Scene parse_scene(std::string_view text, const std::string& source_name);
 std::string to_string(BoundaryCondition bc);
 std::string to_string(LoadKind kind);
 std::string to_string(ModelKind kind);
+std::string to_string(BudgetQuantity quantity);
+BudgetQuantity parse_budget_quantity(const std::string& name);  ///< InputError if unknown
+/// "mm", or "mN" for reaction.
+const char* budget_unit(BudgetQuantity quantity);
 
 }  // namespace vessel

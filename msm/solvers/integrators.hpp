@@ -1,6 +1,7 @@
 #pragma once
 /// Time integrators on a Problem (m ẍ = −∇E(x) + f_damping(x, ẋ) + f_ext, fixed dofs held), with
 /// divergence detection, and dynamic relaxation to the static answer.
+#include <array>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -15,6 +16,10 @@ enum class Integrator {
   verlet,            ///< velocity Verlet
   implicit_euler,    ///< backward Euler linearised per step (Baraff & Witkin 1998), CHOLMOD
 };
+/// Every integrator, in declaration order (for sweeps over all of them).
+inline constexpr std::array<Integrator, 4> kAllIntegrators{
+    Integrator::explicit_euler, Integrator::symplectic_euler, Integrator::verlet,
+    Integrator::implicit_euler};
 Integrator parse_integrator(const std::string& name);
 std::string to_string(Integrator integrator);
 

@@ -18,6 +18,10 @@ enum class StiffnessRule {
   lloyd,       ///< least-squares match of the element's FEM stiffness, Lloyd et al. (2007)
   uniform,     ///< one k for every spring (comparison; seed 000 quotes k = 41.106)
 };
+/// Every rule, in declaration order (for sweeps over all of them, e.g. `vesselverify recommend`).
+inline constexpr std::array<StiffnessRule, 5> kAllStiffnessRules{
+    StiffnessRule::seed000, StiffnessRule::seed001, StiffnessRule::van_gelder, StiffnessRule::lloyd,
+    StiffnessRule::uniform};
 StiffnessRule parse_stiffness_rule(const std::string& name);
 std::string to_string(StiffnessRule rule);
 

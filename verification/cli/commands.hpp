@@ -13,6 +13,8 @@ void add_run_command(CLI::App& app, const std::string& command_line);
 void add_report_command(CLI::App& app, const std::string& command_line);
 /// `vesselverify gate`: the CI gate against a committed baseline.
 void add_gate_command(CLI::App& app, const std::string& command_line);
+/// `vesselverify recommend`: the cheapest model meeting a scene's budget (recommend_command.cpp).
+void add_recommend_command(CLI::App& app, const std::string& command_line);
 /// `vesselverify msm`: run a mass-spring model on a vessel mesh under a contact load.
 void add_msm_command(CLI::App& app);
 /// `vesselverify fem`: the deal.II linear-elastic reference (fem_command.cpp).

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   vessel::cli::add_run_command(app, command_line);
   vessel::cli::add_report_command(app, command_line);
   vessel::cli::add_gate_command(app, command_line);
+  vessel::cli::add_recommend_command(app, command_line);
   vessel::cli::add_msm_command(app);
   vessel::cli::add_fem_command(app);
   vessel::cli::add_stability_command(app, command_line);

@@ -19,12 +19,17 @@ void add_report_command(CLI::App& app, const std::string& command_line) {
       "model; plus the numerical-stability section when given.\n"
       "Examples:\n"
       "  vesselverify report results/results.json\n"
-      "  vesselverify report results/results.json --stability results/stability.md -o report");
+      "  vesselverify report results/results.json --stability results/stability.md -o report\n"
+      "  vesselverify report rec/results.json --recommend rec/recommend.md");
   cmd->add_option("results", o->results, "results.json written by `vesselverify run`")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--stability", o->stability_markdown,
                   "stability.md written by `vesselverify stability`, embedded as a section")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--recommend", o->recommend_markdown,
+                  "recommend.md written by `vesselverify recommend`, embedded as a section "
+                  "(repeatable)")
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output-dir", o->output_dir,
                   "Where report.md, report.html and figures/ go (default: beside the results)");

@@ -1,0 +1,95 @@
+// `vesselverify recommend` end to end on a small level-0 contact scene (every generated candidate
+// against a level-0 reference: a few seconds). The answer is checked against the budget's
+// definition from the written evidence: the recommended candidate meets the tolerance and the
+// time per update, and every candidate faster than it (beyond the 5 % timing tie) misses one;
+// the report embeds the section.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "../test_helpers.hpp"
+
+using vessel::test::CommandResult;
+using vessel::test::read_text;
+using vessel::test::run_command;
+using vessel::test::TempDir;
+using vessel::test::write_text;
+
+namespace {
+
+CommandResult vv(const std::string& args) {
+  return run_command(std::string(VESSELVERIFY_EXE) + " " + args);
+}
+
+const char* kScene = R"(name = "small_contact"
+[vessel]
+kind = "straight"
+mesh = "structured"
+level = 0
+reference_level = 0
+[load]
+type = "contact"
+magnitudes = [1.0e-5, 1.0e-4]
+point = [3.0e-3, 0.0, 20.0e-3]
+patch_radius = 1.0e-3
+[[models]]
+name = "volume"
+kind = "volume_msm"
+solver = "static"
+[budget]
+quantity = "patch"
+radius = 0.003
+tolerance_mm = 0.05
+rate_hz = 30
+)";
+
+}  // namespace
+
+TEST(RecommendCli, NamesACandidateThatMeetsTheBudgetWithItsEvidence) {
+  TempDir dir;
+  write_text(dir / "scene.toml", kScene);
+  const auto out = dir / "rec";
+  const CommandResult r = vv("recommend --quick --repeats 1 --roi-radii 0.004 --output-dir " +
+                             out.string() + " " + (dir / "scene.toml").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(read_text(out / "recommend.json"));
+  EXPECT_EQ(j["schema"], "vesselverify.recommend");
+  EXPECT_EQ(j["budget"]["quantity"], "patch");
+  EXPECT_DOUBLE_EQ(j["budget"]["seconds_per_update"].get<double>(), 1.0 / 30.0);
+  // FEM P1 + 2 kinds × 5 rules × (static, linear, R = 4 mm), level 0.
+  ASSERT_EQ(j["candidates"].size(), 31u);
+  const double tol = 0.05, budget = 1.0 / 30.0;
+  ASSERT_FALSE(j["recommended"].is_null()) << read_text(out / "recommend.md");
+  const std::string best = j["recommended"];
+  double best_time = 0.0;
+  for (const auto& c : j["candidates"]) {
+    if (c["name"] == best) {
+      EXPECT_EQ(c["verdict"], "recommended");
+      EXPECT_LE(c["error"].get<double>(), tol);
+      best_time = c["update_seconds"];
+      EXPECT_LE(best_time, budget);
+    }
+  }
+  for (const auto& c : j["candidates"]) {
+    if (!c["ok"].get<bool>() || c["error"].is_null()) continue;
+    const double e = c["error"], t = c["update_seconds"];
+    if (t < best_time / 1.05) EXPECT_TRUE(e > tol || t > budget) << c.dump();
+  }
+  const std::string md = read_text(out / "recommend.md");
+  EXPECT_NE(md.find("## Model recommendation: small_contact"), std::string::npos);
+  EXPECT_NE(md.find("**Recommended: `" + best + "`**"), std::string::npos) << md;
+  // The candidates' results carry the budget quantity for every outcome, at one load.
+  const nlohmann::json res = nlohmann::json::parse(read_text(out / "results.json"));
+  for (const auto& o : res["scenes"][0]["outcomes"]) {
+    EXPECT_DOUBLE_EQ(o["magnitude"].get<double>(),
+                     res["scenes"][0]["references"][0]["budget_magnitude"].get<double>());
+    if (o["ok"].get<bool>()) EXPECT_TRUE(o["budget_error"].is_number()) << o["model"];
+  }
+  // The report embeds the section.
+  const CommandResult rep = vv("report " + (out / "results.json").string() + " --recommend " +
+                               (out / "recommend.md").string());
+  ASSERT_EQ(rep.exit_code, 0) << rep.output;
+  EXPECT_NE(read_text(out / "report.md").find("## Model recommendation: small_contact"),
+            std::string::npos);
+}

@@ -1,0 +1,102 @@
+#pragma once
+/// `vesselverify recommend` (issue #7): the cheapest model that meets a scene's budget. Candidate
+/// models are generated from the msm library's own lists (every stiffness rule, surface and
+/// volume, static solvers or integrators, mesh levels, region-of-interest radii, plus FEM P1), run
+/// against the FEM reference at the budget's load, and judged on the budget's quantity and on the
+/// compute time per update at its rate.
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "verification/harness.hpp"
+#include "verification/scene.hpp"
+
+namespace vessel {
+
+/// One candidate's evidence: its worst case over the scene's Poisson's ratios at the budget's load.
+struct Candidate {
+  std::string name;    ///< model name and level, e.g. "volume/lloyd/static @ L1"
+  std::string model;   ///< the ModelSpec name in the results
+  std::string detail;  ///< topology, rules, solver
+  int level = 0;
+  double roi_radius = 0.0;  ///< m; 0: whole vessel
+  std::size_t unknowns = 0;
+  bool ok = false;
+  std::string failure;  ///< why it did not finish (ok false)
+  double error = 0.0;   ///< on the budget's quantity (mm, or mN for reaction); NaN: not computable
+  double update_seconds = 0.0;  ///< compute time per update at the budget's rate
+};
+
+enum class Verdict {
+  recommended,   ///< meets both, and the cheapest that does
+  meets_budget,  ///< meets both, but costs more time per update than the recommended one
+  too_slow,
+  too_inaccurate,
+  too_slow_and_inaccurate,
+  failed,  ///< diverged, did not converge, or its error is not computable
+};
+std::string to_string(Verdict verdict);
+
+struct Selection {
+  std::optional<std::size_t> recommended;  ///< the cheapest candidate meeting both
+  /// When none meets the budget: the candidate needing the smallest relaxation of it, i.e. the
+  /// least max(error / tolerance, time / time budget); ties go to the faster.
+  std::optional<std::size_t> closest;
+  std::vector<Verdict> verdicts;     ///< per candidate
+  std::vector<std::string> reasons;  ///< per candidate, why it won or lost, with its numbers
+  std::vector<std::size_t> pareto;   ///< finished candidates on the (time, error) Pareto front
+};
+
+/// Times per update within this fraction of the fastest passing candidate's are a tie.
+inline constexpr double kTimingTie = 0.05;
+
+/// Judges the candidates against `tolerance` (the quantity's unit, named by `unit`) and
+/// `seconds_per_update`. The cheapest is the least time per update; ties (times within
+/// kTimingTie of the least) go to the smaller error, then to the earlier candidate. A candidate
+/// that failed or whose error is not finite can win nothing.
+Selection select_model(const std::vector<Candidate>& candidates, double tolerance,
+                       double seconds_per_update, const std::string& unit = "mm");
+
+struct RecommendOptions {
+  bool quick = false;             ///< models at level 0 only, reference at level ≤ 1
+  std::vector<int> levels;        ///< model levels (empty: 0 and 1; quick: 0)
+  int reference_level = -1;       ///< the reference's level (−1: the scene's)
+  std::vector<double> roi_radii;  ///< m (empty: 2, 4, 8, 16 mm; quick: 4, 8 mm)
+  HarnessOptions harness;
+};
+
+/// The candidate models of a scene. Static scenes: FEM P1; surface (mid-surface, the mesh's
+/// topology) and volume networks with every stiffness rule (msm::kAllStiffnessRules), each with
+/// the static Newton solver and the linearised model; with contact loads also the Newton solver
+/// on each region-of-interest radius. Dynamic scenes (a scene model uses an integrator): every
+/// integrator (msm::kAllIntegrators) at the time steps the scene uses for that family of
+/// integrator (explicit or implicit; all of the scene's if it has none of that family), over the
+/// scene's longest simulated time, with the scene's point damping.
+std::vector<ModelSpec> candidate_models(const Scene& scene, const std::vector<double>& roi_radii);
+
+/// Candidates' evidence from a run: per (model, level) the worst error and time over ν at the
+/// budget's load (SceneResult run with budget_load_only).
+std::vector<Candidate> collect_candidates(const SceneResult& result);
+
+struct Recommendation {
+  Scene scene;  ///< as run (budget, candidate models, levels)
+  SceneResult result;
+  std::vector<Candidate> candidates;
+  Selection selection;
+};
+
+/// Runs the candidates of `scene` (whose budget must be stated) against the reference and writes
+/// results.json/csv/summary.md, recommend.md and recommend.json into `output_dir` (checked
+/// writable before anything runs). `command` is recorded.
+Recommendation recommend(const Scene& scene, const RecommendOptions& options,
+                         const std::filesystem::path& output_dir, const std::string& command);
+
+/// The Markdown section "## Model recommendation: <scene>" with the budget, the answer, and the
+/// evidence table (every candidate's error and time, Pareto front, verdict and reason).
+std::string recommendation_markdown(const Recommendation& r, const std::string& command);
+/// recommend.json (schema "vesselverify.recommend", version 1).
+std::string recommendation_json(const Recommendation& r, const std::string& command);
+
+}  // namespace vessel

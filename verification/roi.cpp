@@ -1,0 +1,82 @@
+#include "verification/roi.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace vessel {
+
+std::vector<char> nodes_beyond(const std::vector<Vec3>& nodes, const Vec3& centre, double radius) {
+  std::vector<char> out(nodes.size(), 0);
+  for (std::size_t i = 0; i < nodes.size(); ++i) out[i] = (nodes[i] - centre).norm() > radius;
+  return out;
+}
+
+std::vector<char> held_nodes(const msm::Problem& full, const Vec3& centre, double radius) {
+  const auto n = static_cast<std::size_t>(full.num_dofs() / 3);
+  std::vector<char> held(n, 0);
+  std::size_t moving = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 x = full.rest.segment<3>(3 * static_cast<Eigen::Index>(i));
+    const bool all_fixed = full.fixed[3 * i] && full.fixed[3 * i + 1] && full.fixed[3 * i + 2];
+    held[i] = all_fixed || (x - centre).norm() > radius;
+    moving += !held[i];
+  }
+  if (moving == 0) {
+    throw std::runtime_error("region of interest of radius " + std::to_string(radius * 1e3) +
+                             " mm holds every node: no node within it moves (expected a radius "
+                             "larger than the node spacing at the contact)");
+  }
+  return held;
+}
+
+RoiNetwork restrict_network(const msm::SpringNetwork& full, const std::vector<char>& held) {
+  const std::size_t n = full.nodes.size();
+  std::vector<char> keep(n, 0);
+  for (std::size_t i = 0; i < n; ++i) keep[i] = !held[i];
+  for (const msm::Spring& s : full.springs) {
+    if (!held[s.a] || !held[s.b]) keep[s.a] = keep[s.b] = 1;  // the boundary ring
+  }
+  RoiNetwork roi;
+  std::vector<int> to_roi(n, -1);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!keep[i]) continue;
+    to_roi[i] = static_cast<int>(roi.full_index.size());
+    roi.full_index.push_back(static_cast<int>(i));
+    roi.network.nodes.push_back(full.nodes[i]);
+    roi.network.source_node.push_back(full.source_node.empty() ? -1 : full.source_node[i]);
+    roi.moving_nodes += !held[i];
+  }
+  for (const msm::Spring& s : full.springs) {
+    if (held[s.a] && held[s.b]) continue;
+    msm::Spring r = s;
+    r.a = to_roi[s.a];
+    r.b = to_roi[s.b];
+    roi.network.springs.push_back(r);
+  }
+  roi.network.thickness = full.thickness;
+  // Triangles and tets are not carried: the spring model and the solvers use springs only.
+  return roi;
+}
+
+msm::Problem restrict_problem(const msm::Problem& full, const RoiNetwork& roi,
+                              const std::vector<char>& held, const msm::Form& form) {
+  const auto m = static_cast<Eigen::Index>(roi.full_index.size());
+  msm::Problem p;
+  p.form = &form;
+  p.rest.resize(3 * m);
+  p.external_force.resize(3 * m);
+  p.mass.resize(3 * m);
+  p.fixed.assign(static_cast<std::size_t>(3 * m), 1);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const int i = roi.full_index[static_cast<std::size_t>(k)];
+    p.rest.segment<3>(3 * k) = full.rest.segment<3>(3 * i);
+    p.external_force.segment<3>(3 * k) = full.external_force.segment<3>(3 * i);
+    p.mass.segment<3>(3 * k) = full.mass.segment<3>(3 * i);
+    if (!held[static_cast<std::size_t>(i)]) {
+      for (int c = 0; c < 3; ++c) p.fixed[3 * k + c] = full.fixed[3 * i + c];
+    }
+  }
+  return p;
+}
+
+}  // namespace vessel
