@@ -39,17 +39,30 @@ void write_fields(std::ostream& out, const std::vector<VtuField>& fields) {
 
 }  // namespace
 
-void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
-               const std::vector<VtuField>& point_fields,
+void write_vtu(const std::filesystem::path& path, const std::vector<Vec3>& points,
+               const VtuCells& cells, const std::vector<VtuField>& point_fields,
                const std::vector<VtuField>& cell_fields) {
-  for (const auto& f : point_fields) check(f, mesh.nodes.size(), "point");
-  for (const auto& f : cell_fields) check(f, mesh.tets.size(), "cell");
+  const auto per_cell = static_cast<std::size_t>(cells.points_per_cell);
+  if (per_cell == 0 || cells.connectivity.size() % per_cell != 0) {
+    throw std::invalid_argument("VTU cells: " + std::to_string(cells.connectivity.size()) +
+                                " connectivity entries are not a multiple of " +
+                                std::to_string(cells.points_per_cell) + " points per cell");
+  }
+  for (const std::size_t p : cells.connectivity) {
+    if (p >= points.size()) {
+      throw std::invalid_argument("VTU cells: point " + std::to_string(p) + " of " +
+                                  std::to_string(points.size()));
+    }
+  }
+  const std::size_t n_cells = cells.connectivity.size() / per_cell;
+  for (const auto& f : point_fields) check(f, points.size(), "point");
+  for (const auto& f : cell_fields) check(f, n_cells, "cell");
   write_file_atomically(path, [&](std::ostream& out) {
     out << "<?xml version=\"1.0\"?>\n"
         << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
         << "  <UnstructuredGrid>\n"
-        << "    <Piece NumberOfPoints=\"" << mesh.nodes.size() << "\" NumberOfCells=\""
-        << mesh.tets.size() << "\">\n";
+        << "    <Piece NumberOfPoints=\"" << points.size() << "\" NumberOfCells=\"" << n_cells
+        << "\">\n";
     out << "      <PointData>\n";
     write_fields(out, point_fields);
     out << "      </PointData>\n      <CellData>\n";
@@ -57,7 +70,7 @@ void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
     out << "      </CellData>\n";
     out << "      <Points>\n        <DataArray type=\"Float64\" NumberOfComponents=\"3\" "
            "format=\"ascii\">\n";
-    for (const auto& x : mesh.nodes) {
+    for (const auto& x : points) {
       put(out, x.x());
       out << ' ';
       put(out, x.y());
@@ -67,16 +80,29 @@ void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
     }
     out << "        </DataArray>\n      </Points>\n      <Cells>\n";
     out << "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (const auto& t : mesh.tets) out << t[0] << ' ' << t[1] << ' ' << t[2] << ' ' << t[3] << '\n';
+    for (std::size_t i = 0; i < cells.connectivity.size(); ++i) {
+      out << cells.connectivity[i] << ((i + 1) % per_cell == 0 ? '\n' : ' ');
+    }
     out << "        </DataArray>\n";
     out << "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (std::size_t i = 1; i <= mesh.tets.size(); ++i) out << 4 * i << '\n';
+    for (std::size_t i = 1; i <= n_cells; ++i) out << per_cell * i << '\n';
     out << "        </DataArray>\n";
     out << "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < mesh.tets.size(); ++i) out << kVtkTetra << '\n';
+    for (std::size_t i = 0; i < n_cells; ++i) out << cells.vtk_type << '\n';
     out << "        </DataArray>\n      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n"
         << "</VTKFile>\n";
   });
+}
+
+void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
+               const std::vector<VtuField>& point_fields,
+               const std::vector<VtuField>& cell_fields) {
+  VtuCells cells{kVtkTetra, 4, {}};
+  cells.connectivity.reserve(4 * mesh.tets.size());
+  for (const auto& t : mesh.tets) {
+    for (const auto v : t) cells.connectivity.push_back(static_cast<std::size_t>(v));
+  }
+  write_vtu(path, mesh.nodes, cells, point_fields, cell_fields);
 }
 
 }  // namespace vessel

@@ -16,8 +16,21 @@ struct VtuField {
   std::vector<double> values;
 };
 
-/// Writes the tets atomically as an ASCII .vtu. Each point field must have components × nodes
-/// values and each cell field components × tets values (std::invalid_argument otherwise).
+/// Cells of one VTK type, each with the same number of points, stored cell-major.
+struct VtuCells {
+  int vtk_type = 10;        ///< 3 line, 5 triangle, 10 tetrahedron (VTK's cell type numbers)
+  int points_per_cell = 4;
+  std::vector<std::size_t> connectivity;
+};
+
+/// Writes the points and cells atomically as an ASCII .vtu. Each point field must have
+/// components × points values and each cell field components × cells values, and every
+/// connectivity entry must name a point (std::invalid_argument otherwise).
+void write_vtu(const std::filesystem::path& path, const std::vector<Vec3>& points,
+               const VtuCells& cells, const std::vector<VtuField>& point_fields = {},
+               const std::vector<VtuField>& cell_fields = {});
+
+/// The mesh's tets as VTK tetrahedra (write_vtu above).
 void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
                const std::vector<VtuField>& point_fields = {},
                const std::vector<VtuField>& cell_fields = {});

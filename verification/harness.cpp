@@ -1,6 +1,7 @@
 #include "verification/harness.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -13,6 +14,7 @@
 #include "fem_reference/elasticity.hpp"
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
+#include "meshes/vtu_io.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
@@ -324,6 +326,83 @@ void finish_outcome(ModelOutcome& out, const Scene& s, const std::vector<Vec3>& 
   out.ok = true;
 }
 
+/// Fields are written at one load per model: the budget's (when the run includes it), else the
+/// largest within the linear regime, else the smallest.
+bool wants_fields(const HarnessOptions& o, const Scene& s, double magnitude,
+                  double ref_max_strain_unit) {
+  if (o.fields_dir.empty()) return false;
+  if (o.fields_every_load) return true;
+  Scene without_budget_load = s;
+  const auto& m = s.load.magnitudes;
+  if (std::find(m.begin(), m.end(), s.budget.magnitude) == m.end()) {
+    without_budget_load.budget.magnitude = 0.0;
+  }
+  return magnitude == budget_magnitude(without_budget_load, ref_max_strain_unit);
+}
+
+/// A file name from a model name ("vol[stiffness=lloyd;dt=2e-05]" → "vol_stiffness_lloyd_dt_2e-05_").
+std::string file_stem(const std::string& name) {
+  std::string stem = name;
+  for (char& c : stem) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '_';
+  }
+  return stem;
+}
+
+/// One model's displacement fields at one load for ParaView: points at the model's rest nodes
+/// (m), vectors in m so that "Warp By Vector" at scale 1 shows the deformed state, and |error| in
+/// mm as the reports use.
+void write_model_fields(const HarnessOptions& o, const Scene& s, const ModelOutcome& out,
+                        const std::vector<Vec3>& nodes, const VtuCells& cells,
+                        const std::vector<Vec3>& u_model, const std::vector<Vec3>& u_ref) {
+  VtuField model{"displacement_model_m", 3, {}};
+  VtuField reference{"displacement_reference_m", 3, {}};
+  VtuField error{"error_m", 3, {}};
+  VtuField error_mm{"error_magnitude_mm", 1, {}};
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const Vec3 e = u_model[i] - u_ref[i];
+    for (int c = 0; c < 3; ++c) {
+      model.values.push_back(u_model[i][c]);
+      reference.values.push_back(u_ref[i][c]);
+      error.values.push_back(e[c]);
+    }
+    error_mm.values.push_back(e.norm() * 1e3);
+  }
+  std::ostringstream name;
+  name << file_stem(out.model) << "_nu" << out.poisson_ratio << "_L" << out.level << "_load"
+       << out.magnitude << ".vtu";
+  const std::filesystem::path dir = o.fields_dir / s.name;
+  std::filesystem::create_directories(dir);
+  write_vtu(dir / name.str(), nodes, cells, {model, reference, error, error_mm});
+}
+
+VtuCells tet_cells(const std::vector<Tet>& tets) {
+  VtuCells cells{10, 4, {}};
+  for (const auto& t : tets) {
+    for (const int v : t) cells.connectivity.push_back(static_cast<std::size_t>(v));
+  }
+  return cells;
+}
+
+/// A mass-spring network's cells: its tets (volume), triangles (surface), else its springs.
+VtuCells network_cells(const msm::SpringNetwork& n) {
+  if (!n.tets.empty()) return tet_cells(n.tets);
+  VtuCells cells;
+  if (!n.triangles.empty()) {
+    cells = {5, 3, {}};
+    for (const auto& t : n.triangles) {
+      for (const int v : t) cells.connectivity.push_back(static_cast<std::size_t>(v));
+    }
+  } else {
+    cells = {3, 2, {}};
+    for (const auto& sp : n.springs) {
+      cells.connectivity.push_back(static_cast<std::size_t>(sp.a));
+      cells.connectivity.push_back(static_cast<std::size_t>(sp.b));
+    }
+  }
+  return cells;
+}
+
 /// A FEM model: always the displacement formulation of its degree, so that P1's locking near
 /// ν = 0.5 shows; at ν = 0.5, where that element cannot be used, it is recorded as failed.
 void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
@@ -359,9 +438,13 @@ void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
       ModelOutcome out = base;
       out.magnitude = mag;
       out.max_strain = r.max_abs_principal_strain * mag;
-      finish_outcome(out, s, mesh.nodes, scaled(r.nodal_displacement, mag), ref_here, mag, at,
-                     fine.max_abs_principal_strain, result.qoi_point, scaled(unit_loads, mag), 0,
-                     0.0);
+      const std::vector<Vec3> u = scaled(r.nodal_displacement, mag);
+      finish_outcome(out, s, mesh.nodes, u, ref_here, mag, at, fine.max_abs_principal_strain,
+                     result.qoi_point, scaled(unit_loads, mag), 0, 0.0);
+      if (wants_fields(o, s, mag, fine.max_abs_principal_strain)) {
+        write_model_fields(o, s, out, mesh.nodes, tet_cells(mesh.tets), u,
+                           scaled(ref_here.u, mag));
+      }
       result.outcomes.push_back(out);
     }
   } catch (const std::exception& e) {
@@ -510,6 +593,10 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
       }
       finish_outcome(out, s, nodes, u, ref_here, mag, at, fine.max_abs_principal_strain,
                      result.qoi_point, loads, spec.steps, spec.dt);
+      if (wants_fields(o, s, mag, fine.max_abs_principal_strain)) {
+        write_model_fields(o, s, out, nodes, network_cells(built.network), u,
+                           scaled(ref_here.u, mag));
+      }
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {

@@ -26,6 +26,11 @@ struct HarnessOptions {
   /// Run the models only at the budget's load (Budget::magnitude, else the representative load:
   /// the largest magnitude within the reference's linear regime, else the smallest), per ν.
   bool budget_load_only = false;
+  /// VTU fields for ParaView (model and reference displacement and their difference at the
+  /// model's nodes) written under fields_dir/<scene>/, one file per model, ν and level; empty:
+  /// none. Only at the representative load (budget_magnitude()) unless fields_every_load.
+  std::filesystem::path fields_dir;
+  bool fields_every_load = false;
 };
 
 /// The reference's answer for one ν (at unit load; scale by the magnitude).

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "../test_helpers.hpp"
@@ -68,12 +69,32 @@ double lame_radial(double p, double a, double b, double E, double nu, double r) 
 class HarnessLame : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    result_ = new SceneResult(run_scene(parse_scene(kLame, "lame_test.toml"), HarnessOptions{}));
+    fields_ = new test::TempDir;
+    HarnessOptions o;
+    o.fields_dir = fields_->path();
+    result_ = new SceneResult(run_scene(parse_scene(kLame, "lame_test.toml"), o));
   }
-  static void TearDownTestSuite() { delete result_; }
+  static void TearDownTestSuite() {
+    delete result_;
+    delete fields_;
+  }
   static SceneResult* result_;
+  static test::TempDir* fields_;  ///< the VTU fields of the run
 };
 SceneResult* HarnessLame::result_ = nullptr;
+test::TempDir* HarnessLame::fields_ = nullptr;
+
+/// The numbers of a VTU DataArray: the one named `name`, or the points for "Points".
+std::vector<double> vtu_array(const std::string& vtu, const std::string& name) {
+  const std::size_t tag = name == "Points" ? vtu.find("<DataArray", vtu.find("<Points>"))
+                                           : vtu.find("Name=\"" + name + "\"");
+  if (tag == std::string::npos) throw std::runtime_error("no DataArray " + name);
+  const std::size_t begin = vtu.find('>', tag) + 1;
+  std::istringstream in(vtu.substr(begin, vtu.find("</DataArray>", begin) - begin));
+  std::vector<double> v;
+  for (double x; in >> x;) v.push_back(x);
+  return v;
+}
 
 }  // namespace
 
@@ -158,6 +179,47 @@ TEST_F(HarnessLame, WallProfileIsLamesUniformRadialDisplacementAlongTheTube) {
     EXPECT_NEAR(o.wall_profile.reference_mm[i] / exact_mm, 1.0, 0.03) << "s = " << o.wall_profile.s_mm[i];
     EXPECT_NEAR(o.wall_profile.model_mm[i], o.wall_profile.reference_mm[i], 1e-9);
   }
+}
+
+TEST_F(HarnessLame, VtuFieldsHoldLamesFieldAndTheModelsErrorAtTheRepresentativeLoad) {
+  // Both loads stay far below 5 % strain, so the representative load is the largest (20 Pa):
+  // one file per finished model there, none at 10 Pa, none for the model that diverged.
+  const std::filesystem::path dir = *fields_ / "lame_test";
+  for (const char* model : {"p2_same_as_reference", "p1", "volume_linear"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / (std::string(model) + "_nu0.3_L0_load20.vtu")))
+        << model;
+    EXPECT_FALSE(std::filesystem::exists(dir / (std::string(model) + "_nu0.3_L0_load10.vtu")))
+        << model;
+  }
+  EXPECT_FALSE(std::filesystem::exists(
+      dir / "volume_explicit_euler_too_big_a_step_nu0.3_L0_load20.vtu"));
+
+  // The reference field is Lamé's at every node (plane strain holds along the whole tube):
+  // u = u_r(r) e_r, no axial or circumferential part.
+  const std::string vtu = test::read_text(dir / "volume_linear_nu0.3_L0_load20.vtu");
+  const std::vector<double> x = vtu_array(vtu, "Points");
+  const std::vector<double> ref = vtu_array(vtu, "displacement_reference_m");
+  const std::vector<double> model = vtu_array(vtu, "displacement_model_m");
+  const std::vector<double> err = vtu_array(vtu, "error_m");
+  const std::vector<double> err_mm = vtu_array(vtu, "error_magnitude_mm");
+  const ModelOutcome& o = find(*result_, "volume_linear", 20.0);
+  ASSERT_EQ(x.size(), 3 * o.nodes);
+  ASSERT_EQ(ref.size(), x.size());
+  ASSERT_EQ(err_mm.size(), o.nodes);
+  double max_err_mm = 0.0;
+  for (std::size_t i = 0; i < o.nodes; ++i) {
+    const double r = std::hypot(x[3 * i], x[3 * i + 1]);
+    const double ur = (ref[3 * i] * x[3 * i] + ref[3 * i + 1] * x[3 * i + 1]) / r;
+    const double exact = lame_radial(20.0, 3e-3, 4e-3, 14.24e3, 0.3, r);
+    EXPECT_NEAR(ur / exact, 1.0, 0.03) << "node " << i << " at r = " << r;
+    EXPECT_LT(std::abs(ref[3 * i + 2]), 0.03 * exact) << "node " << i;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(err[3 * i + c], model[3 * i + c] - ref[3 * i + c], 1e-15);
+    }
+    max_err_mm = std::max(max_err_mm, err_mm[i]);
+  }
+  // The file shows the same model as the results: its largest |error| is the reported maximum.
+  EXPECT_NEAR(max_err_mm, o.error.max_mm, 1e-6 * o.error.max_mm);
 }
 
 namespace {

@@ -21,6 +21,7 @@ struct RunOptions {
   std::vector<int> levels;
   std::vector<double> magnitudes;
   int reference_level = -1;
+  std::string fields = "representative";
   std::string command;
 };
 
@@ -54,6 +55,8 @@ void run(const RunOptions& o) {
   h.cache_dir = o.cache_dir;
   h.log = &std::cout;
   h.repeats = o.repeats;
+  if (o.fields != "none") h.fields_dir = o.output_dir / "fields";
+  h.fields_every_load = o.fields == "all";
   run_and_write(scenes, h, o.output_dir, o.command);
 }
 
@@ -67,7 +70,7 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
       "Run scenes: every model of each scene against the FEM reference (P2, or Taylor-Hood P2-P1 "
       "for nu >= 0.49) at every Poisson's ratio and load magnitude; write results.json (schema "
       "vesselverify.results), results.csv and summary.md (seed 000's error statistics in mm, the "
-      "reference's own uncertainty, timings).\n"
+      "reference's own uncertainty, timings) and VTU fields per model (fields/).\n"
       "Examples:\n"
       "  vesselverify run verification/scenes/contact_straight.toml\n"
       "  vesselverify run --quick --output-dir results verification/scenes/*.toml");
@@ -97,6 +100,13 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
                   "Level of the P2 reference instead of the scene's (its uncertainty comes from "
                   "the level below)")
       ->check(CLI::Range(0, kMaxMeshLevel));
+  cmd->add_option("--fields", o->fields,
+                  "VTU files for ParaView under OUTPUT-DIR/fields/<scene>/ (model and reference "
+                  "displacement, their difference), one per model, nu and level: at the "
+                  "representative load (the budget's, else the largest within 5 % strain), at "
+                  "every load, or none")
+      ->check(CLI::IsMember({"representative", "all", "none"}))
+      ->capture_default_str();
   cmd->callback([o] { run(*o); });
 }
 
