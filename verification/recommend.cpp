@@ -26,6 +26,9 @@ std::string fmt(double v, int digits = 3) {
 
 std::string ms(double seconds) { return fmt(seconds * 1e3) + " ms"; }
 
+/// "30 Hz", "1000 Hz" (fmt's 3 digits would print 1e+03).
+std::string hz(double rate) { return fmt(rate, 6) + " Hz"; }
+
 bool is_integrator(const std::string& solver) {
   return solver != "static" && solver != "linear" && solver != "relaxation";
 }
@@ -299,7 +302,7 @@ std::string budget_text(const Scene& s, const SceneResult& r) {
   if (b.quantity == BudgetQuantity::patch) t << " (within " << fmt(b.radius * 1e3) << " mm)";
   t << " error ≤ " << fmt(b.tolerance) << " " << budget_unit(b.quantity) << ", and ≤ "
     << ms(b.seconds_per_update()) << " of computation per update";
-  if (b.rate_hz > 0.0) t << " (" << fmt(b.rate_hz) << " Hz)";
+  if (b.rate_hz > 0.0) t << " (" << hz(b.rate_hz) << ")";
   const char* unit =
       s.load.kind == LoadKind::contact ? "N" : (s.load.kind == LoadKind::pressure ? "Pa" : "g");
   for (const ReferenceInfo& ref : r.references) {
@@ -322,7 +325,13 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
   const auto& c = rec.candidates;
   const char* unit = budget_unit(s.budget.quantity);
   std::ostringstream md;
-  md << "## Model recommendation: " << s.name << "\n\n";
+  md << "## Model recommendation: " << s.name;
+  // Headings differ per rate, so one report can embed the visual and the haptic answers.
+  if (s.budget.rate_hz > 0.0)
+    md << " at " << hz(s.budget.rate_hz);
+  else
+    md << ", " << ms(s.budget.time_budget_s) << " per update";
+  md << "\n\n";
   md << "Budget: " << budget_text(s, rec.result) << ". " << c.size()
      << " candidates (generated from the mass-spring library's stiffness rules and solvers, "
         "surface and volume, mesh levels";
