@@ -7,7 +7,10 @@
 #      reference → results.json, results.csv, summary.md;
 #   3. `vesselverify stability`: predicted vs found critical time steps and the hard cases →
 #      stability.json, stability.md;
-#   4. `vesselverify report` → report.md, report.html (self-contained) and figures/.
+#   4. `vesselverify recommend` on the two contact scenes at 30 Hz (visual) and 1 kHz (haptic):
+#      the cheapest model meeting each scene's [budget] → recommend/<scene>_<rate>/;
+#   5. `vesselverify report` → report.md, report.html (self-contained) and figures/, with the
+#      stability and recommendation sections.
 #
 # Usage: scripts/verify.sh [--quick] [output-dir]   (default output: results/)
 #   default  the scenes' own levels, loads and sweeps: well under 30 minutes on 2 cores
@@ -27,14 +30,33 @@ build="$root/build"
 vv="$build/verification/vesselverify"
 mkdir -p "$out"
 start=$SECONDS
+phase_start=$SECONDS
+phase() {  # prints the time the previous phase took, then the next one's name
+  echo "== [$((SECONDS - start)) s, previous phase $((SECONDS - phase_start)) s] $1 =="
+  phase_start=$SECONDS
+}
 for vessel in straight arch; do
   echo "== default $vessel vessel =="
   "$vv" mesh --vessel "$vessel" --level 0 --stats-json "$out/${vessel}_vessel_stats.json"
 done
 scenes="$root/verification/scenes"
+phase "run: the shipped scenes"
 "$vv" run "${mode[@]}" --output-dir "$out" "$scenes/contact_straight.toml" \
   "$scenes/pressure_lame.toml" "$scenes/contact_arch.toml" "$scenes/gravity_sag.toml" \
   "$scenes/dynamic_contact.toml"
+phase "stability"
 "$vv" stability "${mode[@]}" --output-dir "$out"
-"$vv" report "$out/results.json" --stability "$out/stability.md" --output-dir "$out"
+recommendations=()
+for scene in contact_straight contact_arch; do
+  for rate in 30 1000; do
+    phase "recommend $scene at $rate Hz"
+    dir="$out/recommend/${scene}_${rate}hz"
+    "$vv" recommend "${mode[@]}" --rate "$rate" --output-dir "$dir" "$scenes/$scene.toml"
+    recommendations+=(--recommend "$dir/recommend.md")
+  done
+done
+phase "report"
+"$vv" report "$out/results.json" --stability "$out/stability.md" "${recommendations[@]}" \
+  --output-dir "$out"
+phase "done"
 echo "verification finished in $((SECONDS - start)) s; report: $out/report.html (and report.md)"
