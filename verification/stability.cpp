@@ -795,7 +795,9 @@ HardCase case_zero_length(const StabilityOptions& o, std::ostream& log) {
   hc.setup = "(1) The level-0 volume model (seed001) plus one extra node coincident with a free "
              "node near the contact point, tied to it by a zero-rest-length spring of the mean "
              "stiffness; (2) the level-0 mesh with one interior node moved onto a neighbour "
-             "(coincident nodes, zero-volume tets). Contact load 0.1 mN, clamped ends.";
+             "(coincident nodes, zero-volume tets): a .msh file like it is refused by the "
+             "reader (inverted or zero-volume tets, exit 1); the models are run on it here "
+             "anyway to show why. Contact load 0.1 mN, clamped ends.";
   VesselParams params;
   const TetMesh mesh = load_mesh(params, o);
   const Vec3 point = default_contact_point(params);
@@ -872,6 +874,15 @@ HardCase case_zero_length(const StabilityOptions& o, std::ostream& log) {
                            std::to_string(q.degenerate) + " zero-volume and " +
                                std::to_string(q.inverted) + " inverted tets reported",
                            {{"degenerate_tets", static_cast<double>(q.degenerate)}}});
+    // The same mesh as a user's .msh file: the reader's volume check (require_positive_volumes)
+    // refuses it before any model sees it. The rows below show what happens without that check.
+    try {
+      require_positive_volumes(bad, "coincident-node mesh");
+      hc.outcomes.push_back({"reading it as a user .msh", true, {}, {}, "accepted", {}});
+    } catch (const InputError& e) {
+      hc.outcomes.push_back({"reading it as a user .msh", false, {}, {},
+                             "refused: " + short_error(e.what()), {}});
+    }
     for (msm::StiffnessRule rule : {msm::StiffnessRule::seed001, msm::StiffnessRule::van_gelder}) {
       const ModelSpec sp{"volume", rule};
       try {
