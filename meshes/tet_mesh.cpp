@@ -211,7 +211,8 @@ void require_positive_volumes(const TetMesh& mesh, std::string_view source,
       s = std::string(source) + ":" + std::to_string(origins[e].line) + ": element " +
           std::to_string(origins[e].tag);
     } else {
-      s = std::string(source) + ": tetrahedron " + std::to_string(e);
+      s = std::string(source) + ": tetrahedron " + std::to_string(e) + " (0-based, of " +
+          std::to_string(mesh.tets.size()) + ")";
     }
     return s;
   };
@@ -224,7 +225,9 @@ void require_positive_volumes(const TetMesh& mesh, std::string_view source,
   const Tet& t = mesh.tets[e];
   const VolumeCheck c = check_volume(mesh, t);
   std::ostringstream msg;
-  msg << where(e) << " (tetrahedron " << e + 1 << " of " << mesh.tets.size() << ") ";
+  msg << where(e);
+  if (have_origins) msg << " (tetrahedron " << e + 1 << " of " << mesh.tets.size() << ")";
+  msg << " ";
   if (c.zero) {
     std::string why;
     for (int i = 0; i < 4 && why.empty(); ++i) {

@@ -184,6 +184,19 @@ TEST(MshIo, AFileWhoseTetsAreAllNegativeIsAConventionAndIsFlipped) {
   EXPECT_NE(msg.find("expected a negative volume"), std::string::npos) << msg;
 }
 
+TEST(TetVolumes, InMemoryMeshNamesTheTetIndexWithoutAFile) {
+  TetMesh mesh;
+  mesh.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1)};
+  mesh.tets = {{0, 1, 2, 3}, {1, 2, 3, 4}};  // +1/6 and +1/3 (hand-derived)
+  EXPECT_NO_THROW(require_positive_volumes(mesh, "in-memory"));
+  mesh.tets[1] = {1, 2, 4, 3};  // −1/3
+  const auto msg = input_error([&] { require_positive_volumes(mesh, "in-memory"); });
+  EXPECT_NE(msg.find("in-memory: tetrahedron 1 (0-based, of 2) is inverted: signed volume "
+                     "-0.3333 m³"),
+            std::string::npos)
+      << msg;
+}
+
 TEST(MshIo, RoundTripV41IsExact) {
   TempDir dir;
   write_msh(dir / "tube.msh", level0_tube(), MshVersion::v41);
