@@ -102,6 +102,7 @@ class MshReader {
 
   const std::string& line() const { return line_; }
   const std::string& path() const { return path_; }
+  long line_number() const { return line_no_; }
 
  private:
   std::string path_;
@@ -131,7 +132,7 @@ class MeshBuilder {
   void set_group_name(int dim, int tag, std::string name) { names_[{dim, tag}] = std::move(name); }
 
   /// Adds one element of `type` with gmsh node tags, belonging to the given physical groups.
-  void add_element(int type, const std::vector<std::size_t>& node_tags,
+  void add_element(int type, std::size_t element_tag, const std::vector<std::size_t>& node_tags,
                    const std::vector<int>& physical_tags) {
     if (type == kGmshPoint || type == kGmshLine) return;
     if (type != kGmshTriangle && type != kGmshTet) {
@@ -148,8 +149,14 @@ class MeshBuilder {
       nodes.push_back(it->second);
     }
     const int dim = type == kGmshTet ? 3 : 2;
+    const std::size_t tets_before = mesh_.tets.size();
     const int element = dim == 3 ? add_unique(nodes, tet_index_, mesh_.tets)
                                  : add_unique(nodes, tri_index_, mesh_.triangles);
+    if (mesh_.tets.size() > tets_before) {  // a new tet: remember where it came from
+      ElementOrigin o{r_.line_number(), element_tag, {}};
+      std::copy(node_tags.begin(), node_tags.end(), o.node_tags.begin());
+      origins_.push_back(o);
+    }
     for (int tag : physical_tags) members_[{dim, tag}].push_back(element);
   }
 
@@ -166,7 +173,14 @@ class MeshBuilder {
                               key.tag, std::move(elements)});
     }
     remove_unused_nodes(mesh_);
-    orient_tets(mesh_);
+    const bool flipped = orient_tets(mesh_);
+    if (flipped) {
+      for (auto& o : origins_) std::swap(o.node_tags[2], o.node_tags[3]);
+    }
+    // Inverted or zero-volume tets make every model meaningless (the FEM's Jacobian is singular or
+    // of the wrong sign, springs get infinite stiffness): refuse them here, where each tet's line
+    // is known, so every user of a .msh file is protected.
+    require_positive_volumes(mesh_, r_.path(), origins_, flipped);
     orient_boundary_outward(mesh_);
     return std::move(mesh_);
   }
@@ -191,6 +205,7 @@ class MeshBuilder {
   std::map<std::array<int, 3>, int> tri_index_;
   std::map<GroupKey, std::vector<int>> members_;
   std::map<GroupKey, std::string> names_;
+  std::vector<ElementOrigin> origins_;  ///< one per tet, parallel to mesh_.tets
 };
 
 void read_physical_names(MshReader& r, MeshBuilder& b) {
@@ -238,7 +253,7 @@ void read_elements_v22(MshReader& r, MeshBuilder& b) {
     const int ntags = r.number<int>(t[2], "number of element tags");
     if (ntags < 0) r.fail("negative number of element tags " + std::to_string(ntags));
     const int nn = nodes_per_element(type);
-    if (nn < 0) b.add_element(type, {}, {});  // refuses the unsupported type, naming it
+    if (nn < 0) b.add_element(type, 0, {}, {});  // refuses the unsupported type, naming it
     const std::size_t expected = 3 + static_cast<std::size_t>(ntags) + static_cast<std::size_t>(nn);
     if (t.size() < expected) {
       r.fail("element line has " + std::to_string(t.size()) + " values, expected " +
@@ -253,7 +268,7 @@ void read_elements_v22(MshReader& r, MeshBuilder& b) {
     for (int k = 0; k < nn; ++k) {
       nodes.push_back(r.number<std::size_t>(t[3 + static_cast<std::size_t>(ntags + k)], "node tag"));
     }
-    b.add_element(type, nodes, physical);
+    b.add_element(type, r.number<std::size_t>(t[0], "element tag"), nodes, physical);
   }
   if (r.next_in(section) != "$EndElements") r.fail("expected $EndElements after " + std::to_string(count) + " elements");
 }
@@ -341,7 +356,7 @@ void read_elements_v41(MshReader& r, MeshBuilder& b, const EntityPhysicals& phys
       for (int k = 0; k < std::max(nn, 0); ++k) {
         nodes.push_back(r.number<std::size_t>(e[1 + k], "node tag"));
       }
-      b.add_element(type, nodes, groups);
+      b.add_element(type, r.number<std::size_t>(e[0], "element tag"), nodes, groups);
     }
   }
   if (r.next_in(section) != "$EndElements") r.fail("expected $EndElements");

@@ -13,9 +13,10 @@ namespace vessel {
 enum class MshVersion { v22, v41 };
 
 /// Reads an ASCII `.msh` 2.2 or 4.1 file. Node indices are renumbered 0.. in file order, unused
-/// nodes dropped, tets flipped if the file's convention makes them all negative, and group triangles that are tet faces oriented
-/// outward. Throws InputError naming the file and line for a missing, truncated, binary or
-/// malformed file, a non-finite coordinate or an unknown node tag. Does not require any group:
+/// nodes dropped, tets flipped if the file's convention makes most of them negative, and group
+/// triangles that are tet faces oriented outward. Throws InputError naming the file and line for a missing, truncated, binary or
+/// malformed file, a non-finite coordinate, an unknown node tag, or an inverted or zero-volume
+/// tet (require_positive_volumes: its line, element tag and signed volume). Does not require any group:
 /// call require_vessel_groups for that.
 TetMesh read_msh(const std::filesystem::path& path);
 /// Same, from a stream; `source` names it in messages.

@@ -2,7 +2,11 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
+#include <iomanip>
 #include <map>
+#include <sstream>
+#include <string>
 #include <unordered_map>
 
 #include "meshes/errors.hpp"
@@ -141,13 +145,131 @@ std::vector<Triangle> boundary_faces(const TetMesh& mesh) {
   return out;
 }
 
-void orient_tets(TetMesh& mesh) {
-  const bool all_negative = std::all_of(mesh.tets.begin(), mesh.tets.end(), [&](const Tet& t) {
-    return signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]) <=
-           0;
-  });
-  if (!all_negative) return;
+bool orient_tets(TetMesh& mesh) {
+  std::size_t negative = 0;
+  std::size_t positive = 0;
+  for (const Tet& t : mesh.tets) {
+    const double v =
+        signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
+    if (v < 0) ++negative;
+    if (v > 0) ++positive;
+  }
+  if (negative <= positive) return false;
   for (auto& t : mesh.tets) std::swap(t[2], t[3]);
+  return true;
+}
+
+namespace {
+
+std::string sci(double x, int digits = 4) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << x;
+  return s.str();
+}
+
+/// One tet's volume test: signed volume V, longest edge ℓ, and whether it is inverted or flat.
+struct VolumeCheck {
+  double volume = 0;
+  double longest_edge = 0;
+  bool zero = false;
+  bool inverted = false;
+};
+
+VolumeCheck check_volume(const TetMesh& mesh, const Tet& t) {
+  VolumeCheck c;
+  c.volume = signed_volume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
+  for (int i = 0; i < 4; ++i) {
+    for (int j = i + 1; j < 4; ++j) {
+      c.longest_edge = std::max(c.longest_edge, (mesh.nodes[t[i]] - mesh.nodes[t[j]]).norm());
+    }
+  }
+  const double l3 = c.longest_edge * c.longest_edge * c.longest_edge;
+  c.zero = !(std::abs(c.volume) > kZeroVolumeTolerance * l3);  // NaN counts as zero
+  c.inverted = !c.zero && c.volume < 0;
+  return c;
+}
+
+}  // namespace
+
+void require_positive_volumes(const TetMesh& mesh, std::string_view source,
+                              const std::vector<ElementOrigin>& origins, bool file_flipped) {
+  const bool have_origins = origins.size() == mesh.tets.size();
+  std::vector<std::size_t> bad;
+  double total = 0;
+  for (std::size_t e = 0; e < mesh.tets.size(); ++e) {
+    const VolumeCheck c = check_volume(mesh, mesh.tets[e]);
+    total += std::abs(c.volume);
+    if (c.zero || c.inverted) bad.push_back(e);
+  }
+  if (bad.empty()) return;
+  const double mean = total / static_cast<double>(mesh.tets.size());
+  const double sign = file_flipped ? -1.0 : 1.0;  // volumes as the file's node order gives them
+  const std::string expected = file_flipped ? "negative" : "positive";
+  auto where = [&](std::size_t e) {
+    std::string s;
+    if (have_origins) {
+      s = std::string(source) + ":" + std::to_string(origins[e].line) + ": element " +
+          std::to_string(origins[e].tag);
+    } else {
+      s = std::string(source) + ": tetrahedron " + std::to_string(e) + " (0-based, of " +
+          std::to_string(mesh.tets.size()) + ")";
+    }
+    return s;
+  };
+  auto node_name = [&](std::size_t e, int k) {
+    return have_origins ? "node " + std::to_string(origins[e].node_tags[k])
+                        : "node " + std::to_string(mesh.tets[e][k]);
+  };
+
+  const std::size_t e = bad.front();
+  const Tet& t = mesh.tets[e];
+  const VolumeCheck c = check_volume(mesh, t);
+  std::ostringstream msg;
+  msg << where(e);
+  if (have_origins) msg << " (tetrahedron " << e + 1 << " of " << mesh.tets.size() << ")";
+  msg << " ";
+  if (c.zero) {
+    std::string why;
+    for (int i = 0; i < 4 && why.empty(); ++i) {
+      for (int j = i + 1; j < 4 && why.empty(); ++j) {
+        const Vec3& p = mesh.nodes[t[i]];
+        if (t[i] == t[j]) {
+          why = "it lists its " + node_name(e, i) + " twice";
+        } else if ((p - mesh.nodes[t[j]]).norm() <= 1e-9 * c.longest_edge) {
+          why = "its " + node_name(e, i) + " and " + node_name(e, j) + " coincide at (" +
+                sci(p.x(), 6) + ", " + sci(p.y(), 6) + ", " + sci(p.z(), 6) + ") m";
+        }
+      }
+    }
+    if (why.empty()) why = "its four nodes are (nearly) coplanar: a flat tet";
+    msg << "has zero volume: signed volume " << sci(sign * c.volume) << " m³, |V| ≤ "
+        << sci(kZeroVolumeTolerance, 1) << " ℓ³ with ℓ = " << sci(c.longest_edge)
+        << " m its longest edge; " << why << "; expected a " << expected << " volume";
+  } else {
+    msg << "is inverted: signed volume " << sci(sign * c.volume) << " m³ ("
+        << sci(sign * c.volume / mean, 3) << " × the mean tet volume); expected a " << expected
+        << " volume like the mesh's other tets (its node order is reversed, or a node is on the "
+           "wrong side of its opposite face)";
+  }
+  msg << ". " << bad.size() << " of " << mesh.tets.size()
+      << " tets are inverted or have zero volume";
+  if (bad.size() > 1) {
+    msg << "; the next: ";
+    const std::size_t shown = std::min<std::size_t>(bad.size(), 6);
+    for (std::size_t i = 1; i < shown; ++i) {
+      const std::size_t b = bad[i];
+      msg << (i > 1 ? ", " : "");
+      if (have_origins) {
+        msg << "element " << origins[b].tag << " (line " << origins[b].line << ")";
+      } else {
+        msg << "tetrahedron " << b;
+      }
+      msg << " V = " << sci(sign * check_volume(mesh, mesh.tets[b]).volume) << " m³";
+    }
+    if (bad.size() > shown) msg << ", ...";
+  }
+  msg << ". Fix the mesh (re-mesh, or merge coincident nodes) and try again.";
+  throw InputError(msg.str());
 }
 
 void orient_boundary_outward(TetMesh& mesh) {

@@ -80,10 +80,33 @@ double group_area(const TetMesh& mesh, const PhysicalGroup& group);
 /// The faces of the tetrahedra that belong to exactly one tet, each oriented outward.
 std::vector<Triangle> boundary_faces(const TetMesh& mesh);
 
-/// If every tet has a non-positive signed volume (a file's orientation convention), swaps two
-/// vertices of each so that they are positive. A mesh with both signs keeps them: its negative tets
-/// are inverted elements, which mesh quality reports.
-void orient_tets(TetMesh& mesh);
+/// If more tets have a negative signed volume than a positive one (a file's orientation
+/// convention), swaps the last two vertices of each so that the majority is positive; returns
+/// whether it did. A mesh with both signs keeps the minority: those are inverted elements, which
+/// require_positive_volumes refuses and mesh quality reports.
+bool orient_tets(TetMesh& mesh);
+
+/// Where a tet came from in a file, for messages: its 1-based line, the file's element tag and its
+/// node tags in the mesh's (oriented) vertex order.
+struct ElementOrigin {
+  long line = 0;
+  std::size_t tag = 0;
+  std::array<std::size_t, 4> node_tags{};
+};
+
+/// A tet has zero volume when |V| ≤ kZeroVolumeTolerance · ℓ³, ℓ its longest edge (a regular tet
+/// has V = ℓ³/(6√2) ≈ 0.12 ℓ³; rounding of the coordinates gives |V| ~ 1e-16 ℓ³·|x|/ℓ): flat, or
+/// with coincident nodes. Relative to each tet's own size, so graded meshes are judged fairly.
+inline constexpr double kZeroVolumeTolerance = 1e-12;
+
+/// Throws InputError unless every tet has a positive signed volume above the zero-volume
+/// tolerance. The message names `source`, the first offending element (with `origins`, one per
+/// tet: its line, element tag and node tags; else its index), its signed volume in m³, what was
+/// expected, how many tets are bad and the next few of them. `file_flipped`: orient_tets flipped
+/// the file's (negative) convention, so volumes are quoted in the file's sign.
+void require_positive_volumes(const TetMesh& mesh, std::string_view source,
+                              const std::vector<ElementOrigin>& origins = {},
+                              bool file_flipped = false);
 /// Orients each group triangle that is a face of a tet so its normal points out of that tet.
 void orient_boundary_outward(TetMesh& mesh);
 /// Canonical element order independent of the mesher's: each element's nodes ascending up to an

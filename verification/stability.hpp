@@ -5,11 +5,13 @@
 /// sliver tets, a refined contact patch, an inverting load, a long run, a tight arch bend,
 /// zero-length springs and coincident nodes), each with what every model did.
 /// Results: stability.json (schema verification/stability.schema.json) and stability.md.
+#include <array>
 #include <filesystem>
 #include <map>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
@@ -28,7 +30,15 @@ struct StabilityOptions {
   long long long_run_steps = 0;
   int max_level = -1;
   bool hard_cases = true;  ///< false: only the critical-step table
+  /// Ids of the hard cases to run (poisson, youngs_modulus, sliver, refined_patch,
+  /// inverting_load, long_run, tight_bend, zero_length); empty: all of them.
+  std::vector<std::string> only_cases;
 };
+
+/// The hard cases' ids, in the order they run.
+inline constexpr std::array<std::string_view, 8> kHardCaseIds{
+    "poisson", "youngs_modulus", "sliver", "refined_patch", "inverting_load", "long_run",
+    "tight_bend", "zero_length"};
 
 /// One row of the critical-step table.
 struct CriticalStepRow {
@@ -44,7 +54,9 @@ struct CriticalStepRow {
   double omega_gershgorin = 0.0;
   double omega_min = 0.0;
   double gamma_max = 0.0;  ///< damping rate of the top mode, 1/s
-  double predicted_dt = 0.0;
+  double predicted_dt = 0.0;  ///< modal estimate (exact undamped; may over-predict when damped)
+  /// Proven stable step (msm::guaranteed_critical_step), s; NaN where none is proven.
+  double guaranteed_dt = 0.0;
   double found_dt = 0.0;     ///< largest step found stable, s
   double unstable_dt = 0.0;  ///< smallest step found unstable, s
   int trials = 0;

@@ -46,7 +46,7 @@ std::string to_string(Integrator i) {
 
 DivergenceError::DivergenceError(int step_, int node_, double energy_, const std::string& why)
     : std::runtime_error("diverged at step " + std::to_string(step_) + ", node " +
-                         std::to_string(node_) + ", energy " + std::to_string(energy_) + " J: " +
+                         std::to_string(node_) + ", energy " + sci(energy_) + " J: " +
                          why + " (reduce the time step or use implicit-euler); no result written"),
       step(step_),
       node(node_),

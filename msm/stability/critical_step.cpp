@@ -190,6 +190,23 @@ Spectrum analyse_spectrum(const Problem& p, const SpectrumOptions& o) {
   s.lanczos_iterations = iters;
   s.omega_max = std::sqrt(std::max(lmax, 0.0));
   s.gamma_max = damping_rate(ymax);
+  // Bounds of the Rayleigh quotient of S C S (Gershgorin discs; exact for a diagonal C).
+  s.gamma_lo = nf > 0 ? kInf : 0.0;
+  s.gamma_hi = 0.0;
+  {
+    VectorXd diag = VectorXd::Zero(nf), off = VectorXd::Zero(nf);
+    for (int k = 0; k < Cs.outerSize(); ++k) {
+      for (SparseMatrix::InnerIterator it(Cs, k); it; ++it) {
+        (it.row() == it.col() ? diag[it.row()] : off[it.row()]) +=
+            it.row() == it.col() ? it.value() : std::abs(it.value());
+      }
+    }
+    for (int i = 0; i < nf; ++i) {
+      s.gamma_lo = std::min(s.gamma_lo, diag[i] - off[i]);
+      s.gamma_hi = std::max(s.gamma_hi, diag[i] + off[i]);
+    }
+    s.gamma_lo = std::max(s.gamma_lo, 0.0);  // C is positive semi-definite
+  }
 
   if (o.lowest) {
     s.has_lowest = true;
@@ -208,6 +225,39 @@ Spectrum analyse_spectrum(const Problem& p, const SpectrumOptions& o) {
   }
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
+}
+
+double guaranteed_critical_step(Integrator integrator, const Spectrum& s) {
+  if (s.gamma_hi <= 0.0) {
+    // No damping: the modes decouple exactly (M⁻¹K alone), the prediction is exact.
+    return critical_step_mode(integrator, s.omega_max, 0.0);
+  }
+  // ω_min: from shift-invert Lanczos when computed, else 0 (a wider rectangle: still a bound).
+  const double w_lo = s.has_lowest ? s.omega_min : 0.0;
+  switch (integrator) {
+    case Integrator::explicit_euler: {
+      // h(ω, γ) of critical_step_mode rises then falls in ω for fixed γ (overdamped branch
+      // 2/(γ/2 + √(γ²/4 − ω²)) increasing up to ω = γ/2, then γ/ω² decreasing) and rises then
+      // falls in γ for fixed ω (γ/ω² increasing up to γ = 2ω, then the overdamped branch
+      // decreasing): quasi-concave in each variable, so its minimum over the rectangle is at a
+      // corner.
+      double h = kInf;
+      for (double w : {w_lo, s.omega_max}) {
+        for (double g : {s.gamma_lo, s.gamma_hi}) {
+          h = std::min(h, critical_step_mode(integrator, w, g));
+        }
+      }
+      return h;
+    }
+    case Integrator::symplectic_euler:
+      // 4/(γ + √(γ² + 4ω²)) decreases in both γ and ω: the corner (ω_max, γ_hi).
+      return critical_step_mode(integrator, s.omega_max, s.gamma_hi);
+    case Integrator::verlet:
+      return std::numeric_limits<double>::quiet_NaN();
+    case Integrator::implicit_euler:
+      return kInf;
+  }
+  return 0.0;
 }
 
 double predicted_critical_step(Integrator integrator, const Spectrum& s) {

@@ -27,6 +27,11 @@ struct Spectrum {
   double omega_min = 0.0;     ///< rad/s (0 when K has a null space: a mechanism)
   double gamma_min = 0.0;     ///< damping rate of the lowest mode, 1/s
   bool has_lowest = false;    ///< omega_min/gamma_min computed
+  /// Bounds of the damping rate γ(x) = x*Cx / x*Mx over every (complex) vector of the free
+  /// dofs, 1/s: the extreme eigenvalues of M⁻¹C. Exact (min/max of C_ii/m_i) when C is diagonal,
+  /// as for point damping; Gershgorin bounds of M^{-1/2} C M^{-1/2} (γ_lo ≥ 0) otherwise.
+  double gamma_lo = 0.0;
+  double gamma_hi = 0.0;
   double gershgorin = 0.0;    ///< max_frequency_bound(): an upper bound of omega_max, rad/s
   int lanczos_iterations = 0;
   double seconds = 0.0;
@@ -45,7 +50,24 @@ struct SpectrumOptions {
 Spectrum analyse_spectrum(const Problem& problem, const SpectrumOptions& options = {});
 
 /// Predicted critical step (s) of an integrator for that spectrum: the most restrictive of the
-/// highest and (when computed) lowest mode. 0 / +infinity as in critical_step_mode.
+/// highest and (when computed) lowest mode. 0 / +infinity as in critical_step_mode. With damping
+/// that is not mass-proportional (point damping with non-uniform masses) this is an estimate
+/// that can exceed the true limit (measured: up to 2.3×); see guaranteed_critical_step.
 double predicted_critical_step(Integrator integrator, const Spectrum& spectrum);
+
+/// A step (s) at and below which the linearised model is provably stable, for any damping
+/// matrix C (symmetric, positive semi-definite) and lumped masses M; NaN where no bound is proven.
+/// Argument (the Rayleigh-quotient reduction of the quadratic eigenvalue problem, e.g. Tisseur &
+/// Meerbergen, "The quadratic eigenvalue problem", SIAM Review 43 (2001), §3): an eigenvalue λ of
+/// ẍ = −M⁻¹Kx − M⁻¹Cẋ has an eigenvector x with (λ²M + λC + K)x = 0, so x*(·)x/x*Mx gives
+/// λ² + γλ + ω² = 0 with ω² = x*Kx/x*Mx ∈ [ω_min², ω_max²] and γ = x*Cx/x*Mx ∈ [γ_lo, γ_hi]:
+/// every λ is a root of some scalar mode in that rectangle. For explicit Euler (amplification
+/// 1 + hλ) and symplectic Euler (its amplification factors μ satisfy (μ − 1)²M + h(μ − 1)C +
+/// h²μK singular, so the same reduction gives the scalar mode's characteristic polynomial), the
+/// step is stable if every scalar mode in the rectangle is: the minimum of critical_step_mode over
+/// it, which lies at a corner (critical_step.cpp). Undamped (γ_hi = 0) it equals the prediction,
+/// 2/ω_max. Velocity Verlet with damping mixes M⁻¹C and M⁻¹K products that this reduction does
+/// not separate: NaN (no bound) unless undamped. Implicit Euler: +infinity.
+double guaranteed_critical_step(Integrator integrator, const Spectrum& spectrum);
 
 }  // namespace vessel::msm

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
+#include <iterator>
+#include <sstream>
 
 #include "../test_helpers.hpp"
 #include "meshes/gmsh_vessel.hpp"
@@ -113,6 +116,86 @@ TEST(Cli, MissingTruncatedAndGrouplessFilesAreClearErrors) {
   r = vv("mesh --input " + (dir / "groups.msh").string());
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "missing physical group 'outer_wall'")) << r.output;
+}
+
+namespace {
+
+/// The generated level-0 tube as msh 2.2 text with the first tet's element line edited by `edit`
+/// (its tokens: tag type ntags tags... n1 n2 n3 n4); `line_no` gets that 1-based line number.
+std::string tube_with_first_tet_edited(
+    const vessel::test::TempDir& dir,
+    const std::function<void(std::vector<std::string>&)>& edit, int& line_no) {
+  vessel::write_msh(dir / "full22.msh", vessel::generate_vessel_mesh(vessel::VesselParams{}),
+                    vessel::MshVersion::v22);
+  std::istringstream in(vessel::test::read_text(dir / "full22.msh"));
+  std::string out, line, nodes_text;
+  bool in_elements = false, done = false;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line == "$Elements") in_elements = true;
+    std::istringstream ls(line);
+    std::vector<std::string> tok{std::istream_iterator<std::string>(ls), {}};
+    if (in_elements && !done && tok.size() > 2 && tok[1] == "4") {
+      edit(tok);
+      line.clear();
+      for (const auto& t : tok) line += (line.empty() ? "" : " ") + t;
+      line_no = n;
+      done = true;
+    }
+    out += line + "\n";
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(Cli, InvertedOrZeroVolumeTetsInAUserMeshAreRefusedWithExitOneAndNoOutput) {
+  TempDir dir;
+  int line_no = 0;
+  std::string element_tag, repeated;
+  // Swapping two nodes of one tet inverts it.
+  write_text(dir / "inverted.msh",
+             tube_with_first_tet_edited(
+                 dir,
+                 [&](std::vector<std::string>& t) {
+                   element_tag = t[0];
+                   std::swap(t[t.size() - 1], t[t.size() - 2]);
+                 },
+                 line_no));
+  const std::string where =
+      (dir / "inverted.msh").string() + ":" + std::to_string(line_no) + ": element " + element_tag;
+  for (const std::string cmd : {"mesh --input " + (dir / "inverted.msh").string() + " -o " +
+                                    (dir / "out.msh").string() + " --stats-json " +
+                                    (dir / "out.json").string(),
+                                "msm --model volume --input " + (dir / "inverted.msh").string() +
+                                    " --json " + (dir / "out.json").string()}) {
+    const auto r = vv(cmd);
+    EXPECT_EQ(r.exit_code, 1) << cmd << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, where)) << where << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, "is inverted: signed volume -")) << r.output;
+    EXPECT_TRUE(contains(r.output, "expected a positive volume")) << r.output;
+    EXPECT_TRUE(contains(r.output, "1 of ")) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out.msh"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "out.json"));
+  }
+  // Listing a node twice in a tet (coincident nodes) gives it zero volume.
+  write_text(dir / "coincident.msh",
+             tube_with_first_tet_edited(
+                 dir,
+                 [&](std::vector<std::string>& t) {
+                   element_tag = t[0];
+                   repeated = t[t.size() - 2];
+                   t[t.size() - 1] = repeated;
+                 },
+                 line_no));
+  const auto r = vv("mesh --input " + (dir / "coincident.msh").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, (dir / "coincident.msh").string() + ":" +
+                                     std::to_string(line_no) + ": element " + element_tag))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "has zero volume: signed volume 0 m³")) << r.output;
+  EXPECT_TRUE(contains(r.output, "it lists its node " + repeated + " twice")) << r.output;
 }
 
 TEST(Cli, UnwritableOutputIsAClearError) {

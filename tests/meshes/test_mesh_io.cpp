@@ -73,7 +73,129 @@ $Elements
 $EndElements
 )";
 
+/// Five nodes and two tets in msh 2.2: element 7 is 1 2 3 4 (V = +1/6, hand-derived: the unit
+/// corner tet) and element 8 is `second` (node 5 at `node5`). With node 5 at (1, 1, 1),
+/// "2 3 4 5" has V = +1/3 ((b−a)·((c−a)×(d−a))/6 = 2/6) and "2 3 5 4" V = −1/3.
+std::string two_tets22(const std::string& second, const std::string& node5 = "1 1 1") {
+  return "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n"
+         "4 0 0 1\n5 " + node5 + "\n$EndNodes\n$Elements\n2\n7 4 2 10 10 1 2 3 4\n"
+         "8 4 2 10 10 " + second + "\n$EndElements\n";
+}
+
+/// The 1-based line of `text` that starts with `start`.
+int line_of(const std::string& text, const std::string& start) {
+  const auto at = text.find("\n" + start);
+  return 2 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+}
+
 }  // namespace
+
+TEST(MshIo, TwoPositiveTetsAreReadWithTheirHandDerivedVolume) {
+  TempDir dir;
+  write_text(dir / "ok.msh", two_tets22("2 3 4 5"));
+  EXPECT_DOUBLE_EQ(mesh_volume(read_msh(dir / "ok.msh")), 1.0 / 6.0 + 1.0 / 3.0);
+}
+
+TEST(MshIo, InvertedTetIsRefusedNamingFileLineElementAndSignedVolume) {
+  TempDir dir;
+  const std::string text = two_tets22("2 3 5 4");
+  write_text(dir / "inverted.msh", text);
+  const auto msg = input_error([&] { (void)read_msh(dir / "inverted.msh"); });
+  const std::string where =
+      (dir / "inverted.msh").string() + ":" + std::to_string(line_of(text, "8 4 ")) + ": element 8";
+  EXPECT_NE(msg.find(where), std::string::npos) << msg;
+  EXPECT_NE(msg.find("inverted"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("signed volume -0.3333 m³"), std::string::npos) << msg;
+  // mean |V| = (1/6 + 1/3)/2 = 1/4, so the ratio is −4/3.
+  EXPECT_NE(msg.find("-1.33 × the mean tet volume"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("expected a positive volume"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("1 of 2 tets"), std::string::npos) << msg;
+}
+
+TEST(MshIo, FlatTetIsRefusedAsZeroVolume) {
+  TempDir dir;
+  // Node 5 at (1, 1, 0) lies in the plane z = 0 of nodes 1, 2, 3: "1 2 3 5" is flat, V = 0.
+  const std::string text = two_tets22("1 2 3 5", "1 1 0");
+  write_text(dir / "flat.msh", text);
+  const auto msg = input_error([&] { (void)read_msh(dir / "flat.msh"); });
+  EXPECT_NE(msg.find("flat.msh:" + std::to_string(line_of(text, "8 4 ")) + ": element 8"),
+            std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("zero volume"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("signed volume 0 m³"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("coplanar"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("expected a positive volume"), std::string::npos) << msg;
+}
+
+TEST(MshIo, NearlyFlatTetBelowTheRelativeToleranceIsRefusedAndASliverAboveItRead) {
+  TempDir dir;
+  // Node 5 lifted h above the plane z = 0: "1 2 3 5" has V = h/6 exactly and longest edge √2, so
+  // it is zero below h = 6·1e-12·2√2 ≈ 1.7e-11 and a (terrible but valid) sliver above.
+  write_text(dir / "flat.msh", two_tets22("1 2 3 5", "1 1 1e-12"));
+  EXPECT_NE(input_error([&] { (void)read_msh(dir / "flat.msh"); }).find("zero volume"),
+            std::string::npos);
+  write_text(dir / "sliver.msh", two_tets22("1 2 3 5", "1 1 1e-9"));
+  EXPECT_NEAR(mesh_volume(read_msh(dir / "sliver.msh")), 1.0 / 6.0 + 1e-9 / 6.0, 1e-15);
+}
+
+TEST(MshIo, CoincidentNodesAreRefusedNamingTheNodes) {
+  TempDir dir;
+  // Node 5 at node 4's position (0, 0, 1): "2 3 4 5" has zero volume.
+  const std::string text = two_tets22("2 3 4 5", "0 0 1");
+  write_text(dir / "coincident.msh", text);
+  const auto msg = input_error([&] { (void)read_msh(dir / "coincident.msh"); });
+  EXPECT_NE(msg.find(":" + std::to_string(line_of(text, "8 4 ")) + ": element 8"),
+            std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("zero volume"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("node 4 and node 5 coincide at (0, 0, 1) m"), std::string::npos) << msg;
+}
+
+TEST(MshIo, InvertedTetInMsh41IsRefusedWithItsLine) {
+  TempDir dir;
+  const std::string text =
+      "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 5 1 5\n3 1 0 5\n1\n2\n3\n4\n5\n"
+      "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n$EndNodes\n$Elements\n1 2 1 2\n3 1 4 2\n"
+      "11 1 2 3 4\n12 2 3 5 4\n$EndElements\n";
+  write_text(dir / "inv41.msh", text);
+  const auto msg = input_error([&] { (void)read_msh(dir / "inv41.msh"); });
+  EXPECT_NE(msg.find("inv41.msh:" + std::to_string(line_of(text, "12 2 3 5 4")) + ": element 12"),
+            std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("signed volume -0.3333 m³"), std::string::npos) << msg;
+}
+
+TEST(MshIo, AFileWhoseTetsAreAllNegativeIsAConventionAndIsFlipped) {
+  TempDir dir;
+  // Both tets listed with negative volume: a consistent convention, not inverted elements.
+  std::string neg = two_tets22("2 3 5 4");
+  neg.replace(neg.find("1 2 3 4"), 7, "1 2 4 3");
+  write_text(dir / "neg.msh", neg);
+  const TetMesh mesh = read_msh(dir / "neg.msh");
+  EXPECT_DOUBLE_EQ(mesh_volume(mesh), 0.5);
+  // With the majority negative, the one positive tet is the inverted one; quoted in the file's sign.
+  write_text(dir / "mixed.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n6\n1 0 0 0\n"
+                                "2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n6 0 0 -1\n$EndNodes\n"
+                                "$Elements\n3\n7 4 2 10 10 1 2 4 3\n8 4 2 10 10 2 3 5 4\n"
+                                "9 4 2 10 10 1 3 2 6\n$EndElements\n");
+  const auto msg = input_error([&] { (void)read_msh(dir / "mixed.msh"); });
+  EXPECT_NE(msg.find("element 9"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("signed volume 0.1667 m³"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("expected a negative volume"), std::string::npos) << msg;
+}
+
+TEST(TetVolumes, InMemoryMeshNamesTheTetIndexWithoutAFile) {
+  TetMesh mesh;
+  mesh.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1)};
+  mesh.tets = {{0, 1, 2, 3}, {1, 2, 3, 4}};  // +1/6 and +1/3 (hand-derived)
+  EXPECT_NO_THROW(require_positive_volumes(mesh, "in-memory"));
+  mesh.tets[1] = {1, 2, 4, 3};  // −1/3
+  const auto msg = input_error([&] { require_positive_volumes(mesh, "in-memory"); });
+  EXPECT_NE(msg.find("in-memory: tetrahedron 1 (0-based, of 2) is inverted: signed volume "
+                     "-0.3333 m³"),
+            std::string::npos)
+      << msg;
+}
 
 TEST(MshIo, RoundTripV41IsExact) {
   TempDir dir;

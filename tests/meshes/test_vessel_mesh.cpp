@@ -95,6 +95,8 @@ TEST_P(VesselMesh, Level0HasEveryGroupAClosedOrientedBoundaryAndValidTets) {
   const MeshQuality q = compute_quality(mesh);
   EXPECT_EQ(q.inverted, 0u);
   EXPECT_EQ(q.degenerate, 0u);
+  // The check every .msh read goes through accepts the generated meshes.
+  EXPECT_NO_THROW(require_positive_volumes(mesh, "generated"));
   EXPECT_GT(q.dihedral_deg.min, 5.0);
   EXPECT_GT(q.radius_ratio.min, 0.05);
 }

@@ -49,6 +49,47 @@ TEST(StabilityCli, LevelZeroTableFindsTheUndampedLimitAtTheLanczosPrediction) {
   EXPECT_EQ(md.rfind("## Numerical stability", 0), 0u);
 }
 
+TEST(StabilityCli, LongRunKeepsSymplecticEulerAndVerletBoundedAndExplicitEulerDiverges) {
+  TempDir dir;
+  const auto r = vv("stability --quick --max-level 0 --trial-steps 100 --hard-case long_run "
+                    "--long-run-steps 5000 --output-dir " + dir.path().string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(read_text(dir / "stability.json"));
+  ASSERT_EQ(j["hard_cases"].size(), 1u);  // --hard-case runs only that case
+  const auto& hc = j["hard_cases"][0];
+  EXPECT_EQ(hc["id"], "long_run");
+  ASSERT_EQ(hc["outcomes"].size(), 4u);
+  // Symplectic Euler and Verlet, undamped, at h = 0.9 × 2/ω_max. On a linear mode each conserves
+  // a modified energy Ĥ exactly, and H = ½v² + ½ω²x² stays within fixed bounds of it: with
+  // a = hω/2 ≤ 0.9, H/H₀ ≤ (1 + a)/(1 − a) = 19 for symplectic Euler (Ĥ = H − ½hω²xv) and
+  // ≤ 1/(1 − a²) = 5.26 for velocity Verlet (Ĥ = ½v² + ½(1 − a²)ω²x²), for any number of steps
+  // (both bounds are reached by a single mode from its worst phase; checked numerically).
+  const double bound[] = {19.0, 1.0 / (1.0 - 0.81)};
+  for (int k : {0, 1}) {
+    const auto& oc = hc["outcomes"][k];
+    SCOPED_TRACE(oc.dump());
+    EXPECT_TRUE(oc["finished"].get<bool>());
+    EXPECT_TRUE(oc["bounded"].get<bool>());
+    EXPECT_EQ(oc["values"]["steps"].get<double>(), 5000.0);
+    EXPECT_GE(oc["values"]["energy_max_over_initial"].get<double>(), 1.0);
+    EXPECT_LT(oc["values"]["energy_max_over_initial"].get<double>(), bound[k]);
+  }
+  // Undamped explicit Euler multiplies each mode's energy by exactly 1 + h²ω² per step
+  // (h = 0.1 × 2/ω_max: at most 1.04), so reaching the 1000 × H₀ blow-up limit takes at least
+  // ln 1000 / ln 1.04 ≈ 176 steps; it must stop there, long before 5000.
+  const auto& ee = hc["outcomes"][3];
+  EXPECT_FALSE(ee["finished"].get<bool>()) << ee.dump();
+  EXPECT_FALSE(ee["bounded"].get<bool>()) << ee.dump();
+  EXPECT_GE(ee["values"]["diverged_at_step"].get<double>(), 170.0) << ee.dump();
+  EXPECT_LT(ee["values"]["diverged_at_step"].get<double>(), 5000.0) << ee.dump();
+
+  const auto bad = vv("stability --quick --hard-case long_walk --output-dir " + dir.path().string());
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "--hard-case: unknown case 'long_walk'")) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "long_run")) << bad.output;
+  EXPECT_FALSE(contains(bad.output, "[stability]")) << bad.output;  // refused before any work
+}
+
 TEST(StabilityCli, UnwritableOutputDirectoryFailsBeforeAnyWorkAndBadOptionsLeaveResults) {
   TempDir dir;
   write_text(dir / "file", "x");

@@ -24,6 +24,7 @@ struct StabilityCli {
   long long long_run_steps = 0;
   int max_level = -1;
   bool no_hard_cases = false;
+  std::vector<std::string> only_cases;
 };
 
 /// Fails early (before minutes of work) when the output directory cannot be written: creates it
@@ -72,6 +73,9 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
                   "Steps of the long run (default 2e4 quick, 1e6 full)");
   cmd->add_option("--max-level", o->max_level, "Highest mesh level of the step table");
   cmd->add_flag("--no-hard-cases", o->no_hard_cases, "Only the critical-step table");
+  cmd->add_option("--hard-case", o->only_cases,
+                  "Run only this hard case (repeatable): poisson, youngs_modulus, sliver, "
+                  "refined_patch, inverting_load, long_run, tight_bend, zero_length");
   cmd->callback([o, command_line] {
     if (o->trial_steps < 0) {
       throw InputError("--trial-steps: expected ≥ 1, got " + std::to_string(o->trial_steps));
@@ -90,6 +94,7 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
     so.long_run_steps = o->long_run_steps;
     so.max_level = o->max_level;
     so.hard_cases = !o->no_hard_cases;
+    so.only_cases = o->only_cases;
     const StabilityReport report = run_stability(so);
     write_stability(o->output_dir, report);
     std::cout << "wrote " << (o->output_dir / "stability.json").string() << " and stability.md\n";
