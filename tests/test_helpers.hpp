@@ -30,4 +30,12 @@ struct CommandResult {
 /// Runs a shell command and captures its combined output and exit code.
 CommandResult run_command(const std::string& command);
 
+#ifdef VESSELVERIFY_EXE
+/// Runs the vesselverify program built with the tests (its path is the target's compile
+/// definition VESSELVERIFY_EXE) with `args`.
+inline CommandResult vv(const std::string& args) {
+  return run_command(std::string(VESSELVERIFY_EXE) + " " + args);
+}
+#endif
+
 }  // namespace vessel::test

@@ -7,12 +7,9 @@ using vessel::test::CommandResult;
 using vessel::test::run_command;
 using vessel::test::TempDir;
 using vessel::test::write_text;
+using vessel::test::vv;
 
 namespace {
-
-CommandResult vv(const std::string& args) {
-  return run_command(std::string(VESSELVERIFY_EXE) + " " + args);
-}
 
 const char* kScene = R"(name = "small_contact"
 [vessel]

@@ -10,12 +10,10 @@
 using vessel::test::CommandResult;
 using vessel::test::run_command;
 using vessel::test::TempDir;
+using vessel::test::vv;
 
 namespace {
 
-CommandResult vv(const std::string& args) {
-  return run_command(std::string(VESSELVERIFY_EXE) + " " + args);
-}
 CommandResult mpi_vv(int ranks, const std::string& args) {
   return run_command(std::string(VESSEL_MPIRUN) + " " + std::to_string(ranks) + " " +
                      VESSELVERIFY_EXE + " " + args);

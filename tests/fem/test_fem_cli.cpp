@@ -11,12 +11,10 @@
 using vessel::test::CommandResult;
 using vessel::test::run_command;
 using vessel::test::TempDir;
+using vessel::test::vv;
 
 namespace {
 
-CommandResult vv(const std::string& args) {
-  return run_command(std::string(VESSELVERIFY_EXE) + " " + args);
-}
 bool contains(const std::string& s, const std::string& what) {
   return s.find(what) != std::string::npos;
 }

@@ -13,12 +13,9 @@ using vessel::test::read_text;
 using vessel::test::run_command;
 using vessel::test::TempDir;
 using vessel::test::write_text;
+using vessel::test::vv;
 
 namespace {
-
-CommandResult vv(const std::string& args) {
-  return run_command(std::string(VESSELVERIFY_EXE) + " " + args);
-}
 
 bool contains(const std::string& s, const std::string& what) {
   return s.find(what) != std::string::npos;
