@@ -4,6 +4,7 @@
 /// solve time regresses.
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
@@ -67,11 +68,12 @@ void gate(const GateOptions& o) {
   const reports::GateOutcome outcome = reports::compare_with_baseline(baseline, current, o.tolerances);
   reports::Document doc;
   doc.heading(1, std::string("Gate ") + (outcome.passed() ? "passed" : "FAILED"));
-  doc.paragraph("Compared " + std::to_string(outcome.compared) + " cases of `" +
-                results_path.string() + "` with the baseline `" + o.baseline.string() +
-                "` (error tolerance +" + std::to_string(o.tolerances.error_relative * 100.0) +
-                " %, timing ratio " + std::to_string(o.tolerances.timing_ratio) +
-                " on times normalised by the reference kernel).");
+  std::ostringstream summary;  // default stream precision: "+2 %", not "+2.000000 %"
+  summary << "Compared " << outcome.compared << " cases of `" << results_path.string()
+          << "` with the baseline `" << o.baseline.string() << "` (error tolerance +"
+          << o.tolerances.error_relative * 100.0 << " %, timing ratio "
+          << o.tolerances.timing_ratio << " on times normalised by the reference kernel).";
+  doc.paragraph(summary.str());
   if (!outcome.findings.empty()) doc.table(reports::gate_table(outcome));
   const std::string text = doc.markdown_text(".");
   std::cout << text;
