@@ -856,9 +856,12 @@ HardCase case_zero_length(const StabilityOptions& o, std::ostream& log) {
     try {
       const msm::Spectrum s = msm::analyse_spectrum(p);
       sp.finished = true;
-      sp.reported = "ω_max " + fmt(s.omega_max) + " rad/s, ω_min " + fmt(s.omega_min) +
-                    " rad/s (0: the extra node has no stiffness at rest — the spring kernel "
-                    "returns a zero Hessian at zero length, where ½kL² has Hessian kI)";
+      // ½kL² has the Hessian k[I −I; −I I] at zero length; a kernel that returned zero there
+      // would leave the extra node without stiffness (ω_min = 0).
+      sp.reported = "ω_max " + fmt(s.omega_max) + " rad/s, ω_min " + fmt(s.omega_min) + " rad/s" +
+                    (s.omega_min > 0.0 ? " (the zero-length spring's Hessian k[I −I; −I I] holds "
+                                         "the extra node)"
+                                       : " (0: the extra node has no stiffness at rest)");
       sp.values["omega_min"] = s.omega_min;
     } catch (const std::exception& e) {
       sp.reported = "failed: " + short_error(e.what());
