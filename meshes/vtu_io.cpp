@@ -94,15 +94,19 @@ void write_vtu(const std::filesystem::path& path, const std::vector<Vec3>& point
   });
 }
 
+VtuCells tet_cells(const std::vector<Tet>& tets) {
+  VtuCells cells{kVtkTetra, 4, {}};
+  cells.connectivity.reserve(4 * tets.size());
+  for (const auto& t : tets) {
+    for (const int v : t) cells.connectivity.push_back(static_cast<std::size_t>(v));
+  }
+  return cells;
+}
+
 void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
                const std::vector<VtuField>& point_fields,
                const std::vector<VtuField>& cell_fields) {
-  VtuCells cells{kVtkTetra, 4, {}};
-  cells.connectivity.reserve(4 * mesh.tets.size());
-  for (const auto& t : mesh.tets) {
-    for (const auto v : t) cells.connectivity.push_back(static_cast<std::size_t>(v));
-  }
-  write_vtu(path, mesh.nodes, cells, point_fields, cell_fields);
+  write_vtu(path, mesh.nodes, tet_cells(mesh.tets), point_fields, cell_fields);
 }
 
 }  // namespace vessel

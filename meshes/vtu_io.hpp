@@ -23,6 +23,9 @@ struct VtuCells {
   std::vector<std::size_t> connectivity;
 };
 
+/// Tets as VTK tetrahedra.
+VtuCells tet_cells(const std::vector<Tet>& tets);
+
 /// Writes the points and cells atomically as an ASCII .vtu. Each point field must have
 /// components × points values and each cell field components × cells values, and every
 /// connectivity entry must name a point (std::invalid_argument otherwise).

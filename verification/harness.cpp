@@ -376,14 +376,6 @@ void write_model_fields(const HarnessOptions& o, const Scene& s, const ModelOutc
   write_vtu(dir / name.str(), nodes, cells, {model, reference, error, error_mm});
 }
 
-VtuCells tet_cells(const std::vector<Tet>& tets) {
-  VtuCells cells{10, 4, {}};
-  for (const auto& t : tets) {
-    for (const int v : t) cells.connectivity.push_back(static_cast<std::size_t>(v));
-  }
-  return cells;
-}
-
 /// A mass-spring network's cells: its tets (volume), triangles (surface), else its springs.
 VtuCells network_cells(const msm::SpringNetwork& n) {
   if (!n.tets.empty()) return tet_cells(n.tets);
