@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <numeric>
 #include <sstream>
 
 #include "meshes/atomic_file.hpp"
@@ -248,6 +249,17 @@ double surface_area(const TriangleSurface& s) {
   double a = 0.0;
   for (const auto& t : s.triangles) a += triangle_area(s.nodes[t[0]], s.nodes[t[1]], s.nodes[t[2]]);
   return a;
+}
+
+TetMesh surface_as_mesh(const TriangleSurface& surface, const std::string& group) {
+  TetMesh mesh;
+  mesh.nodes = surface.nodes;
+  mesh.triangles = surface.triangles;
+  PhysicalGroup g{group, 2, 1, {}};
+  g.elements.resize(mesh.triangles.size());
+  std::iota(g.elements.begin(), g.elements.end(), 0);
+  mesh.groups.push_back(g);
+  return mesh;
 }
 
 }  // namespace vessel

@@ -36,4 +36,9 @@ TriangleSurface extract_surface(const TetMesh& mesh, const std::vector<std::stri
 /// Total area, m².
 double surface_area(const TriangleSurface& surface);
 
+/// A surface as a TetMesh without tets: its nodes and triangles, all triangles in one physical
+/// group `group` (dimension 2), so the shared surface loads (contact patch, pressure) work on it
+/// unchanged. Mesh node i is surface node i.
+TetMesh surface_as_mesh(const TriangleSurface& surface, const std::string& group);
+
 }  // namespace vessel

@@ -22,34 +22,18 @@
 #include "verification/memory.hpp"
 #include "verification/progress.hpp"
 #include "verification/roi.hpp"
+#include "verification/scene_problems.hpp"
 #include "verification/timing.hpp"
 
 namespace vessel {
 
 namespace {
 
-constexpr double kStandardGravity = 9.81;  ///< m/s²; gravity magnitudes are multiples of g
 constexpr double kLinearRegimeStrain = 0.05;
 /// Straight-sided tets cap the reference's observed order near 2 on the curved walls (the
 /// reference's own Lamé verification), so Richardson uses p = 2 between its two levels.
 constexpr double kReferenceOrder = 2.0;
-constexpr double kMixedThreshold = 0.49;
 constexpr int kHistorySamples = 200;  ///< points kept of a dynamic model's QoI history
-
-TetMesh mesh_at_level(const Scene& s, int level, const HarnessOptions& o) {
-  VesselParams p = s.vessel;
-  p.level = level;
-  return load_or_generate_vessel(p, o.cache_dir, {});
-}
-
-/// Where the "contact-point displacement" is read: the contact point, or for distributed loads the
-/// inner wall at mid-length (tube: θ = 0 side; arch: the outer bend's apex).
-Vec3 qoi_point(const Scene& s) {
-  if (s.load.kind == LoadKind::contact) return s.load.contact.point;
-  const VesselParams& p = s.vessel;
-  if (p.kind == VesselKind::straight) return {p.inner_radius, 0.0, 0.5 * p.length};
-  return {0.0, p.bend_radius + p.inner_radius, 0.0};
-}
 
 /// Barycentric tolerance for evaluating the reference at model nodes: a node on the exact curved
 /// wall lies outside the reference's straight-sided tets by up to the chord's sagitta ℓ²/(8r),
@@ -60,122 +44,6 @@ std::vector<Vec3> scaled(const std::vector<Vec3>& u, double factor) {
   std::vector<Vec3> out(u.size());
   for (std::size_t i = 0; i < u.size(); ++i) out[i] = factor * u[i];
   return out;
-}
-
-std::vector<std::string> groups_with(const Scene& s, BoundaryCondition bc) {
-  std::vector<std::string> out;
-  for (const auto& [group, condition] : s.boundary) {
-    if (condition == bc) out.push_back(group);
-  }
-  return out;
-}
-
-/// The FEM problem of the scene at unit load.
-fem::ElasticityProblem fem_problem(const Scene& s, const TetMesh& mesh, double nu, int degree) {
-  fem::ElasticityProblem prob;
-  prob.material.youngs_modulus = s.youngs_modulus;
-  prob.material.poisson_ratio = nu;
-  prob.material.density = s.density;
-  prob.options.degree = degree;
-  // Taylor–Hood only from ν = 0.49: its saddle-point system goes to the direct solver (minutes and
-  // gigabytes at reference levels), while P2 displacement elements do not lock appreciably below
-  // 0.49 and scale with AMG-CG.
-  prob.options.mixed_threshold = kMixedThreshold;
-  for (const auto& g : groups_with(s, BoundaryCondition::clamped)) {
-    prob.dirichlet.push_back(fem::DirichletCondition::clamped(g));
-  }
-  const auto rollers = groups_with(s, BoundaryCondition::axial_roller);
-  if (!rollers.empty()) {
-    if (s.vessel.kind != VesselKind::straight) {
-      throw InputError(s.source.string() + ": roller ends are supported on the straight tube only");
-    }
-    for (const auto& g : rollers) {
-      prob.dirichlet.push_back(fem::DirichletCondition::roller(g, 2));
-    }
-    if (groups_with(s, BoundaryCondition::clamped).empty()) {
-      prob.point_constraints = fem::tube_in_plane_pins(s.vessel.inner_radius, 0.0);
-    }
-  }
-  if (prob.dirichlet.empty()) {
-    throw InputError(s.source.string() +
-                     ": [boundary] leaves both ends free; expected at least one clamped or roller "
-                     "end (a free body has rigid motions and no static answer)");
-  }
-  switch (s.load.kind) {
-    case LoadKind::contact: {
-      ContactPatchSpec spec = s.load.contact;
-      spec.force = 1.0;
-      prob.patches.push_back(contact_patch(mesh, spec));
-      break;
-    }
-    case LoadKind::pressure:
-      prob.pressures.push_back({s.load.contact.surface_group, 1.0});
-      break;
-    case LoadKind::gravity:
-      prob.gravity = kStandardGravity * s.load.gravity_direction;
-      break;
-  }
-  return prob;
-}
-
-/// The mass-spring problem of the scene at load `magnitude`.
-msm::Problem msm_problem(const Scene& s, const msm::Form& form, const msm::BuiltNetwork& built,
-                         const TetMesh& mesh, double magnitude) {
-  std::vector<Vec3> loads(mesh.nodes.size(), Vec3::Zero());
-  if (s.load.kind == LoadKind::contact) {
-    ContactPatchSpec spec = s.load.contact;
-    spec.force = magnitude;
-    loads = traction_nodal_loads(mesh, contact_patch(mesh, spec));
-  } else if (s.load.kind == LoadKind::pressure) {
-    loads = pressure_nodal_loads(mesh, s.load.contact.surface_group, magnitude);
-  }
-  msm::Problem problem = msm::make_problem(form, built.network, built.masses, mesh, loads,
-                                           groups_with(s, BoundaryCondition::clamped));
-  if (s.load.kind == LoadKind::gravity) {
-    // The network's own masses carry gravity (for the volume model with consistent masses this is
-    // exactly the FEM's ρg V/4 per tet vertex).
-    const Vec3 g = magnitude * kStandardGravity * s.load.gravity_direction;
-    for (Eigen::Index i = 0; i < problem.num_dofs(); i += 3) {
-      for (int c = 0; c < 3; ++c) problem.external_force[i + c] += problem.mass[i] * g[c];
-    }
-  }
-  const auto rollers = groups_with(s, BoundaryCondition::axial_roller);
-  if (!rollers.empty()) {
-    // Straight tube: u_z = 0 on the end planes, plus the FEM's three in-plane pins at the nodes
-    // nearest (±ρ, 0, 0) and (0, ρ, 0) of the inlet plane.
-    const double tol = 1e-9 + 1e-6 * s.vessel.length;
-    const auto& nodes = built.network.nodes;
-    std::array<int, 3> pin{-1, -1, -1};
-    std::array<double, 3> best{};
-    best.fill(std::numeric_limits<double>::infinity());
-    for (std::size_t i = 0; i < nodes.size(); ++i) {
-      const Vec3& x = nodes[i];
-      const bool at_inlet = std::abs(x.z()) < tol;
-      const bool at_outlet = std::abs(x.z() - s.vessel.length) < tol;
-      if ((at_inlet && s.boundary.at("inlet") == BoundaryCondition::axial_roller) ||
-          (at_outlet && s.boundary.at("outlet") == BoundaryCondition::axial_roller)) {
-        problem.fixed[3 * i + 2] = 1;
-      }
-      if (!at_inlet) continue;
-      // Pin candidates: (ρ, 0) and (−ρ, 0) for u_y, (0, ρ) for u_x.
-      const auto consider = [&](int k, bool right_side, double off_axis) {
-        if (right_side && off_axis < best[k]) {
-          best[k] = off_axis;
-          pin[k] = static_cast<int>(i);
-        }
-      };
-      consider(0, x.x() > 0, std::abs(x.y()));
-      consider(1, x.x() < 0, std::abs(x.y()));
-      consider(2, x.y() > 0, std::abs(x.x()));
-    }
-    if (groups_with(s, BoundaryCondition::clamped).empty()) {
-      for (int k = 0; k < 3; ++k) {
-        if (pin[k] < 0) throw InputError("no mass-spring node on the inlet plane to pin");
-        problem.fixed[3 * pin[k] + (k < 2 ? 1 : 0)] = 1;  // u_y at (±ρ,0), u_x at (0,ρ)
-      }
-    }
-  }
-  return problem;
 }
 
 std::size_t free_unknowns(const msm::Problem& p) {
@@ -420,12 +288,8 @@ void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
     base.unknowns = r.n_dofs;
     const ReferenceAtPoints ref_here = reference_at(ref, mesh.nodes);
     const ReadOut at = read_out(s, base.level, mesh.nodes, result.qoi_point);
-    std::vector<Vec3> unit_loads;
-    if (s.load.kind == LoadKind::contact) {
-      ContactPatchSpec spec_unit = s.load.contact;
-      spec_unit.force = 1.0;
-      unit_loads = traction_nodal_loads(mesh, contact_patch(mesh, spec_unit));
-    }
+    std::vector<Vec3> unit_loads;  // the indentation's weights: contact loads only
+    if (s.load.kind == LoadKind::contact) unit_loads = surface_nodal_loads(s, mesh, 1.0);
     for (const double mag : s.load.magnitudes) {
       ModelOutcome out = base;
       out.magnitude = mag;
@@ -455,8 +319,8 @@ void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
 /// mean nodal mass: exact for uniform masses, an average otherwise.
 void add_reference_history(History& h, const ReferenceSolvers& ref, const Vec3& probe,
                            const ModelSpec& spec, const msm::Problem& problem, double magnitude) {
-  h.steps = spec.steps;
-  h.simulated_s = spec.dt * static_cast<double>(spec.steps);
+  h.steps = spec.solver.steps;
+  h.simulated_s = spec.solver.dt * static_cast<double>(spec.solver.steps);
   const double mean_mass = problem.mass.sum() / static_cast<double>(problem.mass.size());
   h.mass_damping = spec.damping > 0.0 ? spec.damping / mean_mass : 0.0;
   const auto& [t, u] = transient_at(ref, probe, h.simulated_s, h.mass_damping);
@@ -468,131 +332,155 @@ void add_reference_history(History& h, const ReferenceSolvers& ref, const Vec3& 
   }
 }
 
+/// What is solved for one load: the whole network, or its region of interest (the nodes beyond R
+/// held and their unknowns removed: verification/roi).
+struct SolvedSystem {
+  const msm::Problem* problem = nullptr;
+  const msm::SpringModel* model = nullptr;
+  const msm::SpringNetwork* network = nullptr;
+  Eigen::Index qoi = -1;  ///< the QoI node in the solved problem (−1 if the region holds it)
+  std::unique_ptr<RoiNetwork> roi;
+  std::unique_ptr<msm::SpringModel> roi_model;
+  std::unique_ptr<msm::Problem> roi_problem;
+
+  /// Positions of the whole network from the solved ones (held nodes at rest).
+  [[nodiscard]] Eigen::VectorXd to_full(const Eigen::VectorXd& x, const msm::Problem& full) const {
+    if (!roi) return x;
+    Eigen::VectorXd x_full = full.rest;
+    for (std::size_t k = 0; k < roi->full_index.size(); ++k) {
+      x_full.segment<3>(3 * static_cast<Eigen::Index>(roi->full_index[k])) =
+          x.segment<3>(3 * static_cast<Eigen::Index>(k));
+    }
+    return x_full;
+  }
+};
+
+SolvedSystem solved_system(const msm::Problem& full, const msm::SpringModel& model,
+                           const msm::SpringNetwork& network, const ModelSpec& spec,
+                           const Vec3& qoi_point, std::size_t qoi) {
+  SolvedSystem sys{&full, &model, &network, static_cast<Eigen::Index>(qoi), {}, {}, {}};
+  if (spec.roi_radius <= 0.0) return sys;
+  const std::vector<char> held = held_nodes(full, qoi_point, spec.roi_radius);
+  sys.roi = std::make_unique<RoiNetwork>(restrict_network(network, held));
+  sys.roi_model = std::make_unique<msm::SpringModel>(sys.roi->network, spec.damping);
+  sys.roi_problem =
+      std::make_unique<msm::Problem>(restrict_problem(full, *sys.roi, held, *sys.roi_model));
+  sys.problem = sys.roi_problem.get();
+  sys.model = sys.roi_model.get();
+  sys.network = &sys.roi->network;
+  const auto& index = sys.roi->full_index;
+  const auto it = std::find(index.begin(), index.end(), static_cast<int>(qoi));
+  sys.qoi = it == index.end() ? -1 : it - index.begin();
+  return sys;
+}
+
+/// Solves `repeats` times (median time into out.solve_seconds); a dynamic solver's QoI history
+/// (kHistorySamples samples) goes into out.history. Returns the solved positions.
+Eigen::VectorXd timed_solve(const SolvedSystem& sys, const ModelSpec& spec, const Vec3& qoi_rest,
+                            int repeats, ModelOutcome& out) {
+  std::vector<double> times;
+  Eigen::VectorXd x;
+  for (int k = 0; k < std::max(1, repeats); ++k) {
+    msm::StepObserver on_step;
+    if (spec.solver.is_dynamic()) {
+      out.history = {};
+      out.history.time_s.push_back(0.0);  // at rest
+      out.history.model_mm.push_back(0.0);
+      const long every = std::max(1L, spec.solver.steps / kHistorySamples);
+      on_step = [&](int step, const Eigen::VectorXd& xs) {
+        if (step % every != 0 && step != spec.solver.steps) return;
+        out.history.time_s.push_back(step * spec.solver.dt);
+        out.history.model_mm.push_back(
+            sys.qoi < 0 ? 0.0 : (xs.segment<3>(3 * sys.qoi) - qoi_rest).norm() * 1e3);
+      };
+    }
+    Stopwatch solve;
+    x = msm::solve(*sys.problem, spec.solver, sys.network, on_step).x;
+    times.push_back(solve.seconds());
+  }
+  out.solve_seconds = median(times);
+  return x;
+}
+
+/// A flat per-dof vector (x0, y0, z0, x1, ...) as one Vec3 per node.
+std::vector<Vec3> per_node(const Eigen::VectorXd& v) {
+  std::vector<Vec3> out(static_cast<std::size_t>(v.size() / 3));
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = v.segment<3>(3 * static_cast<Eigen::Index>(i));
+  }
+  return out;
+}
+
+/// Node displacements x − rest, m.
+std::vector<Vec3> displacements(const Eigen::VectorXd& x, const std::vector<Vec3>& nodes) {
+  std::vector<Vec3> u = per_node(x);
+  for (std::size_t i = 0; i < u.size(); ++i) u[i] -= nodes[i];
+  return u;
+}
+
+/// A mass-spring model's description in results: topology, rules, solver, region.
+std::string msm_detail(const std::string& topology, const ModelSpec& spec) {
+  std::ostringstream d;
+  d << topology << ", " << msm::to_string(spec.stiffness) << " stiffness, "
+    << msm::to_string(spec.mass) << " masses, " << msm::to_string(spec.solver);
+  if (spec.roi_radius > 0.0) d << ", region of interest R = " << spec.roi_radius * 1e3 << " mm";
+  return d.str();
+}
+
+/// One load of a mass-spring model: build its problem, solve (timed), compare.
+void run_msm_load(const Scene& s, const ModelSpec& spec, const msm::BuiltNetwork& built,
+                  const msm::SpringModel& model, const TetMesh& mesh, const ReferenceSolvers& ref,
+                  const ReferenceAtPoints& ref_here, const ReadOut& at, double ref_strain_unit,
+                  const Vec3& qoi_point, const HarnessOptions& o, ModelOutcome& out) {
+  const std::vector<Vec3>& nodes = built.network.nodes;
+  const double mag = out.magnitude;
+  const msm::Problem full = msm_problem(s, model, built, mesh, mag);
+  const SolvedSystem sys = solved_system(full, model, built.network, spec, qoi_point, at.qoi);
+  out.unknowns = free_unknowns(*sys.problem);
+  const MemoryProbe solve_memory;
+  const Eigen::VectorXd x_solved = timed_solve(sys, spec, nodes[at.qoi], o.repeats, out);
+  out.memory_mib = std::max(out.memory_mib, solve_memory.added_mib());
+  // The FEM transient beside the history (computed once per scene and ν, then cached) costs the
+  // reference's time and memory, not the model's: outside the measurements above.
+  if (!out.history.time_s.empty()) {
+    add_reference_history(out.history, ref, nodes[at.qoi], spec, *sys.problem, mag);
+  }
+  out.max_strain = sys.model->max_strain(x_solved);
+  const std::vector<Vec3> u = displacements(sys.to_full(x_solved, full), nodes);
+  std::vector<Vec3> loads;
+  if (s.load.kind == LoadKind::contact) loads = per_node(full.external_force);
+  finish_outcome(out, s, nodes, u, ref_here, mag, at, ref_strain_unit, qoi_point, loads,
+                 spec.solver.steps, spec.solver.dt);
+  if (wants_fields(o, s, mag, ref_strain_unit)) {
+    write_model_fields(o, s, out, nodes, network_cells(built.network), u, scaled(ref_here.u, mag));
+  }
+}
+
 /// A mass-spring model at every load magnitude.
 void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
                    const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
                    const HarnessOptions& o, Progress& progress, ModelOutcome base,
                    SceneResult& result) {
-  msm::NetworkOptions net_options;
-  net_options.model = spec.kind == ModelKind::volume_msm ? "volume" : "surface";
-  net_options.surface = spec.surface;
-  net_options.topology = spec.topology;
-  net_options.stiffness = msm::parse_stiffness_rule(spec.stiffness);
-  net_options.stiffness_params.youngs_modulus = s.youngs_modulus;
-  net_options.stiffness_params.poisson_ratio = nu;
-  net_options.mass = msm::parse_mass_rule(spec.mass);
-  net_options.density = s.density;
   const MemoryProbe setup_memory;
   Stopwatch setup;
   VesselParams vessel = s.vessel;
   vessel.level = base.level;
-  const msm::BuiltNetwork built = msm::build_network(mesh, vessel, net_options);
+  const msm::BuiltNetwork built = msm::build_network(mesh, vessel, network_options(s, spec, nu));
   const msm::SpringModel model(built.network, spec.damping);
   base.setup_seconds = setup.seconds();
   base.memory_mib = setup_memory.added_mib();
-  base.detail = built.topology + ", " + spec.stiffness + " stiffness, " + spec.mass + " masses, " +
-                spec.solver;
+  base.detail = msm_detail(built.topology, spec);
   base.roi_radius = spec.roi_radius;
-  if (spec.roi_radius > 0.0) {
-    std::ostringstream r;
-    r << ", region of interest R = " << spec.roi_radius * 1e3 << " mm";
-    base.detail += r.str();
-  }
   base.nodes = built.network.nodes.size();
-  const std::vector<Vec3>& nodes = built.network.nodes;
-  const ReferenceAtPoints ref_here = reference_at(ref, nodes);
-  const ReadOut at = read_out(s, base.level, nodes, result.qoi_point);
+  const ReferenceAtPoints ref_here = reference_at(ref, built.network.nodes);
+  const ReadOut at = read_out(s, base.level, built.network.nodes, result.qoi_point);
   for (const double mag : s.load.magnitudes) {
     progress.begin(spec.name + " at " + std::to_string(mag) + " (" + to_string(s.load.kind) + ")");
     ModelOutcome out = base;
     out.magnitude = mag;
     try {
-      const msm::Problem full = msm_problem(s, model, built, mesh, mag);
-      // Region of interest: the nodes beyond R held and removed from the solve (verification/roi).
-      std::unique_ptr<RoiNetwork> roi;
-      std::unique_ptr<msm::SpringModel> roi_model;
-      std::unique_ptr<msm::Problem> roi_problem;
-      std::vector<char> held;
-      if (spec.roi_radius > 0.0) {
-        held = held_nodes(full, result.qoi_point, spec.roi_radius);
-        roi = std::make_unique<RoiNetwork>(restrict_network(built.network, held));
-        roi_model = std::make_unique<msm::SpringModel>(roi->network, spec.damping);
-        roi_problem =
-            std::make_unique<msm::Problem>(restrict_problem(full, *roi, held, *roi_model));
-      }
-      const msm::Problem& problem = roi ? *roi_problem : full;
-      // The QoI node in the solved problem (−1 if the region holds it).
-      Eigen::Index qoi_solved = static_cast<Eigen::Index>(at.qoi);
-      if (roi) {
-        const auto it =
-            std::find(roi->full_index.begin(), roi->full_index.end(), static_cast<int>(at.qoi));
-        qoi_solved = it == roi->full_index.end() ? -1 : it - roi->full_index.begin();
-      }
-      out.unknowns = free_unknowns(problem);
-      std::vector<double> times;
-      Eigen::VectorXd x;
-      const MemoryProbe solve_memory;
-      for (int k = 0; k < std::max(1, o.repeats); ++k) {
-        Stopwatch solve;
-        if (spec.solver == "static") {
-          x = msm::solve_static(problem).x;
-        } else if (spec.solver == "linear") {
-          x = msm::solve_linear(problem).x;
-        } else if (spec.solver == "relaxation") {
-          x = msm::dynamic_relaxation(problem).x;
-        } else {
-          msm::DynamicOptions d;
-          d.integrator = msm::parse_integrator(spec.solver);
-          d.dt = spec.dt;
-          d.steps = static_cast<int>(spec.steps);
-          out.history = {};
-          out.history.time_s.push_back(0.0);  // at rest
-          out.history.model_mm.push_back(0.0);
-          const int every = std::max(1, d.steps / kHistorySamples);
-          d.on_step = [&](int step, const Eigen::VectorXd& xs, const Eigen::VectorXd&) {
-            if (step % every != 0 && step != d.steps) return;
-            out.history.time_s.push_back(step * d.dt);
-            out.history.model_mm.push_back(
-                qoi_solved < 0 ? 0.0
-                               : (xs.segment<3>(3 * qoi_solved) - nodes[at.qoi]).norm() * 1e3);
-          };
-          x = msm::integrate(problem, d).x;
-        }
-        times.push_back(solve.seconds());
-      }
-      out.solve_seconds = median(times);
-      out.memory_mib = std::max(out.memory_mib, solve_memory.added_mib());
-      // The FEM transient beside the history (computed once per scene and ν, then cached) costs
-      // the reference's time and memory, not the model's: outside the measurements above.
-      if (!out.history.time_s.empty()) {
-        add_reference_history(out.history, ref, nodes[at.qoi], spec, problem, mag);
-      }
-      out.max_strain = roi ? roi_model->max_strain(x) : model.max_strain(x);
-      if (roi) {  // back to the full model: the held nodes stay at rest
-        Eigen::VectorXd x_full = full.rest;
-        for (std::size_t k = 0; k < roi->full_index.size(); ++k) {
-          x_full.segment<3>(3 * static_cast<Eigen::Index>(roi->full_index[k])) =
-              x.segment<3>(3 * static_cast<Eigen::Index>(k));
-        }
-        x = std::move(x_full);
-      }
-      std::vector<Vec3> u(nodes.size());
-      std::vector<Vec3> loads;
-      for (std::size_t i = 0; i < u.size(); ++i) {
-        u[i] = x.segment<3>(3 * static_cast<Eigen::Index>(i)) - nodes[i];
-      }
-      if (s.load.kind == LoadKind::contact) {
-        loads.resize(nodes.size());
-        for (std::size_t i = 0; i < u.size(); ++i) {
-          loads[i] = full.external_force.segment<3>(3 * static_cast<Eigen::Index>(i));
-        }
-      }
-      finish_outcome(out, s, nodes, u, ref_here, mag, at, fine.max_abs_principal_strain,
-                     result.qoi_point, loads, spec.steps, spec.dt);
-      if (wants_fields(o, s, mag, fine.max_abs_principal_strain)) {
-        write_model_fields(o, s, out, nodes, network_cells(built.network), u,
-                           scaled(ref_here.u, mag));
-      }
+      run_msm_load(s, spec, built, model, mesh, ref, ref_here, at, fine.max_abs_principal_strain,
+                   result.qoi_point, o, out);
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {
@@ -708,11 +596,11 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
 
   log << "scene " << s.name << ": " << describe(s.vessel) << "\n";
   std::map<int, TetMesh> model_meshes;
-  for (const int level : s.model_levels) model_meshes.emplace(level, mesh_at_level(s, level, o));
-  const TetMesh fine_mesh = mesh_at_level(s, s.reference_level, o);
+  for (const int level : s.model_levels) model_meshes.emplace(level, scene_mesh(s, level, o.cache_dir));
+  const TetMesh fine_mesh = scene_mesh(s, s.reference_level, o.cache_dir);
   std::unique_ptr<TetMesh> coarse_mesh;
   if (s.reference_level > 0) {
-    coarse_mesh = std::make_unique<TetMesh>(mesh_at_level(s, s.reference_level - 1, o));
+    coarse_mesh = std::make_unique<TetMesh>(scene_mesh(s, s.reference_level - 1, o.cache_dir));
   }
 
   std::size_t cases = 0;

@@ -29,9 +29,7 @@ std::string ms(double seconds) { return fmt(seconds * 1e3) + " ms"; }
 /// "30 Hz", "1000 Hz" (fmt's 3 digits would print 1e+03).
 std::string hz(double rate) { return fmt(rate, 6) + " Hz"; }
 
-bool is_integrator(const std::string& solver) {
-  return solver != "static" && solver != "linear" && solver != "relaxation";
-}
+bool is_integrator(const ModelSpec& m) { return m.solver.kind == msm::SolverKind::integrator; }
 
 bool is_explicit(msm::Integrator i) { return i != msm::Integrator::implicit_euler; }
 
@@ -151,7 +149,7 @@ Selection select_model(const std::vector<Candidate>& c, double tolerance, double
 std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double>& roi_radii) {
   std::vector<ModelSpec> out;
   const bool dynamic = std::any_of(s.models.begin(), s.models.end(),
-                                   [](const ModelSpec& m) { return is_integrator(m.solver); });
+                                   [](const ModelSpec& m) { return m.solver.is_dynamic(); });
   const std::vector<std::pair<ModelKind, std::string>> kinds{{ModelKind::surface_msm, "surface"},
                                                              {ModelKind::volume_msm, "volume"}};
   if (!dynamic) {
@@ -164,18 +162,20 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
       for (const msm::StiffnessRule rule : msm::kAllStiffnessRules) {
         ModelSpec m;
         m.kind = kind;
-        m.stiffness = msm::to_string(rule);
-        m.mass = "consistent";  // irrelevant to a static answer
+        m.surface = msm::WallSurface::mid;
+        m.stiffness = rule;
+        m.mass = msm::MassRule::consistent;  // irrelevant to a static answer
+        const std::string rule_name = msm::to_string(rule);
         for (const std::string solver : {"static", "linear"}) {
-          m.solver = solver;
-          m.name = kind_name + "/" + m.stiffness + "/" + solver;
+          m.solver = msm::parse_solver(solver);
+          m.name = kind_name + "/" + rule_name + "/" + solver;
           out.push_back(m);
         }
         if (s.load.kind != LoadKind::contact) continue;
         for (const double r : roi_radii) {
-          m.solver = "static";
+          m.solver = msm::parse_solver("static");
           m.roi_radius = r;
-          m.name = kind_name + "/" + m.stiffness + "/static/R=" + fmt(r * 1e3) + "mm";
+          m.name = kind_name + "/" + rule_name + "/static/R=" + fmt(r * 1e3) + "mm";
           out.push_back(m);
         }
       }
@@ -187,9 +187,9 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
   double duration = 0.0;
   double damping = 0.0;
   for (const ModelSpec& m : s.models) {
-    if (!is_integrator(m.solver)) continue;
-    (is_explicit(msm::parse_integrator(m.solver)) ? explicit_dts : implicit_dts).insert(m.dt);
-    duration = std::max(duration, m.dt * static_cast<double>(m.steps));
+    if (!is_integrator(m)) continue;
+    (is_explicit(m.solver.integrator) ? explicit_dts : implicit_dts).insert(m.solver.dt);
+    duration = std::max(duration, m.solver.dt * static_cast<double>(m.solver.steps));
     damping = std::max(damping, m.damping);
   }
   std::set<double> all = explicit_dts;
@@ -201,13 +201,16 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
         for (const double dt : family.empty() ? all : family) {
           ModelSpec m;
           m.kind = kind;
-          m.stiffness = msm::to_string(rule);
-          m.mass = "consistent";  // the FEM transient's mass
-          m.solver = msm::to_string(integrator);
-          m.dt = dt;
-          m.steps = std::max(1L, std::lround(duration / dt));
+          m.surface = msm::WallSurface::mid;
+          m.stiffness = rule;
+          m.mass = msm::MassRule::consistent;  // the FEM transient's mass
+          m.solver.kind = msm::SolverKind::integrator;
+          m.solver.integrator = integrator;
+          m.solver.dt = dt;
+          m.solver.steps = std::max(1L, std::lround(duration / dt));
           m.damping = damping;
-          m.name = kind_name + "/" + m.stiffness + "/" + m.solver + "/dt=" + fmt(dt);
+          m.name = kind_name + "/" + msm::to_string(rule) + "/" + msm::to_string(integrator) +
+                   "/dt=" + fmt(dt);
           out.push_back(m);
         }
       }

@@ -16,11 +16,7 @@ namespace vessel {
 
 namespace {
 
-// Stiffness and mass rules and integrators are checked by the msm library's own parsers (one list
-// of names, theirs); these are the scene's other choices.
-const std::vector<std::string> kSurfaces{"inner", "outer", "mid"};
-const std::vector<std::string> kStaticSolvers{"static", "linear", "relaxation"};
-const std::vector<std::string> kTopologies{"auto", "grid", "triangles"};
+// Every choice of a model is checked by the msm library's own parser (one list of names, theirs).
 
 std::string join(const std::vector<std::string>& names) {
   std::string s;
@@ -163,6 +159,13 @@ class TableReader {
     }
     return out;
   }
+  /// One string accepted by `parse` (an msm parse_* function), not an array.
+  template <class Parse>
+  std::string name_or(const std::string& key, const std::string& fallback, Parse&& parse) {
+    const toml::node* n = table_.get(key);
+    if (n && n->is_array()) fail(n, key, "found an array, expected one string");
+    return names_or(key, fallback, std::forward<Parse>(parse)).front();
+  }
   std::string string_or(const std::string& key, const std::string& fallback,
                         const std::vector<std::string>& allowed = {}) {
     const toml::node* n = get(key);
@@ -254,8 +257,38 @@ VesselParams read_vessel(TableReader r, std::vector<int>& levels, int& reference
   return p;
 }
 
-bool is_integrator(const std::string& solver) {
-  return std::find(kStaticSolvers.begin(), kStaticSolvers.end(), solver) == kStaticSolvers.end();
+bool is_dynamic(const std::string& solver) { return msm::parse_solver(solver).is_dynamic(); }
+
+/// A FEM [[models]] table: `degree` 1 or 2, or an array of them (a sweep).
+std::vector<ModelSpec> fem_models(TableReader& r, const ModelSpec& m) {
+  const std::vector<int> degrees = r.integers_or("degree", {2}, 1, 2);
+  r.finish();
+  std::vector<ModelSpec> out;
+  for (const int d : degrees) {
+    ModelSpec c = m;
+    c.degree = d;
+    if (degrees.size() > 1) c.name += "[degree=" + std::to_string(d) + "]";
+    out.push_back(c);
+  }
+  return out;
+}
+
+/// Region of interest: a radius or an array of radii (a sweep), each > 0 m; contact loads only.
+/// {0} (the whole vessel) when absent.
+std::vector<double> roi_radii(TableReader& r, LoadKind load) {
+  const toml::node* roi = r.get("roi_radius");
+  if (!roi) return {0.0};
+  if (load != LoadKind::contact) {
+    r.fail(roi, "roi_radius",
+           "found a region-of-interest radius on a " + to_string(load) +
+               " load; expected it only with a contact load (the region is centred on the "
+               "contact point)");
+  }
+  std::vector<double> radii = r.numbers(*roi, "roi_radius", 0.0, HUGE_VAL, "m");
+  for (const double v : radii) {
+    if (v <= 0.0) r.fail(roi, "roi_radius", "found 0, expected a radius > 0 m");
+  }
+  return radii;
 }
 
 /// "5e-05" rather than "0.000050".
@@ -265,9 +298,9 @@ std::string short_number(double v) {
   return s.str();
 }
 
-/// One [[models]] table. `stiffness`, `mass`, `solver` and `dt` (and `degree` for FEM) may be
-/// arrays: the table then stands for every combination (a sweep), each named after the table's
-/// name plus the swept values, e.g. "volume[stiffness=lloyd;dt=2e-05]".
+/// One [[models]] table. `stiffness`, `mass`, `solver`, `dt` and `roi_radius` (and `degree` for
+/// FEM) may be arrays: the table then stands for every combination (a sweep), each named after the
+/// table's name plus the swept values, e.g. "volume[stiffness=lloyd;dt=2e-05]".
 std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind load) {
   ModelSpec m;
   const std::string kind = r.string_or("kind", "", {"fem", "surface_msm", "volume_msm"});
@@ -275,75 +308,49 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
   m.kind = kind == "fem" ? ModelKind::fem
                          : (kind == "surface_msm" ? ModelKind::surface_msm : ModelKind::volume_msm);
   m.name = r.string_or("name", kind + "_" + std::to_string(index + 1));
-  if (m.kind == ModelKind::fem) {
-    const std::vector<int> degrees = r.integers_or("degree", {2}, 1, 2);
-    r.finish();
-    std::vector<ModelSpec> out;
-    for (const int d : degrees) {
-      ModelSpec c = m;
-      c.degree = d;
-      if (degrees.size() > 1) c.name += "[degree=" + std::to_string(d) + "]";
-      out.push_back(c);
-    }
-    return out;
+  if (m.kind == ModelKind::fem) return fem_models(r, m);
+  if (m.kind == ModelKind::surface_msm) {
+    m.surface = msm::parse_wall_surface(r.name_or("surface", msm::to_string(m.surface), msm::parse_wall_surface));
+    m.topology = msm::parse_topology(r.name_or("topology", "auto", msm::parse_topology));
   }
-  if (m.kind == ModelKind::surface_msm) m.surface = r.string_or("surface", m.surface, kSurfaces);
-  if (m.kind == ModelKind::surface_msm) m.topology = r.string_or("topology", m.topology, kTopologies);
   const auto stiffness = r.names_or(
       "stiffness", m.kind == ModelKind::volume_msm ? "seed001" : "seed000", msm::parse_stiffness_rule);
-  const auto mass = r.names_or("mass", m.mass, msm::parse_mass_rule);
-  const auto solvers = r.names_or("solver", m.solver, [](const std::string& name) {
-    if (!is_integrator(name)) return 0;
-    try {
-      (void)msm::parse_integrator(name);
-    } catch (const InputError& e) {
-      throw InputError("expected static, linear, relaxation or an integrator (" +
-                       std::string(e.what()) + ")");
-    }
-    return 0;
-  });
-  m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
-  // Region of interest: a radius or an array of radii (a sweep), each > 0 m.
-  std::vector<double> radii{0.0};
-  if (const toml::node* roi = r.get("roi_radius")) {
-    if (load != LoadKind::contact) {
-      r.fail(roi, "roi_radius",
-             "found a region-of-interest radius on a " + to_string(load) +
-                 " load; expected it only with a contact load (the region is "
-                 "centred on the contact point)");
-    }
-    radii = r.numbers(*roi, "roi_radius", 0.0, HUGE_VAL, "m");
-    for (const double v : radii) {
-      if (v <= 0.0) r.fail(roi, "roi_radius", "found 0, expected a radius > 0 m");
-    }
+  const auto mass = r.names_or("mass", "consistent", msm::parse_mass_rule);
+  const auto solvers = r.names_or("solver", "static", msm::parse_solver);
+  if (m.kind == ModelKind::volume_msm &&
+      std::find(solvers.begin(), solvers.end(), "pbd") != solvers.end()) {
+    r.fail(r.table().get("solver"), "solver",
+           "found \"pbd\" on a volume model; expected it on a surface_msm model (seed 002's "
+           "constraints act on a surface network)");
   }
-  const bool any_integrator = std::any_of(solvers.begin(), solvers.end(), is_integrator);
+  m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
+  const std::vector<double> radii = roi_radii(r, load);
   std::vector<double> dts{0.0};
-  if (any_integrator) {
+  const auto dynamic = std::find_if(solvers.begin(), solvers.end(), is_dynamic);
+  if (dynamic != solvers.end()) {
     const toml::node* dt = r.get("dt");
-    const std::string integrator = *std::find_if(solvers.begin(), solvers.end(), is_integrator);
-    if (!dt) r.fail(nullptr, "dt", "missing; solver \"" + integrator + "\" needs a time step > 0 s");
+    if (!dt) r.fail(nullptr, "dt", "missing; solver \"" + *dynamic + "\" needs a time step > 0 s");
     dts = r.numbers(*dt, "dt", 0.0, HUGE_VAL, "s");
     for (const double v : dts) {
       if (v <= 0.0) r.fail(dt, "dt", "found 0, expected a time step > 0 s");
     }
-    m.steps = r.integer_or("steps", 0, 1, 1'000'000'000L);
-    if (m.steps == 0) r.fail(nullptr, "steps", "missing; expected the number of steps (> 0)");
+    m.solver.steps = r.integer_or("steps", 0, 1, 1'000'000'000L);
+    if (m.solver.steps == 0) r.fail(nullptr, "steps", "missing; expected the number of steps (> 0)");
   }
   r.finish();
   std::vector<ModelSpec> out;
   for (const auto& k : stiffness) {
     for (const auto& ms : mass) {
       for (const auto& solver : solvers) {
-        for (const double dt : is_integrator(solver) ? dts : std::vector<double>{0.0}) {
+        for (const double dt : is_dynamic(solver) ? dts : std::vector<double>{0.0}) {
           for (const double roi : radii) {
             ModelSpec c = m;
             c.roi_radius = roi;
-            c.stiffness = k;
-            c.mass = ms;
-            c.solver = solver;
-            c.dt = dt;
-            if (!is_integrator(solver)) c.steps = 0;
+            c.stiffness = msm::parse_stiffness_rule(k);
+            c.mass = msm::parse_mass_rule(ms);
+            c.solver = msm::parse_solver(solver);
+            c.solver.dt = dt;
+            c.solver.steps = is_dynamic(solver) ? m.solver.steps : 0;
             std::string swept;
             const auto add = [&](bool varies, const std::string& key, const std::string& value) {
               if (varies) swept += (swept.empty() ? "" : ";") + key + "=" + value;
@@ -351,7 +358,7 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
             add(stiffness.size() > 1, "stiffness", k);
             add(mass.size() > 1, "mass", ms);
             add(solvers.size() > 1, "solver", solver);
-            add(dts.size() > 1 && is_integrator(solver), "dt", short_number(dt));
+            add(dts.size() > 1 && is_dynamic(solver), "dt", short_number(dt));
             add(radii.size() > 1, "roi_radius", short_number(roi));
             if (!swept.empty()) c.name += "[" + swept + "]";
             out.push_back(c);
@@ -494,10 +501,8 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
 
   TableReader boundary = r.sub("boundary", false);
   for (const auto& group : {std::string(group_names::inlet), std::string(group_names::outlet)}) {
-    const std::string bc = boundary.string_or(group, "clamped", {"clamped", "roller", "free"});
-    scene.boundary[group] = bc == "clamped" ? BoundaryCondition::clamped
-                                            : (bc == "roller" ? BoundaryCondition::axial_roller
-                                                              : BoundaryCondition::free);
+    scene.boundary[group] = parse_end_condition(
+        boundary.string_or(group, "clamped", {"clamped", "roller", "free"}));
   }
   boundary.finish();
 
@@ -537,15 +542,6 @@ Scene read_scene(const std::filesystem::path& path) {
   std::ostringstream text;
   text << in.rdbuf();
   return parse_scene(text.str(), path.string());
-}
-
-std::string to_string(BoundaryCondition bc) {
-  switch (bc) {
-    case BoundaryCondition::clamped: return "clamped";
-    case BoundaryCondition::axial_roller: return "roller";
-    case BoundaryCondition::free: return "free";
-  }
-  return "?";
 }
 
 std::string to_string(LoadKind kind) {

@@ -7,31 +7,34 @@
 #include <string>
 #include <vector>
 
+#include "meshes/supports.hpp"
 #include "meshes/surface_loads.hpp"
 #include "meshes/vessel_geometry.hpp"
+#include "msm/mass/mass_rules.hpp"
+#include "msm/model/build_network.hpp"
+#include "msm/solvers/solve.hpp"
+#include "msm/stiffness/stiffness_rules.hpp"
 
 namespace vessel {
 
-enum class BoundaryCondition { clamped, axial_roller, free };
 enum class LoadKind { contact, pressure, gravity };
 enum class ModelKind { fem, surface_msm, volume_msm };
 
 /// One model to run against the reference. FEM models use `degree`; mass-spring models use the
-/// rest (names as the msm library defines them; checked against the lists in scene.cpp). A
-/// [[models]] table whose stiffness, mass, solver, dt or degree is an array expands into one
-/// ModelSpec per combination (a sweep from the scene file).
+/// rest. A [[models]] table whose stiffness, mass, solver, dt or degree is an array expands into
+/// one ModelSpec per combination (a sweep from the scene file).
 struct ModelSpec {
   std::string name;  ///< unique within the scene, used in results and reports
   ModelKind kind = ModelKind::fem;
-  int degree = 2;                      ///< FEM: 1 or 2
-  std::string surface = "mid";         ///< surface msm: inner | outer | mid
-  std::string topology = "auto";       ///< surface msm: auto | grid | triangles
-  std::string stiffness;               ///< msm stiffness rule (msm::parse_stiffness_rule names)
-  std::string mass = "consistent";     ///< msm mass rule (msm::parse_mass_rule names)
-  std::string solver = "static";       ///< static | linear | relaxation | an integrator
-  double dt = 0.0;                     ///< s, integrators only (> 0)
-  double damping = 0.0;                ///< point damping k_v of seed 000 eq. (3.3), N·s/m per node
-  long steps = 0;                      ///< integrators: number of steps (> 0)
+  int degree = 2;                                         ///< FEM: 1 or 2
+  msm::WallSurface surface = msm::NetworkOptions{}.surface;  ///< surface msm: which wall
+  msm::Topology topology = msm::Topology::automatic;      ///< surface msm
+  msm::StiffnessRule stiffness = msm::StiffnessRule::seed000;
+  msm::MassRule mass = msm::MassRule::consistent;
+  /// static | linear | relaxation | an integrator | pbd; dynamic solvers with dt (s, > 0) and
+  /// steps (> 0).
+  msm::SolverSpec solver;
+  double damping = 0.0;  ///< point damping k_v of seed 000 eq. (3.3), N·s/m per node
   /// Region of interest (mass-spring, contact loads): nodes farther than this from the contact
   /// point are fixed and their unknowns removed from the solve, m; 0 = the whole vessel.
   double roi_radius = 0.0;
@@ -43,6 +46,9 @@ struct LoadSpec {
   ContactPatchSpec contact;        ///< point, radius, surface group (force set per magnitude)
   Vec3 gravity_direction = Vec3(0.0, -1.0, 0.0);
 };
+
+/// Standard gravity, m/s²: gravity magnitudes are multiples of it.
+inline constexpr double kStandardGravity = 9.81;
 
 struct Tolerances {
   double max_error_mm = 0.1;  ///< seed 000's visual threshold
@@ -88,8 +94,11 @@ struct Scene {
   double youngs_modulus = 14.24e3;  ///< Pa
   std::vector<double> poisson_ratios{0.45};
   double density = 1060.0;  ///< kg/m³
-  std::map<std::string, BoundaryCondition> boundary;  ///< group name → condition
-  LoadSpec load;
+  std::map<std::string, EndCondition> boundary;  ///< end group name → condition
+  LoadSpec load;  ///< the load the runs sweep over its magnitudes
+  /// Further loads applied together with `load`, each at its single magnitude (the fem and msm
+  /// commands combine pressure, contact and gravity; a scene file has none).
+  std::vector<LoadSpec> constant_loads;
   std::vector<ModelSpec> models;
   Tolerances tolerances;
   Budget budget;
@@ -102,7 +111,6 @@ Scene read_scene(const std::filesystem::path& path);
 /// Same, from text; `source_name` is used in messages.
 Scene parse_scene(std::string_view text, const std::string& source_name);
 
-std::string to_string(BoundaryCondition bc);
 std::string to_string(LoadKind kind);
 std::string to_string(ModelKind kind);
 std::string to_string(BudgetQuantity quantity);

@@ -86,7 +86,7 @@ std::unique_ptr<Msm> make_msm(const TetMesh& mesh, const VesselParams& params,
                               double point_damping = 0.0) {
   auto m = std::make_unique<Msm>();
   msm::NetworkOptions no;
-  no.model = spec.model;
+  no.model = msm::parse_model_type(spec.model);
   no.stiffness = spec.rule;
   no.stiffness_params.youngs_modulus = E;
   no.stiffness_params.poisson_ratio = nu;

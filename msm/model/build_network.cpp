@@ -6,46 +6,82 @@
 
 namespace vessel::msm {
 
+std::string to_string(ModelType type) { return type == ModelType::volume ? "volume" : "surface"; }
+
+ModelType parse_model_type(const std::string& name) {
+  if (name == "surface") return ModelType::surface;
+  if (name == "volume") return ModelType::volume;
+  throw InputError("model: expected 'surface' or 'volume', got '" + name + "'");
+}
+
+std::string to_string(Topology topology) {
+  switch (topology) {
+    case Topology::automatic: return "auto";
+    case Topology::grid: return "grid";
+    case Topology::triangles: return "triangles";
+  }
+  return "?";
+}
+
+Topology parse_topology(const std::string& name) {
+  for (const auto t : {Topology::automatic, Topology::grid, Topology::triangles}) {
+    if (name == to_string(t)) return t;
+  }
+  throw InputError("topology: expected auto, grid or triangles, got '" + name + "'");
+}
+
+namespace {
+
+std::string triangle_topology_name(bool two_ring) {
+  return std::string("triangle mesh (edges + bend across edges") + (two_ring ? " + two-ring)" : ")");
+}
+
+/// Stiffness, axial damping and masses: the same for every topology.
+void assign_laws_and_masses(BuiltNetwork& built, const NetworkOptions& o) {
+  assign_stiffness(built.network, o.stiffness, o.stiffness_params);
+  for (auto& s : built.network.springs) s.damping = o.axial_damping;
+  built.masses = nodal_masses(built.network, o.mass, o.density);
+}
+
+}  // namespace
+
 BuiltNetwork build_network(const TetMesh& mesh, const VesselParams& params,
                            const NetworkOptions& o) {
   validate(o.stiffness_params);
   BuiltNetwork built;
-  if (o.model == "volume") {
+  if (o.model == ModelType::volume) {
     built.network = build_volume_network(mesh);
     built.topology = "tetrahedral edges (seed 001)";
-  } else if (o.model == "surface") {
-    const TriangleSurface surface = wall_surface(mesh, params, parse_wall_surface(o.surface));
-    std::string topology = o.topology;
-    if (topology == "auto") topology = params.style == MeshStyle::structured ? "grid" : "triangles";
-    if (topology == "grid") {
+  } else {
+    const TriangleSurface surface = wall_surface(mesh, params, o.surface);
+    Topology topology = o.topology;
+    if (topology == Topology::automatic) {
+      topology = params.style == MeshStyle::structured ? Topology::grid : Topology::triangles;
+    }
+    if (topology == Topology::grid) {
       built.network = build_tube_grid_network(surface, params, params.wall_thickness);
       built.topology = "structured tube grid (seed 000 families)";
-    } else if (topology == "triangles") {
-      built.network = build_triangle_network(surface, params.wall_thickness, o.two_ring);
-      built.topology = std::string("triangle mesh (edges + bend across edges") +
-                       (o.two_ring ? " + two-ring)" : ")");
     } else {
-      throw InputError("topology: expected auto, grid or triangles, got '" + o.topology + "'");
+      built.network = build_triangle_network(surface, params.wall_thickness, o.two_ring);
+      built.topology = triangle_topology_name(o.two_ring);
     }
-  } else {
-    throw InputError("model: expected 'surface' or 'volume', got '" + o.model + "'");
   }
-  assign_stiffness(built.network, o.stiffness, o.stiffness_params);
-  for (auto& s : built.network.springs) s.damping = o.axial_damping;
-  built.masses = nodal_masses(built.network, o.mass, o.density);
+  assign_laws_and_masses(built, o);
   return built;
 }
 
 BuiltNetwork build_surface_network(const TriangleSurface& surface, double thickness,
                                    const NetworkOptions& o) {
   validate(o.stiffness_params);
-  if (o.model != "surface") {
-    throw InputError("model: a triangle surface carries only the surface model, got '" + o.model +
-                     "'; the volume model needs a tetrahedral .msh mesh");
+  if (o.model != ModelType::surface) {
+    throw InputError(
+        "model: a triangle surface carries only the surface model, got 'volume'; the volume model "
+        "needs a tetrahedral .msh mesh");
   }
-  if (o.topology != "auto" && o.topology != "triangles") {
-    throw InputError("topology: expected auto or triangles on a triangle surface, got '" +
-                     o.topology + "' (seed 000's grid needs the generated --structured tube)");
+  if (o.topology == Topology::grid) {
+    throw InputError(
+        "topology: expected auto or triangles on a triangle surface, got 'grid' (seed 000's grid "
+        "needs the generated --structured tube)");
   }
   if (!(thickness > 0) || !std::isfinite(thickness)) {
     throw InputError("wall thickness t: expected a finite value > 0 m, got " +
@@ -53,11 +89,8 @@ BuiltNetwork build_surface_network(const TriangleSurface& surface, double thickn
   }
   BuiltNetwork built;
   built.network = build_triangle_network(surface, thickness, o.two_ring);
-  built.topology = std::string("triangle mesh (edges + bend across edges") +
-                   (o.two_ring ? " + two-ring)" : ")");
-  assign_stiffness(built.network, o.stiffness, o.stiffness_params);
-  for (auto& s : built.network.springs) s.damping = o.axial_damping;
-  built.masses = nodal_masses(built.network, o.mass, o.density);
+  built.topology = triangle_topology_name(o.two_ring);
+  assign_laws_and_masses(built, o);
   return built;
 }
 

@@ -13,10 +13,21 @@
 
 namespace vessel::msm {
 
+/// Which network: springs on a wall surface (seeds 000/002) or on every tet edge (seed 001).
+enum class ModelType { surface, volume };
+std::string to_string(ModelType type);
+ModelType parse_model_type(const std::string& name);  ///< "surface" | "volume"; else InputError
+
+/// A surface model's springs: seed 000's structured grid families, the triangle edges with bend
+/// springs across them, or `automatic` (the grid on a structured vessel, triangles otherwise).
+enum class Topology { automatic, grid, triangles };
+std::string to_string(Topology topology);             ///< "auto" | "grid" | "triangles"
+Topology parse_topology(const std::string& name);     ///< InputError if unknown
+
 struct NetworkOptions {
-  std::string model = "surface";   ///< "surface" (seeds 000/002) or "volume" (seed 001)
-  std::string surface = "inner";   ///< surface model: inner | outer | mid wall
-  std::string topology = "auto";   ///< surface model: auto | grid | triangles
+  ModelType model = ModelType::surface;
+  WallSurface surface = WallSurface::inner;  ///< surface model: which wall
+  Topology topology = Topology::automatic;   ///< surface model
   bool two_ring = false;           ///< triangle topology: add two-ring springs
   StiffnessRule stiffness = StiffnessRule::seed000;
   StiffnessParams stiffness_params;

@@ -250,6 +250,7 @@ PbdResult run_pbd(const Problem& p, const std::vector<Constraint>& constraints, 
           "PBD kinetic energy above the blow-up limit " + std::to_string(ke_limit) + " J");
     }
     r.steps = step;
+    if (o.on_step) o.on_step(step, r.x);
   }
   for (const Constraint& c : constraints) {
     if (c.type == ConstraintType::stretch)

@@ -3,6 +3,7 @@
 /// XPBD compliance (Macklin, Müller & Chentanez 2016) so that stiffness is in physical units and
 /// independent of the iteration count.
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "msm/model/form.hpp"
@@ -68,6 +69,8 @@ struct PbdOptions {
   /// upper bound of what the loads can supply over the model's size, or × the kinetic energy
   /// after the first step (which releases any initially violated constraint).
   double blowup_factor = 1e3;
+  /// Called after every step with (step, x); may be empty.
+  std::function<void(int, const VectorXd&)> on_step;
 };
 
 struct PbdResult {

@@ -223,6 +223,15 @@ WallSurface parse_wall_surface(const std::string& name) {
   throw InputError("surface: expected 'inner', 'outer' or 'mid', got '" + name + "'");
 }
 
+std::string to_string(WallSurface surface) {
+  switch (surface) {
+    case WallSurface::inner: return "inner";
+    case WallSurface::outer: return "outer";
+    case WallSurface::mid: return "mid";
+  }
+  return "?";
+}
+
 TriangleSurface wall_surface(const TetMesh& mesh, const VesselParams& params, WallSurface which) {
   const std::string group(which == WallSurface::outer ? group_names::outer_wall
                                                       : group_names::inner_wall);

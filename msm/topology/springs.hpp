@@ -77,6 +77,7 @@ SpringNetwork build_tube_grid_network(const TriangleSurface& surface, const Vess
 /// Which wall surface a surface model is built on.
 enum class WallSurface { inner, outer, mid };
 WallSurface parse_wall_surface(const std::string& name);
+std::string to_string(WallSurface surface);  ///< "inner" | "outer" | "mid"
 
 /// The wall surface of a vessel mesh: inner or outer wall triangles, or the mid-surface (the
 /// inner-wall triangles with their nodes moved radially to the centreline distance a + t/2).

@@ -13,6 +13,7 @@
 #include "msm/mass/mass_rules.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
+#include "msm/solvers/solve.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 
@@ -342,4 +343,45 @@ TEST(StaticSolver, SurfaceMembraneEquilibriumBalancesTheLoadAndIsStable) {
     EXPECT_GT(ldlt.vectorD().minCoeff(), 0.0) << iterations;
     EXPECT_GT(r.indefinite_iterations, r.iterations / 4);
   }
+}
+
+TEST(Solve, EveryNamedSolverRoundTripsAndUnknownNamesAreListed) {
+  for (const char* name : kSolverNames) EXPECT_EQ(to_string(parse_solver(name)), name);
+  EXPECT_EQ(parse_solver("pbd").kind, SolverKind::pbd);
+  EXPECT_TRUE(parse_solver("verlet").is_dynamic());
+  EXPECT_FALSE(parse_solver("relaxation").is_dynamic());
+  try {
+    (void)parse_solver("rk4");
+    FAIL() << "rk4 accepted";
+  } catch (const vessel::InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("'rk4'"), std::string::npos) << m;
+    EXPECT_NE(m.find("implicit-euler, pbd"), std::string::npos) << m;
+  }
+}
+
+TEST(Solve, OneEntryReachesHookesLawWithEveryStaticSolver) {
+  // k = 41.106 N/m under 10 mN: u = F/k (Hooke), by Newton, the linearised model and relaxation.
+  const double k = 41.106, F = 0.01;
+  for (const char* name : {"static", "linear", "relaxation"}) {
+    Chain c = make_chain({k}, F);
+    const SolveResult r = solve(c.problem, parse_solver(name));
+    EXPECT_NEAR(end_displacement(c.problem, r.x), F / k, 1e-6 * F / k) << name;
+  }
+}
+
+TEST(Solve, DynamicSolversNeedStepsAndPbdNeedsASurfaceNetwork) {
+  Chain c = make_chain({41.106}, 0.01);
+  SolverSpec verlet = parse_solver("verlet");
+  EXPECT_THROW((void)solve(c.problem, verlet), vessel::InputError);  // steps = 0
+  verlet.steps = 10;
+  int observed = 0;
+  const SolveResult r = solve(c.problem, verlet, nullptr, [&](int, const Eigen::VectorXd&) { ++observed; });
+  EXPECT_EQ(observed, 10);
+  EXPECT_GT(r.dt, 0.0);  // automatic: half the critical-step bound
+  EXPECT_NEAR(r.dt, 0.5 * 2.0 / max_frequency_bound(c.problem), 1e-15);
+  SolverSpec pbd = parse_solver("pbd");
+  pbd.steps = 5;
+  EXPECT_THROW((void)solve(c.problem, pbd, &c.net), vessel::InputError);  // a chain has no triangles
+  EXPECT_THROW((void)solve(c.problem, pbd), vessel::InputError);
 }

@@ -274,3 +274,23 @@ TEST(HarnessDynamic, FemTransientSettlesOnTheStaticReferenceAndTheHistoryIsSampl
   }
   EXPECT_DOUBLE_EQ(h.max_error_mm, max_diff);
 }
+
+TEST(HarnessDynamic, SeedTwoPositionBasedModelRunsFromASceneWithItsHistory) {
+  // Seed 002's XPBD surface model, named in a scene like any solver: it finishes, its history is
+  // sampled over the run and ends at its final state, and it moves the contact point inwards.
+  std::string scene = kDynamic;
+  scene.replace(scene.find("[[models]]"), std::string::npos,
+                "[[models]]\nname = \"surface_pbd\"\nkind = \"surface_msm\"\nsurface = \"mid\"\n"
+                "solver = \"pbd\"\ndt = 1e-3\nsteps = 50\n");
+  const SceneResult r = run_scene(parse_scene(scene, "pbd_test.toml"), HarnessOptions{});
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  const ModelOutcome& o = r.outcomes[0];
+  ASSERT_TRUE(o.ok) << o.failure;
+  EXPECT_NE(o.detail.find("pbd"), std::string::npos) << o.detail;
+  EXPECT_EQ(o.history.steps, 50);
+  EXPECT_NEAR(o.history.time_s.back(), 0.05, 1e-12);
+  EXPECT_EQ(o.history.time_s.size(), o.history.reference_mm.size());
+  EXPECT_NEAR(o.history.model_mm.back(), o.qoi_displacement_mm, 1e-9);
+  ASSERT_TRUE(o.quantities.indentation_mm.has_value());
+  EXPECT_GT(*o.quantities.indentation_mm, 0.0);
+}

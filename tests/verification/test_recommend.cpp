@@ -178,7 +178,7 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   s.load.kind = LoadKind::contact;
   ModelSpec m;
   m.kind = ModelKind::volume_msm;
-  m.stiffness = "seed001";
+  m.stiffness = msm::StiffnessRule::seed001;
   s.models = {m};
   const std::vector<ModelSpec> c = candidate_models(s, {4e-3, 8e-3});
   // FEM P1 + 2 kinds × 5 rules × (static, linear, 2 radii).
@@ -186,7 +186,7 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   std::set<std::string> names, rules;
   for (const auto& x : c) {
     names.insert(x.name);
-    if (x.kind != ModelKind::fem) rules.insert(x.stiffness);
+    if (x.kind != ModelKind::fem) rules.insert(msm::to_string(x.stiffness));
   }
   EXPECT_EQ(names.size(), c.size());  // unique
   EXPECT_EQ(rules.size(), msm::kAllStiffnessRules.size());
@@ -199,21 +199,22 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   // Dynamic: every integrator at its family's time steps, over the scene's longest run.
   s.load.kind = LoadKind::contact;
   ModelSpec e = m;
-  e.solver = "verlet";
-  e.dt = 1e-5;
-  e.steps = 20000;
+  e.solver = msm::parse_solver("verlet");
+  e.solver.dt = 1e-5;
+  e.solver.steps = 20000;
   e.damping = 1e-4;
   ModelSpec i = m;
-  i.solver = "implicit-euler";
-  i.dt = 1e-3;
-  i.steps = 100;
+  i.solver = msm::parse_solver("implicit-euler");
+  i.solver.dt = 1e-3;
+  i.solver.steps = 100;
   s.models = {e, i};
   const std::vector<ModelSpec> d = candidate_models(s, {4e-3});
   ASSERT_EQ(d.size(), 2 * msm::kAllStiffnessRules.size() * msm::kAllIntegrators.size());
   for (const auto& x : d) {
-    const bool implicit = x.solver == "implicit-euler";
-    EXPECT_DOUBLE_EQ(x.dt, implicit ? 1e-3 : 1e-5) << x.name;
-    EXPECT_EQ(x.steps, implicit ? 200 : 20000) << x.name;  // 0.2 s simulated
+    const bool implicit = x.solver.integrator == msm::Integrator::implicit_euler;
+    EXPECT_EQ(x.solver.kind, msm::SolverKind::integrator) << x.name;
+    EXPECT_DOUBLE_EQ(x.solver.dt, implicit ? 1e-3 : 1e-5) << x.name;
+    EXPECT_EQ(x.solver.steps, implicit ? 200 : 20000) << x.name;  // 0.2 s simulated
     EXPECT_DOUBLE_EQ(x.damping, 1e-4);
   }
 }

@@ -73,7 +73,7 @@ TEST(Scene, DefaultsAndValuesAreRead) {
   EXPECT_DOUBLE_EQ(s.load.contact.radius, 0.5e-3);
   EXPECT_EQ(s.models.at(0).degree, 1);
   EXPECT_EQ(s.models.at(0).name, "fem_1");
-  EXPECT_EQ(s.boundary.at("inlet"), BoundaryCondition::clamped);
+  EXPECT_EQ(s.boundary.at("inlet"), EndCondition::clamped);
 }
 
 TEST(Scene, UnknownKeyIsRefusedWithLineAndKnownKeys) {
@@ -162,12 +162,35 @@ TEST(Scene, ArraysInAModelTableExpandIntoOneModelPerCombination) {
                        "vol[stiffness=lloyd;solver=static]",
                        "vol[stiffness=lloyd;solver=verlet;dt=1e-05]",
                        "vol[stiffness=lloyd;solver=verlet;dt=2e-05]"}));
-  EXPECT_EQ(s.models[3].stiffness, "seed001");
-  EXPECT_EQ(s.models[3].solver, "verlet");
-  EXPECT_DOUBLE_EQ(s.models[3].dt, 2e-5);
-  EXPECT_EQ(s.models[4].steps, 0);  // static: no steps
+  EXPECT_EQ(s.models[3].stiffness, msm::StiffnessRule::seed001);
+  EXPECT_EQ(s.models[3].solver.kind, msm::SolverKind::integrator);
+  EXPECT_EQ(s.models[3].solver.integrator, msm::Integrator::verlet);
+  EXPECT_DOUBLE_EQ(s.models[3].solver.dt, 2e-5);
+  EXPECT_EQ(s.models[3].solver.steps, 10);
+  EXPECT_EQ(s.models[4].solver.kind, msm::SolverKind::static_newton);
+  EXPECT_EQ(s.models[4].solver.steps, 0);  // static: no steps
   const auto msg = error_of(std::string(kMinimal) +
                             "[[models]]\nkind = \"volume_msm\"\nstiffness = [\"seed001\", 3]\n");
   EXPECT_NE(msg.find("key 'models[1].stiffness': found 3, expected a string"), std::string::npos)
       << msg;
+}
+
+TEST(Scene, PositionBasedDynamicsIsASolverOfSurfaceModels) {
+  const std::string pbd =
+      "[[models]]\nname = \"pbd\"\nkind = \"surface_msm\"\nsolver = \"pbd\"\ndt = 1e-3\n"
+      "steps = 20\n";
+  const Scene s = parse_scene(std::string(kMinimal) + pbd, "scene.toml");
+  const ModelSpec& m = s.models.back();
+  EXPECT_EQ(m.solver.kind, msm::SolverKind::pbd);
+  EXPECT_TRUE(m.solver.is_dynamic());
+  EXPECT_DOUBLE_EQ(m.solver.dt, 1e-3);
+  EXPECT_EQ(m.solver.steps, 20);
+  // Like an integrator it needs a time step; on a volume model it is refused with the key's line.
+  const auto no_dt = error_of(std::string(kMinimal) +
+                              "[[models]]\nkind = \"surface_msm\"\nsolver = \"pbd\"\nsteps = 5\n");
+  EXPECT_NE(no_dt.find("models[1].dt"), std::string::npos) << no_dt;
+  const auto volume = error_of(std::string(kMinimal) +
+                               "[[models]]\nkind = \"volume_msm\"\nsolver = \"pbd\"\n");
+  EXPECT_NE(volume.find("models[1].solver"), std::string::npos) << volume;
+  EXPECT_NE(volume.find("surface_msm"), std::string::npos) << volume;
 }

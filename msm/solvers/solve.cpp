@@ -1,0 +1,115 @@
+#include "msm/solvers/solve.hpp"
+
+#include <algorithm>
+
+#include "meshes/errors.hpp"
+
+namespace vessel::msm {
+
+SolverSpec parse_solver(const std::string& name) {
+  SolverSpec spec;
+  if (name == "static") return spec;
+  if (name == "linear") {
+    spec.kind = SolverKind::linear;
+  } else if (name == "relaxation") {
+    spec.kind = SolverKind::relaxation;
+  } else if (name == "pbd") {
+    spec.kind = SolverKind::pbd;
+  } else {
+    try {
+      spec.integrator = parse_integrator(name);
+      spec.kind = SolverKind::integrator;
+    } catch (const InputError&) {
+      std::string names;
+      for (const char* n : kSolverNames) names += (names.empty() ? "" : ", ") + std::string(n);
+      throw InputError("solver: expected one of " + names + "; got '" + name + "'");
+    }
+  }
+  return spec;
+}
+
+std::string to_string(const SolverSpec& spec) {
+  switch (spec.kind) {
+    case SolverKind::static_newton: return "static";
+    case SolverKind::linear: return "linear";
+    case SolverKind::relaxation: return "relaxation";
+    case SolverKind::integrator: return to_string(spec.integrator);
+    case SolverKind::pbd: return "pbd";
+  }
+  return "?";
+}
+
+double resolved_time_step(const Problem& problem, const SolverSpec& spec) {
+  if (spec.dt > 0.0) return spec.dt;
+  if (spec.kind == SolverKind::pbd) return 1e-3;
+  const double critical = 2.0 / max_frequency_bound(problem);
+  return (spec.integrator == Integrator::implicit_euler ? 10.0 : 0.5) * critical;
+}
+
+namespace {
+
+SolveResult run_pbd_solver(const Problem& problem, const SolverSpec& spec,
+                           const SpringNetwork* network, const StepObserver& on_step) {
+  if (!network || network->triangles.empty()) {
+    throw InputError(
+        "solver pbd: seed 002's position-based constraints need a surface network (its "
+        "triangles carry the bending constraints); use a surface model");
+  }
+  std::vector<Vec3> loads(network->nodes.size(), Vec3::Zero());
+  for (std::size_t i = 0; i < loads.size(); ++i) {
+    loads[i] = problem.external_force.segment<3>(3 * static_cast<Eigen::Index>(i));
+  }
+  PbdConstraintOptions c;
+  c.dihedral = spec.pbd.dihedral;
+  c.angle = spec.pbd.angle;
+  c.bending_compliance = spec.pbd.bending_compliance;
+  c.angle_compliance = spec.pbd.bending_compliance;
+  PbdOptions o;
+  o.dt = resolved_time_step(problem, spec);
+  o.steps = static_cast<int>(spec.steps);
+  o.iterations = spec.pbd.iterations;
+  o.velocity_damping = spec.pbd.velocity_damping;
+  o.on_step = on_step;
+  PbdResult r = run_pbd(problem, build_pbd_constraints(*network, loads, c), o);
+  return {r.x, r.seconds, o.dt, std::move(r)};
+}
+
+SolveResult run_integrator(const Problem& problem, const SolverSpec& spec,
+                           const StepObserver& on_step) {
+  DynamicOptions d;
+  d.integrator = spec.integrator;
+  d.dt = resolved_time_step(problem, spec);
+  d.steps = static_cast<int>(spec.steps);
+  if (on_step) d.on_step = [&](int step, const VectorXd& x, const VectorXd&) { on_step(step, x); };
+  DynamicResult r = integrate(problem, d);
+  return {r.x, r.seconds, d.dt, std::move(r)};
+}
+
+}  // namespace
+
+SolveResult solve(const Problem& problem, const SolverSpec& spec, const SpringNetwork* network,
+                  const StepObserver& on_step) {
+  if (spec.is_dynamic() && spec.steps < 1) {
+    throw InputError("solver " + to_string(spec) + ": expected a number of steps >= 1, got " +
+                     std::to_string(spec.steps));
+  }
+  switch (spec.kind) {
+    case SolverKind::static_newton: {
+      StaticResult r = solve_static(problem, spec.static_options);
+      return {r.x, r.seconds, 0.0, std::move(r)};
+    }
+    case SolverKind::linear: {
+      StaticResult r = solve_linear(problem);
+      return {r.x, r.seconds, 0.0, std::move(r)};
+    }
+    case SolverKind::relaxation: {
+      RelaxationResult r = dynamic_relaxation(problem);
+      return {r.x, r.seconds, r.dt, std::move(r)};
+    }
+    case SolverKind::integrator: return run_integrator(problem, spec, on_step);
+    case SolverKind::pbd: return run_pbd_solver(problem, spec, network, on_step);
+  }
+  throw InputError("solver: unknown kind");
+}
+
+}  // namespace vessel::msm

@@ -1,0 +1,86 @@
+#pragma once
+/// One entry for every mass-spring solver: static Newton, the linearised model, dynamic
+/// relaxation, the time integrators and seed 002's position-based dynamics (XPBD). A SolverSpec
+/// says which and with what settings; `solve` runs it on a Problem. The command line, the scenes
+/// and the studies name solvers with the strings of `kSolverNames`.
+#include <array>
+#include <functional>
+#include <string>
+#include <variant>
+
+#include "msm/model/form.hpp"
+#include "msm/pbd/constraints.hpp"
+#include "msm/solvers/integrators.hpp"
+#include "msm/solvers/static_solver.hpp"
+#include "msm/topology/springs.hpp"
+
+namespace vessel::msm {
+
+enum class SolverKind {
+  static_newton,  ///< "static": Newton on the total potential
+  linear,         ///< "linear": the stiffness at rest, one solve
+  relaxation,     ///< "relaxation": dynamic relaxation to equilibrium
+  integrator,     ///< a time integrator (explicit/symplectic Euler, Verlet, implicit Euler)
+  pbd,            ///< "pbd": seed 002's constraints with XPBD (surface models)
+};
+
+/// Seed 002's position-based model: constraint families and XPBD settings.
+struct PbdSettings {
+  int iterations = 10;              ///< Gauss–Seidel sweeps per step
+  double velocity_damping = 0.01;   ///< fraction of the velocity removed per step, [0, 1)
+  double bending_compliance = 0.0;  ///< 1/(N·m), dihedral and angle constraints
+  bool dihedral = true;             ///< bending by the dihedral angle
+  bool angle = false;               ///< the seed's simplified angle constraint
+};
+
+struct SolverSpec {
+  SolverKind kind = SolverKind::static_newton;
+  Integrator integrator = Integrator::symplectic_euler;  ///< kind integrator
+  double dt = 0.0;  ///< s, integrator and pbd; 0: automatic (resolved_time_step)
+  long steps = 0;   ///< integrator and pbd: number of steps (> 0)
+  StaticOptions static_options;  ///< static_newton
+  PbdSettings pbd;               ///< pbd
+
+  /// Time-stepping solvers (integrators and PBD): compared over time and at their final state.
+  [[nodiscard]] bool is_dynamic() const {
+    return kind == SolverKind::integrator || kind == SolverKind::pbd;
+  }
+};
+
+/// Every solver name: the static ones, then the integrators, then PBD.
+inline constexpr std::array<const char*, 8> kSolverNames{
+    "static",          "linear", "relaxation",     "explicit-euler",
+    "symplectic-euler", "verlet", "implicit-euler", "pbd"};
+/// The solver of a name in kSolverNames (dt, steps and options left at their defaults).
+/// InputError listing the names otherwise.
+SolverSpec parse_solver(const std::string& name);
+/// The name parse_solver reads.
+std::string to_string(const SolverSpec& spec);
+
+/// The time step a dynamic solver runs with, s: spec.dt if set; otherwise for the integrators a
+/// fraction of the undamped critical-step bound 2/ω_max (Gershgorin, max_frequency_bound): 0.5×
+/// for the explicit ones, 10× for implicit Euler (stable at any step; 10× keeps its numerical
+/// damping moderate); 1 ms for PBD (seed 002's frame time).
+double resolved_time_step(const Problem& problem, const SolverSpec& spec);
+
+/// What a solve did, by solver family (StaticResult for static and linear).
+using SolveDetail = std::variant<StaticResult, RelaxationResult, DynamicResult, PbdResult>;
+
+struct SolveResult {
+  VectorXd x;            ///< final positions, m
+  double seconds = 0.0;  ///< the solver's own time
+  double dt = 0.0;       ///< s, dynamic solvers: the step used
+  SolveDetail detail;
+};
+
+/// Called after every step of a dynamic solver with (step, x).
+using StepObserver = std::function<void(int, const VectorXd&)>;
+
+/// Runs the solver on the problem. `network` is needed by PBD (its constraints are built on the
+/// surface network's springs and triangles; InputError if null or not a surface network); the
+/// other solvers work on problem.form alone. Errors as the solvers throw them: InputError for bad
+/// settings, DivergenceError for a blow-up, std::runtime_error for no convergence.
+SolveResult solve(const Problem& problem, const SolverSpec& spec,
+                  const SpringNetwork* network = nullptr, const StepObserver& on_step = {});
+
+}  // namespace vessel::msm

@@ -1,0 +1,137 @@
+#include "verification/scene_problems.hpp"
+
+#include "meshes/errors.hpp"
+#include "meshes/mesh_cache.hpp"
+#include "msm/model/spring_model.hpp"
+
+namespace vessel {
+
+Vec3 default_contact_point(const VesselParams& v, const std::string& surface_group) {
+  const double r = surface_group == group_names::outer_wall ? v.outer_radius() : v.inner_radius;
+  if (v.kind == VesselKind::straight) return {r, 0.0, 0.5 * v.length};
+  return {0.0, v.bend_radius + r, 0.0};
+}
+
+Vec3 qoi_point(const Scene& s) {
+  if (s.load.kind == LoadKind::contact) return s.load.contact.point;
+  return default_contact_point(s.vessel, std::string(group_names::inner_wall));
+}
+
+TetMesh scene_mesh(const Scene& s, int level, const std::filesystem::path& cache_dir) {
+  VesselParams p = s.vessel;
+  p.level = level;
+  return load_or_generate_vessel(p, cache_dir, {});
+}
+
+Supports scene_supports(const Scene& s) {
+  return end_supports(s.vessel, s.boundary, s.source.string());
+}
+
+TractionPatch scene_contact_patch(const LoadSpec& load, const TetMesh& mesh, double force) {
+  ContactPatchSpec spec = load.contact;
+  spec.force = force;
+  return contact_patch(mesh, spec);
+}
+
+namespace {
+
+/// The swept load at `magnitude`, then each constant load at its own; loads of magnitude 0 are
+/// left out (nothing is built for an absent load).
+std::vector<std::pair<const LoadSpec*, double>> applied_loads(const Scene& s, double magnitude) {
+  std::vector<std::pair<const LoadSpec*, double>> out;
+  if (magnitude != 0.0) out.emplace_back(&s.load, magnitude);
+  for (const LoadSpec& l : s.constant_loads) {
+    if (!l.magnitudes.empty() && l.magnitudes.front() != 0.0) {
+      out.emplace_back(&l, l.magnitudes.front());
+    }
+  }
+  return out;
+}
+
+void add_fem_supports(const Scene& s, fem::ElasticityProblem& prob) {
+  const Supports supports = scene_supports(s);
+  if (supports.holds_nothing()) {
+    throw InputError(s.source.string() +
+                     ": [boundary] leaves both ends free; expected at least one clamped or roller "
+                     "end (a free body has rigid motions and no static answer)");
+  }
+  for (const auto& g : supports.clamped) {
+    prob.dirichlet.push_back(fem::DirichletCondition::clamped(g));
+  }
+  for (const auto& g : supports.rollers) {
+    prob.dirichlet.push_back(fem::DirichletCondition::roller(g, Supports::kRollerComponent));
+  }
+  for (const Pin& pin : supports.pins) prob.point_constraints.push_back({pin.point, pin.component});
+}
+
+}  // namespace
+
+fem::ElasticityProblem fem_problem(const Scene& s, const TetMesh& mesh, double nu, int degree,
+                                   double magnitude) {
+  fem::ElasticityProblem prob;
+  prob.material.youngs_modulus = s.youngs_modulus;
+  prob.material.poisson_ratio = nu;
+  prob.material.density = s.density;
+  prob.options.degree = degree;
+  prob.options.mixed_threshold = kMixedThreshold;
+  add_fem_supports(s, prob);
+  for (const auto& [load, m] : applied_loads(s, magnitude)) {
+    switch (load->kind) {
+      case LoadKind::contact:
+        prob.patches.push_back(scene_contact_patch(*load, mesh, m));
+        break;
+      case LoadKind::pressure:
+        prob.pressures.push_back({load->contact.surface_group, m});
+        break;
+      case LoadKind::gravity:
+        prob.gravity += m * kStandardGravity * load->gravity_direction;
+        break;
+    }
+  }
+  return prob;
+}
+
+msm::NetworkOptions network_options(const Scene& s, const ModelSpec& model, double nu) {
+  msm::NetworkOptions o;
+  o.model = model.kind == ModelKind::volume_msm ? msm::ModelType::volume : msm::ModelType::surface;
+  o.surface = model.surface;
+  o.topology = model.topology;
+  o.stiffness = model.stiffness;
+  o.stiffness_params.youngs_modulus = s.youngs_modulus;
+  o.stiffness_params.poisson_ratio = nu;
+  o.mass = model.mass;
+  o.density = s.density;
+  return o;
+}
+
+std::vector<Vec3> surface_nodal_loads(const Scene& s, const TetMesh& mesh, double magnitude) {
+  std::vector<Vec3> loads(mesh.nodes.size(), Vec3::Zero());
+  for (const auto& [load, m] : applied_loads(s, magnitude)) {
+    std::vector<Vec3> f;
+    if (load->kind == LoadKind::contact) {
+      f = traction_nodal_loads(mesh, scene_contact_patch(*load, mesh, m));
+    } else if (load->kind == LoadKind::pressure) {
+      f = pressure_nodal_loads(mesh, load->contact.surface_group, m);
+    }
+    for (std::size_t i = 0; i < f.size(); ++i) loads[i] += f[i];
+  }
+  return loads;
+}
+
+msm::Problem msm_problem(const Scene& s, const msm::Form& form, const msm::BuiltNetwork& built,
+                         const TetMesh& mesh, double magnitude) {
+  msm::Problem problem = msm::make_problem(form, built.network, built.masses, mesh,
+                                           surface_nodal_loads(s, mesh, magnitude), {});
+  Vec3 g = Vec3::Zero();
+  for (const auto& [load, m] : applied_loads(s, magnitude)) {
+    if (load->kind == LoadKind::gravity) g += m * kStandardGravity * load->gravity_direction;
+  }
+  for (Eigen::Index i = 0; i < problem.num_dofs(); i += 3) {
+    problem.external_force.segment<3>(i) += problem.mass[i] * g;
+  }
+  problem.fixed =
+      held_dofs(mesh, built.network.nodes, built.network.source_node, scene_supports(s));
+  return problem;
+}
+
+}  // namespace vessel

@@ -1,0 +1,62 @@
+#pragma once
+/// The one place that builds the problems a Scene describes, for the harness, the studies and the
+/// fem/msm commands alike: its meshes, the FEM reference's problem and each mass-spring model's
+/// network and problem (material, supports, loads), with every default they share. The FEM and the
+/// springs get the same loads (the contact patch and pressure triangles of meshes/surface_loads)
+/// and the same supports (meshes/supports). SI units.
+#include <filesystem>
+#include <string>
+
+#include "fem_reference/elasticity.hpp"
+#include "msm/model/build_network.hpp"
+#include "msm/model/form.hpp"
+#include "verification/scene.hpp"
+
+namespace vessel {
+
+/// The reference switches to the mixed Taylor–Hood element from this ν (and always at 0.5): below
+/// it P2 displacement elements do not lock appreciably, while the saddle-point system costs
+/// minutes and gigabytes at reference levels (docs/fem_measurements.md).
+inline constexpr double kMixedThreshold = 0.49;
+
+/// Where a contact pushes when no point is given: on the named wall (inner_wall or outer_wall,
+/// radius a or b) at mid-length on the θ = 0 side: (r, 0, L/2) on the tube, the outer bend's
+/// apex (0, R + r, 0) on the arch.
+Vec3 default_contact_point(const VesselParams& vessel, const std::string& surface_group);
+
+/// Where a scene's "contact-point displacement" (its QoI) is read: the contact point, or for
+/// distributed loads the inner wall's default contact point.
+Vec3 qoi_point(const Scene& scene);
+
+/// The scene's vessel mesh at `level`: generated with gmsh, cached under cache_dir (none if empty).
+TetMesh scene_mesh(const Scene& scene, int level, const std::filesystem::path& cache_dir);
+
+/// The supports of the scene's [boundary] (meshes/supports), errors naming the scene's file.
+Supports scene_supports(const Scene& scene);
+
+/// The contact patch of a contact load with force `force` (N) on `mesh`.
+TractionPatch scene_contact_patch(const LoadSpec& load, const TetMesh& mesh, double force);
+
+/// The FEM problem of the scene on `mesh` at Poisson's ratio ν with elements of `degree`: the
+/// scene's material, supports, the swept load at `magnitude` and every constant load at its
+/// magnitude; a load of magnitude 0 is not built. Formulation automatic with kMixedThreshold.
+/// Throws InputError (naming the scene's file) if nothing supports the body.
+fem::ElasticityProblem fem_problem(const Scene& scene, const TetMesh& mesh, double nu, int degree,
+                                   double magnitude = 1.0);
+
+/// The network options of a mass-spring model of the scene at ν.
+msm::NetworkOptions network_options(const Scene& scene, const ModelSpec& model, double nu);
+
+/// The consistent nodal loads (N, per mesh node) of the scene's surface loads (contact patch,
+/// pressure) at `magnitude` for the swept load: what the FEM integrates, lumped to the nodes.
+/// Gravity is not among them: mass-spring models carry it on their own masses.
+std::vector<Vec3> surface_nodal_loads(const Scene& scene, const TetMesh& mesh, double magnitude);
+
+/// The mass-spring problem of a network built on `mesh`: surface loads as consistent nodal loads
+/// (mapped to the network's nodes), gravity on the network's own masses (for the volume model
+/// with consistent masses exactly the FEM's ρgV/4 per tet vertex), and the scene's supports as
+/// held dofs.
+msm::Problem msm_problem(const Scene& scene, const msm::Form& form, const msm::BuiltNetwork& built,
+                         const TetMesh& mesh, double magnitude);
+
+}  // namespace vessel
