@@ -95,10 +95,6 @@ LoadSpec command_load(const FemCommandOptions& o, const std::string& name) {
     l.contact.surface_group = o.contact_surface;
     l.contact.radius = o.contact_radius;
     l.contact.point = default_contact_point(o.vessel.params, o.contact_surface);
-    const VesselParams& v = o.vessel.params;
-    if (v.kind == VesselKind::arch && o.contact_surface == group_names::inner_wall) {
-      l.contact.point = Vec3(0.0, v.bend_radius - v.inner_radius, 0.0);  // the bend's inner side
-    }
     if (!o.contact_point.empty()) {
       l.contact.point = {o.contact_point[0], o.contact_point[1], o.contact_point[2]};
     }
@@ -476,7 +472,8 @@ void add_load_options(CLI::App* cmd, FemCommandOptions& o) {
   cmd->add_option("--force", o.force, "Contact force, N (pushes into the wall)")
       ->capture_default_str();
   cmd->add_option("--contact-point", o.contact_point,
-                  "Contact point x y z, metres (default: mid-length on the chosen wall at +x)")
+                  "Contact point x y z, metres (default: the chosen wall at mid-length, (r, 0, L/2) "
+                  "on the tube, the outer bend's apex (0, R + r, 0) on the arch)")
       ->expected(3);
   cmd->add_option("--contact-radius", o.contact_radius, "Contact patch radius, metres")
       ->capture_default_str();

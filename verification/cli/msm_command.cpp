@@ -478,7 +478,8 @@ void add_solver_options(CLI::App* cmd, MsmOptions& o) {
 CLI::Option* add_load_options(CLI::App* cmd, MsmOptions& o) {
   cmd->add_option("--force", o.force, "Contact force, N")->capture_default_str();
   cmd->add_option("--contact-point", o.contact_point,
-                  "Contact point x y z, m (default: inner wall at mid-length)")
+                  "Contact point x y z, m (default: the inner wall at mid-length, (a, 0, L/2) on "
+                  "the tube, the outer bend's apex (0, R + a, 0) on the arch)")
       ->expected(3);
   cmd->add_option("--pressure", o.pressure, "Internal pressure on the inner wall, Pa")
       ->capture_default_str();
