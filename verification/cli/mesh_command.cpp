@@ -91,6 +91,20 @@ void run_stl_input(const MeshCommandOptions& o) {
   if (!o.stl.empty()) write_stl(o.stl, s);
 }
 
+/// The mesh with each tet's radius ratio and smallest dihedral angle, for ParaView.
+void write_quality_vtu(const fs::path& path, const TetMesh& mesh) {
+  VtuField ratio{"radius_ratio", 1, {}};
+  VtuField dihedral{"min_dihedral_deg", 1, {}};
+  for (const auto& t : mesh.tets) {
+    const auto tq =
+        tet_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
+    ratio.values.push_back(tq.radius_ratio);
+    dihedral.values.push_back(tq.min_dihedral_deg);
+  }
+  write_vtu(path, mesh, {}, {ratio, dihedral});
+  std::cout << "wrote " << path.string() << " (VTU with per-tet quality)\n";
+}
+
 void run(MeshCommandOptions& o) {
   if (!o.input.empty() && (o.input.extension() == ".stl" || o.input.extension() == ".STL")) {
     run_stl_input(o);
@@ -136,17 +150,7 @@ void run(MeshCommandOptions& o) {
     write_msh(o.output, mesh, o.msh_version == "2.2" ? MshVersion::v22 : MshVersion::v41);
     std::cout << "wrote " << o.output.string() << " (msh " << o.msh_version << ")\n";
   }
-  if (!o.vtu.empty()) {
-    VtuField ratio{"radius_ratio", 1, {}};
-    VtuField dihedral{"min_dihedral_deg", 1, {}};
-    for (const auto& t : mesh.tets) {
-      const auto tq = tet_quality(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
-      ratio.values.push_back(tq.radius_ratio);
-      dihedral.values.push_back(tq.min_dihedral_deg);
-    }
-    write_vtu(o.vtu, mesh, {}, {ratio, dihedral});
-    std::cout << "wrote " << o.vtu.string() << " (VTU with per-tet quality)\n";
-  }
+  if (!o.vtu.empty()) write_quality_vtu(o.vtu, mesh);
   if (!o.stl.empty()) {
     write_stl(o.stl, extract_surface(mesh, {o.stl_group}, "mesh"));
     std::cout << "wrote " << o.stl.string() << " (" << o.stl_group << " surface)\n";
