@@ -36,6 +36,8 @@ TractionPatch contact_patch(const TetMesh& mesh, const ContactPatchSpec& spec) {
     const Vec3 n2a = area_normal(mesh, t);
     patch.area += 0.5 * n2a.norm();
     normal_sum += n2a;
+    for (const SurfacePoint& q : whole_triangle_points(e, 0.5 * n2a.norm()))
+      patch.points.push_back(q);
   }
   if (patch.triangles.empty()) {
     std::ostringstream m;
@@ -50,16 +52,25 @@ TractionPatch contact_patch(const TetMesh& mesh, const ContactPatchSpec& spec) {
   return patch;
 }
 
+std::vector<SurfacePoint> whole_triangle_points(int triangle, double area) {
+  std::vector<SurfacePoint> points;
+  for (int k = 0; k < 3; ++k) {
+    Vec3 bary = Vec3::Constant(1.0 / 6.0);
+    bary[k] = 2.0 / 3.0;
+    points.push_back({triangle, bary, area / 3.0});
+  }
+  return points;
+}
+
 std::vector<int> pressure_triangles(const TetMesh& mesh, const std::string& group) {
   return mesh.require_group(group, 2, "pressure load").elements;
 }
 
 std::vector<Vec3> traction_nodal_loads(const TetMesh& mesh, const TractionPatch& patch) {
   std::vector<Vec3> f(mesh.nodes.size(), Vec3::Zero());
-  for (int e : patch.triangles) {
-    const Triangle& t = mesh.triangles[e];
-    const double area = 0.5 * area_normal(mesh, t).norm();
-    for (int n : t) f[n] += patch.traction * area / 3.0;
+  for (const SurfacePoint& q : patch.points) {
+    const Triangle& t = mesh.triangles[q.triangle];
+    for (int k = 0; k < 3; ++k) f[t[k]] += patch.traction * (q.weight * q.barycentric[k]);
   }
   return f;
 }

@@ -19,13 +19,29 @@ struct ContactPatchSpec {
   std::string surface_group = "inner_wall";
 };
 
-/// A uniform traction (Pa, a vector) on a set of boundary triangles.
+/// A quadrature point of a surface load on one boundary triangle: barycentric coordinates with
+/// respect to the triangle's nodes (in TetMesh::triangles order) and a weight (m², the area it
+/// stands for). The FEM and the mass-spring models integrate a patch's traction over the same
+/// points, so both see the same force distribution: ∫ t N_i dA ≈ Σ_q w_q t N_i(ξ_q).
+struct SurfacePoint {
+  int triangle = -1;                 ///< index into TetMesh::triangles
+  Vec3 barycentric = Vec3::Zero();   ///< (λ0, λ1, λ2), summing to 1
+  double weight = 0.0;               ///< m²
+};
+
+/// A uniform traction (Pa, a vector) over part of the boundary, given by quadrature points.
 struct TractionPatch {
-  std::vector<int> triangles;  ///< indices into TetMesh::triangles
+  std::vector<int> triangles;        ///< indices into TetMesh::triangles the patch touches
+  std::vector<SurfacePoint> points;  ///< the quadrature of the loaded region
   Vec3 traction = Vec3::Zero();
-  double area = 0.0;           ///< m², sum of the triangles' areas
+  double area = 0.0;                 ///< m², the sum of the points' weights
   Vec3 outward_normal = Vec3::Zero();  ///< area-weighted mean outward unit normal of the patch
 };
+
+/// Quadrature points covering whole triangle `triangle` (area `area`, m²): the symmetric 3-point
+/// rule, exact for polynomials of degree 2 (Strang & Fix), so P1 and P2 load vectors equal the
+/// exact integrals of a uniform traction.
+std::vector<SurfacePoint> whole_triangle_points(int triangle, double area);
 
 /// Selects the contact patch and its traction t = −F n̂ / A (n̂ the patch's mean outward normal),
 /// so ∫ t dA = −F n̂ exactly. Throws InputError naming the group if it is missing or if no triangle
@@ -38,8 +54,9 @@ TractionPatch contact_patch(const TetMesh& mesh, const ContactPatchSpec& spec);
 /// p > 0; the FEM integrates that, the nodal version is pressure_nodal_loads.
 std::vector<int> pressure_triangles(const TetMesh& mesh, const std::string& group);
 
-/// Consistent nodal loads (N per node, indexed like mesh.nodes) of linear triangles under uniform
-/// traction: each triangle gives t·A/3 to each of its three nodes.
+/// Consistent nodal loads (N per node, indexed like mesh.nodes) of linear triangles under the
+/// patch's uniform traction: Σ_q w_q t λ_k(ξ_q) to node k of each point's triangle (t·A/3 per
+/// node for a whole triangle).
 std::vector<Vec3> traction_nodal_loads(const TetMesh& mesh, const TractionPatch& patch);
 /// Consistent nodal loads of pressure p on the group's triangles: −p n A/3 per triangle node.
 std::vector<Vec3> pressure_nodal_loads(const TetMesh& mesh, const std::string& group, double p);
