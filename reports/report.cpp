@@ -11,6 +11,7 @@
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
+#include "reports/representative_load.hpp"
 #include "reports/svg_plot.hpp"
 
 namespace vessel::reports {
@@ -384,7 +385,7 @@ void scene_section(Document& doc, const SceneRows& s) {
                          fmt(r.max_abs_strain_at_unit_load)});
   }
   doc.table(refs);
-  const FigureContext c{doc, s, representative_magnitude(s), first_nu(s)};
+  const FigureContext c{doc, s, representative_load(s), first_nu(s)};
   speed_error_figure(c);
   error_vs_nu_figure(c);
   error_vs_level_figure(c);
@@ -402,7 +403,7 @@ Table summary_table(const ResultsFile& r) {
   t.header = {"scene", "model", "level", "load", "max mm", "RMS mm", "rel. L2", "ref. unc. mm",
               "within tol.", "solve s", "set-up s", "memory MiB"};
   for (const auto& s : r.scenes) {
-    const double mag = representative_magnitude(s);
+    const double mag = representative_load(s);
     const double nu = first_nu(s);
     for (const auto& o : s.outcomes) {
       if (o.magnitude != mag || o.poisson_ratio != nu) continue;
@@ -431,14 +432,24 @@ std::string read_text(const std::filesystem::path& path) {
 
 }  // namespace
 
-double representative_magnitude(const SceneRows& s) {
-  double best = -1.0;
-  double smallest = HUGE_VAL;
+double representative_load(const SceneRows& s) {
+  std::vector<double> magnitudes;
   for (const auto& o : s.outcomes) {
-    smallest = std::min(smallest, o.magnitude);
-    if (o.ok && !o.beyond_linear_regime) best = std::max(best, o.magnitude);
+    if (std::find(magnitudes.begin(), magnitudes.end(), o.magnitude) == magnitudes.end()) {
+      magnitudes.push_back(o.magnitude);
+    }
   }
-  return best > 0.0 ? best : smallest;
+  // The budget's load is drawn only where the run has it (a --quick run keeps only the smallest
+  // and largest load); the file's own value is used, so the outcomes' filters match it exactly.
+  std::optional<double> budget;
+  if (s.budget_magnitude) {
+    for (const double m : magnitudes) {
+      if (std::abs(m - *s.budget_magnitude) <= 1e-12 * std::abs(m)) budget = m;
+    }
+  }
+  const double strain_at_unit_load =
+      s.references.empty() ? 0.0 : s.references.front().max_abs_strain_at_unit_load;
+  return vessel::representative_load(magnitudes, strain_at_unit_load, budget);
 }
 
 Document build_report(const ResultsFile& r, const std::string& stability_markdown,
@@ -459,8 +470,9 @@ Document build_report(const ResultsFile& r, const std::string& stability_markdow
                 "seconds of a Release build (median of the repeats); memory is the peak resident "
                 "memory a model's set-up and solve added.");
   doc.heading(2, "Summary");
-  doc.paragraph("Each scene at its representative load (the largest within the linear regime) "
-                "and its first Poisson's ratio; *within tol.* compares the max error with the "
+  doc.paragraph("Each scene at its representative load (the load its [budget] applies at, when "
+                "it names one, else the largest within the linear regime) and its first Poisson's "
+                "ratio; *within tol.* compares the max error with the "
                 "scene's tolerance (seed 000's visual threshold, 0.1 mm, unless the scene says "
                 "otherwise).");
   doc.table(summary_table(r));

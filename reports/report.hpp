@@ -33,8 +33,9 @@ Document build_report(const ResultsFile& results, const std::string& stability_m
 /// atomically. InputError for a missing or malformed input or an unwritable output directory.
 void write_report(const ReportOptions& options);
 
-/// The load magnitude a scene's figures are drawn at: the largest one whose reference strain
-/// stays within the linear regime (≤ 5 %), else the smallest.
-double representative_magnitude(const SceneRows& scene);
+/// The load magnitude a scene's summary and figures are drawn at: representative_load
+/// (reports/representative_load.hpp) of the outcomes' magnitudes, at the first reference's strain,
+/// with the budget's magnitude when the scene sets one and the run has that load.
+double representative_load(const SceneRows& scene);
 
 }  // namespace vessel::reports

@@ -8,6 +8,7 @@
 #include "reports/document.hpp"
 #include "reports/gate.hpp"
 #include "reports/report.hpp"
+#include "reports/representative_load.hpp"
 #include "reports/svg_plot.hpp"
 
 using namespace vessel;
@@ -144,12 +145,27 @@ TEST(ResultsFile, WrongSchemaVersionOrMissingFieldsNameTheFile) {
             std::string::npos);
 }
 
-TEST(Report, RepresentativeLoadIsTheLargestWithinTheLinearRegime) {
-  const auto r = results_with({outcome("m", 1e-4, 0.01, 1), outcome("m", 1e-3, 0.1, 1),
-                               outcome("m", 0.14, 5.0, 1, true)});
-  EXPECT_DOUBLE_EQ(representative_magnitude(r.scenes[0]), 1e-3);
+TEST(RepresentativeLoad, TheBudgetsMagnitudeElseTheLargestWithinTheLinearRegime) {
+  // Strain 40 per unit load: the linear regime (5 %) ends at 0.05 / 40 = 1.25e-3.
+  const std::vector<double> loads{1e-5, 1e-4, 5e-4, 1e-3, 0.01, 0.14};
+  EXPECT_DOUBLE_EQ(representative_load(loads, 40.0, std::nullopt), 1e-3);
+  EXPECT_DOUBLE_EQ(representative_load(loads, 40.0, 5e-4), 5e-4);
+  EXPECT_DOUBLE_EQ(representative_load(loads, 40.0, 0.14), 0.14);  // the budget even beyond it
+  EXPECT_DOUBLE_EQ(representative_load(loads, 1e6, std::nullopt), 1e-5);  // none within: smallest
+}
+
+TEST(Report, RepresentativeLoadOfAScene) {
+  // results_with: the reference strains 40 per unit load, so 1e-3 N (4 %) is within 5 %, 0.14 N
+  // (560 %) beyond.
+  auto r = results_with({outcome("m", 1e-4, 0.01, 1), outcome("m", 1e-3, 0.1, 1),
+                         outcome("m", 0.14, 5.0, 1, true)});
+  EXPECT_DOUBLE_EQ(representative_load(r.scenes[0]), 1e-3);
+  r.scenes[0].budget_magnitude = 1e-4;
+  EXPECT_DOUBLE_EQ(representative_load(r.scenes[0]), 1e-4);
+  r.scenes[0].budget_magnitude = 5e-4;  // a load the run does not have (a --quick run)
+  EXPECT_DOUBLE_EQ(representative_load(r.scenes[0]), 1e-3);
   const auto all_beyond = results_with({outcome("m", 0.05, 2, 1, true), outcome("m", 0.14, 5, 1, true)});
-  EXPECT_DOUBLE_EQ(representative_magnitude(all_beyond.scenes[0]), 0.05);
+  EXPECT_DOUBLE_EQ(representative_load(all_beyond.scenes[0]), 0.05);
 }
 
 TEST(Report, SummaryJudgesTheToleranceAndEveryFigureIsWritten) {
