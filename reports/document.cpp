@@ -10,34 +10,9 @@ namespace {
 
 std::string cell_md(const std::string& s) {
   std::string out;
-  for (const char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c);
+  // A pipe would end the cell and a line break the row.
+  for (const char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c == '\n' ? ' ' : c);
   return out;
-}
-
-std::vector<std::string> split_row(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  std::string body = line;
-  if (!body.empty() && body.front() == '|') body.erase(0, 1);
-  if (!body.empty() && body.back() == '|') body.pop_back();
-  for (std::size_t i = 0; i < body.size(); ++i) {
-    if (body[i] == '\\' && i + 1 < body.size() && body[i + 1] == '|') {
-      cell += '|';
-      ++i;
-    } else if (body[i] == '|') {
-      cells.push_back(cell);
-      cell.clear();
-    } else {
-      cell += body[i];
-    }
-  }
-  cells.push_back(cell);
-  for (auto& c : cells) {
-    const auto a = c.find_first_not_of(' ');
-    const auto b = c.find_last_not_of(' ');
-    c = a == std::string::npos ? "" : c.substr(a, b - a + 1);
-  }
-  return cells;
 }
 
 std::string table_html(const Table& t) {
@@ -87,67 +62,6 @@ std::string inline_html(const std::string& md) {
   return out;
 }
 
-std::string markdown_to_html(const std::string& md) {
-  std::istringstream in(md);
-  std::vector<std::string> lines;
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  std::ostringstream out;
-  std::string paragraph;
-  const auto flush = [&] {
-    if (!paragraph.empty()) out << "<p>" << inline_html(paragraph) << "</p>\n";
-    paragraph.clear();
-  };
-  for (std::size_t i = 0; i < lines.size(); ++i) {
-    const std::string& line = lines[i];
-    if (line.empty()) {
-      flush();
-    } else if (line.rfind("```", 0) == 0) {
-      flush();
-      out << "<pre>";
-      for (++i; i < lines.size() && lines[i].rfind("```", 0) != 0; ++i) {
-        out << escape_xml(lines[i]) << "\n";
-      }
-      out << "</pre>\n";
-    } else if (line.rfind("    ", 0) == 0 && paragraph.empty()) {
-      out << "<pre>";
-      for (; i < lines.size() && lines[i].rfind("    ", 0) == 0; ++i) {
-        out << escape_xml(lines[i].substr(4)) << "\n";
-      }
-      --i;
-      out << "</pre>\n";
-    } else if (line[0] == '#') {
-      flush();
-      std::size_t level = line.find_first_not_of('#');
-      const std::string text = line.substr(std::min(line.size(), level + 1));
-      out << "<h" << level << ">" << inline_html(text) << "</h" << level << ">\n";
-    } else if (line[0] == '|') {
-      flush();
-      Table t;
-      t.header = split_row(line);
-      i += 2;  // the header and the |---| line
-      for (; i < lines.size() && !lines[i].empty() && lines[i][0] == '|'; ++i) {
-        t.rows.push_back(split_row(lines[i]));
-      }
-      --i;
-      out << table_html(t);
-    } else if (line.rfind("- ", 0) == 0) {
-      flush();
-      out << "<ul>\n";
-      for (; i < lines.size() && lines[i].rfind("- ", 0) == 0; ++i) {
-        std::string item = lines[i].substr(2);
-        while (i + 1 < lines.size() && lines[i + 1].rfind("  ", 0) == 0) item += " " + lines[++i];
-        out << "<li>" << inline_html(item) << "</li>\n";
-      }
-      --i;
-      out << "</ul>\n";
-    } else {
-      paragraph += (paragraph.empty() ? "" : " ") + line;
-    }
-  }
-  flush();
-  return out.str();
-}
-
 void Document::heading(int level, std::string text) {
   Block b;
   b.kind = Block::Kind::heading;
@@ -179,9 +93,9 @@ void Document::figure(std::string file_name, std::string svg, std::string captio
   blocks_.push_back(std::move(b));
 }
 
-void Document::markdown(std::string text) {
+void Document::code(std::string text) {
   Block b;
-  b.kind = Block::Kind::markdown;
+  b.kind = Block::Kind::code;
   b.text = std::move(text);
   blocks_.push_back(std::move(b));
 }
@@ -214,9 +128,12 @@ std::string Document::markdown_text(const std::string& figures_dir) const {
         out << "![" << b.text << "](" << figures_dir << '/' << b.file_name << ")\n\n*" << b.text
             << "*\n\n";
         break;
-      case Block::Kind::markdown:
-        out << b.text << (b.text.ends_with("\n") ? "\n" : "\n\n");
+      case Block::Kind::code: {
+        std::istringstream lines(b.text);
+        for (std::string line; std::getline(lines, line);) out << "    " << line << '\n';
+        out << '\n';
         break;
+      }
     }
   }
   return out.str();
@@ -232,7 +149,7 @@ std::string Document::html_text(const std::string& title) const {
         out << "<h" << b.level << ">" << inline_html(b.text) << "</h" << b.level << ">\n";
         break;
       case Block::Kind::paragraph:
-        out << markdown_to_html(b.text);
+        out << "<p>" << inline_html(b.text) << "</p>\n";
         break;
       case Block::Kind::table:
         out << table_html(b.table);
@@ -241,8 +158,8 @@ std::string Document::html_text(const std::string& title) const {
         out << "<figure>\n" << b.svg << "<figcaption>" << inline_html(b.text)
             << "</figcaption>\n</figure>\n";
         break;
-      case Block::Kind::markdown:
-        out << markdown_to_html(b.text);
+      case Block::Kind::code:
+        out << "<pre>" << escape_xml(b.text) << "</pre>\n";
         break;
     }
   }

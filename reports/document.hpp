@@ -13,11 +13,11 @@ struct Table {
 };
 
 struct Block {
-  enum class Kind { heading, paragraph, table, figure, markdown };
+  enum class Kind { heading, paragraph, table, figure, code };
   Kind kind = Kind::paragraph;
   int level = 2;          ///< heading level
-  std::string text;       ///< heading or paragraph (inline Markdown: `code`, **bold**), caption,
-                          ///< or a Markdown section (kind markdown)
+  std::string text;       ///< heading or paragraph (inline Markdown: `code`, **bold**, *italic*),
+                          ///< caption, or a preformatted line (kind code, e.g. a command)
   Table table;
   std::string svg;        ///< figure
   std::string file_name;  ///< figure: its .svg file beside the Markdown report
@@ -29,8 +29,8 @@ class Document {
   void paragraph(std::string text);
   void table(Table table);
   void figure(std::string file_name, std::string svg, std::string caption);
-  /// A Markdown section written elsewhere (e.g. stability.md), embedded as it is.
-  void markdown(std::string text);
+  /// Preformatted text shown as it is (a command line): indented in Markdown, <pre> in HTML.
+  void code(std::string text);
 
   /// Markdown; figures are referenced as `figures_dir/<file_name>`.
   [[nodiscard]] std::string markdown_text(const std::string& figures_dir) const;
@@ -44,8 +44,5 @@ class Document {
 
 /// Inline Markdown (`code`, **bold**, *italic*) of escaped text as HTML.
 std::string inline_html(const std::string& markdown);
-/// A Markdown section (headings, paragraphs, pipe tables, "- " lists, fenced or indented code)
-/// as HTML: enough for the sections this project writes itself.
-std::string markdown_to_html(const std::string& markdown);
 
 }  // namespace vessel::reports

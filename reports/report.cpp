@@ -11,6 +11,8 @@
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
+#include "reports/representative_load.hpp"
+#include "reports/study_sections.hpp"
 #include "reports/svg_plot.hpp"
 
 namespace vessel::reports {
@@ -384,7 +386,7 @@ void scene_section(Document& doc, const SceneRows& s) {
                          fmt(r.max_abs_strain_at_unit_load)});
   }
   doc.table(refs);
-  const FigureContext c{doc, s, representative_magnitude(s), first_nu(s)};
+  const FigureContext c{doc, s, representative_load(s), first_nu(s)};
   speed_error_figure(c);
   error_vs_nu_figure(c);
   error_vs_level_figure(c);
@@ -402,7 +404,7 @@ Table summary_table(const ResultsFile& r) {
   t.header = {"scene", "model", "level", "load", "max mm", "RMS mm", "rel. L2", "ref. unc. mm",
               "within tol.", "solve s", "set-up s", "memory MiB"};
   for (const auto& s : r.scenes) {
-    const double mag = representative_magnitude(s);
+    const double mag = representative_load(s);
     const double nu = first_nu(s);
     for (const auto& o : s.outcomes) {
       if (o.magnitude != mag || o.poisson_ratio != nu) continue;
@@ -421,35 +423,40 @@ Table summary_table(const ResultsFile& r) {
   return t;
 }
 
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string() + ": cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 }  // namespace
 
-double representative_magnitude(const SceneRows& s) {
-  double best = -1.0;
-  double smallest = HUGE_VAL;
+double representative_load(const SceneRows& s) {
+  std::vector<double> magnitudes;
   for (const auto& o : s.outcomes) {
-    smallest = std::min(smallest, o.magnitude);
-    if (o.ok && !o.beyond_linear_regime) best = std::max(best, o.magnitude);
+    if (std::find(magnitudes.begin(), magnitudes.end(), o.magnitude) == magnitudes.end()) {
+      magnitudes.push_back(o.magnitude);
+    }
   }
-  return best > 0.0 ? best : smallest;
+  // The budget's load is drawn only where the run has it (a --quick run keeps only the smallest
+  // and largest load); the file's own value is used, so the outcomes' filters match it exactly.
+  std::optional<double> budget;
+  if (s.budget_magnitude) {
+    for (const double m : magnitudes) {
+      if (std::abs(m - *s.budget_magnitude) <= 1e-12 * std::abs(m)) budget = m;
+    }
+  }
+  const double strain_at_unit_load =
+      s.references.empty() ? 0.0 : s.references.front().max_abs_strain_at_unit_load;
+  return vessel::representative_load(magnitudes, strain_at_unit_load, budget);
 }
 
-Document build_report(const ResultsFile& r, const std::string& stability_markdown,
-                      const std::string& command, const std::vector<std::string>& recommendations) {
+Document build_report(const ResultsFile& r, const std::optional<StabilityFile>& stability,
+                      const std::string& command,
+                      const std::vector<RecommendFile>& recommendations) {
   Document doc;
   doc.heading(1, "vesselverify report");
   doc.paragraph("How wrong, and how fast, is each mass-spring vessel model against linear-elastic "
                 "FEM? Results `" + r.path.filename().string() + "` were produced " + r.date +
                 " on `" + r.host + "` (" + std::to_string(r.hardware_threads) +
-                " hardware threads), built with " + r.compiler + ", by\n\n    " + r.command +
-                "\n\nThis report was generated " + now_utc() + " by\n\n    " + command);
+                " hardware threads), built with " + r.compiler + ", by");
+  doc.code(r.command);
+  doc.paragraph("This report was generated " + now_utc() + " by");
+  doc.code(command);
   doc.paragraph("Errors are the model's nodal displacement minus the FEM reference's (P2, or "
                 "Taylor–Hood P2–P1 for ν ≥ 0.49) evaluated at each model node's rest position, in "
                 "mm, with seed 000's statistics (max, mean, standard deviation, RMS). *ref. unc.* "
@@ -459,29 +466,48 @@ Document build_report(const ResultsFile& r, const std::string& stability_markdow
                 "seconds of a Release build (median of the repeats); memory is the peak resident "
                 "memory a model's set-up and solve added.");
   doc.heading(2, "Summary");
-  doc.paragraph("Each scene at its representative load (the largest within the linear regime) "
-                "and its first Poisson's ratio; *within tol.* compares the max error with the "
+  doc.paragraph("Each scene at its representative load (the load its [budget] applies at, when "
+                "it names one, else the largest within the linear regime) and its first Poisson's "
+                "ratio; *within tol.* compares the max error with the "
                 "scene's tolerance (seed 000's visual threshold, 0.1 mm, unless the scene says "
                 "otherwise).");
   doc.table(summary_table(r));
   for (const auto& s : r.scenes) scene_section(doc, s);
-  for (const auto& section : recommendations) doc.markdown(section);
-  if (stability_markdown.empty()) {
-    doc.heading(2, "Numerical stability");
-    doc.paragraph("Not part of these results: `vesselverify stability` writes `stability.md`, "
-                  "which `vesselverify report --stability` embeds here.");
+  for (const auto& recommendation : recommendations) recommendation_section(doc, recommendation);
+  if (stability) {
+    stability_section(doc, *stability);
   } else {
-    doc.markdown(stability_markdown);
+    doc.heading(2, "Numerical stability");
+    doc.paragraph("Not part of these results: `vesselverify stability` writes `stability.json`, "
+                  "which `vesselverify report --stability` draws here.");
   }
   return doc;
 }
 
+void attach_run(RecommendFile& recommendation, const ResultsFile& run) {
+  for (const SceneRows& scene : run.scenes) {
+    if (scene.name != recommendation.scene) continue;
+    recommendation.load_unit = scene.load_unit;
+    for (BudgetLoadEntry& load : recommendation.loads) {
+      for (const ReferenceRow& ref : scene.references) {
+        if (ref.poisson_ratio == load.poisson_ratio) load.reference_element = ref.element;
+      }
+    }
+  }
+}
+
 void write_report(const ReportOptions& o) {
   const ResultsFile results = read_results(o.results);
-  std::string stability;
-  if (!o.stability_markdown.empty()) stability = read_text(o.stability_markdown);
-  std::vector<std::string> recommendations;
-  for (const auto& f : o.recommend_markdown) recommendations.push_back(read_text(f));
+  std::optional<StabilityFile> stability;
+  if (!o.stability.empty()) stability = read_stability(o.stability);
+  std::vector<RecommendFile> recommendations;
+  for (const auto& f : o.recommend) {
+    RecommendFile r = read_recommend(f);
+    // `vesselverify recommend` writes its run's results.json beside recommend.json.
+    const auto run = f.parent_path() / "results.json";
+    if (std::filesystem::exists(run)) attach_run(r, read_results(run));
+    recommendations.push_back(std::move(r));
+  }
   const Document doc = build_report(results, stability, o.command, recommendations);
   std::error_code ec;
   std::filesystem::create_directories(o.output_dir / "figures", ec);

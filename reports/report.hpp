@@ -1,12 +1,14 @@
 #pragma once
-/// `vesselverify report`: results.json (and the stability section, if run) → report.md with its
-/// figures as .svg files, and report.html, self-contained with the same figures inline.
+/// `vesselverify report`: results.json (and stability.json, recommend.json, if run) → report.md
+/// with its figures as .svg files, and report.html, self-contained with the same figures inline.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "reports/document.hpp"
 #include "reports/results_file.hpp"
+#include "reports/study_files.hpp"
 
 namespace vessel::reports {
 
@@ -15,26 +17,32 @@ namespace vessel::reports {
 inline constexpr double kSeed000HookeStiffness = 41.106;  // N/m
 
 struct ReportOptions {
-  std::filesystem::path results;           ///< results.json of `vesselverify run`
-  std::filesystem::path stability_markdown;  ///< stability.md of `vesselverify stability` (optional)
-  /// recommend.md files of `vesselverify recommend`, each embedded as a section (optional).
-  std::vector<std::filesystem::path> recommend_markdown;
-  std::filesystem::path output_dir;        ///< report.md, report.html, figures/
-  std::string command;                     ///< the command line that makes the report
+  std::filesystem::path results;    ///< results.json of `vesselverify run`
+  std::filesystem::path stability;  ///< stability.json of `vesselverify stability` (optional)
+  /// recommend.json files of `vesselverify recommend`, each drawn as a section (optional); the
+  /// results.json its run wrote beside it, when there, names the load unit and the reference.
+  std::vector<std::filesystem::path> recommend;
+  std::filesystem::path output_dir;  ///< report.md, report.html, figures/
+  std::string command;               ///< the command line that makes the report
 };
 
-/// The report's content. `stability_markdown` is embedded verbatim (empty: a note says it was
-/// not run), and so is each of `recommendations` (recommend.md sections), after the scenes.
-Document build_report(const ResultsFile& results, const std::string& stability_markdown,
+/// The report's content: the summary and every scene of `results`, a section per
+/// recommendation, then the stability section (absent: a note says it was not run).
+Document build_report(const ResultsFile& results, const std::optional<StabilityFile>& stability,
                       const std::string& command,
-                      const std::vector<std::string>& recommendations = {});
+                      const std::vector<RecommendFile>& recommendations = {});
+
+/// Fills in what recommend.json leaves to its run's results.json: the scene's load unit and the
+/// reference element at each Poisson's ratio (matched by scene name and ν).
+void attach_run(RecommendFile& recommendation, const ResultsFile& run);
 
 /// Reads the inputs, builds the report and writes report.md, report.html and figures/*.svg, each
 /// atomically. InputError for a missing or malformed input or an unwritable output directory.
 void write_report(const ReportOptions& options);
 
-/// The load magnitude a scene's figures are drawn at: the largest one whose reference strain
-/// stays within the linear regime (≤ 5 %), else the smallest.
-double representative_magnitude(const SceneRows& scene);
+/// The load magnitude a scene's summary and figures are drawn at: representative_load
+/// (reports/representative_load.hpp) of the outcomes' magnitudes, at the first reference's strain,
+/// with the budget's magnitude when the scene sets one and the run has that load.
+double representative_load(const SceneRows& scene);
 
 }  // namespace vessel::reports

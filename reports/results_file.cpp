@@ -1,36 +1,14 @@
 #include "reports/results_file.hpp"
 
-#include <fstream>
-#include <nlohmann/json.hpp>
-#include <sstream>
-
-#include "meshes/errors.hpp"
+#include "reports/json_fields.hpp"
 
 namespace vessel::reports {
 
 namespace {
 
+using json_fields::field;
+using json_fields::field_or;
 using nlohmann::json;
-
-/// j[key] as T, or an InputError naming the file and the JSON path.
-template <class T>
-T field(const json& j, const char* key, const std::string& where) {
-  const auto it = j.find(key);
-  if (it == j.end() || it->is_null()) {
-    throw InputError(where + ": missing field '" + key + "'");
-  }
-  try {
-    return it->get<T>();
-  } catch (const json::exception&) {
-    throw InputError(where + ": field '" + key + "' has the wrong type (" + it->type_name() + ")");
-  }
-}
-
-template <class T>
-T field_or(const json& j, const char* key, T fallback, const std::string& where) {
-  const auto it = j.find(key);
-  return it == j.end() || it->is_null() ? fallback : field<T>(j, key, where);
-}
 
 OutcomeRow read_outcome(const json& j, const std::string& where) {
   OutcomeRow o;
@@ -84,23 +62,11 @@ OutcomeRow read_outcome(const json& j, const std::string& where) {
 
 ResultsFile parse_results(const std::string& text, const std::filesystem::path& source) {
   const std::string file = source.string();
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw InputError(file + ": not valid JSON (" + e.what() + ")");
-  }
-  if (!j.is_object() || j.value("schema", "") != "vesselverify.results") {
-    throw InputError(file + ": not a vesselverify results file (expected \"schema\": "
-                            "\"vesselverify.results\")");
-  }
+  const json j = json_fields::parse_versioned(text, file, "vesselverify.results", 2,
+                                              "results file", "vesselverify run");
   ResultsFile r;
   r.path = source;
-  r.schema_version = field<int>(j, "schema_version", file);
-  if (r.schema_version != 2) {
-    throw InputError(file + ": schema_version " + std::to_string(r.schema_version) +
-                     ", expected 2 (rerun `vesselverify run` with this build)");
-  }
+  r.schema_version = 2;
   r.date = field<std::string>(j, "date", file);
   r.command = field<std::string>(j, "command", file);
   r.host = field<std::string>(field<json>(j, "machine", file), "host", file + ": machine");
@@ -123,6 +89,9 @@ ResultsFile parse_results(const std::string& text, const std::filesystem::path& 
     sr.reference_level = field<int>(s, "reference_level", where);
     sr.tolerance_mm = field_or<double>(s, "tolerance_max_error_mm", 0.1, where);
     sr.seconds = field<double>(s, "seconds", where);
+    if (const auto b = s.find("budget"); b != s.end() && !b->is_null()) {
+      sr.budget_magnitude = json_fields::optional_field<double>(*b, "magnitude", where + ".budget");
+    }
     for (const json& ref : field<json>(s, "references", where)) {
       ReferenceRow rr;
       rr.poisson_ratio = field<double>(ref, "poisson_ratio", where + ".references");
@@ -145,11 +114,7 @@ ResultsFile parse_results(const std::string& text, const std::filesystem::path& 
 }
 
 ResultsFile read_results(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string() + ": cannot open results file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_results(text.str(), path);
+  return parse_results(json_fields::read_text(path, "results file"), path);
 }
 
 }  // namespace vessel::reports

@@ -43,6 +43,9 @@ struct SceneRows {
   int reference_level = 0;
   double tolerance_mm = 0.1;
   double seconds = 0.0;
+  /// The load the scene's [budget] applies at (scene's load unit); nullopt without a budget, or
+  /// when the budget leaves it to the representative load.
+  std::optional<double> budget_magnitude;
   std::vector<ReferenceRow> references;
   std::vector<OutcomeRow> outcomes;
 };

@@ -10,7 +10,7 @@
 #   4. `vesselverify recommend` on the two contact scenes at 30 Hz (visual) and 1 kHz (haptic):
 #      the cheapest model meeting each scene's [budget] → recommend/<scene>_<rate>/;
 #   5. `vesselverify report` → report.md, report.html (self-contained) and figures/, with the
-#      stability and recommendation sections.
+#      stability and recommendation sections drawn from stability.json and each recommend.json.
 #
 # Usage: scripts/verify.sh [--quick] [output-dir]   (default output: results/)
 #   default  the scenes' own levels, loads and sweeps: well under 30 minutes on 2 cores
@@ -57,11 +57,11 @@ for scene in contact_straight contact_arch; do
     # Level-0 candidates and ROI radii 4 and 8 mm in both modes (~1 minute each); the level-1
     # candidates take 5-10 minutes per run: `vesselverify recommend SCENE` for those.
     "$vv" recommend --quick --rate "$rate" --output-dir "$dir" "$scenes/$scene.toml"
-    recommendations+=(--recommend "$dir/recommend.md")
+    recommendations+=(--recommend "$dir/recommend.json")
   done
 done
 phase "report"
-"$vv" report "$out/results.json" --stability "$out/stability.md" "${recommendations[@]}" \
+"$vv" report "$out/results.json" --stability "$out/stability.json" "${recommendations[@]}" \
   --output-dir "$out"
 phase "done"
 echo "verification finished in $((SECONDS - start)) s; report: $out/report.html (and report.md)"

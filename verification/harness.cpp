@@ -19,6 +19,7 @@
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/static_solver.hpp"
+#include "reports/representative_load.hpp"
 #include "verification/memory.hpp"
 #include "verification/progress.hpp"
 #include "verification/roi.hpp"
@@ -29,7 +30,6 @@ namespace vessel {
 
 namespace {
 
-constexpr double kLinearRegimeStrain = 0.05;
 /// Straight-sided tets cap the reference's observed order near 2 on the curved walls (the
 /// reference's own Lamé verification), so Richardson uses p = 2 between its two levels.
 constexpr double kReferenceOrder = 2.0;
@@ -539,14 +539,9 @@ QuantityErrors quantity_errors(const Budget& budget, const std::vector<Vec3>& no
 }
 
 double budget_magnitude(const Scene& s, double max_abs_strain_unit) {
-  if (s.budget.magnitude > 0.0) return s.budget.magnitude;
-  double best = -1.0;
-  double smallest = HUGE_VAL;
-  for (const double m : s.load.magnitudes) {
-    smallest = std::min(smallest, m);
-    if (max_abs_strain_unit * m <= kLinearRegimeStrain) best = std::max(best, m);
-  }
-  return best > 0.0 ? best : smallest;
+  return representative_load(s.load.magnitudes, max_abs_strain_unit,
+                             s.budget.magnitude > 0.0 ? std::optional(s.budget.magnitude)
+                                                      : std::nullopt);
 }
 
 double budget_quantity_error(const QuantityErrors& q, BudgetQuantity quantity) {

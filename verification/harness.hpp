@@ -134,7 +134,8 @@ struct SceneResult {
 /// keep their reference at level 0 (then without an uncertainty estimate).
 Scene quick_variant(Scene scene);
 
-/// The load the budget applies at: Budget::magnitude if set, else the largest of the scene's
+/// The load the budget applies at: the scene's representative_load (reports/representative_load.hpp,
+/// the rule the report draws at too): Budget::magnitude if set, else the largest of the scene's
 /// magnitudes whose reference strain (max_abs_strain_unit × magnitude) stays within 5 %, else the
 /// smallest.
 double budget_magnitude(const Scene& scene, double max_abs_strain_unit);

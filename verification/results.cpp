@@ -46,7 +46,8 @@ nlohmann::json budget_json(const Budget& b) {
                    {"tolerance", b.tolerance},
                    {"rate_hz", number_or_null(b.rate_hz > 0.0 ? b.rate_hz : NAN)},
                    {"seconds_per_update", b.seconds_per_update()},
-                   {"update_period_s", b.update_period()}};
+                   {"update_period_s", b.update_period()},
+                   {"magnitude", number_or_null(b.magnitude > 0.0 ? b.magnitude : NAN)}};
   if (b.quantity == BudgetQuantity::patch) j["radius_mm"] = b.radius * 1e3;
   return j;
 }

@@ -83,10 +83,11 @@ TEST(RecommendCli, NamesACandidateThatMeetsTheBudgetWithItsEvidence) {
                      res["scenes"][0]["references"][0]["budget_magnitude"].get<double>());
     if (o["ok"].get<bool>()) EXPECT_TRUE(o["budget_error"].is_number()) << o["model"];
   }
-  // The report embeds the section.
+  // The report draws the section from recommend.json.
   const CommandResult rep = vv("report " + (out / "results.json").string() + " --recommend " +
-                               (out / "recommend.md").string());
+                               (out / "recommend.json").string());
   ASSERT_EQ(rep.exit_code, 0) << rep.output;
-  EXPECT_NE(read_text(out / "report.md").find("## Model recommendation: small_contact"),
-            std::string::npos);
+  const std::string report = read_text(out / "report.md");
+  EXPECT_NE(report.find("## Model recommendation: small_contact"), std::string::npos);
+  EXPECT_NE(report.find("**Recommended: `" + best + "`**"), std::string::npos) << report;
 }

@@ -79,6 +79,57 @@ TEST(ReportCli, ANonResultsFileIsAClearError) {
   EXPECT_FALSE(std::filesystem::exists(dir / "report.md"));
 }
 
+TEST(ReportCli, DrawsTheStudiesFromTheirJsonFiles) {
+  TempDir dir;
+  // Hand-written: a critical step predicted at 12.34 µs and found at 10 µs (ratio 0.8104), and a
+  // recommendation of one candidate at 0.0421 mm; the recommend run's results.json beside it
+  // (the baseline: contact_straight, load unit N, reference P2) gives the load in mN.
+  write_text(dir / "stability.json", R"({"schema": "vesselverify.stability", "schema_version": 1,
+    "command": "vesselverify stability --quick", "quick": true, "steps_per_trial": 400,
+    "critical_steps": [{"model": "volume / seed001", "integrator": "verlet", "zeta": 0,
+      "level": 0, "nodes": 321, "omega_max": 81234.4, "omega_gershgorin": 99000,
+      "predicted_dt": 1.234e-5, "guaranteed_dt": null, "found_dt": 1.0e-5}],
+    "refinement": [], "hard_cases": [], "total_seconds": 42.0})");
+  std::filesystem::create_directories(dir / "rec");
+  std::filesystem::copy_file(kBaseline, dir / "rec" / "results.json");
+  write_text(dir / "rec" / "recommend.json", R"({"schema": "vesselverify.recommend",
+    "schema_version": 1, "command": "vesselverify recommend --quick", "scene": "contact_straight",
+    "model_levels": [0], "reference_level": 1, "reference_contact_point_mm": 0.25,
+    "budget": {"quantity": "contact_point", "unit": "mm", "tolerance": 0.1,
+               "seconds_per_update": 0.001, "rate_hz": 1000},
+    "loads": [{"poisson_ratio": 0.45, "magnitude": 0.0005}],
+    "recommended": "volume/lloyd/static @ L0", "closest": null,
+    "candidates": [{"name": "volume/lloyd/static @ L0", "detail": "Newton", "unknowns": 600,
+      "ok": true, "pareto": true, "verdict": "recommended", "reason": "the fastest",
+      "error": 0.0421, "update_seconds": 0.0005}]})");
+  const auto r = vv("report " + kBaseline + " --stability " + (dir / "stability.json").string() +
+                    " --recommend " + (dir / "rec" / "recommend.json").string() + " -o " +
+                    dir.path().string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string html = read_text(dir / "report.html");
+  EXPECT_TRUE(contains(html, "<td>12.34</td><td>–</td><td>10</td><td>0.8104</td><td>–</td>"))
+      << html;
+  EXPECT_TRUE(contains(html, "<h2>Model recommendation: contact_straight at 1000 Hz</h2>"));
+  EXPECT_TRUE(contains(html, "the load is 0.5 mN (reference P2, level 1)")) << html;
+  EXPECT_TRUE(contains(html, "<strong>Recommended: <code>volume/lloyd/static @ L0</code></strong>"));
+  EXPECT_TRUE(contains(read_text(dir / "report.md"), "| `volume/lloyd/static @ L0` | 600 | 0.0421 |"));
+}
+
+TEST(ReportCli, AStudyFileOfAnotherKindIsAClearErrorNamingIt) {
+  TempDir dir;
+  auto r = vv("report " + kBaseline + " --stability " + kBaseline + " -o " + dir.path().string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "baseline.json: not a vesselverify stability file (expected "
+                                 "\"schema\": \"vesselverify.stability\""))
+      << r.output;
+  write_text(dir / "recommend.json", "{\"schema\": \"vesselverify.recommend\", \"schema_version\": 1");
+  r = vv("report " + kBaseline + " --recommend " + (dir / "recommend.json").string() + " -o " +
+         dir.path().string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "recommend.json: not valid JSON")) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "report.md"));
+}
+
 TEST(GateCli, TheBaselineAgainstItselfPasses) {
   TempDir dir;
   const auto r = vv("gate --baseline " + kBaseline + " --current " + kBaseline + " --output-dir " +

@@ -8,6 +8,8 @@
 #include "reports/document.hpp"
 #include "reports/gate.hpp"
 #include "reports/report.hpp"
+#include "reports/representative_load.hpp"
+#include "reports/study_files.hpp"
 #include "reports/svg_plot.hpp"
 
 using namespace vessel;
@@ -57,6 +59,61 @@ ResultsFile results_with(std::vector<OutcomeRow> outcomes, double kernel_s = 0.0
   s.outcomes = std::move(outcomes);
   r.scenes.push_back(s);
   return r;
+}
+
+
+/// A stability.json as `vesselverify stability` writes it, by hand: one critical-step row
+/// (predicted 12.34 µs, found 10 µs: found / predicted = 0.8104; guaranteed 8 µs: 1.25), one
+/// refinement fit and one hard case whose report has a pipe in it.
+const char* kStability = R"({
+  "schema": "vesselverify.stability", "schema_version": 1,
+  "command": "vesselverify stability --quick", "quick": true, "units": {},
+  "steps_per_trial": 400,
+  "critical_steps": [{"model": "volume / seed001", "integrator": "symplectic-euler", "zeta": 0,
+    "point_damping": 0, "level": 0, "nodes": 321, "springs": 1500, "h_nominal": 0.001,
+    "omega_max": 81234.4, "omega_gershgorin": 99000, "omega_min": 10, "gamma_max": 0,
+    "predicted_dt": 1.234e-5, "guaranteed_dt": 8e-6, "found_over_guaranteed": 1.25,
+    "found_dt": 1.0e-5, "unstable_dt": 1.1e-5, "found_over_predicted": 0.8104, "trials": 9,
+    "seconds": 1.5}],
+  "refinement": [{"model": "volume / seed001", "integrator": "verlet", "zeta": 0.1,
+    "levels": [0, 1], "found_exponent": 0.987, "predicted_exponent": 1.02}],
+  "hard_cases": [{"id": "sliver", "title": "Sliver tets", "setup": "one tet flattened to 1e-3",
+    "seconds": 2.5, "outcomes": [{"model": "fem_p1", "finished": true, "converged": true,
+    "bounded": null, "reported": "max |u| 0.123 mm", "values": {}}]}],
+  "total_seconds": 42.0
+})";
+
+/// A recommend.json by hand: three candidates, the recommended one with error 0.0421 mm at
+/// 1.5 ms per update, one too slow, one failed; the budget's load 0.5 mN at ν = 0.45.
+const char* kRecommend = R"({
+  "schema": "vesselverify.recommend", "schema_version": 1,
+  "command": "vesselverify recommend --quick --rate 30 contact_straight.toml",
+  "scene": "contact_straight", "source": "contact_straight.toml", "model_levels": [0],
+  "reference_level": 1, "reference_contact_point_mm": 0.25,
+  "budget": {"quantity": "contact_point", "unit": "mm", "tolerance": 0.1,
+             "seconds_per_update": 0.0333333, "update_period_s": 0.0333333, "rate_hz": 30},
+  "loads": [{"poisson_ratio": 0.45, "magnitude": 0.0005}],
+  "recommended": "volume/lloyd/static @ L0", "closest": null,
+  "candidates": [
+    {"name": "fem_p1 @ L0", "model": "fem_p1", "detail": "P1", "level": 0, "unknowns": 900,
+     "ok": true, "pareto": true, "verdict": "too slow", "reason": "77 ms per update", "error": 0.01,
+     "update_seconds": 0.077},
+    {"name": "surface/seed000/explicit @ L0", "model": "s", "detail": "explicit", "level": 0,
+     "unknowns": 300, "ok": false, "pareto": false, "verdict": "failed", "reason": "diverged",
+     "failure": "energy grew"},
+    {"name": "volume/lloyd/static @ L0", "model": "v", "detail": "Newton", "level": 0,
+     "unknowns": 600, "ok": true, "pareto": true, "verdict": "recommended",
+     "reason": "the fastest meeting both", "error": 0.0421, "update_seconds": 0.0015}]
+})";
+
+template <class Parse>
+std::string error_of(Parse&& parse, const std::string& text) {
+  try {
+    parse(text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 }  // namespace
@@ -112,16 +169,24 @@ TEST(SvgPlot, RendersSeriesEscapesTextAndCountsPointsALogAxisCannotShow) {
   EXPECT_NE(render_svg(empty).find("no data to plot"), std::string::npos);
 }
 
-TEST(Document, MarkdownSectionsBecomeHtml) {
-  const std::string html = markdown_to_html(
-      "## Numerical stability\n\nSome *text* with `code`.\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\n"
-      "- one\n- two\n");
+TEST(Document, BlocksRenderAsMarkdownAndHtml) {
+  Document doc;
+  doc.heading(2, "Numerical stability");
+  doc.paragraph("Some *text* with `code` and **bold**.");
+  doc.code("vesselverify run a<b.toml");
+  doc.table({{"a", "b"}, {{"1", "x|y\nz"}}});
+  const std::string md = doc.markdown_text("figures");
+  EXPECT_NE(md.find("## Numerical stability\n\nSome *text*"), std::string::npos) << md;
+  EXPECT_NE(md.find("\n    vesselverify run a<b.toml\n"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 1 | x\\|y z |"), std::string::npos) << md;  // one row, pipe escaped
+  const std::string html = doc.html_text("t");
   EXPECT_NE(html.find("<h2>Numerical stability</h2>"), std::string::npos);
-  EXPECT_NE(html.find("<em>text</em>"), std::string::npos);
-  EXPECT_NE(html.find("<code>code</code>"), std::string::npos);
+  EXPECT_NE(html.find("<p>Some <em>text</em> with <code>code</code> and <strong>bold</strong>.</p>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<pre>vesselverify run a&lt;b.toml</pre>"), std::string::npos) << html;
   EXPECT_NE(html.find("<th>a</th><th>b</th>"), std::string::npos);
-  EXPECT_NE(html.find("<td>1</td><td>2</td>"), std::string::npos);
-  EXPECT_EQ(count(html, "<li>"), 2u);
+  EXPECT_NE(html.find("<td>1</td><td>x|y\nz</td>"), std::string::npos) << html;
 }
 
 TEST(ResultsFile, WrongSchemaVersionOrMissingFieldsNameTheFile) {
@@ -144,18 +209,41 @@ TEST(ResultsFile, WrongSchemaVersionOrMissingFieldsNameTheFile) {
             std::string::npos);
 }
 
-TEST(Report, RepresentativeLoadIsTheLargestWithinTheLinearRegime) {
-  const auto r = results_with({outcome("m", 1e-4, 0.01, 1), outcome("m", 1e-3, 0.1, 1),
-                               outcome("m", 0.14, 5.0, 1, true)});
-  EXPECT_DOUBLE_EQ(representative_magnitude(r.scenes[0]), 1e-3);
+TEST(RepresentativeLoad, TheBudgetsMagnitudeElseTheLargestWithinTheLinearRegime) {
+  // Strain 40 per unit load: the linear regime (5 %) ends at 0.05 / 40 = 1.25e-3.
+  const std::vector<double> loads{1e-5, 1e-4, 5e-4, 1e-3, 0.01, 0.14};
+  EXPECT_DOUBLE_EQ(representative_load(loads, 40.0, std::nullopt), 1e-3);
+  EXPECT_DOUBLE_EQ(representative_load(loads, 40.0, 5e-4), 5e-4);
+  EXPECT_DOUBLE_EQ(representative_load(loads, 40.0, 0.14), 0.14);  // the budget even beyond it
+  EXPECT_DOUBLE_EQ(representative_load(loads, 1e6, std::nullopt), 1e-5);  // none within: smallest
+}
+
+TEST(Report, RepresentativeLoadOfAScene) {
+  // results_with: the reference strains 40 per unit load, so 1e-3 N (4 %) is within 5 %, 0.14 N
+  // (560 %) beyond.
+  auto r = results_with({outcome("m", 1e-4, 0.01, 1), outcome("m", 1e-3, 0.1, 1),
+                         outcome("m", 0.14, 5.0, 1, true)});
+  EXPECT_DOUBLE_EQ(representative_load(r.scenes[0]), 1e-3);
+  r.scenes[0].budget_magnitude = 1e-4;
+  EXPECT_DOUBLE_EQ(representative_load(r.scenes[0]), 1e-4);
+  r.scenes[0].budget_magnitude = 5e-4;  // a load the run does not have (a --quick run)
+  EXPECT_DOUBLE_EQ(representative_load(r.scenes[0]), 1e-3);
   const auto all_beyond = results_with({outcome("m", 0.05, 2, 1, true), outcome("m", 0.14, 5, 1, true)});
-  EXPECT_DOUBLE_EQ(representative_magnitude(all_beyond.scenes[0]), 0.05);
+  EXPECT_DOUBLE_EQ(representative_load(all_beyond.scenes[0]), 0.05);
+}
+
+TEST(Report, TheSummaryIsAtTheBudgetsLoad) {
+  auto r = results_with({outcome("m", 1e-4, 0.01, 1), outcome("m", 1e-3, 0.25, 1)});
+  r.scenes[0].budget_magnitude = 1e-4;
+  const std::string md = build_report(r, std::nullopt, "vesselverify report").markdown_text("f");
+  EXPECT_NE(md.find("| contact_straight | m | 0 | 0.1 mN | 0.01 |"), std::string::npos) << md;
+  EXPECT_EQ(md.find("| contact_straight | m | 0 | 1 mN |"), std::string::npos) << md;
 }
 
 TEST(Report, SummaryJudgesTheToleranceAndEveryFigureIsWritten) {
   const auto r = results_with({outcome("fast", 1e-4, 0.05, 0.01), outcome("fast", 1e-3, 0.5, 0.01),
                                outcome("slow", 1e-4, 0.01, 1.0), outcome("slow", 1e-3, 0.08, 1.0)});
-  const Document doc = build_report(r, "## Numerical stability\n\ntable here\n", "vesselverify report");
+  const Document doc = build_report(r, std::nullopt, "vesselverify report");
   const std::string md = doc.markdown_text("figures");
   // Representative load 1 mN: fast misses 0.1 mm, slow meets it.
   EXPECT_NE(md.find("| contact_straight | fast | 0 | 1 mN | 0.5 |"), std::string::npos) << md;
@@ -168,10 +256,85 @@ TEST(Report, SummaryJudgesTheToleranceAndEveryFigureIsWritten) {
             std::string::npos);
   EXPECT_NE(md.find("figures/contact_straight_load_displacement.svg"), std::string::npos);
   EXPECT_NE(md.find("figures/contact_straight_wall_profile.svg"), std::string::npos);
-  EXPECT_NE(md.find("## Numerical stability\n\ntable here"), std::string::npos);
+  EXPECT_NE(md.find("## Numerical stability\n\nNot part of these results"), std::string::npos);
   const std::string html = doc.html_text("t");
   EXPECT_EQ(count(html, "<svg"), 3u);
   EXPECT_NE(html.find("<h2>Numerical stability</h2>"), std::string::npos);
+}
+
+TEST(StudyFiles, TheReportDrawsTheStabilityFilesFigures) {
+  const StabilityFile st = parse_stability(kStability, "stability.json");
+  const Document doc = build_report(results_with({outcome("m", 1e-3, 0.1, 1)}), st, "cmd");
+  const std::string md = doc.markdown_text("figures");
+  const std::string html = doc.html_text("t");
+  // The critical step in µs, the hand-worked ratios, the refinement exponent, the hard case.
+  EXPECT_NE(html.find("<td>volume / seed001</td><td>symplectic-euler</td><td>0</td><td>0</td>"
+                      "<td>321</td><td>81234</td><td>99000</td><td>12.34</td><td>8</td><td>10</td>"
+                      "<td>0.8104</td><td>1.25</td>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<td>0,1</td><td>0.987</td><td>1.02</td>"), std::string::npos);
+  EXPECT_NE(html.find("<h4>Sliver tets</h4>"), std::string::npos);
+  EXPECT_NE(md.find("| fem_p1 | yes | yes | – | max \\|u\\| 0.123 mm |"), std::string::npos) << md;
+  EXPECT_NE(md.find("400 steps per trial"), std::string::npos);
+  EXPECT_NE(md.find("`vesselverify stability --quick` (quick mode) in 42 s"), std::string::npos);
+}
+
+TEST(StudyFiles, TheReportDrawsTheRecommendationWithItsRunsUnitAndReference) {
+  RecommendFile rec = parse_recommend(kRecommend, "rec/recommend.json");
+  auto run = results_with({});
+  run.scenes[0].references[0].element = "Taylor-Hood P2-P1";
+  attach_run(rec, run);
+  const Document doc = build_report(results_with({outcome("m", 1e-3, 0.1, 1)}), std::nullopt,
+                                    "cmd", {rec});
+  const std::string md = doc.markdown_text("figures");
+  EXPECT_NE(md.find("## Model recommendation: contact_straight at 30 Hz"), std::string::npos) << md;
+  EXPECT_NE(md.find("at ν = 0.45 the load is 0.5 mN (reference Taylor-Hood P2-P1, level 1)"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("**Recommended: `volume/lloyd/static @ L0`** (Newton): error 0.0421 mm, "
+                    "1.5 ms per update, 600 unknowns."),
+            std::string::npos)
+      << md;
+  // Winner first, then by time, the failure last.
+  const auto winner = md.find("| `volume/lloyd/static @ L0` | 600 | 0.0421 | 1.5 | ★ | recommended |");
+  const auto slow = md.find("| `fem_p1 @ L0` | 900 | 0.01 | 77 | ★ | too slow |");
+  const auto failed = md.find("| `surface/seed000/explicit @ L0` | 300 | – | – |  | failed |");
+  ASSERT_NE(winner, std::string::npos) << md;
+  ASSERT_NE(slow, std::string::npos) << md;
+  ASSERT_NE(failed, std::string::npos) << md;
+  EXPECT_LT(winner, slow);
+  EXPECT_LT(slow, failed);
+  // 0.1 mm against a reference moving 0.25 mm: the tolerance discriminates, no warning.
+  EXPECT_EQ(md.find("does not discriminate"), std::string::npos);
+}
+
+TEST(StudyFiles, MalformedOrForeignFilesAreClearErrorsNamingTheFile) {
+  const auto stability = [](const std::string& t) { (void)parse_stability(t, "s.json"); };
+  const auto recommend = [](const std::string& t) { (void)parse_recommend(t, "r.json"); };
+  EXPECT_NE(error_of(stability, "{").find("s.json: not valid JSON"), std::string::npos);
+  EXPECT_NE(error_of(stability, kRecommend)
+                .find("s.json: not a vesselverify stability file (expected \"schema\": "
+                      "\"vesselverify.stability\""),
+            std::string::npos)
+      << error_of(stability, kRecommend);
+  EXPECT_NE(error_of(recommend, kStability).find("r.json: not a vesselverify recommend file"),
+            std::string::npos);
+  EXPECT_NE(error_of(stability, R"({"schema":"vesselverify.stability","schema_version":2})")
+                .find("s.json: schema_version 2, expected 1"),
+            std::string::npos);
+  std::string no_found = kStability;
+  no_found.replace(no_found.find("\"found_dt\""), 10, "\"lost_dt\"");
+  EXPECT_NE(error_of(stability, no_found)
+                .find("s.json: critical_steps[0]: missing field 'found_dt'"),
+            std::string::npos)
+      << error_of(stability, no_found);
+  std::string bad_candidate = kRecommend;
+  bad_candidate.replace(bad_candidate.find("\"unknowns\": 600"), 15, "\"unknowns\": \"x\"");
+  EXPECT_NE(error_of(recommend, bad_candidate)
+                .find("r.json: candidates[2]: field 'unknowns' has the wrong type"),
+            std::string::npos)
+      << error_of(recommend, bad_candidate);
 }
 
 TEST(Gate, IdenticalResultsPass) {

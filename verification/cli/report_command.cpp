@@ -1,4 +1,5 @@
-/// `vesselverify report`: results.json (+ stability.md) → report.md, report.html, figures/.
+/// `vesselverify report`: results.json (+ stability.json, recommend.json) → report.md,
+/// report.html, figures/.
 #include <iostream>
 
 #include "reports/report.hpp"
@@ -16,20 +17,21 @@ void add_report_command(CLI::App& app, const std::string& command_line) {
       "against error with the Pareto front, error against nu and against mesh level, load "
       "against contact displacement beside the FEM and seed 000's Hooke line, the radial "
       "displacement along the wall, dynamic histories, and seed 000's statistics for every "
-      "model; plus the numerical-stability section when given.\n"
+      "model; plus the numerical-stability and model-recommendation sections, drawn from the "
+      "studies' JSON files, when given.\n"
       "Examples:\n"
       "  vesselverify report results/results.json\n"
-      "  vesselverify report results/results.json --stability results/stability.md -o report\n"
-      "  vesselverify report rec/results.json --recommend rec/recommend.md");
+      "  vesselverify report results/results.json --stability results/stability.json -o report\n"
+      "  vesselverify report rec/results.json --recommend rec/recommend.json");
   cmd->add_option("results", o->results, "results.json written by `vesselverify run`")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--stability", o->stability_markdown,
-                  "stability.md written by `vesselverify stability`, embedded as a section")
+  cmd->add_option("--stability", o->stability,
+                  "stability.json written by `vesselverify stability`, drawn as a section")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--recommend", o->recommend_markdown,
-                  "recommend.md written by `vesselverify recommend`, embedded as a section "
-                  "(repeatable)")
+  cmd->add_option("--recommend", o->recommend,
+                  "recommend.json written by `vesselverify recommend`, drawn as a section "
+                  "(repeatable; the results.json beside it names the load unit and reference)")
       ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output-dir", o->output_dir,
                   "Where report.md, report.html and figures/ go (default: beside the results)");

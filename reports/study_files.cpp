@@ -1,0 +1,150 @@
+#include "reports/study_files.hpp"
+
+#include "reports/json_fields.hpp"
+
+namespace vessel::reports {
+
+namespace {
+
+using json_fields::field;
+using json_fields::optional_field;
+using nlohmann::json;
+
+/// j[key] as an array, each element with its JSON path for messages.
+template <class Read>
+auto read_array(const json& j, const char* key, const std::string& where, Read&& read) {
+  const json a = field<json>(j, key, where);
+  if (!a.is_array()) throw InputError(where + ": field '" + key + "' is not an array");
+  std::vector<decltype(read(a[0], where))> out;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    // "file: key[i]" at the top level, "file: outer[k].key[i]" below it.
+    const std::string sep = where.find(": ") == std::string::npos ? ": " : ".";
+    out.push_back(read(a[i], where + sep + key + "[" + std::to_string(i) + "]"));
+  }
+  return out;
+}
+
+CriticalStepEntry read_step(const json& j, const std::string& where) {
+  CriticalStepEntry e;
+  e.model = field<std::string>(j, "model", where);
+  e.integrator = field<std::string>(j, "integrator", where);
+  e.zeta = field<double>(j, "zeta", where);
+  e.level = field<int>(j, "level", where);
+  e.nodes = field<int>(j, "nodes", where);
+  e.omega_max = field<double>(j, "omega_max", where);
+  e.omega_gershgorin = field<double>(j, "omega_gershgorin", where);
+  e.predicted_dt = field<double>(j, "predicted_dt", where);
+  e.found_dt = field<double>(j, "found_dt", where);
+  e.guaranteed_dt = optional_field<double>(j, "guaranteed_dt", where);
+  return e;
+}
+
+RefinementEntry read_refinement(const json& j, const std::string& where) {
+  RefinementEntry e;
+  e.model = field<std::string>(j, "model", where);
+  e.integrator = field<std::string>(j, "integrator", where);
+  e.zeta = field<double>(j, "zeta", where);
+  e.levels = field<std::vector<int>>(j, "levels", where);
+  e.found_exponent = field<double>(j, "found_exponent", where);
+  e.predicted_exponent = field<double>(j, "predicted_exponent", where);
+  return e;
+}
+
+HardCaseOutcomeEntry read_hard_outcome(const json& j, const std::string& where) {
+  HardCaseOutcomeEntry e;
+  e.model = field<std::string>(j, "model", where);
+  e.finished = field<bool>(j, "finished", where);
+  e.converged = optional_field<bool>(j, "converged", where);
+  e.bounded = optional_field<bool>(j, "bounded", where);
+  e.reported = field<std::string>(j, "reported", where);
+  return e;
+}
+
+HardCaseEntry read_hard_case(const json& j, const std::string& where) {
+  HardCaseEntry e;
+  e.id = field<std::string>(j, "id", where);
+  e.title = field<std::string>(j, "title", where);
+  e.setup = field<std::string>(j, "setup", where);
+  e.seconds = field<double>(j, "seconds", where);
+  e.outcomes = read_array(j, "outcomes", where, read_hard_outcome);
+  return e;
+}
+
+CandidateEntry read_candidate(const json& j, const std::string& where) {
+  CandidateEntry e;
+  e.name = field<std::string>(j, "name", where);
+  e.detail = field<std::string>(j, "detail", where);
+  e.unknowns = field<std::size_t>(j, "unknowns", where);
+  e.ok = field<bool>(j, "ok", where);
+  e.pareto = field<bool>(j, "pareto", where);
+  e.verdict = field<std::string>(j, "verdict", where);
+  e.reason = field<std::string>(j, "reason", where);
+  if (e.ok) {
+    e.error = optional_field<double>(j, "error", where);
+    e.update_seconds = field<double>(j, "update_seconds", where);
+  } else {
+    e.failure = field<std::string>(j, "failure", where);
+  }
+  return e;
+}
+
+BudgetLoadEntry read_load(const json& j, const std::string& where) {
+  BudgetLoadEntry e;
+  e.poisson_ratio = field<double>(j, "poisson_ratio", where);
+  e.magnitude = field<double>(j, "magnitude", where);
+  return e;
+}
+
+}  // namespace
+
+StabilityFile parse_stability(const std::string& text, const std::filesystem::path& source) {
+  const std::string file = source.string();
+  const json j = json_fields::parse_versioned(text, file, "vesselverify.stability", 1,
+                                              "stability file", "vesselverify stability");
+  StabilityFile s;
+  s.path = source;
+  s.command = field<std::string>(j, "command", file);
+  s.quick = field<bool>(j, "quick", file);
+  s.steps_per_trial = field<int>(j, "steps_per_trial", file);
+  s.total_seconds = field<double>(j, "total_seconds", file);
+  s.critical_steps = read_array(j, "critical_steps", file, read_step);
+  s.refinement = read_array(j, "refinement", file, read_refinement);
+  s.hard_cases = read_array(j, "hard_cases", file, read_hard_case);
+  return s;
+}
+
+StabilityFile read_stability(const std::filesystem::path& path) {
+  return parse_stability(json_fields::read_text(path, "stability file"), path);
+}
+
+RecommendFile parse_recommend(const std::string& text, const std::filesystem::path& source) {
+  const std::string file = source.string();
+  const json j = json_fields::parse_versioned(text, file, "vesselverify.recommend", 1,
+                                              "recommend file", "vesselverify recommend");
+  RecommendFile r;
+  r.path = source;
+  r.command = field<std::string>(j, "command", file);
+  r.scene = field<std::string>(j, "scene", file);
+  r.model_levels = field<std::vector<int>>(j, "model_levels", file);
+  r.reference_level = field<int>(j, "reference_level", file);
+  const json budget = field<json>(j, "budget", file);
+  const std::string where = file + ": budget";
+  r.quantity = field<std::string>(budget, "quantity", where);
+  r.unit = field<std::string>(budget, "unit", where);
+  r.tolerance = field<double>(budget, "tolerance", where);
+  r.seconds_per_update = field<double>(budget, "seconds_per_update", where);
+  r.rate_hz = optional_field<double>(budget, "rate_hz", where);
+  r.radius_mm = optional_field<double>(budget, "radius_mm", where);
+  r.loads = read_array(j, "loads", file, read_load);
+  r.recommended = optional_field<std::string>(j, "recommended", file);
+  r.closest = optional_field<std::string>(j, "closest", file);
+  r.reference_contact_point_mm = field<double>(j, "reference_contact_point_mm", file);
+  r.candidates = read_array(j, "candidates", file, read_candidate);
+  return r;
+}
+
+RecommendFile read_recommend(const std::filesystem::path& path) {
+  return parse_recommend(json_fields::read_text(path, "recommend file"), path);
+}
+
+}  // namespace vessel::reports

@@ -1,0 +1,98 @@
+#pragma once
+/// The studies' result files read back into plain structs for the report, like results.json:
+/// stability.json (schema "vesselverify.stability", version 1; verification/stability.schema.json)
+/// of `vesselverify stability`, and recommend.json (schema "vesselverify.recommend", version 1) of
+/// `vesselverify recommend`. Only what the report shows is read.
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace vessel::reports {
+
+/// One row of the critical-step table (times in s, angular frequencies in rad/s).
+struct CriticalStepEntry {
+  std::string model, integrator;
+  double zeta = 0.0;
+  int level = 0, nodes = 0;
+  double omega_max = 0.0, omega_gershgorin = 0.0;
+  double predicted_dt = 0.0, found_dt = 0.0;
+  std::optional<double> guaranteed_dt;  ///< none where no stable step is proven (damped Verlet)
+};
+
+/// dt ∝ h^p over the levels: the found and the predicted exponent.
+struct RefinementEntry {
+  std::string model, integrator;
+  double zeta = 0.0;
+  std::vector<int> levels;
+  double found_exponent = 0.0, predicted_exponent = 0.0;
+};
+
+struct HardCaseOutcomeEntry {
+  std::string model;
+  bool finished = false;
+  std::optional<bool> converged, bounded;  ///< none where not applicable
+  std::string reported;
+};
+
+struct HardCaseEntry {
+  std::string id, title, setup;
+  double seconds = 0.0;
+  std::vector<HardCaseOutcomeEntry> outcomes;
+};
+
+struct StabilityFile {
+  std::filesystem::path path;
+  std::string command;
+  bool quick = false;
+  int steps_per_trial = 0;
+  double total_seconds = 0.0;
+  std::vector<CriticalStepEntry> critical_steps;
+  std::vector<RefinementEntry> refinement;
+  std::vector<HardCaseEntry> hard_cases;
+};
+
+/// One candidate of a recommendation. error and update_seconds are present when it finished
+/// (error absent also where not computable); failure when it did not.
+struct CandidateEntry {
+  std::string name, detail;
+  std::size_t unknowns = 0;
+  bool ok = false, pareto = false;
+  std::string verdict, reason, failure;
+  std::optional<double> error, update_seconds;
+};
+
+/// The load the budget applies at for one Poisson's ratio (scene's load unit).
+struct BudgetLoadEntry {
+  double poisson_ratio = 0.0;
+  double magnitude = 0.0;
+  std::string reference_element;  ///< from the run's results.json (attach_run); "" if unknown
+};
+
+struct RecommendFile {
+  std::filesystem::path path;
+  std::string command, scene;
+  std::vector<int> model_levels;
+  int reference_level = 0;
+  // The budget: quantity (contact_point | patch | field | reaction) and its unit (mm or mN).
+  std::string quantity, unit;
+  double tolerance = 0.0, seconds_per_update = 0.0;
+  std::optional<double> rate_hz, radius_mm;
+  std::vector<BudgetLoadEntry> loads;
+  std::string load_unit;  ///< N, Pa or g, from the run's results.json (attach_run); "" if unknown
+  std::optional<std::string> recommended, closest;  ///< candidate names
+  double reference_contact_point_mm = 0.0;  ///< the reference's largest QoI displacement
+  std::vector<CandidateEntry> candidates;
+};
+
+/// Reads and checks a stability file; InputError naming the file and what is wrong (missing file,
+/// not JSON, another schema or version, a missing field).
+StabilityFile read_stability(const std::filesystem::path& path);
+StabilityFile parse_stability(const std::string& text, const std::filesystem::path& source);
+
+/// Reads and checks a recommend file; InputError as read_stability.
+RecommendFile read_recommend(const std::filesystem::path& path);
+RecommendFile parse_recommend(const std::string& text, const std::filesystem::path& source);
+
+}  // namespace vessel::reports

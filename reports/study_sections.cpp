@@ -1,0 +1,235 @@
+#include "reports/study_sections.hpp"
+
+#include <algorithm>
+#include <iomanip>
+#include <numeric>
+#include <sstream>
+
+namespace vessel::reports {
+
+namespace {
+
+std::string fmt(double v, int digits) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << v;
+  return s.str();
+}
+
+std::string yes_no(const std::optional<bool>& b) {
+  if (!b) return "–";
+  return *b ? "yes" : "**no**";
+}
+
+std::string ms(double seconds) { return fmt(seconds * 1e3, 3) + " ms"; }
+
+/// "30 Hz", "1000 Hz" (3 digits would print 1e+03).
+std::string hz(double rate) { return fmt(rate, 6) + " Hz"; }
+
+Table critical_step_table(const StabilityFile& s) {
+  Table t;
+  t.header = {"model", "integrator", "ζ", "level", "nodes", "ω_max (rad/s)", "Gershgorin bound",
+              "predicted (µs)", "guaranteed (µs)", "found stable (µs)", "found / predicted",
+              "found / guaranteed"};
+  for (const auto& r : s.critical_steps) {
+    const bool proven = r.guaranteed_dt.has_value();
+    t.rows.push_back({r.model, r.integrator, fmt(r.zeta, 4), std::to_string(r.level),
+                      std::to_string(r.nodes), fmt(r.omega_max, 5), fmt(r.omega_gershgorin, 5),
+                      fmt(r.predicted_dt * 1e6, 5), proven ? fmt(*r.guaranteed_dt * 1e6, 5) : "–",
+                      fmt(r.found_dt * 1e6, 5), fmt(r.found_dt / r.predicted_dt, 4),
+                      proven && *r.guaranteed_dt > 0 ? fmt(r.found_dt / *r.guaranteed_dt, 4)
+                                                     : "–"});
+  }
+  return t;
+}
+
+Table refinement_table(const StabilityFile& s) {
+  Table t;
+  t.header = {"model", "integrator", "ζ", "levels", "p (found)", "p (predicted)"};
+  for (const auto& f : s.refinement) {
+    std::string levels;
+    for (const int l : f.levels) {
+      if (!levels.empty()) levels += ',';
+      levels += std::to_string(l);
+    }
+    t.rows.push_back({f.model, f.integrator, fmt(f.zeta, 4), levels, fmt(f.found_exponent, 3),
+                      fmt(f.predicted_exponent, 3)});
+  }
+  return t;
+}
+
+void hard_cases(Document& doc, const StabilityFile& s) {
+  if (s.hard_cases.empty()) return;
+  doc.heading(3, "Hard cases");
+  doc.paragraph("Each case lists what every model did: finished (returned a result), converged "
+                "(static or linear solve), bounded (dynamic run), and what it reported. "
+                "Displacements in mm, loads in mN.");
+  for (const auto& hc : s.hard_cases) {
+    doc.heading(4, hc.title);
+    doc.paragraph(hc.setup + " (" + fmt(hc.seconds, 3) + " s)");
+    Table t;
+    t.header = {"model", "finished", "converged", "bounded", "reported"};
+    for (const auto& o : hc.outcomes) {
+      t.rows.push_back({o.model, o.finished ? "yes" : "**no**", yes_no(o.converged),
+                        yes_no(o.bounded), o.reported});
+    }
+    doc.table(t);
+  }
+}
+
+}  // namespace
+
+void stability_section(Document& doc, const StabilityFile& s) {
+  doc.heading(2, "Numerical stability");
+  doc.paragraph(
+      "How large a time step each explicit integrator of the mass-spring models takes before it "
+      "blows up — predicted from the largest eigenvalue of M⁻¹K at rest (Lanczos) and found by "
+      "running (bisection on dt, " + std::to_string(s.steps_per_trial) +
+      " steps per trial from a small random velocity, unstable when the energy exceeds 1000× its "
+      "start or turns non-finite) — and what every model does on hard cases. Produced by `" +
+      s.command + "`" + (s.quick ? " (quick mode)" : "") + " in " + fmt(s.total_seconds, 3) +
+      " s (`" + s.path.filename().string() + "`).");
+  doc.heading(3, "Predicted vs found stable step");
+  doc.paragraph(
+      "Straight tube, unstructured levels; surface models on the inner wall (triangle topology), "
+      "E = 14.24 kPa, consistent masses, inlet and outlet fixed. Damped rows: point damping "
+      "c = 2ζ·ω_max·(mean nodal mass), seed 000 eq. (3.3). Predicted: symplectic Euler "
+      "4/(γ + √(γ² + 4ω²)), Verlet the root of its amplification matrix's Jury condition (2/ω "
+      "undamped), explicit Euler γ/ω² (= 2ζ/ω) or its overdamped lowest-mode bound, with γ the "
+      "damping rate of the top (and lowest) mode. Undamped, the prediction is exact. **Damped, it "
+      "is an estimate that may be unsafe**: point damping with non-uniform (consistent) masses "
+      "does not decouple into modes, γ is only a Rayleigh quotient, and the found step can be "
+      "well below it (found / predicted < 1). The *guaranteed* column is a proven bound instead: "
+      "every eigenvalue of the damped system solves λ² + γλ + ω² = 0 for some ω ∈ [ω_min, ω_max] "
+      "and γ between the extreme eigenvalues of M⁻¹C (here c/m_max and c/m_min), so the smallest "
+      "critical step over that rectangle is safe for explicit and symplectic Euler "
+      "(`msm/stability/critical_step.hpp`; none is proven for damped Verlet). Use it, not the "
+      "prediction, as a safe damped step. Steps in µs.");
+  doc.table(critical_step_table(s));
+  doc.paragraph("Explicit Euler without damping is not in the table: it is unstable at every step "
+                "(|1 + ihω| > 1; the energy grows by a factor 1 + h²ω² per step in each mode), "
+                "asserted by the test suite.");
+  doc.heading(3, "Step against refinement");
+  doc.paragraph("Least-squares exponent p of dt ∝ h^p over the levels (h the nominal element "
+                "size, halved per level; p = 1 expected for springs whose k scales like E·h and "
+                "masses like ρh³).");
+  doc.table(refinement_table(s));
+  hard_cases(doc, s);
+}
+
+namespace {
+
+std::string load_text(const RecommendFile& r, double magnitude) {
+  if (r.load_unit == "N") return fmt(magnitude * 1e3, 3) + " mN";
+  if (r.load_unit.empty()) return fmt(magnitude, 3) + " (the scene's load unit)";
+  return fmt(magnitude, 3) + " " + r.load_unit;
+}
+
+std::string budget_text(const RecommendFile& r) {
+  std::string t = "the " + r.quantity;
+  if (r.radius_mm) t += " (within " + fmt(*r.radius_mm, 3) + " mm)";
+  t += " error ≤ " + fmt(r.tolerance, 3) + " " + r.unit + ", and ≤ " + ms(r.seconds_per_update) +
+       " of computation per update";
+  if (r.rate_hz) t += " (" + hz(*r.rate_hz) + ")";
+  for (const auto& l : r.loads) {
+    t += "; at ν = " + fmt(l.poisson_ratio, 6) + " the load is " + load_text(r, l.magnitude) +
+         " (reference " + (l.reference_element.empty() ? "" : l.reference_element + ", ") +
+         "level " + std::to_string(r.reference_level) + ")";
+  }
+  return t;
+}
+
+const CandidateEntry* candidate_named(const RecommendFile& r, const std::optional<std::string>& n) {
+  if (!n) return nullptr;
+  for (const auto& c : r.candidates) {
+    if (c.name == *n) return &c;
+  }
+  return nullptr;
+}
+
+std::string error_text(const CandidateEntry& c, const std::string& unit) {
+  return c.error ? fmt(*c.error, 3) + " " + unit : "not computable";
+}
+
+void answer(Document& doc, const RecommendFile& r) {
+  if (const CandidateEntry* best = candidate_named(r, r.recommended)) {
+    doc.paragraph("**Recommended: `" + best->name + "`** (" + best->detail + "): error " +
+                  error_text(*best, r.unit) + ", " + ms(best->update_seconds.value_or(0.0)) +
+                  " per update, " + std::to_string(best->unknowns) + " unknowns.");
+  } else if (const CandidateEntry* near = candidate_named(r, r.closest)) {
+    doc.paragraph("**No candidate meets the budget.** The closest is `" + near->name + "` (" +
+                  near->detail + "): error " + error_text(*near, r.unit) + ", " +
+                  ms(near->update_seconds.value_or(0.0)) + " per update; " + near->reason + ".");
+  } else {
+    doc.paragraph("**No candidate meets the budget**, and none finished.");
+  }
+  // A tolerance at or above the reference's own contact displacement is met by a model that does
+  // not move at all: the answer then says nothing about accuracy.
+  if (r.quantity != "reaction" && r.reference_contact_point_mm > 0.0 &&
+      r.tolerance >= r.reference_contact_point_mm) {
+    doc.paragraph("⚠ **The tolerance does not discriminate**: at this load the reference's "
+                  "contact point moves " + fmt(r.reference_contact_point_mm, 3) +
+                  " mm, no more than the " + fmt(r.tolerance, 3) +
+                  " mm tolerance, so a model that does not move at all would meet it. State a "
+                  "tighter tolerance or a larger load (`magnitude`) for an answer about accuracy.");
+  }
+}
+
+/// Winners first (recommended, then meeting the budget), then by time per update; failures last.
+std::vector<const CandidateEntry*> evidence_order(const RecommendFile& r) {
+  std::vector<const CandidateEntry*> order;
+  for (const auto& c : r.candidates) order.push_back(&c);
+  const auto rank = [](const CandidateEntry* c) {
+    if (c->verdict == "failed") return 3;
+    if (c->verdict == "recommended") return 0;
+    return c->verdict.starts_with("meets") ? 1 : 2;
+  };
+  std::stable_sort(order.begin(), order.end(), [&](const auto* a, const auto* b) {
+    if (rank(a) != rank(b)) return rank(a) < rank(b);
+    return a->update_seconds.value_or(0.0) < b->update_seconds.value_or(0.0);
+  });
+  return order;
+}
+
+Table evidence_table(const RecommendFile& r) {
+  Table t;
+  t.header = {"candidate", "unknowns", "error (" + r.unit + ")", "time per update (ms)", "Pareto",
+              "verdict", "why"};
+  for (const CandidateEntry* c : evidence_order(r)) {
+    t.rows.push_back({"`" + c->name + "`", std::to_string(c->unknowns),
+                      c->ok && c->error ? fmt(*c->error, 3) : "–",
+                      c->ok && c->update_seconds ? fmt(*c->update_seconds * 1e3, 3) : "–",
+                      c->pareto ? "★" : "", c->verdict, c->reason});
+  }
+  return t;
+}
+
+}  // namespace
+
+void recommendation_section(Document& doc, const RecommendFile& r) {
+  // Headings differ per rate, so one report can hold the visual and the haptic answers.
+  doc.heading(2, "Model recommendation: " + r.scene +
+                     (r.rate_hz ? " at " + hz(*r.rate_hz)
+                                : ", " + ms(r.seconds_per_update) + " per update"));
+  std::string levels;
+  for (const int l : r.model_levels) {
+    levels += ' ';
+    levels += std::to_string(l);
+  }
+  doc.paragraph("Budget: " + budget_text(r) + ". " + std::to_string(r.candidates.size()) +
+                " candidates (generated from the mass-spring library's stiffness rules and "
+                "solvers, surface and volume, mesh levels" + levels +
+                ", regions of interest; FEM P1 for comparison) were run against the FEM "
+                "reference by");
+  doc.code(r.command);
+  answer(doc, r);
+  doc.paragraph("Time per update: one static solve from rest for static solvers (set-up "
+                "excluded: it is done once); for integrators the time per step × the steps one "
+                "update period needs. Errors are the worst over the scene's Poisson's ratios, "
+                "against the P2 reference at each model node; region-of-interest models (R) hold "
+                "every node farther than R from the contact and are compared on the whole vessel. "
+                "★ marks the Pareto front (no other candidate is both faster and more accurate). "
+                "From `" + r.path.filename().string() + "`.");
+  doc.table(evidence_table(r));
+}
+
+}  // namespace vessel::reports
