@@ -1,7 +1,5 @@
 #include "verification/stability.hpp"
 
-#include <gmsh.h>
-
 #include <cmath>
 #include <iomanip>
 #include <memory>
@@ -13,6 +11,7 @@
 #include "fem_reference/elasticity.hpp"
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
+#include "meshes/gmsh_vessel.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "meshes/mesh_quality.hpp"
 #include "meshes/surface_loads.hpp"
@@ -959,110 +958,6 @@ double loglog_slope(const std::vector<double>& x, const std::vector<double>& y) 
   }
   if (!(sxx > 0)) throw InputError("loglog_slope: expected at least two distinct x values");
   return sxy / sxx;
-}
-
-TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
-                           double radius) {
-  validate(params);
-  if (params.kind != VesselKind::straight) {
-    throw InputError("refined_patch_mesh: expected a straight vessel");
-  }
-  const double a = params.inner_radius, b = params.outer_radius(), L = params.length;
-  const double h = unstructured_mesh_size(params);
-  gmsh::initialize(0, nullptr, false);
-  TetMesh mesh;
-  try {
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::option::setNumber("General.NumThreads", 1);
-    gmsh::model::add("refined_patch");
-    const int outer = gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, L, b);
-    const int inner = gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, L, a);
-    gmsh::vectorpair out;
-    std::vector<gmsh::vectorpair> out_map;
-    gmsh::model::occ::cut({{3, outer}}, {{3, inner}}, out, out_map);
-    gmsh::model::occ::synchronize();
-    // Classify the faces geometrically (OCC renumbers them; bounding boxes padded ~1e-7).
-    gmsh::vectorpair faces;
-    gmsh::model::getEntities(faces, 2);
-    std::vector<int> inlet, outlet, inner_wall, outer_wall, volumes;
-    const double tol = 1e-5;
-    for (const auto& [dim, tag] : faces) {
-      double x0, y0, z0, x1, y1, z1;
-      gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
-      if (z1 < tol) inlet.push_back(tag);
-      else if (z0 > L - tol) outlet.push_back(tag);
-      else if (x1 < a + tol) inner_wall.push_back(tag);
-      else outer_wall.push_back(tag);
-    }
-    gmsh::vectorpair vols;
-    gmsh::model::getEntities(vols, 3);
-    for (const auto& v : vols) volumes.push_back(v.second);
-    for (const auto& spec : kVesselGroups) {
-      const std::vector<int>& tags = spec.name == group_names::inlet        ? inlet
-                                     : spec.name == group_names::outlet     ? outlet
-                                     : spec.name == group_names::inner_wall ? inner_wall
-                                     : spec.name == group_names::outer_wall ? outer_wall
-                                                                            : volumes;
-      gmsh::model::addPhysicalGroup(spec.dim, tags, spec.tag);
-      gmsh::model::setPhysicalName(spec.dim, spec.tag, std::string(spec.name));
-    }
-    // Size field: `fine` within `radius` of the point, growing linearly to h over 2 mm.
-    const int f = gmsh::model::mesh::field::add("MathEval");
-    std::ostringstream expr;
-    expr << std::setprecision(17) << "Min(" << h << ", " << fine << " + Max(0, Sqrt((x-"
-         << point.x() << ")^2+(y-" << point.y() << ")^2+(z-" << point.z() << ")^2) - " << radius
-         << ") * " << (h - fine) / 2e-3 << ")";
-    gmsh::model::mesh::field::setString(f, "F", expr.str());
-    gmsh::model::mesh::field::setAsBackgroundMesh(f);
-    gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeMax", h);
-    gmsh::option::setNumber("Mesh.Algorithm3D", 10);
-    gmsh::model::mesh::generate(3);
-    std::vector<std::size_t> node_tags;
-    std::vector<double> coords, param;
-    gmsh::model::mesh::getNodes(node_tags, coords, param);
-    std::map<std::size_t, int> index;
-    for (std::size_t i = 0; i < node_tags.size(); ++i) {
-      index.emplace(node_tags[i], static_cast<int>(i));
-      mesh.nodes.emplace_back(coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]);
-    }
-    for (const auto& spec : kVesselGroups) {
-      PhysicalGroup group{std::string(spec.name), spec.dim, spec.tag, {}};
-      std::vector<int> entity_tags;
-      gmsh::model::getEntitiesForPhysicalGroup(spec.dim, spec.tag, entity_tags);
-      const int type = spec.dim == 3 ? 4 : 2;
-      for (int entity : entity_tags) {
-        std::vector<std::size_t> et, en;
-        gmsh::model::mesh::getElementsByType(type, et, en, entity);
-        for (std::size_t e = 0; e < et.size(); ++e) {
-          if (spec.dim == 3) {
-            Tet t{};
-            for (int k = 0; k < 4; ++k) t[k] = index.at(en[4 * e + k]);
-            group.elements.push_back(static_cast<int>(mesh.tets.size()));
-            mesh.tets.push_back(t);
-          } else {
-            Triangle t{};
-            for (int k = 0; k < 3; ++k) t[k] = index.at(en[3 * e + k]);
-            group.elements.push_back(static_cast<int>(mesh.triangles.size()));
-            mesh.triangles.push_back(t);
-          }
-        }
-      }
-      mesh.groups.push_back(std::move(group));
-    }
-  } catch (...) {
-    gmsh::finalize();
-    throw;
-  }
-  gmsh::finalize();
-  remove_unused_nodes(mesh);
-  sort_elements(mesh);
-  orient_tets(mesh);
-  orient_boundary_outward(mesh);
-  require_vessel_groups(mesh, "refined-patch mesh");
-  return mesh;
 }
 
 StabilityReport run_stability(const StabilityOptions& o) {

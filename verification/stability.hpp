@@ -115,10 +115,4 @@ void write_stability(const std::filesystem::path& dir, const StabilityReport& re
 /// Least-squares slope of log(y) against log(x) (InputError unless ≥ 2 positive pairs).
 double loglog_slope(const std::vector<double>& x, const std::vector<double>& y);
 
-/// A straight tube meshed with gmsh (OpenCASCADE) with the element size graded from `fine` (m)
-/// at `point` up to the vessel's nominal size (level 0) beyond `radius` + a transition: the
-/// finely refined contact patch. Groups as in kVesselGroups.
-TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
-                           double radius);
-
 }  // namespace vessel
