@@ -4,7 +4,8 @@
 /// with refinement, and the hard cases (near-incompressible ν, stiff and soft E at a fixed step,
 /// sliver tets, a refined contact patch, an inverting load, a long run, a tight arch bend,
 /// zero-length springs and coincident nodes), each with what every model did.
-/// Results: stability.json (schema verification/stability.schema.json) and stability.md.
+/// Results: stability.json (schema verification/studies/stability/stability.schema.json) and
+/// stability.md. One file per hard case (case_<id>.cpp); study_models.hpp has their shared pieces.
 #include <array>
 #include <filesystem>
 #include <map>

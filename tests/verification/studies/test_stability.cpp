@@ -6,9 +6,9 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
-#include "../test_helpers.hpp"
+#include "../../test_helpers.hpp"
 #include "meshes/errors.hpp"
-#include "verification/stability.hpp"
+#include "verification/studies/stability/stability.hpp"
 
 using namespace vessel;
 
