@@ -10,19 +10,18 @@ HardCase case_inverting_load(const StabilityOptions& o, std::ostream& log) {
   HardCase hc;
   hc.id = "inverting_load";
   hc.title = "A large load that inverts elements";
-  VesselParams params;
-  const TetMesh mesh = load_mesh(params, o);
-  const Vec3 point = default_contact_point(params);
+  const TetMesh mesh = case_mesh(study_scene(VesselParams{}, 14.24e3, 0.0), o);
   hc.setup = "Straight tube level 0, clamped ends, contact load on the 0.5 mm patch raised "
              "from 1 mN to 100 mN. After each solve the deformed volume mesh is checked for "
              "tets with non-positive signed volume (inverted): reported, not hidden.";
-  const ModelSpec spec{"volume", msm::StiffnessRule::seed001};
+  const ModelSpec spec = volume_model(msm::StiffnessRule::seed001);
   for (double force : {1e-3, 1e-2, 1e-1}) {
     log << "  " << force * 1e3 << " mN" << std::endl;
-    const auto m = make_msm(mesh, params, spec, 14.24e3, 0.25, force, point);
+    const Scene scene = study_scene(VesselParams{}, 14.24e3, force);
+    const auto m = build_model(scene, mesh, spec, 0.25);
     Eigen::VectorXd x;
     HardCaseOutcome oc =
-        static_outcome(spec.name() + ", static, " + fmt(force * 1e3) + " mN", *m, &x);
+        static_outcome(spec.name + ", static, " + fmt(force * 1e3) + " mN", *m, &x);
     if (oc.finished) {
       const std::size_t inv = inverted_tets(mesh, unflatten(x));
       oc.reported += "; " + std::to_string(inv) + " inverted tets in the deformed mesh" +
@@ -36,7 +35,7 @@ HardCase case_inverting_load(const StabilityOptions& o, std::ostream& log) {
                                 msm::analyse_spectrum(m->problem, {.lowest = false}));
     Eigen::VectorXd xd;
     HardCaseOutcome od = dynamic_outcome(
-        spec.name() + ", symplectic Euler, " + fmt(force * 1e3) + " mN", m->problem,
+        spec.name + ", symplectic Euler, " + fmt(force * 1e3) + " mN", m->problem,
         Integrator::symplectic_euler, dt, o.quick ? 2000 : 10000, {}, &xd);
     if (od.finished) {
       const std::size_t inv = inverted_tets(mesh, unflatten(xd));
@@ -44,7 +43,7 @@ HardCase case_inverting_load(const StabilityOptions& o, std::ostream& log) {
       od.values["inverted_tets"] = static_cast<double>(inv);
     }
     hc.outcomes.push_back(od);
-    const FemRun r = run_fem(mesh, 14.24e3, 0.3, 1, fem::Formulation::displacement, point, force);
+    const FemRun r = run_fem(scene, mesh, 0.3, 1, fem::Formulation::displacement);
     HardCaseOutcome of = fem_outcome("FEM P1 (linear), " + fmt(force * 1e3) + " mN", r);
     if (r.ok) {
       std::vector<Vec3> deformed = mesh.nodes;

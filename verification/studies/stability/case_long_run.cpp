@@ -19,9 +19,10 @@ HardCase case_long_run(const StabilityOptions& o, std::ostream& log) {
   VesselParams params;
   params.style = MeshStyle::structured;
   params.length = 10e-3;
-  const TetMesh mesh = load_mesh(params, o);
-  const ModelSpec spec{"surface", msm::StiffnessRule::seed000};
-  const auto base = make_msm(mesh, params, spec, 14.24e3, 0.25, 0.0, Vec3::Zero());
+  const Scene scene = study_scene(params, 14.24e3, 0.0);
+  const TetMesh mesh = case_mesh(scene, o);
+  const ModelSpec spec = surface_model(msm::StiffnessRule::seed000);
+  const auto base = build_model(scene, mesh, spec, 0.25);
   const msm::Spectrum s0 = msm::analyse_spectrum(base->problem, {.lowest = false});
   const long long early = std::max<long long>(steps / 10, 1);
   hc.setup = "The smallest model: seed 000's grid surface model on a 10 mm segment of the "
@@ -80,7 +81,7 @@ HardCase case_long_run(const StabilityOptions& o, std::ostream& log) {
       }
     };
     HardCaseOutcome oc;
-    oc.model = spec.name() + ", " + name;
+    oc.model = spec.name + ", " + name;
     oc.values["dt_s"] = dt;
     oc.values["steps"] = static_cast<double>(steps);
     try {

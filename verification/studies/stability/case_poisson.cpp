@@ -17,15 +17,13 @@ HardCase case_poisson(const StabilityOptions& o, std::ostream& log) {
       "formulation and Taylor–Hood P2–P1 (mixed); volume mass-spring models with each stiffness "
       "rule (static Newton; only `lloyd` reads ν). Displacement at the mesh node nearest the "
       "contact point.";
-  VesselParams params;
-  const TetMesh mesh = load_mesh(params, o);
-  const Vec3 point = default_contact_point(params);
+  const Scene scene = study_scene(VesselParams{}, 14.24e3, force);
+  const TetMesh mesh = case_mesh(scene, o);
   for (double nu : {0.49, 0.499, 0.5}) {
     log << "  ν = " << nu << std::endl;
-    const FemRun mixed = run_fem(mesh, 14.24e3, nu, 2, fem::Formulation::mixed, point, force);
+    const FemRun mixed = run_fem(scene, mesh, nu, 2, fem::Formulation::mixed);
     for (int degree : {1, 2}) {
-      const FemRun r =
-          run_fem(mesh, 14.24e3, nu, degree, fem::Formulation::displacement, point, force);
+      const FemRun r = run_fem(scene, mesh, nu, degree, fem::Formulation::displacement);
       HardCaseOutcome oc = fem_outcome("FEM P" + std::to_string(degree) +
                                            " displacement, ν = " + fmt(nu),
                                        r);
@@ -40,11 +38,11 @@ HardCase case_poisson(const StabilityOptions& o, std::ostream& log) {
                                     msm::StiffnessRule::van_gelder, msm::StiffnessRule::lloyd}) {
       // Rules other than lloyd ignore ν: run them once (at ν = 0.49).
       if (rule != msm::StiffnessRule::lloyd && nu != 0.49) continue;
-      const ModelSpec spec{"volume", rule};
+      const ModelSpec spec = volume_model(rule);
       const std::string name =
-          spec.name() + (rule == msm::StiffnessRule::lloyd ? ", ν = " + fmt(nu) : " (any ν)");
+          spec.name + (rule == msm::StiffnessRule::lloyd ? ", ν = " + fmt(nu) : " (any ν)");
       try {
-        const auto m = make_msm(mesh, params, spec, 14.24e3, nu, force, point);
+        const auto m = build_model(scene, mesh, spec, nu);
         HardCaseOutcome oc = static_outcome(name, *m);
         if (oc.finished && mixed.ok) {
           oc.reported += "; " + fmt(oc.values["u_contact_mm"] / (mixed.u_contact * 1e3), 3) +

@@ -10,11 +10,10 @@ HardCase case_refined_patch(const StabilityOptions& o, std::ostream& log) {
   HardCase hc;
   hc.id = "refined_patch";
   hc.title = "A finely refined contact patch";
-  VesselParams params;
-  const Vec3 point = default_contact_point(params);
+  const Scene scene = study_scene(VesselParams{}, 14.24e3, 1e-4);
   const double fine = o.quick ? 0.1e-3 : 0.05e-3;
-  const TetMesh coarse = load_mesh(params, o);
-  const TetMesh mesh = refined_patch_mesh(params, point, fine, 0.5e-3);
+  const TetMesh coarse = case_mesh(scene, o);
+  const TetMesh mesh = refined_patch_mesh(scene.vessel, qoi_point(scene), fine, 0.5e-3);
   const MeshQuality q = compute_quality(mesh);
   hc.setup = "Straight tube meshed with gmsh (OpenCASCADE) at 1 mm, graded down to " +
              fmt(fine * 1e3) + " mm within 0.5 mm of the contact point: " +
@@ -27,15 +26,16 @@ HardCase case_refined_patch(const StabilityOptions& o, std::ostream& log) {
   for (const auto* m : {&coarse, &mesh}) {
     const std::string tag = m == &coarse ? " (level 0)" : " (refined patch)";
     log << "  " << tag << std::endl;
-    for (const ModelSpec& spec : {ModelSpec{"volume", msm::StiffnessRule::seed001},
-                                  ModelSpec{"surface", msm::StiffnessRule::seed000}}) {
-      const auto model = make_msm(*m, params, spec, 14.24e3, 0.25, 1e-4, point);
-      hc.outcomes.push_back(step_outcome(spec.name() + tag, *model, steps));
-      if (spec.model == "volume") hc.outcomes.push_back(static_outcome(spec.name() + tag, *model));
+    for (const ModelSpec& spec : {volume_model(msm::StiffnessRule::seed001),
+                                  surface_model(msm::StiffnessRule::seed000)}) {
+      const auto model = build_model(scene, *m, spec, 0.25);
+      hc.outcomes.push_back(step_outcome(spec.name + tag, *model, steps));
+      if (spec.kind == ModelKind::volume_msm) {
+        hc.outcomes.push_back(static_outcome(spec.name + tag, *model));
+      }
     }
     hc.outcomes.push_back(fem_outcome(
-        "FEM P2" + tag,
-        run_fem(*m, 14.24e3, 0.3, 2, fem::Formulation::displacement, point, 1e-4)));
+        "FEM P2" + tag, run_fem(scene, *m, 0.3, 2, fem::Formulation::displacement)));
   }
   return hc;
 }

@@ -70,10 +70,9 @@ HardCase case_sliver(const StabilityOptions& o, std::ostream& log) {
   HardCase hc;
   hc.id = "sliver";
   hc.title = "Sliver tetrahedra (minimum dihedral angle below 5°)";
-  VesselParams params;
-  const TetMesh mesh = load_mesh(params, o);
-  const Vec3 point = default_contact_point(params);
-  const Sliver s = make_sliver(mesh, point + Vec3(0.5e-3, 0, 0));
+  const Scene scene = study_scene(VesselParams{}, 14.24e3, 1e-4);
+  const TetMesh mesh = case_mesh(scene, o);
+  const Sliver s = make_sliver(mesh, qoi_point(scene) + Vec3(0.5e-3, 0, 0));
   const MeshQuality q0 = compute_quality(mesh), q1 = compute_quality(s.mesh);
   hc.setup = "Straight tube level 0 with one interior node near the contact point moved towards "
              "the opposite face of one of its tets: minimum dihedral angle " +
@@ -86,15 +85,15 @@ HardCase case_sliver(const StabilityOptions& o, std::ostream& log) {
     const std::string tag = m == &mesh ? " (regular mesh)" : " (sliver mesh)";
     log << "  " << tag << std::endl;
     for (msm::StiffnessRule rule : {msm::StiffnessRule::seed001, msm::StiffnessRule::van_gelder}) {
-      const ModelSpec spec{"volume", rule};
-      const auto model = make_msm(*m, params, spec, 14.24e3, 0.25, 1e-4, point);
-      hc.outcomes.push_back(step_outcome(spec.name() + tag, *model, steps));
-      hc.outcomes.push_back(static_outcome(spec.name() + tag, *model));
+      const ModelSpec spec = volume_model(rule);
+      const auto model = build_model(scene, *m, spec, 0.25);
+      hc.outcomes.push_back(step_outcome(spec.name + tag, *model, steps));
+      hc.outcomes.push_back(static_outcome(spec.name + tag, *model));
     }
     for (int degree : {1, 2}) {
-      hc.outcomes.push_back(fem_outcome(
-          "FEM P" + std::to_string(degree) + tag,
-          run_fem(*m, 14.24e3, 0.3, degree, fem::Formulation::displacement, point, 1e-4)));
+      hc.outcomes.push_back(
+          fem_outcome("FEM P" + std::to_string(degree) + tag,
+                      run_fem(scene, *m, 0.3, degree, fem::Formulation::displacement)));
     }
   }
   return hc;

@@ -19,10 +19,11 @@ HardCase case_tight_bend(const StabilityOptions& o, std::ostream& log) {
     VesselParams params;
     params.kind = VesselKind::arch;
     params.bend_radius = R;
+    const Scene scene = study_scene(params, 14.24e3, 1e-4, 1e-3);
     const std::string tag = ", R = " + fmt(R * 1e3) + " mm";
     TetMesh mesh;
     try {
-      mesh = load_mesh(params, o);
+      mesh = case_mesh(scene, o);
     } catch (const std::exception& e) {
       hc.outcomes.push_back({"gmsh" + tag, false, {}, {}, "meshing failed: " + short_error(e.what()), {}});
       continue;
@@ -33,14 +34,12 @@ HardCase case_tight_bend(const StabilityOptions& o, std::ostream& log) {
                                fmt(q.dihedral_deg.min, 3) + "°, shortest edge " +
                                fmt(q.edge_length.min * 1e3, 3) + " mm",
                            {{"min_dihedral_deg", q.dihedral_deg.min}}});
-    const Vec3 point = default_contact_point(params);
-    const ModelSpec spec{"volume", msm::StiffnessRule::seed001};
-    const auto m = make_msm(mesh, params, spec, 14.24e3, 0.25, 1e-4, point, 1e-3);
-    hc.outcomes.push_back(step_outcome(spec.name() + tag, *m, steps));
-    hc.outcomes.push_back(static_outcome(spec.name() + tag, *m));
+    const ModelSpec spec = volume_model(msm::StiffnessRule::seed001);
+    const auto m = build_model(scene, mesh, spec, 0.25);
+    hc.outcomes.push_back(step_outcome(spec.name + tag, *m, steps));
+    hc.outcomes.push_back(static_outcome(spec.name + tag, *m));
     hc.outcomes.push_back(fem_outcome(
-        "FEM P2" + tag,
-        run_fem(mesh, 14.24e3, 0.3, 2, fem::Formulation::displacement, point, 1e-4, 1e-3)));
+        "FEM P2" + tag, run_fem(scene, mesh, 0.3, 2, fem::Formulation::displacement)));
   }
   return hc;
 }

@@ -11,12 +11,11 @@ HardCase case_youngs_modulus(const StabilityOptions& o, std::ostream& log) {
   hc.id = "youngs_modulus";
   hc.title = "E from 1 kPa to 1 MPa at a fixed step";
   const int steps = o.quick ? 1000 : 5000;
-  VesselParams params;
-  const TetMesh mesh = load_mesh(params, o);
-  const Vec3 point = default_contact_point(params);
-  const ModelSpec spec{"volume", msm::StiffnessRule::seed001};
+  const ModelSpec spec = volume_model(msm::StiffnessRule::seed001);
   const double E0 = 14.24e3;
-  const auto ref = make_msm(mesh, params, spec, E0, 0.25, 0.0, point);
+  const Scene unloaded = study_scene(VesselParams{}, E0, 0.0);
+  const TetMesh mesh = case_mesh(unloaded, o);
+  const auto ref = build_model(unloaded, mesh, spec, 0.25);
   const double dt =
       0.9 * msm::predicted_critical_step(Integrator::symplectic_euler,
                                          msm::analyse_spectrum(ref->problem, {.lowest = false}));
@@ -28,13 +27,14 @@ HardCase case_youngs_modulus(const StabilityOptions& o, std::ostream& log) {
   for (double E : {1e3, 1e4, E0, 1e5, 1e6}) {
     log << "  E = " << E << " Pa" << std::endl;
     const double force = 1e-4 * E / E0;
-    const auto m = make_msm(mesh, params, spec, E, 0.25, force, point);
+    const Scene scene = study_scene(VesselParams{}, E, force);
+    const auto m = build_model(scene, mesh, spec, 0.25);
     const double crit = msm::predicted_critical_step(
         Integrator::symplectic_euler, msm::analyse_spectrum(m->problem, {.lowest = false}));
     for (Integrator in : {Integrator::symplectic_euler, Integrator::verlet,
                           Integrator::implicit_euler}) {
       HardCaseOutcome oc =
-          dynamic_outcome(spec.name() + ", " + msm::to_string(in) + ", E = " + fmt(E) + " Pa",
+          dynamic_outcome(spec.name + ", " + msm::to_string(in) + ", E = " + fmt(E) + " Pa",
                           m->problem, in, dt, in == Integrator::implicit_euler ? 20 : steps);
       oc.reported += "; predicted critical step " + fmt(crit) + " s (dt/critical " +
                      fmt(dt / crit, 3) + ")";
@@ -42,7 +42,7 @@ HardCase case_youngs_modulus(const StabilityOptions& o, std::ostream& log) {
       hc.outcomes.push_back(oc);
     }
     if (E == 1e3 || E == 1e6) {
-      const FemRun r = run_fem(mesh, E, 0.3, 1, fem::Formulation::displacement, point, force);
+      const FemRun r = run_fem(scene, mesh, 0.3, 1, fem::Formulation::displacement);
       hc.outcomes.push_back(fem_outcome("FEM P1, ν = 0.3, E = " + fmt(E) + " Pa", r));
     }
   }

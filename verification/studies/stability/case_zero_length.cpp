@@ -21,15 +21,15 @@ HardCase case_zero_length(const StabilityOptions& o, std::ostream& log) {
              "(coincident nodes, zero-volume tets): a .msh file like it is refused by the "
              "reader (inverted or zero-volume tets, exit 1); the models are run on it here "
              "anyway to show why. Contact load 0.1 mN, clamped ends.";
-  VesselParams params;
-  const TetMesh mesh = load_mesh(params, o);
-  const Vec3 point = default_contact_point(params);
-  const ModelSpec spec{"volume", msm::StiffnessRule::seed001};
+  const Scene scene = study_scene(VesselParams{}, 14.24e3, 1e-4);
+  const TetMesh mesh = case_mesh(scene, o);
+  const Vec3 point = qoi_point(scene);
+  const ModelSpec spec = volume_model(msm::StiffnessRule::seed001);
   log << "  zero-length spring" << std::endl;
   {
-    auto m = make_msm(mesh, params, spec, 14.24e3, 0.25, 1e-4, point);
+    auto m = build_model(scene, mesh, spec, 0.25);
     msm::SpringNetwork net = m->built.network;
-    const int j = m->contact_node;
+    const int j = static_cast<int>(m->contact_node);
     double kmean = 0.0;
     for (const auto& sp : net.springs) kmean += sp.law.k1;
     kmean /= static_cast<double>(net.springs.size());
@@ -68,9 +68,9 @@ HardCase case_zero_length(const StabilityOptions& o, std::ostream& log) {
       sp.reported = "failed: " + short_error(e.what());
     }
     hc.outcomes.push_back(sp);
-    Msm tmp;
+    StudyModel tmp;
     tmp.problem = p;
-    tmp.contact_node = j;
+    tmp.contact_node = m->contact_node;
     tmp.model = std::make_unique<msm::SpringModel>(net);
     tmp.problem.form = tmp.model.get();
     hc.outcomes.push_back(static_outcome("volume / seed001 + zero-length spring: static", tmp));
@@ -110,24 +110,24 @@ HardCase case_zero_length(const StabilityOptions& o, std::ostream& log) {
                              "refused: " + short_error(e.what()), {}});
     }
     for (msm::StiffnessRule rule : {msm::StiffnessRule::seed001, msm::StiffnessRule::van_gelder}) {
-      const ModelSpec sp{"volume", rule};
+      const ModelSpec sp = volume_model(rule);
       try {
-        const auto m = make_msm(bad, params, sp, 14.24e3, 0.25, 1e-4, point);
+        const auto m = build_model(scene, bad, sp, 0.25);
         std::size_t bad_k = 0;
         for (const auto& s : m->built.network.springs) {
           if (!std::isfinite(s.law.k1)) ++bad_k;
         }
-        HardCaseOutcome oc = static_outcome(sp.name() + ", coincident nodes", *m);
+        HardCaseOutcome oc = static_outcome(sp.name + ", coincident nodes", *m);
         oc.reported = std::to_string(bad_k) + " springs with non-finite k; " + oc.reported;
         hc.outcomes.push_back(oc);
       } catch (const std::exception& e) {
-        hc.outcomes.push_back({sp.name() + ", coincident nodes", false, false, {},
+        hc.outcomes.push_back({sp.name + ", coincident nodes", false, false, {},
                                "refused: " + short_error(e.what()), {}});
       }
     }
     hc.outcomes.push_back(fem_outcome(
         "FEM P1, coincident nodes",
-        run_fem(bad, 14.24e3, 0.3, 1, fem::Formulation::displacement, point, 1e-4)));
+        run_fem(scene, bad, 0.3, 1, fem::Formulation::displacement)));
   }
   return hc;
 }

@@ -17,21 +17,22 @@ constexpr IntegratorConfig kConfigs[] = {{Integrator::symplectic_euler, 0.0},
 
 std::vector<CriticalStepRow> critical_step_table(const StabilityOptions& o, int max_level,
                                                  int steps, std::ostream& log) {
-  const std::vector<ModelSpec> specs{{"surface", msm::StiffnessRule::seed000},
-                                     {"volume", msm::StiffnessRule::seed001},
-                                     {"volume", msm::StiffnessRule::van_gelder}};
+  const std::vector<ModelSpec> specs{surface_model(msm::StiffnessRule::seed000),
+                                     volume_model(msm::StiffnessRule::seed001),
+                                     volume_model(msm::StiffnessRule::van_gelder)};
   std::vector<CriticalStepRow> rows;
   for (int level = 0; level <= max_level; ++level) {
     VesselParams params;
     params.level = level;
-    const TetMesh mesh = load_mesh(params, o);
+    const Scene scene = study_scene(params, 14.24e3, 0.0);  // unloaded: the spectrum at rest
+    const TetMesh mesh = case_mesh(scene, o);
     for (const ModelSpec& spec : specs) {
-      const auto base = make_msm(mesh, params, spec, 14.24e3, 0.25, 0.0, Vec3::Zero());
+      const auto base = build_model(scene, mesh, spec, 0.25);
       const msm::Spectrum s0 = msm::analyse_spectrum(base->problem, {.lowest = false});
       for (const IntegratorConfig& cfg : kConfigs) {
         Stopwatch clock;
         CriticalStepRow row;
-        row.model = spec.name();
+        row.model = spec.name;
         row.integrator = msm::to_string(cfg.integrator);
         row.zeta = cfg.zeta;
         row.level = level;
@@ -41,8 +42,8 @@ std::vector<CriticalStepRow> critical_step_table(const StabilityOptions& o, int 
         // Point damping c = 2ζ ω_max m̄ (seed 000 eq. 3.3): ζ on the top mode exactly for
         // uniform masses, approximately (Rayleigh quotient) for the consistent ones used here.
         row.point_damping = 2.0 * cfg.zeta * s0.omega_max * mean_mass(base->problem);
-        std::unique_ptr<Msm> damped;
-        const Msm* m = base.get();
+        std::unique_ptr<StudyModel> damped;
+        const StudyModel* m = base.get();
         msm::Spectrum s = s0;
         if (cfg.zeta > 0) {
           damped = with_damping(*base, row.point_damping);

@@ -4,11 +4,10 @@
 #include <iomanip>
 #include <sstream>
 
-#include "meshes/mesh_cache.hpp"
-#include "meshes/surface_loads.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/stability/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
+#include "verification/scene_problems.hpp"
 #include "verification/timing.hpp"
 
 namespace vessel::stability_study {
@@ -25,89 +24,75 @@ std::string fmt(double v, int precision) {
   return s.str();
 }
 
-/// Default contact point: inner wall at mid-length on the θ = 0 side (as `vesselverify msm`).
-Vec3 default_contact_point(const VesselParams& p) {
-  if (p.kind == VesselKind::straight) return {p.inner_radius, 0.0, 0.5 * p.length};
-  const double alpha = std::numbers::pi / 2;
-  return (p.bend_radius + p.inner_radius) * Vec3(std::cos(alpha), std::sin(alpha), 0.0);
+Scene study_scene(const VesselParams& vessel, double E, double force, double patch_radius) {
+  Scene s;
+  s.name = "stability";
+  s.source = "the stability study";
+  s.vessel = vessel;
+  s.youngs_modulus = E;
+  s.boundary = {{std::string(group_names::inlet), EndCondition::clamped},
+                {std::string(group_names::outlet), EndCondition::clamped}};
+  s.load.kind = LoadKind::contact;
+  s.load.magnitudes = {force};
+  s.load.contact.surface_group = std::string(group_names::inner_wall);
+  s.load.contact.point = default_contact_point(vessel, s.load.contact.surface_group);
+  s.load.contact.radius = patch_radius;
+  return s;
 }
 
-int nearest_node(const std::vector<Vec3>& nodes, const Vec3& p) {
-  int best = 0;
-  double d = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const double di = (nodes[i] - p).squaredNorm();
-    if (di < d) {
-      d = di;
-      best = static_cast<int>(i);
-    }
-  }
-  return best;
+namespace {
+ModelSpec spring_model(ModelKind kind, msm::StiffnessRule rule) {
+  ModelSpec m;
+  m.kind = kind;
+  m.stiffness = rule;
+  m.name = std::string(kind == ModelKind::volume_msm ? "volume" : "surface") + " / " +
+           msm::to_string(rule);
+  return m;
+}
+}  // namespace
+
+ModelSpec volume_model(msm::StiffnessRule rule) {
+  return spring_model(ModelKind::volume_msm, rule);
+}
+ModelSpec surface_model(msm::StiffnessRule rule) {
+  return spring_model(ModelKind::surface_msm, rule);
 }
 
-std::unique_ptr<Msm> make_msm(const TetMesh& mesh, const VesselParams& params,
-                              const ModelSpec& spec, double E, double nu, double force,
-                              const Vec3& point, double patch_radius,
-                              double point_damping) {
-  auto m = std::make_unique<Msm>();
-  msm::NetworkOptions no;
-  no.model = msm::parse_model_type(spec.model);
-  no.stiffness = spec.rule;
-  no.stiffness_params.youngs_modulus = E;
-  no.stiffness_params.poisson_ratio = nu;
-  m->built = msm::build_network(mesh, params, no);
-  m->model = std::make_unique<msm::SpringModel>(m->built.network, point_damping);
-  std::vector<Vec3> loads(mesh.nodes.size(), Vec3::Zero());
-  if (force > 0) {
-    ContactPatchSpec cs;
-    cs.point = point;
-    cs.radius = patch_radius;
-    cs.force = force;
-    loads = traction_nodal_loads(mesh, contact_patch(mesh, cs));
-  }
-  m->problem = msm::make_problem(*m->model, m->built.network, m->built.masses, mesh, loads,
-                                 {"inlet", "outlet"});
-  m->point = point;
-  m->contact_node = nearest_node(m->built.network.nodes, point);
+std::unique_ptr<StudyModel> build_model(const Scene& scene, const TetMesh& mesh,
+                                        const ModelSpec& spec, double nu) {
+  auto m = std::make_unique<StudyModel>();
+  m->built = msm::build_network(mesh, scene.vessel, network_options(scene, spec, nu));
+  m->model = std::make_unique<msm::SpringModel>(m->built.network, spec.damping);
+  m->problem = msm_problem(scene, *m->model, m->built, mesh, scene.load.magnitudes.front());
+  m->contact_node = nearest_node(m->built.network.nodes, qoi_point(scene));
   return m;
 }
 
-/// The same network with point damping c (a new SpringModel; problem copied).
-std::unique_ptr<Msm> with_damping(const Msm& base, double c) {
-  auto m = std::make_unique<Msm>();
+std::unique_ptr<StudyModel> with_damping(const StudyModel& base, double c) {
+  auto m = std::make_unique<StudyModel>();
   m->built = base.built;
   m->model = std::make_unique<msm::SpringModel>(m->built.network, c);
   m->problem = base.problem;
   m->problem.form = m->model.get();
-  m->point = base.point;
   m->contact_node = base.contact_node;
   return m;
 }
 
 double mean_mass(const msm::Problem& p) { return p.mass.sum() / static_cast<double>(p.mass.size()); }
 
-FemRun run_fem(const TetMesh& mesh, double E, double nu, int degree, fem::Formulation f,
-               const Vec3& point, double force, double patch_radius) {
+FemRun run_fem(const Scene& scene, const TetMesh& mesh, double nu, int degree,
+               fem::Formulation f) {
   FemRun r;
   Stopwatch clock;
   try {
-    fem::ElasticityProblem pb;
-    pb.material.youngs_modulus = E;
-    pb.material.poisson_ratio = nu;
-    pb.dirichlet = {fem::DirichletCondition::clamped("inlet"),
-                    fem::DirichletCondition::clamped("outlet")};
-    ContactPatchSpec cs;
-    cs.point = point;
-    cs.radius = patch_radius;
-    cs.force = force;
-    pb.patches = {contact_patch(mesh, cs)};
-    pb.options.degree = degree;
+    fem::ElasticityProblem pb =
+        fem_problem(scene, mesh, nu, degree, scene.load.magnitudes.front());
     pb.options.formulation = f;
     pb.options.solver = fem::LinearSolver::direct;
     const fem::ElasticityResult res = fem::solve_elasticity(mesh, pb);
     r.u = res.nodal_displacement;
     r.element = res.element;
-    r.u_contact = r.u[static_cast<std::size_t>(nearest_node(mesh.nodes, point))].norm();
+    r.u_contact = r.u[nearest_node(mesh.nodes, qoi_point(scene))].norm();
     r.max_strain = res.max_abs_principal_strain;
     bool finite = std::isfinite(r.max_strain);
     for (const Vec3& u : r.u) finite = finite && u.allFinite();
@@ -150,8 +135,8 @@ HardCaseOutcome fem_outcome(const std::string& name, const FemRun& r) {
   return o;
 }
 
-/// Static Newton on an Msm; outcome with the contact displacement.
-HardCaseOutcome static_outcome(const std::string& name, const Msm& m,
+/// Static Newton on a model; outcome with the contact displacement.
+HardCaseOutcome static_outcome(const std::string& name, const StudyModel& m,
                                Eigen::VectorXd* x_out) {
   HardCaseOutcome o;
   o.model = name;
@@ -221,12 +206,12 @@ HardCaseOutcome dynamic_outcome(const std::string& name, const msm::Problem& p, 
   return o;
 }
 
-TetMesh load_mesh(const VesselParams& p, const StabilityOptions& o) {
-  return load_or_generate_vessel(p, o.cache_dir, {});
+TetMesh case_mesh(const Scene& scene, const StabilityOptions& o) {
+  return vessel::scene_mesh(scene, scene.vessel.level, o.cache_dir);
 }
 
 /// Predicted and found symplectic-Euler step of a volume model, as an outcome.
-HardCaseOutcome step_outcome(const std::string& name, const Msm& m, int steps) {
+HardCaseOutcome step_outcome(const std::string& name, const StudyModel& m, int steps) {
   HardCaseOutcome o;
   o.model = name;
   try {

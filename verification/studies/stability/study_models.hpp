@@ -10,6 +10,8 @@
 #include "msm/model/build_network.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
+#include "verification/scene.hpp"
+#include "verification/scene_problems.hpp"
 #include "verification/studies/stability/stability.hpp"
 
 namespace vessel::stability_study {
@@ -23,66 +25,71 @@ std::string fmt(double v, int precision = 4);
 /// An error message cut to 300 characters.
 std::string short_error(const std::string& what);
 
-/// Default contact point: inner wall at mid-length on the θ = 0 side (as `vesselverify msm`).
-Vec3 default_contact_point(const VesselParams& p);
-int nearest_node(const std::vector<Vec3>& nodes, const Vec3& p);
+/// A case's problem as a Scene, for scene_problems to build (the one place that builds FEM and
+/// mass-spring problems): the vessel `vessel`, Young's modulus E (Pa), both ends clamped, and a
+/// contact load of `force` (N) on a patch of radius `patch_radius` (m) on the inner wall at the
+/// shared default contact point (default_contact_point). ν is given per run.
+Scene study_scene(const VesselParams& vessel, double E, double force,
+                  double patch_radius = 0.5e-3);
 
-/// A mass-spring model on a mesh with the shared contact load, inlet and outlet fixed.
-struct Msm {
+/// The study's mass-spring models: consistent masses, the inner wall for surface models, named
+/// "volume / seed001" in its tables.
+ModelSpec volume_model(msm::StiffnessRule rule);
+ModelSpec surface_model(msm::StiffnessRule rule);
+
+/// A mass-spring model of a case's scene on one mesh, with its problem (loads and supports).
+struct StudyModel {
   msm::BuiltNetwork built;
   std::unique_ptr<msm::SpringModel> model;
   msm::Problem problem;
-  Vec3 point = Vec3::Zero();
-  int contact_node = 0;
+  std::size_t contact_node = 0;  ///< the network node nearest the scene's contact point
   [[nodiscard]] double contact_displacement(const Eigen::VectorXd& x) const {
-    return (x.segment<3>(3 * contact_node) - problem.rest.segment<3>(3 * contact_node)).norm();
+    const auto i = static_cast<Eigen::Index>(3 * contact_node);
+    return (x.segment<3>(i) - problem.rest.segment<3>(i)).norm();
   }
 };
 
-struct ModelSpec {
-  std::string model;  ///< surface | volume
-  msm::StiffnessRule rule;
-  [[nodiscard]] std::string name() const { return model + " / " + msm::to_string(rule); }
-};
-
-std::unique_ptr<Msm> make_msm(const TetMesh& mesh, const VesselParams& params,
-                              const ModelSpec& spec, double E, double nu, double force,
-                              const Vec3& point, double patch_radius = 0.5e-3,
-                              double point_damping = 0.0);
-/// The same network with point damping c (a new SpringModel; problem copied).
-std::unique_ptr<Msm> with_damping(const Msm& base, double c);
+/// The model `spec` of `scene` at ν on `mesh` (the scene's generated mesh, or one a case made
+/// from it): network_options, msm::build_network and msm_problem of scene_problems, the point
+/// damping of spec.damping, the contact load at the scene's magnitude.
+std::unique_ptr<StudyModel> build_model(const Scene& scene, const TetMesh& mesh,
+                                        const ModelSpec& spec, double nu);
+/// The same network and problem with point damping c, N·s/m per node (a new SpringModel).
+std::unique_ptr<StudyModel> with_damping(const StudyModel& base, double c);
 double mean_mass(const msm::Problem& p);
 
 struct FemRun {
   bool ok = false;
   std::string error;
   std::string element;
-  double u_contact = 0.0;  ///< m
+  double u_contact = 0.0;  ///< m, at the mesh node nearest the contact point
   double max_strain = 0.0;
   double seconds = 0.0;
   std::vector<Vec3> u;
 };
 
-FemRun run_fem(const TetMesh& mesh, double E, double nu, int degree, fem::Formulation f,
-               const Vec3& point, double force, double patch_radius = 0.5e-3);
+/// The FEM reference of `scene` at ν on `mesh` (fem_problem of scene_problems) with elements of
+/// `degree` in formulation `f` (the study chooses it: the ν → 0.5 case compares them) and the
+/// direct solver. Errors are recorded in the run, not thrown.
+FemRun run_fem(const Scene& scene, const TetMesh& mesh, double nu, int degree, fem::Formulation f);
 
 /// Tets of `mesh` with non-positive signed volume when its nodes are at `x`.
 std::size_t inverted_tets(const TetMesh& mesh, const std::vector<Vec3>& x);
 std::vector<Vec3> unflatten(const Eigen::VectorXd& x);
 
 HardCaseOutcome fem_outcome(const std::string& name, const FemRun& r);
-/// Static Newton on an Msm; outcome with the contact displacement.
-HardCaseOutcome static_outcome(const std::string& name, const Msm& m,
+/// Static Newton on a model; outcome with the contact displacement.
+HardCaseOutcome static_outcome(const std::string& name, const StudyModel& m,
                                Eigen::VectorXd* x_out = nullptr);
 /// A dynamic run; outcome bounded or the DivergenceError's message.
 HardCaseOutcome dynamic_outcome(const std::string& name, const msm::Problem& p, Integrator in,
                                 double dt, int steps, const Eigen::VectorXd& v0 = {},
                                 Eigen::VectorXd* x_out = nullptr);
 /// Predicted and found symplectic-Euler step of a model, as an outcome.
-HardCaseOutcome step_outcome(const std::string& name, const Msm& m, int steps);
+HardCaseOutcome step_outcome(const std::string& name, const StudyModel& m, int steps);
 
-/// The vessel's mesh from the options' cache.
-TetMesh load_mesh(const VesselParams& p, const StabilityOptions& o);
+/// The scene's generated mesh at its vessel's level (scene_mesh), from the options' cache.
+TetMesh case_mesh(const Scene& scene, const StabilityOptions& o);
 
 /// An explicit integrator and the damping ratio its point damping targets on the top mode.
 struct IntegratorConfig {
