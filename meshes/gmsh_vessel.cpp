@@ -3,8 +3,10 @@
 #include <gmsh.h>
 
 #include <cmath>
+#include <iomanip>
 #include <map>
 #include <numbers>
+#include <sstream>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -254,6 +256,69 @@ TetMesh generate_vessel_mesh(const VesselParams& params, const MeshingOptions& o
   orient_tets(mesh);
   orient_boundary_outward(mesh);
   require_vessel_groups(mesh, "generated " + describe(params));
+  return mesh;
+}
+
+TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
+                           double radius) {
+  validate(params);
+  if (params.kind != VesselKind::straight) {
+    throw InputError("refined_patch_mesh: expected a straight vessel");
+  }
+  const double a = params.inner_radius, b = params.outer_radius(), L = params.length;
+  const double h = unstructured_mesh_size(params);
+  GmshSession session(MeshingOptions{});
+  const int outer = gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, L, b);
+  const int inner = gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, L, a);
+  gmsh::vectorpair out;
+  std::vector<gmsh::vectorpair> out_map;
+  gmsh::model::occ::cut({{3, outer}}, {{3, inner}}, out, out_map);
+  gmsh::model::occ::synchronize();
+  // Classify the faces geometrically (OCC renumbers them; bounding boxes padded ~1e-7).
+  gmsh::vectorpair faces;
+  gmsh::model::getEntities(faces, 2);
+  std::vector<int> inlet, outlet, inner_wall, outer_wall, volumes;
+  const double tol = 1e-5;
+  for (const auto& [dim, tag] : faces) {
+    double x0, y0, z0, x1, y1, z1;
+    gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
+    if (z1 < tol) inlet.push_back(tag);
+    else if (z0 > L - tol) outlet.push_back(tag);
+    else if (x1 < a + tol) inner_wall.push_back(tag);
+    else outer_wall.push_back(tag);
+  }
+  gmsh::vectorpair vols;
+  gmsh::model::getEntities(vols, 3);
+  for (const auto& v : vols) volumes.push_back(v.second);
+  for (const auto& spec : kVesselGroups) {
+    const std::vector<int>& tags = spec.name == group_names::inlet        ? inlet
+                                   : spec.name == group_names::outlet     ? outlet
+                                   : spec.name == group_names::inner_wall ? inner_wall
+                                   : spec.name == group_names::outer_wall ? outer_wall
+                                                                          : volumes;
+    gmsh::model::addPhysicalGroup(spec.dim, tags, spec.tag);
+    gmsh::model::setPhysicalName(spec.dim, spec.tag, std::string(spec.name));
+  }
+  // Size field: `fine` within `radius` of the point, growing linearly to h over 2 mm.
+  const int f = gmsh::model::mesh::field::add("MathEval");
+  std::ostringstream expr;
+  expr << std::setprecision(17) << "Min(" << h << ", " << fine << " + Max(0, Sqrt((x-"
+       << point.x() << ")^2+(y-" << point.y() << ")^2+(z-" << point.z() << ")^2) - " << radius
+       << ") * " << (h - fine) / 2e-3 << ")";
+  gmsh::model::mesh::field::setString(f, "F", expr.str());
+  gmsh::model::mesh::field::setAsBackgroundMesh(f);
+  gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+  gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
+  gmsh::option::setNumber("Mesh.MeshSizeMax", h);
+  gmsh::option::setNumber("Mesh.Algorithm3D", 10);
+  gmsh::model::mesh::generate(3);
+  TetMesh mesh = extract_mesh();
+  remove_unused_nodes(mesh);
+  sort_elements(mesh);
+  orient_tets(mesh);
+  orient_boundary_outward(mesh);
+  require_vessel_groups(mesh, "refined-patch mesh");
   return mesh;
 }
 

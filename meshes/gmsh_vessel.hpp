@@ -17,6 +17,16 @@ struct MeshingOptions {
 /// std::runtime_error if gmsh fails.
 TetMesh generate_vessel_mesh(const VesselParams& params, const MeshingOptions& options = {});
 
+/// A straight tube meshed with gmsh's OpenCASCADE kernel (a cylinder cut from a cylinder), the
+/// element size graded from `fine` (m) within `radius` (m) of `point` up to the vessel's nominal
+/// size (unstructured_mesh_size, its level) over a 2 mm transition: a finely refined contact
+/// patch, as the stability study's hard case uses. Groups as in kVesselGroups (faces classified by
+/// their bounding boxes: OCC renumbers them), tets positively oriented, boundary outward. Throws
+/// InputError for invalid params or a vessel that is not straight; std::runtime_error if gmsh
+/// fails.
+TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
+                           double radius);
+
 /// The gmsh API version string ("4.8.0"), part of the mesh cache key.
 std::string gmsh_version();
 

@@ -1,6 +1,6 @@
 #pragma once
 /// The studies' result files read back into plain structs for the report, like results.json:
-/// stability.json (schema "vesselverify.stability", version 1; verification/stability.schema.json)
+/// stability.json (schema "vesselverify.stability", version 1; verification/studies/stability/stability.schema.json)
 /// of `vesselverify stability`, and recommend.json (schema "vesselverify.recommend", version 1) of
 /// `vesselverify recommend`. Only what the report shows is read.
 #include <filesystem>

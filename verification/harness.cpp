@@ -16,13 +16,13 @@
 #include "meshes/mesh_cache.hpp"
 #include "meshes/vtu_io.hpp"
 #include "msm/model/build_network.hpp"
+#include "msm/model/roi.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "reports/representative_load.hpp"
 #include "verification/memory.hpp"
 #include "verification/progress.hpp"
-#include "verification/roi.hpp"
 #include "verification/scene_problems.hpp"
 #include "verification/timing.hpp"
 
@@ -339,7 +339,7 @@ struct SolvedSystem {
   const msm::SpringModel* model = nullptr;
   const msm::SpringNetwork* network = nullptr;
   Eigen::Index qoi = -1;  ///< the QoI node in the solved problem (−1 if the region holds it)
-  std::unique_ptr<RoiNetwork> roi;
+  std::unique_ptr<msm::RoiNetwork> roi;
   std::unique_ptr<msm::SpringModel> roi_model;
   std::unique_ptr<msm::Problem> roi_problem;
 
@@ -360,11 +360,11 @@ SolvedSystem solved_system(const msm::Problem& full, const msm::SpringModel& mod
                            const Vec3& qoi_point, std::size_t qoi) {
   SolvedSystem sys{&full, &model, &network, static_cast<Eigen::Index>(qoi), {}, {}, {}};
   if (spec.roi_radius <= 0.0) return sys;
-  const std::vector<char> held = held_nodes(full, qoi_point, spec.roi_radius);
-  sys.roi = std::make_unique<RoiNetwork>(restrict_network(network, held));
+  const std::vector<char> held = msm::held_nodes(full, qoi_point, spec.roi_radius);
+  sys.roi = std::make_unique<msm::RoiNetwork>(msm::restrict_network(network, held));
   sys.roi_model = std::make_unique<msm::SpringModel>(sys.roi->network, spec.damping);
   sys.roi_problem =
-      std::make_unique<msm::Problem>(restrict_problem(full, *sys.roi, held, *sys.roi_model));
+      std::make_unique<msm::Problem>(msm::restrict_problem(full, *sys.roi, held, *sys.roi_model));
   sys.problem = sys.roi_problem.get();
   sys.model = sys.roi_model.get();
   sys.network = &sys.roi->network;

@@ -1,5 +1,7 @@
 #include "verification/scene_problems.hpp"
 
+#include <limits>
+
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "msm/model/spring_model.hpp"
@@ -15,6 +17,19 @@ Vec3 default_contact_point(const VesselParams& v, const std::string& surface_gro
 Vec3 qoi_point(const Scene& s) {
   if (s.load.kind == LoadKind::contact) return s.load.contact.point;
   return default_contact_point(s.vessel, std::string(group_names::inner_wall));
+}
+
+std::size_t nearest_node(const std::vector<Vec3>& nodes, const Vec3& point) {
+  std::size_t best = 0;
+  double d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const double di = (nodes[i] - point).squaredNorm();
+    if (di < d) {
+      d = di;
+      best = i;
+    }
+  }
+  return best;
 }
 
 TetMesh scene_mesh(const Scene& s, int level, const std::filesystem::path& cache_dir) {

@@ -28,6 +28,9 @@ Vec3 default_contact_point(const VesselParams& vessel, const std::string& surfac
 /// distributed loads the inner wall's default contact point.
 Vec3 qoi_point(const Scene& scene);
 
+/// The node of `nodes` nearest `point` (the first of equals): where a point's displacement is read.
+std::size_t nearest_node(const std::vector<Vec3>& nodes, const Vec3& point);
+
 /// The scene's vessel mesh at `level`: generated with gmsh, cached under cache_dir (none if empty).
 TetMesh scene_mesh(const Scene& scene, int level, const std::filesystem::path& cache_dir);
 

@@ -3,7 +3,7 @@
 
 #include "meshes/mesh_cache.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/recommend.hpp"
+#include "verification/studies/recommend.hpp"
 
 namespace vessel::cli {
 

@@ -7,7 +7,7 @@
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/stability.hpp"
+#include "verification/studies/stability/stability.hpp"
 
 namespace vessel::cli {
 

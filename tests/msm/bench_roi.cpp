@@ -1,8 +1,8 @@
 // Google Benchmark: a region-of-interest solve with the held nodes' unknowns removed
-// (verification/roi) against the same region held by identity rows in the full system (what
+// (msm/model/roi) against the same region held by identity rows in the full system (what
 // Problem::fixed alone gives: the full matrix, its fill-in and every spring's Hessian block stay).
 // Volume model (seed 001) on the structured straight tube at level 1, contact at mid-length,
-// static Newton. Not a test: run build/tests/roi_bench by hand; the figures go in the README.
+// static Newton. Not a test: run build/tests/msm/roi_bench by hand; the figures go in the README.
 #include <benchmark/benchmark.h>
 
 #include "meshes/gmsh_vessel.hpp"
@@ -11,9 +11,10 @@
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
-#include "verification/roi.hpp"
+#include "msm/model/roi.hpp"
 
 using namespace vessel;
+using namespace vessel::msm;
 
 namespace {
 

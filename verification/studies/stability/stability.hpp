@@ -4,7 +4,8 @@
 /// with refinement, and the hard cases (near-incompressible ν, stiff and soft E at a fixed step,
 /// sliver tets, a refined contact patch, an inverting load, a long run, a tight arch bend,
 /// zero-length springs and coincident nodes), each with what every model did.
-/// Results: stability.json (schema verification/stability.schema.json) and stability.md.
+/// Results: stability.json (schema verification/studies/stability/stability.schema.json) and
+/// stability.md. One file per hard case (case_<id>.cpp); study_models.hpp has their shared pieces.
 #include <array>
 #include <filesystem>
 #include <map>
@@ -114,11 +115,5 @@ void write_stability(const std::filesystem::path& dir, const StabilityReport& re
 
 /// Least-squares slope of log(y) against log(x) (InputError unless ≥ 2 positive pairs).
 double loglog_slope(const std::vector<double>& x, const std::vector<double>& y);
-
-/// A straight tube meshed with gmsh (OpenCASCADE) with the element size graded from `fine` (m)
-/// at `point` up to the vessel's nominal size (level 0) beyond `radius` + a transition: the
-/// finely refined contact patch. Groups as in kVesselGroups.
-TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
-                           double radius);
 
 }  // namespace vessel

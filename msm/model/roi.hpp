@@ -12,7 +12,7 @@
 #include "msm/model/form.hpp"
 #include "msm/topology/springs.hpp"
 
-namespace vessel {
+namespace vessel::msm {
 
 /// Per node: 1 if it lies farther than `radius` (m) from `centre`, else 0.
 std::vector<char> nodes_beyond(const std::vector<Vec3>& nodes, const Vec3& centre, double radius);
@@ -21,23 +21,23 @@ std::vector<char> nodes_beyond(const std::vector<Vec3>& nodes, const Vec3& centr
 /// nodes one spring away from them (the region's boundary ring, all dofs fixed); springs with at
 /// least one moving end (a spring between two held nodes exerts no force on a moving node).
 struct RoiNetwork {
-  msm::SpringNetwork network;   ///< kept nodes and springs, renumbered
+  SpringNetwork network;        ///< kept nodes and springs, renumbered
   std::vector<int> full_index;  ///< per kept node: its index in the full network
   std::size_t moving_nodes = 0;
 };
 
 /// `held[i]`: node i of the full problem is held (beyond R, or all its dofs fixed already).
-RoiNetwork restrict_network(const msm::SpringNetwork& full, const std::vector<char>& held);
+RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& held);
 
 /// The full problem restricted to the region's network (rest, loads, masses and fixed dofs of
 /// the kept nodes; the ring held), on `form` (a model of roi.network). Loads on held nodes are
 /// carried by the supports, as they would be on the full problem with those nodes fixed.
-msm::Problem restrict_problem(const msm::Problem& full, const RoiNetwork& roi,
-                              const std::vector<char>& held, const msm::Form& form);
+Problem restrict_problem(const Problem& full, const RoiNetwork& roi, const std::vector<char>& held,
+                         const Form& form);
 
 /// The full problem's held nodes for a region of radius R about `centre`: beyond R, or with all
 /// three dofs already fixed. Throws std::runtime_error if no node moves (R smaller than the
 /// node spacing around the contact).
-std::vector<char> held_nodes(const msm::Problem& full, const Vec3& centre, double radius);
+std::vector<char> held_nodes(const Problem& full, const Vec3& centre, double radius);
 
-}  // namespace vessel
+}  // namespace vessel::msm

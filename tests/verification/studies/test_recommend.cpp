@@ -8,7 +8,7 @@
 
 #include "msm/solvers/integrators.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
-#include "verification/recommend.hpp"
+#include "verification/studies/recommend.hpp"
 
 using namespace vessel;
 

@@ -1,4 +1,4 @@
-#include "verification/recommend.hpp"
+#include "verification/studies/recommend.hpp"
 
 #include <algorithm>
 #include <cmath>

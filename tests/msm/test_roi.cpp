@@ -7,9 +7,10 @@
 
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/static_solver.hpp"
-#include "verification/roi.hpp"
+#include "msm/model/roi.hpp"
 
 using namespace vessel;
+using namespace vessel::msm;
 
 namespace {
 

@@ -1,9 +1,9 @@
-#include "verification/roi.hpp"
+#include "msm/model/roi.hpp"
 
 #include <stdexcept>
 #include <string>
 
-namespace vessel {
+namespace vessel::msm {
 
 std::vector<char> nodes_beyond(const std::vector<Vec3>& nodes, const Vec3& centre, double radius) {
   std::vector<char> out(nodes.size(), 0);
@@ -11,7 +11,7 @@ std::vector<char> nodes_beyond(const std::vector<Vec3>& nodes, const Vec3& centr
   return out;
 }
 
-std::vector<char> held_nodes(const msm::Problem& full, const Vec3& centre, double radius) {
+std::vector<char> held_nodes(const Problem& full, const Vec3& centre, double radius) {
   const auto n = static_cast<std::size_t>(full.num_dofs() / 3);
   std::vector<char> held(n, 0);
   std::size_t moving = 0;
@@ -29,11 +29,11 @@ std::vector<char> held_nodes(const msm::Problem& full, const Vec3& centre, doubl
   return held;
 }
 
-RoiNetwork restrict_network(const msm::SpringNetwork& full, const std::vector<char>& held) {
+RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& held) {
   const std::size_t n = full.nodes.size();
   std::vector<char> keep(n, 0);
   for (std::size_t i = 0; i < n; ++i) keep[i] = !held[i];
-  for (const msm::Spring& s : full.springs) {
+  for (const Spring& s : full.springs) {
     if (!held[s.a] || !held[s.b]) keep[s.a] = keep[s.b] = 1;  // the boundary ring
   }
   RoiNetwork roi;
@@ -46,9 +46,9 @@ RoiNetwork restrict_network(const msm::SpringNetwork& full, const std::vector<ch
     roi.network.source_node.push_back(full.source_node.empty() ? -1 : full.source_node[i]);
     roi.moving_nodes += !held[i];
   }
-  for (const msm::Spring& s : full.springs) {
+  for (const Spring& s : full.springs) {
     if (held[s.a] && held[s.b]) continue;
-    msm::Spring r = s;
+    Spring r = s;
     r.a = to_roi[s.a];
     r.b = to_roi[s.b];
     roi.network.springs.push_back(r);
@@ -58,10 +58,10 @@ RoiNetwork restrict_network(const msm::SpringNetwork& full, const std::vector<ch
   return roi;
 }
 
-msm::Problem restrict_problem(const msm::Problem& full, const RoiNetwork& roi,
-                              const std::vector<char>& held, const msm::Form& form) {
+Problem restrict_problem(const Problem& full, const RoiNetwork& roi, const std::vector<char>& held,
+                         const Form& form) {
   const auto m = static_cast<Eigen::Index>(roi.full_index.size());
-  msm::Problem p;
+  Problem p;
   p.form = &form;
   p.rest.resize(3 * m);
   p.external_force.resize(3 * m);
@@ -79,4 +79,4 @@ msm::Problem restrict_problem(const msm::Problem& full, const RoiNetwork& roi,
   return p;
 }
 
-}  // namespace vessel
+}  // namespace vessel::msm

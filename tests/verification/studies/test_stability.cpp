@@ -1,16 +1,14 @@
-// The stability study's pieces: the refinement-exponent fit on exact power laws, the graded
-// contact-patch mesh against the tube's closed-form volume, the JSON against its schema, and the
-// Markdown section's title.
+// The stability study's pieces: the refinement-exponent fit on exact power laws, the JSON against
+// its schema, and the Markdown section's title.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <numbers>
 
-#include "../test_helpers.hpp"
+#include "../../test_helpers.hpp"
 #include "meshes/errors.hpp"
-#include "meshes/mesh_quality.hpp"
-#include "verification/stability.hpp"
+#include "verification/studies/stability/stability.hpp"
 
 using namespace vessel;
 
@@ -23,34 +21,6 @@ TEST(Stability, LogLogSlopeRecoversTheExponentOfAPowerLaw) {
   }
   EXPECT_THROW((void)loglog_slope({1e-3}, {1.0}), InputError);
   EXPECT_THROW((void)loglog_slope({1e-3, 1e-3}, {1.0, 2.0}), InputError);
-}
-
-TEST(Stability, RefinedPatchMeshIsFineAtThePointCoarseElsewhereAndHasTheTubesVolume) {
-  VesselParams params;
-  const Vec3 point(params.inner_radius, 0.0, 0.5 * params.length);
-  const double fine = 0.15e-3;
-  const TetMesh mesh = refined_patch_mesh(params, point, fine, 0.5e-3);
-  EXPECT_NO_THROW(require_vessel_groups(mesh, "refined"));
-  const MeshQuality q = compute_quality(mesh);
-  EXPECT_EQ(q.inverted, 0u);
-  // Closed form π(b² − a²)L; the straight-sided tets miss the circular segments (O(h²)).
-  const double exact = analytic_wall_volume(params);
-  EXPECT_NEAR(q.total_volume, exact, 0.02 * exact);
-  // Edges touching the point's neighbourhood are near `fine`; far away near the nominal 1 mm.
-  double near_max = 0.0, far_min = 1.0;
-  for (const Tet& t : mesh.tets) {
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) {
-        const Vec3 a = mesh.nodes[t[i]], b = mesh.nodes[t[j]];
-        const double len = (a - b).norm();
-        if ((0.5 * (a + b) - point).norm() < 0.3e-3) near_max = std::max(near_max, len);
-        if ((0.5 * (a + b) - point).norm() > 8e-3) far_min = std::min(far_min, len);
-      }
-  }
-  EXPECT_LT(near_max, 2.5 * fine);
-  EXPECT_GT(far_min, 0.3e-3);
-  EXPECT_THROW((void)refined_patch_mesh(VesselParams{.kind = VesselKind::arch}, point, fine, 1e-3),
-               InputError);
 }
 
 namespace {
