@@ -50,19 +50,6 @@ std::size_t free_unknowns(const msm::Problem& p) {
   return static_cast<std::size_t>(std::count(p.fixed.begin(), p.fixed.end(), 0));
 }
 
-std::size_t nearest(const std::vector<Vec3>& points, const Vec3& x) {
-  std::size_t best = 0;
-  double d = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const double di = (points[i] - x).squaredNorm();
-    if (di < d) {
-      d = di;
-      best = i;
-    }
-  }
-  return best;
-}
-
 /// The model nodes on the wall line through the QoI point: within a third of the level's cell size
 /// of the QoI's angle around the centreline, at the radius nearest the QoI's; sorted by arc length.
 std::vector<std::size_t> wall_line(const VesselParams& v, int level,
@@ -164,7 +151,7 @@ struct ReadOut {
 };
 
 ReadOut read_out(const Scene& s, int level, const std::vector<Vec3>& nodes, const Vec3& qoi) {
-  return {nearest(nodes, qoi), wall_line(s.vessel, level, nodes, qoi)};
+  return {nearest_node(nodes, qoi), wall_line(s.vessel, level, nodes, qoi)};
 }
 
 void finish_outcome(ModelOutcome& out, const Scene& s, const std::vector<Vec3>& nodes,

@@ -359,13 +359,7 @@ void print_displacements(const msm::SpringNetwork& net, const msm::SpringModel& 
   }
   run.max_spring_strain = model.max_strain(x);
   if (run.contact) {
-    std::size_t nearest = 0;
-    for (std::size_t i = 0; i < net.nodes.size(); ++i) {
-      if ((net.nodes[i] - run.contact->point).squaredNorm() <
-          (net.nodes[nearest] - run.contact->point).squaredNorm()) {
-        nearest = i;
-      }
-    }
+    const std::size_t nearest = nearest_node(net.nodes, run.contact->point);
     const Vec3 u = x.segment<3>(3 * static_cast<Eigen::Index>(nearest)) - net.nodes[nearest];
     run.contact->displacement = u;
     std::cout << "contact-point displacement: " << u.norm() * 1e3 << " mm (along the load "
