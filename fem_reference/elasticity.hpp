@@ -1,7 +1,8 @@
 #pragma once
 /// The FEM reference: small-strain isotropic linear elasticity on a vessel TetMesh with deal.II
 /// simplex elements (P1, P2, Taylor–Hood P2–P1 for ν → 0.5). Plain data only: deal.II stays inside
-/// elasticity.cpp (pimpl), so including this header compiles no deal.II. SI units throughout.
+/// fem_reference's .cpp files and its private detail/ headers (pimpl), so including this header
+/// compiles no deal.II. SI units throughout.
 #include <array>
 #include <cstddef>
 #include <filesystem>
@@ -107,9 +108,12 @@ struct ElasticityProblem {
   std::vector<DirichletCondition> dirichlet;
   std::vector<PointConstraint> point_constraints;
   std::vector<PressureLoad> pressures;
-  std::vector<TractionPatch> patches;  ///< from vessel::contact_patch (shared with mass-spring)
-  /// Curved geometry for degree 2 (ignored for P1). Note: a traction patch is then integrated over
-  /// the curved faces, whose area differs from the flat triangles' by O(h²).
+  /// From vessel::contact_patch (shared with mass-spring): each patch's traction is integrated at
+  /// its quadrature points, Σ_q w_q t·v(ξ_q), so the applied force is Σ_q w_q t exactly.
+  std::vector<TractionPatch> patches;
+  /// Curved geometry for degree 2 (ignored for P1). A traction patch's points then sit at the same
+  /// parameter points of the curved faces with their flat-triangle weights (its force unchanged);
+  /// pressure is integrated over the curved faces, whose area differs from the flat ones' by O(h²).
   std::vector<CurvedSurface> curved_surfaces;
   Vec3 gravity = Vec3::Zero();  ///< m/s²; body force ρg
   /// Optional extra body force density b(x), N/m³ (manufactured solutions); added to ρg.
