@@ -73,12 +73,6 @@ std::vector<CurvedSurface> tube_curved_walls(double a, double b) {
   return {{"inner_wall", cylinder(a)}, {"outer_wall", cylinder(b)}};
 }
 
-std::vector<PointConstraint> tube_in_plane_pins(double a, double z) {
-  // In-plane rigid motion (t_x − θy, t_y + θx): u_y(±a,0) = 0 gives t_y = θ = 0, u_x(0,a) = 0
-  // then t_x = 0. A radial field u_r(r) e_r satisfies all three.
-  return {{Vec3(a, 0.0, z), 1}, {Vec3(-a, 0.0, z), 1}, {Vec3(0.0, a, z), 0}};
-}
-
 void ElasticitySolver::Impl::build_triangulation() {
   detail::create_coarse_triangulation(mesh, tria);
   mesh_map = detail::match_and_tag_boundary(tria, mesh);

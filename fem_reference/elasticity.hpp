@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "meshes/supports.hpp"
 #include "meshes/surface_loads.hpp"
 #include "meshes/tet_mesh.hpp"
 
@@ -55,12 +56,10 @@ struct DirichletCondition {
   }
 };
 
-/// u[component] = 0 at the mesh node at `point` (within 1e-9 of the mesh size; InputError
-/// otherwise). Used to remove the rigid-body modes that rollers leave free.
-struct PointConstraint {
-  Vec3 point = Vec3::Zero();
-  int component = 0;
-};
+/// u[component] = 0 at the mesh node at `point` (within 1e-6 of a typical element length;
+/// InputError otherwise). Used to remove the rigid-body modes that rollers leave free. The same
+/// type as the supports' pins (meshes/supports.hpp), e.g. vessel::tube_in_plane_pins.
+using PointConstraint = Pin;
 
 /// Uniform pressure p (Pa) on a boundary group: traction −p n (n outward).
 struct PressureLoad {
@@ -82,7 +81,11 @@ std::vector<CurvedSurface> tube_curved_walls(double inner_radius, double outer_r
 struct SolverOptions {
   int degree = 1;  ///< displacement element degree, 1 or 2 (the mixed element is always P2–P1)
   Formulation formulation = Formulation::automatic;
-  double mixed_threshold = 0.45;  ///< automatic: mixed when ν ≥ this (and always at ν = 0.5)
+  /// automatic: mixed Taylor–Hood when ν ≥ this (and always at ν = 0.5). Below 0.49 P2
+  /// displacement elements do not lock appreciably, while the saddle-point system costs minutes
+  /// and gigabytes at reference levels (docs/fem_measurements.md). The one default the harness,
+  /// the scenes and the `fem` command (--mixed-threshold) use.
+  double mixed_threshold = 0.49;
   LinearSolver solver = LinearSolver::automatic;
   /// automatic: direct at or below this many DoFs (CHOLMOD for the displacement system, UMFPACK
   /// for the mixed one), else CG-AMG. Measured on this machine (2 cores, OpenBLAS), default tube,
@@ -238,12 +241,6 @@ class ElasticitySolver {
 
 /// Convenience: ElasticitySolver(mesh, problem).solve().
 ElasticityResult solve_elasticity(const TetMesh& mesh, const ElasticityProblem& problem);
-
-/// Three point constraints that remove the in-plane rigid motions (x, y translation, rotation
-/// about z) of a straight tube along z whose ends are on rollers, without restraining radial
-/// expansion: u_y = 0 at (±a, 0, z), u_x = 0 at (0, a, z). The mesh must have nodes there (the
-/// generated tube has, on its end faces).
-std::vector<PointConstraint> tube_in_plane_pins(double inner_radius, double z);
 
 std::string to_string(Formulation f);
 std::string to_string(LinearSolver s);
