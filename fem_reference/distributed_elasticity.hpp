@@ -2,7 +2,7 @@
 /// The FEM reference in parallel with MPI (issue #3): the displacement formulation (P1, P2) on
 /// deal.II's fully distributed triangulation, Trilinos matrices and vectors, CG with ML AMG (all
 /// six rigid-body modes as near-null space). Plain data only: deal.II and mpi.h stay inside
-/// distributed_elasticity.cpp. SI units throughout.
+/// fem_reference's .cpp files and detail/ headers. SI units throughout.
 ///
 /// Every function here is collective over MPI_COMM_WORLD (or over the single calling rank with
 /// DistributedOptions::self_only): every rank must call it with the same mesh and problem.

@@ -1,7 +1,8 @@
 #pragma once
 /// The FEM reference: small-strain isotropic linear elasticity on a vessel TetMesh with deal.II
 /// simplex elements (P1, P2, Taylor–Hood P2–P1 for ν → 0.5). Plain data only: deal.II stays inside
-/// elasticity.cpp (pimpl), so including this header compiles no deal.II. SI units throughout.
+/// fem_reference's .cpp files and its private detail/ headers (pimpl), so including this header
+/// compiles no deal.II. SI units throughout.
 #include <array>
 #include <cstddef>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "meshes/supports.hpp"
 #include "meshes/surface_loads.hpp"
 #include "meshes/tet_mesh.hpp"
 
@@ -54,12 +56,10 @@ struct DirichletCondition {
   }
 };
 
-/// u[component] = 0 at the mesh node at `point` (within 1e-9 of the mesh size; InputError
-/// otherwise). Used to remove the rigid-body modes that rollers leave free.
-struct PointConstraint {
-  Vec3 point = Vec3::Zero();
-  int component = 0;
-};
+/// u[component] = 0 at the mesh node at `point` (within 1e-6 of a typical element length;
+/// InputError otherwise). Used to remove the rigid-body modes that rollers leave free. The same
+/// type as the supports' pins (meshes/supports.hpp), e.g. vessel::tube_in_plane_pins.
+using PointConstraint = Pin;
 
 /// Uniform pressure p (Pa) on a boundary group: traction −p n (n outward).
 struct PressureLoad {
@@ -81,7 +81,11 @@ std::vector<CurvedSurface> tube_curved_walls(double inner_radius, double outer_r
 struct SolverOptions {
   int degree = 1;  ///< displacement element degree, 1 or 2 (the mixed element is always P2–P1)
   Formulation formulation = Formulation::automatic;
-  double mixed_threshold = 0.45;  ///< automatic: mixed when ν ≥ this (and always at ν = 0.5)
+  /// automatic: mixed Taylor–Hood when ν ≥ this (and always at ν = 0.5). Below 0.49 P2
+  /// displacement elements do not lock appreciably, while the saddle-point system costs minutes
+  /// and gigabytes at reference levels (docs/fem_measurements.md). The one default the harness,
+  /// the scenes and the `fem` command (--mixed-threshold) use.
+  double mixed_threshold = 0.49;
   LinearSolver solver = LinearSolver::automatic;
   /// automatic: direct at or below this many DoFs (CHOLMOD for the displacement system, UMFPACK
   /// for the mixed one), else CG-AMG. Measured on this machine (2 cores, OpenBLAS), default tube,
@@ -107,9 +111,12 @@ struct ElasticityProblem {
   std::vector<DirichletCondition> dirichlet;
   std::vector<PointConstraint> point_constraints;
   std::vector<PressureLoad> pressures;
-  std::vector<TractionPatch> patches;  ///< from vessel::contact_patch (shared with mass-spring)
-  /// Curved geometry for degree 2 (ignored for P1). Note: a traction patch is then integrated over
-  /// the curved faces, whose area differs from the flat triangles' by O(h²).
+  /// From vessel::contact_patch (shared with mass-spring): each patch's traction is integrated at
+  /// its quadrature points, Σ_q w_q t·v(ξ_q), so the applied force is Σ_q w_q t exactly.
+  std::vector<TractionPatch> patches;
+  /// Curved geometry for degree 2 (ignored for P1). A traction patch's points then sit at the same
+  /// parameter points of the curved faces with their flat-triangle weights (its force unchanged);
+  /// pressure is integrated over the curved faces, whose area differs from the flat ones' by O(h²).
   std::vector<CurvedSurface> curved_surfaces;
   Vec3 gravity = Vec3::Zero();  ///< m/s²; body force ρg
   /// Optional extra body force density b(x), N/m³ (manufactured solutions); added to ρg.
@@ -234,12 +241,6 @@ class ElasticitySolver {
 
 /// Convenience: ElasticitySolver(mesh, problem).solve().
 ElasticityResult solve_elasticity(const TetMesh& mesh, const ElasticityProblem& problem);
-
-/// Three point constraints that remove the in-plane rigid motions (x, y translation, rotation
-/// about z) of a straight tube along z whose ends are on rollers, without restraining radial
-/// expansion: u_y = 0 at (±a, 0, z), u_x = 0 at (0, a, z). The mesh must have nodes there (the
-/// generated tube has, on its end faces).
-std::vector<PointConstraint> tube_in_plane_pins(double inner_radius, double z);
 
 std::string to_string(Formulation f);
 std::string to_string(LinearSolver s);

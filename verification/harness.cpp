@@ -559,8 +559,9 @@ std::pair<double, long> time_per_update(double solve_seconds, long steps, double
 Scene quick_variant(Scene s) {
   s.model_levels = {0};
   s.vessel.level = 0;
+  const double mixed_threshold = fem::SolverOptions{}.mixed_threshold;
   const bool mixed = std::any_of(s.poisson_ratios.begin(), s.poisson_ratios.end(),
-                                 [](double nu) { return nu >= kMixedThreshold; });
+                                 [&](double nu) { return nu >= mixed_threshold; });
   s.reference_level = std::min(s.reference_level, mixed ? 0 : 1);
   if (s.load.magnitudes.size() > 2) {
     s.load.magnitudes = {s.load.magnitudes.front(), s.load.magnitudes.back()};

@@ -76,7 +76,8 @@ void add_fem_supports(const Scene& s, fem::ElasticityProblem& prob) {
   for (const auto& g : supports.rollers) {
     prob.dirichlet.push_back(fem::DirichletCondition::roller(g, Supports::kRollerComponent));
   }
-  for (const Pin& pin : supports.pins) prob.point_constraints.push_back({pin.point, pin.component});
+  prob.point_constraints.insert(prob.point_constraints.end(), supports.pins.begin(),
+                                supports.pins.end());
 }
 
 }  // namespace
@@ -88,7 +89,6 @@ fem::ElasticityProblem fem_problem(const Scene& s, const TetMesh& mesh, double n
   prob.material.poisson_ratio = nu;
   prob.material.density = s.density;
   prob.options.degree = degree;
-  prob.options.mixed_threshold = kMixedThreshold;
   add_fem_supports(s, prob);
   for (const auto& [load, m] : applied_loads(s, magnitude)) {
     switch (load->kind) {

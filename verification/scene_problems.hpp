@@ -14,11 +14,6 @@
 
 namespace vessel {
 
-/// The reference switches to the mixed Taylor–Hood element from this ν (and always at 0.5): below
-/// it P2 displacement elements do not lock appreciably, while the saddle-point system costs
-/// minutes and gigabytes at reference levels (docs/fem_measurements.md).
-inline constexpr double kMixedThreshold = 0.49;
-
 /// Where a contact pushes when no point is given: on the named wall (inner_wall or outer_wall,
 /// radius a or b) at mid-length on the θ = 0 side: (r, 0, L/2) on the tube, the outer bend's
 /// apex (0, R + r, 0) on the arch.
@@ -42,7 +37,8 @@ TractionPatch scene_contact_patch(const LoadSpec& load, const TetMesh& mesh, dou
 
 /// The FEM problem of the scene on `mesh` at Poisson's ratio ν with elements of `degree`: the
 /// scene's material, supports, the swept load at `magnitude` and every constant load at its
-/// magnitude; a load of magnitude 0 is not built. Formulation automatic with kMixedThreshold.
+/// magnitude; a load of magnitude 0 is not built. Formulation automatic at the default mixed
+/// threshold (fem::SolverOptions::mixed_threshold).
 /// Throws InputError (naming the scene's file) if nothing supports the body.
 fem::ElasticityProblem fem_problem(const Scene& scene, const TetMesh& mesh, double nu, int degree,
                                    double magnitude = 1.0);

@@ -16,7 +16,7 @@ inline fem::ElasticityProblem lame_problem(double nu, int degree, fem::Formulati
   p.options.solver = fem::LinearSolver::automatic;  // direct up to 20k DoFs, then AMG-CG (1e-10)
   p.dirichlet = {fem::DirichletCondition::roller("inlet", 2),
                  fem::DirichletCondition::roller("outlet", 2)};
-  p.point_constraints = fem::tube_in_plane_pins(3e-3, 0.0);
+  p.point_constraints = tube_in_plane_pins(3e-3, 0.0);  // meshes/supports.hpp
   p.pressures = {{"inner_wall", kLamePressure}};
   return p;
 }

@@ -155,7 +155,13 @@ TEST(LameFem, TaylorHoodConvergesAtNuOneHalf) {
 }
 
 TEST(LameFem, AutomaticFormulationSwitchesToMixedAtTheThreshold) {
-  auto p = test::lame_problem(0.45, 1, Formulation::automatic);
+  auto p = test::lame_problem(0.49, 1, Formulation::automatic);  // ν = the default threshold
+  EXPECT_EQ(ElasticitySolver(test::short_tube_mesh(0), p).result().formulation, Formulation::mixed);
+  p.material.poisson_ratio = 0.48;
+  EXPECT_EQ(ElasticitySolver(test::short_tube_mesh(0), p).result().formulation,
+            Formulation::displacement);
+  p.material.poisson_ratio = 0.45;
+  p.options.mixed_threshold = 0.45;
   EXPECT_EQ(ElasticitySolver(test::short_tube_mesh(0), p).result().formulation, Formulation::mixed);
   p.options.mixed_threshold = 0.46;
   EXPECT_EQ(ElasticitySolver(test::short_tube_mesh(0), p).result().formulation,

@@ -31,7 +31,7 @@ struct FemCommandOptions {
   double poisson_ratio = fem::Material{}.poisson_ratio;
   double density = fem::Material{}.density;
   std::string formulation = "auto";
-  double mixed_threshold = kMixedThreshold;
+  double mixed_threshold = fem::SolverOptions{}.mixed_threshold;
   std::vector<std::string> loads{"pressure"};
   double pressure = 10.0;
   double force = 1e-4;

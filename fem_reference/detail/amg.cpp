@@ -1,0 +1,78 @@
+#include "fem_reference/detail/amg.hpp"
+
+#include <Epetra_MultiVector.h>
+#include <mpi.h>
+
+#include <Teuchos_ParameterList.hpp>
+#include <algorithm>
+#include <cstdlib>
+#include <memory>
+
+namespace vessel::fem::detail {
+
+void ensure_mpi_initialized() {
+  int initialized = 0;
+  MPI_Initialized(&initialized);
+  if (initialized) return;
+  int provided = 0;
+  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
+  std::atexit([] {
+    int finalized = 0;
+    MPI_Finalized(&finalized);
+    if (!finalized) MPI_Finalize();
+  });
+}
+
+Vec3 node_centroid(const TetMesh& mesh) {
+  Vec3 centre = Vec3::Zero();
+  for (const auto& p : mesh.nodes) centre += p;
+  return centre / static_cast<double>(std::max<std::size_t>(mesh.nodes.size(), 1));
+}
+
+namespace {
+
+/// Column-major n × 6: translations along x, y, z, then rotations ω × r about x, y, z.
+std::vector<double> rigid_body_mode_vectors(const DisplacementRows& rows, const Vec3& centre) {
+  const std::size_t n = rows.support.size();
+  std::vector<double> modes(6 * n, 0.0);
+  for (std::size_t d = 0; d < n; ++d) {
+    const Vec3 r = to_vec3(rows.support[d]) - centre;
+    const unsigned c = rows.component[d];
+    modes[c * n + d] = 1.0;  // translation along c
+    // rotations ω × r about x, y, z: (0, −z, y), (z, 0, −x), (−y, x, 0)
+    const double rot[3][3] = {{0, -r[2], r[1]}, {r[2], 0, -r[0]}, {-r[1], r[0], 0}};
+    for (unsigned k = 0; k < 3; ++k) modes[(3 + k) * n + d] = rot[k][c];
+  }
+  return modes;
+}
+
+}  // namespace
+
+void initialize_elasticity_amg(dl::TrilinosWrappers::PreconditionAMG& amg,
+                               const dl::TrilinosWrappers::SparseMatrix& matrix,
+                               const DisplacementRows& rows, const Vec3& centre, bool higher_order,
+                               bool rigid_body_modes, std::vector<double>& storage) {
+  ensure_mpi_initialized();
+  dl::TrilinosWrappers::PreconditionAMG::AdditionalData data;
+  data.elliptic = true;
+  data.higher_order_elements = higher_order;
+  data.smoother_sweeps = 2;
+  data.aggregation_threshold = 0.02;
+  const std::size_t n = rows.support.size();
+  if (!rigid_body_modes) {
+    data.constant_modes.assign(3, std::vector<bool>(n, false));
+    for (std::size_t d = 0; d < n; ++d) data.constant_modes[rows.component[d]][d] = true;
+    amg.initialize(matrix, data);
+    return;
+  }
+  Teuchos::ParameterList ml;
+  std::unique_ptr<Epetra_MultiVector> unused;
+  data.set_parameters(ml, unused, matrix);
+  storage = rigid_body_mode_vectors(rows, centre);
+  ml.set("null space: type", "pre-computed");
+  ml.set("null space: dimension", 6);
+  ml.set("null space: vectors", storage.data());
+  amg.initialize(matrix, ml);
+}
+
+}  // namespace vessel::fem::detail

@@ -1,0 +1,39 @@
+#pragma once
+/// Private to fem_reference: Trilinos ML algebraic multigrid for the elasticity matrix, with the
+/// rigid-body modes as near-null space; shared by the serial CG / block preconditioner and the
+/// distributed CG.
+#include <deal.II/lac/trilinos_precondition.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+
+#include <vector>
+
+#include "fem_reference/detail/common.hpp"
+
+namespace vessel::fem::detail {
+
+/// Trilinos (Epetra/ML) is built with MPI: it needs MPI initialised even on one process. The
+/// program may not have done so (a serial run): initialise once and finalise at exit.
+void ensure_mpi_initialized();
+
+/// The displacement DoFs a preconditioner works on, in the matrix's (local) row order: each row's
+/// support point (m) and displacement component (0..2).
+struct DisplacementRows {
+  std::vector<dl::Point<kDim>> support;
+  std::vector<unsigned> component;
+};
+
+/// Smoothed-aggregation AMG (Vaněk, Mandel & Brezina 1996) of `matrix`. With `rigid_body_modes`
+/// all six rigid-body modes of `rows` (translations, rotations about `centre`) are ML's
+/// near-null space (AdditionalData only passes constant modes, so the ML parameter list is filled
+/// first and the modes added as pre-computed vectors; `storage` holds them and must outlive
+/// `amg`); without, only the three translations.
+void initialize_elasticity_amg(dl::TrilinosWrappers::PreconditionAMG& amg,
+                               const dl::TrilinosWrappers::SparseMatrix& matrix,
+                               const DisplacementRows& rows, const Vec3& centre, bool higher_order,
+                               bool rigid_body_modes, std::vector<double>& storage);
+
+/// The centroid of the mesh's nodes: the rotation centre of the rigid-body modes (the same point
+/// on every MPI rank).
+Vec3 node_centroid(const TetMesh& mesh);
+
+}  // namespace vessel::fem::detail

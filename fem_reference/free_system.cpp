@@ -1,0 +1,97 @@
+/// The serial displacement system on its unconstrained DoFs as Eigen matrices (stiffness,
+/// consistent mass, load), for the modal analysis and the Newmark transient.
+#include <stdexcept>
+
+#include "fem_reference/detail/serial_solver.hpp"
+
+namespace vessel::fem {
+
+namespace {
+
+/// Consistent mass M_ij = ∫ ρ φ_i·φ_j dV of the cell at `fev` (nonzero only between equal
+/// components).
+void cell_mass(const dl::FEValues<kDim>& fev, const std::vector<unsigned>& component, double rho,
+               dl::FullMatrix<double>& m) {
+  const unsigned n = fev.dofs_per_cell;
+  m = 0.0;
+  for (unsigned q = 0; q < fev.n_quadrature_points; ++q) {
+    const double w = rho * fev.JxW(q);
+    for (unsigned i = 0; i < n; ++i) {
+      const double ni = fev.shape_value(i, q) * w;
+      for (unsigned j = 0; j < n; ++j) {
+        if (component[i] == component[j]) m(i, j) += ni * fev.shape_value(j, q);
+      }
+    }
+  }
+}
+
+/// The rows and columns of `a` at free DoFs (free_index ≥ 0), renumbered by free_index.
+Eigen::SparseMatrix<double> free_block(const dl::SparseMatrix<double>& a,
+                                       const std::vector<int>& free_index, int n_free) {
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(a.n_nonzero_elements());
+  for (Index row = 0; row < a.m(); ++row) {
+    const int fr = free_index[row];
+    if (fr < 0) continue;
+    for (auto it = a.begin(row); it != a.end(row); ++it) {
+      const int fc = free_index[it->column()];
+      if (fc >= 0 && it->value() != 0.0) t.emplace_back(fr, fc, it->value());
+    }
+  }
+  Eigen::SparseMatrix<double> e(n_free, n_free);
+  e.setFromTriplets(t.begin(), t.end());
+  return e;
+}
+
+}  // namespace
+
+ElasticitySolver::Impl::FreeSystem ElasticitySolver::Impl::assemble_free_system(
+    bool with_mass) const {
+  // The same local systems and constraint condensation as the static assemble(), into matrices
+  // of their own (this is const); then the unconstrained rows and columns are kept.
+  detail::CellValues values(*mapping, *fe, degree);
+  const unsigned n = fe->n_dofs_per_cell();
+  dl::FullMatrix<double> k(n, n), m(n, n);
+  dl::Vector<double> f(n);
+  std::vector<Index> dofs(n);
+  std::vector<unsigned> comp(n);
+  for (unsigned i = 0; i < n; ++i) comp[i] = fe->system_to_component_index(i).first;
+  dl::SparseMatrix<double> kd(sparsity), md;
+  if (with_mass) md.reinit(sparsity);
+  dl::Vector<double> fd(dof.n_dofs());
+  for (const auto& cell : dof.active_cell_iterators()) {
+    form->local_system(cell, values, k, f, nullptr);  // leaves values.cell on this cell
+    cell->get_dof_indices(dofs);
+    constraints.distribute_local_to_global(k, f, dofs, kd, fd);
+    if (!with_mass) continue;
+    cell_mass(values.cell, comp, problem.material.density, m);
+    constraints.distribute_local_to_global(m, dofs, md);
+  }
+  FreeSystem out;
+  const Index n_all = dof.n_dofs();
+  out.free_index.assign(n_all, -1);
+  out.constrained_value.assign(n_all, 0.0);
+  int n_free = 0;
+  for (Index d = 0; d < n_all; ++d) {
+    if (!constraints.is_constrained(d)) {
+      out.free_index[d] = n_free++;
+      continue;
+    }
+    // Only Dirichlet-type lines (u_d = g) exist here: no hanging nodes on this unrefined mesh.
+    const auto* entries = constraints.get_constraint_entries(d);
+    if (entries != nullptr && !entries->empty()) {
+      throw std::logic_error("constraint couples DoFs: not supported by the free-DoF system");
+    }
+    out.constrained_value[d] = constraints.get_inhomogeneity(d);
+  }
+  out.K = free_block(kd, out.free_index, n_free);
+  kd.clear();
+  if (with_mass) out.M = free_block(md, out.free_index, n_free);
+  out.f.resize(n_free);
+  for (Index d = 0; d < n_all; ++d) {
+    if (out.free_index[d] >= 0) out.f[out.free_index[d]] = fd(d);
+  }
+  return out;
+}
+
+}  // namespace vessel::fem

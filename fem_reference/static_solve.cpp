@@ -1,0 +1,217 @@
+/// The serial static solve: assembly of the weak form (detail/weak_form), the linear solvers
+/// (CHOLMOD, UMFPACK, CG with AMG; the mixed system's FGMRES is in mixed_block_solve.cpp) and the
+/// post-processing (nodal displacement, energy, strains, stresses, reactions).
+#include <deal.II/base/symmetric_tensor.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/sparse_direct.h>
+
+#include <algorithm>
+#include <sstream>
+
+#include "fem_reference/cholmod_solve.hpp"
+#include "fem_reference/detail/constraints.hpp"
+#include "fem_reference/detail/serial_solver.hpp"
+#include "meshes/errors.hpp"
+
+namespace vessel::fem {
+
+void ElasticitySolver::Impl::assemble() {
+  detail::CellValues values(*mapping, *fe, degree);
+  const unsigned n = fe->n_dofs_per_cell();
+  dl::FullMatrix<double> k(n, n);
+  dl::Vector<double> f(n);
+  std::vector<Index> dofs(n);
+  Vec3 applied = Vec3::Zero();
+  for (const auto& cell : dof.active_cell_iterators()) {
+    form->local_system(cell, values, k, f, &applied);
+    cell->get_dof_indices(dofs);
+    constraints.distribute_local_to_global(k, f, dofs, matrix, rhs);
+  }
+  result.applied_load = applied;
+}
+
+namespace {
+
+/// The solver `automatic` picks, or InputError for a solver that does not fit the system.
+LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dofs) {
+  LinearSolver s = o.solver;
+  if (s == LinearSolver::automatic) {
+    const std::size_t limit = mixed ? o.direct_max_mixed_dofs : o.direct_max_dofs;
+    s = n_dofs <= limit ? LinearSolver::direct
+                        : (mixed ? LinearSolver::gmres_block : LinearSolver::cg_amg);
+  }
+  if (s == LinearSolver::cg_amg && mixed) {
+    throw InputError(
+        "solver cg-amg is for the symmetric positive definite displacement system; the mixed "
+        "(Taylor-Hood) system is indefinite: use gmres-block (block-preconditioned FGMRES) or "
+        "direct");
+  }
+  if (s == LinearSolver::gmres_block && !mixed) {
+    throw InputError(
+        "solver gmres-block is for the mixed (Taylor-Hood) system; the displacement system is "
+        "symmetric positive definite: use cg-amg or direct");
+  }
+  return s;
+}
+
+}  // namespace
+
+void ElasticitySolver::Impl::solve_linear() {
+  const LinearSolver s = chosen_solver(problem.options, mixed, dof.n_dofs());
+  result.solver = s;
+  if (rhs.l2_norm() == 0.0) {
+    solution = 0.0;  // no load and homogeneous constraints: u = 0
+  } else if (s == LinearSolver::direct && !mixed) {
+    solve_displacement_direct();
+  } else if (s == LinearSolver::direct) {
+    // UMFPACK for the indefinite mixed (Taylor–Hood) system.
+    dl::SparseDirectUMFPACK direct;
+    direct.initialize(matrix);
+    direct.vmult(solution, rhs);
+  } else if (s == LinearSolver::gmres_block) {
+    solve_mixed_iterative();
+  } else {
+    solve_displacement_cg_amg();
+  }
+  constraints.distribute(solution);
+}
+
+void ElasticitySolver::Impl::solve_displacement_direct() {
+  // CHOLMOD (supernodal Cholesky) for the SPD displacement system: the constraints keep K
+  // symmetric with positive diagonal entries on constrained rows.
+  const Index n = dof.n_dofs();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(matrix.n_nonzero_elements());
+  for (Index row = 0; row < n; ++row) {
+    for (auto it = matrix.begin(row); it != matrix.end(row); ++it) {
+      if (it->value() != 0.0) {
+        entries.emplace_back(static_cast<int>(row), static_cast<int>(it->column()), it->value());
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> K(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  K.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::VectorXd x = solve_spd_cholmod(
+      K, Eigen::Map<const Eigen::VectorXd>(rhs.begin(), static_cast<Eigen::Index>(n)));
+  std::copy(x.data(), x.data() + x.size(), solution.begin());
+}
+
+std::vector<unsigned> ElasticitySolver::Impl::dof_components() const {
+  std::vector<unsigned> component(dof.n_dofs(), 0);
+  std::vector<Index> dofs(fe->n_dofs_per_cell());
+  for (const auto& cell : dof.active_cell_iterators()) {
+    cell->get_dof_indices(dofs);
+    for (unsigned i = 0; i < dofs.size(); ++i)
+      component[dofs[i]] = fe->system_to_component_index(i).first;
+  }
+  return component;
+}
+
+detail::DisplacementRows ElasticitySolver::Impl::displacement_rows(
+    const std::vector<Index>& rows) const {
+  std::vector<dl::Point<kDim>> x(dof.n_dofs());
+  dl::DoFTools::map_dofs_to_support_points(*mapping, dof, x);
+  const auto component = dof_components();
+  detail::DisplacementRows out;
+  if (rows.empty()) {
+    out.support = std::move(x);
+    out.component = component;
+    return out;
+  }
+  for (const Index d : rows) {
+    out.support.push_back(x[d]);
+    out.component.push_back(component[d]);
+  }
+  return out;
+}
+
+void ElasticitySolver::Impl::solve_displacement_cg_amg() {
+  const auto& o = problem.options;
+  detail::ensure_mpi_initialized();  // before any Trilinos object is made
+  dl::TrilinosWrappers::SparseMatrix trilinos_matrix;
+  trilinos_matrix.reinit(matrix);
+  dl::TrilinosWrappers::PreconditionAMG amg;
+  std::vector<double> modes_storage;  // must outlive amg
+  detail::initialize_elasticity_amg(amg, trilinos_matrix, displacement_rows({}),
+                                    detail::node_centroid(mesh), degree > 1,
+                                    o.amg_rigid_body_modes, modes_storage);
+  dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs.l2_norm());
+  dl::SolverCG<dl::Vector<double>> cg(control);
+  try {
+    cg.solve(matrix, solution, rhs, amg);
+  } catch (const dl::SolverControl::NoConvergence& e) {
+    std::ostringstream m;
+    m << "CG with AMG did not converge in " << e.last_step << " iterations (residual "
+      << e.last_residual << "); try --solver direct or more --max-iterations";
+    throw std::runtime_error(m.str());
+  }
+  result.iterations = control.last_step();
+}
+
+namespace {
+
+/// ε and σ = 2μ ε − p I at the centroid of `cell`, as (xx, yy, zz, xy, yz, xz).
+void centroid_strain_stress(const detail::WeakForm& form, dl::FEValues<kDim>& centre,
+                            const detail::CellIterator& cell, const dl::Vector<double>& u,
+                            std::array<double, 6>& strain, std::array<double, 6>& stress) {
+  const dl::FEValuesExtractors::Vector disp(0);
+  const dl::FEValuesExtractors::Scalar pres(kDim);
+  centre.reinit(cell);
+  std::vector<dl::SymmetricTensor<2, kDim>> e1(1);
+  std::vector<double> p1(1, 0.0);
+  centre[disp].get_function_symmetric_gradients(u, e1);
+  if (form.mixed()) centre[pres].get_function_values(u, p1);
+  const double pc = form.mixed() ? p1[0] : -form.lambda() * dl::trace(e1[0]);
+  const dl::SymmetricTensor<2, kDim> sigma =
+      2.0 * form.mu() * e1[0] - pc * dl::unit_symmetric_tensor<kDim>();
+  constexpr std::array<std::array<unsigned, 2>, 6> kVoigt{
+      {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}}};
+  for (unsigned v = 0; v < 6; ++v) {
+    strain[v] = e1[0][kVoigt[v][0]][kVoigt[v][1]];
+    stress[v] = sigma[kVoigt[v][0]][kVoigt[v][1]];
+  }
+}
+
+}  // namespace
+
+void ElasticitySolver::Impl::postprocess() {
+  result.nodal_displacement = nodal([&](Index d) { return solution(d); });
+
+  // Energy and principal strains at the assembly quadrature points; ε, σ at each centroid; the
+  // residual K_e u_e − f_e of the unconstrained system: the support reactions at Dirichlet DoFs.
+  detail::CellValues values(*mapping, *fe, degree);
+  dl::FEValues<kDim> centre(*mapping, *fe, dl::Quadrature<kDim>(dl::Point<kDim>(0.25, 0.25, 0.25)),
+                            dl::update_values | dl::update_gradients);
+  detail::StrainSummary strain;
+  result.tet_strain.assign(mesh.tets.size(), {});
+  result.tet_stress.assign(mesh.tets.size(), {});
+  dl::Vector<double> r_local, residual(dof.n_dofs());
+  std::vector<Index> dofs;
+  for (const auto& cell : dof.active_cell_iterators()) {
+    values.cell.reinit(cell);
+    detail::add_cell_strain(*form, values.cell, solution, strain);
+    const auto idx = cell->active_cell_index();
+    centroid_strain_stress(*form, centre, cell, solution, result.tet_strain[idx],
+                           result.tet_stress[idx]);
+    detail::element_residual(*form, cell, values, solution, dofs, r_local);
+    for (unsigned i = 0; i < dofs.size(); ++i) residual(dofs[i]) += r_local(i);
+  }
+  result.strain_energy = strain.energy;
+  result.max_principal_strain = strain.max_principal;
+  result.max_abs_principal_strain = strain.max_abs_principal;
+
+  result.reactions.clear();
+  const dl::IndexSet all = dof.locally_owned_dofs();
+  std::vector<std::string> seen;
+  for (const auto& bc : problem.dirichlet) {
+    if (std::find(seen.begin(), seen.end(), bc.group) != seen.end()) continue;
+    seen.push_back(bc.group);
+    result.reactions.push_back(
+        {bc.group, detail::group_reaction(dof, constraints, detail::group_boundary_id(mesh, bc.group),
+                                          all, residual)});
+  }
+}
+
+}  // namespace vessel::fem
