@@ -1,8 +1,11 @@
 #include "meshes/surface_loads.hpp"
 
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <sstream>
 
+#include "meshes/disc_quadrature.hpp"
 #include "meshes/errors.hpp"
 
 namespace vessel {
@@ -13,6 +16,52 @@ namespace {
 Vec3 area_normal(const TetMesh& mesh, const Triangle& t) {
   return (mesh.nodes[t[1]] - mesh.nodes[t[0]]).cross(mesh.nodes[t[2]] - mesh.nodes[t[0]]);
 }
+
+/// Distance from x to the triangle's nearest point.
+double distance_to_triangle(const TetMesh& mesh, const Triangle& t, const Vec3& x) {
+  return (closest_point_on_triangle(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], x) - x)
+      .norm();
+}
+
+std::string mm_text(const Vec3& x) {
+  std::ostringstream m;
+  m << "(" << x.x() * 1e3 << ", " << x.y() * 1e3 << ", " << x.z() * 1e3 << ")";
+  return m.str();
+}
+
+/// The point of the group's surface nearest spec.point; InputError if it is farther than r_c.
+Vec3 nearest_wall_point(const TetMesh& mesh, const PhysicalGroup& group,
+                        const ContactPatchSpec& spec, double r) {
+  Vec3 best = Vec3::Constant(std::numeric_limits<double>::infinity());
+  for (int e : group.elements) {
+    const Triangle& t = mesh.triangles[e];
+    const Vec3 p =
+        closest_point_on_triangle(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], spec.point);
+    if ((p - spec.point).squaredNorm() < (best - spec.point).squaredNorm()) best = p;
+  }
+  const double distance = (best - spec.point).norm();
+  if (!(distance <= r)) {
+    std::ostringstream m;
+    m << "contact point " << mm_text(spec.point) << " mm is off the wall: the nearest point of '"
+      << spec.surface_group << "' is " << distance * 1e3 << " mm away, more than the patch radius "
+      << r * 1e3 << " mm; expected a point on that surface";
+    throw InputError(m.str());
+  }
+  return best;
+}
+
+/// Barycentric coordinates of x with respect to the plane triangle t.
+Vec3 barycentric(const std::array<Vec2, 3>& t, const Vec2& x) {
+  const auto cross2 = [](const Vec2& u, const Vec2& v) { return u.x() * v.y() - u.y() * v.x(); };
+  const double total = cross2(t[1] - t[0], t[2] - t[0]);
+  const double l1 = cross2(x - t[0], t[2] - t[0]) / total;
+  const double l2 = cross2(t[1] - t[0], x - t[0]) / total;
+  return {1.0 - l1 - l2, l1, l2};
+}
+
+/// Triangles more steeply inclined to the contact's tangent plane than this are not loaded: they
+/// would cover a sliver of the disc with a weight 1/cos that grows without bound.
+constexpr double kMinFacingCosine = 1e-3;
 
 }  // namespace
 
@@ -26,28 +75,53 @@ TractionPatch contact_patch(const TetMesh& mesh, const ContactPatchSpec& spec) {
     throw InputError("contact force and point must be finite numbers");
   }
   const auto& group = mesh.require_group(spec.surface_group, 2, "contact patch");
-  TractionPatch patch;
+  const double r = spec.radius;
+  const Vec3 centre = nearest_wall_point(mesh, group, spec, r);
+
+  // The tangent plane at the centre: the mean outward normal of the triangles within r_c.
   Vec3 normal_sum = Vec3::Zero();
   for (int e : group.elements) {
     const Triangle& t = mesh.triangles[e];
-    const Vec3 centroid = (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]]) / 3.0;
-    if ((centroid - spec.point).norm() > spec.radius) continue;
-    patch.triangles.push_back(e);
-    const Vec3 n2a = area_normal(mesh, t);
-    patch.area += 0.5 * n2a.norm();
-    normal_sum += n2a;
-    for (const SurfacePoint& q : whole_triangle_points(e, 0.5 * n2a.norm()))
-      patch.points.push_back(q);
+    if (distance_to_triangle(mesh, t, centre) <= r) normal_sum += area_normal(mesh, t);
   }
-  if (patch.triangles.empty()) {
+  const Vec3 n0 = normal_sum.normalized();
+  const Vec3 e1 = n0.unitOrthogonal();
+  const Vec3 e2 = n0.cross(e1);
+  const auto in_plane = [&](const Vec3& x) { return Vec2((x - centre).dot(e1), (x - centre).dot(e2)); };
+
+  TractionPatch patch;
+  patch.centre = centre;
+  Vec3 weighted_normal = Vec3::Zero();
+  for (int e : group.elements) {
+    const Triangle& t = mesh.triangles[e];
+    const Vec3 n2a = area_normal(mesh, t);
+    const double cosine = n2a.normalized().dot(n0);
+    // Only triangles facing the plane can lie under the disc; a triangle within the disc is
+    // nearer than r_c·(1 + curvature), so 2 r_c keeps every candidate and drops the far wall.
+    if (cosine <= kMinFacingCosine || distance_to_triangle(mesh, t, centre) > 2.0 * r) continue;
+    const std::array<Vec2, 3> flat{in_plane(mesh.nodes[t[0]]), in_plane(mesh.nodes[t[1]]),
+                                   in_plane(mesh.nodes[t[2]])};
+    const auto points = triangle_disc_quadrature(flat, Vec2::Zero(), r);
+    if (points.empty()) continue;
+    patch.triangles.push_back(e);
+    for (const PlanePoint& q : points) {
+      const Vec3 bary = barycentric(flat, q.x);
+      const double weight = q.weight / cosine;  // the plane's area element back on the triangle
+      patch.points.push_back({e, bary, weight});
+      patch.area += weight;
+      patch.projected_area += q.weight;
+      weighted_normal += weight * n2a.normalized();
+    }
+  }
+  const double disc_area = std::numbers::pi * r * r;
+  if (patch.projected_area > disc_area * (1.0 + 1e-9)) {
     std::ostringstream m;
-    m << "contact point (" << spec.point.x() * 1e3 << ", " << spec.point.y() * 1e3 << ", "
-      << spec.point.z() * 1e3 << ") mm is off the wall: no triangle of '" << spec.surface_group
-      << "' has its centroid within the patch radius " << spec.radius * 1e3
-      << " mm; expected a point on that surface (or a larger radius than the local element size)";
+    m << "contact patch of radius " << r * 1e3 << " mm at " << mm_text(centre) << " mm covers "
+      << patch.projected_area / disc_area << " times its disc on '" << spec.surface_group
+      << "': the wall folds back within the radius; expected a smaller radius";
     throw InputError(m.str());
   }
-  patch.outward_normal = normal_sum.normalized();
+  patch.outward_normal = weighted_normal.normalized();
   patch.traction = -spec.force / patch.area * patch.outward_normal;
   return patch;
 }

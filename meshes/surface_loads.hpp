@@ -9,9 +9,9 @@
 
 namespace vessel {
 
-/// A catheter-tip contact: normal force `force` (N) spread uniformly over the triangles of
-/// `surface_group` whose centroid lies within `radius` (m) of `point`. A point force would give
-/// infinite displacement in the continuum (Kelvin's solution ~ 1/r); a patch does not.
+/// A catheter-tip contact: normal force `force` (N) spread uniformly over the disc of `radius` (m)
+/// about `point` on the wall `surface_group`. A point force would give infinite displacement in
+/// the continuum (Kelvin's solution ~ 1/r); a patch does not.
 struct ContactPatchSpec {
   Vec3 point = Vec3::Zero();
   double radius = 0.5e-3;
@@ -36,6 +36,10 @@ struct TractionPatch {
   Vec3 traction = Vec3::Zero();
   double area = 0.0;                 ///< m², the sum of the points' weights
   Vec3 outward_normal = Vec3::Zero();  ///< area-weighted mean outward unit normal of the patch
+  Vec3 centre = Vec3::Zero();          ///< the contact point on the wall (contact patches)
+  /// m², a contact patch's area projected on the wall's tangent plane at the centre: π r_c²
+  /// unless the disc reaches past the wall's edge (an end of the vessel).
+  double projected_area = 0.0;
 };
 
 /// Quadrature points covering whole triangle `triangle` (area `area`, m²): the symmetric 3-point
@@ -43,10 +47,19 @@ struct TractionPatch {
 /// exact integrals of a uniform traction.
 std::vector<SurfacePoint> whole_triangle_points(int triangle, double area);
 
-/// Selects the contact patch and its traction t = −F n̂ / A (n̂ the patch's mean outward normal),
-/// so ∫ t dA = −F n̂ exactly. Throws InputError naming the group if it is missing or if no triangle
-/// lies within the radius (a contact point off the wall), or if radius or force is not finite or
-/// radius ≤ 0.
+/// The contact patch: the exact disc of radius r_c on the wall, and its traction t = −F n̂ / A (n̂
+/// the patch's mean outward normal, A its area), so ∫ t dA = −F n̂ exactly.
+/// - The centre is the point of the group's surface nearest `spec.point` (a point given off the
+///   faceted wall, e.g. on the exact cylinder, is projected onto it).
+/// - The disc lies in the wall's tangent plane at the centre (normal: the mean outward normal of
+///   the triangles within r_c). Each facing triangle is projected onto that plane, clipped to the
+///   disc with its arcs (triangle_disc_quadrature) and the quadrature points are carried back to
+///   the triangle with their barycentric coordinates and weights divided by the projection's
+///   cosine. So the patch covers exactly π r_c² of the tangent plane at every mesh level, and its
+///   wall area exceeds that only by the wall's curvature within the disc (1 + O(r_c²/R²)).
+/// Throws InputError naming the group if it is missing, if the nearest point of the wall is
+/// farther than r_c from `spec.point` (a contact point off the wall), if the wall covers the disc
+/// more than once (it folds back within r_c), or if radius or force is not finite or radius ≤ 0.
 TractionPatch contact_patch(const TetMesh& mesh, const ContactPatchSpec& spec);
 
 /// The triangles a pressure acts on (the group's, InputError if missing). Pressure p (Pa) gives

@@ -100,6 +100,31 @@ double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
   return 0.5 * (b - a).cross(c - a).norm();
 }
 
+namespace {
+Vec3 closest_point_on_segment(const Vec3& a, const Vec3& b, const Vec3& x) {
+  const Vec3 d = b - a;
+  const double len2 = d.squaredNorm();
+  const double t = len2 > 0.0 ? std::clamp((x - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+  return a + t * d;
+}
+}  // namespace
+
+Vec3 closest_point_on_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& x) {
+  const Vec3 n = (b - a).cross(c - a);
+  const double n2 = n.squaredNorm();
+  if (n2 > 0.0) {
+    const Vec3 p = x - (x - a).dot(n) / n2 * n;
+    // Inside when p is on the inner side of all three edges.
+    if ((b - a).cross(p - a).dot(n) >= 0.0 && (c - b).cross(p - b).dot(n) >= 0.0 &&
+        (a - c).cross(p - c).dot(n) >= 0.0)
+      return p;
+  }
+  Vec3 best = closest_point_on_segment(a, b, x);
+  for (const Vec3& q : {closest_point_on_segment(b, c, x), closest_point_on_segment(c, a, x)})
+    if ((q - x).squaredNorm() < (best - x).squaredNorm()) best = q;
+  return best;
+}
+
 double mesh_volume(const TetMesh& mesh) {
   double v = 0.0;
   for (const auto& t : mesh.tets) {

@@ -71,6 +71,9 @@ struct TetMesh {
 double signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
 /// Area of a triangle, m².
 double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c);
+/// The point of triangle (a, b, c) nearest to x: x's projection on the plane if it falls inside,
+/// else the nearest point of the nearest edge.
+Vec3 closest_point_on_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& x);
 
 /// Total volume of the tetrahedra, m³.
 double mesh_volume(const TetMesh& mesh);

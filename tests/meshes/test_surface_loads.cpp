@@ -25,13 +25,84 @@ TEST(SurfaceLoads, ContactPatchCarriesExactlyTheForceInwardIntoTheWall) {
   spec.force = 0.05;
   const TractionPatch patch = contact_patch(tube(), spec);
   EXPECT_GT(patch.triangles.size(), 3u);
-  // The patch is a disc of radius ≈ r_c on the cylinder: area ≈ π r_c² (within the centroid
-  // selection's granularity at h ≈ 1 mm).
-  EXPECT_NEAR(patch.area / (std::numbers::pi * 4e-6), 1.0, 0.35);
+  // The exact disc: π r_c² on the tangent plane; on the cylinder (a = 3 mm) the wall's area over
+  // it is π r_c² (1 + r_c²/(8a²) + ...), 1.4 % more for r_c = 2 mm.
+  const double disc = std::numbers::pi * 4e-6;
+  EXPECT_NEAR(patch.projected_area / disc, 1.0, 1e-9);
+  EXPECT_GT(patch.area / disc, 1.0);
+  EXPECT_LT(patch.area / disc, 1.0 + 4.0 / 9.0 / 4.0);  // < 1 + r_c²/(4a²)
   EXPECT_NEAR(patch.outward_normal.x(), -1.0, 0.02);  // inner wall faces the axis
   const Vec3 total = total_load(traction_nodal_loads(tube(), patch));
   EXPECT_NEAR(total.x(), 0.05 * -patch.outward_normal.x(), 1e-14);
   EXPECT_NEAR((total - (-0.05) * patch.outward_normal).norm(), 0.0, 1e-14);
+}
+
+namespace {
+/// A flat square wall of side 4 mm in z = 0, split into n × n squares of two triangles, facing +z,
+/// as the group "inner_wall" (no tets: the patch needs only the surface).
+TetMesh flat_wall(int n) {
+  TetMesh m;
+  const double h = 4e-3 / n;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) m.nodes.emplace_back(-2e-3 + i * h, -2e-3 + j * h, 0.0);
+  PhysicalGroup g{"inner_wall", 2, 3, {}};
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 2, d = a + n + 1;
+      g.elements.push_back(static_cast<int>(m.triangles.size()));
+      m.triangles.push_back({a, b, c});
+      g.elements.push_back(static_cast<int>(m.triangles.size()));
+      m.triangles.push_back({a, c, d});
+    }
+  m.groups.push_back(g);
+  return m;
+}
+}  // namespace
+
+TEST(SurfaceLoads, ContactPatchOnAFlatWallIsTheExactDiscAtEveryRefinement) {
+  // Closed forms on a plane: area π r², and the consistent nodal loads' centre of force is the
+  // disc's centre (Σ_k f_k x_k = ∫ t x dA for linear shape functions, = t · c · π r²).
+  ContactPatchSpec spec;
+  spec.point = Vec3(0.23e-3, -0.11e-3, 0.05e-3);  // 0.05 mm above the wall: projected onto it
+  spec.radius = 0.5e-3;
+  spec.force = 1e-3;
+  for (int n : {4, 9, 16, 40}) {
+    const TetMesh wall = flat_wall(n);
+    const TractionPatch patch = contact_patch(wall, spec);
+    EXPECT_NEAR(patch.area / (std::numbers::pi * 0.25e-6), 1.0, 1e-12) << n;
+    EXPECT_NEAR((patch.centre - Vec3(0.23e-3, -0.11e-3, 0.0)).norm(), 0.0, 1e-15) << n;
+    const auto f = traction_nodal_loads(wall, patch);
+    Vec3 moment = Vec3::Zero();
+    for (std::size_t i = 0; i < f.size(); ++i) moment += f[i].z() * wall.nodes[i];
+    const Vec3 centre_of_force = moment / total_load(f).z();
+    EXPECT_NEAR((centre_of_force - patch.centre).norm(), 0.0, 1e-15) << n;
+    EXPECT_NEAR(total_load(f).z(), -1e-3, 1e-16) << n;  // pushes into the wall (−z)
+  }
+}
+
+TEST(SurfaceLoads, DefaultRadiusPatchIsTheDiscAtEveryLevelOnBothVessels) {
+  // The issue that made the arch's default contact fail: at level 0, no triangle centroid lay
+  // within 0.5 mm of the outer bend's apex. The exact disc has π r² at every level.
+  VesselParams arch;
+  arch.kind = VesselKind::arch;
+  for (const VesselParams& v : {VesselParams{}, arch}) {
+    for (int level : {0, 1}) {
+      VesselParams p = v;
+      p.level = level;
+      const TetMesh mesh = generate_vessel_mesh(p);
+      ContactPatchSpec spec;  // default radius 0.5 mm
+      spec.force = 1e-4;
+      spec.point = v.kind == VesselKind::arch
+                       ? Vec3(0.0, v.bend_radius + v.inner_radius, 0.0)
+                       : Vec3(v.inner_radius, 0.0, 0.5 * v.length);
+      const TractionPatch patch = contact_patch(mesh, spec);
+      const double disc = std::numbers::pi * 0.25e-6;
+      EXPECT_NEAR(patch.projected_area / disc, 1.0, 1e-9) << level;
+      EXPECT_NEAR(patch.area / disc, 1.0, 0.01) << level;  // r²/(8a²) = 0.35 % on the cylinder
+      // The faceted wall lies within the chord's sagitta of the exact surface.
+      EXPECT_LT((patch.centre - spec.point).norm(), 0.1e-3) << level;
+    }
+  }
 }
 
 TEST(SurfaceLoads, ContactPointOffTheWallIsRefused) {

@@ -170,7 +170,7 @@ std::optional<ContactRecord> contact_record(const Scene& s, const fem::Elasticit
   if (!contact || p.patches.empty()) return std::nullopt;
   const TractionPatch& patch = p.patches.front();
   ContactRecord c;
-  c.point = contact->contact.point;
+  c.point = patch.centre;
   c.inward_normal = -patch.outward_normal;
   c.radius = contact->contact.radius;
   c.force = contact->magnitudes.front();

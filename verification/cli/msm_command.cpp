@@ -338,7 +338,7 @@ std::optional<ContactRecord> contact_record(const Scene& s, const TetMesh& mesh)
   if (s.load.magnitudes.front() == 0.0) return std::nullopt;
   const TractionPatch patch = scene_contact_patch(s.load, mesh, s.load.magnitudes.front());
   ContactRecord c;
-  c.point = s.load.contact.point;
+  c.point = patch.centre;
   c.inward_normal = -patch.outward_normal;
   c.radius = s.load.contact.radius;
   c.force = s.load.magnitudes.front();
