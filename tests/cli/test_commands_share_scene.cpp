@@ -40,8 +40,9 @@ TEST(CommandsShareTheScene, FemAndMsmPushTheArchAtTheSameDefaultPointOverTheSame
       EXPECT_DOUBLE_EQ(c["radius_mm"].get<double>(), 0.5) << mesh;
       // It pushes the wall outwards, away from the bend's centre: +y.
       EXPECT_GT(c["inward_normal"][1].get<double>(), 0.99) << mesh;
-      // The exact disc: π (0.5 mm)² = 0.785 mm², up to the wall's curvature (< 1 %).
-      EXPECT_NEAR(c["patch_area_mm2"].get<double>() / (std::numbers::pi * 0.25), 1.0, 0.01) << mesh;
+      // The exact disc: π (0.5 mm)² = 0.785 mm², up to the wall's curvature and the level-0
+      // facets' tilt to the tangent plane (about 1 %).
+      EXPECT_NEAR(c["patch_area_mm2"].get<double>() / (std::numbers::pi * 0.25), 1.0, 0.02) << mesh;
     }
     EXPECT_EQ(fem["contact"]["point_mm"], msm["contact"]["point_mm"]) << mesh;
     EXPECT_EQ(fem["contact"]["patch_triangles"], msm["contact"]["patch_triangles"]) << mesh;

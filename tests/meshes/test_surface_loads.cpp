@@ -98,7 +98,10 @@ TEST(SurfaceLoads, DefaultRadiusPatchIsTheDiscAtEveryLevelOnBothVessels) {
       const TractionPatch patch = contact_patch(mesh, spec);
       const double disc = std::numbers::pi * 0.25e-6;
       EXPECT_NEAR(patch.projected_area / disc, 1.0, 1e-9) << level;
-      EXPECT_NEAR(patch.area / disc, 1.0, 0.01) << level;  // r²/(8a²) = 0.35 % on the cylinder
+      // On the smooth cylinder the wall area over the disc is π r² (1 + r²/(8a²)), +0.35 %; the
+      // facets add their tilt to the tangent plane (1/cos θ, θ ~ h/a): measured +0.93 %, +0.40 %,
+      // +0.37 % at levels 0, 1, 2 on the tube.
+      EXPECT_NEAR(patch.area / disc, 1.0, 0.02) << level;
       // The faceted wall lies within the chord's sagitta of the exact surface.
       EXPECT_LT((patch.centre - spec.point).norm(), 0.1e-3) << level;
     }
