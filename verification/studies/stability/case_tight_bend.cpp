@@ -10,9 +10,8 @@ HardCase case_tight_bend(const StabilityOptions& o, std::ostream& log) {
   hc.id = "tight_bend";
   hc.title = "The tight bend of the arch";
   hc.setup = "180° arch, level 0, bend radius 15 mm (default), 6 mm and 4.5 mm (the wall's "
-             "outer radius is 4 mm), contact load 0.1 mN on a 1 mm patch (level 0's triangles "
-             "are too coarse for 0.5 mm) at mid-arch on the outer side of the bend, clamped "
-             "ends.";
+             "outer radius is 4 mm), contact load 0.1 mN on a 1 mm patch at mid-arch on the "
+             "outer side of the bend, clamped ends.";
   const int steps = o.quick ? 300 : 1000;
   for (double R : {15e-3, 6e-3, 4.5e-3}) {
     log << "  R = " << R * 1e3 << " mm" << std::endl;
