@@ -63,9 +63,7 @@ Vec3 barycentric(const std::array<Vec2, 3>& t, const Vec2& x) {
 /// would cover a sliver of the disc with a weight 1/cos that grows without bound.
 constexpr double kMinFacingCosine = 1e-3;
 
-}  // namespace
-
-TractionPatch contact_patch(const TetMesh& mesh, const ContactPatchSpec& spec) {
+void validate(const ContactPatchSpec& spec) {
   if (!std::isfinite(spec.radius) || spec.radius <= 0.0) {
     std::ostringstream m;
     m << "contact patch radius = " << spec.radius << " m is invalid: expected a finite value > 0";
@@ -74,51 +72,67 @@ TractionPatch contact_patch(const TetMesh& mesh, const ContactPatchSpec& spec) {
   if (!std::isfinite(spec.force) || !spec.point.allFinite()) {
     throw InputError("contact force and point must be finite numbers");
   }
+}
+
+/// The wall's tangent plane at the contact: its normal is the mean outward normal of the
+/// triangles within r_c of the centre; (e1, e2) span it.
+struct TangentPlane {
+  Vec3 centre, normal, e1, e2;
+  TangentPlane(const TetMesh& mesh, const PhysicalGroup& group, const Vec3& c, double r)
+      : centre(c) {
+    Vec3 sum = Vec3::Zero();
+    for (int e : group.elements) {
+      const Triangle& t = mesh.triangles[e];
+      if (distance_to_triangle(mesh, t, centre) <= r) sum += area_normal(mesh, t);
+    }
+    normal = sum.normalized();
+    e1 = normal.unitOrthogonal();
+    e2 = normal.cross(e1);
+  }
+  [[nodiscard]] Vec2 of(const Vec3& x) const { return {(x - centre).dot(e1), (x - centre).dot(e2)}; }
+};
+
+/// Adds to the patch the disc's quadrature points on triangle e (none if it does not face the
+/// plane or lies outside the disc): clipped in the plane, carried back with weight / cos.
+void add_disc_points(const TetMesh& mesh, int e, const TangentPlane& plane, double r,
+                     TractionPatch& patch, Vec3& weighted_normal) {
+  const Triangle& t = mesh.triangles[e];
+  const Vec3 n = area_normal(mesh, t).normalized();
+  const double cosine = n.dot(plane.normal);
+  // Only triangles facing the plane can lie under the disc; a triangle within the disc is
+  // nearer than r_c·(1 + curvature), so 2 r_c keeps every candidate and drops the far wall.
+  if (cosine <= kMinFacingCosine || distance_to_triangle(mesh, t, plane.centre) > 2.0 * r) return;
+  const std::array<Vec2, 3> flat{plane.of(mesh.nodes[t[0]]), plane.of(mesh.nodes[t[1]]),
+                                 plane.of(mesh.nodes[t[2]])};
+  const auto points = triangle_disc_quadrature(flat, Vec2::Zero(), r);
+  if (points.empty()) return;
+  patch.triangles.push_back(e);
+  for (const PlanePoint& q : points) {
+    const double weight = q.weight / cosine;  // the plane's area element back on the triangle
+    patch.points.push_back({e, barycentric(flat, q.x), weight});
+    patch.area += weight;
+    patch.projected_area += q.weight;
+    weighted_normal += weight * n;
+  }
+}
+
+}  // namespace
+
+TractionPatch contact_patch(const TetMesh& mesh, const ContactPatchSpec& spec) {
+  validate(spec);
   const auto& group = mesh.require_group(spec.surface_group, 2, "contact patch");
   const double r = spec.radius;
-  const Vec3 centre = nearest_wall_point(mesh, group, spec, r);
-
-  // The tangent plane at the centre: the mean outward normal of the triangles within r_c.
-  Vec3 normal_sum = Vec3::Zero();
-  for (int e : group.elements) {
-    const Triangle& t = mesh.triangles[e];
-    if (distance_to_triangle(mesh, t, centre) <= r) normal_sum += area_normal(mesh, t);
-  }
-  const Vec3 n0 = normal_sum.normalized();
-  const Vec3 e1 = n0.unitOrthogonal();
-  const Vec3 e2 = n0.cross(e1);
-  const auto in_plane = [&](const Vec3& x) { return Vec2((x - centre).dot(e1), (x - centre).dot(e2)); };
-
+  const TangentPlane plane(mesh, group, nearest_wall_point(mesh, group, spec, r), r);
   TractionPatch patch;
-  patch.centre = centre;
+  patch.centre = plane.centre;
   Vec3 weighted_normal = Vec3::Zero();
-  for (int e : group.elements) {
-    const Triangle& t = mesh.triangles[e];
-    const Vec3 n2a = area_normal(mesh, t);
-    const double cosine = n2a.normalized().dot(n0);
-    // Only triangles facing the plane can lie under the disc; a triangle within the disc is
-    // nearer than r_c·(1 + curvature), so 2 r_c keeps every candidate and drops the far wall.
-    if (cosine <= kMinFacingCosine || distance_to_triangle(mesh, t, centre) > 2.0 * r) continue;
-    const std::array<Vec2, 3> flat{in_plane(mesh.nodes[t[0]]), in_plane(mesh.nodes[t[1]]),
-                                   in_plane(mesh.nodes[t[2]])};
-    const auto points = triangle_disc_quadrature(flat, Vec2::Zero(), r);
-    if (points.empty()) continue;
-    patch.triangles.push_back(e);
-    for (const PlanePoint& q : points) {
-      const Vec3 bary = barycentric(flat, q.x);
-      const double weight = q.weight / cosine;  // the plane's area element back on the triangle
-      patch.points.push_back({e, bary, weight});
-      patch.area += weight;
-      patch.projected_area += q.weight;
-      weighted_normal += weight * n2a.normalized();
-    }
-  }
+  for (int e : group.elements) add_disc_points(mesh, e, plane, r, patch, weighted_normal);
   const double disc_area = std::numbers::pi * r * r;
   if (patch.projected_area > disc_area * (1.0 + 1e-9)) {
     std::ostringstream m;
-    m << "contact patch of radius " << r * 1e3 << " mm at " << mm_text(centre) << " mm covers "
-      << patch.projected_area / disc_area << " times its disc on '" << spec.surface_group
-      << "': the wall folds back within the radius; expected a smaller radius";
+    m << "contact patch of radius " << r * 1e3 << " mm at " << mm_text(plane.centre)
+      << " mm covers " << patch.projected_area / disc_area << " times its disc on '"
+      << spec.surface_group << "': the wall folds back within the radius; expected a smaller radius";
     throw InputError(m.str());
   }
   patch.outward_normal = weighted_normal.normalized();
