@@ -44,7 +44,7 @@ struct MsmOptions {
   double axial_damping = 0.0;
   double force = 1e-3;
   std::vector<double> contact_point;
-  double patch_radius = 0.5e-3;
+  double patch_radius = ContactPatchSpec{}.radius;
   std::vector<std::string> fixed_groups{"inlet", "outlet"};
   fs::path json;
   bool verbose = false;

@@ -30,7 +30,7 @@ std::string short_error(const std::string& what);
 /// contact load of `force` (N) on a patch of radius `patch_radius` (m) on the inner wall at the
 /// shared default contact point (default_contact_point). ν is given per run.
 Scene study_scene(const VesselParams& vessel, double E, double force,
-                  double patch_radius = 0.5e-3);
+                  double patch_radius = ContactPatchSpec{}.radius);
 
 /// The study's mass-spring models: consistent masses, the inner wall for surface models, named
 /// "volume / seed001" in its tables.
