@@ -16,6 +16,11 @@ namespace vessel {
 
 namespace {
 
+/// The unit of a scene's load magnitudes: N (contact), Pa (pressure), g (gravity, in g).
+const char* load_unit(LoadKind k) {
+  return k == LoadKind::contact ? "N" : (k == LoadKind::pressure ? "Pa" : "g");
+}
+
 std::string now_utc() {
   const std::time_t t = std::time(nullptr);
   char buf[32];
@@ -129,18 +134,13 @@ nlohmann::json scene_json(const SceneResult& r) {
       {"reference_level", s.reference_level},
       {"youngs_modulus_pa", s.youngs_modulus},
       {"load", to_string(s.load.kind)},
-      {"load_unit",
-       s.load.kind == LoadKind::contact ? "N" : (s.load.kind == LoadKind::pressure ? "Pa" : "g")},
+      {"load_unit", load_unit(s.load.kind)},
       {"qoi_point_mm", {r.qoi_point.x() * 1e3, r.qoi_point.y() * 1e3, r.qoi_point.z() * 1e3}},
       {"tolerance_max_error_mm", s.tolerances.max_error_mm},
       {"budget", s.budget.stated ? budget_json(s.budget) : nlohmann::json(nullptr)},
       {"seconds", r.seconds},
       {"references", refs},
       {"outcomes", outcomes}};
-}
-
-const char* load_unit(LoadKind k) {
-  return k == LoadKind::contact ? "N" : (k == LoadKind::pressure ? "Pa" : "g");
 }
 
 }  // namespace
