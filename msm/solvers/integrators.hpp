@@ -61,7 +61,8 @@ struct DynamicResult {
   VectorXd v;
   int steps = 0;
   double seconds = 0.0;        ///< the steps, s (set-up excluded)
-  double setup_seconds = 0.0;  ///< before the first step (implicit-euler-rest: assembly, factorisation), s
+  double setup_seconds = 0.0;  ///< before the first step, s (implicit-euler-rest: assembly and
+                               ///< factorisation at rest)
   int numeric_factorisations = 0;  ///< CHOLMOD numeric factorisations (implicit Euler)
   double energy = 0.0;  ///< total energy ½vᵀMv + Π(x) at the end, J
 };

@@ -43,8 +43,9 @@ std::atomic<int> g_solver_threads{1};
 std::atomic<int> g_openblas_threads{0};  // what OpenBLAS was last given; 0: not yet
 
 /// Applies the setting before CHOLMOD runs, on the calling thread: OpenMP's nthreads-var and
-/// max-active-levels-var belong to the calling thread's data environment (OpenMP 5.0, ICV scopes), so
-/// they are set every time; OpenBLAS's count is process-wide and set only when it changes.
+/// max-active-levels-var belong to the calling thread's data environment (OpenMP 5.0, ICV
+/// scopes), so they are set every time; OpenBLAS's count is process-wide and set only when it
+/// changes.
 void apply_solver_threads() {
   const ThreadingEntryPoints& e = threading_entry_points();
   const int n = g_solver_threads.load(std::memory_order_relaxed);
