@@ -28,6 +28,8 @@ nlohmann::json solver_json(const std::string& name, const msm::SolveResult& s) {
     j.update({{"steps", dyn->steps},
               {"dt", s.dt},
               {"seconds_per_step", dyn->seconds / std::max(1, dyn->steps)},
+              {"setup_seconds", dyn->setup_seconds},
+              {"numeric_factorisations", dyn->numeric_factorisations},
               {"energy_J", dyn->energy}});
   } else if (const auto* pbd = std::get_if<msm::PbdResult>(&s.detail)) {
     j.update({{"steps", pbd->steps},

@@ -107,6 +107,29 @@ void check(const Problem& p, int step, const VectorXd& x, const VectorXd& v, dou
   }
 }
 
+/// Implicit Euler's matrix A = M + h D + h² K with the fixed dofs' rows and columns replaced by
+/// the identity (apply_dirichlet).
+SparseMatrix implicit_euler_matrix(const Problem& p, double h, const SparseMatrix& K,
+                                   const SparseMatrix& D) {
+  SparseMatrix A = h * h * K + h * D;
+  for (int i = 0; i < p.num_dofs(); ++i) A.coeffRef(i, i) += p.mass[i];
+  apply_dirichlet(A, p.fixed);
+  return A;
+}
+
+/// Baraff & Witkin (1998): (M + h D + h² K) Δv = h (f(x, v) − h K v); v += Δv; x += h v, with
+/// `solver` holding the factorised left-hand side and f the total force at (x, v).
+void implicit_euler_update(const Problem& p, double h, const SparseMatrix& K,
+                           const CholmodSolver& solver, const VectorXd& f, VectorXd& x,
+                           VectorXd& v) {
+  VectorXd rhs = h * (f - h * (K * v));
+  for (int i = 0; i < p.num_dofs(); ++i) {
+    if (p.fixed[i]) rhs[i] = 0.0;
+  }
+  v += solver.solve(rhs);
+  x += h * v;
+}
+
 }  // namespace
 
 double total_energy(const Problem& p, const VectorXd& x, const VectorXd& v) {
@@ -137,6 +160,16 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
   VectorXd f(n), scratch(n);
   CholmodSolver solver;
   SparseMatrix K, D;
+  const bool prefactored = o.integrator == Integrator::implicit_euler &&
+                           o.implicit_matrix == ImplicitMatrix::rest_prefactored;
+  if (prefactored) {
+    // Set-up of implicit-euler-rest: K and D at rest, A factorised once for every step.
+    const double t_setup = now();
+    p.form->hessian(p.rest, K, o.project_psd);
+    p.form->damping_jacobian(p.rest, D);
+    solver.factorize(implicit_euler_matrix(p, h, K, D));
+    r.setup_seconds = now() - t_setup;
+  }
   const double t0 = now();
   double energy = H0;
   for (int step = 1; step <= o.steps; ++step) {
@@ -163,20 +196,13 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
         break;
       }
       case Integrator::implicit_euler: {
-        // Baraff & Witkin (1998): (M + h D + h² K) Δv = h (f(x, v) − h K v); v += Δv; x += h v.
         total_force(p, r.x, r.v, f, scratch);
-        p.form->hessian(r.x, K, o.project_psd);
-        p.form->damping_jacobian(r.x, D);
-        VectorXd rhs = h * (f - h * (K * r.v));
-        SparseMatrix A = h * h * K + h * D;
-        for (int i = 0; i < n; ++i) A.coeffRef(i, i) += p.mass[i];
-        apply_dirichlet(A, p.fixed);
-        for (int i = 0; i < n; ++i) {
-          if (p.fixed[i]) rhs[i] = 0.0;
+        if (!prefactored) {  // K and D at this step's state, A refactorised
+          p.form->hessian(r.x, K, o.project_psd);
+          p.form->damping_jacobian(r.x, D);
+          solver.factorize(implicit_euler_matrix(p, h, K, D));
         }
-        solver.factorize(A);
-        r.v += solver.solve(rhs);
-        r.x += h * r.v;
+        implicit_euler_update(p, h, K, solver, f, r.x, r.v);
         break;
       }
     }
@@ -191,6 +217,7 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
     if (o.on_step) o.on_step(step, r.x, r.v);
   }
   r.seconds = now() - t0;
+  r.numeric_factorisations = solver.numeric_factorisations();
   r.energy = energy;
   return r;
 }

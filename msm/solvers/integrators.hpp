@@ -23,6 +23,17 @@ inline constexpr std::array<Integrator, 4> kAllIntegrators{
 Integrator parse_integrator(const std::string& name);
 std::string to_string(Integrator integrator);
 
+/// Implicit Euler's matrix A = M + h D + h² K (stiffness K, damping Jacobian D).
+enum class ImplicitMatrix {
+  current_state,     ///< "implicit-euler": K and D at the step's state, refactorised every step
+  rest_prefactored,  ///< "implicit-euler-rest": K and D at rest, factorised once at set-up; each
+                     ///< step assembles the right-hand side and does one solve (as simulators do)
+};
+// rest_prefactored is not unconditionally stable: the part of the stiffness that K at rest lacks
+// (K(x) − K(rest), e.g. the surface membrane's tension-borne transverse stiffness, zero at rest) is
+// integrated explicitly. On the level-0 surface models it diverged at the default 10× critical
+// step (step 7–10) but ran at 1 ms; on the volume model it ran at both.
+
 /// A run that blew up: a non-finite value, or the energy beyond the limit.
 class DivergenceError : public std::runtime_error {
  public:
@@ -40,6 +51,7 @@ struct DynamicOptions {
   /// |H₀| and ‖f_ext‖·(bounding-box diagonal) (an upper bound of the loads' work).
   double blowup_factor = 1e3;
   bool project_psd = true;  ///< implicit Euler: PSD-projected stiffness
+  ImplicitMatrix implicit_matrix = ImplicitMatrix::current_state;  ///< implicit Euler
   /// Called after every step with (step, x, v); may be empty.
   std::function<void(int, const VectorXd&, const VectorXd&)> on_step;
 };
@@ -48,7 +60,10 @@ struct DynamicResult {
   VectorXd x;
   VectorXd v;
   int steps = 0;
-  double seconds = 0.0;
+  double seconds = 0.0;        ///< the steps, s (set-up excluded)
+  double setup_seconds = 0.0;  ///< before the first step, s (implicit-euler-rest: assembly and
+                               ///< factorisation at rest)
+  int numeric_factorisations = 0;  ///< CHOLMOD numeric factorisations (implicit Euler)
   double energy = 0.0;  ///< total energy ½vᵀMv + Π(x) at the end, J
 };
 

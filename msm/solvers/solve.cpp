@@ -15,6 +15,10 @@ SolverSpec parse_solver(const std::string& name) {
     spec.kind = SolverKind::relaxation;
   } else if (name == "pbd") {
     spec.kind = SolverKind::pbd;
+  } else if (name == "implicit-euler-rest") {
+    spec.kind = SolverKind::integrator;
+    spec.integrator = Integrator::implicit_euler;
+    spec.implicit_matrix = ImplicitMatrix::rest_prefactored;
   } else {
     try {
       spec.integrator = parse_integrator(name);
@@ -33,7 +37,12 @@ std::string to_string(const SolverSpec& spec) {
     case SolverKind::static_newton: return "static";
     case SolverKind::linear: return "linear";
     case SolverKind::relaxation: return "relaxation";
-    case SolverKind::integrator: return to_string(spec.integrator);
+    case SolverKind::integrator:
+      if (spec.integrator == Integrator::implicit_euler &&
+          spec.implicit_matrix == ImplicitMatrix::rest_prefactored) {
+        return "implicit-euler-rest";
+      }
+      return to_string(spec.integrator);
     case SolverKind::pbd: return "pbd";
   }
   return "?";
@@ -78,6 +87,7 @@ SolveResult run_integrator(const Problem& problem, const SolverSpec& spec,
                            const StepObserver& on_step) {
   DynamicOptions d;
   d.integrator = spec.integrator;
+  d.implicit_matrix = spec.implicit_matrix;
   d.dt = resolved_time_step(problem, spec);
   d.steps = static_cast<int>(spec.steps);
   if (on_step) d.on_step = [&](int step, const VectorXd& x, const VectorXd&) { on_step(step, x); };

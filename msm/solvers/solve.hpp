@@ -36,6 +36,8 @@ struct PbdSettings {
 struct SolverSpec {
   SolverKind kind = SolverKind::static_newton;
   Integrator integrator = Integrator::symplectic_euler;  ///< kind integrator
+  /// Integrator implicit_euler: "implicit-euler" (current_state) or "implicit-euler-rest".
+  ImplicitMatrix implicit_matrix = ImplicitMatrix::current_state;
   double dt = 0.0;  ///< s, integrator and pbd; 0: automatic (resolved_time_step)
   long steps = 0;   ///< integrator and pbd: number of steps (> 0)
   StaticOptions static_options;  ///< static_newton
@@ -47,10 +49,11 @@ struct SolverSpec {
   }
 };
 
-/// Every solver name: the static ones, then the integrators, then PBD.
-inline constexpr std::array<const char*, 8> kSolverNames{
-    "static",          "linear", "relaxation",     "explicit-euler",
-    "symplectic-euler", "verlet", "implicit-euler", "pbd"};
+/// Every solver name: the static ones, then the integrators, then PBD. "implicit-euler-rest" is
+/// implicit Euler with the matrix at rest, factorised once (ImplicitMatrix::rest_prefactored).
+inline constexpr std::array<const char*, 9> kSolverNames{
+    "static",         "linear",         "relaxation",          "explicit-euler", "symplectic-euler",
+    "verlet",         "implicit-euler", "implicit-euler-rest", "pbd"};
 /// The solver of a name in kSolverNames (dt, steps and options left at their defaults).
 /// InputError listing the names otherwise.
 SolverSpec parse_solver(const std::string& name);
@@ -68,7 +71,7 @@ using SolveDetail = std::variant<StaticResult, RelaxationResult, DynamicResult, 
 
 struct SolveResult {
   VectorXd x;            ///< final positions, m
-  double seconds = 0.0;  ///< the solver's own time
+  double seconds = 0.0;  ///< the solver's own time (after set-up, for implicit-euler-rest)
   double dt = 0.0;       ///< s, dynamic solvers: the step used
   SolveDetail detail;
 };

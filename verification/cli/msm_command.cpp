@@ -11,6 +11,8 @@
 #include <limits>
 #include <numeric>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "meshes/errors.hpp"
 #include "meshes/msh_io.hpp"
@@ -301,7 +303,12 @@ void print_solve(const msm::SolverSpec& spec, const msm::Problem& problem,
   } else if (const auto* dyn = std::get_if<msm::DynamicResult>(&s.detail)) {
     std::cout << msm::to_string(spec) << ": " << dyn->steps << " steps of " << s.dt
               << " s (critical step bound 2/ω_max = " << 2.0 / msm::max_frequency_bound(problem)
-              << " s)\n  " << dyn->seconds << " s, " << dyn->seconds / dyn->steps * 1e6
+              << " s)\n  ";
+    if (spec.implicit_matrix == msm::ImplicitMatrix::rest_prefactored) {
+      std::cout << "set-up (assembly and factorisation at rest) " << dyn->setup_seconds
+                << " s, then ";
+    }
+    std::cout << dyn->seconds << " s, " << dyn->seconds / dyn->steps * 1e6
               << " µs per step, final energy " << dyn->energy << " J\n";
   } else if (const auto* pbd = std::get_if<msm::PbdResult>(&s.detail)) {
     std::cout << "XPBD (seed 002): " << pbd->steps << " steps of " << s.dt << " s, "
@@ -453,11 +460,13 @@ void add_model_options(CLI::App* cmd, MsmOptions& o) {
 
 /// Solver, time step and damping.
 void add_solver_options(CLI::App* cmd, MsmOptions& o) {
+  std::vector<std::string> names(msm::kSolverNames.begin(), msm::kSolverNames.end());
+  std::string listed;
+  for (const std::string& n : names) listed += (listed.empty() ? "" : ", ") + n;
   cmd->add_option("--solver", o.solver,
-                  "static, linear, relaxation, explicit-euler, symplectic-euler, verlet, "
-                  "implicit-euler, pbd (XPBD constraints of seed 002, surface model)")
-      ->check(CLI::IsMember({"static", "linear", "relaxation", "explicit-euler", "symplectic-euler",
-                             "verlet", "implicit-euler", "pbd"}))
+                  listed + " (implicit-euler-rest: the matrix at rest, factorised once; pbd: XPBD "
+                           "constraints of seed 002, surface model)")
+      ->check(CLI::IsMember(names))
       ->capture_default_str();
   cmd->add_option("--dt", o.dt,
                   "Time step, s (default: 0.5 × the critical-step bound; implicit: 10 ×)");
