@@ -128,7 +128,8 @@ void BM_Reference(benchmark::State& state, const Case* c) {
 
 void BM_Fast(benchmark::State& state, const Case* c) {
   const int threads = static_cast<int>(state.range(0));
-  const FastSprings fast(c->net.springs, static_cast<int>(c->net.nodes.size()), threads);
+  const FastSprings fast(c->net.springs, static_cast<int>(c->net.nodes.size()), threads,
+                         c->net.nodes);
   Eigen::VectorXd g(c->x.size());
   for (auto _ : state) {
     fast.gradient(c->x.data(), g.data());

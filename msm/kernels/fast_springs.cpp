@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
+#include <utility>
 #include <string>
 #include <thread>
 
@@ -171,15 +173,14 @@ int available_cores() {
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
-FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int threads)
+FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int threads,
+                         const std::vector<Vec3>& rest_positions)
     : num_nodes_(num_nodes), threads_(threads), num_springs_(springs.size()) {
   if (threads < 1) {
     throw InputError("spring kernel threads: expected >= 1, got " + std::to_string(threads));
   }
   if (num_nodes < 0) throw InputError("FastSprings: negative node count");
   const int T = threads;
-  // Node ranges balanced by the springs whose lower end lies in them.
-  std::vector<std::size_t> per_node(static_cast<std::size_t>(num_nodes) + 1, 0);
   for (std::size_t s = 0; s < springs.size(); ++s) {
     const Spring& sp = springs[s];
     if (sp.a < 0 || sp.b < 0 || sp.a >= num_nodes || sp.b >= num_nodes) {
@@ -187,31 +188,73 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
                        std::to_string(sp.a) + " and " + std::to_string(sp.b) +
                        ", expected indices below " + std::to_string(num_nodes));
     }
-    ++per_node[static_cast<std::size_t>(std::min(sp.a, sp.b))];
   }
   parts_.resize(static_cast<std::size_t>(T));
+  // The order nodes are walked in: along a Morton (Z-order) curve of the rest positions when they
+  // are given, so that each thread's nodes form a compact region (few springs cross between
+  // threads) and consecutive springs touch nearby nodes (their positions and forces stay in
+  // cache); else the index order.
+  std::vector<std::int32_t> order(static_cast<std::size_t>(num_nodes));
+  for (int v = 0; v < num_nodes; ++v) order[static_cast<std::size_t>(v)] = v;
+  if (!rest_positions.empty()) {
+    if (static_cast<int>(rest_positions.size()) != num_nodes) {
+      throw InputError("FastSprings: " + std::to_string(rest_positions.size()) +
+                       " rest positions, expected one per node (" + std::to_string(num_nodes) +
+                       ")");
+    }
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const Vec3& p : rest_positions) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    const double extent = std::max((hi - lo).maxCoeff(), 1e-300);
+    std::vector<std::uint64_t> code(static_cast<std::size_t>(num_nodes));
+    for (int v = 0; v < num_nodes; ++v) {
+      std::uint64_t c = 0;
+      std::uint64_t q[3];
+      for (int d = 0; d < 3; ++d) {
+        const double u = (rest_positions[static_cast<std::size_t>(v)][d] - lo[d]) / extent;
+        q[d] = static_cast<std::uint64_t>(std::clamp(u, 0.0, 1.0) * 2097151.0);  // 21 bits
+      }
+      for (int bit = 20; bit >= 0; --bit) {
+        for (int d = 0; d < 3; ++d) c = (c << 1) | ((q[d] >> bit) & 1u);
+      }
+      code[static_cast<std::size_t>(v)] = c;
+    }
+    std::stable_sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
+      return code[static_cast<std::size_t>(a)] < code[static_cast<std::size_t>(b)];
+    });
+  }
+  std::vector<std::int32_t> rank(static_cast<std::size_t>(num_nodes));
+  for (int r = 0; r < num_nodes; ++r) rank[static_cast<std::size_t>(order[r])] = r;
+  // Threads own consecutive runs of that order, balanced by the springs whose first end in the
+  // order lies in them.
+  std::vector<std::size_t> per_rank(static_cast<std::size_t>(num_nodes), 0);
+  for (const Spring& sp : springs) {
+    ++per_rank[static_cast<std::size_t>(
+        std::min(rank[static_cast<std::size_t>(sp.a)], rank[static_cast<std::size_t>(sp.b)]))];
+  }
   std::vector<int> owner(static_cast<std::size_t>(num_nodes), T - 1);
   {
     std::size_t seen = 0;
     int t = 0;
-    parts_[0].node_begin = 0;
-    for (int v = 0; v < num_nodes; ++v) {
-      // Start thread t+1's range once t's share of springs is reached.
-      while (t + 1 < T && seen >= (springs.size() * static_cast<std::size_t>(t + 1)) / T) {
-        parts_[static_cast<std::size_t>(t)].node_end = v;
-        ++t;
-        parts_[static_cast<std::size_t>(t)].node_begin = v;
-      }
-      owner[static_cast<std::size_t>(v)] = t;
-      seen += per_node[static_cast<std::size_t>(v)];
+    for (int r = 0; r < num_nodes; ++r) {
+      while (t + 1 < T && seen >= (springs.size() * static_cast<std::size_t>(t + 1)) / T) ++t;
+      owner[static_cast<std::size_t>(order[r])] = t;
+      seen += per_rank[static_cast<std::size_t>(r)];
     }
-    parts_[static_cast<std::size_t>(t)].node_end = num_nodes;
-    for (++t; t < T; ++t) {
-      parts_[static_cast<std::size_t>(t)].node_begin = num_nodes;
-      parts_[static_cast<std::size_t>(t)].node_end = num_nodes;
+    // Each thread's nodes in index order (it zeroes their gradient entries).
+    std::vector<std::vector<std::int32_t>> owned(static_cast<std::size_t>(T));
+    for (int v = 0; v < num_nodes; ++v) owned[owner[static_cast<std::size_t>(v)]].push_back(v);
+    owned_nodes_.clear();
+    owned_nodes_.reserve(static_cast<std::size_t>(num_nodes));
+    for (int u = 0; u < T; ++u) {
+      parts_[u].nodes[0] = owned_nodes_.size();
+      owned_nodes_.insert(owned_nodes_.end(), owned[u].begin(), owned[u].end());
+      parts_[u].nodes[1] = owned_nodes_.size();
     }
   }
-  // Per thread, in the network's order: full springs and halves of split springs.
+  // Per thread: full springs and halves of split springs.
   struct Item {
     std::int32_t i, j;
     std::size_t s;
@@ -231,6 +274,20 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
       ++num_split_;
       (bilinear ? bh : hh)[oa].push_back({sp.a, sp.b, s});
       (bilinear ? bh : hh)[ob].push_back({sp.b, sp.a, s});
+    }
+  }
+  // Springs in the order of their first end along the node order (then the second end).
+  auto by_rank = [&](const Item& x, const Item& y) {
+    const auto key = [&](const Item& it) {
+      const std::int32_t ri = rank[static_cast<std::size_t>(it.i)];
+      const std::int32_t rj = rank[static_cast<std::size_t>(it.j)];
+      return std::make_pair(std::min(ri, rj), std::max(ri, rj));
+    };
+    return key(x) < key(y);
+  };
+  if (!rest_positions.empty()) {
+    for (auto* lists : {&hf, &hh, &bf, &bh}) {
+      for (auto& l : *lists) std::stable_sort(l.begin(), l.end(), by_rank);
     }
   }
   auto fill_hooke = [&](std::vector<std::vector<Item>>& lists, HookeSet& set,
@@ -287,6 +344,7 @@ FastSprings& FastSprings::operator=(const FastSprings& o) {
   bil_full_ = o.bil_full_;
   bil_half_ = o.bil_half_;
   parts_ = o.parts_;
+  owned_nodes_ = o.owned_nodes_;
   last_team_.store(o.last_team_.load());
   return *this;
 }
@@ -294,8 +352,10 @@ FastSprings& FastSprings::operator=(const FastSprings& o) {
 template <bool kGradient, bool kEnergy>
 double FastSprings::run_part(const Part& p, const double* x, double* g) const {
   if constexpr (kGradient) {
-    std::fill(g + 3 * static_cast<std::ptrdiff_t>(p.node_begin),
-              g + 3 * static_cast<std::ptrdiff_t>(p.node_end), 0.0);
+    for (std::size_t u = p.nodes[0]; u < p.nodes[1]; ++u) {
+      double* gv = g + 3 * static_cast<std::ptrdiff_t>(owned_nodes_[u]);
+      gv[0] = gv[1] = gv[2] = 0.0;
+    }
   }
   auto r = [&](Range which, int end) { return p.range[which][end]; };
   // Σ 2ψ of whole springs, and of split springs (each counted by both of its threads).

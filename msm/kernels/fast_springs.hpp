@@ -10,8 +10,8 @@
 /// - per block of springs, a branch-free loop (the coincident-ends case is a select) that GCC
 ///   auto-vectorises (see msm/CMakeLists.txt), then a scalar scatter of the block's forces;
 /// - threads over the cores without write conflicts by owner-computes: the nodes are split into
-///   one contiguous range per thread (balanced by springs), a thread zeroes and accumulates only
-///   its own range of g, a spring with both ends in one range is that thread's, and a spring whose
+///   one compact region per thread (consecutive runs of a Morton curve through the rest
+///   positions, balanced by springs), a thread zeroes and accumulates only its own nodes of g, a spring with both ends in one range is that thread's, and a spring whose
 ///   ends lie in two ranges is evaluated by both threads, each adding only its own end's force
 ///   (and half the energy). No atomics, no per-thread buffers, no reduction of g.
 /// The thread count is fixed when the layout is built (it decides the split); it is this object's
@@ -37,9 +37,12 @@ class FastSprings {
  public:
   FastSprings() = default;
   /// Lays out `springs` (Hooke when law.threshold is infinite, bilinear otherwise) on
-  /// `num_nodes` nodes for `threads` threads. InputError if threads < 1 or a spring's node is out
-  /// of range.
-  FastSprings(const std::vector<Spring>& springs, int num_nodes, int threads = 1);
+  /// `num_nodes` nodes for `threads` threads. With the nodes' rest positions (m), threads own
+  /// compact regions and springs are ordered along a Morton curve; without, index ranges and the
+  /// given order. InputError if threads < 1, a spring's node is out of range or the positions
+  /// are not one per node.
+  FastSprings(const std::vector<Spring>& springs, int num_nodes, int threads = 1,
+              const std::vector<Vec3>& rest_positions = {});
 
   /// Σ ψ over the springs at x (3·num_nodes values), J.
   [[nodiscard]] double energy(const double* x) const;
@@ -73,7 +76,7 @@ class FastSprings {
   /// What thread t owns: its node range and its slice of each set.
   enum Range { kHookeFull, kHookeHalf, kBilinearFull, kBilinearHalf };
   struct Part {
-    std::int32_t node_begin = 0, node_end = 0;
+    std::size_t nodes[2]{};     ///< [begin, end) into owned_nodes_: the nodes it zeroes
     std::size_t range[4][2]{};  ///< [Range][begin, end) into the set of that kind
   };
   template <bool kGradient, bool kEnergy>
@@ -91,6 +94,7 @@ class FastSprings {
   HookeSet hooke_full_, hooke_half_;
   BilinearSet bil_full_, bil_half_;
   std::vector<Part> parts_ = std::vector<Part>(1);  // one per thread
+  std::vector<std::int32_t> owned_nodes_;           // each thread's nodes, thread by thread
   mutable std::atomic<int> last_team_{1};
 
  public:

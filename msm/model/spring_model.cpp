@@ -38,7 +38,9 @@ SpringModel::SpringModel(const SpringNetwork& network, double point_damping)
     : num_nodes_(static_cast<int>(network.nodes.size())),
       springs_(network.springs),
       point_damping_(point_damping),
-      fast_(network.springs, static_cast<int>(network.nodes.size()), spring_kernel_threads()) {
+      rest_nodes_(network.nodes),
+      fast_(network.springs, static_cast<int>(network.nodes.size()), spring_kernel_threads(),
+            network.nodes) {
   if (!(point_damping >= 0)) {
     throw InputError("point_damping k_v: expected a value ≥ 0 N·s/m, got " +
                      std::to_string(point_damping));
@@ -90,7 +92,7 @@ void SpringModel::assemble(SparseMatrix& H, double diagonal, BlockFn block) cons
 }
 
 void SpringModel::set_threads(int n) {
-  if (n != fast_.threads()) fast_ = FastSprings(springs_, num_nodes_, n);
+  if (n != fast_.threads()) fast_ = FastSprings(springs_, num_nodes_, n, rest_nodes_);
 }
 
 void SpringModel::require_size(const VectorXd& x) const {

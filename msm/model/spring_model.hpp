@@ -47,6 +47,7 @@ class SpringModel : public Form {
   int num_nodes_ = 0;
   std::vector<Spring> springs_;
   double point_damping_ = 0.0;
+  std::vector<Vec3> rest_nodes_;     ///< rest positions (the fast kernel's layout), m
   FastSprings fast_;                 ///< the springs laid out for the fast kernel
   std::vector<int> damped_;          ///< springs with axial damping k_d ≠ 0
   SparseMatrix pattern_;             ///< the Hessian's sparsity pattern (values zero)

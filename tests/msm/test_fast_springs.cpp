@@ -127,6 +127,12 @@ TEST(FastSprings, ThreadsSplitTheNodesAndEvaluateOnlyCrossingSpringsTwice) {
   const FastSprings two(net.springs, n, 2);
   EXPECT_GT(two.num_split_springs(), 0u);
   EXPECT_LT(two.num_split_springs(), net.springs.size());
+  // Regions along a Morton curve of the rest positions: on a tube, a cut across it, which far
+  // fewer springs cross than the split of the index range (gmsh's numbering is not local).
+  const FastSprings spatial(net.springs, n, 2, net.nodes);
+  EXPECT_GT(spatial.num_split_springs(), 0u);
+  EXPECT_LT(spatial.num_split_springs(), two.num_split_springs());
+  EXPECT_THROW(FastSprings(net.springs, n, 2, {Vec3::Zero()}), InputError);
   // More threads than nodes: empty ranges, still the whole answer.
   std::vector<Spring> pair{net.springs.front()};
   pair.front().a = 0;
