@@ -41,8 +41,8 @@ double hooke_range(const FastSprings::HookeSet& set, std::size_t begin, std::siz
     // does not if-convert `L > 0 ? … : 0` here under the default -ftrapping-math).
 #pragma omp simd
     for (std::size_t q = 0; q < m; ++q) {
-      const std::ptrdiff_t a = 3 * static_cast<std::ptrdiff_t>(I[q]);
-      const std::ptrdiff_t b = 3 * static_cast<std::ptrdiff_t>(J[q]);
+      const std::int32_t a = I[q];
+      const std::int32_t b = J[q];
       const double ex = x[a] - x[b];
       const double ey = x[a + 1] - x[b + 1];
       const double ez = x[a + 2] - x[b + 2];
@@ -66,12 +66,12 @@ double hooke_range(const FastSprings::HookeSet& set, std::size_t begin, std::siz
     }
     if constexpr (kGradient) {
       for (std::size_t q = 0; q < m; ++q) {
-        const std::ptrdiff_t a = 3 * static_cast<std::ptrdiff_t>(I[q]);
+        const std::int32_t a = I[q];
         g[a] += cx[q];
         g[a + 1] += cy[q];
         g[a + 2] += cz[q];
         if constexpr (kFull) {
-          const std::ptrdiff_t b = 3 * static_cast<std::ptrdiff_t>(J[q]);
+          const std::int32_t b = J[q];
           g[b] -= cx[q];
           g[b + 1] -= cy[q];
           g[b + 2] -= cz[q];
@@ -100,8 +100,8 @@ double bilinear_range(const FastSprings::BilinearSet& set, std::size_t begin, st
     const double* __restrict dc = set.threshold.data() + b0;
 #pragma omp simd
     for (std::size_t q = 0; q < m; ++q) {
-      const std::ptrdiff_t a = 3 * static_cast<std::ptrdiff_t>(I[q]);
-      const std::ptrdiff_t b = 3 * static_cast<std::ptrdiff_t>(J[q]);
+      const std::int32_t a = I[q];
+      const std::int32_t b = J[q];
       const double ex = x[a] - x[b];
       const double ey = x[a + 1] - x[b + 1];
       const double ez = x[a + 2] - x[b + 2];
@@ -133,12 +133,12 @@ double bilinear_range(const FastSprings::BilinearSet& set, std::size_t begin, st
     }
     if constexpr (kGradient) {
       for (std::size_t q = 0; q < m; ++q) {
-        const std::ptrdiff_t a = 3 * static_cast<std::ptrdiff_t>(I[q]);
+        const std::int32_t a = I[q];
         g[a] += cx[q];
         g[a + 1] += cy[q];
         g[a + 2] += cz[q];
         if constexpr (kFull) {
-          const std::ptrdiff_t b = 3 * static_cast<std::ptrdiff_t>(J[q]);
+          const std::int32_t b = J[q];
           g[b] -= cx[q];
           g[b + 1] -= cy[q];
           g[b + 2] -= cz[q];
@@ -179,7 +179,10 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
   if (threads < 1) {
     throw InputError("spring kernel threads: expected >= 1, got " + std::to_string(threads));
   }
-  if (num_nodes < 0) throw InputError("FastSprings: negative node count");
+  if (num_nodes < 0 || num_nodes > std::numeric_limits<std::int32_t>::max() / 3) {
+    throw InputError("FastSprings: " + std::to_string(num_nodes) +
+                     " nodes, expected 0 to 2^31/3 (32-bit offsets 3·node)");
+  }
   const int T = threads;
   for (std::size_t s = 0; s < springs.size(); ++s) {
     const Spring& sp = springs[s];
@@ -298,8 +301,8 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
     for (int t = 0; t < T; ++t) {
       parts_[t].range[range][0] = set.i.size();
       for (const Item& it : lists[t]) {
-        set.i.push_back(it.i);
-        set.j.push_back(it.j);
+        set.i.push_back(3 * it.i);
+        set.j.push_back(3 * it.j);
         set.rest.push_back(springs[it.s].rest_length);
         set.k.push_back(springs[it.s].law.k1);
       }
@@ -316,8 +319,8 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
     for (int t = 0; t < T; ++t) {
       parts_[t].range[range][0] = set.i.size();
       for (const Item& it : lists[t]) {
-        set.i.push_back(it.i);
-        set.j.push_back(it.j);
+        set.i.push_back(3 * it.i);
+        set.j.push_back(3 * it.j);
         set.rest.push_back(springs[it.s].rest_length);
         set.k.push_back(springs[it.s].law.k1);
         set.k2.push_back(springs[it.s].law.k2);

@@ -61,7 +61,8 @@ class FastSprings {
   /// Springs evaluated twice because their ends lie in two threads' node ranges.
   [[nodiscard]] std::size_t num_split_springs() const { return num_split_; }
 
-  /// Hooke springs: ψ = ½k(L − l)². `i` is the node whose gradient a half spring writes.
+  /// Hooke springs: ψ = ½k(L − l)². i, j: offsets 3·node of the ends into x and g (no index
+  /// arithmetic in the vectorised loop); `i` is the end whose gradient a half spring writes.
   struct HookeSet {
     std::vector<std::int32_t> i, j;
     std::vector<double> rest, k;
