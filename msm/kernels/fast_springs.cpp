@@ -293,6 +293,24 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
       for (auto& l : *lists) std::stable_sort(l.begin(), l.end(), by_rank);
     }
   }
+  // Sorted, consecutive springs share their first end: the scatter's read-modify-write of that
+  // node's force would chain from one spring to the next through memory (store-to-load
+  // forwarding, several cycles a link). Each chunk of kBlock springs is read column-wise as a
+  // kStride × (kBlock/kStride) table, so neighbours in the loop are kBlock/kStride springs apart
+  // in the sorted order: other nodes, still within the chunk's small region.
+  constexpr std::size_t kStride = 8;
+  for (auto* lists : {&hf, &hh, &bf, &bh}) {
+    for (auto& l : *lists) {
+      std::vector<Item> chunk;
+      for (std::size_t c0 = 0; c0 + kBlock <= l.size(); c0 += kBlock) {
+        chunk.assign(l.begin() + static_cast<std::ptrdiff_t>(c0),
+                     l.begin() + static_cast<std::ptrdiff_t>(c0 + kBlock));
+        for (std::size_t p = 0; p < kBlock; ++p) {
+          l[c0 + p] = chunk[(p % kStride) * (kBlock / kStride) + p / kStride];
+        }
+      }
+    }
+  }
   auto fill_hooke = [&](std::vector<std::vector<Item>>& lists, HookeSet& set,
                         int range) {
     std::size_t total = 0;
