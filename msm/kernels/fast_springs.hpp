@@ -2,18 +2,22 @@
 /// The fast spring force pass: the same energies and gradients as the per-spring reference kernel
 /// (spring_kernels.hpp: Hooke ψ = ½k(L − l)², seed 000 eq. 3.2; the bilinear spring of seed 001
 /// eq. 1), laid out for the memory system rather than for one spring at a time:
-/// - structure of arrays: node indices, rest length and k in separate arrays (24 bytes per Hooke
-///   spring streamed, against the 56-byte Spring record), the bilinear springs' k2 and threshold
-///   in a set of their own, so the Hooke pass has no per-spring branch on the law;
+/// - structure of arrays: the ends' offsets 3·node into x and g (4 bytes each), rest length and k
+///   in separate arrays (24 bytes per Hooke spring streamed, against the 56-byte Spring record);
+///   the bilinear springs' k2 and threshold in a set of their own, so the Hooke pass has no
+///   per-spring branch on the law;
 /// - positions read from the flat x = (x0, y0, z0, x1, ...) and the gradient written into a flat
 ///   g of the same layout;
-/// - per block of springs, a branch-free loop (the coincident-ends case is a select) that GCC
+/// - per block of springs, a branch-free loop (coincident ends by a 0/1 factor) that GCC
 ///   auto-vectorises (see msm/CMakeLists.txt), then a scalar scatter of the block's forces;
 /// - threads over the cores without write conflicts by owner-computes: the nodes are split into
 ///   one compact region per thread (consecutive runs of a Morton curve through the rest
-///   positions, balanced by springs), a thread zeroes and accumulates only its own nodes of g, a spring with both ends in one range is that thread's, and a spring whose
-///   ends lie in two ranges is evaluated by both threads, each adding only its own end's force
-///   (and half the energy). No atomics, no per-thread buffers, no reduction of g.
+///   positions, balanced by springs); a thread zeroes and accumulates only its own nodes of g; a
+///   spring with both ends in one region is that thread's, and a spring whose ends lie in two
+///   regions is evaluated by both threads, each adding only its own end's force (and half the
+///   energy). No atomics, no per-thread buffers, no reduction of g.
+/// Measured against the memory-bandwidth roofline by msm/benchmarks/spring_kernel_benchmark.cpp
+/// (docs/msm_kernel_benchmark.md).
 /// The thread count is fixed when the layout is built (it decides the split); it is this object's
 /// own setting, independent of set_solver_threads (the OpenMP limits set there for CHOLMOD are
 /// overridden for the kernel's own parallel region and restored after it).
@@ -25,12 +29,14 @@
 
 namespace vessel::msm {
 
-/// Threads of the spring force pass of models built from now on (SpringModel); default 1: the
-/// harness and the gate time one model per core, and on small networks (level 0, a few thousand
-/// springs) a parallel region costs more than it saves. InputError if n < 1.
+/// Threads of the spring force pass of models built from now on (SpringModel); default 1, like
+/// set_solver_threads: timings stay per core, and on a machine shared with other work a
+/// fork–join pass waits for descheduled threads (docs/msm_kernel_benchmark.md, "Under
+/// contention"). InputError if n < 1.
 void set_spring_kernel_threads(int n);
 [[nodiscard]] int spring_kernel_threads();
-/// Processor cores available to this process (std::thread::hardware_concurrency, at least 1).
+/// Processor cores this process may run on (its CPU affinity mask; else
+/// std::thread::hardware_concurrency; at least 1).
 [[nodiscard]] int available_cores();
 
 class FastSprings {
