@@ -136,6 +136,49 @@ void SpringModel::reference_gradient(const VectorXd& x, VectorXd& g) const {
 }
 
 void SpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
+  require_size(x);
+  H = pattern_;
+  double* values = H.valuePtr();
+  std::fill(values, values + H.nonZeros(), 0.0);
+  const int* slot = slots_.data();
+  for (const Spring& s : springs_) {
+    const Vec3 xa = node(x, s.a), xb = node(x, s.b);
+    const Vec3 e = xa - xb;
+    const double L = e.norm();
+    if (!(L > 0.0)) {  // coincident ends: the reference kernel's special case
+      const Mat6 B = spring_hessian(xa, xb, s.rest_length, s.law, project_psd);
+      for (int p = 0; p < 2; ++p)
+        for (int q = 0; q < 2; ++q)
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) values[*slot++] += B(3 * p + i, 3 * q + j);
+      continue;
+    }
+    // spring_hessian's block K = ψ''·d dᵀ + ψ'/L·(I − d dᵀ) (kernels/spring_kernels.hpp), built
+    // here as one 3×3 block and added as [[K, −K], [−K, K]]: no 6×6 matrix per spring.
+    const Vec3 d = e / L;
+    const LengthProfile prof = spring_profile(L, s.rest_length, s.law);
+    double axial = prof.ddpsi;
+    double transverse = prof.dpsi / L;
+    if (project_psd) {
+      axial = std::max(axial, 0.0);
+      transverse = std::max(transverse, 0.0);
+    }
+    double K[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const double D = d[i] * d[j];
+        K[i][j] = axial * D + transverse * ((i == j ? 1.0 : 0.0) - D);
+      }
+    for (int p = 0; p < 2; ++p)
+      for (int q = 0; q < 2; ++q) {
+        const double sign = p == q ? 1.0 : -1.0;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) values[*slot++] += sign * K[i][j];
+      }
+  }
+}
+
+void SpringModel::reference_hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
   assemble(H, 0.0, [&](const Spring& s) {
     return spring_hessian(node(x, s.a), node(x, s.b), s.rest_length, s.law, project_psd);
   });

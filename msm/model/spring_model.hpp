@@ -1,8 +1,9 @@
 #pragma once
 /// The spring model: a Form over a SpringNetwork (any family mix, Hooke or bilinear springs),
 /// with axial (seed 000 eq. 3.4) and point (eq. 3.3) damping. Energy and gradient run on the fast
-/// kernel (kernels/fast_springs.hpp); the Hessian and damping on the per-spring reference kernel
-/// (kernels/spring_kernels.hpp), which reference_energy/reference_gradient keep callable.
+/// kernel (kernels/fast_springs.hpp); the Hessian adds one 3×3 block per spring (spring_hessian's
+/// formula) into a fixed pattern; damping uses the per-spring kernel (kernels/spring_kernels.hpp),
+/// which reference_energy/gradient/hessian keep callable as the reference.
 #include <string>
 
 #include "meshes/tet_mesh.hpp"
@@ -35,6 +36,9 @@ class SpringModel : public Form {
   /// (spring_energy / spring_gradient), single-threaded: the fast path's check and benchmark.
   [[nodiscard]] double reference_energy(const VectorXd& x) const;
   void reference_gradient(const VectorXd& x, VectorXd& g) const;
+  /// The Hessian assembled from spring_hessian's 6×6 blocks (hessian() builds each spring's 3×3
+  /// block once and adds it with its signs into the same pattern).
+  void reference_hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const;
   /// Largest strain |L − l|/l over the springs at x.
   [[nodiscard]] double max_strain(const VectorXd& x) const;
 

@@ -86,6 +86,17 @@ void expect_fast_equals_reference(const SpringNetwork& net, int threads, unsigne
     // One pass for both gives the same numbers as the separate passes, bit for bit.
     EXPECT_EQ(e2, e);
     EXPECT_EQ((g2 - g).lpNorm<Eigen::Infinity>(), 0.0);
+    // The Hessian's 3×3-block assembly against the reference kernel's 6×6 blocks, same pattern.
+    for (bool psd : {false, true}) {
+      SparseMatrix H, H_ref;
+      model.hessian(x, H, psd);
+      model.reference_hessian(x, H_ref, psd);
+      ASSERT_EQ(H.nonZeros(), H_ref.nonZeros());
+      const Eigen::Map<const Eigen::VectorXd> h(H.valuePtr(), H.nonZeros());
+      const Eigen::Map<const Eigen::VectorXd> h_ref(H_ref.valuePtr(), H_ref.nonZeros());
+      EXPECT_LE((h - h_ref).lpNorm<Eigen::Infinity>(), 1e-12 * h_ref.lpNorm<Eigen::Infinity>());
+      EXPECT_LE((SparseMatrix(H - H_ref)).norm(), 1e-12 * H_ref.norm());
+    }
   }
 }
 
