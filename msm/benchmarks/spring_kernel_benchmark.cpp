@@ -41,7 +41,7 @@ using namespace vessel::msm;
 namespace {
 
 constexpr double kBytesPerSpring = 2 * 4 + 8 + 8 + 2 * 24 + 2 * 24;  // = 120
-constexpr std::size_t kTriadElements = std::size_t{1} << 24;        // 128 MiB per array
+constexpr std::size_t kTriadElements = std::size_t{1} << 24;         // 128 MiB per array
 
 /// Triad bandwidth (bytes/s) measured on each thread count, filled by BM_Triad, which runs first.
 std::map<int, double> g_triad_bandwidth;
@@ -72,8 +72,8 @@ Case make_case(const std::string& name, ModelType model, MeshStyle style, int le
   std::mt19937 rng(1);
   std::normal_distribution<double> n(0.0, 1e-6);  // 1 µm against mm-long springs
   for (Eigen::Index i = 0; i < c.x.size(); ++i) c.x[i] += n(rng);
-  c.compulsory_bytes_per_spring =
-      24.0 + 48.0 * static_cast<double>(c.net.nodes.size()) / static_cast<double>(c.net.springs.size());
+  c.compulsory_bytes_per_spring = 24.0 + 48.0 * static_cast<double>(c.net.nodes.size()) /
+                                             static_cast<double>(c.net.springs.size());
   return c;
 }
 
@@ -92,11 +92,9 @@ void BM_Triad(benchmark::State& state) {
     benchmark::ClobberMemory();
   }
   const double bytes = 24.0 * static_cast<double>(kTriadElements);
-  state.SetBytesProcessed(static_cast<int64_t>(state.iterations()) *
-                          static_cast<int64_t>(bytes));
-  state.counters["triad_bytes_per_s"] =
-      benchmark::Counter(bytes * static_cast<double>(state.iterations()),
-                         benchmark::Counter::kIsRate);
+  state.SetBytesProcessed(static_cast<int64_t>(state.iterations()) * static_cast<int64_t>(bytes));
+  state.counters["triad_bytes_per_s"] = benchmark::Counter(
+      bytes * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 /// Sets the springs/s and roofline counters of a force-pass benchmark on `threads` threads.
@@ -108,11 +106,10 @@ void set_counters(benchmark::State& state, const Case& c, int threads) {
   const auto bw = g_triad_bandwidth.find(threads);
   if (bw != g_triad_bandwidth.end() && bw->second > 0) {
     // A rate counter of springs × bytes / bandwidth is the fraction of the roofline.
-    state.counters["roofline"] = benchmark::Counter(springs * kBytesPerSpring / bw->second,
-                                                    benchmark::Counter::kIsRate);
-    state.counters["roofline_compulsory"] =
-        benchmark::Counter(springs * c.compulsory_bytes_per_spring / bw->second,
-                           benchmark::Counter::kIsRate);
+    state.counters["roofline"] =
+        benchmark::Counter(springs * kBytesPerSpring / bw->second, benchmark::Counter::kIsRate);
+    state.counters["roofline_compulsory"] = benchmark::Counter(
+        springs * c.compulsory_bytes_per_spring / bw->second, benchmark::Counter::kIsRate);
   }
 }
 
@@ -192,8 +189,10 @@ int main(int argc, char** argv) {
     benchmark::AddCustomContext("network_" + c.name, info);
   }
 
-  auto* triad =
-      benchmark::RegisterBenchmark("BM_Triad", BM_Triad)->UseRealTime()->Unit(benchmark::kMillisecond)->Arg(1);
+  auto* triad = benchmark::RegisterBenchmark("BM_Triad", BM_Triad)
+                    ->UseRealTime()
+                    ->Unit(benchmark::kMillisecond)
+                    ->Arg(1);
   if (cores > 1) triad->Arg(cores);
   for (const Case& c : cases) {
     benchmark::RegisterBenchmark(("BM_Reference/" + c.name).c_str(), BM_Reference, &c)

@@ -7,9 +7,9 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <utility>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "meshes/errors.hpp"
 
@@ -122,8 +122,9 @@ double bilinear_range(const FastSprings::BilinearSet& set, std::size_t begin, st
       }
       if constexpr (kEnergy) {
         // 2ψ: k1δ² below; k1Δx_c² + 2k1Δx_c(δ − Δx_c) + k2(δ − Δx_c)² beyond.
-        en[q] = beyond * (k1[q] * dc[q] * dc[q] + 2.0 * k1[q] * dc[q] * over + k2[q] * over * over) +
-                below * (k1[q] * delta * delta);
+        en[q] =
+            beyond * (k1[q] * dc[q] * dc[q] + 2.0 * k1[q] * dc[q] * over + k2[q] * over * over) +
+            below * (k1[q] * delta * delta);
       }
     }
     // Summed in spring order, not in the vector lanes' order: energy() and energy_gradient()
@@ -311,8 +312,7 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
       }
     }
   }
-  auto fill_hooke = [&](std::vector<std::vector<Item>>& lists, HookeSet& set,
-                        int range) {
+  auto fill_hooke = [&](std::vector<std::vector<Item>>& lists, HookeSet& set, int range) {
     std::size_t total = 0;
     for (const auto& l : lists) total += l.size();
     reserve_set(set, total);
@@ -327,8 +327,7 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
       parts_[t].range[range][1] = set.i.size();
     }
   };
-  auto fill_bilinear = [&](std::vector<std::vector<Item>>& lists, BilinearSet& set,
-                           int range) {
+  auto fill_bilinear = [&](std::vector<std::vector<Item>>& lists, BilinearSet& set, int range) {
     std::size_t total = 0;
     for (const auto& l : lists) total += l.size();
     reserve_set(set, total);
@@ -381,15 +380,13 @@ double FastSprings::run_part(const Part& p, const double* x, double* g) const {
   auto r = [&](Range which, int end) { return p.range[which][end]; };
   // Σ 2ψ of whole springs, and of split springs (each counted by both of its threads).
   const double full =
-      hooke_range<true, kGradient, kEnergy>(hooke_full_, r(kHookeFull, 0), r(kHookeFull, 1), x,
-                                            g) +
-      bilinear_range<true, kGradient, kEnergy>(bil_full_, r(kBilinearFull, 0),
-                                               r(kBilinearFull, 1), x, g);
-  const double half =
-      hooke_range<false, kGradient, kEnergy>(hooke_half_, r(kHookeHalf, 0), r(kHookeHalf, 1), x,
-                                             g) +
-      bilinear_range<false, kGradient, kEnergy>(bil_half_, r(kBilinearHalf, 0),
-                                                r(kBilinearHalf, 1), x, g);
+      hooke_range<true, kGradient, kEnergy>(hooke_full_, r(kHookeFull, 0), r(kHookeFull, 1), x, g) +
+      bilinear_range<true, kGradient, kEnergy>(bil_full_, r(kBilinearFull, 0), r(kBilinearFull, 1),
+                                               x, g);
+  const double half = hooke_range<false, kGradient, kEnergy>(hooke_half_, r(kHookeHalf, 0),
+                                                             r(kHookeHalf, 1), x, g) +
+                      bilinear_range<false, kGradient, kEnergy>(bil_half_, r(kBilinearHalf, 0),
+                                                                r(kBilinearHalf, 1), x, g);
   return 0.5 * full + 0.25 * half;
 }
 

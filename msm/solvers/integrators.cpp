@@ -95,8 +95,7 @@ void check_finite(const Problem& p, int step, const VectorXd& x, const VectorXd&
 /// ½ vᵀ M v + Π(x) with the Form's energy E(x) already known (total_energy's expression).
 double total_energy_given(const Problem& p, const VectorXd& x, const VectorXd& v,
                           double form_energy) {
-  return 0.5 * v.dot(p.mass.cwiseProduct(v)) +
-         (form_energy - p.external_force.dot(x - p.rest));
+  return 0.5 * v.dot(p.mass.cwiseProduct(v)) + (form_energy - p.external_force.dot(x - p.rest));
 }
 
 /// Throws DivergenceError if the total energy is not finite or beyond the limit.
