@@ -20,6 +20,12 @@ class Form {
   [[nodiscard]] virtual double energy(const VectorXd& x) const = 0;
   /// ∂E/∂x, N (resized to num_dofs).
   virtual void gradient(const VectorXd& x, VectorXd& g) const = 0;
+  /// Both in one call; returns the energy, the same value energy(x) returns. Default: the two
+  /// calls; a Form whose kernel makes both in one pass (SpringModel) overrides it.
+  virtual double energy_gradient(const VectorXd& x, VectorXd& g) const {
+    gradient(x, g);
+    return energy(x);
+  }
   /// ∂²E/∂x², N/m, as a sparse symmetric matrix with a pattern that does not depend on x (so a
   /// symbolic factorisation can be reused). With project_psd, each element's block is projected
   /// onto the positive semi-definite cone.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <stdexcept>
 
 #include "meshes/errors.hpp"
 
@@ -36,10 +37,16 @@ void add_block(std::vector<Eigen::Triplet<double>>& t, const Spring& s, const Ma
 SpringModel::SpringModel(const SpringNetwork& network, double point_damping)
     : num_nodes_(static_cast<int>(network.nodes.size())),
       springs_(network.springs),
-      point_damping_(point_damping) {
+      point_damping_(point_damping),
+      rest_nodes_(network.nodes),
+      fast_(network.springs, static_cast<int>(network.nodes.size()), spring_kernel_threads(),
+            network.nodes) {
   if (!(point_damping >= 0)) {
     throw InputError("point_damping k_v: expected a value ≥ 0 N·s/m, got " +
                      std::to_string(point_damping));
+  }
+  for (std::size_t s = 0; s < springs_.size(); ++s) {
+    if (springs_[s].damping != 0.0) damped_.push_back(static_cast<int>(s));
   }
   // The pattern: the full diagonal plus the four 3×3 blocks of every spring.
   const int n = num_dofs();
@@ -84,14 +91,42 @@ void SpringModel::assemble(SparseMatrix& H, double diagonal, BlockFn block) cons
   }
 }
 
+void SpringModel::set_threads(int n) {
+  if (n != fast_.threads()) fast_ = FastSprings(springs_, num_nodes_, n, rest_nodes_);
+}
+
+void SpringModel::require_size(const VectorXd& x) const {
+  if (x.size() != num_dofs()) {
+    throw std::invalid_argument("SpringModel: state of " + std::to_string(x.size()) +
+                                " values, expected 3 × " + std::to_string(num_nodes_));
+  }
+}
+
 double SpringModel::energy(const VectorXd& x) const {
+  require_size(x);
+  return fast_.energy(x.data());
+}
+
+void SpringModel::gradient(const VectorXd& x, VectorXd& g) const {
+  require_size(x);
+  g.resize(num_dofs());
+  fast_.gradient(x.data(), g.data());
+}
+
+double SpringModel::energy_gradient(const VectorXd& x, VectorXd& g) const {
+  require_size(x);
+  g.resize(num_dofs());
+  return fast_.energy_gradient(x.data(), g.data());
+}
+
+double SpringModel::reference_energy(const VectorXd& x) const {
   double e = 0.0;
   for (const Spring& s : springs_)
     e += spring_energy(node(x, s.a), node(x, s.b), s.rest_length, s.law);
   return e;
 }
 
-void SpringModel::gradient(const VectorXd& x, VectorXd& g) const {
+void SpringModel::reference_gradient(const VectorXd& x, VectorXd& g) const {
   g.setZero(num_dofs());
   for (const Spring& s : springs_) {
     const Vec6 gs = spring_gradient(node(x, s.a), node(x, s.b), s.rest_length, s.law);
@@ -101,6 +136,49 @@ void SpringModel::gradient(const VectorXd& x, VectorXd& g) const {
 }
 
 void SpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
+  require_size(x);
+  H = pattern_;
+  double* values = H.valuePtr();
+  std::fill(values, values + H.nonZeros(), 0.0);
+  const int* slot = slots_.data();
+  for (const Spring& s : springs_) {
+    const Vec3 xa = node(x, s.a), xb = node(x, s.b);
+    const Vec3 e = xa - xb;
+    const double L = e.norm();
+    if (!(L > 0.0)) {  // coincident ends: the reference kernel's special case
+      const Mat6 B = spring_hessian(xa, xb, s.rest_length, s.law, project_psd);
+      for (int p = 0; p < 2; ++p)
+        for (int q = 0; q < 2; ++q)
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) values[*slot++] += B(3 * p + i, 3 * q + j);
+      continue;
+    }
+    // spring_hessian's block K = ψ''·d dᵀ + ψ'/L·(I − d dᵀ) (kernels/spring_kernels.hpp), built
+    // here as one 3×3 block and added as [[K, −K], [−K, K]]: no 6×6 matrix per spring.
+    const Vec3 d = e / L;
+    const LengthProfile prof = spring_profile(L, s.rest_length, s.law);
+    double axial = prof.ddpsi;
+    double transverse = prof.dpsi / L;
+    if (project_psd) {
+      axial = std::max(axial, 0.0);
+      transverse = std::max(transverse, 0.0);
+    }
+    double K[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const double D = d[i] * d[j];
+        K[i][j] = axial * D + transverse * ((i == j ? 1.0 : 0.0) - D);
+      }
+    for (int p = 0; p < 2; ++p)
+      for (int q = 0; q < 2; ++q) {
+        const double sign = p == q ? 1.0 : -1.0;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) values[*slot++] += sign * K[i][j];
+      }
+  }
+}
+
+void SpringModel::reference_hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
   assemble(H, 0.0, [&](const Spring& s) {
     return spring_hessian(node(x, s.a), node(x, s.b), s.rest_length, s.law, project_psd);
   });
@@ -108,8 +186,8 @@ void SpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) 
 
 void SpringModel::damping_force(const VectorXd& x, const VectorXd& v, VectorXd& f) const {
   f = -point_damping_ * v;  // seed 000 eq. (3.3), every node
-  for (const Spring& s : springs_) {
-    if (s.damping == 0.0) continue;
+  for (int index : damped_) {  // only the springs with k_d ≠ 0: none walked when all are zero
+    const Spring& s = springs_[static_cast<std::size_t>(index)];
     const Vec6 fs = axial_damping_force(node(x, s.a), node(x, s.b), node(v, s.a), node(v, s.b),
                                         s.damping);  // seed 000 eq. (3.4)
     f.segment<3>(3 * s.a) += fs.head<3>();
@@ -118,6 +196,13 @@ void SpringModel::damping_force(const VectorXd& x, const VectorXd& v, VectorXd& 
 }
 
 void SpringModel::damping_jacobian(const VectorXd& x, SparseMatrix& D) const {
+  if (damped_.empty()) {  // no axial damping: k_v on the diagonal, in the Hessian's pattern
+    D = pattern_;
+    double* values = D.valuePtr();
+    std::fill(values, values + D.nonZeros(), 0.0);
+    for (int slot : diagonal_slots_) values[slot] = point_damping_;
+    return;
+  }
   assemble(D, point_damping_, [&](const Spring& s) {
     return axial_damping_jacobian(node(x, s.a), node(x, s.b), s.damping);
   });

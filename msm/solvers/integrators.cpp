@@ -82,16 +82,24 @@ double bbox_diagonal(const VectorXd& x) {
   return x.size() ? (hi - lo).norm() : 0.0;
 }
 
-/// Throws DivergenceError if x or v is not finite or the energy is beyond the limit.
-void check(const Problem& p, int step, const VectorXd& x, const VectorXd& v, double limit,
-           double& energy) {
+/// Throws DivergenceError if x or v is not finite.
+void check_finite(const Problem& p, int step, const VectorXd& x, const VectorXd& v) {
   for (Eigen::Index i = 0; i < x.size(); ++i) {
     if (!std::isfinite(x[i]) || !std::isfinite(v[i])) {
       throw DivergenceError(step, static_cast<int>(i / 3), total_energy(p, x, v),
                             "non-finite position or velocity");
     }
   }
-  energy = total_energy(p, x, v);
+}
+
+/// ½ vᵀ M v + Π(x) with the Form's energy E(x) already known (total_energy's expression).
+double total_energy_given(const Problem& p, const VectorXd& x, const VectorXd& v,
+                          double form_energy) {
+  return 0.5 * v.dot(p.mass.cwiseProduct(v)) + (form_energy - p.external_force.dot(x - p.rest));
+}
+
+/// Throws DivergenceError if the total energy is not finite or beyond the limit.
+void check_energy(const Problem& p, int step, const VectorXd& v, double limit, double energy) {
   if (!std::isfinite(energy) || energy > limit) {
     int worst = 0;
     double worst_ke = -1.0;
@@ -104,6 +112,32 @@ void check(const Problem& p, int step, const VectorXd& x, const VectorXd& v, dou
     }
     throw DivergenceError(step, worst, energy,
                           "energy above the blow-up limit " + sci(limit) + " J");
+  }
+}
+
+/// Throws DivergenceError if x or v is not finite or the energy is beyond the limit.
+void check(const Problem& p, int step, const VectorXd& x, const VectorXd& v, double limit,
+           double& energy) {
+  check_finite(p, step, x, v);
+  energy = total_energy(p, x, v);
+  check_energy(p, step, v, limit, energy);
+}
+
+/// The explicit steps' total force from ∇E already known: f = −∇E + f_damp + f_ext, zero on fixed
+/// dofs (total_force's arithmetic).
+void explicit_force(const Problem& p, const VectorXd& grad, const VectorXd& x, const VectorXd& v,
+                    VectorXd& f, VectorXd& scratch) {
+  f = -grad + p.external_force;
+  p.form->damping_force(x, v, scratch);
+  f += scratch;
+  for (int i = 0; i < f.size(); ++i) {
+    if (p.fixed[i]) f[i] = 0.0;
+  }
+}
+
+void hold_fixed_positions(const Problem& p, VectorXd& x) {
+  for (int i = 0; i < x.size(); ++i) {
+    if (p.fixed[i]) x[i] = p.rest[i];
   }
 }
 
@@ -133,7 +167,7 @@ void implicit_euler_update(const Problem& p, double h, const SparseMatrix& K,
 }  // namespace
 
 double total_energy(const Problem& p, const VectorXd& x, const VectorXd& v) {
-  return 0.5 * v.dot(p.mass.cwiseProduct(v)) + p.potential(x);
+  return total_energy_given(p, x, v, p.form->energy(x));
 }
 
 DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorXd& x0,
@@ -172,26 +206,36 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
   }
   const double t0 = now();
   double energy = H0;
+  // Explicit integrators: ∇E at the state a step starts from comes from the previous step's
+  // divergence check, which evaluates the energy and the gradient there in one pass
+  // (Form::energy_gradient): one pass over the springs per step (Verlet: per force evaluation)
+  // instead of a gradient plus a separate energy. Same numbers, same checks.
+  const bool is_explicit = o.integrator != Integrator::implicit_euler;
+  VectorXd grad(n);
+  double form_energy = 0.0;  // E at r.x, with grad, once a step has been checked
+  if (is_explicit && o.steps > 0) p.form->gradient(r.x, grad);
   for (int step = 1; step <= o.steps; ++step) {
     switch (o.integrator) {
       case Integrator::explicit_euler: {
         // seed 000 eq. (3.7), both updates from the state at the start of the step.
-        total_force(p, r.x, r.v, f, scratch);
+        explicit_force(p, grad, r.x, r.v, f, scratch);
         r.x += h * r.v;
         r.v += h * inv_mass.cwiseProduct(f);
         break;
       }
       case Integrator::symplectic_euler: {
-        total_force(p, r.x, r.v, f, scratch);
+        explicit_force(p, grad, r.x, r.v, f, scratch);
         r.v += h * inv_mass.cwiseProduct(f);
         r.x += h * r.v;
         break;
       }
       case Integrator::verlet: {
-        total_force(p, r.x, r.v, f, scratch);
+        explicit_force(p, grad, r.x, r.v, f, scratch);
         const VectorXd v_half = r.v + 0.5 * h * inv_mass.cwiseProduct(f);
         r.x += h * v_half;
-        total_force(p, r.x, v_half, f, scratch);
+        hold_fixed_positions(p, r.x);  // (v_half is 0 there: x is unchanged, as before)
+        form_energy = p.form->energy_gradient(r.x, grad);  // at the state checked below
+        explicit_force(p, grad, r.x, v_half, f, scratch);
         r.v = v_half + 0.5 * h * inv_mass.cwiseProduct(f);
         break;
       }
@@ -212,7 +256,15 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
         r.v[i] = 0.0;
       }
     }
-    check(p, step, r.x, r.v, limit, energy);
+    if (is_explicit) {
+      check_finite(p, step, r.x, r.v);
+      // E and ∇E at the new state; ∇E is the next step's (Verlet evaluated both above).
+      if (o.integrator != Integrator::verlet) form_energy = p.form->energy_gradient(r.x, grad);
+      energy = total_energy_given(p, r.x, r.v, form_energy);
+      check_energy(p, step, r.v, limit, energy);
+    } else {
+      check(p, step, r.x, r.v, limit, energy);
+    }
     r.steps = step;
     if (o.on_step) o.on_step(step, r.x, r.v);
   }
