@@ -227,13 +227,12 @@ void LocalGlobalSystem::global_step(const SpringDirections& d, const VectorXd& b
     if (fa >= 0) rhs.row(fa) += kd;
     if (fb >= 0) rhs.row(fb) -= kd;
   }
+  // The x, y and z systems share A (A ⊗ I3): one CHOLMOD solve with three columns.
+  const Eigen::MatrixXd sol = m.solver.solve_columns(rhs);
   x = problem_->rest;  // fixed nodes at rest
-  for (int c = 0; c < 3; ++c) {
-    const VectorXd col = m.solver.solve(rhs.col(c));
-    for (int i = 0; i < m.nodes; ++i) {
-      const int f = m.free_index[i];
-      if (f >= 0) x[3 * i + c] = col[f];
-    }
+  for (int i = 0; i < m.nodes; ++i) {
+    const int f = m.free_index[i];
+    if (f >= 0) x.segment<3>(3 * i) = sol.row(f).transpose();
   }
 }
 
