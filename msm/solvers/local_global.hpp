@@ -98,7 +98,7 @@ StaticResult solve_static_local_global(const Problem& problem, const LocalGlobal
                                        const VectorXd& start = VectorXd());
 
 /// Implicit Euler by local–global iterations (Liu et al. 2013): `options.iterations` per step from
-/// the inertial prediction y. dynamic.dt, dynamic.steps and dynamic.on_step are used (the other
+/// x_n + h v_n. dynamic.dt, dynamic.steps and dynamic.on_step are used (the other
 /// DynamicOptions are Newton's). setup_seconds: assembly and factorisation; seconds: the steps.
 /// DivergenceError if the state becomes non-finite.
 DynamicResult integrate_local_global(const Problem& problem, const DynamicOptions& dynamic,
