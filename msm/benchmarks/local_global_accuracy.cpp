@@ -54,7 +54,8 @@ void measure(const Scene& scene, const ModelSpec& spec, int level, double force,
   VesselParams vessel = scene.vessel;
   vessel.level = level;
   const double nu = scene.poisson_ratios.front();
-  const msm::BuiltNetwork built = msm::build_network(mesh, vessel, network_options(scene, spec, nu));
+  const msm::BuiltNetwork built =
+      msm::build_network(mesh, vessel, network_options(scene, spec, nu));
   const msm::SpringModel model(built.network, spec.damping);
   const msm::Problem p = msm_problem(scene, model, built, mesh, force);
   const std::size_t node = nearest_node(built.network.nodes, qoi_point(scene));
@@ -109,7 +110,8 @@ void measure(const Scene& scene, const ModelSpec& spec, int level, double force,
               << " ms per iteration (median of 5 × 10), to the 1e-8 gradient tolerance: "
               << converged << ".\n\n";
   }
-  std::cout << "| iterations | rel. error ‖x − x_Newton‖/‖u‖ | QoI error (mm) |\n| --- | --- | --- |\n";
+  std::cout
+      << "| iterations | rel. error ‖x − x_Newton‖/‖u‖ | QoI error (mm) |\n| --- | --- | --- |\n";
   for (std::size_t i = 0; i < kIterations.size(); ++i) {
     std::cout << "| " << kIterations[i] << " | " << sci(at[i].first) << " | "
               << sci(at[i].second * 1e3) << " |\n";

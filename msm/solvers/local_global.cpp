@@ -72,14 +72,14 @@ LocalGlobalSystem::LocalGlobalSystem(const Problem& p, double h, const std::stri
                        "implicit-euler");
     }
     if (s.damping != 0.0) {
-      throw InputError(who + "spring " + std::to_string(i) + " has axial damping k_d = " +
-                       std::to_string(s.damping) +
+      throw InputError(who + "spring " + std::to_string(i) +
+                       " has axial damping k_d = " + std::to_string(s.damping) +
                        " N·s/m, which depends on the spring's direction and so cannot enter the "
                        "constant matrix; use point damping or implicit-euler");
     }
     if (!(s.law.k1 >= 0.0)) {
-      throw InputError(who + "spring " + std::to_string(i) + ": expected a stiffness >= 0 N/m, got " +
-                       std::to_string(s.law.k1));
+      throw InputError(who + "spring " + std::to_string(i) +
+                       ": expected a stiffness >= 0 N/m, got " + std::to_string(s.law.k1));
     }
     m.springs.push_back({s.a, s.b, s.law.k1, s.rest_length});
   }
@@ -98,8 +98,9 @@ LocalGlobalSystem::LocalGlobalSystem(const Problem& p, double h, const std::stri
                        "nodes (its matrix is the same for x, y and z)");
     }
     if (p.mass[3 * i + 1] != p.mass[3 * i] || p.mass[3 * i + 2] != p.mass[3 * i]) {
-      throw InputError(who + "node " + std::to_string(i) +
-                       " has different masses on its three dofs; expected one lumped mass per node");
+      throw InputError(
+          who + "node " + std::to_string(i) +
+          " has different masses on its three dofs; expected one lumped mass per node");
     }
     if (h > 0.0 && !fx && !(p.mass[3 * i] > 0.0)) {
       throw InputError(who + "node " + std::to_string(i) + ": expected a mass > 0 kg, got " +
@@ -112,7 +113,7 @@ LocalGlobalSystem::LocalGlobalSystem(const Problem& p, double h, const std::stri
   if (m.free_nodes == 0) throw InputError(who + "every node is fixed; nothing can move");
 
   // A = L (+ M/h² + C/h) on the free nodes, per coordinate (the 3n × 3n matrix is A ⊗ I3):
-  // L = Σ_s k_s A_s A_sᵀ with A_s the incidence vector of spring s (Liu et al. eq. 9).
+  // L = Σ_s k_s A_s A_sᵀ with A_s the incidence vector of spring s (Liu et al.'s L).
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(4 * m.springs.size() + static_cast<std::size_t>(m.free_nodes));
   m.fixed_coupling = Eigen::MatrixX3d::Zero(m.free_nodes, 3);
@@ -186,7 +187,7 @@ void LocalGlobalSystem::local_step(const VectorXd& x, SpringDirections& d) const
     const double len = e.norm();
     const auto col = static_cast<Eigen::Index>(i);
     if (len > 0.0) {
-      // Liu et al. §4.2: d = l (p1 − p2)/|p1 − p2| minimises |p1 − p2 − d| over |d| = l.
+      // Liu et al.'s local step: d = l (p1 − p2)/|p1 − p2| minimises |p1 − p2 − d| over |d| = l.
       d.col(col) = (s.length / len) * e;
     } else if (fresh) {
       const Eigen::Vector3d r =
@@ -200,7 +201,7 @@ VectorXd LocalGlobalSystem::constant_rhs(const VectorXd& x_n, const VectorXd& v_
   const Problem& p = *problem_;
   if (h_ == 0.0) return p.external_force;
   const Impl& m = *impl_;
-  // M y/h² + C x_n/h with y = x_n + h v_n + h² M⁻¹ f_ext (Liu et al. eq. 5's inertial term).
+  // M y/h² + C x_n/h with y = x_n + h v_n + h² M⁻¹ f_ext (Liu et al.'s inertial term).
   VectorXd b(p.num_dofs());
   for (int i = 0; i < m.nodes; ++i) {
     const auto x = x_n.segment<3>(3 * i);
@@ -219,7 +220,7 @@ void LocalGlobalSystem::global_step(const SpringDirections& d, const VectorXd& b
     const int f = m.free_index[i];
     if (f >= 0) rhs.row(f) += b.segment<3>(3 * i).transpose();
   }
-  // J d = Σ_s k_s A_s d_sᵀ (Liu et al. eq. 9): +k d on node a, −k d on node b.
+  // J d = Σ_s k_s A_s d_sᵀ (Liu et al.'s L): +k d on node a, −k d on node b.
   for (std::size_t i = 0; i < m.springs.size(); ++i) {
     const LgSpring& s = m.springs[i];
     const Eigen::RowVector3d kd = s.k * d.col(static_cast<Eigen::Index>(i)).transpose();
@@ -249,7 +250,8 @@ void LocalGlobalSystem::objective_gradient(const VectorXd& x, const SpringDirect
   }
   if (h_ > 0.0) {
     for (int i = 0; i < m.nodes; ++i) {
-      g.segment<3>(3 * i) += (m.node_mass[i] / (h_ * h_) + m.node_damping[i] / h_) * x.segment<3>(3 * i);
+      g.segment<3>(3 * i) +=
+          (m.node_mass[i] / (h_ * h_) + m.node_damping[i] / h_) * x.segment<3>(3 * i);
     }
   }
   g -= b;
@@ -316,7 +318,8 @@ StaticResult solve_static_local_global(const Problem& p, const LocalGlobalOption
     }
     if (r.iterations == o.max_iterations) break;
     sys.global_step(d, b, r.x);
-    if (o.on_half_step) o.on_half_step(r.iterations + 1, true, r.x, sys.objective(r.x, d, r.x, r.x));
+    if (o.on_half_step)
+      o.on_half_step(r.iterations + 1, true, r.x, sys.objective(r.x, d, r.x, r.x));
   }
   r.seconds = now() - t0;
   if (!r.converged) {
@@ -376,7 +379,8 @@ DynamicResult integrate_local_global(const Problem& p, const DynamicOptions& dyn
     }
     for (Eigen::Index i = 0; i < x.size(); ++i) {
       if (!std::isfinite(x[i])) {
-        throw DivergenceError(step, static_cast<int>(i / 3), std::numeric_limits<double>::quiet_NaN(),
+        throw DivergenceError(step, static_cast<int>(i / 3),
+                              std::numeric_limits<double>::quiet_NaN(),
                               "non-finite position in the local-global step");
       }
     }

@@ -79,8 +79,8 @@ TEST(DefaultTimeStep, DampedIsWithinTheGuaranteedStepAndRunsWhereTheOldDefaultDi
     Integrator integrator;
     double zeta;
   };
-  for (const Case c : {Case{Integrator::explicit_euler, 0.1},
-                       Case{Integrator::symplectic_euler, 3.0}}) {
+  for (const Case c :
+       {Case{Integrator::explicit_euler, 0.1}, Case{Integrator::symplectic_euler, 3.0}}) {
     SCOPED_TRACE(to_string(c.integrator));
     const double damping = 2.0 * c.zeta * omega_max * mean_free_mass(p0);
     const SpringModel model(tube().net, damping);
