@@ -1,6 +1,6 @@
 #pragma once
 /// The local–global solver of Liu, Bargteil, O'Brien & Kavan 2013, "Fast Simulation of
-/// Mass-Spring Systems" (ACM TOG 32(6), §4), the mass-spring case of Projective Dynamics (Bouaziz
+/// Mass-Spring Systems" (ACM TOG 32(6)), the mass-spring case of Projective Dynamics (Bouaziz
 /// et al. 2014): for Hooke springs, ½k(|x_a − x_b| − l)² = min over |d| = l of ½k|x_a − x_b − d|²
 /// (Liu et al.'s key identity), so with the spring directions d as extra unknowns the objective is
 /// quadratic in the positions. The matrix of that quadratic (M/h² + C/h + L for implicit Euler, L

@@ -138,7 +138,7 @@ TEST(LocalGlobal, StaticSolveConvergesToStaticNewtonOnTheTube) {
 }
 
 TEST(LocalGlobal, EveryLocalAndGlobalStepDoesNotIncreaseTheObjective) {
-  // Block coordinate descent (Liu et al. §4): the local step minimises g over d, the global step
+  // Block coordinate descent (Liu et al.): the local step minimises g over d, the global step
   // over x, so g never increases; after a local step g(x, d(x)) is the total potential Π(x),
   // here evaluated by the spring model itself.
   const Problem& p = tube().problem;
