@@ -337,6 +337,16 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
     m.solver.steps = r.integer_or("steps", 0, 1, 1'000'000'000L);
     if (m.solver.steps == 0) r.fail(nullptr, "steps", "missing; expected the number of steps (> 0)");
   }
+  // `iterations`: local–global iterations per step of local-global-euler (Liu et al. 2013).
+  if (const toml::node* it = r.get("iterations")) {
+    if (std::find(solvers.begin(), solvers.end(), "local-global-euler") == solvers.end()) {
+      r.fail(it, "iterations",
+             "found local-global iterations without solver \"local-global-euler\"; expected it "
+             "only with that solver");
+    }
+    m.solver.local_global.iterations = static_cast<int>(
+        r.integer_or("iterations", m.solver.local_global.iterations, 1, 1'000'000L));
+  }
   r.finish();
   std::vector<ModelSpec> out;
   for (const auto& k : stiffness) {
@@ -349,6 +359,7 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
             c.stiffness = msm::parse_stiffness_rule(k);
             c.mass = msm::parse_mass_rule(ms);
             c.solver = msm::parse_solver(solver);
+            c.solver.local_global = m.solver.local_global;
             c.solver.dt = dt;
             c.solver.steps = is_dynamic(solver) ? m.solver.steps : 0;
             std::string swept;

@@ -119,4 +119,9 @@ VectorXd CholmodSolver::solve(const VectorXd& b) const {
   return llt_.solve(b);
 }
 
+Eigen::MatrixXd CholmodSolver::solve_columns(const Eigen::MatrixXd& B) const {
+  apply_solver_threads();
+  return llt_.solve(B);
+}
+
 }  // namespace vessel::msm

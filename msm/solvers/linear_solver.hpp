@@ -38,6 +38,8 @@ class CholmodSolver {
   /// Factorises A without regularisation; false if A is not positive definite.
   [[nodiscard]] bool try_factorize(const SparseMatrix& A);
   [[nodiscard]] VectorXd solve(const VectorXd& b) const;
+  /// Solves for several right-hand sides (the columns of B) in one CHOLMOD call.
+  [[nodiscard]] Eigen::MatrixXd solve_columns(const Eigen::MatrixXd& B) const;
   [[nodiscard]] int symbolic_analyses() const { return analyses_; }
   [[nodiscard]] int numeric_factorisations() const { return factorisations_; }
   [[nodiscard]] double last_regularisation() const { return mu_; }

@@ -22,6 +22,9 @@ enum class SolverKind {
   relaxation,     ///< "relaxation": dynamic relaxation to equilibrium
   integrator,     ///< a time integrator (explicit/symplectic Euler, Verlet, implicit Euler)
   pbd,            ///< "pbd": seed 002's constraints with XPBD (surface models)
+  local_global,   ///< "local-global": Liu et al. 2013's local–global iterations to equilibrium
+  local_global_euler,  ///< "local-global-euler": implicit Euler, a fixed number of local–global
+                       ///< iterations per step (Liu et al. 2013), one prefactored matrix
 };
 
 /// Seed 002's position-based model: constraint families and XPBD settings.
@@ -33,6 +36,12 @@ struct PbdSettings {
   bool angle = false;               ///< the seed's simplified angle constraint
 };
 
+/// Liu et al. 2013's local–global solver (local_global.hpp).
+struct LocalGlobalSettings {
+  int iterations = 10;  ///< local-global-euler: local–global iterations per step (>= 1)
+  int max_iterations = 100'000;  ///< local-global (statics): iterations before giving up
+};
+
 struct SolverSpec {
   SolverKind kind = SolverKind::static_newton;
   Integrator integrator = Integrator::symplectic_euler;  ///< kind integrator
@@ -42,28 +51,44 @@ struct SolverSpec {
   long steps = 0;   ///< integrator and pbd: number of steps (> 0)
   StaticOptions static_options;  ///< static_newton
   PbdSettings pbd;               ///< pbd
+  LocalGlobalSettings local_global;  ///< local_global, local_global_euler
 
   /// Time-stepping solvers (integrators and PBD): compared over time and at their final state.
   [[nodiscard]] bool is_dynamic() const {
-    return kind == SolverKind::integrator || kind == SolverKind::pbd;
+    return kind == SolverKind::integrator || kind == SolverKind::pbd ||
+           kind == SolverKind::local_global_euler;
   }
 };
 
-/// Every solver name: the static ones, then the integrators, then PBD. "implicit-euler-rest" is
-/// implicit Euler with the matrix at rest, factorised once (ImplicitMatrix::rest_prefactored).
-inline constexpr std::array<const char*, 9> kSolverNames{
+/// Every solver name: the static ones, then the integrators, then PBD, then Liu et al. 2013's
+/// local–global solvers (statics and implicit Euler). "implicit-euler-rest" is implicit Euler with
+/// the matrix at rest, factorised once (ImplicitMatrix::rest_prefactored).
+inline constexpr std::array<const char*, 11> kSolverNames{
     "static",         "linear",         "relaxation",          "explicit-euler", "symplectic-euler",
-    "verlet",         "implicit-euler", "implicit-euler-rest", "pbd"};
+    "verlet",         "implicit-euler", "implicit-euler-rest", "pbd",            "local-global",
+    "local-global-euler"};
 /// The solver of a name in kSolverNames (dt, steps and options left at their defaults).
 /// InputError listing the names otherwise.
 SolverSpec parse_solver(const std::string& name);
 /// The name parse_solver reads.
 std::string to_string(const SolverSpec& spec);
 
-/// The time step a dynamic solver runs with, s: spec.dt if set; otherwise for the integrators a
-/// fraction of the undamped critical-step bound 2/ω_max (Gershgorin, max_frequency_bound): 0.5×
-/// for the explicit ones, 10× for implicit Euler (stable at any step; 10× keeps its numerical
-/// damping moderate); 1 ms for PBD (seed 002's frame time).
+/// Fraction of the critical-step bound an explicit integrator runs at by default.
+inline constexpr double kExplicitStepFraction = 0.5;
+/// Multiple of the undamped critical-step bound implicit Euler (Newton or local–global) runs at
+/// by default: stable at any step; 10× keeps its numerical damping moderate.
+inline constexpr double kImplicitStepMultiple = 10.0;
+
+/// The time step a dynamic solver runs with, s: spec.dt if set; otherwise
+/// - explicit integrators: kExplicitStepFraction × the critical-step bound, which is the undamped
+///   bound 2/ω_max (Gershgorin, max_frequency_bound) or, for a damped model (non-zero damping
+///   Jacobian at rest), the smaller of it and the guaranteed damped step
+///   (guaranteed_critical_step, critical_step.hpp: explicit and symplectic Euler; with the lowest
+///   mode taken as ω = 0, a wider and still proven rectangle). Velocity Verlet has no proven
+///   damped bound and keeps the undamped one; where the guaranteed step is 0 (explicit Euler with
+///   an undamped dof: unstable at every step) the undamped one is kept too;
+/// - implicit Euler and local-global-euler: kImplicitStepMultiple × 2/ω_max (Gershgorin);
+/// - PBD: 1 ms (seed 002's frame time).
 double resolved_time_step(const Problem& problem, const SolverSpec& spec);
 
 /// What a solve did, by solver family (StaticResult for static and linear).

@@ -165,3 +165,19 @@ TEST_F(MsmCli, InputMshAndStlGiveTheSameModelAsTheGeneratedMesh) {
     EXPECT_FALSE(std::filesystem::exists(dir / "bad.json"));
   }
 }
+
+TEST_F(MsmCli, LocalGlobalSolversRunAndRefuseBilinearSprings) {
+  const auto r = vv("--model volume --solver local-global-euler --dt 1e-3 --steps 5 "
+                    "--lg-iterations 3 --json " + (dir / "lg.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "3 local-global iterations per step")) << r.output;
+  const auto j = nlohmann::json::parse(read_text(dir / "lg.json"));
+  EXPECT_EQ(j["solver"]["numeric_factorisations"], 1) << j.dump();
+  const auto bilinear =
+      vv("--model volume --solver local-global --bilinear-threshold 0.01 --json " +
+         (dir / "bad.json").string());
+  EXPECT_EQ(bilinear.exit_code, 1) << bilinear.output;
+  EXPECT_TRUE(contains(bilinear.output, "solver local-global")) << bilinear.output;
+  EXPECT_TRUE(contains(bilinear.output, "bilinear")) << bilinear.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.json"));
+}

@@ -194,3 +194,26 @@ TEST(Scene, PositionBasedDynamicsIsASolverOfSurfaceModels) {
   EXPECT_NE(volume.find("models[1].solver"), std::string::npos) << volume;
   EXPECT_NE(volume.find("surface_msm"), std::string::npos) << volume;
 }
+
+TEST(Scene, LocalGlobalEulerTakesItsIterationsPerStep) {
+  const std::string lg =
+      "[[models]]\nname = \"lg\"\nkind = \"volume_msm\"\nsolver = \"local-global-euler\"\n"
+      "dt = 1e-3\nsteps = 20\n";
+  Scene s = parse_scene(std::string(kMinimal) + lg, "scene.toml");
+  EXPECT_EQ(s.models.back().solver.kind, msm::SolverKind::local_global_euler);
+  EXPECT_TRUE(s.models.back().solver.is_dynamic());
+  EXPECT_EQ(s.models.back().solver.local_global.iterations, 10);  // the default
+  s = parse_scene(std::string(kMinimal) + lg + "iterations = 3\n", "scene.toml");
+  EXPECT_EQ(s.models.back().solver.local_global.iterations, 3);
+  auto msg = error_of(std::string(kMinimal) + lg + "iterations = 0\n");
+  EXPECT_NE(msg.find("models[1].iterations"), std::string::npos) << msg;
+  msg = error_of(std::string(kMinimal) +
+                 "[[models]]\nkind = \"volume_msm\"\nsolver = \"static\"\niterations = 3\n");
+  EXPECT_NE(msg.find("local-global-euler"), std::string::npos) << msg;
+  EXPECT_EQ(parse_scene(std::string(kMinimal) +
+                            "[[models]]\nname = \"lgs\"\nkind = \"volume_msm\"\nsolver = \"local-global\"\n",
+                        "scene.toml")
+                .models.back()
+                .solver.kind,
+            msm::SolverKind::local_global);
+}

@@ -51,6 +51,7 @@ struct MsmOptions {
   fs::path json;
   bool verbose = false;
   int pbd_iterations = 10;
+  int lg_iterations = msm::LocalGlobalSettings{}.iterations;
   double bending_compliance = 0.0;
   bool angle_constraints = false;
   bool no_dihedral = false;
@@ -272,6 +273,7 @@ msm::SolverSpec command_solver(const MsmOptions& o) {
   so.curvature_shift = o.curvature_shift;
   so.exact_backoff = o.exact_backoff;
   spec.pbd.iterations = o.pbd_iterations;
+  spec.local_global.iterations = o.lg_iterations;
   spec.pbd.velocity_damping = o.pbd_damping;
   spec.pbd.bending_compliance = o.bending_compliance;
   spec.pbd.dihedral = !o.no_dihedral;
@@ -284,7 +286,9 @@ void print_solve(const msm::SolverSpec& spec, const msm::Problem& problem,
                  const msm::SolveResult& s) {
   if (const auto* r = std::get_if<msm::StaticResult>(&s.detail)) {
     const bool newton = spec.kind == msm::SolverKind::static_newton;
-    std::cout << (newton ? "static Newton" : "linearised model") << ": " << r->iterations
+    const bool lg = spec.kind == msm::SolverKind::local_global;
+    std::cout << (newton ? "static Newton" : lg ? "local-global (Liu et al. 2013)" : "linearised model")
+              << ": " << r->iterations
               << " iteration(s), residual " << r->residual << " N, " << std::setprecision(4)
               << r->seconds << " s per static solve (" << r->symbolic_analyses << " symbolic, "
               << r->numeric_factorisations << " numeric CHOLMOD factorisations, "
@@ -304,7 +308,10 @@ void print_solve(const msm::SolverSpec& spec, const msm::Problem& problem,
     std::cout << msm::to_string(spec) << ": " << dyn->steps << " steps of " << s.dt
               << " s (critical step bound 2/ω_max = " << 2.0 / msm::max_frequency_bound(problem)
               << " s)\n  ";
-    if (spec.implicit_matrix == msm::ImplicitMatrix::rest_prefactored) {
+    if (spec.kind == msm::SolverKind::local_global_euler) {
+      std::cout << spec.local_global.iterations << " local-global iterations per step; set-up "
+                << "(assembly and factorisation) " << dyn->setup_seconds << " s, then ";
+    } else if (spec.implicit_matrix == msm::ImplicitMatrix::rest_prefactored) {
       std::cout << "set-up (assembly and factorisation at rest) " << dyn->setup_seconds
                 << " s, then ";
     }
@@ -465,11 +472,13 @@ void add_solver_options(CLI::App* cmd, MsmOptions& o) {
   for (const std::string& n : names) listed += (listed.empty() ? "" : ", ") + n;
   cmd->add_option("--solver", o.solver,
                   listed + " (implicit-euler-rest: the matrix at rest, factorised once; pbd: XPBD "
-                           "constraints of seed 002, surface model)")
+                           "constraints of seed 002, surface model; local-global, "
+                           "local-global-euler: Liu et al. 2013, Hooke springs only)")
       ->check(CLI::IsMember(names))
       ->capture_default_str();
   cmd->add_option("--dt", o.dt,
-                  "Time step, s (default: 0.5 × the critical-step bound; implicit: 10 ×)");
+                  "Time step, s (default: 0.5 × the critical-step bound, damped: within the "
+                  "guaranteed damped step; implicit: 10 ×)");
   cmd->add_option("--steps", o.steps, "Number of time steps")->capture_default_str();
   cmd->add_option("--point-damping", o.point_damping, "k_v of seed 000 eq. (3.3), N·s/m")
       ->capture_default_str();
@@ -506,6 +515,9 @@ CLI::Option* add_load_options(CLI::App* cmd, MsmOptions& o) {
 /// PBD and static Newton settings, verbosity, output.
 void add_solver_tuning_options(CLI::App* cmd, MsmOptions& o) {
   cmd->add_option("--pbd-iterations", o.pbd_iterations, "XPBD iterations per step")
+      ->capture_default_str();
+  cmd->add_option("--lg-iterations", o.lg_iterations,
+                  "local-global-euler: local-global iterations per step (Liu et al. 2013)")
       ->capture_default_str();
   cmd->add_option("--bending-compliance", o.bending_compliance,
                   "XPBD compliance of the dihedral/angle constraints, 1/(N·m) (0: rigid)")
