@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "meshes/errors.hpp"
@@ -91,18 +92,25 @@ class StaticNewtonUpdater final : public Updater {
     UpdateResult r;
     p_.potential_gradient(x_, g_);
     double residual = g_.norm();
-    // Modified Newton: the step −F⁻¹∇Π with the factorisation F held. Kept while the residual
-    // contracts by `contraction` per step; the first step that does not is discarded.
+    // Modified Newton: the step −F⁻¹∇Π with the factorisation F held, kept while the residual
+    // contracts by `contraction` per step; a step that does not is discarded. Then (Shamanskii)
+    // F is replaced once by the exact Hessian at the state reached, if positive definite, and the
+    // iteration goes on with it; a second failure hands over to full Newton.
+    bool refreshed = false;
     for (int k = 0; residual > stop && k < uo_.max_reused_iterations; ++k) {
       trial_ = x_ - solver_.solve(g_);
       p_.potential_gradient(trial_, gt_);
       const double next = gt_.norm();
-      if (!(next <= uo_.contraction * residual)) break;
+      if (!(next <= uo_.contraction * residual)) {
+        if (refreshed || !refactorise_at(x_)) break;
+        refreshed = true;
+        continue;
+      }
       x_.swap(trial_);
       g_.swap(gt_);
       residual = next;
       ++r.iterations;
-      ++r.reused_iterations;
+      if (!refreshed) ++r.reused_iterations;
     }
     if (residual > stop) {
       const StaticResult full = solve_static(p_, so_, x_, solver_);
@@ -119,12 +127,30 @@ class StaticNewtonUpdater final : public Updater {
   [[nodiscard]] int factorisations() const override { return solver_.numeric_factorisations(); }
 
  private:
+  /// Factorises the exact Hessian at x, or where it is not positive definite (a wrinkling
+  /// membrane) the per-spring PSD-projected one (solve_static's fallback, regularised if still
+  /// singular). False if even that fails.
+  bool refactorise_at(const VectorXd& x) {
+    p_.form->hessian(x, H_, false);
+    apply_dirichlet(H_, p_.fixed);
+    if (solver_.try_factorize(H_)) return true;
+    p_.form->hessian(x, H_, so_.project_psd);
+    apply_dirichlet(H_, p_.fixed);
+    try {
+      solver_.factorize(H_);
+    } catch (const std::runtime_error&) {
+      return false;
+    }
+    return true;
+  }
+
   Problem p_;
   StaticOptions so_;
   UpdateOptions uo_;
   CholmodSolver solver_;
   double roundoff_ = 0.0;
   VectorXd g_, gt_, trial_;
+  SparseMatrix H_;
 };
 
 }  // namespace

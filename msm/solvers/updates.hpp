@@ -8,8 +8,10 @@
 /// - "static": modified Newton warm-started from the previous update's state. Each update first
 ///   iterates with the factorisation it already holds (K at rest after prepare, later the last one
 ///   Newton made) while the residual falls by at least `contraction` per iteration; where it does
-///   not, full Newton (solve_static, which refactorises) takes over from the state reached. The
-///   stopping test is solve_static's, so an update ends at the solver's tolerance either way.
+///   not, it refactorises once at the state reached (the exact Hessian, or where indefinite the
+///   PSD-projected one) and goes on (the Shamanskii variant); where that fails too, full
+///   Newton (solve_static) takes over from the state reached. The stopping test is
+///   solve_static's, so an update ends at the solver's tolerance either way.
 ///
 /// Another solver with a prefactored matrix (e.g. a local–global solver) plugs in as one more
 /// Updater made by prepare_updates from its SolverSpec.
@@ -25,6 +27,7 @@ struct UpdateResult {
   double seconds = 0.0;    ///< wall-clock time of the update, s
   int iterations = 0;      ///< Newton iterations (modified and full); 1 for the linear model
   int reused_iterations = 0;  ///< of those, modified-Newton ones with the factorisation held
+                              ///< from before the update (none made during it)
   int factorisations = 0;  ///< CHOLMOD numeric factorisations made during the update
   /// ‖∇Π‖ on the free dofs at the end, N (static Newton; 0 where the update does not compute it,
   /// the linear model's solve being exact to round-off)
