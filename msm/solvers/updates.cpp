@@ -3,7 +3,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <string>
 
 #include "meshes/errors.hpp"
@@ -127,21 +126,15 @@ class StaticNewtonUpdater final : public Updater {
   [[nodiscard]] int factorisations() const override { return solver_.numeric_factorisations(); }
 
  private:
-  /// Factorises the exact Hessian at x, or where it is not positive definite (a wrinkling
-  /// membrane) the per-spring PSD-projected one (solve_static's fallback, regularised if still
-  /// singular). False if even that fails.
+  /// Factorises the exact Hessian at x; false if it is not positive definite. Then later
+  /// updates skip the refactorisation (a wrinkling membrane's Hessian stays indefinite, and a
+  /// failed factorisation costs as much as a good one): full Newton, which projects, takes over.
   bool refactorise_at(const VectorXd& x) {
+    if (!refresh_exact_) return false;
     p_.form->hessian(x, H_, false);
     apply_dirichlet(H_, p_.fixed);
-    if (solver_.try_factorize(H_)) return true;
-    p_.form->hessian(x, H_, so_.project_psd);
-    apply_dirichlet(H_, p_.fixed);
-    try {
-      solver_.factorize(H_);
-    } catch (const std::runtime_error&) {
-      return false;
-    }
-    return true;
+    refresh_exact_ = solver_.try_factorize(H_);
+    return refresh_exact_;
   }
 
   Problem p_;
@@ -149,6 +142,7 @@ class StaticNewtonUpdater final : public Updater {
   UpdateOptions uo_;
   CholmodSolver solver_;
   double roundoff_ = 0.0;
+  bool refresh_exact_ = true;  ///< false once an exact Hessian failed to factorise
   VectorXd g_, gt_, trial_;
   SparseMatrix H_;
 };

@@ -8,8 +8,9 @@
 /// - "static": modified Newton warm-started from the previous update's state. Each update first
 ///   iterates with the factorisation it already holds (K at rest after prepare, later the last one
 ///   Newton made) while the residual falls by at least `contraction` per iteration; where it does
-///   not, it refactorises once at the state reached (the exact Hessian, or where indefinite the
-///   PSD-projected one) and goes on (the Shamanskii variant); where that fails too, full
+///   not, it refactorises once with the exact Hessian at the state reached and goes on (the
+///   Shamanskii variant; skipped for good once that Hessian was indefinite, as on a wrinkling
+///   membrane); where that fails too (indefinite, or still not contracting), full
 ///   Newton (solve_static) takes over from the state reached. The stopping test is
 ///   solve_static's, so an update ends at the solver's tolerance either way.
 ///

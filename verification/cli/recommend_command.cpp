@@ -1,4 +1,5 @@
 /// `vesselverify recommend`: the cheapest model that meets a scene's accuracy and rate budget.
+#include <iomanip>
 #include <iostream>
 
 #include "meshes/mesh_cache.hpp"
@@ -54,6 +55,7 @@ void run(const Options& o) {
   r.harness.ramp_updates = o.updates;
   const Recommendation rec = recommend(s, r, o.output_dir, o.command);
   const Selection& sel = rec.selection;
+  std::cout << std::defaultfloat << std::setprecision(3);  // the progress log may have changed it
   const char* unit = budget_unit(rec.scene.budget.quantity);
   if (sel.recommended) {
     const Candidate& c = rec.candidates[*sel.recommended];
