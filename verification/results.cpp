@@ -229,11 +229,11 @@ void write_results_csv(const std::filesystem::path& path, const std::vector<Scen
         } else {
           out << ",,,,,,,,,,";
         }
-        out << ',';
+        out << ',';  // updates, iterations and factorisations per update; empty without a ramp
         if (o.updates > 0) {
           out << o.updates << ',' << o.iterations_per_update << ',' << o.factorisations_per_update;
         } else {
-          out << ',';
+          out << ",,";
         }
         out << '\n';
       }

@@ -167,9 +167,22 @@ TEST_F(HarnessLame, ResultsJsonHasEveryFieldItsSchemaRequires) {
       EXPECT_TRUE(outcome.contains("failure"));
     }
   }
-  // One CSV row per outcome plus the header.
+  // One CSV row per outcome plus the header, every row with the header's number of fields.
   const std::string csv = test::read_text(dir / "results.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 8);
+  std::istringstream rows(csv);
+  std::string header;
+  std::getline(rows, header);
+  const auto fields = [](const std::string& line) { return std::count(line.begin(), line.end(), ','); };
+  for (std::string row; std::getline(rows, row);) EXPECT_EQ(fields(row), fields(header)) << row;
+  // The linear model's timed load ramp is recorded (count, iterations, factorisations).
+  for (const auto& outcome : scene["outcomes"]) {
+    if (outcome["model"] == "volume_linear") {
+      ASSERT_TRUE(outcome.contains("updates")) << outcome.dump();
+      EXPECT_EQ(outcome["updates"]["count"], kRampUpdates);
+      EXPECT_EQ(outcome["updates"]["factorisations_per_update"], 0.0);
+    }
+  }
   EXPECT_NE(test::read_text(dir / "summary.md").find("| p1 | 0.3 | 0 | 10 |"), std::string::npos);
 }
 
