@@ -3,7 +3,10 @@
 /// of the same gate scenes). A model fails the gate if its error grows beyond the tolerance, if it
 /// finished in the baseline and fails now (diverged, did not converge), if it disappeared, or if
 /// its solve time — normalised by a reference kernel timed in the same run, so a faster or slower
-/// machine does not count — grew beyond a noise-tolerant ratio.
+/// machine does not count — grew beyond a noise-tolerant ratio. The solve time is results.json's
+/// solve_seconds, set-up excluded: for static and linear mass-spring models the time per update
+/// (median over the load ramp's warm-started updates), for integrators the run's steps, for FEM
+/// assembly and solve. Set-up (build, assembly and factorisation at rest) is not gated.
 #include <string>
 #include <vector>
 

@@ -120,7 +120,7 @@ void speed_error_figure(const FigureContext& c) {
   if (rows.empty()) return;
   Plot plot;
   plot.title = c.scene.name + ": speed against error at " + load_text(c.magnitude, c.scene);
-  plot.x = {"solve time per load case (s)", Scale::log};
+  plot.x = {"solve time after set-up (s; static and linear: per update)", Scale::log};
   plot.y = {"max nodal error (mm)", Scale::log};
   std::map<std::string, std::size_t> series_of;
   std::vector<double> xs, ys;
@@ -394,7 +394,12 @@ void scene_section(Document& doc, const SceneRows& s) {
   wall_profile_figure(c);
   history_figure(c);
   doc.paragraph("Seed 000's statistics of the nodal displacement error for every model, Poisson's "
-                "ratio, level and load (⚠: the reference strains beyond 5 % there):");
+                "ratio, level and load (⚠: the reference strains beyond 5 % there). Set-up is "
+                "done once (model build; for static and linear mass-spring models also assembly "
+                "and factorisation at rest); solve s is the time after it: per update for static "
+                "and linear mass-spring models (the median over a load ramp of warm-started "
+                "updates ending at the row's load, as a simulator runs them), the run's steps for "
+                "integrators, assembly and solve for FEM:");
   doc.table(statistics_table(s));
 }
 

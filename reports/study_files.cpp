@@ -82,6 +82,7 @@ CandidateEntry read_candidate(const json& j, const std::string& where) {
   if (e.ok) {
     e.error = optional_field<double>(j, "error", where);
     e.update_seconds = field<double>(j, "update_seconds", where);
+    e.setup_seconds = optional_field<double>(j, "setup_seconds", where);
   } else {
     e.failure = field<std::string>(j, "failure", where);
   }
@@ -138,6 +139,7 @@ RecommendFile parse_recommend(const std::string& text, const std::filesystem::pa
   r.loads = read_array(j, "loads", file, read_load);
   r.recommended = optional_field<std::string>(j, "recommended", file);
   r.closest = optional_field<std::string>(j, "closest", file);
+  r.whole_vessel = optional_field<std::string>(j, "whole_vessel", file);
   r.reference_contact_point_mm = field<double>(j, "reference_contact_point_mm", file);
   r.candidates = read_array(j, "candidates", file, read_candidate);
   return r;

@@ -61,6 +61,7 @@ struct CandidateEntry {
   bool ok = false, pareto = false;
   std::string verdict, reason, failure;
   std::optional<double> error, update_seconds;
+  std::optional<double> setup_seconds;  ///< absent in files written before set-up was reported
 };
 
 /// The load the budget applies at for one Poisson's ratio (scene's load unit).
@@ -82,6 +83,8 @@ struct RecommendFile {
   std::vector<BudgetLoadEntry> loads;
   std::string load_unit;  ///< N, Pa or g, from the run's results.json (attach_run); "" if unknown
   std::optional<std::string> recommended, closest;  ///< candidate names
+  /// The cheapest whole-vessel candidate meeting the budget (absent in older files, or none).
+  std::optional<std::string> whole_vessel;
   double reference_contact_point_mm = 0.0;  ///< the reference's largest QoI displacement
   std::vector<CandidateEntry> candidates;
 };

@@ -162,6 +162,13 @@ void answer(Document& doc, const RecommendFile& r) {
   } else {
     doc.paragraph("**No candidate meets the budget**, and none finished.");
   }
+  const CandidateEntry* whole = candidate_named(r, r.whole_vessel);
+  if (whole && r.whole_vessel != r.recommended) {
+    doc.paragraph("Whole vessel (no region of interest): `" + whole->name + "` (" +
+                  whole->detail + ") meets the budget too: error " + error_text(*whole, r.unit) +
+                  ", " + ms(whole->update_seconds.value_or(0.0)) + " per update, " +
+                  std::to_string(whole->unknowns) + " unknowns.");
+  }
   // A tolerance at or above the reference's own contact displacement is met by a model that does
   // not move at all: the answer then says nothing about accuracy.
   if (r.quantity != "reaction" && r.reference_contact_point_mm > 0.0 &&
@@ -192,12 +199,13 @@ std::vector<const CandidateEntry*> evidence_order(const RecommendFile& r) {
 
 Table evidence_table(const RecommendFile& r) {
   Table t;
-  t.header = {"candidate", "unknowns", "error (" + r.unit + ")", "time per update (ms)", "Pareto",
-              "verdict", "why"};
+  t.header = {"candidate", "unknowns", "error (" + r.unit + ")", "time per update (ms)",
+              "set-up (ms)", "Pareto", "verdict", "why"};
   for (const CandidateEntry* c : evidence_order(r)) {
     t.rows.push_back({"`" + c->name + "`", std::to_string(c->unknowns),
                       c->ok && c->error ? fmt(*c->error, 3) : "–",
                       c->ok && c->update_seconds ? fmt(*c->update_seconds * 1e3, 3) : "–",
+                      c->ok && c->setup_seconds ? fmt(*c->setup_seconds * 1e3, 3) : "–",
                       c->pareto ? "★" : "", c->verdict, c->reason});
   }
   return t;
@@ -222,9 +230,8 @@ void recommendation_section(Document& doc, const RecommendFile& r) {
                 "reference by");
   doc.code(r.command);
   answer(doc, r);
-  doc.paragraph("Time per update: one static solve from rest for static solvers (set-up "
-                "excluded: it is done once); for integrators the time per step × the steps one "
-                "update period needs. Errors are the worst over the scene's Poisson's ratios, "
+  doc.paragraph(std::string(kTimePerUpdateText) +
+                " Errors are the worst over the scene's Poisson's ratios, "
                 "against the P2 reference at each model node; region-of-interest models (R) hold "
                 "every node farther than R from the contact and are compared on the whole vessel. "
                 "★ marks the Pareto front (no other candidate is both faster and more accurate). "

@@ -10,6 +10,16 @@ namespace vessel::reports {
 /// refinement, and what every model did on each hard case.
 void stability_section(Document& doc, const StabilityFile& stability);
 
+/// What a recommendation's "time per update" and "set-up" are (the paragraph under its answer,
+/// shared by `vesselverify recommend`'s recommend.md and the report).
+inline constexpr const char* kTimePerUpdateText =
+    "Time per update, on which the budget is judged: for static and linear solvers the median "
+    "over a load ramp of warm-started updates ending at the budget's load, each from the "
+    "previous state (the linear model one solve with its factorisation at rest; static Newton "
+    "reusing the factorisation it holds while it converges fast, refactorising where not); for "
+    "integrators the time per step × the steps one update period needs. Set-up (model build, "
+    "assembly and factorisation at rest) is done once and shown apart.";
+
 /// "## Model recommendation: <scene> at <rate>": the budget and its loads, the answer, a warning
 /// when the tolerance cannot discriminate, and every candidate's evidence (winners first, then
 /// by time per update, failures last).

@@ -14,15 +14,22 @@
 #include <string>
 #include <vector>
 
+#include "msm/model/form.hpp"
+#include "msm/solvers/solve.hpp"
 #include "verification/metrics.hpp"
 #include "verification/scene.hpp"
 
 namespace vessel {
 
+/// Updates of the load ramp static and linear mass-spring models are timed on (timed_updates).
+inline constexpr int kRampUpdates = 8;
+
 struct HarnessOptions {
   std::filesystem::path cache_dir;  ///< generated meshes (empty: no cache)
   std::ostream* log = nullptr;      ///< progress; nullptr for none
   int repeats = 1;                  ///< timed repeats of each model solve (median reported)
+  /// Static and linear mass-spring models: updates in the timed load ramp (timed_updates).
+  int ramp_updates = kRampUpdates;
   /// Run the models only at the budget's load (Budget::magnitude, else the representative load:
   /// the largest magnitude within the reference's linear regime, else the smallest), per ν.
   bool budget_load_only = false;
@@ -97,8 +104,19 @@ struct ModelOutcome {
   std::string failure;     ///< why it did not finish (divergence, no convergence, ...)
   std::size_t nodes = 0;
   std::size_t unknowns = 0;  ///< DoFs or 3 × free nodes
+  /// Model build, plus for mass-spring models the solver's preparation (static and linear:
+  /// assembly and factorisation at rest, msm::prepare_updates; implicit-euler-rest its
+  /// factorisation), s; median over repeats where timed per repeat.
   double setup_seconds = 0.0;
-  double solve_seconds = 0.0;  ///< median over repeats
+  /// The solver's time after set-up, s. Static and linear mass-spring models: the time per
+  /// update, the median over the warm-started updates of a load ramp to the case's magnitude
+  /// (timed_updates); dynamic ones: the run's steps (median over repeats); FEM: assembly + solve.
+  double solve_seconds = 0.0;
+  /// Static and linear mass-spring models: the ramp's updates (0: timed as one solve), and per
+  /// update the mean Newton iterations and CHOLMOD factorisations (last repeat).
+  int updates = 0;
+  double iterations_per_update = 0.0;
+  double factorisations_per_update = 0.0;
   double memory_mib = 0.0;  ///< peak resident memory added by set-up and solve
   ErrorStatistics error;       ///< against the reference at the model's nodes
   ErrorStatistics reference_uncertainty;  ///< the reference's own estimated error there (max, rms)
@@ -113,9 +131,9 @@ struct ModelOutcome {
   QuantityErrors quantities;
   /// The scene's budget quantity's error (mm, or mN for reaction); NaN without a [budget].
   double budget_error = std::numeric_limits<double>::quiet_NaN();
-  /// Compute time per update at the budget's rate, s: one solve for static solvers; for
-  /// integrators the time per step × the steps one update period needs (at least 1). 0 without a
-  /// budget rate.
+  /// Compute time per update at the budget's rate, s: solve_seconds for static solvers (the
+  /// ramp's median update); for integrators the time per step × the steps one update period
+  /// needs (at least 1). Set-up is excluded. 0 without a budget rate.
   double update_seconds = 0.0;
   long steps_per_update = 0;  ///< integrators with a budget rate
 };
@@ -153,8 +171,24 @@ QuantityErrors quantity_errors(const Budget& budget, const std::vector<Vec3>& no
 double budget_quantity_error(const QuantityErrors& q, BudgetQuantity quantity);
 
 /// Time per update (s) and steps per update of a run that took `solve_seconds`: static solvers
-/// (steps = 0) one solve; integrators `steps` steps of `dt` → per step × ⌈period/dt⌉ (at least 1).
+/// (steps = 0) solve_seconds (their time per update already); integrators `steps` steps of `dt`
+/// → per step × ⌈period/dt⌉ (at least 1).
 std::pair<double, long> time_per_update(double solve_seconds, long steps, double dt, double period);
+
+/// A static or linear mass-spring model timed as a simulator runs it (msm/solvers/updates.hpp):
+/// prepared once, then `updates` updates whose loads ramp to the problem's external_force
+/// (f·k/updates, k = 1 … updates), each from the previous state. `repeats` times afresh.
+struct UpdateSequence {
+  Eigen::VectorXd x;            ///< the last update's state, at the full load, m
+  double setup_seconds = 0.0;   ///< msm::prepare_updates, median over the repeats, s
+  double update_seconds = 0.0;  ///< median over every update of every repeat, s
+  int updates = 0;
+  double iterations_per_update = 0.0;      ///< mean over the last repeat
+  double factorisations_per_update = 0.0;  ///< mean over the last repeat (set-up excluded)
+};
+/// InputError if the solver has no prepared updates (msm::supports_updates) or updates < 1.
+UpdateSequence timed_updates(const msm::Problem& problem, const msm::SolverSpec& solver,
+                             int updates, int repeats);
 
 /// Runs the scene. Throws InputError for inputs the scene validation cannot see (a contact point
 /// off the generated wall, roller ends on the arch); a model that fails (diverges, does not

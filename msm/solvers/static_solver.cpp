@@ -49,15 +49,18 @@ double negative_curvature(const SparseMatrix& H, const SparseMatrix& Hp,
   return c < -1e-8 * std::abs(cp) ? c : 0.0;
 }
 
-StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& start) {
+StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& start,
+                    CholmodSolver& solver) {
   const double t0 = now();
+  const int analyses0 = solver.symbolic_analyses();
+  const int factorisations0 = solver.numeric_factorisations();
+  const double factorisation_seconds0 = solver.factorisation_seconds();
   StaticResult r;
   r.x = start.size() == p.num_dofs() ? start : p.rest;
   for (int i = 0; i < p.num_dofs(); ++i) {
     if (p.fixed[i]) r.x[i] = p.rest[i];
   }
   const double target = o.tolerance * std::max(p.external_force.norm(), o.force_scale);
-  CholmodSolver solver;
   VectorXd g;
   SparseMatrix H, Hp;
   VectorXd curvature_direction;
@@ -203,9 +206,9 @@ StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& st
       *o.log << ", energy " << energy << " J\n";
     }
   }
-  r.symbolic_analyses = solver.symbolic_analyses();
-  r.numeric_factorisations = solver.numeric_factorisations();
-  r.factorisation_seconds = solver.factorisation_seconds();
+  r.symbolic_analyses = solver.symbolic_analyses() - analyses0;
+  r.numeric_factorisations = solver.numeric_factorisations() - factorisations0;
+  r.factorisation_seconds = solver.factorisation_seconds() - factorisation_seconds0;
   r.seconds = now() - t0;
   if (!r.converged) {
     std::ostringstream msg;
@@ -219,7 +222,13 @@ StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& st
 }  // namespace
 
 StaticResult solve_static(const Problem& p, const StaticOptions& o, const VectorXd& start) {
-  if (o.load_steps <= 1) return newton(p, o, start);
+  CholmodSolver solver;
+  return solve_static(p, o, start, solver);
+}
+
+StaticResult solve_static(const Problem& p, const StaticOptions& o, const VectorXd& start,
+                          CholmodSolver& solver) {
+  if (o.load_steps <= 1) return newton(p, o, start, solver);
   // Load stepping: Newton on f_ext·s/N for s = 1..N, each from the previous equilibrium.
   const double t0 = now();
   Problem step = p;
@@ -227,7 +236,7 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
   total.x = start;
   for (int s = 1; s <= o.load_steps; ++s) {
     step.external_force = p.external_force * (static_cast<double>(s) / o.load_steps);
-    const StaticResult r = newton(step, o, total.x);
+    const StaticResult r = newton(step, o, total.x, solver);
     total.x = r.x;
     total.iterations += r.iterations;
     total.residual = r.residual;

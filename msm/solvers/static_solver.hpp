@@ -8,6 +8,8 @@
 
 namespace vessel::msm {
 
+class CholmodSolver;  // msm/solvers/linear_solver.hpp
+
 struct StaticOptions {
   /// Converged when ‖∇Π‖ on the free dofs ≤ tolerance·max(‖f_ext‖, force_scale), or below the
   /// round-off floor ε·max|K_ii|·(model size)·√n.
@@ -52,6 +54,12 @@ struct StaticResult {
 /// does not converge.
 StaticResult solve_static(const Problem& problem, const StaticOptions& options = {},
                           const VectorXd& start = VectorXd());
+/// The same with the caller's CHOLMOD solver: its symbolic analysis is reused while the pattern
+/// stays, and on return it holds the last factorisation (of the Hessian at the last iterate but
+/// one), which modified-Newton updates reuse (msm/solvers/updates.hpp). The result's counts and
+/// times are this call's own.
+StaticResult solve_static(const Problem& problem, const StaticOptions& options,
+                          const VectorXd& start, CholmodSolver& solver);
 
 /// Linearised model: K(x0) u = f_ext with the Hessian at rest, one CHOLMOD solve; x = x0 + u.
 StaticResult solve_linear(const Problem& problem);

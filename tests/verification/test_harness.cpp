@@ -10,6 +10,12 @@
 
 #include "../test_helpers.hpp"
 
+#include "meshes/errors.hpp"
+#include "meshes/gmsh_vessel.hpp"
+#include "meshes/surface_loads.hpp"
+#include "msm/mass/mass_rules.hpp"
+#include "msm/model/spring_model.hpp"
+#include "msm/stiffness/stiffness_rules.hpp"
 #include "verification/harness.hpp"
 
 using namespace vessel;
@@ -161,9 +167,22 @@ TEST_F(HarnessLame, ResultsJsonHasEveryFieldItsSchemaRequires) {
       EXPECT_TRUE(outcome.contains("failure"));
     }
   }
-  // One CSV row per outcome plus the header.
+  // One CSV row per outcome plus the header, every row with the header's number of fields.
   const std::string csv = test::read_text(dir / "results.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 8);
+  std::istringstream rows(csv);
+  std::string header;
+  std::getline(rows, header);
+  const auto fields = [](const std::string& line) { return std::count(line.begin(), line.end(), ','); };
+  for (std::string row; std::getline(rows, row);) EXPECT_EQ(fields(row), fields(header)) << row;
+  // The linear model's timed load ramp is recorded (count, iterations, factorisations).
+  for (const auto& outcome : scene["outcomes"]) {
+    if (outcome["model"] == "volume_linear") {
+      ASSERT_TRUE(outcome.contains("updates")) << outcome.dump();
+      EXPECT_EQ(outcome["updates"]["count"], kRampUpdates);
+      EXPECT_EQ(outcome["updates"]["factorisations_per_update"], 0.0);
+    }
+  }
   EXPECT_NE(test::read_text(dir / "summary.md").find("| p1 | 0.3 | 0 | 10 |"), std::string::npos);
 }
 
@@ -293,4 +312,37 @@ TEST(HarnessDynamic, SeedTwoPositionBasedModelRunsFromASceneWithItsHistory) {
   EXPECT_NEAR(o.history.model_mm.back(), o.qoi_displacement_mm, 1e-9);
   ASSERT_TRUE(o.quantities.indentation_mm.has_value());
   EXPECT_GT(*o.quantities.indentation_mm, 0.0);
+}
+
+TEST(HarnessUpdates, TheUpdateSequencesFinalStateEqualsAColdSolve) {
+  // timed_updates (what the harness times static and linear models with) ramps the load in 8
+  // warm-started updates; its last state must be the cold solve from rest at the full load
+  // (msm::solve), to the solver's tolerance: exactly for the linear model (1e-12), and for Newton
+  // within 1e-6 of the displacement (both stop at ‖∇Π‖ ≤ 1e-8‖f‖).
+  const VesselParams params;
+  const TetMesh mesh = generate_vessel_mesh(params);
+  msm::SpringNetwork net = msm::build_volume_network(mesh);
+  msm::assign_stiffness(net, msm::StiffnessRule::seed001, msm::StiffnessParams{});
+  const msm::SpringModel model(net);
+  ContactPatchSpec spec;
+  spec.point = Vec3(3e-3, 0, 20e-3);
+  spec.radius = 1e-3;
+  spec.force = 2e-3;
+  const msm::Problem p = msm::make_problem(
+      model, net, msm::nodal_masses(net, msm::MassRule::consistent, msm::kVesselDensity), mesh,
+      traction_nodal_loads(mesh, contact_patch(mesh, spec)), {"inlet", "outlet"});
+  for (const char* solver : {"linear", "static"}) {
+    const msm::SolverSpec s = msm::parse_solver(solver);
+    const UpdateSequence seq = timed_updates(p, s, 8, 2);
+    const Eigen::VectorXd cold = msm::solve(p, s).x;
+    const double u = (cold - p.rest).norm();
+    EXPECT_LT((seq.x - cold).norm(), (std::string(solver) == "linear" ? 1e-12 : 1e-6) * u)
+        << solver;
+    EXPECT_EQ(seq.updates, 8);
+    EXPECT_GT(seq.update_seconds, 0.0);
+    EXPECT_GT(seq.setup_seconds, 0.0);
+    if (std::string(solver) == "linear") EXPECT_EQ(seq.factorisations_per_update, 0.0);
+  }
+  EXPECT_THROW(timed_updates(p, msm::parse_solver("verlet"), 8, 1), InputError);
+  EXPECT_THROW(timed_updates(p, msm::parse_solver("linear"), 0, 1), InputError);
 }

@@ -72,7 +72,9 @@ void gate(const GateOptions& o) {
   summary << "Compared " << outcome.compared << " cases of `" << results_path.string()
           << "` with the baseline `" << o.baseline.string() << "` (error tolerance +"
           << o.tolerances.error_relative * 100.0 << " %, timing ratio "
-          << o.tolerances.timing_ratio << " on times normalised by the reference kernel).";
+          << o.tolerances.timing_ratio
+          << " on solve times normalised by the reference kernel: per update for static and "
+             "linear mass-spring models, the run's steps for integrators, set-up not gated).";
   doc.paragraph(summary.str());
   if (!outcome.findings.empty()) doc.table(reports::gate_table(outcome));
   const std::string text = doc.markdown_text(".");

@@ -1,4 +1,5 @@
 /// `vesselverify recommend`: the cheapest model that meets a scene's accuracy and rate budget.
+#include <iomanip>
 #include <iostream>
 
 #include "meshes/mesh_cache.hpp"
@@ -18,6 +19,7 @@ struct Options {
   std::filesystem::path cache_dir = default_cache_dir();
   bool quick = false;
   int repeats = 3;
+  int updates = kRampUpdates;  ///< static and linear models: updates of the timed load ramp
   std::vector<int> levels;
   int reference_level = -1;
   std::vector<double> roi_radii;
@@ -50,19 +52,30 @@ void run(const Options& o) {
   r.harness.cache_dir = o.cache_dir;
   r.harness.log = &std::cout;
   r.harness.repeats = o.repeats;
+  r.harness.ramp_updates = o.updates;
   const Recommendation rec = recommend(s, r, o.output_dir, o.command);
   const Selection& sel = rec.selection;
+  std::cout << std::defaultfloat << std::setprecision(3);  // the progress log may have changed it
   const char* unit = budget_unit(rec.scene.budget.quantity);
   if (sel.recommended) {
     const Candidate& c = rec.candidates[*sel.recommended];
     std::cout << "recommended: " << c.name << " (" << c.detail << "): error " << c.error << " "
-              << unit << ", " << c.update_seconds * 1e3 << " ms per update\n";
+              << unit << ", " << c.update_seconds * 1e3 << " ms per update ("
+              << c.setup_seconds * 1e3 << " ms set-up, once)\n";
   } else if (sel.closest) {
     const Candidate& c = rec.candidates[*sel.closest];
     std::cout << "no candidate meets the budget; closest: " << c.name << ": "
               << sel.reasons[*sel.closest] << "\n";
   } else {
     std::cout << "no candidate meets the budget, and none finished\n";
+  }
+  if (sel.whole_vessel) {
+    const Candidate& c = rec.candidates[*sel.whole_vessel];
+    std::cout << "whole vessel (no region of interest): " << c.name << ": error " << c.error
+              << " " << unit << ", " << c.update_seconds * 1e3 << " ms per update, "
+              << c.setup_seconds * 1e3 << " ms set-up\n";
+  } else {
+    std::cout << "no whole-vessel candidate (without a region of interest) meets the budget\n";
   }
   std::cout << "wrote " << (o.output_dir / "recommend.md").string()
             << ", recommend.json and the candidates' results.json\n";
@@ -101,6 +114,12 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
                 "Candidates at level 0 only (reference at level <= 1), ROI radii 4 and 8 mm");
   cmd->add_option("--repeats", o->repeats, "Timed repeats per solve (median)")
       ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd->add_option("--updates", o->updates,
+                  "Static and linear mass-spring models: timed as a simulator runs them, set-up "
+                  "(assembly, factorisation at rest) apart, then this many warm-started updates "
+                  "ramping the load to each case's magnitude; the time per update is their median")
+      ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   cmd->add_option("--levels", o->levels, "Model levels instead of 0,1 (quick: 0)")
       ->delimiter(',')

@@ -17,6 +17,7 @@ struct RunOptions {
   std::filesystem::path cache_dir = default_cache_dir();
   bool quick = false;
   int repeats = 1;
+  int updates = kRampUpdates;  ///< static and linear models: updates of the timed load ramp
   std::vector<double> poisson_ratios;  ///< sweeps overriding the scenes' own (empty: keep)
   std::vector<int> levels;
   std::vector<double> magnitudes;
@@ -55,6 +56,7 @@ void run(const RunOptions& o) {
   h.cache_dir = o.cache_dir;
   h.log = &std::cout;
   h.repeats = o.repeats;
+  h.ramp_updates = o.updates;
   if (o.fields != "none") h.fields_dir = o.output_dir / "fields";
   h.fields_every_load = o.fields == "all";
   run_and_write(scenes, h, o.output_dir, o.command);
@@ -81,6 +83,12 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
                 "Coarse levels (models 0, reference 1) and the smallest and largest load only");
   cmd->add_option("--repeats", o->repeats, "Timed repeats per model solve (median reported)")
       ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd->add_option("--updates", o->updates,
+                  "Static and linear mass-spring models: timed as a simulator runs them, set-up "
+                  "(assembly, factorisation at rest) apart, then this many warm-started updates "
+                  "ramping the load to each case's magnitude; the time per update is their median")
+      ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   cmd->add_option("--nu", o->poisson_ratios,
                   "Sweep Poisson's ratio over these values instead of the scenes' (e.g. "

@@ -12,6 +12,7 @@
 #include "meshes/errors.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
+#include "reports/study_sections.hpp"
 #include "reports/svg_plot.hpp"
 
 namespace vessel {
@@ -67,16 +68,26 @@ Selection select_model(const std::vector<Candidate>& c, double tolerance, double
   // Cheapest meeting both: least time per update; times within kTimingTie of the least are a tie
   // (wall-clock timings of one run differ by a few per cent), won by the least error, then by
   // the earlier candidate.
-  double fastest = HUGE_VAL;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (meets(c[i], tolerance, budget)) fastest = std::min(fastest, c[i].update_seconds);
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    if (!meets(c[i], tolerance, budget) || c[i].update_seconds > fastest * (1.0 + kTimingTie)) {
-      continue;
+  const auto cheapest = [&](const auto& eligible) {
+    std::optional<std::size_t> best;
+    double fastest = HUGE_VAL;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (eligible(i) && meets(c[i], tolerance, budget)) {
+        fastest = std::min(fastest, c[i].update_seconds);
+      }
     }
-    if (!sel.recommended || c[i].error < c[*sel.recommended].error) sel.recommended = i;
-  }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!eligible(i) || !meets(c[i], tolerance, budget) ||
+          c[i].update_seconds > fastest * (1.0 + kTimingTie)) {
+        continue;
+      }
+      if (!best || c[i].error < c[*best].error) best = i;
+    }
+    return std::make_pair(best, fastest);
+  };
+  const auto [recommended, fastest] = cheapest([](std::size_t) { return true; });
+  sel.recommended = recommended;
+  sel.whole_vessel = cheapest([&](std::size_t i) { return c[i].roi_radius <= 0.0; }).first;
   if (!sel.recommended) {
     // Closest: the least factor by which the budget would have to grow for it to pass.
     double best_factor = HUGE_VAL;
@@ -247,6 +258,7 @@ std::vector<Candidate> collect_candidates(const SceneResult& r) {
     c.error =
         std::isnan(c.error) || std::isnan(o.budget_error) ? NAN : std::max(c.error, o.budget_error);
     c.update_seconds = std::max(c.update_seconds, o.update_seconds);
+    c.setup_seconds = std::max(c.setup_seconds, o.setup_seconds);
   }
   return out;
 }
@@ -344,8 +356,9 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
   if (sel.recommended) {
     const Candidate& best = c[*sel.recommended];
     md << "**Recommended: `" << best.name << "`** (" << best.detail << "): error "
-       << fmt(best.error) << " " << unit << ", " << ms(best.update_seconds) << " per update, "
-       << best.unknowns << " unknowns.\n\n";
+       << fmt(best.error) << " " << unit << ", " << ms(best.update_seconds) << " per update ("
+       << ms(best.setup_seconds) << " set-up, once), " << best.unknowns << " unknowns"
+       << (best.roi_radius > 0.0 ? "" : ", the whole vessel") << ".\n\n";
   } else if (sel.closest) {
     const Candidate& near = c[*sel.closest];
     md << "**No candidate meets the budget.** The closest is `" << near.name << "` (" << near.detail
@@ -353,6 +366,14 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
        << " per update; " << sel.reasons[*sel.closest] << ".\n\n";
   } else {
     md << "**No candidate meets the budget**, and none finished.\n\n";
+  }
+  if (sel.whole_vessel && sel.whole_vessel != sel.recommended) {
+    const Candidate& w = c[*sel.whole_vessel];
+    md << "Whole vessel (no region of interest): `" << w.name << "` (" << w.detail << ") meets "
+       << "the budget too: error " << fmt(w.error) << " " << unit << ", "
+       << ms(w.update_seconds) << " per update, " << w.unknowns << " unknowns.\n\n";
+  } else if (!sel.whole_vessel) {
+    md << "No whole-vessel candidate (without a region of interest) meets the budget.\n\n";
   }
   // A tolerance at or above the reference's own contact displacement is met by a model that does
   // not move at all: say so, the answer then says nothing about accuracy.
@@ -368,15 +389,14 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
        << " mm tolerance, so a model that does not move at all would meet it. State a tighter "
           "tolerance or a larger load (`magnitude`) for an answer about accuracy.\n\n";
   }
-  md << "Time per update: one static solve from rest for static solvers (set-up excluded: it is "
-        "done once); for integrators the time per step × the steps one update period needs. "
-        "Errors are the worst over the scene's Poisson's ratios, against the P2 reference at each "
-        "model node; region-of-interest models (R) hold every node farther than R from the "
+  md << reports::kTimePerUpdateText
+     << " Errors are the worst over the scene's Poisson's ratios, against the P2 reference at "
+        "each model node; region-of-interest models (R) hold every node farther than R from the "
         "contact and are compared on the whole vessel. ★ marks the Pareto front (no other "
         "candidate is both faster and more accurate).\n\n";
   md << "| candidate | unknowns | error (" << unit
-     << ") | time per update (ms) | Pareto | verdict | "
-        "why |\n|---|---|---|---|---|---|---|\n";
+     << ") | time per update (ms) | set-up (ms) | Pareto | verdict | "
+        "why |\n|---|---|---|---|---|---|---|---|\n";
   // Winners first, then by time per update; failures last.
   std::vector<std::size_t> order(c.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -393,7 +413,8 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
     const bool front = std::find(sel.pareto.begin(), sel.pareto.end(), i) != sel.pareto.end();
     md << "| `" << c[i].name << "` | " << c[i].unknowns << " | "
        << (c[i].ok && std::isfinite(c[i].error) ? fmt(c[i].error) : "–") << " | "
-       << (c[i].ok ? fmt(c[i].update_seconds * 1e3) : "–") << " | " << (front ? "★" : "") << " | "
+       << (c[i].ok ? fmt(c[i].update_seconds * 1e3) : "–") << " | "
+       << (c[i].ok ? fmt(c[i].setup_seconds * 1e3) : "–") << " | " << (front ? "★" : "") << " | "
        << to_string(sel.verdicts[i]) << " | " << sel.reasons[i] << " |\n";
   }
   md << "\n";
@@ -420,6 +441,7 @@ std::string recommendation_json(const Recommendation& rec, const std::string& co
     if (c.ok) {
       j["error"] = std::isfinite(c.error) ? nlohmann::json(c.error) : nlohmann::json(nullptr);
       j["update_seconds"] = c.update_seconds;
+      j["setup_seconds"] = c.setup_seconds;
     } else {
       j["failure"] = c.failure;
     }
@@ -455,6 +477,7 @@ std::string recommendation_json(const Recommendation& rec, const std::string& co
                          {"loads", loads},
                          {"recommended", name_of(sel.recommended)},
                          {"closest", name_of(sel.closest)},
+                         {"whole_vessel", name_of(sel.whole_vessel)},
                          {"candidates", candidates}};
   return j.dump(2) + "\n";
 }

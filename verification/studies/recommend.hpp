@@ -26,7 +26,8 @@ struct Candidate {
   bool ok = false;
   std::string failure;  ///< why it did not finish (ok false)
   double error = 0.0;   ///< on the budget's quantity (mm, or mN for reaction); NaN: not computable
-  double update_seconds = 0.0;  ///< compute time per update at the budget's rate
+  double update_seconds = 0.0;  ///< compute time per update at the budget's rate (judged)
+  double setup_seconds = 0.0;   ///< done once: build, assembly and factorisation (not judged)
 };
 
 enum class Verdict {
@@ -44,6 +45,9 @@ struct Selection {
   /// When none meets the budget: the candidate needing the smallest relaxation of it, i.e. the
   /// least max(error / tolerance, time / time budget); ties go to the faster.
   std::optional<std::size_t> closest;
+  /// The cheapest candidate meeting both among the whole-vessel ones (no region of interest), by
+  /// the same rule as `recommended` (the same candidate when that one is whole-vessel).
+  std::optional<std::size_t> whole_vessel;
   std::vector<Verdict> verdicts;     ///< per candidate
   std::vector<std::string> reasons;  ///< per candidate, why it won or lost, with its numbers
   std::vector<std::size_t> pareto;   ///< finished candidates on the (time, error) Pareto front

@@ -56,6 +56,24 @@ TEST(Selection, TheCheapestMeetingBothWinsAndEveryOtherSaysWhy) {
             (std::set<std::size_t>{0, 1, 2, 3}));
 }
 
+TEST(Selection, TheCheapestWholeVesselCandidateIsNamedBesideARegionOfInterest) {
+  // Tolerance 0.1 mm, 1 ms: a region-of-interest model wins; the whole-vessel one meeting both
+  // is named apart; a whole-vessel one too slow or too inaccurate is not.
+  std::vector<Candidate> c{candidate("roi", 0.05, 0.0002), candidate("whole_slow", 0.01, 0.002),
+                           candidate("whole_ok", 0.08, 0.0005),
+                           candidate("whole_wrong", 0.2, 0.0001)};
+  c[0].roi_radius = 4e-3;
+  Selection s = select_model(c, 0.1, 0.001);
+  ASSERT_TRUE(s.recommended && s.whole_vessel);
+  EXPECT_EQ(*s.recommended, 0u);
+  EXPECT_EQ(*s.whole_vessel, 2u);
+  // None of the whole-vessel candidates meets both: none named.
+  c[2].error = 0.15;
+  s = select_model(c, 0.1, 0.001);
+  EXPECT_EQ(*s.recommended, 0u);
+  EXPECT_FALSE(s.whole_vessel.has_value());
+}
+
 TEST(Selection, ExactlyOnTheBudgetMeetsIt) {
   const Selection s = select_model({candidate("edge", 0.1, 0.01)}, 0.1, 0.01);
   ASSERT_TRUE(s.recommended.has_value());
@@ -106,7 +124,7 @@ TEST(Selection, NothingFinishedNamesNothing) {
 }
 
 TEST(TimePerUpdate, StaticSolvesAndIntegratorSteps) {
-  // Static: one solve per update, whatever the rate.
+  // Static: solve_seconds is already the time per update (the ramp's median), whatever the rate.
   EXPECT_EQ(time_per_update(0.02, 0, 0.0, 1.0 / 30.0), std::make_pair(0.02, 0L));
   // 20 000 steps of 1e-5 s in 2 s: 1e-4 s per step; at 1 kHz 100 steps per update → 10 ms.
   const auto [haptic, steps] = time_per_update(2.0, 20000, 1e-5, 1e-3);
