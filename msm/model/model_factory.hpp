@@ -1,7 +1,7 @@
 #pragma once
 /// The one place that turns a built network into the Form the solvers run on: the spring model,
-/// plus, for the hybrid volume model, the volume term of every tet (Golec et al. 2020). The harness,
-/// the `msm` command, regions of interest and the studies build their models here.
+/// plus, for the hybrid volume model, the volume term of every tet (Golec et al. 2020). The
+/// harness, the `msm` command, regions of interest and the studies build their models here.
 ///
 /// The hybrid volume model ("volume_term = true" on a volume_msm model, `--volume-term`):
 /// springs with Van Gelder weights k = E_s·Σ V_e/L² carry the shear modulus μ, and each tet's
@@ -33,8 +33,8 @@ namespace vessel::msm {
 
 /// Moduli of the hybrid volume model for E (Pa) and ν.
 struct HybridModuli {
-  double lambda = 0.0;  ///< target Lamé λ = Eν/((1 + ν)(1 − 2ν)), Pa
-  double mu = 0.0;      ///< target shear modulus μ = E/(2(1 + ν)), Pa
+  double lambda = 0.0;                 ///< target Lamé λ = Eν/((1 + ν)(1 − 2ν)), Pa
+  double mu = 0.0;                     ///< target shear modulus μ = E/(2(1 + ν)), Pa
   double spring_youngs_modulus = 0.0;  ///< E_s = 2.5μ: van-gelder springs with λ_s = μ_s = μ, Pa
   double kappa = 0.0;                  ///< κ = λ − μ, Pa
 };

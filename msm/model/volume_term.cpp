@@ -97,7 +97,8 @@ VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, do
                          std::to_string(num_nodes_));
       }
     }
-    const double v0 = tet_signed_volume({nodes[tet[0]], nodes[tet[1]], nodes[tet[2]], nodes[tet[3]]});
+    const double v0 =
+        tet_signed_volume({nodes[tet[0]], nodes[tet[1]], nodes[tet[2]], nodes[tet[3]]});
     if (!(std::abs(v0) > 0.0)) {
       throw InputError("volume term: tet " + std::to_string(e) +
                        " has zero rest volume; expected a non-degenerate tetrahedron");

@@ -177,7 +177,8 @@ TEST(StiffnessRulesByHand, TrianglesEveryRule) {
   //   plane stress λ* + 2μ = E/(1 − ν²): g Kg = 2tA(2λ* + 4μ)/l² = √3·t·E/(1 − ν²),
   //   k = (2√3/9)·E·t/(1 − ν²), which at ν = 1/3 is (√3/4)·E·t.
   const double l = 1e-3, t = 1e-3;
-  const std::array<Vec3, 3> eq{Vec3(0, 0, 0), Vec3(l, 0, 0), Vec3(l / 2, l * std::sqrt(3.0) / 2, 0)};
+  const std::array<Vec3, 3> eq{Vec3(0, 0, 0), Vec3(l, 0, 0),
+                               Vec3(l / 2, l * std::sqrt(3.0) / 2, 0)};
   const double tol = 1e-12 * kE * t;
   for (auto [a, b] : {std::pair{0, 1}, {0, 2}, {1, 2}}) {
     EXPECT_NEAR(k_of(triangle_network(eq, StiffnessRule::van_gelder, 0.3, t), a, b),

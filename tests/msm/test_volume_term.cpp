@@ -94,8 +94,7 @@ TEST(VolumeTerm, KernelMatchesFiniteDifferencesForBothSignsOfKappa) {
     EXPECT_LT(c.hessian_asymmetry, 1e-12) << kappa;
     // Projection: PSD, and unchanged where the exact block is already PSD (at rest, κ > 0).
     const Mat12 P = volume_hessian(corners(x), v0, kappa, true);
-    EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat12>(P).eigenvalues().minCoeff(),
-              -1e-9 * P.norm());
+    EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat12>(P).eigenvalues().minCoeff(), -1e-9 * P.norm());
   }
   const Mat12 at_rest = volume_hessian(rest, v0, 5e4, false);
   EXPECT_LT((volume_hessian(rest, v0, 5e4, true) - at_rest).norm(), 1e-9 * at_rest.norm());
@@ -180,7 +179,8 @@ TEST(VolumeTerm, CriticalStepBoundAccountsForTheVolumeTerm) {
     p.external_force = Eigen::VectorXd::Zero(p.rest.size());
     p.fixed.assign(static_cast<std::size_t>(p.rest.size()), 0);
     for (std::size_t i = 0; i < built.network.nodes.size(); ++i) {
-      if (built.network.nodes[i].z() < 1e-9) p.fixed[3 * i] = p.fixed[3 * i + 1] = p.fixed[3 * i + 2] = 1;
+      if (built.network.nodes[i].z() < 1e-9)
+        p.fixed[3 * i] = p.fixed[3 * i + 1] = p.fixed[3 * i + 2] = 1;
     }
     return p;
   };
