@@ -16,8 +16,8 @@
 #include "meshes/mesh_cache.hpp"
 #include "meshes/vtu_io.hpp"
 #include "msm/model/build_network.hpp"
+#include "msm/model/model_factory.hpp"
 #include "msm/model/roi.hpp"
-#include "msm/model/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/solvers/updates.hpp"
@@ -324,11 +324,11 @@ void add_reference_history(History& h, const ReferenceSolvers& ref, const Vec3& 
 /// held and their unknowns removed: verification/roi).
 struct SolvedSystem {
   const msm::Problem* problem = nullptr;
-  const msm::SpringModel* model = nullptr;
+  const msm::MassSpringModel* model = nullptr;
   const msm::SpringNetwork* network = nullptr;
   Eigen::Index qoi = -1;  ///< the QoI node in the solved problem (−1 if the region holds it)
   std::unique_ptr<msm::RoiNetwork> roi;
-  std::unique_ptr<msm::SpringModel> roi_model;
+  std::unique_ptr<msm::MassSpringModel> roi_model;
   std::unique_ptr<msm::Problem> roi_problem;
 
   /// Positions of the whole network from the solved ones (held nodes at rest).
@@ -343,14 +343,15 @@ struct SolvedSystem {
   }
 };
 
-SolvedSystem solved_system(const msm::Problem& full, const msm::SpringModel& model,
-                           const msm::SpringNetwork& network, const ModelSpec& spec,
+SolvedSystem solved_system(const msm::Problem& full, const msm::MassSpringModel& model,
+                           const msm::BuiltNetwork& built, const ModelSpec& spec,
                            const Vec3& qoi_point, std::size_t qoi) {
+  const msm::SpringNetwork& network = built.network;
   SolvedSystem sys{&full, &model, &network, static_cast<Eigen::Index>(qoi), {}, {}, {}};
   if (spec.roi_radius <= 0.0) return sys;
   const std::vector<char> held = msm::held_nodes(full, qoi_point, spec.roi_radius);
   sys.roi = std::make_unique<msm::RoiNetwork>(msm::restrict_network(network, held));
-  sys.roi_model = std::make_unique<msm::SpringModel>(sys.roi->network, spec.damping);
+  sys.roi_model = msm::make_model(sys.roi->network, built.volume_kappa, spec.damping);
   sys.roi_problem =
       std::make_unique<msm::Problem>(msm::restrict_problem(full, *sys.roi, held, *sys.roi_model));
   sys.problem = sys.roi_problem.get();
@@ -425,13 +426,13 @@ std::string msm_detail(const std::string& topology, const ModelSpec& spec) {
 
 /// One load of a mass-spring model: build its problem, solve (timed), compare.
 void run_msm_load(const Scene& s, const ModelSpec& spec, const msm::BuiltNetwork& built,
-                  const msm::SpringModel& model, const TetMesh& mesh, const ReferenceSolvers& ref,
+                  const msm::MassSpringModel& model, const TetMesh& mesh, const ReferenceSolvers& ref,
                   const ReferenceAtPoints& ref_here, const ReadOut& at, double ref_strain_unit,
                   const Vec3& qoi_point, const HarnessOptions& o, ModelOutcome& out) {
   const std::vector<Vec3>& nodes = built.network.nodes;
   const double mag = out.magnitude;
   const msm::Problem full = msm_problem(s, model, built, mesh, mag);
-  const SolvedSystem sys = solved_system(full, model, built.network, spec, qoi_point, at.qoi);
+  const SolvedSystem sys = solved_system(full, model, built, spec, qoi_point, at.qoi);
   out.unknowns = free_unknowns(*sys.problem);
   const MemoryProbe solve_memory;
   Eigen::VectorXd x_solved;
@@ -468,12 +469,30 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
                    const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
                    const HarnessOptions& o, Progress& progress, ModelOutcome base,
                    SceneResult& result) {
+  if (spec.volume_term && (nu < 0.25 || nu >= 0.5)) {
+    // The hybrid model refuses ν outside [1/4, 1/2) (κ = λ − μ negative or infinite): recorded as
+    // failed, as P1 is at ν = 0.5, not fatal to the run.
+    std::string why;
+    try {
+      (void)msm::hybrid_moduli(s.youngs_modulus, nu);
+    } catch (const InputError& e) {
+      why = e.what();
+    }
+    for (const double mag : s.load.magnitudes) {
+      ModelOutcome out = base;
+      out.magnitude = mag;
+      out.failure = why;
+      result.outcomes.push_back(out);
+    }
+    return;
+  }
   const MemoryProbe setup_memory;
   Stopwatch setup;
   VesselParams vessel = s.vessel;
   vessel.level = base.level;
   const msm::BuiltNetwork built = msm::build_network(mesh, vessel, network_options(s, spec, nu));
-  const msm::SpringModel model(built.network, spec.damping);
+  const auto model_ptr = msm::make_model(built, spec.damping);
+  const msm::MassSpringModel& model = *model_ptr;
   base.setup_seconds = setup.seconds();
   base.memory_mib = setup_memory.added_mib();
   base.detail = msm_detail(built.topology, spec);

@@ -166,6 +166,13 @@ class TableReader {
     if (n && n->is_array()) fail(n, key, "found an array, expected one string");
     return names_or(key, fallback, std::forward<Parse>(parse)).front();
   }
+  bool boolean_or(const std::string& key, bool fallback) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    const auto v = n->value_exact<bool>();
+    if (!v) fail(n, key, "found " + show(*n) + ", expected true or false");
+    return *v;
+  }
   std::string string_or(const std::string& key, const std::string& fallback,
                         const std::vector<std::string>& allowed = {}) {
     const toml::node* n = get(key);
@@ -313,8 +320,20 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
     m.surface = msm::parse_wall_surface(r.name_or("surface", msm::to_string(m.surface), msm::parse_wall_surface));
     m.topology = msm::parse_topology(r.name_or("topology", "auto", msm::parse_topology));
   }
+  if (m.kind == ModelKind::volume_msm) m.volume_term = r.boolean_or("volume_term", false);
   const auto stiffness = r.names_or(
-      "stiffness", m.kind == ModelKind::volume_msm ? "seed001" : "seed000", msm::parse_stiffness_rule);
+      "stiffness",
+      m.kind == ModelKind::volume_msm ? (m.volume_term ? "van-gelder" : "seed001") : "seed000",
+      msm::parse_stiffness_rule);
+  if (m.volume_term) {
+    for (const auto& k : stiffness) {
+      if (msm::parse_stiffness_rule(k) != msm::StiffnessRule::van_gelder) {
+        r.fail(r.table().get("stiffness"), "stiffness",
+               "found \"" + k + "\" with volume_term = true; expected \"van-gelder\" (the hybrid "
+               "volume model's κ = λ − μ assumes van-gelder springs, whose λ = μ)");
+      }
+    }
+  }
   const auto mass = r.names_or("mass", "consistent", msm::parse_mass_rule);
   const auto solvers = r.names_or("solver", "static", msm::parse_solver);
   if (m.kind == ModelKind::volume_msm &&

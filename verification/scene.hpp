@@ -30,6 +30,9 @@ struct ModelSpec {
   msm::WallSurface surface = msm::NetworkOptions{}.surface;  ///< surface msm: which wall
   msm::Topology topology = msm::Topology::automatic;      ///< surface msm
   msm::StiffnessRule stiffness = msm::StiffnessRule::seed000;
+  /// volume_msm: the hybrid volume model (Golec et al. 2020; msm/model/model_factory.hpp):
+  /// van-gelder springs carrying μ plus a volume energy per tet with κ = λ − μ (any ν < 0.5).
+  bool volume_term = false;
   msm::MassRule mass = msm::MassRule::consistent;
   /// static | linear | relaxation | an integrator | pbd; dynamic solvers with dt (s, > 0) and
   /// steps (> 0).

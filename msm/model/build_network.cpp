@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "meshes/errors.hpp"
+#include "msm/model/model_factory.hpp"
 
 namespace vessel::msm {
 
@@ -36,9 +37,27 @@ std::string triangle_topology_name(bool two_ring) {
   return std::string("triangle mesh (edges + bend across edges") + (two_ring ? " + two-ring)" : ")");
 }
 
-/// Stiffness, axial damping and masses: the same for every topology.
+/// Stiffness, axial damping and masses: the same for every topology. With the volume term, the
+/// springs carry μ (E_s = 2.5μ) and κ = λ − μ is recorded (model_factory.hpp).
 void assign_laws_and_masses(BuiltNetwork& built, const NetworkOptions& o) {
-  assign_stiffness(built.network, o.stiffness, o.stiffness_params);
+  StiffnessParams params = o.stiffness_params;
+  if (o.volume_term) {
+    if (o.model != ModelType::volume) {
+      throw InputError(
+          "volume_term: the hybrid volume model needs the volume model (tetrahedra), got the "
+          "surface model");
+    }
+    if (o.stiffness != StiffnessRule::van_gelder) {
+      throw InputError("volume_term: the hybrid volume model's springs use the van-gelder rule "
+                       "(its κ = λ − μ assumes their λ = μ), got stiffness '" +
+                       to_string(o.stiffness) + "'");
+    }
+    const HybridModuli m = hybrid_moduli(params.youngs_modulus, params.poisson_ratio);
+    params.youngs_modulus = m.spring_youngs_modulus;
+    built.volume_kappa = m.kappa;
+    built.topology += " + volume term per tet (Golec et al. 2020)";
+  }
+  assign_stiffness(built.network, o.stiffness, params);
   for (auto& s : built.network.springs) s.damping = o.axial_damping;
   built.masses = nodal_masses(built.network, o.mass, o.density);
 }

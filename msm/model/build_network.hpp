@@ -2,6 +2,7 @@
 /// One place that turns a model description (volume or surface, which wall, which topology,
 /// stiffness and mass rules) into a spring network with stiffness and masses, for the command
 /// line and the verification harness alike.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,12 +35,19 @@ struct NetworkOptions {
   MassRule mass = MassRule::consistent;
   double density = kVesselDensity;  ///< kg/m³
   double axial_damping = 0.0;       ///< k_d of seed 000 eq. (3.4), N·s/m, every spring
+  /// The hybrid volume model (Golec et al. 2020; model_factory.hpp): volume model only, van-gelder
+  /// springs carrying μ (E replaced by 2.5μ) plus a volume term κ = λ − μ on every tet, so that
+  /// the network reaches the material's ν. InputError with another model or stiffness rule, or at
+  /// ν = 0.5.
+  bool volume_term = false;
 };
 
 struct BuiltNetwork {
   SpringNetwork network;      ///< springs with stiffness and damping assigned
   std::vector<double> masses;  ///< kg per network node
   std::string topology;        ///< human-readable description
+  /// κ (Pa) of the volume term on network.tets (options.volume_term); none: springs only.
+  std::optional<double> volume_kappa;
 };
 
 /// Builds the network on the mesh: "auto" topology is seed 000's grid on a structured vessel and

@@ -54,7 +54,19 @@ RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& 
     roi.network.springs.push_back(r);
   }
   roi.network.thickness = full.thickness;
-  // Triangles and tets are not carried: the spring model and the solvers use springs only.
+  // Tets with a moving node are carried, for the volume term (their other nodes are kept: a volume
+  // network has a spring on every tet edge). Triangles are not: the spring model and the solvers
+  // other than PBD use springs only.
+  for (const Tet& t : full.tets) {
+    if (held[t[0]] && held[t[1]] && held[t[2]] && held[t[3]]) continue;
+    Tet r{};
+    bool kept = true;
+    for (int a = 0; a < 4; ++a) {
+      r[a] = to_roi[t[a]];
+      kept = kept && r[a] >= 0;
+    }
+    if (kept) roi.network.tets.push_back(r);
+  }
   return roi;
 }
 

@@ -19,7 +19,8 @@ std::vector<char> nodes_beyond(const std::vector<Vec3>& nodes, const Vec3& centr
 
 /// A network cut down to a region: the nodes that still move (any free dof, within R) and the held
 /// nodes one spring away from them (the region's boundary ring, all dofs fixed); springs with at
-/// least one moving end (a spring between two held nodes exerts no force on a moving node).
+/// least one moving end (a spring between two held nodes exerts no force on a moving node); tets
+/// with at least one moving node (for the volume term).
 struct RoiNetwork {
   SpringNetwork network;        ///< kept nodes and springs, renumbered
   std::vector<int> full_index;  ///< per kept node: its index in the full network

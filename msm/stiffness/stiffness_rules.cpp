@@ -13,10 +13,13 @@ StiffnessRule parse_stiffness_rule(const std::string& name) {
   if (name == "seed001") return StiffnessRule::seed001;
   if (name == "van-gelder" || name == "van_gelder") return StiffnessRule::van_gelder;
   if (name == "lloyd") return StiffnessRule::lloyd;
+  if (name == "least-squares-fit" || name == "least_squares_fit") {
+    return StiffnessRule::least_squares_fit;
+  }
   if (name == "uniform") return StiffnessRule::uniform;
   throw InputError(
-      "stiffness rule: expected one of seed000, seed001, van-gelder, lloyd, uniform; "
-      "got '" +
+      "stiffness rule: expected one of seed000, seed001, van-gelder, lloyd, least-squares-fit, "
+      "uniform; got '" +
       name + "'");
 }
 
@@ -30,6 +33,8 @@ std::string to_string(StiffnessRule rule) {
       return "van-gelder";
     case StiffnessRule::lloyd:
       return "lloyd";
+    case StiffnessRule::least_squares_fit:
+      return "least-squares-fit";
     case StiffnessRule::uniform:
       return "uniform";
   }
@@ -72,6 +77,17 @@ double van_gelder_stiffness(double E, double measure_around_edge, double L) {
   // Van Gelder (1998), abstract: k ∝ area/|c|²; k_c = E·Σ_e |T_e| / |c|² (|T_e| volume, or
   // t × area in 2D). Constant and 3D form not verified against the paper's text (see header).
   return E * measure_around_edge / (L * L);
+}
+
+double lloyd_tet_edge_stiffness(double E, double volume, double L) {
+  // Lloyd et al. (2007), regular tet: k = (2√2/25)·E·l = (24/25)·E·V/l² with V = l³/(6√2);
+  // per element in the V/L² form for irregular tets (header: why).
+  return 24.0 / 25.0 * E * volume / (L * L);
+}
+
+double lloyd_triangle_edge_stiffness(double E, double thickness, double area, double L) {
+  // Lloyd et al. (2007), equilateral triangle: k = (√3/4)·E·t = E·t·A/l² (A = (√3/4)·l²).
+  return E * thickness * area / (L * L);
 }
 
 namespace {
@@ -160,12 +176,13 @@ Eigen::MatrixXd fem_triangle_stiffness(const std::array<Vec3, 3>& x, double E, d
   return K;
 }
 
-std::array<double, 6> lloyd_tet_stiffness(const std::array<Vec3, 4>& x, double E, double nu) {
+std::array<double, 6> least_squares_fit_tet_stiffness(const std::array<Vec3, 4>& x, double E,
+                                                      double nu) {
   return lsq_springs<6>(fem_tet_stiffness(x, E, nu), {x.begin(), x.end()}, kTetEdges);
 }
 
-std::array<double, 3> lloyd_triangle_stiffness(const std::array<Vec3, 3>& x, double E, double nu,
-                                               double t) {
+std::array<double, 3> least_squares_fit_triangle_stiffness(const std::array<Vec3, 3>& x, double E,
+                                                           double nu, double t) {
   return lsq_springs<3>(fem_triangle_stiffness(x, E, nu, t), {x.begin(), x.end()}, kTriEdges);
 }
 
@@ -173,10 +190,12 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
   validate(p);
   const double E = p.youngs_modulus;
   const bool volume = !net.tets.empty();
-  if (rule == StiffnessRule::lloyd && volume && p.poisson_ratio >= 0.5) {
-    // λ = Eν/((1+ν)(1−2ν)) is infinite at ν = 0.5: the FEM element matrix Lloyd fits does not exist.
-    throw InputError("stiffness rule lloyd on tetrahedra: poisson_ratio ν = 0.5 makes λ infinite; "
-                     "expected ν < 0.5");
+  const bool fit = rule == StiffnessRule::least_squares_fit;
+  if (fit && volume && p.poisson_ratio >= 0.5) {
+    // λ = Eν/((1+ν)(1−2ν)) is infinite at ν = 0.5: the FEM element matrix to fit does not exist.
+    throw InputError(
+        "stiffness rule least-squares-fit on tetrahedra: poisson_ratio ν = 0.5 makes λ infinite; "
+        "expected ν < 0.5");
   }
   const double t = net.thickness;
   if (!volume && rule != StiffnessRule::uniform && !(t > 0)) {
@@ -184,20 +203,20 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
   }
   using Edge = std::pair<int, int>;
   auto key = [](int a, int b) { return a < b ? Edge{a, b} : Edge{b, a}; };
-  // Element measure around each edge (Σ V, or t·Σ A) and the lloyd sums.
+  // Element measure around each edge (Σ V, or t·Σ A) and the least-squares-fit sums.
   std::map<Edge, double> measure;
-  std::map<Edge, double> lloyd;
+  std::map<Edge, double> fitted;
   if (volume) {
     for (const Tet& tet : net.tets) {
       std::array<Vec3, 4> x{net.nodes[tet[0]], net.nodes[tet[1]], net.nodes[tet[2]],
                             net.nodes[tet[3]]};
       const double V = std::abs(signed_volume(x[0], x[1], x[2], x[3]));
       std::array<double, 6> kl{};
-      if (rule == StiffnessRule::lloyd) kl = lloyd_tet_stiffness(x, E, p.poisson_ratio);
+      if (fit) kl = least_squares_fit_tet_stiffness(x, E, p.poisson_ratio);
       for (int e = 0; e < 6; ++e) {
         const Edge k = key(tet[kTetEdges[e].first], tet[kTetEdges[e].second]);
         measure[k] += V;
-        lloyd[k] += kl[e];
+        fitted[k] += kl[e];
       }
     }
   } else {
@@ -205,11 +224,11 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
       std::array<Vec3, 3> x{net.nodes[tri[0]], net.nodes[tri[1]], net.nodes[tri[2]]};
       const double A = triangle_area(x[0], x[1], x[2]);
       std::array<double, 3> kl{};
-      if (rule == StiffnessRule::lloyd) kl = lloyd_triangle_stiffness(x, E, p.poisson_ratio, t);
+      if (fit) kl = least_squares_fit_triangle_stiffness(x, E, p.poisson_ratio, t);
       for (int e = 0; e < 3; ++e) {
         const Edge k = key(tri[kTriEdges[e].first], tri[kTriEdges[e].second]);
         measure[k] += t * A;
-        lloyd[k] += kl[e];
+        fitted[k] += kl[e];
       }
     }
   }
@@ -242,7 +261,18 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
         k = van_gelder_stiffness(E, m, L);
         break;
       case StiffnessRule::lloyd:
-        k = is_edge ? lloyd.at(key(s.a, s.b)) : van_gelder_stiffness(E, m, L);
+        // Σ over the elements sharing the edge of the per-element closed form; a non-edge spring
+        // takes the equilateral triangle's (√3/4)·E·t, as van_gelder.
+        if (!is_edge) {
+          k = van_gelder_stiffness(E, m, L);
+        } else if (volume) {
+          k = lloyd_tet_edge_stiffness(E, m, L);  // (24/25)·E·Σ V_e/L²
+        } else {
+          k = lloyd_triangle_edge_stiffness(E, 1.0, m, L);  // m = t·Σ A_e already
+        }
+        break;
+      case StiffnessRule::least_squares_fit:
+        k = is_edge ? fitted.at(key(s.a, s.b)) : van_gelder_stiffness(E, m, L);
         break;
       case StiffnessRule::uniform:
         k = p.uniform_k;

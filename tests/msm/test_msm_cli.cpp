@@ -43,6 +43,10 @@ TEST_F(MsmCli, SurfaceAndVolumeModelsSolveStaticallyAndWriteJson) {
   const auto v = vv("--model volume --stiffness seed001 --mass seed001 --json " +
                     (dir / "volume.json").string());
   ASSERT_EQ(v.exit_code, 0) << v.output;
+  // The hybrid volume model: its springs and its volume term, named in the topology.
+  const auto h = vv("--model volume --volume-term --poisson-ratio 0.45");
+  ASSERT_EQ(h.exit_code, 0) << h.output;
+  EXPECT_TRUE(contains(h.output, "volume term")) << h.output;
   const auto jv = nlohmann::json::parse(read_text(dir / "volume.json"));
   EXPECT_GT(jv["springs"]["volume"].get<int>(), 5000);
   EXPECT_GT(jv["contact_displacement_along_load_mm"].get<double>(), 0.0);
@@ -77,6 +81,9 @@ TEST_F(MsmCli, BadInputNamesTheParameterAndExitsOne) {
       {"--stiffness magic", "stiffness rule"},
       {"--mass heavy", "mass rule"},
       {"--model volume --solver pbd", "surface model"},
+      {"--model volume --volume-term --poisson-ratio 0.5", "κ = λ − μ is infinite"},
+      {"--model volume --volume-term --stiffness lloyd --poisson-ratio 0.45", "van-gelder"},
+      {"--model surface --volume-term", "volume model"},
   };
   for (const auto& [args, what] : cases) {
     const auto r = vv(args + " --json " + (dir / "bad.json").string());

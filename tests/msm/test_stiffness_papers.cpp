@@ -1,7 +1,7 @@
 // Van Gelder (1998) and Lloyd, Székely & Harders (2007) spring constants on one element, checked
 // against hand-derived values: the energy of the element's springs under a uniform strain ε,
 // Σ ½ k (dᵀεd · l)², against the continuum's ½ V (λ (tr ε)² + 2μ ε:ε) (plane stress for a
-// triangle: λ* = Eν/(1 − ν²), V = t·A). The FEM element matrices of the lloyd rule are checked
+// triangle: λ* = Eν/(1 − ν²), V = t·A). The FEM element matrices of the least-squares-fit rule are checked
 // against the same closed form, so nothing here compares the code with itself.
 #include <gtest/gtest.h>
 
@@ -141,7 +141,8 @@ TEST(StiffnessPapers, EquilateralTriangleReproducesThePlaneStressContinuumAtNuOn
   // exactly the plane-stress energy under every uniform in-plane strain (three independent ones).
   const double l = 0.8e-3, t = 1e-3, A = std::sqrt(3.0) / 4 * l * l;
   const auto x = equilateral(l);
-  for (StiffnessRule rule : {StiffnessRule::van_gelder, StiffnessRule::lloyd}) {
+  for (StiffnessRule rule :
+       {StiffnessRule::van_gelder, StiffnessRule::lloyd, StiffnessRule::least_squares_fit}) {
     const auto k = rule_on_triangle(x, rule, 1.0 / 3.0, t);
     for (double ki : k) EXPECT_NEAR(ki, std::sqrt(3.0) / 4 * kE * t, 1e-12 * kE * t);
     for (const Eigen::Matrix3d& eps :
@@ -151,11 +152,11 @@ TEST(StiffnessPapers, EquilateralTriangleReproducesThePlaneStressContinuumAtNuOn
       EXPECT_NEAR(spring_energy(x, kTri, k, eps), w, 1e-12 * w) << to_string(rule);
     }
   }
-  // At ν = 0 the lloyd rule's least squares gives, by symmetry, one k for the three edges; by hand
+  // At ν = 0 the least-squares-fit rule gives, by symmetry, one k for the three edges; by hand
   // it matches the uniaxial energy (edges at 0°, 60°, 120°: dᵀεd = e, e/4, e/4, so ½kl²e²·9/8 =
   // ½tAEe², k = (8/9)(√3/4)Et = (2√3/9)Et), and then the equibiaxial energy (each edge e·l:
   // 3·½kl²e²) is 4/3 of the continuum's tAEe²: no k is exact away from ν = 1/3.
-  const auto k0 = rule_on_triangle(x, StiffnessRule::lloyd, 0.0, t);
+  const auto k0 = rule_on_triangle(x, StiffnessRule::least_squares_fit, 0.0, t);
   for (double ki : k0) EXPECT_NEAR(ki, 2 * std::sqrt(3.0) / 9 * kE * t, 1e-12 * kE * t);
   const Eigen::Matrix3d uni = strain(1e-3, 0, 0, 0, 0, 0), bi = strain(1e-3, 1e-3, 0, 0, 0, 0);
   EXPECT_NEAR(spring_energy(x, kTri, k0, uni) / plane_stress_energy(uni, kE, 0.0, A, t), 1.0, 1e-12);
@@ -200,14 +201,14 @@ TEST(StiffnessPapers, RegularTetrahedronHandValuesUnderDilationAndShear) {
   EXPECT_NEAR(spring_energy(x, kTet, ll, s2), 0.96 * 0.125 * kE * V * g * g, tol);
 }
 
-TEST(StiffnessPapers, LloydIsTheLeastSquaresMatchOfTheFemMatrixOnAnyElement) {
-  // The lloyd rule minimises ‖Σ k_e g_e g_eᵀ − K_FEM‖_F: on a distorted tet and triangle, any
+TEST(StiffnessPapers, LeastSquaresFitIsTheLeastSquaresMatchOfTheFemMatrixOnAnyElement) {
+  // The least-squares-fit rule minimises ‖Σ k_e g_e g_eᵀ − K_FEM‖_F: on a distorted tet and triangle, any
   // perturbation of one k raises the misfit (first-order optimality, checked by hand: the misfit
   // is quadratic in k, so f(k ± h e_i) − f(k) = h²‖g_i g_iᵀ‖² > 0 exactly).
   const std::array<Vec3, 4> tet{Vec3(0, 0, 0), Vec3(1.3e-3, 0.2e-3, 0.1e-3),
                                 Vec3(0.4e-3, 1.1e-3, -0.2e-3), Vec3(0.3e-3, 0.5e-3, 0.9e-3)};
   const Eigen::MatrixXd K = fem_tet_stiffness(tet, kE, 0.3);
-  const auto k = lloyd_tet_stiffness(tet, kE, 0.3);
+  const auto k = least_squares_fit_tet_stiffness(tet, kE, 0.3);
   auto misfit = [&](const std::array<double, 6>& kk) {
     Eigen::MatrixXd S = Eigen::MatrixXd::Zero(12, 12);
     for (int e = 0; e < 6; ++e) {

@@ -217,3 +217,25 @@ TEST(Scene, LocalGlobalEulerTakesItsIterationsPerStep) {
                 .solver.kind,
             msm::SolverKind::local_global);
 }
+
+TEST(Scene, VolumeTermSelectsTheHybridVolumeModel) {
+  const Scene s = parse_scene(std::string(kMinimal) +
+                                  "[[models]]\nname = \"hybrid\"\nkind = \"volume_msm\"\n"
+                                  "volume_term = true\n",
+                              "scene.toml");
+  const ModelSpec& m = s.models.back();
+  EXPECT_TRUE(m.volume_term);
+  EXPECT_EQ(m.stiffness, msm::StiffnessRule::van_gelder);  // its default
+  // Another rule, a non-boolean, or the key on a surface model: refused, naming the key.
+  const auto rule = error_of(std::string(kMinimal) +
+                             "[[models]]\nkind = \"volume_msm\"\nvolume_term = true\n"
+                             "stiffness = \"lloyd\"\n");
+  EXPECT_NE(rule.find("models[1].stiffness"), std::string::npos) << rule;
+  EXPECT_NE(rule.find("van-gelder"), std::string::npos) << rule;
+  const auto type = error_of(std::string(kMinimal) +
+                             "[[models]]\nkind = \"volume_msm\"\nvolume_term = 1\n");
+  EXPECT_NE(type.find("models[1].volume_term"), std::string::npos) << type;
+  const auto surface = error_of(std::string(kMinimal) +
+                                "[[models]]\nkind = \"surface_msm\"\nvolume_term = true\n");
+  EXPECT_NE(surface.find("volume_term"), std::string::npos) << surface;
+}

@@ -17,7 +17,7 @@
 #include "meshes/errors.hpp"
 #include "meshes/msh_io.hpp"
 #include "meshes/stl_io.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/model/model_factory.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/cli/vessel_options.hpp"
 #include "verification/msm_document.hpp"
@@ -35,7 +35,8 @@ struct MsmOptions {
   std::string surface = msm::to_string(msm::NetworkOptions{}.surface);
   std::string topology = "auto";
   bool two_ring = false;
-  std::string stiffness = "seed000";
+  std::string stiffness;  ///< empty: seed000, or van-gelder with --volume-term
+  bool volume_term = false;
   msm::StiffnessParams stiffness_params;
   std::string mass = "consistent";
   double density = msm::kVesselDensity;
@@ -212,6 +213,7 @@ msm::BuiltNetwork command_network(const MsmOptions& o, const Scene& s, const Tet
   n.topology = msm::parse_topology(o.topology);
   n.two_ring = o.two_ring;
   n.stiffness = msm::parse_stiffness_rule(o.stiffness);
+  n.volume_term = o.volume_term;
   n.stiffness_params = o.stiffness_params;
   n.mass = msm::parse_mass_rule(o.mass);
   n.density = o.density;
@@ -365,7 +367,7 @@ std::optional<ContactRecord> contact_record(const Scene& s, const TetMesh& mesh)
 }
 
 /// Displacements at the node nearest the contact point and the largest, and the spring strain.
-void print_displacements(const msm::SpringNetwork& net, const msm::SpringModel& model,
+void print_displacements(const msm::SpringNetwork& net, const msm::MassSpringModel& model,
                          const Eigen::VectorXd& x, MsmRunRecord& run) {
   for (std::size_t i = 0; i < net.nodes.size(); ++i) {
     const double u = (x.segment<3>(3 * static_cast<Eigen::Index>(i)) - net.nodes[i]).norm();
@@ -389,6 +391,7 @@ void print_displacements(const msm::SpringNetwork& net, const msm::SpringModel& 
 
 void run(MsmOptions& o) {
   const auto t_total = std::chrono::steady_clock::now();
+  if (o.stiffness.empty()) o.stiffness = o.volume_term ? "van-gelder" : "seed000";
   std::cout << std::setprecision(6);
   const bool stl = is_stl(o);
   if (stl) check_stl_options(o);  // first: what an STL cannot give explains the rest
@@ -407,7 +410,8 @@ void run(MsmOptions& o) {
   run.contact = contact_record(scene, mesh);
   const auto t_build = std::chrono::steady_clock::now();
   const msm::BuiltNetwork built = command_network(o, scene, mesh, stl_surface);
-  const msm::SpringModel model(built.network, o.point_damping);
+  const auto model_ptr = msm::make_model(built, o.point_damping);
+  const msm::MassSpringModel& model = *model_ptr;
   msm::Problem problem = msm_problem(scene, model, built, mesh, o.force);
   fix_by_options(o, built.network, problem);
   run.build_seconds = seconds_since(t_build);
@@ -445,11 +449,17 @@ void add_model_options(CLI::App* cmd, MsmOptions& o) {
       ->capture_default_str();
   cmd->add_flag("--two-ring", o.two_ring, "Add two-ring springs (triangle topology)");
   cmd->add_option("--stiffness", o.stiffness,
-                  "Stiffness rule: seed000, seed001, van-gelder, lloyd, uniform")
-      ->capture_default_str();
+                  "Stiffness rule: seed000, seed001, van-gelder, lloyd, least-squares-fit, uniform "
+                  "(default seed000; van-gelder with --volume-term)");
+  cmd->add_flag("--volume-term", o.volume_term,
+                "Hybrid volume model (Golec et al. 2020), volume model only: van-gelder springs "
+                "carrying the shear modulus plus a volume energy per tet, κ = λ − μ, so that the "
+                "network has the material's ν (< 0.5)");
   auto& sp = o.stiffness_params;
   cmd->add_option("--youngs-modulus", sp.youngs_modulus, "E, Pa")->capture_default_str();
-  cmd->add_option("--poisson-ratio", sp.poisson_ratio, "ν (lloyd rule)")->capture_default_str();
+  cmd->add_option("--poisson-ratio", sp.poisson_ratio,
+                  "ν (least-squares-fit rule and --volume-term)")
+      ->capture_default_str();
   cmd->add_option("--uniform-k", sp.uniform_k, "k of the uniform rule, N/m")->capture_default_str();
   cmd->add_option("--shear-factor", sp.shear_factor, "Factor on shear springs")
       ->capture_default_str();

@@ -157,6 +157,23 @@ Selection select_model(const std::vector<Candidate>& c, double tolerance, double
   return sel;
 }
 
+namespace {
+
+/// The spring models of a kind: every stiffness rule, and for volume networks also the hybrid
+/// volume model (van-gelder springs + volume term, msm/model/model_factory.hpp).
+std::vector<std::pair<msm::StiffnessRule, bool>> spring_rules(ModelKind kind) {
+  std::vector<std::pair<msm::StiffnessRule, bool>> out;
+  for (const msm::StiffnessRule rule : msm::kAllStiffnessRules) out.emplace_back(rule, false);
+  if (kind == ModelKind::volume_msm) out.emplace_back(msm::StiffnessRule::van_gelder, true);
+  return out;
+}
+
+std::string rule_label(msm::StiffnessRule rule, bool volume_term) {
+  return volume_term ? "hybrid-volume" : msm::to_string(rule);
+}
+
+}  // namespace
+
 std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double>& roi_radii) {
   std::vector<ModelSpec> out;
   const bool dynamic = std::any_of(s.models.begin(), s.models.end(),
@@ -170,13 +187,14 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
     fem.degree = 1;
     out.push_back(fem);
     for (const auto& [kind, kind_name] : kinds) {
-      for (const msm::StiffnessRule rule : msm::kAllStiffnessRules) {
+      for (const auto& [rule, volume_term] : spring_rules(kind)) {
         ModelSpec m;
         m.kind = kind;
         m.surface = msm::WallSurface::mid;
         m.stiffness = rule;
+        m.volume_term = volume_term;
         m.mass = msm::MassRule::consistent;  // irrelevant to a static answer
-        const std::string rule_name = msm::to_string(rule);
+        const std::string rule_name = rule_label(rule, volume_term);
         for (const std::string solver : {"static", "linear"}) {
           m.solver = msm::parse_solver(solver);
           m.name = kind_name + "/" + rule_name + "/" + solver;
@@ -206,7 +224,7 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
   std::set<double> all = explicit_dts;
   all.insert(implicit_dts.begin(), implicit_dts.end());
   for (const auto& [kind, kind_name] : kinds) {
-    for (const msm::StiffnessRule rule : msm::kAllStiffnessRules) {
+    for (const auto& [rule, volume_term] : spring_rules(kind)) {
       for (const msm::Integrator integrator : msm::kAllIntegrators) {
         const std::set<double>& family = is_explicit(integrator) ? explicit_dts : implicit_dts;
         for (const double dt : family.empty() ? all : family) {
@@ -214,13 +232,15 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
           m.kind = kind;
           m.surface = msm::WallSurface::mid;
           m.stiffness = rule;
+          m.volume_term = volume_term;
           m.mass = msm::MassRule::consistent;  // the FEM transient's mass
           m.solver.kind = msm::SolverKind::integrator;
           m.solver.integrator = integrator;
           m.solver.dt = dt;
           m.solver.steps = std::max(1L, std::lround(duration / dt));
           m.damping = damping;
-          m.name = kind_name + "/" + msm::to_string(rule) + "/" + msm::to_string(integrator) +
+          m.name = kind_name + "/" + rule_label(rule, volume_term) + "/" +
+                   msm::to_string(integrator) +
                    "/dt=" + fmt(dt);
           out.push_back(m);
         }

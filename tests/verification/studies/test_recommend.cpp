@@ -199,8 +199,9 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   m.stiffness = msm::StiffnessRule::seed001;
   s.models = {m};
   const std::vector<ModelSpec> c = candidate_models(s, {4e-3, 8e-3});
-  // FEM P1 + 2 kinds × 5 rules × (static, linear, 2 radii).
-  ASSERT_EQ(c.size(), 1 + 2 * msm::kAllStiffnessRules.size() * 4);
+  // FEM P1 + (2 kinds × every rule + the hybrid volume model) × (static, linear, 2 radii).
+  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 1;
+  ASSERT_EQ(c.size(), 1 + spring_models * 4);
   std::set<std::string> names, rules;
   for (const auto& x : c) {
     names.insert(x.name);
@@ -209,10 +210,12 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   EXPECT_EQ(names.size(), c.size());  // unique
   EXPECT_EQ(rules.size(), msm::kAllStiffnessRules.size());
   EXPECT_TRUE(names.count("volume/lloyd/static/R=4mm"));
+  EXPECT_TRUE(names.count("volume/hybrid-volume/static"));
+  EXPECT_TRUE(names.count("volume/least-squares-fit/linear"));
   EXPECT_TRUE(names.count("surface/seed000/linear"));
   // Pressure: no regions of interest.
   s.load.kind = LoadKind::pressure;
-  EXPECT_EQ(candidate_models(s, {4e-3}).size(), 1 + 2 * msm::kAllStiffnessRules.size() * 2);
+  EXPECT_EQ(candidate_models(s, {4e-3}).size(), 1 + spring_models * 2);
 
   // Dynamic: every integrator at its family's time steps, over the scene's longest run.
   s.load.kind = LoadKind::contact;
@@ -227,7 +230,7 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   i.solver.steps = 100;
   s.models = {e, i};
   const std::vector<ModelSpec> d = candidate_models(s, {4e-3});
-  ASSERT_EQ(d.size(), 2 * msm::kAllStiffnessRules.size() * msm::kAllIntegrators.size());
+  ASSERT_EQ(d.size(), spring_models * msm::kAllIntegrators.size());
   for (const auto& x : d) {
     const bool implicit = x.solver.integrator == msm::Integrator::implicit_euler;
     EXPECT_EQ(x.solver.kind, msm::SolverKind::integrator) << x.name;

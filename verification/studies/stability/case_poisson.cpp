@@ -15,8 +15,9 @@ HardCase case_poisson(const StabilityOptions& o, std::ostream& log) {
       "Straight tube, level 0, inlet and outlet clamped, contact load " + fmt(force * 1e3) +
       " mN on the shared 0.5 mm patch, E = 14.24 kPa. FEM P1 and P2 in the displacement "
       "formulation and Taylor–Hood P2–P1 (mixed); volume mass-spring models with each stiffness "
-      "rule (static Newton; only `lloyd` reads ν). Displacement at the mesh node nearest the "
-      "contact point.";
+      "rule (static Newton; only `least-squares-fit` reads ν) and the hybrid volume model "
+      "(van-gelder springs + volume term κ = λ − μ; refuses ν = 0.5). Displacement at the mesh "
+      "node nearest the contact point.";
   const Scene scene = study_scene(VesselParams{}, 14.24e3, force);
   const TetMesh mesh = case_mesh(scene, o);
   for (double nu : {0.49, 0.499, 0.5}) {
@@ -34,13 +35,22 @@ HardCase case_poisson(const StabilityOptions& o, std::ostream& log) {
       hc.outcomes.push_back(oc);
     }
     hc.outcomes.push_back(fem_outcome("FEM P2–P1 mixed, ν = " + fmt(nu), mixed));
-    for (msm::StiffnessRule rule : {msm::StiffnessRule::seed000, msm::StiffnessRule::seed001,
-                                    msm::StiffnessRule::van_gelder, msm::StiffnessRule::lloyd}) {
-      // Rules other than lloyd ignore ν: run them once (at ν = 0.49).
-      if (rule != msm::StiffnessRule::lloyd && nu != 0.49) continue;
-      const ModelSpec spec = volume_model(rule);
-      const std::string name =
-          spec.name + (rule == msm::StiffnessRule::lloyd ? ", ν = " + fmt(nu) : " (any ν)");
+    std::vector<ModelSpec> specs;
+    for (msm::StiffnessRule rule :
+         {msm::StiffnessRule::seed000, msm::StiffnessRule::seed001, msm::StiffnessRule::van_gelder,
+          msm::StiffnessRule::lloyd, msm::StiffnessRule::least_squares_fit}) {
+      specs.push_back(volume_model(rule));
+    }
+    ModelSpec hybrid = volume_model(msm::StiffnessRule::van_gelder);
+    hybrid.volume_term = true;
+    hybrid.name = "volume / hybrid (van-gelder + volume term)";
+    specs.push_back(hybrid);
+    for (const ModelSpec& spec : specs) {
+      // Models that ignore ν run once (at ν = 0.49).
+      const bool reads_nu =
+          spec.volume_term || spec.stiffness == msm::StiffnessRule::least_squares_fit;
+      if (!reads_nu && nu != 0.49) continue;
+      const std::string name = spec.name + (reads_nu ? ", ν = " + fmt(nu) : " (any ν)");
       try {
         const auto m = build_model(scene, mesh, spec, nu);
         HardCaseOutcome oc = static_outcome(name, *m);

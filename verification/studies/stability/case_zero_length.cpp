@@ -41,9 +41,9 @@ HardCase case_zero_length(const StabilityOptions& o, std::ostream& log) {
     z.rest_length = 0.0;
     z.law = {kmean, kmean};
     net.springs.push_back(z);
-    const msm::SpringModel model(net);
+    const auto model = msm::make_model(net, std::nullopt);
     msm::Problem p = m->problem;
-    p.form = &model;
+    p.form = model.get();
     const Eigen::Index n = p.rest.size();
     p.rest.conservativeResize(n + 3);
     p.rest.tail<3>() = net.nodes.back();
@@ -71,7 +71,7 @@ HardCase case_zero_length(const StabilityOptions& o, std::ostream& log) {
     StudyModel tmp;
     tmp.problem = p;
     tmp.contact_node = m->contact_node;
-    tmp.model = std::make_unique<msm::SpringModel>(net);
+    tmp.model = msm::make_model(net, std::nullopt);
     tmp.problem.form = tmp.model.get();
     hc.outcomes.push_back(static_outcome("volume / seed001 + zero-length spring: static", tmp));
     const double dt = 0.5 * msm::predicted_critical_step(

@@ -62,7 +62,7 @@ std::unique_ptr<StudyModel> build_model(const Scene& scene, const TetMesh& mesh,
                                         const ModelSpec& spec, double nu) {
   auto m = std::make_unique<StudyModel>();
   m->built = msm::build_network(mesh, scene.vessel, network_options(scene, spec, nu));
-  m->model = std::make_unique<msm::SpringModel>(m->built.network, spec.damping);
+  m->model = msm::make_model(m->built, spec.damping);
   m->problem = msm_problem(scene, *m->model, m->built, mesh, scene.load.magnitudes.front());
   m->contact_node = nearest_node(m->built.network.nodes, qoi_point(scene));
   return m;
@@ -71,7 +71,7 @@ std::unique_ptr<StudyModel> build_model(const Scene& scene, const TetMesh& mesh,
 std::unique_ptr<StudyModel> with_damping(const StudyModel& base, double c) {
   auto m = std::make_unique<StudyModel>();
   m->built = base.built;
-  m->model = std::make_unique<msm::SpringModel>(m->built.network, c);
+  m->model = msm::make_model(m->built, c);
   m->problem = base.problem;
   m->problem.form = m->model.get();
   m->contact_node = base.contact_node;

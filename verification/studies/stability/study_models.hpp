@@ -8,7 +8,7 @@
 
 #include "fem_reference/elasticity.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/model/model_factory.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_problems.hpp"
@@ -40,7 +40,7 @@ ModelSpec surface_model(msm::StiffnessRule rule);
 /// A mass-spring model of a case's scene on one mesh, with its problem (loads and supports).
 struct StudyModel {
   msm::BuiltNetwork built;
-  std::unique_ptr<msm::SpringModel> model;
+  std::unique_ptr<msm::MassSpringModel> model;
   msm::Problem problem;
   std::size_t contact_node = 0;  ///< the network node nearest the scene's contact point
   [[nodiscard]] double contact_displacement(const Eigen::VectorXd& x) const {
@@ -54,7 +54,7 @@ struct StudyModel {
 /// damping of spec.damping, the contact load at the scene's magnitude.
 std::unique_ptr<StudyModel> build_model(const Scene& scene, const TetMesh& mesh,
                                         const ModelSpec& spec, double nu);
-/// The same network and problem with point damping c, N·s/m per node (a new SpringModel).
+/// The same network and problem with point damping c, N·s/m per node (a new model).
 std::unique_ptr<StudyModel> with_damping(const StudyModel& base, double c);
 double mean_mass(const msm::Problem& p);
 

@@ -1,0 +1,109 @@
+#include "msm/model/model_factory.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "meshes/errors.hpp"
+
+namespace vessel::msm {
+
+HybridModuli hybrid_moduli(double E, double nu) {
+  if (!(E > 0) || !std::isfinite(E)) {
+    throw InputError("hybrid volume model: expected Young's modulus E > 0 Pa, got " +
+                     std::to_string(E));
+  }
+  if (!(nu >= 0.25 && nu < 0.5)) {
+    throw InputError(
+        "hybrid volume model (volume_term): poisson_ratio ν must be in [0.25, 0.5), got " +
+        std::to_string(nu) +
+        (nu >= 0.5 ? "; at ν = 0.5 the volume term's κ = λ − μ is infinite (an incompressibility "
+                     "constraint, which this penalty model does not offer)"
+                   : "; below 1/4 the volume term's κ = λ − μ is negative, and a negative volume "
+                     "energy makes sliver tets unstable (the static solver diverged on a gmsh "
+                     "cube at ν = 0 and 0.1)"));
+  }
+  HybridModuli m;
+  m.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+  m.mu = E / (2 * (1 + nu));
+  m.spring_youngs_modulus = 2.5 * m.mu;  // van-gelder: λ_s = μ_s = 0.4·E_s (header)
+  m.kappa = m.lambda - m.mu;
+  return m;
+}
+
+MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damping,
+                                 std::optional<double> volume_kappa)
+    : springs_(network, point_damping) {
+  if (!volume_kappa) return;
+  if (network.tets.empty()) {
+    throw InputError("volume term: the network has no tetrahedra; expected a volume network");
+  }
+  volume_ = std::make_unique<VolumeTerm>(network.nodes, network.tets, *volume_kappa);
+  SparseMatrix Hs;
+  springs_.hessian(flatten(network.nodes), Hs, false);
+  volume_slots_ = volume_->slots_in(Hs);
+  if (std::find(volume_slots_.begin(), volume_slots_.end(), -1) == volume_slots_.end()) return;
+  // Some tet entries are not in the springs' pattern: assemble into the union of both.
+  union_pattern_ = Hs + volume_->pattern();
+  union_pattern_.makeCompressed();
+  std::fill(union_pattern_.valuePtr(), union_pattern_.valuePtr() + union_pattern_.nonZeros(), 0.0);
+  for (int col = 0; col < Hs.outerSize(); ++col) {
+    for (SparseMatrix::InnerIterator it(Hs, col); it; ++it) {
+      const int* inner = union_pattern_.innerIndexPtr();
+      const int* begin = inner + union_pattern_.outerIndexPtr()[col];
+      const int* end = inner + union_pattern_.outerIndexPtr()[col + 1];
+      spring_to_union_.push_back(static_cast<int>(std::lower_bound(begin, end, it.row()) - inner));
+    }
+  }
+  volume_slots_ = volume_->slots_in(union_pattern_);
+}
+
+double MassSpringModel::energy(const VectorXd& x) const {
+  return springs_.energy(x) + (volume_ ? volume_->energy(x) : 0.0);
+}
+
+void MassSpringModel::gradient(const VectorXd& x, VectorXd& g) const {
+  springs_.gradient(x, g);
+  if (volume_) volume_->add_gradient(x, g);
+}
+
+void MassSpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
+  if (!volume_) {
+    springs_.hessian(x, H, project_psd);
+    return;
+  }
+  if (spring_to_union_.empty()) {
+    springs_.hessian(x, H, project_psd);
+  } else {
+    SparseMatrix Hs;
+    springs_.hessian(x, Hs, project_psd);
+    H = union_pattern_;
+    double* values = H.valuePtr();
+    const double* spring_values = Hs.valuePtr();
+    for (std::size_t k = 0; k < spring_to_union_.size(); ++k) {
+      values[spring_to_union_[k]] += spring_values[k];
+    }
+  }
+  // Each term's blocks are projected separately (per spring, per tet).
+  volume_->add_hessian(x, H.valuePtr(), volume_slots_, project_psd);
+}
+
+void MassSpringModel::damping_force(const VectorXd& x, const VectorXd& v, VectorXd& f) const {
+  springs_.damping_force(x, v, f);
+}
+
+void MassSpringModel::damping_jacobian(const VectorXd& x, SparseMatrix& D) const {
+  springs_.damping_jacobian(x, D);
+}
+
+std::unique_ptr<MassSpringModel> make_model(const SpringNetwork& network,
+                                            std::optional<double> volume_kappa,
+                                            double point_damping) {
+  return std::make_unique<MassSpringModel>(network, point_damping, volume_kappa);
+}
+
+std::unique_ptr<MassSpringModel> make_model(const BuiltNetwork& built, double point_damping) {
+  return make_model(built.network, built.volume_kappa, point_damping);
+}
+
+}  // namespace vessel::msm

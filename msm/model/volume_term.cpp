@@ -1,0 +1,182 @@
+#include "msm/model/volume_term.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "meshes/errors.hpp"
+
+namespace vessel::msm {
+
+namespace {
+
+/// [a]×: the matrix of a × ·.
+Eigen::Matrix3d cross_matrix(const Vec3& a) {
+  Eigen::Matrix3d m;
+  m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  return m;
+}
+
+}  // namespace
+
+double tet_signed_volume(const std::array<Vec3, 4>& x) {
+  return (x[1] - x[0]).dot((x[2] - x[0]).cross(x[3] - x[0])) / 6.0;
+}
+
+Vec12 tet_volume_gradient(const std::array<Vec3, 4>& x) {
+  // V = e1·(e2 × e3)/6 with e_i = x_i − x0: ∂V/∂e1 = e2×e3/6 (cyclic), ∂V/∂x0 = −Σ ∂V/∂e_i.
+  const Vec3 e1 = x[1] - x[0], e2 = x[2] - x[0], e3 = x[3] - x[0];
+  Vec12 g;
+  g.segment<3>(3) = e2.cross(e3) / 6.0;
+  g.segment<3>(6) = e3.cross(e1) / 6.0;
+  g.segment<3>(9) = e1.cross(e2) / 6.0;
+  g.segment<3>(0) = -(g.segment<3>(3) + g.segment<3>(6) + g.segment<3>(9));
+  return g;
+}
+
+Mat12 tet_volume_hessian(const std::array<Vec3, 4>& x) {
+  // In the edge vectors: ∂²V/∂e_i∂e_j = −[e_k]×/6 for (i, j, k) cyclic, +[e_k]×/6 anti-cyclic,
+  // zero for i = j. Then x0's blocks by e_i = x_i − x0 (row and column sums with a minus sign).
+  const std::array<Vec3, 3> e{x[1] - x[0], x[2] - x[0], x[3] - x[0]};
+  Eigen::Matrix<double, 9, 9> He = Eigen::Matrix<double, 9, 9>::Zero();
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    const Eigen::Matrix3d c = cross_matrix(e[k]) / 6.0;
+    He.block<3, 3>(3 * i, 3 * j) = -c;
+    He.block<3, 3>(3 * j, 3 * i) = c;
+  }
+  Eigen::Matrix<double, 9, 12> T = Eigen::Matrix<double, 9, 12>::Zero();
+  for (int i = 0; i < 3; ++i) {
+    T.block<3, 3>(3 * i, 0) = -Eigen::Matrix3d::Identity();
+    T.block<3, 3>(3 * i, 3 * (i + 1)) = Eigen::Matrix3d::Identity();
+  }
+  return T.transpose() * He * T;
+}
+
+double volume_energy(const std::array<Vec3, 4>& x, double rest_volume, double kappa) {
+  const double dv = tet_signed_volume(x) - rest_volume;
+  return 0.5 * kappa * dv * dv / std::abs(rest_volume);  // ½κV₀(V/V₀ − 1)²
+}
+
+Vec12 volume_gradient(const std::array<Vec3, 4>& x, double rest_volume, double kappa) {
+  const double dv = tet_signed_volume(x) - rest_volume;
+  return kappa * dv / std::abs(rest_volume) * tet_volume_gradient(x);
+}
+
+Mat12 volume_hessian(const std::array<Vec3, 4>& x, double rest_volume, double kappa,
+                     bool project_psd) {
+  const double v0 = std::abs(rest_volume);
+  const double dv = tet_signed_volume(x) - rest_volume;
+  const Vec12 gv = tet_volume_gradient(x);
+  Mat12 H = kappa / v0 * gv * gv.transpose();
+  if (dv != 0.0) H += kappa * dv / v0 * tet_volume_hessian(x);
+  if (!project_psd) return H;
+  const Eigen::SelfAdjointEigenSolver<Mat12> eig(H);
+  const Vec12 lambda = eig.eigenvalues().cwiseMax(0.0);
+  return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
+}
+
+VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, double kappa)
+    : num_nodes_(static_cast<int>(nodes.size())), tets_(std::move(tets)), kappa_(kappa) {
+  if (!std::isfinite(kappa)) {
+    throw InputError("volume term: expected a finite bulk stiffness κ (Pa), got " +
+                     std::to_string(kappa));
+  }
+  rest_volumes_.reserve(tets_.size());
+  std::vector<Eigen::Triplet<double>> t;
+  const int n = num_dofs();
+  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 0.0);
+  for (std::size_t e = 0; e < tets_.size(); ++e) {
+    const Tet& tet = tets_[e];
+    for (int v : tet) {
+      if (v < 0 || v >= num_nodes_) {
+        throw InputError("volume term: tet " + std::to_string(e) + " refers to node " +
+                         std::to_string(v) + ", expected an index below " +
+                         std::to_string(num_nodes_));
+      }
+    }
+    const double v0 =
+        tet_signed_volume({nodes[tet[0]], nodes[tet[1]], nodes[tet[2]], nodes[tet[3]]});
+    if (!(std::abs(v0) > 0.0)) {
+      throw InputError("volume term: tet " + std::to_string(e) +
+                       " has zero rest volume; expected a non-degenerate tetrahedron");
+    }
+    rest_volumes_.push_back(v0);
+    for (int a : tet)
+      for (int b : tet)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) t.emplace_back(3 * a + i, 3 * b + j, 0.0);
+  }
+  pattern_.resize(n, n);
+  pattern_.setFromTriplets(t.begin(), t.end());
+  pattern_.makeCompressed();
+  slots_ = slots_in(pattern_);
+}
+
+std::array<Vec3, 4> VolumeTerm::corners(const VectorXd& x, const Tet& t) const {
+  return {x.segment<3>(3 * t[0]), x.segment<3>(3 * t[1]), x.segment<3>(3 * t[2]),
+          x.segment<3>(3 * t[3])};
+}
+
+double VolumeTerm::energy(const VectorXd& x) const {
+  double e = 0.0;
+  for (std::size_t k = 0; k < tets_.size(); ++k) {
+    e += volume_energy(corners(x, tets_[k]), rest_volumes_[k], kappa_);
+  }
+  return e;
+}
+
+void VolumeTerm::add_gradient(const VectorXd& x, VectorXd& g) const {
+  for (std::size_t k = 0; k < tets_.size(); ++k) {
+    const Tet& t = tets_[k];
+    const Vec12 gk = volume_gradient(corners(x, t), rest_volumes_[k], kappa_);
+    for (int a = 0; a < 4; ++a) g.segment<3>(3 * t[a]) += gk.segment<3>(3 * a);
+  }
+}
+
+void VolumeTerm::gradient(const VectorXd& x, VectorXd& g) const {
+  g.setZero(num_dofs());
+  add_gradient(x, g);
+}
+
+std::vector<int> VolumeTerm::slots_in(const SparseMatrix& pattern) const {
+  std::vector<int> slots;
+  slots.reserve(tets_.size() * 144);
+  const int* inner = pattern.innerIndexPtr();
+  const int* outer = pattern.outerIndexPtr();
+  auto slot = [&](int row, int col) {
+    const int* begin = inner + outer[col];
+    const int* end = inner + outer[col + 1];
+    const int* it = std::lower_bound(begin, end, row);
+    return it != end && *it == row ? static_cast<int>(it - inner) : -1;
+  };
+  // Block order: (a, b) node pairs, then (i, j) components, the 12×12 block's (3a + i, 3b + j).
+  for (const Tet& t : tets_)
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) slots.push_back(slot(3 * t[a] + i, 3 * t[b] + j));
+  return slots;
+}
+
+void VolumeTerm::add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,
+                             bool project_psd) const {
+  const int* s = slots.data();
+  for (std::size_t k = 0; k < tets_.size(); ++k) {
+    const Mat12 B = volume_hessian(corners(x, tets_[k]), rest_volumes_[k], kappa_, project_psd);
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) values[*s++] += B(3 * a + i, 3 * b + j);
+  }
+}
+
+void VolumeTerm::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
+  H = pattern_;
+  std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
+  add_hessian(x, H.valuePtr(), slots_, project_psd);
+}
+
+}  // namespace vessel::msm

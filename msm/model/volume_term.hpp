@@ -1,0 +1,83 @@
+#pragma once
+/// The volume term of the hybrid mass-spring system of Golec, Palierne, Zara, Nicolle & Damiand
+/// (2020), "Hybrid 3D mass-spring system for simulation of isotropic materials with any Poisson's
+/// ratio", The Visual Computer 36(4): 809–825: an energy of each tetrahedron's volume alone,
+/// insensitive to its change of shape, added to a spring network so that the network reaches any
+/// Lamé λ (a spring network alone obeys the Cauchy relation λ = μ, ν = 1/4).
+///
+/// Per tet (rest volume V₀, current signed volume V, bulk stiffness κ in Pa):
+///   W = ½·κ·V₀·(V/V₀ − 1)² = ½·κ·(V − V₀)²/V₀,
+///   ∇W = κ·(V − V₀)/V₀ · ∇V,
+///   ∇²W = κ/V₀ · ∇V ∇Vᵀ + κ·(V − V₀)/V₀ · ∇²V.
+/// Under a small uniform strain ε, V − V₀ = V₀·tr ε, so W = ½·κ·V₀·(tr ε)²: the term adds exactly κ
+/// to the network's λ and nothing to μ, on every tet whatever its shape (derivation of κ for the
+/// network in model/model_factory.hpp). Source check (2026-11): the paper's abstract was retrieved
+/// ("supplement the spring deformation energy with an energy depending on the volume only,
+/// insensitive to change of shape"); its own formulation (equations) was not, so this quadratic
+/// form is the issue's, W = ½κV₀(V/V₀ − 1)², and the paper's equation numbers are not cited.
+/// Units: positions m, κ Pa, volume m³, energy J, gradient N, Hessian N/m.
+#include <array>
+#include <vector>
+
+#include "meshes/tet_mesh.hpp"
+#include "msm/model/form.hpp"
+
+namespace vessel::msm {
+
+using Vec12 = Eigen::Matrix<double, 12, 1>;
+using Mat12 = Eigen::Matrix<double, 12, 12>;
+
+/// Signed volume (x1 − x0)·((x2 − x0) × (x3 − x0))/6 of the tet (x0, x1, x2, x3), m³.
+double tet_signed_volume(const std::array<Vec3, 4>& x);
+/// ∂V/∂(x0, x1, x2, x3) stacked, m².
+Vec12 tet_volume_gradient(const std::array<Vec3, 4>& x);
+/// ∂²V/∂x², m (constant in each edge vector, linear in the third: V is trilinear in the edges).
+Mat12 tet_volume_hessian(const std::array<Vec3, 4>& x);
+
+/// One tet's volume energy W = ½κ(V − V₀)²/|V₀|, J (V₀ the signed rest volume, nonzero).
+double volume_energy(const std::array<Vec3, 4>& x, double rest_volume, double kappa);
+Vec12 volume_gradient(const std::array<Vec3, 4>& x, double rest_volume, double kappa);
+/// 12×12 Hessian; with project_psd, projected onto the positive semi-definite cone (eigenvalues
+/// clamped at zero). For κ < 0 (ν < 1/4, see model_factory.hpp) the projection at rest is zero.
+Mat12 volume_hessian(const std::array<Vec3, 4>& x, double rest_volume, double kappa,
+                     bool project_psd);
+
+/// The volume term of a tet mesh as a Form (no damping).
+class VolumeTerm : public Form {
+ public:
+  /// `nodes`: rest positions (m) of num_nodes nodes; `tets` index them; κ in Pa. Throws
+  /// InputError for a tet of zero rest volume or a non-finite κ.
+  VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, double kappa);
+
+  [[nodiscard]] int num_dofs() const override { return 3 * num_nodes_; }
+  [[nodiscard]] double energy(const VectorXd& x) const override;
+  void gradient(const VectorXd& x, VectorXd& g) const override;
+  void hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const override;
+
+  /// g += ∇W (g already sized).
+  void add_gradient(const VectorXd& x, VectorXd& g) const;
+  /// Per tet, the 144 value indices of its 12×12 block in `pattern` (compressed, column-major);
+  /// −1 where the pattern lacks an entry.
+  [[nodiscard]] std::vector<int> slots_in(const SparseMatrix& pattern) const;
+  /// Adds every tet's Hessian block into `values` at `slots` (from slots_in, none −1).
+  void add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,
+                   bool project_psd) const;
+  /// The sparsity pattern of the term's Hessian (tet blocks plus the full diagonal), values 0.
+  [[nodiscard]] const SparseMatrix& pattern() const { return pattern_; }
+
+  [[nodiscard]] double kappa() const { return kappa_; }
+  [[nodiscard]] const std::vector<Tet>& tets() const { return tets_; }
+  [[nodiscard]] const std::vector<double>& rest_volumes() const { return rest_volumes_; }
+
+ private:
+  [[nodiscard]] std::array<Vec3, 4> corners(const VectorXd& x, const Tet& t) const;
+
+  int num_nodes_ = 0;
+  std::vector<Tet> tets_;
+  std::vector<double> rest_volumes_;
+  double kappa_ = 0.0;
+  SparseMatrix pattern_;
+  std::vector<int> slots_;
+};
+
+}  // namespace vessel::msm
