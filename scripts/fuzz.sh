@@ -8,7 +8,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds="${1:-30}"
 build="$root/build-fuzz"
 
-"$root/scripts/install_deps.sh" clang libclang-rt-14-dev
+"$root/scripts/install_deps.sh" clang libclang-rt-14-dev libomp-dev  # libomp: clang's OpenMP (fast spring kernel)
 if [ ! -f "$build/CMakeCache.txt" ]; then
   CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DVESSEL_FUZZ=ON

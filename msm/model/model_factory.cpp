@@ -67,6 +67,15 @@ void MassSpringModel::gradient(const VectorXd& x, VectorXd& g) const {
   if (volume_) volume_->add_gradient(x, g);
 }
 
+double MassSpringModel::energy_gradient(const VectorXd& x, VectorXd& g) const {
+  double e = springs_.energy_gradient(x, g);
+  if (volume_) {
+    volume_->add_gradient(x, g);
+    e += volume_->energy(x);
+  }
+  return e;
+}
+
 void MassSpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
   if (!volume_) {
     springs_.hessian(x, H, project_psd);
@@ -104,6 +113,14 @@ std::unique_ptr<MassSpringModel> make_model(const SpringNetwork& network,
 
 std::unique_ptr<MassSpringModel> make_model(const BuiltNetwork& built, double point_damping) {
   return make_model(built.network, built.volume_kappa, point_damping);
+}
+
+const SpringModel* plain_spring_model(const Form& form) {
+  if (const auto* springs = dynamic_cast<const SpringModel*>(&form)) return springs;
+  if (const auto* model = dynamic_cast<const MassSpringModel*>(&form)) {
+    if (!model->volume_term()) return &model->springs();
+  }
+  return nullptr;
 }
 
 }  // namespace vessel::msm

@@ -52,6 +52,9 @@ class MassSpringModel : public Form {
   [[nodiscard]] int num_dofs() const override { return springs_.num_dofs(); }
   [[nodiscard]] double energy(const VectorXd& x) const override;
   void gradient(const VectorXd& x, VectorXd& g) const override;
+  /// One pass of the fast spring kernel for both (the explicit integrators call this), plus the
+  /// volume term's.
+  double energy_gradient(const VectorXd& x, VectorXd& g) const override;
   void hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const override;
   void damping_force(const VectorXd& x, const VectorXd& v, VectorXd& f) const override;
   void damping_jacobian(const VectorXd& x, SparseMatrix& D) const override;
@@ -71,6 +74,11 @@ class MassSpringModel : public Form {
   std::vector<int> spring_to_union_;
   std::vector<int> volume_slots_;  ///< in the springs' pattern, or in union_pattern_
 };
+
+/// The springs alone of a Form that is nothing but springs: a SpringModel, or a MassSpringModel
+/// without a volume term; nullptr for any other Form (solvers that need a plain spring network,
+/// such as the local-global method, refuse those).
+const SpringModel* plain_spring_model(const Form& form);
 
 /// The model of a network (volume_kappa as in BuiltNetwork), point damping k_v in N·s/m per node.
 std::unique_ptr<MassSpringModel> make_model(const SpringNetwork& network,

@@ -6,10 +6,10 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <typeinfo>
 #include <vector>
 
 #include "meshes/errors.hpp"
+#include "msm/model/model_factory.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/linear_solver.hpp"
 
@@ -51,13 +51,14 @@ LocalGlobalSystem::LocalGlobalSystem(const Problem& p, double h, const std::stri
     throw InputError(who + "expected a finite time step >= 0 s (0: statics), got " +
                      std::to_string(h));
   }
-  if (!p.form || typeid(*p.form) != typeid(SpringModel)) {
+  const SpringModel* springs = p.form ? plain_spring_model(*p.form) : nullptr;
+  if (!springs) {
     throw InputError(who +
                      "the local-global method (Liu et al. 2013) needs a plain spring model (a sum "
                      "of Hooke springs); this problem's model is another Form (e.g. springs with a "
                      "volume term), whose energy the local step cannot write as spring directions");
   }
-  const auto& model = static_cast<const SpringModel&>(*p.form);
+  const SpringModel& model = *springs;
   Impl& m = *impl_;
   m.nodes = p.num_dofs() / 3;
   m.springs.reserve(model.springs().size());

@@ -11,6 +11,7 @@
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/mass/mass_rules.hpp"
+#include "msm/model/model_factory.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/local_global.hpp"
 #include "msm/solvers/solve.hpp"
@@ -220,6 +221,27 @@ TEST(LocalGlobal, NamedInSolveWithItsIterationsSetting) {
   EXPECT_EQ((s.x - integrate_local_global(c.problem, d, o).x).norm(), 0.0);
   const SolveResult st = solve(c.problem, parse_solver("local-global"));
   EXPECT_LT((st.x - solve_static(c.problem).x).norm(), 1e-7 * (st.x - c.problem.rest).norm());
+}
+
+TEST(LocalGlobal, RunsOnTheFactorysSpringsOnlyModelAndRefusesItsVolumeTerm) {
+  // The harness and the msm command build every model with make_model: without a volume term it
+  // is the same springs, so local-global must give the SpringModel's answer bit for bit.
+  const Lattice c = make_lattice(2e-4);
+  const auto factory_model = make_model(c.net, std::nullopt, 2e-4);
+  Problem via_factory = c.problem;
+  via_factory.form = factory_model.get();
+  DynamicOptions d;
+  d.dt = 1e-3;
+  d.steps = 3;
+  EXPECT_EQ((integrate_local_global(via_factory, d).x - integrate_local_global(c.problem, d).x)
+                .norm(),
+            0.0);
+  // With the hybrid model's volume term: refused, naming why.
+  const auto hybrid = make_model(tube().net, 1.0e3);
+  Problem with_volume = tube().problem;
+  with_volume.form = hybrid.get();
+  const std::string e = error_of([&] { solve_static_local_global(with_volume); });
+  EXPECT_NE(e.find("volume term"), std::string::npos) << e;
 }
 
 TEST(LocalGlobal, RefusesWhatItCannotSolveNamingTheSolverAndWhy) {

@@ -245,6 +245,22 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
           out.push_back(m);
         }
       }
+      // The real-time solver (Liu et al. 2013), implicit Euler with its default iterations per
+      // step, at the implicit family's steps: plain spring networks only (no volume term).
+      if (volume_term) continue;
+      for (const double dt : implicit_dts.empty() ? all : implicit_dts) {
+        ModelSpec m;
+        m.kind = kind;
+        m.surface = msm::WallSurface::mid;
+        m.stiffness = rule;
+        m.mass = msm::MassRule::consistent;
+        m.solver = msm::parse_solver("local-global-euler");
+        m.solver.dt = dt;
+        m.solver.steps = std::max(1L, std::lround(duration / dt));
+        m.damping = damping;
+        m.name = kind_name + "/" + rule_label(rule, false) + "/local-global-euler/dt=" + fmt(dt);
+        out.push_back(m);
+      }
     }
   }
   return out;

@@ -78,7 +78,9 @@ struct RecommendOptions {
 /// on each region-of-interest radius. Dynamic scenes (a scene model uses an integrator): every
 /// integrator (msm::kAllIntegrators) at the time steps the scene uses for that family of
 /// integrator (explicit or implicit; all of the scene's if it has none of that family), over the
-/// scene's longest simulated time, with the scene's point damping.
+/// scene's longest simulated time, with the scene's point damping, and the local–global implicit
+/// Euler (Liu et al. 2013, its default iterations per step) at the implicit family's time steps
+/// on the plain spring networks.
 std::vector<ModelSpec> candidate_models(const Scene& scene, const std::vector<double>& roi_radii);
 
 /// Candidates' evidence from a run: per (model, level) the worst error and time over ν at the
