@@ -15,9 +15,12 @@
 #include <deal.II/fe/mapping_fe_field.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <stdexcept>
+#include <string>
 
 #include "fem_reference/detail/constraints.hpp"
 #include "fem_reference/detail/serial_solver.hpp"
@@ -198,6 +201,28 @@ const ElasticityResult& ElasticitySolver::solve() {
 }
 
 const ElasticityResult& ElasticitySolver::result() const { return impl_->result; }
+
+std::vector<double> ElasticitySolver::solution_dofs() const {
+  const auto& im = *impl_;
+  if (!im.solved) throw std::logic_error("solution_dofs called before solve()");
+  return {im.solution.begin(), im.solution.end()};
+}
+
+const ElasticityResult& ElasticitySolver::restore(ElasticityResult result,
+                                                  const std::vector<double>& dofs) {
+  auto& im = *impl_;
+  if (dofs.size() != im.dof.n_dofs() || result.n_dofs != im.dof.n_dofs()) {
+    throw std::invalid_argument("restore: " + std::to_string(dofs.size()) +
+                                " DoF values for a solver with " +
+                                std::to_string(im.dof.n_dofs()) + " DoFs");
+  }
+  im.solution.reinit(im.dof.n_dofs());
+  std::copy(dofs.begin(), dofs.end(), im.solution.begin());
+  result.timings.setup = im.result.timings.setup;  // this solver's own set-up
+  im.result = std::move(result);
+  im.solved = true;
+  return im.result;
+}
 
 ElasticityResult solve_elasticity(const TetMesh& mesh, const ElasticityProblem& problem) {
   ElasticitySolver solver(mesh, problem);

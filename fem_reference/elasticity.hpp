@@ -207,6 +207,14 @@ class ElasticitySolver {
   const ElasticityResult& solve();
   [[nodiscard]] const ElasticityResult& result() const;
 
+  /// The solved DoF values (displacement, and pressure for the mixed formulation), in this
+  /// solver's DoF numbering, which depends only on the mesh and the problem. Requires solve().
+  [[nodiscard]] std::vector<double> solution_dofs() const;
+  /// Puts the solver in the state solve() would leave it in, from a result and DoF values that
+  /// an earlier solve() of the same mesh and problem produced (fem::SolutionCache): no assembly,
+  /// no solve. std::invalid_argument if the DoF count differs from this solver's.
+  const ElasticityResult& restore(ElasticityResult result, const std::vector<double>& dofs);
+
   /// The FE displacement (m) at arbitrary points inside the mesh (within a relative tolerance of
   /// 1e-9 of the element size). Throws InputError naming the first point outside. Requires solve().
   /// `outside_tolerance` (barycentric, dimensionless) also accepts points that far outside the

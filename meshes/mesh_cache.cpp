@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "meshes/content_hash.hpp"
 #include "meshes/errors.hpp"
 #include "meshes/msh_io.hpp"
 
@@ -17,15 +18,6 @@ namespace {
 
 /// Bumped whenever the generator's output for the same params changes.
 constexpr int kGeneratorVersion = 2;
-
-std::uint64_t fnv1a(const std::string& s) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : s) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
 
 std::string exact(double x) {
   char buf[32];

@@ -12,6 +12,7 @@
 
 #include "fem_reference/convergence.hpp"
 #include "fem_reference/elasticity.hpp"
+#include "fem_reference/solution_cache.hpp"
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "meshes/vtu_io.hpp"
@@ -132,6 +133,15 @@ double interpolate(const std::vector<double>& t, const std::vector<double>& v, d
   const auto hi = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), x) - t.begin());
   const double w = (x - t[hi - 1]) / (t[hi] - t[hi - 1]);
   return (1.0 - w) * v[hi - 1] + w * v[hi];
+}
+
+/// The scene's P2 reference on `mesh` at ν (unit load), from the solution cache when it has it.
+const fem::ElasticityResult& solve_reference(std::unique_ptr<fem::ElasticitySolver>& solver,
+                                             const TetMesh& mesh, const Scene& s, double nu,
+                                             const HarnessOptions& o) {
+  fem::ElasticityProblem problem = fem_problem(s, mesh, nu, 2);
+  solver = std::make_unique<fem::ElasticitySolver>(mesh, problem);
+  return o.solution_cache ? o.solution_cache->solve(*solver, mesh, problem) : solver->solve();
 }
 
 ReferenceAtPoints reference_at(const ReferenceSolvers& ref, const std::vector<Vec3>& points) {
@@ -668,13 +678,8 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
     progress.begin("reference P2 (level " + std::to_string(s.reference_level) + ", ν = " +
                    std::to_string(nu) + ")");
     ReferenceSolvers ref;
-    ref.fine = std::make_unique<fem::ElasticitySolver>(fine_mesh, fem_problem(s, fine_mesh, nu, 2));
-    const fem::ElasticityResult& fine = ref.fine->solve();
-    if (coarse_mesh) {
-      ref.coarse =
-          std::make_unique<fem::ElasticitySolver>(*coarse_mesh, fem_problem(s, *coarse_mesh, nu, 2));
-      ref.coarse->solve();
-    }
+    const fem::ElasticityResult& fine = solve_reference(ref.fine, fine_mesh, s, nu, o);
+    if (coarse_mesh) solve_reference(ref.coarse, *coarse_mesh, s, nu, o);
     ReferenceInfo info;
     info.poisson_ratio = nu;
     info.element = fine.element;

@@ -19,6 +19,10 @@
 #include "verification/metrics.hpp"
 #include "verification/scene.hpp"
 
+namespace vessel::fem {
+class SolutionCache;
+}
+
 namespace vessel {
 
 /// Updates of the load ramp static and linear mass-spring models are timed on (timed_updates).
@@ -26,6 +30,9 @@ inline constexpr int kRampUpdates = 8;
 
 struct HarnessOptions {
   std::filesystem::path cache_dir;  ///< generated meshes (empty: no cache)
+  /// FEM references solved once and kept on disk (nullptr: each solved afresh). The FEM models
+  /// the scene times (P1, P2 as models) are always solved: their time is a measurement.
+  fem::SolutionCache* solution_cache = nullptr;
   std::ostream* log = nullptr;      ///< progress; nullptr for none
   int repeats = 1;                  ///< timed repeats of each model solve (median reported)
   /// Static and linear mass-spring models: updates in the timed load ramp (timed_updates).

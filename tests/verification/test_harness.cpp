@@ -16,6 +16,7 @@
 #include "msm/mass/mass_rules.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
+#include "fem_reference/solution_cache.hpp"
 #include "verification/harness.hpp"
 
 using namespace vessel;
@@ -345,4 +346,45 @@ TEST(HarnessUpdates, TheUpdateSequencesFinalStateEqualsAColdSolve) {
   }
   EXPECT_THROW(timed_updates(p, msm::parse_solver("verlet"), 8, 1), InputError);
   EXPECT_THROW(timed_updates(p, msm::parse_solver("linear"), 0, 1), InputError);
+}
+
+TEST(HarnessCache, ARepeatedRunReadsItsReferenceFromTheCacheAndGivesTheSameResults) {
+  // Lamé's scene with its linear spring model only: the reference is the run's FEM solve.
+  std::string text = kLame;
+  text = text.substr(0, text.find("[[models]]")) +
+         "[[models]]\nname = \"volume_linear\"\nkind = \"volume_msm\"\nstiffness = \"seed001\"\n"
+         "solver = \"linear\"\n";
+  const Scene scene = parse_scene(text, "lame_cached.toml");
+  test::TempDir dir;
+  std::ostringstream log;
+  fem::SolutionCache cache(dir.path(), &log);
+  HarnessOptions o;
+  o.solution_cache = &cache;
+  const SceneResult first = run_scene(scene, o);
+  EXPECT_EQ(cache.statistics().misses, 1);  // reference level 0: no coarser level
+  EXPECT_EQ(cache.statistics().hits, 0);
+  const SceneResult second = run_scene(scene, o);
+  EXPECT_EQ(cache.statistics().misses, 1);
+  EXPECT_EQ(cache.statistics().hits, 1);
+  // The hit restores the first run's reference bitwise. A fresh solve may differ in the last
+  // bits (threaded BLAS inside CHOLMOD sums in a different order): 1e-12 relative.
+  const SceneResult uncached = run_scene(scene, HarnessOptions{});
+  auto compare = [&](const SceneResult& r, double rtol) {
+    ASSERT_EQ(r.outcomes.size(), first.outcomes.size());
+    auto near = [rtol](double x, double y) { return std::abs(x - y) <= rtol * std::abs(x); };
+    for (std::size_t i = 0; i < first.outcomes.size(); ++i) {
+      const ModelOutcome &a = first.outcomes[i], &b = r.outcomes[i];
+      ASSERT_TRUE(a.ok && b.ok) << a.failure << b.failure;
+      EXPECT_PRED2(near, a.qoi_reference_mm, b.qoi_reference_mm);
+      EXPECT_PRED2(near, a.qoi_displacement_mm, b.qoi_displacement_mm);
+      EXPECT_PRED2(near, a.error.max_mm, b.error.max_mm);
+      EXPECT_PRED2(near, a.error.relative_l2, b.error.relative_l2);
+    }
+    EXPECT_PRED2(near, r.references.at(0).max_abs_strain_unit,
+                 first.references.at(0).max_abs_strain_unit);
+    EXPECT_EQ(r.references.at(0).dofs, first.references.at(0).dofs);
+  };
+  compare(second, 0.0);
+  compare(uncached, 1e-12);
+  EXPECT_EQ(log.str(), "");
 }

@@ -8,8 +8,8 @@
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
-#include "meshes/mesh_cache.hpp"
 #include "reports/gate.hpp"
+#include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/harness.hpp"
 
@@ -26,7 +26,7 @@ struct GateOptions {
   std::filesystem::path current;  ///< compare this results file instead of running the scenes
   std::filesystem::path scenes_dir = VESSELVERIFY_SCENES_DIR;
   std::filesystem::path output_dir = "gate-results";
-  std::filesystem::path cache_dir = default_cache_dir();
+  CacheOptions cache;
   bool update_baseline = false;
   reports::GateTolerances tolerances;
   std::string command;
@@ -45,10 +45,13 @@ void gate(const GateOptions& o) {
       scenes.push_back(quick_variant(read_scene(o.scenes_dir / name)));
     }
     HarnessOptions h;
-    h.cache_dir = o.cache_dir;
+    h.cache_dir = o.cache.mesh_dir();
+    const auto solution_cache = o.cache.solution_cache(std::cout);
+    h.solution_cache = solution_cache.get();
     h.log = &std::cout;
     h.repeats = 3;  // medians: the gate compares times
     run_and_write(scenes, h, o.output_dir, o.command);
+    std::cout << solution_cache->summary() << "\n";
     results_path = o.output_dir / "results.json";
   }
   const reports::ResultsFile current = reports::read_results(results_path);
@@ -114,7 +117,7 @@ void add_gate_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--scenes-dir", o->scenes_dir, "Where the gate scenes are")->capture_default_str();
   cmd->add_option("--output-dir", o->output_dir, "Where this run's results and gate.md go")
       ->capture_default_str();
-  cmd->add_option("--cache-dir", o->cache_dir, "Mesh cache directory")->capture_default_str();
+  add_cache_options(*cmd, o->cache);
   cmd->add_option("--error-tolerance", o->tolerances.error_relative,
                   "Relative growth of a max or RMS error that fails the gate")
       ->check(CLI::Range(0.0, 10.0))

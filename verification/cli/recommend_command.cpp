@@ -2,7 +2,7 @@
 #include <iomanip>
 #include <iostream>
 
-#include "meshes/mesh_cache.hpp"
+#include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/studies/recommend.hpp"
 
@@ -16,7 +16,7 @@ struct Options {
   double time_budget_s = 0.0;
   double tolerance = 0.0;
   std::filesystem::path output_dir = "recommend";
-  std::filesystem::path cache_dir = default_cache_dir();
+  CacheOptions cache;
   bool quick = false;
   int repeats = 3;
   int updates = kRampUpdates;  ///< static and linear models: updates of the timed load ramp
@@ -49,7 +49,9 @@ void run(const Options& o) {
   r.levels = o.levels;
   r.reference_level = o.reference_level;
   r.roi_radii = o.roi_radii;
-  r.harness.cache_dir = o.cache_dir;
+  r.harness.cache_dir = o.cache.mesh_dir();
+  const auto solution_cache = o.cache.solution_cache(std::cout);
+  r.harness.solution_cache = solution_cache.get();
   r.harness.log = &std::cout;
   r.harness.repeats = o.repeats;
   r.harness.ramp_updates = o.updates;
@@ -79,6 +81,7 @@ void run(const Options& o) {
   }
   std::cout << "wrote " << (o.output_dir / "recommend.md").string()
             << ", recommend.json and the candidates' results.json\n";
+  std::cout << solution_cache->summary() << "\n";
 }
 
 }  // namespace
@@ -109,7 +112,7 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
                   "Error tolerance in the budget quantity's unit (mm; mN for reaction)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--output-dir", o->output_dir, "Where the outputs go")->capture_default_str();
-  cmd->add_option("--cache-dir", o->cache_dir, "Mesh cache directory")->capture_default_str();
+  add_cache_options(*cmd, o->cache);
   cmd->add_flag("--quick", o->quick,
                 "Candidates at level 0 only (reference at level <= 1), ROI radii 4 and 8 mm");
   cmd->add_option("--repeats", o->repeats, "Timed repeats per solve (median)")

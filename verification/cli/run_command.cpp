@@ -3,7 +3,7 @@
 #include <iostream>
 
 #include "meshes/errors.hpp"
-#include "meshes/mesh_cache.hpp"
+#include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/harness.hpp"
 
@@ -14,7 +14,7 @@ namespace {
 struct RunOptions {
   std::vector<std::string> scenes;
   std::filesystem::path output_dir = "results";
-  std::filesystem::path cache_dir = default_cache_dir();
+  CacheOptions cache;
   bool quick = false;
   int repeats = 1;
   int updates = kRampUpdates;  ///< static and linear models: updates of the timed load ramp
@@ -53,13 +53,16 @@ void run(const RunOptions& o) {
     apply_sweeps(o, s);
   }
   HarnessOptions h;
-  h.cache_dir = o.cache_dir;
+  h.cache_dir = o.cache.mesh_dir();
+  const auto solution_cache = o.cache.solution_cache(std::cout);
+  h.solution_cache = solution_cache.get();
   h.log = &std::cout;
   h.repeats = o.repeats;
   h.ramp_updates = o.updates;
   if (o.fields != "none") h.fields_dir = o.output_dir / "fields";
   h.fields_every_load = o.fields == "all";
   run_and_write(scenes, h, o.output_dir, o.command);
+  std::cout << solution_cache->summary() << "\n";
 }
 
 }  // namespace
@@ -78,7 +81,7 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
       "  vesselverify run --quick --output-dir results verification/scenes/*.toml");
   cmd->add_option("scenes", o->scenes, "Scene files (TOML)")->required();
   cmd->add_option("--output-dir", o->output_dir, "Where results are written")->capture_default_str();
-  cmd->add_option("--cache-dir", o->cache_dir, "Mesh cache directory")->capture_default_str();
+  add_cache_options(*cmd, o->cache);
   cmd->add_flag("--quick", o->quick,
                 "Coarse levels (models 0, reference 1) and the smallest and largest load only");
   cmd->add_option("--repeats", o->repeats, "Timed repeats per model solve (median reported)")

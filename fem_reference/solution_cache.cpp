@@ -1,0 +1,360 @@
+#include "fem_reference/solution_cache.hpp"
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "fem_reference/reference_code_version.hpp"
+#include "meshes/atomic_file.hpp"
+#include "meshes/content_hash.hpp"
+
+namespace vessel::fem {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::string_view kMagic = "vesselverify-fem-solution\n";
+constexpr std::uint32_t kFormatVersion = 1;
+
+/// Two FNV-1a streams fed the same bytes from different starting states: a 128-bit key.
+struct KeyHash {
+  ContentHash a, b;
+  KeyHash() { b.text("second stream"); }
+  KeyHash& text(std::string_view s) { return a.text(s), b.text(s), *this; }
+  KeyHash& real(double x) { return a.real(x), b.real(x), *this; }
+  KeyHash& integer(std::int64_t i) { return a.integer(i), b.integer(i), *this; }
+  KeyHash& point(const Vec3& p) { return real(p.x()).real(p.y()).real(p.z()); }
+  template <class Range>
+  KeyHash& indices(const Range& r) {
+    integer(static_cast<std::int64_t>(std::size(r)));
+    for (const auto i : r) integer(i);
+    return *this;
+  }
+};
+
+void hash_mesh(KeyHash& h, const TetMesh& mesh) {
+  h.text("nodes").integer(static_cast<std::int64_t>(mesh.nodes.size()));
+  for (const Vec3& p : mesh.nodes) h.point(p);
+  h.text("tets");
+  for (const Tet& t : mesh.tets) h.indices(t);
+  h.text("triangles");
+  for (const Triangle& t : mesh.triangles) h.indices(t);
+  h.text("groups");
+  for (const PhysicalGroup& g : mesh.groups) {
+    h.text(g.name).integer(g.dim).integer(g.tag).indices(g.elements);
+  }
+}
+
+/// The points a curved wall's projection moves (P2 geometry nodes on the wall's triangle edges),
+/// keyed by their images.
+void hash_curved_surface(KeyHash& h, const TetMesh& mesh, const CurvedSurface& c) {
+  h.text(c.group);
+  const PhysicalGroup* g = mesh.find_group(c.group, 2);
+  if (!g || !c.project) return;  // the solver's own validation reports it
+  for (const Triangle& t : mesh.group_triangles(*g)) {
+    for (int e = 0; e < 3; ++e) {
+      h.point(c.project(0.5 * (mesh.nodes[t[e]] + mesh.nodes[t[(e + 1) % 3]])));
+    }
+  }
+}
+
+void hash_options(KeyHash& h, const SolverOptions& o) {
+  h.integer(o.degree).integer(static_cast<int>(o.formulation)).real(o.mixed_threshold);
+  h.integer(static_cast<int>(o.solver)).integer(static_cast<std::int64_t>(o.direct_max_dofs));
+  h.integer(static_cast<std::int64_t>(o.direct_max_mixed_dofs)).integer(o.amg_rigid_body_modes);
+  h.real(o.cg_relative_tolerance).integer(o.gmres_restart).integer(o.max_iterations);
+}
+
+// Binary (de)serialisation of a result and its DoF values, native byte order: the cache is a
+// machine's own, keyed by its build's code version.
+class Writer {
+ public:
+  template <class T>
+  void pod(const T& x) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    out_.append(reinterpret_cast<const char*>(&x), sizeof x);
+  }
+  void text(const std::string& s) {
+    pod(static_cast<std::uint64_t>(s.size()));
+    out_ += s;
+  }
+  template <class T>
+  void pods(const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    pod(static_cast<std::uint64_t>(v.size()));
+    out_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+  void point(const Vec3& p) { pod(std::array<double, 3>{p.x(), p.y(), p.z()}); }
+  void points(const std::vector<Vec3>& v) {
+    pod(static_cast<std::uint64_t>(v.size()));
+    for (const Vec3& p : v) point(p);
+  }
+  [[nodiscard]] const std::string& bytes() const { return out_; }
+
+ private:
+  std::string out_;
+};
+
+struct Truncated : std::runtime_error {
+  Truncated() : std::runtime_error("truncated") {}
+};
+
+class Reader {
+ public:
+  explicit Reader(std::string_view in) : in_(in) {}
+  template <class T>
+  T pod() {
+    T x;
+    take(&x, sizeof x);
+    return x;
+  }
+  std::string text() {
+    const auto n = pod<std::uint64_t>();
+    if (n > in_.size()) throw Truncated();
+    std::string s(in_.substr(0, n));
+    in_.remove_prefix(n);
+    return s;
+  }
+  template <class T>
+  std::vector<T> pods() {
+    const auto n = pod<std::uint64_t>();
+    if (n > in_.size() / sizeof(T)) throw Truncated();
+    std::vector<T> v(n);
+    take(v.data(), n * sizeof(T));
+    return v;
+  }
+  Vec3 point() {
+    const auto a = pod<std::array<double, 3>>();
+    return {a[0], a[1], a[2]};
+  }
+  std::vector<Vec3> points() {
+    const auto n = pod<std::uint64_t>();
+    if (n > in_.size() / (3 * sizeof(double))) throw Truncated();
+    std::vector<Vec3> v(n);
+    for (Vec3& p : v) p = point();
+    return v;
+  }
+  [[nodiscard]] bool done() const { return in_.empty(); }
+
+ private:
+  void take(void* out, std::size_t n) {
+    if (n > in_.size()) throw Truncated();
+    std::memcpy(out, in_.data(), n);
+    in_.remove_prefix(n);
+  }
+  std::string_view in_;
+};
+
+std::string serialise(const ElasticityResult& r, const std::vector<double>& dofs) {
+  Writer w;
+  w.text(r.element);
+  w.pod(r.curved);
+  w.pod(r.formulation);
+  w.pod(r.solver);
+  w.pod(r.iterations);
+  w.pod(r.inner_iterations);
+  w.pod(static_cast<std::uint64_t>(r.n_dofs));
+  w.pod(static_cast<std::uint64_t>(r.n_pressure_dofs));
+  w.points(r.nodal_displacement);
+  w.pod(static_cast<std::uint64_t>(r.reactions.size()));
+  for (const GroupReaction& g : r.reactions) {
+    w.text(g.group);
+    w.point(g.force);
+  }
+  w.point(r.applied_load);
+  w.pod(r.strain_energy);
+  w.pod(r.max_principal_strain);
+  w.pod(r.max_abs_principal_strain);
+  w.pods(r.tet_strain);
+  w.pods(r.tet_stress);
+  w.pod(r.timings);
+  w.pods(dofs);
+  return w.bytes();
+}
+
+std::pair<ElasticityResult, std::vector<double>> deserialise(std::string_view bytes) {
+  Reader in(bytes);
+  ElasticityResult r;
+  r.element = in.text();
+  r.curved = in.pod<bool>();
+  r.formulation = in.pod<Formulation>();
+  r.solver = in.pod<LinearSolver>();
+  r.iterations = in.pod<unsigned>();
+  r.inner_iterations = in.pod<double>();
+  r.n_dofs = in.pod<std::uint64_t>();
+  r.n_pressure_dofs = in.pod<std::uint64_t>();
+  r.nodal_displacement = in.points();
+  const auto reactions = in.pod<std::uint64_t>();
+  if (reactions > bytes.size()) throw Truncated();
+  for (std::uint64_t i = 0; i < reactions; ++i) {
+    GroupReaction g;
+    g.group = in.text();
+    g.force = in.point();
+    r.reactions.push_back(std::move(g));
+  }
+  r.applied_load = in.point();
+  r.strain_energy = in.pod<double>();
+  r.max_principal_strain = in.pod<double>();
+  r.max_abs_principal_strain = in.pod<double>();
+  r.tet_strain = in.pods<std::array<double, 6>>();
+  r.tet_stress = in.pods<std::array<double, 6>>();
+  r.timings = in.pod<PhaseTimings>();
+  std::vector<double> dofs = in.pods<double>();
+  if (!in.done()) throw Truncated();
+  return {std::move(r), std::move(dofs)};
+}
+
+/// The entry's file: magic, format version, key, payload size, payload, FNV-1a of the payload.
+std::string entry_file(const std::string& key, const std::string& payload) {
+  Writer w;
+  w.pod(kFormatVersion);
+  w.text(key);
+  w.text(payload);
+  w.pod(fnv1a(payload));
+  return std::string(kMagic) + w.bytes();
+}
+
+enum class EntryState { missing, ok, corrupt, other_key };
+
+/// Reads the entry at `path` for `key`; `why` says what is wrong with a corrupt one.
+EntryState read_entry(const fs::path& path, const std::string& key, std::string& payload,
+                      std::string& why) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return EntryState::missing;
+  const std::string file((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  if (file.compare(0, kMagic.size(), kMagic) != 0) {
+    why = "not a vesselverify FEM solution";
+    return EntryState::corrupt;
+  }
+  try {
+    Reader in(std::string_view(file).substr(kMagic.size()));
+    if (in.pod<std::uint32_t>() != kFormatVersion) return EntryState::other_key;
+    if (in.text() != key) return EntryState::other_key;  // a hash collision: never trusted
+    payload = in.text();
+    if (in.pod<std::uint64_t>() != fnv1a(payload) || !in.done()) {
+      why = "checksum mismatch";
+      return EntryState::corrupt;
+    }
+  } catch (const Truncated&) {
+    why = "truncated";
+    return EntryState::corrupt;
+  }
+  return EntryState::ok;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+std::optional<std::string> solution_cache_key(const TetMesh& mesh, const ElasticityProblem& p) {
+  if (p.body_force) return std::nullopt;
+  for (const DirichletCondition& d : p.dirichlet) {
+    if (d.value) return std::nullopt;
+  }
+  KeyHash h;
+  hash_mesh(h, mesh);
+  const Material& m = p.material;
+  h.text("material").real(m.youngs_modulus).real(m.poisson_ratio).real(m.density);
+  h.text("dirichlet");
+  for (const DirichletCondition& d : p.dirichlet) {
+    h.text(d.group).integer(static_cast<int>(d.kind)).integer(d.component);
+  }
+  h.text("pins");
+  for (const PointConstraint& c : p.point_constraints) h.point(c.point).integer(c.component);
+  h.text("pressures");
+  for (const PressureLoad& l : p.pressures) h.text(l.group).real(l.pressure);
+  h.text("patches");
+  for (const TractionPatch& t : p.patches) {
+    h.point(t.traction).indices(t.triangles);
+    for (const SurfacePoint& q : t.points)
+      h.integer(q.triangle).point(q.barycentric).real(q.weight);
+  }
+  h.text("curved");
+  for (const CurvedSurface& c : p.curved_surfaces) hash_curved_surface(h, mesh, c);
+  h.text("gravity").point(p.gravity);
+  h.text("options");
+  hash_options(h, p.options);
+  return "fem-solution code=" + std::string(kReferenceCodeVersion) + " key=" + h.a.hex() +
+         h.b.hex();
+}
+
+SolutionCache::SolutionCache(fs::path dir, std::ostream* log) : dir_(std::move(dir)), log_(log) {}
+
+const ElasticityResult& SolutionCache::solve(ElasticitySolver& solver, const TetMesh& mesh,
+                                             const ElasticityProblem& problem) {
+  const std::optional<std::string> key =
+      enabled() ? solution_cache_key(mesh, problem) : std::nullopt;
+  if (!key) {
+    if (enabled()) {
+      const std::lock_guard lock(mutex_);
+      ++stats_.uncacheable;
+    }
+    return solver.solve();
+  }
+  const fs::path path = dir_ / ("solution-" + key->substr(key->size() - 32) + ".bin");
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string payload, why;
+  const EntryState state = read_entry(path, *key, payload, why);
+  if (state == EntryState::ok) {
+    try {
+      auto [result, dofs] = deserialise(payload);
+      const double original = result.timings.assembly + result.timings.solve;
+      const ElasticityResult& r = solver.restore(std::move(result), dofs);
+      const std::lock_guard lock(mutex_);
+      ++stats_.hits;
+      stats_.seconds_saved += original - seconds_since(t0);
+      return r;
+    } catch (const std::exception& e) {  // Truncated, or a DoF count this solver does not have
+      why = e.what();
+    }
+  }
+  if (state == EntryState::corrupt || state == EntryState::ok) {
+    (log_ ? *log_ : std::cerr) << "FEM solution cache: entry " << path.string() << " is corrupt ("
+                               << why << "); solving again and replacing it\n";
+  }
+  const ElasticityResult& r = solver.solve();
+  const std::string file = entry_file(*key, serialise(r, solver.solution_dofs()));
+  try {
+    write_file_atomically(
+        path, [&](std::ostream& out) { out << file; }, true);
+  } catch (const std::exception& e) {  // a read-only cache costs time, not the result
+    (log_ ? *log_ : std::cerr) << "FEM solution cache: cannot store " << path.string() << " ("
+                               << e.what() << "); continuing without it\n";
+  }
+  const std::lock_guard lock(mutex_);
+  ++stats_.misses;
+  if (state == EntryState::corrupt || state == EntryState::ok) ++stats_.corrupt;
+  return r;
+}
+
+SolutionCacheStatistics SolutionCache::statistics() const {
+  const std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+std::string SolutionCache::summary() const {
+  const SolutionCacheStatistics s = statistics();
+  std::ostringstream o;
+  if (!enabled()) return "FEM solution cache: off (--no-cache)";
+  o.precision(3);
+  o << "FEM solution cache (" << dir_.string() << "): " << s.hits << " hits, " << s.misses
+    << " misses";
+  if (s.corrupt > 0) o << " (" << s.corrupt << " corrupt entries recomputed)";
+  if (s.uncacheable > 0) o << ", " << s.uncacheable << " problems not cacheable";
+  o << ", " << s.seconds_saved << " s of FEM solving saved";
+  return o.str();
+}
+
+}  // namespace vessel::fem

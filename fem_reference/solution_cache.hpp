@@ -1,0 +1,62 @@
+#pragma once
+/// FEM solutions kept on disk, so that every study (run, recommend, stability, gate) and every
+/// repeated run solves each reference once. An entry is keyed by a hash of everything that
+/// determines the solution: the mesh (nodes, elements, groups), the problem (material, supports,
+/// pins, loads with their quadrature points, curved walls, gravity, solver options) and the
+/// version of the reference code (a hash of fem_reference's sources, made at build time). Each
+/// file stores its full key and a checksum of its contents: a corrupt or truncated entry is
+/// detected, reported and recomputed. Entries are written atomically (write, then rename), so
+/// concurrent writers never leave a partial file.
+#include <cstddef>
+#include <filesystem>
+#include <mutex>
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "fem_reference/elasticity.hpp"
+
+namespace vessel::fem {
+
+/// What a cache did over its life.
+struct SolutionCacheStatistics {
+  int hits = 0;
+  int misses = 0;   ///< solved and stored (including the corrupt entries below)
+  int corrupt = 0;  ///< entries found unreadable or failing their checksum, recomputed
+  int uncacheable =
+      0;  ///< problems with a load or support given as a function (solved, not stored)
+  double seconds_saved = 0.0;  ///< the hits' original assembly + solve time, less their reading
+};
+
+/// The canonical key of (mesh, problem), or nullopt when the problem cannot be keyed: a body
+/// force or a prescribed Dirichlet value given as a function. A curved wall's projection is keyed
+/// by its images of the midpoints of the wall's triangle edges, the points it moves.
+std::optional<std::string> solution_cache_key(const TetMesh& mesh,
+                                              const ElasticityProblem& problem);
+
+class SolutionCache {
+ public:
+  /// Entries live in `dir` (created on the first write). An empty path disables the cache:
+  /// solve() then always solves. `log` receives a line per corrupt entry (nullptr: std::cerr).
+  explicit SolutionCache(std::filesystem::path dir, std::ostream* log = nullptr);
+
+  /// solver.solve(), or the stored solution of the same mesh and problem restored into `solver`.
+  /// The mesh and problem must be those `solver` was built from.
+  const ElasticityResult& solve(ElasticitySolver& solver, const TetMesh& mesh,
+                                const ElasticityProblem& problem);
+
+  [[nodiscard]] bool enabled() const { return !dir_.empty(); }
+  [[nodiscard]] const std::filesystem::path& directory() const { return dir_; }
+  [[nodiscard]] SolutionCacheStatistics statistics() const;
+  /// One line: "FEM solution cache (DIR): H hits, M misses, C corrupt entries recomputed, S s
+  /// saved".
+  [[nodiscard]] std::string summary() const;
+
+ private:
+  std::filesystem::path dir_;
+  std::ostream* log_;
+  mutable std::mutex mutex_;  // statistics only: entries are files written atomically
+  SolutionCacheStatistics stats_;
+};
+
+}  // namespace vessel::fem
