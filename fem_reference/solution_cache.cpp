@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <iterator>
 #include <sstream>
@@ -214,6 +215,39 @@ std::pair<ElasticityResult, std::vector<double>> deserialise(std::string_view by
   return {std::move(r), std::move(dofs)};
 }
 
+std::string serialise_transient(const TransientResult& r) {
+  Writer w;
+  w.pods(r.time);
+  w.pod(static_cast<std::uint64_t>(r.probe_displacement.size()));
+  for (const auto& step : r.probe_displacement) w.points(step);
+  w.points(r.final_nodal_displacement);
+  w.pod(r.setup_seconds);
+  w.pod(r.seconds_per_step);
+  w.pod(static_cast<std::uint64_t>(r.n_dofs));
+  w.pods(r.kinetic_energy);
+  w.pods(r.strain_energy);
+  w.pods(r.load_work);
+  return w.bytes();
+}
+
+TransientResult deserialise_transient(std::string_view bytes) {
+  Reader in(bytes);
+  TransientResult r;
+  r.time = in.pods<double>();
+  const auto steps = in.pod<std::uint64_t>();
+  if (steps > bytes.size()) throw Truncated();
+  for (std::uint64_t k = 0; k < steps; ++k) r.probe_displacement.push_back(in.points());
+  r.final_nodal_displacement = in.points();
+  r.setup_seconds = in.pod<double>();
+  r.seconds_per_step = in.pod<double>();
+  r.n_dofs = in.pod<std::uint64_t>();
+  r.kinetic_energy = in.pods<double>();
+  r.strain_energy = in.pods<double>();
+  r.load_work = in.pods<double>();
+  if (!in.done() || r.time.empty()) throw Truncated();
+  return r;
+}
+
 /// The entry's file: magic, format version, key, payload size, payload, FNV-1a of the payload.
 std::string entry_file(const std::string& key, const std::string& payload) {
   Writer w;
@@ -292,40 +326,32 @@ std::optional<std::string> solution_cache_key(const TetMesh& mesh, const Elastic
 
 SolutionCache::SolutionCache(fs::path dir, std::ostream* log) : dir_(std::move(dir)), log_(log) {}
 
-const ElasticityResult& SolutionCache::solve(ElasticitySolver& solver, const TetMesh& mesh,
-                                             const ElasticityProblem& problem) {
-  const std::optional<std::string> key =
-      enabled() ? solution_cache_key(mesh, problem) : std::nullopt;
-  if (!key) {
-    if (enabled()) {
-      const std::lock_guard lock(mutex_);
-      ++stats_.uncacheable;
-    }
-    return solver.solve();
-  }
-  const fs::path path = dir_ / ("solution-" + key->substr(key->size() - 32) + ".bin");
+void SolutionCache::lookup(const std::string& key,
+                           const std::function<double(std::string_view)>& use,
+                           const std::function<std::string()>& compute) {
+  // The file name is a hash of the key; the file holds the key itself, so a collision of names
+  // is a miss, never a wrong answer.
+  const fs::path path = dir_ / ("entry-" + ContentHash().text(key).hex() + ".bin");
   const auto t0 = std::chrono::steady_clock::now();
   std::string payload, why;
-  const EntryState state = read_entry(path, *key, payload, why);
+  const EntryState state = read_entry(path, key, payload, why);
   if (state == EntryState::ok) {
     try {
-      auto [result, dofs] = deserialise(payload);
-      const double original = result.timings.assembly + result.timings.solve;
-      const ElasticityResult& r = solver.restore(std::move(result), dofs);
+      const double original_seconds = use(payload);
       const std::lock_guard lock(mutex_);
       ++stats_.hits;
-      stats_.seconds_saved += original - seconds_since(t0);
-      return r;
+      stats_.seconds_saved += original_seconds - seconds_since(t0);
+      return;
     } catch (const std::exception& e) {  // Truncated, or a DoF count this solver does not have
       why = e.what();
     }
   }
-  if (state == EntryState::corrupt || state == EntryState::ok) {
+  const bool corrupt = state == EntryState::corrupt || state == EntryState::ok;
+  if (corrupt) {
     (log_ ? *log_ : std::cerr) << "FEM solution cache: entry " << path.string() << " is corrupt ("
                                << why << "); solving again and replacing it\n";
   }
-  const ElasticityResult& r = solver.solve();
-  const std::string file = entry_file(*key, serialise(r, solver.solution_dofs()));
+  const std::string file = entry_file(key, compute());
   try {
     write_file_atomically(
         path, [&](std::ostream& out) { out << file; }, true);
@@ -335,8 +361,61 @@ const ElasticityResult& SolutionCache::solve(ElasticitySolver& solver, const Tet
   }
   const std::lock_guard lock(mutex_);
   ++stats_.misses;
-  if (state == EntryState::corrupt || state == EntryState::ok) ++stats_.corrupt;
-  return r;
+  if (corrupt) ++stats_.corrupt;
+}
+
+std::optional<std::string> SolutionCache::key_or_count(const TetMesh& mesh,
+                                                       const ElasticityProblem& problem) {
+  if (!enabled()) return std::nullopt;
+  std::optional<std::string> key = solution_cache_key(mesh, problem);
+  if (!key) {
+    const std::lock_guard lock(mutex_);
+    ++stats_.uncacheable;
+  }
+  return key;
+}
+
+const ElasticityResult& SolutionCache::solve(ElasticitySolver& solver, const TetMesh& mesh,
+                                             const ElasticityProblem& problem) {
+  const std::optional<std::string> key = key_or_count(mesh, problem);
+  if (!key) return solver.solve();
+  lookup(
+      *key,
+      [&](std::string_view payload) {
+        auto [result, dofs] = deserialise(payload);
+        const double original = result.timings.assembly + result.timings.solve;
+        solver.restore(std::move(result), dofs);
+        return original;
+      },
+      [&] {
+        const ElasticityResult& solved = solver.solve();  // before solution_dofs()
+        return serialise(solved, solver.solution_dofs());
+      });
+  return solver.result();
+}
+
+TransientResult SolutionCache::transient(const ElasticitySolver& solver, const TetMesh& mesh,
+                                         const ElasticityProblem& problem,
+                                         const TransientOptions& options) {
+  const std::optional<std::string> solution_key = key_or_count(mesh, problem);
+  if (!solution_key) return solver.transient(options);
+  KeyHash h;
+  h.real(options.dt).integer(options.steps).real(options.mass_damping);
+  h.real(options.outside_tolerance);
+  for (const Vec3& p : options.probe_points) h.point(p);
+  TransientResult result;
+  lookup(
+      *solution_key + " transient=" + h.a.hex() + h.b.hex(),
+      [&](std::string_view payload) {
+        result = deserialise_transient(payload);
+        return result.setup_seconds +
+               result.seconds_per_step * static_cast<double>(result.time.size() - 1);
+      },
+      [&] {
+        result = solver.transient(options);
+        return serialise_transient(result);
+      });
+  return result;
 }
 
 SolutionCacheStatistics SolutionCache::statistics() const {

@@ -1,18 +1,20 @@
 #pragma once
-/// FEM solutions kept on disk, so that every study (run, recommend, stability, gate) and every
-/// repeated run solves each reference once. An entry is keyed by a hash of everything that
-/// determines the solution: the mesh (nodes, elements, groups), the problem (material, supports,
-/// pins, loads with their quadrature points, curved walls, gravity, solver options) and the
-/// version of the reference code (a hash of fem_reference's sources, made at build time). Each
-/// file stores its full key and a checksum of its contents: a corrupt or truncated entry is
-/// detected, reported and recomputed. Entries are written atomically (write, then rename), so
-/// concurrent writers never leave a partial file.
+/// FEM solutions (and FEM transients) kept on disk, so that every study (run, recommend, stability,
+/// gate) and every repeated run solves each reference once. An entry is keyed by a hash of
+/// everything that determines the solution: the mesh (nodes, elements, groups), the problem
+/// (material, supports, pins, loads with their quadrature points, curved walls, gravity, solver
+/// options) and the version of the reference code (a hash of fem_reference's sources, made at build
+/// time). Each file stores its full key and a checksum of its contents: a corrupt or truncated
+/// entry is detected, reported and recomputed. Entries are written atomically (write, then rename),
+/// so concurrent writers never leave a partial file.
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <string_view>
 
 #include "fem_reference/elasticity.hpp"
 
@@ -45,6 +47,10 @@ class SolutionCache {
   const ElasticityResult& solve(ElasticitySolver& solver, const TetMesh& mesh,
                                 const ElasticityProblem& problem);
 
+  /// solver.transient(options), or the stored history of the same mesh, problem and options.
+  TransientResult transient(const ElasticitySolver& solver, const TetMesh& mesh,
+                            const ElasticityProblem& problem, const TransientOptions& options);
+
   [[nodiscard]] bool enabled() const { return !dir_.empty(); }
   [[nodiscard]] const std::filesystem::path& directory() const { return dir_; }
   [[nodiscard]] SolutionCacheStatistics statistics() const;
@@ -53,6 +59,13 @@ class SolutionCache {
   [[nodiscard]] std::string summary() const;
 
  private:
+  /// The problem's key, or nullopt (counted as uncacheable when the cache is on).
+  std::optional<std::string> key_or_count(const TetMesh& mesh, const ElasticityProblem& problem);
+  /// The entry for `key`: `use(payload)` restores a good one and returns the seconds its
+  /// computation took; otherwise `compute()` computes and returns the payload, which is stored.
+  void lookup(const std::string& key, const std::function<double(std::string_view)>& use,
+              const std::function<std::string()>& compute);
+
   std::filesystem::path dir_;
   std::ostream* log_;
   mutable std::mutex mutex_;  // statistics only: entries are files written atomically

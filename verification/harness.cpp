@@ -98,6 +98,9 @@ struct ReferenceAtPoints {
 struct ReferenceSolvers {
   std::unique_ptr<fem::ElasticitySolver> fine;
   std::unique_ptr<fem::ElasticitySolver> coarse;
+  const TetMesh* fine_mesh = nullptr;
+  fem::ElasticityProblem fine_problem;  ///< what `fine` solves: the solution cache's key
+  fem::SolutionCache* cache = nullptr;  ///< nullptr: solve and run transients afresh
   /// FEM transients already run, by (probe point, simulated time, α): |u(t)| at unit load, m.
   mutable std::map<std::tuple<double, double, double, double, double>,
                    std::pair<std::vector<double>, std::vector<double>>>
@@ -120,7 +123,9 @@ const std::pair<std::vector<double>, std::vector<double>>& transient_at(
   t.mass_damping = alpha;
   t.probe_points = {probe};
   t.outside_tolerance = kOutsideTolerance;
-  const fem::TransientResult r = ref.fine->transient(t);
+  const fem::TransientResult r =
+      ref.cache ? ref.cache->transient(*ref.fine, *ref.fine_mesh, ref.fine_problem, t)
+                : ref.fine->transient(t);
   std::vector<double> u(r.time.size());
   for (std::size_t k = 0; k < u.size(); ++k) u[k] = r.probe_displacement[k][0].norm();
   return ref.transients.emplace(key, std::make_pair(r.time, u)).first->second;
@@ -135,13 +140,13 @@ double interpolate(const std::vector<double>& t, const std::vector<double>& v, d
   return (1.0 - w) * v[hi - 1] + w * v[hi];
 }
 
-/// The scene's P2 reference on `mesh` at ν (unit load), from the solution cache when it has it.
+/// A reference solve on `mesh`, from the solution cache when it has it.
 const fem::ElasticityResult& solve_reference(std::unique_ptr<fem::ElasticitySolver>& solver,
-                                             const TetMesh& mesh, const Scene& s, double nu,
-                                             const HarnessOptions& o) {
-  fem::ElasticityProblem problem = fem_problem(s, mesh, nu, 2);
+                                             const TetMesh& mesh,
+                                             const fem::ElasticityProblem& problem,
+                                             fem::SolutionCache* cache) {
   solver = std::make_unique<fem::ElasticitySolver>(mesh, problem);
-  return o.solution_cache ? o.solution_cache->solve(*solver, mesh, problem) : solver->solve();
+  return cache ? cache->solve(*solver, mesh, problem) : solver->solve();
 }
 
 ReferenceAtPoints reference_at(const ReferenceSolvers& ref, const std::vector<Vec3>& points) {
@@ -677,9 +682,15 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
   for (const double nu : s.poisson_ratios) {
     progress.begin("reference P2 (level " + std::to_string(s.reference_level) + ", ν = " +
                    std::to_string(nu) + ")");
-    ReferenceSolvers ref;
-    const fem::ElasticityResult& fine = solve_reference(ref.fine, fine_mesh, s, nu, o);
-    if (coarse_mesh) solve_reference(ref.coarse, *coarse_mesh, s, nu, o);
+    ReferenceSolvers ref;  // the scene's P2 reference at ν, unit load
+    ref.cache = o.solution_cache;
+    ref.fine_mesh = &fine_mesh;
+    ref.fine_problem = fem_problem(s, fine_mesh, nu, 2);
+    const fem::ElasticityResult& fine =
+        solve_reference(ref.fine, fine_mesh, ref.fine_problem, ref.cache);
+    if (coarse_mesh) {
+      solve_reference(ref.coarse, *coarse_mesh, fem_problem(s, *coarse_mesh, nu, 2), ref.cache);
+    }
     ReferenceInfo info;
     info.poisson_ratio = nu;
     info.element = fine.element;

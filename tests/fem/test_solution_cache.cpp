@@ -174,6 +174,46 @@ TEST(SolutionCache, ACorruptOrTruncatedEntryIsRecomputedWithAMessage) {
   expect_same_solution(fresh, hit);
 }
 
+TEST(SolutionCache, AStoredTransientEqualsTheFreshOneAndOtherStepsMiss) {
+  const TetMesh& mesh = test::short_tube_mesh(0);
+  const fem::ElasticityProblem problem = test::lame_problem(0.3, 1, fem::Formulation::displacement);
+  fem::TransientOptions t;
+  t.dt = 1e-4;
+  t.steps = 20;
+  t.mass_damping = 5.0;
+  t.probe_points = probes();
+  const fem::ElasticitySolver solver(mesh, problem);
+  const fem::TransientResult fresh = solver.transient(t);
+
+  test::TempDir dir;
+  fem::SolutionCache cache(dir.path());
+  const fem::TransientResult stored = cache.transient(solver, mesh, problem, t);
+  const fem::TransientResult read = cache.transient(solver, mesh, problem, t);
+  EXPECT_EQ(cache.statistics().misses, 1);
+  EXPECT_EQ(cache.statistics().hits, 1);
+  for (const fem::TransientResult* r : {&stored, &read}) {
+    EXPECT_EQ(r->time, fresh.time);
+    ASSERT_EQ(r->probe_displacement.size(), fresh.probe_displacement.size());
+    for (std::size_t k = 0; k < fresh.probe_displacement.size(); ++k) {
+      for (std::size_t i = 0; i < fresh.probe_displacement[k].size(); ++i) {
+        ASSERT_EQ(r->probe_displacement[k][i], fresh.probe_displacement[k][i]) << k << " " << i;
+      }
+    }
+    EXPECT_EQ(r->kinetic_energy, fresh.kinetic_energy);
+    EXPECT_EQ(r->strain_energy, fresh.strain_energy);
+    EXPECT_EQ(r->load_work, fresh.load_work);
+    EXPECT_EQ(r->final_nodal_displacement, fresh.final_nodal_displacement);
+  }
+  fem::TransientOptions other = t;
+  other.dt = 2e-4;
+  cache.transient(solver, mesh, problem, other);
+  other = t;
+  other.probe_points.pop_back();
+  cache.transient(solver, mesh, problem, other);
+  EXPECT_EQ(cache.statistics().misses, 3);
+  EXPECT_EQ(cache.statistics().hits, 1);
+}
+
 TEST(SolutionCache, ProblemsWithFunctionsAreSolvedButNotStored) {
   const TetMesh& mesh = test::short_tube_mesh(0);
   fem::ElasticityProblem problem = test::lame_problem(0.3, 1, fem::Formulation::displacement);
