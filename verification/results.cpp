@@ -339,6 +339,32 @@ void write_summary_markdown(const std::filesystem::path& path,
             << o.unknowns << " |\n";
       }
       out << "\n";
+      if (r.reference_modes.empty() && r.model_modes.empty()) continue;
+      // Natural frequencies ([modes]): each model's beside the modal reference's, by rank.
+      out << "Natural frequencies (Hz) at rest, the scene's supports held; f/f_ref mode by mode "
+             "(k-th lowest against k-th lowest). Reference: P2, displacement formulation, "
+             "consistent mass; mass-spring models: K at rest, lumped masses.\n\n"
+          << "| model | ν | level | frequencies Hz | f / f_ref | zero modes |\n"
+             "|---|---|---|---|---|---|\n";
+      const auto row = [&](const ModalOutcome& m, const std::string& name) {
+        out << "| " << name << " | " << m.poisson_ratio << " | " << m.level << " | ";
+        if (!m.ok) {
+          out << "FAILED: " << m.failure << " | | |\n";
+          return;
+        }
+        for (std::size_t k = 0; k < m.frequencies_hz.size(); ++k) {
+          out << (k ? ", " : "") << m.frequencies_hz[k];
+        }
+        out << " | ";
+        if (const ModalOutcome* ref = reference_modes_at(r, m.poisson_ratio); ref && &m != ref) {
+          const std::vector<double> q = frequency_ratios(m, *ref);
+          for (std::size_t k = 0; k < q.size(); ++k) out << (k ? ", " : "") << q[k];
+        }
+        out << " | " << m.mechanisms << " |\n";
+      };
+      for (const auto& m : r.reference_modes) row(m, "reference (" + m.detail + ")");
+      for (const auto& m : r.model_modes) row(m, m.model);
+      out << "\n";
     }
   });
 }

@@ -277,6 +277,11 @@ TEST(HarnessModes, NaturalFrequenciesBesideTheModalReference) {
   }
   const std::string csv = test::read_text(dir / "results.csv");
   EXPECT_NE(csv.find("mode_frequencies_hz,reference_mode_frequencies_hz"), std::string::npos);
+  write_summary_markdown(dir / "summary.md", {result}, "test");
+  const std::string summary = test::read_text(dir / "summary.md");
+  EXPECT_NE(summary.find("| model | ν | level | frequencies Hz | f / f_ref | zero modes |"),
+            std::string::npos) << summary;
+  EXPECT_NE(summary.find("| p2_same_as_reference | 0.3 | 0 | "), std::string::npos) << summary;
 }
 
 TEST_F(HarnessLame, WallProfileIsLamesUniformRadialDisplacementAlongTheTube) {
