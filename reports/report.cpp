@@ -11,6 +11,8 @@
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
+#include "reports/best_model.hpp"
+#include "reports/modal_section.hpp"
 #include "reports/representative_load.hpp"
 #include "reports/study_sections.hpp"
 #include "reports/svg_plot.hpp"
@@ -393,6 +395,7 @@ void scene_section(Document& doc, const SceneRows& s) {
   load_displacement_figure(c);
   wall_profile_figure(c);
   history_figure(c);
+  natural_frequency_section(doc, s);
   doc.paragraph("Seed 000's statistics of the nodal displacement error for every model, Poisson's "
                 "ratio, level and load (⚠: the reference strains beyond 5 % there). Set-up is "
                 "done once (model build; for static and linear mass-spring models also assembly "
@@ -477,6 +480,7 @@ Document build_report(const ResultsFile& r, const std::optional<StabilityFile>& 
                 "scene's tolerance (seed 000's visual threshold, 0.1 mm, unless the scene says "
                 "otherwise).");
   doc.table(summary_table(r));
+  best_model_section(doc, r);
   for (const auto& s : r.scenes) scene_section(doc, s);
   for (const auto& recommendation : recommendations) recommendation_section(doc, recommendation);
   if (stability) {

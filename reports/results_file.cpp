@@ -58,6 +58,26 @@ OutcomeRow read_outcome(const json& j, const std::string& where) {
   return o;
 }
 
+ModalRow read_modal(const json& j, const std::string& where) {
+  ModalRow m;
+  m.model = field<std::string>(j, "model", where);
+  m.kind = field<std::string>(j, "kind", where);
+  m.detail = field<std::string>(j, "detail", where);
+  m.poisson_ratio = field<double>(j, "poisson_ratio", where);
+  m.level = field<int>(j, "level", where);
+  m.ok = field<bool>(j, "ok", where);
+  m.dofs = field<std::size_t>(j, "dofs", where);
+  m.seconds = field<double>(j, "seconds", where);
+  if (!m.ok) {
+    m.failure = field<std::string>(j, "failure", where);
+    return m;
+  }
+  m.frequencies_hz = field<std::vector<double>>(j, "frequencies_hz", where);
+  m.mechanisms = field_or<int>(j, "mechanisms", 0, where);
+  m.ratio_to_reference = field_or<std::vector<double>>(j, "ratio_to_reference", {}, where);
+  return m;
+}
+
 }  // namespace
 
 ResultsFile parse_results(const std::string& text, const std::filesystem::path& source) {
@@ -107,6 +127,18 @@ ResultsFile parse_results(const std::string& text, const std::filesystem::path& 
     for (std::size_t k = 0; k < outcomes.size(); ++k) {
       sr.outcomes.push_back(
           read_outcome(outcomes[k], where + ".outcomes[" + std::to_string(k) + "]"));
+    }
+    if (const auto m = s.find("modes"); m != s.end() && !m->is_null()) {
+      const std::string w = where + ".modes";
+      const json reference = field<json>(*m, "reference", w);
+      for (std::size_t k = 0; k < reference.size(); ++k) {
+        sr.reference_modes.push_back(
+            read_modal(reference[k], w + ".reference[" + std::to_string(k) + "]"));
+      }
+      const json models = field<json>(*m, "models", w);
+      for (std::size_t k = 0; k < models.size(); ++k) {
+        sr.model_modes.push_back(read_modal(models[k], w + ".models[" + std::to_string(k) + "]"));
+      }
     }
     r.scenes.push_back(std::move(sr));
   }

@@ -37,6 +37,21 @@ struct ReferenceRow {
   double max_abs_strain_at_unit_load = 0.0;
 };
 
+/// One model's (or the modal reference's) lowest natural frequencies at one ν and level (the
+/// scene's "modes" block; verification/harness.hpp ModalOutcome).
+struct ModalRow {
+  std::string model, kind, detail;
+  double poisson_ratio = 0.0;
+  int level = 0;
+  bool ok = false;
+  std::string failure;
+  std::vector<double> frequencies_hz;
+  std::vector<double> ratio_to_reference;  ///< f/f_reference mode by mode (models only)
+  int mechanisms = 0;
+  std::size_t dofs = 0;
+  double seconds = 0.0;
+};
+
 struct SceneRows {
   std::string name, description, vessel, load, load_unit;
   std::vector<int> model_levels;
@@ -48,6 +63,8 @@ struct SceneRows {
   std::optional<double> budget_magnitude;
   std::vector<ReferenceRow> references;
   std::vector<OutcomeRow> outcomes;
+  /// Natural frequencies (absent from runs without [modes]): the reference per ν, the models.
+  std::vector<ModalRow> reference_modes, model_modes;
 };
 
 struct ResultsFile {

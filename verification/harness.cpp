@@ -24,6 +24,7 @@
 #include "msm/solvers/updates.hpp"
 #include "reports/representative_load.hpp"
 #include "verification/memory.hpp"
+#include "verification/modal.hpp"
 #include "verification/progress.hpp"
 #include "verification/scene_problems.hpp"
 #include "verification/timing.hpp"
@@ -289,6 +290,8 @@ void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
     base.detail = r.element + ", " + fem::to_string(r.solver);
     base.nodes = mesh.nodes.size();
     base.unknowns = r.n_dofs;
+    // Natural frequencies (scene's [modes]): after the timed solves, outside their measurements.
+    if (s.modes.count > 0) result.model_modes.push_back(fem_model_modes(solver, base, s.modes.count));
     const ReferenceAtPoints ref_here = reference_at(ref, mesh.nodes);
     const ReadOut at = read_out(s, base.level, mesh.nodes, result.qoi_point);
     std::vector<Vec3> unit_loads;  // the indentation's weights: contact loads only
@@ -513,6 +516,12 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
   base.detail = msm_detail(built.topology, spec);
   base.roi_radius = spec.roi_radius;
   base.nodes = built.network.nodes.size();
+  if (s.modes.count > 0) {
+    // Natural frequencies (scene's [modes]) of the whole model with the scene's supports (a
+    // region of interest is a solve-time restriction, not another vessel), outside the timings.
+    const msm::Problem at_rest = msm_problem(s, model, built, mesh, 0.0);
+    result.model_modes.push_back(msm_model_modes(at_rest, base, s.modes.count));
+  }
   const ReferenceAtPoints ref_here = reference_at(ref, built.network.nodes);
   const ReadOut at = read_out(s, base.level, built.network.nodes, result.qoi_point);
   for (const double mag : s.load.magnitudes) {
@@ -634,6 +643,17 @@ UpdateSequence timed_updates(const msm::Problem& problem, const msm::SolverSpec&
   return seq;
 }
 
+std::vector<double> frequency_ratios(const ModalOutcome& model, const ModalOutcome& reference) {
+  std::vector<double> r;
+  if (!model.ok || !reference.ok) return r;
+  const std::size_t n = std::min(model.frequencies_hz.size(), reference.frequencies_hz.size());
+  for (std::size_t k = 0; k < n; ++k) {
+    const double f = reference.frequencies_hz[k];
+    r.push_back(f > 0.0 ? model.frequencies_hz[k] / f : 0.0);
+  }
+  return r;
+}
+
 std::pair<double, long> time_per_update(double solve_seconds, long steps, double dt,
                                         double period) {
   if (period <= 0.0) return {0.0, 0};
@@ -674,10 +694,28 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
     coarse_mesh = std::make_unique<TetMesh>(scene_mesh(s, s.reference_level - 1, o.cache_dir));
   }
 
+  // The modal reference's mesh (scene's [modes]): one of those above, else its own.
+  std::unique_ptr<TetMesh> modal_mesh;
+  const TetMesh* modal_reference_mesh = nullptr;
+  const int modal_level = modal_reference_level(s);
+  if (s.modes.count > 0) {
+    if (modal_level == s.reference_level) {
+      modal_reference_mesh = &fine_mesh;
+    } else if (coarse_mesh && modal_level == s.reference_level - 1) {
+      modal_reference_mesh = coarse_mesh.get();
+    } else if (model_meshes.count(modal_level)) {
+      modal_reference_mesh = &model_meshes.at(modal_level);
+    } else {
+      modal_mesh = std::make_unique<TetMesh>(scene_mesh(s, modal_level, o.cache_dir));
+      modal_reference_mesh = modal_mesh.get();
+    }
+  }
+
   std::size_t cases = 0;
   const std::size_t loads = o.budget_load_only ? 1 : s.load.magnitudes.size();
   for (const auto& m : s.models) cases += m.kind == ModelKind::fem ? 1 : loads;
-  Progress progress(log, s.poisson_ratios.size() * (1 + s.model_levels.size() * cases));
+  Progress progress(log, s.poisson_ratios.size() * (1 + s.model_levels.size() * cases +
+                                                    (s.modes.count > 0 ? 1 : 0)));
 
   for (const double nu : s.poisson_ratios) {
     progress.begin("reference P2 (level " + std::to_string(s.reference_level) + ", ν = " +
@@ -701,6 +739,15 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
     info.budget_magnitude = budget_magnitude(s, fine.max_abs_principal_strain);
     result.references.push_back(info);
     progress.end();
+    if (modal_reference_mesh) {
+      progress.begin("modal reference P2 (level " + std::to_string(modal_level) + ", ν = " +
+                     std::to_string(nu) + ", " + std::to_string(s.modes.count) + " modes)");
+      result.reference_modes.push_back(reference_modes(s, nu, *modal_reference_mesh, modal_level));
+      if (!result.reference_modes.back().ok) {
+        log << "      modal reference FAILED: " << result.reference_modes.back().failure << "\n";
+      }
+      progress.end();
+    }
     Scene at_nu = s;  // the scene's loads for this ν (only the budget's, if asked)
     if (o.budget_load_only) at_nu.load.magnitudes = {info.budget_magnitude};
 

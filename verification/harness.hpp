@@ -145,11 +145,36 @@ struct ModelOutcome {
   long steps_per_update = 0;  ///< integrators with a budget rate
 };
 
+/// The lowest natural frequencies of one model, or of the modal reference, at one ν and level
+/// (the scene's [modes]): mass-spring models K φ = ω² M φ with K their exact Hessian at rest and
+/// M their lumped masses (msm::natural_frequencies); FEM models and the reference with the
+/// consistent mass (fem::ElasticitySolver::modes). The scene's supports are held in both.
+struct ModalOutcome {
+  std::string model;   ///< the model's name; "reference" for the modal reference
+  std::string kind;    ///< fem | surface_msm | volume_msm
+  std::string detail;  ///< element and mass (FEM), or the model's description
+  double poisson_ratio = 0.0;
+  int level = 0;
+  bool ok = false;
+  std::string failure;
+  std::vector<double> frequencies_hz;  ///< ascending
+  int mechanisms = 0;       ///< zero-frequency modes among them (mass-spring models)
+  std::size_t dofs = 0;     ///< free dofs of the eigenproblem
+  double seconds = 0.0;     ///< assembly, factorisation and Lanczos
+};
+
+/// f_model,k / f_reference,k mode by mode (modes paired by rank, both sorted ascending); as many
+/// as both have, 0 where the reference's frequency is 0.
+std::vector<double> frequency_ratios(const ModalOutcome& model, const ModalOutcome& reference);
+
 struct SceneResult {
   Scene scene;
   Vec3 qoi_point = Vec3::Zero();  ///< where the "contact-point displacement" is read
   std::vector<ReferenceInfo> references;
   std::vector<ModelOutcome> outcomes;
+  /// Natural frequencies (scene.modes.count > 0): the modal reference per ν, then each model's.
+  std::vector<ModalOutcome> reference_modes;
+  std::vector<ModalOutcome> model_modes;
   double seconds = 0.0;
 };
 

@@ -57,6 +57,37 @@ nlohmann::json budget_json(const Budget& b) {
   return j;
 }
 
+/// The modal reference at ν, or nullptr.
+const ModalOutcome* reference_modes_at(const SceneResult& r, double nu) {
+  for (const auto& m : r.reference_modes) {
+    if (m.poisson_ratio == nu) return &m;
+  }
+  return nullptr;
+}
+
+/// The natural frequencies of a model (or the reference), with f/f_reference mode by mode.
+nlohmann::json modal_json(const ModalOutcome& m, const ModalOutcome* reference) {
+  nlohmann::json j{{"model", m.model},   {"kind", m.kind},   {"detail", m.detail},
+                   {"poisson_ratio", m.poisson_ratio},     {"level", m.level},
+                   {"ok", m.ok},         {"dofs", m.dofs},   {"seconds", m.seconds}};
+  if (!m.ok) {
+    j["failure"] = m.failure;
+    return j;
+  }
+  j["frequencies_hz"] = m.frequencies_hz;
+  j["mechanisms"] = m.mechanisms;
+  if (reference) j["ratio_to_reference"] = frequency_ratios(m, *reference);
+  return j;
+}
+
+/// "f1;f2;..." for a CSV cell.
+std::string joined(const std::vector<double>& v) {
+  std::ostringstream s;
+  s << std::setprecision(8);
+  for (std::size_t i = 0; i < v.size(); ++i) s << (i ? ";" : "") << v[i];
+  return s.str();
+}
+
 nlohmann::json scene_json(const SceneResult& r) {
   nlohmann::json refs = nlohmann::json::array();
   for (const auto& ref : r.references) {
@@ -130,6 +161,15 @@ nlohmann::json scene_json(const SceneResult& r) {
     outcomes.push_back(j);
   }
   const Scene& s = r.scene;
+  nlohmann::json modes = nullptr;
+  if (s.modes.count > 0) {
+    nlohmann::json reference = nlohmann::json::array(), models = nlohmann::json::array();
+    for (const auto& m : r.reference_modes) reference.push_back(modal_json(m, nullptr));
+    for (const auto& m : r.model_modes) {
+      models.push_back(modal_json(m, reference_modes_at(r, m.poisson_ratio)));
+    }
+    modes = {{"count", s.modes.count}, {"reference", reference}, {"models", models}};
+  }
   return {
       {"name", s.name},
       {"source", s.source.string()},
@@ -145,7 +185,8 @@ nlohmann::json scene_json(const SceneResult& r) {
       {"budget", s.budget.stated ? budget_json(s.budget) : nlohmann::json(nullptr)},
       {"seconds", r.seconds},
       {"references", refs},
-      {"outcomes", outcomes}};
+      {"outcomes", outcomes},
+      {"modes", modes}};
 }
 
 }  // namespace
@@ -211,7 +252,7 @@ void write_results_csv(const std::filesystem::path& path, const std::vector<Scen
            "solve_s,memory_mib,"
            "max_mm,mean_mm,stddev_mm,rms_mm,relative_l2,ref_uncertainty_max_mm,qoi_mm,"
            "qoi_reference_mm,max_strain,beyond_linear_regime,updates,iterations_per_update,"
-           "factorisations_per_update\n";
+           "factorisations_per_update,mode_frequencies_hz,reference_mode_frequencies_hz\n";
     out << std::setprecision(8);
     for (const auto& r : results) {
       for (const auto& o : r.outcomes) {
@@ -234,6 +275,19 @@ void write_results_csv(const std::filesystem::path& path, const std::vector<Scen
           out << o.updates << ',' << o.iterations_per_update << ',' << o.factorisations_per_update;
         } else {
           out << ",,";
+        }
+        // Natural frequencies (scene's [modes]) of this model at this ν and level and of the
+        // modal reference at this ν, "f1;f2;..." in Hz; empty where not computed.
+        out << ',';
+        for (const auto& m : r.model_modes) {
+          if (m.ok && m.model == o.model && m.poisson_ratio == o.poisson_ratio &&
+              m.level == o.level) {
+            out << joined(m.frequencies_hz);
+          }
+        }
+        out << ',';
+        if (const ModalOutcome* ref = reference_modes_at(r, o.poisson_ratio); ref && ref->ok) {
+          out << joined(ref->frequencies_hz);
         }
         out << '\n';
       }
@@ -284,6 +338,32 @@ void write_summary_markdown(const std::filesystem::path& path,
             << o.qoi_reference_mm << " | " << o.setup_seconds << " | " << o.solve_seconds << " | "
             << o.unknowns << " |\n";
       }
+      out << "\n";
+      if (r.reference_modes.empty() && r.model_modes.empty()) continue;
+      // Natural frequencies ([modes]): each model's beside the modal reference's, by rank.
+      out << "Natural frequencies (Hz) at rest, the scene's supports held; f/f_ref mode by mode "
+             "(k-th lowest against k-th lowest). Reference: P2, displacement formulation, "
+             "consistent mass; mass-spring models: K at rest, lumped masses.\n\n"
+          << "| model | ν | level | frequencies Hz | f / f_ref | zero modes |\n"
+             "|---|---|---|---|---|---|\n";
+      const auto row = [&](const ModalOutcome& m, const std::string& name) {
+        out << "| " << name << " | " << m.poisson_ratio << " | " << m.level << " | ";
+        if (!m.ok) {
+          out << "FAILED: " << m.failure << " | | |\n";
+          return;
+        }
+        for (std::size_t k = 0; k < m.frequencies_hz.size(); ++k) {
+          out << (k ? ", " : "") << m.frequencies_hz[k];
+        }
+        out << " | ";
+        if (const ModalOutcome* ref = reference_modes_at(r, m.poisson_ratio); ref && &m != ref) {
+          const std::vector<double> q = frequency_ratios(m, *ref);
+          for (std::size_t k = 0; k < q.size(); ++k) out << (k ? ", " : "") << q[k];
+        }
+        out << " | " << m.mechanisms << " |\n";
+      };
+      for (const auto& m : r.reference_modes) row(m, "reference (" + m.detail + ")");
+      for (const auto& m : r.model_modes) row(m, m.model);
       out << "\n";
     }
   });

@@ -561,6 +561,11 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
   scene.tolerances.max_error_mm = tol.positive("max_error_mm", scene.tolerances.max_error_mm, "mm");
   tol.finish();
   if (r.get("budget")) scene.budget = read_budget(r.sub("budget", false), scene);
+  TableReader modes = r.sub("modes", false);
+  scene.modes.count = static_cast<int>(modes.integer_or("count", 0, 0, 100));
+  scene.modes.reference_level =
+      static_cast<int>(modes.integer_or("reference_level", -1, 0, kMaxMeshLevel));
+  modes.finish();
   r.finish();
   return scene;
 }

@@ -86,6 +86,17 @@ struct Budget {
   }
 };
 
+/// Natural frequencies (the `[modes]` table; issue 14): each model's lowest `count` modes at rest
+/// beside the FEM's of the same vessel (same supports and density). Mass-spring models: K their
+/// exact Hessian at rest, M their lumped masses (msm/dynamics/natural_frequencies.hpp); FEM models
+/// of the scene and the modal reference: consistent mass, displacement formulation.
+struct ModalSpec {
+  int count = 0;  ///< lowest modes per model; 0: none computed
+  /// Mesh level of the modal reference (P2, displacement formulation); −1: the scene's
+  /// reference_level.
+  int reference_level = -1;
+};
+
 struct Scene {
   std::string name;
   std::string description;
@@ -105,6 +116,7 @@ struct Scene {
   std::vector<ModelSpec> models;
   Tolerances tolerances;
   Budget budget;
+  ModalSpec modes;
 };
 
 /// Reads and validates a scene file. Throws InputError ("file:line: key: what was found, what was

@@ -3,6 +3,7 @@
 // linear scaling, and a diverging model recorded as failed while the others still run.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -59,6 +60,45 @@ stiffness = "seed001"
 solver = "explicit-euler"
 dt = 1.0
 steps = 50
+)";
+
+/// The Lamé tube with natural frequencies ([modes]): P2 on the reference's mesh, P1, and two
+/// seed001 volume models that differ in their solver only.
+const char* kLameModes = R"(name = "lame_modes_test"
+[vessel]
+kind = "straight"
+mesh = "structured"
+level = 0
+reference_level = 0
+[material]
+E = 14.24e3
+nu = 0.3
+[boundary]
+inlet = "roller"
+outlet = "roller"
+[load]
+type = "pressure"
+magnitudes = [10.0]
+[modes]
+count = 4
+[[models]]
+name = "p2_same_as_reference"
+kind = "fem"
+degree = 2
+[[models]]
+name = "p1"
+kind = "fem"
+degree = 1
+[[models]]
+name = "volume_linear"
+kind = "volume_msm"
+stiffness = "seed001"
+solver = "linear"
+[[models]]
+name = "volume_static"
+kind = "volume_msm"
+stiffness = "seed001"
+solver = "static"
 )";
 
 const ModelOutcome& find(const SceneResult& r, const std::string& model, double magnitude) {
@@ -185,6 +225,64 @@ TEST_F(HarnessLame, ResultsJsonHasEveryFieldItsSchemaRequires) {
     }
   }
   EXPECT_NE(test::read_text(dir / "summary.md").find("| p1 | 0.3 | 0 | 10 |"), std::string::npos);
+}
+
+TEST(HarnessModes, NaturalFrequenciesBesideTheModalReference) {
+  // [modes] count = 4: the modal reference is P2 (displacement formulation) on the reference's
+  // mesh, so the P2 model on that mesh has the same eigenproblem (ratios 1); P1 on the same mesh
+  // spans a subspace of P2's with the same consistent mass, so by the Rayleigh–Ritz (min–max)
+  // principle each of its k-th eigenvalues is ≥ P2's (ratios ≥ 1). Every mass-spring model gets
+  // its own frequencies with the roller ends held (no rigid motion: no zero modes).
+  const SceneResult result = run_scene(parse_scene(kLameModes, "lame_modes_test.toml"), {});
+  ASSERT_EQ(result.reference_modes.size(), 1u);
+  const ModalOutcome& ref = result.reference_modes[0];
+  ASSERT_TRUE(ref.ok) << ref.failure;
+  ASSERT_EQ(ref.frequencies_hz.size(), 4u);
+  EXPECT_GT(ref.frequencies_hz[0], 1.0);
+  const auto modes_of = [&](const std::string& model) -> const ModalOutcome& {
+    for (const auto& m : result.model_modes) {
+      if (m.model == model) return m;
+    }
+    throw std::runtime_error("no modes for " + model);
+  };
+  const std::vector<double> same = frequency_ratios(modes_of("p2_same_as_reference"), ref);
+  const std::vector<double> p1 = frequency_ratios(modes_of("p1"), ref);
+  ASSERT_EQ(same.size(), 4u);
+  ASSERT_EQ(p1.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_NEAR(same[k], 1.0, 1e-6) << "mode " << k;
+    EXPECT_GE(p1[k], 1.0 - 1e-9) << "mode " << k;
+  }
+  for (const char* model : {"volume_linear", "volume_static"}) {
+    const ModalOutcome& m = modes_of(model);
+    ASSERT_TRUE(m.ok) << model << ": " << m.failure;
+    EXPECT_EQ(m.mechanisms, 0) << model;
+    ASSERT_EQ(m.frequencies_hz.size(), 4u);
+    EXPECT_TRUE(std::is_sorted(m.frequencies_hz.begin(), m.frequencies_hz.end()));
+    EXPECT_GT(m.frequencies_hz[0], 0.0);
+  }
+  // Both seed001 models share K and M (they differ in solver only): the same frequencies.
+  EXPECT_EQ(modes_of("volume_linear").frequencies_hz, modes_of("volume_static").frequencies_hz);
+  // The results file carries them, with the ratios, and the CSV row the model's list.
+  test::TempDir dir;
+  write_results_json(dir / "results.json", {result}, "test");
+  write_results_csv(dir / "results.csv", {result});
+  const auto j = nlohmann::json::parse(test::read_text(dir / "results.json"));
+  const auto& modes = j["scenes"][0]["modes"];
+  EXPECT_EQ(modes["count"], 4);
+  ASSERT_EQ(modes["reference"].size(), 1u);
+  const auto schema = nlohmann::json::parse(test::read_text(VESSEL_RESULTS_SCHEMA));
+  for (const auto& m : modes["models"]) {
+    for (const auto& key : schema["$defs"]["modal"]["required"]) EXPECT_TRUE(m.contains(key)) << key;
+    if (m["model"] == "p1") EXPECT_EQ(m["ratio_to_reference"].size(), 4u);
+  }
+  const std::string csv = test::read_text(dir / "results.csv");
+  EXPECT_NE(csv.find("mode_frequencies_hz,reference_mode_frequencies_hz"), std::string::npos);
+  write_summary_markdown(dir / "summary.md", {result}, "test");
+  const std::string summary = test::read_text(dir / "summary.md");
+  EXPECT_NE(summary.find("| model | ν | level | frequencies Hz | f / f_ref | zero modes |"),
+            std::string::npos) << summary;
+  EXPECT_NE(summary.find("| p2_same_as_reference | 0.3 | 0 | "), std::string::npos) << summary;
 }
 
 TEST_F(HarnessLame, WallProfileIsLamesUniformRadialDisplacementAlongTheTube) {

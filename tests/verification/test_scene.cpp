@@ -239,3 +239,21 @@ TEST(Scene, VolumeTermSelectsTheHybridVolumeModel) {
                                 "[[models]]\nkind = \"surface_msm\"\nvolume_term = true\n");
   EXPECT_NE(surface.find("volume_term"), std::string::npos) << surface;
 }
+
+TEST(Scene, ModesTableIsReadAndCheckedNamingTheKey) {
+  EXPECT_EQ(parse_scene(kMinimal, "scene.toml").modes.count, 0);  // off unless asked for
+  const Scene s = parse_scene(std::string(kMinimal) + "[modes]\ncount = 6\nreference_level = 0\n",
+                              "scene.toml");
+  EXPECT_EQ(s.modes.count, 6);
+  EXPECT_EQ(s.modes.reference_level, 0);
+  EXPECT_EQ(parse_scene(std::string(kMinimal) + "[modes]\ncount = 3\n", "scene.toml")
+                .modes.reference_level,
+            -1);  // the scene's reference level
+  auto msg = error_of(std::string(kMinimal) + "[modes]\ncount = -1\n");
+  EXPECT_NE(msg.find("key 'modes.count': found -1, expected an integer in [0, 100]"),
+            std::string::npos) << msg;
+  msg = error_of(std::string(kMinimal) + "[modes]\ncount = 6\nreference_level = 9\n");
+  EXPECT_NE(msg.find("key 'modes.reference_level'"), std::string::npos) << msg;
+  msg = error_of(std::string(kMinimal) + "[modes]\nnumber = 6\n");
+  EXPECT_NE(msg.find("key 'modes.number': unknown key"), std::string::npos) << msg;
+}

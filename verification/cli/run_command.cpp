@@ -22,6 +22,8 @@ struct RunOptions {
   std::vector<int> levels;
   std::vector<double> magnitudes;
   int reference_level = -1;
+  int modes = -1;                 ///< natural frequencies per model (−1: the scenes' [modes])
+  int modes_reference_level = -1;  ///< level of the modal reference (−1: the scenes')
   std::string fields = "representative";
   std::string command;
 };
@@ -38,6 +40,8 @@ void apply_sweeps(const RunOptions& o, Scene& s) {
     s.vessel.level = s.model_levels.front();
   }
   if (o.reference_level >= 0) s.reference_level = o.reference_level;
+  if (o.modes >= 0) s.modes.count = o.modes;
+  if (o.modes_reference_level >= 0) s.modes.reference_level = o.modes_reference_level;
   if (s.reference_level < s.model_levels.back()) {
     std::cerr << "warning: " << s.name << ": the reference (level " << s.reference_level
               << ") is coarser than the finest model level (" << s.model_levels.back()
@@ -110,6 +114,14 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--reference-level", o->reference_level,
                   "Level of the P2 reference instead of the scene's (its uncertainty comes from "
                   "the level below)")
+      ->check(CLI::Range(0, kMaxMeshLevel));
+  cmd->add_option("--modes", o->modes,
+                  "Lowest natural frequencies per model instead of the scenes' [modes] count (0: "
+                  "none), beside the FEM's (P2, displacement formulation, consistent mass)")
+      ->check(CLI::Range(0, 100));
+  cmd->add_option("--modes-reference-level", o->modes_reference_level,
+                  "Mesh level of the modal reference instead of the scenes' [modes] "
+                  "reference_level (default there: the scene's reference level)")
       ->check(CLI::Range(0, kMaxMeshLevel));
   cmd->add_option("--fields", o->fields,
                   "VTU files for ParaView under OUTPUT-DIR/fields/<scene>/ (model and reference "

@@ -309,6 +309,7 @@ Recommendation recommend(const Scene& scene, const RecommendOptions& o,
   Recommendation rec;
   rec.scene = scene;
   Scene& s = rec.scene;
+  s.modes.count = 0;  // the budget asks for accuracy and speed: no natural frequencies ([modes])
   if (o.quick) {
     const std::vector<double> magnitudes = s.load.magnitudes;
     s = quick_variant(std::move(s));
