@@ -214,8 +214,9 @@ const ShapeAnswer& shape_answer(VesselContext& v, const LoadCase& c, double nu,
   const fem::ElasticityResult& r = p1_solver.solve();
   a.p1 = r.nodal_displacement;
   a.p1_seconds = r.timings.assembly + r.timings.solve;
+  const std::streamsize precision = log.precision();
   log << " " << std::fixed << std::setprecision(1) << clock.seconds() << " s\n"
-      << std::defaultfloat;
+      << std::defaultfloat << std::setprecision(static_cast<int>(precision));
   return v.shapes.emplace(key, std::move(a)).first->second;
 }
 
