@@ -92,10 +92,12 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
       ->capture_default_str();
   cmd->add_option("--train", o->train,
                   "Load types fitted on (contact, pressure, gravity; default the scene's); the "
-                  "others are held out");
+                  "others are held out")
+      ->delimiter(',');
   cmd->add_option("--held-out-scene", o->held_out_scenes,
                   "Scenes whose loads are held-out cases on another vessel (groups only)")
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingFile)
+      ->delimiter(',');
   cmd->add_option("--nu", o->nu, "Poisson's ratio (default 0.45 if the scene has it, else its first)")
       ->check(CLI::Range(0.0, 0.5));
   cmd->add_option("--level", o->level, "Model mesh level (default the scene's first)")

@@ -8,7 +8,10 @@
 #include <sstream>
 
 #include "fem_reference/elasticity.hpp"
+#include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
+#include <cstdio>
+#include <fstream>
 #include "msm/calibration/lbfgs.hpp"
 #include "msm/model/model_factory.hpp"
 #include "msm/solvers/updates.hpp"
@@ -175,6 +178,7 @@ struct VesselContext {
   TetMesh reference_mesh;
   msm::BuiltNetwork base;
   std::map<std::string, ShapeAnswer> shapes;
+  std::filesystem::path cache_dir;  ///< FEM answers cached under cache_dir/calibrate (empty: none)
 };
 
 std::string shape_key(const LoadCase& c) {
@@ -190,6 +194,79 @@ std::vector<Vec3> scaled(const std::vector<Vec3>& u, double f) {
   return out;
 }
 
+/// Everything that determines a shape's FEM answers: the meshes, the points, the material, the
+/// supports and the load's shape (the key of the on-disk cache).
+std::string answer_key(const VesselContext& v, const Scene& cs, double nu) {
+  std::ostringstream k;
+  k << std::setprecision(17) << "calibrate-fem-v1|" << mesh_hash(v.reference_mesh) << "|"
+    << mesh_hash(v.mesh) << "|" << v.base.network.nodes.size() << "|" << cs.youngs_modulus << "|"
+    << nu << "|" << cs.density << "|";
+  for (const Vec3& p : v.base.network.nodes) k << std::llround(p.x() * 1e9) << ","
+                                               << std::llround(p.y() * 1e9) << ","
+                                               << std::llround(p.z() * 1e9) << ";";
+  for (const auto& [g, e] : cs.boundary) k << g << "=" << to_string(e) << ";";
+  const LoadSpec& l = cs.load;
+  k << to_string(l.kind) << "|" << l.contact.point.transpose() << "|" << l.contact.radius << "|"
+    << l.contact.surface_group << "|" << l.gravity_direction.transpose();
+  return k.str();
+}
+
+std::uint64_t fnv1a(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+void write_vectors(std::ostream& out, const std::vector<Vec3>& v) {
+  const std::uint64_t n = v.size();
+  out.write(reinterpret_cast<const char*>(&n), sizeof n);
+  for (const Vec3& p : v) out.write(reinterpret_cast<const char*>(p.data()), 3 * sizeof(double));
+}
+
+bool read_vectors(std::istream& in, std::vector<Vec3>& v) {
+  std::uint64_t n = 0;
+  if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n > (1u << 28)) return false;
+  v.resize(n);
+  for (Vec3& p : v) {
+    if (!in.read(reinterpret_cast<char*>(p.data()), 3 * sizeof(double))) return false;
+  }
+  return true;
+}
+
+/// The cached FEM answers of a shape (cache_dir/calibrate/<hash>.bin holding the key itself, so
+/// a hash collision is a miss), or false.
+bool read_cached(const std::filesystem::path& file, const std::string& key, ShapeAnswer& a) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return false;
+  std::uint64_t n = 0;
+  if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n != key.size()) return false;
+  std::string stored(n, '\0');
+  if (!in.read(stored.data(), static_cast<std::streamsize>(n)) || stored != key) return false;
+  return read_vectors(in, a.reference_at_network) && read_vectors(in, a.reference_at_mesh) &&
+         read_vectors(in, a.p1) &&
+         static_cast<bool>(in.read(reinterpret_cast<char*>(&a.p1_seconds), sizeof(double))) &&
+         static_cast<bool>(in.read(reinterpret_cast<char*>(&a.strain_unit), sizeof(double)));
+}
+
+void write_cached(const std::filesystem::path& file, const std::string& key, const ShapeAnswer& a) {
+  write_file_atomically(
+      file,
+      [&](std::ostream& out) {
+        const std::uint64_t n = key.size();
+        out.write(reinterpret_cast<const char*>(&n), sizeof n);
+        out.write(key.data(), static_cast<std::streamsize>(n));
+        write_vectors(out, a.reference_at_network);
+        write_vectors(out, a.reference_at_mesh);
+        write_vectors(out, a.p1);
+        out.write(reinterpret_cast<const char*>(&a.p1_seconds), sizeof(double));
+        out.write(reinterpret_cast<const char*>(&a.strain_unit), sizeof(double));
+      },
+      true);
+}
+
 const ShapeAnswer& shape_answer(VesselContext& v, const LoadCase& c, double nu,
                                 std::ostream& log) {
   const std::string key = shape_key(c);
@@ -198,6 +275,20 @@ const ShapeAnswer& shape_answer(VesselContext& v, const LoadCase& c, double nu,
   LoadCase unit = c;
   unit.magnitude = 1.0;
   const Scene cs = case_scene(*v.scene, unit);
+  // The FEM answers are cached on disk (they cost a P2 solve each; the fit and the models do not
+  // depend on them being recomputed).
+  std::filesystem::path cache_file;
+  const std::string disk_key = answer_key(v, cs, nu);
+  if (!v.cache_dir.empty()) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%016llx.bin", static_cast<unsigned long long>(fnv1a(disk_key)));
+    cache_file = v.cache_dir / "calibrate" / name;
+    ShapeAnswer cached;
+    if (read_cached(cache_file, disk_key, cached)) {
+      log << "  FEM reference and P1 for " << v.scene->name << ": " << c.name << " (cached)\n";
+      return v.shapes.emplace(key, std::move(cached)).first->second;
+    }
+  }
   log << "  FEM reference P2 (level " << v.scene->reference_level << ") and P1 (level " << v.level
       << ") for " << v.scene->name << ": " << c.name << " ..." << std::flush;
   Stopwatch clock;
@@ -217,6 +308,7 @@ const ShapeAnswer& shape_answer(VesselContext& v, const LoadCase& c, double nu,
   const std::streamsize precision = log.precision();
   log << " " << std::fixed << std::setprecision(1) << clock.seconds() << " s\n"
       << std::defaultfloat << std::setprecision(static_cast<int>(precision));
+  if (!cache_file.empty()) write_cached(cache_file, disk_key, a);
   return v.shapes.emplace(key, std::move(a)).first->second;
 }
 
@@ -276,6 +368,7 @@ const ModelSpec& pick_model(const Scene& s, const std::string& name) {
 VesselContext make_context(const Scene& s, const ModelSpec& spec, int level, int reference_level,
                            double nu, const std::filesystem::path& cache) {
   VesselContext v;
+  v.cache_dir = cache;
   v.scene = &s;
   v.level = level;
   v.vessel = s.vessel;
@@ -396,8 +489,10 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
     cal.training_loads.push_back({c.name, c.kind, c.magnitude, c.point});
   }
   if (fit_cases.empty()) throw InputError("calibrate: no training load; expected --train kinds");
+  // Groups: the ridge alone (without it a contact-only fit drove the circumferential classes to
+  // ~0 and κ up 12×, which fitted contact and failed pressure by 4× P1; docs/msm_calibration.md).
   const msm::Regulariser reg = o.granularity == CalibrationGranularity::groups
-                                   ? msm::Regulariser{}
+                                   ? msm::Regulariser{0.0, o.regulariser.ridge}
                                    : o.regulariser;
   const msm::LinearisedFit fit(main.base.network, main.base.volume_kappa, fixed, params,
                                fit_cases, reg);
@@ -442,7 +537,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   method << "least squares on nodal displacements against the P2 reference (level "
          << reference_level << "), model linearised at rest, adjoint gradients, L-BFGS; "
          << (o.granularity == CalibrationGranularity::groups
-                 ? "a factor per spring class and kappa"
+                 ? "a factor per spring class and kappa, ridge on the log factors"
                  : "a factor per spring and kappa, smoothness regulariser on log k over springs "
                    "sharing a node");
   cal.method = method.str();

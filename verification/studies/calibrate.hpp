@@ -43,7 +43,7 @@ struct CalibrateOptions {
   std::optional<int> reference_level;   ///< default: the scene's
   CalibrationGranularity granularity = CalibrationGranularity::groups;
   std::vector<LoadKind> train;  ///< load types fitted on; default: the scene's load type
-  /// Per-spring fits; groups use none. Defaults: msm::Regulariser's doc.
+  /// Per-spring fits: both terms; group fits: the ridge alone. Defaults: msm::Regulariser's doc.
   msm::Regulariser regulariser{1e-2, 1e-3};
   int max_iterations = 200;
   /// Further scenes whose own loads are held-out cases on another vessel (group calibrations).
