@@ -17,6 +17,9 @@
 ///   calibrated one and FEM P1 on the model's mesh, all against the P2 reference at the model's
 ///   nodes (the harness's metric, verification/metrics.hpp). Training and held-out errors are
 ///   reported apart.
+/// - The FEM answers of each load shape (P2 at the model's nodes, P1) are cached under
+///   cache_dir/calibrate/, keyed by everything that determines them (meshes, points, material,
+///   supports, load); a cached P1 keeps the solve time measured when it was computed.
 #include <filesystem>
 #include <optional>
 #include <ostream>
