@@ -439,6 +439,7 @@ std::string msm_detail(const std::string& topology, const ModelSpec& spec) {
   d << topology << ", " << msm::to_string(spec.stiffness) << " stiffness, "
     << msm::to_string(spec.mass) << " masses, " << msm::to_string(spec.solver);
   if (spec.roi_radius > 0.0) d << ", region of interest R = " << spec.roi_radius * 1e3 << " mm";
+  if (!spec.calibration.empty()) d << ", calibrated (" << spec.calibration.filename().string() << ")";
   return d.str();
 }
 
@@ -508,7 +509,7 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
   Stopwatch setup;
   VesselParams vessel = s.vessel;
   vessel.level = base.level;
-  const msm::BuiltNetwork built = msm::build_network(mesh, vessel, network_options(s, spec, nu));
+  const msm::BuiltNetwork built = scene_network(s, spec, mesh, vessel, nu);
   const auto model_ptr = msm::make_model(built, spec.damping);
   const msm::MassSpringModel& model = *model_ptr;
   base.setup_seconds = setup.seconds();

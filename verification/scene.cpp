@@ -343,6 +343,12 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
            "constraints act on a surface network)");
   }
   m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
+  m.calibration = r.string_or("calibration", "");
+  m.calibration_transfer = r.boolean_or("calibration_transfer", false);
+  if (m.calibration_transfer && m.calibration.empty()) {
+    r.fail(r.get("calibration_transfer"), "calibration_transfer",
+           "found without a calibration file; expected calibration = \"file.json\" beside it");
+  }
   const std::vector<double> radii = roi_radii(r, load);
   std::vector<double> dts{0.0};
   const auto dynamic = std::find_if(solvers.begin(), solvers.end(), is_dynamic);
@@ -549,6 +555,9 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
     for (ModelSpec& m :
          read_model(TableReader(*t, "models[" + std::to_string(i) + "].", source_name), i,
                     scene.load.kind)) {
+      if (!m.calibration.empty() && m.calibration.is_relative()) {
+        m.calibration = std::filesystem::path(source_name).parent_path() / m.calibration;
+      }
       if (!names.insert(m.name).second) {
         r.fail(list->get(i), "models",
                "model name \"" + m.name + "\" is used twice; names must be unique");

@@ -41,6 +41,12 @@ struct ModelSpec {
   /// Region of interest (mass-spring, contact loads): nodes farther than this from the contact
   /// point are fixed and their unknowns removed from the solve, m; 0 = the whole vessel.
   double roi_radius = 0.0;
+  /// Mass-spring: a calibration file of `vesselverify calibrate` (verification/calibration_file
+  /// .hpp) whose stiffness factors are applied to the built network; relative paths are resolved
+  /// against the scene file's folder. Empty: none.
+  std::filesystem::path calibration;
+  /// Apply a group calibration to a mesh other than the one it was fitted on (its hash differs).
+  bool calibration_transfer = false;
 };
 
 struct LoadSpec {

@@ -5,6 +5,7 @@
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "msm/model/spring_model.hpp"
+#include "verification/calibration_file.hpp"
 
 namespace vessel {
 
@@ -118,6 +119,18 @@ msm::NetworkOptions network_options(const Scene& s, const ModelSpec& model, doub
   o.mass = model.mass;
   o.density = s.density;
   return o;
+}
+
+msm::BuiltNetwork scene_network(const Scene& s, const ModelSpec& model, const TetMesh& mesh,
+                                const VesselParams& vessel, double nu) {
+  msm::BuiltNetwork built = msm::build_network(mesh, vessel, network_options(s, model, nu));
+  if (!model.calibration.empty()) {
+    const std::string source = s.source.string() + ": model " + model.name + ": calibration " +
+                               model.calibration.string();
+    apply_calibration(read_calibration(model.calibration), source, built, mesh, vessel, model,
+                      s.youngs_modulus, nu, model.calibration_transfer);
+  }
+  return built;
 }
 
 std::vector<Vec3> surface_nodal_loads(const Scene& s, const TetMesh& mesh, double magnitude) {

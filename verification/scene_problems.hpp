@@ -46,6 +46,11 @@ fem::ElasticityProblem fem_problem(const Scene& scene, const TetMesh& mesh, doub
 /// The network options of a mass-spring model of the scene at ν.
 msm::NetworkOptions network_options(const Scene& scene, const ModelSpec& model, double nu);
 
+/// The network of a mass-spring model of the scene on `mesh` (vessel at the mesh's level) at ν,
+/// with the model's calibration file applied when it names one (verification/calibration_file).
+msm::BuiltNetwork scene_network(const Scene& scene, const ModelSpec& model, const TetMesh& mesh,
+                                const VesselParams& vessel, double nu);
+
 /// The consistent nodal loads (N, per mesh node) of the scene's surface loads (contact patch,
 /// pressure) at `magnitude` for the swept load: what the FEM integrates, lumped to the nodes.
 /// Gravity is not among them: mass-spring models carry it on their own masses.

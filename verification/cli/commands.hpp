@@ -21,5 +21,7 @@ void add_msm_command(CLI::App& app);
 void add_fem_command(CLI::App& app);
 /// `vesselverify stability`: critical time steps and hard cases (stability_command.cpp).
 void add_stability_command(CLI::App& app, const std::string& command_line);
+/// `vesselverify calibrate`: stiffness fitted to the FEM, checked on held-out loads.
+void add_calibrate_command(CLI::App& app, const std::string& command_line);
 
 }  // namespace vessel::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   vessel::cli::add_msm_command(app);
   vessel::cli::add_fem_command(app);
   vessel::cli::add_stability_command(app, command_line);
+  vessel::cli::add_calibrate_command(app, command_line);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

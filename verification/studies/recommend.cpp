@@ -209,6 +209,19 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
         }
       }
     }
+    // The scene's calibrated mass-spring models (`calibration = "file.json"`, vesselverify
+    // calibrate), with the same calibration, under both static solvers.
+    for (const ModelSpec& scene_model : s.models) {
+      if (scene_model.kind == ModelKind::fem || scene_model.calibration.empty()) continue;
+      ModelSpec m = scene_model;
+      m.roi_radius = 0.0;
+      for (const std::string solver : {"static", "linear"}) {
+        m.solver = msm::parse_solver(solver);
+        m.name = std::string(m.kind == ModelKind::volume_msm ? "volume" : "surface") +
+                 "/calibrated-" + scene_model.calibration.stem().string() + "/" + solver;
+        out.push_back(m);
+      }
+    }
     return out;
   }
   // Dynamic: the scene's time steps per integrator family, its longest simulated time, its damping.

@@ -80,7 +80,8 @@ struct RecommendOptions {
 /// integrator (explicit or implicit; all of the scene's if it has none of that family), over the
 /// scene's longest simulated time, with the scene's point damping, and the local–global implicit
 /// Euler (Liu et al. 2013, its default iterations per step) at the implicit family's time steps
-/// on the plain spring networks.
+/// on the plain spring networks. Static scenes also get each calibrated mass-spring model of the
+/// scene (`calibration = "file.json"`) under both static solvers ("volume/calibrated-<file>/...").
 std::vector<ModelSpec> candidate_models(const Scene& scene, const std::vector<double>& roi_radii);
 
 /// Candidates' evidence from a run: per (model, level) the worst error and time over ν at the

@@ -247,3 +247,29 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
     EXPECT_DOUBLE_EQ(x.damping, 1e-4);
   }
 }
+
+TEST(Candidates, IncludeTheScenesCalibratedModels) {
+  Scene s;
+  s.load.kind = LoadKind::contact;
+  ModelSpec m;
+  m.kind = ModelKind::volume_msm;
+  m.stiffness = msm::StiffnessRule::van_gelder;
+  m.volume_term = true;
+  m.calibration = "/x/hybrid_groups.json";
+  m.calibration_transfer = true;
+  s.models = {m};
+  const std::vector<ModelSpec> c = candidate_models(s, {4e-3});
+  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 1;
+  ASSERT_EQ(c.size(), 1 + spring_models * 3 + 2);
+  int calibrated = 0;
+  for (const auto& x : c) {
+    if (x.calibration.empty()) continue;
+    ++calibrated;
+    EXPECT_TRUE(x.volume_term);
+    EXPECT_TRUE(x.calibration_transfer);
+    EXPECT_TRUE(x.name == "volume/calibrated-hybrid_groups/static" ||
+                x.name == "volume/calibrated-hybrid_groups/linear")
+        << x.name;
+  }
+  EXPECT_EQ(calibrated, 2);
+}

@@ -1,0 +1,135 @@
+#pragma once
+/// Stiffness calibration of a mass-spring network against reference displacements (issue 14
+/// item 4): the network's spring stiffnesses and its volume term's κ, scaled by factors
+/// exp(θ) (log-parameters keep every stiffness positive), are fitted by least squares on nodal
+/// displacements over a set of load cases.
+///
+/// The fit uses the model linearised at rest: K(θ)·u_c = f_c on the free dofs, with
+///   K(θ) = Σ_s k_s(θ)·B_s + κ(θ)·Σ_t g_t g_tᵀ/|V₀,t|,
+/// B_s = d dᵀ ⊗ [1 −1; −1 1] the rest Hessian of spring s (direction d; the transverse term ψ'/L
+/// vanishes at rest) and g_t = ∂V/∂x of tet t at rest (the volume term's rest Hessian,
+/// volume_term.hpp; its ∇²V term carries V − V₀ = 0). K is linear in the stiffnesses, so
+///   J(θ) = Σ_c ½·w_c·|u_c(θ) − r_c|²  (+ regulariser),   w_c = 1/(C·|r_c|²)
+/// (C cases: J is half the mean squared relative L2 error of the harness's metric) has the
+/// adjoint gradient (one extra solve per case with the same factorisation):
+///   K λ_c = w_c (u_c − r_c),   ∂J/∂θ_p = −Σ_c λ_cᵀ (∂K/∂θ_p) u_c
+///   = −Σ_c [Σ_{s∈p} k_s (d·Δλ_s)(d·Δu_s) + (p = κ) Σ_t κ/|V₀| (g_t·λ_t)(g_t·u_t)],
+/// Δ the difference of the spring's two end nodes. The loads of the scenes are in the linear
+/// regime, so the linearised fit is what the calibrated model does to first order; the
+/// calibrated model is then evaluated as the scene solves it (nonlinear), by the caller.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "meshes/vessel_geometry.hpp"
+#include "msm/model/form.hpp"
+#include "msm/topology/springs.hpp"
+
+namespace vessel::msm {
+
+/// Which parameter scales each spring and the volume term: k_s = k_s0·exp(θ[of_spring[s]]),
+/// κ = κ0·exp(θ[kappa]). of_spring[s] = −1: spring s keeps its stiffness.
+struct StiffnessParameters {
+  std::vector<std::string> names;  ///< one per parameter
+  std::vector<int> of_spring;      ///< per spring of the network
+  int kappa = -1;                  ///< κ's parameter, −1: none (or no volume term)
+  [[nodiscard]] int size() const { return static_cast<int>(names.size()); }
+};
+
+/// A few parameters ("groups"): on a surface network one factor per spring family present
+/// (structural, shear, bend, two_ring); on a volume network one per (direction, boundary) class
+/// of the tet-edge springs: direction = the largest component of the spring's unit vector in the
+/// vessel's centreline frame at its midpoint (radial e_ρ, circumferential e_θ, axial e_s), and
+/// boundary = whether the edge lies on a boundary face of the tet mesh (boundary edges get less
+/// tet volume under Van Gelder's Σ V_e weights, so they are the class most likely to be off).
+/// Plus "kappa" when with_kappa. The classes are defined by the vessel's geometry, not by spring
+/// indices, so a group calibration applies to any mesh of any vessel kind.
+StiffnessParameters group_parameters(const SpringNetwork& network, const VesselParams& vessel,
+                                     bool with_kappa);
+/// The class name group_parameters gives spring s ("volume/axial/boundary", "bend", ...).
+std::string spring_class(const SpringNetwork& network, const VesselParams& vessel,
+                         const std::vector<char>& boundary_edge, std::size_t s);
+/// Per spring of a volume network: whether it is an edge of a boundary face (one tet only).
+std::vector<char> boundary_edges(const SpringNetwork& network);
+
+/// One parameter per spring ("spring/<index>"), plus "kappa" when with_kappa. Such a
+/// calibration belongs to this network only.
+StiffnessParameters per_spring_parameters(const SpringNetwork& network, bool with_kappa);
+
+/// Scales network's spring laws (k1 and k2) and *kappa by the factors exp(θ). InputError if the
+/// sizes do not match the network, or θ names κ while kappa is empty.
+void apply_stiffness_factors(SpringNetwork& network, std::optional<double>& kappa,
+                             const StiffnessParameters& params, const VectorXd& theta);
+
+/// One load case of a fit: nodal forces f (N, per dof, full network) and the reference
+/// displacement r at the network's nodes (m, per dof), in the same dof order.
+struct FitCase {
+  std::string name;
+  VectorXd force;
+  VectorXd reference;
+};
+
+/// The smoothness regulariser of a per-spring fit:
+///   R(θ) = α/(2·N_s) · Σ_nodes Σ_{s∋n} (θ_{p(s)} − θ̄_n)²  +  β/(2·P) · Σ_p θ_p²,
+/// θ̄_n the mean of θ over the springs meeting at node n. The first term is, per node, 1/m_n
+/// times the sum over all pairs of its m_n springs of (log k_s/k_s0 − log k_t/k_t0)²/2: springs
+/// sharing a node are pushed towards the same correction of their base rule. The ridge β keeps
+/// the fit well posed where the data see nothing.
+struct Regulariser {
+  double smoothness = 0.0;  ///< α
+  double ridge = 0.0;       ///< β
+};
+
+/// The linearised least-squares fit and its adjoint gradient (header comment).
+class LinearisedFit {
+ public:
+  /// `fixed` per dof (the problem's supports). InputError if a case's sizes differ from the
+  /// network's dofs, its reference is zero, or params do not match the network.
+  LinearisedFit(const SpringNetwork& network, std::optional<double> kappa,
+                const std::vector<char>& fixed, StiffnessParameters params,
+                std::vector<FitCase> cases, Regulariser regulariser = {});
+
+  /// J(θ) and ∂J/∂θ (adjoint: one factorisation, one forward and one adjoint solve per case).
+  double objective(const VectorXd& theta, VectorXd& gradient) const;
+  /// The data term alone and the regulariser alone at θ.
+  [[nodiscard]] double misfit(const VectorXd& theta) const;
+  [[nodiscard]] double regularisation(const VectorXd& theta) const;
+  /// Displacements u_c(θ) of the linearised model (per dof, full network, fixed dofs 0), m.
+  [[nodiscard]] std::vector<VectorXd> displacements(const VectorXd& theta) const;
+  /// Per case, the relative L2 error |u_c − r_c|/|r_c| of the linearised model at θ.
+  [[nodiscard]] std::vector<double> relative_errors(const VectorXd& theta) const;
+  /// K(θ) on the free dofs (N/m).
+  [[nodiscard]] SparseMatrix stiffness(const VectorXd& theta) const;
+
+  [[nodiscard]] const StiffnessParameters& parameters() const { return params_; }
+  [[nodiscard]] int num_cases() const { return static_cast<int>(cases_.size()); }
+
+ private:
+  struct Evaluation;
+  [[nodiscard]] Evaluation evaluate(const VectorXd& theta, bool adjoint) const;
+  [[nodiscard]] double regulariser_value(const VectorXd& theta, VectorXd* gradient) const;
+
+  struct RestSpring {
+    int a, b, param;
+    Vec3 d;
+    double k;
+  };
+  struct RestTet {
+    std::array<int, 4> nodes;
+    Eigen::Matrix<double, 12, 1> g;  ///< ∂V/∂x at rest
+    double inv_volume;               ///< 1/|V₀|
+  };
+  std::vector<RestSpring> springs_;
+  std::vector<RestTet> tets_;
+  double kappa0_ = 0.0;
+  StiffnessParameters params_;
+  std::vector<FitCase> cases_;
+  std::vector<double> weights_;
+  Regulariser regulariser_;
+  int num_dofs_ = 0;
+  std::vector<int> free_index_;  ///< per dof: its index among the free dofs, −1 if fixed
+  int num_free_ = 0;
+  std::vector<std::vector<int>> node_springs_;  ///< springs meeting at each node
+};
+
+}  // namespace vessel::msm

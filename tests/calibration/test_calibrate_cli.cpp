@@ -1,0 +1,91 @@
+// `vesselverify calibrate` end to end on a short tube (models at level 0, reference P2 at level 0
+// to keep it short): the calibration file is written with its training loads, training and
+// held-out errors are reported apart, the calibrated model improves on its training load (the
+// P2 reference is the independent truth), a scene's model runs with the file, and the same file
+// on another mesh level is refused with an error naming the mesh hash.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "test_helpers.hpp"
+
+using vessel::test::read_text;
+using vessel::test::TempDir;
+using vessel::test::vv;
+using vessel::test::write_text;
+
+namespace {
+
+std::string scene_text(int level, const std::string& extra_model) {
+  return R"(name = "short_contact"
+[vessel]
+kind = "straight"
+length = 10.0e-3
+mesh = "structured"
+level = )" + std::to_string(level) + R"(
+reference_level = 0
+[material]
+E = 14.24e3
+nu = 0.45
+[load]
+type = "contact"
+magnitudes = [1.0e-4, 5.0e-4]
+point = [3.0e-3, 0.0, 5.0e-3]
+patch_radius = 1.0e-3
+[budget]
+magnitude = 5.0e-4
+rate_hz = 30
+[[models]]
+name = "volume_hybrid"
+kind = "volume_msm"
+volume_term = true
+stiffness = "van-gelder"
+)" + extra_model;
+}
+
+}  // namespace
+
+TEST(CalibrateCli, FitsReportsHeldOutAndTheFileIsUsedOnItsMeshOnly) {
+  const TempDir dir;
+  write_text(dir / "scene.toml", scene_text(0, ""));
+  const auto r = vv("calibrate " + (dir / "scene.toml").string() + " --output " +
+                    (dir / "cal.json").string() + " --cache-dir " + (dir / "cache").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("## Training loads"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("## Held-out loads"), std::string::npos);
+  EXPECT_NE(r.output.find("other contact point"), std::string::npos);
+  EXPECT_NE(r.output.find("other load type"), std::string::npos);
+  EXPECT_NE(r.output.find("other magnitude"), std::string::npos);
+  const auto j = nlohmann::json::parse(read_text(dir / "cal.json"));
+  EXPECT_EQ(j["schema"], "vesselverify.calibration");
+  EXPECT_EQ(j["training_loads"].size(), 2u);
+  EXPECT_EQ(j["model"]["name"], "volume_hybrid");
+  ASSERT_TRUE(j["factors"].contains("kappa"));
+  // The fit lowered the training loads' error (linearised model, against the P2 reference).
+  for (const auto& c : j["fit"]["training_cases_linearised"]) {
+    EXPECT_LT(c["relative_l2_after"].get<double>(), c["relative_l2_before"].get<double>());
+  }
+
+  const std::string calibrated = R"(
+[[models]]
+name = "volume_calibrated"
+kind = "volume_msm"
+volume_term = true
+stiffness = "van-gelder"
+calibration = "cal.json"
+)";
+  write_text(dir / "with_cal.toml", scene_text(0, calibrated));
+  const auto run = vv("run --fields none --output-dir " + (dir / "out").string() + " --cache-dir " +
+                      (dir / "cache").string() + " " + (dir / "with_cal.toml").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto results = nlohmann::json::parse(read_text(dir / "out" / "results.json"));
+  EXPECT_NE(results.dump().find("calibrated (cal.json)"), std::string::npos);
+
+  write_text(dir / "level1.toml", scene_text(1, calibrated));
+  const auto bad = vv("run --fields none --output-dir " + (dir / "out1").string() +
+                      " --cache-dir " + (dir / "cache").string() + " " +
+                      (dir / "level1.toml").string());
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("mesh.hash"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("cal.json"), std::string::npos) << bad.output;
+}

@@ -1,0 +1,232 @@
+// Calibration files (verification/calibration_file): a round trip, the factors applied to a
+// network as the fit defines them, and clear errors for another mesh, a per-spring transfer,
+// and bad files; the scene keys that refer to a file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "meshes/errors.hpp"
+#include "msm/model/build_network.hpp"
+#include "verification/calibration_file.hpp"
+#include "verification/scene.hpp"
+
+using namespace vessel;
+
+namespace {
+
+TetMesh block_mesh(int n, double h) {
+  TetMesh m;
+  auto id = [n](int i, int j, int k) { return (k * (n + 1) + j) * (n + 1) + i; };
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) m.nodes.emplace_back(3e-3 + i * h, j * h, k * h);
+  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7},
+                          {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (const auto& t : kuhn) {
+          Tet tet{};
+          for (int a = 0; a < 4; ++a) {
+            const int c = t[a];
+            tet[a] = id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1));
+          }
+          m.tets.push_back(tet);
+        }
+  orient_tets(m);
+  return m;
+}
+
+constexpr double kE = 14.24e3;
+
+ModelSpec hybrid_spec() {
+  ModelSpec m;
+  m.name = "volume_hybrid";
+  m.kind = ModelKind::volume_msm;
+  m.stiffness = msm::StiffnessRule::van_gelder;
+  m.volume_term = true;
+  return m;
+}
+
+msm::BuiltNetwork hybrid(const TetMesh& mesh) {
+  msm::NetworkOptions o;
+  o.model = msm::ModelType::volume;
+  o.stiffness = msm::StiffnessRule::van_gelder;
+  o.stiffness_params.youngs_modulus = kE;
+  o.stiffness_params.poisson_ratio = 0.45;
+  o.volume_term = true;
+  return msm::build_network(mesh, VesselParams{}, o);
+}
+
+/// A calibration of `built` on `mesh` with factors 1 + 0.1·(index + 1).
+Calibration make_calibration(const TetMesh& mesh, const msm::BuiltNetwork& built, bool per_spring) {
+  const msm::StiffnessParameters p =
+      per_spring ? msm::per_spring_parameters(built.network, true)
+                 : msm::group_parameters(built.network, VesselParams{}, true);
+  Calibration c;
+  c.granularity = per_spring ? "per_spring" : "groups";
+  c.scene = "block";
+  c.model = "volume_hybrid";
+  c.model_kind = "volume_msm";
+  c.stiffness = "van-gelder";
+  c.volume_term = true;
+  c.poisson_ratio = 0.45;
+  c.youngs_modulus = kE;
+  c.mesh_hash = mesh_hash(mesh);
+  c.vessel = "block";
+  c.nodes = mesh.nodes.size();
+  c.springs = built.network.springs.size();
+  c.tets = mesh.tets.size();
+  c.names = p.names;
+  for (int i = 0; i < p.size(); ++i) c.factors.push_back(1.0 + 0.1 * (i % 7 + 1));
+  c.training_loads.push_back({"contact θ+0°", LoadKind::contact, 5e-4, Vec3(3e-3, 0, 0.02)});
+  c.fit_cases.push_back({"contact θ+0°", 0.5, 0.1});
+  c.method = "test";
+  return c;
+}
+
+std::filesystem::path temp_file(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / "vessel_calibration_tests";
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
+void expect_input_error(const std::function<void()>& f, const std::string& needle) {
+  try {
+    f();
+    ADD_FAILURE() << "expected an InputError mentioning " << needle;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+
+TEST(CalibrationFile, RoundTripAndAppliedFactorsScaleEachSpringAndKappa) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  for (const bool per_spring : {false, true}) {
+    const msm::BuiltNetwork base = hybrid(mesh);
+    const Calibration c = make_calibration(mesh, base, per_spring);
+    const auto path = temp_file(per_spring ? "per_spring.json" : "groups.json");
+    write_calibration(path, c);
+    const Calibration r = read_calibration(path);
+    EXPECT_EQ(r.granularity, c.granularity);
+    EXPECT_EQ(r.mesh_hash, c.mesh_hash);
+    ASSERT_EQ(r.names.size(), c.names.size());
+    for (std::size_t i = 0; i < c.names.size(); ++i) {
+      const auto it = std::find(r.names.begin(), r.names.end(), c.names[i]);
+      ASSERT_NE(it, r.names.end()) << c.names[i];
+      EXPECT_DOUBLE_EQ(r.factors[static_cast<std::size_t>(it - r.names.begin())], c.factors[i]);
+    }
+    ASSERT_EQ(r.training_loads.size(), 1u);
+    EXPECT_EQ(r.training_loads[0].kind, LoadKind::contact);
+    EXPECT_DOUBLE_EQ(r.training_loads[0].point.z(), 0.02);
+
+    msm::BuiltNetwork applied = base;
+    apply_calibration(r, "test", applied, mesh, VesselParams{}, hybrid_spec(), kE, 0.45, false);
+    // Each spring's k is its base k times the factor its class (or index) was given.
+    const msm::StiffnessParameters p =
+        per_spring ? msm::per_spring_parameters(base.network, true)
+                   : msm::group_parameters(base.network, VesselParams{}, true);
+    for (std::size_t s = 0; s < base.network.springs.size(); ++s) {
+      const double factor = c.factors[static_cast<std::size_t>(p.of_spring[s])];
+      EXPECT_NEAR(applied.network.springs[s].law.k1, factor * base.network.springs[s].law.k1,
+                  1e-12 * base.network.springs[s].law.k1);
+    }
+    EXPECT_NEAR(*applied.volume_kappa, c.factors.back() * *base.volume_kappa,
+                1e-12 * *base.volume_kappa);
+  }
+}
+
+TEST(CalibrationFile, AnotherMeshIsRefusedUnlessAGroupCalibrationTransfers) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  TetMesh moved = mesh;
+  moved.nodes[5].x() += 1e-6;  // one node 1 µm away: another mesh
+  EXPECT_NE(mesh_hash(mesh), mesh_hash(moved));
+  EXPECT_EQ(mesh_hash(mesh), mesh_hash(block_mesh(2, 1e-3)));
+  const msm::BuiltNetwork base = hybrid(mesh);
+  for (const bool per_spring : {false, true}) {
+    const Calibration c = make_calibration(mesh, base, per_spring);
+    msm::BuiltNetwork on_moved = hybrid(moved);
+    expect_input_error(
+        [&] {
+          apply_calibration(c, "cal.json", on_moved, moved, VesselParams{}, hybrid_spec(), kE,
+                            0.45, false);
+        },
+        "mesh.hash");
+    if (per_spring) {
+      expect_input_error(
+          [&] {
+            apply_calibration(c, "cal.json", on_moved, moved, VesselParams{}, hybrid_spec(), kE,
+                              0.45, true);
+          },
+          "cannot transfer");
+    } else {
+      EXPECT_NO_THROW(apply_calibration(c, "cal.json", on_moved, moved, VesselParams{},
+                                        hybrid_spec(), kE, 0.45, true));
+    }
+  }
+  // Another ν or another model is refused too.
+  const Calibration c = make_calibration(mesh, base, false);
+  msm::BuiltNetwork b = base;
+  expect_input_error(
+      [&] { apply_calibration(c, "cal.json", b, mesh, VesselParams{}, hybrid_spec(), kE, 0.49, false); },
+      "nu = 0.45");
+  ModelSpec other = hybrid_spec();
+  other.volume_term = false;
+  expect_input_error(
+      [&] { apply_calibration(c, "cal.json", b, mesh, VesselParams{}, other, kE, 0.45, false); },
+      "cal.json: model");
+}
+
+TEST(CalibrationFile, BadFilesGiveErrorsNamingFileAndKey) {
+  const auto path = temp_file("bad.json");
+  const auto write = [&](const std::string& text) {
+    std::ofstream(path) << text;
+  };
+  expect_input_error([&] { read_calibration(temp_file("missing.json")); }, "cannot open");
+  write("{ not json");
+  expect_input_error([&] { read_calibration(path); }, "not valid JSON");
+  write(R"({"schema": "other", "version": 1})");
+  expect_input_error([&] { read_calibration(path); }, "\"schema\"");
+  const TetMesh mesh = block_mesh(1, 1e-3);
+  const msm::BuiltNetwork base = hybrid(mesh);
+  write_calibration(path, make_calibration(mesh, base, false));
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    t.replace(at, from.size(), to);
+    return t;
+  };
+  write(replace("\"hash\"", "\"hush\""));
+  expect_input_error([&] { read_calibration(path); }, "\"hash\" missing");
+  write(replace("\"kappa\": 1.", "\"kappa\": -1."));
+  expect_input_error([&] { read_calibration(path); }, "expected a finite factor > 0");
+  write(replace("\"granularity\": \"groups\"", "\"granularity\": \"both\""));
+  expect_input_error([&] { read_calibration(path); }, "\"granularity\"");
+}
+
+TEST(CalibrationFile, SceneModelsReferToAFileBesideTheScene) {
+  const std::string base = R"(
+name = "t"
+[vessel]
+kind = "straight"
+[load]
+type = "pressure"
+magnitudes = [10.0]
+[[models]]
+name = "cal"
+kind = "volume_msm"
+volume_term = true
+)";
+  const Scene s = parse_scene(base + "calibration = \"cal.json\"\ncalibration_transfer = true\n",
+                              "/some/dir/scene.toml");
+  EXPECT_EQ(s.models[0].calibration, std::filesystem::path("/some/dir/cal.json"));
+  EXPECT_TRUE(s.models[0].calibration_transfer);
+  expect_input_error([&] { parse_scene(base + "calibration_transfer = true\n", "scene.toml"); },
+                     "calibration_transfer");
+}

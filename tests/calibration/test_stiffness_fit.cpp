@@ -1,0 +1,236 @@
+// The linearised stiffness fit (msm/calibration/stiffness_fit): its stiffness matrix against the
+// model's own Hessian at rest, the adjoint gradient against central finite differences of the
+// objective, and the recovery of stiffness factors planted in synthetic data that the nonlinear
+// model generated with them (the planted factors are the independent truth).
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+
+#include "meshes/errors.hpp"
+#include "msm/calibration/lbfgs.hpp"
+#include "msm/calibration/stiffness_fit.hpp"
+#include "msm/model/build_network.hpp"
+#include "msm/model/model_factory.hpp"
+#include "msm/solvers/solve.hpp"
+
+using namespace vessel;
+using namespace vessel::msm;
+
+namespace {
+
+constexpr double kE = 14.24e3;
+
+/// An n×n×n block of cubes of side h (Kuhn's six tets each), shifted to x ≥ 3 mm so that the
+/// straight vessel's centreline frame (radial from the z axis) is defined everywhere.
+TetMesh block_mesh(int n, double h) {
+  TetMesh m;
+  auto id = [n](int i, int j, int k) { return (k * (n + 1) + j) * (n + 1) + i; };
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) m.nodes.emplace_back(3e-3 + i * h, j * h, k * h);
+  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7},
+                          {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (const auto& t : kuhn) {
+          Tet tet{};
+          for (int a = 0; a < 4; ++a) {
+            const int c = t[a];
+            tet[a] = id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1));
+          }
+          m.tets.push_back(tet);
+        }
+  orient_tets(m);
+  return m;
+}
+
+BuiltNetwork hybrid(const TetMesh& mesh, double nu) {
+  NetworkOptions o;
+  o.model = ModelType::volume;
+  o.stiffness = StiffnessRule::van_gelder;
+  o.stiffness_params.youngs_modulus = kE;
+  o.stiffness_params.poisson_ratio = nu;
+  o.volume_term = true;
+  return build_network(mesh, VesselParams{}, o);
+}
+
+/// The bottom face (z = 0) held.
+std::vector<char> bottom_fixed(const SpringNetwork& net) {
+  std::vector<char> fixed(3 * net.nodes.size(), 0);
+  for (std::size_t i = 0; i < net.nodes.size(); ++i) {
+    if (net.nodes[i].z() < 1e-9) fixed[3 * i] = fixed[3 * i + 1] = fixed[3 * i + 2] = 1;
+  }
+  return fixed;
+}
+
+/// Random forces (N) on the free nodes of the upper half.
+Eigen::VectorXd random_load(const SpringNetwork& net, std::mt19937& rng, double scale) {
+  std::normal_distribution<double> g;
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(net.nodes.size()));
+  for (std::size_t i = 0; i < net.nodes.size(); ++i) {
+    if (net.nodes[i].z() < 1.5e-3) continue;
+    for (int c = 0; c < 3; ++c) f[3 * static_cast<Eigen::Index>(i) + c] = scale * g(rng);
+  }
+  return f;
+}
+
+/// The nonlinear model's static answer u = x − x0 (m, per dof) under f.
+Eigen::VectorXd static_displacement(const BuiltNetwork& built, const std::vector<char>& fixed,
+                                    const Eigen::VectorXd& f) {
+  const auto model = make_model(built);
+  Problem p;
+  p.form = model.get();
+  p.rest = flatten(built.network.nodes);
+  p.external_force = f;
+  p.mass = Eigen::VectorXd::Ones(p.rest.size());
+  p.fixed = fixed;
+  const SolveResult r = solve(p, parse_solver("static"));
+  return r.x - p.rest;
+}
+
+}  // namespace
+
+TEST(StiffnessFit, LinearisedStiffnessIsTheModelsHessianAtRest) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  const BuiltNetwork built = hybrid(mesh, 0.45);
+  const std::vector<char> fixed = bottom_fixed(built.network);
+  const StiffnessParameters params = group_parameters(built.network, VesselParams{}, true);
+  std::mt19937 rng(1);
+  const Eigen::VectorXd f = random_load(built.network, rng, 1e-6);
+  const LinearisedFit fit(built.network, built.volume_kappa, fixed, params,
+                          {{"c", f, Eigen::VectorXd::Ones(f.size())}});
+  const SparseMatrix K = fit.stiffness(Eigen::VectorXd::Zero(params.size()));
+  const auto model = make_model(built);
+  SparseMatrix H;
+  model->hessian(flatten(built.network.nodes), H, false);
+  const Eigen::MatrixXd Hd(H);
+  std::vector<int> free;
+  for (std::size_t i = 0; i < fixed.size(); ++i) {
+    if (!fixed[i]) free.push_back(static_cast<int>(i));
+  }
+  const Eigen::MatrixXd Kd(K);
+  ASSERT_EQ(Kd.rows(), static_cast<Eigen::Index>(free.size()));
+  double worst = 0.0;
+  for (std::size_t i = 0; i < free.size(); ++i) {
+    for (std::size_t j = 0; j < free.size(); ++j) {
+      worst = std::max(worst, std::abs(Kd(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) -
+                                       Hd(free[i], free[j])));
+    }
+  }
+  EXPECT_LT(worst, 1e-9 * Hd.cwiseAbs().maxCoeff());
+}
+
+TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  const BuiltNetwork built = hybrid(mesh, 0.45);
+  const std::vector<char> fixed = bottom_fixed(built.network);
+  std::mt19937 rng(5);
+  std::vector<FitCase> cases;
+  for (int c = 0; c < 2; ++c) {
+    const Eigen::VectorXd f = random_load(built.network, rng, 1e-6);
+    Eigen::VectorXd r = static_displacement(built, fixed, 1.3 * f);  // a different stiffness
+    for (Eigen::Index i = 0; i < r.size(); ++i) {
+      if (!fixed[static_cast<std::size_t>(i)]) r[i] += 1e-8 * std::sin(1.0 + i);
+    }
+    cases.push_back({"case" + std::to_string(c), f, r});
+  }
+  for (const bool per_spring : {false, true}) {
+    const StiffnessParameters params =
+        per_spring ? per_spring_parameters(built.network, true)
+                   : group_parameters(built.network, VesselParams{}, true);
+    const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases,
+                            per_spring ? Regulariser{0.3, 1e-3} : Regulariser{});
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    Eigen::VectorXd theta(params.size());
+    for (Eigen::Index i = 0; i < theta.size(); ++i) theta[i] = u(rng);
+    Eigen::VectorXd g;
+    fit.objective(theta, g);
+    const double h = 1e-6;
+    int checked = 0;
+    for (Eigen::Index p = 0; p < theta.size(); p += per_spring ? 7 : 1) {
+      Eigen::VectorXd tp = theta, tm = theta, dummy;
+      tp[p] += h;
+      tm[p] -= h;
+      const double fd = (fit.objective(tp, dummy) - fit.objective(tm, dummy)) / (2 * h);
+      EXPECT_NEAR(g[p], fd, 1e-6 * std::abs(fd) + 1e-7 * g.lpNorm<Eigen::Infinity>())
+          << (per_spring ? "per spring, " : "groups, ") << params.names[static_cast<std::size_t>(p)];
+      ++checked;
+    }
+    EXPECT_GT(checked, 5);
+  }
+}
+
+TEST(StiffnessFit, RecoversPlantedGroupFactorsFromTheModelsOwnData) {
+  const TetMesh mesh = block_mesh(3, 1e-3);
+  const BuiltNetwork built = hybrid(mesh, 0.45);
+  const std::vector<char> fixed = bottom_fixed(built.network);
+  const StiffnessParameters params = group_parameters(built.network, VesselParams{}, true);
+  ASSERT_GE(params.size(), 5);  // several direction/boundary classes plus kappa
+  // Planted factors: exp(θ*) from 0.5 to 2 across the classes.
+  Eigen::VectorXd planted(params.size());
+  for (Eigen::Index p = 0; p < planted.size(); ++p) {
+    planted[p] = std::log(0.5) + std::log(4.0) * static_cast<double>(p) / (planted.size() - 1);
+  }
+  BuiltNetwork truth = built;
+  apply_stiffness_factors(truth.network, truth.volume_kappa, params, planted);
+  std::mt19937 rng(11);
+  std::vector<FitCase> cases;
+  for (int c = 0; c < 4; ++c) {
+    const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);  // strain ~1e-5: linear
+    cases.push_back({"case" + std::to_string(c), f, static_displacement(truth, fixed, f)});
+  }
+  const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases);
+  const Objective f = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+    return fit.objective(x, g);
+  };
+  LbfgsOptions o;
+  o.max_iterations = 500;
+  o.gradient_tolerance = 1e-12;
+  const LbfgsResult r = minimize_lbfgs(f, Eigen::VectorXd::Zero(params.size()), o);
+  for (Eigen::Index p = 0; p < planted.size(); ++p) {
+    EXPECT_NEAR(std::exp(r.x[p]), std::exp(planted[p]), 2e-3 * std::exp(planted[p]))
+        << params.names[static_cast<std::size_t>(p)];
+  }
+  for (const double e : fit.relative_errors(r.x)) EXPECT_LT(e, 1e-4);
+}
+
+TEST(StiffnessFit, PerSpringFitReducesTheMisfitOfPlantedData) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  const BuiltNetwork built = hybrid(mesh, 0.45);
+  const std::vector<char> fixed = bottom_fixed(built.network);
+  const StiffnessParameters groups = group_parameters(built.network, VesselParams{}, true);
+  Eigen::VectorXd planted = Eigen::VectorXd::Zero(groups.size());
+  planted[0] = std::log(1.8);
+  BuiltNetwork truth = built;
+  apply_stiffness_factors(truth.network, truth.volume_kappa, groups, planted);
+  std::mt19937 rng(2);
+  const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
+  const LinearisedFit fit(built.network, built.volume_kappa, fixed,
+                          per_spring_parameters(built.network, true),
+                          {{"c", f, static_displacement(truth, fixed, f)}}, Regulariser{1e-4, 1e-6});
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(fit.parameters().size());
+  const double before = fit.misfit(zero);
+  const Objective obj = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+    return fit.objective(x, g);
+  };
+  LbfgsOptions o;
+  o.max_iterations = 300;
+  const LbfgsResult r = minimize_lbfgs(obj, zero, o);
+  EXPECT_LT(fit.misfit(r.x), 1e-2 * before);
+}
+
+TEST(StiffnessFit, RefusesMismatchedSizesAndKappaWithoutVolumeTerm) {
+  const TetMesh mesh = block_mesh(1, 1e-3);
+  BuiltNetwork built = hybrid(mesh, 0.45);
+  const StiffnessParameters params = group_parameters(built.network, VesselParams{}, true);
+  std::optional<double> none;
+  EXPECT_THROW(apply_stiffness_factors(built.network, none, params,
+                                       Eigen::VectorXd::Zero(params.size())),
+               InputError);
+  EXPECT_THROW(apply_stiffness_factors(built.network, built.volume_kappa, params,
+                                       Eigen::VectorXd::Zero(params.size() + 1)),
+               InputError);
+}

@@ -1,0 +1,125 @@
+/// `vesselverify calibrate`: a mass-spring model's stiffness fitted to the FEM reference on a
+/// scene's training loads, and checked on held-out loads (verification/studies/calibrate.hpp).
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "meshes/atomic_file.hpp"
+#include "meshes/errors.hpp"
+#include "meshes/mesh_cache.hpp"
+#include "verification/cli/commands.hpp"
+#include "verification/studies/calibrate.hpp"
+
+namespace vessel::cli {
+
+namespace {
+
+struct Options {
+  std::string scene;
+  std::string model;
+  std::string granularity = "groups";
+  std::vector<std::string> train;
+  std::vector<std::string> held_out_scenes;
+  double nu = -1.0;
+  int level = -1;
+  int reference_level = -1;
+  double smoothness = CalibrateOptions{}.regulariser.smoothness;
+  double ridge = CalibrateOptions{}.regulariser.ridge;
+  int iterations = CalibrateOptions{}.max_iterations;
+  std::filesystem::path output = "calibration.json";
+  std::filesystem::path summary;
+  std::filesystem::path cache_dir = default_cache_dir();
+  std::string command;
+};
+
+LoadKind parse_kind(const std::string& k) {
+  if (k == "contact") return LoadKind::contact;
+  if (k == "pressure") return LoadKind::pressure;
+  if (k == "gravity") return LoadKind::gravity;
+  throw InputError("--train: found \"" + k + "\", expected contact, pressure or gravity");
+}
+
+void run(const Options& o) {
+  const Scene s = read_scene(o.scene);
+  CalibrateOptions c;
+  c.model = o.model;
+  c.granularity = parse_calibration_granularity(o.granularity);
+  for (const auto& k : o.train) c.train.push_back(parse_kind(k));
+  for (const auto& f : o.held_out_scenes) c.other_vessels.push_back(read_scene(f));
+  if (o.nu >= 0.0) c.poisson_ratio = o.nu;
+  if (o.level >= 0) c.level = o.level;
+  if (o.reference_level >= 0) c.reference_level = o.reference_level;
+  c.regulariser = {o.smoothness, o.ridge};
+  c.max_iterations = o.iterations;
+  c.cache_dir = o.cache_dir;
+  c.log = &std::cout;
+  const CalibrationStudy study = calibrate_scene(s, c);
+  write_calibration(o.output, study.calibration);
+  std::ostringstream md;
+  write_calibration_markdown(md, study, o.command);
+  std::cout << "\n" << md.str();
+  if (!o.summary.empty()) {
+    write_file_atomically(o.summary, [&](std::ostream& out) { out << md.str(); });
+  }
+  std::cout << "\nwrote " << o.output.string()
+            << (o.summary.empty() ? "" : " and " + o.summary.string()) << "\n";
+}
+
+}  // namespace
+
+void add_calibrate_command(CLI::App& app, const std::string& command_line) {
+  auto o = std::make_shared<Options>();
+  o->command = command_line;
+  CLI::App* cmd = app.add_subcommand(
+      "calibrate",
+      "Fit a mass-spring model's stiffness to the FEM reference (P2) on the scene's training "
+      "loads, by least squares on nodal displacements (the model linearised at rest, adjoint "
+      "gradients, L-BFGS), and report its error on held-out loads (other magnitudes, other "
+      "contact points, other load types, other vessels) beside P1 and the uncalibrated model. "
+      "Writes a calibration file that a scene's model uses with calibration = \"file.json\".\n"
+      "Examples:\n"
+      "  vesselverify calibrate verification/scenes/contact_straight.toml --held-out-scene "
+      "verification/scenes/contact_arch.toml\n"
+      "  vesselverify calibrate SCENE --granularity per-spring --output per_spring.json");
+  cmd->add_option("scene", o->scene, "Scene file (TOML)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--model", o->model,
+                  "The scene's mass-spring model to calibrate (default: its hybrid volume model, "
+                  "else its first mass-spring model)");
+  cmd->add_option("--granularity", o->granularity,
+                  "groups: a factor per spring class and kappa; per-spring: a factor per spring "
+                  "and kappa, with a smoothness regulariser")
+      ->check(CLI::IsMember({"groups", "per-spring"}))
+      ->capture_default_str();
+  cmd->add_option("--train", o->train,
+                  "Load types fitted on (contact, pressure, gravity; default the scene's); the "
+                  "others are held out")
+      ->delimiter(',');
+  cmd->add_option("--held-out-scene", o->held_out_scenes,
+                  "Scenes whose loads are held-out cases on another vessel (groups only)")
+      ->check(CLI::ExistingFile)
+      ->delimiter(',');
+  cmd->add_option("--nu", o->nu, "Poisson's ratio (default 0.45 if the scene has it, else its first)")
+      ->check(CLI::Range(0.0, 0.5));
+  cmd->add_option("--level", o->level, "Model mesh level (default the scene's first)")
+      ->check(CLI::Range(0, 4));
+  cmd->add_option("--reference-level", o->reference_level,
+                  "Level of the P2 reference (default the scene's)")
+      ->check(CLI::Range(0, 4));
+  cmd->add_option("--smoothness", o->smoothness,
+                  "Per-spring: weight alpha of the smoothness regulariser (log k differences of "
+                  "springs sharing a node)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--ridge", o->ridge, "Per-spring: weight beta of the ridge on log factors")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--iterations", o->iterations, "L-BFGS iterations at most")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("--output", o->output, "Calibration file to write (JSON)")->capture_default_str();
+  cmd->add_option("--summary", o->summary, "Also write the Markdown tables here");
+  cmd->add_option("--cache-dir", o->cache_dir, "Mesh cache directory")->capture_default_str();
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace vessel::cli

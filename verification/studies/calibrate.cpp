@@ -1,0 +1,658 @@
+#include "verification/studies/calibrate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <numbers>
+#include <sstream>
+
+#include "fem_reference/elasticity.hpp"
+#include "meshes/atomic_file.hpp"
+#include "meshes/errors.hpp"
+#include <cstdio>
+#include <fstream>
+#include "msm/calibration/lbfgs.hpp"
+#include "msm/model/model_factory.hpp"
+#include "msm/solvers/updates.hpp"
+#include "reports/representative_load.hpp"
+#include "verification/harness.hpp"
+#include "verification/scene_problems.hpp"
+#include "verification/timing.hpp"
+
+namespace vessel {
+
+std::string to_string(CalibrationGranularity g) {
+  return g == CalibrationGranularity::groups ? "groups" : "per_spring";
+}
+
+CalibrationGranularity parse_calibration_granularity(const std::string& name) {
+  if (name == "groups") return CalibrationGranularity::groups;
+  if (name == "per_spring" || name == "per-spring") return CalibrationGranularity::per_spring;
+  throw InputError("granularity: found \"" + name + "\", expected groups or per-spring");
+}
+
+namespace {
+
+/// Barycentric tolerance of the reference at model nodes (the harness's: nodes on the exact
+/// curved wall lie slightly outside the straight-sided reference tets).
+constexpr double kOutsideTolerance = 0.25;
+/// Held-out contacts on scenes without a contact load: the scenes' patch radius and a load in the
+/// linear regime (the contact scenes' budget load).
+constexpr double kContactRadius = 1.0e-3;
+constexpr double kContactForce = 5.0e-4;
+constexpr double kPressure = 10.0;  ///< Pa: pressure_lame's load
+constexpr double kGravity = 1.0;    ///< g
+
+struct LoadCase {
+  std::string name;
+  bool training = false;
+  std::string holds_out;
+  LoadKind kind = LoadKind::contact;
+  double magnitude = 0.0;
+  Vec3 point = Vec3::Zero();
+};
+
+/// The wall point at arc length s, angle θ around the centreline and distance ρ from it
+/// (the inverse of centreline_coordinates).
+Vec3 wall_point(const VesselParams& v, double s, double theta, double rho) {
+  if (v.kind == VesselKind::straight) {
+    return {rho * std::cos(theta), rho * std::sin(theta), s};
+  }
+  const double phi = s / v.bend_radius;
+  const Vec3 outward(std::cos(phi), std::sin(phi), 0.0);
+  return v.bend_radius * outward + rho * (std::cos(theta) * outward + std::sin(theta) * Vec3::UnitZ());
+}
+
+Vec3 contact_point_of(const Scene& s) {
+  if (s.load.kind == LoadKind::contact) return s.load.contact.point;
+  return default_contact_point(s.vessel, std::string(group_names::inner_wall));
+}
+
+/// The scene reduced to one load case (its supports, material and vessel; no constant loads).
+Scene case_scene(const Scene& s, const LoadCase& c) {
+  Scene out = s;
+  out.constant_loads.clear();
+  LoadSpec l;
+  l.kind = c.kind;
+  l.magnitudes = {c.magnitude};
+  if (c.kind == LoadKind::contact) {
+    if (s.load.kind == LoadKind::contact) {
+      l.contact = s.load.contact;
+    } else {
+      l.contact.radius = kContactRadius;
+      l.contact.surface_group = std::string(group_names::inner_wall);
+    }
+    l.contact.point = c.point;
+  } else if (c.kind == LoadKind::pressure) {
+    l.contact.surface_group = s.load.kind == LoadKind::pressure
+                                  ? s.load.contact.surface_group
+                                  : std::string(group_names::inner_wall);
+  } else if (s.load.kind == LoadKind::gravity) {
+    l.gravity_direction = s.load.gravity_direction;
+  }
+  out.load = l;
+  return out;
+}
+
+/// The scene's load at which it is trained: its budget load, else the middle of its magnitudes.
+double training_magnitude(const Scene& s) {
+  if (s.budget.magnitude > 0.0) return s.budget.magnitude;
+  std::vector<double> m = s.load.magnitudes;
+  std::sort(m.begin(), m.end());
+  return m[m.size() / 2];
+}
+
+double default_magnitude(const Scene& s, LoadKind kind) {
+  if (s.load.kind == kind) return training_magnitude(s);
+  switch (kind) {
+    case LoadKind::contact: return kContactForce;
+    case LoadKind::pressure: return kPressure;
+    case LoadKind::gravity: return kGravity;
+  }
+  return 1.0;
+}
+
+/// The load cases of a scene: training ones for the kinds in `train`, the rest held out.
+std::vector<LoadCase> load_cases(const Scene& s, const std::vector<LoadKind>& train,
+                                 bool other_vessel) {
+  std::vector<LoadCase> out;
+  const auto trained = [&](LoadKind k) {
+    return !other_vessel && std::find(train.begin(), train.end(), k) != train.end();
+  };
+  const std::string other_type = other_vessel ? "other vessel" : "other load type";
+  // Contact: the scene's point, the point 90° round (training), 180° round, and 45° back a
+  // quarter of the vessel along (held out).
+  {
+    const bool t = trained(LoadKind::contact);
+    const double m = default_magnitude(s, LoadKind::contact);
+    const Vec3 p0 = contact_point_of(s);
+    const CentrelineCoordinates c = centreline_coordinates(s.vessel, p0);
+    const double L = s.vessel.centreline_length();
+    const std::string held = t ? "other contact point" : other_type;
+    out.push_back({"contact θ+0°", t, t ? "training" : other_type, LoadKind::contact, m, p0});
+    if (!other_vessel) {
+      out.push_back({"contact θ+90°", t, t ? "training" : other_type, LoadKind::contact, m,
+                     wall_point(s.vessel, c.s, c.theta + 0.5 * std::numbers::pi, c.rho)});
+      out.push_back({"contact θ+180°", false, held, LoadKind::contact, m,
+                     wall_point(s.vessel, c.s, c.theta + std::numbers::pi, c.rho)});
+      const double s2 = std::min(c.s + 0.25 * L, 0.85 * L);
+      out.push_back({"contact θ−45°, s+L/4", false, held, LoadKind::contact, m,
+                     wall_point(s.vessel, s2, c.theta - 0.25 * std::numbers::pi, c.rho)});
+    }
+  }
+  for (const LoadKind k : {LoadKind::pressure, LoadKind::gravity}) {
+    const bool t = trained(k);
+    out.push_back({to_string(k), t, t ? "training" : other_type, k, default_magnitude(s, k),
+                   Vec3::Zero()});
+  }
+  return out;
+}
+
+/// The other magnitudes of the scene's own load at its point (added once the reference's strain
+/// per unit load is known: only those within the linear regime).
+std::vector<double> other_magnitudes(const Scene& s, double strain_unit) {
+  std::vector<double> out;
+  const double m0 = training_magnitude(s);
+  for (const double m : s.load.magnitudes) {
+    if (m != m0 && m * strain_unit <= kLinearRegimeStrain) out.push_back(m);
+  }
+  return out;
+}
+
+/// The FEM answers of one load shape at unit magnitude.
+struct ShapeAnswer {
+  std::vector<Vec3> reference_at_network;
+  std::vector<Vec3> reference_at_mesh;
+  std::vector<Vec3> p1;  ///< P1 on the model's mesh, at its nodes
+  double p1_seconds = 0.0;
+  double strain_unit = 0.0;
+};
+
+/// One vessel: its scene, the model's mesh, the reference mesh and the base network.
+struct VesselContext {
+  const Scene* scene = nullptr;
+  int level = 0;
+  VesselParams vessel;  ///< at the model's level
+  TetMesh mesh;
+  TetMesh reference_mesh;
+  msm::BuiltNetwork base;
+  std::map<std::string, ShapeAnswer> shapes;
+  std::filesystem::path cache_dir;  ///< FEM answers cached under cache_dir/calibrate (empty: none)
+};
+
+std::string shape_key(const LoadCase& c) {
+  std::ostringstream k;
+  k << to_string(c.kind);
+  if (c.kind == LoadKind::contact) k << std::setprecision(17) << c.point.transpose();
+  return k.str();
+}
+
+std::vector<Vec3> scaled(const std::vector<Vec3>& u, double f) {
+  std::vector<Vec3> out(u.size());
+  for (std::size_t i = 0; i < u.size(); ++i) out[i] = f * u[i];
+  return out;
+}
+
+/// Everything that determines a shape's FEM answers: the meshes, the points, the material, the
+/// supports and the load's shape (the key of the on-disk cache).
+std::string answer_key(const VesselContext& v, const Scene& cs, double nu) {
+  std::ostringstream k;
+  k << std::setprecision(17) << "calibrate-fem-v1|" << mesh_hash(v.reference_mesh) << "|"
+    << mesh_hash(v.mesh) << "|" << v.base.network.nodes.size() << "|" << cs.youngs_modulus << "|"
+    << nu << "|" << cs.density << "|";
+  for (const Vec3& p : v.base.network.nodes) k << std::llround(p.x() * 1e9) << ","
+                                               << std::llround(p.y() * 1e9) << ","
+                                               << std::llround(p.z() * 1e9) << ";";
+  for (const auto& [g, e] : cs.boundary) k << g << "=" << to_string(e) << ";";
+  const LoadSpec& l = cs.load;
+  k << to_string(l.kind) << "|" << l.contact.point.transpose() << "|" << l.contact.radius << "|"
+    << l.contact.surface_group << "|" << l.gravity_direction.transpose();
+  return k.str();
+}
+
+std::uint64_t fnv1a(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+void write_vectors(std::ostream& out, const std::vector<Vec3>& v) {
+  const std::uint64_t n = v.size();
+  out.write(reinterpret_cast<const char*>(&n), sizeof n);
+  for (const Vec3& p : v) out.write(reinterpret_cast<const char*>(p.data()), 3 * sizeof(double));
+}
+
+bool read_vectors(std::istream& in, std::vector<Vec3>& v) {
+  std::uint64_t n = 0;
+  if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n > (1u << 28)) return false;
+  v.resize(n);
+  for (Vec3& p : v) {
+    if (!in.read(reinterpret_cast<char*>(p.data()), 3 * sizeof(double))) return false;
+  }
+  return true;
+}
+
+/// The cached FEM answers of a shape (cache_dir/calibrate/<hash>.bin holding the key itself, so
+/// a hash collision is a miss), or false.
+bool read_cached(const std::filesystem::path& file, const std::string& key, ShapeAnswer& a) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return false;
+  std::uint64_t n = 0;
+  if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n != key.size()) return false;
+  std::string stored(n, '\0');
+  if (!in.read(stored.data(), static_cast<std::streamsize>(n)) || stored != key) return false;
+  return read_vectors(in, a.reference_at_network) && read_vectors(in, a.reference_at_mesh) &&
+         read_vectors(in, a.p1) &&
+         static_cast<bool>(in.read(reinterpret_cast<char*>(&a.p1_seconds), sizeof(double))) &&
+         static_cast<bool>(in.read(reinterpret_cast<char*>(&a.strain_unit), sizeof(double)));
+}
+
+void write_cached(const std::filesystem::path& file, const std::string& key, const ShapeAnswer& a) {
+  write_file_atomically(
+      file,
+      [&](std::ostream& out) {
+        const std::uint64_t n = key.size();
+        out.write(reinterpret_cast<const char*>(&n), sizeof n);
+        out.write(key.data(), static_cast<std::streamsize>(n));
+        write_vectors(out, a.reference_at_network);
+        write_vectors(out, a.reference_at_mesh);
+        write_vectors(out, a.p1);
+        out.write(reinterpret_cast<const char*>(&a.p1_seconds), sizeof(double));
+        out.write(reinterpret_cast<const char*>(&a.strain_unit), sizeof(double));
+      },
+      true);
+}
+
+const ShapeAnswer& shape_answer(VesselContext& v, const LoadCase& c, double nu,
+                                std::ostream& log) {
+  const std::string key = shape_key(c);
+  const auto it = v.shapes.find(key);
+  if (it != v.shapes.end()) return it->second;
+  LoadCase unit = c;
+  unit.magnitude = 1.0;
+  const Scene cs = case_scene(*v.scene, unit);
+  // The FEM answers are cached on disk (they cost a P2 solve each; the fit and the models do not
+  // depend on them being recomputed).
+  std::filesystem::path cache_file;
+  const std::string disk_key = answer_key(v, cs, nu);
+  if (!v.cache_dir.empty()) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%016llx.bin", static_cast<unsigned long long>(fnv1a(disk_key)));
+    cache_file = v.cache_dir / "calibrate" / name;
+    ShapeAnswer cached;
+    if (read_cached(cache_file, disk_key, cached)) {
+      log << "  FEM reference and P1 for " << v.scene->name << ": " << c.name << " (cached)\n";
+      return v.shapes.emplace(key, std::move(cached)).first->second;
+    }
+  }
+  log << "  FEM reference P2 (level " << v.scene->reference_level << ") and P1 (level " << v.level
+      << ") for " << v.scene->name << ": " << c.name << " ..." << std::flush;
+  Stopwatch clock;
+  ShapeAnswer a;
+  {
+    fem::ElasticitySolver ref(v.reference_mesh, fem_problem(cs, v.reference_mesh, nu, 2, 1.0));
+    a.strain_unit = ref.solve().max_abs_principal_strain;
+    a.reference_at_network = ref.displacement_at(v.base.network.nodes, kOutsideTolerance);
+    a.reference_at_mesh = ref.displacement_at(v.mesh.nodes, kOutsideTolerance);
+  }
+  fem::ElasticityProblem p1 = fem_problem(cs, v.mesh, nu, 1, 1.0);
+  p1.options.formulation = fem::Formulation::displacement;
+  fem::ElasticitySolver p1_solver(v.mesh, p1);
+  const fem::ElasticityResult& r = p1_solver.solve();
+  a.p1 = r.nodal_displacement;
+  a.p1_seconds = r.timings.assembly + r.timings.solve;
+  const std::streamsize precision = log.precision();
+  log << " " << std::fixed << std::setprecision(1) << clock.seconds() << " s\n"
+      << std::defaultfloat << std::setprecision(static_cast<int>(precision));
+  if (!cache_file.empty()) write_cached(cache_file, disk_key, a);
+  return v.shapes.emplace(key, std::move(a)).first->second;
+}
+
+/// A model's nodal displacements (m) for one case, solved as the harness solves it.
+struct ModelAnswer {
+  std::vector<Vec3> u;
+  double update_seconds = 0.0;
+};
+
+ModelAnswer solve_model(const Scene& cs, const ModelSpec& spec, const msm::BuiltNetwork& built,
+                        const TetMesh& mesh, double magnitude) {
+  const auto model = msm::make_model(built, spec.damping);
+  const msm::Problem p = msm_problem(cs, *model, built, mesh, magnitude);
+  Eigen::VectorXd x;
+  ModelAnswer a;
+  if (msm::supports_updates(spec.solver)) {
+    UpdateSequence seq = timed_updates(p, spec.solver, kRampUpdates, 1);
+    x = std::move(seq.x);
+    a.update_seconds = seq.update_seconds;
+  } else {
+    msm::SolveResult r = msm::solve(p, spec.solver, &built.network);
+    x = std::move(r.x);
+    a.update_seconds = r.seconds;
+  }
+  const auto& nodes = built.network.nodes;
+  a.u.resize(nodes.size());
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    a.u[i] = x.segment<3>(3 * static_cast<Eigen::Index>(i)) - nodes[i];
+  }
+  return a;
+}
+
+const ModelSpec& pick_model(const Scene& s, const std::string& name) {
+  if (!name.empty()) {
+    for (const ModelSpec& m : s.models) {
+      if (m.name != name) continue;
+      if (m.kind == ModelKind::fem) {
+        throw InputError("calibrate: --model " + name +
+                         " is a FEM model; expected a surface_msm or volume_msm model");
+      }
+      return m;
+    }
+    std::string names;
+    for (const ModelSpec& m : s.models) names += (names.empty() ? "" : ", ") + m.name;
+    throw InputError("calibrate: --model " + name + ": no such model in " + s.source.string() +
+                     "; expected one of " + names);
+  }
+  for (const ModelSpec& m : s.models) {
+    if (m.volume_term) return m;
+  }
+  for (const ModelSpec& m : s.models) {
+    if (m.kind != ModelKind::fem) return m;
+  }
+  throw InputError("calibrate: " + s.source.string() + " has no mass-spring model to calibrate");
+}
+
+VesselContext make_context(const Scene& s, const ModelSpec& spec, int level, int reference_level,
+                           double nu, const std::filesystem::path& cache) {
+  VesselContext v;
+  v.cache_dir = cache;
+  v.scene = &s;
+  v.level = level;
+  v.vessel = s.vessel;
+  v.vessel.level = level;
+  v.mesh = scene_mesh(s, level, cache);
+  v.reference_mesh = scene_mesh(s, reference_level, cache);
+  ModelSpec plain = spec;
+  plain.calibration.clear();  // the base: the model's own rule
+  v.base = scene_network(s, plain, v.mesh, v.vessel, nu);
+  return v;
+}
+
+/// Evaluates base, calibrated and P1 on one case of a vessel.
+CalibrationCaseResult evaluate_case(VesselContext& v, const LoadCase& c, const ModelSpec& spec,
+                                    const msm::BuiltNetwork* calibrated, const std::string& why_not,
+                                    double nu, std::ostream& log) {
+  const ShapeAnswer& a = shape_answer(v, c, nu, log);
+  CalibrationCaseResult r;
+  r.scene = v.scene->name;
+  r.name = c.name;
+  r.training = c.training;
+  r.holds_out = c.holds_out;
+  r.kind = c.kind;
+  r.magnitude = c.magnitude;
+  r.point = c.point;
+  r.level = v.level;
+  r.max_strain_reference = a.strain_unit * c.magnitude;
+  r.p1 = compare_displacements(scaled(a.p1, c.magnitude), scaled(a.reference_at_mesh, c.magnitude));
+  r.p1_solve_seconds = a.p1_seconds;
+  const Scene cs = case_scene(*v.scene, c);
+  const std::vector<Vec3> ref = scaled(a.reference_at_network, c.magnitude);
+  const ModelAnswer base = solve_model(cs, spec, v.base, v.mesh, c.magnitude);
+  r.base = compare_displacements(base.u, ref);
+  r.base_update_seconds = base.update_seconds;
+  if (calibrated) {
+    const ModelAnswer cal = solve_model(cs, spec, *calibrated, v.mesh, c.magnitude);
+    r.calibrated = compare_displacements(cal.u, ref);
+    r.calibrated_update_seconds = cal.update_seconds;
+  } else {
+    r.ok = false;
+    r.failure = why_not;
+  }
+  log << "  " << r.scene << " L" << r.level << " " << r.name << " (" << r.holds_out << ", "
+      << r.magnitude << "): relative L2 P1 " << r.p1.relative_l2 << ", base "
+      << r.base.relative_l2;
+  if (r.ok) log << ", calibrated " << r.calibrated.relative_l2;
+  log << "\n";
+  return r;
+}
+
+}  // namespace
+
+CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
+  std::ostream null_stream(nullptr);
+  std::ostream& log = o.log ? *o.log : null_stream;
+  const ModelSpec& spec = pick_model(s, o.model);
+  double nu = s.poisson_ratios.front();
+  if (std::find(s.poisson_ratios.begin(), s.poisson_ratios.end(), 0.45) != s.poisson_ratios.end())
+    nu = 0.45;
+  if (o.poisson_ratio) nu = *o.poisson_ratio;
+  const int level = o.level.value_or(s.model_levels.front());
+  const int reference_level = o.reference_level.value_or(s.reference_level);
+  if (o.granularity == CalibrationGranularity::per_spring && !o.other_vessels.empty()) {
+    throw InputError(
+        "calibrate: --held-out-scene with --granularity per-spring: a per-spring calibration "
+        "cannot transfer to another mesh (its factors are indexed by one mesh's springs); use "
+        "--granularity groups for another vessel");
+  }
+  std::vector<LoadKind> train = o.train.empty() ? std::vector<LoadKind>{s.load.kind} : o.train;
+  Scene scene = s;
+  scene.reference_level = reference_level;
+
+  log << "calibrate " << spec.name << " of " << s.name << " (ν = " << nu << ", level " << level
+      << ", reference P2 level " << reference_level << ", " << to_string(o.granularity) << ")\n";
+  VesselContext main = make_context(scene, spec, level, reference_level, nu, o.cache_dir);
+
+  // The cases: the fixed list, plus the scene's other magnitudes at its point.
+  std::vector<LoadCase> cases = load_cases(scene, train, false);
+  {
+    const LoadCase& first = cases.front();  // contact θ+0°
+    LoadCase own = first;
+    for (const LoadCase& c : cases) {
+      if (c.kind == scene.load.kind) {
+        own = c;
+        break;
+      }
+    }
+    const ShapeAnswer& a = shape_answer(main, own, nu, log);
+    for (const double m : other_magnitudes(scene, a.strain_unit)) {
+      LoadCase c = own;
+      c.training = false;
+      c.holds_out = "other magnitude";
+      c.magnitude = m;
+      cases.push_back(c);
+    }
+  }
+
+  // The fit on the training cases.
+  const bool has_kappa = main.base.volume_kappa.has_value();
+  msm::StiffnessParameters params =
+      o.granularity == CalibrationGranularity::groups
+          ? msm::group_parameters(main.base.network, main.vessel, has_kappa)
+          : msm::per_spring_parameters(main.base.network, has_kappa);
+  std::vector<msm::FitCase> fit_cases;
+  std::vector<char> fixed;
+  Calibration cal;
+  for (const LoadCase& c : cases) {
+    if (!c.training) continue;
+    const ShapeAnswer& a = shape_answer(main, c, nu, log);
+    const auto model = msm::make_model(main.base);
+    const msm::Problem p = msm_problem(case_scene(scene, c), *model, main.base, main.mesh, c.magnitude);
+    fixed = p.fixed;
+    Eigen::VectorXd r(p.num_dofs());
+    for (std::size_t i = 0; i < a.reference_at_network.size(); ++i) {
+      r.segment<3>(3 * static_cast<Eigen::Index>(i)) = c.magnitude * a.reference_at_network[i];
+    }
+    fit_cases.push_back({c.name, p.external_force, r});
+    cal.training_loads.push_back({c.name, c.kind, c.magnitude, c.point});
+  }
+  if (fit_cases.empty()) throw InputError("calibrate: no training load; expected --train kinds");
+  // Groups: the ridge alone (without it a contact-only fit drove the circumferential classes to
+  // ~0 and κ up 12×, which fitted contact and failed pressure by 4× P1; docs/msm_calibration.md).
+  const msm::Regulariser reg = o.granularity == CalibrationGranularity::groups
+                                   ? msm::Regulariser{0.0, o.regulariser.ridge}
+                                   : o.regulariser;
+  const msm::LinearisedFit fit(main.base.network, main.base.volume_kappa, fixed, params,
+                               fit_cases, reg);
+  log << "  fitting " << params.size() << " parameters on " << fit_cases.size()
+      << " training loads (model linearised at rest, adjoint gradients, L-BFGS)\n";
+  const Eigen::VectorXd theta0 = Eigen::VectorXd::Zero(params.size());
+  const std::vector<double> before = fit.relative_errors(theta0);
+  msm::LbfgsOptions lo;
+  lo.max_iterations = o.max_iterations;
+  lo.gradient_tolerance = 1e-6;
+  lo.relative_decrease = 1e-10;
+  lo.on_iteration = [&](int it, double f, double g) {
+    if (it % 10 == 0) log << "    iteration " << it << ": J = " << f << ", |∇J|∞ = " << g << "\n";
+  };
+  Stopwatch fit_clock;
+  const msm::LbfgsResult res = msm::minimize_lbfgs(
+      [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) { return fit.objective(x, g); }, theta0,
+      lo);
+  CalibrationStudy study;
+  study.fit_seconds = fit_clock.seconds();
+  const std::vector<double> after = fit.relative_errors(res.x);
+  log << "  fit: J " << fit.misfit(theta0) << " → " << res.f << " in " << res.iterations
+      << " iterations (" << res.stop_reason << "), " << study.fit_seconds << " s\n";
+
+  cal.granularity = to_string(o.granularity);
+  cal.scene = s.name;
+  cal.model = spec.name;
+  cal.model_kind = to_string(spec.kind);
+  cal.stiffness = msm::to_string(spec.stiffness);
+  cal.volume_term = spec.volume_term;
+  cal.poisson_ratio = nu;
+  cal.youngs_modulus = s.youngs_modulus;
+  cal.mesh_hash = mesh_hash(main.mesh);
+  cal.vessel = describe(main.vessel);
+  cal.level = level;
+  cal.nodes = main.base.network.nodes.size();
+  cal.springs = main.base.network.springs.size();
+  cal.tets = main.base.network.tets.size();
+  cal.names = params.names;
+  for (Eigen::Index p = 0; p < res.x.size(); ++p) cal.factors.push_back(std::exp(res.x[p]));
+  std::ostringstream method;
+  method << "least squares on nodal displacements against the P2 reference (level "
+         << reference_level << "), model linearised at rest, adjoint gradients, L-BFGS; "
+         << (o.granularity == CalibrationGranularity::groups
+                 ? "a factor per spring class and kappa, ridge on the log factors"
+                 : "a factor per spring and kappa, smoothness regulariser on log k over springs "
+                   "sharing a node");
+  cal.method = method.str();
+  cal.smoothness = reg.smoothness;
+  cal.ridge = reg.ridge;
+  cal.objective_before = fit.misfit(theta0) + fit.regularisation(theta0);
+  cal.objective_after = res.f;
+  cal.iterations = res.iterations;
+  cal.stop_reason = res.stop_reason;
+  for (std::size_t i = 0; i < fit_cases.size(); ++i) {
+    cal.fit_cases.push_back({fit_cases[i].name, before[i], after[i]});
+  }
+  study.calibration = cal;
+
+  // The calibrated network through the file's own path (apply_calibration), then every case.
+  msm::BuiltNetwork calibrated = main.base;
+  apply_calibration(cal, "calibration", calibrated, main.mesh, main.vessel, spec, s.youngs_modulus,
+                    nu, false);
+  std::ostringstream detail;
+  detail << msm::to_string(spec.stiffness) << (spec.volume_term ? " + volume term" : "") << ", "
+         << msm::to_string(spec.solver);
+  study.model_detail = detail.str();
+  for (const LoadCase& c : cases) {
+    study.cases.push_back(evaluate_case(main, c, spec, &calibrated, "", nu, log));
+  }
+
+  // Other vessels: the group calibration applied to their meshes (calibration_transfer).
+  for (const Scene& other_scene : o.other_vessels) {
+    const int other_level = other_scene.model_levels.front();
+    VesselContext other =
+        make_context(other_scene, spec, other_level, other_scene.reference_level, nu, o.cache_dir);
+    msm::BuiltNetwork transferred = other.base;
+    std::string why;
+    const msm::BuiltNetwork* use = &transferred;
+    try {
+      apply_calibration(cal, "calibration", transferred, other.mesh, other.vessel, spec,
+                        other_scene.youngs_modulus, nu, true);
+    } catch (const InputError& e) {
+      why = e.what();
+      use = nullptr;
+    }
+    for (const LoadCase& c : load_cases(other_scene, train, true)) {
+      study.cases.push_back(evaluate_case(other, c, spec, use, why, nu, log));
+    }
+  }
+  return study;
+}
+
+namespace {
+
+std::string fixed3(double v) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(3) << v;
+  return s.str();
+}
+
+std::string load_text(const CalibrationCaseResult& c) {
+  std::ostringstream s;
+  s << c.magnitude << (c.kind == LoadKind::contact ? " N" : c.kind == LoadKind::pressure ? " Pa" : " g");
+  return s.str();
+}
+
+void case_table(std::ostream& out, const std::vector<CalibrationCaseResult>& cases, bool training) {
+  out << "| scene | level | case | holds out | load | P1 | base | calibrated | calibrated / P1 | "
+         "base s/update | calibrated s/update | P1 solve s |\n"
+      << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& c : cases) {
+    if (c.training != training) continue;
+    out << "| " << c.scene << " | " << c.level << " | " << c.name << " | " << c.holds_out << " | "
+        << load_text(c) << " | " << fixed3(c.p1.relative_l2) << " | " << fixed3(c.base.relative_l2)
+        << " | " << (c.ok ? fixed3(c.calibrated.relative_l2) : "—") << " | "
+        << (c.ok ? fixed3(c.calibrated.relative_l2 / c.p1.relative_l2) : "—") << " | "
+        << std::setprecision(3) << c.base_update_seconds << " | "
+        << (c.ok ? std::to_string(c.calibrated_update_seconds).substr(0, 7) : std::string("—"))
+        << " | " << c.p1_solve_seconds << " |\n";
+  }
+}
+
+}  // namespace
+
+void write_calibration_markdown(std::ostream& out, const CalibrationStudy& st,
+                                const std::string& command) {
+  const Calibration& c = st.calibration;
+  out << "# Calibration of " << c.model << " (" << c.scene << ", " << c.granularity << ")\n\n"
+      << "    " << command << "\n\n"
+      << "Model: " << st.model_detail << ", ν = " << c.poisson_ratio << ", " << c.vessel
+      << " (mesh " << c.mesh_hash << ", " << c.nodes << " nodes, " << c.springs << " springs).\n"
+      << "Fit: " << c.method << ". " << c.names.size() << " parameters, " << c.iterations
+      << " iterations (" << c.stop_reason << "), " << fixed3(st.fit_seconds)
+      << " s; objective " << c.objective_before << " → " << c.objective_after << ".\n\n";
+  if (c.granularity == "groups") {
+    out << "| parameter | factor |\n|---|---|\n";
+    for (std::size_t i = 0; i < c.names.size(); ++i) {
+      out << "| " << c.names[i] << " | " << fixed3(c.factors[i]) << " |\n";
+    }
+    out << "\n";
+  } else {
+    std::vector<double> f = c.factors;
+    std::sort(f.begin(), f.end());
+    out << "Per-spring factors: min " << fixed3(f.front()) << ", median "
+        << fixed3(f[f.size() / 2]) << ", max " << fixed3(f.back()) << ".\n\n";
+  }
+  out << "Relative L2 errors against the P2 reference at the model's nodes (P1 at its mesh's "
+         "nodes), each model solved as the scene solves it; *s/update*: the median time per "
+         "update of a warm-started load ramp (set-up apart).\n\n## Training loads\n\n";
+  case_table(out, st.cases, true);
+  out << "\n## Held-out loads\n\n";
+  case_table(out, st.cases, false);
+  for (const auto& cs : st.cases) {
+    if (!cs.ok) {
+      out << "\n" << cs.scene << " " << cs.name << ": calibrated model not evaluated: " << cs.failure
+          << "\n";
+      break;
+    }
+  }
+}
+
+}  // namespace vessel

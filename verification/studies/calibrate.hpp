@@ -1,0 +1,92 @@
+#pragma once
+/// `vesselverify calibrate` (issue 14 item 4): a mass-spring model's stiffness fitted to the FEM
+/// reference's displacements on a scene's training loads, then checked on held-out loads.
+///
+/// - Fit: msm/calibration/stiffness_fit.hpp (least squares on nodal displacements of the model
+///   linearised at rest, adjoint gradients, msm/calibration/lbfgs.hpp), at two granularities:
+///   a few factors (spring classes and κ) or one factor per spring with a smoothness regulariser.
+/// - Cases: the training loads (the scene's load type: its contact point and the point 90° round
+///   the centreline, at the scene's budget load; or the scene's pressure/gravity load) and the
+///   held-out ones, each named by what it holds out: other magnitudes of the scene's load (within
+///   the reference's linear regime), other contact points (180° round, and 45° back and a quarter
+///   of the vessel along), other load types (contact, pressure 10 Pa, gravity 1 g, whichever were
+///   not trained on) and other vessels (further scenes, e.g. the arch for a straight-tube fit;
+///   group calibrations only, applied with calibration_transfer).
+/// - Every case is solved as the scene solves the model (the nonlinear static model with its
+///   solver, a ramp of warm-started updates as the harness times it), for the base model, the
+///   calibrated one and FEM P1 on the model's mesh, all against the P2 reference at the model's
+///   nodes (the harness's metric, verification/metrics.hpp). Training and held-out errors are
+///   reported apart.
+/// - The FEM answers of each load shape (P2 at the model's nodes, P1) are cached under
+///   cache_dir/calibrate/, keyed by everything that determines them (meshes, points, material,
+///   supports, load); a cached P1 keeps the solve time measured when it was computed.
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "msm/calibration/stiffness_fit.hpp"
+#include "verification/calibration_file.hpp"
+#include "verification/metrics.hpp"
+#include "verification/scene.hpp"
+
+namespace vessel {
+
+enum class CalibrationGranularity { groups, per_spring };
+std::string to_string(CalibrationGranularity g);  ///< "groups" | "per_spring"
+CalibrationGranularity parse_calibration_granularity(const std::string& name);  ///< InputError
+
+struct CalibrateOptions {
+  /// The scene's mass-spring model to calibrate; empty: its hybrid volume model
+  /// (volume_term = true), else its first mass-spring model.
+  std::string model;
+  std::optional<double> poisson_ratio;  ///< default: 0.45 if the scene has it, else its first ν
+  std::optional<int> level;             ///< default: the scene's first model level
+  std::optional<int> reference_level;   ///< default: the scene's
+  CalibrationGranularity granularity = CalibrationGranularity::groups;
+  std::vector<LoadKind> train;  ///< load types fitted on; default: the scene's load type
+  /// Per-spring fits: both terms; group fits: the ridge alone. Defaults: msm::Regulariser's doc.
+  msm::Regulariser regulariser{1e-2, 1e-3};
+  int max_iterations = 200;
+  /// Further scenes whose own loads are held-out cases on another vessel (group calibrations).
+  std::vector<Scene> other_vessels;
+  std::filesystem::path cache_dir;
+  std::ostream* log = nullptr;  ///< progress
+};
+
+/// One case solved by the base model, the calibrated model and P1.
+struct CalibrationCaseResult {
+  std::string scene;
+  std::string name;        ///< e.g. "contact θ+180°"
+  bool training = false;
+  std::string holds_out;   ///< "training", "other magnitude", "other contact point", ...
+  LoadKind kind = LoadKind::contact;
+  double magnitude = 0.0;  ///< N, Pa or g
+  Vec3 point = Vec3::Zero();
+  int level = 0;
+  ErrorStatistics p1, base, calibrated;
+  double p1_solve_seconds = 0.0;
+  double base_update_seconds = 0.0, calibrated_update_seconds = 0.0;  ///< per update (ramp median)
+  double max_strain_reference = 0.0;  ///< reference's largest principal strain at this load
+  bool ok = true;
+  std::string failure;  ///< why the calibrated model could not be evaluated
+};
+
+struct CalibrationStudy {
+  Calibration calibration;
+  std::vector<CalibrationCaseResult> cases;
+  double fit_seconds = 0.0;  ///< the L-BFGS fit alone
+  std::string model_detail;
+};
+
+/// Fits and evaluates. InputError for an unknown model name, a FEM model, ν or a level the scene
+/// cannot give, or granularity per_spring with other vessels (reported as such, not silently).
+CalibrationStudy calibrate_scene(const Scene& scene, const CalibrateOptions& options);
+
+/// Markdown: the fit, then the cases with P1, base and calibrated relative L2 errors (training and
+/// held-out in separate tables) and the calibrated model's ratio to P1.
+void write_calibration_markdown(std::ostream& out, const CalibrationStudy& study,
+                                const std::string& command);
+
+}  // namespace vessel
