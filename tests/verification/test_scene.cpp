@@ -7,6 +7,7 @@
 #include "../test_helpers.hpp"
 #include "meshes/errors.hpp"
 #include "verification/scene.hpp"
+#include "verification/scene_problems.hpp"
 
 using namespace vessel;
 
@@ -238,4 +239,31 @@ TEST(Scene, VolumeTermSelectsTheHybridVolumeModel) {
   const auto surface = error_of(std::string(kMinimal) +
                                 "[[models]]\nkind = \"surface_msm\"\nvolume_term = true\n");
   EXPECT_NE(surface.find("volume_term"), std::string::npos) << surface;
+}
+
+TEST(Scene, BendingSelectsTheDiscreteShellsSurfaceModel) {
+  const Scene s = parse_scene(std::string(kMinimal) +
+                                  "[[models]]\nname = \"shell\"\nkind = \"surface_msm\"\n"
+                                  "bending = \"discrete-shells\"\n",
+                              "scene.toml");
+  const ModelSpec& m = s.models.back();
+  EXPECT_EQ(m.bending, msm::Bending::discrete_shells);
+  EXPECT_EQ(m.stiffness, msm::StiffnessRule::van_gelder);  // its default membrane
+  EXPECT_EQ(network_options(s, m, 0.45).bending, msm::Bending::discrete_shells);
+  // An unknown name, the grid topology, PBD, or the key on a volume model: refused, naming the key.
+  const auto name = error_of(std::string(kMinimal) +
+                             "[[models]]\nkind = \"surface_msm\"\nbending = \"kirchhoff\"\n");
+  EXPECT_NE(name.find("models[1].bending"), std::string::npos) << name;
+  EXPECT_NE(name.find("discrete-shells"), std::string::npos) << name;
+  const auto grid = error_of(std::string(kMinimal) +
+                             "[[models]]\nkind = \"surface_msm\"\nbending = \"discrete-shells\"\n"
+                             "topology = \"grid\"\n");
+  EXPECT_NE(grid.find("models[1].topology"), std::string::npos) << grid;
+  const auto pbd = error_of(std::string(kMinimal) +
+                            "[[models]]\nkind = \"surface_msm\"\nbending = \"discrete-shells\"\n"
+                            "solver = \"pbd\"\ndt = 1e-3\nsteps = 10\n");
+  EXPECT_NE(pbd.find("models[1].solver"), std::string::npos) << pbd;
+  const auto volume = error_of(std::string(kMinimal) +
+                               "[[models]]\nkind = \"volume_msm\"\nbending = \"discrete-shells\"\n");
+  EXPECT_NE(volume.find("bending"), std::string::npos) << volume;
 }

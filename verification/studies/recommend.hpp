@@ -73,7 +73,8 @@ struct RecommendOptions {
 
 /// The candidate models of a scene. Static scenes: FEM P1; surface (mid-surface, the mesh's
 /// topology) and volume networks with every stiffness rule (msm::kAllStiffnessRules), and the hybrid
-/// volume model ("volume/hybrid-volume/...": van-gelder springs + volume term), each with
+/// volume model ("volume/hybrid-volume/...": van-gelder springs + volume term) and the Discrete
+/// Shells surface model ("surface/discrete-shells/...": van-gelder membrane + hinges), each with
 /// the static Newton solver and the linearised model; with contact loads also the Newton solver
 /// on each region-of-interest radius. Dynamic scenes (a scene model uses an integrator): every
 /// integrator (msm::kAllIntegrators) at the time steps the scene uses for that family of
