@@ -329,12 +329,12 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
     }
   }
   if (m.kind == ModelKind::volume_msm) m.volume_term = r.boolean_or("volume_term", false);
-  const auto stiffness = r.names_or(
-      "stiffness",
-      m.kind == ModelKind::volume_msm
-          ? (m.volume_term ? "van-gelder" : "seed001")
-          : (m.bending != msm::Bending::none ? "van-gelder" : "seed000"),
-      msm::parse_stiffness_rule);
+  const auto stiffness =
+      r.names_or("stiffness",
+                 m.kind == ModelKind::volume_msm
+                     ? (m.volume_term ? "van-gelder" : "seed001")
+                     : (m.bending != msm::Bending::none ? "van-gelder" : "seed000"),
+                 msm::parse_stiffness_rule);
   if (m.volume_term) {
     for (const auto& k : stiffness) {
       if (msm::parse_stiffness_rule(k) != msm::StiffnessRule::van_gelder) {

@@ -70,9 +70,8 @@ void apply_bending(BuiltNetwork& built, const NetworkOptions& o) {
   springs.erase(std::remove_if(springs.begin(), springs.end(),
                                [](const Spring& s) { return s.family == SpringFamily::bend; }),
                 springs.end());
-  built.bending_rigidity =
-      plate_bending_rigidity(o.stiffness_params.youngs_modulus, built.network.thickness,
-                             o.stiffness_params.poisson_ratio);
+  built.bending_rigidity = plate_bending_rigidity(
+      o.stiffness_params.youngs_modulus, built.network.thickness, o.stiffness_params.poisson_ratio);
   built.topology += " without bend springs + discrete-shell hinges (Grinspun et al. 2003)";
 }
 

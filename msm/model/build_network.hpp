@@ -28,8 +28,8 @@ Topology parse_topology(const std::string& name);     ///< InputError if unknown
 /// A surface model's bending: none beyond its springs, or the Discrete Shells hinge energy
 /// (Grinspun et al. 2003; msm/model/bending_term.hpp) with the wall's plate rigidity.
 enum class Bending { none, discrete_shells };
-std::string to_string(Bending bending);           ///< "none" | "discrete-shells"
-Bending parse_bending(const std::string& name);   ///< InputError if unknown
+std::string to_string(Bending bending);          ///< "none" | "discrete-shells"
+Bending parse_bending(const std::string& name);  ///< InputError if unknown
 
 struct NetworkOptions {
   ModelType model = ModelType::surface;

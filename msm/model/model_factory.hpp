@@ -87,8 +87,8 @@ class MassSpringModel : public Form {
 };
 
 /// The springs alone of a Form that is nothing but springs: a SpringModel, or a MassSpringModel
-/// without a volume or bending term; nullptr for any other Form (solvers that need a plain spring network,
-/// such as the local-global method, refuse those).
+/// without a volume or bending term; nullptr for any other Form (solvers that need a plain spring
+/// network, such as the local-global method, refuse those).
 const SpringModel* plain_spring_model(const Form& form);
 
 /// The model of a network (volume_kappa and bending_rigidity as in BuiltNetwork), point damping

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <set>
 #include <stdexcept>
-#include <utility>
 #include <string>
+#include <utility>
 
 namespace vessel::msm {
 

@@ -48,8 +48,8 @@ TEST_F(MsmCli, SurfaceAndVolumeModelsSolveStaticallyAndWriteJson) {
   ASSERT_EQ(h.exit_code, 0) << h.output;
   EXPECT_TRUE(contains(h.output, "volume term")) << h.output;
   // The discrete-shells surface model: hinges named in the topology, no bend springs left.
-  const auto b = vv("--bending discrete-shells --poisson-ratio 0.45 --json " +
-                    (dir / "shell.json").string());
+  const auto b =
+      vv("--bending discrete-shells --poisson-ratio 0.45 --json " + (dir / "shell.json").string());
   ASSERT_EQ(b.exit_code, 0) << b.output;
   EXPECT_TRUE(contains(b.output, "discrete-shell hinges")) << b.output;
   const auto jb = nlohmann::json::parse(read_text(dir / "shell.json"));

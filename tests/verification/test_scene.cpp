@@ -263,7 +263,7 @@ TEST(Scene, BendingSelectsTheDiscreteShellsSurfaceModel) {
                             "[[models]]\nkind = \"surface_msm\"\nbending = \"discrete-shells\"\n"
                             "solver = \"pbd\"\ndt = 1e-3\nsteps = 10\n");
   EXPECT_NE(pbd.find("models[1].solver"), std::string::npos) << pbd;
-  const auto volume = error_of(std::string(kMinimal) +
-                               "[[models]]\nkind = \"volume_msm\"\nbending = \"discrete-shells\"\n");
+  const auto volume = error_of(
+      std::string(kMinimal) + "[[models]]\nkind = \"volume_msm\"\nbending = \"discrete-shells\"\n");
   EXPECT_NE(volume.find("bending"), std::string::npos) << volume;
 }

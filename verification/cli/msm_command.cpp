@@ -459,10 +459,11 @@ void add_model_options(CLI::App* cmd, MsmOptions& o) {
                 "Hybrid volume model (Golec et al. 2020), volume model only: van-gelder springs "
                 "carrying the shear modulus plus a volume energy per tet, κ = λ − μ, so that the "
                 "network has the material's ν (< 0.5)");
-  cmd->add_option("--bending", o.bending,
-                  "Surface model's bending: none, or discrete-shells (Grinspun et al. 2003: a hinge "
-                  "energy on every interior edge with D = E·t³/(12(1 − ν²)) from --youngs-modulus "
-                  "and --poisson-ratio, replacing the bend springs; triangle topology)")
+  cmd->add_option(
+         "--bending", o.bending,
+         "Surface model's bending: none, or discrete-shells (Grinspun et al. 2003: a hinge "
+         "energy on every interior edge with D = E·t³/(12(1 − ν²)) from --youngs-modulus "
+         "and --poisson-ratio, replacing the bend springs; triangle topology)")
       ->check(CLI::IsMember({"none", "discrete-shells"}))
       ->capture_default_str();
   auto& sp = o.stiffness_params;

@@ -255,8 +255,7 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
           m.solver.dt = dt;
           m.solver.steps = std::max(1L, std::lround(duration / dt));
           m.damping = damping;
-          m.name = kind_name + "/" + rule_label(choice) + "/" +
-                   msm::to_string(integrator) +
+          m.name = kind_name + "/" + rule_label(choice) + "/" + msm::to_string(integrator) +
                    "/dt=" + fmt(dt);
           out.push_back(m);
         }
