@@ -368,8 +368,10 @@ SolvedSystem solved_system(const msm::Problem& full, const msm::MassSpringModel&
   SolvedSystem sys{&full, &model, &network, static_cast<Eigen::Index>(qoi), {}, {}, {}};
   if (spec.roi_radius <= 0.0) return sys;
   const std::vector<char> held = msm::held_nodes(full, qoi_point, spec.roi_radius);
-  sys.roi = std::make_unique<msm::RoiNetwork>(msm::restrict_network(network, held));
-  sys.roi_model = msm::make_model(sys.roi->network, built.volume_kappa, spec.damping);
+  sys.roi = std::make_unique<msm::RoiNetwork>(
+      msm::restrict_network(network, held, built.bending_rigidity.has_value()));
+  sys.roi_model =
+      msm::make_model(sys.roi->network, built.volume_kappa, spec.damping, built.bending_rigidity);
   sys.roi_problem =
       std::make_unique<msm::Problem>(msm::restrict_problem(full, *sys.roi, held, *sys.roi_model));
   sys.problem = sys.roi_problem.get();

@@ -319,12 +319,22 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
   if (m.kind == ModelKind::surface_msm) {
     m.surface = msm::parse_wall_surface(r.name_or("surface", msm::to_string(m.surface), msm::parse_wall_surface));
     m.topology = msm::parse_topology(r.name_or("topology", "auto", msm::parse_topology));
+    // `bending = "discrete-shells"`: the hinge energy of Grinspun et al. 2003 on the triangles
+    // (msm/model/bending_term.hpp), membrane springs van-gelder by default.
+    m.bending = msm::parse_bending(r.name_or("bending", "none", msm::parse_bending));
+    if (m.bending != msm::Bending::none && m.topology == msm::Topology::grid) {
+      r.fail(r.table().get("topology"), "topology",
+             "found \"grid\" with bending = \"discrete-shells\"; expected \"triangles\" or "
+             "\"auto\" (the hinges replace the triangle topology's bend springs)");
+    }
   }
   if (m.kind == ModelKind::volume_msm) m.volume_term = r.boolean_or("volume_term", false);
-  const auto stiffness = r.names_or(
-      "stiffness",
-      m.kind == ModelKind::volume_msm ? (m.volume_term ? "van-gelder" : "seed001") : "seed000",
-      msm::parse_stiffness_rule);
+  const auto stiffness =
+      r.names_or("stiffness",
+                 m.kind == ModelKind::volume_msm
+                     ? (m.volume_term ? "van-gelder" : "seed001")
+                     : (m.bending != msm::Bending::none ? "van-gelder" : "seed000"),
+                 msm::parse_stiffness_rule);
   if (m.volume_term) {
     for (const auto& k : stiffness) {
       if (msm::parse_stiffness_rule(k) != msm::StiffnessRule::van_gelder) {
@@ -341,6 +351,12 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
     r.fail(r.table().get("solver"), "solver",
            "found \"pbd\" on a volume model; expected it on a surface_msm model (seed 002's "
            "constraints act on a surface network)");
+  }
+  if (m.bending != msm::Bending::none &&
+      std::find(solvers.begin(), solvers.end(), "pbd") != solvers.end()) {
+    r.fail(r.table().get("solver"), "solver",
+           "found \"pbd\" with bending = \"discrete-shells\"; expected another solver (PBD "
+           "projects its own constraints and would ignore the bending energy)");
   }
   m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
   m.calibration = r.string_or("calibration", "");

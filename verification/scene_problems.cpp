@@ -114,6 +114,7 @@ msm::NetworkOptions network_options(const Scene& s, const ModelSpec& model, doub
   o.topology = model.topology;
   o.stiffness = model.stiffness;
   o.volume_term = model.volume_term;
+  o.bending = model.bending;
   o.stiffness_params.youngs_modulus = s.youngs_modulus;
   o.stiffness_params.poisson_ratio = nu;
   o.mass = model.mass;

@@ -1,5 +1,6 @@
 #include "msm/model/build_network.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "meshes/errors.hpp"
@@ -31,10 +32,47 @@ Topology parse_topology(const std::string& name) {
   throw InputError("topology: expected auto, grid or triangles, got '" + name + "'");
 }
 
+std::string to_string(Bending bending) {
+  return bending == Bending::discrete_shells ? "discrete-shells" : "none";
+}
+
+Bending parse_bending(const std::string& name) {
+  if (name == "none") return Bending::none;
+  if (name == "discrete-shells" || name == "discrete_shells") return Bending::discrete_shells;
+  throw InputError("bending: expected 'none' or 'discrete-shells', got '" + name + "'");
+}
+
 namespace {
 
 std::string triangle_topology_name(bool two_ring) {
   return std::string("triangle mesh (edges + bend across edges") + (two_ring ? " + two-ring)" : ")");
+}
+
+/// The bending option's checks that need no network: a surface model, not on seed 000's grid.
+void check_bending(const NetworkOptions& o, Topology topology) {
+  if (o.bending == Bending::none) return;
+  if (o.model != ModelType::surface) {
+    throw InputError(
+        "bending: the discrete-shells term lives on a surface model's triangles, got the volume "
+        "model (expected model surface, or bending none)");
+  }
+  if (topology == Topology::grid) {
+    throw InputError(
+        "bending: the discrete-shells term replaces the bend springs of the triangle topology; "
+        "expected topology 'triangles' or 'auto', got 'grid' (seed 000's grid families)");
+  }
+}
+
+/// The bending term's network changes: the bend springs go (the hinges carry bending), D recorded.
+void apply_bending(BuiltNetwork& built, const NetworkOptions& o) {
+  if (o.bending == Bending::none) return;
+  auto& springs = built.network.springs;
+  springs.erase(std::remove_if(springs.begin(), springs.end(),
+                               [](const Spring& s) { return s.family == SpringFamily::bend; }),
+                springs.end());
+  built.bending_rigidity = plate_bending_rigidity(
+      o.stiffness_params.youngs_modulus, built.network.thickness, o.stiffness_params.poisson_ratio);
+  built.topology += " without bend springs + discrete-shell hinges (Grinspun et al. 2003)";
 }
 
 /// Stiffness, axial damping and masses: the same for every topology. With the volume term, the
@@ -69,14 +107,18 @@ BuiltNetwork build_network(const TetMesh& mesh, const VesselParams& params,
   validate(o.stiffness_params);
   BuiltNetwork built;
   if (o.model == ModelType::volume) {
+    check_bending(o, o.topology);
     built.network = build_volume_network(mesh);
     built.topology = "tetrahedral edges (seed 001)";
   } else {
     const TriangleSurface surface = wall_surface(mesh, params, o.surface);
     Topology topology = o.topology;
     if (topology == Topology::automatic) {
-      topology = params.style == MeshStyle::structured ? Topology::grid : Topology::triangles;
+      topology = params.style == MeshStyle::structured && o.bending == Bending::none
+                     ? Topology::grid
+                     : Topology::triangles;
     }
+    check_bending(o, topology);
     if (topology == Topology::grid) {
       built.network = build_tube_grid_network(surface, params, params.wall_thickness);
       built.topology = "structured tube grid (seed 000 families)";
@@ -85,6 +127,7 @@ BuiltNetwork build_network(const TetMesh& mesh, const VesselParams& params,
       built.topology = triangle_topology_name(o.two_ring);
     }
   }
+  apply_bending(built, o);
   assign_laws_and_masses(built, o);
   return built;
 }
@@ -107,8 +150,10 @@ BuiltNetwork build_surface_network(const TriangleSurface& surface, double thickn
                      std::to_string(thickness));
   }
   BuiltNetwork built;
+  check_bending(o, Topology::triangles);
   built.network = build_triangle_network(surface, thickness, o.two_ring);
   built.topology = triangle_topology_name(o.two_ring);
+  apply_bending(built, o);
   assign_laws_and_masses(built, o);
   return built;
 }

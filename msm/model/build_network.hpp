@@ -25,6 +25,12 @@ enum class Topology { automatic, grid, triangles };
 std::string to_string(Topology topology);             ///< "auto" | "grid" | "triangles"
 Topology parse_topology(const std::string& name);     ///< InputError if unknown
 
+/// A surface model's bending: none beyond its springs, or the Discrete Shells hinge energy
+/// (Grinspun et al. 2003; msm/model/bending_term.hpp) with the wall's plate rigidity.
+enum class Bending { none, discrete_shells };
+std::string to_string(Bending bending);          ///< "none" | "discrete-shells"
+Bending parse_bending(const std::string& name);  ///< InputError if unknown
+
 struct NetworkOptions {
   ModelType model = ModelType::surface;
   WallSurface surface = WallSurface::inner;  ///< surface model: which wall
@@ -40,6 +46,12 @@ struct NetworkOptions {
   /// the network reaches the material's ν. InputError with another model or stiffness rule, or at
   /// ν = 0.5.
   bool volume_term = false;
+  /// Surface model only: discrete_shells adds the hinge energy of Grinspun et al. (2003) on every
+  /// interior edge with D = E·t³/(12(1 − ν²)) (E and ν from stiffness_params, t the wall thickness)
+  /// and drops the triangle topology's bend springs, whose job the hinges take over; the springs on
+  /// the triangle edges are the membrane (van-gelder: E·t·ΣA/L²). Needs the triangle topology
+  /// (auto picks it); InputError with the volume model or the grid topology.
+  Bending bending = Bending::none;
 };
 
 struct BuiltNetwork {
@@ -48,6 +60,9 @@ struct BuiltNetwork {
   std::string topology;        ///< human-readable description
   /// κ (Pa) of the volume term on network.tets (options.volume_term); none: springs only.
   std::optional<double> volume_kappa;
+  /// D (N·m) of the Discrete Shells bending term on network.triangles (options.bending); none: no
+  /// bending term.
+  std::optional<double> bending_rigidity;
 };
 
 /// Builds the network on the mesh: "auto" topology is seed 000's grid on a structured vessel and

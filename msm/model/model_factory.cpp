@@ -32,19 +32,38 @@ HybridModuli hybrid_moduli(double E, double nu) {
 }
 
 MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damping,
-                                 std::optional<double> volume_kappa)
+                                 std::optional<double> volume_kappa,
+                                 std::optional<double> bending_rigidity)
     : springs_(network, point_damping) {
-  if (!volume_kappa) return;
-  if (network.tets.empty()) {
-    throw InputError("volume term: the network has no tetrahedra; expected a volume network");
+  if (volume_kappa) {
+    if (network.tets.empty()) {
+      throw InputError("volume term: the network has no tetrahedra; expected a volume network");
+    }
+    volume_ = std::make_unique<VolumeTerm>(network.nodes, network.tets, *volume_kappa);
   }
-  volume_ = std::make_unique<VolumeTerm>(network.nodes, network.tets, *volume_kappa);
+  if (bending_rigidity) {
+    if (network.triangles.empty()) {
+      throw InputError(
+          "bending term (discrete-shells): the network has no triangles; expected a surface "
+          "network");
+    }
+    bending_ = std::make_unique<BendingTerm>(network.nodes, network.triangles, *bending_rigidity);
+  }
+  if (!volume_ && !bending_) return;
   SparseMatrix Hs;
   springs_.hessian(flatten(network.nodes), Hs, false);
-  volume_slots_ = volume_->slots_in(Hs);
-  if (std::find(volume_slots_.begin(), volume_slots_.end(), -1) == volume_slots_.end()) return;
-  // Some tet entries are not in the springs' pattern: assemble into the union of both.
-  union_pattern_ = Hs + volume_->pattern();
+  auto missing = [](const std::vector<int>& slots) {
+    return std::find(slots.begin(), slots.end(), -1) != slots.end();
+  };
+  if (volume_) volume_slots_ = volume_->slots_in(Hs);
+  if (bending_) bending_slots_ = bending_->slots_in(Hs);
+  if (!missing(volume_slots_) && !missing(bending_slots_)) return;
+  // Some term entries are not in the springs' pattern (a region of interest drops the springs
+  // between two held nodes; a hinge couples its two opposite vertices, which no spring joins once
+  // the bend springs are dropped): assemble into the union of the patterns.
+  union_pattern_ = Hs;
+  if (volume_) union_pattern_ += volume_->pattern();
+  if (bending_) union_pattern_ += bending_->pattern();
   union_pattern_.makeCompressed();
   std::fill(union_pattern_.valuePtr(), union_pattern_.valuePtr() + union_pattern_.nonZeros(), 0.0);
   for (int col = 0; col < Hs.outerSize(); ++col) {
@@ -55,16 +74,19 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
       spring_to_union_.push_back(static_cast<int>(std::lower_bound(begin, end, it.row()) - inner));
     }
   }
-  volume_slots_ = volume_->slots_in(union_pattern_);
+  if (volume_) volume_slots_ = volume_->slots_in(union_pattern_);
+  if (bending_) bending_slots_ = bending_->slots_in(union_pattern_);
 }
 
 double MassSpringModel::energy(const VectorXd& x) const {
-  return springs_.energy(x) + (volume_ ? volume_->energy(x) : 0.0);
+  return springs_.energy(x) + (volume_ ? volume_->energy(x) : 0.0) +
+         (bending_ ? bending_->energy(x) : 0.0);
 }
 
 void MassSpringModel::gradient(const VectorXd& x, VectorXd& g) const {
   springs_.gradient(x, g);
   if (volume_) volume_->add_gradient(x, g);
+  if (bending_) bending_->add_gradient(x, g);
 }
 
 double MassSpringModel::energy_gradient(const VectorXd& x, VectorXd& g) const {
@@ -73,11 +95,15 @@ double MassSpringModel::energy_gradient(const VectorXd& x, VectorXd& g) const {
     volume_->add_gradient(x, g);
     e += volume_->energy(x);
   }
+  if (bending_) {
+    bending_->add_gradient(x, g);
+    e += bending_->energy(x);
+  }
   return e;
 }
 
 void MassSpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
-  if (!volume_) {
+  if (!volume_ && !bending_) {
     springs_.hessian(x, H, project_psd);
     return;
   }
@@ -93,8 +119,9 @@ void MassSpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_p
       values[spring_to_union_[k]] += spring_values[k];
     }
   }
-  // Each term's blocks are projected separately (per spring, per tet).
-  volume_->add_hessian(x, H.valuePtr(), volume_slots_, project_psd);
+  // Each term's blocks are projected separately (per spring, per tet, per hinge).
+  if (volume_) volume_->add_hessian(x, H.valuePtr(), volume_slots_, project_psd);
+  if (bending_) bending_->add_hessian(x, H.valuePtr(), bending_slots_, project_psd);
 }
 
 void MassSpringModel::damping_force(const VectorXd& x, const VectorXd& v, VectorXd& f) const {
@@ -107,18 +134,19 @@ void MassSpringModel::damping_jacobian(const VectorXd& x, SparseMatrix& D) const
 
 std::unique_ptr<MassSpringModel> make_model(const SpringNetwork& network,
                                             std::optional<double> volume_kappa,
-                                            double point_damping) {
-  return std::make_unique<MassSpringModel>(network, point_damping, volume_kappa);
+                                            double point_damping,
+                                            std::optional<double> bending_rigidity) {
+  return std::make_unique<MassSpringModel>(network, point_damping, volume_kappa, bending_rigidity);
 }
 
 std::unique_ptr<MassSpringModel> make_model(const BuiltNetwork& built, double point_damping) {
-  return make_model(built.network, built.volume_kappa, point_damping);
+  return make_model(built.network, built.volume_kappa, point_damping, built.bending_rigidity);
 }
 
 const SpringModel* plain_spring_model(const Form& form) {
   if (const auto* springs = dynamic_cast<const SpringModel*>(&form)) return springs;
   if (const auto* model = dynamic_cast<const MassSpringModel*>(&form)) {
-    if (!model->volume_term()) return &model->springs();
+    if (!model->volume_term() && !model->bending_term()) return &model->springs();
   }
   return nullptr;
 }

@@ -25,6 +25,7 @@
 #include <memory>
 #include <optional>
 
+#include "msm/model/bending_term.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/model/volume_term.hpp"
@@ -42,12 +43,17 @@ struct HybridModuli {
 HybridModuli hybrid_moduli(double E, double nu);
 
 /// A mass-spring model as the solvers see it: the spring model, plus the volume term when the
-/// network carries one. Energy, gradient and Hessian are the sums; damping is the springs'.
+/// network carries one, plus the Discrete Shells bending term (bending_term.hpp) on a surface
+/// network's triangles when asked. Energy, gradient and Hessian are the sums; damping is the
+/// springs'.
 class MassSpringModel : public Form {
  public:
-  /// volume_kappa: κ (Pa) of the volume term on network.tets; none: springs only.
+  /// volume_kappa: κ (Pa) of the volume term on network.tets; bending_rigidity: D (N·m) of the
+  /// bending term on network.triangles; none: without that term. InputError if the network lacks
+  /// the tets or triangles a term needs.
   MassSpringModel(const SpringNetwork& network, double point_damping,
-                  std::optional<double> volume_kappa);
+                  std::optional<double> volume_kappa,
+                  std::optional<double> bending_rigidity = std::nullopt);
 
   [[nodiscard]] int num_dofs() const override { return springs_.num_dofs(); }
   [[nodiscard]] double energy(const VectorXd& x) const override;
@@ -62,29 +68,36 @@ class MassSpringModel : public Form {
   [[nodiscard]] const SpringModel& springs() const { return springs_; }
   /// The volume term, or nullptr.
   [[nodiscard]] const VolumeTerm* volume_term() const { return volume_.get(); }
+  /// The bending term, or nullptr.
+  [[nodiscard]] const BendingTerm* bending_term() const { return bending_.get(); }
   /// Largest spring strain |L − l|/l at x.
   [[nodiscard]] double max_strain(const VectorXd& x) const { return springs_.max_strain(x); }
 
  private:
   SpringModel springs_;
   std::unique_ptr<VolumeTerm> volume_;
-  /// Hessian pattern when the springs' lacks some tet entries (a region of interest drops the
-  /// springs between two held nodes): the union, and where each spring value goes in it.
+  std::unique_ptr<BendingTerm> bending_;
+  /// Hessian pattern when the springs' lacks some tet or hinge entries (a region of interest drops
+  /// the springs between two held nodes; no spring joins a hinge's opposite vertices): the union,
+  /// and where each spring value goes in it.
   SparseMatrix union_pattern_;
   std::vector<int> spring_to_union_;
-  std::vector<int> volume_slots_;  ///< in the springs' pattern, or in union_pattern_
+  std::vector<int> volume_slots_;   ///< in the springs' pattern, or in union_pattern_
+  std::vector<int> bending_slots_;  ///< likewise
 };
 
 /// The springs alone of a Form that is nothing but springs: a SpringModel, or a MassSpringModel
-/// without a volume term; nullptr for any other Form (solvers that need a plain spring network,
-/// such as the local-global method, refuse those).
+/// without a volume or bending term; nullptr for any other Form (solvers that need a plain spring
+/// network, such as the local-global method, refuse those).
 const SpringModel* plain_spring_model(const Form& form);
 
-/// The model of a network (volume_kappa as in BuiltNetwork), point damping k_v in N·s/m per node.
+/// The model of a network (volume_kappa and bending_rigidity as in BuiltNetwork), point damping
+/// k_v in N·s/m per node.
 std::unique_ptr<MassSpringModel> make_model(const SpringNetwork& network,
                                             std::optional<double> volume_kappa,
-                                            double point_damping = 0.0);
-/// The model of a built network (its volume term if it has one).
+                                            double point_damping = 0.0,
+                                            std::optional<double> bending_rigidity = std::nullopt);
+/// The model of a built network (its volume and bending terms if it has them).
 std::unique_ptr<MassSpringModel> make_model(const BuiltNetwork& built, double point_damping = 0.0);
 
 }  // namespace vessel::msm

@@ -1,7 +1,10 @@
 #include "msm/model/roi.hpp"
 
+#include <algorithm>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace vessel::msm {
 
@@ -29,12 +32,31 @@ std::vector<char> held_nodes(const Problem& full, const Vec3& centre, double rad
   return held;
 }
 
-RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& held) {
+RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& held,
+                            bool carry_triangles) {
   const std::size_t n = full.nodes.size();
   std::vector<char> keep(n, 0);
   for (std::size_t i = 0; i < n; ++i) keep[i] = !held[i];
   for (const Spring& s : full.springs) {
     if (!held[s.a] || !held[s.b]) keep[s.a] = keep[s.b] = 1;  // the boundary ring
+  }
+  // Triangles for the bending term: a hinge moves when any of its four nodes does, and its two
+  // triangles are then one with a moving node and one sharing an edge with it.
+  std::vector<Triangle> carried;
+  if (carry_triangles) {
+    std::set<std::pair<int, int>> moving_edges;
+    auto edge = [](int p, int q) { return std::make_pair(std::min(p, q), std::max(p, q)); };
+    for (const Triangle& t : full.triangles) {
+      if (held[t[0]] && held[t[1]] && held[t[2]]) continue;
+      for (int k = 0; k < 3; ++k) moving_edges.insert(edge(t[k], t[(k + 1) % 3]));
+    }
+    for (const Triangle& t : full.triangles) {
+      bool near = false;
+      for (int k = 0; k < 3; ++k) near = near || moving_edges.count(edge(t[k], t[(k + 1) % 3]));
+      if (!near) continue;
+      carried.push_back(t);
+      for (int v : t) keep[v] = 1;
+    }
   }
   RoiNetwork roi;
   std::vector<int> to_roi(n, -1);
@@ -54,9 +76,12 @@ RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& 
     roi.network.springs.push_back(r);
   }
   roi.network.thickness = full.thickness;
+  for (const Triangle& t : carried) {
+    roi.network.triangles.push_back({to_roi[t[0]], to_roi[t[1]], to_roi[t[2]]});
+  }
   // Tets with a moving node are carried, for the volume term (their other nodes are kept: a volume
-  // network has a spring on every tet edge). Triangles are not: the spring model and the solvers
-  // other than PBD use springs only.
+  // network has a spring on every tet edge). Triangles only with carry_triangles (above): the
+  // spring model and the solvers other than PBD use springs only.
   for (const Tet& t : full.tets) {
     if (held[t[0]] && held[t[1]] && held[t[2]] && held[t[3]]) continue;
     Tet r{};

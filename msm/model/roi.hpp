@@ -20,7 +20,9 @@ std::vector<char> nodes_beyond(const std::vector<Vec3>& nodes, const Vec3& centr
 /// A network cut down to a region: the nodes that still move (any free dof, within R) and the held
 /// nodes one spring away from them (the region's boundary ring, all dofs fixed); springs with at
 /// least one moving end (a spring between two held nodes exerts no force on a moving node); tets
-/// with at least one moving node (for the volume term).
+/// with at least one moving node (for the volume term); with carry_triangles, the triangles with a
+/// moving node and those sharing an edge with them, their nodes kept (every hinge of the bending
+/// term with a moving node lies between two of them).
 struct RoiNetwork {
   SpringNetwork network;        ///< kept nodes and springs, renumbered
   std::vector<int> full_index;  ///< per kept node: its index in the full network
@@ -28,7 +30,8 @@ struct RoiNetwork {
 };
 
 /// `held[i]`: node i of the full problem is held (beyond R, or all its dofs fixed already).
-RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& held);
+RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& held,
+                            bool carry_triangles = false);
 
 /// The full problem restricted to the region's network (rest, loads, masses and fixed dofs of
 /// the kept nodes; the ring held), on `form` (a model of roi.network). Loads on held nodes are

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "meshes/errors.hpp"
+#include "msm/model/model_factory.hpp"
 #include "msm/solvers/local_global.hpp"
 #include "msm/stability/critical_step.hpp"
 
@@ -85,6 +86,14 @@ SolveResult run_pbd_solver(const Problem& problem, const SolverSpec& spec,
     throw InputError(
         "solver pbd: seed 002's position-based constraints need a surface network (its "
         "triangles carry the bending constraints); use a surface model");
+  }
+  if (problem.form && !plain_spring_model(*problem.form)) {
+    // PBD projects its own constraints and never reads the Form: an energy term beyond the
+    // springs (the discrete-shells bending term) would be silently ignored.
+    throw InputError(
+        "solver pbd: seed 002's position-based constraints replace the model's energy; this "
+        "model has a term beyond its springs (bending = discrete-shells), which PBD would ignore; "
+        "use another solver or bending none");
   }
   std::vector<Vec3> loads(network->nodes.size(), Vec3::Zero());
   for (std::size_t i = 0; i < loads.size(); ++i) {

@@ -47,6 +47,14 @@ TEST_F(MsmCli, SurfaceAndVolumeModelsSolveStaticallyAndWriteJson) {
   const auto h = vv("--model volume --volume-term --poisson-ratio 0.45");
   ASSERT_EQ(h.exit_code, 0) << h.output;
   EXPECT_TRUE(contains(h.output, "volume term")) << h.output;
+  // The discrete-shells surface model: hinges named in the topology, no bend springs left.
+  const auto b =
+      vv("--bending discrete-shells --poisson-ratio 0.45 --json " + (dir / "shell.json").string());
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_TRUE(contains(b.output, "discrete-shell hinges")) << b.output;
+  const auto jb = nlohmann::json::parse(read_text(dir / "shell.json"));
+  EXPECT_EQ(jb["springs"].value("bend", 0), 0);
+  EXPECT_GT(jb["contact_displacement_along_load_mm"].get<double>(), 0.0);
   const auto jv = nlohmann::json::parse(read_text(dir / "volume.json"));
   EXPECT_GT(jv["springs"]["volume"].get<int>(), 5000);
   EXPECT_GT(jv["contact_displacement_along_load_mm"].get<double>(), 0.0);
@@ -84,6 +92,10 @@ TEST_F(MsmCli, BadInputNamesTheParameterAndExitsOne) {
       {"--model volume --volume-term --poisson-ratio 0.5", "κ = λ − μ is infinite"},
       {"--model volume --volume-term --stiffness lloyd --poisson-ratio 0.45", "van-gelder"},
       {"--model surface --volume-term", "volume model"},
+      {"--model volume --bending discrete-shells", "surface model"},
+      {"--structured --topology grid --bending discrete-shells", "grid"},
+      {"--bending discrete-shells --solver pbd", "PBD"},
+      {"--bending discrete-shells --solver local-global", "local-global"},
   };
   for (const auto& [args, what] : cases) {
     const auto r = vv(args + " --json " + (dir / "bad.json").string());

@@ -7,6 +7,7 @@
 #include "../test_helpers.hpp"
 #include "meshes/errors.hpp"
 #include "verification/scene.hpp"
+#include "verification/scene_problems.hpp"
 
 using namespace vessel;
 
@@ -256,4 +257,31 @@ TEST(Scene, ModesTableIsReadAndCheckedNamingTheKey) {
   EXPECT_NE(msg.find("key 'modes.reference_level'"), std::string::npos) << msg;
   msg = error_of(std::string(kMinimal) + "[modes]\nnumber = 6\n");
   EXPECT_NE(msg.find("key 'modes.number': unknown key"), std::string::npos) << msg;
+}
+
+TEST(Scene, BendingSelectsTheDiscreteShellsSurfaceModel) {
+  const Scene s = parse_scene(std::string(kMinimal) +
+                                  "[[models]]\nname = \"shell\"\nkind = \"surface_msm\"\n"
+                                  "bending = \"discrete-shells\"\n",
+                              "scene.toml");
+  const ModelSpec& m = s.models.back();
+  EXPECT_EQ(m.bending, msm::Bending::discrete_shells);
+  EXPECT_EQ(m.stiffness, msm::StiffnessRule::van_gelder);  // its default membrane
+  EXPECT_EQ(network_options(s, m, 0.45).bending, msm::Bending::discrete_shells);
+  // An unknown name, the grid topology, PBD, or the key on a volume model: refused, naming the key.
+  const auto name = error_of(std::string(kMinimal) +
+                             "[[models]]\nkind = \"surface_msm\"\nbending = \"kirchhoff\"\n");
+  EXPECT_NE(name.find("models[1].bending"), std::string::npos) << name;
+  EXPECT_NE(name.find("discrete-shells"), std::string::npos) << name;
+  const auto grid = error_of(std::string(kMinimal) +
+                             "[[models]]\nkind = \"surface_msm\"\nbending = \"discrete-shells\"\n"
+                             "topology = \"grid\"\n");
+  EXPECT_NE(grid.find("models[1].topology"), std::string::npos) << grid;
+  const auto pbd = error_of(std::string(kMinimal) +
+                            "[[models]]\nkind = \"surface_msm\"\nbending = \"discrete-shells\"\n"
+                            "solver = \"pbd\"\ndt = 1e-3\nsteps = 10\n");
+  EXPECT_NE(pbd.find("models[1].solver"), std::string::npos) << pbd;
+  const auto volume = error_of(
+      std::string(kMinimal) + "[[models]]\nkind = \"volume_msm\"\nbending = \"discrete-shells\"\n");
+  EXPECT_NE(volume.find("bending"), std::string::npos) << volume;
 }

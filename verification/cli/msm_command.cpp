@@ -35,8 +35,9 @@ struct MsmOptions {
   std::string surface = msm::to_string(msm::NetworkOptions{}.surface);
   std::string topology = "auto";
   bool two_ring = false;
-  std::string stiffness;  ///< empty: seed000, or van-gelder with --volume-term
+  std::string stiffness;  ///< empty: seed000, or van-gelder with --volume-term or --bending
   bool volume_term = false;
+  std::string bending = "none";
   msm::StiffnessParams stiffness_params;
   std::string mass = "consistent";
   double density = msm::kVesselDensity;
@@ -214,6 +215,7 @@ msm::BuiltNetwork command_network(const MsmOptions& o, const Scene& s, const Tet
   n.two_ring = o.two_ring;
   n.stiffness = msm::parse_stiffness_rule(o.stiffness);
   n.volume_term = o.volume_term;
+  n.bending = msm::parse_bending(o.bending);
   n.stiffness_params = o.stiffness_params;
   n.mass = msm::parse_mass_rule(o.mass);
   n.density = o.density;
@@ -391,7 +393,9 @@ void print_displacements(const msm::SpringNetwork& net, const msm::MassSpringMod
 
 void run(MsmOptions& o) {
   const auto t_total = std::chrono::steady_clock::now();
-  if (o.stiffness.empty()) o.stiffness = o.volume_term ? "van-gelder" : "seed000";
+  if (o.stiffness.empty()) {
+    o.stiffness = o.volume_term || o.bending != "none" ? "van-gelder" : "seed000";
+  }
   std::cout << std::setprecision(6);
   const bool stl = is_stl(o);
   if (stl) check_stl_options(o);  // first: what an STL cannot give explains the rest
@@ -450,15 +454,22 @@ void add_model_options(CLI::App* cmd, MsmOptions& o) {
   cmd->add_flag("--two-ring", o.two_ring, "Add two-ring springs (triangle topology)");
   cmd->add_option("--stiffness", o.stiffness,
                   "Stiffness rule: seed000, seed001, van-gelder, lloyd, least-squares-fit, uniform "
-                  "(default seed000; van-gelder with --volume-term)");
+                  "(default seed000; van-gelder with --volume-term or --bending)");
   cmd->add_flag("--volume-term", o.volume_term,
                 "Hybrid volume model (Golec et al. 2020), volume model only: van-gelder springs "
                 "carrying the shear modulus plus a volume energy per tet, κ = λ − μ, so that the "
                 "network has the material's ν (< 0.5)");
+  cmd->add_option(
+         "--bending", o.bending,
+         "Surface model's bending: none, or discrete-shells (Grinspun et al. 2003: a hinge "
+         "energy on every interior edge with D = E·t³/(12(1 − ν²)) from --youngs-modulus "
+         "and --poisson-ratio, replacing the bend springs; triangle topology)")
+      ->check(CLI::IsMember({"none", "discrete-shells"}))
+      ->capture_default_str();
   auto& sp = o.stiffness_params;
   cmd->add_option("--youngs-modulus", sp.youngs_modulus, "E, Pa")->capture_default_str();
   cmd->add_option("--poisson-ratio", sp.poisson_ratio,
-                  "ν (least-squares-fit rule and --volume-term)")
+                  "ν (least-squares-fit rule, --volume-term and --bending)")
       ->capture_default_str();
   cmd->add_option("--uniform-k", sp.uniform_k, "k of the uniform rule, N/m")->capture_default_str();
   cmd->add_option("--shear-factor", sp.shear_factor, "Factor on shear springs")

@@ -159,17 +159,31 @@ Selection select_model(const std::vector<Candidate>& c, double tolerance, double
 
 namespace {
 
-/// The spring models of a kind: every stiffness rule, and for volume networks also the hybrid
-/// volume model (van-gelder springs + volume term, msm/model/model_factory.hpp).
-std::vector<std::pair<msm::StiffnessRule, bool>> spring_rules(ModelKind kind) {
-  std::vector<std::pair<msm::StiffnessRule, bool>> out;
-  for (const msm::StiffnessRule rule : msm::kAllStiffnessRules) out.emplace_back(rule, false);
-  if (kind == ModelKind::volume_msm) out.emplace_back(msm::StiffnessRule::van_gelder, true);
+/// One spring model of a kind: its stiffness rule, and the term it adds to its springs.
+struct SpringChoice {
+  msm::StiffnessRule rule = msm::StiffnessRule::seed000;
+  bool volume_term = false;
+  msm::Bending bending = msm::Bending::none;
+  [[nodiscard]] bool plain() const { return !volume_term && bending == msm::Bending::none; }
+};
+
+/// The spring models of a kind: every stiffness rule; for volume networks also the hybrid volume
+/// model (van-gelder springs + volume term, msm/model/model_factory.hpp); for surface networks
+/// also the Discrete Shells model (van-gelder membrane + hinge energy, msm/model/bending_term.hpp).
+std::vector<SpringChoice> spring_rules(ModelKind kind) {
+  std::vector<SpringChoice> out;
+  for (const msm::StiffnessRule rule : msm::kAllStiffnessRules) out.push_back({rule});
+  if (kind == ModelKind::volume_msm) out.push_back({msm::StiffnessRule::van_gelder, true});
+  if (kind == ModelKind::surface_msm) {
+    out.push_back({msm::StiffnessRule::van_gelder, false, msm::Bending::discrete_shells});
+  }
   return out;
 }
 
-std::string rule_label(msm::StiffnessRule rule, bool volume_term) {
-  return volume_term ? "hybrid-volume" : msm::to_string(rule);
+std::string rule_label(const SpringChoice& c) {
+  if (c.volume_term) return "hybrid-volume";
+  if (c.bending != msm::Bending::none) return msm::to_string(c.bending);
+  return msm::to_string(c.rule);
 }
 
 }  // namespace
@@ -187,14 +201,15 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
     fem.degree = 1;
     out.push_back(fem);
     for (const auto& [kind, kind_name] : kinds) {
-      for (const auto& [rule, volume_term] : spring_rules(kind)) {
+      for (const SpringChoice& choice : spring_rules(kind)) {
         ModelSpec m;
         m.kind = kind;
         m.surface = msm::WallSurface::mid;
-        m.stiffness = rule;
-        m.volume_term = volume_term;
+        m.stiffness = choice.rule;
+        m.volume_term = choice.volume_term;
+        m.bending = choice.bending;
         m.mass = msm::MassRule::consistent;  // irrelevant to a static answer
-        const std::string rule_name = rule_label(rule, volume_term);
+        const std::string rule_name = rule_label(choice);
         for (const std::string solver : {"static", "linear"}) {
           m.solver = msm::parse_solver(solver);
           m.name = kind_name + "/" + rule_name + "/" + solver;
@@ -237,41 +252,42 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
   std::set<double> all = explicit_dts;
   all.insert(implicit_dts.begin(), implicit_dts.end());
   for (const auto& [kind, kind_name] : kinds) {
-    for (const auto& [rule, volume_term] : spring_rules(kind)) {
+    for (const SpringChoice& choice : spring_rules(kind)) {
       for (const msm::Integrator integrator : msm::kAllIntegrators) {
         const std::set<double>& family = is_explicit(integrator) ? explicit_dts : implicit_dts;
         for (const double dt : family.empty() ? all : family) {
           ModelSpec m;
           m.kind = kind;
           m.surface = msm::WallSurface::mid;
-          m.stiffness = rule;
-          m.volume_term = volume_term;
+          m.stiffness = choice.rule;
+          m.volume_term = choice.volume_term;
+          m.bending = choice.bending;
           m.mass = msm::MassRule::consistent;  // the FEM transient's mass
           m.solver.kind = msm::SolverKind::integrator;
           m.solver.integrator = integrator;
           m.solver.dt = dt;
           m.solver.steps = std::max(1L, std::lround(duration / dt));
           m.damping = damping;
-          m.name = kind_name + "/" + rule_label(rule, volume_term) + "/" +
-                   msm::to_string(integrator) +
+          m.name = kind_name + "/" + rule_label(choice) + "/" + msm::to_string(integrator) +
                    "/dt=" + fmt(dt);
           out.push_back(m);
         }
       }
       // The real-time solver (Liu et al. 2013), implicit Euler with its default iterations per
-      // step, at the implicit family's steps: plain spring networks only (no volume term).
-      if (volume_term) continue;
+      // step, at the implicit family's steps: plain spring networks only (no volume or bending
+      // term).
+      if (!choice.plain()) continue;
       for (const double dt : implicit_dts.empty() ? all : implicit_dts) {
         ModelSpec m;
         m.kind = kind;
         m.surface = msm::WallSurface::mid;
-        m.stiffness = rule;
+        m.stiffness = choice.rule;
         m.mass = msm::MassRule::consistent;
         m.solver = msm::parse_solver("local-global-euler");
         m.solver.dt = dt;
         m.solver.steps = std::max(1L, std::lround(duration / dt));
         m.damping = damping;
-        m.name = kind_name + "/" + rule_label(rule, false) + "/local-global-euler/dt=" + fmt(dt);
+        m.name = kind_name + "/" + rule_label(choice) + "/local-global-euler/dt=" + fmt(dt);
         out.push_back(m);
       }
     }

@@ -72,11 +72,12 @@ struct RecommendOptions {
 };
 
 /// The candidate models of a scene. Static scenes: FEM P1; surface (mid-surface, the mesh's
-/// topology) and volume networks with every stiffness rule (msm::kAllStiffnessRules), and the hybrid
-/// volume model ("volume/hybrid-volume/...": van-gelder springs + volume term), each with
-/// the static Newton solver and the linearised model; with contact loads also the Newton solver
-/// on each region-of-interest radius. Dynamic scenes (a scene model uses an integrator): every
-/// integrator (msm::kAllIntegrators) at the time steps the scene uses for that family of
+/// topology) and volume networks with every stiffness rule (msm::kAllStiffnessRules), and the
+/// hybrid volume model ("volume/hybrid-volume/...": van-gelder springs + volume term) and the
+/// Discrete Shells surface model ("surface/discrete-shells/...": van-gelder membrane + hinges),
+/// each with the static Newton solver and the linearised model; with contact loads also the Newton
+/// solver on each region-of-interest radius. Dynamic scenes (a scene model uses an integrator):
+/// every integrator (msm::kAllIntegrators) at the time steps the scene uses for that family of
 /// integrator (explicit or implicit; all of the scene's if it has none of that family), over the
 /// scene's longest simulated time, with the scene's point damping, and the local–global implicit
 /// Euler (Liu et al. 2013, its default iterations per step) at the implicit family's time steps

@@ -199,8 +199,9 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   m.stiffness = msm::StiffnessRule::seed001;
   s.models = {m};
   const std::vector<ModelSpec> c = candidate_models(s, {4e-3, 8e-3});
-  // FEM P1 + (2 kinds × every rule + the hybrid volume model) × (static, linear, 2 radii).
-  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 1;
+  // FEM P1 + (2 kinds × every rule + the hybrid volume model + the discrete-shells surface
+  // model) × (static, linear, 2 radii).
+  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 2;
   ASSERT_EQ(c.size(), 1 + spring_models * 4);
   std::set<std::string> names, rules;
   for (const auto& x : c) {
@@ -211,6 +212,15 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   EXPECT_EQ(rules.size(), msm::kAllStiffnessRules.size());
   EXPECT_TRUE(names.count("volume/lloyd/static/R=4mm"));
   EXPECT_TRUE(names.count("volume/hybrid-volume/static"));
+  EXPECT_TRUE(names.count("surface/discrete-shells/static/R=8mm"));
+  for (const auto& x : c) {
+    if (x.name.starts_with("surface/discrete-shells/")) {
+      EXPECT_EQ(x.bending, msm::Bending::discrete_shells) << x.name;
+      EXPECT_EQ(x.stiffness, msm::StiffnessRule::van_gelder) << x.name;
+    } else {
+      EXPECT_EQ(x.bending, msm::Bending::none) << x.name;
+    }
+  }
   EXPECT_TRUE(names.count("volume/least-squares-fit/linear"));
   EXPECT_TRUE(names.count("surface/seed000/linear"));
   // Pressure: no regions of interest.
@@ -231,11 +241,12 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   s.models = {e, i};
   const std::vector<ModelSpec> d = candidate_models(s, {4e-3});
   // Every integrator on every spring model, plus local-global-euler on the plain spring networks
-  // (all but the hybrid volume model), at the implicit step.
-  ASSERT_EQ(d.size(), spring_models * msm::kAllIntegrators.size() + spring_models - 1);
+  // (all but the hybrid volume and discrete-shells models), at the implicit step.
+  ASSERT_EQ(d.size(), spring_models * msm::kAllIntegrators.size() + spring_models - 2);
   for (const auto& x : d) {
     if (x.solver.kind == msm::SolverKind::local_global_euler) {
       EXPECT_FALSE(x.volume_term) << x.name;
+      EXPECT_EQ(x.bending, msm::Bending::none) << x.name;
       EXPECT_DOUBLE_EQ(x.solver.dt, 1e-3) << x.name;
       EXPECT_EQ(x.solver.steps, 200) << x.name;
       continue;
