@@ -418,6 +418,11 @@ TransientResult SolutionCache::transient(const ElasticitySolver& solver, const T
   return result;
 }
 
+const ElasticityResult& solve_with(SolutionCache* cache, ElasticitySolver& solver,
+                                   const TetMesh& mesh, const ElasticityProblem& problem) {
+  return cache ? cache->solve(solver, mesh, problem) : solver.solve();
+}
+
 SolutionCacheStatistics SolutionCache::statistics() const {
   const std::lock_guard lock(mutex_);
   return stats_;

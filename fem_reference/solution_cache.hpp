@@ -72,4 +72,8 @@ class SolutionCache {
   SolutionCacheStatistics stats_;
 };
 
+/// cache->solve(solver, mesh, problem), or solver.solve() without a cache.
+const ElasticityResult& solve_with(SolutionCache* cache, ElasticitySolver& solver,
+                                   const TetMesh& mesh, const ElasticityProblem& problem);
+
 }  // namespace vessel::fem

@@ -147,7 +147,7 @@ const fem::ElasticityResult& solve_reference(std::unique_ptr<fem::ElasticitySolv
                                              const fem::ElasticityProblem& problem,
                                              fem::SolutionCache* cache) {
   solver = std::make_unique<fem::ElasticitySolver>(mesh, problem);
-  return cache ? cache->solve(*solver, mesh, problem) : solver->solve();
+  return fem::solve_with(cache, *solver, mesh, problem);
 }
 
 ReferenceAtPoints reference_at(const ReferenceSolvers& ref, const std::vector<Vec3>& points) {

@@ -6,7 +6,7 @@
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
-#include "meshes/mesh_cache.hpp"
+#include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/studies/calibrate.hpp"
 
@@ -28,7 +28,7 @@ struct Options {
   int iterations = CalibrateOptions{}.max_iterations;
   std::filesystem::path output = "calibration.json";
   std::filesystem::path summary;
-  std::filesystem::path cache_dir = default_cache_dir();
+  CacheOptions cache;
   std::string command;
 };
 
@@ -51,7 +51,9 @@ void run(const Options& o) {
   if (o.reference_level >= 0) c.reference_level = o.reference_level;
   c.regulariser = {o.smoothness, o.ridge};
   c.max_iterations = o.iterations;
-  c.cache_dir = o.cache_dir;
+  c.cache_dir = o.cache.mesh_dir();
+  const auto solution_cache = o.cache.solution_cache(std::cout);
+  c.solution_cache = solution_cache.get();
   c.log = &std::cout;
   const CalibrationStudy study = calibrate_scene(s, c);
   write_calibration(o.output, study.calibration);
@@ -63,6 +65,7 @@ void run(const Options& o) {
   }
   std::cout << "\nwrote " << o.output.string()
             << (o.summary.empty() ? "" : " and " + o.summary.string()) << "\n";
+  std::cout << solution_cache->summary() << "\n";
 }
 
 }  // namespace
@@ -118,7 +121,7 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
       ->capture_default_str();
   cmd->add_option("--output", o->output, "Calibration file to write (JSON)")->capture_default_str();
   cmd->add_option("--summary", o->summary, "Also write the Markdown tables here");
-  cmd->add_option("--cache-dir", o->cache_dir, "Mesh cache directory")->capture_default_str();
+  add_cache_options(*cmd, o->cache);
   cmd->callback([o] { run(*o); });
 }
 

@@ -8,10 +8,8 @@
 #include <sstream>
 
 #include "fem_reference/elasticity.hpp"
-#include "meshes/atomic_file.hpp"
+#include "fem_reference/solution_cache.hpp"
 #include "meshes/errors.hpp"
-#include <cstdio>
-#include <fstream>
 #include "msm/calibration/lbfgs.hpp"
 #include "msm/model/model_factory.hpp"
 #include "msm/solvers/updates.hpp"
@@ -178,7 +176,7 @@ struct VesselContext {
   TetMesh reference_mesh;
   msm::BuiltNetwork base;
   std::map<std::string, ShapeAnswer> shapes;
-  std::filesystem::path cache_dir;  ///< FEM answers cached under cache_dir/calibrate (empty: none)
+  fem::SolutionCache* cache = nullptr;  ///< FEM solutions kept on disk (nullptr: none)
 };
 
 std::string shape_key(const LoadCase& c) {
@@ -194,79 +192,6 @@ std::vector<Vec3> scaled(const std::vector<Vec3>& u, double f) {
   return out;
 }
 
-/// Everything that determines a shape's FEM answers: the meshes, the points, the material, the
-/// supports and the load's shape (the key of the on-disk cache).
-std::string answer_key(const VesselContext& v, const Scene& cs, double nu) {
-  std::ostringstream k;
-  k << std::setprecision(17) << "calibrate-fem-v1|" << mesh_hash(v.reference_mesh) << "|"
-    << mesh_hash(v.mesh) << "|" << v.base.network.nodes.size() << "|" << cs.youngs_modulus << "|"
-    << nu << "|" << cs.density << "|";
-  for (const Vec3& p : v.base.network.nodes) k << std::llround(p.x() * 1e9) << ","
-                                               << std::llround(p.y() * 1e9) << ","
-                                               << std::llround(p.z() * 1e9) << ";";
-  for (const auto& [g, e] : cs.boundary) k << g << "=" << to_string(e) << ";";
-  const LoadSpec& l = cs.load;
-  k << to_string(l.kind) << "|" << l.contact.point.transpose() << "|" << l.contact.radius << "|"
-    << l.contact.surface_group << "|" << l.gravity_direction.transpose();
-  return k.str();
-}
-
-std::uint64_t fnv1a(const std::string& s) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (const unsigned char c : s) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
-void write_vectors(std::ostream& out, const std::vector<Vec3>& v) {
-  const std::uint64_t n = v.size();
-  out.write(reinterpret_cast<const char*>(&n), sizeof n);
-  for (const Vec3& p : v) out.write(reinterpret_cast<const char*>(p.data()), 3 * sizeof(double));
-}
-
-bool read_vectors(std::istream& in, std::vector<Vec3>& v) {
-  std::uint64_t n = 0;
-  if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n > (1u << 28)) return false;
-  v.resize(n);
-  for (Vec3& p : v) {
-    if (!in.read(reinterpret_cast<char*>(p.data()), 3 * sizeof(double))) return false;
-  }
-  return true;
-}
-
-/// The cached FEM answers of a shape (cache_dir/calibrate/<hash>.bin holding the key itself, so
-/// a hash collision is a miss), or false.
-bool read_cached(const std::filesystem::path& file, const std::string& key, ShapeAnswer& a) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return false;
-  std::uint64_t n = 0;
-  if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n != key.size()) return false;
-  std::string stored(n, '\0');
-  if (!in.read(stored.data(), static_cast<std::streamsize>(n)) || stored != key) return false;
-  return read_vectors(in, a.reference_at_network) && read_vectors(in, a.reference_at_mesh) &&
-         read_vectors(in, a.p1) &&
-         static_cast<bool>(in.read(reinterpret_cast<char*>(&a.p1_seconds), sizeof(double))) &&
-         static_cast<bool>(in.read(reinterpret_cast<char*>(&a.strain_unit), sizeof(double)));
-}
-
-void write_cached(const std::filesystem::path& file, const std::string& key, const ShapeAnswer& a) {
-  write_file_atomically(
-      file,
-      [&](std::ostream& out) {
-        const std::uint64_t n = key.size();
-        out.write(reinterpret_cast<const char*>(&n), sizeof n);
-        out.write(key.data(), static_cast<std::streamsize>(n));
-        write_vectors(out, a.reference_at_network);
-        write_vectors(out, a.reference_at_mesh);
-        write_vectors(out, a.p1);
-        out.write(reinterpret_cast<const char*>(&a.p1_seconds), sizeof(double));
-        out.write(reinterpret_cast<const char*>(&a.strain_unit), sizeof(double));
-      },
-      true);
-}
-
 const ShapeAnswer& shape_answer(VesselContext& v, const LoadCase& c, double nu,
                                 std::ostream& log) {
   const std::string key = shape_key(c);
@@ -275,40 +200,27 @@ const ShapeAnswer& shape_answer(VesselContext& v, const LoadCase& c, double nu,
   LoadCase unit = c;
   unit.magnitude = 1.0;
   const Scene cs = case_scene(*v.scene, unit);
-  // The FEM answers are cached on disk (they cost a P2 solve each; the fit and the models do not
-  // depend on them being recomputed).
-  std::filesystem::path cache_file;
-  const std::string disk_key = answer_key(v, cs, nu);
-  if (!v.cache_dir.empty()) {
-    char name[32];
-    std::snprintf(name, sizeof name, "%016llx.bin", static_cast<unsigned long long>(fnv1a(disk_key)));
-    cache_file = v.cache_dir / "calibrate" / name;
-    ShapeAnswer cached;
-    if (read_cached(cache_file, disk_key, cached)) {
-      log << "  FEM reference and P1 for " << v.scene->name << ": " << c.name << " (cached)\n";
-      return v.shapes.emplace(key, std::move(cached)).first->second;
-    }
-  }
   log << "  FEM reference P2 (level " << v.scene->reference_level << ") and P1 (level " << v.level
       << ") for " << v.scene->name << ": " << c.name << " ..." << std::flush;
   Stopwatch clock;
   ShapeAnswer a;
   {
-    fem::ElasticitySolver ref(v.reference_mesh, fem_problem(cs, v.reference_mesh, nu, 2, 1.0));
-    a.strain_unit = ref.solve().max_abs_principal_strain;
+    const fem::ElasticityProblem p2 = fem_problem(cs, v.reference_mesh, nu, 2, 1.0);
+    fem::ElasticitySolver ref(v.reference_mesh, p2);
+    a.strain_unit = fem::solve_with(v.cache, ref, v.reference_mesh, p2).max_abs_principal_strain;
     a.reference_at_network = ref.displacement_at(v.base.network.nodes, kOutsideTolerance);
     a.reference_at_mesh = ref.displacement_at(v.mesh.nodes, kOutsideTolerance);
   }
   fem::ElasticityProblem p1 = fem_problem(cs, v.mesh, nu, 1, 1.0);
   p1.options.formulation = fem::Formulation::displacement;
   fem::ElasticitySolver p1_solver(v.mesh, p1);
-  const fem::ElasticityResult& r = p1_solver.solve();
+  // From the cache, P1's time is the one measured when it was solved.
+  const fem::ElasticityResult& r = fem::solve_with(v.cache, p1_solver, v.mesh, p1);
   a.p1 = r.nodal_displacement;
   a.p1_seconds = r.timings.assembly + r.timings.solve;
   const std::streamsize precision = log.precision();
   log << " " << std::fixed << std::setprecision(1) << clock.seconds() << " s\n"
       << std::defaultfloat << std::setprecision(static_cast<int>(precision));
-  if (!cache_file.empty()) write_cached(cache_file, disk_key, a);
   return v.shapes.emplace(key, std::move(a)).first->second;
 }
 
@@ -366,9 +278,10 @@ const ModelSpec& pick_model(const Scene& s, const std::string& name) {
 }
 
 VesselContext make_context(const Scene& s, const ModelSpec& spec, int level, int reference_level,
-                           double nu, const std::filesystem::path& cache) {
+                           double nu, const CalibrateOptions& o) {
+  const std::filesystem::path& cache = o.cache_dir;
   VesselContext v;
-  v.cache_dir = cache;
+  v.cache = o.solution_cache;
   v.scene = &s;
   v.level = level;
   v.vessel = s.vessel;
@@ -443,7 +356,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
 
   log << "calibrate " << spec.name << " of " << s.name << " (ν = " << nu << ", level " << level
       << ", reference P2 level " << reference_level << ", " << to_string(o.granularity) << ")\n";
-  VesselContext main = make_context(scene, spec, level, reference_level, nu, o.cache_dir);
+  VesselContext main = make_context(scene, spec, level, reference_level, nu, o);
 
   // The cases: the fixed list, plus the scene's other magnitudes at its point.
   std::vector<LoadCase> cases = load_cases(scene, train, false);
@@ -568,7 +481,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   for (const Scene& other_scene : o.other_vessels) {
     const int other_level = other_scene.model_levels.front();
     VesselContext other =
-        make_context(other_scene, spec, other_level, other_scene.reference_level, nu, o.cache_dir);
+        make_context(other_scene, spec, other_level, other_scene.reference_level, nu, o);
     msm::BuiltNetwork transferred = other.base;
     std::string why;
     const msm::BuiltNetwork* use = &transferred;

@@ -17,9 +17,9 @@
 ///   calibrated one and FEM P1 on the model's mesh, all against the P2 reference at the model's
 ///   nodes (the harness's metric, verification/metrics.hpp). Training and held-out errors are
 ///   reported apart.
-/// - The FEM answers of each load shape (P2 at the model's nodes, P1) are cached under
-///   cache_dir/calibrate/, keyed by everything that determines them (meshes, points, material,
-///   supports, load); a cached P1 keeps the solve time measured when it was computed.
+/// - The FEM solutions of each load shape (P2, P1) come from the FEM solution cache
+///   (fem::SolutionCache) when given one; a cached P1 keeps the solve time measured when it was
+///   computed.
 #include <filesystem>
 #include <optional>
 #include <ostream>
@@ -30,6 +30,10 @@
 #include "verification/calibration_file.hpp"
 #include "verification/metrics.hpp"
 #include "verification/scene.hpp"
+
+namespace vessel::fem {
+class SolutionCache;
+}
 
 namespace vessel {
 
@@ -51,7 +55,8 @@ struct CalibrateOptions {
   int max_iterations = 200;
   /// Further scenes whose own loads are held-out cases on another vessel (group calibrations).
   std::vector<Scene> other_vessels;
-  std::filesystem::path cache_dir;
+  std::filesystem::path cache_dir;  ///< generated meshes (empty: none)
+  fem::SolutionCache* solution_cache = nullptr;  ///< FEM solutions kept on disk (nullptr: none)
   std::ostream* log = nullptr;  ///< progress
 };
 

@@ -270,7 +270,7 @@ TEST(Candidates, IncludeTheScenesCalibratedModels) {
   m.calibration_transfer = true;
   s.models = {m};
   const std::vector<ModelSpec> c = candidate_models(s, {4e-3});
-  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 1;
+  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 2;  // as above
   ASSERT_EQ(c.size(), 1 + spring_models * 3 + 2);
   int calibrated = 0;
   for (const auto& x : c) {
