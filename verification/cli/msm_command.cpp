@@ -318,9 +318,8 @@ void print_solve(const msm::SolverSpec& spec, const msm::Problem& problem,
       std::cout << spec.local_global.iterations << " local-global iterations per step; set-up "
                 << "(assembly and factorisation) " << dyn->setup_seconds << " s, then ";
     } else if (spec.implicit_matrix == msm::ImplicitMatrix::rest_prefactored) {
-      std::cout << "set-up (assembly and factorisation at rest, factor of "
-                << dyn->factor_entries << " entries) " << dyn->setup_seconds
-                << " s, then ";
+      std::cout << "set-up (assembly and factorisation at rest) " << dyn->setup_seconds
+                << " s (factor of " << dyn->factor_entries << " entries), then ";
     }
     std::cout << dyn->seconds << " s, " << dyn->seconds / dyn->steps * 1e6
               << " µs per step, final energy " << dyn->energy << " J\n";
