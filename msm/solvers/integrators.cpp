@@ -154,8 +154,8 @@ SparseMatrix implicit_euler_matrix(const Problem& p, double h, const SparseMatri
 /// Baraff & Witkin (1998): (M + h D + h² K) Δv = h (f(x, v) − h K v); v += Δv; x += h v, with
 /// `solver` holding the factorised left-hand side and f the total force at (x, v).
 void implicit_euler_update(const Problem& p, double h, const SparseMatrix& K,
-                           const CholmodSolver& solver, const VectorXd& f, VectorXd& x,
-                           VectorXd& v, VectorXd& rhs, VectorXd& dv) {
+                           const CholmodSolver& solver, const VectorXd& f, VectorXd& x, VectorXd& v,
+                           VectorXd& rhs, VectorXd& dv) {
   rhs.noalias() = h * f - (h * h) * (K * v);
   for (int i = 0; i < p.num_dofs(); ++i) {
     if (p.fixed[i]) rhs[i] = 0.0;

@@ -1,7 +1,7 @@
 #include "msm/solvers/static_solver.hpp"
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -62,7 +62,7 @@ double to_boundary(double zz, double zp, double pp, double radius) {
 struct SteihaugStep {
   VectorXd d;
   int iterations = 0;
-  bool boundary = false;           ///< stopped on the trust-region boundary
+  bool boundary = false;            ///< stopped on the trust-region boundary
   bool negative_curvature = false;  ///< stopped along a direction with pᵀHp ≤ 0
 };
 
@@ -79,7 +79,8 @@ SteihaugStep steihaug_cg(const SparseMatrix& H, const SparseMatrix& Pm, const Ch
                          const VectorXd& g, double radius, double forcing, int max_iterations) {
   SteihaugStep out;
   const Eigen::Index n = g.size();
-  VectorXd z = VectorXd::Zero(n), r = g, y = solver.solve(r), p = -y, Hp(n), Pp(n), Pz = VectorXd::Zero(n);
+  VectorXd z = VectorXd::Zero(n), r = g, y = solver.solve(r), p = -y, Hp(n), Pp(n),
+           Pz = VectorXd::Zero(n);
   double ry = r.dot(y);
   const double stop = forcing * g.norm();
   double zz = 0.0;
@@ -224,8 +225,8 @@ StaticResult trust_region_newton(const Problem& p, const StaticOptions& o, const
       *o.log << "  trust region " << r.iterations << ": residual " << r.residual << " N, ratio "
              << rho << ", " << step.iterations << " CG iterations"
              << (step.negative_curvature ? ", negative curvature"
-                 : step.boundary        ? ", boundary"
-                                        : "")
+                 : step.boundary         ? ", boundary"
+                                         : "")
              << ", next radius " << radius << ", energy " << energy << " J\n";
     }
     if (!accepted) break;

@@ -63,7 +63,7 @@ struct StaticResult {
                                      ///< (trust_region: where CG met negative curvature)
   int negative_curvature_steps = 0;  ///< of those, steps taken along a negative-curvature direction
                                      ///< (trust_region: accepted CG steps that met one)
-  int boundary_steps = 0;  ///< trust_region: iterations whose step ended on the boundary
+  int boundary_steps = 0;            ///< trust_region: iterations whose step ended on the boundary
   int rejected_steps = 0;  ///< trust_region: trial steps rejected (radius cut, same Hessian)
   double factorisation_seconds = 0.0;  ///< of `seconds`: CHOLMOD symbolic + numeric factorisations
   double assembly_seconds = 0.0;       ///< of `seconds`: Hessian assembly

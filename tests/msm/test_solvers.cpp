@@ -3,8 +3,8 @@
 // energy of an undamped linear oscillator.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <Eigen/SparseCholesky>
+#include <cmath>
 #include <cstdio>
 
 #include "meshes/errors.hpp"
@@ -437,9 +437,9 @@ TEST(StaticSolver, TrustRegionEqualsLineSearchNewtonWhereBothConverge) {
     spec.point = Vec3(3e-3, 0, 20e-3);
     spec.radius = 1e-3;
     spec.force = 1e-3;
-    const Problem p = make_problem(model, built.network, built.masses, mesh,
-                                   traction_nodal_loads(mesh, contact_patch(mesh, spec)),
-                                   {"inlet", "outlet"});
+    const Problem p =
+        make_problem(model, built.network, built.masses, mesh,
+                     traction_nodal_loads(mesh, contact_patch(mesh, spec)), {"inlet", "outlet"});
     StaticOptions o;
     const StaticResult ls = solve_static(p, o);
     o.globalisation = StaticGlobalisation::trust_region;

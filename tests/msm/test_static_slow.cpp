@@ -27,9 +27,9 @@ TEST(StaticSolverSlow, TrustRegionConvergesOnTheLevel2MembraneToAStableBalancedE
   ContactPatchSpec spec;
   spec.point = Vec3(3e-3, 0, 20e-3);
   spec.force = 1e-3;
-  const Problem p = make_problem(model, built.network, built.masses, mesh,
-                                 traction_nodal_loads(mesh, contact_patch(mesh, spec)),
-                                 {"inlet", "outlet"});
+  const Problem p =
+      make_problem(model, built.network, built.masses, mesh,
+                   traction_nodal_loads(mesh, contact_patch(mesh, spec)), {"inlet", "outlet"});
   StaticOptions o;
   o.globalisation = StaticGlobalisation::trust_region;
   const StaticResult r = solve_static(p, o);  // throws if not converged in 200 iterations

@@ -301,9 +301,8 @@ void print_solve(const msm::SolverSpec& spec, const msm::Problem& problem,
       std::cout << "  " << r->indefinite_iterations << " iteration(s) with an indefinite Hessian, "
                 << r->negative_curvature_steps << " negative-curvature step(s), "
                 << r->boundary_steps << " trust-region step(s) on the boundary, "
-                << r->rejected_steps << " rejected; assembly "
-                << r->assembly_seconds << " s, negative-curvature search " << r->curvature_seconds
-                << " s\n";
+                << r->rejected_steps << " rejected; assembly " << r->assembly_seconds
+                << " s, negative-curvature search " << r->curvature_seconds << " s\n";
     }
     std::cout << std::setprecision(6);
   } else if (const auto* rel = std::get_if<msm::RelaxationResult>(&s.detail)) {
@@ -543,9 +542,10 @@ void add_solver_tuning_options(CLI::App* cmd, MsmOptions& o) {
       ->capture_default_str();
   cmd->add_option("--load-steps", o.load_steps, "Static Newton: load increments")
       ->capture_default_str();
-  cmd->add_option("--globalisation", o.globalisation,
-                  "Static Newton: line-search (projected Hessian where indefinite) or "
-                  "trust-region (Steihaug-Toint CG on the exact Hessian, projected-Hessian preconditioner)")
+  cmd->add_option(
+         "--globalisation", o.globalisation,
+         "Static Newton: line-search (projected Hessian where indefinite) or "
+         "trust-region (Steihaug-Toint CG on the exact Hessian, projected-Hessian preconditioner)")
       ->check(CLI::IsMember({"line-search", "trust-region"}))
       ->capture_default_str();
   cmd->add_option("--curvature-iterations", o.curvature_iterations,
