@@ -154,13 +154,14 @@ SparseMatrix implicit_euler_matrix(const Problem& p, double h, const SparseMatri
 /// Baraff & Witkin (1998): (M + h D + h² K) Δv = h (f(x, v) − h K v); v += Δv; x += h v, with
 /// `solver` holding the factorised left-hand side and f the total force at (x, v).
 void implicit_euler_update(const Problem& p, double h, const SparseMatrix& K,
-                           const CholmodSolver& solver, const VectorXd& f, VectorXd& x,
-                           VectorXd& v) {
-  VectorXd rhs = h * (f - h * (K * v));
+                           const CholmodSolver& solver, const VectorXd& f, VectorXd& x, VectorXd& v,
+                           VectorXd& rhs, VectorXd& dv) {
+  rhs.noalias() = h * f - (h * h) * (K * v);
   for (int i = 0; i < p.num_dofs(); ++i) {
     if (p.fixed[i]) rhs[i] = 0.0;
   }
-  v += solver.solve(rhs);
+  solver.solve_into(rhs, dv);
+  v += dv;
   x += h * v;
 }
 
@@ -191,7 +192,7 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
   const double scale = std::max(std::abs(H0), p.external_force.norm() * bbox_diagonal(p.rest));
   const double limit = std::abs(H0) + o.blowup_factor * std::max(scale, 1e-300);
   const VectorXd inv_mass = p.mass.cwiseInverse();
-  VectorXd f(n), scratch(n);
+  VectorXd f(n), scratch(n), rhs(n), dv(n);
   CholmodSolver solver;
   SparseMatrix K, D;
   const bool prefactored = o.integrator == Integrator::implicit_euler &&
@@ -206,14 +207,13 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
   }
   const double t0 = now();
   double energy = H0;
-  // Explicit integrators: ∇E at the state a step starts from comes from the previous step's
+  // Every integrator: ∇E at the state a step starts from comes from the previous step's
   // divergence check, which evaluates the energy and the gradient there in one pass
   // (Form::energy_gradient): one pass over the springs per step (Verlet: per force evaluation)
   // instead of a gradient plus a separate energy. Same numbers, same checks.
-  const bool is_explicit = o.integrator != Integrator::implicit_euler;
   VectorXd grad(n);
   double form_energy = 0.0;  // E at r.x, with grad, once a step has been checked
-  if (is_explicit && o.steps > 0) p.form->gradient(r.x, grad);
+  if (o.steps > 0) p.form->gradient(r.x, grad);
   for (int step = 1; step <= o.steps; ++step) {
     switch (o.integrator) {
       case Integrator::explicit_euler: {
@@ -240,13 +240,13 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
         break;
       }
       case Integrator::implicit_euler: {
-        total_force(p, r.x, r.v, f, scratch);
+        explicit_force(p, grad, r.x, r.v, f, scratch);  // the total force at (x, v)
         if (!prefactored) {  // K and D at this step's state, A refactorised
           p.form->hessian(r.x, K, o.project_psd);
           p.form->damping_jacobian(r.x, D);
           solver.factorize(implicit_euler_matrix(p, h, K, D));
         }
-        implicit_euler_update(p, h, K, solver, f, r.x, r.v);
+        implicit_euler_update(p, h, K, solver, f, r.x, r.v, rhs, dv);
         break;
       }
     }
@@ -256,20 +256,17 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
         r.v[i] = 0.0;
       }
     }
-    if (is_explicit) {
-      check_finite(p, step, r.x, r.v);
-      // E and ∇E at the new state; ∇E is the next step's (Verlet evaluated both above).
-      if (o.integrator != Integrator::verlet) form_energy = p.form->energy_gradient(r.x, grad);
-      energy = total_energy_given(p, r.x, r.v, form_energy);
-      check_energy(p, step, r.v, limit, energy);
-    } else {
-      check(p, step, r.x, r.v, limit, energy);
-    }
+    check_finite(p, step, r.x, r.v);
+    // E and ∇E at the new state; ∇E is the next step's (Verlet evaluated both above).
+    if (o.integrator != Integrator::verlet) form_energy = p.form->energy_gradient(r.x, grad);
+    energy = total_energy_given(p, r.x, r.v, form_energy);
+    check_energy(p, step, r.v, limit, energy);
     r.steps = step;
     if (o.on_step) o.on_step(step, r.x, r.v);
   }
   r.seconds = now() - t0;
   r.numeric_factorisations = solver.numeric_factorisations();
+  r.factor_entries = solver.factor_entries();
   r.energy = energy;
   return r;
 }

@@ -64,6 +64,7 @@ struct DynamicResult {
   double setup_seconds = 0.0;  ///< before the first step, s (implicit-euler-rest: assembly and
                                ///< factorisation at rest)
   int numeric_factorisations = 0;  ///< CHOLMOD numeric factorisations (implicit Euler)
+  double factor_entries = 0.0;     ///< implicit Euler: numbers stored in the Cholesky factor
   double energy = 0.0;  ///< total energy ½vᵀMv + Π(x) at the end, J
 };
 

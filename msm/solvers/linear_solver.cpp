@@ -70,7 +70,12 @@ int solver_threads() { return g_solver_threads.load(); }
 CholmodSolver::CholmodSolver() {
   llt_.cholmod().print = 0;  // a failed (indefinite) attempt is handled here, not printed
 }
-CholmodSolver::~CholmodSolver() = default;
+CholmodSolver::~CholmodSolver() {
+  // Before llt_'s destructor finishes the CHOLMOD common object these were allocated with.
+  cholmod_free_dense(&x_, &llt_.common());
+  cholmod_free_dense(&y_, &llt_.common());
+  cholmod_free_dense(&e_, &llt_.common());
+}
 
 bool CholmodSolver::try_factorize(const SparseMatrix& A) {
   apply_solver_threads();
@@ -117,6 +122,34 @@ void CholmodSolver::factorize(const SparseMatrix& A) {
 VectorXd CholmodSolver::solve(const VectorXd& b) const {
   apply_solver_threads();
   return llt_.solve(b);
+}
+
+double CholmodSolver::factor_entries() const {
+  const cholmod_factor* L = llt_.factor();
+  if (L == nullptr) return 0.0;
+  return static_cast<double>(L->is_super ? L->xsize : L->nzmax);
+}
+
+void CholmodSolver::solve_into(const VectorXd& b, VectorXd& x) const {
+  apply_solver_threads();
+  cholmod_factor* L = llt_.factor();
+  if (L == nullptr || llt_.info() != Eigen::Success) {
+    throw std::logic_error("CholmodSolver::solve_into before a successful factorisation");
+  }
+  if (b.size() != static_cast<Eigen::Index>(L->n)) {
+    throw std::invalid_argument("CholmodSolver::solve_into: right-hand side of the wrong size");
+  }
+  cholmod_dense B{};
+  B.nrow = B.d = L->n;
+  B.ncol = 1;
+  B.nzmax = L->n;
+  B.x = const_cast<double*>(b.data());  // read only: CHOLMOD_A does not write B
+  B.xtype = CHOLMOD_REAL;
+  B.dtype = CHOLMOD_DOUBLE;
+  if (!cholmod_solve2(CHOLMOD_A, L, &B, nullptr, &x_, nullptr, &y_, &e_, &llt_.common())) {
+    throw std::runtime_error("CHOLMOD: solve failed");
+  }
+  x = Eigen::Map<const VectorXd>(static_cast<const double*>(x_->x), b.size());
 }
 
 Eigen::MatrixXd CholmodSolver::solve_columns(const Eigen::MatrixXd& B) const {

@@ -24,6 +24,18 @@ void set_solver_threads(int n);
 /// The current setting of set_solver_threads (1 unless changed).
 [[nodiscard]] int solver_threads();
 
+namespace detail {
+/// Eigen's CHOLMOD wrapper, opened up for cholmod_solve2 (the factor and the common object are
+/// protected members of Eigen::CholmodBase).
+class CholmodFactor : public Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower> {
+ public:
+  [[nodiscard]] cholmod_factor* factor() const { return m_cholmodFactor; }
+  [[nodiscard]] cholmod_common& common() const {
+    return const_cast<CholmodFactor*>(this)->cholmod();  // Eigen's accessor is non-const only
+  }
+};
+}  // namespace detail
+
 class CholmodSolver {
  public:
   CholmodSolver();
@@ -38,8 +50,16 @@ class CholmodSolver {
   /// Factorises A without regularisation; false if A is not positive definite.
   [[nodiscard]] bool try_factorize(const SparseMatrix& A);
   [[nodiscard]] VectorXd solve(const VectorXd& b) const;
+  /// x = A⁻¹b into the caller's vector (resized to n). cholmod_solve2 with this solver's kept
+  /// solution and workspace arrays: once warmed up no allocation per solve, where Eigen's solve
+  /// allocates and frees the solution and CHOLMOD's workspace on every call. Not for concurrent
+  /// calls on one solver.
+  void solve_into(const VectorXd& b, VectorXd& x) const;
   /// Solves for several right-hand sides (the columns of B) in one CHOLMOD call.
   [[nodiscard]] Eigen::MatrixXd solve_columns(const Eigen::MatrixXd& B) const;
+  /// Numbers stored in the factor L (supernodal: with the zeros of supernode amalgamation), what
+  /// each triangular sweep of a solve reads; 0 before the first analysis.
+  [[nodiscard]] double factor_entries() const;
   [[nodiscard]] int symbolic_analyses() const { return analyses_; }
   [[nodiscard]] int numeric_factorisations() const { return factorisations_; }
   [[nodiscard]] double last_regularisation() const { return mu_; }
@@ -47,7 +67,10 @@ class CholmodSolver {
   [[nodiscard]] double factorisation_seconds() const { return seconds_; }
 
  private:
-  Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower> llt_;
+  detail::CholmodFactor llt_;
+  mutable cholmod_dense* x_ = nullptr;  ///< cholmod_solve2's solution, kept between solves
+  mutable cholmod_dense* y_ = nullptr;  ///< and its workspace
+  mutable cholmod_dense* e_ = nullptr;
   Eigen::Index pattern_rows_ = -1;
   Eigen::Index pattern_nonzeros_ = -1;
   int analyses_ = 0;

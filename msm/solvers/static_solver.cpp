@@ -1,7 +1,7 @@
 #include "msm/solvers/static_solver.hpp"
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "meshes/errors.hpp"
 #include "msm/solvers/linear_solver.hpp"
 
 namespace vessel::msm {
@@ -49,8 +50,205 @@ double negative_curvature(const SparseMatrix& H, const SparseMatrix& Hp,
   return c < -1e-8 * std::abs(cp) ? c : 0.0;
 }
 
+/// The step s ≥ 0 at which ‖z + s·p‖_P = Δ (the positive root of a quadratic in s), given
+/// zᵀPz, zᵀPp and pᵀPp.
+double to_boundary(double zz, double zp, double pp, double radius) {
+  const double c = zz - radius * radius;  // ≤ 0: z is inside
+  const double disc = std::max(zp * zp - pp * c, 0.0);
+  // The positive root (−zp + √disc)/pp, written without cancellation.
+  return zp > 0.0 ? -c / (zp + std::sqrt(disc)) : (-zp + std::sqrt(disc)) / pp;
+}
+
+struct SteihaugStep {
+  VectorXd d;
+  int iterations = 0;
+  bool boundary = false;            ///< stopped on the trust-region boundary
+  bool negative_curvature = false;  ///< stopped along a direction with pᵀHp ≤ 0
+};
+
+/// Steihaug–Toint truncated conjugate gradients for min m(d) = gᵀd + ½dᵀHd subject to
+/// ‖d‖_P ≤ Δ (Steihaug 1983; Nocedal & Wright 2006, Algorithm 7.2, here preconditioned with P,
+/// Gould, Lucidi, Roma & Toint 1999): CG on H d = −g with the preconditioner P = the factorised
+/// PSD-projected Hessian, stopped at the boundary, at a direction of non-positive curvature (then
+/// followed to the boundary: the step exploits the negative curvature a projected Newton step
+/// cannot see), or at the relative residual `forcing`. P ⪰ H differs from H only on the springs
+/// whose block was projected, so P⁻¹H is the identity plus a perturbation of low rank and CG
+/// needs few iterations. ‖v‖²_P = vᵀ(Pm)v with Pm the matrix whose factorisation `solver` holds
+/// (up to its regularisation).
+SteihaugStep steihaug_cg(const SparseMatrix& H, const SparseMatrix& Pm, const CholmodSolver& solver,
+                         const VectorXd& g, double radius, double forcing, int max_iterations) {
+  SteihaugStep out;
+  const Eigen::Index n = g.size();
+  VectorXd z = VectorXd::Zero(n), r = g, y = solver.solve(r), p = -y, Hp(n), Pp(n),
+           Pz = VectorXd::Zero(n);
+  double ry = r.dot(y);
+  const double stop = forcing * g.norm();
+  double zz = 0.0;
+  for (out.iterations = 1; out.iterations <= max_iterations; ++out.iterations) {
+    Hp.noalias() = H * p;
+    Pp.noalias() = Pm * p;
+    const double kappa = p.dot(Hp);
+    const double pp = p.dot(Pp), zp = Pz.dot(p);
+    if (!(kappa > 0.0)) {
+      out.negative_curvature = out.boundary = true;
+      out.d = z + to_boundary(zz, zp, pp, radius) * p;
+      return out;
+    }
+    const double alpha = ry / kappa;
+    const double zz_next = zz + 2.0 * alpha * zp + alpha * alpha * pp;
+    if (zz_next >= radius * radius) {
+      out.boundary = true;
+      out.d = z + to_boundary(zz, zp, pp, radius) * p;
+      return out;
+    }
+    z += alpha * p;
+    Pz += alpha * Pp;
+    zz = zz_next;
+    r += alpha * Hp;
+    if (r.norm() <= stop) break;
+    y = solver.solve(r);
+    const double ry_next = r.dot(y);
+    p = -y + (ry_next / ry) * p;
+    ry = ry_next;
+  }
+  out.iterations = std::min(out.iterations, max_iterations);
+  out.d = std::move(z);
+  return out;
+}
+
+/// Trust-region Newton with Steihaug–Toint CG steps (Nocedal & Wright 2006, Algorithms 4.1 and
+/// 7.2). Each iteration: the exact Hessian H and the PSD-projected Hessian P at x, P factorised
+/// (CHOLMOD, regularised if singular); the step minimises the quadratic model with the exact H
+/// within ‖d‖_P ≤ Δ; accepted if Π falls by at least 1e-4 of the model's predicted decrease;
+/// Δ ×1/4 after a poor step (ratio < 1/4), ×2 after a good one that reached the boundary
+/// (ratio > 3/4). Δ starts at the P-norm of the first projected Newton step. The CG forcing term
+/// min(1/2, √(‖g‖/‖g₀‖)) gives superlinear convergence once the steps are interior
+/// (Eisenstat & Walker 1996; Nocedal & Wright §7.1).
+StaticResult trust_region_newton(const Problem& p, const StaticOptions& o, const VectorXd& start,
+                                 CholmodSolver& solver) {
+  const double t0 = now();
+  const int analyses0 = solver.symbolic_analyses();
+  const int factorisations0 = solver.numeric_factorisations();
+  const double factorisation_seconds0 = solver.factorisation_seconds();
+  StaticResult r;
+  r.x = start.size() == p.num_dofs() ? start : p.rest;
+  for (int i = 0; i < p.num_dofs(); ++i) {
+    if (p.fixed[i]) r.x[i] = p.rest[i];
+  }
+  const double target = o.tolerance * std::max(p.external_force.norm(), o.force_scale);
+  VectorXd g, gt, Hd, trial;
+  SparseMatrix H, P;
+  double energy = p.potential(r.x);
+  double roundoff = 0.0, radius = 0.0, first_residual = 0.0;
+  for (r.iterations = 0; r.iterations <= o.max_iterations; ++r.iterations) {
+    p.potential_gradient(r.x, g);
+    r.residual = g.norm();
+    if (!std::isfinite(r.residual)) break;
+    if (first_residual == 0.0) first_residual = r.residual;
+    if (r.residual <= std::max(target, roundoff)) {
+      r.converged = true;
+      break;
+    }
+    if (r.iterations == o.max_iterations) break;
+    const double ta = now();
+    p.form->hessian(r.x, H, false);
+    apply_dirichlet(H, p.fixed);
+    p.form->hessian(r.x, P, true);
+    apply_dirichlet(P, p.fixed);
+    r.assembly_seconds += now() - ta;
+    if (roundoff == 0.0) {
+      const double size = (p.rest.maxCoeff() - p.rest.minCoeff());
+      roundoff = std::numeric_limits<double>::epsilon() * H.diagonal().cwiseAbs().maxCoeff() *
+                 size * std::sqrt(static_cast<double>(p.num_dofs()));
+    }
+    solver.factorize(P);
+    // The norm of the trust region: P plus the regularisation CHOLMOD needed (and at least 1e-8
+    // of its diagonal), so that a direction P has no stiffness in (a membrane at rest, a
+    // compressed pair at its saddle) still has a length.
+    {
+      const VectorXd diag = P.diagonal();
+      const double floor = 1e-3 * diag.cwiseAbs().mean() + 1e-300;
+      const double sigma = std::max(solver.last_regularisation(), 1e-8);
+      for (Eigen::Index i = 0; i < P.rows(); ++i) {
+        if (!p.fixed[i]) P.coeffRef(i, i) += sigma * std::max(diag[i], floor);
+      }
+    }
+    if (radius == 0.0) {
+      // Δ₀: the first projected Newton step, shortened to move no node by more than 1 % of the
+      // model's size (its P-norm is meaningless where P is nearly singular).
+      VectorXd d0 = solver.solve(g);
+      const double size = p.rest.maxCoeff() - p.rest.minCoeff();
+      const double largest = d0.cwiseAbs().maxCoeff();
+      if (largest > 1e-2 * size) d0 *= 1e-2 * size / largest;
+      radius = std::sqrt(std::max(d0.dot(P * d0), 0.0));
+    }
+    const double forcing = std::min(0.5, std::sqrt(r.residual / first_residual));
+    bool accepted = false;
+    double rho = 0.0;
+    SteihaugStep step;
+    // A rejected step shrinks Δ and re-runs CG with the same H and P (no new factorisation).
+    for (int attempt = 0; attempt < 60 && !accepted; ++attempt) {
+      step = steihaug_cg(H, P, solver, g, radius, forcing, 200);
+      Hd.noalias() = H * step.d;
+      const double predicted = -(g.dot(step.d) + 0.5 * step.d.dot(Hd));
+      trial = r.x + step.d;
+      const double trial_energy = p.potential(trial);
+      if (!std::isfinite(trial_energy) || !(predicted > 0.0)) {
+        rho = -1.0;
+      } else if (predicted <= 1e-11 * std::abs(energy)) {
+        // The decrease is at the energy's round-off (its terms cancel to ~1e-13 of |Π|): judge
+        // the step by the residual instead, as the line search does.
+        p.potential_gradient(trial, gt);
+        rho = gt.norm() < r.residual ? 1.0 : -1.0;
+      } else {
+        rho = (energy - trial_energy) / predicted;
+      }
+      const double length = std::sqrt(std::max(step.d.dot(P * step.d), 0.0));
+      if (rho < 0.25) {
+        radius = 0.25 * std::min(radius, length);
+      } else if (rho > 0.75 && step.boundary) {
+        radius *= 2.0;
+      }
+      if (rho > 1e-4) {
+        accepted = true;
+        r.x.swap(trial);
+        energy = trial_energy;
+        if (step.negative_curvature) ++r.negative_curvature_steps;
+      } else {
+        ++r.rejected_steps;
+      }
+      if (!(radius > 0.0)) break;
+    }
+    if (step.boundary) ++r.boundary_steps;
+    if (step.negative_curvature) ++r.indefinite_iterations;
+    if (o.log) {
+      *o.log << "  trust region " << r.iterations << ": residual " << r.residual << " N, ratio "
+             << rho << ", " << step.iterations << " CG iterations"
+             << (step.negative_curvature ? ", negative curvature"
+                 : step.boundary         ? ", boundary"
+                                         : "")
+             << ", next radius " << radius << ", energy " << energy << " J\n";
+    }
+    if (!accepted) break;
+  }
+  r.symbolic_analyses = solver.symbolic_analyses() - analyses0;
+  r.numeric_factorisations = solver.numeric_factorisations() - factorisations0;
+  r.factorisation_seconds = solver.factorisation_seconds() - factorisation_seconds0;
+  r.seconds = now() - t0;
+  if (!r.converged) {
+    std::ostringstream msg;
+    msg << "static Newton (trust region) did not converge: iteration " << r.iterations
+        << ", residual " << r.residual << " N (target " << target << " N)";
+    throw std::runtime_error(msg.str());
+  }
+  return r;
+}
+
 StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& start,
                     CholmodSolver& solver) {
+  if (o.globalisation == StaticGlobalisation::trust_region) {
+    return trust_region_newton(p, o, start, solver);
+  }
   const double t0 = now();
   const int analyses0 = solver.symbolic_analyses();
   const int factorisations0 = solver.numeric_factorisations();
@@ -221,6 +419,17 @@ StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& st
 
 }  // namespace
 
+StaticGlobalisation parse_static_globalisation(const std::string& name) {
+  if (name == "line-search") return StaticGlobalisation::line_search;
+  if (name == "trust-region") return StaticGlobalisation::trust_region;
+  throw InputError("static globalisation: expected line-search or trust-region, got '" + name +
+                   "'");
+}
+
+std::string to_string(StaticGlobalisation g) {
+  return g == StaticGlobalisation::trust_region ? "trust-region" : "line-search";
+}
+
 StaticResult solve_static(const Problem& p, const StaticOptions& o, const VectorXd& start) {
   CholmodSolver solver;
   return solve_static(p, o, start, solver);
@@ -245,6 +454,8 @@ StaticResult solve_static(const Problem& p, const StaticOptions& o, const Vector
     total.numeric_factorisations += r.numeric_factorisations;
     total.indefinite_iterations += r.indefinite_iterations;
     total.negative_curvature_steps += r.negative_curvature_steps;
+    total.boundary_steps += r.boundary_steps;
+    total.rejected_steps += r.rejected_steps;
     total.factorisation_seconds += r.factorisation_seconds;
     total.assembly_seconds += r.assembly_seconds;
     total.curvature_seconds += r.curvature_seconds;

@@ -40,6 +40,7 @@ class LinearUpdater final : public Updater {
     solver_.factorize(stiffness_at_rest(p_));
     x_ = p_.rest;
     f_ = VectorXd::Zero(p_.num_dofs());
+    u_ = VectorXd::Zero(p_.num_dofs());
     setup_seconds_ = now() - t0;
   }
 
@@ -47,7 +48,9 @@ class LinearUpdater final : public Updater {
     check_size(p_, external_force);
     const double t0 = now();
     for (int i = 0; i < f_.size(); ++i) f_[i] = p_.fixed[i] ? 0.0 : external_force[i];
-    x_ = p_.rest + solver_.solve(f_);
+    // One solve into kept storage (no allocation per update), then x = x0 + u.
+    solver_.solve_into(f_, u_);
+    x_ = p_.rest + u_;
     UpdateResult r;
     r.iterations = 1;
     r.seconds = now() - t0;
@@ -59,7 +62,7 @@ class LinearUpdater final : public Updater {
  private:
   Problem p_;
   CholmodSolver solver_;
-  VectorXd f_;
+  VectorXd f_, u_;
 };
 
 /// "static": warm-started modified Newton, full Newton where the reused factorisation stops

@@ -19,7 +19,10 @@ namespace {
 
 /// A 3 × 3 × 2 lattice of 1 mm cells with edge and face-diagonal springs, axial damping on every
 /// spring and point damping; the x = 0 face fixed, a load on the far corner large enough that the
-/// stiffness at the deformed state differs from the one at rest (geometric nonlinearity).
+/// stiffness at the deformed state differs from the one at rest (geometric nonlinearity: 0.34 mm
+/// of displacement on 1 mm cells) and small enough that the motion settles. (At 10× the load the
+/// trajectory never settles, stays at ~1 m/s and amplifies round-off ~1.8× per step: two codes
+/// then agree to 1e-12 only if their arithmetic is bit-identical, which tests nothing.)
 struct Lattice {
   SpringNetwork net;
   std::unique_ptr<SpringModel> model;
@@ -56,7 +59,7 @@ Lattice make_lattice() {
   p.mass = Eigen::VectorXd::Constant(3 * n, 1e-5);
   p.external_force = Eigen::VectorXd::Zero(3 * n);
   const int corner = id(nx - 1, ny - 1, nz - 1);
-  p.external_force.segment<3>(3 * corner) = Vec3(0.0, -0.02, 0.03);
+  p.external_force.segment<3>(3 * corner) = Vec3(0.0, -0.002, 0.003);
   p.fixed.assign(3 * n, 0);
   for (int k = 0; k < nz; ++k) {
     for (int j = 0; j < ny; ++j) {
@@ -128,14 +131,17 @@ TEST(ImplicitEulerRest, EqualsTheSameSchemeRefactorisedEveryStepAndFactorisesOnc
   EXPECT_EQ(r.numeric_factorisations, 1);
   EXPECT_GE(r.setup_seconds, 0.0);
 
-  // The problem tells the two matrices apart: implicit Euler with K at the current state
-  // (refactorised every step) ends elsewhere.
+  // The motion has settled on the static answer, which both matrices share.
+  EXPECT_LT(v_ref.back().norm(), 1e-6 * v_scale);
+  // The problem tells the two matrices apart on the way: implicit Euler with K at the current
+  // state (refactorised every step) is elsewhere after 10 steps.
   o.implicit_matrix = ImplicitMatrix::current_state;
   o.on_step = {};
+  o.steps = 10;
   const DynamicResult current = integrate(p, o);
-  EXPECT_EQ(current.numeric_factorisations, steps);
-  const Eigen::VectorXd u = x_ref.back() - p.rest;
-  EXPECT_GT((current.x - x_ref.back()).norm(), 1e-6 * u.norm());
+  EXPECT_EQ(current.numeric_factorisations, 10);
+  const Eigen::VectorXd u = x_ref[9] - p.rest;
+  EXPECT_GT((current.x - x_ref[9]).norm(), 1e-6 * u.norm());
 }
 
 TEST(ImplicitEulerRest, IsNamedAndRunsThroughSolve) {

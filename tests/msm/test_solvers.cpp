@@ -3,14 +3,15 @@
 // energy of an undamped linear oscillator.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <Eigen/SparseCholesky>
+#include <cmath>
 #include <cstdio>
 
 #include "meshes/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/mass/mass_rules.hpp"
+#include "msm/model/build_network.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/solve.hpp"
@@ -384,4 +385,69 @@ TEST(Solve, DynamicSolversNeedStepsAndPbdNeedsASurfaceNetwork) {
   pbd.steps = 5;
   EXPECT_THROW((void)solve(c.problem, pbd, &c.net), vessel::InputError);  // a chain has no triangles
   EXPECT_THROW((void)solve(c.problem, pbd), vessel::InputError);
+}
+
+TEST(StaticSolver, TrustRegionSnapsToTheClosedFormEquilibriumFromTheSaddle) {
+  // The compressed pair starts at a saddle (straight, transverse stiffness < 0): the trust region
+  // must follow the negative curvature. Truth as above, by bisection.
+  const double k = 10.0, f = 1e-4, L0 = 1.2e-3, h = 1e-3;
+  double lo = std::sqrt(L0 * L0 - h * h), hi = 1.0;
+  for (int i = 0; i < 200; ++i) {
+    const double y = 0.5 * (lo + hi), L = std::hypot(h, y);
+    (2 * k * (L - L0) * y / L - f > 0 ? hi : lo) = y;
+  }
+  Snap s = make_snap(k, f);
+  StaticOptions o;
+  o.globalisation = StaticGlobalisation::trust_region;
+  const StaticResult r = solve_static(s.problem, o);
+  EXPECT_NEAR(r.x[4], lo, 1e-12);
+  EXPECT_NEAR(r.x[3], 0.0, 1e-15);
+  EXPECT_GT(r.negative_curvature_steps, 0);
+}
+
+TEST(StaticSolver, TrustRegionFollowsHookesLawOnTheChain) {
+  // Springs in series: u = F Σ 1/k_i at the free end (as the line-search test above).
+  const std::vector<double> k{10.0, 20.0, 40.0};
+  const double F = 1e-2;
+  Chain c = make_chain(k, F);
+  StaticOptions o;
+  o.globalisation = StaticGlobalisation::trust_region;
+  const StaticResult r = solve_static(c.problem, o);
+  EXPECT_NEAR(end_displacement(c.problem, r.x), F * (1 / 10.0 + 1 / 20.0 + 1 / 40.0), 1e-12);
+  EXPECT_EQ(parse_static_globalisation("trust-region"), StaticGlobalisation::trust_region);
+  EXPECT_EQ(to_string(StaticGlobalisation::line_search), "line-search");
+  EXPECT_THROW((void)parse_static_globalisation("dogleg"), InputError);
+}
+
+TEST(StaticSolver, TrustRegionEqualsLineSearchNewtonWhereBothConverge) {
+  // Two globalisations of Newton on the same potential; where the line-search Newton converges
+  // and the equilibrium is unique (the volume model: positive-definite Hessian on every
+  // iteration; the structured level-0 membrane, whose equilibrium both reach) their answers
+  // agree to what the residual tolerance allows: |Δx| ≤ ‖residual‖/λ_min, here ≤ 1e-6 ‖u‖.
+  for (const ModelType type : {ModelType::volume, ModelType::surface}) {
+    VesselParams params;
+    if (type == ModelType::surface) params.style = MeshStyle::structured;
+    const TetMesh mesh = generate_vessel_mesh(params);
+    NetworkOptions no;
+    no.model = type;
+    no.stiffness = type == ModelType::surface ? StiffnessRule::seed000 : StiffnessRule::seed001;
+    const BuiltNetwork built = build_network(mesh, params, no);
+    const SpringModel model(built.network);
+    ContactPatchSpec spec;
+    spec.point = Vec3(3e-3, 0, 20e-3);
+    spec.radius = 1e-3;
+    spec.force = 1e-3;
+    const Problem p =
+        make_problem(model, built.network, built.masses, mesh,
+                     traction_nodal_loads(mesh, contact_patch(mesh, spec)), {"inlet", "outlet"});
+    StaticOptions o;
+    const StaticResult ls = solve_static(p, o);
+    o.globalisation = StaticGlobalisation::trust_region;
+    const StaticResult tr = solve_static(p, o);
+    const Eigen::VectorXd u = ls.x - p.rest;
+    EXPECT_LT((tr.x - ls.x).norm(), 1e-6 * u.norm()) << (type == ModelType::surface);
+    EXPECT_LE(tr.residual, 1e-8 * p.external_force.norm());
+    // One factorisation per iteration, never of an indefinite Hessian.
+    EXPECT_EQ(tr.numeric_factorisations, tr.iterations);
+  }
 }

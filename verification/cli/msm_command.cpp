@@ -61,6 +61,7 @@ struct MsmOptions {
   double pressure = 0.0;
   bool gravity = false;
   int load_steps = 1;
+  std::string globalisation = "line-search";
   fs::path input;                                            ///< .msh or .stl instead of --vessel
   double fix_below_z = std::numeric_limits<double>::quiet_NaN();  ///< m
   double fix_above_z = std::numeric_limits<double>::quiet_NaN();  ///< m
@@ -273,6 +274,7 @@ msm::SolverSpec command_solver(const MsmOptions& o) {
   auto& so = spec.static_options;
   if (o.verbose) so.log = &std::cout;
   so.load_steps = o.load_steps;
+  so.globalisation = msm::parse_static_globalisation(o.globalisation);
   so.curvature_iterations = o.curvature_iterations;
   so.curvature_shift = o.curvature_shift;
   so.exact_backoff = o.exact_backoff;
@@ -299,9 +301,10 @@ void print_solve(const msm::SolverSpec& spec, const msm::Problem& problem,
               << r->factorisation_seconds << " s)\n";
     if (newton) {
       std::cout << "  " << r->indefinite_iterations << " iteration(s) with an indefinite Hessian, "
-                << r->negative_curvature_steps << " negative-curvature step(s); assembly "
-                << r->assembly_seconds << " s, negative-curvature search " << r->curvature_seconds
-                << " s\n";
+                << r->negative_curvature_steps << " negative-curvature step(s), "
+                << r->boundary_steps << " trust-region step(s) on the boundary, "
+                << r->rejected_steps << " rejected; assembly " << r->assembly_seconds
+                << " s, negative-curvature search " << r->curvature_seconds << " s\n";
     }
     std::cout << std::setprecision(6);
   } else if (const auto* rel = std::get_if<msm::RelaxationResult>(&s.detail)) {
@@ -317,7 +320,7 @@ void print_solve(const msm::SolverSpec& spec, const msm::Problem& problem,
                 << "(assembly and factorisation) " << dyn->setup_seconds << " s, then ";
     } else if (spec.implicit_matrix == msm::ImplicitMatrix::rest_prefactored) {
       std::cout << "set-up (assembly and factorisation at rest) " << dyn->setup_seconds
-                << " s, then ";
+                << " s (factor of " << dyn->factor_entries << " entries), then ";
     }
     std::cout << dyn->seconds << " s, " << dyn->seconds / dyn->steps * 1e6
               << " µs per step, final energy " << dyn->energy << " J\n";
@@ -549,6 +552,12 @@ void add_solver_tuning_options(CLI::App* cmd, MsmOptions& o) {
   cmd->add_option("--pbd-damping", o.pbd_damping, "Fraction of velocity removed per PBD step")
       ->capture_default_str();
   cmd->add_option("--load-steps", o.load_steps, "Static Newton: load increments")
+      ->capture_default_str();
+  cmd->add_option(
+         "--globalisation", o.globalisation,
+         "Static Newton: line-search (projected Hessian where indefinite) or "
+         "trust-region (Steihaug-Toint CG on the exact Hessian, projected-Hessian preconditioner)")
+      ->check(CLI::IsMember({"line-search", "trust-region"}))
       ->capture_default_str();
   cmd->add_option("--curvature-iterations", o.curvature_iterations,
                   "Static Newton: power iterations for a negative-curvature direction where the "
