@@ -11,17 +11,11 @@ namespace vessel::reports {
 
 namespace {
 
-std::string fmt(double v, int digits = 3) {
-  std::ostringstream s;
-  s << std::setprecision(digits) << v;
-  return s.str();
-}
-
 /// P1 FEM: a FEM model whose element (the head of its detail, "P1, direct ...") is P1.
 bool is_p1(const OutcomeRow& o) { return o.kind == "fem" && o.detail.rfind("P1", 0) == 0; }
 
 std::string load_text(double magnitude, const std::string& unit) {
-  return unit == "N" ? fmt(magnitude * 1e3) + " mN" : fmt(magnitude) + " " + unit;
+  return unit == "N" ? significant(magnitude * 1e3) + " mN" : significant(magnitude) + " " + unit;
 }
 
 }  // namespace
@@ -78,14 +72,14 @@ Table best_model_table(const std::vector<BestModelRow>& rows) {
               "best mass-spring model",   "its rel. L2",     "P1 rel. L2",
               "error / P1",   "its solve s", "P1 solve s",   "time / P1"};
   for (const BestModelRow& r : rows) {
-    const auto ratio = [](const std::optional<double>& v) { return v ? fmt(*v) : "–"; };
+    const auto ratio = [](const std::optional<double>& v) { return v ? significant(*v) : "–"; };
     t.rows.push_back(
-        {r.scene, fmt(r.poisson_ratio), std::to_string(r.level), load_text(r.magnitude, r.load_unit),
+        {r.scene, significant(r.poisson_ratio), std::to_string(r.level), load_text(r.magnitude, r.load_unit),
          r.best_model.empty() ? "none finished" : r.best_model,
-         r.best_model.empty() ? "–" : fmt(r.best_relative_l2),
-         r.p1_model ? fmt(r.p1_relative_l2) : "no P1", ratio(r.error_ratio),
-         r.best_model.empty() ? "–" : fmt(r.best_solve_seconds),
-         r.p1_model ? fmt(r.p1_solve_seconds) : "–", ratio(r.time_ratio)});
+         r.best_model.empty() ? "–" : significant(r.best_relative_l2),
+         r.p1_model ? significant(r.p1_relative_l2) : "no P1", ratio(r.error_ratio),
+         r.best_model.empty() ? "–" : significant(r.best_solve_seconds),
+         r.p1_model ? significant(r.p1_solve_seconds) : "–", ratio(r.time_ratio)});
   }
   return t;
 }

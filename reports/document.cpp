@@ -1,10 +1,17 @@
 #include "reports/document.hpp"
 
+#include <iomanip>
 #include <sstream>
 
 #include "reports/svg_plot.hpp"
 
 namespace vessel::reports {
+
+std::string significant(double v, int digits) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << v;
+  return s.str();
+}
 
 namespace {
 

@@ -7,6 +7,10 @@
 
 namespace vessel::reports {
 
+/// `v` with `digits` significant digits (shortest form: 0.0131, 1.5e-05), as report tables show
+/// numbers.
+std::string significant(double v, int digits = 3);
+
 struct Table {
   std::vector<std::string> header;
   std::vector<std::vector<std::string>> rows;

@@ -11,15 +11,9 @@ namespace vessel::reports {
 
 namespace {
 
-std::string fmt(double v, int digits = 3) {
-  std::ostringstream s;
-  s << std::setprecision(digits) << v;
-  return s.str();
-}
-
 std::string list(const std::vector<double>& v, int digits = 3) {
   std::string s;
-  for (const double x : v) s += (s.empty() ? "" : ", ") + fmt(x, digits);
+  for (const double x : v) s += (s.empty() ? "" : ", ") + significant(x, digits);
   return s;
 }
 
@@ -50,17 +44,17 @@ void natural_frequency_section(Document& doc, const SceneRows& s) {
   t.header = {"model", "ν", "level", "frequencies (Hz)", "f / f_FEM", "zero modes", "free dofs",
               "s"};
   for (const ModalRow& r : s.reference_modes) {
-    t.rows.push_back({"**FEM reference** (" + r.detail + ")", fmt(r.poisson_ratio),
+    t.rows.push_back({"**FEM reference** (" + r.detail + ")", significant(r.poisson_ratio),
                       std::to_string(r.level),
                       r.ok ? list(r.frequencies_hz) : "**failed**: " + r.failure, "1", "–",
-                      std::to_string(r.dofs), fmt(r.seconds)});
+                      std::to_string(r.dofs), significant(r.seconds)});
   }
   for (const ModalRow& m : s.model_modes) {
-    t.rows.push_back({m.model, fmt(m.poisson_ratio), std::to_string(m.level),
+    t.rows.push_back({m.model, significant(m.poisson_ratio), std::to_string(m.level),
                       m.ok ? list(m.frequencies_hz) : "**failed**: " + m.failure,
                       m.ratio_to_reference.empty() ? "–" : list(m.ratio_to_reference),
                       m.ok ? std::to_string(m.mechanisms) : "–", std::to_string(m.dofs),
-                      fmt(m.seconds)});
+                      significant(m.seconds)});
   }
   doc.table(t);
 
@@ -95,7 +89,7 @@ void natural_frequency_section(Document& doc, const SceneRows& s) {
   plot.series.insert(plot.series.begin(), one);
   doc.figure(file_safe(s.name) + "_natural_frequencies.svg", render_svg(plot),
              "Natural frequencies of each model over the FEM reference's, mode by mode (k-th "
-             "lowest against k-th lowest), ν = " + fmt(nu) +
+             "lowest against k-th lowest), ν = " + significant(nu) +
                  ". Above 1: stiffer (or lighter) than the continuum in that mode; a zero-frequency "
                  "mechanism shows as a point missing from the log axis.");
 }

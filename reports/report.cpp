@@ -21,12 +21,6 @@ namespace vessel::reports {
 
 namespace {
 
-std::string fmt(double v, int digits = 3) {
-  std::ostringstream s;
-  s << std::setprecision(digits) << v;
-  return s.str();
-}
-
 std::string file_safe(const std::string& name) {
   std::string out;
   for (const char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
@@ -74,12 +68,12 @@ std::vector<std::string> model_names(const SceneRows& s) {
 }
 
 std::string load_text(double magnitude, const SceneRows& s) {
-  if (s.load_unit == "N") return fmt(magnitude * 1e3) + " mN";
-  return fmt(magnitude) + " " + s.load_unit;
+  if (s.load_unit == "N") return significant(magnitude * 1e3) + " mN";
+  return significant(magnitude) + " " + s.load_unit;
 }
 
 std::string reference_uncertainty_text(const OutcomeRow& o) {
-  return o.reference_uncertainty_max_mm ? fmt(*o.reference_uncertainty_max_mm) : "–";
+  return o.reference_uncertainty_max_mm ? significant(*o.reference_uncertainty_max_mm) : "–";
 }
 
 Series series(std::string label, bool lines, bool markers = true) {
@@ -138,7 +132,7 @@ void speed_error_figure(const FigureContext& c) {
     s.y.push_back(o->max_mm);
     xs.push_back(std::max(o->solve_seconds, 1e-6));
     ys.push_back(o->max_mm);
-    labels.push_back(label + (c.scene.references.size() > 1 ? " ν=" + fmt(o->poisson_ratio) : ""));
+    labels.push_back(label + (c.scene.references.size() > 1 ? " ν=" + significant(o->poisson_ratio) : ""));
   }
   const auto front = pareto_front(xs, ys);
   Series pareto = black_line("Pareto front");
@@ -150,7 +144,7 @@ void speed_error_figure(const FigureContext& c) {
   }
   plot.series.push_back(pareto);
   const auto [xmin, xmax] = std::minmax_element(xs.begin(), xs.end());
-  Series tolerance = grey_dashed("tolerance " + fmt(c.scene.tolerance_mm) + " mm");
+  Series tolerance = grey_dashed("tolerance " + significant(c.scene.tolerance_mm) + " mm");
   tolerance.x = {*xmin, *xmax};
   tolerance.y = {c.scene.tolerance_mm, c.scene.tolerance_mm};
   plot.series.push_back(tolerance);
@@ -211,7 +205,7 @@ void error_vs_level_figure(const FigureContext& c) {
   }
   if (!unc.x.empty()) plot.series.push_back(unc);
   c.doc.figure(file_safe(c.scene.name) + "_error_vs_level.svg", render_svg(plot),
-               "Convergence: max nodal error against mesh level, ν = " + fmt(c.nu) + ", load " +
+               "Convergence: max nodal error against mesh level, ν = " + significant(c.nu) + ", load " +
                    load_text(c.magnitude, c.scene) +
                    ". FEM errors fall with refinement; a mass-spring error that does not fall is "
                    "the model's own, not the mesh's. Grey: the reference's own uncertainty, "
@@ -253,7 +247,7 @@ void load_displacement_figure(const FigureContext& c) {
   }
   plot.series.insert(plot.series.begin(), sorted);
   std::string caption = "Load against the displacement at the QoI point (" + c.scene.name +
-                        ", ν = " + fmt(c.nu) + ", level " + std::to_string(finest_level(c.scene)) +
+                        ", ν = " + significant(c.nu) + ", level " + std::to_string(finest_level(c.scene)) +
                         "). The FEM reference is linear, so it is only valid up to about 5 % strain.";
   if (c.scene.load_unit == "N") {
     Series hooke = grey_dashed("seed 000 Hooke line, F/k, k = 41.106 N/m");
@@ -294,7 +288,7 @@ void wall_profile_figure(const FigureContext& c) {
   c.doc.figure(file_safe(c.scene.name) + "_wall_profile.svg", render_svg(plot),
                "Radial displacement along the wall line through the QoI point (each model's "
                "nodes at its angle around the centreline), load " +
-                   load_text(c.magnitude, c.scene) + ", ν = " + fmt(c.nu) +
+                   load_text(c.magnitude, c.scene) + ", ν = " + significant(c.nu) +
                    ". Where the curves part is where each model's error lives.");
 }
 
@@ -327,11 +321,11 @@ void history_figure(const FigureContext& c) {
               "max error over time mm", "final max error mm", "FEM damping α 1/s"};
   for (const OutcomeRow* o : rows) {
     t.rows.push_back({o->model, load_text(o->magnitude, c.scene), std::to_string(o->steps),
-                      fmt(o->simulated_s), fmt(o->solve_seconds),
-                      fmt(static_cast<double>(o->steps) / o->solve_seconds),
-                      fmt(o->simulated_s / o->solve_seconds),
-                      reference_drawn ? fmt(o->history_max_error_mm) : "–", fmt(o->max_mm),
-                      fmt(o->mass_damping_per_s)});
+                      significant(o->simulated_s), significant(o->solve_seconds),
+                      significant(static_cast<double>(o->steps) / o->solve_seconds),
+                      significant(o->simulated_s / o->solve_seconds),
+                      reference_drawn ? significant(o->history_max_error_mm) : "–", significant(o->max_mm),
+                      significant(o->mass_damping_per_s)});
   }
   c.doc.figure(file_safe(c.scene.name) + "_history.svg", render_svg(plot),
                "The contact force applied as a step at t = 0: displacement of the QoI point over "
@@ -350,20 +344,20 @@ Table statistics_table(const SceneRows& s) {
               "ref. unc. mm", "QoI model / ref. mm", "max strain", "solve s", "set-up s",
               "memory MiB", "unknowns"};
   for (const auto& o : s.outcomes) {
-    std::vector<std::string> row{o.model, fmt(o.poisson_ratio), std::to_string(o.level),
+    std::vector<std::string> row{o.model, significant(o.poisson_ratio), std::to_string(o.level),
                                  load_text(o.magnitude, s) + (o.beyond_linear_regime ? " ⚠" : "")};
     if (!o.ok) {
       row.push_back("**failed**: " + o.failure);
       row.resize(t.header.size());
-      row[12] = fmt(o.solve_seconds);
-      row[13] = fmt(o.setup_seconds);
+      row[12] = significant(o.solve_seconds);
+      row[13] = significant(o.setup_seconds);
       t.rows.push_back(row);
       continue;
     }
     for (const std::string& v :
-         {fmt(o.max_mm), fmt(o.mean_mm), fmt(o.stddev_mm), fmt(o.rms_mm), fmt(o.relative_l2),
-          reference_uncertainty_text(o), fmt(o.qoi_mm) + " / " + fmt(o.qoi_reference_mm),
-          fmt(o.max_strain, 2), fmt(o.solve_seconds), fmt(o.setup_seconds), fmt(o.memory_mib, 3),
+         {significant(o.max_mm), significant(o.mean_mm), significant(o.stddev_mm), significant(o.rms_mm), significant(o.relative_l2),
+          reference_uncertainty_text(o), significant(o.qoi_mm) + " / " + significant(o.qoi_reference_mm),
+          significant(o.max_strain, 2), significant(o.solve_seconds), significant(o.setup_seconds), significant(o.memory_mib, 3),
           std::to_string(o.unknowns)}) {
       row.push_back(v);
     }
@@ -379,13 +373,13 @@ void scene_section(Document& doc, const SceneRows& s) {
                   std::string l;
                   for (const int v : s.model_levels) l += (l.empty() ? "" : ", ") + std::to_string(v);
                   return l;
-                }() + "; " + fmt(s.seconds, 3) + " s for the whole scene.");
+                }() + "; " + significant(s.seconds, 3) + " s for the whole scene.");
   Table refs;
   refs.header = {"ν", "reference element", "level", "DoFs", "solve s", "max strain per unit load"};
   for (const auto& r : s.references) {
-    refs.rows.push_back({fmt(r.poisson_ratio), r.element, std::to_string(r.level),
-                         std::to_string(r.dofs), fmt(r.solve_seconds),
-                         fmt(r.max_abs_strain_at_unit_load)});
+    refs.rows.push_back({significant(r.poisson_ratio), r.element, std::to_string(r.level),
+                         std::to_string(r.dofs), significant(r.solve_seconds),
+                         significant(r.max_abs_strain_at_unit_load)});
   }
   doc.table(refs);
   const FigureContext c{doc, s, representative_load(s), first_nu(s)};
@@ -418,14 +412,14 @@ Table summary_table(const ResultsFile& r) {
       if (o.magnitude != mag || o.poisson_ratio != nu) continue;
       if (!o.ok) {
         t.rows.push_back({s.name, o.model, std::to_string(o.level), load_text(mag, s),
-                          "**failed**", "", "", "", "no", "", fmt(o.setup_seconds), ""});
+                          "**failed**", "", "", "", "no", "", significant(o.setup_seconds), ""});
         continue;
       }
       t.rows.push_back({s.name, o.model, std::to_string(o.level),
-                        load_text(mag, s) + (o.beyond_linear_regime ? " ⚠" : ""), fmt(o.max_mm),
-                        fmt(o.rms_mm), fmt(o.relative_l2), reference_uncertainty_text(o),
-                        o.max_mm <= s.tolerance_mm ? "yes" : "no", fmt(o.solve_seconds),
-                        fmt(o.setup_seconds), fmt(o.memory_mib, 3)});
+                        load_text(mag, s) + (o.beyond_linear_regime ? " ⚠" : ""), significant(o.max_mm),
+                        significant(o.rms_mm), significant(o.relative_l2), reference_uncertainty_text(o),
+                        o.max_mm <= s.tolerance_mm ? "yes" : "no", significant(o.solve_seconds),
+                        significant(o.setup_seconds), significant(o.memory_mib, 3)});
     }
   }
   return t;

@@ -9,21 +9,15 @@ namespace vessel::reports {
 
 namespace {
 
-std::string fmt(double v, int digits) {
-  std::ostringstream s;
-  s << std::setprecision(digits) << v;
-  return s.str();
-}
-
 std::string yes_no(const std::optional<bool>& b) {
   if (!b) return "–";
   return *b ? "yes" : "**no**";
 }
 
-std::string ms(double seconds) { return fmt(seconds * 1e3, 3) + " ms"; }
+std::string ms(double seconds) { return significant(seconds * 1e3, 3) + " ms"; }
 
 /// "30 Hz", "1000 Hz" (3 digits would print 1e+03).
-std::string hz(double rate) { return fmt(rate, 6) + " Hz"; }
+std::string hz(double rate) { return significant(rate, 6) + " Hz"; }
 
 Table critical_step_table(const StabilityFile& s) {
   Table t;
@@ -32,11 +26,11 @@ Table critical_step_table(const StabilityFile& s) {
               "found / guaranteed"};
   for (const auto& r : s.critical_steps) {
     const bool proven = r.guaranteed_dt.has_value();
-    t.rows.push_back({r.model, r.integrator, fmt(r.zeta, 4), std::to_string(r.level),
-                      std::to_string(r.nodes), fmt(r.omega_max, 5), fmt(r.omega_gershgorin, 5),
-                      fmt(r.predicted_dt * 1e6, 5), proven ? fmt(*r.guaranteed_dt * 1e6, 5) : "–",
-                      fmt(r.found_dt * 1e6, 5), fmt(r.found_dt / r.predicted_dt, 4),
-                      proven && *r.guaranteed_dt > 0 ? fmt(r.found_dt / *r.guaranteed_dt, 4)
+    t.rows.push_back({r.model, r.integrator, significant(r.zeta, 4), std::to_string(r.level),
+                      std::to_string(r.nodes), significant(r.omega_max, 5), significant(r.omega_gershgorin, 5),
+                      significant(r.predicted_dt * 1e6, 5), proven ? significant(*r.guaranteed_dt * 1e6, 5) : "–",
+                      significant(r.found_dt * 1e6, 5), significant(r.found_dt / r.predicted_dt, 4),
+                      proven && *r.guaranteed_dt > 0 ? significant(r.found_dt / *r.guaranteed_dt, 4)
                                                      : "–"});
   }
   return t;
@@ -51,8 +45,8 @@ Table refinement_table(const StabilityFile& s) {
       if (!levels.empty()) levels += ',';
       levels += std::to_string(l);
     }
-    t.rows.push_back({f.model, f.integrator, fmt(f.zeta, 4), levels, fmt(f.found_exponent, 3),
-                      fmt(f.predicted_exponent, 3)});
+    t.rows.push_back({f.model, f.integrator, significant(f.zeta, 4), levels, significant(f.found_exponent, 3),
+                      significant(f.predicted_exponent, 3)});
   }
   return t;
 }
@@ -65,7 +59,7 @@ void hard_cases(Document& doc, const StabilityFile& s) {
                 "Displacements in mm, loads in mN.");
   for (const auto& hc : s.hard_cases) {
     doc.heading(4, hc.title);
-    doc.paragraph(hc.setup + " (" + fmt(hc.seconds, 3) + " s)");
+    doc.paragraph(hc.setup + " (" + significant(hc.seconds, 3) + " s)");
     Table t;
     t.header = {"model", "finished", "converged", "bounded", "reported"};
     for (const auto& o : hc.outcomes) {
@@ -86,7 +80,7 @@ void stability_section(Document& doc, const StabilityFile& s) {
       "running (bisection on dt, " + std::to_string(s.steps_per_trial) +
       " steps per trial from a small random velocity, unstable when the energy exceeds 1000× its "
       "start or turns non-finite) — and what every model does on hard cases. Produced by `" +
-      s.command + "`" + (s.quick ? " (quick mode)" : "") + " in " + fmt(s.total_seconds, 3) +
+      s.command + "`" + (s.quick ? " (quick mode)" : "") + " in " + significant(s.total_seconds, 3) +
       " s (`" + s.path.filename().string() + "`).");
   doc.heading(3, "Predicted vs found stable step");
   doc.paragraph(
@@ -119,19 +113,19 @@ void stability_section(Document& doc, const StabilityFile& s) {
 namespace {
 
 std::string load_text(const RecommendFile& r, double magnitude) {
-  if (r.load_unit == "N") return fmt(magnitude * 1e3, 3) + " mN";
-  if (r.load_unit.empty()) return fmt(magnitude, 3) + " (the scene's load unit)";
-  return fmt(magnitude, 3) + " " + r.load_unit;
+  if (r.load_unit == "N") return significant(magnitude * 1e3, 3) + " mN";
+  if (r.load_unit.empty()) return significant(magnitude, 3) + " (the scene's load unit)";
+  return significant(magnitude, 3) + " " + r.load_unit;
 }
 
 std::string budget_text(const RecommendFile& r) {
   std::string t = "the " + r.quantity;
-  if (r.radius_mm) t += " (within " + fmt(*r.radius_mm, 3) + " mm)";
-  t += " error ≤ " + fmt(r.tolerance, 3) + " " + r.unit + ", and ≤ " + ms(r.seconds_per_update) +
+  if (r.radius_mm) t += " (within " + significant(*r.radius_mm, 3) + " mm)";
+  t += " error ≤ " + significant(r.tolerance, 3) + " " + r.unit + ", and ≤ " + ms(r.seconds_per_update) +
        " of computation per update";
   if (r.rate_hz) t += " (" + hz(*r.rate_hz) + ")";
   for (const auto& l : r.loads) {
-    t += "; at ν = " + fmt(l.poisson_ratio, 6) + " the load is " + load_text(r, l.magnitude) +
+    t += "; at ν = " + significant(l.poisson_ratio, 6) + " the load is " + load_text(r, l.magnitude) +
          " (reference " + (l.reference_element.empty() ? "" : l.reference_element + ", ") +
          "level " + std::to_string(r.reference_level) + ")";
   }
@@ -147,7 +141,7 @@ const CandidateEntry* candidate_named(const RecommendFile& r, const std::optiona
 }
 
 std::string error_text(const CandidateEntry& c, const std::string& unit) {
-  return c.error ? fmt(*c.error, 3) + " " + unit : "not computable";
+  return c.error ? significant(*c.error, 3) + " " + unit : "not computable";
 }
 
 void answer(Document& doc, const RecommendFile& r) {
@@ -174,8 +168,8 @@ void answer(Document& doc, const RecommendFile& r) {
   if (r.quantity != "reaction" && r.reference_contact_point_mm > 0.0 &&
       r.tolerance >= r.reference_contact_point_mm) {
     doc.paragraph("⚠ **The tolerance does not discriminate**: at this load the reference's "
-                  "contact point moves " + fmt(r.reference_contact_point_mm, 3) +
-                  " mm, no more than the " + fmt(r.tolerance, 3) +
+                  "contact point moves " + significant(r.reference_contact_point_mm, 3) +
+                  " mm, no more than the " + significant(r.tolerance, 3) +
                   " mm tolerance, so a model that does not move at all would meet it. State a "
                   "tighter tolerance or a larger load (`magnitude`) for an answer about accuracy.");
   }
@@ -203,9 +197,9 @@ Table evidence_table(const RecommendFile& r) {
               "set-up (ms)", "Pareto", "verdict", "why"};
   for (const CandidateEntry* c : evidence_order(r)) {
     t.rows.push_back({"`" + c->name + "`", std::to_string(c->unknowns),
-                      c->ok && c->error ? fmt(*c->error, 3) : "–",
-                      c->ok && c->update_seconds ? fmt(*c->update_seconds * 1e3, 3) : "–",
-                      c->ok && c->setup_seconds ? fmt(*c->setup_seconds * 1e3, 3) : "–",
+                      c->ok && c->error ? significant(*c->error, 3) : "–",
+                      c->ok && c->update_seconds ? significant(*c->update_seconds * 1e3, 3) : "–",
+                      c->ok && c->setup_seconds ? significant(*c->setup_seconds * 1e3, 3) : "–",
                       c->pareto ? "★" : "", c->verdict, c->reason});
   }
   return t;

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "meshes/errors.hpp"
+#include "msm/model/pattern_slots.hpp"
 
 namespace vessel::msm {
 
@@ -232,23 +233,10 @@ void BendingTerm::gradient(const VectorXd& x, VectorXd& g) const {
 }
 
 std::vector<int> BendingTerm::slots_in(const SparseMatrix& pattern) const {
-  std::vector<int> slots;
-  slots.reserve(hinges_.size() * 144);
-  const int* inner = pattern.innerIndexPtr();
-  const int* outer = pattern.outerIndexPtr();
-  auto slot = [&](int row, int col) {
-    const int* begin = inner + outer[col];
-    const int* end = inner + outer[col + 1];
-    const int* it = std::lower_bound(begin, end, row);
-    return it != end && *it == row ? static_cast<int>(it - inner) : -1;
-  };
-  // Block order as VolumeTerm::slots_in: node pairs (a, b), then components (i, j).
-  for (const Hinge& h : hinges_)
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) slots.push_back(slot(3 * h.nodes[a] + i, 3 * h.nodes[b] + j));
-  return slots;
+  std::vector<std::array<int, 4>> nodes;
+  nodes.reserve(hinges_.size());
+  for (const Hinge& h : hinges_) nodes.push_back(h.nodes);
+  return four_node_block_slots(pattern, nodes);
 }
 
 void BendingTerm::add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "meshes/errors.hpp"
+#include "msm/model/pattern_slots.hpp"
 
 namespace vessel::msm {
 
@@ -68,10 +69,7 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
   std::fill(union_pattern_.valuePtr(), union_pattern_.valuePtr() + union_pattern_.nonZeros(), 0.0);
   for (int col = 0; col < Hs.outerSize(); ++col) {
     for (SparseMatrix::InnerIterator it(Hs, col); it; ++it) {
-      const int* inner = union_pattern_.innerIndexPtr();
-      const int* begin = inner + union_pattern_.outerIndexPtr()[col];
-      const int* end = inner + union_pattern_.outerIndexPtr()[col + 1];
-      spring_to_union_.push_back(static_cast<int>(std::lower_bound(begin, end, it.row()) - inner));
+      spring_to_union_.push_back(pattern_slot(union_pattern_, static_cast<int>(it.row()), col));
     }
   }
   if (volume_) volume_slots_ = volume_->slots_in(union_pattern_);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "meshes/errors.hpp"
+#include "msm/model/pattern_slots.hpp"
 
 namespace vessel::msm {
 
@@ -142,23 +143,7 @@ void VolumeTerm::gradient(const VectorXd& x, VectorXd& g) const {
 }
 
 std::vector<int> VolumeTerm::slots_in(const SparseMatrix& pattern) const {
-  std::vector<int> slots;
-  slots.reserve(tets_.size() * 144);
-  const int* inner = pattern.innerIndexPtr();
-  const int* outer = pattern.outerIndexPtr();
-  auto slot = [&](int row, int col) {
-    const int* begin = inner + outer[col];
-    const int* end = inner + outer[col + 1];
-    const int* it = std::lower_bound(begin, end, row);
-    return it != end && *it == row ? static_cast<int>(it - inner) : -1;
-  };
-  // Block order: (a, b) node pairs, then (i, j) components, the 12×12 block's (3a + i, 3b + j).
-  for (const Tet& t : tets_)
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) slots.push_back(slot(3 * t[a] + i, 3 * t[b] + j));
-  return slots;
+  return four_node_block_slots(pattern, tets_);
 }
 
 void VolumeTerm::add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,

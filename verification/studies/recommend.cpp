@@ -17,18 +17,14 @@
 
 namespace vessel {
 
+using reports::significant;
+
 namespace {
 
-std::string fmt(double v, int digits = 3) {
-  std::ostringstream s;
-  s << std::setprecision(digits) << v;
-  return s.str();
-}
+std::string ms(double seconds) { return significant(seconds * 1e3) + " ms"; }
 
-std::string ms(double seconds) { return fmt(seconds * 1e3) + " ms"; }
-
-/// "30 Hz", "1000 Hz" (fmt's 3 digits would print 1e+03).
-std::string hz(double rate) { return fmt(rate, 6) + " Hz"; }
+/// "30 Hz", "1000 Hz" (significant's 3 digits would print 1e+03).
+std::string hz(double rate) { return significant(rate, 6) + " Hz"; }
 
 bool is_integrator(const ModelSpec& m) { return m.solver.kind == msm::SolverKind::integrator; }
 
@@ -101,7 +97,7 @@ Selection select_model(const std::vector<Candidate>& c, double tolerance, double
       }
     }
   }
-  const std::string tol_text = fmt(tolerance) + " " + unit;
+  const std::string tol_text = significant(tolerance) + " " + unit;
   for (std::size_t i = 0; i < n; ++i) {
     if (!c[i].ok) {
       sel.verdicts[i] = Verdict::failed;
@@ -117,7 +113,7 @@ Selection select_model(const std::vector<Candidate>& c, double tolerance, double
     }
     const bool accurate = c[i].error <= tolerance;
     const bool fast = c[i].update_seconds <= budget;
-    const std::string err = fmt(c[i].error) + " " + unit;
+    const std::string err = significant(c[i].error) + " " + unit;
     const std::string time = ms(c[i].update_seconds);
     if (sel.recommended == i) {
       sel.verdicts[i] = Verdict::recommended;
@@ -129,7 +125,7 @@ Selection select_model(const std::vector<Candidate>& c, double tolerance, double
       const bool tied = c[i].update_seconds <= fastest * (1.0 + kTimingTie);
       sel.reasons[i] =
           "meets both, but " + time + " per update against " + ms(best.update_seconds) +
-          (tied ? " (a tie within " + fmt(kTimingTie * 100) + " %) with a larger error" : "");
+          (tied ? " (a tie within " + significant(kTimingTie * 100) + " %) with a larger error" : "");
     } else if (!accurate && !fast) {
       sel.verdicts[i] = Verdict::too_slow_and_inaccurate;
       sel.reasons[i] = err + " > " + tol_text + " and " + time + " > " + ms(budget) + " per update";
@@ -142,7 +138,7 @@ Selection select_model(const std::vector<Candidate>& c, double tolerance, double
     }
     if (sel.closest == i) {
       sel.reasons[i] += "; the closest: the budget would have to grow " +
-                        fmt(std::max(c[i].error / tolerance, c[i].update_seconds / budget)) + "×";
+                        significant(std::max(c[i].error / tolerance, c[i].update_seconds / budget)) + "×";
     }
   }
   std::vector<std::size_t> finished;
@@ -219,7 +215,7 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
         for (const double r : roi_radii) {
           m.solver = msm::parse_solver("static");
           m.roi_radius = r;
-          m.name = kind_name + "/" + rule_name + "/static/R=" + fmt(r * 1e3) + "mm";
+          m.name = kind_name + "/" + rule_name + "/static/R=" + significant(r * 1e3) + "mm";
           out.push_back(m);
         }
       }
@@ -269,7 +265,7 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
           m.solver.steps = std::max(1L, std::lround(duration / dt));
           m.damping = damping;
           m.name = kind_name + "/" + rule_label(choice) + "/" + msm::to_string(integrator) +
-                   "/dt=" + fmt(dt);
+                   "/dt=" + significant(dt);
           out.push_back(m);
         }
       }
@@ -287,7 +283,7 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
         m.solver.dt = dt;
         m.solver.steps = std::max(1L, std::lround(duration / dt));
         m.damping = damping;
-        m.name = kind_name + "/" + rule_label(choice) + "/local-global-euler/dt=" + fmt(dt);
+        m.name = kind_name + "/" + rule_label(choice) + "/local-global-euler/dt=" + significant(dt);
         out.push_back(m);
       }
     }
@@ -380,8 +376,8 @@ std::string budget_text(const Scene& s, const SceneResult& r) {
   const Budget& b = s.budget;
   std::ostringstream t;
   t << "the " << to_string(b.quantity);
-  if (b.quantity == BudgetQuantity::patch) t << " (within " << fmt(b.radius * 1e3) << " mm)";
-  t << " error ≤ " << fmt(b.tolerance) << " " << budget_unit(b.quantity) << ", and ≤ "
+  if (b.quantity == BudgetQuantity::patch) t << " (within " << significant(b.radius * 1e3) << " mm)";
+  t << " error ≤ " << significant(b.tolerance) << " " << budget_unit(b.quantity) << ", and ≤ "
     << ms(b.seconds_per_update()) << " of computation per update";
   if (b.rate_hz > 0.0) t << " (" << hz(b.rate_hz) << ")";
   const char* unit =
@@ -389,9 +385,9 @@ std::string budget_text(const Scene& s, const SceneResult& r) {
   for (const ReferenceInfo& ref : r.references) {
     t << "; at ν = " << ref.poisson_ratio << " the load is ";
     if (s.load.kind == LoadKind::contact) {
-      t << fmt(ref.budget_magnitude * 1e3) << " mN";
+      t << significant(ref.budget_magnitude * 1e3) << " mN";
     } else {
-      t << fmt(ref.budget_magnitude) << " " << unit;
+      t << significant(ref.budget_magnitude) << " " << unit;
     }
     t << " (reference " << ref.element << ", level " << ref.level << ")";
   }
@@ -422,13 +418,13 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
   if (sel.recommended) {
     const Candidate& best = c[*sel.recommended];
     md << "**Recommended: `" << best.name << "`** (" << best.detail << "): error "
-       << fmt(best.error) << " " << unit << ", " << ms(best.update_seconds) << " per update ("
+       << significant(best.error) << " " << unit << ", " << ms(best.update_seconds) << " per update ("
        << ms(best.setup_seconds) << " set-up, once), " << best.unknowns << " unknowns"
        << (best.roi_radius > 0.0 ? "" : ", the whole vessel") << ".\n\n";
   } else if (sel.closest) {
     const Candidate& near = c[*sel.closest];
     md << "**No candidate meets the budget.** The closest is `" << near.name << "` (" << near.detail
-       << "): error " << fmt(near.error) << " " << unit << ", " << ms(near.update_seconds)
+       << "): error " << significant(near.error) << " " << unit << ", " << ms(near.update_seconds)
        << " per update; " << sel.reasons[*sel.closest] << ".\n\n";
   } else {
     md << "**No candidate meets the budget**, and none finished.\n\n";
@@ -436,7 +432,7 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
   if (sel.whole_vessel && sel.whole_vessel != sel.recommended) {
     const Candidate& w = c[*sel.whole_vessel];
     md << "Whole vessel (no region of interest): `" << w.name << "` (" << w.detail << ") meets "
-       << "the budget too: error " << fmt(w.error) << " " << unit << ", "
+       << "the budget too: error " << significant(w.error) << " " << unit << ", "
        << ms(w.update_seconds) << " per update, " << w.unknowns << " unknowns.\n\n";
   } else if (!sel.whole_vessel) {
     md << "No whole-vessel candidate (without a region of interest) meets the budget.\n\n";
@@ -451,7 +447,7 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
       s.budget.tolerance >= reference_qoi_mm) {
     md << "⚠ **The tolerance does not discriminate**: at this load the reference's contact point "
           "moves "
-       << fmt(reference_qoi_mm) << " mm, no more than the " << fmt(s.budget.tolerance)
+       << significant(reference_qoi_mm) << " mm, no more than the " << significant(s.budget.tolerance)
        << " mm tolerance, so a model that does not move at all would meet it. State a tighter "
           "tolerance or a larger load (`magnitude`) for an answer about accuracy.\n\n";
   }
@@ -478,9 +474,9 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
   for (const std::size_t i : order) {
     const bool front = std::find(sel.pareto.begin(), sel.pareto.end(), i) != sel.pareto.end();
     md << "| `" << c[i].name << "` | " << c[i].unknowns << " | "
-       << (c[i].ok && std::isfinite(c[i].error) ? fmt(c[i].error) : "–") << " | "
-       << (c[i].ok ? fmt(c[i].update_seconds * 1e3) : "–") << " | "
-       << (c[i].ok ? fmt(c[i].setup_seconds * 1e3) : "–") << " | " << (front ? "★" : "") << " | "
+       << (c[i].ok && std::isfinite(c[i].error) ? significant(c[i].error) : "–") << " | "
+       << (c[i].ok ? significant(c[i].update_seconds * 1e3) : "–") << " | "
+       << (c[i].ok ? significant(c[i].setup_seconds * 1e3) : "–") << " | " << (front ? "★" : "") << " | "
        << to_string(sel.verdicts[i]) << " | " << sel.reasons[i] << " |\n";
   }
   md << "\n";
