@@ -1,6 +1,5 @@
 #include "msm/model/bending_term.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -8,7 +7,7 @@
 #include <utility>
 
 #include "meshes/errors.hpp"
-#include "msm/model/pattern_slots.hpp"
+#include "msm/model/four_node_blocks.hpp"
 
 namespace vessel::msm {
 
@@ -143,9 +142,7 @@ Mat12 hinge_hessian(const std::array<Vec3, 4>& x, double rest_angle, double k, b
   }
   if (!project_psd) return H;
   if (d == 0.0 && k >= 0.0) return H;  // k·∇θ∇θᵀ: already PSD
-  const Eigen::SelfAdjointEigenSolver<Mat12> eig(H);
-  const Vec12 lambda = eig.eigenvalues().cwiseMax(0.0);
-  return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
+  return psd_projection(H);
 }
 
 std::vector<std::array<int, 4>> interior_hinges(const std::vector<Triangle>& triangles) {
@@ -168,6 +165,17 @@ std::vector<std::array<int, 4>> interior_hinges(const std::vector<Triangle>& tri
   return out;
 }
 
+namespace {
+
+std::vector<std::array<int, 4>> hinge_nodes(const std::vector<Hinge>& hinges) {
+  std::vector<std::array<int, 4>> nodes;
+  nodes.reserve(hinges.size());
+  for (const Hinge& h : hinges) nodes.push_back(h.nodes);
+  return nodes;
+}
+
+}  // namespace
+
 BendingTerm::BendingTerm(const std::vector<Vec3>& nodes, const std::vector<Triangle>& triangles,
                          double bending_rigidity)
     : num_nodes_(static_cast<int>(nodes.size())), rigidity_(bending_rigidity) {
@@ -184,9 +192,6 @@ BendingTerm::BendingTerm(const std::vector<Vec3>& nodes, const std::vector<Trian
       }
     }
   }
-  std::vector<Eigen::Triplet<double>> t;
-  const int n = num_dofs();
-  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 0.0);
   for (const auto& q : interior_hinges(triangles)) {
     const std::array<Vec3, 4> x{nodes[q[0]], nodes[q[1]], nodes[q[2]], nodes[q[3]]};
     const double A = triangle_area(x[0], x[1], x[2]) + triangle_area(x[0], x[3], x[1]);
@@ -197,14 +202,8 @@ BendingTerm::BendingTerm(const std::vector<Vec3>& nodes, const std::vector<Trian
     }
     hinges_.push_back(
         {q, dihedral_angle(x), discrete_shells_hinge_stiffness(bending_rigidity, L, A)});
-    for (int a : q)
-      for (int b : q)
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) t.emplace_back(3 * a + i, 3 * b + j, 0.0);
   }
-  pattern_.resize(n, n);
-  pattern_.setFromTriplets(t.begin(), t.end());
-  pattern_.makeCompressed();
+  pattern_ = four_node_block_pattern(num_dofs(), hinge_nodes(hinges_));
   slots_ = slots_in(pattern_);
 }
 
@@ -233,21 +232,15 @@ void BendingTerm::gradient(const VectorXd& x, VectorXd& g) const {
 }
 
 std::vector<int> BendingTerm::slots_in(const SparseMatrix& pattern) const {
-  std::vector<std::array<int, 4>> nodes;
-  nodes.reserve(hinges_.size());
-  for (const Hinge& h : hinges_) nodes.push_back(h.nodes);
-  return four_node_block_slots(pattern, nodes);
+  return four_node_block_slots(pattern, hinge_nodes(hinges_));
 }
 
 void BendingTerm::add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,
                               bool project_psd) const {
   const int* s = slots.data();
   for (const Hinge& h : hinges_) {
-    const Mat12 B = hinge_hessian(corners(x, h), h.rest_angle, h.stiffness, project_psd);
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) values[*s++] += B(3 * a + i, 3 * b + j);
+    add_four_node_block(hinge_hessian(corners(x, h), h.rest_angle, h.stiffness, project_psd), s,
+                        values);
   }
 }
 

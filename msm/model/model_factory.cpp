@@ -5,7 +5,7 @@
 #include <string>
 
 #include "meshes/errors.hpp"
-#include "msm/model/pattern_slots.hpp"
+#include "msm/model/four_node_blocks.hpp"
 
 namespace vessel::msm {
 

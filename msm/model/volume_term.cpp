@@ -1,13 +1,12 @@
 #include "msm/model/volume_term.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "meshes/errors.hpp"
-#include "msm/model/pattern_slots.hpp"
+#include "msm/model/four_node_blocks.hpp"
 
 namespace vessel::msm {
 
@@ -74,9 +73,7 @@ Mat12 volume_hessian(const std::array<Vec3, 4>& x, double rest_volume, double ka
   Mat12 H = kappa / v0 * gv * gv.transpose();
   if (dv != 0.0) H += kappa * dv / v0 * tet_volume_hessian(x);
   if (!project_psd) return H;
-  const Eigen::SelfAdjointEigenSolver<Mat12> eig(H);
-  const Vec12 lambda = eig.eigenvalues().cwiseMax(0.0);
-  return eig.eigenvectors() * lambda.asDiagonal() * eig.eigenvectors().transpose();
+  return psd_projection(H);
 }
 
 VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, double kappa)
@@ -86,9 +83,6 @@ VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, do
                      std::to_string(kappa));
   }
   rest_volumes_.reserve(tets_.size());
-  std::vector<Eigen::Triplet<double>> t;
-  const int n = num_dofs();
-  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 0.0);
   for (std::size_t e = 0; e < tets_.size(); ++e) {
     const Tet& tet = tets_[e];
     for (int v : tet) {
@@ -105,14 +99,8 @@ VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, do
                        " has zero rest volume; expected a non-degenerate tetrahedron");
     }
     rest_volumes_.push_back(v0);
-    for (int a : tet)
-      for (int b : tet)
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) t.emplace_back(3 * a + i, 3 * b + j, 0.0);
   }
-  pattern_.resize(n, n);
-  pattern_.setFromTriplets(t.begin(), t.end());
-  pattern_.makeCompressed();
+  pattern_ = four_node_block_pattern(num_dofs(), tets_);
   slots_ = slots_in(pattern_);
 }
 
@@ -150,11 +138,8 @@ void VolumeTerm::add_hessian(const VectorXd& x, double* values, const std::vecto
                              bool project_psd) const {
   const int* s = slots.data();
   for (std::size_t k = 0; k < tets_.size(); ++k) {
-    const Mat12 B = volume_hessian(corners(x, tets_[k]), rest_volumes_[k], kappa_, project_psd);
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) values[*s++] += B(3 * a + i, 3 * b + j);
+    add_four_node_block(
+        volume_hessian(corners(x, tets_[k]), rest_volumes_[k], kappa_, project_psd), s, values);
   }
 }
 

@@ -21,11 +21,9 @@
 
 #include "meshes/tet_mesh.hpp"
 #include "msm/model/form.hpp"
+#include "msm/model/four_node_blocks.hpp"
 
 namespace vessel::msm {
-
-using Vec12 = Eigen::Matrix<double, 12, 1>;
-using Mat12 = Eigen::Matrix<double, 12, 12>;
 
 /// Signed volume (x1 − x0)·((x2 − x0) × (x3 − x0))/6 of the tet (x0, x1, x2, x3), m³.
 double tet_signed_volume(const std::array<Vec3, 4>& x);
