@@ -3,6 +3,8 @@
 #include <Eigen/CholmodSupport>
 #include <stdexcept>
 
+#include "meshes/solver_threads.hpp"
+
 namespace vessel::fem {
 
 Eigen::VectorXd solve_spd_cholmod(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& b) {
@@ -15,6 +17,7 @@ struct CholmodFactor::Impl {
 
 CholmodFactor::CholmodFactor(const Eigen::SparseMatrix<double>& K)
     : impl_(std::make_unique<Impl>()) {
+  apply_solver_threads();
   impl_->llt.compute(K);
   if (impl_->llt.info() != Eigen::Success) {
     throw std::runtime_error(
@@ -26,6 +29,7 @@ CholmodFactor::CholmodFactor(const Eigen::SparseMatrix<double>& K)
 CholmodFactor::~CholmodFactor() = default;
 
 Eigen::VectorXd CholmodFactor::solve(const Eigen::VectorXd& b) const {
+  apply_solver_threads();
   Eigen::VectorXd x = impl_->llt.solve(b);
   if (impl_->llt.info() != Eigen::Success) throw std::runtime_error("CHOLMOD solve failed");
   return x;

@@ -14,6 +14,7 @@
 #include "fem_reference/detail/constraints.hpp"
 #include "fem_reference/detail/serial_solver.hpp"
 #include "meshes/errors.hpp"
+#include "meshes/solver_threads.hpp"
 
 namespace vessel::fem {
 
@@ -67,6 +68,7 @@ void ElasticitySolver::Impl::solve_linear() {
     solve_displacement_direct();
   } else if (s == LinearSolver::direct) {
     // UMFPACK for the indefinite mixed (Taylor–Hood) system.
+    apply_solver_threads();  // UMFPACK's dense kernels are OpenBLAS's
     dl::SparseDirectUMFPACK direct;
     direct.initialize(matrix);
     direct.vmult(solution, rhs);
