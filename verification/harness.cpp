@@ -1,13 +1,20 @@
 #include "verification/harness.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
+#include <exception>
+#include <functional>
+#include <iomanip>
 #include <limits>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <numbers>
+#include <optional>
 #include <sstream>
+#include <thread>
 #include <tuple>
 
 #include "fem_reference/convergence.hpp"
@@ -15,6 +22,7 @@
 #include "fem_reference/solution_cache.hpp"
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
+#include "meshes/solver_threads.hpp"
 #include "meshes/vtu_io.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/model/model_factory.hpp"
@@ -680,81 +688,141 @@ Scene quick_variant(Scene s) {
   return s;
 }
 
-SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
-  std::ostream null_stream(nullptr);
-  std::ostream& log = o.log ? *o.log : null_stream;
-  Stopwatch total;
+namespace {
+
+/// A scene's meshes and its reference at each ν: what its models are compared against, solved
+/// before the models (in parallel across scenes with HarnessOptions::jobs > 1). Not movable: the
+/// solvers point at the meshes.
+struct SceneReferences {
+  std::map<int, TetMesh> model_meshes;
+  TetMesh fine_mesh;
+  std::unique_ptr<TetMesh> coarse_mesh;
+  std::unique_ptr<TetMesh> modal_mesh;          ///< the modal reference's, when no other is
+  const TetMesh* modal_reference_mesh = nullptr;  ///< nullptr: the scene asks for no modes
+  int modal_level = 0;
+  struct AtNu {
+    ReferenceSolvers ref;
+    ReferenceInfo info;
+    std::optional<ModalOutcome> modes;
+    double seconds = 0.0;
+  };
+  std::vector<AtNu> at_nu;  ///< one per scene ν, in the scene's order
+
+  SceneReferences() = default;
+  SceneReferences(const SceneReferences&) = delete;
+  SceneReferences& operator=(const SceneReferences&) = delete;
+};
+
+/// The scene's meshes (generated or read from the mesh cache; gmsh is not thread-safe, so this
+/// runs on one thread).
+std::unique_ptr<SceneReferences> scene_meshes(const Scene& s, const HarnessOptions& o) {
+  auto r = std::make_unique<SceneReferences>();
+  for (const int level : s.model_levels) {
+    r->model_meshes.emplace(level, scene_mesh(s, level, o.cache_dir));
+  }
+  r->fine_mesh = scene_mesh(s, s.reference_level, o.cache_dir);
+  if (s.reference_level > 0) {
+    r->coarse_mesh = std::make_unique<TetMesh>(scene_mesh(s, s.reference_level - 1, o.cache_dir));
+  }
+  // The modal reference's mesh (scene's [modes]): one of those above, else its own.
+  r->modal_level = modal_reference_level(s);
+  if (s.modes.count > 0) {
+    if (r->modal_level == s.reference_level) {
+      r->modal_reference_mesh = &r->fine_mesh;
+    } else if (r->coarse_mesh && r->modal_level == s.reference_level - 1) {
+      r->modal_reference_mesh = r->coarse_mesh.get();
+    } else if (r->model_meshes.count(r->modal_level)) {
+      r->modal_reference_mesh = &r->model_meshes.at(r->modal_level);
+    } else {
+      r->modal_mesh = std::make_unique<TetMesh>(scene_mesh(s, r->modal_level, o.cache_dir));
+      r->modal_reference_mesh = r->modal_mesh.get();
+    }
+  }
+  r->at_nu.resize(s.poisson_ratios.size());
+  return r;
+}
+
+std::string reference_label(const Scene& s, double nu) {
+  return "reference P2 (level " + std::to_string(s.reference_level) + ", ν = " +
+         std::to_string(nu) + ")";
+}
+
+std::string modal_label(const Scene& s, const SceneReferences& r, double nu) {
+  return "modal reference P2 (level " + std::to_string(r.modal_level) + ", ν = " +
+         std::to_string(nu) + ", " + std::to_string(s.modes.count) + " modes)";
+}
+
+/// The scene's P2 reference at its k-th ν (unit load), on the fine level and the one below.
+void solve_reference_at(const Scene& s, SceneReferences& r, std::size_t k,
+                        const HarnessOptions& o) {
+  Stopwatch clock;
+  const double nu = s.poisson_ratios[k];
+  SceneReferences::AtNu& a = r.at_nu[k];
+  ReferenceSolvers& ref = a.ref;
+  ref.cache = o.solution_cache;
+  ref.fine_mesh = &r.fine_mesh;
+  ref.fine_problem = fem_problem(s, r.fine_mesh, nu, 2);
+  const fem::ElasticityResult& fine =
+      solve_reference(ref.fine, r.fine_mesh, ref.fine_problem, ref.cache);
+  if (r.coarse_mesh) {
+    solve_reference(ref.coarse, *r.coarse_mesh, fem_problem(s, *r.coarse_mesh, nu, 2), ref.cache);
+  }
+  a.info.poisson_ratio = nu;
+  a.info.element = fine.element;
+  a.info.level = s.reference_level;
+  a.info.dofs = fine.n_dofs + fine.n_pressure_dofs;
+  a.info.solve_seconds = fine.timings.assembly + fine.timings.solve;
+  a.info.max_abs_strain_unit = fine.max_abs_principal_strain;
+  a.info.budget_magnitude = budget_magnitude(s, fine.max_abs_principal_strain);
+  a.seconds = clock.seconds();
+}
+
+void solve_modal_reference_at(const Scene& s, SceneReferences& r, std::size_t k) {
+  if (!r.modal_reference_mesh) return;
+  Stopwatch clock;
+  r.at_nu[k].modes = reference_modes(s, s.poisson_ratios[k], *r.modal_reference_mesh, r.modal_level);
+  r.at_nu[k].seconds += clock.seconds();
+}
+
+void log_modal_failure(std::ostream& log, const SceneReferences::AtNu& a) {
+  if (a.modes && !a.modes->ok) log << "      modal reference FAILED: " << a.modes->failure << "\n";
+}
+
+std::size_t model_cases(const Scene& s, const HarnessOptions& o) {
+  const std::size_t loads = o.budget_load_only ? 1 : s.load.magnitudes.size();
+  std::size_t cases = 0;
+  for (const auto& m : s.models) cases += m.kind == ModelKind::fem ? 1 : loads;
+  return s.poisson_ratios.size() * s.model_levels.size() * cases;
+}
+
+/// The scene's models against its references (solved). `progress` counts one case per model,
+/// level, ν and load; `solve_here` solves each ν's reference as the models reach it (serial runs).
+SceneResult run_models(const Scene& s, SceneReferences& r, const HarnessOptions& o,
+                       Progress& progress, bool solve_here, std::ostream& log) {
   SceneResult result;
   result.scene = s;
   result.qoi_point = qoi_point(s);
-
-  log << "scene " << s.name << ": " << describe(s.vessel) << "\n";
-  std::map<int, TetMesh> model_meshes;
-  for (const int level : s.model_levels) model_meshes.emplace(level, scene_mesh(s, level, o.cache_dir));
-  const TetMesh fine_mesh = scene_mesh(s, s.reference_level, o.cache_dir);
-  std::unique_ptr<TetMesh> coarse_mesh;
-  if (s.reference_level > 0) {
-    coarse_mesh = std::make_unique<TetMesh>(scene_mesh(s, s.reference_level - 1, o.cache_dir));
-  }
-
-  // The modal reference's mesh (scene's [modes]): one of those above, else its own.
-  std::unique_ptr<TetMesh> modal_mesh;
-  const TetMesh* modal_reference_mesh = nullptr;
-  const int modal_level = modal_reference_level(s);
-  if (s.modes.count > 0) {
-    if (modal_level == s.reference_level) {
-      modal_reference_mesh = &fine_mesh;
-    } else if (coarse_mesh && modal_level == s.reference_level - 1) {
-      modal_reference_mesh = coarse_mesh.get();
-    } else if (model_meshes.count(modal_level)) {
-      modal_reference_mesh = &model_meshes.at(modal_level);
-    } else {
-      modal_mesh = std::make_unique<TetMesh>(scene_mesh(s, modal_level, o.cache_dir));
-      modal_reference_mesh = modal_mesh.get();
-    }
-  }
-
-  std::size_t cases = 0;
-  const std::size_t loads = o.budget_load_only ? 1 : s.load.magnitudes.size();
-  for (const auto& m : s.models) cases += m.kind == ModelKind::fem ? 1 : loads;
-  Progress progress(log, s.poisson_ratios.size() * (1 + s.model_levels.size() * cases +
-                                                    (s.modes.count > 0 ? 1 : 0)));
-
-  for (const double nu : s.poisson_ratios) {
-    progress.begin("reference P2 (level " + std::to_string(s.reference_level) + ", ν = " +
-                   std::to_string(nu) + ")");
-    ReferenceSolvers ref;  // the scene's P2 reference at ν, unit load
-    ref.cache = o.solution_cache;
-    ref.fine_mesh = &fine_mesh;
-    ref.fine_problem = fem_problem(s, fine_mesh, nu, 2);
-    const fem::ElasticityResult& fine =
-        solve_reference(ref.fine, fine_mesh, ref.fine_problem, ref.cache);
-    if (coarse_mesh) {
-      solve_reference(ref.coarse, *coarse_mesh, fem_problem(s, *coarse_mesh, nu, 2), ref.cache);
-    }
-    ReferenceInfo info;
-    info.poisson_ratio = nu;
-    info.element = fine.element;
-    info.level = s.reference_level;
-    info.dofs = fine.n_dofs + fine.n_pressure_dofs;
-    info.solve_seconds = fine.timings.assembly + fine.timings.solve;
-    info.max_abs_strain_unit = fine.max_abs_principal_strain;
-    info.budget_magnitude = budget_magnitude(s, fine.max_abs_principal_strain);
-    result.references.push_back(info);
-    progress.end();
-    if (modal_reference_mesh) {
-      progress.begin("modal reference P2 (level " + std::to_string(modal_level) + ", ν = " +
-                     std::to_string(nu) + ", " + std::to_string(s.modes.count) + " modes)");
-      result.reference_modes.push_back(reference_modes(s, nu, *modal_reference_mesh, modal_level));
-      if (!result.reference_modes.back().ok) {
-        log << "      modal reference FAILED: " << result.reference_modes.back().failure << "\n";
-      }
+  for (std::size_t k = 0; k < s.poisson_ratios.size(); ++k) {
+    const double nu = s.poisson_ratios[k];
+    SceneReferences::AtNu& a = r.at_nu[k];
+    if (solve_here) {
+      progress.begin(reference_label(s, nu));
+      solve_reference_at(s, r, k, o);
       progress.end();
+      if (r.modal_reference_mesh) {
+        progress.begin(modal_label(s, r, nu));
+        solve_modal_reference_at(s, r, k);
+        log_modal_failure(log, a);
+        progress.end();
+      }
     }
+    result.references.push_back(a.info);
+    if (a.modes) result.reference_modes.push_back(*a.modes);
+    const fem::ElasticityResult& fine = a.ref.fine->result();
     Scene at_nu = s;  // the scene's loads for this ν (only the budget's, if asked)
-    if (o.budget_load_only) at_nu.load.magnitudes = {info.budget_magnitude};
+    if (o.budget_load_only) at_nu.load.magnitudes = {a.info.budget_magnitude};
 
-    for (const auto& [level, mesh] : model_meshes) {
+    for (const auto& [level, mesh] : r.model_meshes) {
       for (const auto& spec : s.models) {
         ModelOutcome base;
         base.model = spec.name;
@@ -764,16 +832,149 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
         if (spec.kind == ModelKind::fem) {
           progress.begin(spec.name + " (FEM P" + std::to_string(spec.degree) + ", level " +
                          std::to_string(level) + ")");
-          run_fem_model(at_nu, spec, nu, mesh, ref, fine, o, base, result);
+          run_fem_model(at_nu, spec, nu, mesh, a.ref, fine, o, base, result);
           progress.end();
         } else {
-          run_msm_model(at_nu, spec, nu, mesh, ref, fine, o, progress, base, result);
+          run_msm_model(at_nu, spec, nu, mesh, a.ref, fine, o, progress, base, result);
         }
       }
     }
   }
+  return result;
+}
+
+/// Runs `task(i)` for i in [0, n) on `jobs` threads; rethrows the first exception after all have
+/// stopped (the others' tasks still finish).
+void parallel_for(std::size_t n, int jobs, const std::function<void(std::size_t)>& task) {
+  std::atomic<std::size_t> next{0};
+  std::mutex failure_mutex;
+  std::exception_ptr failure;
+  auto worker = [&] {
+    for (std::size_t i = next++; i < n; i = next++) {
+      try {
+        task(i);
+      } catch (...) {
+        const std::lock_guard lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  const auto extra = static_cast<std::size_t>(std::max(0, jobs - 1));
+  for (std::size_t t = 0; t < std::min(extra, n); ++t) threads.emplace_back(worker);
+  worker();
+  for (std::thread& t : threads) t.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+/// Every scene's references, `o.jobs` solves at a time, each sparse factorisation with its share
+/// of the cores. Scenes whose fine problems are equal (the same key in the solution cache) are
+/// solved in one task, one after the other, so that the later ones read the first's entry.
+void solve_all_references(const std::vector<Scene>& scenes,
+                          std::vector<std::unique_ptr<SceneReferences>>& refs,
+                          const HarnessOptions& o, std::ostream& log) {
+  std::vector<std::pair<std::size_t, std::size_t>> cases;  // (scene, ν index)
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    for (std::size_t k = 0; k < scenes[i].poisson_ratios.size(); ++k) cases.emplace_back(i, k);
+  }
+  std::map<std::string, std::vector<std::size_t>> by_key;  // cases sharing a fine problem
+  std::vector<std::vector<std::size_t>> tasks;
+  for (std::size_t c = 0; c < cases.size(); ++c) {
+    const auto [i, k] = cases[c];
+    const std::optional<std::string> key =
+        o.solution_cache && o.solution_cache->enabled()
+            ? fem::solution_cache_key(refs[i]->fine_mesh,
+                                      fem_problem(scenes[i], refs[i]->fine_mesh,
+                                                  scenes[i].poisson_ratios[k], 2))
+            : std::nullopt;
+    if (key) {
+      by_key[*key].push_back(c);
+    } else {
+      tasks.push_back({c});
+    }
+  }
+  for (auto& [key, group] : by_key) tasks.push_back(std::move(group));
+  std::sort(tasks.begin(), tasks.end());  // the scenes' order, which the log follows
+
+  const int jobs = std::max(1, o.jobs);
+  log << "FEM references: " << cases.size() << " (scene, ν) cases of " << scenes.size()
+      << " scene(s), " << jobs << " at a time; the timed models follow one at a time\n";
+  const int saved_threads = solver_threads();
+  const int cores = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  set_solver_threads(std::max(1, cores / jobs));
+  std::mutex log_mutex;
+  Stopwatch clock;
+  std::atomic<std::size_t> finished{0};
+  try {
+    parallel_for(tasks.size(), jobs, [&](std::size_t t) {
+      for (const std::size_t c : tasks[t]) {
+        const auto [i, k] = cases[c];
+        const Scene& s = scenes[i];
+        solve_reference_at(s, *refs[i], k, o);
+        solve_modal_reference_at(s, *refs[i], k);
+        const std::lock_guard lock(log_mutex);
+        log << "  [" << ++finished << "/" << cases.size() << "] " << s.name << ": "
+            << reference_label(s, s.poisson_ratios[k])
+            << (refs[i]->modal_reference_mesh ? " and its modes" : "") << " in "
+            << std::setprecision(3) << refs[i]->at_nu[k].seconds << " s (elapsed "
+            << clock.seconds() << " s)\n";
+        log_modal_failure(log, refs[i]->at_nu[k]);
+      }
+    });
+  } catch (...) {
+    set_solver_threads(saved_threads);
+    throw;
+  }
+  set_solver_threads(saved_threads);
+}
+
+void log_scene_header(std::ostream& log, const Scene& s, std::size_t i, std::size_t n) {
+  log << "== scene " << i + 1 << "/" << n << ": " << s.name << " ==\n";
+  log << "scene " << s.name << ": " << describe(s.vessel) << "\n";
+}
+
+}  // namespace
+
+SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
+  std::ostream null_stream(nullptr);
+  std::ostream& log = o.log ? *o.log : null_stream;
+  Stopwatch total;
+  log << "scene " << s.name << ": " << describe(s.vessel) << "\n";
+  const std::unique_ptr<SceneReferences> refs = scene_meshes(s, o);
+  const std::size_t reference_steps = s.poisson_ratios.size() * (s.modes.count > 0 ? 2 : 1);
+  Progress progress(log, reference_steps + model_cases(s, o));
+  SceneResult result = run_models(s, *refs, o, progress, true, log);
   result.seconds = total.seconds();
   return result;
+}
+
+std::vector<SceneResult> run_scenes(const std::vector<Scene>& scenes, const HarnessOptions& o) {
+  std::ostream null_stream(nullptr);
+  std::ostream& log = o.log ? *o.log : null_stream;
+  std::vector<SceneResult> results;
+  if (o.jobs <= 1) {
+    for (std::size_t i = 0; i < scenes.size(); ++i) {
+      log << "== scene " << i + 1 << "/" << scenes.size() << ": " << scenes[i].name << " ==\n";
+      results.push_back(run_scene(scenes[i], o));
+    }
+    return results;
+  }
+  // The references first, in parallel (untimed), then each scene's models alone: their set-up
+  // and update times are measurements and must not share the cores.
+  std::vector<std::unique_ptr<SceneReferences>> refs;
+  for (const Scene& s : scenes) refs.push_back(scene_meshes(s, o));
+  solve_all_references(scenes, refs, o, log);
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    Stopwatch clock;
+    log_scene_header(log, scenes[i], i, scenes.size());
+    Progress progress(log, model_cases(scenes[i], o));
+    results.push_back(run_models(scenes[i], *refs[i], o, progress, false, log));
+    double solved = 0.0;
+    for (const auto& a : refs[i]->at_nu) solved += a.seconds;
+    results.back().seconds = clock.seconds() + solved;
+    refs[i].reset();  // its solvers and meshes are no longer needed
+  }
+  return results;
 }
 
 }  // namespace vessel

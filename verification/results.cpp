@@ -228,14 +228,7 @@ std::vector<SceneResult> run_and_write(const std::vector<Scene>& scenes,
                      "; expected a writable directory");
   }
   const double kernel = reference_kernel_seconds();
-  std::vector<SceneResult> results;
-  for (std::size_t i = 0; i < scenes.size(); ++i) {
-    if (options.log) {
-      *options.log << "== scene " << i + 1 << "/" << scenes.size() << ": " << scenes[i].name
-                   << " ==\n";
-    }
-    results.push_back(run_scene(scenes[i], options));
-  }
+  std::vector<SceneResult> results = run_scenes(scenes, options);
   write_results_json(output_dir / "results.json", results, command, kernel);
   write_results_csv(output_dir / "results.csv", results);
   write_summary_markdown(output_dir / "summary.md", results, command);

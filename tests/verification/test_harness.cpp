@@ -486,3 +486,74 @@ TEST(HarnessCache, ARepeatedRunReadsItsReferenceFromTheCacheAndGivesTheSameResul
   compare(uncached, 1e-12);
   EXPECT_EQ(log.str(), "");
 }
+
+TEST(HarnessJobs, ReferencesSolvedInParallelGiveTheSameResultsAsOneAtATime) {
+  // Two scenes on the same tube: the Lamé scene at two ν with natural frequencies, and a second
+  // scene whose fine problem equals the first's at ν = 0.3 (another model list): with a cache the
+  // parallel pass solves that problem once and the second case reads it.
+  const std::string head = std::string(kLame).substr(0, std::string(kLame).find("[[models]]"));
+  std::string lame = head + "[modes]\ncount = 2\n" +
+                     "[[models]]\nname = \"p1\"\nkind = \"fem\"\ndegree = 1\n" +
+                     "[[models]]\nname = \"volume_linear\"\nkind = \"volume_msm\"\n" +
+                     "stiffness = \"seed001\"\nsolver = \"linear\"\n";
+  lame.replace(lame.find("nu = 0.3"), 8, "nu = [0.3, 0.45]");
+  std::string other = head + "[[models]]\nname = \"surface_linear\"\nkind = \"surface_msm\"\n" +
+                      "stiffness = \"seed000\"\nsolver = \"linear\"\n";
+  other.replace(other.find("lame_test"), 9, "lame_other");
+  const std::vector<Scene> scenes{parse_scene(lame, "lame_modes_jobs.toml"),
+                                  parse_scene(other, "lame_other.toml")};
+  HarnessOptions serial;
+  const std::vector<SceneResult> one = run_scenes(scenes, serial);
+  test::TempDir dir;
+  std::ostringstream cache_log;
+  fem::SolutionCache cache(dir.path(), &cache_log);
+  HarnessOptions parallel;
+  parallel.jobs = 2;
+  parallel.solution_cache = &cache;
+  std::ostringstream log;
+  parallel.log = &log;
+  const std::vector<SceneResult> two = run_scenes(scenes, parallel);
+  // Three (scene, ν) cases, two distinct problems: the shared one is solved once.
+  EXPECT_EQ(cache.statistics().misses, 2);
+  EXPECT_EQ(cache.statistics().hits, 1);
+  EXPECT_NE(log.str().find("FEM references: 3 (scene, ν) cases of 2 scene(s), 2 at a time"),
+            std::string::npos)
+      << log.str();
+
+  // Fresh CHOLMOD solves agree to round-off, not bitwise (threaded BLAS): 1e-10 relative to the
+  // displacement (an error near zero differs by round-off of the displacement, not of itself).
+  auto near = [](double x, double y) { return std::abs(x - y) <= 1e-10 * std::abs(x); };
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t s = 0; s < one.size(); ++s) {
+    ASSERT_EQ(one[s].outcomes.size(), two[s].outcomes.size());
+    for (std::size_t i = 0; i < one[s].outcomes.size(); ++i) {
+      const ModelOutcome &a = one[s].outcomes[i], &b = two[s].outcomes[i];
+      EXPECT_EQ(a.model, b.model);
+      EXPECT_EQ(a.poisson_ratio, b.poisson_ratio);
+      EXPECT_EQ(a.magnitude, b.magnitude);
+      EXPECT_EQ(a.ok, b.ok) << a.failure << " / " << b.failure;
+      EXPECT_EQ(a.failure, b.failure);
+      if (!a.ok) continue;
+      EXPECT_PRED2(near, a.qoi_reference_mm, b.qoi_reference_mm);
+      EXPECT_PRED2(near, a.qoi_displacement_mm, b.qoi_displacement_mm);
+      EXPECT_NEAR(a.error.max_mm, b.error.max_mm, 1e-10 * a.qoi_reference_mm);
+      EXPECT_NEAR(a.error.relative_l2, b.error.relative_l2, 1e-10);
+    }
+    ASSERT_EQ(one[s].references.size(), two[s].references.size());
+    for (std::size_t k = 0; k < one[s].references.size(); ++k) {
+      EXPECT_EQ(one[s].references[k].dofs, two[s].references[k].dofs);
+      EXPECT_PRED2(near, one[s].references[k].max_abs_strain_unit,
+                   two[s].references[k].max_abs_strain_unit);
+    }
+    ASSERT_EQ(one[s].reference_modes.size(), two[s].reference_modes.size());
+    for (std::size_t k = 0; k < one[s].reference_modes.size(); ++k) {
+      const auto &fa = one[s].reference_modes[k].frequencies_hz,
+                 &fb = two[s].reference_modes[k].frequencies_hz;
+      ASSERT_EQ(fa.size(), fb.size());
+      for (std::size_t m = 0; m < fa.size(); ++m) {
+        EXPECT_NEAR(fa[m], fb[m], 1e-8 * fa[m]);  // Lanczos to its own tolerance
+      }
+    }
+  }
+  EXPECT_EQ(one[0].reference_modes.size(), 2u);  // one modal reference per ν
+}

@@ -10,6 +10,7 @@
 #include "meshes/errors.hpp"
 #include "reports/gate.hpp"
 #include "verification/cli/cache_options.hpp"
+#include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/harness.hpp"
 
@@ -27,6 +28,7 @@ struct GateOptions {
   std::filesystem::path scenes_dir = VESSELVERIFY_SCENES_DIR;
   std::filesystem::path output_dir = "gate-results";
   CacheOptions cache;
+  int jobs = 1;
   bool update_baseline = false;
   reports::GateTolerances tolerances;
   std::string command;
@@ -49,6 +51,7 @@ void gate(const GateOptions& o) {
     const auto solution_cache = o.cache.solution_cache(std::cout);
     h.solution_cache = solution_cache.get();
     h.log = &std::cout;
+    h.jobs = o.jobs;
     h.repeats = 3;  // medians: the gate compares times
     run_and_write(scenes, h, o.output_dir, o.command);
     std::cout << solution_cache->summary() << "\n";
@@ -118,6 +121,7 @@ void add_gate_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--output-dir", o->output_dir, "Where this run's results and gate.md go")
       ->capture_default_str();
   add_cache_options(*cmd, o->cache);
+  add_jobs_option(*cmd, o->jobs);
   cmd->add_option("--error-tolerance", o->tolerances.error_relative,
                   "Relative growth of a max or RMS error that fails the gate")
       ->check(CLI::Range(0.0, 10.0))

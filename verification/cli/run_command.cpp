@@ -4,6 +4,7 @@
 
 #include "meshes/errors.hpp"
 #include "verification/cli/cache_options.hpp"
+#include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/harness.hpp"
 
@@ -15,6 +16,7 @@ struct RunOptions {
   std::vector<std::string> scenes;
   std::filesystem::path output_dir = "results";
   CacheOptions cache;
+  int jobs = 1;
   bool quick = false;
   int repeats = 1;
   int updates = kRampUpdates;  ///< static and linear models: updates of the timed load ramp
@@ -61,6 +63,7 @@ void run(const RunOptions& o) {
   const auto solution_cache = o.cache.solution_cache(std::cout);
   h.solution_cache = solution_cache.get();
   h.log = &std::cout;
+  h.jobs = o.jobs;
   h.repeats = o.repeats;
   h.ramp_updates = o.updates;
   if (o.fields != "none") h.fields_dir = o.output_dir / "fields";
@@ -86,6 +89,7 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("scenes", o->scenes, "Scene files (TOML)")->required();
   cmd->add_option("--output-dir", o->output_dir, "Where results are written")->capture_default_str();
   add_cache_options(*cmd, o->cache);
+  add_jobs_option(*cmd, o->jobs);
   cmd->add_flag("--quick", o->quick,
                 "Coarse levels (models 0, reference 1) and the smallest and largest load only");
   cmd->add_option("--repeats", o->repeats, "Timed repeats per model solve (median reported)")
