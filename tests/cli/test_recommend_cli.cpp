@@ -92,3 +92,40 @@ TEST(RecommendCli, NamesACandidateThatMeetsTheBudgetWithItsEvidence) {
   EXPECT_NE(report.find("## Model recommendation: small_contact"), std::string::npos);
   EXPECT_NE(report.find("**Recommended: `" + best + "`**"), std::string::npos) << report;
 }
+
+TEST(RecommendCli, SeveralRatesRunTheCandidatesOnceAndJudgeThemAtEachRate) {
+  TempDir dir;
+  write_text(dir / "scene.toml", kScene);
+  const auto out = dir / "rec";
+  const CommandResult r =
+      vv("recommend --quick --repeats 1 --roi-radii 0.004 --rate 30,1000 --output-dir " +
+         out.string() + " " + (dir / "scene.toml").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::size_t runs = 0;  // "recommend small_contact: N candidate models ..." once per harness run
+  for (std::size_t at = r.output.find("recommend small_contact:"); at != std::string::npos;
+       at = r.output.find("recommend small_contact:", at + 1)) {
+    ++runs;
+  }
+  EXPECT_EQ(runs, 1u) << r.output;
+  const nlohmann::json slow = nlohmann::json::parse(read_text(out / "30hz" / "recommend.json"));
+  const nlohmann::json fast = nlohmann::json::parse(read_text(out / "1000hz" / "recommend.json"));
+  EXPECT_DOUBLE_EQ(slow["budget"]["seconds_per_update"].get<double>(), 1.0 / 30.0);
+  EXPECT_DOUBLE_EQ(fast["budget"]["seconds_per_update"].get<double>(), 1e-3);
+  ASSERT_EQ(slow["candidates"].size(), fast["candidates"].size());
+  for (std::size_t i = 0; i < slow["candidates"].size(); ++i) {
+    const auto &a = slow["candidates"][i], &b = fast["candidates"][i];
+    EXPECT_EQ(a["name"], b["name"]);
+    if (!a["ok"].get<bool>() || a["error"].is_null()) continue;
+    EXPECT_EQ(a["update_seconds"], b["update_seconds"]);  // the same measurement
+    EXPECT_EQ(a["error"], b["error"]);
+    // At 1 kHz every candidate slower than 1 ms is too slow, whatever it was at 30 Hz.
+    if (b["update_seconds"].get<double>() > 1e-3) {
+      EXPECT_NE(b["verdict"].get<std::string>().find("too slow"), std::string::npos) << b.dump();
+    }
+  }
+  // Each rate's directory holds the run's results beside its recommend.json, for the report.
+  const CommandResult rep = vv("report " + (out / "1000hz" / "results.json").string() +
+                               " --recommend " + (out / "1000hz" / "recommend.json").string());
+  ASSERT_EQ(rep.exit_code, 0) << rep.output;
+  EXPECT_NE(read_text(out / "1000hz" / "report.md").find("1000 Hz"), std::string::npos);
+}

@@ -2,7 +2,9 @@
 #include <iomanip>
 #include <iostream>
 
+#include "reports/document.hpp"
 #include "verification/cli/cache_options.hpp"
+#include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/studies/recommend.hpp"
 
@@ -10,13 +12,16 @@ namespace vessel::cli {
 
 namespace {
 
+using reports::significant;
+
 struct Options {
   std::string scene;
-  double rate_hz = 0.0;
+  std::vector<double> rates_hz;  ///< several: one recommendation per rate, in <output-dir>/<rate>hz
   double time_budget_s = 0.0;
   double tolerance = 0.0;
   std::filesystem::path output_dir = "recommend";
   CacheOptions cache;
+  int jobs = 1;
   bool quick = false;
   int repeats = 3;
   int updates = kRampUpdates;  ///< static and linear models: updates of the timed load ramp
@@ -26,36 +31,8 @@ struct Options {
   std::string command;
 };
 
-void run(const Options& o) {
-  Scene s = read_scene(o.scene);
-  if (!s.budget.stated) {
-    // No [budget]: the defaults of issue #7 (contact point, the scene's tolerance, 30 Hz visual).
-    s.budget.stated = true;
-    s.budget.tolerance = s.tolerances.max_error_mm;
-    if (o.rate_hz == 0.0 && o.time_budget_s == 0.0) {
-      s.budget.rate_hz = 30.0;
-      std::cout << "note: " << s.name << " states no [budget]; using the contact point's error ≤ "
-                << s.budget.tolerance << " mm at 30 Hz\n";
-    }
-  }
-  if (o.rate_hz > 0.0) {
-    s.budget.rate_hz = o.rate_hz;
-    s.budget.time_budget_s = 0.0;
-  }
-  if (o.time_budget_s > 0.0) s.budget.time_budget_s = o.time_budget_s;
-  if (o.tolerance > 0.0) s.budget.tolerance = o.tolerance;
-  RecommendOptions r;
-  r.quick = o.quick;
-  r.levels = o.levels;
-  r.reference_level = o.reference_level;
-  r.roi_radii = o.roi_radii;
-  r.harness.cache_dir = o.cache.mesh_dir();
-  const auto solution_cache = o.cache.solution_cache(std::cout);
-  r.harness.solution_cache = solution_cache.get();
-  r.harness.log = &std::cout;
-  r.harness.repeats = o.repeats;
-  r.harness.ramp_updates = o.updates;
-  const Recommendation rec = recommend(s, r, o.output_dir, o.command);
+/// The answer on the terminal: the recommended (or closest) candidate and the whole-vessel one.
+void print_recommendation(const Recommendation& rec, const std::filesystem::path& dir) {
   const Selection& sel = rec.selection;
   std::cout << std::defaultfloat << std::setprecision(3);  // the progress log may have changed it
   const char* unit = budget_unit(rec.scene.budget.quantity);
@@ -79,8 +56,69 @@ void run(const Options& o) {
   } else {
     std::cout << "no whole-vessel candidate (without a region of interest) meets the budget\n";
   }
-  std::cout << "wrote " << (o.output_dir / "recommend.md").string()
+  std::cout << "wrote " << (dir / "recommend.md").string()
             << ", recommend.json and the candidates' results.json\n";
+}
+
+/// Where one rate's recommendation goes: the output directory, or with several rates its
+/// <rate>hz subdirectory.
+std::filesystem::path rate_dir(const Options& o, double rate_hz) {
+  if (o.rates_hz.size() <= 1) return o.output_dir;
+  return o.output_dir / (significant(rate_hz, 6) + "hz");
+}
+
+void run(const Options& o) {
+  Scene s = read_scene(o.scene);
+  if (!s.budget.stated) {
+    // No [budget]: the defaults of issue #7 (contact point, the scene's tolerance, 30 Hz visual).
+    s.budget.stated = true;
+    s.budget.tolerance = s.tolerances.max_error_mm;
+    if (o.rates_hz.empty() && o.time_budget_s == 0.0) {
+      s.budget.rate_hz = 30.0;
+      std::cout << "note: " << s.name << " states no [budget]; using the contact point's error ≤ "
+                << s.budget.tolerance << " mm at 30 Hz\n";
+    }
+  }
+  if (!o.rates_hz.empty()) {
+    s.budget.rate_hz = o.rates_hz.front();
+    s.budget.time_budget_s = 0.0;
+  }
+  if (o.time_budget_s > 0.0) s.budget.time_budget_s = o.time_budget_s;
+  if (o.tolerance > 0.0) s.budget.tolerance = o.tolerance;
+  RecommendOptions r;
+  r.quick = o.quick;
+  r.levels = o.levels;
+  r.reference_level = o.reference_level;
+  r.roi_radii = o.roi_radii;
+  r.harness.cache_dir = o.cache.mesh_dir();
+  const auto solution_cache = o.cache.solution_cache(std::cout);
+  r.harness.solution_cache = solution_cache.get();
+  r.harness.log = &std::cout;
+  r.harness.jobs = o.jobs;
+  r.harness.repeats = o.repeats;
+  r.harness.ramp_updates = o.updates;
+  const Recommendation first = recommend(s, r, rate_dir(o, s.budget.rate_hz), o.command);
+  print_recommendation(first, rate_dir(o, s.budget.rate_hz));
+  for (std::size_t k = 1; k < o.rates_hz.size(); ++k) {
+    const double rate = o.rates_hz[k];
+    std::cout << "\n== " << significant(rate, 6) << " Hz ==\n";
+    if (rate_independent(first)) {
+      // Static and linear candidates cost the same per update at any rate: judged again, not run.
+      const Recommendation rec = rejudged(first, rate);
+      const std::filesystem::path dir = rate_dir(o, rate);
+      std::filesystem::create_directories(dir);
+      for (const char* file : {"results.json", "results.csv", "summary.md"}) {  // the same run's
+        std::filesystem::copy_file(rate_dir(o, s.budget.rate_hz) / file, dir / file,
+                                   std::filesystem::copy_options::overwrite_existing);
+      }
+      write_recommendation(rec, dir, o.command);
+      print_recommendation(rec, rate_dir(o, rate));
+    } else {
+      Scene at_rate = s;
+      at_rate.budget.rate_hz = rate;
+      print_recommendation(recommend(at_rate, r, rate_dir(o, rate), o.command), rate_dir(o, rate));
+    }
+  }
   std::cout << solution_cache->summary() << "\n";
 }
 
@@ -101,8 +139,11 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
       "  vesselverify recommend verification/scenes/contact_straight.toml --rate 1000\n"
       "  vesselverify recommend --quick --time-budget 0.005 --tolerance 0.05 SCENE");
   cmd->add_option("scene", o->scene, "Scene file (TOML)")->required()->check(CLI::ExistingFile);
-  auto* rate = cmd->add_option("--rate", o->rate_hz,
-                               "Update rate, Hz (30 visual, 1000 haptic); replaces the scene's")
+  auto* rate = cmd->add_option("--rate", o->rates_hz,
+                               "Update rate, Hz (30 visual, 1000 haptic); replaces the scene's. "
+                               "Several (--rate 30,1000): one recommendation per rate in "
+                               "<output-dir>/<rate>hz, the candidates run once (static scenes)")
+                   ->delimiter(',')
                    ->check(CLI::PositiveNumber);
   cmd->add_option("--time-budget", o->time_budget_s,
                   "Compute time allowed per update, s; replaces the scene's")
@@ -113,6 +154,7 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--output-dir", o->output_dir, "Where the outputs go")->capture_default_str();
   add_cache_options(*cmd, o->cache);
+  add_jobs_option(*cmd, o->jobs);
   cmd->add_flag("--quick", o->quick,
                 "Candidates at level 0 only (reference at level <= 1), ROI radii 4 and 8 mm");
   cmd->add_option("--repeats", o->repeats, "Timed repeats per solve (median)")

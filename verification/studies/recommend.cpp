@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
@@ -363,11 +364,35 @@ Recommendation recommend(const Scene& scene, const RecommendOptions& o,
   rec.candidates = collect_candidates(rec.result);
   rec.selection = select_model(rec.candidates, s.budget.tolerance, s.budget.seconds_per_update(),
                                budget_unit(s.budget.quantity));
+  write_recommendation(rec, output_dir, command);
+  return rec;
+}
+
+bool rate_independent(const Recommendation& rec) {
+  return std::none_of(rec.scene.models.begin(), rec.scene.models.end(),
+                      [](const ModelSpec& m) { return is_integrator(m); });
+}
+
+Recommendation rejudged(const Recommendation& rec, double rate_hz) {
+  if (!rate_independent(rec)) {
+    throw std::logic_error("rejudged: " + rec.scene.name +
+                           " has integrator candidates, whose time per update depends on the rate");
+  }
+  Recommendation out = rec;
+  out.scene.budget.rate_hz = rate_hz;
+  out.scene.budget.time_budget_s = 0.0;
+  const Budget& b = out.scene.budget;
+  out.selection =
+      select_model(out.candidates, b.tolerance, b.seconds_per_update(), budget_unit(b.quantity));
+  return out;
+}
+
+void write_recommendation(const Recommendation& rec, const std::filesystem::path& output_dir,
+                          const std::string& command) {
   write_file_atomically(output_dir / "recommend.md",
                         [&](std::ostream& out) { out << recommendation_markdown(rec, command); });
   write_file_atomically(output_dir / "recommend.json",
                         [&](std::ostream& out) { out << recommendation_json(rec, command); });
-  return rec;
 }
 
 namespace {

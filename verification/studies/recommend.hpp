@@ -102,6 +102,18 @@ struct Recommendation {
 Recommendation recommend(const Scene& scene, const RecommendOptions& options,
                          const std::filesystem::path& output_dir, const std::string& command);
 
+/// True when every candidate's time per update is the same at any rate: no integrator candidates
+/// (static and linear models are timed per update; an integrator's update is ⌈period/dt⌉ steps).
+bool rate_independent(const Recommendation& r);
+
+/// The same candidates judged against another rate (time per update 1/rate_hz), without running
+/// them again. std::logic_error unless rate_independent(r).
+Recommendation rejudged(const Recommendation& r, double rate_hz);
+
+/// recommend.md and recommend.json into `output_dir`.
+void write_recommendation(const Recommendation& r, const std::filesystem::path& output_dir,
+                          const std::string& command);
+
 /// The Markdown section "## Model recommendation: <scene>" with the budget, the answer, and the
 /// evidence table (every candidate's error and time, Pareto front, verdict and reason).
 std::string recommendation_markdown(const Recommendation& r, const std::string& command);

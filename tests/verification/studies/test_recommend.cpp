@@ -284,3 +284,36 @@ TEST(Candidates, IncludeTheScenesCalibratedModels) {
   }
   EXPECT_EQ(calibrated, 2);
 }
+
+TEST(Rejudged, TheSameCandidatesAtAnotherRateWithoutRunningThemAgain) {
+  // Judged at 30 Hz (33 ms) the accurate 20 ms model wins; at 1 kHz (1 ms) only the 0.5 ms one
+  // is fast enough, and it is too inaccurate: none meets, the closest is named.
+  Recommendation rec;
+  rec.scene.budget.stated = true;
+  rec.scene.budget.tolerance = 0.1;
+  rec.scene.budget.rate_hz = 30.0;
+  ModelSpec linear;
+  linear.kind = ModelKind::volume_msm;
+  linear.solver = msm::parse_solver("linear");
+  rec.scene.models = {linear};
+  rec.candidates = {candidate("accurate", 0.05, 0.020), candidate("fast", 0.3, 0.0005)};
+  rec.selection = select_model(rec.candidates, 0.1, rec.scene.budget.seconds_per_update());
+  ASSERT_TRUE(rec.selection.recommended.has_value());
+  EXPECT_EQ(*rec.selection.recommended, 0u);
+  ASSERT_TRUE(rate_independent(rec));
+
+  const Recommendation at_1khz = rejudged(rec, 1000.0);
+  EXPECT_EQ(at_1khz.scene.budget.rate_hz, 1000.0);
+  EXPECT_DOUBLE_EQ(at_1khz.scene.budget.seconds_per_update(), 1e-3);
+  EXPECT_FALSE(at_1khz.selection.recommended.has_value());
+  EXPECT_EQ(at_1khz.selection.verdicts[0], Verdict::too_slow);
+  EXPECT_EQ(at_1khz.selection.verdicts[1], Verdict::too_inaccurate);
+  EXPECT_EQ(at_1khz.candidates.size(), rec.candidates.size());  // the same evidence
+
+  // An integrator's update is ⌈period/dt⌉ steps: its time depends on the rate, so no re-judging.
+  ModelSpec integrator = linear;
+  integrator.solver = msm::parse_solver("verlet");
+  rec.scene.models.push_back(integrator);
+  EXPECT_FALSE(rate_independent(rec));
+  EXPECT_THROW((void)rejudged(rec, 1000.0), std::logic_error);
+}
