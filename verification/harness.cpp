@@ -328,15 +328,21 @@ void run_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
   }
 }
 
-/// The FEM transient next to a dynamic model's history. The model's point damping c (force −c v
+/// The FEM transient's damping beside a dynamic model: the model's point damping c (force −c v
 /// per node, seed 000 eq. 3.3) becomes mass-proportional damping α = c / m̄ with m̄ the model's
 /// mean nodal mass: exact for uniform masses, an average otherwise.
+double transient_mass_damping(const ModelSpec& spec, const msm::Problem& problem) {
+  const double mean_mass = problem.mass.sum() / static_cast<double>(problem.mass.size());
+  return spec.damping > 0.0 ? spec.damping / mean_mass : 0.0;
+}
+
+/// The FEM transient next to a dynamic model's history (transient_at: run once per probe, time
+/// and damping).
 void add_reference_history(History& h, const ReferenceSolvers& ref, const Vec3& probe,
                            const ModelSpec& spec, const msm::Problem& problem, double magnitude) {
   h.steps = spec.solver.steps;
   h.simulated_s = spec.solver.dt * static_cast<double>(spec.solver.steps);
-  const double mean_mass = problem.mass.sum() / static_cast<double>(problem.mass.size());
-  h.mass_damping = spec.damping > 0.0 ? spec.damping / mean_mass : 0.0;
+  h.mass_damping = transient_mass_damping(spec, problem);
   const auto& [t, u] = transient_at(ref, probe, h.simulated_s, h.mass_damping);
   h.reference_mm.clear();
   h.max_error_mm = 0.0;
@@ -784,6 +790,32 @@ void solve_modal_reference_at(const Scene& s, SceneReferences& r, std::size_t k)
   r.at_nu[k].seconds += clock.seconds();
 }
 
+/// The FEM transients the scene's dynamic models at its k-th ν will be compared with (each model's
+/// probe node and damping, as add_reference_history asks for them), run now so that the models'
+/// pass finds them in ReferenceSolvers::transients. Models on a region of interest or with an
+/// automatic time step are left to the models' pass.
+void run_reference_transients_at(const Scene& s, SceneReferences& r, std::size_t k) {
+  const double nu = s.poisson_ratios[k];
+  const Vec3 qoi = qoi_point(s);
+  for (const auto& [level, mesh] : r.model_meshes) {
+    for (const ModelSpec& spec : s.models) {
+      if (spec.kind == ModelKind::fem || !spec.solver.is_dynamic() || spec.roi_radius > 0.0 ||
+          spec.solver.dt <= 0.0 || (spec.volume_term && (nu < 0.25 || nu >= 0.5))) {
+        continue;
+      }
+      VesselParams vessel = s.vessel;
+      vessel.level = level;
+      const msm::BuiltNetwork built = scene_network(s, spec, mesh, vessel, nu);
+      const auto model = msm::make_model(built, spec.damping);
+      const msm::Problem at_rest = msm_problem(s, *model, built, mesh, 0.0);
+      const Vec3 probe = built.network.nodes[nearest_node(built.network.nodes, qoi)];
+      (void)transient_at(r.at_nu[k].ref, probe,
+                         spec.solver.dt * static_cast<double>(spec.solver.steps),
+                         transient_mass_damping(spec, at_rest));
+    }
+  }
+}
+
 void log_modal_failure(std::ostream& log, const SceneReferences::AtNu& a) {
   if (a.modes && !a.modes->ok) log << "      modal reference FAILED: " << a.modes->failure << "\n";
 }
@@ -912,10 +944,16 @@ void solve_all_references(const std::vector<Scene>& scenes,
         const Scene& s = scenes[i];
         solve_reference_at(s, *refs[i], k, o);
         solve_modal_reference_at(s, *refs[i], k);
+        {
+          Stopwatch transients;
+          run_reference_transients_at(s, *refs[i], k);
+          refs[i]->at_nu[k].seconds += transients.seconds();
+        }
         const std::lock_guard lock(log_mutex);
         log << "  [" << ++finished << "/" << cases.size() << "] " << s.name << ": "
             << reference_label(s, s.poisson_ratios[k])
-            << (refs[i]->modal_reference_mesh ? " and its modes" : "") << " in "
+            << (refs[i]->modal_reference_mesh ? ", its modes" : "")
+            << (refs[i]->at_nu[k].ref.transients.empty() ? "" : ", its FEM transients") << " in "
             << std::setprecision(3) << refs[i]->at_nu[k].seconds << " s (elapsed "
             << clock.seconds() << " s)\n";
         log_modal_failure(log, refs[i]->at_nu[k]);

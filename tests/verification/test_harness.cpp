@@ -487,21 +487,12 @@ TEST(HarnessCache, ARepeatedRunReadsItsReferenceFromTheCacheAndGivesTheSameResul
   EXPECT_EQ(log.str(), "");
 }
 
-TEST(HarnessJobs, ReferencesSolvedInParallelGiveTheSameResultsAsOneAtATime) {
-  // Two scenes on the same tube: the Lamé scene at two ν with natural frequencies, and a second
-  // scene whose fine problem equals the first's at ν = 0.3 (another model list): with a cache the
-  // parallel pass solves that problem once and the second case reads it.
-  const std::string head = std::string(kLame).substr(0, std::string(kLame).find("[[models]]"));
-  std::string lame = head + "[modes]\ncount = 2\n" +
-                     "[[models]]\nname = \"p1\"\nkind = \"fem\"\ndegree = 1\n" +
-                     "[[models]]\nname = \"volume_linear\"\nkind = \"volume_msm\"\n" +
-                     "stiffness = \"seed001\"\nsolver = \"linear\"\n";
-  lame.replace(lame.find("nu = 0.3"), 8, "nu = [0.3, 0.45]");
-  std::string other = head + "[[models]]\nname = \"surface_linear\"\nkind = \"surface_msm\"\n" +
-                      "stiffness = \"seed000\"\nsolver = \"linear\"\n";
-  other.replace(other.find("lame_test"), 9, "lame_other");
-  const std::vector<Scene> scenes{parse_scene(lame, "lame_modes_jobs.toml"),
-                                  parse_scene(other, "lame_other.toml")};
+namespace {
+
+/// run_scenes with --jobs 1 (no cache) and --jobs 2 (a fresh cache) give the same results, the
+/// parallel run's cache counts `misses` and `hits`, and its log contains `expected_log`.
+void expect_same_results_serial_and_parallel(const std::vector<Scene>& scenes, int misses,
+                                             int hits, const std::string& expected_log) {
   HarnessOptions serial;
   const std::vector<SceneResult> one = run_scenes(scenes, serial);
   test::TempDir dir;
@@ -513,12 +504,9 @@ TEST(HarnessJobs, ReferencesSolvedInParallelGiveTheSameResultsAsOneAtATime) {
   std::ostringstream log;
   parallel.log = &log;
   const std::vector<SceneResult> two = run_scenes(scenes, parallel);
-  // Three (scene, ν) cases, two distinct problems: the shared one is solved once.
-  EXPECT_EQ(cache.statistics().misses, 2);
-  EXPECT_EQ(cache.statistics().hits, 1);
-  EXPECT_NE(log.str().find("FEM references: 3 (scene, ν) cases of 2 scene(s), 2 at a time"),
-            std::string::npos)
-      << log.str();
+  EXPECT_EQ(cache.statistics().misses, misses);
+  EXPECT_EQ(cache.statistics().hits, hits);
+  EXPECT_NE(log.str().find(expected_log), std::string::npos) << log.str();
 
   // Fresh CHOLMOD solves agree to round-off, not bitwise (threaded BLAS): 1e-10 relative to the
   // displacement (an error near zero differs by round-off of the displacement, not of itself).
@@ -538,6 +526,11 @@ TEST(HarnessJobs, ReferencesSolvedInParallelGiveTheSameResultsAsOneAtATime) {
       EXPECT_PRED2(near, a.qoi_displacement_mm, b.qoi_displacement_mm);
       EXPECT_NEAR(a.error.max_mm, b.error.max_mm, 1e-10 * a.qoi_reference_mm);
       EXPECT_NEAR(a.error.relative_l2, b.error.relative_l2, 1e-10);
+      ASSERT_EQ(a.history.reference_mm.size(), b.history.reference_mm.size());
+      for (std::size_t h = 0; h < a.history.reference_mm.size(); ++h) {
+        EXPECT_NEAR(a.history.reference_mm[h], b.history.reference_mm[h],
+                    1e-10 * a.qoi_reference_mm);
+      }
     }
     ASSERT_EQ(one[s].references.size(), two[s].references.size());
     for (std::size_t k = 0; k < one[s].references.size(); ++k) {
@@ -555,5 +548,37 @@ TEST(HarnessJobs, ReferencesSolvedInParallelGiveTheSameResultsAsOneAtATime) {
       }
     }
   }
-  EXPECT_EQ(one[0].reference_modes.size(), 2u);  // one modal reference per ν
+}
+
+/// The Lamé tube at ν = 0.3 and 0.45, optionally with natural frequencies, and a second scene
+/// whose fine problem equals the first's at ν = 0.3 (another model list).
+std::vector<Scene> two_lame_scenes(bool modes) {
+  const std::string head = std::string(kLame).substr(0, std::string(kLame).find("[[models]]"));
+  std::string lame = head + (modes ? "[modes]\ncount = 2\n" : "") +
+                     "[[models]]\nname = \"p1\"\nkind = \"fem\"\ndegree = 1\n" +
+                     "[[models]]\nname = \"volume_linear\"\nkind = \"volume_msm\"\n" +
+                     "stiffness = \"seed001\"\nsolver = \"linear\"\n";
+  lame.replace(lame.find("nu = 0.3"), 8, "nu = [0.3, 0.45]");
+  std::string other = head + "[[models]]\nname = \"surface_linear\"\nkind = \"surface_msm\"\n" +
+                      "stiffness = \"seed000\"\nsolver = \"linear\"\n";
+  other.replace(other.find("lame_test"), 9, "lame_other");
+  return {parse_scene(lame, "lame_jobs.toml"), parse_scene(other, "lame_other.toml")};
+}
+
+}  // namespace
+
+TEST(HarnessJobs, ReferencesSolvedInParallelGiveTheSameResultsAsOneAtATime) {
+  // Three (scene, ν) cases, two distinct problems: the shared one is solved once, and the other
+  // case reads it from the cache.
+  expect_same_results_serial_and_parallel(
+      two_lame_scenes(false), 2, 1, "FEM references: 3 (scene, ν) cases of 2 scene(s), 2 at a time");
+}
+
+TEST(HarnessJobsSlow, ModalReferencesAndFemTransientsInParallelGiveTheSameResults) {
+  // With [modes] (a modal reference per ν) and a dynamic scene, whose FEM transient is run in the
+  // references' pass: four cases, three distinct problems and one transient stored.
+  std::vector<Scene> scenes = two_lame_scenes(true);
+  scenes.push_back(parse_scene(kDynamic, "dynamic_jobs.toml"));
+  expect_same_results_serial_and_parallel(
+      scenes, 4, 1, "dynamic_test: reference P2 (level 0, ν = 0.300000), its FEM transients");
 }
