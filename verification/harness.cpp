@@ -33,6 +33,7 @@
 #include "reports/representative_load.hpp"
 #include "verification/memory.hpp"
 #include "verification/modal.hpp"
+#include "verification/parallel.hpp"
 #include "verification/progress.hpp"
 #include "verification/scene_problems.hpp"
 #include "verification/timing.hpp"
@@ -873,30 +874,6 @@ SceneResult run_models(const Scene& s, SceneReferences& r, const HarnessOptions&
     }
   }
   return result;
-}
-
-/// Runs `task(i)` for i in [0, n) on `jobs` threads; rethrows the first exception after all have
-/// stopped (the others' tasks still finish).
-void parallel_for(std::size_t n, int jobs, const std::function<void(std::size_t)>& task) {
-  std::atomic<std::size_t> next{0};
-  std::mutex failure_mutex;
-  std::exception_ptr failure;
-  auto worker = [&] {
-    for (std::size_t i = next++; i < n; i = next++) {
-      try {
-        task(i);
-      } catch (...) {
-        const std::lock_guard lock(failure_mutex);
-        if (!failure) failure = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> threads;
-  const auto extra = static_cast<std::size_t>(std::max(0, jobs - 1));
-  for (std::size_t t = 0; t < std::min(extra, n); ++t) threads.emplace_back(worker);
-  worker();
-  for (std::thread& t : threads) t.join();
-  if (failure) std::rethrow_exception(failure);
 }
 
 /// Every scene's references, `o.jobs` solves at a time, each sparse factorisation with its share

@@ -121,7 +121,7 @@ void add_gate_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--output-dir", o->output_dir, "Where this run's results and gate.md go")
       ->capture_default_str();
   add_cache_options(*cmd, o->cache);
-  add_jobs_option(*cmd, o->jobs);
+  add_jobs_option(*cmd, o->jobs, kReferencesAtATime);
   cmd->add_option("--error-tolerance", o->tolerances.error_relative,
                   "Relative growth of a max or RMS error that fails the gate")
       ->check(CLI::Range(0.0, 10.0))

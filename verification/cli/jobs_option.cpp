@@ -7,11 +7,9 @@ namespace vessel::cli {
 
 int default_jobs() { return static_cast<int>(std::max(1U, std::thread::hardware_concurrency())); }
 
-void add_jobs_option(CLI::App& cmd, int& jobs) {
+void add_jobs_option(CLI::App& cmd, int& jobs, const std::string& what) {
   jobs = default_jobs();
-  cmd.add_option("--jobs,-j", jobs,
-                 "FEM references solved at a time, before the models (default: the core count). "
-                 "The models always run one at a time: their times are measurements")
+  cmd.add_option("--jobs,-j", jobs, what)
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
 }

@@ -1,14 +1,21 @@
 #pragma once
-/// --jobs of the commands that run scenes (run, recommend, gate): how many FEM references are
-/// solved at a time.
+/// --jobs of the commands that run scenes (run, recommend, gate: FEM references solved at a time)
+/// and of the stability study (rows of its critical-step table computed at a time).
 #include <CLI/CLI.hpp>
+#include <string>
 
 namespace vessel::cli {
 
 /// The machine's core count (at least 1): the default of --jobs.
 [[nodiscard]] int default_jobs();
 
-/// Adds --jobs N (N ≥ 1, default default_jobs()) writing into `jobs`.
-void add_jobs_option(CLI::App& cmd, int& jobs);
+/// Adds --jobs N (N ≥ 1, default default_jobs()) writing into `jobs`; `what` says what runs N at
+/// a time (the help text).
+void add_jobs_option(CLI::App& cmd, int& jobs, const std::string& what);
+
+/// The help of the scene-running commands' --jobs.
+inline constexpr const char* kReferencesAtATime =
+    "FEM references solved at a time, before the models (default: the core count). The models "
+    "always run one at a time: their times are measurements";
 
 }  // namespace vessel::cli

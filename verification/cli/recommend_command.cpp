@@ -154,7 +154,7 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--output-dir", o->output_dir, "Where the outputs go")->capture_default_str();
   add_cache_options(*cmd, o->cache);
-  add_jobs_option(*cmd, o->jobs);
+  add_jobs_option(*cmd, o->jobs, kReferencesAtATime);
   cmd->add_flag("--quick", o->quick,
                 "Candidates at level 0 only (reference at level <= 1), ROI radii 4 and 8 mm");
   cmd->add_option("--repeats", o->repeats, "Timed repeats per solve (median)")

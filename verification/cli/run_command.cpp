@@ -89,7 +89,7 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("scenes", o->scenes, "Scene files (TOML)")->required();
   cmd->add_option("--output-dir", o->output_dir, "Where results are written")->capture_default_str();
   add_cache_options(*cmd, o->cache);
-  add_jobs_option(*cmd, o->jobs);
+  add_jobs_option(*cmd, o->jobs, kReferencesAtATime);
   cmd->add_flag("--quick", o->quick,
                 "Coarse levels (models 0, reference 1) and the smallest and largest load only");
   cmd->add_option("--repeats", o->repeats, "Timed repeats per model solve (median reported)")

@@ -6,6 +6,7 @@
 
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
+#include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/studies/stability/stability.hpp"
 
@@ -25,6 +26,7 @@ struct StabilityCli {
   int max_level = -1;
   bool no_hard_cases = false;
   std::vector<std::string> only_cases;
+  int jobs = 1;
 };
 
 /// Fails early (before minutes of work) when the output directory cannot be written: creates it
@@ -72,6 +74,9 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--long-run-steps", o->long_run_steps,
                   "Steps of the long run (default 2e4 quick, 1e6 full)");
   cmd->add_option("--max-level", o->max_level, "Highest mesh level of the step table");
+  add_jobs_option(*cmd, o->jobs,
+                  "Rows of the critical-step table computed at a time, one (level, model) per "
+                  "thread (default: the core count); the hard cases run one after another");
   cmd->add_flag("--no-hard-cases", o->no_hard_cases, "Only the critical-step table");
   cmd->add_option("--hard-case", o->only_cases,
                   "Run only this hard case (repeatable): poisson, youngs_modulus, sliver, "
@@ -95,6 +100,7 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
     so.max_level = o->max_level;
     so.hard_cases = !o->no_hard_cases;
     so.only_cases = o->only_cases;
+    so.jobs = o->jobs;
     const StabilityReport report = run_stability(so);
     write_stability(o->output_dir, report);
     std::cout << "wrote " << (o->output_dir / "stability.json").string() << " and stability.md\n";

@@ -80,3 +80,29 @@ TEST(Stability, WritesBothFilesAtomicallyAndRefusesAnUnwritableDirectory) {
   test::write_text(dir / "file", "x");
   EXPECT_THROW(write_stability(dir / "file" / "sub", sample_report()), InputError);
 }
+
+TEST(Stability, TheStepTableIsTheSameComputedOneRowAtATimeOrInParallel) {
+  // Level 0 only, short trials, both runs on the same mesh (the cache's: gmsh's parallel HXT
+  // mesher does not give the same mesh twice). The search is deterministic, so the table computed
+  // on two threads equals the one computed on one, row for row.
+  test::TempDir cache;
+  StabilityOptions o;
+  o.cache_dir = cache.path();
+  o.hard_cases = false;
+  o.max_level = 0;
+  o.trial_steps = 50;
+  o.jobs = 1;
+  const StabilityReport one = run_stability(o);
+  o.jobs = 2;
+  const StabilityReport two = run_stability(o);
+  ASSERT_EQ(one.rows.size(), 12u);  // 3 models × 4 integrator configurations
+  ASSERT_EQ(two.rows.size(), one.rows.size());
+  for (std::size_t i = 0; i < one.rows.size(); ++i) {
+    EXPECT_EQ(one.rows[i].model, two.rows[i].model);
+    EXPECT_EQ(one.rows[i].integrator, two.rows[i].integrator);
+    EXPECT_EQ(one.rows[i].zeta, two.rows[i].zeta);
+    EXPECT_EQ(one.rows[i].predicted_dt, two.rows[i].predicted_dt) << i;
+    EXPECT_EQ(one.rows[i].found_dt, two.rows[i].found_dt) << i;
+    EXPECT_EQ(one.rows[i].trials, two.rows[i].trials) << i;
+  }
+}

@@ -31,6 +31,9 @@ struct StabilityOptions {
   long long long_run_steps = 0;
   int max_level = -1;
   bool hard_cases = true;  ///< false: only the critical-step table
+  /// Rows of the critical-step table computed at a time (each (level, model) on its own thread);
+  /// the hard cases run one after another.
+  int jobs = 1;
   /// Ids of the hard cases to run (poisson, youngs_modulus, sliver, refined_patch,
   /// inverting_load, long_run, tight_bend, zero_length); empty: all of them.
   std::vector<std::string> only_cases;

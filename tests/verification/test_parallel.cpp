@@ -1,0 +1,54 @@
+// parallel_for: every index runs exactly once on the threads asked for, and a failing task's
+// exception reaches the caller after the other tasks have run.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <mutex>
+#include <set>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "verification/parallel.hpp"
+
+using namespace vessel;
+
+TEST(ParallelFor, EveryIndexRunsExactlyOnce) {
+  for (const int jobs : {1, 2, 5}) {
+    for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{3}, std::size_t{100}}) {
+      std::vector<std::atomic<int>> runs(n);
+      parallel_for(n, jobs, [&](std::size_t i) { ++runs[i]; });
+      for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(runs[i].load(), 1) << jobs << " " << i;
+    }
+  }
+}
+
+TEST(ParallelFor, UsesAsManyThreadsAsJobsAndOneWithOneJob) {
+  std::mutex m;
+  std::set<std::thread::id> ids;
+  std::atomic<int> waiting{0};
+  // Each of the first two tasks waits until both have started: only two threads can finish it.
+  parallel_for(2, 2, [&](std::size_t) {
+    {
+      const std::lock_guard lock(m);
+      ids.insert(std::this_thread::get_id());
+    }
+    ++waiting;
+    while (waiting.load() < 2) std::this_thread::yield();
+  });
+  EXPECT_EQ(ids.size(), 2u);
+  ids.clear();
+  parallel_for(10, 1, [&](std::size_t) { ids.insert(std::this_thread::get_id()); });
+  EXPECT_EQ(ids, std::set<std::thread::id>{std::this_thread::get_id()});
+}
+
+TEST(ParallelFor, TheFirstFailureIsRethrownAfterTheOthersRan) {
+  std::atomic<int> ran{0};
+  EXPECT_THROW(parallel_for(20, 2,
+                            [&](std::size_t i) {
+                              ++ran;
+                              if (i == 3) throw std::runtime_error("task 3 failed");
+                            }),
+               std::runtime_error);
+  EXPECT_EQ(ran.load(), 20);
+}
