@@ -114,6 +114,7 @@ nlohmann::json scene_json(const SceneResult& r) {
                      {"solve_seconds", o.solve_seconds},
                      {"memory_mib", o.memory_mib}};
     if (o.roi_radius > 0.0) j["roi_radius_mm"] = o.roi_radius * 1e3;
+    if (!o.timing_source.empty()) j["timing_source"] = o.timing_source;
     if (o.updates > 0) {
       j["updates"] = {{"count", o.updates},
                       {"iterations_per_update", o.iterations_per_update},
