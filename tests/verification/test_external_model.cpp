@@ -417,3 +417,45 @@ with open(os.path.join(os.path.dirname(sys.argv[1]), "displacements.csv"), "w") 
   }
   EXPECT_EQ(failures, 10);
 }
+
+TEST(ExternalHarness, DynamicModelsHistoryIsComparedWithTheFemTransient) {
+  test::TempDir dir;
+  // At rest for the whole run: its history's error is the FEM transient's own |u(t)| at the QoI,
+  // and its final state's error the static reference's.
+  test::write_text(dir / "still.py", R"(import json, os, sys
+m = json.load(open(sys.argv[1]))
+d = os.path.dirname(sys.argv[1])
+assert m["analysis"]["type"] == "dynamic"
+with open(os.path.join(d, "displacements.csv"), "w") as f:
+    f.write("node,ux,uy,uz\n")
+    for i in range(m["problem"]["nodes"]):
+        f.write("%d,0,0,0\n" % i)
+with open(os.path.join(d, "history.csv"), "w") as f:
+    f.write("time_s,ux,uy,uz\n")
+    for k in range(m["analysis"]["steps"] + 1):
+        f.write("%r,0,0,0\n" % (k * m["analysis"]["dt_s"]))
+)");
+  const char* load = R"([load]
+type = "contact"
+magnitudes = [1.0e-4]
+point = [3.0e-3, 0.0, 5.0e-3]
+)";
+  test::write_text(dir / "scene.toml",
+                   scene_text(load, external_model("still", R"(["/usr/bin/python3", "still.py"])",
+                                                   "dt = 1e-4\nsteps = 20\n")));
+  HarnessOptions o;
+  o.exchange_dir = dir / "exchange";
+  const SceneResult r = run_scene(read_scene(dir / "scene.toml"), o);
+  ASSERT_EQ(r.outcomes.size(), 1u);
+  const ModelOutcome& out = r.outcomes[0];
+  ASSERT_TRUE(out.ok) << out.failure;
+  EXPECT_EQ(out.history.steps, 20);
+  EXPECT_NEAR(out.history.simulated_s, 2e-3, 1e-15);
+  ASSERT_EQ(out.history.time_s.size(), 21u);
+  double peak = 0.0;
+  for (const double v : out.history.reference_mm) peak = std::max(peak, v);
+  EXPECT_GT(peak, 0.0);  // the step load moves the wall within 2 ms
+  EXPECT_DOUBLE_EQ(out.history.max_error_mm, peak);
+  EXPECT_NEAR(out.error.relative_l2, 1.0, 1e-12);
+  EXPECT_GE(out.quantities.contact_point_mm, peak);  // the larger of history and final state
+}
