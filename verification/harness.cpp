@@ -573,7 +573,7 @@ History outside_history(const ExternalAnswer& a, const ReferenceSolvers& ref, co
   }
   ModelSpec as_run = spec;  // add_reference_history reads the run's dt and steps from the solver
   as_run.solver.dt = spec.external.dt;
-  as_run.solver.steps = static_cast<int>(spec.external.steps);
+  as_run.solver.steps = spec.external.steps;
   as_run.damping = 0.0;
   add_reference_history(h, ref, probe, as_run, problem, magnitude);
   return h;
