@@ -72,6 +72,16 @@ std::string load_text(double magnitude, const SceneRows& s) {
   return significant(magnitude) + " " + s.load_unit;
 }
 
+/// A solve time, marked for models outside the suite with whose time it is: the simulator's own
+/// (its timing.json) or its whole process's wall time (start-up and file I/O included).
+std::string solve_time_text(const OutcomeRow& o) {
+  std::string t = significant(o.solve_seconds);
+  if (o.timing_source == "simulator") t += " (simulator's own)";
+  if (o.timing_source == "process") t += " (process wall time)";
+  if (o.timing_source == "none") t += " (not timed)";
+  return t;
+}
+
 std::string reference_uncertainty_text(const OutcomeRow& o) {
   return o.reference_uncertainty_max_mm ? significant(*o.reference_uncertainty_max_mm) : "–";
 }
@@ -357,7 +367,7 @@ Table statistics_table(const SceneRows& s) {
     for (const std::string& v :
          {significant(o.max_mm), significant(o.mean_mm), significant(o.stddev_mm), significant(o.rms_mm), significant(o.relative_l2),
           reference_uncertainty_text(o), significant(o.qoi_mm) + " / " + significant(o.qoi_reference_mm),
-          significant(o.max_strain, 2), significant(o.solve_seconds), significant(o.setup_seconds), significant(o.memory_mib, 3),
+          significant(o.max_strain, 2), solve_time_text(o), significant(o.setup_seconds), significant(o.memory_mib, 3),
           std::to_string(o.unknowns)}) {
       row.push_back(v);
     }
@@ -418,7 +428,7 @@ Table summary_table(const ResultsFile& r) {
       t.rows.push_back({s.name, o.model, std::to_string(o.level),
                         load_text(mag, s) + (o.beyond_linear_regime ? " ⚠" : ""), significant(o.max_mm),
                         significant(o.rms_mm), significant(o.relative_l2), reference_uncertainty_text(o),
-                        o.max_mm <= s.tolerance_mm ? "yes" : "no", significant(o.solve_seconds),
+                        o.max_mm <= s.tolerance_mm ? "yes" : "no", solve_time_text(o),
                         significant(o.setup_seconds), significant(o.memory_mib, 3)});
     }
   }

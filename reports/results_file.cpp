@@ -24,6 +24,7 @@ OutcomeRow read_outcome(const json& j, const std::string& where) {
   o.setup_seconds = field<double>(j, "setup_seconds", where);
   o.solve_seconds = field<double>(j, "solve_seconds", where);
   o.memory_mib = field_or<double>(j, "memory_mib", 0.0, where);
+  o.timing_source = field_or<std::string>(j, "timing_source", "", where);
   if (!o.ok) {
     o.failure = field<std::string>(j, "failure", where);
     return o;

@@ -17,6 +17,9 @@ struct OutcomeRow {
   std::string failure;
   std::size_t nodes = 0, unknowns = 0;
   double setup_seconds = 0.0, solve_seconds = 0.0, memory_mib = 0.0;
+  /// Models outside the suite: "simulator" (their own times), "process" (their process's wall
+  /// time), "none"; empty for the suite's own models.
+  std::string timing_source;
   // Present when ok:
   double max_mm = 0.0, mean_mm = 0.0, stddev_mm = 0.0, rms_mm = 0.0, relative_l2 = 0.0;
   std::optional<double> reference_uncertainty_max_mm;

@@ -1,5 +1,7 @@
 #include "verification/harness.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cctype>
@@ -31,6 +33,7 @@
 #include "msm/solvers/static_solver.hpp"
 #include "msm/solvers/updates.hpp"
 #include "reports/representative_load.hpp"
+#include "verification/external_model.hpp"
 #include "verification/memory.hpp"
 #include "verification/modal.hpp"
 #include "verification/parallel.hpp"
@@ -219,15 +222,6 @@ bool wants_fields(const HarnessOptions& o, const Scene& s, double magnitude,
     without_budget_load.budget.magnitude = 0.0;
   }
   return magnitude == budget_magnitude(without_budget_load, ref_max_strain_unit);
-}
-
-/// A file name from a model name ("vol[stiffness=lloyd;dt=2e-05]" → "vol_stiffness_lloyd_dt_2e-05_").
-std::string file_stem(const std::string& name) {
-  std::string stem = name;
-  for (char& c : stem) {
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '_';
-  }
-  return stem;
 }
 
 /// One model's displacement fields at one load for ParaView: points at the model's rest nodes
@@ -561,6 +555,126 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
   }
 }
 
+/// The largest |Δl|/l over the edges of the exchange cells under displacements u: the strain an
+/// outside model's answer implies, since its own elements are not known.
+double largest_edge_strain(const std::vector<Vec3>& nodes, const VtuCells& cells,
+                           const std::vector<Vec3>& u) {
+  const auto per = static_cast<std::size_t>(cells.points_per_cell);
+  double worst = 0.0;
+  for (std::size_t c = 0; c + per <= cells.connectivity.size(); c += per) {
+    for (std::size_t i = 0; i < per; ++i) {
+      for (std::size_t j = i + 1; j < per; ++j) {
+        const std::size_t a = cells.connectivity[c + i], b = cells.connectivity[c + j];
+        const double rest = (nodes[b] - nodes[a]).norm();
+        const double now = (nodes[b] + u[b] - nodes[a] - u[a]).norm();
+        if (rest > 0.0) worst = std::max(worst, std::abs(now - rest) / rest);
+      }
+    }
+  }
+  return worst;
+}
+
+/// A dynamic outside model's QoI history (its history.csv) beside the FEM transient, sampled to
+/// at most kHistorySamples + 1 points.
+History outside_history(const ExternalAnswer& a, const ReferenceSolvers& ref, const Vec3& probe,
+                        const ModelSpec& spec, const msm::Problem& problem, double magnitude) {
+  History h;
+  const std::size_t n = a.history_time_s.size();
+  const std::size_t every = std::max<std::size_t>(1, n / kHistorySamples);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k % every != 0 && k + 1 != n) continue;
+    h.time_s.push_back(a.history_time_s[k]);
+    h.model_mm.push_back(a.history_u[k].norm() * 1e3);
+  }
+  ModelSpec as_run = spec;  // add_reference_history reads the run's dt and steps from the solver
+  as_run.solver.dt = spec.external.dt;
+  as_run.solver.steps = spec.external.steps;
+  as_run.damping = 0.0;
+  add_reference_history(h, ref, probe, as_run, problem, magnitude);
+  return h;
+}
+
+/// A model outside the suite (kinds external and displacements; verification/external_model.hpp)
+/// at every load: the case written to its exchange folder and its command run (external), or the
+/// answer read from the folder the export named (displacements); then compared as any model. A
+/// case whose command fails, times out or answers badly is recorded as failed with the reason,
+/// and the run goes on.
+void run_outside_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
+                       const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
+                       const HarnessOptions& o, Progress& progress, ModelOutcome base,
+                       SceneResult& result) {
+  const ExchangeNetwork network = exchange_network(s, spec, mesh, base.level, nu);
+  const std::vector<Vec3>& nodes = network.built.network.nodes;
+  const bool external = spec.kind == ModelKind::external;
+  std::filesystem::path root = spec.external.directory;
+  if (external) {
+    const std::filesystem::path exchange =
+        o.exchange_dir.empty() ? std::filesystem::temp_directory_path() /
+                                     ("vesselverify-exchange-" + std::to_string(getpid()))
+                               : o.exchange_dir;
+    root = exchange / file_stem(s.name) / file_stem(spec.name);
+  }
+  std::ostringstream detail;
+  if (external) {
+    detail << "external:";
+    for (const auto& a : spec.external.command) detail << " " << a;
+  } else {
+    detail << "displacements from " << spec.external.directory.string();
+  }
+  detail << "; " << network.description;
+  if (spec.external.steps > 0) {
+    detail << "; dynamic, " << spec.external.steps << " steps of " << spec.external.dt << " s";
+  }
+  base.detail = detail.str();
+  base.nodes = nodes.size();
+  const ReferenceAtPoints ref_here = reference_at(ref, nodes);
+  const ReadOut at = read_out(s, base.level, nodes, result.qoi_point);
+  for (const double mag : s.load.magnitudes) {
+    progress.begin(spec.name + " at " + std::to_string(mag) + " (" + to_string(s.load.kind) + ", " +
+                   to_string(spec.kind) + ")");
+    ModelOutcome out = base;
+    out.magnitude = mag;
+    try {
+      const ExchangeProblem p =
+          exchange_problem(network, s, spec, mesh, base.level, nu, mag, result.qoi_point);
+      out.unknowns = free_unknowns(p.problem);
+      ExternalAnswer answer;
+      if (external) {
+        const std::filesystem::path dir = write_exchange_case(root, p);
+        ProcessResult process;
+        answer = run_external_case(spec.external, dir, nodes.size(), &process);
+        out.solve_seconds = process.wall_seconds;
+        out.timing_source = "process";
+      } else {
+        answer = read_external_answer(root / p.id, nodes.size());
+        out.timing_source = "none";
+      }
+      if (answer.solve_seconds) {
+        out.solve_seconds = *answer.solve_seconds;
+        out.setup_seconds = answer.setup_seconds.value_or(0.0);
+        out.timing_source = "simulator";
+      }
+      if (!answer.history_time_s.empty() && spec.external.steps > 0) {
+        out.history = outside_history(answer, ref, nodes[at.qoi], spec, p.problem, mag);
+      }
+      out.max_strain = largest_edge_strain(nodes, network.cells, answer.u);
+      std::vector<Vec3> loads;
+      if (s.load.kind == LoadKind::contact) loads = p.loads;
+      finish_outcome(out, s, nodes, answer.u, ref_here, mag, at, fine.max_abs_principal_strain,
+                     result.qoi_point, loads, spec.external.steps, spec.external.dt);
+      if (wants_fields(o, s, mag, fine.max_abs_principal_strain)) {
+        write_model_fields(o, s, out, nodes, network.cells, answer.u, scaled(ref_here.u, mag));
+      }
+    } catch (const ExternalModelError& e) {
+      out.ok = false;
+      out.failure = e.what();
+      if (o.log) *o.log << "      FAILED: " << e.what() << "\n";
+    }
+    result.outcomes.push_back(out);
+    progress.end();
+  }
+}
+
 }  // namespace
 
 QuantityErrors quantity_errors(const Budget& budget, const std::vector<Vec3>& nodes,
@@ -867,6 +981,8 @@ SceneResult run_models(const Scene& s, SceneReferences& r, const HarnessOptions&
                          std::to_string(level) + ")");
           run_fem_model(at_nu, spec, nu, mesh, a.ref, fine, o, base, result);
           progress.end();
+        } else if (spec.kind == ModelKind::external || spec.kind == ModelKind::displacements) {
+          run_outside_model(at_nu, spec, nu, mesh, a.ref, fine, o, progress, base, result);
         } else {
           run_msm_model(at_nu, spec, nu, mesh, a.ref, fine, o, progress, base, result);
         }

@@ -50,6 +50,9 @@ struct HarnessOptions {
   /// set-up and update times are measurements. 1: scene after scene, each ν's reference just
   /// before its models.
   int jobs = 1;
+  /// Models of kind `external`: their case folders go under exchange_dir/<scene>/<model>/<case>
+  /// (verification/external_model.hpp); empty: a folder under the system's temporary directory.
+  std::filesystem::path exchange_dir;
 };
 
 /// The reference's answer for one ν (at unit load; scale by the magnitude).
@@ -129,7 +132,15 @@ struct ModelOutcome {
   int updates = 0;
   double iterations_per_update = 0.0;
   double factorisations_per_update = 0.0;
-  double memory_mib = 0.0;  ///< peak resident memory added by set-up and solve
+  /// Peak resident memory added by set-up and solve; 0 for models outside the suite (a child
+  /// process's peak is not measured: wait4's ru_maxrss counts the memory it shared with this
+  /// process while being spawned).
+  double memory_mib = 0.0;
+  /// Where setup_seconds and solve_seconds come from for models outside the suite: "simulator"
+  /// (the simulator's own timing.json), "process" (the wall time of its whole process: start-up
+  /// and file I/O included), "none" (displacements read from files: no time); empty for the
+  /// suite's own models, which it times itself.
+  std::string timing_source;
   ErrorStatistics error;       ///< against the reference at the model's nodes
   ErrorStatistics reference_uncertainty;  ///< the reference's own estimated error there (max, rms)
   bool has_reference_uncertainty = false;  ///< false when the reference has no coarser level

@@ -114,6 +114,7 @@ nlohmann::json scene_json(const SceneResult& r) {
                      {"solve_seconds", o.solve_seconds},
                      {"memory_mib", o.memory_mib}};
     if (o.roi_radius > 0.0) j["roi_radius_mm"] = o.roi_radius * 1e3;
+    if (!o.timing_source.empty()) j["timing_source"] = o.timing_source;
     if (o.updates > 0) {
       j["updates"] = {{"count", o.updates},
                       {"iterations_per_update", o.iterations_per_update},
@@ -245,7 +246,8 @@ void write_results_csv(const std::filesystem::path& path, const std::vector<Scen
            "solve_s,memory_mib,"
            "max_mm,mean_mm,stddev_mm,rms_mm,relative_l2,ref_uncertainty_max_mm,qoi_mm,"
            "qoi_reference_mm,max_strain,beyond_linear_regime,updates,iterations_per_update,"
-           "factorisations_per_update,mode_frequencies_hz,reference_mode_frequencies_hz\n";
+           "factorisations_per_update,mode_frequencies_hz,reference_mode_frequencies_hz,"
+           "timing_source\n";
     out << std::setprecision(8);
     for (const auto& r : results) {
       for (const auto& o : r.outcomes) {
@@ -282,7 +284,7 @@ void write_results_csv(const std::filesystem::path& path, const std::vector<Scen
         if (const ModalOutcome* ref = reference_modes_at(r, o.poisson_ratio); ref && ref->ok) {
           out << joined(ref->frequencies_hz);
         }
-        out << '\n';
+        out << ',' << o.timing_source << '\n';  // models outside the suite: whose times these are
       }
     }
   });
@@ -302,7 +304,9 @@ void write_summary_markdown(const std::filesystem::path& path,
            "model build and the solver's preparation (assembly, factorisation at rest), done once. "
            "*solve s*: static and linear mass-spring models the time per update (median over a "
            "load ramp of warm-started updates ending at the row's load); integrators the run's "
-           "steps; FEM assembly and solve.\n\n";
+           "steps; FEM assembly and solve; models outside the suite (external, displacements) "
+           "the simulator's own times from its timing.json, else its process's wall time "
+           "(start-up and file I/O included), as marked.\n\n";
     out << std::setprecision(3);
     for (const auto& r : results) {
       const char* unit = load_unit(r.scene.load.kind);
@@ -327,9 +331,14 @@ void write_summary_markdown(const std::filesystem::path& path,
         } else {
           out << "–";
         }
+        // Models outside the suite: say whose times these are (their own, or their process's).
+        const std::string source = o.timing_source == "simulator" ? " (simulator's own)"
+                                   : o.timing_source == "process" ? " (process wall time)"
+                                   : o.timing_source == "none"    ? " (not timed)"
+                                                                  : "";
         out << " | " << o.qoi_displacement_mm << " / "
-            << o.qoi_reference_mm << " | " << o.setup_seconds << " | " << o.solve_seconds << " | "
-            << o.unknowns << " |\n";
+            << o.qoi_reference_mm << " | " << o.setup_seconds << " | " << o.solve_seconds << source
+            << " | " << o.unknowns << " |\n";
       }
       out << "\n";
       if (r.reference_modes.empty() && r.model_modes.empty()) continue;

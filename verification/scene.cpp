@@ -305,17 +305,78 @@ std::string short_number(double v) {
   return s.str();
 }
 
+/// An `external` or `displacements` [[models]] table (a model outside the suite,
+/// verification/external_model.hpp): the nodes it is given, and its command and time limit, or
+/// the folder of answers computed elsewhere; `dt` and `steps` make the problem dynamic.
+std::vector<ModelSpec> outside_model(TableReader& r, ModelSpec m) {
+  ExternalSpec& e = m.external;
+  if (m.kind == ModelKind::external) {
+    const toml::node* c = r.get("command");
+    const auto* arr = c ? c->as_array() : nullptr;
+    const std::string expected =
+        "a non-empty array of strings, the program and its arguments (e.g. [\"python3\", "
+        "\"model.py\"]); the manifest's path is appended";
+    if (!c) r.fail(nullptr, "command", "missing; expected " + expected);
+    if (!arr || arr->empty()) r.fail(c, "command", "found " + show(*c) + ", expected " + expected);
+    for (const auto& item : *arr) {
+      const auto v = item.value_exact<std::string>();
+      if (!v || v->empty()) r.fail(&item, "command", "found " + show(item) + ", expected " + expected);
+      e.command.push_back(*v);
+    }
+    e.timeout_s = r.positive("timeout_s", e.timeout_s, "s");
+  } else {
+    const toml::node* f = r.get("file");
+    const auto v = f ? f->value_exact<std::string>() : std::nullopt;
+    const std::string expected =
+        "the folder of case folders with the answers (as `vesselverify export` wrote them, one "
+        "folder per case holding displacements.csv or displacements.vtu)";
+    if (!f) r.fail(nullptr, "file", "missing; expected " + expected);
+    if (!v || v->empty()) r.fail(f, "file", "found " + show(*f) + ", expected " + expected);
+    e.directory = *v;
+  }
+  e.nodes = r.string_or("nodes", "volume", {"volume", "surface"}) == "surface"
+                ? ExchangeNodes::surface
+                : ExchangeNodes::volume;
+  if (const toml::node* sf = r.table().get("surface"); sf && e.nodes != ExchangeNodes::surface) {
+    r.get("surface");
+    r.fail(sf, "surface", "found a wall surface with nodes = \"volume\"; expected it only with "
+                          "nodes = \"surface\"");
+  }
+  e.surface = msm::parse_wall_surface(
+      r.name_or("surface", msm::to_string(e.surface), msm::parse_wall_surface));
+  const toml::node* dt = r.get("dt");
+  const toml::node* steps = r.table().get("steps");
+  if (dt || steps) {
+    if (!dt) r.fail(steps, "steps", "found steps without dt; expected both (a dynamic problem) or neither");
+    if (!steps) r.fail(dt, "dt", "found dt without steps; expected both (a dynamic problem) or neither");
+    e.dt = r.number(*dt, "dt", 0.0, HUGE_VAL, "s");
+    if (e.dt <= 0.0) r.fail(dt, "dt", "found 0, expected a time step > 0 s");
+  }
+  e.steps = r.integer_or("steps", 0, 1, 1'000'000'000L);
+  r.finish();
+  return {m};
+}
+
 /// One [[models]] table. `stiffness`, `mass`, `solver`, `dt` and `roi_radius` (and `degree` for
 /// FEM) may be arrays: the table then stands for every combination (a sweep), each named after the
 /// table's name plus the swept values, e.g. "volume[stiffness=lloyd;dt=2e-05]".
 std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind load) {
   ModelSpec m;
-  const std::string kind = r.string_or("kind", "", {"fem", "surface_msm", "volume_msm"});
-  if (kind.empty()) r.fail(nullptr, "kind", "missing; expected one of fem, surface_msm, volume_msm");
+  const std::string kind = r.string_or(
+      "kind", "", {"fem", "surface_msm", "volume_msm", "external", "displacements"});
+  if (kind.empty()) {
+    r.fail(nullptr, "kind",
+           "missing; expected one of fem, surface_msm, volume_msm, external, displacements");
+  }
   m.kind = kind == "fem" ? ModelKind::fem
                          : (kind == "surface_msm" ? ModelKind::surface_msm : ModelKind::volume_msm);
+  if (kind == "external") m.kind = ModelKind::external;
+  if (kind == "displacements") m.kind = ModelKind::displacements;
   m.name = r.string_or("name", kind + "_" + std::to_string(index + 1));
   if (m.kind == ModelKind::fem) return fem_models(r, m);
+  if (m.kind == ModelKind::external || m.kind == ModelKind::displacements) {
+    return outside_model(r, m);
+  }
   if (m.kind == ModelKind::surface_msm) {
     m.surface = msm::parse_wall_surface(r.name_or("surface", msm::to_string(m.surface), msm::parse_wall_surface));
     m.topology = msm::parse_topology(r.name_or("topology", "auto", msm::parse_topology));
@@ -571,6 +632,12 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
     for (ModelSpec& m :
          read_model(TableReader(*t, "models[" + std::to_string(i) + "].", source_name), i,
                     scene.load.kind)) {
+      // Models outside the suite: their command runs in the scene file's folder, and their
+      // answers' folder is relative to it.
+      m.external.working_dir = std::filesystem::path(source_name).parent_path();
+      if (!m.external.directory.empty() && m.external.directory.is_relative()) {
+        m.external.directory = m.external.working_dir / m.external.directory;
+      }
       if (!m.calibration.empty() && m.calibration.is_relative()) {
         m.calibration = std::filesystem::path(source_name).parent_path() / m.calibration;
       }
@@ -643,8 +710,14 @@ std::string to_string(ModelKind kind) {
     case ModelKind::fem: return "fem";
     case ModelKind::surface_msm: return "surface_msm";
     case ModelKind::volume_msm: return "volume_msm";
+    case ModelKind::external: return "external";
+    case ModelKind::displacements: return "displacements";
   }
   return "?";
+}
+
+std::string to_string(ExchangeNodes nodes) {
+  return nodes == ExchangeNodes::surface ? "surface" : "volume";
 }
 
 }  // namespace vessel

@@ -18,7 +18,32 @@
 namespace vessel {
 
 enum class LoadKind { contact, pressure, gravity };
-enum class ModelKind { fem, surface_msm, volume_msm };
+enum class ModelKind { fem, surface_msm, volume_msm, external, displacements };
+
+/// Which nodes a model outside the suite (kinds external and displacements) is given and answers
+/// at: every node of the vessel's tet mesh (cells: its tets), or the nodes of one wall surface
+/// (cells: its triangles; the surface mass-spring models' network on that wall).
+enum class ExchangeNodes { volume, surface };
+std::string to_string(ExchangeNodes nodes);  ///< "volume" | "surface"
+
+/// A model outside the suite (verification/external_model.hpp): `external` runs `command` once per
+/// case on an exchange directory; `displacements` reads answers computed elsewhere from
+/// `directory`, one case folder each as `vesselverify export` names them.
+struct ExternalSpec {
+  std::vector<std::string> command;  ///< external: the program and its arguments
+  double timeout_s = 600.0;          ///< external: the process group is killed after this, s
+  ExchangeNodes nodes = ExchangeNodes::volume;
+  msm::WallSurface surface = msm::WallSurface::inner;  ///< nodes = surface: which wall
+  /// displacements: the folder of case folders (relative paths: against the scene file's folder).
+  std::filesystem::path directory;
+  /// Dynamic problems (both > 0): the simulator runs `steps` steps of `dt` from rest under the
+  /// load applied as a step at t = 0; 0: a static problem.
+  double dt = 0.0;
+  long steps = 0;
+  /// The folder the command runs in (the scene file's folder; relative paths in `command` resolve
+  /// there).
+  std::filesystem::path working_dir;
+};
 
 /// One model to run against the reference. FEM models use `degree`; mass-spring models use the
 /// rest. A [[models]] table whose stiffness, mass, solver, dt or degree is an array expands into
@@ -50,6 +75,7 @@ struct ModelSpec {
   std::filesystem::path calibration;
   /// Apply a group calibration to a mesh other than the one it was fitted on (its hash differs).
   bool calibration_transfer = false;
+  ExternalSpec external;  ///< kinds external and displacements only
 };
 
 struct LoadSpec {

@@ -7,6 +7,8 @@ namespace vessel::cli {
 
 void add_mesh_command(CLI::App& app);
 void add_scene_command(CLI::App& app);
+/// `export`: a scene's exchange folders for models outside the suite (export_command.cpp).
+void add_export_command(CLI::App& app);
 /// `vesselverify run`; `command_line` is recorded in the results.
 void add_run_command(CLI::App& app, const std::string& command_line);
 /// `vesselverify report`: results → Markdown and HTML report; `command_line` is recorded in it.

@@ -2,6 +2,7 @@
 /// levels, smallest and largest load) and compares with a committed baseline; fails with a table
 /// of what changed when a model's error grows, a model that finished now fails, or a normalised
 /// solve time regresses.
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -26,6 +27,10 @@ struct GateOptions {
   std::filesystem::path baseline;
   std::filesystem::path current;  ///< compare this results file instead of running the scenes
   std::filesystem::path scenes_dir = VESSELVERIFY_SCENES_DIR;
+  /// The user's own scenes (files, or folders of *.toml) instead of the shipped gate scenes; run
+  /// as written unless `quick`.
+  std::vector<std::filesystem::path> scenes;
+  bool quick = false;
   std::filesystem::path output_dir = "gate-results";
   CacheOptions cache;
   int jobs = 1;
@@ -39,12 +44,40 @@ class GateFailed : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The scene files named: files as given, folders as their *.toml files (sorted by name).
+std::vector<std::filesystem::path> scene_files(const std::vector<std::filesystem::path>& given) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& p : given) {
+    if (!std::filesystem::is_directory(p)) {
+      files.push_back(p);  // read_scene says if it is missing
+      continue;
+    }
+    std::vector<std::filesystem::path> in_dir;
+    for (const auto& e : std::filesystem::directory_iterator(p)) {
+      if (e.is_regular_file() && e.path().extension() == ".toml") in_dir.push_back(e.path());
+    }
+    if (in_dir.empty()) {
+      throw InputError(p.string() + ": no *.toml scene files in this folder; expected at least one");
+    }
+    std::sort(in_dir.begin(), in_dir.end());
+    files.insert(files.end(), in_dir.begin(), in_dir.end());
+  }
+  return files;
+}
+
 void gate(const GateOptions& o) {
   std::filesystem::path results_path = o.current;
   if (results_path.empty()) {
     std::vector<Scene> scenes;
-    for (const auto& name : kGateScenes) {
-      scenes.push_back(quick_variant(read_scene(o.scenes_dir / name)));
+    if (o.scenes.empty()) {
+      for (const auto& name : kGateScenes) {
+        scenes.push_back(quick_variant(read_scene(o.scenes_dir / name)));
+      }
+    } else {
+      for (const auto& file : scene_files(o.scenes)) {
+        Scene s = read_scene(file);  // every scene validated before anything runs
+        scenes.push_back(o.quick ? quick_variant(std::move(s)) : std::move(s));
+      }
     }
     HarnessOptions h;
     h.cache_dir = o.cache.mesh_dir();
@@ -53,6 +86,7 @@ void gate(const GateOptions& o) {
     h.log = &std::cout;
     h.jobs = o.jobs;
     h.repeats = 3;  // medians: the gate compares times
+    h.exchange_dir = o.output_dir / "exchange";  // external models' case folders
     run_and_write(scenes, h, o.output_dir, o.command);
     std::cout << solution_cache->summary() << "\n";
     results_path = o.output_dir / "results.json";
@@ -110,7 +144,9 @@ void add_gate_command(CLI::App& app, const std::string& command_line) {
       "Examples:\n"
       "  vesselverify gate --baseline reports/baseline.json\n"
       "  vesselverify gate --baseline reports/baseline.json --update-baseline\n"
-      "  vesselverify gate --baseline reports/baseline.json --current results/results.json");
+      "  vesselverify gate --baseline reports/baseline.json --current results/results.json\n"
+      "  vesselverify gate --scenes my_scenes/ --baseline my_baseline.json --update-baseline\n"
+      "  vesselverify gate --scenes my_scenes/ --baseline my_baseline.json");
   cmd->add_option("--baseline", o->baseline, "Baseline results file (committed)")->required();
   cmd->add_flag("--update-baseline", o->update_baseline,
                 "Rewrite the baseline with this run's results instead of comparing");
@@ -118,6 +154,14 @@ void add_gate_command(CLI::App& app, const std::string& command_line) {
                   "Compare this results file (same gate scenes) instead of running the scenes")
       ->check(CLI::ExistingFile);
   cmd->add_option("--scenes-dir", o->scenes_dir, "Where the gate scenes are")->capture_default_str();
+  cmd->add_option("--scenes", o->scenes,
+                  "Your own scenes instead of the shipped gate scenes: scene files, or folders "
+                  "whose *.toml files are taken (their external models are run too), run as "
+                  "written (see --quick); compare against your own --baseline")
+      ->expected(1, -1);
+  cmd->add_flag("--quick", o->quick,
+                "With --scenes: run their quick variants (models at level 0, smallest and "
+                "largest load), as the shipped gate scenes are");
   cmd->add_option("--output-dir", o->output_dir, "Where this run's results and gate.md go")
       ->capture_default_str();
   add_cache_options(*cmd, o->cache);

@@ -68,6 +68,7 @@ void run(const RunOptions& o) {
   h.ramp_updates = o.updates;
   if (o.fields != "none") h.fields_dir = o.output_dir / "fields";
   h.fields_every_load = o.fields == "all";
+  h.exchange_dir = o.output_dir / "exchange";  // external models' case folders
   run_and_write(scenes, h, o.output_dir, o.command);
   std::cout << solution_cache->summary() << "\n";
 }
