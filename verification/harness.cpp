@@ -168,6 +168,8 @@ struct ReadOut {
 };
 
 ReadOut read_out(const Scene& s, int level, const std::vector<Vec3>& nodes, const Vec3& qoi) {
+  // A vessel from a file has no centreline to run a wall line along: no wall profile.
+  if (!s.vessel.parametric()) return {nearest_node(nodes, qoi), {}};
   return {nearest_node(nodes, qoi), wall_line(s.vessel, level, nodes, qoi)};
 }
 
@@ -680,18 +682,26 @@ Scene quick_variant(Scene s) {
   return s;
 }
 
-SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
+SceneResult run_scene(const Scene& scene, const HarnessOptions& o) {
   std::ostream null_stream(nullptr);
   std::ostream& log = o.log ? *o.log : null_stream;
   Stopwatch total;
   SceneResult result;
+
+  log << "scene " << scene.name << ": " << describe(scene.vessel) << "\n";
+  const TetMesh fine_mesh = scene_mesh(scene, scene.reference_level, o.cache_dir);
+  // A vessel from a file takes its contact and QoI points from the reference mesh's wall.
+  const Scene s = resolve_file_vessel(scene, fine_mesh);
+  if (!s.vessel.parametric()) {
+    const Vec3 p = s.load.contact.point * 1e3;
+    log << "  " << (s.load.kind == LoadKind::contact ? "contact" : "QoI") << " point on "
+        << s.load.contact.surface_group << ": (" << p.x() << ", " << p.y() << ", " << p.z()
+        << ") mm\n";
+  }
   result.scene = s;
   result.qoi_point = qoi_point(s);
-
-  log << "scene " << s.name << ": " << describe(s.vessel) << "\n";
   std::map<int, TetMesh> model_meshes;
   for (const int level : s.model_levels) model_meshes.emplace(level, scene_mesh(s, level, o.cache_dir));
-  const TetMesh fine_mesh = scene_mesh(s, s.reference_level, o.cache_dir);
   std::unique_ptr<TetMesh> coarse_mesh;
   if (s.reference_level > 0) {
     coarse_mesh = std::make_unique<TetMesh>(scene_mesh(s, s.reference_level - 1, o.cache_dir));
