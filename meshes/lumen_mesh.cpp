@@ -396,41 +396,82 @@ TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>&
       normal[i].normalize();
     }
   }
-  TetMesh mesh;
-  mesh.nodes.reserve(static_cast<std::size_t>(n) * (layers + 1));
-  for (int k = 0; k <= layers; ++k) {
-    const double offset = thickness * k / layers;
-    for (int i = 0; i < n; ++i) mesh.nodes.push_back(lumen.nodes[i] + offset * normal[i]);
+  // Lumen neighbours of each node (for smoothing the normals at a crease).
+  std::vector<std::vector<int>> neighbours(n);
+  for (const Triangle& t : lumen.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      neighbours[t[k]].push_back(t[(k + 1) % 3]);
+      neighbours[t[k]].push_back(t[(k + 2) % 3]);
+    }
   }
   const auto id = [n](int layer, int i) { return layer * n + i; };
+  TetMesh mesh;
   std::size_t inverted = 0;
   Vec3 first_inverted = Vec3::Zero();
-  for (int k = 0; k < layers; ++k) {
-    for (const Triangle& t : lumen.triangles) {
-      const std::array<int, 6> g{id(k, t[0]),     id(k, t[1]),     id(k, t[2]),
-                                 id(k + 1, t[0]), id(k + 1, t[1]), id(k + 1, t[2])};
-      for (const auto& slots : prism_tets(g)) {
-        const Tet tet{g[slots[0]], g[slots[1]], g[slots[2]], g[slots[3]]};
-        const Vec3 &a = mesh.nodes[tet[0]], &b = mesh.nodes[tet[1]], &c = mesh.nodes[tet[2]],
-                   &d = mesh.nodes[tet[3]];
-        double longest = 0.0;
-        for (const auto& [p, q] : {std::pair{&a, &b}, {&a, &c}, {&a, &d}, {&b, &c}, {&b, &d},
-                                   {&c, &d}}) {
-          longest = std::max(longest, (*p - *q).norm());
+  for (int pass = 0;; ++pass) {
+    mesh = TetMesh{};
+    mesh.nodes.reserve(static_cast<std::size_t>(n) * (layers + 1));
+    for (int k = 0; k <= layers; ++k) {
+      const double offset = thickness * k / layers;
+      for (int i = 0; i < n; ++i) mesh.nodes.push_back(lumen.nodes[i] + offset * normal[i]);
+    }
+    inverted = 0;
+    std::vector<char> near_flat(n, 0);
+    for (int k = 0; k < layers; ++k) {
+      for (const Triangle& t : lumen.triangles) {
+        const std::array<int, 6> g{id(k, t[0]),     id(k, t[1]),     id(k, t[2]),
+                                   id(k + 1, t[0]), id(k + 1, t[1]), id(k + 1, t[2])};
+        for (const auto& slots : prism_tets(g)) {
+          const Tet tet{g[slots[0]], g[slots[1]], g[slots[2]], g[slots[3]]};
+          const Vec3 &a = mesh.nodes[tet[0]], &b = mesh.nodes[tet[1]], &c = mesh.nodes[tet[2]],
+                     &d = mesh.nodes[tet[3]];
+          double longest = 0.0;
+          for (const auto& [p, q] : {std::pair{&a, &b}, {&a, &c}, {&a, &d}, {&b, &c},
+                                     {&b, &d}, {&c, &d}}) {
+            longest = std::max(longest, (*p - *q).norm());
+          }
+          const double v = signed_volume(a, b, c, d), l3 = longest * longest * longest;
+          if (v <= kZeroVolumeTolerance * l3 && inverted++ == 0) {
+            first_inverted = 0.25 * (a + b + c + d);
+          }
+          if (v <= kNearFlatPrismTet * l3) {
+            for (const int i : t) near_flat[i] = 1;
+          }
+          mesh.tets.push_back(tet);
         }
-        if (signed_volume(a, b, c, d) <= kZeroVolumeTolerance * longest * longest * longest) {
-          if (inverted++ == 0) first_inverted = 0.25 * (a + b + c + d);
-        }
-        mesh.tets.push_back(tet);
       }
     }
+    if (std::find(near_flat.begin(), near_flat.end(), 1) == near_flat.end() ||
+        pass == kMaxNormalSmoothingPasses) {
+      break;
+    }
+    // A crease (where a branch leaves) turns the normals faster than the wall is thick: average
+    // the normals there and around with their neighbours', keeping the ends' in their planes.
+    std::vector<char> smooth = near_flat;
+    for (int i = 0; i < n; ++i) {
+      if (near_flat[i]) {
+        for (const int j : neighbours[i]) smooth[j] = 1;
+      }
+    }
+    std::vector<Vec3> averaged = normal;
+    for (int i = 0; i < n; ++i) {
+      if (!smooth[i]) continue;
+      for (const int j : neighbours[i]) averaged[i] += normal[j];
+      if (end_of[i] >= 0) {
+        const Vec3& e = ends[end_of[i]].normal;
+        averaged[i] -= averaged[i].dot(e) * e;
+      }
+      averaged[i].normalize();
+    }
+    normal = std::move(averaged);
   }
   if (inverted > 0) {
     throw InputError(source + ": extruding the lumen outward by wall_thickness = " +
                      num(thickness * 1e3) + " mm folds the wall over itself near " +
                      mm(first_inverted) + " (" + std::to_string(inverted) +
-                     " inverted or flat tets): the lumen curves more tightly than the wall is "
-                     "thick there; expected a thinner wall or a smoother lumen");
+                     " inverted or flat tets, after " + std::to_string(kMaxNormalSmoothingPasses) +
+                     " passes of smoothing the normals there): the lumen curves more tightly "
+                     "than the wall is thick there; expected a thinner wall or a smoother lumen");
   }
   std::vector<Triangle> outer;
   for (const Triangle& t : lumen.triangles) outer.push_back({id(layers, t[0]), id(layers, t[1]), id(layers, t[2])});

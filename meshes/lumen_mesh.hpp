@@ -79,11 +79,20 @@ int inlet_end(const std::vector<LumenEnd>& ends);
 /// Splits every triangle into four at its edge midpoints, `times` times (each halves the edges).
 TriangleSurface subdivide_surface(const TriangleSurface& surface, int times);
 
+/// A prism's tet is nearly flat when its volume is at most this × its longest edge³ (a regular tet
+/// has 0.118): the extrusion then smooths the normals of its nodes and their neighbours, pass after
+/// pass, at most kMaxNormalSmoothingPasses times.
+inline constexpr double kNearFlatPrismTet = 1e-3;
+inline constexpr int kMaxNormalSmoothingPasses = 100;
+
 /// Extrudes a checked lumen (outward normals, `ends` from check_lumen on this surface) outward by
 /// `thickness` (m) in `layers` layers of prisms, each split into three tets by the vertex-index
 /// rule of Dompierre et al. 1999 (conforming across prisms). A node moves along its angle-weighted
 /// normal; on an end's loop the normal is projected into the end's plane, so each end face stays
-/// in its plane. Groups of kVesselGroups: inner_wall (the lumen), outer_wall, inlet (the end of
+/// in its plane. Where a prism's tet would be nearly flat or inverted (a crease, e.g. where a
+/// branch leaves, turns the normals within less than the thickness), the normals of its nodes and
+/// their neighbours are averaged with their neighbours', pass after pass, until none is (the wall
+/// there is thinner than t by the cosine of the tilt). Groups of kVesselGroups: inner_wall (the lumen), outer_wall, inlet (the end of
 /// largest area), outlet (every other end), wall. Throws InputError naming `source` if a tet
 /// inverts (the lumen curves more tightly than the wall is thick) or the outer wall crosses itself
 /// (two parts of the vessel closer than the thickness).

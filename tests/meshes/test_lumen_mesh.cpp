@@ -231,6 +231,12 @@ TEST(LumenMesh, BifurcationFromGmshMeshesWithThreeEnds) {
   EXPECT_NEAR(group_area_of(m, group_names::outlet), main_ring + branch_ring,
               0.08 * (main_ring + branch_ring));
   EXPECT_TRUE(surface_topology(boundary_faces(m)).closed_and_oriented());
+  // Level 1: edges of ~0.6 mm against the 0.5 mm wall fold the prisms at the branch's crease
+  // unless the normals there are smoothed; none is inverted or flat.
+  const TetMesh fine = lumen_wall_mesh({dir / "bifurcation.stl", t, 1.0, 1});
+  EXPECT_EQ(fine.tets.size(), 8 * m.tets.size());
+  EXPECT_EQ(compute_quality(fine).inverted, 0u);
+  EXPECT_EQ(compute_quality(fine).degenerate, 0u);
 }
 
 TEST(LumenMesh, CacheKeysTheFileContent) {
