@@ -4,10 +4,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "meshes/content_hash.hpp"
 #include "meshes/errors.hpp"
+#include "meshes/lumen_mesh.hpp"
 #include "meshes/msh_io.hpp"
 
 namespace vessel {
@@ -18,6 +21,18 @@ namespace {
 
 /// Bumped whenever the generator's output for the same params changes.
 constexpr int kGeneratorVersion = 2;
+/// Bumped whenever the lumen extrusion's output for the same file and params changes.
+constexpr int kLumenGeneratorVersion = 1;
+
+/// The hash of a file's bytes (InputError naming it if it cannot be read).
+std::string file_hash(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!fs::exists(path)) throw InputError(path.string() + ": lumen file not found");
+  if (!in) throw InputError(path.string() + ": cannot open lumen file");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return ContentHash().text(bytes.str()).hex();
+}
 
 std::string exact(double x) {
   char buf[32];
@@ -43,6 +58,12 @@ fs::path default_cache_dir() {
 }
 
 std::string mesh_cache_key(const VesselParams& p) {
+  if (p.kind == VesselKind::lumen) {
+    return "vesselverify-lumen-wall generator=" + std::to_string(kLumenGeneratorVersion) +
+           " file=" + file_hash(p.file) + " scale=" + exact(p.file_scale) +
+           " t=" + exact(p.wall_thickness) + " level=" + std::to_string(p.level);
+  }
+  if (p.kind == VesselKind::mesh_file) throw InputError(p.file.string() + ": a mesh file is not cached");
   std::string key = "vesselverify-mesh generator=" + std::to_string(kGeneratorVersion) +
                     " gmsh=" + gmsh_version() + " kind=" + to_string(p.kind) +
                     " style=" + to_string(p.style) + " level=" + std::to_string(p.level) +
@@ -55,6 +76,9 @@ std::string mesh_cache_file_name(const VesselParams& p) {
   char hash[17];
   std::snprintf(hash, sizeof hash, "%016llx",
                 static_cast<unsigned long long>(fnv1a(mesh_cache_key(p))));
+  if (p.kind == VesselKind::lumen) {
+    return "lumen-" + p.file.stem().string() + "-L" + std::to_string(p.level) + "-" + hash + ".msh";
+  }
   return to_string(p.kind) + "-" + to_string(p.style) + "-L" + std::to_string(p.level) + "-" +
          hash + ".msh";
 }
@@ -64,6 +88,13 @@ TetMesh load_or_generate_vessel(const VesselParams& params, const fs::path& cach
   validate(params);
   MeshSource info;
   const auto t0 = std::chrono::steady_clock::now();
+  if (params.kind == VesselKind::mesh_file) {  // used as given: nothing to cache
+    TetMesh mesh = read_msh(params.file);
+    require_vessel_groups(mesh, params.file.string());
+    info.seconds = seconds_since(t0);
+    if (source) *source = info;
+    return mesh;
+  }
   if (!cache_dir.empty()) {
     info.path = cache_dir / mesh_cache_file_name(params);
     if (fs::exists(info.path)) {
@@ -80,7 +111,10 @@ TetMesh load_or_generate_vessel(const VesselParams& params, const fs::path& cach
       }
     }
   }
-  TetMesh mesh = generate_vessel_mesh(params, options);
+  TetMesh mesh = params.kind == VesselKind::lumen
+                     ? lumen_wall_mesh({params.file, params.wall_thickness, params.file_scale,
+                                        params.level})
+                     : generate_vessel_mesh(params, options);
   info.seconds = seconds_since(t0);
   if (!cache_dir.empty()) write_msh(info.path, mesh);
   if (source) *source = info;

@@ -40,8 +40,9 @@ Supports end_supports(const VesselParams& vessel, const std::map<std::string, En
   const std::string prefix = where.empty() ? "" : where + ": ";
   if (!s.rollers.empty() && vessel.kind != VesselKind::straight) {
     throw InputError(prefix +
-                     "roller ends (u_z = 0 on the end faces) need the straight tube; the arch's "
-                     "ends are not normal to z: clamp them");
+                     "roller ends (u_z = 0 on the end faces) need the straight tube; the " +
+                     std::string(vessel.parametric() ? "arch's ends are" : "file vessel's ends may be") +
+                     " not normal to z: clamp them");
   }
   if (s.clamped.empty() && !s.rollers.empty()) {
     s.pins = tube_in_plane_pins(vessel.inner_radius, 0.0);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -416,6 +417,39 @@ double enclosed_volume(const std::vector<Vec3>& nodes, const std::vector<Triangl
     v += nodes[t[0]].dot(nodes[t[1]].cross(nodes[t[2]])) / 6.0;
   }
   return v;
+}
+
+Vec3 nearest_point_on_group(const TetMesh& mesh, std::string_view group, const Vec3& x,
+                            std::string_view source) {
+  const PhysicalGroup& g = mesh.require_group(group, 2, source);
+  if (g.elements.empty()) {
+    throw InputError(std::string(source) + ": group '" + std::string(group) + "' has no triangles");
+  }
+  Vec3 best = Vec3::Zero();
+  double d = std::numeric_limits<double>::infinity();
+  for (const int e : g.elements) {
+    const Triangle& t = mesh.triangles[e];
+    const Vec3 p = closest_point_on_triangle(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], x);
+    if ((p - x).squaredNorm() < d) {
+      d = (p - x).squaredNorm();
+      best = p;
+    }
+  }
+  return best;
+}
+
+double estimate_wall_thickness(const TetMesh& mesh, std::string_view source) {
+  const std::vector<int> outer =
+      mesh.group_nodes(mesh.require_group(group_names::outer_wall, 2, source));
+  if (outer.empty()) throw InputError(std::string(source) + ": group 'outer_wall' has no nodes");
+  const std::size_t stride = std::max<std::size_t>(1, outer.size() / 400);
+  std::vector<double> d;
+  for (std::size_t i = 0; i < outer.size(); i += stride) {
+    const Vec3& x = mesh.nodes[outer[i]];
+    d.push_back((nearest_point_on_group(mesh, group_names::inner_wall, x, source) - x).norm());
+  }
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
 }
 
 }  // namespace vessel

@@ -75,6 +75,17 @@ double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c);
 /// else the nearest point of the nearest edge.
 Vec3 closest_point_on_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& x);
 
+/// The point of the group's triangles nearest x (InputError naming `source` unless the group exists
+/// with dimension 2 and has triangles): how a contact point given for a vessel from a file is put
+/// on its wall.
+Vec3 nearest_point_on_group(const TetMesh& mesh, std::string_view group, const Vec3& x,
+                            std::string_view source);
+
+/// The wall thickness of a vessel mesh, m: the median distance of the outer wall's nodes from the
+/// inner wall's triangles (at most 400 nodes, evenly strided, so large meshes stay cheap). For a
+/// mesh file whose scene gives no thickness (the surface models' shell thickness).
+double estimate_wall_thickness(const TetMesh& mesh, std::string_view source);
+
 /// Total volume of the tetrahedra, m³.
 double mesh_volume(const TetMesh& mesh);
 /// Total area of the group's triangles, m².

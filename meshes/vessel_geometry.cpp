@@ -26,10 +26,35 @@ constexpr int kRadialLevel0 = 2;
 }  // namespace
 
 double VesselParams::centreline_length() const {
+  require_parametric(*this, "the centreline's length");
   return kind == VesselKind::straight ? length : std::numbers::pi * bend_radius;
 }
 
+void require_parametric(const VesselParams& p, const std::string& what) {
+  if (p.parametric()) return;
+  throw InputError(what + " needs a parametric vessel (straight or arch, with a centreline); got " +
+                   describe(p));
+}
+
 void validate(const VesselParams& p) {
+  if (p.level < 0 || p.level > kMaxMeshLevel) {
+    throw InputError("mesh level " + std::to_string(p.level) + " is out of range: expected 0.." +
+                     std::to_string(kMaxMeshLevel));
+  }
+  if (!p.parametric()) {
+    if (p.file.empty()) throw InputError("vessel: expected a file for a " + to_string(p.kind) + " vessel");
+    if (p.kind == VesselKind::mesh_file && p.level != 0) {
+      throw InputError(p.file.string() + ": mesh level " + std::to_string(p.level) +
+                       " asked of a mesh file; expected level 0 only (a .msh file is used as "
+                       "given: levels do not refine it)");
+    }
+    if (p.kind == VesselKind::lumen) require_positive("wall_thickness", p.wall_thickness);
+    if (!std::isfinite(p.file_scale) || p.file_scale <= 0.0) {
+      throw InputError(p.file.string() + ": unit scale " + std::to_string(p.file_scale) +
+                       ": expected a finite value > 0");
+    }
+    return;
+  }
   require_positive("inner_radius", p.inner_radius);
   require_positive("wall_thickness", p.wall_thickness);
   if (p.kind == VesselKind::straight) {
@@ -52,10 +77,6 @@ void validate(const VesselParams& p) {
         << " m; expected a tube, not a solid rod (the lumen would vanish in the mesh)";
     throw InputError(msg.str());
   }
-  if (p.level < 0 || p.level > kMaxMeshLevel) {
-    throw InputError("mesh level " + std::to_string(p.level) + " is out of range: expected 0.." +
-                     std::to_string(kMaxMeshLevel));
-  }
 }
 
 double analytic_wall_volume(const VesselParams& p) {
@@ -76,6 +97,7 @@ double analytic_end_area(const VesselParams& p) {
 
 
 CentrelineCoordinates centreline_coordinates(const VesselParams& p, const Vec3& x) {
+  require_parametric(p, "centreline coordinates");
   CentrelineCoordinates c;
   Vec3 offset;  // from the centreline to x
   Vec3 outward;  // θ = 0 direction in the cross-section
@@ -122,7 +144,13 @@ double unstructured_mesh_size(const VesselParams& p) {
 }
 
 std::string to_string(VesselKind kind) {
-  return kind == VesselKind::straight ? "straight" : "arch";
+  switch (kind) {
+    case VesselKind::straight: return "straight";
+    case VesselKind::arch: return "arch";
+    case VesselKind::mesh_file: return "file";
+    case VesselKind::lumen: return "lumen";
+  }
+  return "?";
 }
 
 std::string to_string(MeshStyle style) {
@@ -131,6 +159,15 @@ std::string to_string(MeshStyle style) {
 
 std::string describe(const VesselParams& p) {
   std::ostringstream s;
+  if (p.kind == VesselKind::mesh_file) {
+    s << "vessel mesh " << p.file.string() << " (as given, level 0)";
+    return s.str();
+  }
+  if (p.kind == VesselKind::lumen) {
+    s << "lumen " << p.file.string() << (p.file_scale != 1.0 ? " (scaled to m)" : "")
+      << ", wall " << p.wall_thickness * 1e3 << " mm extruded outward, level " << p.level;
+    return s.str();
+  }
   s << to_string(p.kind) << " vessel, " << to_string(p.style) << " level " << p.level
     << ": inner radius " << p.inner_radius * 1e3 << " mm, wall " << p.wall_thickness * 1e3
     << " mm, ";

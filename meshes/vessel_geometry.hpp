@@ -1,13 +1,17 @@
 #pragma once
-/// Parametric vessels: a straight thick-walled tube and a 180° arch of the same cross-section.
-/// Lengths in metres.
+/// Parametric vessels: a straight thick-walled tube and a 180° arch of the same cross-section;
+/// and the user's own vessels from a file: a tet mesh (.msh) or a lumen surface (STL) the wall is
+/// extruded from (meshes/lumen_mesh.hpp). Lengths in metres.
+#include <filesystem>
 #include <string>
 
 #include "meshes/tet_mesh.hpp"
 
 namespace vessel {
 
-enum class VesselKind { straight, arch };
+/// `mesh_file`: a tet mesh with the five groups, used as given (one level, 0). `lumen`: an STL
+/// lumen surface extruded outward by wall_thickness; levels refine it (meshes/lumen_mesh.hpp).
+enum class VesselKind { straight, arch, mesh_file, lumen };
 
 /// How the wall is meshed: unstructured Delaunay tets of size h0/2^level, or a structured
 /// (transfinite, extruded) grid of circumferential × axial × radial layers doubled per level.
@@ -21,7 +25,15 @@ struct VesselParams {
   double bend_radius = 15e-3;    ///< arch centreline radius R, m (the arch spans 180°)
   MeshStyle style = MeshStyle::unstructured;
   int level = 0;  ///< refinement level 0..4; each level halves the element size
+  /// mesh_file and lumen: the file (absolute, or relative to the working directory).
+  std::filesystem::path file;
+  /// lumen: the file's length unit in metres (1e-3 for an STL in millimetres).
+  double file_scale = 1.0;
 
+  /// straight or arch: the vessel is given by the parameters above, not by a file.
+  [[nodiscard]] bool parametric() const {
+    return kind == VesselKind::straight || kind == VesselKind::arch;
+  }
   [[nodiscard]] double outer_radius() const { return inner_radius + wall_thickness; }
   /// Length of the centreline, m: L for the tube, πR for the arch.
   [[nodiscard]] double centreline_length() const;
@@ -30,8 +42,13 @@ struct VesselParams {
 inline constexpr int kMaxMeshLevel = 4;
 
 /// Throws InputError naming the parameter, the value and the allowed range when the vessel cannot
-/// be built (non-positive or non-finite sizes, a wall reaching the bend's axis, a bad level).
+/// be built (non-positive or non-finite sizes, a wall reaching the bend's axis, a bad level; for a
+/// file: no file, a level other than 0 for a mesh file, a bad thickness or unit scale of a lumen).
 void validate(const VesselParams& params);
+
+/// InputError naming `what` unless the vessel is parametric (straight or arch): for the things
+/// that need its centreline or its closed-form geometry.
+void require_parametric(const VesselParams& params, const std::string& what);
 
 /// Closed-form wall volume, m³: π(b²−a²)L for the tube; for the arch, Pappus' theorem gives the
 /// torus segment π(b²−a²)·πR.
@@ -44,7 +61,7 @@ double analytic_end_area(const VesselParams& params);
 /// Distance of a point from the vessel centreline, m (the local radius ρ of the cross-section).
 double distance_from_centreline(const VesselParams& params, const Vec3& p);
 
-/// A point's position relative to the vessel's centreline: arc length s along it (m; z for the
+/// A point's position relative to the parametric vessel's centreline (InputError for a file): arc length s along it (m; z for the
 /// tube, Rφ for the arch with φ = atan2(y, x)), distance ρ from it (m), the angle θ around it
 /// (rad, in (−π, π]; θ = 0 at +x for the tube and on the outer bend, away from the arch's centre)
 /// and the unit vector e_ρ from the centreline to the point.

@@ -180,6 +180,8 @@ struct ReadOut {
 };
 
 ReadOut read_out(const Scene& s, int level, const std::vector<Vec3>& nodes, const Vec3& qoi) {
+  // A vessel from a file has no centreline to run a wall line along: no wall profile.
+  if (!s.vessel.parametric()) return {nearest_node(nodes, qoi), {}};
   return {nearest_node(nodes, qoi), wall_line(s.vessel, level, nodes, qoi)};
 }
 
@@ -815,6 +817,9 @@ namespace {
 /// before the models (in parallel across scenes with HarnessOptions::jobs > 1). Not movable: the
 /// solvers point at the meshes.
 struct SceneReferences {
+  /// The scene as run: a vessel from a file has its contact and QoI points moved onto the
+  /// reference mesh's wall (resolve_file_vessel).
+  Scene scene;
   std::map<int, TetMesh> model_meshes;
   TetMesh fine_mesh;
   std::unique_ptr<TetMesh> coarse_mesh;
@@ -836,12 +841,21 @@ struct SceneReferences {
 
 /// The scene's meshes (generated or read from the mesh cache; gmsh is not thread-safe, so this
 /// runs on one thread).
-std::unique_ptr<SceneReferences> scene_meshes(const Scene& s, const HarnessOptions& o) {
+std::unique_ptr<SceneReferences> scene_meshes(const Scene& scene, const HarnessOptions& o,
+                                              std::ostream& log) {
   auto r = std::make_unique<SceneReferences>();
+  r->fine_mesh = scene_mesh(scene, scene.reference_level, o.cache_dir);
+  r->scene = resolve_file_vessel(scene, r->fine_mesh);
+  const Scene& s = r->scene;
+  if (!s.vessel.parametric()) {
+    const Vec3 p = s.load.contact.point * 1e3;
+    log << "  " << (s.load.kind == LoadKind::contact ? "contact" : "QoI") << " point on "
+        << s.load.contact.surface_group << ": (" << p.x() << ", " << p.y() << ", " << p.z()
+        << ") mm\n";
+  }
   for (const int level : s.model_levels) {
     r->model_meshes.emplace(level, scene_mesh(s, level, o.cache_dir));
   }
-  r->fine_mesh = scene_mesh(s, s.reference_level, o.cache_dir);
   if (s.reference_level > 0) {
     r->coarse_mesh = std::make_unique<TetMesh>(scene_mesh(s, s.reference_level - 1, o.cache_dir));
   }
@@ -944,8 +958,9 @@ std::size_t model_cases(const Scene& s, const HarnessOptions& o) {
 
 /// The scene's models against its references (solved). `progress` counts one case per model,
 /// level, ν and load; `solve_here` solves each ν's reference as the models reach it (serial runs).
-SceneResult run_models(const Scene& s, SceneReferences& r, const HarnessOptions& o,
-                       Progress& progress, bool solve_here, std::ostream& log) {
+SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& progress,
+                       bool solve_here, std::ostream& log) {
+  const Scene& s = r.scene;
   SceneResult result;
   result.scene = s;
   result.qoi_point = qoi_point(s);
@@ -995,12 +1010,11 @@ SceneResult run_models(const Scene& s, SceneReferences& r, const HarnessOptions&
 /// Every scene's references, `o.jobs` solves at a time, each sparse factorisation with its share
 /// of the cores. Scenes whose fine problems are equal (the same key in the solution cache) are
 /// solved in one task, one after the other, so that the later ones read the first's entry.
-void solve_all_references(const std::vector<Scene>& scenes,
-                          std::vector<std::unique_ptr<SceneReferences>>& refs,
+void solve_all_references(std::vector<std::unique_ptr<SceneReferences>>& refs,
                           const HarnessOptions& o, std::ostream& log) {
   std::vector<std::pair<std::size_t, std::size_t>> cases;  // (scene, ν index)
-  for (std::size_t i = 0; i < scenes.size(); ++i) {
-    for (std::size_t k = 0; k < scenes[i].poisson_ratios.size(); ++k) cases.emplace_back(i, k);
+  for (std::size_t i = 0; i < refs.size(); ++i) {
+    for (std::size_t k = 0; k < refs[i]->scene.poisson_ratios.size(); ++k) cases.emplace_back(i, k);
   }
   std::map<std::string, std::vector<std::size_t>> by_key;  // cases sharing a fine problem
   std::vector<std::vector<std::size_t>> tasks;
@@ -1009,8 +1023,8 @@ void solve_all_references(const std::vector<Scene>& scenes,
     const std::optional<std::string> key =
         o.solution_cache && o.solution_cache->enabled()
             ? fem::solution_cache_key(refs[i]->fine_mesh,
-                                      fem_problem(scenes[i], refs[i]->fine_mesh,
-                                                  scenes[i].poisson_ratios[k], 2))
+                                      fem_problem(refs[i]->scene, refs[i]->fine_mesh,
+                                                  refs[i]->scene.poisson_ratios[k], 2))
             : std::nullopt;
     if (key) {
       by_key[*key].push_back(c);
@@ -1022,7 +1036,7 @@ void solve_all_references(const std::vector<Scene>& scenes,
   std::sort(tasks.begin(), tasks.end());  // the scenes' order, which the log follows
 
   const int jobs = std::max(1, o.jobs);
-  log << "FEM references: " << cases.size() << " (scene, ν) cases of " << scenes.size()
+  log << "FEM references: " << cases.size() << " (scene, ν) cases of " << refs.size()
       << " scene(s), " << jobs << " at a time; the timed models follow one at a time\n";
   const int saved_threads = solver_threads();
   const int cores = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
@@ -1034,7 +1048,7 @@ void solve_all_references(const std::vector<Scene>& scenes,
     parallel_for(tasks.size(), jobs, [&](std::size_t t) {
       for (const std::size_t c : tasks[t]) {
         const auto [i, k] = cases[c];
-        const Scene& s = scenes[i];
+        const Scene& s = refs[i]->scene;
         solve_reference_at(s, *refs[i], k, o);
         solve_modal_reference_at(s, *refs[i], k);
         {
@@ -1071,10 +1085,10 @@ SceneResult run_scene(const Scene& s, const HarnessOptions& o) {
   std::ostream& log = o.log ? *o.log : null_stream;
   Stopwatch total;
   log << "scene " << s.name << ": " << describe(s.vessel) << "\n";
-  const std::unique_ptr<SceneReferences> refs = scene_meshes(s, o);
+  const std::unique_ptr<SceneReferences> refs = scene_meshes(s, o, log);
   const std::size_t reference_steps = s.poisson_ratios.size() * (s.modes.count > 0 ? 2 : 1);
   Progress progress(log, reference_steps + model_cases(s, o));
-  SceneResult result = run_models(s, *refs, o, progress, true, log);
+  SceneResult result = run_models(*refs, o, progress, true, log);
   result.seconds = total.seconds();
   return result;
 }
@@ -1093,13 +1107,13 @@ std::vector<SceneResult> run_scenes(const std::vector<Scene>& scenes, const Harn
   // The references first, in parallel (untimed), then each scene's models alone: their set-up
   // and update times are measurements and must not share the cores.
   std::vector<std::unique_ptr<SceneReferences>> refs;
-  for (const Scene& s : scenes) refs.push_back(scene_meshes(s, o));
-  solve_all_references(scenes, refs, o, log);
+  for (const Scene& s : scenes) refs.push_back(scene_meshes(s, o, log));
+  solve_all_references(refs, o, log);
   for (std::size_t i = 0; i < scenes.size(); ++i) {
     Stopwatch clock;
     log_scene_header(log, scenes[i], i, scenes.size());
     Progress progress(log, model_cases(scenes[i], o));
-    results.push_back(run_models(scenes[i], *refs[i], o, progress, false, log));
+    results.push_back(run_models(*refs[i], o, progress, false, log));
     double solved = 0.0;
     for (const auto& a : refs[i]->at_nu) solved += a.seconds;
     results.back().seconds = clock.seconds() + solved;

@@ -239,7 +239,62 @@ class TableReader {
   std::vector<std::string> known_;
 };
 
-VesselParams read_vessel(TableReader r, std::vector<int>& levels, int& reference_level) {
+/// A vessel from a file (`file = "x.msh"` or `lumen = "x.stl"`), paths relative to the scene's
+/// folder. A mesh file is used as given: its one level is 0, and a scene asking for another is an
+/// error. A lumen needs its wall_thickness (m) and may say `units = "mm"`; levels refine it.
+VesselParams read_file_vessel(TableReader& r, const std::string& scene_file,
+                              std::vector<int>& levels, int& reference_level) {
+  VesselParams p;
+  const toml::node* file = r.get("file");
+  const toml::node* lumen = r.get("lumen");
+  if (file && lumen) {
+    r.fail(lumen, "lumen", "found with `file`; expected one of them: a tet mesh (.msh) or a lumen surface (STL)");
+  }
+  const std::string key = file ? "file" : "lumen";
+  const auto name = (file ? file : lumen)->value_exact<std::string>();
+  if (!name || name->empty()) {
+    r.fail(file ? file : lumen, key, "found " + show(file ? *file : *lumen) + ", expected a file name");
+  }
+  p.file = *name;
+  if (p.file.is_relative()) p.file = std::filesystem::path(scene_file).parent_path() / p.file;
+  p.kind = file ? VesselKind::mesh_file : VesselKind::lumen;
+  p.style = MeshStyle::unstructured;
+  levels = r.integers_or("level", {0}, 0, kMaxMeshLevel);
+  std::sort(levels.begin(), levels.end());
+  levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+  reference_level =
+      static_cast<int>(r.integer_or("reference_level", levels.back(), 0, kMaxMeshLevel));
+  if (file) {
+    if (levels != std::vector<int>{0} || reference_level != 0) {
+      r.fail(r.table().get(levels != std::vector<int>{0} ? "level" : "reference_level"),
+             levels != std::vector<int>{0} ? "level" : "reference_level",
+             "found a level other than 0 with a mesh file; expected 0 or none (a .msh file is "
+             "used as given, its one level: mesh it finer yourself, or give a lumen STL, which "
+             "levels refine)");
+    }
+    // Optional: the surface models' shell thickness; else estimated from the mesh
+    // (file_vessel_wall_thickness).
+    p.wall_thickness = r.positive("wall_thickness", 0.0, "m");
+  } else {
+    const toml::node* t = r.get("wall_thickness");
+    if (!t) r.fail(nullptr, "wall_thickness", "missing; a lumen needs the wall's thickness (m) to extrude it outward");
+    p.wall_thickness = r.positive("wall_thickness", 0.0, "m");
+    const std::string units = r.string_or("units", "m", {"m", "mm"});
+    p.file_scale = units == "mm" ? 1e-3 : 1.0;
+  }
+  p.level = levels.front();
+  r.finish();
+  if (!std::filesystem::exists(p.file)) {
+    r.fail(file ? file : lumen, key, "file " + p.file.string() + " not found");
+  }
+  return p;
+}
+
+VesselParams read_vessel(TableReader r, std::vector<int>& levels, int& reference_level,
+                         const std::string& scene_file) {
+  if (r.table().contains("file") || r.table().contains("lumen")) {
+    return read_file_vessel(r, scene_file, levels, reference_level);
+  }
   VesselParams p;
   const std::string kind = r.string_or("kind", "straight", {"straight", "arch"});
   p.kind = kind == "arch" ? VesselKind::arch : VesselKind::straight;
@@ -602,7 +657,8 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
   scene.name = r.string_or("name", "");
   if (scene.name.empty()) r.fail(nullptr, "name", "missing; expected the scene's name");
   scene.description = r.string_or("description", "");
-  scene.vessel = read_vessel(r.sub("vessel", true), scene.model_levels, scene.reference_level);
+  scene.vessel =
+      read_vessel(r.sub("vessel", true), scene.model_levels, scene.reference_level, source_name);
 
   TableReader material = r.sub("material", false);
   scene.youngs_modulus = material.positive("E", scene.youngs_modulus, "Pa");

@@ -10,13 +10,17 @@
 namespace vessel {
 
 Vec3 default_contact_point(const VesselParams& v, const std::string& surface_group) {
+  if (!v.parametric()) {
+    throw InputError(describe(v) + ": no default contact point on a vessel from a file; expected "
+                     "the point to be given (it is moved onto the wall)");
+  }
   const double r = surface_group == group_names::outer_wall ? v.outer_radius() : v.inner_radius;
   if (v.kind == VesselKind::straight) return {r, 0.0, 0.5 * v.length};
   return {0.0, v.bend_radius + r, 0.0};
 }
 
 Vec3 qoi_point(const Scene& s) {
-  if (s.load.kind == LoadKind::contact) return s.load.contact.point;
+  if (s.load.kind == LoadKind::contact || !s.vessel.parametric()) return s.load.contact.point;
   return default_contact_point(s.vessel, std::string(group_names::inner_wall));
 }
 
@@ -37,6 +41,27 @@ TetMesh scene_mesh(const Scene& s, int level, const std::filesystem::path& cache
   VesselParams p = s.vessel;
   p.level = level;
   return load_or_generate_vessel(p, cache_dir, {});
+}
+
+Scene resolve_file_vessel(Scene s, const TetMesh& mesh) {
+  if (s.vessel.parametric()) return s;
+  const std::string source = s.source.string() + ": " + describe(s.vessel);
+  const auto project = [&](LoadSpec& l) {
+    l.contact.point = nearest_point_on_group(mesh, l.contact.surface_group, l.contact.point, source);
+  };
+  if (s.load.kind == LoadKind::contact) {
+    project(s.load);
+  } else {
+    Vec3 centroid = Vec3::Zero();
+    for (const Vec3& x : mesh.nodes) centroid += x;
+    centroid /= static_cast<double>(mesh.nodes.size());
+    s.load.contact.point =
+        nearest_point_on_group(mesh, std::string(group_names::inner_wall), centroid, source);
+  }
+  for (LoadSpec& l : s.constant_loads) {
+    if (l.kind == LoadKind::contact) project(l);
+  }
+  return s;
 }
 
 Supports scene_supports(const Scene& s) {
@@ -124,11 +149,15 @@ msm::NetworkOptions network_options(const Scene& s, const ModelSpec& model, doub
 
 msm::BuiltNetwork scene_network(const Scene& s, const ModelSpec& model, const TetMesh& mesh,
                                 const VesselParams& vessel, double nu) {
-  msm::BuiltNetwork built = msm::build_network(mesh, vessel, network_options(s, model, nu));
+  VesselParams v = vessel;
+  if (v.kind == VesselKind::mesh_file && v.wall_thickness <= 0.0) {
+    v.wall_thickness = estimate_wall_thickness(mesh, v.file.string());
+  }
+  msm::BuiltNetwork built = msm::build_network(mesh, v, network_options(s, model, nu));
   if (!model.calibration.empty()) {
     const std::string source = s.source.string() + ": model " + model.name + ": calibration " +
                                model.calibration.string();
-    apply_calibration(read_calibration(model.calibration), source, built, mesh, vessel, model,
+    apply_calibration(read_calibration(model.calibration), source, built, mesh, v, model,
                       s.youngs_modulus, nu, model.calibration_transfer);
   }
   return built;

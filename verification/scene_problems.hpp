@@ -16,12 +16,20 @@ namespace vessel {
 
 /// Where a contact pushes when no point is given: on the named wall (inner_wall or outer_wall,
 /// radius a or b) at mid-length on the θ = 0 side: (r, 0, L/2) on the tube, the outer bend's
-/// apex (0, R + r, 0) on the arch.
+/// apex (0, R + r, 0) on the arch. InputError for a vessel from a file (its point must be given).
 Vec3 default_contact_point(const VesselParams& vessel, const std::string& surface_group);
 
 /// Where a scene's "contact-point displacement" (its QoI) is read: the contact point, or for
-/// distributed loads the inner wall's default contact point.
+/// distributed loads the inner wall's default contact point. For a vessel from a file, the point
+/// resolve_file_vessel put in load.contact.point.
 Vec3 qoi_point(const Scene& scene);
+
+/// A vessel from a file (mesh or lumen) has no parametric wall, so its points come from its mesh
+/// (the scene's reference mesh, the same for every level): a contact point (also of the constant
+/// loads) moves to the nearest point of its wall group (`surface`: inner_wall or outer_wall); for
+/// a distributed load the QoI becomes the point of the inner wall nearest the centroid of the
+/// wall's nodes, kept in load.contact.point. A parametric vessel's scene is returned unchanged.
+Scene resolve_file_vessel(Scene scene, const TetMesh& mesh);
 
 /// The node of `nodes` nearest `point` (the first of equals): where a point's displacement is read.
 std::size_t nearest_node(const std::vector<Vec3>& nodes, const Vec3& point);
@@ -48,6 +56,8 @@ msm::NetworkOptions network_options(const Scene& scene, const ModelSpec& model, 
 
 /// The network of a mass-spring model of the scene on `mesh` (vessel at the mesh's level) at ν,
 /// with the model's calibration file applied when it names one (verification/calibration_file).
+/// A mesh file without a wall_thickness gets estimate_wall_thickness(mesh) (the surface models'
+/// shell thickness).
 msm::BuiltNetwork scene_network(const Scene& scene, const ModelSpec& model, const TetMesh& mesh,
                                 const VesselParams& vessel, double nu);
 

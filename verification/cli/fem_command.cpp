@@ -79,6 +79,7 @@ bool has_load(const FemCommandOptions& o, const std::string& name) {
 /// "roller" for pressure alone, "clamped" otherwise (--bc auto); else --bc itself.
 std::string end_condition_name(const FemCommandOptions& o) {
   if (o.bc != "auto") return o.bc;
+  if (!o.vessel.params.parametric()) return "clamped";  // rollers need the straight tube's ends
   return has_load(o, "pressure") && o.loads.size() == 1 ? "roller" : "clamped";
 }
 
@@ -94,10 +95,9 @@ LoadSpec command_load(const FemCommandOptions& o, const std::string& name) {
     l.magnitudes = {o.force};
     l.contact.surface_group = o.contact_surface;
     l.contact.radius = o.contact_radius;
-    l.contact.point = default_contact_point(o.vessel.params, o.contact_surface);
-    if (!o.contact_point.empty()) {
-      l.contact.point = {o.contact_point[0], o.contact_point[1], o.contact_point[2]};
-    }
+    l.contact.point = o.contact_point.empty()
+                          ? default_contact_point(o.vessel.params, o.contact_surface)
+                          : Vec3(o.contact_point[0], o.contact_point[1], o.contact_point[2]);
   } else {
     const Vec3 g(o.gravity[0], o.gravity[1], o.gravity[2]);
     if (!g.allFinite()) throw InputError("--gravity: expected three finite numbers, m/s²");
@@ -427,7 +427,8 @@ void run(FemCommandOptions& o) {
           : mesh_vessel(o.vessel, std::cout, &source);
   FemRunRecord run = run_record(o, mesh, source.cache_hit, since(t0));
   std::cout << "mesh: " << mesh.nodes.size() << " nodes, " << mesh.tets.size() << " tets\n";
-  const Scene scene = command_scene(o);
+  // A vessel from a file: the contact point moves onto the chosen wall of its mesh.
+  const Scene scene = resolve_file_vessel(command_scene(o), mesh);
   const fem::ElasticityProblem problem = command_problem(o, scene, mesh);
   run.contact = contact_record(scene, problem);
   std::cout << std::setprecision(6) << "material: E " << o.youngs_modulus << " Pa, nu "
@@ -578,6 +579,7 @@ void add_fem_command(CLI::App& app) {
       "--history-csv h.csv\n"
       "  mpirun -np 2 vesselverify fem --distributed --degree 2 --level 1 --load contact");
   add_vessel_options(*cmd, o->vessel);
+  add_mesh_file_option(*cmd, o->vessel);
   add_material_options(cmd, *o);
   add_load_options(cmd, *o);
   add_solver_options(cmd, *o);

@@ -129,7 +129,9 @@ void run(MeshCommandOptions& o) {
     std::cout << "  structured grid " << c.circumferential << " circumferential × " << c.axial
               << " axial × " << c.radial << " radial divisions\n";
   }
-  nlohmann::json groups = report_groups(mesh, generated ? &params : nullptr, std::cout);
+  // Closed forms exist for the parametric vessels only (not for a --lumen wall).
+  nlohmann::json groups =
+      report_groups(mesh, generated && params.parametric() ? &params : nullptr, std::cout);
 
   std::vector<Triangle> wall_surface;
   for (const auto& name : {group_names::inlet, group_names::outlet, group_names::inner_wall,

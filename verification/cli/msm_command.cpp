@@ -406,7 +406,8 @@ void run(MsmOptions& o) {
   TriangleSurface stl_surface;
   const TetMesh mesh = load_mesh(o, stl_surface);
   std::cout << std::defaultfloat << std::setprecision(6);
-  const Scene scene = command_scene(o, stl);
+  // A --lumen vessel: the contact point moves onto the chosen wall of its mesh.
+  const Scene scene = resolve_file_vessel(command_scene(o, stl), mesh);
   MsmRunRecord run;
   run.vessel = scene.vessel;
   run.model = o.model;

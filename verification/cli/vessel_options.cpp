@@ -2,6 +2,8 @@
 
 #include <iomanip>
 
+#include "meshes/errors.hpp"
+
 namespace vessel::cli {
 
 void add_vessel_options(CLI::App& cmd, VesselOptions& o) {
@@ -20,6 +22,13 @@ void add_vessel_options(CLI::App& cmd, VesselOptions& o) {
   cmd.add_option("--length", p.length, "Straight tube length, metres")->capture_default_str();
   cmd.add_option("--bend-radius", p.bend_radius, "Arch centreline radius, metres")
       ->capture_default_str();
+  cmd.add_option("--lumen", o.lumen,
+                 "An STL lumen surface (open at its ends, normals outward) instead of --vessel: "
+                 "the wall is extruded outward by --wall-thickness; inlet = the largest end, "
+                 "outlet = the others; --level subdivides the lumen");
+  cmd.add_option("--units", o.units, "Length unit of the --lumen file: m or mm")
+      ->check(CLI::IsMember({"m", "mm"}))
+      ->capture_default_str();
   cmd.add_option("--cache-dir", o.cache_dir,
                  "Directory of cached generated meshes (env VESSELVERIFY_CACHE_DIR)")
       ->capture_default_str();
@@ -27,9 +36,25 @@ void add_vessel_options(CLI::App& cmd, VesselOptions& o) {
   cmd.add_flag("--gmsh-log", o.meshing.verbose, "Show gmsh's own log");
 }
 
+void add_mesh_file_option(CLI::App& cmd, VesselOptions& o) {
+  cmd.add_option("--input", o.mesh_file,
+                 "A vessel mesh (.msh 2.2/4.1 ASCII, linear tets, groups inlet, outlet, "
+                 "inner_wall, outer_wall, wall) instead of --vessel, used as given (level 0)");
+}
+
 VesselParams resolve(VesselOptions& o) {
   o.params.kind = o.vessel == "arch" ? VesselKind::arch : VesselKind::straight;
   o.params.style = o.structured ? MeshStyle::structured : MeshStyle::unstructured;
+  if (!o.mesh_file.empty() && !o.lumen.empty()) {
+    throw InputError("--input and --lumen: expected one vessel file, got both");
+  }
+  if (!o.mesh_file.empty() || !o.lumen.empty()) {
+    if (o.structured) throw InputError("--structured: a vessel from a file has its own mesh");
+    o.params.kind = o.mesh_file.empty() ? VesselKind::lumen : VesselKind::mesh_file;
+    o.params.file = o.mesh_file.empty() ? o.lumen : o.mesh_file;
+    o.params.file_scale = o.units == "mm" ? 1e-3 : 1.0;
+    o.params.style = MeshStyle::unstructured;
+  }
   validate(o.params);
   return o.params;
 }

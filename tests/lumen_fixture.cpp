@@ -1,0 +1,119 @@
+#include "lumen_fixture.hpp"
+
+#include <gmsh.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+
+namespace vessel::test {
+
+namespace {
+
+/// The point of the torus segment's centreline circle (radius R about z, in z = 0) nearest p.
+Vec3 on_centreline(double R, const Vec3& p) {
+  const Vec3 planar(p.x(), p.y(), 0.0);
+  return planar.norm() > 0.0 ? Vec3(R * planar.normalized()) : Vec3(R, 0.0, 0.0);
+}
+
+}  // namespace
+
+TriangleSurface bifurcation_lumen(const BifurcationSpec& b) {
+  gmsh::initialize(0, nullptr, false);
+  gmsh::option::setNumber("General.Terminal", 0);
+  gmsh::option::setNumber("General.NumThreads", 1);
+  gmsh::model::add("bifurcation");
+  namespace occ = gmsh::model::occ;
+  const int torus = occ::addTorus(0, 0, 0, b.bend_radius, b.radius, -1, b.angle);
+  const double phi = 0.5 * b.angle;
+  const Vec3 dir(std::cos(phi), std::sin(phi), 0.0);
+  const Vec3 start = b.bend_radius * dir;  // on the centreline: the cylinder's cap lies inside
+  const Vec3 axis = (b.radius + b.branch_length) * dir;
+  const int branch = occ::addCylinder(start.x(), start.y(), start.z(), axis.x(), axis.y(),
+                                      axis.z(), b.branch_radius);
+  gmsh::vectorpair out;
+  std::vector<gmsh::vectorpair> out_map;
+  occ::fuse({{3, torus}}, {{3, branch}}, out, out_map);
+  occ::synchronize();
+  gmsh::option::setNumber("Mesh.MeshSizeMax", b.mesh_size);
+  gmsh::option::setNumber("Mesh.MeshSizeMin", 0.5 * b.mesh_size);
+  gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
+  gmsh::model::mesh::generate(2);
+
+  TriangleSurface s;
+  std::map<std::size_t, int> index;
+  gmsh::vectorpair faces;
+  gmsh::model::getEntities(faces, 2);
+  for (const auto& [dim, tag] : faces) {
+    std::string type;
+    gmsh::model::getType(dim, tag, type);
+    if (type == "Plane") continue;  // the three caps: the ends stay open
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> elements, nodes;
+    gmsh::model::mesh::getElements(types, elements, nodes, 2, tag);
+    std::vector<Triangle> face;
+    for (std::size_t k = 0; k < types.size(); ++k) {
+      if (types[k] != 2) continue;  // 3-node triangles
+      for (std::size_t e = 0; e + 2 < nodes[k].size(); e += 3) {
+        Triangle t{};
+        for (int c = 0; c < 3; ++c) {
+          const std::size_t node = nodes[k][e + c];
+          auto [it, inserted] = index.emplace(node, static_cast<int>(s.nodes.size()));
+          if (inserted) {
+            std::vector<double> x, param;
+            gmsh::model::mesh::getNode(node, x, param);
+            s.nodes.emplace_back(x[0], x[1], x[2]);
+            s.source_node.push_back(-1);
+          }
+          t[c] = it->second;
+        }
+        face.push_back(t);
+      }
+    }
+    // A face lies on the torus or on the branch's cylinder: whichever its triangles are nearer.
+    double to_torus = 0.0, to_branch = 0.0;
+    for (const Triangle& t : face) {
+      const Vec3 c = (s.nodes[t[0]] + s.nodes[t[1]] + s.nodes[t[2]]) / 3.0;
+      to_torus += std::abs((c - on_centreline(b.bend_radius, c)).norm() - b.radius);
+      to_branch += std::abs((c - (start + (c - start).dot(dir) * dir)).norm() - b.branch_radius);
+    }
+    const bool on_branch = to_branch < to_torus;
+    for (Triangle t : face) {
+      // Outward: away from the axis of the part the triangle lies on.
+      const Vec3 c = (s.nodes[t[0]] + s.nodes[t[1]] + s.nodes[t[2]]) / 3.0;
+      const Vec3 outward = on_branch ? Vec3(c - (start + (c - start).dot(dir) * dir))
+                                     : Vec3(c - on_centreline(b.bend_radius, c));
+      const Vec3 n = (s.nodes[t[1]] - s.nodes[t[0]]).cross(s.nodes[t[2]] - s.nodes[t[0]]);
+      if (n.dot(outward) < 0.0) std::swap(t[1], t[2]);
+      s.triangles.push_back(t);
+    }
+  }
+  gmsh::finalize();
+  return s;
+}
+
+void write_bifurcation_stl(const std::filesystem::path& path, const BifurcationSpec& spec) {
+  write_stl(path, bifurcation_lumen(spec), StlFormat::binary);
+}
+
+TriangleSurface polygon_tube(double radius, double length, int sides, int rings) {
+  TriangleSurface s;
+  for (int j = 0; j <= rings; ++j) {
+    for (int i = 0; i < sides; ++i) {
+      const double th = 2.0 * std::numbers::pi * i / sides;
+      s.nodes.emplace_back(radius * std::cos(th), radius * std::sin(th), length * j / rings);
+      s.source_node.push_back(-1);
+    }
+  }
+  const auto id = [sides](int i, int j) { return j * sides + (i % sides); };
+  for (int j = 0; j < rings; ++j) {
+    for (int i = 0; i < sides; ++i) {
+      // Counter-clockwise seen from outside: (i, j), (i+1, j), (i+1, j+1) has normal +radial.
+      s.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      s.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  }
+  return s;
+}
+
+}  // namespace vessel::test
