@@ -18,7 +18,9 @@
 namespace vessel {
 
 enum class LoadKind { contact, pressure, gravity };
-enum class ModelKind { fem, surface_msm, volume_msm };
+/// network: a spring network read from a file (msm/model/network_file.hpp), run by the suite's
+/// own solvers like the built-in mass-spring models.
+enum class ModelKind { fem, surface_msm, volume_msm, network };
 
 /// One model to run against the reference. FEM models use `degree`; mass-spring models use the
 /// rest. A [[models]] table whose stiffness, mass, solver, dt or degree is an array expands into
@@ -50,6 +52,10 @@ struct ModelSpec {
   std::filesystem::path calibration;
   /// Apply a group calibration to a mesh other than the one it was fitted on (its hash differs).
   bool calibration_transfer = false;
+  /// kind network: the spring-network file (.json or .vtu; docs/network_format.md), relative
+  /// paths resolved against the scene file's folder. Its springs, masses and supports replace
+  /// the stiffness, mass and topology keys.
+  std::filesystem::path network_file;
 };
 
 struct LoadSpec {

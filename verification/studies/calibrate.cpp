@@ -257,9 +257,10 @@ const ModelSpec& pick_model(const Scene& s, const std::string& name) {
   if (!name.empty()) {
     for (const ModelSpec& m : s.models) {
       if (m.name != name) continue;
-      if (m.kind == ModelKind::fem) {
-        throw InputError("calibrate: --model " + name +
-                         " is a FEM model; expected a surface_msm or volume_msm model");
+      if (m.kind == ModelKind::fem || m.kind == ModelKind::network) {
+        throw InputError("calibrate: --model " + name + " is a " + to_string(m.kind) +
+                         " model; expected a surface_msm or volume_msm model (a network file's "
+                         "stiffness is the file's own)");
       }
       return m;
     }
@@ -272,7 +273,7 @@ const ModelSpec& pick_model(const Scene& s, const std::string& name) {
     if (m.volume_term) return m;
   }
   for (const ModelSpec& m : s.models) {
-    if (m.kind != ModelKind::fem) return m;
+    if (m.kind != ModelKind::fem && m.kind != ModelKind::network) return m;
   }
   throw InputError("calibrate: " + s.source.string() + " has no mass-spring model to calibrate");
 }
