@@ -178,10 +178,8 @@ class VtuParser {
           fail(tag_pos, "VTKFile type \"" + attribute(tag, "type") +
                             "\"; expected \"UnstructuredGrid\" (a .vtu file)");
         }
-        if (!attribute(tag, "compressor").empty()) {
-          fail(tag_pos, "compressed data (compressor \"" + attribute(tag, "compressor") +
-                            "\"); expected uncompressed ASCII data arrays");
-        }
+        // VTK names a compressor even for ASCII files; it applies only to binary arrays, which
+        // each DataArray's format check refuses.
       } else if (tag.name == "AppendedData") {
         fail(tag_pos, "appended (binary) data; expected ASCII data arrays (format=\"ascii\"; in "
                       "ParaView: Save Data with Data Mode \"Ascii\")");

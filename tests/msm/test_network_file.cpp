@@ -355,3 +355,23 @@ TEST(NetworkFile, NodesOnTheMeshAreMatchedAndNodesOutsideAreNamed) {
     EXPECT_NE(m.find("up to 2 mm"), std::string::npos) << m;
   }
 }
+
+TEST(NetworkFile, AnAsciiVtuWrittenByVtkItselfReadsToTheValuesItWasGiven) {
+  // tests/fixtures/network_by_vtk.vtu: written by VTK 9.1's vtkXMLUnstructuredGridWriter in ASCII
+  // mode (tests/fixtures/make_network_by_vtk.py), as ParaView saves: Int32 and Int64 arrays, a
+  // compressor attribute, and an InformationKey inside the points.
+  const NetworkFile f = read_network_file(std::string(VESSEL_TEST_FIXTURES) + "/network_by_vtk.vtu");
+  ASSERT_EQ(f.network.nodes.size(), 4u);
+  EXPECT_EQ(f.network.nodes[2], Vec3(0.0035, 0.0, 0.001));
+  EXPECT_EQ(f.masses, (std::vector<double>{1e-6, 2e-6, 3e-6, 4e-6}));
+  ASSERT_EQ(f.network.springs.size(), 4u);
+  EXPECT_EQ(f.network.springs[3].a, 3);
+  EXPECT_EQ(f.network.springs[3].b, 0);
+  EXPECT_EQ(f.network.springs[3].law.k1, 40.5);
+  EXPECT_EQ(f.network.springs[3].rest_length, 0.0005);
+  EXPECT_TRUE(std::isinf(f.network.springs[0].law.threshold));
+  EXPECT_EQ(f.network.springs[1].law.k2, 60.0);
+  EXPECT_EQ(f.network.springs[1].law.threshold, 1e-4);
+  EXPECT_EQ(f.supports.fixed_nodes, std::vector<int>{0});
+  EXPECT_EQ(f.supports.follow_groups, std::vector<std::string>{"inlet"});
+}
