@@ -68,16 +68,46 @@ std::vector<char> in_groups(const TetMesh& mesh, const std::vector<int>& source_
 
 }  // namespace
 
-std::vector<char> held_dofs(const TetMesh& mesh, const std::vector<Vec3>& nodes,
-                            const std::vector<int>& source_node, const Supports& supports) {
-  if (source_node.size() != nodes.size()) {
-    throw InputError("supports: one source node per node expected (" +
-                     std::to_string(source_node.size()) + " for " + std::to_string(nodes.size()) +
-                     " nodes)");
+namespace {
+
+/// Nodes within `tolerance` (m) of one of the groups' triangles.
+std::vector<char> on_groups(const TetMesh& mesh, const std::vector<Vec3>& nodes,
+                            const std::vector<std::string>& groups, double tolerance) {
+  std::vector<char> member(nodes.size(), 0);
+  for (const auto& name : groups) {
+    const std::vector<Triangle> tris = mesh.group_triangles(mesh.require_group(name, 2, "support"));
+    if (tris.empty()) continue;
+    Vec3 lo = mesh.nodes[static_cast<std::size_t>(tris[0][0])], hi = lo;
+    for (const Triangle& t : tris) {
+      for (const int v : t) {
+        lo = lo.cwiseMin(mesh.nodes[static_cast<std::size_t>(v)]);
+        hi = hi.cwiseMax(mesh.nodes[static_cast<std::size_t>(v)]);
+      }
+    }
+    lo -= Vec3::Constant(tolerance);
+    hi += Vec3::Constant(tolerance);
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      const Vec3& x = nodes[i];
+      if (member[i] || (x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
+      for (const Triangle& t : tris) {
+        const Vec3 c = closest_point_on_triangle(mesh.nodes[static_cast<std::size_t>(t[0])],
+                                                 mesh.nodes[static_cast<std::size_t>(t[1])],
+                                                 mesh.nodes[static_cast<std::size_t>(t[2])], x);
+        if ((c - x).norm() <= tolerance) {
+          member[i] = 1;
+          break;
+        }
+      }
+    }
   }
+  return member;
+}
+
+/// Held dofs from group membership: clamped nodes in every component, roller nodes in z, each pin
+/// at the roller node nearest its point.
+std::vector<char> held_from(const std::vector<Vec3>& nodes, const std::vector<char>& clamped,
+                            const std::vector<char>& rollers, const Supports& supports) {
   std::vector<char> held(3 * nodes.size(), 0);
-  const auto clamped = in_groups(mesh, source_node, supports.clamped);
-  const auto rollers = in_groups(mesh, source_node, supports.rollers);
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     if (clamped[i]) held[3 * i] = held[3 * i + 1] = held[3 * i + 2] = 1;
     if (rollers[i]) held[3 * i + Supports::kRollerComponent] = 1;
@@ -98,6 +128,25 @@ std::vector<char> held_dofs(const TetMesh& mesh, const std::vector<Vec3>& nodes,
     held[3 * best + static_cast<std::size_t>(pin.component)] = 1;
   }
   return held;
+}
+
+}  // namespace
+
+std::vector<char> held_dofs(const TetMesh& mesh, const std::vector<Vec3>& nodes,
+                            const std::vector<int>& source_node, const Supports& supports) {
+  if (source_node.size() != nodes.size()) {
+    throw InputError("supports: one source node per node expected (" +
+                     std::to_string(source_node.size()) + " for " + std::to_string(nodes.size()) +
+                     " nodes)");
+  }
+  return held_from(nodes, in_groups(mesh, source_node, supports.clamped),
+                   in_groups(mesh, source_node, supports.rollers), supports);
+}
+
+std::vector<char> held_dofs_by_position(const TetMesh& mesh, const std::vector<Vec3>& nodes,
+                                        const Supports& supports, double tolerance) {
+  return held_from(nodes, on_groups(mesh, nodes, supports.clamped, tolerance),
+                   on_groups(mesh, nodes, supports.rollers, tolerance), supports);
 }
 
 std::vector<std::size_t> nodes_beyond_plane_z(const std::vector<Vec3>& nodes, double z,

@@ -60,6 +60,13 @@ Supports end_supports(const VesselParams& vessel, const std::map<std::string, En
 std::vector<char> held_dofs(const TetMesh& mesh, const std::vector<Vec3>& nodes,
                             const std::vector<int>& source_node, const Supports& supports);
 
+/// The same supports on nodes that need not be mesh nodes (a spring network from a file): a node
+/// is in a group when it lies within `tolerance` (m) of one of the group's triangles; clamped,
+/// roller and pin rules as in held_dofs. Throws InputError if a group is missing or a pin finds
+/// no node.
+std::vector<char> held_dofs_by_position(const TetMesh& mesh, const std::vector<Vec3>& nodes,
+                                        const Supports& supports, double tolerance);
+
 /// The nodes at or below the plane z = `z` (`below`), else at or above it.
 std::vector<std::size_t> nodes_beyond_plane_z(const std::vector<Vec3>& nodes, double z, bool below);
 

@@ -1,11 +1,11 @@
 #include "meshes/vtu_io.hpp"
 
+#include <algorithm>
 #include <cctype>
-#include <cerrno>
-#include <optional>
 #include <charconv>
-#include <cstdlib>
+#include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -32,10 +32,12 @@ void check(const VtuField& f, std::size_t count, const char* kind) {
   }
 }
 
-void write_fields(std::ostream& out, const std::vector<VtuField>& fields) {
+void write_fields(std::ostream& out, const std::vector<VtuField>& fields, bool tuples = false) {
   for (const auto& f : fields) {
     out << "        <DataArray type=\"Float64\" Name=\"" << f.name
-        << "\" NumberOfComponents=\"" << f.components << "\" format=\"ascii\">\n";
+        << "\" NumberOfComponents=\"" << f.components << "\"";
+    if (tuples) out << " NumberOfTuples=\"" << f.values.size() / f.components << "\"";
+    out << " format=\"ascii\">\n";
     for (std::size_t i = 0; i < f.values.size(); ++i) {
       put(out, f.values[i]);
       out << ((i + 1) % static_cast<std::size_t>(f.components) == 0 ? '\n' : ' ');
@@ -48,7 +50,8 @@ void write_fields(std::ostream& out, const std::vector<VtuField>& fields) {
 
 void write_vtu(const std::filesystem::path& path, const std::vector<Vec3>& points,
                const VtuCells& cells, const std::vector<VtuField>& point_fields,
-               const std::vector<VtuField>& cell_fields) {
+               const std::vector<VtuField>& cell_fields,
+               const std::vector<VtuField>& field_data) {
   const auto per_cell = static_cast<std::size_t>(cells.points_per_cell);
   if (per_cell == 0 || cells.connectivity.size() % per_cell != 0) {
     throw std::invalid_argument("VTU cells: " + std::to_string(cells.connectivity.size()) +
@@ -64,11 +67,23 @@ void write_vtu(const std::filesystem::path& path, const std::vector<Vec3>& point
   const std::size_t n_cells = cells.connectivity.size() / per_cell;
   for (const auto& f : point_fields) check(f, points.size(), "point");
   for (const auto& f : cell_fields) check(f, n_cells, "cell");
+  for (const auto& f : field_data) {
+    if (f.components < 1 || f.values.empty() || f.values.size() % f.components != 0) {
+      throw std::invalid_argument("VTU field data '" + f.name + "' has " +
+                                  std::to_string(f.values.size()) + " values, expected tuples of " +
+                                  std::to_string(f.components));
+    }
+  }
   write_file_atomically(path, [&](std::ostream& out) {
     out << "<?xml version=\"1.0\"?>\n"
         << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-        << "  <UnstructuredGrid>\n"
-        << "    <Piece NumberOfPoints=\"" << points.size() << "\" NumberOfCells=\"" << n_cells
+        << "  <UnstructuredGrid>\n";
+    if (!field_data.empty()) {
+      out << "    <FieldData>\n";
+      write_fields(out, field_data, true);
+      out << "    </FieldData>\n";
+    }
+    out << "    <Piece NumberOfPoints=\"" << points.size() << "\" NumberOfCells=\"" << n_cells
         << "\">\n";
     out << "      <PointData>\n";
     write_fields(out, point_fields);
@@ -118,200 +133,289 @@ void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
 
 namespace {
 
-/// A minimal reader of the XML VTK writes: tags and their attributes, no entities or CDATA.
-struct VtuText {
-  std::string text;
-  std::string file;
+/// A minimal reader of the XML that VTU files are: elements with attributes, and the text of
+/// DataArray elements. Comments and processing instructions are skipped.
+class VtuParser {
+ public:
+  VtuParser(std::string text, std::string file) : text_(std::move(text)), file_(std::move(file)) {}
 
-  [[noreturn]] void fail(const std::string& what) const {
-    throw InputError(file + ": " + what);
+  [[noreturn]] void fail(std::size_t pos, const std::string& what) const {
+    const auto line = 1 + std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(
+                                                                     std::min(pos, text_.size())),
+                                     '\n');
+    throw InputError(file_ + ":" + std::to_string(line) + ": " + what);
   }
 
-  /// The attribute `name` of the tag starting at `tag` (up to its '>'), or "".
-  [[nodiscard]] std::string attribute(std::size_t tag, const std::string& name) const {
-    const std::size_t end = text.find('>', tag);
-    std::size_t at = tag;
-    while (true) {
-      at = text.find(name + "=", at);
-      if (at == std::string::npos || at > end) return "";
-      const char before = text[at - 1];
-      if (before == ' ' || before == '\t' || before == '\n' || before == '\r') break;
-      at += name.size();
-    }
-    const std::size_t q = at + name.size() + 1;
-    const char quote = text[q];
-    if (quote != '"' && quote != '\'') return "";
-    const std::size_t close = text.find(quote, q + 1);
-    return text.substr(q + 1, close - q - 1);
-  }
-
-  /// The body of the element `<name ...>...</name>` within [from, to), or nullopt; an empty
-  /// element `<name/>` gives an empty body.
-  [[nodiscard]] std::optional<std::pair<std::size_t, std::size_t>> element(
-      const std::string& name, std::size_t from, std::size_t to) const {
-    std::size_t at = from;
-    while (true) {
-      at = text.find("<" + name, at);
-      if (at == std::string::npos || at >= to) return std::nullopt;
-      const char next = text[at + 1 + name.size()];
-      if (next == ' ' || next == '>' || next == '/' || next == '\n' || next == '\t' || next == '\r') break;
-      ++at;
-    }
-    const std::size_t open_end = text.find('>', at);
-    if (open_end == std::string::npos) fail("unterminated <" + name + "> tag");
-    if (text[open_end - 1] == '/') return std::make_pair(open_end + 1, open_end + 1);
-    const std::size_t close = text.find("</" + name + ">", open_end);
-    if (close == std::string::npos || close > to) fail("<" + name + "> is not closed");
-    return std::make_pair(open_end + 1, close);
-  }
-
-  /// Every DataArray in [from, to): its name, components and values.
-  [[nodiscard]] std::vector<VtuField> arrays(std::size_t from, std::size_t to,
-                                             const std::string& where) const {
-    std::vector<VtuField> out;
-    std::size_t at = from;
-    while (true) {
-      const std::size_t tag = text.find("<DataArray", at);
-      if (tag == std::string::npos || tag >= to) break;
-      const auto body = element("DataArray", tag, to);
-      VtuField f;
-      f.name = attribute(tag, "Name");
-      const std::string format = attribute(tag, "format");
-      if (format != "ascii") {
-        fail(where + " DataArray '" + f.name + "': found format=\"" + format +
-             "\", expected format=\"ascii\" (binary and appended data are not read)");
+  VtuData parse() {
+    VtuData d;
+    std::vector<std::string> stack;
+    bool seen_file = false, seen_piece = false;
+    std::size_t n_points = 0, n_cells = 0, piece_pos = 0;
+    bool has_points = false;
+    std::size_t pos = 0;
+    while ((pos = text_.find('<', pos)) != std::string::npos) {
+      if (text_.compare(pos, 4, "<!--") == 0) {
+        pos = skip_to(pos, "-->");
+        continue;
       }
-      const std::string comps = attribute(tag, "NumberOfComponents");
-      f.components = comps.empty() ? 1 : std::atoi(comps.c_str());
-      if (f.components < 1) fail(where + " DataArray '" + f.name + "': NumberOfComponents \"" + comps + "\"");
-      const char* p = text.c_str() + body->first;
-      const char* end = text.c_str() + body->second;
-      while (true) {
-        while (p < end && std::isspace(static_cast<unsigned char>(*p))) ++p;
-        if (p >= end) break;
-        char* stop = nullptr;
-        errno = 0;
-        const double v = std::strtod(p, &stop);
-        if (stop == p || stop > end) {
-          fail(where + " DataArray '" + f.name + "': value " + std::to_string(f.values.size() + 1) +
-               " is not a number (\"" + std::string(p, std::min<std::size_t>(12, end - p)) + "\")");
+      if (text_.compare(pos, 2, "<?") == 0) {
+        pos = skip_to(pos, "?>");
+        continue;
+      }
+      const std::size_t tag_pos = pos;
+      Tag tag = read_tag(pos);
+      if (tag.closing) {
+        if (stack.empty() || stack.back() != tag.name) {
+          fail(tag_pos, "closing tag </" + tag.name + "> does not match the open element" +
+                            (stack.empty() ? std::string() : " <" + stack.back() + ">"));
         }
-        f.values.push_back(v);
-        p = stop;
+        stack.pop_back();
+        continue;
       }
-      out.push_back(std::move(f));
-      at = body->second;
+      if (tag.name == "VTKFile") {
+        seen_file = true;
+        if (attribute(tag, "type") != "UnstructuredGrid") {
+          fail(tag_pos, "VTKFile type \"" + attribute(tag, "type") +
+                            "\"; expected \"UnstructuredGrid\" (a .vtu file)");
+        }
+        // VTK names a compressor even for ASCII files; it applies only to binary arrays, which
+        // each DataArray's format check refuses.
+      } else if (tag.name == "AppendedData") {
+        fail(tag_pos, "appended (binary) data; expected ASCII data arrays (format=\"ascii\"; in "
+                      "ParaView: Save Data with Data Mode \"Ascii\")");
+      } else if (tag.name == "Piece") {
+        if (seen_piece) fail(tag_pos, "a second <Piece>; expected one piece");
+        seen_piece = true;
+        piece_pos = tag_pos;
+        n_points = count_attribute(tag, "NumberOfPoints", tag_pos);
+        n_cells = count_attribute(tag, "NumberOfCells", tag_pos);
+      } else if (tag.name == "DataArray") {
+        const std::string section = stack.empty() ? "" : stack.back();
+        VtuField f;
+        f.name = attribute(tag, "Name");
+        const std::string comps = attribute(tag, "NumberOfComponents");
+        f.components = comps.empty() ? 1 : static_cast<int>(count_attribute(tag, "NumberOfComponents", tag_pos));
+        if (f.components < 1) fail(tag_pos, "DataArray \"" + f.name + "\": NumberOfComponents 0; expected >= 1");
+        const std::string format = attribute(tag, "format");
+        if (format != "ascii") {
+          fail(tag_pos, "DataArray \"" + f.name + "\" has format \"" + format +
+                            "\"; expected format=\"ascii\" (in ParaView: Save Data with Data "
+                            "Mode \"Ascii\")");
+        }
+        if (!tag.self_closing) {
+          const std::size_t end = text_.find("</DataArray>", pos);
+          if (end == std::string::npos) fail(tag_pos, "DataArray \"" + f.name + "\" is not closed");
+          f.values = numbers(pos, end, f.name);
+          pos = end + std::string("</DataArray>").size();
+        }
+        if (f.values.size() % static_cast<std::size_t>(f.components) != 0) {
+          fail(tag_pos, "DataArray \"" + f.name + "\" has " + std::to_string(f.values.size()) +
+                            " values, not a multiple of its " + std::to_string(f.components) +
+                            " components");
+        }
+        if (section == "PointData") {
+          d.point_fields.push_back(std::move(f));
+        } else if (section == "CellData") {
+          d.cell_fields.push_back(std::move(f));
+        } else if (section == "FieldData") {
+          d.field_data.push_back(std::move(f));
+        } else if (section == "Points") {
+          if (f.components != 3) fail(tag_pos, "Points: expected 3 components per point");
+          has_points = true;
+          for (std::size_t i = 0; i < f.values.size(); i += 3) {
+            d.points.emplace_back(f.values[i], f.values[i + 1], f.values[i + 2]);
+          }
+        } else if (section == "Cells") {
+          if (f.name == "connectivity") {
+            d.connectivity = indices(f, tag_pos);
+          } else if (f.name == "offsets") {
+            d.offsets = indices(f, tag_pos);
+          } else if (f.name == "types") {
+            for (const std::size_t t : indices(f, tag_pos)) d.types.push_back(static_cast<int>(t));
+          }
+        }
+        continue;
+      }
+      if (!tag.self_closing) stack.push_back(tag.name);
+    }
+    if (!seen_file) fail(0, "no <VTKFile> element; expected a VTK XML unstructured grid (.vtu)");
+    if (!seen_piece) fail(0, "no <Piece>; expected one piece with points and cells");
+    if (!has_points) fail(piece_pos, "no <Points> data array");
+    if (d.points.size() != n_points) {
+      fail(piece_pos, "NumberOfPoints=" + std::to_string(n_points) + " but the Points array has " +
+                          std::to_string(d.points.size()) + " points");
+    }
+    if (d.offsets.size() != n_cells || d.types.size() != n_cells) {
+      fail(piece_pos, "NumberOfCells=" + std::to_string(n_cells) + " but the Cells have " +
+                          std::to_string(d.offsets.size()) + " offsets and " +
+                          std::to_string(d.types.size()) + " types");
+    }
+    std::size_t previous = 0;
+    for (std::size_t c = 0; c < n_cells; ++c) {
+      if (d.offsets[c] <= previous || d.offsets[c] > d.connectivity.size()) {
+        fail(piece_pos, "Cells: offset " + std::to_string(d.offsets[c]) + " of cell " +
+                            std::to_string(c) + " does not fit a connectivity of " +
+                            std::to_string(d.connectivity.size()) + " entries (expected ascending ends)");
+      }
+      previous = d.offsets[c];
+    }
+    if (n_cells > 0 && previous != d.connectivity.size()) {
+      fail(piece_pos, "Cells: the last offset " + std::to_string(previous) +
+                          " is not the connectivity's length " + std::to_string(d.connectivity.size()));
+    }
+    for (std::size_t k = 0; k < d.connectivity.size(); ++k) {
+      if (d.connectivity[k] >= n_points) {
+        fail(piece_pos, "Cells: connectivity entry " + std::to_string(k) + " names point " +
+                            std::to_string(d.connectivity[k]) + "; expected < " + std::to_string(n_points));
+      }
+    }
+    for (const auto& f : d.point_fields) check_count(f, n_points, "point", piece_pos);
+    for (const auto& f : d.cell_fields) check_count(f, n_cells, "cell", piece_pos);
+    return d;
+  }
+
+ private:
+  struct Tag {
+    std::string name;
+    bool closing = false;
+    bool self_closing = false;
+    std::map<std::string, std::string> attributes;
+  };
+
+  std::size_t skip_to(std::size_t pos, const char* end) const {
+    const std::size_t e = text_.find(end, pos);
+    if (e == std::string::npos) fail(pos, std::string("unterminated markup; expected ") + end);
+    return e + std::char_traits<char>::length(end);
+  }
+
+  /// Reads the tag at text_[pos] == '<'; pos ends after its '>'.
+  Tag read_tag(std::size_t& pos) const {
+    const std::size_t start = pos;
+    const std::size_t end = text_.find('>', pos);
+    if (end == std::string::npos) fail(start, "unterminated tag");
+    std::string body = text_.substr(pos + 1, end - pos - 1);
+    pos = end + 1;
+    Tag t;
+    if (!body.empty() && body.front() == '/') {
+      t.closing = true;
+      body.erase(0, 1);
+    }
+    if (!body.empty() && body.back() == '/') {
+      t.self_closing = true;
+      body.pop_back();
+    }
+    std::size_t i = 0;
+    while (i < body.size() && !std::isspace(static_cast<unsigned char>(body[i]))) ++i;
+    t.name = body.substr(0, i);
+    if (t.name.empty()) fail(start, "a tag without a name");
+    while (i < body.size()) {
+      while (i < body.size() && std::isspace(static_cast<unsigned char>(body[i]))) ++i;
+      if (i >= body.size()) break;
+      const std::size_t eq = body.find('=', i);
+      if (eq == std::string::npos) fail(start, "<" + t.name + ">: attribute without a value");
+      std::string key = body.substr(i, eq - i);
+      while (!key.empty() && std::isspace(static_cast<unsigned char>(key.back()))) key.pop_back();
+      std::size_t q = eq + 1;
+      while (q < body.size() && std::isspace(static_cast<unsigned char>(body[q]))) ++q;
+      if (q >= body.size() || (body[q] != '"' && body[q] != '\'')) {
+        fail(start, "<" + t.name + ">: attribute " + key + " without a quoted value");
+      }
+      const std::size_t close = body.find(body[q], q + 1);
+      if (close == std::string::npos) fail(start, "<" + t.name + ">: unterminated attribute " + key);
+      t.attributes[key] = body.substr(q + 1, close - q - 1);
+      i = close + 1;
+    }
+    return t;
+  }
+
+  static std::string attribute(const Tag& t, const std::string& key) {
+    const auto it = t.attributes.find(key);
+    return it == t.attributes.end() ? std::string() : it->second;
+  }
+
+  std::size_t count_attribute(const Tag& t, const std::string& key, std::size_t pos) const {
+    const std::string v = attribute(t, key);
+    std::size_t n = 0;
+    const auto r = std::from_chars(v.data(), v.data() + v.size(), n);
+    if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size()) {
+      fail(pos, "<" + t.name + "> " + key + "=\"" + v + "\"; expected a non-negative integer");
+    }
+    return n;
+  }
+
+  std::vector<double> numbers(std::size_t begin, std::size_t end, const std::string& name) const {
+    std::vector<double> out;
+    std::size_t i = begin;
+    while (i < end) {
+      while (i < end && std::isspace(static_cast<unsigned char>(text_[i]))) ++i;
+      if (i >= end) break;
+      if (text_.compare(i, 15, "<InformationKey") == 0) {  // ParaView's array metadata
+        const std::size_t close = text_.find("</InformationKey>", i);
+        if (close == std::string::npos || close > end) fail(i, "unterminated <InformationKey>");
+        i = close + std::string("</InformationKey>").size();
+        continue;
+      }
+      std::size_t j = i;
+      while (j < end && !std::isspace(static_cast<unsigned char>(text_[j]))) ++j;
+      double v = 0.0;
+      const char* first = text_.data() + i;
+      const char* last = text_.data() + j;
+      if (*first == '+') ++first;  // from_chars refuses a leading '+', which C's strtod accepts
+      const auto r = std::from_chars(first, last, v);
+      if (r.ec != std::errc() || r.ptr != last) {
+        fail(i, "DataArray \"" + name + "\": value " + std::to_string(out.size()) + " is \"" +
+                    text_.substr(i, std::min<std::size_t>(j - i, 40)) + "\"; expected a number");
+      }
+      out.push_back(v);
+      i = j;
     }
     return out;
   }
-};
 
-std::size_t count_attribute(const VtuText& t, std::size_t tag, const std::string& name) {
-  const std::string v = t.attribute(tag, name);
-  char* stop = nullptr;
-  const long long n = std::strtoll(v.c_str(), &stop, 10);
-  if (v.empty() || *stop != '\0' || n < 0) t.fail("<Piece> " + name + ": found \"" + v + "\", expected a count");
-  return static_cast<std::size_t>(n);
-}
-
-void check_count(const VtuText& t, const VtuField& f, std::size_t count, const std::string& where) {
-  if (f.values.size() != count * static_cast<std::size_t>(f.components)) {
-    t.fail(where + " DataArray '" + f.name + "': " + std::to_string(f.values.size()) +
-           " values, expected " + std::to_string(count) + " × " + std::to_string(f.components));
+  std::vector<std::size_t> indices(const VtuField& f, std::size_t pos) const {
+    std::vector<std::size_t> out;
+    out.reserve(f.values.size());
+    for (std::size_t k = 0; k < f.values.size(); ++k) {
+      const double v = f.values[k];
+      if (!(v >= 0) || v != std::floor(v) || v > 9.0e15) {
+        std::ostringstream m;
+        m << "Cells: " << f.name << " value " << k << " is " << v
+          << "; expected a non-negative integer";
+        fail(pos, m.str());
+      }
+      out.push_back(static_cast<std::size_t>(v));
+    }
+    return out;
   }
-}
+
+  void check_count(const VtuField& f, std::size_t count, const char* kind, std::size_t pos) const {
+    if (f.values.size() != count * static_cast<std::size_t>(f.components)) {
+      fail(pos, std::string(kind) + " data \"" + f.name + "\" has " +
+                    std::to_string(f.values.size()) + " values; expected " + std::to_string(count) +
+                    " " + kind + "s × " + std::to_string(f.components) + " components");
+    }
+  }
+
+  std::string text_;
+  std::string file_;
+};
 
 }  // namespace
 
-const VtuField* VtuData::point_field(const std::string& name) const {
-  for (const auto& f : point_fields) {
-    if (f.name == name) return &f;
-  }
-  return nullptr;
-}
-
-const VtuField* VtuData::cell_field(const std::string& name) const {
-  for (const auto& f : cell_fields) {
+const VtuField* VtuData::find(const std::vector<VtuField>& fields, const std::string& name) {
+  for (const auto& f : fields) {
     if (f.name == name) return &f;
   }
   return nullptr;
 }
 
 VtuData read_vtu(const std::filesystem::path& path) {
+  if (!std::filesystem::exists(path)) throw InputError(path.string() + ": file not found");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": VTU file not found or unreadable");
-  VtuText t;
-  t.file = path.string();
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  t.text = buf.str();
-  const std::size_t grid = t.text.find("<UnstructuredGrid");
-  if (t.text.find("<VTKFile") == std::string::npos || grid == std::string::npos) {
-    t.fail("not a VTK UnstructuredGrid file; expected <VTKFile type=\"UnstructuredGrid\">");
-  }
-  if (t.text.find("<AppendedData") != std::string::npos) {
-    t.fail("appended data is not read; expected DataArrays in format=\"ascii\"");
-  }
-  const std::size_t piece = t.text.find("<Piece", grid);
-  if (piece == std::string::npos) t.fail("no <Piece>; expected one");
-  const std::size_t n_points = count_attribute(t, piece, "NumberOfPoints");
-  const std::size_t n_cells = count_attribute(t, piece, "NumberOfCells");
-  const auto piece_body = t.element("Piece", piece, t.text.size());
-  const auto [from, to] = *piece_body;
-  VtuData d;
-  if (const auto pd = t.element("PointData", from, to)) {
-    d.point_fields = t.arrays(pd->first, pd->second, "<PointData>");
-    for (const auto& f : d.point_fields) check_count(t, f, n_points, "<PointData>");
-  }
-  if (const auto cd = t.element("CellData", from, to)) {
-    d.cell_fields = t.arrays(cd->first, cd->second, "<CellData>");
-    for (const auto& f : d.cell_fields) check_count(t, f, n_cells, "<CellData>");
-  }
-  const auto pts = t.element("Points", from, to);
-  if (!pts) t.fail("no <Points>; expected the point coordinates");
-  const std::vector<VtuField> coords = t.arrays(pts->first, pts->second, "<Points>");
-  if (coords.size() != 1 || coords[0].components != 3) {
-    t.fail("<Points>: expected one DataArray with NumberOfComponents=\"3\"");
-  }
-  check_count(t, coords[0], n_points, "<Points>");
-  for (std::size_t i = 0; i < n_points; ++i) {
-    d.points.emplace_back(coords[0].values[3 * i], coords[0].values[3 * i + 1],
-                          coords[0].values[3 * i + 2]);
-  }
-  if (const auto cells = t.element("Cells", from, to)) {
-    const std::vector<VtuField> arrays = t.arrays(cells->first, cells->second, "<Cells>");
-    const auto find = [&](const std::string& name) -> const VtuField& {
-      for (const auto& f : arrays) {
-        if (f.name == name) return f;
-      }
-      t.fail("<Cells>: no DataArray '" + name + "'");
-    };
-    const VtuField& conn = find("connectivity");
-    const VtuField& offsets = find("offsets");
-    const VtuField& types = find("types");
-    check_count(t, offsets, n_cells, "<Cells>");
-    check_count(t, types, n_cells, "<Cells>");
-    std::size_t previous = 0;
-    for (std::size_t c = 0; c < n_cells; ++c) {
-      const double o = offsets.values[c];
-      if (o < static_cast<double>(previous) || o > static_cast<double>(conn.values.size())) {
-        t.fail("<Cells>: offset " + std::to_string(c) + " out of order or beyond the connectivity");
-      }
-      previous = static_cast<std::size_t>(o);
-      d.offsets.push_back(previous);
-      d.cell_types.push_back(static_cast<int>(types.values[c]));
-    }
-    for (const double v : conn.values) {
-      if (v < 0 || v >= static_cast<double>(n_points)) {
-        t.fail("<Cells>: connectivity names point " + std::to_string(static_cast<long long>(v)) +
-               " of " + std::to_string(n_points));
-      }
-      d.connectivity.push_back(static_cast<std::size_t>(v));
-    }
-  } else if (n_cells > 0) {
-    t.fail("no <Cells>; expected " + std::to_string(n_cells) + " cells");
-  }
-  return d;
+  if (!in) throw InputError(path.string() + ": cannot open the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return VtuParser(text.str(), path.string()).parse();
 }
 
 }  // namespace vessel

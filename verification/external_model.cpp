@@ -176,7 +176,7 @@ std::vector<Vec3> read_displacements_vtu(const std::filesystem::path& path, std:
                              " points, expected " + std::to_string(nodes) +
                              " (the points of problem.vtu, in its order)");
   }
-  const VtuField* f = d.point_field("displacement");
+  const VtuField* f = VtuData::find(d.point_fields, "displacement");
   if (!f || f->components != 3) {
     throw ExternalModelError(path.string() +
                              ": no point data 'displacement' with 3 components; expected it (m)");

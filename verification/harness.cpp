@@ -28,6 +28,7 @@
 #include "meshes/vtu_io.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/model/model_factory.hpp"
+#include "msm/model/network_file.hpp"
 #include "msm/model/roi.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/static_solver.hpp"
@@ -449,8 +450,12 @@ std::vector<Vec3> displacements(const Eigen::VectorXd& x, const std::vector<Vec3
 /// A mass-spring model's description in results: topology, rules, solver, region.
 std::string msm_detail(const std::string& topology, const ModelSpec& spec) {
   std::ostringstream d;
-  d << topology << ", " << msm::to_string(spec.stiffness) << " stiffness, "
-    << msm::to_string(spec.mass) << " masses, " << msm::to_string(spec.solver);
+  if (spec.kind == ModelKind::network) {  // its springs and masses are the file's own
+    d << topology << ", " << msm::to_string(spec.solver);
+  } else {
+    d << topology << ", " << msm::to_string(spec.stiffness) << " stiffness, "
+      << msm::to_string(spec.mass) << " masses, " << msm::to_string(spec.solver);
+  }
   if (spec.roi_radius > 0.0) d << ", region of interest R = " << spec.roi_radius * 1e3 << " mm";
   if (!spec.calibration.empty()) d << ", calibrated (" << spec.calibration.filename().string() << ")";
   return d.str();
@@ -523,6 +528,12 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
   VesselParams vessel = s.vessel;
   vessel.level = base.level;
   const msm::BuiltNetwork built = scene_network(s, spec, mesh, vessel, nu);
+  if (spec.kind == ModelKind::network) {
+    // The reference is read at the network's rest positions: every node must lie in its mesh
+    // (within the evaluation's own tolerance), else the run stops naming them.
+    msm::require_nodes_inside(built.network.nodes, *ref.fine_mesh, kOutsideTolerance,
+                              s.source.string() + ": model " + spec.name + ": " + built.file);
+  }
   const auto model_ptr = msm::make_model(built, spec.damping);
   const msm::MassSpringModel& model = *model_ptr;
   base.setup_seconds = setup.seconds();

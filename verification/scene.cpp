@@ -418,19 +418,31 @@ std::vector<ModelSpec> outside_model(TableReader& r, ModelSpec m) {
 std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind load) {
   ModelSpec m;
   const std::string kind = r.string_or(
-      "kind", "", {"fem", "surface_msm", "volume_msm", "external", "displacements"});
+      "kind", "", {"fem", "surface_msm", "volume_msm", "network", "external", "displacements"});
   if (kind.empty()) {
     r.fail(nullptr, "kind",
-           "missing; expected one of fem, surface_msm, volume_msm, external, displacements");
+           "missing; expected one of fem, surface_msm, volume_msm, network, external, "
+           "displacements");
   }
-  m.kind = kind == "fem" ? ModelKind::fem
-                         : (kind == "surface_msm" ? ModelKind::surface_msm : ModelKind::volume_msm);
-  if (kind == "external") m.kind = ModelKind::external;
-  if (kind == "displacements") m.kind = ModelKind::displacements;
+  m.kind = kind == "fem"             ? ModelKind::fem
+           : kind == "surface_msm"   ? ModelKind::surface_msm
+           : kind == "network"       ? ModelKind::network
+           : kind == "external"      ? ModelKind::external
+           : kind == "displacements" ? ModelKind::displacements
+                                     : ModelKind::volume_msm;
   m.name = r.string_or("name", kind + "_" + std::to_string(index + 1));
   if (m.kind == ModelKind::fem) return fem_models(r, m);
   if (m.kind == ModelKind::external || m.kind == ModelKind::displacements) {
     return outside_model(r, m);
+  }
+  const bool network = m.kind == ModelKind::network;
+  if (network) {
+    // A spring network from a file: its springs, masses and supports come from the file, so the
+    // stiffness, mass, topology and calibration keys are unknown here.
+    m.network_file = r.string_or("file", "");
+    if (m.network_file.empty()) {
+      r.fail(nullptr, "file", "missing; expected the spring-network file (.json or .vtu)");
+    }
   }
   if (m.kind == ModelKind::surface_msm) {
     m.surface = msm::parse_wall_surface(r.name_or("surface", msm::to_string(m.surface), msm::parse_wall_surface));
@@ -445,7 +457,7 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
     }
   }
   if (m.kind == ModelKind::volume_msm) m.volume_term = r.boolean_or("volume_term", false);
-  const auto stiffness =
+  const auto stiffness = network ? std::vector<std::string>{msm::to_string(m.stiffness)} :
       r.names_or("stiffness",
                  m.kind == ModelKind::volume_msm
                      ? (m.volume_term ? "van-gelder" : "seed001")
@@ -460,8 +472,14 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
       }
     }
   }
-  const auto mass = r.names_or("mass", "consistent", msm::parse_mass_rule);
+  const auto mass = network ? std::vector<std::string>{msm::to_string(m.mass)}
+                            : r.names_or("mass", "consistent", msm::parse_mass_rule);
   const auto solvers = r.names_or("solver", "static", msm::parse_solver);
+  if (network && std::find(solvers.begin(), solvers.end(), "pbd") != solvers.end()) {
+    r.fail(r.table().get("solver"), "solver",
+           "found \"pbd\" on a network model; expected another solver (seed 002's constraints "
+           "need a surface network's triangles, which a network file does not give)");
+  }
   if (m.kind == ModelKind::volume_msm &&
       std::find(solvers.begin(), solvers.end(), "pbd") != solvers.end()) {
     r.fail(r.table().get("solver"), "solver",
@@ -475,8 +493,10 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
            "projects its own constraints and would ignore the bending energy)");
   }
   m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
-  m.calibration = r.string_or("calibration", "");
-  m.calibration_transfer = r.boolean_or("calibration_transfer", false);
+  if (!network) {
+    m.calibration = r.string_or("calibration", "");
+    m.calibration_transfer = r.boolean_or("calibration_transfer", false);
+  }
   if (m.calibration_transfer && m.calibration.empty()) {
     r.fail(r.get("calibration_transfer"), "calibration_transfer",
            "found without a calibration file; expected calibration = \"file.json\" beside it");
@@ -697,6 +717,9 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
       if (!m.calibration.empty() && m.calibration.is_relative()) {
         m.calibration = std::filesystem::path(source_name).parent_path() / m.calibration;
       }
+      if (!m.network_file.empty() && m.network_file.is_relative()) {
+        m.network_file = std::filesystem::path(source_name).parent_path() / m.network_file;
+      }
       if (!names.insert(m.name).second) {
         r.fail(list->get(i), "models",
                "model name \"" + m.name + "\" is used twice; names must be unique");
@@ -766,6 +789,7 @@ std::string to_string(ModelKind kind) {
     case ModelKind::fem: return "fem";
     case ModelKind::surface_msm: return "surface_msm";
     case ModelKind::volume_msm: return "volume_msm";
+    case ModelKind::network: return "network";
     case ModelKind::external: return "external";
     case ModelKind::displacements: return "displacements";
   }

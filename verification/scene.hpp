@@ -18,7 +18,10 @@
 namespace vessel {
 
 enum class LoadKind { contact, pressure, gravity };
-enum class ModelKind { fem, surface_msm, volume_msm, external, displacements };
+/// network: a spring network read from a file (msm/model/network_file.hpp), run by the suite's
+/// own solvers like the built-in mass-spring models; external and displacements: models outside
+/// the suite (ExternalSpec).
+enum class ModelKind { fem, surface_msm, volume_msm, network, external, displacements };
 
 /// Which nodes a model outside the suite (kinds external and displacements) is given and answers
 /// at: every node of the vessel's tet mesh (cells: its tets), or the nodes of one wall surface
@@ -76,6 +79,10 @@ struct ModelSpec {
   /// Apply a group calibration to a mesh other than the one it was fitted on (its hash differs).
   bool calibration_transfer = false;
   ExternalSpec external;  ///< kinds external and displacements only
+  /// kind network: the spring-network file (.json or .vtu; docs/network_format.md), relative
+  /// paths resolved against the scene file's folder. Its springs, masses and supports replace
+  /// the stiffness, mass and topology keys.
+  std::filesystem::path network_file;
 };
 
 struct LoadSpec {

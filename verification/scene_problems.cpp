@@ -1,9 +1,11 @@
 #include "verification/scene_problems.hpp"
 
+#include <algorithm>
 #include <limits>
 
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
+#include "msm/model/network_file.hpp"
 #include "msm/model/spring_model.hpp"
 #include "verification/calibration_file.hpp"
 
@@ -149,6 +151,10 @@ msm::NetworkOptions network_options(const Scene& s, const ModelSpec& model, doub
 
 msm::BuiltNetwork scene_network(const Scene& s, const ModelSpec& model, const TetMesh& mesh,
                                 const VesselParams& vessel, double nu) {
+  if (model.kind == ModelKind::network) {
+    const std::string source = model.network_file.string();
+    return msm::network_on_mesh(msm::read_network_file(model.network_file), mesh, source);
+  }
   VesselParams v = vessel;
   if (v.kind == VesselKind::mesh_file && v.wall_thickness <= 0.0) {
     v.wall_thickness = estimate_wall_thickness(mesh, v.file.string());
@@ -177,6 +183,43 @@ std::vector<Vec3> surface_nodal_loads(const Scene& s, const TetMesh& mesh, doubl
   return loads;
 }
 
+std::vector<char> file_network_held_dofs(const Scene& s, const TetMesh& mesh,
+                                         const msm::BuiltNetwork& built) {
+  const msm::NetworkSupports& file = *built.file_supports;
+  const auto& follow = file.follow_groups;
+  const auto followed = [&](const std::string& g) {
+    return std::find(follow.begin(), follow.end(), g) != follow.end();
+  };
+  Supports supports = scene_supports(s);
+  std::erase_if(supports.clamped, [&](const std::string& g) { return !followed(g); });
+  std::erase_if(supports.rollers, [&](const std::string& g) { return !followed(g); });
+  if (supports.rollers.empty()) supports.pins.clear();
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec3& x : mesh.nodes) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  const double tolerance = msm::kNodeMatchTolerance * (hi - lo).norm();
+  std::vector<char> held;
+  try {
+    held = held_dofs_by_position(mesh, built.network.nodes, supports, tolerance);
+  } catch (const InputError& e) {
+    throw InputError(built.file + ": follow_groups: " + e.what());
+  }
+  for (const int i : file.fixed_nodes) {
+    for (int c = 0; c < 3; ++c) held[3 * static_cast<std::size_t>(i) + c] = 1;
+  }
+  if (std::find(held.begin(), held.end(), 1) == held.end()) {
+    std::string groups;
+    for (const auto& g : follow) groups += (groups.empty() ? "" : ", ") + g;
+    throw InputError(built.file + ": no node of the network is held: fixed.nodes is empty and "
+                     "follow_groups [" + groups + "] hold no node under the scene's [boundary] "
+                     "(a node follows a group when it lies on the group's surface); expected "
+                     "fixed nodes, or nodes on a clamped or roller end");
+  }
+  return held;
+}
+
 msm::Problem msm_problem(const Scene& s, const msm::Form& form, const msm::BuiltNetwork& built,
                          const TetMesh& mesh, double magnitude) {
   msm::Problem problem = msm::make_problem(form, built.network, built.masses, mesh,
@@ -188,8 +231,10 @@ msm::Problem msm_problem(const Scene& s, const msm::Form& form, const msm::Built
   for (Eigen::Index i = 0; i < problem.num_dofs(); i += 3) {
     problem.external_force.segment<3>(i) += problem.mass[i] * g;
   }
-  problem.fixed =
-      held_dofs(mesh, built.network.nodes, built.network.source_node, scene_supports(s));
+  problem.fixed = built.file_supports
+                      ? file_network_held_dofs(s, mesh, built)
+                      : held_dofs(mesh, built.network.nodes, built.network.source_node,
+                                  scene_supports(s));
   return problem;
 }
 

@@ -55,11 +55,18 @@ fem::ElasticityProblem fem_problem(const Scene& scene, const TetMesh& mesh, doub
 msm::NetworkOptions network_options(const Scene& scene, const ModelSpec& model, double nu);
 
 /// The network of a mass-spring model of the scene on `mesh` (vessel at the mesh's level) at ν,
-/// with the model's calibration file applied when it names one (verification/calibration_file).
-/// A mesh file without a wall_thickness gets estimate_wall_thickness(mesh) (the surface models'
-/// shell thickness).
+/// with the model's calibration file applied when it names one (verification/calibration_file);
+/// for a network model, its file placed on the mesh (msm::network_on_mesh). A mesh file without a
+/// wall_thickness gets estimate_wall_thickness(mesh) (the surface models' shell thickness).
 msm::BuiltNetwork scene_network(const Scene& scene, const ModelSpec& model, const TetMesh& mesh,
                                 const VesselParams& vessel, double nu);
+
+/// The held dofs of a network read from a file (built.file_supports): its fixed nodes in every
+/// component, and the scene's supports of the groups it follows (a clamped group holds every
+/// component, a roller group z, with the pins) on the nodes lying on those groups' triangles
+/// (within kNodeMatchTolerance of the mesh's size). InputError naming the file if nothing is held.
+std::vector<char> file_network_held_dofs(const Scene& scene, const TetMesh& mesh,
+                                         const msm::BuiltNetwork& built);
 
 /// The consistent nodal loads (N, per mesh node) of the scene's surface loads (contact patch,
 /// pressure) at `magnitude` for the swept load: what the FEM integrates, lumped to the nodes.

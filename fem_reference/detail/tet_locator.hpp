@@ -1,34 +1,9 @@
 #pragma once
-/// Private to fem_reference: point location in a TetMesh (a uniform bucket grid over the tets'
-/// bounding boxes). Free of deal.II.
-#include <array>
-#include <vector>
-
-#include "meshes/tet_mesh.hpp"
+/// Point location in a TetMesh lives in meshes/tet_locator.hpp (the harness checks user networks'
+/// nodes with it too); the FEM's private names for it.
+#include "meshes/tet_locator.hpp"
 
 namespace vessel::fem::detail {
-
-class TetLocator {
- public:
-  static constexpr double kBoxPadding = 0.1;  ///< of a tet's box diagonal
-  explicit TetLocator(const TetMesh& mesh);
-
-  /// The tet containing x (the one with the largest smallest barycentric coordinate, ≥ −tol), or
-  /// −1.
-  [[nodiscard]] int find(const Vec3& x, double tol = 1e-9) const;
-
- private:
-  [[nodiscard]] std::array<int, 3> bucket_of(const Vec3& x) const;
-  [[nodiscard]] std::size_t index(int i, int j, int k) const {
-    return (static_cast<std::size_t>(i) * n_[1] + j) * n_[2] + k;
-  }
-  const TetMesh* mesh_;
-  Vec3 lo_, hi_;
-  std::array<int, 3> n_{};
-  std::vector<std::vector<int>> buckets_;
-};
-
-/// The smallest barycentric coordinate of x in `tet` (≥ 0 inside).
-double min_barycentric(const TetMesh& mesh, const Tet& tet, const Vec3& x);
-
+using vessel::min_barycentric;
+using vessel::TetLocator;
 }  // namespace vessel::fem::detail

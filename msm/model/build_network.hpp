@@ -54,6 +54,14 @@ struct NetworkOptions {
   Bending bending = Bending::none;
 };
 
+/// The supports a spring-network file gives (msm/model/network_file.hpp): nodes held in every
+/// component, and the mesh's surface groups whose supports (clamped, roller) hold the nodes lying
+/// on them. Built-in networks have none: they follow every support through their source nodes.
+struct NetworkSupports {
+  std::vector<int> fixed_nodes;            ///< indices into the network's nodes, ascending
+  std::vector<std::string> follow_groups;  ///< e.g. "inlet", "outlet"
+};
+
 struct BuiltNetwork {
   SpringNetwork network;      ///< springs with stiffness and damping assigned
   std::vector<double> masses;  ///< kg per network node
@@ -63,6 +71,10 @@ struct BuiltNetwork {
   /// D (N·m) of the Discrete Shells bending term on network.triangles (options.bending); none: no
   /// bending term.
   std::optional<double> bending_rigidity;
+  /// A network read from a file: its own supports (the problem holds exactly those), and the file
+  /// for messages. Unset for built-in networks.
+  std::optional<NetworkSupports> file_supports;
+  std::string file;
 };
 
 /// Builds the network on the mesh: "auto" topology is seed 000's grid on a structured vessel and

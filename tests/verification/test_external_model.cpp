@@ -154,15 +154,15 @@ TEST_F(Exchange, ContactLoadsSumToTheForceAndClampedEndsAreHeld) {
   EXPECT_EQ(folder.filename(), "nu0.45_L0_load0.0005");
   const VtuData d = read_vtu(folder / "problem.vtu");
   ASSERT_EQ(d.points.size(), p.nodes.size());
-  EXPECT_EQ(d.cell_types.front(), 10);
+  EXPECT_EQ(d.types.front(), 10);
   EXPECT_EQ(d.connectivity.size(), 4 * mesh.tets.size());
-  const VtuField* load = d.point_field("load_N");
+  const VtuField* load = VtuData::find(d.point_fields, "load_N");
   ASSERT_NE(load, nullptr);
   double sum_x = 0.0;
   for (std::size_t i = 0; i < d.points.size(); ++i) sum_x += load->values[3 * i];
   EXPECT_NEAR(sum_x, total.x(), 1e-15);
-  ASSERT_NE(d.point_field("fixed"), nullptr);
-  ASSERT_NE(d.point_field("mass_kg"), nullptr);
+  ASSERT_NE(VtuData::find(d.point_fields, "fixed"), nullptr);
+  ASSERT_NE(VtuData::find(d.point_fields, "mass_kg"), nullptr);
 
   const auto m = nlohmann::json::parse(test::read_text(folder / "manifest.json"));
   EXPECT_EQ(m["schema"], "vesselverify.exchange");
@@ -292,13 +292,13 @@ TEST(VtuRead, ReadsWhatWriteVtuWritesAndRefusesBinary) {
   EXPECT_EQ(d.points, pts);
   EXPECT_EQ(d.connectivity, (std::vector<std::size_t>{0, 1, 2, 3}));
   EXPECT_EQ(d.offsets, (std::vector<std::size_t>{4}));
-  EXPECT_EQ(d.point_field("s")->values, (std::vector<double>{1, 2, 3, 4}));
-  EXPECT_EQ(d.cell_field("c")->values, (std::vector<double>{7, 8}));
+  EXPECT_EQ(VtuData::find(d.point_fields, "s")->values, (std::vector<double>{1, 2, 3, 4}));
+  EXPECT_EQ(VtuData::find(d.cell_fields, "c")->values, (std::vector<double>{7, 8}));
   std::string text = test::read_text(dir / "t.vtu");
   text.replace(text.find("format=\"ascii\""), 14, "format=\"binary\"");
   test::write_text(dir / "b.vtu", text);
   EXPECT_TRUE(contains(expect_error([&] { (void)read_vtu(dir / "b.vtu"); }), "expected format=\"ascii\""));
-  EXPECT_TRUE(contains(expect_error([&] { (void)read_vtu(dir / "none.vtu"); }), "none.vtu: VTU file not found"));
+  EXPECT_TRUE(contains(expect_error([&] { (void)read_vtu(dir / "none.vtu"); }), "none.vtu: file not found"));
 }
 
 // ---------------------------------------------------------------------------- processes

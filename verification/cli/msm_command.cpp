@@ -18,6 +18,7 @@
 #include "meshes/msh_io.hpp"
 #include "meshes/stl_io.hpp"
 #include "msm/model/model_factory.hpp"
+#include "msm/model/network_file.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/cli/vessel_options.hpp"
 #include "verification/msm_document.hpp"
@@ -51,6 +52,7 @@ struct MsmOptions {
   double patch_radius = ContactPatchSpec{}.radius;
   std::vector<std::string> fixed_groups{"inlet", "outlet"};
   fs::path json;
+  fs::path export_network;  ///< .json or .vtu: the built network in the network-file format
   bool verbose = false;
   int pbd_iterations = 10;
   int lg_iterations = msm::LocalGlobalSettings{}.iterations;
@@ -394,6 +396,28 @@ void print_displacements(const msm::SpringNetwork& net, const msm::MassSpringMod
             << (strain > 0.05 ? " (beyond 5 %: outside the linear regime)" : "") << "\n";
 }
 
+/// --export-network: the built network (stiffness and mass rules applied) in the network-file
+/// format. Its supports: the --fixed groups it follows (a scene then applies its own [boundary] to
+/// the nodes on them), and the nodes the --fix-* options held, as fixed nodes.
+void export_network(const MsmOptions& o, bool stl, const msm::BuiltNetwork& built,
+                    const std::vector<char>& held_by_groups, const msm::Problem& problem) {
+  msm::NetworkSupports supports;
+  if (!stl) supports.follow_groups = o.fixed_groups;
+  for (std::size_t i = 0; 3 * i < problem.fixed.size(); ++i) {
+    if (problem.fixed[3 * i] && !held_by_groups[3 * i]) supports.fixed_nodes.push_back(static_cast<int>(i));
+  }
+  std::ostringstream d;
+  d << "exported by vesselverify msm: " << o.model
+    << (o.model == "surface" ? " model (" + o.surface + " wall)" : " model") << ", "
+    << built.topology << ", " << o.stiffness << " stiffness (E = "
+    << o.stiffness_params.youngs_modulus << " Pa), " << o.mass << " masses (density " << o.density
+    << " kg/m³)";
+  msm::write_network_file(o.export_network,
+                     msm::network_file_of(built, std::move(supports), d.str()));
+  std::cout << "wrote the network (" << built.network.nodes.size() << " nodes, "
+            << built.network.springs.size() << " springs) to " << o.export_network.string() << "\n";
+}
+
 void run(MsmOptions& o) {
   const auto t_total = std::chrono::steady_clock::now();
   if (o.stiffness.empty()) {
@@ -421,7 +445,9 @@ void run(MsmOptions& o) {
   const auto model_ptr = msm::make_model(built, o.point_damping);
   const msm::MassSpringModel& model = *model_ptr;
   msm::Problem problem = msm_problem(scene, model, built, mesh, o.force);
+  const std::vector<char> held_by_groups = problem.fixed;
   fix_by_options(o, built.network, problem);
+  if (!o.export_network.empty()) export_network(o, stl, built, held_by_groups, problem);
   run.build_seconds = seconds_since(t_build);
   run.topology = built.topology;
   run.nodes = built.network.nodes.size();
@@ -577,6 +603,10 @@ void add_solver_tuning_options(CLI::App* cmd, MsmOptions& o) {
       ->capture_default_str();
   cmd->add_flag("-v,--verbose", o.verbose, "Print the Newton iterations");
   cmd->add_option("--json", o.json, "Write the results as JSON (atomically)");
+  cmd->add_option("--export-network", o.export_network,
+                  "Write the built network (after its stiffness and mass rules) as a spring-network "
+                  "file, .json or .vtu (docs/network_format.md), which a scene runs with "
+                  "kind = \"network\"");
 }
 
 }  // namespace

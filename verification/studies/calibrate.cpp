@@ -257,10 +257,10 @@ const ModelSpec& pick_model(const Scene& s, const std::string& name) {
   if (!name.empty()) {
     for (const ModelSpec& m : s.models) {
       if (m.name != name) continue;
-      if (m.kind == ModelKind::fem || m.kind == ModelKind::external ||
-          m.kind == ModelKind::displacements) {
+      if (m.kind != ModelKind::surface_msm && m.kind != ModelKind::volume_msm) {
         throw InputError("calibrate: --model " + name + " is a " + to_string(m.kind) +
-                         " model; expected a surface_msm or volume_msm model");
+                         " model; expected a surface_msm or volume_msm model (a network file's "
+                         "stiffness is the file's own; an outside model's is its own)");
       }
       return m;
     }

@@ -1,10 +1,10 @@
-#include "fem_reference/detail/tet_locator.hpp"
+#include "meshes/tet_locator.hpp"
 
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 
-namespace vessel::fem::detail {
+namespace vessel {
 
 double min_barycentric(const TetMesh& mesh, const Tet& tet, const Vec3& x) {
   const Vec3& p0 = mesh.nodes[static_cast<std::size_t>(tet[0])];
@@ -76,4 +76,4 @@ std::array<int, 3> TetLocator::bucket_of(const Vec3& x) const {
   return ijk;
 }
 
-}  // namespace vessel::fem::detail
+}  // namespace vessel
