@@ -243,6 +243,9 @@ class ElasticitySolver {
   [[nodiscard]] double domain_volume() const;
 
  private:
+  /// The finite-strain reference reuses this solver's discretisation (triangulation, DoFs,
+  /// supports, loads, linear solvers, point evaluation) and assembles its own tangent.
+  friend class HyperelasticSolver;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

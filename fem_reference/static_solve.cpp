@@ -59,15 +59,23 @@ LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dof
 
 }  // namespace
 
-void ElasticitySolver::Impl::solve_linear() {
-  const LinearSolver s = chosen_solver(problem.options, mixed, dof.n_dofs());
+void ElasticitySolver::Impl::solve_linear(bool symmetric) {
+  LinearSolver s = chosen_solver(problem.options, mixed, dof.n_dofs());
+  if (!symmetric && !mixed && s == LinearSolver::cg_amg) {
+    if (problem.options.solver == LinearSolver::cg_amg) {
+      throw InputError(
+          "solver cg-amg needs a symmetric matrix; the finite-strain tangent with follower "
+          "pressure is not symmetric: use direct (UMFPACK)");
+    }
+    s = LinearSolver::direct;
+  }
   result.solver = s;
   if (rhs.l2_norm() == 0.0) {
     solution = 0.0;  // no load and homogeneous constraints: u = 0
-  } else if (s == LinearSolver::direct && !mixed) {
+  } else if (s == LinearSolver::direct && !mixed && symmetric) {
     solve_displacement_direct();
   } else if (s == LinearSolver::direct) {
-    // UMFPACK for the indefinite mixed (Taylor–Hood) system.
+    // UMFPACK for the indefinite mixed (Taylor–Hood) system and for a nonsymmetric matrix.
     apply_solver_threads();  // UMFPACK's dense kernels are OpenBLAS's
     dl::SparseDirectUMFPACK direct;
     direct.initialize(matrix);

@@ -148,6 +148,8 @@ struct ModelOutcome {
   double qoi_reference_mm = 0.0;     ///< reference there
   double max_strain = 0.0;           ///< largest strain of the model (springs or FEM)
   bool beyond_linear_regime = false;  ///< max strain of the reference > 5 %
+  /// Which reference judged the case: "linear" or "finite-strain" (the scene's `reference`).
+  std::string reference = "linear";
   WallProfile wall_profile;
   History history;  ///< dynamic models only
   double roi_radius = 0.0;  ///< m; 0: the whole vessel

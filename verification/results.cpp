@@ -107,6 +107,7 @@ nlohmann::json scene_json(const SceneResult& r) {
                      {"poisson_ratio", o.poisson_ratio},
                      {"magnitude", o.magnitude},
                      {"level", o.level},
+                     {"reference", o.reference},
                      {"ok", o.ok},
                      {"nodes", o.nodes},
                      {"unknowns", o.unknowns},

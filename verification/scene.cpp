@@ -737,6 +737,11 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
   scene.modes.reference_level =
       static_cast<int>(modes.integer_or("reference_level", -1, 0, kMaxMeshLevel));
   modes.finish();
+  const std::string reference =
+      r.string_or("reference", "linear", {"linear", "finite-strain", "auto"});
+  scene.reference = reference == "finite-strain" ? ReferenceChoice::finite_strain
+                    : reference == "auto"        ? ReferenceChoice::automatic
+                                                 : ReferenceChoice::linear;
   r.finish();
   return scene;
 }
@@ -755,6 +760,15 @@ std::string to_string(LoadKind kind) {
     case LoadKind::contact: return "contact";
     case LoadKind::pressure: return "pressure";
     case LoadKind::gravity: return "gravity";
+  }
+  return "?";
+}
+
+std::string to_string(ReferenceChoice choice) {
+  switch (choice) {
+    case ReferenceChoice::linear: return "linear";
+    case ReferenceChoice::finite_strain: return "finite-strain";
+    case ReferenceChoice::automatic: return "auto";
   }
   return "?";
 }

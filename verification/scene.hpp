@@ -139,6 +139,12 @@ struct ModalSpec {
   int reference_level = -1;
 };
 
+/// Which FEM reference judges the mass-spring models (issue 17): the linear one (small strain),
+/// the finite-strain one (neo-Hookean with the same E and ν, fem::HyperelasticSolver, solved at
+/// each load magnitude), or automatic: finite-strain where the linear reference's largest strain
+/// at that load exceeds 5 %.
+enum class ReferenceChoice { linear, finite_strain, automatic };
+
 struct Scene {
   std::string name;
   std::string description;
@@ -159,6 +165,7 @@ struct Scene {
   Tolerances tolerances;
   Budget budget;
   ModalSpec modes;
+  ReferenceChoice reference = ReferenceChoice::linear;  ///< `reference = "linear"` (default)
 };
 
 /// Reads and validates a scene file. Throws InputError ("file:line: key: what was found, what was
@@ -169,6 +176,7 @@ Scene read_scene(const std::filesystem::path& path);
 Scene parse_scene(std::string_view text, const std::string& source_name);
 
 std::string to_string(LoadKind kind);
+std::string to_string(ReferenceChoice choice);  ///< linear | finite-strain | auto
 std::string to_string(ModelKind kind);
 std::string to_string(BudgetQuantity quantity);
 BudgetQuantity parse_budget_quantity(const std::string& name);  ///< InputError if unknown

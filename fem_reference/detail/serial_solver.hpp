@@ -63,7 +63,10 @@ struct ElasticitySolver::Impl {
 
   // static_solve.cpp
   void assemble();
-  void solve_linear();
+  /// Solves matrix · solution = rhs and distributes the constraints. `symmetric` false (the
+  /// finite-strain tangent with follower pressure): UMFPACK instead of CHOLMOD, and automatic
+  /// never picks CG-AMG.
+  void solve_linear(bool symmetric = true);
   void solve_displacement_direct();
   void solve_displacement_cg_amg();
   void postprocess();

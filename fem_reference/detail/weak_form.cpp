@@ -61,15 +61,20 @@ void WeakForm::local_system(const CellIterator& cell, CellValues& values,
                             dl::FullMatrix<double>& k, dl::Vector<double>& f,
                             Vec3* applied) const {
   k = 0.0;
+  local_load(cell, values, f, applied, true);
+  add_stiffness(values.cell, k);
+}
+
+void WeakForm::local_load(const CellIterator& cell, CellValues& values, dl::Vector<double>& f,
+                          Vec3* applied, bool with_pressure) const {
   f = 0.0;
   values.cell.reinit(cell);
-  add_stiffness(values.cell, k);
   add_body_force(values.cell, f, applied);
   const auto& faces = mesh_map_.face_triangle[cell->active_cell_index()];
   for (unsigned face = 0; face < 4; ++face) {
     const int tri = faces[face];
     if (tri < 0) continue;
-    if (double p = 0.0; pressure_on(tri, p)) {
+    if (double p = 0.0; with_pressure && pressure_on(tri, p)) {
       values.face.reinit(cell, face);
       add_pressure(values.face, p, f, applied);
     }

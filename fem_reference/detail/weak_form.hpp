@@ -47,6 +47,15 @@ class WeakForm {
   void local_system(const CellIterator& cell, CellValues& values, dl::FullMatrix<double>& k,
                     dl::Vector<double>& f, Vec3* applied) const;
 
+  /// Only the load f of `cell` (values.cell is left on this cell): body force, contact-patch
+  /// points and, when `with_pressure`, the pressure on the reference faces (a dead load; the
+  /// finite-strain reference applies pressure on the deformed faces itself).
+  void local_load(const CellIterator& cell, CellValues& values, dl::Vector<double>& f,
+                  Vec3* applied, bool with_pressure) const;
+
+  /// Σ of the pressures on `triangle`'s group (Pa); false if no pressure acts on it.
+  bool pressure_on(int triangle, double& pressure) const;
+
   [[nodiscard]] bool mixed() const { return mixed_; }
   [[nodiscard]] double lambda() const { return lambda_; }
   [[nodiscard]] double mu() const { return mu_; }
@@ -68,9 +77,6 @@ class WeakForm {
   /// Σ_q w_q t·v(ξ_q) over the patch points on `triangle`, a face of `cell`.
   void add_patch_points(const CellIterator& cell, int triangle, dl::Vector<double>& f,
                         Vec3* applied) const;
-  /// Σ of the pressures on `triangle`'s group; false if no pressure acts on it.
-  bool pressure_on(int triangle, double& pressure) const;
-
   const TetMesh& mesh_;
   const ElasticityProblem& problem_;
   const MeshCorrespondence& mesh_map_;

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <string>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -132,4 +134,40 @@ TEST(FemCli, RichardsonNeedsALevelToCoarsen) {
   const auto r = vv("fem " + kTube + "--level 0 --richardson");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "--level >= 1")) << r.output;
+}
+
+namespace {
+
+/// The number printed right after `label` in `text` (NaN if absent).
+double number_after(const std::string& text, const std::string& label) {
+  const auto at = text.find(label);
+  if (at == std::string::npos) return std::nan("");
+  return std::stod(text.substr(at + label.size()));
+}
+
+}  // namespace
+
+TEST(FemCli, FiniteStrainReferenceAgreesWithTheLinearOneAtASmallLoad) {
+  // 0.1 mN on the short tube: strain well below 1 %, so the neo-Hookean answer along the patch
+  // normal is within a few per cent of the linear reference's (O(load) relative difference).
+  const auto r = vv("fem " + kTube +
+                    "--load contact --force 1e-4 --contact-point 0.003 0 0.001 --reference "
+                    "finite-strain");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "load factor reached 1")) << r.output;
+  EXPECT_TRUE(contains(r.output, "Newton iterations")) << r.output;
+  const double finite = number_after(r.output, "along the patch normal ");
+  const double linear = number_after(r.output, "linear reference at the same load ");
+  ASSERT_GT(linear, 0.0) << r.output;
+  EXPECT_NEAR(finite, linear, 0.03 * linear) << r.output;
+  EXPECT_NE(finite, linear) << r.output;
+}
+
+TEST(FemCli, FiniteStrainRefusesOptionsOfTheLinearReferenceOnly) {
+  const auto r = vv("fem " + kTube + "--reference finite-strain --json x.json");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "--json is available with the linear reference only")) << r.output;
+  const auto d = vv("fem " + kTube + "--dead-pressure");
+  EXPECT_EQ(d.exit_code, 1) << d.output;
+  EXPECT_TRUE(contains(d.output, "--dead-pressure is for --reference finite-strain")) << d.output;
 }

@@ -65,6 +65,17 @@ TEST(Scene, EveryShippedSceneParsesAndValidates) {
   EXPECT_GE(count, 5);
 }
 
+TEST(Scene, ReferenceChoiceIsReadAndChecked) {
+  EXPECT_EQ(parse_scene(kMinimal, "scene.toml").reference, ReferenceChoice::linear);
+  EXPECT_EQ(parse_scene(with("name", "reference = \"finite-strain\""), "s").reference,
+            ReferenceChoice::finite_strain);
+  EXPECT_EQ(parse_scene(with("name", "reference = \"auto\""), "s").reference,
+            ReferenceChoice::automatic);
+  const std::string e = error_of(with("name", "reference = \"nonlinear\""));
+  EXPECT_NE(e.find("reference"), std::string::npos) << e;
+  EXPECT_NE(e.find("finite-strain"), std::string::npos) << e;
+}
+
 TEST(Scene, DefaultsAndValuesAreRead) {
   const Scene s = parse_scene(kMinimal, "scene.toml");
   EXPECT_EQ(s.vessel.kind, VesselKind::straight);

@@ -11,6 +11,7 @@
 
 #include "fem_reference/distributed_elasticity.hpp"
 #include "fem_reference/elasticity.hpp"
+#include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/reference_checks.hpp"
 #include "meshes/errors.hpp"
 #include "verification/cli/commands.hpp"
@@ -58,6 +59,8 @@ struct FemCommandOptions {
   double richardson_order = 2.0;
   fs::path vtu;
   fs::path json;
+  std::string reference = "linear";  // or finite-strain (neo-Hookean, fem::HyperelasticSolver)
+  bool dead_pressure = false;         // finite-strain: pressure on the reference surface
 };
 
 using Clock = std::chrono::steady_clock;
@@ -397,7 +400,72 @@ void run_distributed(const TetMesh& mesh,
   std::cout << "\n";
 }
 
+/// The finite-strain reference on the same problem: load steps, Newton iterations, how far the
+/// load got, the contact point's displacement beside the linear reference's, timings.
+void run_finite_strain(const FemCommandOptions& o, const fem::ElasticityProblem& problem,
+                       const TetMesh& mesh, FemRunRecord& run) {
+  fem::HyperelasticOptions ho;
+  ho.follower_pressure = !o.dead_pressure;
+  fem::HyperelasticSolver solver(mesh, problem, ho);
+  std::cout << "element " << solver.result().element << ": " << solver.n_dofs() << " DoFs\n"
+            << "solving finite strain (compressible neo-Hookean"
+            << (solver.result().formulation == fem::Formulation::mixed ? ", mixed u-p" : "")
+            << (problem.pressures.empty() ? ""
+                                          : (o.dead_pressure ? ", dead pressure"
+                                                             : ", follower pressure"))
+            << ") ..." << std::flush;
+  const auto& r = solver.solve();
+  std::cout << " " << fem::to_string(r.solver);
+  if (r.linear_iterations > 0) std::cout << ", " << r.linear_iterations << " Krylov iterations";
+  std::cout << "\n  load steps " << r.steps.size() << " accepted, " << r.rejected_steps
+            << " rejected; Newton iterations " << r.newton_iterations << "\n";
+  if (r.completed) {
+    std::cout << "  load factor reached 1 (the full load)\n";
+  } else {
+    std::cout << "  WARNING: stopped at load factor " << r.load_factor << " of the load: "
+              << r.stop_reason << "\n";
+  }
+  double max_u = 0.0;
+  for (const auto& u : r.nodal_displacement) max_u = std::max(max_u, u.norm());
+  std::cout << std::setprecision(6) << "results (mm, mJ), at load factor " << r.load_factor
+            << ":\n  max |u|                 " << max_u * 1e3 << " mm\n";
+  if (run.contact) {
+    const Vec3 u = solver.displacement_at({run.contact->point})[0];
+    fem::ElasticitySolver linear(mesh, problem);
+    linear.solve();
+    const Vec3 ul = linear.displacement_at({run.contact->point})[0] * r.load_factor;
+    const Vec3& n = run.contact->inward_normal;
+    std::cout << "  u at contact point      " << mm(u) << " mm, along the patch normal "
+              << u.dot(n) * 1e3 << " mm (linear reference at the same load " << ul.dot(n) * 1e3
+              << " mm)\n";
+  }
+  std::cout << "  strain energy           " << r.strain_energy * 1e3 << " mJ\n"
+            << "  max principal Green-Lagrange strain " << r.max_abs_principal_strain
+            << ", min J " << r.min_jacobian << "\n";
+  std::cout << std::fixed << std::setprecision(3) << "timings (s): mesh " << run.mesh_seconds
+            << ", setup " << r.timings.setup << ", assembly " << r.timings.assembly << ", solve "
+            << r.timings.solve << ", postprocess " << r.timings.postprocess << std::defaultfloat
+            << "\n";
+}
+
 void check_options(const FemCommandOptions& o) {
+  if (o.reference == "finite-strain") {
+    const char* other = o.distributed      ? "--distributed"
+                        : o.modes > 0      ? "--modes"
+                        : o.transient      ? "--transient"
+                        : o.richardson     ? "--richardson"
+                        : !o.vtu.empty()   ? "--vtu"
+                        : !o.json.empty()  ? "--json"
+                                           : nullptr;
+    if (other) {
+      throw InputError(std::string(other) +
+                       " is available with the linear reference only: drop it or --reference "
+                       "finite-strain");
+    }
+  } else if (o.dead_pressure) {
+    throw InputError("--dead-pressure is for --reference finite-strain (the linear reference's "
+                     "pressure is always on the reference surface)");
+  }
   if (o.richardson && o.vessel.params.level < 1) {
     throw InputError("--richardson also solves one level coarser: it needs --level >= 1, found " +
                      std::to_string(o.vessel.params.level));
@@ -433,6 +501,10 @@ void run(FemCommandOptions& o) {
   run.contact = contact_record(scene, problem);
   std::cout << std::setprecision(6) << "material: E " << o.youngs_modulus << " Pa, nu "
             << o.poisson_ratio << ", rho " << o.density << " kg/m³; ends: " << run.ends << "\n";
+  if (o.reference == "finite-strain") {
+    run_finite_strain(o, problem, mesh, run);
+    return;
+  }
   if (o.distributed) {
     run_distributed(mesh, problem, run);
     if (run.result.nodal_displacement.empty()) return;  // not rank 0: nothing to write
@@ -461,6 +533,15 @@ void add_material_options(CLI::App* cmd, FemCommandOptions& o) {
   cmd->add_option("--mixed-threshold", o.mixed_threshold,
                   "auto: mixed formulation when nu >= this")
       ->capture_default_str();
+  cmd->add_option("--reference", o.reference,
+                  "linear (small strain) or finite-strain (compressible neo-Hookean with the same "
+                  "E and nu, total Lagrangian, Newton with load stepping; mixed u-p as above; "
+                  "docs/finite_strain.md)")
+      ->check(CLI::IsMember({"linear", "finite-strain"}))
+      ->capture_default_str();
+  cmd->add_flag("--dead-pressure", o.dead_pressure,
+                "finite-strain: pressure acts on the reference surface (dead load) instead of the "
+                "deformed one (follower load, the default)");
 }
 
 /// Loads: pressure, contact patch, gravity.
@@ -573,6 +654,7 @@ void add_fem_command(CLI::App& app) {
       "  vesselverify fem --load contact --force 1e-4 --contact-radius 5e-4 --json fem.json\n"
       "  vesselverify fem --load gravity --bc clamped-inlet\n"
       "  vesselverify fem --nu 0.5                          # Taylor-Hood P2-P1 (automatic)\n"
+      "  vesselverify fem --load contact --force 0.02 --reference finite-strain\n"
       "  vesselverify fem --degree 2 --bc clamped-inlet --modes 10   # natural frequencies\n"
       "  vesselverify fem --degree 2 --level 2 --solver cg-amg\n"
       "  vesselverify fem --load contact --degree 2 --transient --dt 1e-4 --steps 200 "

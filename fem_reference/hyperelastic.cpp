@@ -1,0 +1,548 @@
+/// The finite-strain reference: the neo-Hookean kernel, the total-Lagrangian residual and tangent
+/// (displacement or mixed u–p, dead loads from the linear reference's weak form, follower
+/// pressure on the deformed faces), and Newton with a line search inside adaptive load stepping.
+/// The discretisation (triangulation, DoFs, supports, linear solvers, point evaluation) is the
+/// linear reference's (ElasticitySolver::Impl). Derivations: docs/finite_strain.md.
+#include "fem_reference/hyperelastic.hpp"
+
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/full_matrix.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "fem_reference/detail/serial_solver.hpp"
+#include "meshes/errors.hpp"
+
+namespace vessel::fem {
+
+using detail::Clock;
+using detail::seconds_since;
+
+// ---------------------------------------------------------------------------------------------
+// The material kernel.
+
+double NeoHookean::energy(const Mat3& F) const {
+  const double J = F.determinant();
+  if (!(J > 0.0)) return std::numeric_limits<double>::infinity();
+  const double ln_j = std::log(J);
+  return 0.5 * mu * (F.squaredNorm() - 3.0) - mu * ln_j + 0.5 * lambda * ln_j * ln_j;
+}
+
+Mat3 NeoHookean::stress_at_pressure(const Mat3& F, double p, double mu) {
+  const Mat3 f_inv_t = F.inverse().transpose();
+  return mu * (F - f_inv_t) - p * f_inv_t;
+}
+
+Mat9 NeoHookean::tangent_at_pressure(const Mat3& F, double p, double mu) {
+  // d(F⁻ᵀ)_aJ / dF_bL = −F⁻¹_Jb F⁻¹_La, so ∂[μF − (μ + p)F⁻ᵀ]/∂F as in the header.
+  const Mat3 G = F.inverse();
+  Mat9 A;
+  for (int a = 0; a < 3; ++a)
+    for (int J = 0; J < 3; ++J)
+      for (int b = 0; b < 3; ++b)
+        for (int L = 0; L < 3; ++L)
+          A(3 * a + J, 3 * b + L) = (a == b && J == L ? mu : 0.0) + (mu + p) * G(J, b) * G(L, a);
+  return A;
+}
+
+Mat3 NeoHookean::stress(const Mat3& F) const {
+  return stress_at_pressure(F, -lambda * std::log(F.determinant()), mu);
+}
+
+Mat9 NeoHookean::tangent(const Mat3& F) const {
+  const Mat3 f_inv_t = F.inverse().transpose();
+  Mat9 A = tangent_at_pressure(F, -lambda * std::log(F.determinant()), mu);
+  // p = −λ ln J depends on F: ∂p/∂F_bL = −λ F⁻ᵀ_bL, entering P through −p F⁻ᵀ.
+  Eigen::Matrix<double, 9, 1> g;  // g(3a+J) = F⁻ᵀ_aJ
+  for (int a = 0; a < 3; ++a)
+    for (int J = 0; J < 3; ++J) g(3 * a + J) = f_inv_t(a, J);
+  A += lambda * g * g.transpose();
+  return A;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The solver.
+
+namespace {
+
+Mat3 to_mat3(const dl::Tensor<2, kDim>& t) {
+  Mat3 m;
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = 0; j < 3; ++j) m(i, j) = t[i][j];
+  return m;
+}
+
+/// What one pass over the cells found, besides the local systems it handed on.
+struct PassStats {
+  bool valid = true;  ///< J > 0 at every quadrature point
+  double min_jacobian = std::numeric_limits<double>::infinity();
+  double energy = 0.0;
+  double max_abs_strain = 0.0;
+};
+
+}  // namespace
+
+struct HyperelasticSolver::Impl {
+  ElasticitySolver linear;  // owns the discretisation
+  ElasticitySolver::Impl& d;
+  HyperelasticOptions opt;
+  NeoHookean material;
+  double inv_lambda = 0.0;
+  bool mixed = false;
+  bool symmetric = true;            // false with follower pressure (its tangent is not symmetric)
+  std::vector<unsigned> component;  // per DoF: 0..2 displacement, 3 pressure
+  std::vector<Index> constrained;   // constrained DoFs
+  std::vector<double> prescribed;   // their values at load factor 1
+  dl::Vector<double> pressure_volume;  // per pressure DoF: ∫ψ dV (scale of its residual)
+  dl::Vector<double> u, internal;
+  HyperelasticResult result;
+  bool solved = false;
+
+  Impl(const TetMesh& mesh, ElasticityProblem problem, HyperelasticOptions o)
+      : linear(mesh, std::move(problem)), d(*linear.impl_), opt(o) {
+    material = NeoHookean::of(d.problem.material);
+    mixed = d.mixed;
+    inv_lambda = std::isinf(material.lambda) ? 0.0 : 1.0 / material.lambda;
+    symmetric = !(opt.follower_pressure && !d.problem.pressures.empty());
+    component = d.dof_components();
+    for (Index i = 0; i < d.dof.n_dofs(); ++i) {
+      if (d.constraints.is_constrained(i)) {
+        constrained.push_back(i);
+        prescribed.push_back(d.constraints.get_inhomogeneity(i));
+      }
+    }
+    u.reinit(d.dof.n_dofs());
+    internal.reinit(d.dof.n_dofs());
+    pressure_volume.reinit(d.dof.n_dofs());
+    if (mixed) {
+      detail::CellValues values(*d.mapping, *d.fe, d.degree);
+      std::vector<Index> dofs(d.fe->n_dofs_per_cell());
+      for (const auto& cell : d.dof.active_cell_iterators()) {
+        values.cell.reinit(cell);
+        cell->get_dof_indices(dofs);
+        for (unsigned q = 0; q < values.cell.n_quadrature_points; ++q)
+          for (unsigned i = 0; i < dofs.size(); ++i)
+            if (component[dofs[i]] == 3)
+              pressure_volume(dofs[i]) += values.cell.shape_value(i, q) * values.cell.JxW(q);
+      }
+    }
+    result.element = d.result.element;
+    result.formulation = d.result.formulation;
+    result.n_dofs = d.dof.n_dofs();
+    result.timings.setup = d.result.timings.setup;
+  }
+
+  /// One pass over the cells at DoF values `w` and load factor s: per cell, the residual
+  /// r = f_int − f_follower − s f_dead and (with_matrix) its tangent k = ∂r/∂u, handed to
+  /// sink(dofs, k, r, r_int) with r_int = f_int alone.
+  template <class Sink>
+  PassStats pass(const dl::Vector<double>& w, double s, bool with_matrix, Sink&& sink) const {
+    const unsigned n = d.fe->n_dofs_per_cell();
+    detail::CellValues values(*d.mapping, *d.fe, d.degree);
+    dl::FEFaceValues<kDim> face(*d.mapping, *d.fe, detail::face_quadrature(d.degree),
+                                dl::update_values | dl::update_gradients |
+                                    dl::update_normal_vectors | dl::update_JxW_values);
+    const dl::FEValuesExtractors::Vector disp(0);
+    const dl::FEValuesExtractors::Scalar pres(kDim);
+    dl::FullMatrix<double> k(n, n);
+    dl::Vector<double> r(n), r_int(n), f_dead(n);
+    std::vector<Index> dofs(n);
+    std::vector<unsigned> comp(n);
+    for (unsigned i = 0; i < n; ++i) comp[i] = d.fe->system_to_component_index(i).first;
+    const unsigned nq = values.cell.n_quadrature_points;
+    std::vector<dl::Tensor<2, kDim>> grad_u(nq);
+    std::vector<double> p_h(nq, 0.0);
+    std::vector<dl::Tensor<2, kDim>> face_grad(face.n_quadrature_points);
+    std::vector<Eigen::Vector3d> g(n);
+    std::vector<Eigen::Matrix<double, 9, 1>> h(n);
+    const bool dead_pressure = !opt.follower_pressure;
+    PassStats stats;
+
+    for (const auto& cell : d.dof.active_cell_iterators()) {
+      d.form->local_load(cell, values, f_dead, nullptr, dead_pressure);  // reinits values.cell
+      const auto& fev = values.cell;
+      fev[disp].get_function_gradients(w, grad_u);
+      if (mixed) fev[pres].get_function_values(w, p_h);
+      cell->get_dof_indices(dofs);
+      k = 0.0;
+      r_int = 0.0;
+      for (unsigned q = 0; q < nq; ++q) {
+        const Mat3 F = Mat3::Identity() + to_mat3(grad_u[q]);
+        const double J = F.determinant();
+        stats.min_jacobian = std::min(stats.min_jacobian, J);
+        if (!(J > 0.0)) {
+          stats.valid = false;
+          return stats;
+        }
+        const double ln_j = std::log(J);
+        const double jxw = fev.JxW(q);
+        // p: the mixed field, or −λ ln J (compressible).
+        const double p = mixed ? p_h[q] : -material.lambda * ln_j;
+        const Mat3 P = NeoHookean::stress_at_pressure(F, p, material.mu);
+        const Mat3 f_inv_t = F.inverse().transpose();
+        const double psi =
+            0.5 * material.mu * (F.squaredNorm() - 3.0) - material.mu * ln_j +
+            (mixed ? -p * ln_j - 0.5 * p * p * inv_lambda : 0.5 * material.lambda * ln_j * ln_j);
+        stats.energy += psi * jxw;
+        const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
+        const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Mat3>(E).eigenvalues();
+        stats.max_abs_strain = std::max(stats.max_abs_strain, ev.cwiseAbs().maxCoeff());
+        // R_p = ∫ (−ln J − p/λ) ψ: stationarity of ∫ −p ln J − p²/(2λ) in p (p = −λ ln J).
+        const double r_p = -ln_j - p * inv_lambda;
+        for (unsigned i = 0; i < n; ++i) {
+          if (comp[i] < 3) {
+            const auto gi = fev.shape_grad(i, q);
+            g[i] = Eigen::Vector3d(gi[0], gi[1], gi[2]);
+            r_int(i) += P.row(comp[i]).dot(g[i]) * jxw;
+          } else {
+            r_int(i) += r_p * fev.shape_value(i, q) * jxw;
+          }
+        }
+        if (!with_matrix) continue;
+        const Mat9 A =
+            mixed ? NeoHookean::tangent_at_pressure(F, p, material.mu) : material.tangent(F);
+        for (unsigned j = 0; j < n; ++j) {
+          if (comp[j] < 3) h[j] = A.middleCols<3>(3 * comp[j]) * g[j] * jxw;
+        }
+        for (unsigned i = 0; i < n; ++i) {
+          const double vi = comp[i] < 3 ? 0.0 : fev.shape_value(i, q);
+          for (unsigned j = 0; j < n; ++j) {
+            const double vj = comp[j] < 3 ? 0.0 : fev.shape_value(j, q);
+            double kij;
+            if (comp[i] < 3 && comp[j] < 3) {
+              kij = h[j].segment<3>(3 * comp[i]).dot(g[i]);
+            } else if (comp[i] < 3) {  // ∂R_u/∂p = −F⁻ᵀ : ∇v ψ
+              kij = -f_inv_t.row(comp[i]).dot(g[i]) * vj * jxw;
+            } else if (comp[j] < 3) {  // ∂R_p/∂u = −ψ F⁻ᵀ : ∇δu
+              kij = -vi * f_inv_t.row(comp[j]).dot(g[j]) * jxw;
+            } else {
+              kij = -vi * vj * inv_lambda * jxw;
+            }
+            k(i, j) += kij;
+          }
+        }
+      }
+      r = r_int;
+      r.add(-s, f_dead);
+      if (opt.follower_pressure) {
+        const auto& faces = d.mesh_map.face_triangle[cell->active_cell_index()];
+        for (unsigned fi = 0; fi < 4; ++fi) {
+          double pressure = 0.0;
+          if (faces[fi] < 0 || !d.form->pressure_on(faces[fi], pressure)) continue;
+          add_follower_pressure(face, cell, fi, s * pressure, w, comp, face_grad, with_matrix, k, r,
+                                stats);
+          if (!stats.valid) return stats;
+        }
+      }
+      sink(dofs, k, r, r_int);
+    }
+    return stats;
+  }
+
+  /// The follower pressure on one face: f_ext = −p J F⁻ᵀ N dA (Nanson's n da = J F⁻ᵀ N dA),
+  /// added to the residual as +p ∫ J F⁻ᵀN · v dA, with its tangent
+  /// ∂/∂u: p ∫ J [(F⁻ᵀ:∇δu)(F⁻ᵀN) − (F⁻ᵀ ∇δuᵀ F⁻ᵀ N)]·v dA.
+  void add_follower_pressure(dl::FEFaceValues<kDim>& face, const detail::CellIterator& cell,
+                             unsigned fi, double pressure, const dl::Vector<double>& w,
+                             const std::vector<unsigned>& comp,
+                             std::vector<dl::Tensor<2, kDim>>& grad, bool with_matrix,
+                             dl::FullMatrix<double>& k, dl::Vector<double>& r,
+                             PassStats& stats) const {
+    const dl::FEValuesExtractors::Vector disp(0);
+    face.reinit(cell, fi);
+    face[disp].get_function_gradients(w, grad);
+    const unsigned n = face.dofs_per_cell;
+    for (unsigned q = 0; q < face.n_quadrature_points; ++q) {
+      const Mat3 F = Mat3::Identity() + to_mat3(grad[q]);
+      const double J = F.determinant();
+      if (!(J > 0.0)) {
+        stats.valid = false;
+        return;
+      }
+      const Mat3 G = F.inverse();
+      const auto nn = face.normal_vector(q);
+      const Eigen::Vector3d n0 = G.transpose() * Eigen::Vector3d(nn[0], nn[1], nn[2]);
+      const double c = pressure * J * face.JxW(q);
+      for (unsigned i = 0; i < n; ++i) {
+        if (comp[i] >= 3) continue;
+        const double phi_i = face.shape_value(i, q);
+        if (phi_i == 0.0) continue;
+        r(i) += c * n0[comp[i]] * phi_i;
+        if (!with_matrix) continue;
+        for (unsigned j = 0; j < n; ++j) {
+          if (comp[j] >= 3) continue;
+          const auto gj = face.shape_grad(j, q);
+          const Eigen::Vector3d sj = G.transpose() * Eigen::Vector3d(gj[0], gj[1], gj[2]);
+          k(i, j) += c * phi_i * (sj[comp[j]] * n0[comp[i]] - n0[comp[j]] * sj[comp[i]]);
+        }
+      }
+    }
+  }
+
+  /// Residual norms at a pass: displacement rows relative to the internal force's norm (all
+  /// DoFs: loads and reactions), pressure rows relative to ∫ψ dV (a volumetric strain).
+  struct Norms {
+    double force = 0.0, force_scale = 0.0, pressure = 0.0;
+    [[nodiscard]] double relative(double scale) const {
+      return std::max(force / std::max(scale, std::numeric_limits<double>::min()), pressure);
+    }
+  };
+
+  /// Assembles the constrained Newton system into d.matrix (with_matrix) and d.rhs = −R, using
+  /// d.constraints as they stand (their inhomogeneities: the prescribed increment).
+  PassStats assemble(const dl::Vector<double>& w, double s, bool with_matrix, Norms& norms) {
+    const auto t0 = Clock::now();
+    if (with_matrix) d.matrix = 0.0;
+    d.rhs = 0.0;
+    internal = 0.0;
+    dl::Vector<double> minus_r;
+    const PassStats stats =
+        pass(w, s, with_matrix,
+             [&](const std::vector<Index>& dofs, const dl::FullMatrix<double>& k,
+                 const dl::Vector<double>& r, const dl::Vector<double>& r_int) {
+               minus_r = r;
+               minus_r *= -1.0;
+               if (with_matrix) {
+                 d.constraints.distribute_local_to_global(k, minus_r, dofs, d.matrix, d.rhs);
+               } else {
+                 d.constraints.distribute_local_to_global(minus_r, dofs, d.rhs);
+               }
+               for (unsigned i = 0; i < dofs.size(); ++i) internal(dofs[i]) += r_int(i);
+             });
+    norms = {};
+    double f2 = 0.0, s2 = 0.0, p_max = 0.0;
+    for (Index i = 0; i < d.dof.n_dofs(); ++i) {
+      if (component[i] < 3) {
+        f2 += d.rhs(i) * d.rhs(i);
+        s2 += internal(i) * internal(i);
+      } else {
+        p_max = std::max(p_max, std::abs(d.rhs(i)) / pressure_volume(i));
+      }
+    }
+    norms.force = std::sqrt(f2);
+    norms.force_scale = std::sqrt(s2);
+    norms.pressure = p_max;
+    result.timings.assembly += seconds_since(t0);
+    return stats;
+  }
+
+  void set_prescribed_increment(double ds) {
+    for (std::size_t c = 0; c < constrained.size(); ++c)
+      d.constraints.set_inhomogeneity(constrained[c], ds * prescribed[c]);
+  }
+
+  struct StepOutcome {
+    bool converged = false;
+    int iterations = 0;
+    double residual = 0.0;
+    std::string reason;
+  };
+
+  /// Newton from the equilibrium u at s0 to s1; u is left at the new equilibrium on success.
+  StepOutcome newton_step(double s0, double s1) {
+    StepOutcome out;
+    const bool moves_supports =
+        std::any_of(prescribed.begin(), prescribed.end(), [](double v) { return v != 0.0; });
+    Norms norms;
+    for (int it = 0; it <= opt.max_newton_iterations; ++it) {
+      // The first iteration moves the supports by their whole increment (a tangent predictor);
+      // later updates leave them where they are.
+      const bool predictor = it == 0 && moves_supports;
+      set_prescribed_increment(predictor ? s1 - s0 : 0.0);
+      const PassStats st = assemble(u, s1, true, norms);
+      if (!st.valid) {
+        out.reason = "an element inverted (J <= 0)";
+        return out;
+      }
+      const double scale = norms.force_scale;
+      out.residual = norms.relative(scale);
+      if (!predictor && out.residual <= opt.residual_tolerance) {
+        out.converged = true;
+        out.iterations = it;
+        return out;
+      }
+      if (it == opt.max_newton_iterations) break;
+      const auto t0 = Clock::now();
+      try {
+        d.solve_linear(symmetric);
+      } catch (const std::exception& e) {
+        result.timings.solve += seconds_since(t0);
+        out.reason = std::string("the linear solve failed: ") + e.what();
+        out.iterations = it + 1;
+        return out;
+      }
+      result.timings.solve += seconds_since(t0);
+      result.linear_iterations += d.result.iterations;
+      result.solver = d.result.solver;
+      ++result.newton_iterations;
+      out.iterations = it + 1;
+      if (predictor) {
+        u += d.solution;
+        continue;
+      }
+      // Backtracking on the residual's norm (the follower load has no potential).
+      const dl::Vector<double> du = d.solution;
+      const dl::Vector<double> u0 = u;
+      const double merit0 = out.residual;
+      double alpha = 1.0;
+      bool accepted = false;
+      for (int ls = 0; ls <= opt.max_line_search; ++ls, alpha *= 0.5) {
+        u = u0;
+        u.add(alpha, du);
+        Norms trial;
+        const PassStats ts = assemble(u, s1, false, trial);
+        if (ts.valid && trial.relative(scale) <= (1.0 - 1e-4 * alpha) * merit0) {
+          accepted = true;
+          break;
+        }
+      }
+      if (!accepted) {
+        // At round-off no step decreases the residual: accept when the update is negligible.
+        if (du.linfty_norm() <= 1e-12 * std::max(u0.linfty_norm(), 1e-300) &&
+            merit0 <= 1e3 * opt.residual_tolerance) {
+          u = u0;
+          out.converged = true;
+          return out;
+        }
+        u = u0;
+        std::ostringstream m;
+        m << "the line search found no decrease of the residual (relative residual " << merit0
+          << ")";
+        out.reason = m.str();
+        return out;
+      }
+    }
+    std::ostringstream m;
+    m << "Newton did not converge in " << opt.max_newton_iterations
+      << " iterations (relative residual " << out.residual << ")";
+    out.reason = m.str();
+    return out;
+  }
+
+  void solve() {
+    result.steps.clear();
+    result.rejected_steps = 0;
+    result.newton_iterations = 0;
+    result.linear_iterations = 0;
+    result.timings.assembly = result.timings.solve = 0.0;
+    u = 0.0;
+    double s = 0.0;
+    double ds = std::min(opt.initial_step, opt.max_step);
+    const double target = opt.target_load_factor;
+    result.completed = true;
+    result.stop_reason.clear();
+    while (s < target * (1.0 - 1e-14)) {
+      ds = std::min(ds, target - s);
+      const dl::Vector<double> u_start = u;
+      const StepOutcome o = newton_step(s, s + ds);
+      if (o.converged) {
+        s += ds;
+        result.steps.push_back({s, o.iterations, o.residual});
+        if (o.iterations <= opt.fast_iterations) ds = std::min(ds * opt.growth, opt.max_step);
+        continue;
+      }
+      u = u_start;
+      ++result.rejected_steps;
+      if (ds * 0.5 < opt.min_step) {
+        std::ostringstream m;
+        m << "no equilibrium found beyond load factor " << s << ": at " << s + ds << ", "
+          << o.reason << "; the increment " << ds << " cannot be halved below the minimum "
+          << opt.min_step;
+        result.completed = false;
+        result.stop_reason = m.str();
+        break;
+      }
+      ds *= 0.5;
+    }
+    result.load_factor = s;
+    set_prescribed_increment(0.0);
+    const auto t0 = Clock::now();
+    const PassStats st = pass(u, s, false, [](auto&&...) {});
+    result.strain_energy = st.energy;
+    result.max_abs_principal_strain = st.max_abs_strain;
+    result.min_jacobian = st.min_jacobian;
+    d.solution = u;
+    d.solved = true;
+    result.nodal_displacement = d.nodal([&](Index i) { return u(i); });
+    result.timings.postprocess = seconds_since(t0);
+    solved = true;
+  }
+};
+
+HyperelasticSolver::HyperelasticSolver(const TetMesh& mesh, ElasticityProblem problem,
+                                       HyperelasticOptions options) {
+  const auto& o = options;
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw InputError(std::string("finite-strain option ") + what);
+  };
+  require(o.target_load_factor > 0.0 && std::isfinite(o.target_load_factor),
+          "target_load_factor: expected a finite number > 0");
+  require(o.min_step > 0.0 && o.initial_step >= o.min_step && o.max_step >= o.min_step,
+          "steps: expected 0 < min_step <= initial_step and min_step <= max_step");
+  require(o.growth >= 1.0, "growth: expected >= 1");
+  require(o.max_newton_iterations > 0 && o.max_line_search >= 0,
+          "iterations: expected max_newton_iterations > 0 and max_line_search >= 0");
+  require(o.residual_tolerance > 0.0, "residual_tolerance: expected > 0");
+  impl_ = std::make_unique<Impl>(mesh, std::move(problem), options);
+}
+
+HyperelasticSolver::~HyperelasticSolver() = default;
+
+const HyperelasticResult& HyperelasticSolver::solve() {
+  impl_->solve();
+  return impl_->result;
+}
+
+const HyperelasticResult& HyperelasticSolver::result() const { return impl_->result; }
+
+std::vector<Vec3> HyperelasticSolver::displacement_at(const std::vector<Vec3>& points,
+                                                      double outside_tolerance) const {
+  if (!impl_->solved) throw std::logic_error("displacement_at called before solve()");
+  return impl_->linear.displacement_at(points, outside_tolerance);
+}
+
+double HyperelasticSolver::relative_l2_error(const std::function<Vec3(const Vec3&)>& exact) const {
+  if (!impl_->solved) throw std::logic_error("relative_l2_error called before solve()");
+  return impl_->linear.relative_l2_error(exact);
+}
+
+std::size_t HyperelasticSolver::n_dofs() const { return impl_->d.dof.n_dofs(); }
+
+std::vector<unsigned> HyperelasticSolver::dof_components() const { return impl_->component; }
+
+std::vector<double> HyperelasticSolver::residual(const std::vector<double>& u, double s) const {
+  const auto& im = *impl_;
+  if (u.size() != n_dofs()) throw std::invalid_argument("residual: wrong number of DoF values");
+  dl::Vector<double> w(u.begin(), u.end());
+  std::vector<double> out(n_dofs(), 0.0);
+  const PassStats st = im.pass(
+      w, s, false,
+      [&](const std::vector<Index>& dofs, const auto&, const dl::Vector<double>& r, const auto&) {
+        for (unsigned i = 0; i < dofs.size(); ++i) out[dofs[i]] += r(i);
+      });
+  if (!st.valid) throw std::invalid_argument("residual: an element is inverted (J <= 0)");
+  return out;
+}
+
+std::vector<std::vector<double>> HyperelasticSolver::tangent_columns(const std::vector<double>& u,
+                                                                     double s) const {
+  const auto& im = *impl_;
+  if (u.size() != n_dofs()) throw std::invalid_argument("tangent: wrong number of DoF values");
+  dl::Vector<double> w(u.begin(), u.end());
+  std::vector<std::vector<double>> cols(n_dofs(), std::vector<double>(n_dofs(), 0.0));
+  const PassStats st = im.pass(w, s, true,
+                               [&](const std::vector<Index>& dofs, const dl::FullMatrix<double>& k,
+                                   const auto&, const auto&) {
+                                 for (unsigned i = 0; i < dofs.size(); ++i)
+                                   for (unsigned j = 0; j < dofs.size(); ++j)
+                                     cols[dofs[j]][dofs[i]] += k(i, j);
+                               });
+  if (!st.valid) throw std::invalid_argument("tangent: an element is inverted (J <= 0)");
+  return cols;
+}
+
+}  // namespace vessel::fem

@@ -1,0 +1,128 @@
+#pragma once
+/// The finite-strain FEM reference: hyperelastic statics, total Lagrangian, on the same mesh,
+/// supports, loads, elements and linear solvers as the linear reference (ElasticitySolver, whose
+/// discretisation it reuses). Compressible neo-Hookean with P1 or P2 displacement, or a mixed
+/// displacement–pressure form with Taylor–Hood P2–P1 for ν → 0.5 (and ν = 0.5). Newton with a
+/// line search, adaptive load stepping. Plain data only (no deal.II). SI units. The formulas are
+/// derived in docs/finite_strain.md.
+#include <Eigen/Core>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fem_reference/elasticity.hpp"
+
+namespace vessel::fem {
+
+using Mat3 = Eigen::Matrix3d;
+/// A fourth-order tensor A_{aJbL} as a 9×9 matrix, row 3a+J, column 3b+L.
+using Mat9 = Eigen::Matrix<double, 9, 9>;
+
+/// Compressible neo-Hookean: Ψ(F) = μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)², I₁ = tr FᵀF, J = det F
+/// (e.g. Bonet & Wood, Nonlinear Continuum Mechanics for FE Analysis, 2nd ed., eq. 6.27). Its
+/// linearisation at F = I is linear elasticity with the same λ, μ.
+struct NeoHookean {
+  double mu = 0.0;      ///< shear modulus μ, Pa
+  double lambda = 0.0;  ///< Lamé's λ, Pa (infinite at ν = 0.5: mixed form only)
+
+  static NeoHookean of(const Material& m) { return {m.mu(), m.lambda()}; }
+
+  /// Ψ(F), J/m³ (+∞ if J ≤ 0).
+  [[nodiscard]] double energy(const Mat3& F) const;
+  /// The first Piola–Kirchhoff stress with the volumetric part given by a pressure field p:
+  /// P = μ (F − F⁻ᵀ) − p F⁻ᵀ. The compressible form has p = −λ ln J.
+  [[nodiscard]] static Mat3 stress_at_pressure(const Mat3& F, double p, double mu);
+  /// ∂P/∂F at fixed p: μ δ_ab δ_JL + (μ + p) F⁻¹_Jb F⁻¹_La.
+  [[nodiscard]] static Mat9 tangent_at_pressure(const Mat3& F, double p, double mu);
+  /// P = ∂Ψ/∂F = μ (F − F⁻ᵀ) + λ ln J F⁻ᵀ.
+  [[nodiscard]] Mat3 stress(const Mat3& F) const;
+  /// ∂P/∂F: tangent_at_pressure(F, −λ ln J) + λ F⁻ᵀ ⊗ F⁻ᵀ.
+  [[nodiscard]] Mat9 tangent(const Mat3& F) const;
+};
+
+struct HyperelasticOptions {
+  /// Load stepping: the problem's loads (tractions, pressures, gravity, body force, prescribed
+  /// displacements) all scale with one load factor s from 0 to `target_load_factor`.
+  double target_load_factor = 1.0;
+  double initial_step = 1.0;  ///< first increment of s
+  double min_step = 1e-4;     ///< give up when a failed increment would be smaller
+  double max_step = 1.0;
+  double growth = 1.5;  ///< increment × this after a step that took ≤ fast_iterations
+  int fast_iterations = 4;
+  int max_newton_iterations = 25;
+  int max_line_search = 10;  ///< halvings of the Newton step before the step fails
+  /// Converged when the residual's norm (free DoFs) ≤ this × the internal force's norm (all
+  /// DoFs, i.e. loads and reactions), or the Newton update is at round-off.
+  double residual_tolerance = 1e-9;
+  /// true: pressure acts on the deformed surface (traction −p n da); false: a dead load on the
+  /// reference surface (as the linear reference applies it).
+  bool follower_pressure = true;
+};
+
+/// One accepted load step.
+struct LoadStep {
+  double load_factor = 0.0;
+  int newton_iterations = 0;
+  double residual = 0.0;  ///< relative residual at convergence
+};
+
+struct HyperelasticResult {
+  std::string element;  ///< "P1", "P2" or "P2-P1 (Taylor-Hood)"
+  Formulation formulation = Formulation::displacement;
+  LinearSolver solver = LinearSolver::direct;  ///< the one used for the Newton systems
+  std::size_t n_dofs = 0;
+  /// The largest load factor at which equilibrium was found, and whether it is the target.
+  double load_factor = 0.0;
+  bool completed = false;
+  std::string stop_reason;         ///< empty when completed; else why the load could not go on
+  std::vector<LoadStep> steps;     ///< accepted steps
+  int rejected_steps = 0;          ///< increments halved after a Newton failure
+  int newton_iterations = 0;       ///< total, accepted and rejected steps
+  unsigned linear_iterations = 0;  ///< total CG / FGMRES iterations (0 for direct)
+  std::vector<Vec3> nodal_displacement;  ///< at load_factor, at every TetMesh node, m
+  double strain_energy = 0.0;            ///< ∫Ψ dV, J
+  /// Largest |eigenvalue| of the Green–Lagrange strain E = ½(FᵀF − I) at quadrature points.
+  double max_abs_principal_strain = 0.0;
+  double min_jacobian = 1.0;  ///< smallest J = det F at quadrature points
+  PhaseTimings timings;       ///< assembly and solve summed over all Newton iterations
+};
+
+/// Solves a hyperelastic problem on one mesh (the ElasticityProblem's supports, loads, elements
+/// and solver options; its Material's E, ν give μ, λ).
+class HyperelasticSolver {
+ public:
+  /// InputError for what ElasticitySolver rejects, and for bad options.
+  HyperelasticSolver(const TetMesh& mesh, ElasticityProblem problem,
+                     HyperelasticOptions options = {});
+  ~HyperelasticSolver();
+  HyperelasticSolver(const HyperelasticSolver&) = delete;
+  HyperelasticSolver& operator=(const HyperelasticSolver&) = delete;
+
+  /// Load stepping with Newton from u = 0; returns the result (also kept in result()). When the
+  /// target cannot be reached the result holds the last equilibrium and the reason.
+  const HyperelasticResult& solve();
+  [[nodiscard]] const HyperelasticResult& result() const;
+
+  /// The displacement (m) at points inside the mesh, as ElasticitySolver::displacement_at.
+  [[nodiscard]] std::vector<Vec3> displacement_at(const std::vector<Vec3>& points,
+                                                  double outside_tolerance = 1e-9) const;
+  /// ‖u_h − u‖_L2 / ‖u‖_L2, as ElasticitySolver::relative_l2_error.
+  [[nodiscard]] double relative_l2_error(const std::function<Vec3(const Vec3&)>& exact) const;
+
+  [[nodiscard]] std::size_t n_dofs() const;
+  /// Per DoF: its component (0–2 displacement, 3 the mixed form's pressure).
+  [[nodiscard]] std::vector<unsigned> dof_components() const;
+  /// The residual R(u) = f_int(u) − f_ext(u, s) at DoF values u (size n_dofs) and load factor s,
+  /// on every DoF (no constraints applied), and its tangent ∂R/∂u as dense columns: for tests of
+  /// the tangent against finite differences of the residual (small meshes only).
+  [[nodiscard]] std::vector<double> residual(const std::vector<double>& u, double s) const;
+  [[nodiscard]] std::vector<std::vector<double>> tangent_columns(const std::vector<double>& u,
+                                                                 double s) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace vessel::fem

@@ -1,0 +1,219 @@
+/// The finite-strain reference: the neo-Hookean kernel against finite differences of its energy,
+/// the assembled tangent against finite differences of the residual, the uniaxial stretch of a
+/// cube (closed form) and Rivlin's closed form itself.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <random>
+
+#include "cube_mesh.hpp"
+#include "fem_reference/hyperelastic.hpp"
+#include "fem_reference/rivlin.hpp"
+
+using namespace vessel;
+using namespace vessel::fem;
+
+namespace {
+
+constexpr double kE = 14.24e3;
+
+Mat3 random_deformation(std::mt19937& rng, double amplitude) {
+  std::uniform_real_distribution<double> u(-amplitude, amplitude);
+  Mat3 F = Mat3::Identity();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) F(i, j) += u(rng);
+  return F;
+}
+
+}  // namespace
+
+TEST(NeoHookean, StressIsTheEnergysDerivativeAndTangentTheStresss) {
+  Material m;
+  m.poisson_ratio = 0.3;
+  const NeoHookean nh = NeoHookean::of(m);
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 5; ++trial) {
+    const Mat3 F = random_deformation(rng, 0.3);
+    ASSERT_GT(F.determinant(), 0.0);
+    const Mat3 P = nh.stress(F);
+    const Mat9 A = nh.tangent(F);
+    const double h = 1e-6;
+    for (int b = 0; b < 3; ++b) {
+      for (int L = 0; L < 3; ++L) {
+        Mat3 Fp = F, Fm = F;
+        Fp(b, L) += h;
+        Fm(b, L) -= h;
+        const double dpsi = (nh.energy(Fp) - nh.energy(Fm)) / (2 * h);
+        EXPECT_NEAR(P(b, L), dpsi, 1e-6 * nh.mu);
+        const Mat3 dP = (nh.stress(Fp) - nh.stress(Fm)) / (2 * h);
+        for (int a = 0; a < 3; ++a)
+          for (int J = 0; J < 3; ++J)
+            EXPECT_NEAR(A(3 * a + J, 3 * b + L), dP(a, J), 1e-6 * nh.lambda);
+      }
+    }
+  }
+}
+
+TEST(NeoHookean, LinearisesToLinearElasticityWithTheSameLame) {
+  Material m;
+  m.poisson_ratio = 0.3;
+  const NeoHookean nh = NeoHookean::of(m);
+  EXPECT_EQ(nh.energy(Mat3::Identity()), 0.0);
+  EXPECT_NEAR(nh.stress(Mat3::Identity()).norm(), 0.0, 1e-12 * nh.mu);
+  const Mat9 A = nh.tangent(Mat3::Identity());
+  // C_aJbL = λ δ_aJ δ_bL + μ (δ_ab δ_JL + δ_aL δ_Jb)
+  for (int a = 0; a < 3; ++a)
+    for (int J = 0; J < 3; ++J)
+      for (int b = 0; b < 3; ++b)
+        for (int L = 0; L < 3; ++L) {
+          const double c =
+              nh.lambda * (a == J) * (b == L) + nh.mu * ((a == b) * (J == L) + (a == L) * (J == b));
+          EXPECT_NEAR(A(3 * a + J, 3 * b + L), c, 1e-9 * nh.lambda);
+        }
+}
+
+namespace {
+
+/// A loaded cube: rollers on x0, y0, z0, follower pressure on x1, dead gravity.
+ElasticityProblem cube_problem(double nu, int degree, Formulation f, double pressure) {
+  ElasticityProblem p;
+  p.material.poisson_ratio = nu;
+  p.options.degree = degree;
+  p.options.formulation = f;
+  p.options.solver = LinearSolver::direct;
+  p.dirichlet = {DirichletCondition::roller("x0", 0), DirichletCondition::roller("y0", 1),
+                 DirichletCondition::roller("z0", 2)};
+  if (pressure != 0.0) p.pressures = {{"x1", pressure}};
+  return p;
+}
+
+/// max |K_ij − (R_i(u + h e_j) − R_i(u − h e_j))/2h| over all i, j, relative to max |K_ij|.
+double tangent_fd_mismatch(const HyperelasticSolver& s, const std::vector<double>& u, double lf) {
+  const auto K = s.tangent_columns(u, lf);
+  double kmax = 0.0, err = 0.0;
+  for (std::size_t j = 0; j < u.size(); ++j) {
+    auto up = u, um = u;
+    const double h = 1e-7 * std::max(1e-3, std::abs(u[j]));
+    up[j] += h;
+    um[j] -= h;
+    const auto rp = s.residual(up, lf), rm = s.residual(um, lf);
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      kmax = std::max(kmax, std::abs(K[j][i]));
+      err = std::max(err, std::abs(K[j][i] - (rp[i] - rm[i]) / (2 * h)));
+    }
+  }
+  return err / kmax;
+}
+
+/// Random DoF values: displacements up to `amplitude` (m), pressures up to `pressure` (Pa).
+std::vector<double> random_state(const HyperelasticSolver& s, std::mt19937& rng, double amplitude,
+                                 double pressure) {
+  std::uniform_real_distribution<double> d(-1.0, 1.0);
+  const auto comp = s.dof_components();
+  std::vector<double> u(s.n_dofs());
+  for (std::size_t i = 0; i < u.size(); ++i) u[i] = d(rng) * (comp[i] < 3 ? amplitude : pressure);
+  return u;
+}
+
+}  // namespace
+
+TEST(HyperelasticTangent, MatchesFiniteDifferencesOfTheResidual) {
+  const double L = 1e-3;
+  // Two cells per side for P1; one for P2 (81 DoFs: a finite-difference column per DoF).
+  const TetMesh meshes[2] = {test::cube_mesh(2, L), test::cube_mesh(1, L)};
+  std::mt19937 rng(3);
+  struct Case {
+    int degree;
+    Formulation f;
+    double nu;
+    bool follower;
+  };
+  for (const Case c :
+       {Case{1, Formulation::displacement, 0.3, true},
+        Case{2, Formulation::displacement, 0.3, true},
+        Case{1, Formulation::displacement, 0.3, false}, Case{2, Formulation::mixed, 0.45, true},
+        Case{2, Formulation::mixed, 0.5, true}}) {
+    ElasticityProblem p = cube_problem(c.nu, c.degree, c.f, 2000.0);
+    p.gravity = Vec3(0, 0, -9.81 * 50);
+    HyperelasticOptions o;
+    o.follower_pressure = c.follower;
+    HyperelasticSolver s(meshes[c.degree - 1], p, o);
+    // Displacements of 5 % of the cube and pressures of the order of μ: well into finite strain.
+    const auto u = random_state(s, rng, 0.05 * L, 0.5 * p.material.mu());
+    const double mismatch = tangent_fd_mismatch(s, u, 0.8);
+    std::cout << "  tangent vs FD: degree " << c.degree << " " << to_string(c.f) << " nu " << c.nu
+              << (c.follower ? " follower" : " dead") << " pressure: max rel mismatch " << mismatch
+              << "\n";
+    EXPECT_LT(mismatch, 1e-6);
+  }
+}
+
+namespace {
+
+/// Uniaxial stress of compressible neo-Hookean, stretch l along x: the lateral stretch t solves
+/// σ_yy = (μ(t² − 1) + λ ln(l t²))/J = 0 (bisection; σ_yy increases with t), and
+/// σ_xx = μ(l² − t²)/J, J = l t² (Cauchy stress σ = (μ(B − I) + λ ln J I)/J).
+struct Uniaxial {
+  double lateral, cauchy;
+};
+Uniaxial uniaxial_stress(double l, double mu, double lambda) {
+  double lo = 1e-3, hi = 10.0;
+  for (int i = 0; i < 200; ++i) {
+    const double t = 0.5 * (lo + hi);
+    (mu * (t * t - 1) + lambda * std::log(l * t * t) < 0 ? lo : hi) = t;
+  }
+  const double t = 0.5 * (lo + hi);
+  return {t, mu * (l * l - t * t) / (l * t * t)};
+}
+
+}  // namespace
+
+TEST(HyperelasticCube, UniaxialStretchMatchesTheClosedForm) {
+  // A homogeneous deformation is in every element's space, so the discrete solution is exact up
+  // to the Newton tolerance: P1, P2 (compressible) and Taylor–Hood at ν = 0.5.
+  const double L = 1e-3;
+  const TetMesh mesh = test::cube_mesh(2, L);
+  for (const double stretch : {1.5, 0.8}) {
+    for (const auto& [degree, f, nu] :
+         {std::tuple{1, Formulation::displacement, 0.3},
+          std::tuple{2, Formulation::displacement, 0.3}, std::tuple{2, Formulation::mixed, 0.5}}) {
+      Material m;
+      m.poisson_ratio = nu;
+      const double mu = m.mu(), lambda = m.lambda();
+      // ν = 0.5: t = l^(−1/2) and σ = μ(l² − 1/l) (the λ → ∞ limit of the above).
+      const Uniaxial exact = std::isinf(lambda) ? Uniaxial{1.0 / std::sqrt(stretch),
+                                                           mu * (stretch * stretch - 1.0 / stretch)}
+                                                : uniaxial_stress(stretch, mu, lambda);
+      // The Cauchy traction σ_xx on the deformed face is a follower "pressure" −σ_xx.
+      HyperelasticSolver s(mesh, cube_problem(nu, degree, f, -exact.cauchy));
+      const auto& r = s.solve();
+      ASSERT_TRUE(r.completed) << r.stop_reason;
+      const Vec3 u = s.displacement_at({Vec3(L, L, L)})[0];
+      const Vec3 expect((stretch - 1) * L, (exact.lateral - 1) * L, (exact.lateral - 1) * L);
+      std::cout << "  uniaxial l=" << stretch << " " << r.element << " nu " << nu << ": steps "
+                << r.steps.size() << " (rejected " << r.rejected_steps << "), Newton "
+                << r.newton_iterations << ", |u - exact| / L = " << (u - expect).norm() / L << "\n";
+      EXPECT_LT((u - expect).norm(), 1e-8 * L);
+      EXPECT_GT(r.max_abs_principal_strain, 0.1);
+    }
+  }
+}
+
+TEST(RivlinTubeClosedForm, QuadratureOfTheEquilibriumIntegralMatchesTheClosedForm) {
+  const RivlinTube t;
+  for (double a_over_A : {1.01, 1.2, 1.5, 2.0, 4.0}) {
+    const double a = a_over_A * t.inner_radius;
+    const double closed = t.pressure(a), quad = t.pressure_by_quadrature(a);
+    EXPECT_NEAR(quad, closed, 1e-10 * closed) << "a/A " << a_over_A;
+    EXPECT_NEAR(t.inner_radius_at(closed), a, 1e-12 * a);
+  }
+  EXPECT_NEAR(t.pressure(t.inner_radius), 0.0, 1e-12 * t.shear_modulus);
+  EXPECT_LT(t.pressure(100 * t.inner_radius), t.limit_pressure());
+  EXPECT_THROW((void)t.inner_radius_at(t.limit_pressure()), std::domain_error);
+  // Small pressure: the linear (Lamé, ν = 0.5) inner displacement u = P a b² / (2μ (b² − a²)).
+  const double P = 1e-6 * t.shear_modulus;
+  const double A = t.inner_radius, B = t.outer_radius;
+  const double lame = P * A * B * B / (2 * t.shear_modulus * (B * B - A * A));
+  EXPECT_NEAR(t.inner_radius_at(P) - A, lame, 1e-5 * lame);
+}
