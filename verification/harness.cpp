@@ -6,8 +6,6 @@
 #include <atomic>
 #include <cctype>
 #include <cmath>
-#include <exception>
-#include <functional>
 #include <iomanip>
 #include <limits>
 #include <map>
@@ -1122,12 +1120,14 @@ void solve_all_references(std::vector<std::unique_ptr<SceneReferences>>& refs,
           refs[i]->at_nu[k].seconds += transients.seconds();
         }
         const std::lock_guard lock(log_mutex);
-        log << "  [" << ++finished << "/" << cases.size() << "] " << s.name << ": "
-            << reference_label(s, s.poisson_ratios[k])
-            << (refs[i]->modal_reference_mesh ? ", its modes" : "")
-            << (refs[i]->at_nu[k].ref.transients.empty() ? "" : ", its FEM transients") << " in "
-            << std::setprecision(3) << refs[i]->at_nu[k].seconds << " s (elapsed "
-            << clock.seconds() << " s)\n";
+        std::ostringstream line;  // its own precision: the caller's stream keeps its settings
+        line << "  [" << ++finished << "/" << cases.size() << "] " << s.name << ": "
+             << reference_label(s, s.poisson_ratios[k])
+             << (refs[i]->modal_reference_mesh ? ", its modes" : "")
+             << (refs[i]->at_nu[k].ref.transients.empty() ? "" : ", its FEM transients") << " in "
+             << std::setprecision(3) << refs[i]->at_nu[k].seconds << " s (elapsed "
+             << clock.seconds() << " s)\n";
+        log << line.str();
         log_modal_failure(log, refs[i]->at_nu[k]);
       }
     });
