@@ -111,10 +111,11 @@ TetMesh load_or_generate_vessel(const VesselParams& params, const fs::path& cach
       }
     }
   }
-  TetMesh mesh = params.kind == VesselKind::lumen
-                     ? lumen_wall_mesh({params.file, params.wall_thickness, params.file_scale,
-                                        params.level})
-                     : generate_vessel_mesh(params, options);
+  // As stored, so this run and a later one reading the cache solve the same problem.
+  TetMesh mesh = as_stored(params.kind == VesselKind::lumen
+                               ? lumen_wall_mesh({params.file, params.wall_thickness,
+                                                  params.file_scale, params.level})
+                               : generate_vessel_mesh(params, options));
   info.seconds = seconds_since(t0);
   if (!cache_dir.empty()) write_msh(info.path, mesh);
   if (source) *source = info;

@@ -540,10 +540,18 @@ void write_v41(std::ostream& out, const TetMesh& mesh) {
 
 }  // namespace
 
+void write_msh(std::ostream& out, const TetMesh& mesh, MshVersion version) {
+  version == MshVersion::v22 ? write_v22(out, mesh) : write_v41(out, mesh);
+}
+
 void write_msh(const std::filesystem::path& path, const TetMesh& mesh, MshVersion version) {
-  write_file_atomically(path, [&](std::ostream& out) {
-    version == MshVersion::v22 ? write_v22(out, mesh) : write_v41(out, mesh);
-  });
+  write_file_atomically(path, [&](std::ostream& out) { write_msh(out, mesh, version); });
+}
+
+TetMesh as_stored(const TetMesh& mesh) {
+  std::stringstream text;
+  write_msh(text, mesh);
+  return parse_msh(text, "generated mesh");
 }
 
 }  // namespace vessel

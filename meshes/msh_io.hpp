@@ -26,4 +26,13 @@ TetMesh parse_msh(std::istream& in, const std::string& source);
 void write_msh(const std::filesystem::path& path, const TetMesh& mesh,
                MshVersion version = MshVersion::v41);
 
+/// Writes the mesh as ASCII `.msh` to a stream.
+void write_msh(std::ostream& out, const TetMesh& mesh, MshVersion version = MshVersion::v41);
+
+/// The mesh exactly as write_msh then read_msh give it back (triangles in group order, faces
+/// oriented outward, coordinates bitwise): a generated mesh used in this form is the same mesh,
+/// element for element, as the one a later run reads from the cache, so both key and solve the
+/// same FEM problem.
+TetMesh as_stored(const TetMesh& mesh);
+
 }  // namespace vessel
