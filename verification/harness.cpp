@@ -23,7 +23,6 @@
 #include "fem_reference/solution_cache.hpp"
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
-#include "meshes/solver_threads.hpp"
 #include "meshes/vtu_io.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/model/model_factory.hpp"
@@ -164,12 +163,20 @@ const fem::HyperelasticSolver& finite_reference(const ReferenceSolvers& ref, dou
 /// steps over the run resolve the low modes that a contact step excites.
 constexpr int kTransientSteps = 400;
 
+/// Guards every ReferenceSolvers::transients map: the parallel pass runs a scene's transients
+/// side by side.
+std::mutex transients_mutex;
+
 /// The FEM transient at `probe` for a step unit load over `duration` (cached): times and |u|.
+/// Thread-safe: two calls for the same transient may both run it, and the first stored is kept.
 const std::pair<std::vector<double>, std::vector<double>>& transient_at(
     const ReferenceSolvers& ref, const Vec3& probe, double duration, double alpha) {
   const auto key = std::make_tuple(probe.x(), probe.y(), probe.z(), duration, alpha);
-  const auto it = ref.transients.find(key);
-  if (it != ref.transients.end()) return it->second;
+  {
+    const std::lock_guard lock(transients_mutex);
+    const auto it = ref.transients.find(key);
+    if (it != ref.transients.end()) return it->second;
+  }
   fem::TransientOptions t;
   t.dt = duration / kTransientSteps;
   t.steps = kTransientSteps;
@@ -181,6 +188,7 @@ const std::pair<std::vector<double>, std::vector<double>>& transient_at(
                 : ref.fine->transient(t);
   std::vector<double> u(r.time.size());
   for (std::size_t k = 0; k < u.size(); ++k) u[k] = r.probe_displacement[k][0].norm();
+  const std::lock_guard lock(transients_mutex);
   return ref.transients.emplace(key, std::make_pair(r.time, u)).first->second;
 }
 
@@ -982,13 +990,27 @@ void solve_modal_reference_at(const Scene& s, SceneReferences& r, std::size_t k)
   r.at_nu[k].seconds += clock.seconds();
 }
 
-/// The FEM transients the scene's dynamic models at its k-th ν will be compared with (each model's
-/// probe node and damping, as add_reference_history asks for them), run now so that the models'
-/// pass finds them in ReferenceSolvers::transients. Models on a region of interest or with an
-/// automatic time step are left to the models' pass.
-void run_reference_transients_at(const Scene& s, SceneReferences& r, std::size_t k) {
+/// A FEM transient a dynamic model will be compared with: its probe node, simulated time and
+/// mass damping, as add_reference_history asks for them.
+struct TransientRequest {
+  Vec3 probe;
+  double duration = 0.0;
+  double alpha = 0.0;
+  auto operator<=>(const TransientRequest& o) const {
+    return std::tie(probe.x(), probe.y(), probe.z(), duration, alpha) <=>
+           std::tie(o.probe.x(), o.probe.y(), o.probe.z(), o.duration, o.alpha);
+  }
+  bool operator==(const TransientRequest& o) const { return (*this <=> o) == 0; }
+};
+
+/// The distinct FEM transients of the scene's dynamic models at its k-th ν, so that the parallel
+/// pass runs them and the models' pass finds them in ReferenceSolvers::transients. Models on a
+/// region of interest or with an automatic time step are left to the models' pass.
+std::vector<TransientRequest> transient_requests(const Scene& s, const SceneReferences& r,
+                                                 std::size_t k) {
   const double nu = s.poisson_ratios[k];
   const Vec3 qoi = qoi_point(s);
+  std::vector<TransientRequest> out;
   for (const auto& [level, mesh] : r.model_meshes) {
     for (const ModelSpec& spec : s.models) {
       if (spec.kind == ModelKind::fem || !spec.solver.is_dynamic() || spec.roi_radius > 0.0 ||
@@ -1000,12 +1022,13 @@ void run_reference_transients_at(const Scene& s, SceneReferences& r, std::size_t
       const msm::BuiltNetwork built = scene_network(s, spec, mesh, vessel, nu);
       const auto model = msm::make_model(built, spec.damping);
       const msm::Problem at_rest = msm_problem(s, *model, built, mesh, 0.0);
-      const Vec3 probe = built.network.nodes[nearest_node(built.network.nodes, qoi)];
-      (void)transient_at(r.at_nu[k].ref, probe,
-                         spec.solver.dt * static_cast<double>(spec.solver.steps),
-                         transient_mass_damping(spec, at_rest));
+      const TransientRequest q{built.network.nodes[nearest_node(built.network.nodes, qoi)],
+                               spec.solver.dt * static_cast<double>(spec.solver.steps),
+                               transient_mass_damping(spec, at_rest)};
+      if (std::find(out.begin(), out.end(), q) == out.end()) out.push_back(q);
     }
   }
+  return out;
 }
 
 void log_modal_failure(std::ostream& log, const SceneReferences::AtNu& a) {
@@ -1070,9 +1093,10 @@ SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& pr
   return result;
 }
 
-/// Every scene's references, `o.jobs` solves at a time, each sparse factorisation with its share
-/// of the cores. Scenes whose fine problems are equal (the same key in the solution cache) are
-/// solved in one task, one after the other, so that the later ones read the first's entry.
+/// Every scene's references, `o.jobs` solves at a time, the cores shared among the solves running
+/// (parallel_solves). Scenes whose fine problems are equal (the same key in the solution cache)
+/// are solved in one task, one after the other, so that the later ones read the first's entry.
+/// Then the dynamic models' FEM transients, each its own task.
 void solve_all_references(std::vector<std::unique_ptr<SceneReferences>>& refs,
                           const HarnessOptions& o, std::ostream& log) {
   std::vector<std::pair<std::size_t, std::size_t>> cases;  // (scene, ν index)
@@ -1101,41 +1125,59 @@ void solve_all_references(std::vector<std::unique_ptr<SceneReferences>>& refs,
   const int jobs = std::max(1, o.jobs);
   log << "FEM references: " << cases.size() << " (scene, ν) cases of " << refs.size()
       << " scene(s), " << jobs << " at a time; the timed models follow one at a time\n";
-  const int saved_threads = solver_threads();
-  const int cores = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
-  set_solver_threads(std::max(1, cores / jobs));
   std::mutex log_mutex;
   Stopwatch clock;
   std::atomic<std::size_t> finished{0};
-  try {
-    parallel_for(tasks.size(), jobs, [&](std::size_t t) {
-      for (const std::size_t c : tasks[t]) {
-        const auto [i, k] = cases[c];
-        const Scene& s = refs[i]->scene;
-        solve_reference_at(s, *refs[i], k, o);
-        solve_modal_reference_at(s, *refs[i], k);
-        {
-          Stopwatch transients;
-          run_reference_transients_at(s, *refs[i], k);
-          refs[i]->at_nu[k].seconds += transients.seconds();
-        }
-        const std::lock_guard lock(log_mutex);
-        std::ostringstream line;  // its own precision: the caller's stream keeps its settings
-        line << "  [" << ++finished << "/" << cases.size() << "] " << s.name << ": "
-             << reference_label(s, s.poisson_ratios[k])
-             << (refs[i]->modal_reference_mesh ? ", its modes" : "")
-             << (refs[i]->at_nu[k].ref.transients.empty() ? "" : ", its FEM transients") << " in "
-             << std::setprecision(3) << refs[i]->at_nu[k].seconds << " s (elapsed "
-             << clock.seconds() << " s)\n";
-        log << line.str();
-        log_modal_failure(log, refs[i]->at_nu[k]);
-      }
-    });
-  } catch (...) {
-    set_solver_threads(saved_threads);
-    throw;
+  const auto log_line = [&](const std::string& what, double seconds, std::size_t total) {
+    const std::lock_guard lock(log_mutex);
+    std::ostringstream line;  // its own precision: the caller's stream keeps its settings
+    line << "  [" << ++finished << "/" << total << "] " << what << " in " << std::setprecision(3)
+         << seconds << " s (elapsed " << clock.seconds() << " s)\n";
+    log << line.str();
+  };
+  parallel_solves(tasks.size(), jobs, [&](std::size_t t) {
+    for (const std::size_t c : tasks[t]) {
+      const auto [i, k] = cases[c];
+      const Scene& s = refs[i]->scene;
+      solve_reference_at(s, *refs[i], k, o);
+      solve_modal_reference_at(s, *refs[i], k);
+      log_line(s.name + ": " + reference_label(s, s.poisson_ratios[k]) +
+                   (refs[i]->modal_reference_mesh ? ", its modes" : ""),
+               refs[i]->at_nu[k].seconds, cases.size());
+      const std::lock_guard lock(log_mutex);
+      log_modal_failure(log, refs[i]->at_nu[k]);
+    }
+  });
+
+  struct Transient {
+    std::size_t scene, nu;
+    TransientRequest request;
+  };
+  std::vector<Transient> transients;
+  for (const auto& [i, k] : cases) {
+    for (const TransientRequest& q : transient_requests(refs[i]->scene, *refs[i], k)) {
+      transients.push_back({i, k, q});
+    }
   }
-  set_solver_threads(saved_threads);
+  if (transients.empty()) return;
+  log << "FEM transients of the dynamic models: " << transients.size() << ", " << jobs
+      << " at a time\n";
+  finished = 0;
+  parallel_solves(transients.size(), jobs, [&](std::size_t t) {
+    const Transient& x = transients[t];
+    SceneReferences& r = *refs[x.scene];
+    Stopwatch watch;
+    (void)transient_at(r.at_nu[x.nu].ref, x.request.probe, x.request.duration, x.request.alpha);
+    std::ostringstream what;
+    what << r.scene.name << ": FEM transient (ν = " << r.scene.poisson_ratios[x.nu] << ", "
+         << x.request.duration << " s, α = " << x.request.alpha << " 1/s)";
+    const double seconds = watch.seconds();
+    {
+      const std::lock_guard lock(log_mutex);
+      r.at_nu[x.nu].seconds += seconds;  // the scene's time includes its references'
+    }
+    log_line(what.str(), seconds, transients.size());
+  });
 }
 
 void log_scene_header(std::ostream& log, const Scene& s, std::size_t i, std::size_t n) {

@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <mutex>
 #include <set>
 #include <stdexcept>
 #include <thread>
 #include <vector>
 
+#include "meshes/solver_threads.hpp"
 #include "verification/parallel.hpp"
 
 using namespace vessel;
@@ -51,4 +53,41 @@ TEST(ParallelFor, TheFirstFailureIsRethrownAfterTheOthersRan) {
                             }),
                std::runtime_error);
   EXPECT_EQ(ran.load(), 20);
+}
+
+// parallel_solves shares the cores among the solves running or waiting: two side by side on two
+// cores get one thread each, and the one left running gets both once the other has ended; the
+// process's setting is restored afterwards.
+TEST(ParallelSolves, TheCoresAreSharedAndALoneTaskGetsThemAll) {
+  set_solver_threads(1);
+  std::atomic<int> started{0};
+  std::vector<int> side_by_side(2);
+  int alone = 0;
+  parallel_solves(
+      2, 2,
+      [&](std::size_t i) {
+        ++started;
+        while (started < 2) std::this_thread::yield();  // both are running
+        side_by_side[i] = solver_threads();
+        if (i == 0) return;
+        // Task 1 waits (at most 10 s) for task 0 to be counted out.
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        while (solver_threads() != 2 && std::chrono::steady_clock::now() < deadline) {
+          std::this_thread::yield();
+        }
+        alone = solver_threads();
+      },
+      2);
+  EXPECT_EQ(side_by_side, (std::vector<int>{1, 1}));
+  EXPECT_EQ(alone, 2);
+  EXPECT_EQ(solver_threads(), 1);
+}
+
+TEST(ParallelSolves, OneTaskAtATimeGetsEveryCore) {
+  set_solver_threads(1);
+  std::vector<int> seen;
+  parallel_solves(3, 1, [&](std::size_t) { seen.push_back(solver_threads()); }, 4);
+  EXPECT_EQ(seen, (std::vector<int>{4, 4, 4}));
+  EXPECT_EQ(solver_threads_per_task(2, 3), 1);  // never below one thread
+  EXPECT_EQ(solver_threads(), 1);
 }
