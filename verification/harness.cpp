@@ -1120,7 +1120,17 @@ void solve_all_references(std::vector<std::unique_ptr<SceneReferences>>& refs,
     }
   }
   for (auto& [key, group] : by_key) tasks.push_back(std::move(group));
-  std::sort(tasks.begin(), tasks.end());  // the scenes' order, which the log follows
+  // Largest first (by the fine meshes' tets, the solves' cost), so that no large solve starts
+  // last beside an idle core; ties in the scenes' order.
+  const auto cost = [&](const std::vector<std::size_t>& task) {
+    std::size_t tets = 0;
+    for (const std::size_t c : task) tets += refs[cases[c].first]->fine_mesh.tets.size();
+    return tets;
+  };
+  std::sort(tasks.begin(), tasks.end(), [&](const auto& a, const auto& b) {
+    const std::size_t ca = cost(a), cb = cost(b);
+    return ca != cb ? ca > cb : a < b;
+  });
 
   const int jobs = std::max(1, o.jobs);
   log << "FEM references: " << cases.size() << " (scene, ν) cases of " << refs.size()
