@@ -516,9 +516,7 @@ void write_report(const ReportOptions& o) {
   std::vector<RecommendFile> recommendations;
   for (const auto& f : o.recommend) {
     RecommendFile r = read_recommend(f);
-    // `vesselverify recommend` writes its run's results.json beside recommend.json.
-    const auto run = f.parent_path() / "results.json";
-    if (std::filesystem::exists(run)) attach_run(r, read_results(run));
+    if (std::filesystem::exists(r.results)) attach_run(r, read_results(r.results));
     recommendations.push_back(std::move(r));
   }
   const Document doc = build_report(results, stability, o.command, recommendations);

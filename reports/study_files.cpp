@@ -140,6 +140,8 @@ RecommendFile parse_recommend(const std::string& text, const std::filesystem::pa
   r.recommended = optional_field<std::string>(j, "recommended", file);
   r.closest = optional_field<std::string>(j, "closest", file);
   r.whole_vessel = optional_field<std::string>(j, "whole_vessel", file);
+  const auto results = optional_field<std::string>(j, "results", file);
+  r.results = source.parent_path() / (results ? *results : std::string("results.json"));
   r.reference_contact_point_mm = field<double>(j, "reference_contact_point_mm", file);
   r.candidates = read_array(j, "candidates", file, read_candidate);
   return r;

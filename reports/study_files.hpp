@@ -83,6 +83,9 @@ struct RecommendFile {
   std::vector<BudgetLoadEntry> loads;
   std::string load_unit;  ///< N, Pa or g, from the run's results.json (attach_run); "" if unknown
   std::optional<std::string> recommended, closest;  ///< candidate names
+  /// The candidates' results.json: the file's "results" (relative to its folder), else the
+  /// results.json beside it (files written before "results" existed).
+  std::filesystem::path results;
   /// The cheapest whole-vessel candidate meeting the budget (absent in older files, or none).
   std::optional<std::string> whole_vessel;
   double reference_contact_point_mm = 0.0;  ///< the reference's largest QoI displacement

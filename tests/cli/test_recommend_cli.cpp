@@ -123,9 +123,19 @@ TEST(RecommendCli, SeveralRatesRunTheCandidatesOnceAndJudgeThemAtEachRate) {
       EXPECT_NE(b["verdict"].get<std::string>().find("too slow"), std::string::npos) << b.dump();
     }
   }
-  // Each rate's directory holds the run's results beside its recommend.json, for the report.
-  const CommandResult rep = vv("report " + (out / "1000hz" / "results.json").string() +
-                               " --recommend " + (out / "1000hz" / "recommend.json").string());
+  // The candidates ran once: the later rate's recommend.json names the first rate's results.json
+  // (no copy), and the report reads the run from there.
+  EXPECT_EQ(slow["results"], "results.json");
+  EXPECT_EQ(fast["results"], "../30hz/results.json");
+  EXPECT_FALSE(std::filesystem::exists(out / "1000hz" / "results.json"));
+  const CommandResult rep = vv("report " + (out / "30hz" / "results.json").string() +
+                               " --recommend " + (out / "1000hz" / "recommend.json").string() +
+                               " --output-dir " + (out / "1000hz").string());
   ASSERT_EQ(rep.exit_code, 0) << rep.output;
+  // The load unit came from the named results.json (without it the budget's load would read
+  // "(the scene's load unit)").
+  const std::string md = read_text(out / "1000hz" / "report.md");
+  EXPECT_NE(md.find("1000 Hz"), std::string::npos);
+  EXPECT_EQ(md.find("the scene's load unit"), std::string::npos);
   EXPECT_NE(read_text(out / "1000hz" / "report.md").find("1000 Hz"), std::string::npos);
 }

@@ -107,11 +107,7 @@ void run(const Options& o) {
       const Recommendation rec = rejudged(first, rate);
       const std::filesystem::path dir = rate_dir(o, rate);
       std::filesystem::create_directories(dir);
-      for (const char* file : {"results.json", "results.csv", "summary.md"}) {  // the same run's
-        std::filesystem::copy_file(rate_dir(o, s.budget.rate_hz) / file, dir / file,
-                                   std::filesystem::copy_options::overwrite_existing);
-      }
-      write_recommendation(rec, dir, o.command);
+      write_recommendation(rec, dir, o.command);  // names the first rate's results.json
       print_recommendation(rec, rate_dir(o, rate));
     } else {
       Scene at_rate = s;

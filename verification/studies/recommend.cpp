@@ -361,6 +361,7 @@ Recommendation recommend(const Scene& scene, const RecommendOptions& o,
     *h.log << ", reference level " << s.reference_level << "\n";
   }
   rec.result = run_and_write({s}, h, output_dir, command).front();
+  rec.results_dir = output_dir;
   rec.candidates = collect_candidates(rec.result);
   rec.selection = select_model(rec.candidates, s.budget.tolerance, s.budget.seconds_per_update(),
                                budget_unit(s.budget.quantity));
@@ -392,7 +393,7 @@ void write_recommendation(const Recommendation& rec, const std::filesystem::path
   write_file_atomically(output_dir / "recommend.md",
                         [&](std::ostream& out) { out << recommendation_markdown(rec, command); });
   write_file_atomically(output_dir / "recommend.json",
-                        [&](std::ostream& out) { out << recommendation_json(rec, command); });
+                        [&](std::ostream& out) { out << recommendation_json(rec, command, output_dir); });
 }
 
 namespace {
@@ -508,7 +509,8 @@ std::string recommendation_markdown(const Recommendation& rec, const std::string
   return md.str();
 }
 
-std::string recommendation_json(const Recommendation& rec, const std::string& command) {
+std::string recommendation_json(const Recommendation& rec, const std::string& command,
+                                const std::filesystem::path& output_dir) {
   const Scene& s = rec.scene;
   const Selection& sel = rec.selection;
   nlohmann::json candidates = nlohmann::json::array();
@@ -552,7 +554,7 @@ std::string recommendation_json(const Recommendation& rec, const std::string& co
   for (const ModelOutcome& o : rec.result.outcomes) {
     if (o.ok) reference_qoi_mm = std::max(reference_qoi_mm, o.qoi_reference_mm);
   }
-  const nlohmann::json j{{"schema", "vesselverify.recommend"},
+  nlohmann::json j{{"schema", "vesselverify.recommend"},
                          {"reference_contact_point_mm", reference_qoi_mm},
                          {"schema_version", 1},
                          {"command", command},
@@ -566,6 +568,11 @@ std::string recommendation_json(const Recommendation& rec, const std::string& co
                          {"closest", name_of(sel.closest)},
                          {"whole_vessel", name_of(sel.whole_vessel)},
                          {"candidates", candidates}};
+  if (!rec.results_dir.empty()) {
+    // The candidates' results.json, relative to recommend.json's folder.
+    j["results"] =
+        (rec.results_dir / "results.json").lexically_proximate(output_dir).generic_string();
+  }
   return j.dump(2) + "\n";
 }
 

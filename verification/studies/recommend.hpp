@@ -94,6 +94,8 @@ struct Recommendation {
   SceneResult result;
   std::vector<Candidate> candidates;
   Selection selection;
+  /// Where the candidates' run wrote results.json (a rate judged again shares the first's).
+  std::filesystem::path results_dir;
 };
 
 /// Runs the candidates of `scene` (whose budget must be stated) against the reference and writes
@@ -117,7 +119,9 @@ void write_recommendation(const Recommendation& r, const std::filesystem::path& 
 /// The Markdown section "## Model recommendation: <scene>" with the budget, the answer, and the
 /// evidence table (every candidate's error and time, Pareto front, verdict and reason).
 std::string recommendation_markdown(const Recommendation& r, const std::string& command);
-/// recommend.json (schema "vesselverify.recommend", version 1).
-std::string recommendation_json(const Recommendation& r, const std::string& command);
+/// recommend.json (schema "vesselverify.recommend", version 1) as written into `output_dir`: its
+/// optional "results" names the candidates' results.json relative to that folder.
+std::string recommendation_json(const Recommendation& r, const std::string& command,
+                                const std::filesystem::path& output_dir);
 
 }  // namespace vessel
