@@ -14,4 +14,16 @@ void add_jobs_option(CLI::App& cmd, int& jobs, const std::string& what) {
       ->capture_default_str();
 }
 
+void add_timing_options(CLI::App& cmd, int& repeats, int& updates) {
+  cmd.add_option("--repeats", repeats, "Timed repeats per model solve (median reported)")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd.add_option("--updates", updates,
+                 "Static and linear mass-spring models: timed as a simulator runs them, set-up "
+                 "(assembly, factorisation at rest) apart, then this many warm-started updates "
+                 "ramping the load to each case's magnitude; the time per update is their median")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+}
+
 }  // namespace vessel::cli

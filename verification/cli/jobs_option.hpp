@@ -1,6 +1,7 @@
 #pragma once
 /// --jobs of the commands that run scenes (run, recommend, gate: FEM references solved at a time)
-/// and of the stability study (rows of its critical-step table computed at a time).
+/// and of the stability study (rows of its critical-step table computed at a time); the timing
+/// options of the commands that run scenes.
 #include <CLI/CLI.hpp>
 #include <string>
 
@@ -12,6 +13,10 @@ namespace vessel::cli {
 /// Adds --jobs N (N ≥ 1, default default_jobs()) writing into `jobs`; `what` says what runs N at
 /// a time (the help text).
 void add_jobs_option(CLI::App& cmd, int& jobs, const std::string& what);
+
+/// Adds the scene-running commands' timing options: --repeats (timed repeats per solve, median)
+/// and --updates (the warm-started load ramp whose median is the time per update).
+void add_timing_options(CLI::App& cmd, int& repeats, int& updates);
 
 /// The help of the scene-running commands' --jobs.
 inline constexpr const char* kReferencesAtATime =

@@ -153,15 +153,7 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
   add_jobs_option(*cmd, o->jobs, kReferencesAtATime);
   cmd->add_flag("--quick", o->quick,
                 "Candidates at level 0 only (reference at level <= 1), ROI radii 4 and 8 mm");
-  cmd->add_option("--repeats", o->repeats, "Timed repeats per solve (median)")
-      ->check(CLI::Range(1, 100))
-      ->capture_default_str();
-  cmd->add_option("--updates", o->updates,
-                  "Static and linear mass-spring models: timed as a simulator runs them, set-up "
-                  "(assembly, factorisation at rest) apart, then this many warm-started updates "
-                  "ramping the load to each case's magnitude; the time per update is their median")
-      ->check(CLI::Range(1, 1000))
-      ->capture_default_str();
+  add_timing_options(*cmd, o->repeats, o->updates);
   cmd->add_option("--levels", o->levels, "Model levels instead of 0,1 (quick: 0)")
       ->delimiter(',')
       ->check(CLI::Range(0, kMaxMeshLevel));

@@ -93,15 +93,7 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
   add_jobs_option(*cmd, o->jobs, kReferencesAtATime);
   cmd->add_flag("--quick", o->quick,
                 "Coarse levels (models 0, reference 1) and the smallest and largest load only");
-  cmd->add_option("--repeats", o->repeats, "Timed repeats per model solve (median reported)")
-      ->check(CLI::Range(1, 100))
-      ->capture_default_str();
-  cmd->add_option("--updates", o->updates,
-                  "Static and linear mass-spring models: timed as a simulator runs them, set-up "
-                  "(assembly, factorisation at rest) apart, then this many warm-started updates "
-                  "ramping the load to each case's magnitude; the time per update is their median")
-      ->check(CLI::Range(1, 1000))
-      ->capture_default_str();
+  add_timing_options(*cmd, o->repeats, o->updates);
   cmd->add_option("--nu", o->poisson_ratios,
                   "Sweep Poisson's ratio over these values instead of the scenes' (e.g. "
                   "--nu 0,0.25,0.45,0.49,0.5)")
