@@ -195,14 +195,23 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
   VectorXd f(n), scratch(n), rhs(n), dv(n);
   CholmodSolver solver;
   SparseMatrix K, D;
-  const bool prefactored = o.integrator == Integrator::implicit_euler &&
-                           o.implicit_matrix == ImplicitMatrix::rest_prefactored;
-  if (prefactored) {
-    // Set-up of implicit-euler-rest: K and D at rest, A factorised once for every step.
+  const bool implicit = o.integrator == Integrator::implicit_euler;
+  const bool prefactored = implicit && o.implicit_matrix == ImplicitMatrix::rest_prefactored;
+  const bool rest_iterative = implicit && o.implicit_matrix == ImplicitMatrix::rest_pcg;
+  const bool iterative = rest_iterative || (implicit && o.implicit_matrix == ImplicitMatrix::current_pcg);
+  PcgSolver pcg;
+  VectorXd dv_previous = VectorXd::Zero(n);  // PCG's warm start
+  if (prefactored || rest_iterative) {
+    // Set-up of implicit-euler-rest(-pcg): K and D at rest, A factorised once for every step
+    // (or, -pcg, A and its preconditioner built once).
     const double t_setup = now();
     p.form->hessian(p.rest, K, o.project_psd);
     p.form->damping_jacobian(p.rest, D);
-    solver.factorize(implicit_euler_matrix(p, h, K, D));
+    if (prefactored) {
+      solver.factorize(implicit_euler_matrix(p, h, K, D));
+    } else {
+      pcg.compute(implicit_euler_matrix(p, h, K, D), o.pcg);
+    }
     r.setup_seconds = now() - t_setup;
   }
   const double t0 = now();
@@ -241,6 +250,35 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
       }
       case Integrator::implicit_euler: {
         explicit_force(p, grad, r.x, r.v, f, scratch);  // the total force at (x, v)
+        if (iterative) {
+          // The same step as implicit-euler(-rest), A Δv = h (f − h K v), by PCG from the
+          // previous step's Δv (the velocity change varies slowly from step to step).
+          if (!rest_iterative) {
+            p.form->hessian(r.x, K, o.project_psd);
+            p.form->damping_jacobian(r.x, D);
+            pcg.compute(implicit_euler_matrix(p, h, K, D), o.pcg);
+          }
+          rhs.noalias() = K.transpose() * r.v;  // = K v (symmetric), walked as rows
+          rhs = h * f - (h * h) * rhs;
+          for (int i = 0; i < n; ++i) {
+            if (p.fixed[i]) rhs[i] = 0.0;
+          }
+          dv = dv_previous;
+          const PcgResult cg = pcg.solve(rhs, dv);
+          if (!cg.converged) {
+            throw std::runtime_error(
+                "implicit Euler (PCG): conjugate gradients stopped at step " +
+                std::to_string(step) + " after " + std::to_string(cg.iterations) +
+                " iterations with relative residual " + sci(cg.relative_residual) +
+                " (tolerance " + sci(o.pcg.tolerance) + ")");
+          }
+          r.linear_iterations += cg.iterations;
+          r.max_linear_iterations = std::max(r.max_linear_iterations, cg.iterations);
+          dv_previous = dv;
+          r.v += dv;
+          r.x += h * r.v;
+          break;
+        }
         if (!prefactored) {  // K and D at this step's state, A refactorised
           p.form->hessian(r.x, K, o.project_psd);
           p.form->damping_jacobian(r.x, D);
