@@ -60,8 +60,13 @@ Fixture& fixture(const benchmark::State& state) {
 }
 
 void label(benchmark::State& state, const Fixture& f) {
+  int loaded = 0;  // the patch's free dofs: the responses a linear updater precomputes
+  for (Eigen::Index i = 0; i < f.problem.num_dofs(); ++i) {
+    if (!f.problem.fixed[i] && f.problem.external_force[i] != 0.0) ++loaded;
+  }
   state.SetLabel((state.range(0) == 0 ? "surface L0, " : "volume L1, ") +
-                 std::to_string(f.problem.num_dofs()) + " dofs");
+                 std::to_string(f.problem.num_dofs()) + " dofs, " + std::to_string(loaded) +
+                 " loaded");
 }
 
 /// One linear update on the contact patch (the superposition of the responses precomputed at
