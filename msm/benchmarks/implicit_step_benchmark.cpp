@@ -10,7 +10,8 @@
 // (docs/msm_measurements.md).
 //
 //   implicit_step_benchmark LEVEL STEPS_REST STEPS_CURRENT [TOLERANCE ...]
-//   (STEPS_CURRENT = 0 skips the current-state pair; default tolerances 1e-4 1e-6 1e-8)
+//   (STEPS_CURRENT = 0 skips the current-state pair; default tolerances 1e-4 1e-6 1e-8; "none":
+//   no PCG runs)
 #include <algorithm>
 #include <cstdlib>
 #include <ctime>
@@ -111,8 +112,12 @@ int main(int argc, char** argv) {
   const int steps_rest = std::atoi(argv[2]);
   const int steps_current = std::atoi(argv[3]);
   std::vector<double> tolerances;
-  for (int i = 4; i < argc; ++i) tolerances.push_back(std::atof(argv[i]));
-  if (tolerances.empty()) tolerances = {1e-4, 1e-6, 1e-8};
+  bool cg = true;
+  for (int i = 4; i < argc; ++i) {
+    if (std::string(argv[i]) == "none") cg = false;  // the CHOLMOD steps alone
+    else tolerances.push_back(std::atof(argv[i]));
+  }
+  if (tolerances.empty() && cg) tolerances = {1e-4, 1e-6, 1e-8};
 
   VesselParams params;
   params.level = level;
