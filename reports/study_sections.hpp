@@ -15,7 +15,9 @@ void stability_section(Document& doc, const StabilityFile& stability);
 inline constexpr const char* kTimePerUpdateText =
     "Time per update, on which the budget is judged: for static and linear solvers the median "
     "over a load ramp of warm-started updates ending at the budget's load, each from the "
-    "previous state (the linear model one solve with its factorisation at rest; static Newton "
+    "previous state (the linear model one solve with its factorisation at rest, or, for a load "
+    "on the prepared load's dofs, the superposition of their responses precomputed at set-up; "
+    "static Newton "
     "reusing the factorisation it holds while it converges fast, refactorising where not); for "
     "integrators the time per step × the steps one update period needs. Set-up (model build, "
     "assembly and factorisation at rest) is done once and shown apart.";

@@ -152,16 +152,22 @@ SparseMatrix implicit_euler_matrix(const Problem& p, double h, const SparseMatri
 }
 
 /// Baraff & Witkin (1998): (M + h D + h² K) Δv = h (f(x, v) − h K v); v += Δv; x += h v, with
-/// `solver` holding the factorised left-hand side and f the total force at (x, v).
-void implicit_euler_update(const Problem& p, double h, const SparseMatrix& K,
+/// `solver` holding the factorised left-hand side A and f the total force at (x, v). Solved for
+/// v₁ = v + Δv directly: A v₁ = A v + h f − h² K v = (M + h D) v + h f, which needs no product
+/// with K (7 M entries at level 2) and one with D only for a damped model. Same step; the two
+/// forms differ by round-off.
+void implicit_euler_update(const Problem& p, double h, const SparseMatrix& D, bool damped,
                            const CholmodSolver& solver, const VectorXd& f, VectorXd& x, VectorXd& v,
-                           VectorXd& rhs, VectorXd& dv) {
-  rhs.noalias() = h * f - (h * h) * (K * v);
+                           VectorXd& rhs, VectorXd& scratch) {
+  rhs.noalias() = p.mass.cwiseProduct(v) + h * f;
+  if (damped) {
+    scratch.noalias() = D.transpose() * v;  // = D v (symmetric), walked as rows
+    rhs.noalias() += h * scratch;
+  }
   for (int i = 0; i < p.num_dofs(); ++i) {
     if (p.fixed[i]) rhs[i] = 0.0;
   }
-  solver.solve_into(rhs, dv);
-  v += dv;
+  solver.solve_into(rhs, v);
   x += h * v;
 }
 
@@ -195,14 +201,25 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
   VectorXd f(n), scratch(n), rhs(n), dv(n);
   CholmodSolver solver;
   SparseMatrix K, D;
-  const bool prefactored = o.integrator == Integrator::implicit_euler &&
-                           o.implicit_matrix == ImplicitMatrix::rest_prefactored;
-  if (prefactored) {
-    // Set-up of implicit-euler-rest: K and D at rest, A factorised once for every step.
+  const bool implicit = o.integrator == Integrator::implicit_euler;
+  const bool prefactored = implicit && o.implicit_matrix == ImplicitMatrix::rest_prefactored;
+  const bool rest_iterative = implicit && o.implicit_matrix == ImplicitMatrix::rest_pcg;
+  const bool iterative = rest_iterative || (implicit && o.implicit_matrix == ImplicitMatrix::current_pcg);
+  PcgSolver pcg;
+  VectorXd dv_previous = VectorXd::Zero(n);  // PCG's warm start
+  bool damped = false;                       // D (at rest, or at the step's state) is not zero
+  if (prefactored || rest_iterative) {
+    // Set-up of implicit-euler-rest(-pcg): K and D at rest, A factorised once for every step
+    // (or, -pcg, A and its preconditioner built once).
     const double t_setup = now();
     p.form->hessian(p.rest, K, o.project_psd);
     p.form->damping_jacobian(p.rest, D);
-    solver.factorize(implicit_euler_matrix(p, h, K, D));
+    damped = D.cwiseAbs().sum() > 0.0;
+    if (prefactored) {
+      solver.factorize(implicit_euler_matrix(p, h, K, D));
+    } else {
+      pcg.compute(implicit_euler_matrix(p, h, K, D), o.pcg);
+    }
     r.setup_seconds = now() - t_setup;
   }
   const double t0 = now();
@@ -241,12 +258,42 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
       }
       case Integrator::implicit_euler: {
         explicit_force(p, grad, r.x, r.v, f, scratch);  // the total force at (x, v)
+        if (iterative) {
+          // The same step as implicit-euler(-rest), A Δv = h (f − h K v), by PCG from the
+          // previous step's Δv (the velocity change varies slowly from step to step).
+          if (!rest_iterative) {
+            p.form->hessian(r.x, K, o.project_psd);
+            p.form->damping_jacobian(r.x, D);
+            pcg.compute(implicit_euler_matrix(p, h, K, D), o.pcg);
+          }
+          rhs.noalias() = K.transpose() * r.v;  // = K v (symmetric), walked as rows
+          rhs = h * f - (h * h) * rhs;
+          for (int i = 0; i < n; ++i) {
+            if (p.fixed[i]) rhs[i] = 0.0;
+          }
+          dv = dv_previous;
+          const PcgResult cg = pcg.solve(rhs, dv);
+          if (!cg.converged) {
+            throw std::runtime_error(
+                "implicit Euler (PCG): conjugate gradients stopped at step " +
+                std::to_string(step) + " after " + std::to_string(cg.iterations) +
+                " iterations with relative residual " + sci(cg.relative_residual) +
+                " (tolerance " + sci(o.pcg.tolerance) + ")");
+          }
+          r.linear_iterations += cg.iterations;
+          r.max_linear_iterations = std::max(r.max_linear_iterations, cg.iterations);
+          dv_previous = dv;
+          r.v += dv;
+          r.x += h * r.v;
+          break;
+        }
         if (!prefactored) {  // K and D at this step's state, A refactorised
           p.form->hessian(r.x, K, o.project_psd);
           p.form->damping_jacobian(r.x, D);
+          damped = D.cwiseAbs().sum() > 0.0;
           solver.factorize(implicit_euler_matrix(p, h, K, D));
         }
-        implicit_euler_update(p, h, K, solver, f, r.x, r.v, rhs, dv);
+        implicit_euler_update(p, h, D, damped, solver, f, r.x, r.v, rhs, dv);
         break;
       }
     }

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "msm/model/form.hpp"
+#include "msm/solvers/pcg.hpp"
 
 namespace vessel::msm {
 
@@ -28,6 +29,12 @@ enum class ImplicitMatrix {
   current_state,     ///< "implicit-euler": K and D at the step's state, refactorised every step
   rest_prefactored,  ///< "implicit-euler-rest": K and D at rest, factorised once at set-up; each
                      ///< step assembles the right-hand side and does one solve (as simulators do)
+  rest_pcg,  ///< "implicit-euler-rest-pcg": the same A at rest, assembled once, never factorised;
+             ///< each step solves it by preconditioned conjugate gradients (pcg.hpp) started from
+             ///< the previous step's Δv, to DynamicOptions::pcg's relative residual tolerance
+  current_pcg,  ///< "implicit-euler-pcg": K and D at the step's state, as implicit-euler, assembled
+                ///< every step and solved by the same warm-started PCG instead of a factorisation
+                ///< (Vega FEM's implicit backward Euler with Jacobi-PCG does the same)
 };
 // rest_prefactored is not unconditionally stable: the part of the stiffness that K at rest lacks
 // (K(x) − K(rest), e.g. the surface membrane's tension-borne transverse stiffness, zero at rest) is
@@ -52,6 +59,7 @@ struct DynamicOptions {
   double blowup_factor = 1e3;
   bool project_psd = true;  ///< implicit Euler: PSD-projected stiffness
   ImplicitMatrix implicit_matrix = ImplicitMatrix::current_state;  ///< implicit Euler
+  PcgOptions pcg;  ///< implicit-euler-rest-pcg: tolerance, iteration limit, preconditioner
   /// Called after every step with (step, x, v); may be empty.
   std::function<void(int, const VectorXd&, const VectorXd&)> on_step;
 };
@@ -65,6 +73,8 @@ struct DynamicResult {
                                ///< factorisation at rest)
   int numeric_factorisations = 0;  ///< CHOLMOD numeric factorisations (implicit Euler)
   double factor_entries = 0.0;     ///< implicit Euler: numbers stored in the Cholesky factor
+  long linear_iterations = 0;      ///< implicit Euler by PCG: CG iterations over all steps
+  int max_linear_iterations = 0;   ///< implicit Euler by PCG: most CG iterations in one step
   double energy = 0.0;  ///< total energy ½vᵀMv + Π(x) at the end, J
 };
 
@@ -72,7 +82,8 @@ struct DynamicResult {
 double total_energy(const Problem& problem, const VectorXd& x, const VectorXd& v);
 
 /// Integrates from (x0, v0) (rest and zero if empty). Throws InputError for dt ≤ 0 or steps < 0,
-/// DivergenceError on blow-up (no result returned).
+/// DivergenceError on blow-up (no result returned), std::runtime_error if implicit Euler's PCG
+/// (implicit-euler-pcg, implicit-euler-rest-pcg) does not reach its tolerance within its iteration limit.
 DynamicResult integrate(const Problem& problem, const DynamicOptions& options,
                         const VectorXd& x0 = VectorXd(), const VectorXd& v0 = VectorXd());
 

@@ -26,6 +26,14 @@ SolverSpec parse_solver(const std::string& name) {
     spec.kind = SolverKind::integrator;
     spec.integrator = Integrator::implicit_euler;
     spec.implicit_matrix = ImplicitMatrix::rest_prefactored;
+  } else if (name == "implicit-euler-pcg") {
+    spec.kind = SolverKind::integrator;
+    spec.integrator = Integrator::implicit_euler;
+    spec.implicit_matrix = ImplicitMatrix::current_pcg;
+  } else if (name == "implicit-euler-rest-pcg") {
+    spec.kind = SolverKind::integrator;
+    spec.integrator = Integrator::implicit_euler;
+    spec.implicit_matrix = ImplicitMatrix::rest_pcg;
   } else {
     try {
       spec.integrator = parse_integrator(name);
@@ -48,6 +56,14 @@ std::string to_string(const SolverSpec& spec) {
       if (spec.integrator == Integrator::implicit_euler &&
           spec.implicit_matrix == ImplicitMatrix::rest_prefactored) {
         return "implicit-euler-rest";
+      }
+      if (spec.integrator == Integrator::implicit_euler &&
+          spec.implicit_matrix == ImplicitMatrix::rest_pcg) {
+        return "implicit-euler-rest-pcg";
+      }
+      if (spec.integrator == Integrator::implicit_euler &&
+          spec.implicit_matrix == ImplicitMatrix::current_pcg) {
+        return "implicit-euler-pcg";
       }
       return to_string(spec.integrator);
     case SolverKind::pbd: return "pbd";
@@ -119,6 +135,7 @@ SolveResult run_integrator(const Problem& problem, const SolverSpec& spec,
   DynamicOptions d;
   d.integrator = spec.integrator;
   d.implicit_matrix = spec.implicit_matrix;
+  d.pcg = spec.pcg;
   d.dt = resolved_time_step(problem, spec);
   d.steps = static_cast<int>(spec.steps);
   if (on_step) d.on_step = [&](int step, const VectorXd& x, const VectorXd&) { on_step(step, x); };

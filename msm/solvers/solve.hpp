@@ -45,8 +45,10 @@ struct LocalGlobalSettings {
 struct SolverSpec {
   SolverKind kind = SolverKind::static_newton;
   Integrator integrator = Integrator::symplectic_euler;  ///< kind integrator
-  /// Integrator implicit_euler: "implicit-euler" (current_state) or "implicit-euler-rest".
+  /// Integrator implicit_euler: "implicit-euler" (current_state), "implicit-euler-pcg",
+  /// "implicit-euler-rest" or "implicit-euler-rest-pcg".
   ImplicitMatrix implicit_matrix = ImplicitMatrix::current_state;
+  PcgOptions pcg;  ///< implicit-euler-pcg, implicit-euler-rest-pcg
   double dt = 0.0;  ///< s, integrator and pbd; 0: automatic (resolved_time_step)
   long steps = 0;   ///< integrator and pbd: number of steps (> 0)
   StaticOptions static_options;  ///< static_newton
@@ -62,10 +64,14 @@ struct SolverSpec {
 
 /// Every solver name: the static ones, then the integrators, then PBD, then Liu et al. 2013's
 /// local–global solvers (statics and implicit Euler). "implicit-euler-rest" is implicit Euler with
-/// the matrix at rest, factorised once (ImplicitMatrix::rest_prefactored).
-inline constexpr std::array<const char*, 11> kSolverNames{
+/// the matrix at rest, factorised once (ImplicitMatrix::rest_prefactored); "implicit-euler-rest-pcg"
+/// the same step solved by warm-started preconditioned CG (ImplicitMatrix::rest_pcg);
+/// "implicit-euler-pcg" implicit Euler's step at the current state solved by that CG
+/// (ImplicitMatrix::current_pcg).
+inline constexpr std::array<const char*, 13> kSolverNames{
     "static",         "linear",         "relaxation",          "explicit-euler", "symplectic-euler",
-    "verlet",         "implicit-euler", "implicit-euler-rest", "pbd",            "local-global",
+    "verlet",         "implicit-euler", "implicit-euler-pcg",  "implicit-euler-rest",
+    "implicit-euler-rest-pcg",          "pbd",                 "local-global",
     "local-global-euler"};
 /// The solver of a name in kSolverNames (dt, steps and options left at their defaults).
 /// InputError listing the names otherwise.

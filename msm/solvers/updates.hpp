@@ -4,7 +4,10 @@
 /// returning the new state from the previous one. The harness times the two apart (set-up, and
 /// the steady-state time per update); `msm::solve` (solve.hpp) stays the one-shot cold solve.
 ///
-/// - "linear": K at rest factorised once (CHOLMOD); each update one solve, x = x0 + K⁻¹f.
+/// - "linear": K at rest factorised once (CHOLMOD); each update one solve, x = x0 + K⁻¹f, or,
+///   for a load on the dofs the prepared problem's own load acts on (a contact patch), the
+///   superposition of the responses to those dofs' unit loads, solved for at set-up (where their
+///   number × the dofs does not exceed the factor's entries).
 /// - "static": modified Newton warm-started from the previous update's state. Each update first
 ///   iterates with the factorisation it already holds (K at rest after prepare, later the last one
 ///   Newton made) while the residual falls by at least `contraction` per iteration; where it does
@@ -33,6 +36,9 @@ struct UpdateResult {
   /// ‖∇Π‖ on the free dofs at the end, N (static Newton; 0 where the update does not compute it,
   /// the linear model's solve being exact to round-off)
   double residual = 0.0;
+  /// linear: the update superposed the responses precomputed at set-up for the dofs its load
+  /// acts on, instead of a solve (LinearUpdater, updates.cpp)
+  bool superposed = false;
 };
 
 /// Settings of the updates (static Newton's own settings come from SolverSpec::static_options).
@@ -72,8 +78,9 @@ class Updater {
 /// needs; harness.hpp's time_per_update); dynamic relaxation has no prepared form.
 [[nodiscard]] bool supports_updates(const SolverSpec& spec);
 
-/// Prepares the updates of `problem` (its external_force is ignored: each update brings its own)
-/// with the solver of `spec`. The problem's form must outlive the updater. InputError naming the
+/// Prepares the updates of `problem` with the solver of `spec`. Each update brings its own load;
+/// the problem's external_force only says which dofs loads will act on ("linear" precomputes
+/// the responses to them; a zero external_force precomputes none). The problem's form must outlive the updater. InputError naming the
 /// solver if supports_updates(spec) is false.
 std::unique_ptr<Updater> prepare_updates(const Problem& problem, const SolverSpec& spec,
                                          const UpdateOptions& options = {});

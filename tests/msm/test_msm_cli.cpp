@@ -79,6 +79,13 @@ TEST_F(MsmCli, StructuredGridHasSeed000FamiliesAndEveryDynamicSolverRuns) {
   const auto rest = vv("--model volume --solver implicit-euler-rest --steps 20");
   EXPECT_EQ(rest.exit_code, 0) << rest.output;
   EXPECT_TRUE(contains(rest.output, "set-up (assembly and factorisation at rest)")) << rest.output;
+  // The same steps by conjugate gradients, which print their iterations per step.
+  for (const std::string solver : {"implicit-euler-pcg", "implicit-euler-rest-pcg"}) {
+    const auto cg = vv("--model volume --solver " + solver +
+                       " --steps 5 --cg-tolerance 1e-8 --cg-preconditioner jacobi");
+    EXPECT_EQ(cg.exit_code, 0) << solver << "\n" << cg.output;
+    EXPECT_TRUE(contains(cg.output, "conjugate gradients to relative residual 1e-08")) << cg.output;
+  }
 }
 
 TEST_F(MsmCli, BadInputNamesTheParameterAndExitsOne) {

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+#include <utility>
 
 #include "meshes/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
@@ -128,6 +130,45 @@ TEST(Updates, PrefactoredLinearUpdatesEqualSolveLinearOnARamp) {
     ASSERT_GT(u, 0.0);
     EXPECT_LT((up->state() - cold.x).norm(), 1e-12 * u) << s;
   }
+  EXPECT_EQ(up->factorisations(), 1);
+}
+
+TEST(Updates, LinearUpdatesSuperposeOnThePreparedPatchAndSolveElsewhere) {
+  // Loads on the prepared patch's dofs, with any values there, are the superposition of the
+  // responses solved for at set-up; a load on any other dof is solved with the factor. Both equal
+  // a cold solve_linear of the same load.
+  Tube t = tube();
+  const auto up = prepare_updates(t.problem, spec_of("linear"));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1e-3, 1e-3);
+  Eigen::VectorXd on_patch = Eigen::VectorXd::Zero(t.problem.num_dofs());
+  int loaded = 0;
+  for (Eigen::Index i = 0; i < on_patch.size(); ++i) {
+    if (t.problem.external_force[i] != 0.0 && !t.problem.fixed[i]) {
+      on_patch[i] = u(rng);  // not proportional to the prepared load
+      ++loaded;
+    }
+  }
+  ASSERT_GT(loaded, 3);
+  Eigen::VectorXd elsewhere = on_patch;
+  Eigen::Index other = 0;  // a free dof off the patch
+  while (t.problem.fixed[other] || t.problem.external_force[other] != 0.0) ++other;
+  elsewhere[other] = 2e-4;
+  for (const auto& [f, superposed] : {std::pair{on_patch, true}, std::pair{elsewhere, false}}) {
+    const UpdateResult r = up->update(f);
+    EXPECT_EQ(r.superposed, superposed);
+    EXPECT_EQ(r.factorisations, 0);
+    Problem p = t.problem;
+    p.external_force = f;
+    const StaticResult cold = solve_linear(p);
+    const double size = (cold.x - p.rest).norm();
+    ASSERT_GT(size, 0.0);
+    EXPECT_LT((up->state() - cold.x).norm(), 1e-12 * size) << superposed;
+  }
+  // Prepared without a load: nothing precomputed, every update solves.
+  Problem unloaded = t.problem;
+  unloaded.external_force.setZero();
+  EXPECT_FALSE(prepare_updates(unloaded, spec_of("linear"))->update(on_patch).superposed);
   EXPECT_EQ(up->factorisations(), 1);
 }
 

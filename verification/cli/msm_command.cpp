@@ -56,6 +56,8 @@ struct MsmOptions {
   bool verbose = false;
   int pbd_iterations = 10;
   int lg_iterations = msm::LocalGlobalSettings{}.iterations;
+  double cg_tolerance = msm::PcgOptions{}.tolerance;
+  std::string cg_preconditioner = "block-jacobi";
   double bending_compliance = 0.0;
   bool angle_constraints = false;
   bool no_dihedral = false;
@@ -282,6 +284,8 @@ msm::SolverSpec command_solver(const MsmOptions& o) {
   so.exact_backoff = o.exact_backoff;
   spec.pbd.iterations = o.pbd_iterations;
   spec.local_global.iterations = o.lg_iterations;
+  spec.pcg.tolerance = o.cg_tolerance;
+  spec.pcg.preconditioner = msm::parse_pcg_preconditioner(o.cg_preconditioner);
   spec.pbd.velocity_damping = o.pbd_damping;
   spec.pbd.bending_compliance = o.bending_compliance;
   spec.pbd.dihedral = !o.no_dihedral;
@@ -323,6 +327,14 @@ void print_solve(const msm::SolverSpec& spec, const msm::Problem& problem,
     } else if (spec.implicit_matrix == msm::ImplicitMatrix::rest_prefactored) {
       std::cout << "set-up (assembly and factorisation at rest) " << dyn->setup_seconds
                 << " s (factor of " << dyn->factor_entries << " entries), then ";
+    } else if (spec.implicit_matrix == msm::ImplicitMatrix::rest_pcg ||
+               spec.implicit_matrix == msm::ImplicitMatrix::current_pcg) {
+      if (spec.implicit_matrix == msm::ImplicitMatrix::rest_pcg) {
+        std::cout << "set-up (assembly at rest, preconditioner) " << dyn->setup_seconds << " s; ";
+      }
+      std::cout << "conjugate gradients to relative residual " << spec.pcg.tolerance << ": "
+                << static_cast<double>(dyn->linear_iterations) / std::max(dyn->steps, 1)
+                << " iterations per step (at most " << dyn->max_linear_iterations << "); then ";
     }
     std::cout << dyn->seconds << " s, " << dyn->seconds / dyn->steps * 1e6
               << " µs per step, final energy " << dyn->energy << " J\n";
@@ -522,7 +534,10 @@ void add_solver_options(CLI::App* cmd, MsmOptions& o) {
   std::string listed;
   for (const std::string& n : names) listed += (listed.empty() ? "" : ", ") + n;
   cmd->add_option("--solver", o.solver,
-                  listed + " (implicit-euler-rest: the matrix at rest, factorised once; pbd: XPBD "
+                  listed + " (implicit-euler-rest: the matrix at rest, factorised once; "
+                           "implicit-euler-pcg, implicit-euler-rest-pcg: implicit-euler's and "
+                           "implicit-euler-rest's step by warm-started preconditioned conjugate "
+                           "gradients; pbd: XPBD "
                            "constraints of seed 002, surface model; local-global, "
                            "local-global-euler: Liu et al. 2013, Hooke springs only)")
       ->check(CLI::IsMember(names))
@@ -566,6 +581,14 @@ CLI::Option* add_load_options(CLI::App* cmd, MsmOptions& o) {
 /// PBD and static Newton settings, verbosity, output.
 void add_solver_tuning_options(CLI::App* cmd, MsmOptions& o) {
   cmd->add_option("--pbd-iterations", o.pbd_iterations, "XPBD iterations per step")
+      ->capture_default_str();
+  cmd->add_option("--cg-tolerance", o.cg_tolerance,
+                  "implicit-euler(-rest)-pcg: relative residual ‖b − AΔv‖/‖b‖ at which CG stops")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--cg-preconditioner", o.cg_preconditioner,
+                  "implicit-euler(-rest)-pcg: jacobi or block-jacobi (each node's 3×3 block)")
+      ->check(CLI::IsMember({"jacobi", "block-jacobi"}))
       ->capture_default_str();
   cmd->add_option("--lg-iterations", o.lg_iterations,
                   "local-global-euler: local-global iterations per step (Liu et al. 2013)")

@@ -1,0 +1,63 @@
+#pragma once
+/// Preconditioned conjugate gradients (Hestenes & Stiefel 1952; Saad 2003, "Iterative Methods for
+/// Sparse Linear Systems", Algorithm 9.1) for a symmetric positive-definite sparse matrix, started
+/// from the caller's guess (warm start). The iterative alternative to CholmodSolver where a
+/// factor is too large to stream within the time budget (implicit-euler-rest-pcg,
+/// integrators.hpp).
+#include <Eigen/SparseCore>
+#include <string>
+#include <vector>
+
+#include "msm/model/form.hpp"
+
+namespace vessel::msm {
+
+enum class PcgPreconditioner {
+  jacobi,        ///< diag(A)⁻¹
+  block_jacobi,  ///< the inverse of each node's 3×3 diagonal block (dofs 3i … 3i+2)
+};
+
+/// "jacobi" or "block-jacobi"; InputError otherwise.
+PcgPreconditioner parse_pcg_preconditioner(const std::string& name);
+
+struct PcgOptions {
+  /// Stop when ‖b − A x‖₂ ≤ tolerance · ‖b‖₂ (the unpreconditioned residual, recomputed from A
+  /// at the end so that round-off in the recurrence cannot pass it).
+  double tolerance = 1e-6;
+  int max_iterations = 10'000;
+  PcgPreconditioner preconditioner = PcgPreconditioner::block_jacobi;
+};
+
+struct PcgResult {
+  int iterations = 0;
+  double relative_residual = 0.0;  ///< ‖b − A x‖ / ‖b‖ at the end (0 for b = 0)
+  bool converged = false;
+};
+
+class PcgSolver {
+ public:
+  /// Keeps A (symmetric, both triangles stored, as `Form::hessian` and `apply_dirichlet` give
+  /// it; pass an rvalue to move it in) and builds the preconditioner. std::runtime_error if a
+  /// diagonal entry or block is not positive definite.
+  void compute(SparseMatrix A, const PcgOptions& options);
+  /// Solves A x = b from the x given (resized to zero if its size is wrong). Does not throw on
+  /// non-convergence: the caller reads `converged`.
+  PcgResult solve(const VectorXd& b, VectorXd& x) const;
+  /// y = A x, as Aᵀx (A is symmetric): Eigen then walks the compressed columns as rows, each
+  /// entry of y one gathered dot product, without scattered stores.
+  void multiply(const VectorXd& x, VectorXd& y) const;
+  [[nodiscard]] const PcgOptions& options() const { return options_; }
+  [[nodiscard]] Eigen::Index rows() const { return A_.rows(); }
+  [[nodiscard]] Eigen::Index nonzeros() const { return A_.nonZeros(); }
+
+ private:
+  void precondition(const VectorXd& r, VectorXd& z) const;
+
+  SparseMatrix A_;
+  PcgOptions options_;
+  VectorXd inverse_diagonal_;  ///< jacobi
+  std::vector<double> inverse_blocks_;  ///< block_jacobi: 9 per node, row-major
+  mutable VectorXd r_, z_, p_, q_;
+};
+
+}  // namespace vessel::msm
