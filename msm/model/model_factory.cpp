@@ -40,7 +40,8 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
     if (network.tets.empty()) {
       throw InputError("volume term: the network has no tetrahedra; expected a volume network");
     }
-    volume_ = std::make_unique<VolumeTerm>(network.nodes, network.tets, *volume_kappa);
+    volume_ = std::make_unique<VolumeTerm>(network.nodes, network.tets, *volume_kappa,
+                                           network.tet_kappa_factors);
   }
   if (bending_rigidity) {
     if (network.triangles.empty()) {
