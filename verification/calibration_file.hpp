@@ -51,7 +51,7 @@ struct Calibration {
   std::string model_kind;              ///< "volume_msm" | "surface_msm"
   std::string stiffness;               ///< the model's stiffness rule
   bool volume_term = false;
-  std::string volume_moduli = "golec";  ///< the volume term's (E_s, κ) rule (absent in a file: golec)
+  std::string volume_moduli = "golec";  ///< the volume term's (E_s, κ) rule; golec if absent
   double poisson_ratio = 0.0;
   double youngs_modulus = 0.0;  ///< Pa
   // The mesh it belongs to.

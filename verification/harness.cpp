@@ -1002,8 +1002,8 @@ void run_reference_transients_at(const Scene& s, SceneReferences& r, std::size_t
     for (const ModelSpec& spec : s.models) {
       if (spec.kind == ModelKind::fem || !spec.solver.is_dynamic() || spec.roi_radius > 0.0 ||
           spec.solver.dt <= 0.0 ||
-          (spec.volume_term && (nu >= 0.5 || (nu < 0.25 && spec.volume_moduli ==
-                                                                 msm::VolumeModuli::golec)))) {
+          (spec.volume_term &&
+           (nu >= 0.5 || (nu < 0.25 && spec.volume_moduli == msm::VolumeModuli::golec)))) {
         continue;
       }
       VesselParams vessel = s.vessel;

@@ -36,7 +36,7 @@ Bending parse_bending(const std::string& name);  ///< InputError if unknown
 /// (E_s, κ) for which this mesh's own network, loaded by uniform boundary tractions, has the
 /// target E and ν, with a per-tet stability clip on a negative κ; volume_term_homogenised.hpp).
 enum class VolumeModuli { golec, homogenised };
-std::string to_string(VolumeModuli rule);               ///< "golec" | "homogenised"
+std::string to_string(VolumeModuli rule);                   ///< "golec" | "homogenised"
 VolumeModuli parse_volume_moduli(const std::string& name);  ///< InputError if unknown
 
 struct NetworkOptions {

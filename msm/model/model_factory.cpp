@@ -22,7 +22,8 @@ HybridModuli hybrid_moduli(double E, double nu) {
                      "constraint, which this penalty model does not offer)"
                    : "; below 1/4 the volume term's κ = λ − μ is negative, and a negative volume "
                      "energy makes sliver tets unstable (the static solver diverged on a gmsh "
-                     "cube at ν = 0 and 0.1)"));
+                     "cube at ν = 0 and 0.1); volume_moduli = \"homogenised\" reaches lower "
+                     "ν with a per-tet stability clip"));
   }
   HybridModuli m;
   m.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));

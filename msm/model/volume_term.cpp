@@ -87,14 +87,12 @@ VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, do
                      std::to_string(kappa));
   }
   if (!tet_factors_.empty() && tet_factors_.size() != tets_.size()) {
-    throw InputError("volume term: expected one κ factor per tet (" +
-                     std::to_string(tets_.size()) + "), got " +
-                     std::to_string(tet_factors_.size()));
+    throw InputError("volume term: expected one κ factor per tet (" + std::to_string(tets_.size()) +
+                     "), got " + std::to_string(tet_factors_.size()));
   }
   for (double f : tet_factors_) {
     if (!std::isfinite(f)) {
-      throw InputError("volume term: expected finite per-tet κ factors, got " +
-                       std::to_string(f));
+      throw InputError("volume term: expected finite per-tet κ factors, got " + std::to_string(f));
     }
   }
   rest_volumes_.reserve(tets_.size());

@@ -41,8 +41,9 @@ std::vector<char> rigid_support(const std::vector<Vec3>& nodes) {
     if (d > best) best = d, c = i;
   }
   if (!(best > 1e-24 * ab.squaredNorm() * ab.squaredNorm()) || b == a) {
-    throw InputError("homogenised volume model: the mesh's nodes are collinear; expected a 3-D "
-                     "tetrahedral mesh");
+    throw InputError(
+        "homogenised volume model: the mesh's nodes are collinear; expected a 3-D "
+        "tetrahedral mesh");
   }
   // Row k of u_p = ω × r is −([r]×)_k · ω... written as (r × e_k)·ω.
   auto row = [](const Vec3& r, int k) { return Vec3(r.cross(Vec3::Unit(k))); };
@@ -125,8 +126,7 @@ TractionHomogenisation::TractionHomogenisation(const std::vector<Vec3>& nodes,
   strain_ = Eigen::MatrixXd::Zero(6, num_free);
   const double s2 = std::sqrt(0.5);
   for (const Triangle& f : boundary_faces(mesh)) {
-    const Vec3 m =
-        (nodes[f[1]] - nodes[f[0]]).cross(nodes[f[2]] - nodes[f[0]]) / 6.0 / volume_;
+    const Vec3 m = (nodes[f[1]] - nodes[f[0]]).cross(nodes[f[2]] - nodes[f[0]]) / 6.0 / volume_;
     for (int node : f) {
       auto add = [&](int row, int comp, double value) {
         const int col = free_index[3 * node + comp];
@@ -149,8 +149,7 @@ std::optional<TractionModuli> TractionHomogenisation::moduli(
     double spring_youngs_modulus, double kappa, const std::vector<double>& tet_factors) const {
   SparseMatrix KV;
   VolumeTerm(nodes_, tets_, kappa, tet_factors).hessian(flatten(nodes_), KV, false);
-  const SparseMatrix K =
-      spring_youngs_modulus * springs_ + restrict_to(KV, free_index_, num_free_);
+  const SparseMatrix K = spring_youngs_modulus * springs_ + restrict_to(KV, free_index_, num_free_);
   CholmodSolver solver;
   if (!solver.try_factorize(K)) return std::nullopt;
   TractionModuli m;
@@ -188,8 +187,9 @@ double volume_stability_limit(const std::array<Vec3, 4>& x) {
   const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(G);
   const double q = m.dot(ldlt.solve(m));
   if (ldlt.info() != Eigen::Success || !(q > 0) || !std::isfinite(q)) {
-    throw InputError("homogenised volume model: a degenerate tetrahedron (its six edges do not "
-                     "determine its strain)");
+    throw InputError(
+        "homogenised volume model: a degenerate tetrahedron (its six edges do not "
+        "determine its strain)");
   }
   return -1.0 / q;
 }
@@ -209,13 +209,13 @@ std::vector<double> stability_clipped_factors(const std::vector<Vec3>& nodes,
 HomogenisedModuli homogenised_moduli(const std::vector<Vec3>& nodes, const std::vector<Tet>& tets,
                                      double E, double nu) {
   if (!(E > 0) || !std::isfinite(E)) {
-    throw InputError("homogenised volume model: expected Young's modulus E > 0 Pa, got " +
-                     num(E));
+    throw InputError("homogenised volume model: expected Young's modulus E > 0 Pa, got " + num(E));
   }
   if (!(nu >= 0.0 && nu < 0.5)) {
     throw InputError(
         "homogenised volume model (volume_moduli = \"homogenised\"): poisson_ratio ν must be in "
-        "[0, 0.5), got " + num(nu) +
+        "[0, 0.5), got " +
+        num(nu) +
         (nu >= 0.5 ? "; at ν = 0.5 the volume term's κ is infinite (an incompressibility "
                      "constraint, which this penalty model does not offer)"
                    : ""));
@@ -241,8 +241,10 @@ HomogenisedModuli homogenised_moduli(const std::vector<Vec3>& nodes, const std::
     const auto m = h.moduli(1.0, r, stability_clipped_factors(nodes, tets, r));
     ++out.evaluations;
     if (!m) {  // the clip makes every tet's block positive definite: not expected
-      throw InputError("homogenised volume model: the network's stiffness is not positive "
-                       "definite at κ/E_s = " + num(r) + "; expected a connected tet mesh");
+      throw InputError(
+          "homogenised volume model: the network's stiffness is not positive "
+          "definite at κ/E_s = " +
+          num(r) + "; expected a connected tet mesh");
     }
     return Point{x, m->poisson_ratio - nu, *m};
   };
@@ -250,9 +252,9 @@ HomogenisedModuli homogenised_moduli(const std::vector<Vec3>& nodes, const std::
   // Below r_floor = margin·min_e c_e every tet is clipped: ν_eff stops falling there.
   double r_floor = 0.0;
   for (const Tet& t : tets) {
-    r_floor = std::min(r_floor, kStabilityMargin * volume_stability_limit(
-                                                       {nodes[t[0]], nodes[t[1]], nodes[t[2]],
-                                                        nodes[t[3]]}));
+    r_floor = std::min(
+        r_floor, kStabilityMargin *
+                     volume_stability_limit({nodes[t[0]], nodes[t[1]], nodes[t[2]], nodes[t[3]]}));
   }
   double lo = (r_floor + 0.4) / (1.6 + 2.0 * r_floor), hi = 0.5;  // f(lo) ≤ 0 < f(hi)
   std::optional<Point> found, previous;
@@ -260,13 +262,12 @@ HomogenisedModuli homogenised_moduli(const std::vector<Vec3>& nodes, const std::
     const Point floor = evaluate(lo);
     if (std::abs(floor.f) < kTolerance) found = floor;
     if (floor.f > 0) {
-      throw InputError(
-          "homogenised volume model: poisson_ratio ν = " + num(nu) +
-          " is below the lowest effective ν this mesh's network reaches (" +
-          num(floor.m.poisson_ratio) + ": every tet's negative κ at " +
-          num(kStabilityMargin) +
-          " of its own stability limit, volume_term_homogenised.hpp); expected ν ≥ " +
-          num(std::ceil(floor.m.poisson_ratio * 1000) / 1000));
+      throw InputError("homogenised volume model: poisson_ratio ν = " + num(nu) +
+                       " is below the lowest effective ν this mesh's network reaches (" +
+                       num(floor.m.poisson_ratio) + ": every tet's negative κ at " +
+                       num(kStabilityMargin) +
+                       " of its own stability limit, volume_term_homogenised.hpp); expected ν ≥ " +
+                       num(std::ceil(floor.m.poisson_ratio * 1000) / 1000));
     }
     previous = floor;
   }
@@ -278,17 +279,15 @@ HomogenisedModuli homogenised_moduli(const std::vector<Vec3>& nodes, const std::
       break;
     }
     (p.f < 0 ? lo : hi) = x;
-    double next = previous && previous->f != p.f
-                      ? x - p.f * (x - previous->x) / (p.f - previous->f)
-                      : x - p.f;  // ν_eff ≈ ν_n − offset: unit slope
+    double next = previous && previous->f != p.f ? x - p.f * (x - previous->x) / (p.f - previous->f)
+                                                 : x - p.f;  // ν_eff ≈ ν_n − offset: unit slope
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     previous = p;
     x = next;
   }
   if (!found) {
     throw InputError("homogenised volume model: the fit of κ/E_s to ν = " + num(nu) +
-                     " did not converge (" + std::to_string(out.evaluations) +
-                     " homogenisations)");
+                     " did not converge (" + std::to_string(out.evaluations) + " homogenisations)");
   }
   const double r = ratio(found->x);
   out.spring_youngs_modulus = E / found->m.youngs_modulus;

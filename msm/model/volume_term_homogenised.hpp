@@ -84,19 +84,19 @@ class TractionHomogenisation {
   std::vector<Tet> tets_;
   std::vector<int> free_index_;  ///< per dof: its index among the free dofs, −1 if supported
   int num_free_ = 0;
-  SparseMatrix springs_;  ///< K₁ on the free dofs
-  Eigen::MatrixXd loads_;     ///< 6 columns: nodal loads of the unit Mandel stresses, free dofs
+  SparseMatrix springs_;   ///< K₁ on the free dofs
+  Eigen::MatrixXd loads_;  ///< 6 columns: nodal loads of the unit Mandel stresses, free dofs
   /// Mean strain (Mandel) from the free dofs' displacements: ε̄ = strain_ · u (6 × free dofs).
   Eigen::MatrixXd strain_;
 };
 
 /// Per unit E_s, the most negative κ/E_s at which one tet's own share of the van-gelder springs
 /// (E_s·V/L² per edge) plus its volume term stays positive semi-definite at rest:
-/// c = −1/(mᵀG⁻¹m), G = Σ_edges w wᵀ, w the Mandel vector of d dᵀ (d the unit edge), m = (1,1,1,0,0,0).
-/// (A tet's nodal motion is rigid + uniform strain ε; its springs store ½E_s·V·εᵀGε, its volume
-/// term ½κV(m·ε)²: a rank-one update, PSD iff κ ≥ −E_s/(mᵀG⁻¹m).) −2/3 for a regular tet (the
-/// springs' bulk modulus, 2E_s/3); near 0 for a sliver, whose volume changes at first order under
-/// motions that barely stretch its edges. InputError for a degenerate tet.
+/// c = −1/(mᵀG⁻¹m), G = Σ_edges w wᵀ, w the Mandel vector of d dᵀ (d the unit edge), m =
+/// (1,1,1,0,0,0). (A tet's nodal motion is rigid + uniform strain ε; its springs store ½E_s·V·εᵀGε,
+/// its volume term ½κV(m·ε)²: a rank-one update, PSD iff κ ≥ −E_s/(mᵀG⁻¹m).) −2/3 for a regular tet
+/// (the springs' bulk modulus, 2E_s/3); near 0 for a sliver, whose volume changes at first order
+/// under motions that barely stretch its edges. InputError for a degenerate tet.
 double volume_stability_limit(const std::array<Vec3, 4>& x);
 
 /// The per-tet κ factors of the homogenised rule at κ/E_s = r: for r < 0 each tet's κ_e/E_s is

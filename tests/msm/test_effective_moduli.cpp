@@ -213,13 +213,14 @@ TEST(EffectiveModuli, HomogenisedVolumeModelHitsTheTargetModuli) {
     ASSERT_TRUE(built.volume_kappa.has_value());
     EXPECT_EQ(*built.volume_kappa < 0, nu < 0.25) << "ν = " << nu;
     const Moduli m = measure(built.network, 1e-4, built.volume_kappa);
-    std::printf("homogenised volume model, target nu = %.2f: kappa/E = %+.4f, clipped tets %zu; "
-                "E_eff/E = %.4f, nu_eff = %.4f\n",
-                nu, *built.volume_kappa / E,
-                static_cast<std::size_t>(std::count_if(
-                    built.network.tet_kappa_factors.begin(), built.network.tet_kappa_factors.end(),
-                    [](double f) { return f < 1.0; })),
-                m.E / E, m.nu);
+    std::printf(
+        "homogenised volume model, target nu = %.2f: kappa/E = %+.4f, clipped tets %zu; "
+        "E_eff/E = %.4f, nu_eff = %.4f\n",
+        nu, *built.volume_kappa / E,
+        static_cast<std::size_t>(std::count_if(built.network.tet_kappa_factors.begin(),
+                                               built.network.tet_kappa_factors.end(),
+                                               [](double f) { return f < 1.0; })),
+        m.E / E, m.nu);
     EXPECT_NEAR(m.E / E, 1.0, nu < 0.25 ? 0.025 : 0.02) << "ν = " << nu;
     EXPECT_NEAR(m.nu, nu, 0.01) << "ν = " << nu;
   }
@@ -234,9 +235,9 @@ TEST(EffectiveModuli, HomogenisedVolumeModelHitsTheTargetModuli) {
       (void)build_network(mesh, vessel, o);
       ADD_FAILURE() << "ν = " << nu << " accepted";
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(nu == 0.0 ? "below the lowest effective ν"
-                                                      : "κ is infinite"),
-                std::string::npos)
+      EXPECT_NE(
+          std::string(e.what()).find(nu == 0.0 ? "below the lowest effective ν" : "κ is infinite"),
+          std::string::npos)
           << e.what();
     }
   }

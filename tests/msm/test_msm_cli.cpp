@@ -48,7 +48,8 @@ TEST_F(MsmCli, SurfaceAndVolumeModelsSolveStaticallyAndWriteJson) {
   ASSERT_EQ(h.exit_code, 0) << h.output;
   EXPECT_TRUE(contains(h.output, "volume term")) << h.output;
   // The homogenised rule for its (E_s, κ), named in the topology.
-  const auto hh = vv("--model volume --volume-term --volume-moduli homogenised --poisson-ratio 0.3");
+  const auto hh =
+      vv("--model volume --volume-term --volume-moduli homogenised --poisson-ratio 0.3");
   ASSERT_EQ(hh.exit_code, 0) << hh.output;
   EXPECT_TRUE(contains(hh.output, "homogenised on this mesh")) << hh.output;
   // The discrete-shells surface model: hinges named in the topology, no bend springs left.

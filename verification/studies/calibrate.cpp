@@ -474,8 +474,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   std::ostringstream detail;
   detail << msm::to_string(spec.stiffness)
          << (spec.volume_term ? " + volume term (" + msm::to_string(spec.volume_moduli) + ")" : "")
-         << ", "
-         << msm::to_string(spec.solver);
+         << ", " << msm::to_string(spec.solver);
   study.model_detail = detail.str();
   for (const LoadCase& c : cases) {
     study.cases.push_back(evaluate_case(main, c, spec, &calibrated, "", nu, log));

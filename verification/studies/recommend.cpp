@@ -174,8 +174,8 @@ std::vector<SpringChoice> spring_rules(ModelKind kind) {
   if (kind == ModelKind::volume_msm) {
     out.push_back({msm::StiffnessRule::van_gelder, true});
     // The homogenised rule's (E_s, κ) (msm/model/volume_term_homogenised.hpp).
-    out.push_back({msm::StiffnessRule::van_gelder, true, msm::Bending::none,
-                   msm::VolumeModuli::homogenised});
+    out.push_back(
+        {msm::StiffnessRule::van_gelder, true, msm::Bending::none, msm::VolumeModuli::homogenised});
   }
   if (kind == ModelKind::surface_msm) {
     out.push_back({msm::StiffnessRule::van_gelder, false, msm::Bending::discrete_shells});
@@ -186,7 +186,7 @@ std::vector<SpringChoice> spring_rules(ModelKind kind) {
 std::string rule_label(const SpringChoice& c) {
   if (c.volume_term) {
     return c.volume_moduli == msm::VolumeModuli::homogenised ? "hybrid-volume-homogenised"
-                                                              : "hybrid-volume";
+                                                             : "hybrid-volume";
   }
   if (c.bending != msm::Bending::none) return msm::to_string(c.bending);
   return msm::to_string(c.rule);
