@@ -72,6 +72,7 @@ void write_calibration(const std::filesystem::path& path, const Calibration& c) 
                 {"kind", c.model_kind},
                 {"stiffness", c.stiffness},
                 {"volume_term", c.volume_term},
+                {"volume_moduli", c.volume_moduli},
                 {"poisson_ratio", c.poisson_ratio},
                 {"youngs_modulus_Pa", c.youngs_modulus}};
   j["mesh"] = {{"hash", c.mesh_hash}, {"vessel", c.vessel}, {"level", c.level},
@@ -151,6 +152,10 @@ Calibration read_calibration(const std::filesystem::path& path) {
   c.model_kind = member<std::string>(model, "kind", mfile);
   c.stiffness = member<std::string>(model, "stiffness", mfile);
   c.volume_term = member<bool>(model, "volume_term", mfile);
+  // Files written before the homogenised rule have no volume_moduli: golec.
+  c.volume_moduli = model.contains("volume_moduli")
+                        ? member<std::string>(model, "volume_moduli", mfile)
+                        : std::string("golec");
   c.poisson_ratio = member<double>(model, "poisson_ratio", mfile);
   c.youngs_modulus = member<double>(model, "youngs_modulus_Pa", mfile);
   const auto mesh = member<nlohmann::json>(j, "mesh", file);
@@ -263,6 +268,11 @@ void apply_calibration(const Calibration& c, const std::string& source, msm::Bui
                      (c.volume_term ? " with" : " without") + " the volume term, applied to \"" +
                      msm::to_string(spec.stiffness) + "\"" +
                      (spec.volume_term ? " with" : " without") + " it");
+  }
+  if (c.volume_term && c.volume_moduli != msm::to_string(spec.volume_moduli)) {
+    throw InputError(source + ": model.volume_moduli: fitted on the volume term's \"" +
+                     c.volume_moduli + "\" rule, applied to a model with \"" +
+                     msm::to_string(spec.volume_moduli) + "\"");
   }
   if (std::abs(c.poisson_ratio - nu) > 1e-12 ||
       std::abs(c.youngs_modulus - youngs_modulus) > 1e-9 * youngs_modulus) {

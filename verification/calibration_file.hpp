@@ -46,11 +46,12 @@ struct CalibrationFitCase {
 struct Calibration {
   std::string granularity = "groups";  ///< "groups" | "per_spring"
   // The model it applies to.
-  std::string scene;                   ///< scene name it was fitted on
-  std::string model;                   ///< the scene's model name
-  std::string model_kind;              ///< "volume_msm" | "surface_msm"
-  std::string stiffness;               ///< the model's stiffness rule
+  std::string scene;       ///< scene name it was fitted on
+  std::string model;       ///< the scene's model name
+  std::string model_kind;  ///< "volume_msm" | "surface_msm"
+  std::string stiffness;   ///< the model's stiffness rule
   bool volume_term = false;
+  std::string volume_moduli = "golec";  ///< the volume term's (E_s, κ) rule; golec if absent
   double poisson_ratio = 0.0;
   double youngs_modulus = 0.0;  ///< Pa
   // The mesh it belongs to.

@@ -553,15 +553,27 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
                    const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
                    const HarnessOptions& o, Progress& progress, ModelOutcome base,
                    SceneResult& result) {
+  // The hybrid model refuses ν outside [1/4, 1/2) (κ = λ − μ negative or infinite), the
+  // homogenised one ν = 1/2 and ν below its mesh's floor (found when its network is built):
+  // recorded as failed, as P1 is at ν = 0.5, not fatal to the run.
+  const MemoryProbe setup_memory;
+  Stopwatch setup;  // the homogenised rule's fit is part of the set-up
+  std::string why;
+  std::optional<msm::BuiltNetwork> built_or;
+  VesselParams vessel = s.vessel;
+  vessel.level = base.level;
   if (spec.volume_term && (nu < 0.25 || nu >= 0.5)) {
-    // The hybrid model refuses ν outside [1/4, 1/2) (κ = λ − μ negative or infinite): recorded as
-    // failed, as P1 is at ν = 0.5, not fatal to the run.
-    std::string why;
     try {
-      (void)msm::hybrid_moduli(s.youngs_modulus, nu);
+      if (spec.volume_moduli == msm::VolumeModuli::golec || nu >= 0.5) {
+        (void)msm::hybrid_moduli(s.youngs_modulus, nu);
+      } else {
+        built_or.emplace(scene_network(s, spec, mesh, vessel, nu));
+      }
     } catch (const InputError& e) {
       why = e.what();
     }
+  }
+  if (!why.empty()) {
     for (const double mag : s.load.magnitudes) {
       ModelOutcome out = base;
       out.magnitude = mag;
@@ -570,11 +582,8 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
     }
     return;
   }
-  const MemoryProbe setup_memory;
-  Stopwatch setup;
-  VesselParams vessel = s.vessel;
-  vessel.level = base.level;
-  const msm::BuiltNetwork built = scene_network(s, spec, mesh, vessel, nu);
+  if (!built_or) built_or.emplace(scene_network(s, spec, mesh, vessel, nu));
+  const msm::BuiltNetwork& built = *built_or;
   if (spec.kind == ModelKind::network) {
     // The reference is read at the network's rest positions: every node must lie in its mesh
     // (within the evaluation's own tolerance), else the run stops naming them.
@@ -1014,12 +1023,21 @@ std::vector<TransientRequest> transient_requests(const Scene& s, const SceneRefe
   for (const auto& [level, mesh] : r.model_meshes) {
     for (const ModelSpec& spec : s.models) {
       if (spec.kind == ModelKind::fem || !spec.solver.is_dynamic() || spec.roi_radius > 0.0 ||
-          spec.solver.dt <= 0.0 || (spec.volume_term && (nu < 0.25 || nu >= 0.5))) {
+          spec.solver.dt <= 0.0 ||
+          (spec.volume_term &&
+           (nu >= 0.5 || (nu < 0.25 && spec.volume_moduli == msm::VolumeModuli::golec)))) {
         continue;
       }
       VesselParams vessel = s.vessel;
       vessel.level = level;
-      const msm::BuiltNetwork built = scene_network(s, spec, mesh, vessel, nu);
+      std::optional<msm::BuiltNetwork> built_or;
+      try {
+        built_or.emplace(scene_network(s, spec, mesh, vessel, nu));
+      } catch (const InputError&) {
+        if (!spec.volume_term) throw;
+        continue;  // the homogenised rule below its mesh's floor: the models' pass records it
+      }
+      const msm::BuiltNetwork& built = *built_or;
       const auto model = msm::make_model(built, spec.damping);
       const msm::Problem at_rest = msm_problem(s, *model, built, mesh, 0.0);
       const TransientRequest q{built.network.nodes[nearest_node(built.network.nodes, qoi)],

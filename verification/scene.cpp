@@ -457,6 +457,16 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
     }
   }
   if (m.kind == ModelKind::volume_msm) m.volume_term = r.boolean_or("volume_term", false);
+  if (m.kind == ModelKind::volume_msm) {
+    // volume_moduli = "golec" | "homogenised": the volume term's (E_s, κ) rule.
+    m.volume_moduli =
+        msm::parse_volume_moduli(r.name_or("volume_moduli", "golec", msm::parse_volume_moduli));
+    if (m.volume_moduli != msm::VolumeModuli::golec && !m.volume_term) {
+      r.fail(r.table().get("volume_moduli"), "volume_moduli",
+             "found \"" + msm::to_string(m.volume_moduli) +
+                 "\" without volume_term = true; expected volume_term = true with it");
+    }
+  }
   const auto stiffness = network ? std::vector<std::string>{msm::to_string(m.stiffness)} :
       r.names_or("stiffness",
                  m.kind == ModelKind::volume_msm

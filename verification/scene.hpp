@@ -61,6 +61,8 @@ struct ModelSpec {
   /// volume_msm: the hybrid volume model (Golec et al. 2020; msm/model/model_factory.hpp):
   /// van-gelder springs carrying μ plus a volume energy per tet with κ = λ − μ (any ν < 0.5).
   bool volume_term = false;
+  /// volume_term's rule for (E_s, κ): golec (default) or homogenised (msm/model/build_network.hpp).
+  msm::VolumeModuli volume_moduli = msm::VolumeModuli::golec;
   /// surface msm: discrete_shells adds the Discrete Shells hinge energy (Grinspun et al. 2003) with
   /// D = E·t³/(12(1 − ν²)) and drops the bend springs (msm/model/build_network.hpp).
   msm::Bending bending = msm::Bending::none;

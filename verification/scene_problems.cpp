@@ -141,6 +141,7 @@ msm::NetworkOptions network_options(const Scene& s, const ModelSpec& model, doub
   o.topology = model.topology;
   o.stiffness = model.stiffness;
   o.volume_term = model.volume_term;
+  o.volume_moduli = model.volume_moduli;
   o.bending = model.bending;
   o.stiffness_params.youngs_modulus = s.youngs_modulus;
   o.stiffness_params.poisson_ratio = nu;

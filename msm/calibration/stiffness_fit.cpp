@@ -184,10 +184,13 @@ LinearisedFit::LinearisedFit(const SpringNetwork& net, std::optional<double> kap
   }
   if (kappa) {
     kappa0_ = *kappa;
-    for (const Tet& t : net.tets) {
+    for (std::size_t e = 0; e < net.tets.size(); ++e) {
+      const Tet& t = net.tets[e];
       std::array<Vec3, 4> x;
       for (int i = 0; i < 4; ++i) x[i] = net.nodes[static_cast<std::size_t>(t[i])];
-      tets_.push_back({t, tet_volume_gradient(x), 1.0 / std::abs(tet_signed_volume(x))});
+      // κ_e/|V₀| (the homogenised rule's per-tet κ factor, springs.hpp), as VolumeTerm.
+      const double factor = net.tet_kappa_factors.empty() ? 1.0 : net.tet_kappa_factors[e];
+      tets_.push_back({t, tet_volume_gradient(x), factor / std::abs(tet_signed_volume(x))});
     }
   }
   node_springs_.resize(net.nodes.size());

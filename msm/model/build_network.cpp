@@ -5,6 +5,7 @@
 
 #include "meshes/errors.hpp"
 #include "msm/model/model_factory.hpp"
+#include "msm/model/volume_term_homogenised.hpp"
 
 namespace vessel::msm {
 
@@ -40,6 +41,16 @@ Bending parse_bending(const std::string& name) {
   if (name == "none") return Bending::none;
   if (name == "discrete-shells" || name == "discrete_shells") return Bending::discrete_shells;
   throw InputError("bending: expected 'none' or 'discrete-shells', got '" + name + "'");
+}
+
+std::string to_string(VolumeModuli rule) {
+  return rule == VolumeModuli::homogenised ? "homogenised" : "golec";
+}
+
+VolumeModuli parse_volume_moduli(const std::string& name) {
+  if (name == "golec") return VolumeModuli::golec;
+  if (name == "homogenised") return VolumeModuli::homogenised;
+  throw InputError("volume_moduli: expected 'golec' or 'homogenised', got '" + name + "'");
 }
 
 namespace {
@@ -90,10 +101,22 @@ void assign_laws_and_masses(BuiltNetwork& built, const NetworkOptions& o) {
                        "(its κ = λ − μ assumes their λ = μ), got stiffness '" +
                        to_string(o.stiffness) + "'");
     }
-    const HybridModuli m = hybrid_moduli(params.youngs_modulus, params.poisson_ratio);
-    params.youngs_modulus = m.spring_youngs_modulus;
-    built.volume_kappa = m.kappa;
-    built.topology += " + volume term per tet (Golec et al. 2020)";
+    if (o.volume_moduli == VolumeModuli::homogenised) {
+      const HomogenisedModuli m = homogenised_moduli(built.network.nodes, built.network.tets,
+                                                     params.youngs_modulus, params.poisson_ratio);
+      params.youngs_modulus = m.spring_youngs_modulus;
+      built.volume_kappa = m.kappa;
+      built.network.tet_kappa_factors = m.tet_factors;
+      built.topology += " + volume term per tet, (E_s, κ) homogenised on this mesh";
+    } else {
+      const HybridModuli m = hybrid_moduli(params.youngs_modulus, params.poisson_ratio);
+      params.youngs_modulus = m.spring_youngs_modulus;
+      built.volume_kappa = m.kappa;
+      built.topology += " + volume term per tet (Golec et al. 2020)";
+    }
+  } else if (o.volume_moduli != VolumeModuli::golec) {
+    throw InputError("volume_moduli: '" + to_string(o.volume_moduli) +
+                     "' picks the volume term's moduli; expected volume_term = true with it");
   }
   assign_stiffness(built.network, o.stiffness, params);
   for (auto& s : built.network.springs) s.damping = o.axial_damping;

@@ -31,6 +31,14 @@ enum class Bending { none, discrete_shells };
 std::string to_string(Bending bending);          ///< "none" | "discrete-shells"
 Bending parse_bending(const std::string& name);  ///< InputError if unknown
 
+/// How the hybrid volume model picks its springs' E_s and its κ: `golec` (Golec et al. 2020's
+/// affine rule, E_s = 2.5μ, κ = λ − μ; model_factory.hpp) or `homogenised` (our extension: the
+/// (E_s, κ) for which this mesh's own network, loaded by uniform boundary tractions, has the
+/// target E and ν, with a per-tet stability clip on a negative κ; volume_term_homogenised.hpp).
+enum class VolumeModuli { golec, homogenised };
+std::string to_string(VolumeModuli rule);                   ///< "golec" | "homogenised"
+VolumeModuli parse_volume_moduli(const std::string& name);  ///< InputError if unknown
+
 struct NetworkOptions {
   ModelType model = ModelType::surface;
   WallSurface surface = WallSurface::inner;  ///< surface model: which wall
@@ -46,6 +54,9 @@ struct NetworkOptions {
   /// the network reaches the material's ν. InputError with another model or stiffness rule, or at
   /// ν = 0.5.
   bool volume_term = false;
+  /// The volume term's rule (with volume_term only; InputError otherwise). `homogenised` covers
+  /// ν from the mesh's floor (≈ 0.06 on a gmsh cube) to below 1/2.
+  VolumeModuli volume_moduli = VolumeModuli::golec;
   /// Surface model only: discrete_shells adds the hinge energy of Grinspun et al. (2003) on every
   /// interior edge with D = E·t³/(12(1 − ν²)) (E and ν from stiffness_params, t the wall thickness)
   /// and drops the triangle topology's bend springs, whose job the hinges take over; the springs on

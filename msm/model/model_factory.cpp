@@ -22,7 +22,8 @@ HybridModuli hybrid_moduli(double E, double nu) {
                      "constraint, which this penalty model does not offer)"
                    : "; below 1/4 the volume term's κ = λ − μ is negative, and a negative volume "
                      "energy makes sliver tets unstable (the static solver diverged on a gmsh "
-                     "cube at ν = 0 and 0.1)"));
+                     "cube at ν = 0 and 0.1); volume_moduli = \"homogenised\" reaches lower "
+                     "ν with a per-tet stability clip"));
   }
   HybridModuli m;
   m.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
@@ -40,7 +41,8 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
     if (network.tets.empty()) {
       throw InputError("volume term: the network has no tetrahedra; expected a volume network");
     }
-    volume_ = std::make_unique<VolumeTerm>(network.nodes, network.tets, *volume_kappa);
+    volume_ = std::make_unique<VolumeTerm>(network.nodes, network.tets, *volume_kappa,
+                                           network.tet_kappa_factors);
   }
   if (bending_rigidity) {
     if (network.triangles.empty()) {

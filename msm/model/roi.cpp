@@ -82,7 +82,8 @@ RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& 
   // Tets with a moving node are carried, for the volume term (their other nodes are kept: a volume
   // network has a spring on every tet edge). Triangles only with carry_triangles (above): the
   // spring model and the solvers other than PBD use springs only.
-  for (const Tet& t : full.tets) {
+  for (std::size_t e = 0; e < full.tets.size(); ++e) {
+    const Tet& t = full.tets[e];
     if (held[t[0]] && held[t[1]] && held[t[2]] && held[t[3]]) continue;
     Tet r{};
     bool kept = true;
@@ -90,7 +91,11 @@ RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& 
       r[a] = to_roi[t[a]];
       kept = kept && r[a] >= 0;
     }
-    if (kept) roi.network.tets.push_back(r);
+    if (!kept) continue;
+    roi.network.tets.push_back(r);
+    if (!full.tet_kappa_factors.empty()) {
+      roi.network.tet_kappa_factors.push_back(full.tet_kappa_factors[e]);
+    }
   }
   return roi;
 }

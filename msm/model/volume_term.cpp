@@ -76,11 +76,24 @@ Mat12 volume_hessian(const std::array<Vec3, 4>& x, double rest_volume, double ka
   return psd_projection(H);
 }
 
-VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, double kappa)
-    : num_nodes_(static_cast<int>(nodes.size())), tets_(std::move(tets)), kappa_(kappa) {
+VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, double kappa,
+                       std::vector<double> tet_factors)
+    : num_nodes_(static_cast<int>(nodes.size())),
+      tets_(std::move(tets)),
+      kappa_(kappa),
+      tet_factors_(std::move(tet_factors)) {
   if (!std::isfinite(kappa)) {
     throw InputError("volume term: expected a finite bulk stiffness κ (Pa), got " +
                      std::to_string(kappa));
+  }
+  if (!tet_factors_.empty() && tet_factors_.size() != tets_.size()) {
+    throw InputError("volume term: expected one κ factor per tet (" + std::to_string(tets_.size()) +
+                     "), got " + std::to_string(tet_factors_.size()));
+  }
+  for (double f : tet_factors_) {
+    if (!std::isfinite(f)) {
+      throw InputError("volume term: expected finite per-tet κ factors, got " + std::to_string(f));
+    }
   }
   rest_volumes_.reserve(tets_.size());
   for (std::size_t e = 0; e < tets_.size(); ++e) {
@@ -112,7 +125,7 @@ std::array<Vec3, 4> VolumeTerm::corners(const VectorXd& x, const Tet& t) const {
 double VolumeTerm::energy(const VectorXd& x) const {
   double e = 0.0;
   for (std::size_t k = 0; k < tets_.size(); ++k) {
-    e += volume_energy(corners(x, tets_[k]), rest_volumes_[k], kappa_);
+    e += volume_energy(corners(x, tets_[k]), rest_volumes_[k], tet_kappa(k));
   }
   return e;
 }
@@ -120,7 +133,7 @@ double VolumeTerm::energy(const VectorXd& x) const {
 void VolumeTerm::add_gradient(const VectorXd& x, VectorXd& g) const {
   for (std::size_t k = 0; k < tets_.size(); ++k) {
     const Tet& t = tets_[k];
-    const Vec12 gk = volume_gradient(corners(x, t), rest_volumes_[k], kappa_);
+    const Vec12 gk = volume_gradient(corners(x, t), rest_volumes_[k], tet_kappa(k));
     for (int a = 0; a < 4; ++a) g.segment<3>(3 * t[a]) += gk.segment<3>(3 * a);
   }
 }
@@ -139,7 +152,8 @@ void VolumeTerm::add_hessian(const VectorXd& x, double* values, const std::vecto
   const int* s = slots.data();
   for (std::size_t k = 0; k < tets_.size(); ++k) {
     add_four_node_block(
-        volume_hessian(corners(x, tets_[k]), rest_volumes_[k], kappa_, project_psd), s, values);
+        volume_hessian(corners(x, tets_[k]), rest_volumes_[k], tet_kappa(k), project_psd), s,
+        values);
   }
 }
 

@@ -43,9 +43,12 @@ Mat12 volume_hessian(const std::array<Vec3, 4>& x, double rest_volume, double ka
 /// The volume term of a tet mesh as a Form (no damping).
 class VolumeTerm : public Form {
  public:
-  /// `nodes`: rest positions (m) of num_nodes nodes; `tets` index them; κ in Pa. Throws
-  /// InputError for a tet of zero rest volume or a non-finite κ.
-  VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, double kappa);
+  /// `nodes`: rest positions (m) of num_nodes nodes; `tets` index them; κ in Pa. tet_factors: per
+  /// tet, a factor f_e on κ (tet e's bulk stiffness is κ·f_e; empty: all 1; the homogenised rule's
+  /// stability clip, volume_term_homogenised.hpp). Throws InputError for a tet of zero rest
+  /// volume, a non-finite κ or factor, or a factor count other than the tet count.
+  VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, double kappa,
+             std::vector<double> tet_factors = {});
 
   [[nodiscard]] int num_dofs() const override { return 3 * num_nodes_; }
   [[nodiscard]] double energy(const VectorXd& x) const override;
@@ -64,6 +67,10 @@ class VolumeTerm : public Form {
   [[nodiscard]] const SparseMatrix& pattern() const { return pattern_; }
 
   [[nodiscard]] double kappa() const { return kappa_; }
+  /// κ of tet e (κ·f_e), Pa.
+  [[nodiscard]] double tet_kappa(std::size_t e) const {
+    return tet_factors_.empty() ? kappa_ : kappa_ * tet_factors_[e];
+  }
   [[nodiscard]] const std::vector<Tet>& tets() const { return tets_; }
   [[nodiscard]] const std::vector<double>& rest_volumes() const { return rest_volumes_; }
 
@@ -74,6 +81,7 @@ class VolumeTerm : public Form {
   std::vector<Tet> tets_;
   std::vector<double> rest_volumes_;
   double kappa_ = 0.0;
+  std::vector<double> tet_factors_;  ///< empty: all 1
   SparseMatrix pattern_;
   std::vector<int> slots_;
 };

@@ -41,6 +41,9 @@ struct SpringNetwork {
   /// Triangles of the surface model (empty for the volume model), for masses and PBD bending.
   std::vector<Triangle> triangles;
   std::vector<Tet> tets;   ///< tets of the volume model (empty for surfaces)
+  /// Per tet, a factor on the volume term's κ (the homogenised rule's stability clip,
+  /// msm/model/volume_term_homogenised.hpp); empty: all 1.
+  std::vector<double> tet_kappa_factors;
   double thickness = 0.0;  ///< wall thickness t carried by a surface model, m
   [[nodiscard]] std::size_t count(SpringFamily family) const;
 };

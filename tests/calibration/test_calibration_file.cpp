@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "meshes/errors.hpp"
 #include "msm/model/build_network.hpp"
@@ -178,6 +179,29 @@ TEST(CalibrationFile, AnotherMeshIsRefusedUnlessAGroupCalibrationTransfers) {
   expect_input_error(
       [&] { apply_calibration(c, "cal.json", b, mesh, VesselParams{}, other, kE, 0.45, false); },
       "cal.json: model");
+  // A calibration of Golec's rule applied to the homogenised rule's model (another κ and E_s).
+  ModelSpec homogenised = hybrid_spec();
+  homogenised.volume_moduli = msm::VolumeModuli::homogenised;
+  expect_input_error(
+      [&] {
+        apply_calibration(c, "cal.json", b, mesh, VesselParams{}, homogenised, kE, 0.45, false);
+      },
+      "cal.json: model.volume_moduli");
+  // The rule round-trips through the file; a file without the key is Golec's.
+  Calibration h = c;
+  h.volume_moduli = "homogenised";
+  const auto path = temp_file("homogenised.json");
+  write_calibration(path, h);
+  EXPECT_EQ(read_calibration(path).volume_moduli, "homogenised");
+  write_calibration(path, c);
+  std::stringstream text;
+  text << std::ifstream(path).rdbuf();
+  std::string json = text.str();
+  const auto at = json.find("\"volume_moduli\"");
+  ASSERT_NE(at, std::string::npos);
+  json.erase(at, json.find('\n', at) - at);  // `"volume_moduli": "golec",` (not the last member)
+  std::ofstream(path) << json;
+  EXPECT_EQ(read_calibration(path).volume_moduli, "golec");
 }
 
 TEST(CalibrationFile, BadFilesGiveErrorsNamingFileAndKey) {

@@ -47,6 +47,11 @@ TEST_F(MsmCli, SurfaceAndVolumeModelsSolveStaticallyAndWriteJson) {
   const auto h = vv("--model volume --volume-term --poisson-ratio 0.45");
   ASSERT_EQ(h.exit_code, 0) << h.output;
   EXPECT_TRUE(contains(h.output, "volume term")) << h.output;
+  // The homogenised rule for its (E_s, κ), named in the topology.
+  const auto hh =
+      vv("--model volume --volume-term --volume-moduli homogenised --poisson-ratio 0.3");
+  ASSERT_EQ(hh.exit_code, 0) << hh.output;
+  EXPECT_TRUE(contains(hh.output, "homogenised on this mesh")) << hh.output;
   // The discrete-shells surface model: hinges named in the topology, no bend springs left.
   const auto b =
       vv("--bending discrete-shells --poisson-ratio 0.45 --json " + (dir / "shell.json").string());
@@ -98,6 +103,10 @@ TEST_F(MsmCli, BadInputNamesTheParameterAndExitsOne) {
       {"--model volume --solver pbd", "surface model"},
       {"--model volume --volume-term --poisson-ratio 0.5", "κ = λ − μ is infinite"},
       {"--model volume --volume-term --stiffness lloyd --poisson-ratio 0.45", "van-gelder"},
+      {"--model volume --volume-term --volume-moduli homogenised --poisson-ratio 0.5",
+       "κ is infinite"},
+      {"--model volume --volume-moduli homogenised", "volume_term = true"},
+      {"--model volume --volume-term --volume-moduli voigt", "'golec' or 'homogenised'"},
       {"--model surface --volume-term", "volume model"},
       {"--model volume --bending discrete-shells", "surface model"},
       {"--structured --topology grid --bending discrete-shells", "grid"},

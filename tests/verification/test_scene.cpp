@@ -252,6 +252,31 @@ TEST(Scene, VolumeTermSelectsTheHybridVolumeModel) {
   EXPECT_NE(surface.find("volume_term"), std::string::npos) << surface;
 }
 
+TEST(Scene, VolumeModuliSelectsTheHomogenisedRule) {
+  EXPECT_EQ(parse_scene(std::string(kMinimal) +
+                            "[[models]]\nname = \"h\"\nkind = \"volume_msm\"\nvolume_term = true\n",
+                        "scene.toml")
+                .models.back()
+                .volume_moduli,
+            msm::VolumeModuli::golec);  // the default
+  const Scene s = parse_scene(std::string(kMinimal) +
+                                  "[[models]]\nname = \"h\"\nkind = \"volume_msm\"\n"
+                                  "volume_term = true\nvolume_moduli = \"homogenised\"\n",
+                              "scene.toml");
+  EXPECT_EQ(s.models.back().volume_moduli, msm::VolumeModuli::homogenised);
+  // An unknown rule, or the key without the volume term: refused, naming the key.
+  const auto unknown = error_of(std::string(kMinimal) +
+                                "[[models]]\nkind = \"volume_msm\"\nvolume_term = true\n"
+                                "volume_moduli = \"voigt\"\n");
+  EXPECT_NE(unknown.find("models[1].volume_moduli"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("homogenised"), std::string::npos) << unknown;
+  const auto alone = error_of(std::string(kMinimal) +
+                              "[[models]]\nkind = \"volume_msm\"\n"
+                              "volume_moduli = \"homogenised\"\n");
+  EXPECT_NE(alone.find("models[1].volume_moduli"), std::string::npos) << alone;
+  EXPECT_NE(alone.find("volume_term = true"), std::string::npos) << alone;
+}
+
 TEST(Scene, ModesTableIsReadAndCheckedNamingTheKey) {
   EXPECT_EQ(parse_scene(kMinimal, "scene.toml").modes.count, 0);  // off unless asked for
   const Scene s = parse_scene(std::string(kMinimal) + "[modes]\ncount = 6\nreference_level = 0\n",

@@ -38,6 +38,7 @@ struct MsmOptions {
   bool two_ring = false;
   std::string stiffness;  ///< empty: seed000, or van-gelder with --volume-term or --bending
   bool volume_term = false;
+  std::string volume_moduli = "golec";
   std::string bending = "none";
   msm::StiffnessParams stiffness_params;
   std::string mass = "consistent";
@@ -220,6 +221,7 @@ msm::BuiltNetwork command_network(const MsmOptions& o, const Scene& s, const Tet
   n.two_ring = o.two_ring;
   n.stiffness = msm::parse_stiffness_rule(o.stiffness);
   n.volume_term = o.volume_term;
+  n.volume_moduli = msm::parse_volume_moduli(o.volume_moduli);
   n.bending = msm::parse_bending(o.bending);
   n.stiffness_params = o.stiffness_params;
   n.mass = msm::parse_mass_rule(o.mass);
@@ -501,6 +503,10 @@ void add_model_options(CLI::App* cmd, MsmOptions& o) {
                 "Hybrid volume model (Golec et al. 2020), volume model only: van-gelder springs "
                 "carrying the shear modulus plus a volume energy per tet, κ = λ − μ, so that the "
                 "network has the material's ν (< 0.5)");
+  cmd->add_option("--volume-moduli", o.volume_moduli,
+                  "With --volume-term: golec (default; E_s = 2.5μ, κ = λ − μ) or homogenised "
+                  "((E_s, κ) fitted so that this mesh's network, under uniform boundary "
+                  "traction, has the target E and ν; ν down to the mesh's floor, ~0.06)");
   cmd->add_option(
          "--bending", o.bending,
          "Surface model's bending: none, or discrete-shells (Grinspun et al. 2003: a hinge "

@@ -437,6 +437,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   cal.model_kind = to_string(spec.kind);
   cal.stiffness = msm::to_string(spec.stiffness);
   cal.volume_term = spec.volume_term;
+  cal.volume_moduli = msm::to_string(spec.volume_moduli);
   cal.poisson_ratio = nu;
   cal.youngs_modulus = s.youngs_modulus;
   cal.mesh_hash = mesh_hash(main.mesh);
@@ -471,8 +472,9 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   apply_calibration(cal, "calibration", calibrated, main.mesh, main.vessel, spec, s.youngs_modulus,
                     nu, false);
   std::ostringstream detail;
-  detail << msm::to_string(spec.stiffness) << (spec.volume_term ? " + volume term" : "") << ", "
-         << msm::to_string(spec.solver);
+  detail << msm::to_string(spec.stiffness)
+         << (spec.volume_term ? " + volume term (" + msm::to_string(spec.volume_moduli) + ")" : "")
+         << ", " << msm::to_string(spec.solver);
   study.model_detail = detail.str();
   for (const LoadCase& c : cases) {
     study.cases.push_back(evaluate_case(main, c, spec, &calibrated, "", nu, log));

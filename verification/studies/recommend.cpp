@@ -161,6 +161,7 @@ struct SpringChoice {
   msm::StiffnessRule rule = msm::StiffnessRule::seed000;
   bool volume_term = false;
   msm::Bending bending = msm::Bending::none;
+  msm::VolumeModuli volume_moduli = msm::VolumeModuli::golec;  ///< with volume_term
   [[nodiscard]] bool plain() const { return !volume_term && bending == msm::Bending::none; }
 };
 
@@ -170,7 +171,12 @@ struct SpringChoice {
 std::vector<SpringChoice> spring_rules(ModelKind kind) {
   std::vector<SpringChoice> out;
   for (const msm::StiffnessRule rule : msm::kAllStiffnessRules) out.push_back({rule});
-  if (kind == ModelKind::volume_msm) out.push_back({msm::StiffnessRule::van_gelder, true});
+  if (kind == ModelKind::volume_msm) {
+    out.push_back({msm::StiffnessRule::van_gelder, true});
+    // The homogenised rule's (E_s, κ) (msm/model/volume_term_homogenised.hpp).
+    out.push_back(
+        {msm::StiffnessRule::van_gelder, true, msm::Bending::none, msm::VolumeModuli::homogenised});
+  }
   if (kind == ModelKind::surface_msm) {
     out.push_back({msm::StiffnessRule::van_gelder, false, msm::Bending::discrete_shells});
   }
@@ -178,7 +184,10 @@ std::vector<SpringChoice> spring_rules(ModelKind kind) {
 }
 
 std::string rule_label(const SpringChoice& c) {
-  if (c.volume_term) return "hybrid-volume";
+  if (c.volume_term) {
+    return c.volume_moduli == msm::VolumeModuli::homogenised ? "hybrid-volume-homogenised"
+                                                             : "hybrid-volume";
+  }
   if (c.bending != msm::Bending::none) return msm::to_string(c.bending);
   return msm::to_string(c.rule);
 }
@@ -204,6 +213,7 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
         m.surface = msm::WallSurface::mid;
         m.stiffness = choice.rule;
         m.volume_term = choice.volume_term;
+        m.volume_moduli = choice.volume_moduli;
         m.bending = choice.bending;
         m.mass = msm::MassRule::consistent;  // irrelevant to a static answer
         const std::string rule_name = rule_label(choice);
@@ -258,6 +268,7 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
           m.surface = msm::WallSurface::mid;
           m.stiffness = choice.rule;
           m.volume_term = choice.volume_term;
+          m.volume_moduli = choice.volume_moduli;
           m.bending = choice.bending;
           m.mass = msm::MassRule::consistent;  // the FEM transient's mass
           m.solver.kind = msm::SolverKind::integrator;

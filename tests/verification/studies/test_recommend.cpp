@@ -199,9 +199,9 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   m.stiffness = msm::StiffnessRule::seed001;
   s.models = {m};
   const std::vector<ModelSpec> c = candidate_models(s, {4e-3, 8e-3});
-  // FEM P1 + (2 kinds × every rule + the hybrid volume model + the discrete-shells surface
-  // model) × (static, linear, 2 radii).
-  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 2;
+  // FEM P1 + (2 kinds × every rule + the hybrid volume model under both rules for its moduli +
+  // the discrete-shells surface model) × (static, linear, 2 radii).
+  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 3;
   ASSERT_EQ(c.size(), 1 + spring_models * 4);
   std::set<std::string> names, rules;
   for (const auto& x : c) {
@@ -212,6 +212,7 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   EXPECT_EQ(rules.size(), msm::kAllStiffnessRules.size());
   EXPECT_TRUE(names.count("volume/lloyd/static/R=4mm"));
   EXPECT_TRUE(names.count("volume/hybrid-volume/static"));
+  EXPECT_TRUE(names.count("volume/hybrid-volume-homogenised/static"));
   EXPECT_TRUE(names.count("surface/discrete-shells/static/R=8mm"));
   for (const auto& x : c) {
     if (x.name.starts_with("surface/discrete-shells/")) {
@@ -241,8 +242,8 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   s.models = {e, i};
   const std::vector<ModelSpec> d = candidate_models(s, {4e-3});
   // Every integrator on every spring model, plus local-global-euler on the plain spring networks
-  // (all but the hybrid volume and discrete-shells models), at the implicit step.
-  ASSERT_EQ(d.size(), spring_models * msm::kAllIntegrators.size() + spring_models - 2);
+  // (all but the two hybrid volume and the discrete-shells models), at the implicit step.
+  ASSERT_EQ(d.size(), spring_models * msm::kAllIntegrators.size() + spring_models - 3);
   for (const auto& x : d) {
     if (x.solver.kind == msm::SolverKind::local_global_euler) {
       EXPECT_FALSE(x.volume_term) << x.name;
@@ -270,7 +271,7 @@ TEST(Candidates, IncludeTheScenesCalibratedModels) {
   m.calibration_transfer = true;
   s.models = {m};
   const std::vector<ModelSpec> c = candidate_models(s, {4e-3});
-  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 2;  // as above
+  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 3;  // as above
   ASSERT_EQ(c.size(), 1 + spring_models * 3 + 2);
   int calibrated = 0;
   for (const auto& x : c) {
