@@ -368,7 +368,14 @@ struct HyperelasticSolver::Impl {
       if (it == opt.max_newton_iterations) break;
       const auto t0 = Clock::now();
       try {
-        d.solve_linear(symmetric);
+        try {
+          d.solve_linear(symmetric);
+        } catch (const std::exception&) {
+          // Away from equilibrium (a Newton iterate after a large increment) the symmetric
+          // tangent can be indefinite, which CHOLMOD refuses: LU (UMFPACK) solves it.
+          if (!symmetric || d.mixed) throw;
+          d.solve_linear(false);
+        }
       } catch (const std::exception& e) {
         result.timings.solve += seconds_since(t0);
         out.reason = std::string("the linear solve failed: ") + e.what();
