@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace vessel::fem {
@@ -33,6 +34,36 @@ RichardsonEstimate richardson(double f2, double f1, double p, double r, double f
   // Roache's GCI for the fine grid: Fs |ε| / (r^p − 1), ε = (f2 − f1)/f1.
   e.gci_fine = f1 != 0.0 ? fs * std::abs((f2 - f1) / f1) / rp1 : 0.0;
   return e;
+}
+
+GciOrder gci_order(const std::optional<std::vector<double>>& three, double assumed, double ratio,
+                   double min_order, double max_order) {
+  if (!(min_order > 0.0) || !(min_order <= assumed) || !(assumed <= max_order)) {
+    throw std::invalid_argument("gci_order: need 0 < min_order <= assumed <= max_order");
+  }
+  GciOrder g;
+  g.order = assumed;
+  g.source = "assumed";
+  g.safety_factor = 3.0;
+  std::ostringstream note;
+  if (!three) {
+    note << "assumed order " << assumed << " (fewer than three levels)";
+    g.note = note.str();
+    return g;
+  }
+  if (three->size() != 3) throw std::invalid_argument("gci_order: expected three values");
+  try {
+    const double p = observed_order_three((*three)[0], (*three)[1], (*three)[2], ratio);
+    g.order = std::clamp(p, min_order, max_order);
+    g.source = "observed";
+    g.safety_factor = 1.25;
+    note << "observed order " << p << " from three levels";
+    if (g.order != p) note << ", clamped to " << g.order;
+  } catch (const std::domain_error&) {
+    note << "assumed order " << assumed << " (the three levels converge oscillatorily)";
+  }
+  g.note = note.str();
+  return g;
 }
 
 FieldUncertainty richardson_field(const std::vector<Vec3>& medium, const std::vector<Vec3>& fine,

@@ -2,6 +2,8 @@
 /// Grid-convergence arithmetic: observed order from errors on refined meshes, Richardson
 /// extrapolation and Roache's grid convergence index (GCI), so every report can print the
 /// reference's own discretisation uncertainty next to a model error.
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
@@ -29,6 +31,24 @@ struct RichardsonEstimate {
 /// observed order from three grids, 3 with an assumed one).
 RichardsonEstimate richardson(double f_medium, double f_fine, double order, double ratio = 2.0,
                               double safety_factor = 1.25);
+
+/// The order a Richardson/GCI estimate uses, and where it came from.
+struct GciOrder {
+  double order = 0.0;
+  std::string source;          ///< "observed" (three levels) or "assumed"
+  double safety_factor = 3.0;  ///< Roache: 1.25 with an order observed on three grids, else 3
+  std::string note;            ///< how it was chosen (observed value, clamping, or why assumed)
+};
+
+/// Roache's procedure (Verification and Validation in Computational Science and Engineering,
+/// 1998, §5.10): with a quantity on three levels (`three`: coarse, medium, fine; refinement
+/// ratio `ratio`) the observed order p = observed_order_three, clamped to [min_order, max_order]
+/// (a wildly small or large p from non-asymptotic levels would make the GCI meaningless), with
+/// safety factor 1.25. Without three levels, or when they converge oscillatorily (differences of
+/// opposite sign, or zero), the stated `assumed` order with safety factor 3.
+/// std::invalid_argument unless 0 < min_order ≤ assumed ≤ max_order.
+GciOrder gci_order(const std::optional<std::vector<double>>& three, double assumed,
+                   double ratio = 2.0, double min_order = 0.5, double max_order = 3.0);
 
 /// The reference's discretisation uncertainty at a set of points (e.g. mass-spring nodes), from
 /// its displacement there on the two finest levels.

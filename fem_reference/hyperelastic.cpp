@@ -368,7 +368,14 @@ struct HyperelasticSolver::Impl {
       if (it == opt.max_newton_iterations) break;
       const auto t0 = Clock::now();
       try {
-        d.solve_linear(symmetric);
+        try {
+          d.solve_linear(symmetric);
+        } catch (const std::exception&) {
+          // Away from equilibrium (a Newton iterate after a large increment) the symmetric
+          // tangent can be indefinite, which CHOLMOD refuses: LU (UMFPACK) solves it.
+          if (!symmetric || d.mixed) throw;
+          d.solve_linear(false);
+        }
       } catch (const std::exception& e) {
         result.timings.solve += seconds_since(t0);
         out.reason = std::string("the linear solve failed: ") + e.what();
@@ -423,8 +430,10 @@ struct HyperelasticSolver::Impl {
     return out;
   }
 
-  void solve() {
+  /// Load stepping; `self` and `observer` serve the checkpoints.
+  void solve(const HyperelasticSolver& self, const CheckpointObserver& observer) {
     result.steps.clear();
+    result.checkpoints.clear();
     result.rejected_steps = 0;
     result.newton_iterations = 0;
     result.linear_iterations = 0;
@@ -433,30 +442,44 @@ struct HyperelasticSolver::Impl {
     double s = 0.0;
     double ds = std::min(opt.initial_step, opt.max_step);
     const double target = opt.target_load_factor;
+    std::size_t next = 0;  // the next checkpoint
     result.completed = true;
     result.stop_reason.clear();
     while (s < target * (1.0 - 1e-14)) {
-      ds = std::min(ds, target - s);
+      // A step ends at the next checkpoint when it would pass it; ds itself (the increment the
+      // adaptation has learnt) is kept for the steps after it.
+      const double stop = next < opt.checkpoints.size() ? opt.checkpoints[next] : target;
+      const bool to_stop = ds >= stop - s;
+      const double step = to_stop ? stop - s : ds;
       const dl::Vector<double> u_start = u;
-      const StepOutcome o = newton_step(s, s + ds);
+      const StepOutcome o = newton_step(s, s + step);
       if (o.converged) {
-        s += ds;
+        s = to_stop ? stop : s + step;
         result.steps.push_back({s, o.iterations, o.residual});
         if (o.iterations <= opt.fast_iterations) ds = std::min(ds * opt.growth, opt.max_step);
+        if (to_stop && next < opt.checkpoints.size()) {
+          ++next;
+          const std::string why = checkpoint(self, s, observer);
+          if (!why.empty()) {
+            result.completed = false;
+            result.stop_reason = why;
+            break;
+          }
+        }
         continue;
       }
       u = u_start;
       ++result.rejected_steps;
-      if (ds * 0.5 < opt.min_step) {
+      if (step * 0.5 < opt.min_step) {
         std::ostringstream m;
-        m << "no equilibrium found beyond load factor " << s << ": at " << s + ds << ", "
-          << o.reason << "; the increment " << ds << " cannot be halved below the minimum "
+        m << "no equilibrium found beyond load factor " << s << ": at " << s + step << ", "
+          << o.reason << "; the increment " << step << " cannot be halved below the minimum "
           << opt.min_step;
         result.completed = false;
         result.stop_reason = m.str();
         break;
       }
-      ds *= 0.5;
+      ds = step * 0.5;
     }
     result.load_factor = s;
     set_prescribed_increment(0.0);
@@ -470,6 +493,25 @@ struct HyperelasticSolver::Impl {
     result.nodal_displacement = d.nodal([&](Index i) { return u(i); });
     result.timings.postprocess = seconds_since(t0);
     solved = true;
+  }
+
+  /// Records the equilibrium at checkpoint s and asks the observer whether to go on.
+  std::string checkpoint(const HyperelasticSolver& self, double s,
+                         const CheckpointObserver& observer) {
+    Checkpoint c;
+    c.load_factor = s;
+    c.load_steps = static_cast<int>(result.steps.size());
+    c.rejected_steps = result.rejected_steps;
+    c.newton_iterations = result.newton_iterations;
+    c.seconds = result.timings.assembly + result.timings.solve;
+    c.nodal_displacement = d.nodal([&](Index i) { return u(i); });
+    result.checkpoints.push_back(std::move(c));
+    if (!observer) return {};
+    d.solution = u;  // what displacement_at reads
+    d.solved = true;
+    solved = true;
+    result.load_factor = s;
+    return observer(self, result.checkpoints.back());
   }
 };
 
@@ -487,13 +529,18 @@ HyperelasticSolver::HyperelasticSolver(const TetMesh& mesh, ElasticityProblem pr
   require(o.max_newton_iterations > 0 && o.max_line_search >= 0,
           "iterations: expected max_newton_iterations > 0 and max_line_search >= 0");
   require(o.residual_tolerance > 0.0, "residual_tolerance: expected > 0");
+  for (std::size_t i = 0; i < o.checkpoints.size(); ++i) {
+    const double c = o.checkpoints[i];
+    require(c > 0.0 && c <= o.target_load_factor && (i == 0 || c > o.checkpoints[i - 1]),
+            "checkpoints: expected ascending load factors in (0, target_load_factor]");
+  }
   impl_ = std::make_unique<Impl>(mesh, std::move(problem), options);
 }
 
 HyperelasticSolver::~HyperelasticSolver() = default;
 
-const HyperelasticResult& HyperelasticSolver::solve() {
-  impl_->solve();
+const HyperelasticResult& HyperelasticSolver::solve(const CheckpointObserver& observer) {
+  impl_->solve(*this, observer);
   return impl_->result;
 }
 

@@ -58,6 +58,20 @@ struct HyperelasticOptions {
   /// true: pressure acts on the deformed surface (traction −p n da); false: a dead load on the
   /// reference surface (as the linear reference applies it).
   bool follower_pressure = true;
+  /// Load factors (ascending, in (0, target_load_factor]) where a load step must end: the
+  /// continuation records its state there (HyperelasticResult::checkpoints) and calls the
+  /// observer given to solve(). One continuation then serves a ladder of loads.
+  std::vector<double> checkpoints;
+};
+
+/// The state of a continuation at one of HyperelasticOptions::checkpoints.
+struct Checkpoint {
+  double load_factor = 0.0;
+  int load_steps = 0;         ///< accepted steps so far
+  int rejected_steps = 0;     ///< so far
+  int newton_iterations = 0;  ///< so far, accepted and rejected steps
+  double seconds = 0.0;       ///< assembly + linear solves so far, s
+  std::vector<Vec3> nodal_displacement;  ///< at every TetMesh node, m
 };
 
 /// One accepted load step.
@@ -81,6 +95,7 @@ struct HyperelasticResult {
   int newton_iterations = 0;       ///< total, accepted and rejected steps
   unsigned linear_iterations = 0;  ///< total CG / FGMRES iterations (0 for direct)
   std::vector<Vec3> nodal_displacement;  ///< at load_factor, at every TetMesh node, m
+  std::vector<Checkpoint> checkpoints;   ///< those reached, in order
   double strain_energy = 0.0;            ///< ∫Ψ dV, J
   /// Largest |eigenvalue| of the Green–Lagrange strain E = ½(FᵀF − I) at quadrature points.
   double max_abs_principal_strain = 0.0;
@@ -99,9 +114,15 @@ class HyperelasticSolver {
   HyperelasticSolver(const HyperelasticSolver&) = delete;
   HyperelasticSolver& operator=(const HyperelasticSolver&) = delete;
 
+  /// Called at each checkpoint reached, with the solver at that equilibrium (displacement_at
+  /// reads it) and the checkpoint's record. A non-empty return stops the continuation there with
+  /// that reason (result: completed false, load_factor the checkpoint's).
+  using CheckpointObserver =
+      std::function<std::string(const HyperelasticSolver&, const Checkpoint&)>;
+
   /// Load stepping with Newton from u = 0; returns the result (also kept in result()). When the
   /// target cannot be reached the result holds the last equilibrium and the reason.
-  const HyperelasticResult& solve();
+  const HyperelasticResult& solve(const CheckpointObserver& observer = {});
   [[nodiscard]] const HyperelasticResult& result() const;
 
   /// The displacement (m) at points inside the mesh, as ElasticitySolver::displacement_at.

@@ -418,6 +418,41 @@ TransientResult SolutionCache::transient(const ElasticitySolver& solver, const T
   return result;
 }
 
+std::optional<std::string> continuation_cache_key(const TetMesh& mesh,
+                                                  const ElasticityProblem& problem,
+                                                  const HyperelasticOptions& o,
+                                                  std::string_view what) {
+  const std::optional<std::string> base = solution_cache_key(mesh, problem);
+  if (!base) return std::nullopt;
+  KeyHash h;
+  h.text("hyperelastic").real(o.target_load_factor).real(o.initial_step).real(o.min_step);
+  h.real(o.max_step).real(o.growth).integer(o.fast_iterations).integer(o.max_newton_iterations);
+  h.integer(o.max_line_search).real(o.residual_tolerance).integer(o.follower_pressure ? 1 : 0);
+  h.text("checkpoints").integer(static_cast<std::int64_t>(o.checkpoints.size()));
+  for (const double c : o.checkpoints) h.real(c);
+  h.text("what").text(what);
+  return *base + " continuation=" + h.a.hex() + h.b.hex();
+}
+
+std::string SolutionCache::payload(const std::string& key,
+                                   const std::function<std::string()>& compute,
+                                   const std::function<double(std::string_view)>& original_seconds) {
+  if (!enabled()) return compute();
+  std::string out;
+  lookup(
+      key,
+      [&](std::string_view stored) {
+        const double seconds = original_seconds(stored);
+        out = std::string(stored);
+        return seconds;
+      },
+      [&] {
+        out = compute();
+        return out;
+      });
+  return out;
+}
+
 const ElasticityResult& solve_with(SolutionCache* cache, ElasticitySolver& solver,
                                    const TetMesh& mesh, const ElasticityProblem& problem) {
   return cache ? cache->solve(solver, mesh, problem) : solver.solve();

@@ -17,6 +17,7 @@
 #include <string_view>
 
 #include "fem_reference/elasticity.hpp"
+#include "fem_reference/hyperelastic.hpp"
 
 namespace vessel::fem {
 
@@ -36,6 +37,15 @@ struct SolutionCacheStatistics {
 std::optional<std::string> solution_cache_key(const TetMesh& mesh,
                                               const ElasticityProblem& problem);
 
+/// The key of a finite-strain continuation on (mesh, problem): solution_cache_key's plus every
+/// hyperelastic option (load stepping, Newton, tolerances, follower pressure, the checkpoints) and
+/// `what`, the caller's description of what it keeps of the continuation (e.g. a hash of the
+/// points it samples). nullopt when the problem cannot be keyed.
+std::optional<std::string> continuation_cache_key(const TetMesh& mesh,
+                                                  const ElasticityProblem& problem,
+                                                  const HyperelasticOptions& options,
+                                                  std::string_view what);
+
 class SolutionCache {
  public:
   /// Entries live in `dir` (created on the first write). An empty path disables the cache:
@@ -50,6 +60,14 @@ class SolutionCache {
   /// solver.transient(options), or the stored history of the same mesh, problem and options.
   TransientResult transient(const ElasticitySolver& solver, const TetMesh& mesh,
                             const ElasticityProblem& problem, const TransientOptions& options);
+
+  /// A payload of the caller's own (e.g. what a finite-strain continuation gave at its
+  /// checkpoints) under `key` (from continuation_cache_key): the stored one when `original_seconds`
+  /// accepts it (it returns the seconds computing it took, and throws std::exception for a
+  /// payload it cannot read, which is then recomputed as a corrupt entry), else compute()'s,
+  /// stored. With the cache disabled, compute()'s.
+  std::string payload(const std::string& key, const std::function<std::string()>& compute,
+                      const std::function<double(std::string_view)>& original_seconds);
 
   [[nodiscard]] bool enabled() const { return !dir_.empty(); }
   [[nodiscard]] const std::filesystem::path& directory() const { return dir_; }

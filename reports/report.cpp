@@ -385,11 +385,14 @@ void scene_section(Document& doc, const SceneRows& s) {
                   return l;
                 }() + "; " + significant(s.seconds, 3) + " s for the whole scene.");
   Table refs;
-  refs.header = {"ν", "reference element", "level", "DoFs", "solve s", "max strain per unit load"};
+  refs.header = {"ν", "reference element", "level", "DoFs", "solve s", "max strain per unit load",
+                 "GCI order: linear", "GCI order: finite strain"};
   for (const auto& r : s.references) {
     refs.rows.push_back({significant(r.poisson_ratio), r.element, std::to_string(r.level),
                          std::to_string(r.dofs), significant(r.solve_seconds),
-                         significant(r.max_abs_strain_at_unit_load)});
+                         significant(r.max_abs_strain_at_unit_load),
+                         r.gci_linear.empty() ? "–" : r.gci_linear,
+                         r.gci_finite.empty() ? "–" : r.gci_finite});
   }
   doc.table(refs);
   const FigureContext c{doc, s, representative_load(s), first_nu(s)};
@@ -459,7 +462,8 @@ double representative_load(const SceneRows& s) {
 
 Document build_report(const ResultsFile& r, const std::optional<StabilityFile>& stability,
                       const std::string& command,
-                      const std::vector<RecommendFile>& recommendations) {
+                      const std::vector<RecommendFile>& recommendations,
+                      const std::optional<ValidityFile>& validity) {
   Document doc;
   doc.heading(1, "vesselverify report");
   doc.paragraph("How wrong, and how fast, is each mass-spring vessel model against linear-elastic "
@@ -473,7 +477,8 @@ Document build_report(const ResultsFile& r, const std::optional<StabilityFile>& 
                 "Taylor–Hood P2–P1 for ν ≥ 0.49) evaluated at each model node's rest position, in "
                 "mm, with seed 000's statistics (max, mean, standard deviation, RMS). *ref. unc.* "
                 "is the reference's own estimated error there (Richardson between its two finest "
-                "levels): an error below it is not resolved. ⚠ marks loads that strain the "
+                "levels, with the order each scene's reference table gives: observed on three "
+                "levels, else assumed): an error below it is not resolved. ⚠ marks loads that strain the "
                 "reference beyond 5 %, outside linear elasticity's validity. Times are wall-clock "
                 "seconds of a Release build (median of the repeats); memory is the peak resident "
                 "memory a model's set-up and solve added.");
@@ -487,6 +492,7 @@ Document build_report(const ResultsFile& r, const std::optional<StabilityFile>& 
   best_model_section(doc, r);
   for (const auto& s : r.scenes) scene_section(doc, s);
   for (const auto& recommendation : recommendations) recommendation_section(doc, recommendation);
+  if (validity) validity_section(doc, *validity);
   if (stability) {
     stability_section(doc, *stability);
   } else {
@@ -519,7 +525,9 @@ void write_report(const ReportOptions& o) {
     if (std::filesystem::exists(r.results)) attach_run(r, read_results(r.results));
     recommendations.push_back(std::move(r));
   }
-  const Document doc = build_report(results, stability, o.command, recommendations);
+  std::optional<ValidityFile> validity;
+  if (!o.validity.empty()) validity = read_validity(o.validity);
+  const Document doc = build_report(results, stability, o.command, recommendations, validity);
   std::error_code ec;
   std::filesystem::create_directories(o.output_dir / "figures", ec);
   if (ec) {

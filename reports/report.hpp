@@ -22,6 +22,7 @@ struct ReportOptions {
   /// recommend.json files of `vesselverify recommend`, each drawn as a section (optional); the
   /// results.json its run wrote beside it, when there, names the load unit and the reference.
   std::vector<std::filesystem::path> recommend;
+  std::filesystem::path validity;  ///< validity.json of `vesselverify validity` (optional)
   std::filesystem::path output_dir;  ///< report.md, report.html, figures/
   std::string command;               ///< the command line that makes the report
 };
@@ -30,7 +31,8 @@ struct ReportOptions {
 /// recommendation, then the stability section (absent: a note says it was not run).
 Document build_report(const ResultsFile& results, const std::optional<StabilityFile>& stability,
                       const std::string& command,
-                      const std::vector<RecommendFile>& recommendations = {});
+                      const std::vector<RecommendFile>& recommendations = {},
+                      const std::optional<ValidityFile>& validity = std::nullopt);
 
 /// Fills in what recommend.json leaves to its run's results.json: the scene's load unit and the
 /// reference element at each Poisson's ratio (matched by scene name and ν).

@@ -1,5 +1,7 @@
 #include "reports/results_file.hpp"
 
+#include <sstream>
+
 #include "reports/json_fields.hpp"
 
 namespace vessel::reports {
@@ -79,6 +81,21 @@ ModalRow read_modal(const json& j, const std::string& where) {
   return m;
 }
 
+/// A reference's GCI order as the report shows it: "1 (assumed, Fs 3)", or "none".
+std::string gci_text(const json& j, const std::string& where) {
+  const std::string source = field<std::string>(j, "source", where);
+  if (source == "none") return "none";
+  if (source != "observed" && source != "assumed") {
+    throw InputError(where + ": field 'source' is '" + source +
+                     "', expected observed, assumed or none");
+  }
+  std::ostringstream t;
+  t.precision(3);
+  t << field<double>(j, "order", where) << " (" << source << ", Fs "
+    << field<double>(j, "safety_factor", where) << ")";
+  return t.str();
+}
+
 }  // namespace
 
 ResultsFile parse_results(const std::string& text, const std::filesystem::path& source) {
@@ -122,6 +139,13 @@ ResultsFile parse_results(const std::string& text, const std::filesystem::path& 
       rr.solve_seconds = field<double>(ref, "solve_seconds", where + ".references");
       rr.max_abs_strain_at_unit_load =
           field<double>(ref, "max_abs_strain_at_unit_load", where + ".references");
+      if (const auto u = ref.find("uncertainty_order"); u != ref.end() && !u->is_null()) {
+        rr.gci_linear = gci_text(field<json>(*u, "linear", where + ".references.uncertainty_order"),
+                                 where + ".references.uncertainty_order.linear");
+        if (const auto f = u->find("finite_strain"); f != u->end() && !f->is_null()) {
+          rr.gci_finite = gci_text(*f, where + ".references.uncertainty_order.finite_strain");
+        }
+      }
       sr.references.push_back(rr);
     }
     const auto outcomes = field<json>(s, "outcomes", where);

@@ -38,6 +38,10 @@ struct ReferenceRow {
   std::size_t dofs = 0;
   double solve_seconds = 0.0;
   double max_abs_strain_at_unit_load = 0.0;
+  /// The Richardson/GCI order used for the reference's uncertainty, as text ("1 (assumed, Fs 3)",
+  /// "1.87 (observed, Fs 1.25)", "none"); empty in files written before it was recorded. The
+  /// finite-strain reference's, where the scene uses it; else empty.
+  std::string gci_linear, gci_finite;
 };
 
 /// One model's (or the modal reference's) lowest natural frequencies at one ν and level (the

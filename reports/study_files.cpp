@@ -96,7 +96,99 @@ BudgetLoadEntry read_load(const json& j, const std::string& where) {
   return e;
 }
 
+ValidityCrossingEntry read_crossing(const json& j, const std::string& where) {
+  ValidityCrossingEntry e;
+  e.threshold = field<double>(j, "threshold", where);
+  e.status = field<std::string>(j, "status", where);
+  if (e.status != "interpolated" && e.status != "below_ladder" && e.status != "not_reached") {
+    throw InputError(where + ": field 'status' is '" + e.status +
+                     "', expected interpolated, below_ladder or not_reached");
+  }
+  e.load = optional_field<double>(j, "load", where);
+  if (e.status != "not_reached" && !e.load) throw InputError(where + ": missing field 'load'");
+  e.lower = field<double>(j, "lower", where);
+  e.upper = field<double>(j, "upper", where);
+  return e;
+}
+
+ValidityModelEntry read_validity_model(const json& j, const std::string& where) {
+  ValidityModelEntry e;
+  e.model = field<std::string>(j, "model", where);
+  e.ok = field<bool>(j, "ok", where);
+  if (e.ok) {
+    e.relative_l2 = field<double>(j, "relative_l2", where);
+    e.max_error_mm = field<double>(j, "max_error_mm", where);
+    e.qoi_error_mm = field<double>(j, "qoi_error_mm", where);
+    e.qoi_relative = field<double>(j, "qoi_relative", where);
+  } else {
+    e.failure = field<std::string>(j, "failure", where);
+  }
+  return e;
+}
+
+ValidityRowEntry read_validity_row(const json& j, const std::string& where) {
+  ValidityRowEntry e;
+  e.magnitude = field<double>(j, "magnitude", where);
+  e.linear_qoi_mm = field<double>(j, "linear_qoi_mm", where);
+  e.finite_qoi_mm = field<double>(j, "finite_qoi_mm", where);
+  e.qoi_difference = field<double>(j, "qoi_difference", where);
+  e.l2_difference = field<double>(j, "l2_difference", where);
+  e.linear_strain = field<double>(j, "linear_strain", where);
+  e.newton_iterations = field<int>(j, "newton_iterations", where);
+  e.load_steps = field<int>(j, "load_steps", where);
+  e.finite_seconds = field<double>(j, "finite_seconds", where);
+  e.models = read_array(j, "models", where, read_validity_model);
+  return e;
+}
+
+ValiditySceneEntry read_validity_scene(const json& j, const std::string& where) {
+  ValiditySceneEntry e;
+  e.scene = field<std::string>(j, "scene", where);
+  e.load_kind = field<std::string>(j, "load_kind", where);
+  e.load_unit = field<std::string>(j, "load_unit", where);
+  e.element = field<std::string>(j, "element", where);
+  e.poisson_ratio = field<double>(j, "poisson_ratio", where);
+  e.reference_level = field<int>(j, "reference_level", where);
+  e.model_level = field<int>(j, "model_level", where);
+  e.dofs = field<std::size_t>(j, "dofs", where);
+  e.ladder = field<std::vector<double>>(j, "ladder", where);
+  for (const json& m : field<json>(j, "models", where)) {
+    e.models.push_back(field<std::string>(m, "name", where + ".models[]"));
+  }
+  const json c = field<json>(j, "continuation", where);
+  const std::string cw = where + ".continuation";
+  e.completed = field<bool>(c, "completed", cw);
+  e.largest_load = field<double>(c, "largest_load", cw);
+  e.stop_reason = field<std::string>(c, "stop_reason", cw);
+  e.load_steps = field<int>(c, "load_steps", cw);
+  e.rejected_steps = field<int>(c, "rejected_steps", cw);
+  e.newton_iterations = field<int>(c, "newton_iterations", cw);
+  e.solve_seconds = field<double>(c, "solve_seconds", cw);
+  e.from_cache = field<bool>(c, "from_cache", cw);
+  e.qoi_limits = read_array(j, "qoi_limits", where, read_crossing);
+  e.l2_limits = read_array(j, "l2_limits", where, read_crossing);
+  e.rows = read_array(j, "rows", where, read_validity_row);
+  return e;
+}
+
 }  // namespace
+
+ValidityFile parse_validity(const std::string& text, const std::filesystem::path& source) {
+  const std::string file = source.string();
+  const json j = json_fields::parse_versioned(text, file, "vesselverify.validity", 1,
+                                              "validity file", "vesselverify validity");
+  ValidityFile v;
+  v.path = source;
+  v.command = field<std::string>(j, "command", file);
+  v.full = field<bool>(j, "full", file);
+  v.total_seconds = field<double>(j, "total_seconds", file);
+  v.scenes = read_array(j, "scenes", file, read_validity_scene);
+  return v;
+}
+
+ValidityFile read_validity(const std::filesystem::path& path) {
+  return parse_validity(json_fields::read_text(path, "validity file"), path);
+}
 
 StabilityFile parse_stability(const std::string& text, const std::filesystem::path& source) {
   const std::string file = source.string();

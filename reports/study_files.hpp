@@ -92,6 +92,55 @@ struct RecommendFile {
   std::vector<CandidateEntry> candidates;
 };
 
+/// validity.json of `vesselverify validity` (schema "vesselverify.validity", version 1;
+/// verification/studies/validity/validity.hpp says what each field means).
+struct ValidityCrossingEntry {
+  double threshold = 0.0;
+  std::string status;  ///< interpolated | below_ladder | not_reached
+  std::optional<double> load;
+  double lower = 0.0, upper = 0.0;
+};
+
+struct ValidityModelEntry {
+  std::string model;
+  bool ok = false;
+  std::string failure;
+  double relative_l2 = 0.0, max_error_mm = 0.0, qoi_error_mm = 0.0, qoi_relative = 0.0;
+};
+
+struct ValidityRowEntry {
+  double magnitude = 0.0, linear_qoi_mm = 0.0, finite_qoi_mm = 0.0;
+  double qoi_difference = 0.0, l2_difference = 0.0, linear_strain = 0.0;
+  int newton_iterations = 0, load_steps = 0;
+  double finite_seconds = 0.0;
+  std::vector<ValidityModelEntry> models;
+};
+
+struct ValiditySceneEntry {
+  std::string scene, load_kind, load_unit, element;
+  double poisson_ratio = 0.0;
+  int reference_level = 0, model_level = 0;
+  std::size_t dofs = 0;
+  std::vector<double> ladder;
+  std::vector<std::string> models;  ///< model names
+  bool completed = false;
+  double largest_load = 0.0;
+  std::string stop_reason;
+  int load_steps = 0, rejected_steps = 0, newton_iterations = 0;
+  double solve_seconds = 0.0;
+  bool from_cache = false;
+  std::vector<ValidityCrossingEntry> qoi_limits, l2_limits;
+  std::vector<ValidityRowEntry> rows;
+};
+
+struct ValidityFile {
+  std::filesystem::path path;
+  std::string command;
+  bool full = false;
+  double total_seconds = 0.0;
+  std::vector<ValiditySceneEntry> scenes;
+};
+
 /// Reads and checks a stability file; InputError naming the file and what is wrong (missing file,
 /// not JSON, another schema or version, a missing field).
 StabilityFile read_stability(const std::filesystem::path& path);
@@ -100,5 +149,9 @@ StabilityFile parse_stability(const std::string& text, const std::filesystem::pa
 /// Reads and checks a recommend file; InputError as read_stability.
 RecommendFile read_recommend(const std::filesystem::path& path);
 RecommendFile parse_recommend(const std::string& text, const std::filesystem::path& source);
+
+/// Reads and checks a validity file; InputError as read_stability.
+ValidityFile read_validity(const std::filesystem::path& path);
+ValidityFile parse_validity(const std::string& text, const std::filesystem::path& source);
 
 }  // namespace vessel::reports

@@ -27,4 +27,10 @@ inline constexpr const char* kTimePerUpdateText =
 /// by time per update, failures last).
 void recommendation_section(Document& doc, const RecommendFile& recommendation);
 
+/// "## Limit of the linear reference, and the models at finite strain": per scene of
+/// validity.json, the loads where the linear and the finite-strain references part by 1, 5 and
+/// 10 %, how far the continuation went (and why it stopped), its cost, and each model's errors
+/// against the finite-strain reference at every load of the ladder reached.
+void validity_section(Document& doc, const ValidityFile& validity);
+
 }  // namespace vessel::reports

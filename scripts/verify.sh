@@ -5,12 +5,16 @@
 #   2. `vesselverify run`: every model of every shipped scene (contact on the straight tube and
 #      on the arch, Lamé pressure, gravity sag, the dynamic step contact, the region-of-interest
 #      radii) against the FEM reference → results.json, results.csv, summary.md, fields/;
-#   3. `vesselverify stability`: predicted vs found critical time steps and the hard cases →
+#   3. `vesselverify validity` on the contact scenes and gravity: where the linear reference stops
+#      being valid, and the seed models against the finite-strain reference up to 140 mN (or the
+#      largest load reached) → validity.json;
+#   4. `vesselverify stability`: predicted vs found critical time steps and the hard cases →
 #      stability.json, stability.md;
-#   4. `vesselverify recommend` on the two contact scenes at 30 Hz (visual) and 1 kHz (haptic):
+#   5. `vesselverify recommend` on the two contact scenes at 30 Hz (visual) and 1 kHz (haptic):
 #      the cheapest model meeting each scene's [budget] → recommend/<scene>/<rate>hz/;
-#   5. `vesselverify report` → report.md, report.html (self-contained) and figures/, with the
-#      stability and recommendation sections drawn from stability.json and each recommend.json.
+#   6. `vesselverify report` → report.md, report.html (self-contained) and figures/, with the
+#      stability, recommendation and validity sections drawn from stability.json, each
+#      recommend.json and validity.json.
 #
 # Usage: scripts/verify.sh [--quick | --full] [output-dir]   (default output: results/)
 #   default  the scenes' own levels, loads and sweeps; the stability table at levels 0-1 with a
@@ -49,6 +53,11 @@ phase "run: the shipped scenes"
 "$vv" run "${mode[@]}" --output-dir "$out" "$scenes/contact_straight.toml" \
   "$scenes/pressure_lame.toml" "$scenes/contact_arch.toml" "$scenes/gravity_sag.toml" \
   "$scenes/dynamic_contact.toml" "$scenes/contact_roi.toml"
+phase "validity: the linear reference's limit, the seed models at finite strain"
+# P2 on level 0 and the short ladder (`vesselverify validity --full` for the scenes' reference
+# level, the full ladder and every static model; see README).
+"$vv" validity --output-dir "$out" "$scenes/contact_straight.toml" "$scenes/contact_arch.toml" \
+  "$scenes/gravity_sag.toml"
 phase "stability"
 # Default: the step table at levels 0-1 and every hard case, the long run at 2·10^5 steps (the
 # 10^6 steps of --full take ~40 s more); --full adds level 2 to the table (~13 minutes).
@@ -74,6 +83,6 @@ for scene in contact_straight contact_arch; do
 done
 phase "report"
 "$vv" report "$out/results.json" --stability "$out/stability.json" "${recommendations[@]}" \
-  --output-dir "$out"
+  --validity "$out/validity.json" --output-dir "$out"
 phase "done"
 echo "verification finished in $((SECONDS - start)) s; report: $out/report.html (and report.md)"

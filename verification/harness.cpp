@@ -44,9 +44,14 @@ namespace vessel {
 
 namespace {
 
-/// Straight-sided tets cap the reference's observed order near 2 on the curved walls (the
-/// reference's own Lamé verification), so Richardson uses p = 2 between its two levels.
-constexpr double kReferenceOrder = 2.0;
+/// The order Richardson/GCI assumes without three reference levels (fem::gci_order). Contact: 1.
+/// The patch's traction jumps at the disc's edge and the QoI lies under it, so the field is not
+/// smooth there and no element's formal order holds at the point; P1's observed order there is
+/// 1.0–1.2 (issue 17), and the lower order gives the larger (conservative) estimate. Distributed
+/// loads (pressure, gravity): 2, what straight-sided tets cap the order at on the curved walls
+/// (the reference's own Lamé verification).
+constexpr double kAssumedReferenceOrderContact = 1.0;
+constexpr double kAssumedReferenceOrderDistributed = 2.0;
 constexpr int kHistorySamples = 200;  ///< points kept of a dynamic model's QoI history
 
 /// Barycentric tolerance for evaluating the reference at model nodes: a node on the exact curved
@@ -110,6 +115,7 @@ struct ReferenceAtPoints {
 struct ReferenceSolvers {
   std::unique_ptr<fem::ElasticitySolver> fine;
   std::unique_ptr<fem::ElasticitySolver> coarse;
+  fem::GciOrder gci;  ///< the order reference_at's Richardson uses (with `coarse`)
   const TetMesh* fine_mesh = nullptr;
   fem::ElasticityProblem fine_problem;  ///< what `fine` solves: the solution cache's key
   fem::SolutionCache* cache = nullptr;  ///< nullptr: solve and run transients afresh
@@ -215,7 +221,7 @@ ReferenceAtPoints reference_at(const ReferenceSolvers& ref, const std::vector<Ve
   r.u = ref.fine->displacement_at(points, kOutsideTolerance);
   if (ref.coarse) {
     r.uncertainty = fem::richardson_field(ref.coarse->displacement_at(points, kOutsideTolerance),
-                                          r.u, kReferenceOrder);
+                                          r.u, ref.gci.order);
     r.has_uncertainty = true;
   }
   return r;
@@ -903,6 +909,7 @@ struct SceneReferences {
   std::map<int, TetMesh> model_meshes;
   TetMesh fine_mesh;
   std::unique_ptr<TetMesh> coarse_mesh;
+  std::unique_ptr<TetMesh> coarsest_mesh;  ///< reference_level − 2: the GCI's observed order
   std::unique_ptr<TetMesh> modal_mesh;          ///< the modal reference's, when no other is
   const TetMesh* modal_reference_mesh = nullptr;  ///< nullptr: the scene asks for no modes
   int modal_level = 0;
@@ -939,6 +946,10 @@ std::unique_ptr<SceneReferences> scene_meshes(const Scene& scene, const HarnessO
   if (s.reference_level > 0) {
     r->coarse_mesh = std::make_unique<TetMesh>(scene_mesh(s, s.reference_level - 1, o.cache_dir));
   }
+  if (s.reference_level > 1) {
+    r->coarsest_mesh =
+        std::make_unique<TetMesh>(scene_mesh(s, s.reference_level - 2, o.cache_dir));
+  }
   // The modal reference's mesh (scene's [modes]): one of those above, else its own.
   r->modal_level = modal_reference_level(s);
   if (s.modes.count > 0) {
@@ -967,6 +978,24 @@ std::string modal_label(const Scene& s, const SceneReferences& r, double nu) {
          std::to_string(nu) + ", " + std::to_string(s.modes.count) + " modes)";
 }
 
+/// The GCI order of the scene's reference (fem::gci_order): observed from the QoI point's
+/// displacement along the fine level's direction there on three levels when the coarsest exists
+/// (solved here), else the assumed order of the scene's load.
+fem::GciOrder reference_gci_order(const Scene& s, const SceneReferences& r,
+                                  const ReferenceSolvers& ref, double nu) {
+  const double assumed = s.load.kind == LoadKind::contact ? kAssumedReferenceOrderContact
+                                                          : kAssumedReferenceOrderDistributed;
+  if (!r.coarsest_mesh) return fem::gci_order(std::nullopt, assumed);
+  std::unique_ptr<fem::ElasticitySolver> coarsest;
+  solve_reference(coarsest, *r.coarsest_mesh, fem_problem(s, *r.coarsest_mesh, nu, 2), ref.cache);
+  const Vec3 q = qoi_point(s);
+  const Vec3 fine = ref.fine->displacement_at({q}, kOutsideTolerance)[0];
+  const Vec3 dir = fine.norm() > 0.0 ? Vec3(fine.normalized()) : Vec3(1.0, 0.0, 0.0);
+  const double medium = ref.coarse->displacement_at({q}, kOutsideTolerance)[0].dot(dir);
+  const double coarse = coarsest->displacement_at({q}, kOutsideTolerance)[0].dot(dir);
+  return fem::gci_order(std::vector<double>{coarse, medium, fine.dot(dir)}, assumed);
+}
+
 /// The scene's P2 reference at its k-th ν (unit load), on the fine level and the one below.
 void solve_reference_at(const Scene& s, SceneReferences& r, std::size_t k,
                         const HarnessOptions& o) {
@@ -981,6 +1010,11 @@ void solve_reference_at(const Scene& s, SceneReferences& r, std::size_t k,
       solve_reference(ref.fine, r.fine_mesh, ref.fine_problem, ref.cache);
   if (r.coarse_mesh) {
     solve_reference(ref.coarse, *r.coarse_mesh, fem_problem(s, *r.coarse_mesh, nu, 2), ref.cache);
+    ref.gci = reference_gci_order(s, r, ref, nu);
+    a.info.gci_order = ref.gci.order;
+    a.info.gci_order_source = ref.gci.source;
+    a.info.gci_safety_factor = ref.gci.safety_factor;
+    a.info.gci_note = ref.gci.note;
   }
   a.info.poisson_ratio = nu;
   a.info.element = fine.element;

@@ -4,7 +4,8 @@
 ///
 /// The reference is P2 (Taylor–Hood P2–P1 where ν calls for it) on the scene's reference level,
 /// evaluated at each model node's rest position; the same reference on the level below gives its
-/// own discretisation uncertainty (pointwise Richardson, order 2 for straight-sided geometry), which
+/// own discretisation uncertainty (pointwise Richardson; its order observed on three levels where the
+/// scene's reference level allows, else assumed: ReferenceInfo::gci_order), which
 /// is reported next to every model error. Linear FEM responses are solved once per ν for a unit
 /// load and scaled; mass-spring models are solved for every magnitude (they are nonlinear).
 #include <filesystem>
@@ -64,6 +65,13 @@ struct ReferenceInfo {
   double solve_seconds = 0.0;  ///< fine level, assembly + solve
   double max_abs_strain_unit = 0.0;  ///< largest |principal strain| at unit load
   double budget_magnitude = 0.0;     ///< the load the budget applies at for this ν (scene's unit)
+  /// The order of the linear reference's Richardson/GCI uncertainty (fem::gci_order): observed
+  /// from the QoI on three levels when the scene's reference level is ≥ 2, else assumed
+  /// (kAssumedReferenceOrder*); gci_order_source "none" without a coarser level.
+  double gci_order = 0.0;
+  std::string gci_order_source = "none";  ///< observed | assumed | none
+  double gci_safety_factor = 0.0;
+  std::string gci_note;
 };
 
 /// The error on each quantity a budget may name (issue #7), against the reference at the model's

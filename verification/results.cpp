@@ -17,6 +17,25 @@ namespace vessel {
 namespace {
 
 /// The unit of a scene's load magnitudes: N (contact), Pa (pressure), g (gravity, in g).
+/// The Richardson/GCI order per reference: the linear one's (observed or assumed), and the
+/// finite-strain one's where the scene uses it (no coarser finite-strain level is solved).
+nlohmann::json uncertainty_order_json(const Scene& s, const ReferenceInfo& ref) {
+  nlohmann::json linear{{"source", ref.gci_order_source}, {"note", ref.gci_note}};
+  if (ref.gci_order_source != "none") {
+    linear["order"] = ref.gci_order;
+    linear["safety_factor"] = ref.gci_safety_factor;
+  } else {
+    linear["note"] = "no coarser reference level: no Richardson estimate";
+  }
+  nlohmann::json finite = nullptr;
+  if (s.reference != ReferenceChoice::linear) {
+    finite = {{"source", "none"},
+              {"note", "the finite-strain reference is solved on the fine level only: no "
+                       "Richardson estimate"}};
+  }
+  return {{"linear", linear}, {"finite_strain", finite}};
+}
+
 const char* load_unit(LoadKind k) {
   return k == LoadKind::contact ? "N" : (k == LoadKind::pressure ? "Pa" : "g");
 }
@@ -97,7 +116,8 @@ nlohmann::json scene_json(const SceneResult& r) {
                     {"dofs", ref.dofs},
                     {"solve_seconds", ref.solve_seconds},
                     {"max_abs_strain_at_unit_load", ref.max_abs_strain_unit},
-                    {"budget_magnitude", ref.budget_magnitude}});
+                    {"budget_magnitude", ref.budget_magnitude},
+                    {"uncertainty_order", uncertainty_order_json(r.scene, ref)}});
   }
   nlohmann::json outcomes = nlohmann::json::array();
   for (const auto& o : r.outcomes) {
@@ -300,7 +320,8 @@ void write_summary_markdown(const std::filesystem::path& path,
         << "\n\nDisplacement errors against the FEM reference (P2, or Taylor–Hood P2–P1 for ν ≥ "
            "0.49) evaluated at each model node's rest position, in mm, with seed 000's "
            "statistics. *ref. unc.* is the reference's own estimated error there (Richardson "
-           "between its two finest levels, order 2): errors below it are not resolved. Rows marked "
+           "between its two finest levels, at the order the scene's references record: observed on "
+           "three levels, else assumed): errors below it are not resolved. Rows marked "
            "⚠ strain the reference beyond 5 %, outside linear elasticity's validity. *set-up s*: "
            "model build and the solver's preparation (assembly, factorisation at rest), done once. "
            "*solve s*: static and linear mass-spring models the time per update (median over a "

@@ -49,3 +49,34 @@ TEST(RichardsonField, RecoversThePointwiseErrorOfAPowerLaw) {
   EXPECT_NEAR(est.max_error, 2 * h * h, 1e-15);
   EXPECT_THROW(richardson_field(level(h), {}, 2.0), std::invalid_argument);
 }
+
+TEST(GciOrder, ObservedFromThreeLevelsOfAPowerLaw) {
+  // f(h) = 1 + 0.1 h^1.5 at h = 1, 1/2, 1/4: p = ln((f3 − f2)/(f2 − f1))/ln 2 = 1.5 by hand
+  // ((f3 − f2)/(f2 − f1) = (1 − 2^-1.5)/(2^-1.5 − 4^-1.5) = 2^1.5), with Roache's Fs = 1.25.
+  auto f = [](double h) { return 1.0 + 0.1 * std::pow(h, 1.5); };
+  const GciOrder g = gci_order(std::vector<double>{f(1.0), f(0.5), f(0.25)}, 1.0);
+  EXPECT_EQ(g.source, "observed");
+  EXPECT_NEAR(g.order, 1.5, 1e-12);
+  EXPECT_EQ(g.safety_factor, 1.25);
+  // With that order Richardson recovers f(0) = 1 exactly.
+  EXPECT_NEAR(richardson(f(0.5), f(0.25), g.order).extrapolated, 1.0, 1e-14);
+}
+
+TEST(GciOrder, ClampsAnImplausibleOrderAndFallsBackWhenOscillatory) {
+  // p = 5 observed (differences 32:1) is clamped to the range's top, 3.
+  const GciOrder high = gci_order(std::vector<double>{1.0 + 33e-3, 1.0 + 1e-3, 1.0}, 1.0);
+  EXPECT_EQ(high.source, "observed");
+  EXPECT_DOUBLE_EQ(high.order, 3.0);
+  EXPECT_NE(high.note.find("clamped"), std::string::npos) << high.note;
+  // Differences of opposite sign: the stated order, Fs 3.
+  const GciOrder osc = gci_order(std::vector<double>{1.0, 1.2, 1.1}, 1.0);
+  EXPECT_EQ(osc.source, "assumed");
+  EXPECT_EQ(osc.order, 1.0);
+  EXPECT_EQ(osc.safety_factor, 3.0);
+  EXPECT_NE(osc.note.find("oscillatorily"), std::string::npos) << osc.note;
+  // Two levels only.
+  const GciOrder two = gci_order(std::nullopt, 2.0);
+  EXPECT_EQ(two.source, "assumed");
+  EXPECT_EQ(two.order, 2.0);
+  EXPECT_THROW((void)gci_order(std::nullopt, 5.0), std::invalid_argument);
+}

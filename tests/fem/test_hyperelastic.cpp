@@ -10,6 +10,7 @@
 #include "cube_mesh.hpp"
 #include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/rivlin.hpp"
+#include "meshes/errors.hpp"
 
 using namespace vessel;
 using namespace vessel::fem;
@@ -216,4 +217,103 @@ TEST(RivlinTubeClosedForm, QuadratureOfTheEquilibriumIntegralMatchesTheClosedFor
   const double A = t.inner_radius, B = t.outer_radius;
   const double lame = P * A * B * B / (2 * t.shear_modulus * (B * B - A * A));
   EXPECT_NEAR(t.inner_radius_at(P) - A, lame, 1e-5 * lame);
+}
+
+namespace {
+
+/// The stretch whose uniaxial Cauchy stress is `cauchy` (bisection on the closed form; the stress
+/// grows with the stretch).
+double stretch_at_cauchy(double cauchy, double mu, double lambda) {
+  double lo = 0.3, hi = 3.0;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (uniaxial_stress(mid, mu, lambda).cauchy < cauchy ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+TEST(HyperelasticContinuation, CheckpointsMatchTheClosedFormAtEachLoad) {
+  // One continuation to stretch 1.5 with checkpoints at a quarter and half the load: at each the
+  // cube's corner sits where the closed form puts it for that Cauchy stress (the follower
+  // traction scales with the load factor), and the observer reads the same state.
+  const double L = 1e-3;
+  const TetMesh mesh = test::cube_mesh(2, L);
+  Material m;
+  m.poisson_ratio = 0.3;
+  const double mu = m.mu(), lambda = m.lambda();
+  const Uniaxial full = uniaxial_stress(1.5, mu, lambda);
+  HyperelasticOptions o;
+  o.checkpoints = {0.25, 0.5, 1.0};
+  HyperelasticSolver s(mesh, cube_problem(0.3, 1, Formulation::displacement, -full.cauchy), o);
+  std::vector<Vec3> observed;
+  const auto& r = s.solve([&](const HyperelasticSolver& at, const Checkpoint& c) {
+    observed.push_back(at.displacement_at({Vec3(L, L, L)})[0]);
+    EXPECT_EQ(c.load_steps, static_cast<int>(at.result().steps.size()));
+    return std::string();
+  });
+  ASSERT_TRUE(r.completed) << r.stop_reason;
+  ASSERT_EQ(r.checkpoints.size(), 3u);
+  ASSERT_EQ(observed.size(), 3u);
+  const std::size_t corner = mesh.nodes.size() - 1;  // (L, L, L)
+  ASSERT_LT((mesh.nodes[corner] - Vec3(L, L, L)).norm(), 1e-15);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const Checkpoint& c = r.checkpoints[k];
+    EXPECT_DOUBLE_EQ(c.load_factor, o.checkpoints[k]);
+    const double l = stretch_at_cauchy(c.load_factor * full.cauchy, mu, lambda);
+    const double t = uniaxial_stress(l, mu, lambda).lateral;
+    const Vec3 expect((l - 1) * L, (t - 1) * L, (t - 1) * L);
+    EXPECT_LT((c.nodal_displacement[corner] - expect).norm(), 1e-8 * L) << "checkpoint " << k;
+    EXPECT_LT((observed[k] - expect).norm(), 1e-8 * L) << "checkpoint " << k;
+    if (k > 0) {
+      EXPECT_GE(c.newton_iterations, r.checkpoints[k - 1].newton_iterations);
+    }
+  }
+}
+
+TEST(HyperelasticContinuation, AnObserverStopsTheContinuationWithItsReason) {
+  const TetMesh mesh = test::cube_mesh(1, 1e-3);
+  HyperelasticOptions o;
+  o.checkpoints = {0.2, 0.6, 1.0};
+  HyperelasticSolver s(mesh, cube_problem(0.3, 1, Formulation::displacement, -2000.0), o);
+  const auto& r = s.solve([](const HyperelasticSolver&, const Checkpoint& c) {
+    return c.load_factor >= 0.6 ? std::string("enough") : std::string();
+  });
+  EXPECT_FALSE(r.completed);
+  EXPECT_EQ(r.stop_reason, "enough");
+  EXPECT_DOUBLE_EQ(r.load_factor, 0.6);
+  EXPECT_EQ(r.checkpoints.size(), 2u);
+}
+
+TEST(HyperelasticContinuation, NewtonFailureReportsTheLargestLoadReached) {
+  // One Newton iteration per step cannot reach the tolerance: the increment fails, and halving
+  // it would fall below min_step; the result keeps load factor 0 and says why.
+  const TetMesh mesh = test::cube_mesh(1, 1e-3);
+  HyperelasticOptions o;
+  o.max_newton_iterations = 1;
+  o.min_step = 0.3;
+  o.checkpoints = {0.5, 1.0};
+  HyperelasticSolver s(mesh, cube_problem(0.3, 1, Formulation::displacement, -2000.0), o);
+  const auto& r = s.solve();
+  EXPECT_FALSE(r.completed);
+  EXPECT_EQ(r.load_factor, 0.0);
+  EXPECT_TRUE(r.checkpoints.empty());
+  // The first step ends at the checkpoint 0.5, fails, and half of it (0.25) is below min_step.
+  EXPECT_EQ(r.rejected_steps, 1);
+  EXPECT_NE(r.stop_reason.find("no equilibrium found beyond load factor 0: at 0.5"),
+            std::string::npos)
+      << r.stop_reason;
+  EXPECT_NE(r.stop_reason.find("Newton did not converge in 1 iterations"), std::string::npos)
+      << r.stop_reason;
+}
+
+TEST(HyperelasticContinuation, RefusesCheckpointsOutOfOrderOrBeyondTheTarget) {
+  const TetMesh mesh = test::cube_mesh(1, 1e-3);
+  for (const std::vector<double>& bad : {std::vector<double>{0.5, 0.2}, {0.5, 1.5}, {0.0}}) {
+    HyperelasticOptions o;
+    o.checkpoints = bad;
+    const ElasticityProblem p = cube_problem(0.3, 1, Formulation::displacement, -1.0);
+    EXPECT_THROW({ HyperelasticSolver s(mesh, p, o); }, InputError);
+  }
 }

@@ -25,5 +25,7 @@ void add_fem_command(CLI::App& app);
 void add_stability_command(CLI::App& app, const std::string& command_line);
 /// `vesselverify calibrate`: stiffness fitted to the FEM, checked on held-out loads.
 void add_calibrate_command(CLI::App& app, const std::string& command_line);
+/// `vesselverify validity` (verification/cli/validity_command.cpp).
+void add_validity_command(CLI::App& app, const std::string& command_line);
 
 }  // namespace vessel::cli

@@ -33,6 +33,10 @@ void add_report_command(CLI::App& app, const std::string& command_line) {
                   "recommend.json written by `vesselverify recommend`, drawn as a section "
                   "(repeatable; the results.json beside it names the load unit and reference)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--validity", o->validity,
+                  "validity.json written by `vesselverify validity`: the linear reference's "
+                  "limit and the models against the finite-strain reference, drawn as a section")
+      ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output-dir", o->output_dir,
                   "Where report.md, report.html and figures/ go (default: beside the results)");
   cmd->callback([o] {

@@ -1,0 +1,255 @@
+// The validity study (issue 17 item 3) on a small problem: the threshold interpolation by hand,
+// the measured 1 % crossing against the one the O(load²) difference of the two references
+// predicts from two small loads, the largest-load-reached path, and validity.json read back by
+// the report with errors naming the field.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "meshes/errors.hpp"
+#include "reports/study_files.hpp"
+#include "reports/study_sections.hpp"
+#include "verification/studies/validity/validity.hpp"
+
+using namespace vessel;
+
+namespace {
+
+/// A 20 mm tube, level 0, contact at mid-length, clamped ends; the seed 001 volume model.
+const char* kScene = R"(name = "validity_test"
+[vessel]
+kind = "straight"
+length = 20.0e-3
+mesh = "structured"
+level = 0
+reference_level = 0
+[material]
+E = 14.24e3
+nu = 0.45
+[boundary]
+inlet = "clamped"
+outlet = "clamped"
+[load]
+type = "contact"
+magnitudes = [1.0e-4]
+point = [3.0e-3, 0.0, 10.0e-3]
+patch_radius = 1.0e-3
+surface = "inner_wall"
+[[models]]
+name = "volume_mollemans"
+kind = "volume_msm"
+stiffness = "seed001"
+mass = "seed001"
+solver = "static"
+)";
+
+ValidityOptions small_options() {
+  ValidityOptions o;
+  o.degree = 1;
+  o.reference_level = 0;
+  o.ladder = {1e-6, 2e-6, 3e-4, 1e-3, 2e-3, 4e-3};
+  return o;
+}
+
+std::filesystem::path temp_dir(const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() / ("vesselverify_" + name);
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+}  // namespace
+
+TEST(ThresholdCrossing, InterpolatesLogLinearlyBetweenTheBracketingLoads) {
+  // d = 0.005 F² on F = 1, 2, 4: 1 % at F = √2 and 5 % at √10 exactly (a power law is a line in
+  // ln d against ln F); 10 % is not reached (d(4) = 8 %); at 0.4 % the first load already
+  // exceeds it.
+  const std::vector<double> F{1.0, 2.0, 4.0}, d{0.005, 0.02, 0.08};
+  const ThresholdCrossing one = threshold_crossing(F, d, 0.01);
+  EXPECT_EQ(one.status, "interpolated");
+  EXPECT_NEAR(*one.load, std::sqrt(2.0), 1e-12);
+  EXPECT_EQ(one.lower, 1.0);
+  EXPECT_EQ(one.upper, 2.0);
+  EXPECT_NEAR(*threshold_crossing(F, d, 0.05).load, std::sqrt(10.0), 1e-12);
+  const ThresholdCrossing ten = threshold_crossing(F, d, 0.10);
+  EXPECT_EQ(ten.status, "not_reached");
+  EXPECT_FALSE(ten.load.has_value());
+  EXPECT_EQ(ten.lower, 4.0);
+  const ThresholdCrossing low = threshold_crossing(F, d, 0.004);
+  EXPECT_EQ(low.status, "below_ladder");
+  EXPECT_EQ(*low.load, 1.0);
+  EXPECT_THROW((void)threshold_crossing({2.0, 1.0}, {0.1, 0.2}, 0.15), std::invalid_argument);
+  EXPECT_THROW((void)threshold_crossing({1.0}, {}, 0.15), std::invalid_argument);
+}
+
+TEST(ValidityStudy, TheOnePercentCrossingIsWhatTheLoadSquaredDifferencePredicts) {
+  const Scene s = parse_scene(kScene, "validity_test.toml");
+  const ValidityScene v = run_validity_scene(s, small_options());
+  ASSERT_TRUE(v.completed) << v.stop_reason;
+  ASSERT_EQ(v.rows.size(), 6u);
+  // At small loads the references differ by O(F²): the relative difference doubles with F.
+  const double ratio = v.rows[1].qoi_difference / v.rows[0].qoi_difference;
+  std::cout << "  QoI difference " << v.rows[0].qoi_difference << " at 1 µN, "
+            << v.rows[1].qoi_difference << " at 2 µN (ratio " << ratio << ")\n";
+  EXPECT_NEAR(ratio, 2.0, 0.02);
+  // So d ≈ c F, and 1 % is reached at 0.01 / c: the ladder's interpolated crossing agrees.
+  const double predicted = v.rows[0].magnitude * 0.01 / v.rows[0].qoi_difference;
+  ASSERT_EQ(v.qoi_limits.size(), 3u);
+  ASSERT_EQ(v.qoi_limits[0].status, "interpolated");
+  std::cout << "  1 % crossing: predicted " << predicted << " N, measured "
+            << *v.qoi_limits[0].load << " N (between " << v.qoi_limits[0].lower << " and "
+            << v.qoi_limits[0].upper << ")\n";
+  EXPECT_NEAR(*v.qoi_limits[0].load / predicted, 1.0, 0.1);
+  // Every row has the model, judged against the finite-strain reference.
+  for (const ValidityRow& r : v.rows) {
+    ASSERT_EQ(r.models.size(), 1u);
+    EXPECT_TRUE(r.models[0].ok) << r.models[0].failure;
+    EXPECT_GT(r.models[0].relative_l2, 0.0);
+  }
+  // The continuation's cost is recorded and cumulative.
+  EXPECT_GT(v.newton_iterations, 0);
+  EXPECT_EQ(v.rows.back().newton_iterations, v.newton_iterations);
+  EXPECT_GE(v.load_steps, 6);
+}
+
+TEST(ValidityStudy, ANewtonFailureEndsTheRowsAtTheLargestLoadReached) {
+  // One Newton iteration per step never reaches the tolerance (after the linear predictor the
+  // residual is O(F²), not round-off): no load is reached, there are no rows, and the reason is
+  // kept with the largest load reached, 0.
+  const Scene s = parse_scene(kScene, "validity_test.toml");
+  ValidityOptions o = small_options();
+  o.ladder = {1e-6, 1.0};
+  o.finite.max_newton_iterations = 1;
+  const ValidityScene v = run_validity_scene(s, o);
+  EXPECT_FALSE(v.completed);
+  EXPECT_EQ(v.largest_load, 0.0);
+  EXPECT_TRUE(v.rows.empty());
+  for (const auto& c : v.qoi_limits) EXPECT_FALSE(c.load.has_value());
+  EXPECT_NE(v.stop_reason.find("no equilibrium found beyond load factor"), std::string::npos)
+      << v.stop_reason;
+}
+
+TEST(ValidityStudy, TheCacheGivesTheSameRowsOnASecondRun) {
+  const Scene s = parse_scene(kScene, "validity_test.toml");
+  const auto dir = temp_dir("validity_cache");
+  std::ostringstream log;
+  fem::SolutionCache cache(dir, &log);
+  ValidityOptions o = small_options();
+  o.ladder = {1e-4, 1e-3};
+  o.cache = &cache;
+  const ValidityScene first = run_validity_scene(s, o);
+  const ValidityScene second = run_validity_scene(s, o);
+  EXPECT_FALSE(first.finite_from_cache);
+  EXPECT_TRUE(second.finite_from_cache);
+  ASSERT_EQ(first.rows.size(), second.rows.size());
+  for (std::size_t k = 0; k < first.rows.size(); ++k) {
+    EXPECT_EQ(first.rows[k].finite_qoi_mm, second.rows[k].finite_qoi_mm);
+    EXPECT_EQ(first.rows[k].l2_difference, second.rows[k].l2_difference);
+  }
+  // Another ladder is another continuation: a miss.
+  o.ladder = {1e-4, 2e-3};
+  EXPECT_FALSE(run_validity_scene(s, o).finite_from_cache);
+}
+
+TEST(ValidityFile, WrittenThenReadBackByTheReportWithBadFieldsNamed) {
+  ValidityStudy study;
+  study.command = "vesselverify validity x.toml";
+  ValidityScene v;
+  v.scene = "x";
+  v.load_kind = "contact";
+  v.load_unit = "N";
+  v.element = "P2";
+  v.dofs = 10;
+  v.ladder = {1e-3, 2e-3};
+  v.models = {{"m", "detail", 0, 5}};
+  v.completed = false;
+  v.largest_load = 1.5e-3;
+  v.stop_reason = "no equilibrium";
+  v.newton_iterations = 7;
+  ValidityRow r;
+  r.magnitude = 1e-3;
+  r.qoi_difference = 0.02;
+  r.models = {{"m", true, "", 0.5, 1.0, 0.1, 0.2, 0.3, 4}};
+  v.rows = {r};
+  v.qoi_limits = {threshold_crossing({1e-3}, {0.02}, 0.01),
+                  threshold_crossing({1e-3}, {0.02}, 0.05)};
+  v.l2_limits = v.qoi_limits;
+  study.scenes = {v};
+  const auto dir = temp_dir("validity_file");
+  write_validity_json(study, dir / "validity.json");
+  const reports::ValidityFile f = reports::read_validity(dir / "validity.json");
+  ASSERT_EQ(f.scenes.size(), 1u);
+  const auto& e = f.scenes[0];
+  EXPECT_EQ(e.largest_load, 1.5e-3);
+  EXPECT_FALSE(e.completed);
+  EXPECT_EQ(e.stop_reason, "no equilibrium");
+  EXPECT_EQ(e.newton_iterations, 7);
+  ASSERT_EQ(e.rows.size(), 1u);
+  EXPECT_EQ(e.rows[0].qoi_difference, 0.02);
+  EXPECT_EQ(e.rows[0].models[0].relative_l2, 0.5);
+  EXPECT_EQ(e.qoi_limits[0].status, "below_ladder");
+  EXPECT_EQ(e.qoi_limits[1].status, "not_reached");
+  EXPECT_EQ(e.models, std::vector<std::string>{"m"});
+
+  // A missing field, a wrong status and another schema are refused naming what is wrong.
+  std::ifstream in(dir / "validity.json");
+  const nlohmann::json good = nlohmann::json::parse(in);
+  auto refused = [&](nlohmann::json j) {
+    try {
+      (void)reports::parse_validity(j.dump(), "bad.json");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  nlohmann::json j = good;
+  j["scenes"][0]["rows"][0].erase("qoi_difference");
+  const std::string missing = refused(j);
+  EXPECT_NE(missing.find("bad.json"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("scenes[0].rows[0]"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("'qoi_difference'"), std::string::npos) << missing;
+  j = good;
+  j["scenes"][0]["qoi_limits"][0]["status"] = "maybe";
+  EXPECT_NE(refused(j).find("'status' is 'maybe'"), std::string::npos) << refused(j);
+  j = good;
+  j["scenes"][0]["continuation"].erase("largest_load");
+  EXPECT_NE(refused(j).find("continuation: missing field 'largest_load'"), std::string::npos)
+      << refused(j);
+  j = good;
+  j["schema"] = "vesselverify.results";
+  EXPECT_NE(refused(j).find("vesselverify.validity"), std::string::npos) << refused(j);
+}
+
+TEST(ValidityFile, TheReportSectionShowsTheLimitsAndTheLargestLoadReached) {
+  reports::ValidityFile f;
+  f.command = "vesselverify validity s.toml";
+  reports::ValiditySceneEntry s;
+  s.scene = "contact_straight";
+  s.load_kind = "contact";
+  s.load_unit = "N";
+  s.element = "P2";
+  s.models = {"surface_seed000"};
+  s.completed = false;
+  s.largest_load = 0.0625;
+  s.stop_reason = "no equilibrium found beyond load factor 0.0625";
+  s.newton_iterations = 51;
+  s.qoi_limits = {{0.01, "interpolated", 4e-4, 3e-4, 1e-3}, {0.05, "not_reached", {}, 0.05, 0.05}};
+  s.l2_limits = s.qoi_limits;
+  reports::ValidityRowEntry r;
+  r.magnitude = 0.05;
+  r.models = {{"surface_seed000", true, "", 0.71, 2.0, 1.5, 0.3}};
+  s.rows = {r};
+  f.scenes = {s};
+  reports::Document doc;
+  reports::validity_section(doc, f);
+  const std::string md = doc.markdown_text("figures");
+  EXPECT_NE(md.find("## Limit of the linear reference"), std::string::npos) << md;
+  EXPECT_NE(md.find("**stopped: the largest load reached is 62.5 mN**"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 1 % | 0.4 mN (between 0.3 mN and 1 mN) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("not reached up to 50 mN"), std::string::npos) << md;
+  EXPECT_NE(md.find("surface_seed000: rel. L2 / QoI error (mm)"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 0.71 / 1.5 |"), std::string::npos) << md;
+}

@@ -1,0 +1,582 @@
+#include "verification/studies/validity/validity.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "fem_reference/elasticity.hpp"
+#include "meshes/atomic_file.hpp"
+#include "meshes/content_hash.hpp"
+#include "meshes/errors.hpp"
+#include "msm/model/model_factory.hpp"
+#include "msm/solvers/updates.hpp"
+#include "verification/metrics.hpp"
+#include "verification/parallel.hpp"
+#include "verification/scene_problems.hpp"
+
+namespace vessel {
+
+namespace {
+
+using nlohmann::json;
+
+/// Barycentric tolerance of evaluating the references at model nodes (the harness's: a node on
+/// the exact curved wall lies slightly outside the straight-sided tets).
+constexpr double kOutsideTolerance = 0.25;
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+const char* load_unit(LoadKind k) {
+  return k == LoadKind::contact ? "N" : (k == LoadKind::pressure ? "Pa" : "g");
+}
+
+std::vector<Vec3> scaled(const std::vector<Vec3>& u, double f) {
+  std::vector<Vec3> out(u.size());
+  for (std::size_t i = 0; i < u.size(); ++i) out[i] = f * u[i];
+  return out;
+}
+
+/// What the continuation gave at one checkpoint, at the points the study reads.
+struct Sample {
+  double load = 0.0;
+  int load_steps = 0, rejected_steps = 0, newton_iterations = 0;
+  double seconds = 0.0;
+  Vec3 qoi = Vec3::Zero();
+  std::vector<Vec3> mesh_nodes;                ///< at the reference mesh's nodes
+  std::vector<std::vector<Vec3>> model_nodes;  ///< per model, at its nodes' rest positions
+};
+
+struct Continuation {
+  std::string element;
+  std::size_t dofs = 0;
+  bool completed = false;
+  double largest_load = 0.0;
+  std::string stop_reason;
+  int load_steps = 0, rejected_steps = 0, newton_iterations = 0;
+  double seconds = 0.0;
+  std::vector<Sample> samples;
+};
+
+json points_json(const std::vector<Vec3>& v) {
+  json a = json::array();
+  for (const Vec3& p : v) {
+    a.push_back(p.x());
+    a.push_back(p.y());
+    a.push_back(p.z());
+  }
+  return a;
+}
+
+std::vector<Vec3> points_from(const json& a) {
+  const auto flat = a.get<std::vector<double>>();
+  if (flat.size() % 3 != 0) throw std::runtime_error("point array not a multiple of 3");
+  std::vector<Vec3> v(flat.size() / 3);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = {flat[3 * i], flat[3 * i + 1], flat[3 * i + 2]};
+  return v;
+}
+
+std::string serialise(const Continuation& c) {
+  json j{{"element", c.element},
+         {"dofs", c.dofs},
+         {"completed", c.completed},
+         {"largest_load", c.largest_load},
+         {"stop_reason", c.stop_reason},
+         {"load_steps", c.load_steps},
+         {"rejected_steps", c.rejected_steps},
+         {"newton_iterations", c.newton_iterations},
+         {"seconds", c.seconds}};
+  json samples = json::array();
+  for (const Sample& s : c.samples) {
+    json models = json::array();
+    for (const auto& m : s.model_nodes) models.push_back(points_json(m));
+    samples.push_back({{"load", s.load},
+                       {"load_steps", s.load_steps},
+                       {"rejected_steps", s.rejected_steps},
+                       {"newton_iterations", s.newton_iterations},
+                       {"seconds", s.seconds},
+                       {"qoi", points_json({s.qoi})},
+                       {"mesh_nodes", points_json(s.mesh_nodes)},
+                       {"model_nodes", models}});
+  }
+  j["samples"] = samples;
+  return j.dump();
+}
+
+/// Throws on a payload it cannot read (the cache then recomputes it).
+Continuation deserialise(std::string_view text, std::size_t mesh_nodes,
+                         const std::vector<std::size_t>& model_nodes) {
+  const json j = json::parse(text);
+  Continuation c;
+  c.element = j.at("element").get<std::string>();
+  c.dofs = j.at("dofs").get<std::size_t>();
+  c.completed = j.at("completed").get<bool>();
+  c.largest_load = j.at("largest_load").get<double>();
+  c.stop_reason = j.at("stop_reason").get<std::string>();
+  c.load_steps = j.at("load_steps").get<int>();
+  c.rejected_steps = j.at("rejected_steps").get<int>();
+  c.newton_iterations = j.at("newton_iterations").get<int>();
+  c.seconds = j.at("seconds").get<double>();
+  for (const json& s : j.at("samples")) {
+    Sample x;
+    x.load = s.at("load").get<double>();
+    x.load_steps = s.at("load_steps").get<int>();
+    x.rejected_steps = s.at("rejected_steps").get<int>();
+    x.newton_iterations = s.at("newton_iterations").get<int>();
+    x.seconds = s.at("seconds").get<double>();
+    const auto q = points_from(s.at("qoi"));
+    if (q.size() != 1) throw std::runtime_error("qoi: expected one point");
+    x.qoi = q[0];
+    x.mesh_nodes = points_from(s.at("mesh_nodes"));
+    if (x.mesh_nodes.size() != mesh_nodes) throw std::runtime_error("mesh node count differs");
+    const json& models = s.at("model_nodes");
+    if (models.size() != model_nodes.size()) throw std::runtime_error("model count differs");
+    for (std::size_t m = 0; m < models.size(); ++m) {
+      x.model_nodes.push_back(points_from(models[m]));
+      if (x.model_nodes.back().size() != model_nodes[m])
+        throw std::runtime_error("model node count differs");
+    }
+    c.samples.push_back(std::move(x));
+  }
+  return c;
+}
+
+/// The models the study runs: named ones, else (default) the seed models, else (full) every
+/// whole-vessel static or linear mass-spring model of the scene.
+std::vector<const ModelSpec*> chosen_models(const Scene& s, const ValidityOptions& o) {
+  auto eligible = [](const ModelSpec& m) {
+    return (m.kind == ModelKind::surface_msm || m.kind == ModelKind::volume_msm) &&
+           m.roi_radius <= 0.0 && msm::supports_updates(m.solver);
+  };
+  std::vector<const ModelSpec*> out;
+  if (!o.models.empty()) {
+    for (const std::string& name : o.models) {
+      const auto it = std::find_if(s.models.begin(), s.models.end(),
+                                   [&](const ModelSpec& m) { return m.name == name; });
+      if (it == s.models.end() || !eligible(*it)) {
+        throw InputError("--models " + name + ": " + s.source.string() +
+                         " has no whole-vessel static mass-spring model of that name");
+      }
+      out.push_back(&*it);
+    }
+    return out;
+  }
+  for (const ModelSpec& m : s.models) {
+    if (!eligible(m)) continue;
+    const bool seed = !m.volume_term && m.bending == msm::Bending::none &&
+                      m.calibration.empty() &&
+                      (m.stiffness == msm::StiffnessRule::seed000 ||
+                       m.stiffness == msm::StiffnessRule::seed001);
+    if (o.full || seed) out.push_back(&m);
+  }
+  return out;
+}
+
+void log_line(const ValidityOptions& o, const std::string& text) {
+  if (o.log) *o.log << (text + "\n") << std::flush;  // one write: scenes may run on threads
+}
+
+int reference_level_of(const Scene& s, const ValidityOptions& o) {
+  return o.reference_level >= 0 ? o.reference_level : (o.full ? s.reference_level : 0);
+}
+
+}  // namespace
+
+ThresholdCrossing threshold_crossing(const std::vector<double>& loads,
+                                     const std::vector<double>& d, double threshold) {
+  if (loads.empty() || loads.size() != d.size()) {
+    throw std::invalid_argument("threshold_crossing: expected as many differences as loads, > 0");
+  }
+  for (std::size_t k = 0; k < loads.size(); ++k) {
+    if (!(loads[k] > 0.0) || (k > 0 && !(loads[k] > loads[k - 1]))) {
+      throw std::invalid_argument("threshold_crossing: loads must be > 0 and ascending");
+    }
+  }
+  ThresholdCrossing c;
+  c.threshold = threshold;
+  if (d[0] >= threshold) {
+    c.status = "below_ladder";
+    c.load = loads[0];
+    c.lower = c.upper = loads[0];
+    return c;
+  }
+  for (std::size_t k = 1; k < loads.size(); ++k) {
+    if (d[k] < threshold) continue;
+    c.status = "interpolated";
+    c.lower = loads[k - 1];
+    c.upper = loads[k];
+    if (d[k - 1] > 0.0) {
+      // ln F linear in ln d between the bracketing loads.
+      const double w = std::log(threshold / d[k - 1]) / std::log(d[k] / d[k - 1]);
+      c.load = std::exp(std::log(loads[k - 1]) + w * std::log(loads[k] / loads[k - 1]));
+    } else {  // no log at d = 0: linear in F
+      c.load = loads[k - 1] + (threshold - d[k - 1]) / (d[k] - d[k - 1]) * (loads[k] - loads[k - 1]);
+    }
+    return c;
+  }
+  c.status = "not_reached";
+  c.lower = c.upper = loads.back();
+  return c;
+}
+
+std::vector<double> default_ladder(const Scene& scene, bool full) {
+  if (scene.load.kind == LoadKind::contact) {
+    // Seed 000's range, 0.01 to 140 mN, denser where the references part (0.1–10 mN).
+    if (full) {
+      return {1e-5, 1e-4, 2e-4, 3e-4, 5e-4, 7e-4, 1e-3, 1.5e-3, 2e-3, 3e-3, 5e-3, 7e-3,
+              1e-2, 1.5e-2, 2e-2, 3e-2, 5e-2, 7e-2, 0.1, 0.14};
+    }
+    return {1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.14};
+  }
+  // Other loads: fractions of the scene's largest magnitude (gravity: up to 1 g).
+  const double top = *std::max_element(scene.load.magnitudes.begin(), scene.load.magnitudes.end());
+  if (full) return {0.01 * top, 0.1 * top, 0.25 * top, 0.5 * top, 0.75 * top, top};
+  return {0.5 * top, top};
+}
+
+ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
+  const auto t_scene = std::chrono::steady_clock::now();
+  const bool dynamic = std::any_of(s.models.begin(), s.models.end(),
+                                   [](const ModelSpec& m) { return m.solver.is_dynamic(); });
+  if (dynamic) {
+    throw InputError(s.source.string() +
+                     ": validity compares static answers; this scene's models are dynamic");
+  }
+  ValidityScene out;
+  out.scene = s.name;
+  out.source = s.source.string();
+  out.load_kind = to_string(s.load.kind);
+  out.load_unit = load_unit(s.load.kind);
+  out.poisson_ratio = s.poisson_ratios.front();
+  out.reference_level = reference_level_of(s, o);
+  out.degree = o.degree;
+  out.model_level = s.model_levels.front();
+  out.ladder = o.ladder.empty() ? default_ladder(s, o.full) : o.ladder;
+  std::sort(out.ladder.begin(), out.ladder.end());
+  out.ladder.erase(std::unique(out.ladder.begin(), out.ladder.end()), out.ladder.end());
+  if (out.ladder.empty() || !(out.ladder.front() > 0.0)) {
+    throw InputError("validity: the load ladder must hold loads > 0");
+  }
+  const double nu = out.poisson_ratio;
+  const Vec3 qoi = qoi_point(s);
+
+  // The references: one mesh, one problem at unit load.
+  const TetMesh ref_mesh = scene_mesh(s, out.reference_level, o.mesh_cache_dir);
+  const fem::ElasticityProblem problem = fem_problem(s, ref_mesh, nu, o.degree);
+  fem::ElasticitySolver linear(ref_mesh, problem);
+  const fem::ElasticityResult& lin = fem::solve_with(o.cache, linear, ref_mesh, problem);
+  out.element = lin.element;
+  out.dofs = lin.n_dofs;
+  const Vec3 lin_qoi = linear.displacement_at({qoi}, kOutsideTolerance)[0];
+  log_line(o, "validity " + s.name + ": reference " + lin.element + " on level " +
+                  std::to_string(out.reference_level) + ", " + std::to_string(lin.n_dofs) +
+                  " DoFs");
+
+  // The models, built on their level's mesh.
+  const std::vector<const ModelSpec*> specs = chosen_models(s, o);
+  const TetMesh model_mesh = scene_mesh(s, out.model_level, o.mesh_cache_dir);
+  VesselParams vessel = s.vessel;
+  vessel.level = out.model_level;
+  std::vector<msm::BuiltNetwork> built;
+  std::vector<std::unique_ptr<msm::MassSpringModel>> forms;
+  std::vector<std::size_t> node_counts;
+  for (const ModelSpec* m : specs) {
+    built.push_back(scene_network(s, *m, model_mesh, vessel, nu));
+    forms.push_back(msm::make_model(built.back(), m->damping));
+    node_counts.push_back(built.back().network.nodes.size());
+    out.models.push_back({m->name,
+                          built.back().topology + ", " + msm::to_string(m->stiffness) +
+                              " stiffness, " + msm::to_string(m->solver),
+                          out.model_level, node_counts.back()});
+  }
+
+  // The finite-strain continuation with the ladder as checkpoints (unit load × load factor =
+  // magnitude, as the harness's finite-strain reference), cached with the points it samples.
+  fem::HyperelasticOptions fo = o.finite;
+  fo.target_load_factor = out.ladder.back();
+  fo.initial_step = fo.max_step = out.ladder.back();  // each step tries the next checkpoint
+  fo.min_step = 1e-4 * out.ladder.back();
+  fo.checkpoints = out.ladder;
+  ContentHash what;
+  what.text("validity samples v1").real(qoi.x()).real(qoi.y()).real(qoi.z());
+  what.real(kOutsideTolerance);
+  for (const auto& b : built) {
+    what.integer(static_cast<std::int64_t>(b.network.nodes.size()));
+    for (const Vec3& p : b.network.nodes) what.real(p.x()).real(p.y()).real(p.z());
+  }
+  auto compute = [&] {
+    Continuation c;
+    fem::HyperelasticSolver fs(ref_mesh, problem, fo);
+    const fem::HyperelasticResult& r =
+        fs.solve([&](const fem::HyperelasticSolver& at, const fem::Checkpoint& cp) {
+          Sample x;
+          x.load = cp.load_factor;
+          x.load_steps = cp.load_steps;
+          x.rejected_steps = cp.rejected_steps;
+          x.newton_iterations = cp.newton_iterations;
+          x.seconds = cp.seconds;
+          x.qoi = at.displacement_at({qoi}, kOutsideTolerance)[0];
+          x.mesh_nodes = cp.nodal_displacement;
+          for (const auto& b : built) {
+            x.model_nodes.push_back(at.displacement_at(b.network.nodes, kOutsideTolerance));
+          }
+          std::ostringstream m;
+          m << "  " << s.name << ": finite strain at " << cp.load_factor << " " << load_unit(s.load.kind) << ": "
+            << cp.load_steps << " steps, " << cp.newton_iterations << " Newton iterations, "
+            << std::setprecision(3) << cp.seconds << " s";
+          log_line(o, m.str());
+          c.samples.push_back(std::move(x));
+          return std::string();
+        });
+    c.element = r.element;
+    c.dofs = r.n_dofs;
+    c.completed = r.completed;
+    c.largest_load = r.load_factor;
+    c.stop_reason = r.stop_reason;
+    c.load_steps = static_cast<int>(r.steps.size());
+    c.rejected_steps = r.rejected_steps;
+    c.newton_iterations = r.newton_iterations;
+    c.seconds = r.timings.assembly + r.timings.solve;
+    return serialise(c);
+  };
+  const std::optional<std::string> key =
+      o.cache ? fem::continuation_cache_key(ref_mesh, problem, fo, what.hex()) : std::nullopt;
+  bool computed = false;
+  auto compute_marked = [&] {
+    computed = true;
+    return compute();
+  };
+  const std::string payload =
+      key ? o.cache->payload(*key, compute_marked,
+                             [&](std::string_view text) {
+                               return deserialise(text, ref_mesh.nodes.size(), node_counts).seconds;
+                             })
+          : compute_marked();
+  const Continuation c = deserialise(payload, ref_mesh.nodes.size(), node_counts);
+  out.finite_from_cache = !computed;
+  out.completed = c.completed;
+  out.largest_load = c.largest_load;
+  out.stop_reason = c.stop_reason;
+  out.load_steps = c.load_steps;
+  out.rejected_steps = c.rejected_steps;
+  out.newton_iterations = c.newton_iterations;
+  out.finite_seconds = c.seconds;
+  if (!c.completed) {
+    log_line(o, "  " + s.name + ": finite strain stopped at " + std::to_string(c.largest_load) + " " +
+                    out.load_unit + ": " + c.stop_reason);
+  }
+
+  // The rows: references and models at each checkpoint reached. Each model is updated along
+  // the ladder from its previous state (a continuation too); a failure restarts it from rest.
+  std::vector<std::unique_ptr<msm::Updater>> updaters(specs.size());
+  for (const Sample& x : c.samples) {
+    ValidityRow row;
+    row.magnitude = x.load;
+    const Vec3 ul = x.load * lin_qoi;
+    row.linear_qoi_mm = ul.norm() * 1e3;
+    row.finite_qoi_mm = x.qoi.norm() * 1e3;
+    row.qoi_difference = x.qoi.norm() > 0.0 ? (ul - x.qoi).norm() / x.qoi.norm() : 0.0;
+    row.l2_difference =
+        compare_displacements(scaled(lin.nodal_displacement, x.load), x.mesh_nodes).relative_l2;
+    row.linear_strain = lin.max_abs_principal_strain * x.load;
+    row.newton_iterations = x.newton_iterations;
+    row.load_steps = x.load_steps;
+    row.finite_seconds = x.seconds;
+    for (std::size_t m = 0; m < specs.size(); ++m) {
+      ValidityModelError e;
+      e.model = specs[m]->name;
+      try {
+        const msm::Problem p = msm_problem(s, *forms[m], built[m], model_mesh, x.load);
+        if (!updaters[m]) updaters[m] = msm::prepare_updates(p, specs[m]->solver);
+        const msm::UpdateResult u = updaters[m]->update(p.external_force);
+        e.iterations = u.iterations;
+        const Eigen::VectorXd& state = updaters[m]->state();
+        const auto& nodes = built[m].network.nodes;
+        std::vector<Vec3> um(nodes.size());
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+          um[i] = state.segment<3>(3 * static_cast<Eigen::Index>(i)) - nodes[i];
+        }
+        const ErrorStatistics st = compare_displacements(um, x.model_nodes[m]);
+        e.relative_l2 = st.relative_l2;
+        e.max_error_mm = st.max_mm;
+        const std::size_t q = nearest_node(nodes, qoi);
+        const Vec3 uref = x.model_nodes[m][q];
+        e.qoi_error_mm = (um[q] - uref).norm() * 1e3;
+        e.qoi_model_mm = um[q].norm() * 1e3;
+        e.qoi_relative = uref.norm() > 0.0 ? (um[q] - uref).norm() / uref.norm() : 0.0;
+        e.ok = true;
+      } catch (const InputError&) {
+        throw;
+      } catch (const std::exception& ex) {
+        e.failure = ex.what();
+        updaters[m].reset();
+      }
+      row.models.push_back(std::move(e));
+    }
+    out.rows.push_back(std::move(row));
+  }
+
+  std::vector<double> loads, dq, dl;
+  for (const ValidityRow& r : out.rows) {
+    loads.push_back(r.magnitude);
+    dq.push_back(r.qoi_difference);
+    dl.push_back(r.l2_difference);
+  }
+  if (!loads.empty()) {
+    for (const double t : kValidityThresholds) {
+      out.qoi_limits.push_back(threshold_crossing(loads, dq, t));
+      out.l2_limits.push_back(threshold_crossing(loads, dl, t));
+    }
+  }
+  out.seconds = seconds_since(t_scene);
+  return out;
+}
+
+std::vector<ValidityScene> run_validity(const std::vector<Scene>& scenes,
+                                        const ValidityOptions& o, int jobs) {
+  if (o.mesh_cache_dir.empty()) jobs = 1;
+  if (jobs > 1) {
+    for (const Scene& s : scenes) {
+      (void)scene_mesh(s, reference_level_of(s, o), o.mesh_cache_dir);
+      (void)scene_mesh(s, s.model_levels.front(), o.mesh_cache_dir);
+    }
+  }
+  std::vector<ValidityScene> out(scenes.size());
+  parallel_for(scenes.size(), jobs, [&](std::size_t i) { out[i] = run_validity_scene(scenes[i], o); });
+  return out;
+}
+
+namespace {
+
+json crossing_json(const ThresholdCrossing& c) {
+  return {{"threshold", c.threshold},
+          {"status", c.status},
+          {"load", c.load ? json(*c.load) : json(nullptr)},
+          {"lower", c.lower},
+          {"upper", c.upper}};
+}
+
+}  // namespace
+
+void write_validity_json(const ValidityStudy& study, const std::filesystem::path& path) {
+  json scenes = json::array();
+  for (const ValidityScene& v : study.scenes) {
+    json rows = json::array();
+    for (const ValidityRow& r : v.rows) {
+      json models = json::array();
+      for (const ValidityModelError& e : r.models) {
+        json m{{"model", e.model}, {"ok", e.ok}};
+        if (e.ok) {
+          m.update({{"relative_l2", e.relative_l2},
+                    {"max_error_mm", e.max_error_mm},
+                    {"qoi_error_mm", e.qoi_error_mm},
+                    {"qoi_relative", e.qoi_relative},
+                    {"qoi_model_mm", e.qoi_model_mm},
+                    {"iterations", e.iterations}});
+        } else {
+          m["failure"] = e.failure;
+        }
+        models.push_back(m);
+      }
+      rows.push_back({{"magnitude", r.magnitude},
+                      {"linear_qoi_mm", r.linear_qoi_mm},
+                      {"finite_qoi_mm", r.finite_qoi_mm},
+                      {"qoi_difference", r.qoi_difference},
+                      {"l2_difference", r.l2_difference},
+                      {"linear_strain", r.linear_strain},
+                      {"newton_iterations", r.newton_iterations},
+                      {"load_steps", r.load_steps},
+                      {"finite_seconds", r.finite_seconds},
+                      {"models", models}});
+    }
+    json models = json::array();
+    for (const ValidityModel& m : v.models) {
+      models.push_back({{"name", m.name}, {"detail", m.detail}, {"level", m.level},
+                        {"nodes", m.nodes}});
+    }
+    json qoi_limits = json::array(), l2_limits = json::array();
+    for (const auto& c : v.qoi_limits) qoi_limits.push_back(crossing_json(c));
+    for (const auto& c : v.l2_limits) l2_limits.push_back(crossing_json(c));
+    scenes.push_back({{"scene", v.scene},
+                      {"source", v.source},
+                      {"load_kind", v.load_kind},
+                      {"load_unit", v.load_unit},
+                      {"poisson_ratio", v.poisson_ratio},
+                      {"reference_level", v.reference_level},
+                      {"degree", v.degree},
+                      {"element", v.element},
+                      {"dofs", v.dofs},
+                      {"model_level", v.model_level},
+                      {"ladder", v.ladder},
+                      {"models", models},
+                      {"continuation",
+                       {{"completed", v.completed},
+                        {"largest_load", v.largest_load},
+                        {"stop_reason", v.stop_reason},
+                        {"load_steps", v.load_steps},
+                        {"rejected_steps", v.rejected_steps},
+                        {"newton_iterations", v.newton_iterations},
+                        {"solve_seconds", v.finite_seconds},
+                        {"from_cache", v.finite_from_cache}}},
+                      {"qoi_limits", qoi_limits},
+                      {"l2_limits", l2_limits},
+                      {"rows", rows},
+                      {"seconds", v.seconds}});
+  }
+  const json j{{"schema", "vesselverify.validity"},
+               {"schema_version", 1},
+               {"command", study.command},
+               {"full", study.full},
+               {"total_seconds", study.total_seconds},
+               {"scenes", scenes}};
+  write_file_atomically(path, [&](std::ostream& out) { out << j.dump(2) << "\n"; });
+}
+
+void print_validity_summary(const ValidityStudy& study, std::ostream& out) {
+  for (const ValidityScene& v : study.scenes) {
+    out << v.scene << " (" << v.element << " level " << v.reference_level << ", " << v.dofs
+        << " DoFs, nu " << v.poisson_ratio << "):\n";
+    out << "  continuation: " << v.load_steps << " load steps (" << v.rejected_steps
+        << " rejected), " << v.newton_iterations << " Newton iterations, " << v.finite_seconds
+        << " s" << (v.finite_from_cache ? " (read from the cache; original time)" : "") << "\n";
+    if (v.completed) {
+      out << "  reached the whole ladder, " << v.largest_load << " " << v.load_unit << "\n";
+    } else {
+      out << "  stopped at " << v.largest_load << " " << v.load_unit << ": " << v.stop_reason
+          << "\n";
+    }
+    for (std::size_t k = 0; k < v.qoi_limits.size(); ++k) {
+      const auto& c = v.qoi_limits[k];
+      out << "  references part by " << c.threshold * 100 << " % at the QoI: ";
+      if (c.status == "not_reached") {
+        out << "not up to " << c.lower;
+      } else if (c.status == "below_ladder") {
+        out << "already at " << c.upper;
+      } else {
+        out << *c.load << " (between " << c.lower << " and " << c.upper << ")";
+      }
+      out << " " << v.load_unit << "\n";
+    }
+    for (const ValidityRow& r : v.rows) {
+      out << "  " << std::setw(8) << r.magnitude << " " << v.load_unit << ": u_fs "
+          << r.finite_qoi_mm << " mm, u_lin " << r.linear_qoi_mm << " mm, QoI diff "
+          << r.qoi_difference << ", L2 diff " << r.l2_difference;
+      for (const auto& e : r.models) {
+        out << "; " << e.model << " ";
+        if (e.ok) {
+          out << "rel L2 " << e.relative_l2;
+        } else {
+          out << "failed";
+        }
+      }
+      out << "\n";
+    }
+  }
+}
+
+}  // namespace vessel
