@@ -1145,10 +1145,68 @@ SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& pr
   return result;
 }
 
+/// The parallel pass's log: one line per finished task, numbered, with the pass's elapsed time.
+class PassLog {
+ public:
+  PassLog(std::ostream& log, std::size_t total) : log_(log), total_(total) {}
+  /// `after`: more lines (each ending in a newline) kept with this one.
+  void done(const std::string& what, double seconds, const std::string& after = "") {
+    const std::lock_guard lock(mutex_);
+    std::ostringstream line;  // its own precision: the caller's stream keeps its settings
+    line << "  [" << ++finished_ << "/" << total_ << "] " << what << " in " << std::setprecision(3)
+         << seconds << " s (elapsed " << clock_.seconds() << " s)\n"
+         << after;
+    log_ << line.str();
+  }
+
+ private:
+  std::ostream& log_;
+  std::size_t total_, finished_ = 0;
+  std::mutex mutex_;
+  Stopwatch clock_;
+};
+
+/// The dynamic models' FEM transients of every (scene, ν) case, each its own task, `jobs` at a
+/// time (after the references they are run on).
+void run_all_transients(std::vector<std::unique_ptr<SceneReferences>>& refs,
+                        const std::vector<std::pair<std::size_t, std::size_t>>& cases, int jobs,
+                        std::ostream& log) {
+  struct Transient {
+    std::size_t scene, nu;
+    TransientRequest request;
+  };
+  std::vector<Transient> transients;
+  for (const auto& [i, k] : cases) {
+    for (const TransientRequest& q : transient_requests(refs[i]->scene, *refs[i], k)) {
+      transients.push_back({i, k, q});
+    }
+  }
+  if (transients.empty()) return;
+  log << "FEM transients of the dynamic models: " << transients.size() << ", " << jobs
+      << " at a time\n";
+  PassLog pass(log, transients.size());
+  std::mutex seconds_mutex;
+  parallel_solves(transients.size(), jobs, [&](std::size_t t) {
+    const Transient& x = transients[t];
+    SceneReferences& r = *refs[x.scene];
+    Stopwatch watch;
+    (void)transient_at(r.at_nu[x.nu].ref, x.request.probe, x.request.duration, x.request.alpha);
+    const double seconds = watch.seconds();
+    {
+      const std::lock_guard lock(seconds_mutex);
+      r.at_nu[x.nu].seconds += seconds;  // the scene's time includes its references'
+    }
+    std::ostringstream what;
+    what << r.scene.name << ": FEM transient (ν = " << r.scene.poisson_ratios[x.nu] << ", "
+         << x.request.duration << " s, α = " << x.request.alpha << " 1/s)";
+    pass.done(what.str(), seconds);
+  });
+}
+
 /// Every scene's references, `o.jobs` solves at a time, the cores shared among the solves running
 /// (parallel_solves). Scenes whose fine problems are equal (the same key in the solution cache)
 /// are solved in one task, one after the other, so that the later ones read the first's entry.
-/// Then the dynamic models' FEM transients, each its own task.
+/// Then the dynamic models' FEM transients (run_all_transients).
 void solve_all_references(std::vector<std::unique_ptr<SceneReferences>>& refs,
                           const HarnessOptions& o, std::ostream& log) {
   std::vector<std::pair<std::size_t, std::size_t>> cases;  // (scene, ν index)
@@ -1187,59 +1245,21 @@ void solve_all_references(std::vector<std::unique_ptr<SceneReferences>>& refs,
   const int jobs = std::max(1, o.jobs);
   log << "FEM references: " << cases.size() << " (scene, ν) cases of " << refs.size()
       << " scene(s), " << jobs << " at a time; the timed models follow one at a time\n";
-  std::mutex log_mutex;
-  Stopwatch clock;
-  std::atomic<std::size_t> finished{0};
-  const auto log_line = [&](const std::string& what, double seconds, std::size_t total) {
-    const std::lock_guard lock(log_mutex);
-    std::ostringstream line;  // its own precision: the caller's stream keeps its settings
-    line << "  [" << ++finished << "/" << total << "] " << what << " in " << std::setprecision(3)
-         << seconds << " s (elapsed " << clock.seconds() << " s)\n";
-    log << line.str();
-  };
+  PassLog pass(log, cases.size());
   parallel_solves(tasks.size(), jobs, [&](std::size_t t) {
     for (const std::size_t c : tasks[t]) {
       const auto [i, k] = cases[c];
       const Scene& s = refs[i]->scene;
       solve_reference_at(s, *refs[i], k, o);
       solve_modal_reference_at(s, *refs[i], k);
-      log_line(s.name + ": " + reference_label(s, s.poisson_ratios[k]) +
-                   (refs[i]->modal_reference_mesh ? ", its modes" : ""),
-               refs[i]->at_nu[k].seconds, cases.size());
-      const std::lock_guard lock(log_mutex);
-      log_modal_failure(log, refs[i]->at_nu[k]);
+      std::ostringstream failure;
+      log_modal_failure(failure, refs[i]->at_nu[k]);
+      pass.done(s.name + ": " + reference_label(s, s.poisson_ratios[k]) +
+                    (refs[i]->modal_reference_mesh ? ", its modes" : ""),
+                refs[i]->at_nu[k].seconds, failure.str());
     }
   });
-
-  struct Transient {
-    std::size_t scene, nu;
-    TransientRequest request;
-  };
-  std::vector<Transient> transients;
-  for (const auto& [i, k] : cases) {
-    for (const TransientRequest& q : transient_requests(refs[i]->scene, *refs[i], k)) {
-      transients.push_back({i, k, q});
-    }
-  }
-  if (transients.empty()) return;
-  log << "FEM transients of the dynamic models: " << transients.size() << ", " << jobs
-      << " at a time\n";
-  finished = 0;
-  parallel_solves(transients.size(), jobs, [&](std::size_t t) {
-    const Transient& x = transients[t];
-    SceneReferences& r = *refs[x.scene];
-    Stopwatch watch;
-    (void)transient_at(r.at_nu[x.nu].ref, x.request.probe, x.request.duration, x.request.alpha);
-    std::ostringstream what;
-    what << r.scene.name << ": FEM transient (ν = " << r.scene.poisson_ratios[x.nu] << ", "
-         << x.request.duration << " s, α = " << x.request.alpha << " 1/s)";
-    const double seconds = watch.seconds();
-    {
-      const std::lock_guard lock(log_mutex);
-      r.at_nu[x.nu].seconds += seconds;  // the scene's time includes its references'
-    }
-    log_line(what.str(), seconds, transients.size());
-  });
+  run_all_transients(refs, cases, jobs, log);
 }
 
 void log_scene_header(std::ostream& log, const Scene& s, std::size_t i, std::size_t n) {
