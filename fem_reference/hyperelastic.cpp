@@ -16,6 +16,7 @@
 
 #include "fem_reference/detail/serial_solver.hpp"
 #include "meshes/errors.hpp"
+#include "meshes/self_contact.hpp"
 
 namespace vessel::fem {
 
@@ -444,6 +445,7 @@ struct HyperelasticSolver::Impl {
     const double target = opt.target_load_factor;
     std::size_t next = 0;  // the next checkpoint
     result.completed = true;
+    result.self_contact = false;
     result.stop_reason.clear();
     while (s < target * (1.0 - 1e-14)) {
       // A step ends at the next checkpoint when it would pass it; ds itself (the increment the
@@ -452,7 +454,13 @@ struct HyperelasticSolver::Impl {
       const bool to_stop = ds >= stop - s;
       const double step = to_stop ? stop - s : ds;
       const dl::Vector<double> u_start = u;
-      const StepOutcome o = newton_step(s, s + step);
+      StepOutcome o = newton_step(s, s + step);
+      bool self_contact = false;
+      if (o.converged && opt.stop_at_self_contact) {
+        o.reason = self_penetration();
+        self_contact = !o.reason.empty();
+        o.converged = !self_contact;
+      }
       if (o.converged) {
         s = to_stop ? stop : s + step;
         result.steps.push_back({s, o.iterations, o.residual});
@@ -472,10 +480,12 @@ struct HyperelasticSolver::Impl {
       ++result.rejected_steps;
       if (step * 0.5 < opt.min_step) {
         std::ostringstream m;
-        m << "no equilibrium found beyond load factor " << s << ": at " << s + step << ", "
-          << o.reason << "; the increment " << step << " cannot be halved below the minimum "
-          << opt.min_step;
+        m << (self_contact ? "no equilibrium without self-contact beyond load factor "
+                           : "no equilibrium found beyond load factor ")
+          << s << ": at " << s + step << ", " << o.reason << "; the increment " << step
+          << " cannot be halved below the minimum " << opt.min_step;
         result.completed = false;
+        result.self_contact = self_contact;
         result.stop_reason = m.str();
         break;
       }
@@ -493,6 +503,19 @@ struct HyperelasticSolver::Impl {
     result.nodal_displacement = d.nodal([&](Index i) { return u(i); });
     result.timings.postprocess = seconds_since(t0);
     solved = true;
+  }
+
+  /// Empty when the wall at the current state u does not pass through itself; else what does.
+  std::string self_penetration() const {
+    const std::vector<Vec3> disp = d.nodal([&](Index i) { return u(i); });
+    const SelfPenetration p = find_self_penetration(d.mesh, disp);
+    if (p.nodes.empty()) return {};
+    const Vec3 x = d.mesh.nodes[static_cast<std::size_t>(p.nodes.front())] * 1e3;
+    std::ostringstream m;
+    m << "the wall passes through itself (" << p.nodes.size()
+      << " surface nodes inside the wall elsewhere, the first at rest point (" << x.x() << ", "
+      << x.y() << ", " << x.z() << ") mm; this reference models no self-contact)";
+    return m.str();
   }
 
   /// Records the equilibrium at checkpoint s and asks the observer whether to go on.

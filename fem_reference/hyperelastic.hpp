@@ -62,6 +62,12 @@ struct HyperelasticOptions {
   /// continuation records its state there (HyperelasticResult::checkpoints) and calls the
   /// observer given to solve(). One continuation then serves a ladder of loads.
   std::vector<double> checkpoints;
+  /// true: after each converged step, test whether the wall has passed through itself
+  /// (find_self_penetration, meshes/self_contact.hpp); such a state is no equilibrium of the
+  /// real vessel, which would touch itself first, and this reference models no contact. The step
+  /// is then rejected like a Newton failure, so the continuation stops at the largest load
+  /// without it, to within min_step (HyperelasticResult::self_contact).
+  bool stop_at_self_contact = true;
 };
 
 /// The state of a continuation at one of HyperelasticOptions::checkpoints.
@@ -90,6 +96,8 @@ struct HyperelasticResult {
   double load_factor = 0.0;
   bool completed = false;
   std::string stop_reason;         ///< empty when completed; else why the load could not go on
+  /// The continuation stopped because the next load would make the wall pass through itself.
+  bool self_contact = false;
   std::vector<LoadStep> steps;     ///< accepted steps
   int rejected_steps = 0;          ///< increments halved after a Newton failure
   int newton_iterations = 0;       ///< total, accepted and rejected steps

@@ -428,6 +428,7 @@ std::optional<std::string> continuation_cache_key(const TetMesh& mesh,
   h.text("hyperelastic").real(o.target_load_factor).real(o.initial_step).real(o.min_step);
   h.real(o.max_step).real(o.growth).integer(o.fast_iterations).integer(o.max_newton_iterations);
   h.integer(o.max_line_search).real(o.residual_tolerance).integer(o.follower_pressure ? 1 : 0);
+  h.text("self-contact").integer(o.stop_at_self_contact ? 1 : 0);
   h.text("checkpoints").integer(static_cast<std::int64_t>(o.checkpoints.size()));
   for (const double c : o.checkpoints) h.real(c);
   h.text("what").text(what);

@@ -50,14 +50,19 @@ TetLocator::TetLocator(const TetMesh& mesh) : mesh_(&mesh) {
   }
 }
 
-int TetLocator::find(const Vec3& x, double tol) const {
+const std::vector<int>& TetLocator::candidates(const Vec3& x) const {
+  static const std::vector<int> none;
   for (int d = 0; d < 3; ++d) {
-    if (x[d] < lo_[d] || x[d] > hi_[d]) return -1;
+    if (x[d] < lo_[d] || x[d] > hi_[d]) return none;
   }
   const auto ijk = bucket_of(x);
+  return buckets_[index(ijk[0], ijk[1], ijk[2])];
+}
+
+int TetLocator::find(const Vec3& x, double tol) const {
   int best = -1;
   double best_min = -tol;
-  for (int t : buckets_[index(ijk[0], ijk[1], ijk[2])]) {
+  for (int t : candidates(x)) {
     const double lmin = min_barycentric(*mesh_, mesh_->tets[static_cast<std::size_t>(t)], x);
     if (lmin >= best_min) {
       best_min = lmin;

@@ -16,6 +16,9 @@ class TetLocator {
   /// The tet containing x (the one with the largest smallest barycentric coordinate, ≥ −tol), or
   /// −1.
   [[nodiscard]] int find(const Vec3& x, double tol = 1e-9) const;
+  /// The tets whose (padded) box may contain x, for tests find does not do (every tet holding x,
+  /// not the best one); empty outside the grid.
+  [[nodiscard]] const std::vector<int>& candidates(const Vec3& x) const;
 
  private:
   [[nodiscard]] std::array<int, 3> bucket_of(const Vec3& x) const;

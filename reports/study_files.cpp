@@ -160,6 +160,7 @@ ValiditySceneEntry read_validity_scene(const json& j, const std::string& where) 
   e.completed = field<bool>(c, "completed", cw);
   e.largest_load = field<double>(c, "largest_load", cw);
   e.stop_reason = field<std::string>(c, "stop_reason", cw);
+  e.self_contact = field<bool>(c, "self_contact", cw);
   e.load_steps = field<int>(c, "load_steps", cw);
   e.rejected_steps = field<int>(c, "rejected_steps", cw);
   e.newton_iterations = field<int>(c, "newton_iterations", cw);

@@ -126,6 +126,7 @@ struct ValiditySceneEntry {
   bool completed = false;
   double largest_load = 0.0;
   std::string stop_reason;
+  bool self_contact = false;  ///< stopped where the wall would pass through itself
   int load_steps = 0, rejected_steps = 0, newton_iterations = 0;
   double solve_seconds = 0.0;
   bool from_cache = false;

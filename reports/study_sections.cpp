@@ -257,6 +257,11 @@ void validity_scene(Document& doc, const ValiditySceneEntry& v) {
                   std::to_string(v.model_level) + ". Finite-strain continuation: ";
   if (v.completed) {
     p += "equilibrium at every load of the ladder, up to " + load_text(v.largest_load, v.load_unit) + ". ";
+  } else if (v.self_contact) {
+    p += "**stopped where the wall would touch itself: the largest load reached without the wall "
+         "passing through itself is " + load_text(v.largest_load, v.load_unit) +
+         "**; beyond it the vessel has no equilibrium this reference can represent (it models no "
+         "self-contact). Details: " + v.stop_reason + ". The rows end at the last ladder load reached. ";
   } else {
     p += "**stopped: the largest load reached is " + load_text(v.largest_load, v.load_unit) +
          "** (" + v.stop_reason + "); the rows end at the last ladder load reached. ";

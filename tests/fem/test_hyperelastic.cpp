@@ -308,6 +308,68 @@ TEST(HyperelasticContinuation, NewtonFailureReportsTheLargestLoadReached) {
       << r.stop_reason;
 }
 
+namespace {
+
+/// The cube [0, L]³ (groups x0 … z1) and, a gap g beyond its face x1, a block of side 2L
+/// (groups b_x0 … b_z1) shifted off the cube's node planes: two bodies in one mesh.
+TetMesh cube_facing_a_block(double L, double g) {
+  TetMesh m = test::cube_mesh(2, L);
+  const TetMesh b = test::cube_mesh(2, 2 * L);
+  const int nodes = static_cast<int>(m.nodes.size()), triangles = static_cast<int>(m.triangles.size());
+  const Vec3 shift(L + g, -0.37 * L, -0.41 * L);
+  for (const Vec3& x : b.nodes) m.nodes.push_back(x + shift);
+  for (Tet t : b.tets) {
+    for (int& v : t) v += nodes;
+    m.tets.push_back(t);
+  }
+  for (Triangle t : b.triangles) {
+    for (int& v : t) v += nodes;
+    m.triangles.push_back(t);
+  }
+  for (PhysicalGroup grp : b.groups) {
+    grp.name = "b_" + grp.name;
+    grp.tag += 6;
+    for (int& e : grp.elements) e += triangles;
+    m.groups.push_back(grp);
+  }
+  return m;
+}
+
+}  // namespace
+
+TEST(HyperelasticContinuation, StopsWhereTheWallWouldPassThroughItself) {
+  // The cube is pulled along x towards the clamped block (Cauchy traction up to stretch 1.5);
+  // its face x1 reaches the block at stretch 1 + g/L = 1.2, i.e. at the load factor
+  // s* = σ(1.2)/σ(1.5) of the closed form. Beyond it the face's nodes would lie inside the
+  // block, so the continuation stops there, to within the step it can no longer halve.
+  const double L = 1e-3, g = 0.2e-3;
+  const TetMesh mesh = cube_facing_a_block(L, g);
+  Material m;
+  m.poisson_ratio = 0.3;
+  const double mu = m.mu(), lambda = m.lambda();
+  const double full = uniaxial_stress(1.5, mu, lambda).cauchy;
+  const double s_touch = uniaxial_stress(1.2, mu, lambda).cauchy / full;
+  ElasticityProblem p = cube_problem(0.3, 1, Formulation::displacement, -full);
+  p.dirichlet.push_back(DirichletCondition::clamped("b_x1"));
+  HyperelasticOptions o;
+  o.min_step = 0.01;
+  HyperelasticSolver s(mesh, p, o);
+  const auto& r = s.solve();
+  std::cout << "  self-contact expected at load factor " << s_touch << ", stopped at "
+            << r.load_factor << ": " << r.stop_reason << "\n";
+  EXPECT_FALSE(r.completed);
+  EXPECT_TRUE(r.self_contact);
+  EXPECT_NE(r.stop_reason.find("the wall passes through itself"), std::string::npos) << r.stop_reason;
+  // The last failed step was shorter than 2·min_step and began at the load reached.
+  EXPECT_LE(r.load_factor, s_touch + 1e-9);
+  EXPECT_GE(r.load_factor, s_touch - 2 * o.min_step);
+  // Not a Newton failure: the same problem without the check reaches the full load.
+  o.stop_at_self_contact = false;
+  HyperelasticSolver free(mesh, p, o);
+  EXPECT_TRUE(free.solve().completed);
+  EXPECT_FALSE(free.result().self_contact);
+}
+
 TEST(HyperelasticContinuation, RefusesCheckpointsOutOfOrderOrBeyondTheTarget) {
   const TetMesh mesh = test::cube_mesh(1, 1e-3);
   for (const std::vector<double>& bad : {std::vector<double>{0.5, 0.2}, {0.5, 1.5}, {0.0}}) {

@@ -168,6 +168,7 @@ TEST(ValidityFile, WrittenThenReadBackByTheReportWithBadFieldsNamed) {
   v.completed = false;
   v.largest_load = 1.5e-3;
   v.stop_reason = "no equilibrium";
+  v.self_contact = true;
   v.newton_iterations = 7;
   ValidityRow r;
   r.magnitude = 1e-3;
@@ -186,6 +187,7 @@ TEST(ValidityFile, WrittenThenReadBackByTheReportWithBadFieldsNamed) {
   EXPECT_EQ(e.largest_load, 1.5e-3);
   EXPECT_FALSE(e.completed);
   EXPECT_EQ(e.stop_reason, "no equilibrium");
+  EXPECT_TRUE(e.self_contact);
   EXPECT_EQ(e.newton_iterations, 7);
   ASSERT_EQ(e.rows.size(), 1u);
   EXPECT_EQ(e.rows[0].qoi_difference, 0.02);
@@ -252,4 +254,15 @@ TEST(ValidityFile, TheReportSectionShowsTheLimitsAndTheLargestLoadReached) {
   EXPECT_NE(md.find("not reached up to 50 mN"), std::string::npos) << md;
   EXPECT_NE(md.find("surface_seed000: rel. L2 / QoI error (mm)"), std::string::npos) << md;
   EXPECT_NE(md.find("| 0.71 / 1.5 |"), std::string::npos) << md;
+
+  // Stopped where the wall would pass through itself: said so, not as a Newton failure.
+  f.scenes[0].self_contact = true;
+  reports::Document contact;
+  reports::validity_section(contact, f);
+  const std::string cmd = contact.markdown_text("figures");
+  EXPECT_NE(cmd.find("**stopped where the wall would touch itself: the largest load reached "
+                     "without the wall passing through itself is 62.5 mN**"),
+            std::string::npos)
+      << cmd;
+  EXPECT_EQ(cmd.find("**stopped: the largest load"), std::string::npos) << cmd;
 }

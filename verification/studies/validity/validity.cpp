@@ -58,6 +58,7 @@ struct Continuation {
   bool completed = false;
   double largest_load = 0.0;
   std::string stop_reason;
+  bool self_contact = false;
   int load_steps = 0, rejected_steps = 0, newton_iterations = 0;
   double seconds = 0.0;
   std::vector<Sample> samples;
@@ -87,6 +88,7 @@ std::string serialise(const Continuation& c) {
          {"completed", c.completed},
          {"largest_load", c.largest_load},
          {"stop_reason", c.stop_reason},
+         {"self_contact", c.self_contact},
          {"load_steps", c.load_steps},
          {"rejected_steps", c.rejected_steps},
          {"newton_iterations", c.newton_iterations},
@@ -118,6 +120,7 @@ Continuation deserialise(std::string_view text, std::size_t mesh_nodes,
   c.completed = j.at("completed").get<bool>();
   c.largest_load = j.at("largest_load").get<double>();
   c.stop_reason = j.at("stop_reason").get<std::string>();
+  c.self_contact = j.at("self_contact").get<bool>();
   c.load_steps = j.at("load_steps").get<int>();
   c.rejected_steps = j.at("rejected_steps").get<int>();
   c.newton_iterations = j.at("newton_iterations").get<int>();
@@ -308,7 +311,7 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
   fo.min_step = (o.full ? 1e-4 : 2e-2) * out.ladder.back();
   fo.checkpoints = out.ladder;
   ContentHash what;
-  what.text("validity samples v1").real(qoi.x()).real(qoi.y()).real(qoi.z());
+  what.text("validity samples v2").real(qoi.x()).real(qoi.y()).real(qoi.z());
   what.real(kOutsideTolerance);
   for (const auto& b : built) {
     what.integer(static_cast<std::int64_t>(b.network.nodes.size()));
@@ -343,6 +346,7 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
     c.completed = r.completed;
     c.largest_load = r.load_factor;
     c.stop_reason = r.stop_reason;
+    c.self_contact = r.self_contact;
     c.load_steps = static_cast<int>(r.steps.size());
     c.rejected_steps = r.rejected_steps;
     c.newton_iterations = r.newton_iterations;
@@ -367,6 +371,7 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
   out.completed = c.completed;
   out.largest_load = c.largest_load;
   out.stop_reason = c.stop_reason;
+  out.self_contact = c.self_contact;
   out.load_steps = c.load_steps;
   out.rejected_steps = c.rejected_steps;
   out.newton_iterations = c.newton_iterations;
@@ -523,6 +528,7 @@ void write_validity_json(const ValidityStudy& study, const std::filesystem::path
                        {{"completed", v.completed},
                         {"largest_load", v.largest_load},
                         {"stop_reason", v.stop_reason},
+                        {"self_contact", v.self_contact},
                         {"load_steps", v.load_steps},
                         {"rejected_steps", v.rejected_steps},
                         {"newton_iterations", v.newton_iterations},
@@ -552,8 +558,9 @@ void print_validity_summary(const ValidityStudy& study, std::ostream& out) {
     if (v.completed) {
       out << "  reached the whole ladder, " << v.largest_load << " " << v.load_unit << "\n";
     } else {
-      out << "  stopped at " << v.largest_load << " " << v.load_unit << ": " << v.stop_reason
-          << "\n";
+      out << "  stopped at " << v.largest_load << " " << v.load_unit
+          << (v.self_contact ? " (the wall would pass through itself beyond it)" : "") << ": "
+          << v.stop_reason << "\n";
     }
     for (std::size_t k = 0; k < v.qoi_limits.size(); ++k) {
       const auto& c = v.qoi_limits[k];

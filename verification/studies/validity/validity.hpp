@@ -90,6 +90,9 @@ struct ValidityScene {
   bool completed = false;
   double largest_load = 0.0;
   std::string stop_reason;
+  /// It stopped because the next load would make the wall pass through itself (the reference
+  /// models no self-contact; fem::HyperelasticResult::self_contact).
+  bool self_contact = false;
   int load_steps = 0, rejected_steps = 0, newton_iterations = 0;
   double finite_seconds = 0.0;  ///< assembly + linear solves of the continuation, s
   bool finite_from_cache = false;  ///< read from the FEM solution cache (its seconds: the original's)
