@@ -1,6 +1,7 @@
 #include "meshes/self_contact.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 
 #include "meshes/tet_locator.hpp"
@@ -46,6 +47,26 @@ SelfPenetration find_self_penetration(const TetMesh& mesh, const std::vector<Vec
     }
   }
   return out;
+}
+
+double closest_approach(const TetMesh& mesh, const std::vector<Vec3>& displacement,
+                        std::string_view group, double apart) {
+  if (displacement.size() != mesh.nodes.size()) {
+    throw std::invalid_argument("closest_approach: expected one displacement per mesh node");
+  }
+  const std::vector<int> nodes = mesh.group_nodes(mesh.require_group(group, 2, "the mesh"));
+  double best = std::numeric_limits<double>::infinity();
+  const double apart2 = apart * apart;
+  for (std::size_t a = 0; a < nodes.size(); ++a) {
+    const auto i = static_cast<std::size_t>(nodes[a]);
+    const Vec3 xi = mesh.nodes[i] + displacement[i];
+    for (std::size_t b = a + 1; b < nodes.size(); ++b) {
+      const auto j = static_cast<std::size_t>(nodes[b]);
+      if ((mesh.nodes[i] - mesh.nodes[j]).squaredNorm() < apart2) continue;
+      best = std::min(best, (xi - mesh.nodes[j] - displacement[j]).norm());
+    }
+  }
+  return best;
 }
 
 }  // namespace vessel

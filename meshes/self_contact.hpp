@@ -2,6 +2,7 @@
 /// Whether a deformed mesh has passed through itself: the check that stops a finite-strain
 /// reference, which models no contact between the wall's own surfaces, where the wall would
 /// touch or cross the opposite wall (issue 17).
+#include <string_view>
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
@@ -26,5 +27,14 @@ struct SelfPenetration {
 /// std::invalid_argument otherwise.
 SelfPenetration find_self_penetration(const TetMesh& mesh, const std::vector<Vec3>& displacement,
                                       double tolerance = 1e-6);
+
+/// The smallest deformed distance between two nodes of the boundary group `group` whose rest
+/// distance is at least `apart` (m): how close the wall comes to touching itself, e.g. across
+/// the lumen with the inner wall and apart = the inner radius. Node to node, so it exceeds the
+/// surfaces' true gap by up to about an element size. +∞ when no two nodes are that far apart.
+/// InputError naming the group when the mesh has no such triangle group; std::invalid_argument
+/// for a displacement count other than the node count.
+double closest_approach(const TetMesh& mesh, const std::vector<Vec3>& displacement,
+                        std::string_view group, double apart);
 
 }  // namespace vessel

@@ -134,6 +134,9 @@ ValidityRowEntry read_validity_row(const json& j, const std::string& where) {
   e.qoi_difference = field<double>(j, "qoi_difference", where);
   e.l2_difference = field<double>(j, "l2_difference", where);
   e.linear_strain = field<double>(j, "linear_strain", where);
+  if (const auto g = j.find("wall_gap_mm"); g != j.end() && !g->is_null()) {
+    e.wall_gap_mm = field<double>(j, "wall_gap_mm", where);
+  }
   e.newton_iterations = field<int>(j, "newton_iterations", where);
   e.load_steps = field<int>(j, "load_steps", where);
   e.finite_seconds = field<double>(j, "finite_seconds", where);

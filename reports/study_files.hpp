@@ -111,6 +111,7 @@ struct ValidityModelEntry {
 struct ValidityRowEntry {
   double magnitude = 0.0, linear_qoi_mm = 0.0, finite_qoi_mm = 0.0;
   double qoi_difference = 0.0, l2_difference = 0.0, linear_strain = 0.0;
+  std::optional<double> wall_gap_mm;  ///< the inner wall's closest approach across the lumen
   int newton_iterations = 0, load_steps = 0;
   double finite_seconds = 0.0;
   std::vector<ValidityModelEntry> models;

@@ -283,7 +283,7 @@ void validity_scene(Document& doc, const ValiditySceneEntry& v) {
   doc.table(limits);
   Table rows;
   rows.header = {"load", "u finite strain (mm)", "u linear (mm)", "QoI difference",
-                 "L2 difference", "linear strain", "Newton its (cum.)"};
+                 "L2 difference", "linear strain", "lumen gap (mm)", "Newton its (cum.)"};
   for (const std::string& m : v.models) rows.header.push_back(m + ": rel. L2 / QoI error (mm)");
   for (const ValidityRowEntry& r : v.rows) {
     std::vector<std::string> row = {load_text(r.magnitude, v.load_unit),
@@ -292,6 +292,7 @@ void validity_scene(Document& doc, const ValiditySceneEntry& v) {
                                     percent(r.qoi_difference),
                                     percent(r.l2_difference),
                                     percent(r.linear_strain),
+                                    r.wall_gap_mm ? significant(*r.wall_gap_mm, 3) : "–",
                                     std::to_string(r.newton_iterations)};
     for (const ValidityModelEntry& e : r.models) {
       row.push_back(e.ok ? significant(e.relative_l2, 3) + " / " + significant(e.qoi_error_mm, 3)
@@ -316,7 +317,12 @@ void validity_section(Document& doc, const ValidityFile& v) {
       "power law; at small loads d grows like F since the references differ by O(F²)). The "
       "models' columns are their relative L2 error over their nodes and the displacement error "
       "at their QoI node against the finite-strain reference. *linear strain* is the linear "
-      "reference's largest principal strain (the run flags results beyond 5 %). Made by " +
+      "reference's largest principal strain (the run flags results beyond 5 %). *lumen gap* is "
+      "how close the finite-strain wall comes to touching itself: the smallest distance between "
+      "inner-wall nodes at least the inner radius apart at rest (about the lumen's diameter at "
+      "rest; node to node, so up to an element size above the surfaces' gap). The continuation "
+      "stops where a wall node would enter the wall elsewhere, which this reference cannot "
+      "represent (it models no self-contact). Made by " +
       std::string("`") + v.command + "`" + (v.full ? " (full)" : "") + " in " +
       significant(v.total_seconds, 3) + " s.");
   for (const ValiditySceneEntry& s : v.scenes) validity_scene(doc, s);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "meshes/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/self_contact.hpp"
 
@@ -78,6 +79,23 @@ TEST(SelfPenetration, TheTubeFlattenedAffinelyDoesNotPassThroughItself) {
     u[i] = Vec3(x.x(), 0.05 * x.y() + 0.3 * x.z(), x.z()) - x;
   }
   EXPECT_TRUE(find_self_penetration(m, u).nodes.empty());
+}
+
+TEST(ClosestApproach, IsTheLumensDiameterAtRestAndShrinksWithTheFlattenedTube) {
+  // Inner-wall nodes at least the radius a = 3 mm apart at rest: the closest such pair lies on
+  // the circle with a chord ≥ a, so at rest the approach is between a and the smallest chord of
+  // the circle's nodes that reaches a (≤ 2a = the diameter). Scaled by 0.5 across (y), two nodes
+  // diametrically opposite in y come 0.5 · 2a = a apart.
+  const TetMesh& m = tube();
+  const double a = 3e-3;
+  const std::vector<Vec3> rest(m.nodes.size(), Vec3::Zero());
+  const double d0 = closest_approach(m, rest, "inner_wall", a);
+  EXPECT_GE(d0, a - 1e-12);
+  EXPECT_LE(d0, 2 * a);
+  std::vector<Vec3> u(m.nodes.size());
+  for (std::size_t i = 0; i < u.size(); ++i) u[i] = Vec3(0, -0.5 * m.nodes[i].y(), 0);
+  EXPECT_LE(closest_approach(m, u, "inner_wall", a), a + 1e-12);
+  EXPECT_THROW((void)closest_approach(m, rest, "lumen", a), InputError);
 }
 
 TEST(SelfPenetration, TheTubesUpperHalfPushedThroughTheLowerHalfIsFound) {

@@ -109,6 +109,13 @@ TEST(ValidityStudy, TheOnePercentCrossingIsWhatTheLoadSquaredDifferencePredicts)
     EXPECT_TRUE(r.models[0].ok) << r.models[0].failure;
     EXPECT_GT(r.models[0].relative_l2, 0.0);
   }
+  // The lumen gap: at 1 µN the wall has moved by under 1 µm (the contact point by 0.5 µm), so it
+  // is the rest value to 1 µm, at least the inner radius (the pairs' rest distance) and at most
+  // the diameter; it narrows as the load grows.
+  ASSERT_TRUE(v.rows.front().wall_gap_mm.has_value());
+  EXPECT_GE(*v.rows.front().wall_gap_mm, 3.0 - 1e-3);
+  EXPECT_LE(*v.rows.front().wall_gap_mm, 6.0);
+  EXPECT_LT(*v.rows.back().wall_gap_mm, *v.rows.front().wall_gap_mm);
   // The continuation's cost is recorded and cumulative.
   EXPECT_GT(v.newton_iterations, 0);
   EXPECT_EQ(v.rows.back().newton_iterations, v.newton_iterations);
@@ -173,6 +180,7 @@ TEST(ValidityFile, WrittenThenReadBackByTheReportWithBadFieldsNamed) {
   ValidityRow r;
   r.magnitude = 1e-3;
   r.qoi_difference = 0.02;
+  r.wall_gap_mm = 3.5;
   r.models = {{"m", true, "", 0.5, 1.0, 0.1, 0.2, 0.3, 4}};
   v.rows = {r};
   v.qoi_limits = {threshold_crossing({1e-3}, {0.02}, 0.01),
@@ -191,6 +199,7 @@ TEST(ValidityFile, WrittenThenReadBackByTheReportWithBadFieldsNamed) {
   EXPECT_EQ(e.newton_iterations, 7);
   ASSERT_EQ(e.rows.size(), 1u);
   EXPECT_EQ(e.rows[0].qoi_difference, 0.02);
+  EXPECT_EQ(e.rows[0].wall_gap_mm, 3.5);
   EXPECT_EQ(e.rows[0].models[0].relative_l2, 0.5);
   EXPECT_EQ(e.qoi_limits[0].status, "below_ladder");
   EXPECT_EQ(e.qoi_limits[1].status, "not_reached");

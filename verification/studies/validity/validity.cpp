@@ -11,6 +11,7 @@
 #include "fem_reference/elasticity.hpp"
 #include "meshes/atomic_file.hpp"
 #include "meshes/content_hash.hpp"
+#include "meshes/self_contact.hpp"
 #include "meshes/errors.hpp"
 #include "msm/model/model_factory.hpp"
 #include "msm/solvers/updates.hpp"
@@ -384,6 +385,8 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
   // The rows: references and models at each checkpoint reached. Each model is updated along
   // the ladder from its previous state (a continuation too); a failure restarts it from rest.
   std::vector<std::unique_ptr<msm::Updater>> updaters(specs.size());
+  const bool parametric =
+      s.vessel.kind == VesselKind::straight || s.vessel.kind == VesselKind::arch;
   for (const Sample& x : c.samples) {
     ValidityRow row;
     row.magnitude = x.load;
@@ -394,6 +397,10 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
     row.l2_difference =
         compare_displacements(scaled(lin.nodal_displacement, x.load), x.mesh_nodes).relative_l2;
     row.linear_strain = lin.max_abs_principal_strain * x.load;
+    if (parametric) {
+      row.wall_gap_mm =
+          closest_approach(ref_mesh, x.mesh_nodes, "inner_wall", s.vessel.inner_radius) * 1e3;
+    }
     row.newton_iterations = x.newton_iterations;
     row.load_steps = x.load_steps;
     row.finite_seconds = x.seconds;
@@ -499,6 +506,7 @@ void write_validity_json(const ValidityStudy& study, const std::filesystem::path
                       {"qoi_difference", r.qoi_difference},
                       {"l2_difference", r.l2_difference},
                       {"linear_strain", r.linear_strain},
+                      {"wall_gap_mm", r.wall_gap_mm ? json(*r.wall_gap_mm) : json(nullptr)},
                       {"newton_iterations", r.newton_iterations},
                       {"load_steps", r.load_steps},
                       {"finite_seconds", r.finite_seconds},

@@ -63,6 +63,10 @@ struct ValidityRow {
   double qoi_difference = 0.0;    ///< |u_lin − u_fs| / |u_fs| at the QoI point
   double l2_difference = 0.0;     ///< ‖u_lin − u_fs‖ / ‖u_fs‖ over the reference mesh's nodes
   double linear_strain = 0.0;     ///< the linear reference's largest |principal strain|
+  /// How close the finite-strain wall comes to touching itself across the lumen: the smallest
+  /// deformed distance between inner-wall nodes at least the inner radius apart at rest
+  /// (closest_approach, meshes/self_contact.hpp), mm. None for a vessel from a file.
+  std::optional<double> wall_gap_mm;
   int newton_iterations = 0;      ///< of the continuation up to this load (cumulative)
   int load_steps = 0;             ///< accepted, cumulative
   double finite_seconds = 0.0;    ///< assembly + solves up to this load (cumulative), s
