@@ -319,8 +319,9 @@ void validity_section(Document& doc, const ValidityFile& v) {
       "at their QoI node against the finite-strain reference. *linear strain* is the linear "
       "reference's largest principal strain (the run flags results beyond 5 %). *lumen gap* is "
       "how close the finite-strain wall comes to touching itself: the smallest distance between "
-      "inner-wall nodes at least the inner radius apart at rest (about the lumen's diameter at "
-      "rest; node to node, so up to an element size above the surfaces' gap). The continuation "
+      "inner-wall nodes at least the inner radius apart at rest (so about the inner radius at "
+      "rest, and 0 where the wall touches itself; node to node, up to an element size above the "
+      "surfaces' gap). The continuation "
       "stops where a wall node would enter the wall elsewhere, which this reference cannot "
       "represent (it models no self-contact). Made by " +
       std::string("`") + v.command + "`" + (v.full ? " (full)" : "") + " in " +
