@@ -244,8 +244,11 @@ std::vector<double> default_ladder(const Scene& scene, bool full) {
   return {0.5 * top, top};
 }
 
-ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
-  const auto t_scene = std::chrono::steady_clock::now();
+namespace {
+
+/// The scene's study settings: names, levels, ν and the sorted ladder. InputError for a dynamic
+/// scene or an empty or non-positive ladder.
+ValidityScene scene_settings(const Scene& s, const ValidityOptions& o) {
   const bool dynamic = std::any_of(s.models.begin(), s.models.end(),
                                    [](const ModelSpec& m) { return m.solver.is_dynamic(); });
   if (dynamic) {
@@ -267,58 +270,62 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
   if (out.ladder.empty() || !(out.ladder.front() > 0.0)) {
     throw InputError("validity: the load ladder must hold loads > 0");
   }
-  const double nu = out.poisson_ratio;
-  const Vec3 qoi = qoi_point(s);
+  return out;
+}
 
-  // The references: one mesh, one problem at unit load.
-  const TetMesh ref_mesh = scene_mesh(s, out.reference_level, o.mesh_cache_dir);
-  const fem::ElasticityProblem problem = fem_problem(s, ref_mesh, nu, o.degree);
-  fem::ElasticitySolver linear(ref_mesh, problem);
-  const fem::ElasticityResult& lin = fem::solve_with(o.cache, linear, ref_mesh, problem);
-  out.element = lin.element;
-  out.dofs = lin.n_dofs;
-  const Vec3 lin_qoi = linear.displacement_at({qoi}, kOutsideTolerance)[0];
-  log_line(o, "validity " + s.name + ": reference " + lin.element + " on level " +
-                  std::to_string(out.reference_level) + ", " + std::to_string(lin.n_dofs) +
-                  " DoFs");
-
-  // The models, built on their level's mesh.
-  const std::vector<const ModelSpec*> specs = chosen_models(s, o);
-  const TetMesh model_mesh = scene_mesh(s, out.model_level, o.mesh_cache_dir);
-  VesselParams vessel = s.vessel;
-  vessel.level = out.model_level;
+/// The mass-spring models the study judges, built on their level's mesh.
+struct StudyModels {
+  std::vector<const ModelSpec*> specs;
+  TetMesh mesh;
   std::vector<msm::BuiltNetwork> built;
   std::vector<std::unique_ptr<msm::MassSpringModel>> forms;
   std::vector<std::size_t> node_counts;
-  for (const ModelSpec* m : specs) {
-    built.push_back(scene_network(s, *m, model_mesh, vessel, nu));
-    forms.push_back(msm::make_model(built.back(), m->damping));
-    node_counts.push_back(built.back().network.nodes.size());
-    out.models.push_back({m->name,
-                          built.back().topology + ", " + msm::to_string(m->stiffness) +
-                              " stiffness, " + msm::to_string(m->solver),
-                          out.model_level, node_counts.back()});
-  }
+};
 
-  // The finite-strain continuation with the ladder as checkpoints (unit load × load factor =
-  // magnitude, as the harness's finite-strain reference), cached with the points it samples.
+StudyModels build_models(const Scene& s, const ValidityOptions& o, ValidityScene& out) {
+  StudyModels m;
+  m.specs = chosen_models(s, o);
+  m.mesh = scene_mesh(s, out.model_level, o.mesh_cache_dir);
+  VesselParams vessel = s.vessel;
+  vessel.level = out.model_level;
+  for (const ModelSpec* spec : m.specs) {
+    m.built.push_back(scene_network(s, *spec, m.mesh, vessel, out.poisson_ratio));
+    m.forms.push_back(msm::make_model(m.built.back(), spec->damping));
+    m.node_counts.push_back(m.built.back().network.nodes.size());
+    out.models.push_back({spec->name,
+                          m.built.back().topology + ", " + msm::to_string(spec->stiffness) +
+                              " stiffness, " + msm::to_string(spec->solver),
+                          out.model_level, m.node_counts.back()});
+  }
+  return m;
+}
+
+/// The finite-strain continuation through the ladder (unit load × load factor = magnitude, as
+/// the harness's finite-strain reference), sampled at each checkpoint at the QoI, the mesh's
+/// nodes and the models' nodes; from the cache when it holds it (`from_cache` says which).
+Continuation finite_continuation(const Scene& s, const ValidityOptions& o, const TetMesh& ref_mesh,
+                                 const fem::ElasticityProblem& problem,
+                                 const std::vector<double>& ladder, const StudyModels& models,
+                                 bool& from_cache) {
+  const Vec3 qoi = qoi_point(s);
   fem::HyperelasticOptions fo = o.finite;
-  fo.target_load_factor = out.ladder.back();
-  fo.initial_step = fo.max_step = out.ladder.back();  // each step tries the next checkpoint
+  fo.target_load_factor = ladder.back();
+  fo.initial_step = fo.max_step = ladder.back();  // each step tries the next checkpoint
   // Where no equilibrium follows, the increment is halved down to min_step: the largest load
   // reached is found to within it. Most of the study's cost is that search (on 2 cores the
   // default ladder's hunt to 1e-4 of the top took ~10 min of the main job), so the default
   // stops at 2 % of the top (2.8 mN of 140 mN); --full keeps 1e-4.
-  fo.min_step = (o.full ? 1e-4 : 2e-2) * out.ladder.back();
-  fo.checkpoints = out.ladder;
+  fo.min_step = (o.full ? 1e-4 : 2e-2) * ladder.back();
+  fo.checkpoints = ladder;
   ContentHash what;
   what.text("validity samples v2").real(qoi.x()).real(qoi.y()).real(qoi.z());
   what.real(kOutsideTolerance);
-  for (const auto& b : built) {
+  for (const auto& b : models.built) {
     what.integer(static_cast<std::int64_t>(b.network.nodes.size()));
     for (const Vec3& p : b.network.nodes) what.real(p.x()).real(p.y()).real(p.z());
   }
   auto compute = [&] {
+    from_cache = false;
     Continuation c;
     fem::HyperelasticSolver fs(ref_mesh, problem, fo);
     const fem::HyperelasticResult& r =
@@ -331,7 +338,7 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
           x.seconds = cp.seconds;
           x.qoi = at.displacement_at({qoi}, kOutsideTolerance)[0];
           x.mesh_nodes = cp.nodal_displacement;
-          for (const auto& b : built) {
+          for (const auto& b : models.built) {
             x.model_nodes.push_back(at.displacement_at(b.network.nodes, kOutsideTolerance));
           }
           std::ostringstream m;
@@ -354,21 +361,75 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
     c.seconds = r.timings.assembly + r.timings.solve;
     return serialise(c);
   };
+  from_cache = true;
   const std::optional<std::string> key =
       o.cache ? fem::continuation_cache_key(ref_mesh, problem, fo, what.hex()) : std::nullopt;
-  bool computed = false;
-  auto compute_marked = [&] {
-    computed = true;
-    return compute();
-  };
   const std::string payload =
-      key ? o.cache->payload(*key, compute_marked,
+      key ? o.cache->payload(*key, compute,
                              [&](std::string_view text) {
-                               return deserialise(text, ref_mesh.nodes.size(), node_counts).seconds;
+                               return deserialise(text, ref_mesh.nodes.size(), models.node_counts)
+                                   .seconds;
                              })
-          : compute_marked();
-  const Continuation c = deserialise(payload, ref_mesh.nodes.size(), node_counts);
-  out.finite_from_cache = !computed;
+          : compute();
+  return deserialise(payload, ref_mesh.nodes.size(), models.node_counts);
+}
+
+/// Model m's errors against the finite-strain sample x, updated from its previous state along
+/// the ladder (a continuation too); a failure is recorded and restarts it from rest.
+ValidityModelError model_error(const Scene& s, const StudyModels& models, std::size_t m,
+                               const Sample& x, std::unique_ptr<msm::Updater>& updater) {
+  ValidityModelError e;
+  e.model = models.specs[m]->name;
+  try {
+    const msm::Problem p = msm_problem(s, *models.forms[m], models.built[m], models.mesh, x.load);
+    if (!updater) updater = msm::prepare_updates(p, models.specs[m]->solver);
+    const msm::UpdateResult u = updater->update(p.external_force);
+    e.iterations = u.iterations;
+    const Eigen::VectorXd& state = updater->state();
+    const auto& nodes = models.built[m].network.nodes;
+    std::vector<Vec3> um(nodes.size());
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      um[i] = state.segment<3>(3 * static_cast<Eigen::Index>(i)) - nodes[i];
+    }
+    const ErrorStatistics st = compare_displacements(um, x.model_nodes[m]);
+    e.relative_l2 = st.relative_l2;
+    e.max_error_mm = st.max_mm;
+    const std::size_t q = nearest_node(nodes, qoi_point(s));
+    const Vec3 uref = x.model_nodes[m][q];
+    e.qoi_error_mm = (um[q] - uref).norm() * 1e3;
+    e.qoi_model_mm = um[q].norm() * 1e3;
+    e.qoi_relative = uref.norm() > 0.0 ? (um[q] - uref).norm() / uref.norm() : 0.0;
+    e.ok = true;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& ex) {
+    e.failure = ex.what();
+    updater.reset();
+  }
+  return e;
+}
+
+}  // namespace
+
+ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
+  const auto t_scene = std::chrono::steady_clock::now();
+  ValidityScene out = scene_settings(s, o);
+
+  // The references: one mesh, one problem at unit load.
+  const TetMesh ref_mesh = scene_mesh(s, out.reference_level, o.mesh_cache_dir);
+  const fem::ElasticityProblem problem = fem_problem(s, ref_mesh, out.poisson_ratio, o.degree);
+  fem::ElasticitySolver linear(ref_mesh, problem);
+  const fem::ElasticityResult& lin = fem::solve_with(o.cache, linear, ref_mesh, problem);
+  out.element = lin.element;
+  out.dofs = lin.n_dofs;
+  const Vec3 lin_qoi = linear.displacement_at({qoi_point(s)}, kOutsideTolerance)[0];
+  log_line(o, "validity " + s.name + ": reference " + lin.element + " on level " +
+                  std::to_string(out.reference_level) + ", " + std::to_string(lin.n_dofs) +
+                  " DoFs");
+
+  const StudyModels models = build_models(s, o, out);
+  const Continuation c =
+      finite_continuation(s, o, ref_mesh, problem, out.ladder, models, out.finite_from_cache);
   out.completed = c.completed;
   out.largest_load = c.largest_load;
   out.stop_reason = c.stop_reason;
@@ -382,9 +443,8 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
                     out.load_unit + ": " + c.stop_reason);
   }
 
-  // The rows: references and models at each checkpoint reached. Each model is updated along
-  // the ladder from its previous state (a continuation too); a failure restarts it from rest.
-  std::vector<std::unique_ptr<msm::Updater>> updaters(specs.size());
+  // The rows: references and models at each checkpoint reached.
+  std::vector<std::unique_ptr<msm::Updater>> updaters(models.specs.size());
   const bool parametric =
       s.vessel.kind == VesselKind::straight || s.vessel.kind == VesselKind::arch;
   for (const Sample& x : c.samples) {
@@ -404,36 +464,8 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
     row.newton_iterations = x.newton_iterations;
     row.load_steps = x.load_steps;
     row.finite_seconds = x.seconds;
-    for (std::size_t m = 0; m < specs.size(); ++m) {
-      ValidityModelError e;
-      e.model = specs[m]->name;
-      try {
-        const msm::Problem p = msm_problem(s, *forms[m], built[m], model_mesh, x.load);
-        if (!updaters[m]) updaters[m] = msm::prepare_updates(p, specs[m]->solver);
-        const msm::UpdateResult u = updaters[m]->update(p.external_force);
-        e.iterations = u.iterations;
-        const Eigen::VectorXd& state = updaters[m]->state();
-        const auto& nodes = built[m].network.nodes;
-        std::vector<Vec3> um(nodes.size());
-        for (std::size_t i = 0; i < nodes.size(); ++i) {
-          um[i] = state.segment<3>(3 * static_cast<Eigen::Index>(i)) - nodes[i];
-        }
-        const ErrorStatistics st = compare_displacements(um, x.model_nodes[m]);
-        e.relative_l2 = st.relative_l2;
-        e.max_error_mm = st.max_mm;
-        const std::size_t q = nearest_node(nodes, qoi);
-        const Vec3 uref = x.model_nodes[m][q];
-        e.qoi_error_mm = (um[q] - uref).norm() * 1e3;
-        e.qoi_model_mm = um[q].norm() * 1e3;
-        e.qoi_relative = uref.norm() > 0.0 ? (um[q] - uref).norm() / uref.norm() : 0.0;
-        e.ok = true;
-      } catch (const InputError&) {
-        throw;
-      } catch (const std::exception& ex) {
-        e.failure = ex.what();
-        updaters[m].reset();
-      }
-      row.models.push_back(std::move(e));
+    for (std::size_t m = 0; m < models.specs.size(); ++m) {
+      row.models.push_back(model_error(s, models, m, x, updaters[m]));
     }
     out.rows.push_back(std::move(row));
   }
