@@ -1,7 +1,9 @@
 // The spring force pass against the memory-bandwidth roofline (issue 13, items 3 and 4), in one
 // run: a STREAM-like triad (the roofline, on one thread and on all cores), the per-spring
-// reference kernel (SpringModel::reference_gradient, today's path), and the fast kernel
-// (FastSprings::gradient) on one thread and on all cores, on the level-1 and level-2 volume
+// reference kernel (SpringModel::reference_gradient), the edge-based fast kernel
+// (FastSprings::gradient, "Fast") and the node-centric kernel SpringModel runs on
+// (NodeSprings::gradient, "Node": its AVX2 path, and "NodePortable": its portable path) on one
+// thread and on all cores, on the level-1 and level-2 volume
 // networks (tet edges of the generated straight tube, seed 001 stiffness) and the level-2
 // surface grid (structured straight tube, seed 000). Release build; not run by ctest:
 //
@@ -17,7 +19,11 @@
 //                     forces written (2 × 24 B);
 //   roofline_compulsory  the same with the compulsory traffic only: 24 B of spring data streamed
 //                     per spring plus each node's position read and force written once
-//                     (48 B × nodes / springs), a lower bound that caching can at best reach.
+//                     (48 B × nodes / springs), a lower bound that caching can at best reach;
+//   roofline_layout   (Node only) the same with the bytes its layout streams: 20 B per stored
+//                     entry (4-byte other end, 8-byte k and rest length; every spring at both
+//                     ends, plus padding) plus 48 B × nodes (own position read, force written
+//                     once), per spring.
 // The triad a[i] = b[i] + s·c[i] counts 24 B per element (two reads, one write; STREAM's
 // convention, no write-allocate), on arrays of 128 MiB each, far beyond the caches.
 #include <benchmark/benchmark.h>
@@ -32,6 +38,7 @@
 
 #include "meshes/mesh_cache.hpp"
 #include "msm/kernels/fast_springs.hpp"
+#include "msm/kernels/node_springs.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/model/spring_model.hpp"
 
@@ -123,6 +130,33 @@ void BM_Reference(benchmark::State& state, const Case* c) {
   set_counters(state, *c, 1);
 }
 
+/// The node-centric kernel; `portable` takes its portable path even where AVX2 runs.
+void BM_Node(benchmark::State& state, const Case* c, bool portable) {
+  const int threads = static_cast<int>(state.range(0));
+  NodeSprings node(c->net.springs, static_cast<int>(c->net.nodes.size()), threads, c->net.nodes);
+  node.set_portable(portable);
+  Eigen::VectorXd g(c->x.size());
+  for (auto _ : state) {
+    node.gradient(c->x.data(), g.data());
+    benchmark::DoNotOptimize(g.data());
+    benchmark::ClobberMemory();
+  }
+  set_counters(state, *c, threads);
+  state.counters["avx2"] = node.uses_avx2() ? 1.0 : 0.0;
+  const double springs = static_cast<double>(c->net.springs.size());
+  const double layout_bytes = (20.0 * static_cast<double>(node.num_entries()) +
+                               48.0 * static_cast<double>(c->net.nodes.size())) /
+                              springs;
+  state.counters["layout_bytes_per_spring"] = layout_bytes;
+  const auto bw = g_triad_bandwidth.find(threads);
+  if (bw != g_triad_bandwidth.end() && bw->second > 0) {
+    state.counters["roofline_layout"] =
+        benchmark::Counter(springs * static_cast<double>(state.iterations()) * layout_bytes /
+                               bw->second,
+                           benchmark::Counter::kIsRate);
+  }
+}
+
 void BM_Fast(benchmark::State& state, const Case* c) {
   const int threads = static_cast<int>(state.range(0));
   const FastSprings fast(c->net.springs, static_cast<int>(c->net.nodes.size()), threads,
@@ -181,6 +215,11 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("bytes_per_spring_compulsory",
                               "24 + 48 x nodes/springs (spring data once, each node's position "
                               "read and force written once)");
+  benchmark::AddCustomContext("bytes_per_spring_node_layout",
+                              "(20 x stored entries + 48 x nodes) / springs (NodeSprings: other "
+                              "end 4 B + k 8 B + rest 8 B per entry, each spring at both ends, "
+                              "own position read and force written once per node)");
+  benchmark::AddCustomContext("node_avx2", NodeSprings::cpu_has_avx2_fma() ? "yes" : "no");
   benchmark::AddCustomContext("triad", "a = b + s*c, 3 x 128 MiB, 24 B per element");
   benchmark::AddCustomContext("cores", std::to_string(cores));
   for (const Case& c : cases) {
@@ -204,6 +243,17 @@ int main(int argc, char** argv) {
                      ->ArgName("threads")
                      ->Arg(1);
     if (cores > 1) fast->Arg(cores);
+    auto* node = benchmark::RegisterBenchmark(("BM_Node/" + c.name).c_str(), BM_Node, &c, false)
+                     ->UseRealTime()
+                     ->Unit(benchmark::kMicrosecond)
+                     ->ArgName("threads")
+                     ->Arg(1);
+    if (cores > 1) node->Arg(cores);
+    benchmark::RegisterBenchmark(("BM_NodePortable/" + c.name).c_str(), BM_Node, &c, true)
+        ->UseRealTime()
+        ->Unit(benchmark::kMicrosecond)
+        ->ArgName("threads")
+        ->Arg(1);
   }
   TriadCapture display;
   benchmark::RunSpecifiedBenchmarks(&display);

@@ -174,6 +174,35 @@ int available_cores() {
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
+std::vector<std::int32_t> morton_order(const std::vector<Vec3>& positions) {
+  const int num_nodes = static_cast<int>(positions.size());
+  std::vector<std::int32_t> order(positions.size());
+  for (int v = 0; v < num_nodes; ++v) order[static_cast<std::size_t>(v)] = v;
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Vec3& p : positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double extent = std::max((hi - lo).maxCoeff(), 1e-300);
+  std::vector<std::uint64_t> code(positions.size());
+  for (int v = 0; v < num_nodes; ++v) {
+    std::uint64_t c = 0;
+    std::uint64_t q[3];
+    for (int d = 0; d < 3; ++d) {
+      const double u = (positions[static_cast<std::size_t>(v)][d] - lo[d]) / extent;
+      q[d] = static_cast<std::uint64_t>(std::clamp(u, 0.0, 1.0) * 2097151.0);  // 21 bits
+    }
+    for (int bit = 20; bit >= 0; --bit) {
+      for (int d = 0; d < 3; ++d) c = (c << 1) | ((q[d] >> bit) & 1u);
+    }
+    code[static_cast<std::size_t>(v)] = c;
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
+    return code[static_cast<std::size_t>(a)] < code[static_cast<std::size_t>(b)];
+  });
+  return order;
+}
+
 FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int threads,
                          const std::vector<Vec3>& rest_positions)
     : num_nodes_(num_nodes), threads_(threads), num_springs_(springs.size()) {
@@ -206,28 +235,7 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
                        " rest positions, expected one per node (" + std::to_string(num_nodes) +
                        ")");
     }
-    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (const Vec3& p : rest_positions) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    const double extent = std::max((hi - lo).maxCoeff(), 1e-300);
-    std::vector<std::uint64_t> code(static_cast<std::size_t>(num_nodes));
-    for (int v = 0; v < num_nodes; ++v) {
-      std::uint64_t c = 0;
-      std::uint64_t q[3];
-      for (int d = 0; d < 3; ++d) {
-        const double u = (rest_positions[static_cast<std::size_t>(v)][d] - lo[d]) / extent;
-        q[d] = static_cast<std::uint64_t>(std::clamp(u, 0.0, 1.0) * 2097151.0);  // 21 bits
-      }
-      for (int bit = 20; bit >= 0; --bit) {
-        for (int d = 0; d < 3; ++d) c = (c << 1) | ((q[d] >> bit) & 1u);
-      }
-      code[static_cast<std::size_t>(v)] = c;
-    }
-    std::stable_sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) {
-      return code[static_cast<std::size_t>(a)] < code[static_cast<std::size_t>(b)];
-    });
+    order = morton_order(rest_positions);
   }
   std::vector<std::int32_t> rank(static_cast<std::size_t>(num_nodes));
   for (int r = 0; r < num_nodes; ++r) rank[static_cast<std::size_t>(order[r])] = r;

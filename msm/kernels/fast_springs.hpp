@@ -39,6 +39,11 @@ void set_spring_kernel_threads(int n);
 /// std::thread::hardware_concurrency; at least 1).
 [[nodiscard]] int available_cores();
 
+/// The nodes in the order of a Morton (Z-order) curve through their positions (m): 21 bits per
+/// coordinate over the bounding cube, ties kept in index order. Nearby nodes come close in the
+/// order, so runs of it are compact regions and consecutive nodes share cached neighbours.
+[[nodiscard]] std::vector<std::int32_t> morton_order(const std::vector<Vec3>& positions);
+
 class FastSprings {
  public:
   FastSprings() = default;

@@ -39,7 +39,7 @@ SpringModel::SpringModel(const SpringNetwork& network, double point_damping)
       springs_(network.springs),
       point_damping_(point_damping),
       rest_nodes_(network.nodes),
-      fast_(network.springs, static_cast<int>(network.nodes.size()), spring_kernel_threads(),
+      kernel_(network.springs, static_cast<int>(network.nodes.size()), spring_kernel_threads(),
             network.nodes) {
   if (!(point_damping >= 0)) {
     throw InputError("point_damping k_v: expected a value ≥ 0 N·s/m, got " +
@@ -92,7 +92,7 @@ void SpringModel::assemble(SparseMatrix& H, double diagonal, BlockFn block) cons
 }
 
 void SpringModel::set_threads(int n) {
-  if (n != fast_.threads()) fast_ = FastSprings(springs_, num_nodes_, n, rest_nodes_);
+  if (n != kernel_.threads()) kernel_ = NodeSprings(springs_, num_nodes_, n, rest_nodes_);
 }
 
 void SpringModel::require_size(const VectorXd& x) const {
@@ -104,19 +104,19 @@ void SpringModel::require_size(const VectorXd& x) const {
 
 double SpringModel::energy(const VectorXd& x) const {
   require_size(x);
-  return fast_.energy(x.data());
+  return kernel_.energy(x.data());
 }
 
 void SpringModel::gradient(const VectorXd& x, VectorXd& g) const {
   require_size(x);
   g.resize(num_dofs());
-  fast_.gradient(x.data(), g.data());
+  kernel_.gradient(x.data(), g.data());
 }
 
 double SpringModel::energy_gradient(const VectorXd& x, VectorXd& g) const {
   require_size(x);
   g.resize(num_dofs());
-  return fast_.energy_gradient(x.data(), g.data());
+  return kernel_.energy_gradient(x.data(), g.data());
 }
 
 double SpringModel::reference_energy(const VectorXd& x) const {

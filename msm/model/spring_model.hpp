@@ -1,13 +1,13 @@
 #pragma once
 /// The spring model: a Form over a SpringNetwork (any family mix, Hooke or bilinear springs),
-/// with axial (seed 000 eq. 3.4) and point (eq. 3.3) damping. Energy and gradient run on the fast
-/// kernel (kernels/fast_springs.hpp); the Hessian adds one 3×3 block per spring (spring_hessian's
+/// with axial (seed 000 eq. 3.4) and point (eq. 3.3) damping. Energy and gradient run on the
+/// node-centric kernel (kernels/node_springs.hpp); the Hessian adds one 3×3 block per spring (spring_hessian's
 /// formula) into a fixed pattern; damping uses the per-spring kernel (kernels/spring_kernels.hpp),
 /// which reference_energy/gradient/hessian keep callable as the reference.
 #include <string>
 
 #include "meshes/tet_mesh.hpp"
-#include "msm/kernels/fast_springs.hpp"
+#include "msm/kernels/node_springs.hpp"
 #include "msm/model/form.hpp"
 #include "msm/topology/springs.hpp"
 
@@ -31,9 +31,9 @@ class SpringModel : public Form {
   /// Threads of this model's energy and gradient pass (its own setting; set_solver_threads does
   /// not change it). InputError if n < 1.
   void set_threads(int n);
-  [[nodiscard]] int threads() const { return fast_.threads(); }
+  [[nodiscard]] int threads() const { return kernel_.threads(); }
   /// The same energy and gradient by the per-spring reference kernel, one spring at a time
-  /// (spring_energy / spring_gradient), single-threaded: the fast path's check and benchmark.
+  /// (spring_energy / spring_gradient), single-threaded: the fast paths' check and benchmark.
   [[nodiscard]] double reference_energy(const VectorXd& x) const;
   void reference_gradient(const VectorXd& x, VectorXd& g) const;
   /// The Hessian assembled from spring_hessian's 6×6 blocks (hessian() builds each spring's 3×3
@@ -51,8 +51,8 @@ class SpringModel : public Form {
   int num_nodes_ = 0;
   std::vector<Spring> springs_;
   double point_damping_ = 0.0;
-  std::vector<Vec3> rest_nodes_;     ///< rest positions (the fast kernel's layout), m
-  FastSprings fast_;                 ///< the springs laid out for the fast kernel
+  std::vector<Vec3> rest_nodes_;     ///< rest positions (the kernel's node order), m
+  NodeSprings kernel_;                 ///< the springs laid out for the node-centric kernel
   std::vector<int> damped_;          ///< springs with axial damping k_d ≠ 0
   SparseMatrix pattern_;             ///< the Hessian's sparsity pattern (values zero)
   std::vector<int> slots_;           ///< per spring, 36 indices into pattern_'s value array
