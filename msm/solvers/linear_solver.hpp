@@ -21,6 +21,7 @@ class CholmodFactor : public Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lo
     return const_cast<CholmodFactor*>(this)->cholmod();  // Eigen's accessor is non-const only
   }
 };
+class SupernodalTreeSolve;  // linear_solver.cpp
 }  // namespace detail
 
 class CholmodSolver {
@@ -41,7 +42,20 @@ class CholmodSolver {
   /// solution and workspace arrays: once warmed up no allocation per solve, where Eigen's solve
   /// allocates and frees the solution and CHOLMOD's workspace on every call. Not for concurrent
   /// calls on one solver.
+  ///
+  /// With solver_threads() ≥ 2 and a supernodal factor of at least parallel_solve_min_entries()
+  /// numbers, the two triangular sweeps instead run on that many threads over disjoint subtrees
+  /// of the supernodal elimination tree (the top of the tree, where the subtrees meet, on one
+  /// thread): CHOLMOD 3 (SuiteSparse 5.12) solves on one thread whatever the setting, and a solve
+  /// is bound by reading the factor twice, which two cores do faster than one
+  /// (docs/msm_measurements.md). Same numbers up to rounding.
   void solve_into(const VectorXd& b, VectorXd& x) const;
+  /// The smallest factor (numbers stored) solved on several threads; default 4 M (32 MB, beyond
+  /// the caches, where the sweeps are bound by memory bandwidth). Below it one thread.
+  static void set_parallel_solve_min_entries(double entries);
+  [[nodiscard]] static double parallel_solve_min_entries();
+  /// Threads the last solve_into used (1: CHOLMOD's own solve).
+  [[nodiscard]] int last_solve_threads() const { return last_solve_threads_; }
   /// Solves for several right-hand sides (the columns of B) in one CHOLMOD call.
   [[nodiscard]] Eigen::MatrixXd solve_columns(const Eigen::MatrixXd& B) const;
   /// Numbers stored in the factor L (supernodal: with the zeros of supernode amalgamation), what
@@ -58,6 +72,10 @@ class CholmodSolver {
   mutable cholmod_dense* x_ = nullptr;  ///< cholmod_solve2's solution, kept between solves
   mutable cholmod_dense* y_ = nullptr;  ///< and its workspace
   mutable cholmod_dense* e_ = nullptr;
+  /// The parallel sweeps' plan, for the current symbolic factor and thread count (built at the
+  /// first parallel solve after an analysis).
+  mutable std::unique_ptr<detail::SupernodalTreeSolve> tree_;
+  mutable int last_solve_threads_ = 1;
   Eigen::Index pattern_rows_ = -1;
   Eigen::Index pattern_nonzeros_ = -1;
   int analyses_ = 0;

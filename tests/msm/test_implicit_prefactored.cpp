@@ -3,6 +3,8 @@
 // program's own solver threading (set_solver_threads).
 #include <gtest/gtest.h>
 
+#include <Eigen/SparseCholesky>
+
 #include <algorithm>
 #include <vector>
 
@@ -29,9 +31,8 @@ struct Lattice {
   Problem problem;
 };
 
-Lattice make_lattice() {
+Lattice make_lattice(int nx = 3, int ny = 3, int nz = 2) {
   Lattice c;
-  const int nx = 3, ny = 3, nz = 2;
   auto id = [&](int i, int j, int k) { return (k * ny + j) * nx + i; };
   for (int k = 0; k < nz; ++k) {
     for (int j = 0; j < ny; ++j) {
@@ -69,10 +70,11 @@ Lattice make_lattice() {
   return c;
 }
 
-}  // namespace
-
-TEST(ImplicitEulerRest, EqualsTheSameSchemeRefactorisedEveryStepAndFactorisesOnce) {
-  const Lattice c = make_lattice();
+/// Runs implicit-euler-rest for 100 steps against the same scheme written out with A built and
+/// factorised every step (and solved by CHOLMOD's own solve, on one thread); returns the result.
+/// `settles`: the motion has settled on the static answer after the 100 steps (the 3 × 3 × 2
+/// lattice; the larger one is still moving, at 1e-2 of its fastest velocity).
+DynamicResult expect_rest_equals_refactorised(const Lattice& c, bool settles) {
   const Problem& p = c.problem;
   const double h = 1e-3;
   const int steps = 100;
@@ -132,16 +134,81 @@ TEST(ImplicitEulerRest, EqualsTheSameSchemeRefactorisedEveryStepAndFactorisesOnc
   EXPECT_GE(r.setup_seconds, 0.0);
 
   // The motion has settled on the static answer, which both matrices share.
-  EXPECT_LT(v_ref.back().norm(), 1e-6 * v_scale);
+  if (settles) EXPECT_LT(v_ref.back().norm(), 1e-6 * v_scale);
+  return r;
+}
+
+}  // namespace
+
+TEST(ImplicitEulerRest, EqualsTheSameSchemeRefactorisedEveryStepAndFactorisesOnce) {
+  const Lattice c = make_lattice();
+  const Problem& p = c.problem;
+  expect_rest_equals_refactorised(c, true);
   // The problem tells the two matrices apart on the way: implicit Euler with K at the current
   // state (refactorised every step) is elsewhere after 10 steps.
-  o.implicit_matrix = ImplicitMatrix::current_state;
-  o.on_step = {};
+  DynamicOptions o;
+  o.integrator = Integrator::implicit_euler;
+  o.implicit_matrix = ImplicitMatrix::rest_prefactored;
+  o.dt = 1e-3;
   o.steps = 10;
+  const Eigen::VectorXd x_rest = integrate(p, o).x;
+  o.implicit_matrix = ImplicitMatrix::current_state;
   const DynamicResult current = integrate(p, o);
   EXPECT_EQ(current.numeric_factorisations, 10);
-  const Eigen::VectorXd u = x_ref[9] - p.rest;
-  EXPECT_GT((current.x - x_ref[9]).norm(), 1e-6 * u.norm());
+  const Eigen::VectorXd u = x_rest - p.rest;
+  EXPECT_GT((current.x - x_rest).norm(), 1e-6 * u.norm());
+}
+
+TEST(ImplicitEulerRest, EqualsTheSameSchemeRefactorisedWithTheSolveOnTwoThreads) {
+  // 10 × 8 × 6 nodes, 1 440 dofs: CHOLMOD's factor is supernodal (from 1 000 unknowns), so with
+  // two solver threads and no size threshold every step's solve runs on the parallel sweeps.
+  const Lattice c = make_lattice(10, 8, 6);
+  const double saved = CholmodSolver::parallel_solve_min_entries();
+  CholmodSolver::set_parallel_solve_min_entries(0.0);
+  set_solver_threads(2);
+  expect_rest_equals_refactorised(c, false);
+  set_solver_threads(1);
+  CholmodSolver::set_parallel_solve_min_entries(saved);
+}
+
+TEST(CholmodSolver, ParallelSweepsSolveLikeAnIndependentFactorisationAndFollowRefactorisation) {
+  // A = M + h²K of a 10 × 8 × 6 lattice with its fixed face as identity rows (a forest: every
+  // fixed dof is a tree of its own), against Eigen's simplicial LDLᵀ (another code).
+  const Lattice c = make_lattice(10, 8, 6);
+  const Problem& p = c.problem;
+  SparseMatrix K;
+  p.form->hessian(p.rest, K, true);
+  const double saved = CholmodSolver::parallel_solve_min_entries();
+  CholmodSolver::set_parallel_solve_min_entries(0.0);
+  CholmodSolver solver;
+  Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(p.num_dofs(), -1.0, 2.0).array().sin();
+  for (const double h : {1e-3, 3e-3}) {  // the second: new values, the same pattern
+    SparseMatrix A = h * h * K;
+    for (int i = 0; i < p.num_dofs(); ++i) A.coeffRef(i, i) += p.mass[i];
+    apply_dirichlet(A, p.fixed);
+    solver.factorize(A);
+    const Eigen::SimplicialLDLT<SparseMatrix> ldlt(A);
+    ASSERT_EQ(ldlt.info(), Eigen::Success);
+    const Eigen::VectorXd truth = ldlt.solve(b);
+    for (const int threads : {1, 2, 3}) {
+      set_solver_threads(threads);
+      Eigen::VectorXd x;
+      solver.solve_into(b, x);
+      set_solver_threads(1);
+      EXPECT_EQ(solver.last_solve_threads(), threads);
+      EXPECT_LE((x - truth).norm(), 1e-12 * truth.norm()) << "h " << h << ", threads " << threads;
+      EXPECT_LE((A * x - b).norm(), 1e-12 * b.norm()) << "h " << h << ", threads " << threads;
+    }
+  }
+  EXPECT_EQ(solver.symbolic_analyses(), 1);
+  // Below the size threshold the solve stays on one thread.
+  CholmodSolver::set_parallel_solve_min_entries(1e300);
+  set_solver_threads(2);
+  Eigen::VectorXd x;
+  solver.solve_into(b, x);
+  set_solver_threads(1);
+  EXPECT_EQ(solver.last_solve_threads(), 1);
+  CholmodSolver::set_parallel_solve_min_entries(saved);
 }
 
 TEST(ImplicitEulerRest, IsNamedAndRunsThroughSolve) {
