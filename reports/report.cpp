@@ -411,6 +411,15 @@ void scene_section(Document& doc, const SceneRows& s) {
                 "updates ending at the row's load, as a simulator runs them), the run's steps for "
                 "integrators, assembly and solve for FEM:");
   doc.table(statistics_table(s));
+  std::size_t timed = 0;
+  std::vector<std::string> cached_at;
+  for (const auto& o : s.outcomes) {
+    if (o.timing_measured_at.empty()) continue;
+    ++timed;
+    if (o.timing_cached) cached_at.push_back(o.timing_measured_at);
+  }
+  const std::string provenance = timing_provenance_line(timed, cached_at);
+  if (!provenance.empty()) doc.paragraph("Timings: " + provenance + ".");
 }
 
 /// One row per (scene, model, level) at the scene's representative load and first ν.
