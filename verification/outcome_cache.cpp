@@ -313,6 +313,12 @@ ModelRun deserialise_model_run(std::string_view bytes) {
   return run;
 }
 
+std::string mesh_key(const TetMesh& mesh) {
+  ContentHash h;
+  hash_mesh(h, mesh);
+  return h.hex();
+}
+
 std::string model_run_key(const Scene& s, const ModelSpec& m, double nu, int level,
                           const std::vector<double>& magnitudes, const TetMesh& mesh,
                           const HarnessOptions& o) {

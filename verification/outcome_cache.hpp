@@ -71,6 +71,9 @@ struct ModelRun {
 std::string serialise(const ModelRun& run);
 ModelRun deserialise_model_run(std::string_view bytes);  ///< throws std::exception if unreadable
 
+/// A hash of a mesh's nodes (exact), tets, triangles and groups, for keys.
+std::string mesh_key(const TetMesh& mesh);
+
 /// The key of a model's run: the scene's definition apart from its other models (vessel, levels,
 /// material, supports, loads, budget, modes, reference choice), the model's definition (with the
 /// contents of its calibration and network files), ν, level, the magnitudes run, the model mesh
