@@ -324,17 +324,18 @@ std::optional<std::string> solution_cache_key(const TetMesh& mesh, const Elastic
          h.b.hex();
 }
 
-SolutionCache::SolutionCache(fs::path dir, std::ostream* log) : dir_(std::move(dir)), log_(log) {}
+SolutionCache::SolutionCache(fs::path dir, std::ostream* log, std::string name)
+    : dir_(std::move(dir)), log_(log), name_(std::move(name)) {}
 
 void SolutionCache::lookup(const std::string& key,
                            const std::function<double(std::string_view)>& use,
-                           const std::function<std::string()>& compute) {
+                           const std::function<std::string()>& compute, bool refresh) {
   // The file name is a hash of the key; the file holds the key itself, so a collision of names
   // is a miss, never a wrong answer.
   const fs::path path = dir_ / ("entry-" + ContentHash().text(key).hex() + ".bin");
   const auto t0 = std::chrono::steady_clock::now();
   std::string payload, why;
-  const EntryState state = read_entry(path, key, payload, why);
+  const EntryState state = refresh ? EntryState::missing : read_entry(path, key, payload, why);
   if (state == EntryState::ok) {
     try {
       const double original_seconds = use(payload);
@@ -348,15 +349,15 @@ void SolutionCache::lookup(const std::string& key,
   }
   const bool corrupt = state == EntryState::corrupt || state == EntryState::ok;
   if (corrupt) {
-    (log_ ? *log_ : std::cerr) << "FEM solution cache: entry " << path.string() << " is corrupt ("
-                               << why << "); solving again and replacing it\n";
+    (log_ ? *log_ : std::cerr) << name_ << ": entry " << path.string() << " is corrupt ("
+                               << why << "); computing it again and replacing it\n";
   }
   const std::string file = entry_file(key, compute());
   try {
     write_file_atomically(
         path, [&](std::ostream& out) { out << file; }, true);
   } catch (const std::exception& e) {  // a read-only cache costs time, not the result
-    (log_ ? *log_ : std::cerr) << "FEM solution cache: cannot store " << path.string() << " ("
+    (log_ ? *log_ : std::cerr) << name_ << ": cannot store " << path.string() << " ("
                                << e.what() << "); continuing without it\n";
   }
   const std::lock_guard lock(mutex_);
@@ -437,7 +438,8 @@ std::optional<std::string> continuation_cache_key(const TetMesh& mesh,
 
 std::string SolutionCache::payload(const std::string& key,
                                    const std::function<std::string()>& compute,
-                                   const std::function<double(std::string_view)>& original_seconds) {
+                                   const std::function<double(std::string_view)>& original_seconds,
+                                   bool refresh) {
   if (!enabled()) return compute();
   std::string out;
   lookup(
@@ -450,7 +452,8 @@ std::string SolutionCache::payload(const std::string& key,
       [&] {
         out = compute();
         return out;
-      });
+      },
+      refresh);
   return out;
 }
 
@@ -467,13 +470,13 @@ SolutionCacheStatistics SolutionCache::statistics() const {
 std::string SolutionCache::summary() const {
   const SolutionCacheStatistics s = statistics();
   std::ostringstream o;
-  if (!enabled()) return "FEM solution cache: off (--no-cache)";
+  if (!enabled()) return name_ + ": off (--no-cache)";
   o.precision(3);
-  o << "FEM solution cache (" << dir_.string() << "): " << s.hits << " hits, " << s.misses
+  o << name_ << " (" << dir_.string() << "): " << s.hits << " hits, " << s.misses
     << " misses";
   if (s.corrupt > 0) o << " (" << s.corrupt << " corrupt entries recomputed)";
   if (s.uncacheable > 0) o << ", " << s.uncacheable << " problems not cacheable";
-  o << ", " << s.seconds_saved << " s of FEM solving saved";
+  o << ", " << s.seconds_saved << " s of computing saved";
   return o.str();
 }
 

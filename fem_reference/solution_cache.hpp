@@ -50,7 +50,10 @@ class SolutionCache {
  public:
   /// Entries live in `dir` (created on the first write). An empty path disables the cache:
   /// solve() then always solves. `log` receives a line per corrupt entry (nullptr: std::cerr).
-  explicit SolutionCache(std::filesystem::path dir, std::ostream* log = nullptr);
+  /// `name` starts those lines and summary() (another store built on these entries, such as the
+  /// harness's model outcomes, names itself).
+  explicit SolutionCache(std::filesystem::path dir, std::ostream* log = nullptr,
+                         std::string name = "FEM solution cache");
 
   /// solver.solve(), or the stored solution of the same mesh and problem restored into `solver`.
   /// The mesh and problem must be those `solver` was built from.
@@ -65,14 +68,16 @@ class SolutionCache {
   /// checkpoints) under `key` (from continuation_cache_key): the stored one when `original_seconds`
   /// accepts it (it returns the seconds computing it took, and throws std::exception for a
   /// payload it cannot read, which is then recomputed as a corrupt entry), else compute()'s,
-  /// stored. With the cache disabled, compute()'s.
+  /// stored. With the cache disabled, compute()'s. `refresh`: compute and replace the entry
+  /// without reading it (counted as a miss).
   std::string payload(const std::string& key, const std::function<std::string()>& compute,
-                      const std::function<double(std::string_view)>& original_seconds);
+                      const std::function<double(std::string_view)>& original_seconds,
+                      bool refresh = false);
 
   [[nodiscard]] bool enabled() const { return !dir_.empty(); }
   [[nodiscard]] const std::filesystem::path& directory() const { return dir_; }
   [[nodiscard]] SolutionCacheStatistics statistics() const;
-  /// One line: "FEM solution cache (DIR): H hits, M misses, C corrupt entries recomputed, S s
+  /// One line: "<name> (DIR): H hits, M misses, C corrupt entries recomputed, S s
   /// saved".
   [[nodiscard]] std::string summary() const;
 
@@ -82,10 +87,11 @@ class SolutionCache {
   /// The entry for `key`: `use(payload)` restores a good one and returns the seconds its
   /// computation took; otherwise `compute()` computes and returns the payload, which is stored.
   void lookup(const std::string& key, const std::function<double(std::string_view)>& use,
-              const std::function<std::string()>& compute);
+              const std::function<std::string()>& compute, bool refresh = false);
 
   std::filesystem::path dir_;
   std::ostream* log_;
+  std::string name_;
   mutable std::mutex mutex_;  // statistics only: entries are files written atomically
   SolutionCacheStatistics stats_;
 };

@@ -348,6 +348,18 @@ void history_figure(const FigureContext& c) {
   c.doc.table(t);
 }
 
+/// timing_provenance_line over a scene's outcomes.
+std::string scene_timing_provenance(const SceneRows& s) {
+  std::size_t timed = 0;
+  std::vector<std::string> cached_at;
+  for (const OutcomeRow& o : s.outcomes) {
+    if (o.timing_measured_at.empty()) continue;
+    ++timed;
+    if (o.timing_cached) cached_at.push_back(o.timing_measured_at);
+  }
+  return timing_provenance_line(timed, cached_at);
+}
+
 Table statistics_table(const SceneRows& s) {
   Table t;
   t.header = {"model", "ν", "level", "load", "max mm", "mean mm", "std mm", "RMS mm", "rel. L2",
@@ -411,6 +423,8 @@ void scene_section(Document& doc, const SceneRows& s) {
                 "updates ending at the row's load, as a simulator runs them), the run's steps for "
                 "integrators, assembly and solve for FEM:");
   doc.table(statistics_table(s));
+  const std::string provenance = scene_timing_provenance(s);
+  if (!provenance.empty()) doc.paragraph("Timings: " + provenance + ".");
 }
 
 /// One row per (scene, model, level) at the scene's representative load and first ν.
@@ -507,6 +521,7 @@ void attach_run(RecommendFile& recommendation, const ResultsFile& run) {
   for (const SceneRows& scene : run.scenes) {
     if (scene.name != recommendation.scene) continue;
     recommendation.load_unit = scene.load_unit;
+    recommendation.timing_provenance = scene_timing_provenance(scene);
     for (BudgetLoadEntry& load : recommendation.loads) {
       for (const ReferenceRow& ref : scene.references) {
         if (ref.poisson_ratio == load.poisson_ratio) load.reference_element = ref.element;

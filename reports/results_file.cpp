@@ -1,5 +1,6 @@
 #include "reports/results_file.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include "reports/json_fields.hpp"
@@ -27,6 +28,10 @@ OutcomeRow read_outcome(const json& j, const std::string& where) {
   o.solve_seconds = field<double>(j, "solve_seconds", where);
   o.memory_mib = field_or<double>(j, "memory_mib", 0.0, where);
   o.timing_source = field_or<std::string>(j, "timing_source", "", where);
+  if (const auto t = j.find("timing_provenance"); t != j.end() && t->is_object()) {
+    o.timing_cached = field<std::string>(*t, "source", where + ".timing_provenance") == "cache";
+    o.timing_measured_at = field<std::string>(*t, "measured_at", where + ".timing_provenance");
+  }
   if (!o.ok) {
     o.failure = field<std::string>(j, "failure", where);
     return o;
@@ -172,6 +177,15 @@ ResultsFile parse_results(const std::string& text, const std::filesystem::path& 
 
 ResultsFile read_results(const std::filesystem::path& path) {
   return parse_results(json_fields::read_text(path, "results file"), path);
+}
+
+std::string timing_provenance_line(std::size_t total, std::vector<std::string> cached_at) {
+  if (cached_at.empty()) return "";
+  std::sort(cached_at.begin(), cached_at.end());
+  std::string line = std::to_string(cached_at.size()) + " of " + std::to_string(total) +
+                     " timings from the cache, measured " + cached_at.front();
+  if (cached_at.back() != cached_at.front()) line += " to " + cached_at.back();
+  return line + " by the same executable on this machine; --retime to measure again";
 }
 
 }  // namespace vessel::reports

@@ -20,6 +20,10 @@ struct OutcomeRow {
   /// Models outside the suite: "simulator" (their own times), "process" (their process's wall
   /// time), "none"; empty for the suite's own models.
   std::string timing_source;
+  /// The suite's own models: their times read from the model outcome cache (else measured in the
+  /// run), and when they were measured (UTC; empty in files written before it was recorded).
+  bool timing_cached = false;
+  std::string timing_measured_at;
   // Present when ok:
   double max_mm = 0.0, mean_mm = 0.0, stddev_mm = 0.0, rms_mm = 0.0, relative_l2 = 0.0;
   std::optional<double> reference_uncertainty_max_mm;
@@ -86,6 +90,12 @@ struct ResultsFile {
 /// Reads and checks a results file; InputError naming the file and what is wrong (missing file,
 /// not JSON, another schema or version, a missing field).
 ResultsFile read_results(const std::filesystem::path& path);
+
+/// "n of m timings from the cache, measured <first date>[ to <last date>] by the same executable
+/// on this machine; --retime to measure again" over outcomes with a recorded measurement time
+/// (`cached_at`: the measurement times of those read from the cache); "" when none was. The
+/// report's and summary.md's line beside their timing columns.
+std::string timing_provenance_line(std::size_t total, std::vector<std::string> cached_at);
 /// Same from text; `source` names it in messages.
 ResultsFile parse_results(const std::string& text, const std::filesystem::path& source);
 

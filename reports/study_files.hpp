@@ -82,6 +82,9 @@ struct RecommendFile {
   std::optional<double> rate_hz, radius_mm;
   std::vector<BudgetLoadEntry> loads;
   std::string load_unit;  ///< N, Pa or g, from the run's results.json (attach_run); "" if unknown
+  /// Which of the candidates' timings came from the model outcome cache (timing_provenance_line
+  /// over the run's outcomes, attach_run); "" if all were measured or unknown.
+  std::string timing_provenance;
   std::optional<std::string> recommended, closest;  ///< candidate names
   /// The candidates' results.json: the file's "results" (relative to its folder), else the
   /// results.json beside it (files written before "results" existed).

@@ -231,6 +231,7 @@ void recommendation_section(Document& doc, const RecommendFile& r) {
                 "★ marks the Pareto front (no other candidate is both faster and more accurate). "
                 "From `" + r.path.filename().string() + "`.");
   doc.table(evidence_table(r));
+  if (!r.timing_provenance.empty()) doc.paragraph("Timings: " + r.timing_provenance + ".");
 }
 
 namespace {

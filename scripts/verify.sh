@@ -16,24 +16,35 @@
 #      stability, recommendation and validity sections drawn from stability.json, each
 #      recommend.json and validity.json.
 #
-# Usage: scripts/verify.sh [--quick | --full] [output-dir]   (default output: results/)
-#   default  the scenes' own levels, loads and sweeps; the stability table at levels 0-1 with a
-#            2·10^5-step long run; level-0 recommendation candidates
+# Usage: scripts/verify.sh [--quick | --full] [--retime] [output-dir]   (default: results/)
+#   default  the scenes' own levels, loads and sweeps (contact up to 1 mN, where the linear
+#            reference holds; seed 000's range is the validity study's, against the
+#            finite-strain reference); the stability table at levels 0-1 with a 2·10^5-step long
+#            run; level-0 recommendation candidates
 #   --quick  models at level 0, reference at level 1, smallest and largest load, the quick
 #            stability study: a few minutes
 #   --full   the default plus the stability table at level 2, the 10^6-step long run, the
 #            level-1 recommendation candidates and the validity study at the scenes' reference
 #            level on the dense ladder (not measured: P2 level 1 costs ~10 s per Newton
 #            iteration, so expect well over an hour on 2 cores)
+#   --retime measure every model, recommendation candidate and stability item again instead of
+#            reading the outcomes a run of the same executable on this machine kept in the cache
+#            (VESSELVERIFY_CACHE_DIR, else ~/.cache/vesselverify: model-outcomes/, next to the FEM
+#            references in fem-solutions/)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 mode=()
 full=false
-case "${1:-}" in
-  --quick) mode=(--quick); shift ;;
-  --full) full=true; shift ;;
-  -*) echo "verify.sh: unknown option '$1' (expected --quick or --full)" >&2; exit 2 ;;
-esac
+retime=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --quick) mode=(--quick); shift ;;
+    --full) full=true; shift ;;
+    --retime) retime=(--retime); shift ;;
+    -*) echo "verify.sh: unknown option '$1' (expected --quick, --full or --retime)" >&2; exit 2 ;;
+    *) break ;;
+  esac
+done
 out="${1:-$root/results}"
 build="$root/build"
 
@@ -52,7 +63,7 @@ for vessel in straight arch; do
 done
 scenes="$root/verification/scenes"
 phase "run: the shipped scenes"
-"$vv" run "${mode[@]}" --output-dir "$out" "$scenes/contact_straight.toml" \
+"$vv" run "${mode[@]}" "${retime[@]}" --output-dir "$out" "$scenes/contact_straight.toml" \
   "$scenes/pressure_lame.toml" "$scenes/contact_arch.toml" "$scenes/gravity_sag.toml" \
   "$scenes/dynamic_contact.toml" "$scenes/contact_roi.toml"
 phase "validity: the linear reference's limit, the seed models at finite strain"
@@ -72,7 +83,7 @@ elif [ ${#mode[@]} -eq 0 ]; then
 else
   stability_options=(--max-level 1)
 fi
-"$vv" stability "${mode[@]}" "${stability_options[@]}" --output-dir "$out"
+"$vv" stability "${mode[@]}" "${retime[@]}" "${stability_options[@]}" --output-dir "$out"
 recommendations=()
 for scene in contact_straight contact_arch; do
   phase "recommend $scene at 30 and 1000 Hz"
@@ -82,7 +93,7 @@ for scene in contact_straight contact_arch; do
   # update does not depend on the rate).
   candidates=(--quick)
   if $full; then candidates=(); fi
-  "$vv" recommend "${candidates[@]}" --rate 30,1000 --output-dir "$dir" "$scenes/$scene.toml"
+  "$vv" recommend "${candidates[@]}" "${retime[@]}" --rate 30,1000 --output-dir "$dir" "$scenes/$scene.toml"
   recommendations+=(--recommend "$dir/30hz/recommend.json" --recommend "$dir/1000hz/recommend.json")
 done
 phase "report"

@@ -6,7 +6,10 @@
 #include <atomic>
 #include <cctype>
 #include <cmath>
+#include <fstream>
+#include <functional>
 #include <iomanip>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <memory>
@@ -21,6 +24,7 @@
 #include "fem_reference/elasticity.hpp"
 #include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/solution_cache.hpp"
+#include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "meshes/vtu_io.hpp"
@@ -35,6 +39,7 @@
 #include "verification/external_model.hpp"
 #include "verification/memory.hpp"
 #include "verification/modal.hpp"
+#include "verification/outcome_cache.hpp"
 #include "verification/parallel.hpp"
 #include "verification/progress.hpp"
 #include "verification/scene_problems.hpp"
@@ -280,6 +285,14 @@ bool wants_fields(const HarnessOptions& o, const Scene& s, double magnitude,
   return magnitude == budget_magnitude(without_budget_load, ref_max_strain_unit);
 }
 
+/// Where write_model_fields writes an outcome's fields, relative to the fields directory.
+std::filesystem::path fields_file(const Scene& s, const ModelOutcome& out) {
+  std::ostringstream name;
+  name << file_stem(out.model) << "_nu" << out.poisson_ratio << "_L" << out.level << "_load"
+       << out.magnitude << ".vtu";
+  return std::filesystem::path(s.name) / name.str();
+}
+
 /// One model's displacement fields at one load for ParaView: points at the model's rest nodes
 /// (m), vectors in m so that "Warp By Vector" at scale 1 shows the deformed state, and |error| in
 /// mm as the reports use.
@@ -299,12 +312,9 @@ void write_model_fields(const HarnessOptions& o, const Scene& s, const ModelOutc
     }
     error_mm.values.push_back(e.norm() * 1e3);
   }
-  std::ostringstream name;
-  name << file_stem(out.model) << "_nu" << out.poisson_ratio << "_L" << out.level << "_load"
-       << out.magnitude << ".vtu";
-  const std::filesystem::path dir = o.fields_dir / s.name;
-  std::filesystem::create_directories(dir);
-  write_vtu(dir / name.str(), nodes, cells, {model, reference, error, error_mm});
+  const std::filesystem::path path = o.fields_dir / fields_file(s, out);
+  std::filesystem::create_directories(path.parent_path());
+  write_vtu(path, nodes, cells, {model, reference, error, error_mm});
 }
 
 /// A mass-spring network's cells: its tets (volume), triangles (surface), else its springs.
@@ -1094,6 +1104,74 @@ std::size_t model_cases(const Scene& s, const HarnessOptions& o) {
   return s.poisson_ratios.size() * s.model_levels.size() * cases;
 }
 
+/// A FEM or mass-spring model at one ν and level: `run` (run_fem_model or run_msm_model into the
+/// SceneResult it is given), or, with an outcome cache, the outcomes, natural frequencies and VTU
+/// fields a run of the same model, scene, ν, level, loads, mesh, executable and machine stored.
+/// Each outcome says whether its timings were measured now or read from the cache.
+void run_through_cache(const Scene& s, const ModelSpec& spec, double nu, int level,
+                       const TetMesh& mesh, const HarnessOptions& o, double ref_strain_unit,
+                       Progress& progress, const std::string& fem_label, SceneResult& result,
+                       const std::function<void(SceneResult&)>& run) {
+  const auto measure = [&] {
+    SceneResult part;
+    part.scene = s;
+    part.qoi_point = result.qoi_point;
+    run(part);
+    ModelRun measured{std::move(part.outcomes), std::move(part.model_modes), {}};
+    for (const ModelOutcome& out : measured.outcomes) {
+      if (!out.ok || !wants_fields(o, s, out.magnitude, ref_strain_unit)) continue;
+      const std::filesystem::path file = fields_file(s, out);
+      std::ifstream in(o.fields_dir / file, std::ios::binary);
+      if (in) {
+        measured.field_files.emplace_back(
+            file.string(), std::string(std::istreambuf_iterator<char>(in), {}));
+      }
+    }
+    return measured;
+  };
+  const auto keep = [&](ModelRun run_result, const TimingProvenance& timing) {
+    for (ModelOutcome& out : run_result.outcomes) {
+      out.timing = timing;
+      result.outcomes.push_back(std::move(out));
+    }
+    for (ModalOutcome& m : run_result.modes) result.model_modes.push_back(std::move(m));
+  };
+  if (!o.outcome_cache || !o.outcome_cache->enabled()) {
+    keep(measure(), {false, utc_now()});
+    return;
+  }
+  bool measured_now = false;
+  TimingProvenance timing;
+  const std::string stored = o.outcome_cache->get(
+      model_run_key(s, spec, nu, level, s.load.magnitudes, mesh, o),
+      [&] {
+        measured_now = true;
+        return serialise(measure());
+      },
+      timing);
+  ModelRun cached = deserialise_model_run(stored);
+  if (!measured_now) {  // the progress lines and the fields a measurement would have written
+    if (spec.kind == ModelKind::fem) {
+      progress.begin(fem_label + ", from the outcome cache");
+      progress.end();
+    } else {
+      for (const ModelOutcome& out : cached.outcomes) {
+        std::ostringstream what;
+        what << spec.name << " at " << out.magnitude << " (" << to_string(s.load.kind)
+             << "), from the outcome cache";
+        progress.begin(what.str());
+        progress.end();
+      }
+    }
+    for (const auto& [file, bytes] : cached.field_files) {
+      const std::filesystem::path path = o.fields_dir / file;
+      std::filesystem::create_directories(path.parent_path());
+      write_file_atomically(path, [&](std::ostream& out) { out << bytes; }, true);
+    }
+  }
+  keep(std::move(cached), timing);
+}
+
 /// The scene's models against its references (solved). `progress` counts one case per model,
 /// level, ν and load; `solve_here` solves each ν's reference as the models reach it (serial runs).
 SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& progress,
@@ -1129,16 +1207,23 @@ SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& pr
         base.kind = to_string(spec.kind);
         base.poisson_ratio = nu;
         base.level = level;
-        if (spec.kind == ModelKind::fem) {
-          progress.begin(spec.name + " (FEM P" + std::to_string(spec.degree) + ", level " +
-                         std::to_string(level) + ")");
-          run_fem_model(at_nu, spec, nu, mesh, a.ref, fine, o, base, result);
-          progress.end();
-        } else if (spec.kind == ModelKind::external || spec.kind == ModelKind::displacements) {
+        if (spec.kind == ModelKind::external || spec.kind == ModelKind::displacements) {
           run_outside_model(at_nu, spec, nu, mesh, a.ref, fine, o, progress, base, result);
-        } else {
-          run_msm_model(at_nu, spec, nu, mesh, a.ref, fine, o, progress, base, result);
+          continue;
         }
+        const std::string fem_label = spec.name + " (FEM P" + std::to_string(spec.degree) +
+                                      ", level " + std::to_string(level) + ")";
+        run_through_cache(at_nu, spec, nu, level, mesh, o, fine.max_abs_principal_strain, progress,
+                          fem_label, result, [&](SceneResult& part) {
+                            if (spec.kind == ModelKind::fem) {
+                              progress.begin(fem_label);
+                              run_fem_model(at_nu, spec, nu, mesh, a.ref, fine, o, base, part);
+                              progress.end();
+                            } else {
+                              run_msm_model(at_nu, spec, nu, mesh, a.ref, fine, o, progress, base,
+                                            part);
+                            }
+                          });
       }
     }
   }

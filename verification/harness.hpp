@@ -26,6 +26,8 @@ class SolutionCache;
 
 namespace vessel {
 
+class OutcomeCache;  // verification/outcome_cache.hpp
+
 /// Updates of the load ramp static and linear mass-spring models are timed on (timed_updates).
 inline constexpr int kRampUpdates = 8;
 
@@ -34,6 +36,10 @@ struct HarnessOptions {
   /// FEM references solved once and kept on disk (nullptr: each solved afresh). The FEM models
   /// the scene times (P1, P2 as models) are always solved: their time is a measurement.
   fem::SolutionCache* solution_cache = nullptr;
+  /// The models' outcomes (timings included) kept on disk per model, ν and level, keyed by their
+  /// definition and by the executable and machine (nullptr: every model measured). Models outside
+  /// the suite (external, displacements) are always run.
+  OutcomeCache* outcome_cache = nullptr;
   std::ostream* log = nullptr;      ///< progress; nullptr for none
   int repeats = 1;                  ///< timed repeats of each model solve (median reported)
   /// Static and linear mass-spring models: updates in the timed load ramp (timed_updates).
@@ -115,6 +121,12 @@ struct History {
   double mass_damping = 0.0;  ///< α of the FEM transient, 1/s
 };
 
+/// Where a measured outcome's timings come from (verification/outcome_cache.hpp).
+struct TimingProvenance {
+  bool cached = false;      ///< read from the outcome cache instead of measured in this run
+  std::string measured_at;  ///< when they were measured, UTC (ISO 8601); empty if unknown
+};
+
 /// One model at one (ν, level, magnitude).
 struct ModelOutcome {
   std::string model;
@@ -169,6 +181,7 @@ struct ModelOutcome {
   /// needs (at least 1). Set-up is excluded. 0 without a budget rate.
   double update_seconds = 0.0;
   long steps_per_update = 0;  ///< integrators with a budget rate
+  TimingProvenance timing;  ///< measured in this run, or read from the outcome cache
 };
 
 /// The lowest natural frequencies of one model, or of the modal reference, at one ν and level

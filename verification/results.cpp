@@ -10,6 +10,7 @@
 #include "meshes/atomic_file.hpp"
 #include "meshes/errors.hpp"
 #include "verification/harness.hpp"
+#include "verification/outcome_cache.hpp"
 #include "verification/timing.hpp"
 
 namespace vessel {
@@ -38,13 +39,6 @@ nlohmann::json uncertainty_order_json(const Scene& s, const ReferenceInfo& ref) 
 
 const char* load_unit(LoadKind k) {
   return k == LoadKind::contact ? "N" : (k == LoadKind::pressure ? "Pa" : "g");
-}
-
-std::string now_utc() {
-  const std::time_t t = std::time(nullptr);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
-  return buf;
 }
 
 std::string host_name() {
@@ -136,6 +130,10 @@ nlohmann::json scene_json(const SceneResult& r) {
                      {"memory_mib", o.memory_mib}};
     if (o.roi_radius > 0.0) j["roi_radius_mm"] = o.roi_radius * 1e3;
     if (!o.timing_source.empty()) j["timing_source"] = o.timing_source;
+    if (!o.timing.measured_at.empty()) {
+      j["timing_provenance"] = {{"source", o.timing.cached ? "cache" : "measured"},
+                                {"measured_at", o.timing.measured_at}};
+    }
     if (o.updates > 0) {
       j["updates"] = {{"count", o.updates},
                       {"iterations_per_update", o.iterations_per_update},
@@ -220,7 +218,7 @@ void write_results_json(const std::filesystem::path& path, const std::vector<Sce
   nlohmann::json j{{"schema", "vesselverify.results"},
                          {"schema_version", 2},
                          {"units", {{"displacement", "mm"}, {"time", "s"}, {"strain", "1"}}},
-                         {"date", now_utc()},
+                         {"date", utc_now()},
                          {"command", command},
                          {"machine",
                           {{"host", host_name()},
@@ -315,7 +313,7 @@ void write_summary_markdown(const std::filesystem::path& path,
                             const std::vector<SceneResult>& results, const std::string& command) {
   write_file_atomically(path, [&](std::ostream& out) {
     out << "# vesselverify summary\n\n"
-        << "Produced " << now_utc() << " on " << host_name() << " ("
+        << "Produced " << utc_now() << " on " << host_name() << " ("
         << std::thread::hardware_concurrency() << " hardware threads) by\n\n    " << command
         << "\n\nDisplacement errors against the FEM reference (P2, or Taylor–Hood P2–P1 for ν ≥ "
            "0.49) evaluated at each model node's rest position, in mm, with seed 000's "
@@ -363,6 +361,8 @@ void write_summary_markdown(const std::filesystem::path& path,
             << " | " << o.unknowns << " |\n";
       }
       out << "\n";
+      const std::string provenance = timing_provenance_line(r.outcomes);
+      if (!provenance.empty()) out << "Timings: " << provenance << ".\n\n";
       if (r.reference_modes.empty() && r.model_modes.empty()) continue;
       // Natural frequencies ([modes]): each model's beside the modal reference's, by rank.
       out << "Natural frequencies (Hz) at rest, the scene's supports held; f/f_ref mode by mode "

@@ -1,6 +1,7 @@
 #include "verification/timing.hpp"
 
 #include <Eigen/Sparse>
+#include <ctime>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
@@ -74,6 +75,13 @@ double reference_kernel_seconds() {
     sink = sink + u[0] + f[1];
   });
   return t.median_s;
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
 }
 
 }  // namespace vessel

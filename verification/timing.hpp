@@ -3,6 +3,7 @@
 /// noisy run on a shared machine does not decide a result.
 #include <chrono>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace vessel {
@@ -34,6 +35,9 @@ TimingSample time_median(const std::function<void()>& fn, int repeats = 5, int w
 /// after a warm-up. The gate divides solve times by it, so baselines recorded on one machine
 /// remain comparable on another (Google Benchmark's practice of comparing ratios within one run).
 double reference_kernel_seconds();
+
+/// The current time, UTC, as "YYYY-MM-DDTHH:MM:SSZ".
+std::string utc_now();
 
 /// Median of a non-empty sample (std::invalid_argument if empty).
 double median(std::vector<double> values);

@@ -93,6 +93,8 @@ void run(const Options& o) {
   r.harness.cache_dir = o.cache.mesh_dir();
   const auto solution_cache = o.cache.solution_cache(std::cout);
   r.harness.solution_cache = solution_cache.get();
+  const auto outcome_cache = o.cache.outcome_cache(std::cout);
+  r.harness.outcome_cache = outcome_cache.get();
   r.harness.log = &std::cout;
   r.harness.jobs = o.jobs;
   r.harness.repeats = o.repeats;
@@ -115,7 +117,7 @@ void run(const Options& o) {
       print_recommendation(recommend(at_rate, r, rate_dir(o, rate), o.command), rate_dir(o, rate));
     }
   }
-  std::cout << solution_cache->summary() << "\n";
+  std::cout << solution_cache->summary() << "\n" << outcome_cache->summary() << "\n";
 }
 
 }  // namespace
@@ -150,6 +152,7 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--output-dir", o->output_dir, "Where the outputs go")->capture_default_str();
   add_cache_options(*cmd, o->cache);
+  add_retime_option(*cmd, o->cache.retime);
   add_jobs_option(*cmd, o->jobs, kReferencesAtATime);
   cmd->add_flag("--quick", o->quick,
                 "Candidates at level 0 only (reference at level <= 1), ROI radii 4 and 8 mm");

@@ -62,6 +62,8 @@ void run(const RunOptions& o) {
   h.cache_dir = o.cache.mesh_dir();
   const auto solution_cache = o.cache.solution_cache(std::cout);
   h.solution_cache = solution_cache.get();
+  const auto outcome_cache = o.cache.outcome_cache(std::cout);
+  h.outcome_cache = outcome_cache.get();
   h.log = &std::cout;
   h.jobs = o.jobs;
   h.repeats = o.repeats;
@@ -70,7 +72,7 @@ void run(const RunOptions& o) {
   h.fields_every_load = o.fields == "all";
   h.exchange_dir = o.output_dir / "exchange";  // external models' case folders
   run_and_write(scenes, h, o.output_dir, o.command);
-  std::cout << solution_cache->summary() << "\n";
+  std::cout << solution_cache->summary() << "\n" << outcome_cache->summary() << "\n";
 }
 
 }  // namespace
@@ -90,6 +92,7 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("scenes", o->scenes, "Scene files (TOML)")->required();
   cmd->add_option("--output-dir", o->output_dir, "Where results are written")->capture_default_str();
   add_cache_options(*cmd, o->cache);
+  add_retime_option(*cmd, o->cache.retime);
   add_jobs_option(*cmd, o->jobs, kReferencesAtATime);
   cmd->add_flag("--quick", o->quick,
                 "Coarse levels (models 0, reference 1) and the smallest and largest load only");

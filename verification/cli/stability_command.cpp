@@ -6,6 +6,7 @@
 
 #include "meshes/errors.hpp"
 #include "meshes/mesh_cache.hpp"
+#include "verification/cli/cache_options.hpp"
 #include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/studies/stability/stability.hpp"
@@ -21,6 +22,7 @@ struct StabilityCli {
   fs::path output_dir = "results";
   fs::path cache_dir = default_cache_dir();
   bool no_cache = false;
+  bool retime = false;
   int trial_steps = 0;
   long long long_run_steps = 0;
   int max_level = -1;
@@ -67,8 +69,14 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
                 "Levels 0..1, 500 steps per trial, a 2e4-step long run (a few minutes)");
   cmd->add_option("--output-dir", o->output_dir, "Where stability.json and stability.md go")
       ->capture_default_str();
-  cmd->add_option("--cache-dir", o->cache_dir, "Mesh cache directory")->capture_default_str();
-  cmd->add_flag("--no-cache", o->no_cache, "Do not read or write the mesh cache");
+  cmd->add_option("--cache-dir", o->cache_dir,
+                  "Cache directory: meshes, and the measured rows and hard cases "
+                  "(<dir>/model-outcomes); env VESSELVERIFY_CACHE_DIR")
+      ->capture_default_str();
+  cmd->add_flag("--no-cache", o->no_cache,
+                "Do not read or write the cache (meshes, and the rows and hard cases measured "
+                "before)");
+  add_retime_option(*cmd, o->retime);
   cmd->add_option("--trial-steps", o->trial_steps,
                   "Steps per stability trial (default 500 quick, 1000 full)");
   cmd->add_option("--long-run-steps", o->long_run_steps,
@@ -101,7 +109,11 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
     so.hard_cases = !o->no_hard_cases;
     so.only_cases = o->only_cases;
     so.jobs = o->jobs;
+    OutcomeCache outcomes(o->no_cache ? fs::path() : outcome_cache_dir(o->cache_dir), o->retime,
+                          &std::cout);
+    so.outcome_cache = &outcomes;
     const StabilityReport report = run_stability(so);
+    std::cout << outcomes.summary() << "\n";
     write_stability(o->output_dir, report);
     std::cout << "wrote " << (o->output_dir / "stability.json").string() << " and stability.md\n";
   });

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <sstream>
 
 #include "../../test_helpers.hpp"
 #include "meshes/errors.hpp"
+#include "verification/outcome_cache.hpp"
 #include "verification/studies/stability/stability.hpp"
 
 using namespace vessel;
@@ -105,4 +107,31 @@ TEST(Stability, TheStepTableIsTheSameComputedOneRowAtATimeOrInParallel) {
     EXPECT_EQ(one.rows[i].found_dt, two.rows[i].found_dt) << i;
     EXPECT_EQ(one.rows[i].trials, two.rows[i].trials) << i;
   }
+}
+
+TEST(Stability, ASecondRunReadsTheRowsFromTheOutcomeCacheWithTheirTimings) {
+  test::TempDir cache;
+  std::ostringstream log;
+  OutcomeCache outcomes(cache.path() / "outcomes", false, &log);
+  StabilityOptions o;
+  o.cache_dir = cache.path();
+  o.hard_cases = false;
+  o.max_level = 0;
+  o.trial_steps = 50;
+  o.outcome_cache = &outcomes;
+  const StabilityReport first = run_stability(o);
+  EXPECT_EQ(first.timed_items, 3u);  // one item per model at level 0
+  EXPECT_TRUE(first.cached_at.empty());
+  const StabilityReport second = run_stability(o);
+  EXPECT_EQ(outcomes.statistics().hits, 3);
+  ASSERT_EQ(second.cached_at.size(), 3u);
+  ASSERT_EQ(second.rows.size(), first.rows.size());
+  for (std::size_t i = 0; i < first.rows.size(); ++i) {
+    EXPECT_EQ(second.rows[i].model, first.rows[i].model);
+    EXPECT_EQ(second.rows[i].found_dt, first.rows[i].found_dt) << i;
+    EXPECT_EQ(second.rows[i].guaranteed_dt, first.rows[i].guaranteed_dt) << i;
+    EXPECT_EQ(second.rows[i].seconds, first.rows[i].seconds) << i;  // the cached timing
+  }
+  EXPECT_NE(stability_markdown(second).find("3 of 3 timings from the cache"), std::string::npos);
+  EXPECT_EQ(log.str(), "");
 }

@@ -2,11 +2,13 @@
 #include "verification/studies/stability/study_models.hpp"
 
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <tuple>
 
 #include "msm/stability/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
+#include "verification/outcome_cache.hpp"
 #include "verification/parallel.hpp"
 #include "verification/timing.hpp"
 
@@ -78,10 +80,52 @@ std::vector<CriticalStepRow> model_rows(const Scene& scene, const TetMesh& mesh,
   return rows;
 }
 
+/// A (level, model)'s rows as bytes for the outcome cache (CBOR: doubles bit for bit, NaN too).
+std::string serialise_rows(const std::vector<CriticalStepRow>& rows) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const CriticalStepRow& r : rows) {
+    j.push_back({r.model, r.integrator, r.zeta, r.point_damping, r.level, r.nodes, r.springs,
+                 r.h_nominal, r.omega_max, r.omega_gershgorin, r.omega_min, r.gamma_max,
+                 r.predicted_dt, r.guaranteed_dt, r.found_dt, r.unstable_dt, r.trials,
+                 r.steps_per_trial, r.seconds});
+  }
+  const std::vector<std::uint8_t> b = nlohmann::json::to_cbor(j);
+  return {b.begin(), b.end()};
+}
+
+std::vector<CriticalStepRow> deserialise_rows(const std::string& bytes) {
+  std::vector<CriticalStepRow> rows;
+  for (const nlohmann::json& x : nlohmann::json::from_cbor(bytes.begin(), bytes.end())) {
+    CriticalStepRow r;
+    r.model = x.at(0);
+    r.integrator = x.at(1);
+    r.zeta = x.at(2);
+    r.point_damping = x.at(3);
+    r.level = x.at(4);
+    r.nodes = x.at(5);
+    r.springs = x.at(6);
+    r.h_nominal = x.at(7);
+    r.omega_max = x.at(8);
+    r.omega_gershgorin = x.at(9);
+    r.omega_min = x.at(10);
+    r.gamma_max = x.at(11);
+    r.predicted_dt = x.at(12);
+    r.guaranteed_dt = x.at(13);
+    r.found_dt = x.at(14);
+    r.unstable_dt = x.at(15);
+    r.trials = x.at(16);
+    r.steps_per_trial = x.at(17);
+    r.seconds = x.at(18);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
 }  // namespace
 
 std::vector<CriticalStepRow> critical_step_table(const StabilityOptions& o, int max_level,
-                                                 int steps, std::ostream& log) {
+                                                 int steps, std::ostream& log,
+                                                 std::vector<TimingProvenance>& provenance) {
   const std::vector<ModelSpec> specs{surface_model(msm::StiffnessRule::seed000),
                                      volume_model(msm::StiffnessRule::seed001),
                                      volume_model(msm::StiffnessRule::van_gelder)};
@@ -97,13 +141,35 @@ std::vector<CriticalStepRow> critical_step_table(const StabilityOptions& o, int 
   }
   const std::size_t n = scenes.size() * specs.size();
   std::vector<std::vector<CriticalStepRow>> rows_of(n);
+  provenance.assign(n, {});
   std::mutex log_mutex;
   // The finer levels first: they take longest.
   parallel_for(n, o.jobs, [&](std::size_t t) {
     const std::size_t k = n - 1 - t;
     const std::size_t level = k / specs.size();
-    rows_of[k] = model_rows(scenes[level], meshes[level], specs[k % specs.size()],
-                            static_cast<int>(level), steps, log, log_mutex);
+    const ModelSpec& spec = specs[k % specs.size()];
+    const auto compute = [&] {
+      return model_rows(scenes[level], meshes[level], spec, static_cast<int>(level), steps, log,
+                        log_mutex);
+    };
+    if (!o.outcome_cache || !o.outcome_cache->enabled()) {
+      rows_of[k] = compute();
+      provenance[k] = {false, utc_now()};
+      return;
+    }
+    // Everything else that shapes the rows (the configurations, the search's tolerance, the
+    // model's rules) is code: the executable's identity is in the key.
+    const std::string key = "stability-rows model=" + spec.name +
+                            " level=" + std::to_string(level) + " steps=" + std::to_string(steps) +
+                            " mesh=" + mesh_key(meshes[level]);
+    rows_of[k] = deserialise_rows(
+        o.outcome_cache->get(key, [&] { return serialise_rows(compute()); }, provenance[k]));
+    if (provenance[k].cached) {
+      const std::lock_guard lock(log_mutex);
+      log << "  L" << level << " " << spec.name << ": " << rows_of[k].size()
+          << " rows from the outcome cache (measured " << provenance[k].measured_at << ")"
+          << std::endl;
+    }
   });
   std::vector<CriticalStepRow> rows;  // in the order (level, model, configuration)
   for (auto& r : rows_of) rows.insert(rows.end(), r.begin(), r.end());

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "meshes/errors.hpp"
 #include "meshes/vessel_geometry.hpp"
+#include "verification/outcome_cache.hpp"
 #include "verification/studies/stability/study_models.hpp"
 #include "verification/timing.hpp"
 
@@ -35,6 +37,69 @@ double loglog_slope(const std::vector<double>& x, const std::vector<double>& y) 
   return sxy / sxx;
 }
 
+namespace {
+
+nlohmann::json optional_bool(const std::optional<bool>& b) {
+  return b ? nlohmann::json(*b) : nlohmann::json(nullptr);
+}
+std::optional<bool> optional_bool(const nlohmann::json& j) {
+  if (j.is_null()) return std::nullopt;
+  return j.get<bool>();
+}
+
+/// A hard case as bytes for the outcome cache (CBOR: doubles bit for bit).
+std::string serialise_case(const HardCase& hc) {
+  nlohmann::json outcomes = nlohmann::json::array();
+  for (const HardCaseOutcome& x : hc.outcomes) {
+    outcomes.push_back({x.model, x.finished, optional_bool(x.converged), optional_bool(x.bounded),
+                        x.reported, x.values});
+  }
+  const std::vector<std::uint8_t> b =
+      nlohmann::json::to_cbor({hc.id, hc.title, hc.setup, outcomes, hc.seconds});
+  return {b.begin(), b.end()};
+}
+
+HardCase deserialise_case(const std::string& bytes) {
+  const nlohmann::json j = nlohmann::json::from_cbor(bytes.begin(), bytes.end());
+  HardCase hc;
+  hc.id = j.at(0);
+  hc.title = j.at(1);
+  hc.setup = j.at(2);
+  for (const nlohmann::json& x : j.at(3)) {
+    HardCaseOutcome out;
+    out.model = x.at(0);
+    out.finished = x.at(1);
+    out.converged = optional_bool(x.at(2));
+    out.bounded = optional_bool(x.at(3));
+    out.reported = x.at(4);
+    x.at(5).get_to(out.values);
+    hc.outcomes.push_back(std::move(out));
+  }
+  hc.seconds = j.at(4);
+  return hc;
+}
+
+/// The hard case `fn` (one that cannot be set up is recorded as such, not allowed to stop the
+/// study), timed.
+HardCase run_case(HardCase (*fn)(const StabilityOptions&, std::ostream&), const char* what,
+                  std::size_t k, const StabilityOptions& o, std::ostream& log) {
+  Stopwatch c;
+  HardCase hc;
+  try {
+    hc = fn(o, log);
+  } catch (const std::exception& e) {
+    hc.id = "case_" + std::to_string(k);
+    hc.title = what;
+    hc.setup = "the case could not be set up";
+    hc.outcomes.push_back({"setup", false, {}, {}, "failed: " + short_error(e.what()), {}});
+    log << "  failed: " << e.what() << std::endl;
+  }
+  hc.seconds = c.seconds();
+  return hc;
+}
+
+}  // namespace
+
 StabilityReport run_stability(const StabilityOptions& o) {
   std::ostream& log = o.log ? *o.log : null_stream();
   Stopwatch clock;
@@ -56,7 +121,8 @@ StabilityReport run_stability(const StabilityOptions& o) {
   }
   log << "[stability] critical steps, levels 0.." << max_level << ", " << rep.trial_steps
       << " steps per trial" << std::endl;
-  rep.rows = critical_step_table(o, max_level, rep.trial_steps, log);
+  std::vector<TimingProvenance> provenance;
+  rep.rows = critical_step_table(o, max_level, rep.trial_steps, log, provenance);
   rep.fits = refinement_fits(rep.rows);
   if (o.hard_cases) {
     using CaseFn = HardCase (*)(const StabilityOptions&, std::ostream&);
@@ -66,33 +132,41 @@ StabilityReport run_stability(const StabilityOptions& o) {
         {"inverting load", case_inverting_load}, {"long run", case_long_run},
         {"tight bend", case_tight_bend},    {"zero-length springs", case_zero_length}};
     static_assert(std::size(all_cases) == kHardCaseIds.size());
-    std::vector<std::pair<const char*, CaseFn>> cases;
+    std::vector<std::size_t> cases;
     for (std::size_t i = 0; i < kHardCaseIds.size(); ++i) {
       if (o.only_cases.empty() || std::find(o.only_cases.begin(), o.only_cases.end(),
                                             kHardCaseIds[i]) != o.only_cases.end()) {
-        cases.push_back(all_cases[i]);
+        cases.push_back(i);
       }
     }
     std::size_t k = 0;
-    for (const auto& [what, fn] : cases) {
+    for (const std::size_t i : cases) {
+      const auto& [what, fn] = all_cases[i];
       ++k;
       log << "[stability] hard case " << k << "/" << std::size(cases) << ": " << what << " ("
           << fmt(clock.seconds(), 3) << " s so far)" << std::endl;
-      Stopwatch c;
-      HardCase hc;
-      try {
-        hc = fn(o, log);
-      } catch (const std::exception& e) {
-        // A case that cannot even be set up is recorded, not allowed to stop the study.
-        hc.id = "case_" + std::to_string(k);
-        hc.title = what;
-        hc.setup = "the case could not be set up";
-        hc.outcomes.push_back({"setup", false, {}, {}, "failed: " + short_error(e.what()), {}});
-        log << "  failed: " << e.what() << std::endl;
+      if (!o.outcome_cache || !o.outcome_cache->enabled()) {
+        rep.hard_cases.push_back(run_case(fn, what, k, o, log));
+        provenance.push_back({false, utc_now()});
+        continue;
       }
-      hc.seconds = c.seconds();
-      rep.hard_cases.push_back(std::move(hc));
+      // The options a case reads (the mode, its steps; the rest is code, in the key as the
+      // executable's identity).
+      const std::string key = "stability-case " + std::string(kHardCaseIds[i]) +
+                              " quick=" + std::to_string(o.quick) +
+                              " trial_steps=" + std::to_string(o.trial_steps) +
+                              " long_run_steps=" + std::to_string(o.long_run_steps) +
+                              " max_level=" + std::to_string(o.max_level);
+      TimingProvenance p;
+      rep.hard_cases.push_back(deserialise_case(o.outcome_cache->get(
+          key, [&] { return serialise_case(run_case(fn, what, k, o, log)); }, p)));
+      if (p.cached) log << "  from the outcome cache (measured " << p.measured_at << ")\n";
+      provenance.push_back(p);
     }
+  }
+  rep.timed_items = provenance.size();
+  for (const TimingProvenance& p : provenance) {
+    if (p.cached) rep.cached_at.push_back(p.measured_at);
   }
   rep.seconds = clock.seconds();
   log << "[stability] done in " << fmt(rep.seconds, 3) << " s" << std::endl;

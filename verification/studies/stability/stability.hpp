@@ -20,6 +20,8 @@
 
 namespace vessel {
 
+class OutcomeCache;  // verification/outcome_cache.hpp
+
 struct StabilityOptions {
   bool quick = true;  ///< levels 0..1 and a scaled-down long run; else levels 0..2 and 10⁶ steps
   std::filesystem::path cache_dir;  ///< mesh cache ("" disables it)
@@ -37,6 +39,10 @@ struct StabilityOptions {
   /// Ids of the hard cases to run (poisson, youngs_modulus, sliver, refined_patch,
   /// inverting_load, long_run, tight_bend, zero_length); empty: all of them.
   std::vector<std::string> only_cases;
+  /// The step table's rows (per level and model) and each hard case kept on disk, keyed by the
+  /// options that shape them, the executable and the machine (their times are part of them);
+  /// nullptr: all computed.
+  OutcomeCache* outcome_cache = nullptr;
 };
 
 /// The hard cases' ids, in the order they run.
@@ -104,6 +110,10 @@ struct StabilityReport {
   std::vector<RefinementFit> fits;
   std::vector<HardCase> hard_cases;
   double seconds = 0.0;
+  /// Items timed (each level's model rows, each hard case) and the measurement times of those
+  /// read from the outcome cache.
+  std::size_t timed_items = 0;
+  std::vector<std::string> cached_at;
 };
 
 /// Runs the study. Throws InputError for bad options.

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "meshes/atomic_file.hpp"
+#include "reports/results_file.hpp"
 #include "verification/studies/stability/stability.hpp"
 #include "verification/studies/stability/study_models.hpp"
 
@@ -87,6 +88,8 @@ std::string stability_json(const StabilityReport& r) {
     j["hard_cases"].push_back(c);
   }
   j["total_seconds"] = r.seconds;
+  // Which timings (rows' and cases' seconds) were read from the outcome cache, and when measured.
+  j["timing_provenance"] = {{"items", r.timed_items}, {"cached_measured_at", r.cached_at}};
   return j.dump(2) + "\n";
 }
 
@@ -99,7 +102,12 @@ std::string stability_markdown(const StabilityReport& r) {
      << " steps per trial from a small random velocity, unstable when the energy exceeds "
         "1000× its start or turns non-finite) — and what every model does on hard cases. "
         "Produced by `" << r.command_line << "`" << (r.quick ? " (quick mode)" : "")
-     << " in " << fmt(r.seconds, 3) << " s.\n\n"
+     << " in " << fmt(r.seconds, 3) << " s.";
+  const std::string provenance = reports::timing_provenance_line(r.timed_items, r.cached_at);
+  if (!provenance.empty()) {
+    md << " Timings (per level and model's rows, per hard case): " << provenance << ".";
+  }
+  md << "\n\n"
      << "### Predicted vs found stable step\n\n"
      << "Straight tube, unstructured levels; surface models on the inner wall (triangle "
         "topology), E = 14.24 kPa, consistent masses, inlet and outlet fixed. Damped rows: point "

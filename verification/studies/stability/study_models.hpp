@@ -10,6 +10,7 @@
 #include "msm/model/build_network.hpp"
 #include "msm/model/model_factory.hpp"
 #include "msm/solvers/integrators.hpp"
+#include "verification/harness.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_problems.hpp"
 #include "verification/studies/stability/stability.hpp"
@@ -97,9 +98,11 @@ struct IntegratorConfig {
   double zeta;  ///< target damping ratio on the top mode; 0: undamped
 };
 
-// (a) predicted vs found critical steps (critical_steps.cpp)
+// (a) predicted vs found critical steps (critical_steps.cpp); `provenance`: one per (level,
+// model), whether its rows were computed or read from o.outcome_cache
 std::vector<CriticalStepRow> critical_step_table(const StabilityOptions& o, int max_level,
-                                                 int steps, std::ostream& log);
+                                                 int steps, std::ostream& log,
+                                                 std::vector<TimingProvenance>& provenance);
 std::vector<RefinementFit> refinement_fits(const std::vector<CriticalStepRow>& rows);
 
 // (b) the hard cases, one file each (case_<id>.cpp), in kHardCaseIds' order
