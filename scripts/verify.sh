@@ -22,7 +22,8 @@
 #            finite-strain reference); the stability table at levels 0-1 with a 2·10^5-step long
 #            run; level-0 recommendation candidates
 #   --quick  models at level 0, reference at level 1, smallest and largest load, the quick
-#            stability study: a few minutes
+#            stability study (~8 min from an empty cache, most of it the validity study
+#            and the FEM transients, which it does not shorten; ~1 min once cached)
 #   --full   the default plus the stability table at level 2, the 10^6-step long run, the
 #            level-1 recommendation candidates and the validity study at the scenes' reference
 #            level on the dense ladder (not measured: P2 level 1 costs ~10 s per Newton
