@@ -1,6 +1,7 @@
 #include "reports/study_files.hpp"
 
 #include "reports/json_fields.hpp"
+#include "reports/results_file.hpp"
 
 namespace vessel::reports {
 
@@ -207,6 +208,12 @@ StabilityFile parse_stability(const std::string& text, const std::filesystem::pa
   s.critical_steps = read_array(j, "critical_steps", file, read_step);
   s.refinement = read_array(j, "refinement", file, read_refinement);
   s.hard_cases = read_array(j, "hard_cases", file, read_hard_case);
+  if (const auto t = j.find("timing_provenance"); t != j.end() && t->is_object()) {
+    const std::string where = file + ": timing_provenance";
+    s.timing_provenance = timing_provenance_line(
+        field<std::size_t>(*t, "items", where),
+        field<std::vector<std::string>>(*t, "cached_measured_at", where));
+  }
   return s;
 }
 

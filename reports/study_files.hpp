@@ -51,6 +51,9 @@ struct StabilityFile {
   std::vector<CriticalStepEntry> critical_steps;
   std::vector<RefinementEntry> refinement;
   std::vector<HardCaseEntry> hard_cases;
+  /// Which rows' and hard cases' timings came from the model outcome cache
+  /// (timing_provenance_line); empty in a file without that record.
+  std::string timing_provenance;
 };
 
 /// One candidate of a recommendation. error and update_seconds are present when it finished

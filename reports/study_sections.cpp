@@ -82,6 +82,9 @@ void stability_section(Document& doc, const StabilityFile& s) {
       "start or turns non-finite) — and what every model does on hard cases. Produced by `" +
       s.command + "`" + (s.quick ? " (quick mode)" : "") + " in " + significant(s.total_seconds, 3) +
       " s (`" + s.path.filename().string() + "`).");
+  if (!s.timing_provenance.empty()) {
+    doc.paragraph("Timings (per level and model's rows, per hard case): " + s.timing_provenance + ".");
+  }
   doc.heading(3, "Predicted vs found stable step");
   doc.paragraph(
       "Straight tube, unstructured levels; surface models on the inner wall (triangle topology), "

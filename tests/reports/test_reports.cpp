@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include <nlohmann/json.hpp>
+
 #include "meshes/errors.hpp"
 #include "reports/document.hpp"
 #include "reports/gate.hpp"
@@ -279,6 +281,20 @@ TEST(StudyFiles, TheReportDrawsTheStabilityFilesFigures) {
   EXPECT_NE(md.find("| fem_p1 | yes | yes | – | max \\|u\\| 0.123 mm |"), std::string::npos) << md;
   EXPECT_NE(md.find("400 steps per trial"), std::string::npos);
   EXPECT_NE(md.find("`vesselverify stability --quick` (quick mode) in 42 s"), std::string::npos);
+  EXPECT_EQ(md.find("Timings (per level"), std::string::npos) << "no provenance record, no line";
+
+  // With the record stability.json carries: 2 of 5 items from the cache, measured at two times.
+  nlohmann::json j = nlohmann::json::parse(kStability);
+  j["timing_provenance"] = {{"items", 5},
+                            {"cached_measured_at", {"2026-11-25T06:51:34Z", "2026-11-25T06:50:00Z"}}};
+  const StabilityFile cached = parse_stability(j.dump(), "stability.json");
+  const std::string md2 =
+      build_report(results_with({outcome("m", 1e-3, 0.1, 1)}), cached, "cmd").markdown_text("f");
+  EXPECT_NE(md2.find("Timings (per level and model's rows, per hard case): 2 of 5 timings from "
+                     "the cache, measured 2026-11-25T06:50:00Z to 2026-11-25T06:51:34Z by the "
+                     "same executable on this machine"),
+            std::string::npos)
+      << md2;
 }
 
 TEST(StudyFiles, TheReportDrawsTheRecommendationWithItsRunsUnitAndReference) {
