@@ -164,7 +164,9 @@ ValiditySceneEntry read_validity_scene(const json& j, const std::string& where) 
   e.completed = field<bool>(c, "completed", cw);
   e.largest_load = field<double>(c, "largest_load", cw);
   e.stop_reason = field<std::string>(c, "stop_reason", cw);
-  e.self_contact = field<bool>(c, "self_contact", cw);
+  // Files written before the self-contact check have no such field: their stop is shown as
+  // written (its reason), not as self-contact.
+  if (c.contains("self_contact")) e.self_contact = field<bool>(c, "self_contact", cw);
   e.load_steps = field<int>(c, "load_steps", cw);
   e.rejected_steps = field<int>(c, "rejected_steps", cw);
   e.newton_iterations = field<int>(c, "newton_iterations", cw);

@@ -229,6 +229,9 @@ TEST(ValidityFile, WrittenThenReadBackByTheReportWithBadFieldsNamed) {
   j["scenes"][0]["continuation"].erase("largest_load");
   EXPECT_NE(refused(j).find("continuation: missing field 'largest_load'"), std::string::npos)
       << refused(j);
+  j = good;  // a file from before the self-contact check: read, its stop not called self-contact
+  j["scenes"][0]["continuation"].erase("self_contact");
+  EXPECT_FALSE(reports::parse_validity(j.dump(), "old.json").scenes[0].self_contact);
   j = good;
   j["schema"] = "vesselverify.results";
   EXPECT_NE(refused(j).find("vesselverify.validity"), std::string::npos) << refused(j);
