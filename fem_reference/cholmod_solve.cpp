@@ -18,6 +18,9 @@ struct CholmodFactor::Impl {
 CholmodFactor::CholmodFactor(const Eigen::SparseMatrix<double>& K)
     : impl_(std::make_unique<Impl>()) {
   apply_solver_threads();
+  // A matrix that is not positive definite is reported by the exception below (the
+  // finite-strain Newton then solves by LU); CHOLMOD's own warning on stderr would only repeat it.
+  impl_->llt.cholmod().print = 0;
   impl_->llt.compute(K);
   if (impl_->llt.info() != Eigen::Success) {
     throw std::runtime_error(

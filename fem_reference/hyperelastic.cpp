@@ -81,7 +81,8 @@ Mat3 to_mat3(const dl::Tensor<2, kDim>& t) {
 struct PassStats {
   bool valid = true;  ///< J > 0 at every quadrature point
   double min_jacobian = std::numeric_limits<double>::infinity();
-  double energy = 0.0;
+  double energy = 0.0;     ///< ∫Ψ dV, J
+  double dead_work = 0.0;  ///< f_dead · w at unit load (all DoFs), J
   double max_abs_strain = 0.0;
 };
 
@@ -169,6 +170,7 @@ struct HyperelasticSolver::Impl {
       fev[disp].get_function_gradients(w, grad_u);
       if (mixed) fev[pres].get_function_values(w, p_h);
       cell->get_dof_indices(dofs);
+      for (unsigned i = 0; i < n; ++i) stats.dead_work += f_dead(i) * w(dofs[i]);
       k = 0.0;
       r_int = 0.0;
       for (unsigned q = 0; q < nq; ++q) {
@@ -392,10 +394,19 @@ struct HyperelasticSolver::Impl {
         u += d.solution;
         continue;
       }
-      // Backtracking on the residual's norm (the follower load has no potential).
+      // Backtracking line search. A step is accepted when it decreases the residual's norm or,
+      // where the problem has a potential Π(u) = ∫Ψ dV − s f_dead·u (dead loads, displacement
+      // form: the tangent is Π's Hessian), when it meets Armijo's condition on Π (Nocedal &
+      // Wright, Numerical Optimization, eq. 3.4). The residual's norm alone rejects the full
+      // Newton step of a tube sagging between clamped ends: the step is right, but its
+      // membrane forces raise the norm (gravity_sag took 10+ damped iterations per step).
+      // Follower pressure has no potential, and the mixed form's Π is a saddle.
       const dl::Vector<double> du = d.solution;
       const dl::Vector<double> u0 = u;
       const double merit0 = out.residual;
+      const double energy0 = st.energy - s1 * st.dead_work;
+      const double slope = -(d.rhs * du);  // ∇Π·du = R·du, d.rhs = −R on the free DoFs
+      const bool energy_merit = symmetric && !mixed && slope < 0.0;
       double alpha = 1.0;
       bool accepted = false;
       for (int ls = 0; ls <= opt.max_line_search; ++ls, alpha *= 0.5) {
@@ -403,7 +414,11 @@ struct HyperelasticSolver::Impl {
         u.add(alpha, du);
         Norms trial;
         const PassStats ts = assemble(u, s1, false, trial);
-        if (ts.valid && trial.relative(scale) <= (1.0 - 1e-4 * alpha) * merit0) {
+        if (!ts.valid) continue;
+        const bool residual_decreases = trial.relative(scale) <= (1.0 - 1e-4 * alpha) * merit0;
+        const bool energy_decreases =
+            energy_merit && ts.energy - s1 * ts.dead_work <= energy0 + 1e-4 * alpha * slope;
+        if (residual_decreases || energy_decreases) {
           accepted = true;
           break;
         }

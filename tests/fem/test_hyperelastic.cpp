@@ -286,6 +286,44 @@ TEST(HyperelasticContinuation, AnObserverStopsTheContinuationWithItsReason) {
   EXPECT_EQ(r.checkpoints.size(), 2u);
 }
 
+TEST(HyperelasticContinuation, NewtonTakesFullStepsOnABarSaggingBetweenClampedEnds) {
+  // A 10 × 1 × 1 mm bar clamped at both ends under 5 g sags by about 5 % of its length: its
+  // Newton steps stretch it axially (membrane forces of ½ w'² ≈ 1 %), which raises the residual's
+  // norm although the step is right. Armijo on the potential energy takes the full steps:
+  // quadratic convergence in one load step. The answer must equal a continuation in eight
+  // small steps (a second solution path) to the tolerance.
+  TetMesh bar = test::cube_mesh(3, 1e-3);
+  for (Vec3& x : bar.nodes) x.x() *= 10.0;
+  ElasticityProblem p;
+  p.material.poisson_ratio = 0.45;
+  p.options.degree = 2;
+  p.options.solver = LinearSolver::direct;
+  p.dirichlet = {DirichletCondition::clamped("x0"), DirichletCondition::clamped("x1")};
+  p.gravity = Vec3(0, 0, -5 * 9.81);
+  HyperelasticOptions one;
+  one.max_newton_iterations = 8;
+  one.min_step = 1.0;  // no halving: one load step or a failure
+  HyperelasticSolver s1(bar, p, one);
+  const auto& r1 = s1.solve();
+  ASSERT_TRUE(r1.completed) << r1.stop_reason;
+  EXPECT_EQ(r1.steps.size(), 1u);
+  HyperelasticOptions eight;
+  eight.initial_step = eight.max_step = 0.125;
+  HyperelasticSolver s8(bar, p, eight);
+  const auto& r8 = s8.solve();
+  ASSERT_TRUE(r8.completed) << r8.stop_reason;
+  double diff = 0.0, norm = 0.0;
+  for (std::size_t i = 0; i < r1.nodal_displacement.size(); ++i) {
+    diff = std::max(diff, (r1.nodal_displacement[i] - r8.nodal_displacement[i]).norm());
+    norm = std::max(norm, r8.nodal_displacement[i].norm());
+  }
+  std::cout << "  sagging bar: one step " << r1.newton_iterations << " Newton iterations, eight steps "
+            << r8.newton_iterations << "; max |u| " << norm * 1e3 << " mm, paths differ by "
+            << diff / norm << "\n";
+  EXPECT_GT(norm, 0.03 * 10e-3);
+  EXPECT_LT(diff, 1e-7 * norm);
+}
+
 TEST(HyperelasticContinuation, NewtonFailureReportsTheLargestLoadReached) {
   // One Newton iteration per step cannot reach the tolerance: the increment fails, and halving
   // it would fall below min_step; the result keeps load factor 0 and says why.
