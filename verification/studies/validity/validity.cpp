@@ -235,8 +235,11 @@ std::vector<double> default_ladder(const Scene& scene, bool full) {
       return {1e-5, 1e-4, 2e-4, 3e-4, 5e-4, 7e-4, 1e-3, 1.5e-3, 2e-3, 3e-3, 5e-3, 7e-3,
               1e-2, 1.5e-2, 2e-2, 3e-2, 5e-2, 7e-2, 0.1, 0.14};
     }
-    // 50 and 70 mN: rows close to where the tubes' continuations stop (88–96 mN at P2 level 0).
-    return {1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2, 5e-2, 7e-2, 0.1, 0.14};
+    // Up to 70 mN, below where the tubes' continuations stop at P2 level 0 (89–93 mN: the wall
+    // passing through itself under the straight tube's patch, Newton on the arch). Finding that
+    // largest load is most of the study's cost (halving the increment down to min_step after
+    // each failure), so it is left to --full, whose ladder goes on to 140 mN.
+    return {1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2, 5e-2, 7e-2};
   }
   // Other loads: fractions of the scene's largest magnitude (gravity: up to 1 g).
   const double top = *std::max_element(scene.load.magnitudes.begin(), scene.load.magnitudes.end());
