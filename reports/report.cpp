@@ -313,9 +313,13 @@ void history_figure(const FigureContext& c) {
   plot.x = {"time (s)", Scale::linear};
   plot.y = {"displacement at the QoI point (mm)", Scale::linear};
   bool reference_drawn = false;
+  std::string reference_mesh;  // ", P2 on level N" when the results say which
   for (const OutcomeRow* o : rows) {
     if (o->magnitude != rows.front()->magnitude) continue;
     if (!reference_drawn && o->history_reference_mm.size() == o->history_time_s.size()) {
+      if (o->history_reference_level) {
+        reference_mesh = ", P2 on level " + std::to_string(*o->history_reference_level);
+      }
       plot.series.insert(plot.series.begin(),
                          black_line("FEM transient (Newmark)", o->history_time_s,
                                     o->history_reference_mm));
@@ -340,9 +344,9 @@ void history_figure(const FigureContext& c) {
   c.doc.figure(file_safe(c.scene.name) + "_history.svg", render_svg(plot),
                "The contact force applied as a step at t = 0: displacement of the QoI point over "
                "time for each integrator" +
-                   std::string(reference_drawn ? ", against the FEM transient (Newmark, average "
-                                                 "acceleration)."
-                                               : " (no FEM transient in these results).") +
+                   (reference_drawn ? ", against the FEM transient (Newmark, average "
+                                      "acceleration" + reference_mesh + ")."
+                                    : std::string(" (no FEM transient in these results).")) +
                    " Real-time factor: simulated time over wall-clock time (≥ 1 runs in real "
                    "time). The final error is against the static reference.");
   c.doc.table(t);

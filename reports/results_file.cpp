@@ -62,6 +62,8 @@ OutcomeRow read_outcome(const json& j, const std::string& where) {
     o.steps = field<long>(*h, "steps", where + ".history");
     o.simulated_s = field<double>(*h, "simulated_s", where + ".history");
     o.mass_damping_per_s = field<double>(*h, "mass_damping_per_s", where + ".history");
+    o.history_reference_level =
+        json_fields::optional_field<int>(*h, "reference_level", where + ".history");
   }
   return o;
 }

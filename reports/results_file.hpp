@@ -32,6 +32,7 @@ struct OutcomeRow {
   std::vector<double> profile_s_mm, profile_model_mm, profile_reference_mm;
   std::vector<double> history_time_s, history_model_mm, history_reference_mm;
   double history_max_error_mm = 0.0, simulated_s = 0.0, mass_damping_per_s = 0.0;
+  std::optional<int> history_reference_level;  ///< the FEM transient's mesh level (older files: none)
   long steps = 0;
 };
 

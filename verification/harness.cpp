@@ -124,6 +124,13 @@ struct ReferenceSolvers {
   const TetMesh* fine_mesh = nullptr;
   fem::ElasticityProblem fine_problem;  ///< what `fine` solves: the solution cache's key
   fem::SolutionCache* cache = nullptr;  ///< nullptr: solve and run transients afresh
+  /// The FEM transient's discretisation (scene's [transient] reference_level): `fine` itself,
+  /// or a solver of its own on another level (never solved statically: transient() needs no
+  /// solve).
+  std::unique_ptr<fem::ElasticitySolver> transient_solver;
+  const TetMesh* transient_mesh = nullptr;
+  fem::ElasticityProblem transient_problem;
+  int transient_level = 0;  ///< the transient's mesh level
   /// FEM transients already run, by (probe point, simulated time, α): |u(t)| at unit load, m.
   mutable std::map<std::tuple<double, double, double, double, double>,
                    std::pair<std::vector<double>, std::vector<double>>>
@@ -132,6 +139,16 @@ struct ReferenceSolvers {
   /// mesh with the fine problem (unit load × load factor = magnitude); not cached on disk.
   mutable std::map<double, std::unique_ptr<fem::HyperelasticSolver>> finite;
 };
+
+int transient_reference_level(const Scene& s) {
+  return s.transient.reference_level >= 0 ? s.transient.reference_level : s.reference_level;
+}
+
+bool has_dynamic_models(const Scene& s) {
+  return std::any_of(s.models.begin(), s.models.end(), [](const ModelSpec& m) {
+    return m.kind != ModelKind::fem && m.solver.is_dynamic();
+  });
+}
 
 /// Whether the finite-strain reference judges a case at load `magnitude`: always, never, or
 /// (auto) where the linear reference's largest strain there exceeds the linear regime's 5 %.
@@ -194,9 +211,12 @@ const std::pair<std::vector<double>, std::vector<double>>& transient_at(
   t.mass_damping = alpha;
   t.probe_points = {probe};
   t.outside_tolerance = kOutsideTolerance;
+  const bool own = ref.transient_solver != nullptr;
+  const fem::ElasticitySolver& solver = own ? *ref.transient_solver : *ref.fine;
+  const TetMesh& mesh = own ? *ref.transient_mesh : *ref.fine_mesh;
+  const fem::ElasticityProblem& problem = own ? ref.transient_problem : ref.fine_problem;
   const fem::TransientResult r =
-      ref.cache ? ref.cache->transient(*ref.fine, *ref.fine_mesh, ref.fine_problem, t)
-                : ref.fine->transient(t);
+      ref.cache ? ref.cache->transient(solver, mesh, problem, t) : solver.transient(t);
   std::vector<double> u(r.time.size());
   for (std::size_t k = 0; k < u.size(); ++k) u[k] = r.probe_displacement[k][0].norm();
   const std::lock_guard lock(transients_mutex);
@@ -404,6 +424,7 @@ void add_reference_history(History& h, const ReferenceSolvers& ref, const Vec3& 
   h.steps = spec.solver.steps;
   h.simulated_s = spec.solver.dt * static_cast<double>(spec.solver.steps);
   h.mass_damping = transient_mass_damping(spec, problem);
+  h.reference_level = ref.transient_level;
   const auto& [t, u] = transient_at(ref, probe, h.simulated_s, h.mass_damping);
   h.reference_mm.clear();
   h.max_error_mm = 0.0;
@@ -920,9 +941,12 @@ struct SceneReferences {
   TetMesh fine_mesh;
   std::unique_ptr<TetMesh> coarse_mesh;
   std::unique_ptr<TetMesh> coarsest_mesh;  ///< reference_level − 2: the GCI's observed order
-  std::unique_ptr<TetMesh> modal_mesh;          ///< the modal reference's, when no other is
+  /// Meshes read for the modal reference or the FEM transient alone, by level.
+  std::map<int, std::unique_ptr<TetMesh>> other_meshes;
   const TetMesh* modal_reference_mesh = nullptr;  ///< nullptr: the scene asks for no modes
   int modal_level = 0;
+  const TetMesh* transient_mesh = nullptr;  ///< the FEM transient's (scene's [transient])
+  int transient_level = 0;
   struct AtNu {
     ReferenceSolvers ref;
     ReferenceInfo info;
@@ -935,6 +959,17 @@ struct SceneReferences {
   SceneReferences(const SceneReferences&) = delete;
   SceneReferences& operator=(const SceneReferences&) = delete;
 };
+
+/// The scene's mesh at `level`: one of those already read, else read once into other_meshes.
+const TetMesh& mesh_at_level(SceneReferences& r, int level, const HarnessOptions& o) {
+  if (level == r.scene.reference_level) return r.fine_mesh;
+  if (r.coarse_mesh && level == r.scene.reference_level - 1) return *r.coarse_mesh;
+  if (r.coarsest_mesh && level == r.scene.reference_level - 2) return *r.coarsest_mesh;
+  if (r.model_meshes.count(level)) return r.model_meshes.at(level);
+  auto& slot = r.other_meshes[level];
+  if (!slot) slot = std::make_unique<TetMesh>(scene_mesh(r.scene, level, o.cache_dir));
+  return *slot;
+}
 
 /// The scene's meshes (generated or read from the mesh cache; gmsh is not thread-safe, so this
 /// runs on one thread).
@@ -960,20 +995,11 @@ std::unique_ptr<SceneReferences> scene_meshes(const Scene& scene, const HarnessO
     r->coarsest_mesh =
         std::make_unique<TetMesh>(scene_mesh(s, s.reference_level - 2, o.cache_dir));
   }
-  // The modal reference's mesh (scene's [modes]): one of those above, else its own.
+  // The modal reference's and the FEM transient's meshes (scene's [modes], [transient]).
   r->modal_level = modal_reference_level(s);
-  if (s.modes.count > 0) {
-    if (r->modal_level == s.reference_level) {
-      r->modal_reference_mesh = &r->fine_mesh;
-    } else if (r->coarse_mesh && r->modal_level == s.reference_level - 1) {
-      r->modal_reference_mesh = r->coarse_mesh.get();
-    } else if (r->model_meshes.count(r->modal_level)) {
-      r->modal_reference_mesh = &r->model_meshes.at(r->modal_level);
-    } else {
-      r->modal_mesh = std::make_unique<TetMesh>(scene_mesh(s, r->modal_level, o.cache_dir));
-      r->modal_reference_mesh = r->modal_mesh.get();
-    }
-  }
+  if (s.modes.count > 0) r->modal_reference_mesh = &mesh_at_level(*r, r->modal_level, o);
+  r->transient_level = transient_reference_level(s);
+  r->transient_mesh = &mesh_at_level(*r, r->transient_level, o);
   r->at_nu.resize(s.poisson_ratios.size());
   return r;
 }
@@ -1018,6 +1044,13 @@ void solve_reference_at(const Scene& s, SceneReferences& r, std::size_t k,
   ref.fine_problem = fem_problem(s, r.fine_mesh, nu, 2);
   const fem::ElasticityResult& fine =
       solve_reference(ref.fine, r.fine_mesh, ref.fine_problem, ref.cache);
+  ref.transient_level = r.transient_level;
+  if (r.transient_mesh != &r.fine_mesh && has_dynamic_models(s)) {
+    ref.transient_mesh = r.transient_mesh;
+    ref.transient_problem = fem_problem(s, *r.transient_mesh, nu, 2);
+    ref.transient_solver =
+        std::make_unique<fem::ElasticitySolver>(*r.transient_mesh, ref.transient_problem);
+  }
   if (r.coarse_mesh) {
     solve_reference(ref.coarse, *r.coarse_mesh, fem_problem(s, *r.coarse_mesh, nu, 2), ref.cache);
     ref.gci = reference_gci_order(s, r, ref, nu);

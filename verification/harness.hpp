@@ -119,6 +119,7 @@ struct History {
   long steps = 0;
   double simulated_s = 0.0;   ///< dt × steps
   double mass_damping = 0.0;  ///< α of the FEM transient, 1/s
+  int reference_level = 0;    ///< mesh level of the FEM transient (P2)
 };
 
 /// Where a measured outcome's timings come from (verification/outcome_cache.hpp).

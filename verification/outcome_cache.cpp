@@ -339,6 +339,7 @@ std::string model_run_key(const Scene& s, const ModelSpec& m, double nu, int lev
   h.text("budget").integer(b.stated).integer(static_cast<int>(b.quantity)).real(b.radius);
   h.real(b.tolerance).real(b.rate_hz).real(b.time_budget_s).real(b.magnitude);
   h.integer(s.modes.count).integer(s.modes.reference_level).integer(static_cast<int>(s.reference));
+  h.integer(s.transient.reference_level);
   // The model.
   h.text("model").text(m.name).integer(static_cast<int>(m.kind)).integer(m.degree);
   h.integer(static_cast<int>(m.surface)).integer(static_cast<int>(m.topology));

@@ -173,7 +173,8 @@ nlohmann::json scene_json(const SceneResult& r) {
                         {"max_error_mm", o.history.max_error_mm},
                         {"steps", o.history.steps},
                         {"simulated_s", o.history.simulated_s},
-                        {"mass_damping_per_s", o.history.mass_damping}};
+                        {"mass_damping_per_s", o.history.mass_damping},
+                        {"reference_level", o.history.reference_level}};
       }
     } else {
       j["failure"] = o.failure;

@@ -747,6 +747,10 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
   scene.modes.reference_level =
       static_cast<int>(modes.integer_or("reference_level", -1, 0, kMaxMeshLevel));
   modes.finish();
+  TableReader transient = r.sub("transient", false);
+  scene.transient.reference_level =
+      static_cast<int>(transient.integer_or("reference_level", -1, 0, kMaxMeshLevel));
+  transient.finish();
   const std::string reference =
       r.string_or("reference", "linear", {"linear", "finite-strain", "auto"});
   scene.reference = reference == "finite-strain" ? ReferenceChoice::finite_strain

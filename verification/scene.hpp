@@ -141,6 +141,14 @@ struct ModalSpec {
   int reference_level = -1;
 };
 
+/// The FEM transient the dynamic models' histories are compared with (the `[transient]` table).
+struct TransientSpec {
+  /// Mesh level of the transient (P2, Newmark); −1: the scene's reference_level. Every Newmark
+  /// step is a solve with the level's factor, so a level below the static reference's keeps a
+  /// long transient affordable.
+  int reference_level = -1;
+};
+
 /// Which FEM reference judges the mass-spring models (issue 17): the linear one (small strain),
 /// the finite-strain one (neo-Hookean with the same E and ν, fem::HyperelasticSolver, solved at
 /// each load magnitude), or automatic: finite-strain where the linear reference's largest strain
@@ -167,6 +175,7 @@ struct Scene {
   Tolerances tolerances;
   Budget budget;
   ModalSpec modes;
+  TransientSpec transient;
   ReferenceChoice reference = ReferenceChoice::linear;  ///< `reference = "linear"` (default)
 };
 

@@ -393,6 +393,33 @@ TEST(HarnessDynamic, FemTransientSettlesOnTheStaticReferenceAndTheHistoryIsSampl
   EXPECT_DOUBLE_EQ(h.max_error_mm, max_diff);
 }
 
+TEST(HarnessDynamic, TransientRunsOnTheLevelTheSceneNames) {
+  // A 10 mm tube with its static reference on level 1 and [transient] on level 0: the history
+  // says level 0 and is the transient of the same scene whose whole reference is on level 0
+  // (there the transient runs on the reference's own solver), to round-off.
+  std::string text = kDynamic;
+  text.replace(text.find("reference_level = 0"), 19, "reference_level = 1\nlength = 10.0e-3");
+  text.replace(text.find("20.0e-3]"), 8, "5.0e-3]");
+  const std::string on_level_0 = text + "[transient]\nreference_level = 0\n";
+  const SceneResult split = run_scene(parse_scene(on_level_0, "dynamic_test.toml"), HarnessOptions{});
+  std::string all_level_0 = text;
+  all_level_0.replace(all_level_0.find("reference_level = 1"), 19, "reference_level = 0");
+  const SceneResult whole = run_scene(parse_scene(all_level_0, "dynamic_test.toml"), HarnessOptions{});
+  ASSERT_EQ(split.outcomes.size(), 1u);
+  ASSERT_EQ(whole.outcomes.size(), 1u);
+  const History& a = split.outcomes[0].history;
+  const History& b = whole.outcomes[0].history;
+  ASSERT_TRUE(split.outcomes[0].ok) << split.outcomes[0].failure;
+  EXPECT_EQ(a.reference_level, 0);
+  EXPECT_EQ(b.reference_level, 0);
+  EXPECT_EQ(split.references.at(0).level, 1);  // the static reference stays on level 1
+  ASSERT_EQ(a.reference_mm.size(), b.reference_mm.size());
+  for (std::size_t k = 0; k < a.reference_mm.size(); ++k) {
+    EXPECT_NEAR(a.reference_mm[k], b.reference_mm[k], 1e-12 * b.reference_mm.back()) << k;
+  }
+  EXPECT_GT(b.reference_mm.back(), 0.0);
+}
+
 TEST(HarnessDynamic, SeedTwoPositionBasedModelRunsFromASceneWithItsHistory) {
   // Seed 002's XPBD surface model, named in a scene like any solver: it finishes, its history is
   // sampled over the run and ends at its final state, and it moves the contact point inwards.

@@ -295,6 +295,17 @@ TEST(Scene, ModesTableIsReadAndCheckedNamingTheKey) {
   EXPECT_NE(msg.find("key 'modes.number': unknown key"), std::string::npos) << msg;
 }
 
+TEST(Scene, TransientTableIsReadAndCheckedNamingTheKey) {
+  EXPECT_EQ(parse_scene(kMinimal, "scene.toml").transient.reference_level, -1);  // the scene's
+  EXPECT_EQ(parse_scene(std::string(kMinimal) + "[transient]\nreference_level = 0\n", "scene.toml")
+                .transient.reference_level,
+            0);
+  auto msg = error_of(std::string(kMinimal) + "[transient]\nreference_level = -2\n");
+  EXPECT_NE(msg.find("key 'transient.reference_level'"), std::string::npos) << msg;
+  msg = error_of(std::string(kMinimal) + "[transient]\nlevel = 0\n");
+  EXPECT_NE(msg.find("key 'transient.level': unknown key"), std::string::npos) << msg;
+}
+
 TEST(Scene, BendingSelectsTheDiscreteShellsSurfaceModel) {
   const Scene s = parse_scene(std::string(kMinimal) +
                                   "[[models]]\nname = \"shell\"\nkind = \"surface_msm\"\n"
