@@ -6,8 +6,8 @@
 #      on the arch, Lamé pressure, gravity sag, the dynamic step contact, the region-of-interest
 #      radii) against the FEM reference → results.json, results.csv, summary.md, fields/;
 #   3. `vesselverify validity` on the contact scenes and gravity: where the linear reference stops
-#      being valid, and the seed models against the finite-strain reference up to 140 mN (or the
-#      largest load reached) → validity.json;
+#      being valid, and the seed models against the finite-strain reference up to 70 mN and 1 g
+#      → validity.json;
 #   4. `vesselverify stability`: predicted vs found critical time steps and the hard cases →
 #      stability.json, stability.md;
 #   5. `vesselverify recommend` on the two contact scenes at 30 Hz (visual) and 1 kHz (haptic):
@@ -68,10 +68,10 @@ phase "run: the shipped scenes"
   "$scenes/pressure_lame.toml" "$scenes/contact_arch.toml" "$scenes/gravity_sag.toml" \
   "$scenes/dynamic_contact.toml" "$scenes/contact_roi.toml"
 phase "validity: the linear reference's limit, the seed models at finite strain"
-# P2 on level 0 and the short ladder (`vesselverify validity --full` for the scenes' reference
-# level, the full ladder and every static model; see README).
+# P2 on level 0 and the ladder to 70 mN (--quick: 0.1, 1 and 10 mN; `vesselverify validity
+# --full` for the scenes' reference level, the full ladder to 140 mN and every static model).
 validity_options=()
-if $full; then validity_options=(--full); fi
+if $full; then validity_options=(--full); elif [ ${#mode[@]} -gt 0 ]; then validity_options=(--quick); fi
 "$vv" validity "${validity_options[@]}" --output-dir "$out" "$scenes/contact_straight.toml" \
   "$scenes/contact_arch.toml" "$scenes/gravity_sag.toml"
 phase "stability"

@@ -22,6 +22,7 @@ struct ValidityCli {
   fs::path output_dir = "results";
   CacheOptions cache;
   bool full = false;
+  bool quick = false;
   int reference_level = -1;
   int degree = 2;
   std::vector<double> ladder;
@@ -57,6 +58,9 @@ void add_validity_command(CLI::App& app, const std::string& command_line) {
   cmd->add_flag("--full", o->full,
                 "The scene's reference level, the full ladder and every whole-vessel static "
                 "mass-spring model (default: level 0, the short ladder, the seed models)");
+  cmd->add_flag("--quick", o->quick,
+                "The quick ladder: contact 0.1, 1 and 10 mN, other loads the scene's largest alone")
+      ->excludes("--full");
   cmd->add_option("--reference-level", o->reference_level,
                   "The references' mesh level (default: 0, or the scene's with --full)");
   cmd->add_option("--degree", o->degree, "The references' element degree")
@@ -84,6 +88,7 @@ void add_validity_command(CLI::App& app, const std::string& command_line) {
     const auto cache = o->cache.solution_cache(std::cout);
     ValidityOptions vo;
     vo.full = o->full;
+    vo.quick = o->quick;
     vo.reference_level = o->reference_level;
     vo.degree = o->degree;
     vo.ladder = o->ladder;

@@ -85,6 +85,21 @@ TEST(ThresholdCrossing, InterpolatesLogLinearlyBetweenTheBracketingLoads) {
   EXPECT_THROW((void)threshold_crossing({1.0}, {}, 0.15), std::invalid_argument);
 }
 
+TEST(ValidityLadder, QuickDefaultAndFullLaddersSpanWhatTheyPromise) {
+  Scene contact = parse_scene(kScene, "validity_test.toml");
+  EXPECT_EQ(default_ladder(contact, false, true), (std::vector<double>{1e-4, 1e-3, 1e-2}));
+  const auto standard = default_ladder(contact, false);
+  EXPECT_EQ(standard.front(), 1e-4);
+  EXPECT_EQ(standard.back(), 7e-2);  // the largest load reached is --full's to find
+  EXPECT_EQ(default_ladder(contact, true).back(), 0.14);
+  EXPECT_EQ(default_ladder(contact, true, true).back(), 0.14);  // --full wins
+  Scene gravity = contact;
+  gravity.load.kind = LoadKind::gravity;
+  gravity.load.magnitudes = {0.5, 2.0};
+  EXPECT_EQ(default_ladder(gravity, false, true), (std::vector<double>{2.0}));
+  EXPECT_EQ(default_ladder(gravity, false), (std::vector<double>{1.0, 2.0}));
+}
+
 TEST(ValidityStudy, TheOnePercentCrossingIsWhatTheLoadSquaredDifferencePredicts) {
   const Scene s = parse_scene(kScene, "validity_test.toml");
   const ValidityScene v = run_validity_scene(s, small_options());

@@ -228,8 +228,9 @@ ThresholdCrossing threshold_crossing(const std::vector<double>& loads,
   return c;
 }
 
-std::vector<double> default_ladder(const Scene& scene, bool full) {
+std::vector<double> default_ladder(const Scene& scene, bool full, bool quick) {
   if (scene.load.kind == LoadKind::contact) {
+    if (quick && !full) return {1e-4, 1e-3, 1e-2};
     // Seed 000's range, 0.01 to 140 mN, denser where the references part (0.1–10 mN).
     if (full) {
       return {1e-5, 1e-4, 2e-4, 3e-4, 5e-4, 7e-4, 1e-3, 1.5e-3, 2e-3, 3e-3, 5e-3, 7e-3,
@@ -244,6 +245,7 @@ std::vector<double> default_ladder(const Scene& scene, bool full) {
   // Other loads: fractions of the scene's largest magnitude (gravity: up to 1 g).
   const double top = *std::max_element(scene.load.magnitudes.begin(), scene.load.magnitudes.end());
   if (full) return {0.01 * top, 0.1 * top, 0.25 * top, 0.5 * top, 0.75 * top, top};
+  if (quick) return {top};
   return {0.5 * top, top};
 }
 
@@ -267,7 +269,7 @@ ValidityScene scene_settings(const Scene& s, const ValidityOptions& o) {
   out.reference_level = reference_level_of(s, o);
   out.degree = o.degree;
   out.model_level = s.model_levels.front();
-  out.ladder = o.ladder.empty() ? default_ladder(s, o.full) : o.ladder;
+  out.ladder = o.ladder.empty() ? default_ladder(s, o.full, o.quick) : o.ladder;
   std::sort(out.ladder.begin(), out.ladder.end());
   out.ladder.erase(std::unique(out.ladder.begin(), out.ladder.end()), out.ladder.end());
   if (out.ladder.empty() || !(out.ladder.front() > 0.0)) {

@@ -108,6 +108,9 @@ struct ValidityOptions {
   /// default_ladder, the seed models (stiffness seed000 / seed001). true: the scene's reference level, the full
   /// ladder, every whole-vessel static mass-spring model of the scene.
   bool full = false;
+  /// The quick ladder (`verify.sh --quick`): contact 0.1, 1 and 10 mN, where the linear
+  /// reference's 1, 5 and 10 % limits lie; other loads, the scene's largest alone.
+  bool quick = false;
   int reference_level = -1;      ///< −1: as `full` says
   int degree = 2;                ///< the references' elements
   std::vector<double> ladder;    ///< scene's unit; empty: as `full` says
@@ -118,10 +121,10 @@ struct ValidityOptions {
   std::ostream* log = nullptr;
 };
 
-/// The default ladders: contact, seed 000's range up to 140 mN (N): 0.1, 0.3, 1, 3, 10, 30, 100,
-/// 140 mN (full: 20 loads from 0.01 mN); other loads, 50 % and 100 % of the scene's largest
-/// (full: 1, 10, 25, 50, 75, 100 %).
-std::vector<double> default_ladder(const Scene& scene, bool full);
+/// The default ladders: contact (N) 0.1, 0.3, 1, 3, 10, 30, 50, 70 mN (full: 20 loads from
+/// 0.01 mN to seed 000's 140 mN; quick: 0.1, 1, 10 mN); other loads, 50 % and 100 % of the
+/// scene's largest (full: 1, 10, 25, 50, 75, 100 %; quick: 100 %).
+std::vector<double> default_ladder(const Scene& scene, bool full, bool quick = false);
 
 /// The study on one scene at its first Poisson's ratio. InputError for a scene it cannot run
 /// (a dynamic or modal-only scene, a model named that is not a whole-vessel static mass-spring
