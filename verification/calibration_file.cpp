@@ -77,7 +77,7 @@ void write_calibration(const std::filesystem::path& path, const Calibration& c) 
                 {"youngs_modulus_Pa", c.youngs_modulus}};
   j["mesh"] = {{"hash", c.mesh_hash}, {"vessel", c.vessel}, {"level", c.level},
                {"nodes", c.nodes},    {"springs", c.springs}, {"tets", c.tets}};
-  if (c.granularity == "groups") {
+  if (c.granularity != "per_spring") {
     nlohmann::ordered_json f = nlohmann::ordered_json::object();
     for (std::size_t i = 0; i < c.names.size(); ++i) f[c.names[i]] = c.factors[i];
     j["factors"] = f;
@@ -141,9 +141,10 @@ Calibration read_calibration(const std::filesystem::path& path) {
   }
   Calibration c;
   c.granularity = member<std::string>(j, "granularity", file);
-  if (c.granularity != "groups" && c.granularity != "per_spring") {
+  if (c.granularity != "groups" && c.granularity != "wall_layers" &&
+      c.granularity != "per_spring") {
     throw InputError(file + ": key \"granularity\": found \"" + c.granularity +
-                     "\", expected \"groups\" or \"per_spring\"");
+                     "\", expected \"groups\", \"wall_layers\" or \"per_spring\"");
   }
   const auto model = member<nlohmann::json>(j, "model", file);
   const std::string mfile = file + ": model";
@@ -166,7 +167,7 @@ Calibration read_calibration(const std::filesystem::path& path) {
   c.nodes = member<std::size_t>(mesh, "nodes", meshfile);
   c.springs = member<std::size_t>(mesh, "springs", meshfile);
   c.tets = member<std::size_t>(mesh, "tets", meshfile);
-  if (c.granularity == "groups") {
+  if (c.granularity != "per_spring") {
     const auto f = member<nlohmann::json>(j, "factors", file);
     if (!f.is_object() || f.empty()) {
       throw InputError(file + ": key \"factors\": expected an object of name: factor");
@@ -223,8 +224,9 @@ Calibration read_calibration(const std::filesystem::path& path) {
 std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
     const Calibration& c, const std::string& source, const msm::BuiltNetwork& built,
     const VesselParams& vessel) {
-  const bool has_kappa =
-      std::find(c.names.begin(), c.names.end(), "kappa") != c.names.end();
+  const bool has_kappa = std::any_of(c.names.begin(), c.names.end(), [](const std::string& n) {
+    return n == "kappa" || n.rfind("kappa/", 0) == 0;
+  });
   if (has_kappa && !built.volume_kappa) {
     throw InputError(source + ": the calibration scales kappa, but the model has no volume term");
   }
@@ -237,6 +239,8 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
                        " factors, the model's network has " +
                        std::to_string(built.network.springs.size()) + " springs");
     }
+  } else if (c.granularity == "wall_layers") {
+    params = msm::wall_layer_parameters(built.network, vessel, has_kappa);
   } else {
     params = msm::group_parameters(built.network, vessel, has_kappa);
   }

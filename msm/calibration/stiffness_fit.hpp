@@ -33,7 +33,17 @@ struct StiffnessParameters {
   std::vector<std::string> names;  ///< one per parameter
   std::vector<int> of_spring;      ///< per spring of the network
   int kappa = -1;                  ///< κ's parameter, −1: none (or no volume term)
+  /// Per tet of the network: the parameter scaling that tet's κ (κ_e = κ0·f_e·exp(θ[of_tet[e]])),
+  /// for a κ that differs through the wall (wall_layer_parameters). Empty: `kappa` scales every
+  /// tet alike. When non-empty, `kappa` is −1.
+  std::vector<int> of_tet;
   [[nodiscard]] int size() const { return static_cast<int>(names.size()); }
+  /// Whether any parameter scales κ.
+  [[nodiscard]] bool scales_kappa() const { return kappa >= 0 || !of_tet.empty(); }
+  /// The parameter of tet e's κ, −1: none.
+  [[nodiscard]] int kappa_of_tet(std::size_t e) const {
+    return of_tet.empty() ? kappa : of_tet[e];
+  }
 };
 
 /// A few parameters ("groups"): on a surface network one factor per spring family present
@@ -51,6 +61,26 @@ std::string spring_class(const SpringNetwork& network, const VesselParams& vesse
                          const std::vector<char>& boundary_edge, std::size_t s);
 /// Per spring of a volume network: whether it is an edge of a boundary face (one tet only).
 std::vector<char> boundary_edges(const SpringNetwork& network);
+
+/// Position through the wall of a parametric vessel: ξ = (ρ − a)/t, ρ the distance from the
+/// centreline, a the inner radius, t the wall thickness (0 on the inner wall, 1 on the outer).
+double through_wall_position(const VesselParams& vessel, const Vec3& p);
+
+/// A few parameters by position through the wall ("wall_layers"; our own extension of the
+/// groups, for the wall's bending response, which depends on where a spring sits between the
+/// inner and outer surfaces): on a volume network one factor per (direction, layer) class of the
+/// tet-edge springs, direction as in group_parameters and layer from ξ̄, the mean of the two end
+/// nodes' through_wall_position: "inner" ξ̄ < 1/3, "middle", "outer" ξ̄ > 2/3 (the band edges fall
+/// between node layers of the structured meshes, whose nodes sit at ξ = j/(2·2^level)); and, with
+/// with_kappa, a κ factor per half of the wall by the tet's centroid ξ ("kappa/inner" ξ < 1/2,
+/// "kappa/outer"). Surface networks: the spring families, as group_parameters. The classes are
+/// defined by the vessel's geometry, so such a calibration applies to any mesh of a parametric
+/// vessel (InputError for a mesh-file vessel, which has no centreline).
+StiffnessParameters wall_layer_parameters(const SpringNetwork& network, const VesselParams& vessel,
+                                          bool with_kappa);
+/// The class name wall_layer_parameters gives spring s ("volume/axial/outer", "bend", ...).
+std::string spring_wall_layer_class(const SpringNetwork& network, const VesselParams& vessel,
+                                    std::size_t s);
 
 /// One parameter per spring ("spring/<index>"), plus "kappa" when with_kappa. Such a
 /// calibration belongs to this network only.
@@ -117,7 +147,8 @@ class LinearisedFit {
   struct RestTet {
     std::array<int, 4> nodes;
     Eigen::Matrix<double, 12, 1> g;  ///< ∂V/∂x at rest
-    double inv_volume;               ///< 1/|V₀|
+    double inv_volume;               ///< κ factor f_e/|V₀|
+    int param;                       ///< κ's parameter for this tet, −1: none
   };
   std::vector<RestSpring> springs_;
   std::vector<RestTet> tets_;

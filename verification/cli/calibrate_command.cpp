@@ -89,16 +89,19 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
                   "The scene's mass-spring model to calibrate (default: its hybrid volume model, "
                   "else its first mass-spring model)");
   cmd->add_option("--granularity", o->granularity,
-                  "groups: a factor per spring class and kappa; per-spring: a factor per spring "
-                  "and kappa, with a smoothness regulariser")
-      ->check(CLI::IsMember({"groups", "per-spring"}))
+                  "groups: a factor per spring class (direction x boundary) and kappa; "
+                  "wall-layers: a factor per spring class (direction x layer through the wall: "
+                  "inner, middle, outer third) and a kappa per half of the wall; per-spring: a "
+                  "factor per spring and kappa, with a smoothness regulariser")
+      ->check(CLI::IsMember({"groups", "wall-layers", "per-spring"}))
       ->capture_default_str();
   cmd->add_option("--train", o->train,
                   "Load types fitted on (contact, pressure, gravity; default the scene's); the "
                   "others are held out")
       ->delimiter(',');
   cmd->add_option("--held-out-scene", o->held_out_scenes,
-                  "Scenes whose loads are held-out cases on another vessel (groups only)")
+                  "Scenes whose loads are held-out cases on another vessel (groups and wall-layers "
+                  "only)")
       ->check(CLI::ExistingFile)
       ->delimiter(',');
   cmd->add_option("--nu", o->nu, "Poisson's ratio (default 0.45 if the scene has it, else its first)")

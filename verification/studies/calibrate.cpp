@@ -21,13 +21,20 @@
 namespace vessel {
 
 std::string to_string(CalibrationGranularity g) {
-  return g == CalibrationGranularity::groups ? "groups" : "per_spring";
+  switch (g) {
+    case CalibrationGranularity::groups: return "groups";
+    case CalibrationGranularity::wall_layers: return "wall_layers";
+    case CalibrationGranularity::per_spring: return "per_spring";
+  }
+  return "groups";
 }
 
 CalibrationGranularity parse_calibration_granularity(const std::string& name) {
   if (name == "groups") return CalibrationGranularity::groups;
+  if (name == "wall_layers" || name == "wall-layers") return CalibrationGranularity::wall_layers;
   if (name == "per_spring" || name == "per-spring") return CalibrationGranularity::per_spring;
-  throw InputError("granularity: found \"" + name + "\", expected groups or per-spring");
+  throw InputError("granularity: found \"" + name +
+                   "\", expected groups, wall-layers or per-spring");
 }
 
 namespace {
@@ -385,6 +392,8 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   msm::StiffnessParameters params =
       o.granularity == CalibrationGranularity::groups
           ? msm::group_parameters(main.base.network, main.vessel, has_kappa)
+      : o.granularity == CalibrationGranularity::wall_layers
+          ? msm::wall_layer_parameters(main.base.network, main.vessel, has_kappa)
           : msm::per_spring_parameters(main.base.network, has_kappa);
   std::vector<msm::FitCase> fit_cases;
   std::vector<char> fixed;
@@ -405,7 +414,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   if (fit_cases.empty()) throw InputError("calibrate: no training load; expected --train kinds");
   // Groups: the ridge alone (without it a contact-only fit drove the circumferential classes to
   // ~0 and κ up 12×, which fitted contact and failed pressure by 4× P1; docs/msm_calibration.md).
-  const msm::Regulariser reg = o.granularity == CalibrationGranularity::groups
+  const msm::Regulariser reg = o.granularity != CalibrationGranularity::per_spring
                                    ? msm::Regulariser{0.0, o.regulariser.ridge}
                                    : o.regulariser;
   const msm::LinearisedFit fit(main.base.network, main.base.volume_kappa, fixed, params,
@@ -453,6 +462,9 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
          << reference_level << "), model linearised at rest, adjoint gradients, L-BFGS; "
          << (o.granularity == CalibrationGranularity::groups
                  ? "a factor per spring class and kappa, ridge on the log factors"
+             : o.granularity == CalibrationGranularity::wall_layers
+                 ? "a factor per spring class (direction x layer through the wall) and per half "
+                   "of the wall for kappa, ridge on the log factors"
                  : "a factor per spring and kappa, smoothness regulariser on log k over springs "
                    "sharing a node");
   cal.method = method.str();
@@ -544,7 +556,7 @@ void write_calibration_markdown(std::ostream& out, const CalibrationStudy& st,
       << "Fit: " << c.method << ". " << c.names.size() << " parameters, " << c.iterations
       << " iterations (" << c.stop_reason << "), " << fixed3(st.fit_seconds)
       << " s; objective " << c.objective_before << " → " << c.objective_after << ".\n\n";
-  if (c.granularity == "groups") {
+  if (c.granularity != "per_spring") {
     out << "| parameter | factor |\n|---|---|\n";
     for (std::size_t i = 0; i < c.names.size(); ++i) {
       out << "| " << c.names[i] << " | " << fixed3(c.factors[i]) << " |\n";

@@ -37,8 +37,10 @@ class SolutionCache;
 
 namespace vessel {
 
-enum class CalibrationGranularity { groups, per_spring };
-std::string to_string(CalibrationGranularity g);  ///< "groups" | "per_spring"
+/// groups: msm::group_parameters; wall_layers: msm::wall_layer_parameters; per_spring:
+/// msm::per_spring_parameters.
+enum class CalibrationGranularity { groups, wall_layers, per_spring };
+std::string to_string(CalibrationGranularity g);  ///< "groups" | "wall_layers" | "per_spring"
 CalibrationGranularity parse_calibration_granularity(const std::string& name);  ///< InputError
 
 struct CalibrateOptions {
@@ -50,7 +52,7 @@ struct CalibrateOptions {
   std::optional<int> reference_level;   ///< default: the scene's
   CalibrationGranularity granularity = CalibrationGranularity::groups;
   std::vector<LoadKind> train;  ///< load types fitted on; default: the scene's load type
-  /// Per-spring fits: both terms; group fits: the ridge alone. Defaults: msm::Regulariser's doc.
+  /// Per-spring fits: both terms; group and wall-layer fits: the ridge alone. Defaults: msm::Regulariser's doc.
   msm::Regulariser regulariser{1e-2, 1e-3};
   int max_iterations = 200;
   /// Further scenes whose own loads are held-out cases on another vessel (group calibrations).
