@@ -142,9 +142,10 @@ Calibration read_calibration(const std::filesystem::path& path) {
   Calibration c;
   c.granularity = member<std::string>(j, "granularity", file);
   if (c.granularity != "groups" && c.granularity != "wall_layers" &&
-      c.granularity != "per_spring") {
+      c.granularity != "edge_types" && c.granularity != "per_spring") {
     throw InputError(file + ": key \"granularity\": found \"" + c.granularity +
-                     "\", expected \"groups\", \"wall_layers\" or \"per_spring\"");
+                     "\", expected \"groups\", \"wall_layers\", \"edge_types\" or "
+                     "\"per_spring\"");
   }
   const auto model = member<nlohmann::json>(j, "model", file);
   const std::string mfile = file + ": model";
@@ -239,8 +240,9 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
                        " factors, the model's network has " +
                        std::to_string(built.network.springs.size()) + " springs");
     }
-  } else if (c.granularity == "wall_layers") {
-    params = msm::wall_layer_parameters(built.network, vessel, has_kappa);
+  } else if (c.granularity == "wall_layers" || c.granularity == "edge_types") {
+    params = msm::wall_layer_parameters(built.network, vessel, has_kappa,
+                                        c.granularity == "edge_types");
   } else {
     params = msm::group_parameters(built.network, vessel, has_kappa);
   }

@@ -8,7 +8,8 @@
 ///
 /// Granularities: "groups" (a factor per spring class and κ; msm::group_parameters),
 /// "wall_layers" (a factor per spring class by direction and layer through the wall, and a κ per
-/// half of the wall; msm::wall_layer_parameters) and "per_spring" (a factor per spring and κ).
+/// half of the wall; msm::wall_layer_parameters), "edge_types" (the same with the edge's type,
+/// diagonals apart) and "per_spring" (a factor per spring and κ).
 /// The mesh hash must match the model's mesh, unless the model says `calibration_transfer =
 /// true`, which a group or wall-layer calibration allows (its classes are defined by the
 /// vessel's geometry) and a per-spring one refuses (its factors are indexed by the springs of one
@@ -46,7 +47,8 @@ struct CalibrationFitCase {
 };
 
 struct Calibration {
-  std::string granularity = "groups";  ///< "groups" | "wall_layers" | "per_spring"
+  /// "groups" | "wall_layers" | "edge_types" | "per_spring"
+  std::string granularity = "groups";
   // The model it applies to.
   std::string scene;       ///< scene name it was fitted on
   std::string model;       ///< the scene's model name

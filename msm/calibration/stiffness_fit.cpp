@@ -106,20 +106,33 @@ double through_wall_position(const VesselParams& vessel, const Vec3& p) {
 }
 
 std::string spring_wall_layer_class(const SpringNetwork& net, const VesselParams& vessel,
-                                    std::size_t s) {
+                                    std::size_t s, bool edge_types) {
   const Spring& sp = net.springs[s];
   if (sp.family != SpringFamily::volume) return to_string(sp.family);
-  const double xi = 0.5 * (through_wall_position(vessel, net.nodes[static_cast<std::size_t>(sp.a)]) +
-                           through_wall_position(vessel, net.nodes[static_cast<std::size_t>(sp.b)]));
+  const Vec3 a = net.nodes[static_cast<std::size_t>(sp.a)];
+  const Vec3 b = net.nodes[static_cast<std::size_t>(sp.b)];
+  const double xi = 0.5 * (through_wall_position(vessel, a) + through_wall_position(vessel, b));
   const char* layer = xi < 1.0 / 3.0 ? "/inner" : xi > 2.0 / 3.0 ? "/outer" : "/middle";
-  return std::string("volume/") + kDirections[spring_direction(net, vessel, s)] + layer;
+  if (!edge_types) {
+    return std::string("volume/") + kDirections[spring_direction(net, vessel, s)] + layer;
+  }
+  // The frame directions the edge spans: those with |d·e_i| > kEdgeTypeComponent.
+  const Vec3 d = (b - a).normalized();
+  const auto frame = centreline_frame(vessel, 0.5 * (a + b));
+  std::string type;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(d.dot(frame[i])) > kEdgeTypeComponent) {
+      type += (type.empty() ? "" : "+") + std::string(kDirections[i]);
+    }
+  }
+  return "volume/" + type + layer;
 }
 
 StiffnessParameters wall_layer_parameters(const SpringNetwork& net, const VesselParams& vessel,
-                                          bool with_kappa) {
+                                          bool with_kappa, bool edge_types) {
   std::vector<std::string> classes(net.springs.size());
   for (std::size_t s = 0; s < net.springs.size(); ++s) {
-    classes[s] = spring_wall_layer_class(net, vessel, s);
+    classes[s] = spring_wall_layer_class(net, vessel, s, edge_types);
   }
   StiffnessParameters p = parameters_from_classes(classes);
   if (with_kappa && !net.tets.empty()) {
@@ -289,7 +302,11 @@ LinearisedFit::LinearisedFit(const SpringNetwork& net, std::optional<double> kap
       throw InputError("calibration case " + c.name +
                        ": the reference displacement is zero or not finite; expected a loaded case");
     }
-    weights_.push_back(1.0 / (static_cast<double>(cases_.size()) * r2));
+    if (!(c.weight > 0.0) || !std::isfinite(c.weight)) {
+      throw InputError("calibration case " + c.name + ": weight " + std::to_string(c.weight) +
+                       "; expected a finite weight > 0");
+    }
+    weights_.push_back(c.weight / (static_cast<double>(cases_.size()) * r2));
   }
 }
 

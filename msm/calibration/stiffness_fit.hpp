@@ -9,8 +9,9 @@
 /// B_s = d dᵀ ⊗ [1 −1; −1 1] the rest Hessian of spring s (direction d; the transverse term ψ'/L
 /// vanishes at rest) and g_t = ∂V/∂x of tet t at rest (the volume term's rest Hessian,
 /// volume_term.hpp; its ∇²V term carries V − V₀ = 0). K is linear in the stiffnesses, so
-///   J(θ) = Σ_c ½·w_c·|u_c(θ) − r_c|²  (+ regulariser),   w_c = 1/(C·|r_c|²)
-/// (C cases: J is half the mean squared relative L2 error of the harness's metric) has the
+///   J(θ) = Σ_c ½·w_c·|u_c(θ) − r_c|²  (+ regulariser),   w_c = ω_c/(C·|r_c|²)
+/// (C cases, ω_c = 1: J is half the mean squared relative L2 error of the harness's metric;
+/// FitCase::weight ω_c weighs the cases otherwise) has the
 /// adjoint gradient (one extra solve per case with the same factorisation):
 ///   K λ_c = w_c (u_c − r_c),   ∂J/∂θ_p = −Σ_c λ_cᵀ (∂K/∂θ_p) u_c
 ///   = −Σ_c [Σ_{s∈p} k_s (d·Δλ_s)(d·Δu_s) + (p = κ) Σ_t κ/|V₀| (g_t·λ_t)(g_t·u_t)],
@@ -73,14 +74,24 @@ double through_wall_position(const VesselParams& vessel, const Vec3& p);
 /// nodes' through_wall_position: "inner" ξ̄ < 1/3, "middle", "outer" ξ̄ > 2/3 (the band edges fall
 /// between node layers of the structured meshes, whose nodes sit at ξ = j/(2·2^level)); and, with
 /// with_kappa, a κ factor per half of the wall by the tet's centroid ξ ("kappa/inner" ξ < 1/2,
-/// "kappa/outer"). Surface networks: the spring families, as group_parameters. The classes are
-/// defined by the vessel's geometry, so such a calibration applies to any mesh of a parametric
-/// vessel (InputError for a mesh-file vessel, which has no centreline).
+/// "kappa/outer"). With `edge_types` ("edge_types"), the direction is instead the set of frame
+/// directions the edge spans, |d·e_i| > kEdgeTypeComponent ("radial", "circumferential+axial",
+/// ...): a diagonal of a structured cell gets its own class apart from the cell's axis-aligned
+/// edges. Surface networks: the spring families, as group_parameters. The classes are defined by
+/// the vessel's geometry, so such a calibration applies to any mesh of a parametric vessel
+/// (InputError for a mesh-file vessel, which has no centreline).
 StiffnessParameters wall_layer_parameters(const SpringNetwork& network, const VesselParams& vessel,
-                                          bool with_kappa);
-/// The class name wall_layer_parameters gives spring s ("volume/axial/outer", "bend", ...).
+                                          bool with_kappa, bool edge_types = false);
+/// The class name wall_layer_parameters gives spring s ("volume/axial/outer",
+/// "volume/circumferential+axial/inner", "bend", ...).
 std::string spring_wall_layer_class(const SpringNetwork& network, const VesselParams& vessel,
-                                    std::size_t s);
+                                    std::size_t s, bool edge_types = false);
+/// Edge types: a unit vector's component along a frame direction above this counts (cos 69.5°).
+/// On the structured meshes (cells about 0.5 mm radial × 0.9 mm circumferential × 1.8 mm axial
+/// at level 0, the same proportions at every level) the circumferential–axial and radial–
+/// circumferential diagonals get their own types, while the radial–axial diagonals (radial
+/// component ≈ 0.27) count as axial.
+inline constexpr double kEdgeTypeComponent = 0.35;
 
 /// One parameter per spring ("spring/<index>"), plus "kappa" when with_kappa. Such a
 /// calibration belongs to this network only.
@@ -97,6 +108,9 @@ struct FitCase {
   std::string name;
   VectorXd force;
   VectorXd reference;
+  /// The case's weight ω_c in J: w_c = ω_c/(C·|r_c|²) (1: every case's relative error counts
+  /// alike).
+  double weight = 1.0;
 };
 
 /// The smoothness regulariser of a per-spring fit:

@@ -137,20 +137,20 @@ TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
     for (Eigen::Index i = 0; i < r.size(); ++i) {
       if (!fixed[static_cast<std::size_t>(i)]) r[i] += 1e-8 * std::sin(1.0 + i);
     }
-    cases.push_back({"case" + std::to_string(c), f, r});
+    cases.push_back({"case" + std::to_string(c), f, r, c == 0 ? 1.0 : 2.5});  // unequal weights
   }
   // The block sits at ρ = 3–5 mm from the straight tube's axis: with a 1 mm wall from ρ = 3.5 mm
   // every layer (inner, middle, outer; κ inner and outer half) is populated.
   VesselParams wall;
   wall.inner_radius = 3.5e-3;
   wall.wall_thickness = 1.0e-3;
-  for (const int granularity : {0, 1, 2}) {
+  for (const int granularity : {0, 1, 2, 3}) {
     const bool per_spring = granularity == 1;
     const StiffnessParameters params =
         granularity == 0   ? group_parameters(built.network, VesselParams{}, true)
         : granularity == 1 ? per_spring_parameters(built.network, true)
-                           : wall_layer_parameters(built.network, wall, true);
-    if (granularity == 2) {
+                           : wall_layer_parameters(built.network, wall, true, granularity == 3);
+    if (granularity >= 2) {
       ASSERT_FALSE(params.of_tet.empty());
       EXPECT_EQ(std::count(params.names.begin(), params.names.end(), "kappa/inner"), 1);
       EXPECT_EQ(std::count(params.names.begin(), params.names.end(), "kappa/outer"), 1);
@@ -170,7 +170,10 @@ TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
       tm[p] -= h;
       const double fd = (fit.objective(tp, dummy) - fit.objective(tm, dummy)) / (2 * h);
       EXPECT_NEAR(g[p], fd, 1e-6 * std::abs(fd) + 1e-7 * g.lpNorm<Eigen::Infinity>())
-          << (granularity == 0 ? "groups, " : granularity == 1 ? "per spring, " : "wall layers, ")
+          << (granularity == 0   ? "groups, "
+              : granularity == 1 ? "per spring, "
+              : granularity == 2 ? "wall layers, "
+                                 : "edge types, ")
           << params.names[static_cast<std::size_t>(p)];
       ++checked;
     }
@@ -388,6 +391,28 @@ TEST(StiffnessFit, WallLayerClassesFollowThePositionThroughTheWall) {
   EXPECT_EQ(spring_wall_layer_class(net, tube, 2), "volume/axial/outer");
   EXPECT_EQ(spring_wall_layer_class(net, tube, 3), "volume/radial/inner");   // ξ̄ = 1/4
   EXPECT_EQ(spring_wall_layer_class(net, tube, 4), "volume/radial/outer");   // ξ̄ = 3/4
+  // Edge types: the axis-aligned springs keep their direction; a radial–axial diagonal at 30°
+  // from the axis spans both (components 0.87 and 0.5 > 0.35) where the largest component says
+  // axial; one at 80° from the axis is radial alone (cos 80° = 0.17 < 0.35).
+  EXPECT_EQ(spring_wall_layer_class(net, tube, 0, true), "volume/axial/inner");
+  EXPECT_EQ(spring_wall_layer_class(net, tube, 3, true), "volume/radial/inner");
+  {
+    SpringNetwork diag;
+    const double r0 = 3.0e-3, l = 0.4e-3;
+    const double a30 = std::numbers::pi / 6.0, a80 = 80.0 * std::numbers::pi / 180.0;
+    diag.nodes = {at(r0, 0), at(r0 + l * std::sin(a30), l * std::cos(a30)),
+                  at(r0 + l * std::sin(a80), l * std::cos(a80))};
+    for (const int b : {1, 2}) {
+      Spring sp;
+      sp.a = 0;
+      sp.b = b;
+      sp.family = SpringFamily::volume;
+      diag.springs.push_back(sp);
+    }
+    EXPECT_EQ(spring_wall_layer_class(diag, tube, 0, true), "volume/radial+axial/inner");
+    EXPECT_EQ(spring_wall_layer_class(diag, tube, 0, false), "volume/axial/inner");
+    EXPECT_EQ(spring_wall_layer_class(diag, tube, 1, true), "volume/radial/inner");
+  }
   const StiffnessParameters p = wall_layer_parameters(net, tube, true);
   ASSERT_EQ(p.of_tet.size(), 2u);
   EXPECT_EQ(p.names[static_cast<std::size_t>(p.of_tet[0])], "kappa/inner");
