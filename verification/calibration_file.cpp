@@ -248,6 +248,26 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
   }
   std::map<std::string, double> by_name;
   for (std::size_t i = 0; i < c.names.size(); ++i) by_name[c.names[i]] = c.factors[i];
+  if (c.granularity == "wall_layers" || c.granularity == "edge_types") {
+    // A layer class the fitted mesh did not have (a level-0 mesh has two element layers through
+    // the wall, so e.g. no radial edge has its mean in the middle third; a level-1 mesh does):
+    // the geometric mean of the same direction's factors in the layers the file has (log factors
+    // interpolated through the wall).
+    for (const std::string& name : params.names) {
+      if (by_name.count(name) || name.rfind("volume/", 0) != 0) continue;
+      const std::string type = name.substr(0, name.rfind('/') + 1);
+      double log_sum = 0.0;
+      int found = 0;
+      for (const char* layer : {"inner", "middle", "outer"}) {
+        const auto it = by_name.find(type + layer);
+        if (it != by_name.end()) {
+          log_sum += std::log(it->second);
+          ++found;
+        }
+      }
+      if (found > 0) by_name[name] = std::exp(log_sum / found);
+    }
+  }
   Eigen::VectorXd theta(params.size());
   for (int p = 0; p < params.size(); ++p) {
     const auto it = by_name.find(params.names[static_cast<std::size_t>(p)]);

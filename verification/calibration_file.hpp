@@ -90,7 +90,11 @@ void apply_calibration(const Calibration& c, const std::string& source, msm::Bui
                        const TetMesh& mesh, const VesselParams& vessel, const ModelSpec& spec,
                        double youngs_modulus, double nu, bool transfer);
 
-/// The stiffness parameterisation and log factors θ a calibration describes on `built`.
+/// The stiffness parameterisation and log factors θ a calibration describes on `built`. For
+/// wall_layers and edge_types, a class of `built` that the file lacks (a layer the fitted mesh
+/// had no edges in: e.g. radial edges in the middle third on a level-0 mesh) takes the geometric
+/// mean of the same direction's factors in the other layers; a direction the file lacks
+/// altogether is an InputError.
 std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
     const Calibration& c, const std::string& source, const msm::BuiltNetwork& built,
     const VesselParams& vessel);

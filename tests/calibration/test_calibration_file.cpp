@@ -186,6 +186,43 @@ TEST(CalibrationFile, WallLayerCalibrationRoundTripsAndScalesSpringsAndEachTetsK
                                     true));
 }
 
+// A wall-layer class the fitted mesh did not have gets the geometric mean of its direction's
+// factors in the other layers (hand-computed here); a direction missing altogether is refused.
+TEST(CalibrationFile, AMissingWallLayerTakesTheGeometricMeanOfItsDirectionsLayers) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  VesselParams wall;
+  wall.inner_radius = 3.5e-3;
+  wall.wall_thickness = 1.0e-3;
+  const msm::BuiltNetwork base = hybrid(mesh);
+  const msm::StiffnessParameters p = msm::wall_layer_parameters(base.network, wall, true);
+  const auto has = [&](const std::string& n) {
+    return std::find(p.names.begin(), p.names.end(), n) != p.names.end();
+  };
+  ASSERT_TRUE(has("volume/axial/inner") && has("volume/axial/middle") && has("volume/axial/outer"));
+  Calibration c = make_calibration(mesh, base, false);
+  c.granularity = "wall_layers";
+  c.names.clear();
+  c.factors.clear();
+  for (const std::string& n : p.names) {
+    if (n == "volume/axial/middle") continue;  // as if the fitted mesh had none
+    c.names.push_back(n);
+    c.factors.push_back(n == "volume/axial/inner" ? 4.0 : n == "volume/axial/outer" ? 0.25 * 9.0 : 1.5);
+  }
+  const auto [params, theta] = calibration_parameters(c, "cal.json", base, wall);
+  const auto at = std::find(params.names.begin(), params.names.end(), "volume/axial/middle");
+  ASSERT_NE(at, params.names.end());
+  EXPECT_NEAR(std::exp(theta[at - params.names.begin()]), 3.0, 1e-12);  // sqrt(4 × 2.25)
+  Calibration none = c;
+  for (std::size_t i = none.names.size(); i-- > 0;) {
+    if (none.names[i].rfind("volume/axial/", 0) == 0) {
+      none.names.erase(none.names.begin() + static_cast<std::ptrdiff_t>(i));
+      none.factors.erase(none.factors.begin() + static_cast<std::ptrdiff_t>(i));
+    }
+  }
+  expect_input_error([&] { calibration_parameters(none, "cal.json", base, wall); },
+                     "volume/axial/");
+}
+
 TEST(CalibrationFile, AnotherMeshIsRefusedUnlessAGroupCalibrationTransfers) {
   const TetMesh mesh = block_mesh(2, 1e-3);
   TetMesh moved = mesh;
