@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <map>
 #include <numbers>
 
@@ -418,8 +420,15 @@ double LinearisedFit::regulariser_value(const VectorXd& theta, VectorXd* gradien
 }
 
 double LinearisedFit::objective(const VectorXd& theta, VectorXd& gradient) const {
-  const Evaluation e = evaluate(theta, true);
   gradient.setZero(params_.size());
+  Evaluation e;
+  try {
+    e = evaluate(theta, true);
+  } catch (const std::runtime_error&) {
+    // K(θ) not positive definite: possible where κ is negative (the homogenised rule below
+    // ν = 1/4) and a trial step scales it up. +∞ makes the line search step back.
+    return std::numeric_limits<double>::infinity();
+  }
   // Full-dof view of a free-dof vector's node block.
   const auto node = [&](const VectorXd& v, int n) {
     Vec3 out;

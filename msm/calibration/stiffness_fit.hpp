@@ -133,7 +133,8 @@ class LinearisedFit {
                 const std::vector<char>& fixed, StiffnessParameters params,
                 std::vector<FitCase> cases, Regulariser regulariser = {});
 
-  /// J(θ) and ∂J/∂θ (adjoint: one factorisation, one forward and one adjoint solve per case).
+  /// J(θ) and ∂J/∂θ (adjoint: one factorisation, one forward and one adjoint solve per case);
+  /// +∞ (gradient 0) where K(θ) is not positive definite, so that a line search steps back.
   double objective(const VectorXd& theta, VectorXd& gradient) const;
   /// The data term alone and the regulariser alone at θ.
   [[nodiscard]] double misfit(const VectorXd& theta) const;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <algorithm>
 #include <numbers>
+#include <limits>
 #include <random>
 
 #include "meshes/errors.hpp"
@@ -276,6 +277,24 @@ TEST(StiffnessFit, PerSpringFitReducesTheMisfitOfPlantedData) {
   o.max_iterations = 300;
   const LbfgsResult r = minimize_lbfgs(obj, zero, o);
   EXPECT_LT(fit.misfit(r.x), 1e-2 * before);
+}
+
+// A negative κ (the homogenised rule below ν = 1/4) scaled up makes K indefinite: the objective
+// is then +∞, for the line search to step back, not an exception that ends the fit.
+TEST(StiffnessFit, AnIndefiniteStiffnessGivesAnInfiniteObjective) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  const BuiltNetwork built = hybrid(mesh, 0.45);
+  const std::vector<char> fixed = bottom_fixed(built.network);
+  std::mt19937 rng(3);
+  const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
+  const StiffnessParameters params = group_parameters(built.network, VesselParams{}, true);
+  const double kappa = -0.5 * *built.volume_kappa;  // negative, small enough to start stable
+  const LinearisedFit fit(built.network, kappa, fixed, params,
+                          {{"c", f, Eigen::VectorXd::Ones(f.size())}});
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(params.size()), g;
+  theta[params.kappa] = std::log(1e4);  // κ → −5000·κ0: the volume term overwhelms the springs
+  EXPECT_EQ(fit.objective(theta, g), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(g.size(), params.size());
 }
 
 TEST(StiffnessFit, RefusesMismatchedSizesAndKappaWithoutVolumeTerm) {

@@ -330,21 +330,45 @@ CalibrationCaseResult evaluate_case(VesselContext& v, const LoadCase& c, const M
   r.p1_solve_seconds = a.p1_seconds;
   const Scene cs = case_scene(*v.scene, c);
   const std::vector<Vec3> ref = scaled(a.reference_at_network, c.magnitude);
-  const ModelAnswer base = solve_model(cs, spec, v.base, v.mesh, c.magnitude);
-  r.base = compare_displacements(base.u, ref);
-  r.base_update_seconds = base.update_seconds;
+  // A solver failure on one case (e.g. Newton not converging) is that case's outcome, not the
+  // study's: recorded and shown, the other cases still evaluated.
+  try {
+    const ModelAnswer base = solve_model(cs, spec, v.base, v.mesh, c.magnitude);
+    r.base = compare_displacements(base.u, ref);
+    r.base_update_seconds = base.update_seconds;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    r.base_ok = false;
+    r.base_failure = e.what();
+  }
   if (calibrated) {
-    const ModelAnswer cal = solve_model(cs, spec, *calibrated, v.mesh, c.magnitude);
-    r.calibrated = compare_displacements(cal.u, ref);
-    r.calibrated_update_seconds = cal.update_seconds;
+    try {
+      const ModelAnswer cal = solve_model(cs, spec, *calibrated, v.mesh, c.magnitude);
+      r.calibrated = compare_displacements(cal.u, ref);
+      r.calibrated_update_seconds = cal.update_seconds;
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      r.ok = false;
+      r.failure = e.what();
+    }
   } else {
     r.ok = false;
     r.failure = why_not;
   }
   log << "  " << r.scene << " L" << r.level << " " << r.name << " (" << r.holds_out << ", "
-      << r.magnitude << "): relative L2 P1 " << r.p1.relative_l2 << ", base "
-      << r.base.relative_l2;
-  if (r.ok) log << ", calibrated " << r.calibrated.relative_l2;
+      << r.magnitude << "): relative L2 P1 " << r.p1.relative_l2 << ", base ";
+  if (r.base_ok) {
+    log << r.base.relative_l2;
+  } else {
+    log << "failed (" << r.base_failure << ")";
+  }
+  if (r.ok) {
+    log << ", calibrated " << r.calibrated.relative_l2;
+  } else {
+    log << ", calibrated failed (" << r.failure << ")";
+  }
   log << "\n";
   return r;
 }
@@ -564,10 +588,11 @@ void case_table(std::ostream& out, const std::vector<CalibrationCaseResult>& cas
   for (const auto& c : cases) {
     if (c.training != training) continue;
     out << "| " << c.scene << " | " << c.level << " | " << c.name << " | " << c.holds_out << " | "
-        << load_text(c) << " | " << fixed3(c.p1.relative_l2) << " | " << fixed3(c.base.relative_l2)
+        << load_text(c) << " | " << fixed3(c.p1.relative_l2) << " | "
+        << (c.base_ok ? fixed3(c.base.relative_l2) : "—")
         << " | " << (c.ok ? fixed3(c.calibrated.relative_l2) : "—") << " | "
         << (c.ok ? fixed3(c.calibrated.relative_l2 / c.p1.relative_l2) : "—") << " | "
-        << std::setprecision(3) << c.base_update_seconds << " | "
+        << std::setprecision(3) << (c.base_ok ? c.base_update_seconds : 0.0) << " | "
         << (c.ok ? std::to_string(c.calibrated_update_seconds).substr(0, 7) : std::string("—"))
         << " | " << c.p1_solve_seconds << " | " << std::setprecision(2)
         << 100.0 * c.max_strain_reference << " % |\n";
@@ -604,11 +629,16 @@ void write_calibration_markdown(std::ostream& out, const CalibrationStudy& st,
   case_table(out, st.cases, true);
   out << "\n## Held-out loads\n\n";
   case_table(out, st.cases, false);
+  std::string last_failure;
   for (const auto& cs : st.cases) {
-    if (!cs.ok) {
-      out << "\n" << cs.scene << " " << cs.name << ": calibrated model not evaluated: " << cs.failure
-          << "\n";
-      break;
+    if (!cs.ok && cs.failure != last_failure) {  // a transfer's refusal once, not per case
+      out << "\n" << cs.scene << " " << cs.name << " (" << load_text(cs)
+          << "): calibrated model not evaluated: " << cs.failure << "\n";
+      last_failure = cs.failure;
+    }
+    if (!cs.base_ok) {
+      out << "\n" << cs.scene << " " << cs.name << " (" << load_text(cs)
+          << "): uncalibrated model not evaluated: " << cs.base_failure << "\n";
     }
   }
 }

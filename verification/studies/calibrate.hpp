@@ -89,7 +89,10 @@ struct CalibrationCaseResult {
   double base_update_seconds = 0.0, calibrated_update_seconds = 0.0;  ///< per update (ramp median)
   double max_strain_reference = 0.0;  ///< reference's largest principal strain at this load
   bool ok = true;
-  std::string failure;  ///< why the calibrated model could not be evaluated
+  std::string failure;  ///< why the calibrated model could not be evaluated (a refused
+                        ///< transfer, or its solver's failure on this case)
+  bool base_ok = true;
+  std::string base_failure;  ///< why the uncalibrated model could not be (its solver's failure)
 };
 
 struct CalibrationStudy {
