@@ -424,6 +424,8 @@ double LinearisedFit::objective(const VectorXd& theta, VectorXd& gradient) const
   Evaluation e;
   try {
     e = evaluate(theta, true);
+  } catch (const InputError&) {
+    throw;  // bad input (sizes) stays an error
   } catch (const std::runtime_error&) {
     // K(θ) not positive definite: possible where κ is negative (the homogenised rule below
     // ν = 1/4) and a trial step scales it up. +∞ makes the line search step back.
