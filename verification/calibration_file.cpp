@@ -77,7 +77,7 @@ void write_calibration(const std::filesystem::path& path, const Calibration& c) 
                 {"youngs_modulus_Pa", c.youngs_modulus}};
   j["mesh"] = {{"hash", c.mesh_hash}, {"vessel", c.vessel}, {"level", c.level},
                {"nodes", c.nodes},    {"springs", c.springs}, {"tets", c.tets}};
-  if (c.granularity == "groups") {
+  if (c.granularity != "per_spring") {
     nlohmann::ordered_json f = nlohmann::ordered_json::object();
     for (std::size_t i = 0; i < c.names.size(); ++i) f[c.names[i]] = c.factors[i];
     j["factors"] = f;
@@ -141,9 +141,11 @@ Calibration read_calibration(const std::filesystem::path& path) {
   }
   Calibration c;
   c.granularity = member<std::string>(j, "granularity", file);
-  if (c.granularity != "groups" && c.granularity != "per_spring") {
+  if (c.granularity != "groups" && c.granularity != "wall_layers" &&
+      c.granularity != "edge_types" && c.granularity != "per_spring") {
     throw InputError(file + ": key \"granularity\": found \"" + c.granularity +
-                     "\", expected \"groups\" or \"per_spring\"");
+                     "\", expected \"groups\", \"wall_layers\", \"edge_types\" or "
+                     "\"per_spring\"");
   }
   const auto model = member<nlohmann::json>(j, "model", file);
   const std::string mfile = file + ": model";
@@ -166,7 +168,7 @@ Calibration read_calibration(const std::filesystem::path& path) {
   c.nodes = member<std::size_t>(mesh, "nodes", meshfile);
   c.springs = member<std::size_t>(mesh, "springs", meshfile);
   c.tets = member<std::size_t>(mesh, "tets", meshfile);
-  if (c.granularity == "groups") {
+  if (c.granularity != "per_spring") {
     const auto f = member<nlohmann::json>(j, "factors", file);
     if (!f.is_object() || f.empty()) {
       throw InputError(file + ": key \"factors\": expected an object of name: factor");
@@ -223,8 +225,9 @@ Calibration read_calibration(const std::filesystem::path& path) {
 std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
     const Calibration& c, const std::string& source, const msm::BuiltNetwork& built,
     const VesselParams& vessel) {
-  const bool has_kappa =
-      std::find(c.names.begin(), c.names.end(), "kappa") != c.names.end();
+  const bool has_kappa = std::any_of(c.names.begin(), c.names.end(), [](const std::string& n) {
+    return n == "kappa" || n.rfind("kappa/", 0) == 0;
+  });
   if (has_kappa && !built.volume_kappa) {
     throw InputError(source + ": the calibration scales kappa, but the model has no volume term");
   }
@@ -237,11 +240,34 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
                        " factors, the model's network has " +
                        std::to_string(built.network.springs.size()) + " springs");
     }
+  } else if (c.granularity == "wall_layers" || c.granularity == "edge_types") {
+    params = msm::wall_layer_parameters(built.network, vessel, has_kappa,
+                                        c.granularity == "edge_types");
   } else {
     params = msm::group_parameters(built.network, vessel, has_kappa);
   }
   std::map<std::string, double> by_name;
   for (std::size_t i = 0; i < c.names.size(); ++i) by_name[c.names[i]] = c.factors[i];
+  if (c.granularity == "wall_layers" || c.granularity == "edge_types") {
+    // A layer class the fitted mesh did not have (a level-0 mesh has two element layers through
+    // the wall, so e.g. no radial edge has its mean in the middle third; a level-1 mesh does):
+    // the geometric mean of the same direction's factors in the layers the file has (log factors
+    // interpolated through the wall).
+    for (const std::string& name : params.names) {
+      if (by_name.count(name) || name.rfind("volume/", 0) != 0) continue;
+      const std::string type = name.substr(0, name.rfind('/') + 1);
+      double log_sum = 0.0;
+      int found = 0;
+      for (const char* layer : {"inner", "middle", "outer"}) {
+        const auto it = by_name.find(type + layer);
+        if (it != by_name.end()) {
+          log_sum += std::log(it->second);
+          ++found;
+        }
+      }
+      if (found > 0) by_name[name] = std::exp(log_sum / found);
+    }
+  }
   Eigen::VectorXd theta(params.size());
   for (int p = 0; p < params.size(); ++p) {
     const auto it = by_name.find(params.names[static_cast<std::size_t>(p)]);

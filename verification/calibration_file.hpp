@@ -6,11 +6,14 @@
 /// scene file); its network is then built as usual and the factors applied
 /// (apply_scene_calibration).
 ///
-/// Granularities: "groups" (a factor per spring class and κ; msm::group_parameters) and
-/// "per_spring" (a factor per spring and κ). The mesh hash must match the model's mesh, unless
-/// the model says `calibration_transfer = true`, which a group calibration allows (its classes
-/// are defined by the vessel's geometry) and a per-spring one refuses (its factors are indexed by
-/// the springs of one mesh).
+/// Granularities: "groups" (a factor per spring class and κ; msm::group_parameters),
+/// "wall_layers" (a factor per spring class by direction and layer through the wall, and a κ per
+/// half of the wall; msm::wall_layer_parameters), "edge_types" (the same with the edge's type,
+/// diagonals apart) and "per_spring" (a factor per spring and κ).
+/// The mesh hash must match the model's mesh, unless the model says `calibration_transfer =
+/// true`, which a group or wall-layer calibration allows (its classes are defined by the
+/// vessel's geometry) and a per-spring one refuses (its factors are indexed by the springs of one
+/// mesh).
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -44,7 +47,8 @@ struct CalibrationFitCase {
 };
 
 struct Calibration {
-  std::string granularity = "groups";  ///< "groups" | "per_spring"
+  /// "groups" | "wall_layers" | "edge_types" | "per_spring"
+  std::string granularity = "groups";
   // The model it applies to.
   std::string scene;       ///< scene name it was fitted on
   std::string model;       ///< the scene's model name
@@ -86,7 +90,11 @@ void apply_calibration(const Calibration& c, const std::string& source, msm::Bui
                        const TetMesh& mesh, const VesselParams& vessel, const ModelSpec& spec,
                        double youngs_modulus, double nu, bool transfer);
 
-/// The stiffness parameterisation and log factors θ a calibration describes on `built`.
+/// The stiffness parameterisation and log factors θ a calibration describes on `built`. For
+/// wall_layers and edge_types, a class of `built` that the file lacks (a layer the fitted mesh
+/// had no edges in: e.g. radial edges in the middle third on a level-0 mesh) takes the geometric
+/// mean of the same direction's factors in the other layers; a direction the file lacks
+/// altogether is an InputError.
 std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
     const Calibration& c, const std::string& source, const msm::BuiltNetwork& built,
     const VesselParams& vessel);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 #include <map>
 #include <numbers>
 
@@ -58,40 +60,108 @@ std::vector<char> boundary_edges(const SpringNetwork& net) {
   return out;
 }
 
-std::string spring_class(const SpringNetwork& net, const VesselParams& vessel,
-                         const std::vector<char>& boundary_edge, std::size_t s) {
+namespace {
+
+const char* const kDirections[3] = {"radial", "circumferential", "axial"};
+
+/// Spring s's direction class: the largest component of its unit vector in the centreline frame
+/// at its midpoint (0 radial, 1 circumferential, 2 axial).
+int spring_direction(const SpringNetwork& net, const VesselParams& vessel, std::size_t s) {
   const Spring& sp = net.springs[s];
-  if (sp.family != SpringFamily::volume) return to_string(sp.family);
   const Vec3 a = net.nodes[static_cast<std::size_t>(sp.a)];
   const Vec3 b = net.nodes[static_cast<std::size_t>(sp.b)];
   const Vec3 d = (b - a).normalized();
   const auto frame = centreline_frame(vessel, 0.5 * (a + b));
-  static const char* kDirections[3] = {"radial", "circumferential", "axial"};
   int best = 0;
   for (int i = 1; i < 3; ++i) {
     if (std::abs(d.dot(frame[i])) > std::abs(d.dot(frame[best]))) best = i;
   }
-  return std::string("volume/") + kDirections[best] +
+  return best;
+}
+
+/// Builds parameters from a class name per spring (sorted names: a stable order).
+StiffnessParameters parameters_from_classes(const std::vector<std::string>& classes) {
+  StiffnessParameters p;
+  std::map<std::string, int> index;
+  for (const std::string& c : classes) index.emplace(c, 0);
+  for (auto& [name, i] : index) {
+    i = static_cast<int>(p.names.size());
+    p.names.push_back(name);
+  }
+  p.of_spring.resize(classes.size());
+  for (std::size_t s = 0; s < classes.size(); ++s) p.of_spring[s] = index.at(classes[s]);
+  return p;
+}
+
+}  // namespace
+
+std::string spring_class(const SpringNetwork& net, const VesselParams& vessel,
+                         const std::vector<char>& boundary_edge, std::size_t s) {
+  const Spring& sp = net.springs[s];
+  if (sp.family != SpringFamily::volume) return to_string(sp.family);
+  return std::string("volume/") + kDirections[spring_direction(net, vessel, s)] +
          (boundary_edge[s] ? "/boundary" : "/interior");
+}
+
+double through_wall_position(const VesselParams& vessel, const Vec3& p) {
+  return (centreline_coordinates(vessel, p).rho - vessel.inner_radius) / vessel.wall_thickness;
+}
+
+std::string spring_wall_layer_class(const SpringNetwork& net, const VesselParams& vessel,
+                                    std::size_t s, bool edge_types) {
+  const Spring& sp = net.springs[s];
+  if (sp.family != SpringFamily::volume) return to_string(sp.family);
+  const Vec3 a = net.nodes[static_cast<std::size_t>(sp.a)];
+  const Vec3 b = net.nodes[static_cast<std::size_t>(sp.b)];
+  const double xi = 0.5 * (through_wall_position(vessel, a) + through_wall_position(vessel, b));
+  const char* layer = xi < 1.0 / 3.0 ? "/inner" : xi > 2.0 / 3.0 ? "/outer" : "/middle";
+  if (!edge_types) {
+    return std::string("volume/") + kDirections[spring_direction(net, vessel, s)] + layer;
+  }
+  // The frame directions the edge spans: those with |d·e_i| > kEdgeTypeComponent.
+  const Vec3 d = (b - a).normalized();
+  const auto frame = centreline_frame(vessel, 0.5 * (a + b));
+  std::string type;
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(d.dot(frame[i])) > kEdgeTypeComponent) {
+      type += (type.empty() ? "" : "+") + std::string(kDirections[i]);
+    }
+  }
+  return "volume/" + type + layer;
+}
+
+StiffnessParameters wall_layer_parameters(const SpringNetwork& net, const VesselParams& vessel,
+                                          bool with_kappa, bool edge_types) {
+  std::vector<std::string> classes(net.springs.size());
+  for (std::size_t s = 0; s < net.springs.size(); ++s) {
+    classes[s] = spring_wall_layer_class(net, vessel, s, edge_types);
+  }
+  StiffnessParameters p = parameters_from_classes(classes);
+  if (with_kappa && !net.tets.empty()) {
+    const int inner = p.size();
+    p.names.emplace_back("kappa/inner");
+    p.names.emplace_back("kappa/outer");
+    p.of_tet.resize(net.tets.size());
+    for (std::size_t e = 0; e < net.tets.size(); ++e) {
+      double xi = 0.0;
+      for (const int n : net.tets[e]) {
+        xi += 0.25 * through_wall_position(vessel, net.nodes[static_cast<std::size_t>(n)]);
+      }
+      p.of_tet[e] = xi < 0.5 ? inner : inner + 1;
+    }
+  }
+  return p;
 }
 
 StiffnessParameters group_parameters(const SpringNetwork& net, const VesselParams& vessel,
                                      bool with_kappa) {
-  StiffnessParameters p;
   const std::vector<char> boundary =
       net.tets.empty() ? std::vector<char>(net.springs.size(), 0) : boundary_edges(net);
-  std::map<std::string, int> index;
   std::vector<std::string> classes(net.springs.size());
   for (std::size_t s = 0; s < net.springs.size(); ++s) {
     classes[s] = spring_class(net, vessel, boundary, s);
-    index.emplace(classes[s], 0);
   }
-  for (auto& [name, i] : index) {  // sorted names: a stable parameter order
-    i = static_cast<int>(p.names.size());
-    p.names.push_back(name);
-  }
-  p.of_spring.resize(net.springs.size());
-  for (std::size_t s = 0; s < net.springs.size(); ++s) p.of_spring[s] = index.at(classes[s]);
+  StiffnessParameters p = parameters_from_classes(classes);
   if (with_kappa) {
     p.kappa = static_cast<int>(p.names.size());
     p.names.emplace_back("kappa");
@@ -127,14 +197,31 @@ void check_parameters(const SpringNetwork& net, const StiffnessParameters& param
     throw InputError("stiffness parameters: expected " + std::to_string(params.size()) +
                      " values, got " + std::to_string(theta_size));
   }
+  const auto is_kappa = [&](int p) {
+    return p == params.kappa ||
+           std::find(params.of_tet.begin(), params.of_tet.end(), p) != params.of_tet.end();
+  };
   for (const int p : params.of_spring) {
-    if (p < -1 || p >= params.size() || (p >= 0 && p == params.kappa)) {
+    if (p < -1 || p >= params.size() || (p >= 0 && is_kappa(p))) {
       throw InputError("stiffness parameters: a spring names parameter " + std::to_string(p) +
                        ", expected one of the " + std::to_string(params.size()) +
                        " spring parameters");
     }
   }
-  if (params.kappa >= 0 && !kappa) {
+  if (!params.of_tet.empty()) {
+    if (params.of_tet.size() != net.tets.size() || params.kappa >= 0) {
+      throw InputError("stiffness parameters: they describe the kappa of " +
+                       std::to_string(params.of_tet.size()) + " tets, the network has " +
+                       std::to_string(net.tets.size()));
+    }
+    for (const int p : params.of_tet) {
+      if (p < -1 || p >= params.size()) {
+        throw InputError("stiffness parameters: a tet names parameter " + std::to_string(p) +
+                         ", expected one of the " + std::to_string(params.size()));
+      }
+    }
+  }
+  if (params.scales_kappa() && !kappa) {
     throw InputError("stiffness parameters: a factor for the volume term's kappa, but the model "
                      "has no volume term (expected a hybrid volume model, volume_term = true)");
   }
@@ -153,6 +240,14 @@ void apply_stiffness_factors(SpringNetwork& net, std::optional<double>& kappa,
     net.springs[s].law.k2 *= factor;
   }
   if (params.kappa >= 0) *kappa *= std::exp(theta[params.kappa]);
+  if (!params.of_tet.empty()) {
+    // A κ per tet: through the per-tet factors the volume term already reads (springs.hpp).
+    if (net.tet_kappa_factors.empty()) net.tet_kappa_factors.assign(net.tets.size(), 1.0);
+    for (std::size_t e = 0; e < net.tets.size(); ++e) {
+      const int p = params.of_tet[e];
+      if (p >= 0) net.tet_kappa_factors[e] *= std::exp(theta[p]);
+    }
+  }
 }
 
 struct LinearisedFit::Evaluation {
@@ -190,7 +285,8 @@ LinearisedFit::LinearisedFit(const SpringNetwork& net, std::optional<double> kap
       for (int i = 0; i < 4; ++i) x[i] = net.nodes[static_cast<std::size_t>(t[i])];
       // κ_e/|V₀| (the homogenised rule's per-tet κ factor, springs.hpp), as VolumeTerm.
       const double factor = net.tet_kappa_factors.empty() ? 1.0 : net.tet_kappa_factors[e];
-      tets_.push_back({t, tet_volume_gradient(x), factor / std::abs(tet_signed_volume(x))});
+      tets_.push_back({t, tet_volume_gradient(x), factor / std::abs(tet_signed_volume(x)),
+                       params_.kappa_of_tet(e)});
     }
   }
   node_springs_.resize(net.nodes.size());
@@ -208,7 +304,11 @@ LinearisedFit::LinearisedFit(const SpringNetwork& net, std::optional<double> kap
       throw InputError("calibration case " + c.name +
                        ": the reference displacement is zero or not finite; expected a loaded case");
     }
-    weights_.push_back(1.0 / (static_cast<double>(cases_.size()) * r2));
+    if (!(c.weight > 0.0) || !std::isfinite(c.weight)) {
+      throw InputError("calibration case " + c.name + ": weight " + std::to_string(c.weight) +
+                       "; expected a finite weight > 0");
+    }
+    weights_.push_back(c.weight / (static_cast<double>(cases_.size()) * r2));
   }
 }
 
@@ -234,9 +334,8 @@ SparseMatrix LinearisedFit::stiffness(const VectorXd& theta) const {
     }
   }
   if (!tets_.empty()) {
-    const double kappa =
-        params_.kappa >= 0 ? kappa0_ * std::exp(theta[params_.kappa]) : kappa0_;
     for (const RestTet& t : tets_) {
+      const double kappa = t.param >= 0 ? kappa0_ * std::exp(theta[t.param]) : kappa0_;
       const Eigen::Matrix<double, 12, 12> block = kappa * t.inv_volume * t.g * t.g.transpose();
       for (int I = 0; I < 12; ++I) {
         for (int J = 0; J < 12; ++J) {
@@ -321,8 +420,17 @@ double LinearisedFit::regulariser_value(const VectorXd& theta, VectorXd* gradien
 }
 
 double LinearisedFit::objective(const VectorXd& theta, VectorXd& gradient) const {
-  const Evaluation e = evaluate(theta, true);
   gradient.setZero(params_.size());
+  Evaluation e;
+  try {
+    e = evaluate(theta, true);
+  } catch (const InputError&) {
+    throw;  // bad input (sizes) stays an error
+  } catch (const std::runtime_error&) {
+    // K(θ) not positive definite: possible where κ is negative (the homogenised rule below
+    // ν = 1/4) and a trial step scales it up. +∞ makes the line search step back.
+    return std::numeric_limits<double>::infinity();
+  }
   // Full-dof view of a free-dof vector's node block.
   const auto node = [&](const VectorXd& v, int n) {
     Vec3 out;
@@ -332,7 +440,6 @@ double LinearisedFit::objective(const VectorXd& theta, VectorXd& gradient) const
     }
     return out;
   };
-  const double kappa = params_.kappa >= 0 ? kappa0_ * std::exp(theta[params_.kappa]) : kappa0_;
   for (std::size_t c = 0; c < e.u.size(); ++c) {
     const VectorXd& u = e.u[c];
     const VectorXd& l = e.lambda[c];
@@ -343,18 +450,16 @@ double LinearisedFit::objective(const VectorXd& theta, VectorXd& gradient) const
       const double dl = s.d.dot(node(l, s.b) - node(l, s.a));
       gradient[s.param] -= k * du * dl;
     }
-    if (params_.kappa >= 0) {
-      double sum = 0.0;
-      for (const RestTet& t : tets_) {
-        double gu = 0.0, gl = 0.0;
-        for (int i = 0; i < 4; ++i) {
-          const Vec3 gi = t.g.segment<3>(3 * i);
-          gu += gi.dot(node(u, t.nodes[i]));
-          gl += gi.dot(node(l, t.nodes[i]));
-        }
-        sum += kappa * t.inv_volume * gu * gl;
+    for (const RestTet& t : tets_) {
+      if (t.param < 0) continue;
+      const double kappa = kappa0_ * std::exp(theta[t.param]);
+      double gu = 0.0, gl = 0.0;
+      for (int i = 0; i < 4; ++i) {
+        const Vec3 gi = t.g.segment<3>(3 * i);
+        gu += gi.dot(node(u, t.nodes[i]));
+        gl += gi.dot(node(l, t.nodes[i]));
       }
-      gradient[params_.kappa] -= sum;
+      gradient[t.param] -= kappa * t.inv_volume * gu * gl;
     }
   }
   return e.misfit + regulariser_value(theta, &gradient);

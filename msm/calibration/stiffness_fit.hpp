@@ -9,8 +9,9 @@
 /// B_s = d dᵀ ⊗ [1 −1; −1 1] the rest Hessian of spring s (direction d; the transverse term ψ'/L
 /// vanishes at rest) and g_t = ∂V/∂x of tet t at rest (the volume term's rest Hessian,
 /// volume_term.hpp; its ∇²V term carries V − V₀ = 0). K is linear in the stiffnesses, so
-///   J(θ) = Σ_c ½·w_c·|u_c(θ) − r_c|²  (+ regulariser),   w_c = 1/(C·|r_c|²)
-/// (C cases: J is half the mean squared relative L2 error of the harness's metric) has the
+///   J(θ) = Σ_c ½·w_c·|u_c(θ) − r_c|²  (+ regulariser),   w_c = ω_c/(C·|r_c|²)
+/// (C cases, ω_c = 1: J is half the mean squared relative L2 error of the harness's metric;
+/// FitCase::weight ω_c weighs the cases otherwise) has the
 /// adjoint gradient (one extra solve per case with the same factorisation):
 ///   K λ_c = w_c (u_c − r_c),   ∂J/∂θ_p = −Σ_c λ_cᵀ (∂K/∂θ_p) u_c
 ///   = −Σ_c [Σ_{s∈p} k_s (d·Δλ_s)(d·Δu_s) + (p = κ) Σ_t κ/|V₀| (g_t·λ_t)(g_t·u_t)],
@@ -33,7 +34,17 @@ struct StiffnessParameters {
   std::vector<std::string> names;  ///< one per parameter
   std::vector<int> of_spring;      ///< per spring of the network
   int kappa = -1;                  ///< κ's parameter, −1: none (or no volume term)
+  /// Per tet of the network: the parameter scaling that tet's κ (κ_e = κ0·f_e·exp(θ[of_tet[e]])),
+  /// for a κ that differs through the wall (wall_layer_parameters). Empty: `kappa` scales every
+  /// tet alike. When non-empty, `kappa` is −1.
+  std::vector<int> of_tet;
   [[nodiscard]] int size() const { return static_cast<int>(names.size()); }
+  /// Whether any parameter scales κ.
+  [[nodiscard]] bool scales_kappa() const { return kappa >= 0 || !of_tet.empty(); }
+  /// The parameter of tet e's κ, −1: none.
+  [[nodiscard]] int kappa_of_tet(std::size_t e) const {
+    return of_tet.empty() ? kappa : of_tet[e];
+  }
 };
 
 /// A few parameters ("groups"): on a surface network one factor per spring family present
@@ -52,6 +63,36 @@ std::string spring_class(const SpringNetwork& network, const VesselParams& vesse
 /// Per spring of a volume network: whether it is an edge of a boundary face (one tet only).
 std::vector<char> boundary_edges(const SpringNetwork& network);
 
+/// Position through the wall of a parametric vessel: ξ = (ρ − a)/t, ρ the distance from the
+/// centreline, a the inner radius, t the wall thickness (0 on the inner wall, 1 on the outer).
+double through_wall_position(const VesselParams& vessel, const Vec3& p);
+
+/// A few parameters by position through the wall ("wall_layers"; our own extension of the
+/// groups, for the wall's bending response, which depends on where a spring sits between the
+/// inner and outer surfaces): on a volume network one factor per (direction, layer) class of the
+/// tet-edge springs, direction as in group_parameters and layer from ξ̄, the mean of the two end
+/// nodes' through_wall_position: "inner" ξ̄ < 1/3, "middle", "outer" ξ̄ > 2/3 (the band edges fall
+/// between node layers of the structured meshes, whose nodes sit at ξ = j/(2·2^level)); and, with
+/// with_kappa, a κ factor per half of the wall by the tet's centroid ξ ("kappa/inner" ξ < 1/2,
+/// "kappa/outer"). With `edge_types` ("edge_types"), the direction is instead the set of frame
+/// directions the edge spans, |d·e_i| > kEdgeTypeComponent ("radial", "circumferential+axial",
+/// ...): a diagonal of a structured cell gets its own class apart from the cell's axis-aligned
+/// edges. Surface networks: the spring families, as group_parameters. The classes are defined by
+/// the vessel's geometry, so such a calibration applies to any mesh of a parametric vessel
+/// (InputError for a mesh-file vessel, which has no centreline).
+StiffnessParameters wall_layer_parameters(const SpringNetwork& network, const VesselParams& vessel,
+                                          bool with_kappa, bool edge_types = false);
+/// The class name wall_layer_parameters gives spring s ("volume/axial/outer",
+/// "volume/circumferential+axial/inner", "bend", ...).
+std::string spring_wall_layer_class(const SpringNetwork& network, const VesselParams& vessel,
+                                    std::size_t s, bool edge_types = false);
+/// Edge types: a unit vector's component along a frame direction above this counts (cos 69.5°).
+/// On the structured meshes (cells about 0.5 mm radial × 0.9 mm circumferential × 1.8 mm axial
+/// at level 0, the same proportions at every level) the circumferential–axial and radial–
+/// circumferential diagonals get their own types, while the radial–axial diagonals (radial
+/// component ≈ 0.27) count as axial.
+inline constexpr double kEdgeTypeComponent = 0.35;
+
 /// One parameter per spring ("spring/<index>"), plus "kappa" when with_kappa. Such a
 /// calibration belongs to this network only.
 StiffnessParameters per_spring_parameters(const SpringNetwork& network, bool with_kappa);
@@ -67,6 +108,9 @@ struct FitCase {
   std::string name;
   VectorXd force;
   VectorXd reference;
+  /// The case's weight ω_c in J: w_c = ω_c/(C·|r_c|²) (1: every case's relative error counts
+  /// alike).
+  double weight = 1.0;
 };
 
 /// The smoothness regulariser of a per-spring fit:
@@ -89,7 +133,8 @@ class LinearisedFit {
                 const std::vector<char>& fixed, StiffnessParameters params,
                 std::vector<FitCase> cases, Regulariser regulariser = {});
 
-  /// J(θ) and ∂J/∂θ (adjoint: one factorisation, one forward and one adjoint solve per case).
+  /// J(θ) and ∂J/∂θ (adjoint: one factorisation, one forward and one adjoint solve per case);
+  /// +∞ (gradient 0) where K(θ) is not positive definite, so that a line search steps back.
   double objective(const VectorXd& theta, VectorXd& gradient) const;
   /// The data term alone and the regulariser alone at θ.
   [[nodiscard]] double misfit(const VectorXd& theta) const;
@@ -117,7 +162,8 @@ class LinearisedFit {
   struct RestTet {
     std::array<int, 4> nodes;
     Eigen::Matrix<double, 12, 1> g;  ///< ∂V/∂x at rest
-    double inv_volume;               ///< 1/|V₀|
+    double inv_volume;               ///< κ factor f_e/|V₀|
+    int param;                       ///< κ's parameter for this tet, −1: none
   };
   std::vector<RestSpring> springs_;
   std::vector<RestTet> tets_;

@@ -5,6 +5,7 @@
 // on another mesh level is refused with an error naming the mesh hash.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "test_helpers.hpp"
@@ -88,4 +89,58 @@ calibration = "cal.json"
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.output.find("mesh.hash"), std::string::npos) << bad.output;
   EXPECT_NE(bad.output.find("cal.json"), std::string::npos) << bad.output;
+}
+
+// The edge-types granularity end to end: its classes (edge type x wall layer, kappa per half of
+// the wall) in the file, the gravity magnitude and the P1 weights as asked, the fit lowering the
+// training loads' mean squared error (against the P2 reference), and the file transferring to
+// another mesh level with calibration_transfer (its classes are defined by geometry).
+TEST(CalibrateCli, EdgeTypesWithP1WeightsWritesItsClassesAndTransfers) {
+  const TempDir dir;
+  write_text(dir / "scene.toml", scene_text(0, ""));
+  const auto r = vv("calibrate " + (dir / "scene.toml").string() +
+                    " --granularity edge-types --weights p1 --gravity 0.1"
+                    " --train contact,pressure,gravity --output " +
+                    (dir / "cal.json").string() + " --cache-dir " + (dir / "cache").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("reference max strain"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("weighted by 1/(P1's relative L2 error)^2"), std::string::npos);
+  const auto j = nlohmann::json::parse(read_text(dir / "cal.json"));
+  EXPECT_EQ(j["granularity"], "edge_types");
+  EXPECT_TRUE(j["factors"].contains("kappa/inner"));
+  EXPECT_TRUE(j["factors"].contains("kappa/outer"));
+  EXPECT_FALSE(j["factors"].contains("kappa"));
+  bool diagonal = false;
+  for (const auto& [name, f] : j["factors"].items()) {
+    if (name.find('+') != std::string::npos) diagonal = true;
+  }
+  EXPECT_TRUE(diagonal) << j["factors"].dump();
+  bool gravity_at_01 = false;
+  for (const auto& l : j["training_loads"]) {
+    if (l["type"] == "gravity") gravity_at_01 = l["magnitude"].get<double>() == 0.1;
+  }
+  EXPECT_TRUE(gravity_at_01) << j["training_loads"].dump();
+  double before = 0.0, after = 0.0;
+  for (const auto& c : j["fit"]["training_cases_linearised"]) {
+    before += std::pow(c["relative_l2_before"].get<double>(), 2);
+    after += std::pow(c["relative_l2_after"].get<double>(), 2);
+  }
+  EXPECT_LT(after, before);
+
+  const std::string transferred = R"(
+[[models]]
+name = "volume_edge_types"
+kind = "volume_msm"
+volume_term = true
+stiffness = "van-gelder"
+calibration = "cal.json"
+calibration_transfer = true
+)";
+  write_text(dir / "level1.toml", scene_text(1, transferred));
+  const auto run = vv("run --fields none --magnitudes 5e-4 --output-dir " + (dir / "out1").string() +
+                      " --cache-dir " + (dir / "cache").string() + " " +
+                      (dir / "level1.toml").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto results = nlohmann::json::parse(read_text(dir / "out1" / "results.json"));
+  EXPECT_NE(results.dump().find("cal.json"), std::string::npos);
 }

@@ -140,6 +140,89 @@ TEST(CalibrationFile, RoundTripAndAppliedFactorsScaleEachSpringAndKappa) {
   }
 }
 
+// A wall-layer calibration: its spring factors per (direction, layer) class and κ per half of
+// the wall go through the file and land on each spring and on each tet's κ factor; it transfers
+// to another mesh as a group calibration does.
+TEST(CalibrationFile, WallLayerCalibrationRoundTripsAndScalesSpringsAndEachTetsKappa) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  VesselParams wall;  // the block spans ρ = 3–5.4 mm
+  wall.inner_radius = 3.5e-3;
+  wall.wall_thickness = 1.0e-3;
+  const msm::BuiltNetwork base = hybrid(mesh);
+  const msm::StiffnessParameters p = msm::wall_layer_parameters(base.network, wall, true);
+  Calibration c = make_calibration(mesh, base, false);
+  c.granularity = "wall_layers";
+  c.names = p.names;
+  c.factors.clear();
+  for (int i = 0; i < p.size(); ++i) c.factors.push_back(1.0 + 0.1 * (i + 1));
+  const auto path = temp_file("wall_layers.json");
+  write_calibration(path, c);
+  const Calibration r = read_calibration(path);
+  EXPECT_EQ(r.granularity, "wall_layers");
+  msm::BuiltNetwork applied = base;
+  apply_calibration(r, "test", applied, mesh, wall, hybrid_spec(), kE, 0.45, false);
+  for (std::size_t s = 0; s < base.network.springs.size(); ++s) {
+    const double factor = c.factors[static_cast<std::size_t>(p.of_spring[s])];
+    EXPECT_NEAR(applied.network.springs[s].law.k1, factor * base.network.springs[s].law.k1,
+                1e-12 * base.network.springs[s].law.k1);
+  }
+  EXPECT_DOUBLE_EQ(*applied.volume_kappa, *base.volume_kappa);  // κ scaled per tet instead
+  ASSERT_EQ(applied.network.tet_kappa_factors.size(), base.network.tets.size());
+  int inner = 0, outer = 0;
+  for (std::size_t e = 0; e < base.network.tets.size(); ++e) {
+    const double base_factor =
+        base.network.tet_kappa_factors.empty() ? 1.0 : base.network.tet_kappa_factors[e];
+    const std::string& name = p.names[static_cast<std::size_t>(p.of_tet[e])];
+    (name == "kappa/inner" ? inner : outer) += 1;
+    EXPECT_NEAR(applied.network.tet_kappa_factors[e],
+                c.factors[static_cast<std::size_t>(p.of_tet[e])] * base_factor, 1e-12);
+  }
+  EXPECT_GT(inner, 0);
+  EXPECT_GT(outer, 0);
+  TetMesh moved = mesh;
+  moved.nodes[5].x() += 1e-6;
+  msm::BuiltNetwork on_moved = hybrid(moved);
+  EXPECT_NO_THROW(apply_calibration(r, "cal.json", on_moved, moved, wall, hybrid_spec(), kE, 0.45,
+                                    true));
+}
+
+// A wall-layer class the fitted mesh did not have gets the geometric mean of its direction's
+// factors in the other layers (hand-computed here); a direction missing altogether is refused.
+TEST(CalibrationFile, AMissingWallLayerTakesTheGeometricMeanOfItsDirectionsLayers) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  VesselParams wall;
+  wall.inner_radius = 3.5e-3;
+  wall.wall_thickness = 1.0e-3;
+  const msm::BuiltNetwork base = hybrid(mesh);
+  const msm::StiffnessParameters p = msm::wall_layer_parameters(base.network, wall, true);
+  const auto has = [&](const std::string& n) {
+    return std::find(p.names.begin(), p.names.end(), n) != p.names.end();
+  };
+  ASSERT_TRUE(has("volume/axial/inner") && has("volume/axial/middle") && has("volume/axial/outer"));
+  Calibration c = make_calibration(mesh, base, false);
+  c.granularity = "wall_layers";
+  c.names.clear();
+  c.factors.clear();
+  for (const std::string& n : p.names) {
+    if (n == "volume/axial/middle") continue;  // as if the fitted mesh had none
+    c.names.push_back(n);
+    c.factors.push_back(n == "volume/axial/inner" ? 4.0 : n == "volume/axial/outer" ? 0.25 * 9.0 : 1.5);
+  }
+  const auto [params, theta] = calibration_parameters(c, "cal.json", base, wall);
+  const auto at = std::find(params.names.begin(), params.names.end(), "volume/axial/middle");
+  ASSERT_NE(at, params.names.end());
+  EXPECT_NEAR(std::exp(theta[at - params.names.begin()]), 3.0, 1e-12);  // sqrt(4 × 2.25)
+  Calibration none = c;
+  for (std::size_t i = none.names.size(); i-- > 0;) {
+    if (none.names[i].rfind("volume/axial/", 0) == 0) {
+      none.names.erase(none.names.begin() + static_cast<std::ptrdiff_t>(i));
+      none.factors.erase(none.factors.begin() + static_cast<std::ptrdiff_t>(i));
+    }
+  }
+  expect_input_error([&] { calibration_parameters(none, "cal.json", base, wall); },
+                     "volume/axial/");
+}
+
 TEST(CalibrationFile, AnotherMeshIsRefusedUnlessAGroupCalibrationTransfers) {
   const TetMesh mesh = block_mesh(2, 1e-3);
   TetMesh moved = mesh;

@@ -6,6 +6,9 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <algorithm>
+#include <numbers>
+#include <limits>
 #include <random>
 
 #include "meshes/errors.hpp"
@@ -135,12 +138,24 @@ TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
     for (Eigen::Index i = 0; i < r.size(); ++i) {
       if (!fixed[static_cast<std::size_t>(i)]) r[i] += 1e-8 * std::sin(1.0 + i);
     }
-    cases.push_back({"case" + std::to_string(c), f, r});
+    cases.push_back({"case" + std::to_string(c), f, r, c == 0 ? 1.0 : 2.5});  // unequal weights
   }
-  for (const bool per_spring : {false, true}) {
+  // The block sits at ρ = 3–5 mm from the straight tube's axis: with a 1 mm wall from ρ = 3.5 mm
+  // every layer (inner, middle, outer; κ inner and outer half) is populated.
+  VesselParams wall;
+  wall.inner_radius = 3.5e-3;
+  wall.wall_thickness = 1.0e-3;
+  for (const int granularity : {0, 1, 2, 3}) {
+    const bool per_spring = granularity == 1;
     const StiffnessParameters params =
-        per_spring ? per_spring_parameters(built.network, true)
-                   : group_parameters(built.network, VesselParams{}, true);
+        granularity == 0   ? group_parameters(built.network, VesselParams{}, true)
+        : granularity == 1 ? per_spring_parameters(built.network, true)
+                           : wall_layer_parameters(built.network, wall, true, granularity == 3);
+    if (granularity >= 2) {
+      ASSERT_FALSE(params.of_tet.empty());
+      EXPECT_EQ(std::count(params.names.begin(), params.names.end(), "kappa/inner"), 1);
+      EXPECT_EQ(std::count(params.names.begin(), params.names.end(), "kappa/outer"), 1);
+    }
     const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases,
                             per_spring ? Regulariser{0.3, 1e-3} : Regulariser{});
     std::uniform_real_distribution<double> u(-0.5, 0.5);
@@ -156,7 +171,11 @@ TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
       tm[p] -= h;
       const double fd = (fit.objective(tp, dummy) - fit.objective(tm, dummy)) / (2 * h);
       EXPECT_NEAR(g[p], fd, 1e-6 * std::abs(fd) + 1e-7 * g.lpNorm<Eigen::Infinity>())
-          << (per_spring ? "per spring, " : "groups, ") << params.names[static_cast<std::size_t>(p)];
+          << (granularity == 0   ? "groups, "
+              : granularity == 1 ? "per spring, "
+              : granularity == 2 ? "wall layers, "
+                                 : "edge types, ")
+          << params.names[static_cast<std::size_t>(p)];
       ++checked;
     }
     EXPECT_GT(checked, 5);
@@ -197,6 +216,44 @@ TEST(StiffnessFit, RecoversPlantedGroupFactorsFromTheModelsOwnData) {
   for (const double e : fit.relative_errors(r.x)) EXPECT_LT(e, 1e-4);
 }
 
+// The wall-layer granularity, with its two κ halves, recovers factors planted in data the
+// nonlinear model generated with them.
+TEST(StiffnessFit, RecoversPlantedWallLayerFactorsFromTheModelsOwnData) {
+  const TetMesh mesh = block_mesh(3, 1e-3);
+  const BuiltNetwork built = hybrid(mesh, 0.45);
+  const std::vector<char> fixed = bottom_fixed(built.network);
+  VesselParams wall;  // the block spans ρ = 3–6.7 mm: all three layers and both halves
+  wall.inner_radius = 3.5e-3;
+  wall.wall_thickness = 1.5e-3;
+  const StiffnessParameters params = wall_layer_parameters(built.network, wall, true);
+  ASSERT_GE(params.size(), 8);
+  Eigen::VectorXd planted(params.size());
+  for (Eigen::Index p = 0; p < planted.size(); ++p) {
+    planted[p] = std::log(0.5) + std::log(4.0) * static_cast<double>((3 * p) % planted.size()) /
+                                     (planted.size() - 1);
+  }
+  BuiltNetwork truth = built;
+  apply_stiffness_factors(truth.network, truth.volume_kappa, params, planted);
+  std::mt19937 rng(13);
+  std::vector<FitCase> cases;
+  for (int c = 0; c < 4; ++c) {
+    const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
+    cases.push_back({"case" + std::to_string(c), f, static_displacement(truth, fixed, f)});
+  }
+  const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases);
+  const Objective f = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+    return fit.objective(x, g);
+  };
+  LbfgsOptions o;
+  o.max_iterations = 1000;
+  o.gradient_tolerance = 1e-12;
+  const LbfgsResult r = minimize_lbfgs(f, Eigen::VectorXd::Zero(params.size()), o);
+  for (Eigen::Index p = 0; p < planted.size(); ++p) {
+    EXPECT_NEAR(std::exp(r.x[p]), std::exp(planted[p]), 5e-3 * std::exp(planted[p]))
+        << params.names[static_cast<std::size_t>(p)];
+  }
+}
+
 TEST(StiffnessFit, PerSpringFitReducesTheMisfitOfPlantedData) {
   const TetMesh mesh = block_mesh(2, 1e-3);
   const BuiltNetwork built = hybrid(mesh, 0.45);
@@ -222,6 +279,24 @@ TEST(StiffnessFit, PerSpringFitReducesTheMisfitOfPlantedData) {
   EXPECT_LT(fit.misfit(r.x), 1e-2 * before);
 }
 
+// A negative κ (the homogenised rule below ν = 1/4) scaled up makes K indefinite: the objective
+// is then +∞, for the line search to step back, not an exception that ends the fit.
+TEST(StiffnessFit, AnIndefiniteStiffnessGivesAnInfiniteObjective) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  const BuiltNetwork built = hybrid(mesh, 0.45);
+  const std::vector<char> fixed = bottom_fixed(built.network);
+  std::mt19937 rng(3);
+  const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
+  const StiffnessParameters params = group_parameters(built.network, VesselParams{}, true);
+  const double kappa = -0.5 * *built.volume_kappa;  // negative, small enough to start stable
+  const LinearisedFit fit(built.network, kappa, fixed, params,
+                          {{"c", f, Eigen::VectorXd::Ones(f.size())}});
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(params.size()), g;
+  theta[params.kappa] = std::log(1e4);  // κ → −5000·κ0: the volume term overwhelms the springs
+  EXPECT_EQ(fit.objective(theta, g), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(g.size(), params.size());
+}
+
 TEST(StiffnessFit, RefusesMismatchedSizesAndKappaWithoutVolumeTerm) {
   const TetMesh mesh = block_mesh(1, 1e-3);
   BuiltNetwork built = hybrid(mesh, 0.45);
@@ -233,4 +308,144 @@ TEST(StiffnessFit, RefusesMismatchedSizesAndKappaWithoutVolumeTerm) {
   EXPECT_THROW(apply_stiffness_factors(built.network, built.volume_kappa, params,
                                        Eigen::VectorXd::Zero(params.size() + 1)),
                InputError);
+}
+
+namespace {
+
+/// A network of springs from node 0 to each of `ends`, no tets.
+SpringNetwork star_network(const Vec3& centre, const std::vector<Vec3>& ends) {
+  SpringNetwork net;
+  net.nodes.push_back(centre);
+  for (const Vec3& e : ends) {
+    net.nodes.push_back(e);
+    Spring s;
+    s.a = 0;
+    s.b = static_cast<int>(net.nodes.size()) - 1;
+    s.family = SpringFamily::volume;
+    s.rest_length = (e - centre).norm();
+    net.springs.push_back(s);
+  }
+  return net;
+}
+
+}  // namespace
+
+// The direction classes on the arch use its local centreline frame: at a point at angle φ round
+// the arch axis the axial direction is the tangent (−sin φ, cos φ, 0), radial points away from the
+// centreline circle of radius R, circumferential is the rest. Hand-built springs along those
+// directions (worked out here, not by the classifier's own frame) at two arch angles and two
+// section angles; a fixed z axis (the straight tube's frame) would call the tangential springs
+// "circumferential" or "radial".
+TEST(StiffnessFit, ArchEdgeClassesUseTheLocalCentrelineFrame) {
+  VesselParams arch;
+  arch.kind = VesselKind::arch;
+  arch.bend_radius = 15e-3;
+  arch.inner_radius = 3e-3;
+  arch.wall_thickness = 1e-3;
+  const double h = 0.2e-3;  // spring length
+  for (const double phi : {std::numbers::pi / 6, std::numbers::pi / 2, 0.8 * std::numbers::pi}) {
+    const Vec3 outward(std::cos(phi), std::sin(phi), 0.0);
+    const Vec3 tangent(-std::sin(phi), std::cos(phi), 0.0);
+    const Vec3 up = Vec3::UnitZ();
+    const Vec3 centre = arch.bend_radius * outward;
+    // Section angle 0 (outer bend): radial = outward, circumferential = z.
+    // Section angle 90° (top): radial = z, circumferential = outward.
+    for (const bool top : {false, true}) {
+      const Vec3 radial = top ? up : outward;
+      const Vec3 circ = top ? outward : up;
+      const Vec3 p = centre + 3.5e-3 * radial;
+      // Tilted slightly towards another direction, so the largest component decides.
+      const SpringNetwork net = star_network(
+          p, {p + h * (tangent + 0.3 * radial).normalized(), p + h * (radial + 0.2 * circ).normalized(),
+              p + h * (circ + 0.4 * tangent).normalized()});
+      const std::vector<char> boundary(net.springs.size(), 0);
+      const std::string where = "phi " + std::to_string(phi) + (top ? ", top" : ", outer bend");
+      EXPECT_EQ(spring_class(net, arch, boundary, 0), "volume/axial/interior") << where;
+      EXPECT_EQ(spring_class(net, arch, boundary, 1), "volume/radial/interior") << where;
+      EXPECT_EQ(spring_class(net, arch, boundary, 2), "volume/circumferential/interior") << where;
+      // The wall-layer classes: same directions; ξ̄ = (3.5 mm + ~0.1 mm·(radial share) − a)/t
+      // lies in the middle third.
+      EXPECT_EQ(spring_wall_layer_class(net, arch, 0), "volume/axial/middle") << where;
+      EXPECT_EQ(spring_wall_layer_class(net, arch, 1), "volume/radial/middle") << where;
+      EXPECT_EQ(spring_wall_layer_class(net, arch, 2), "volume/circumferential/middle") << where;
+      if (!top && std::abs(phi - std::numbers::pi / 2) < 1e-12) {
+        // The discriminating case: a straight tube's fixed frame (axis z) at the same point
+        // calls the arch's tangential spring circumferential.
+        VesselParams straight = arch;
+        straight.kind = VesselKind::straight;
+        EXPECT_EQ(spring_class(net, straight, boundary, 0), "volume/circumferential/interior");
+      }
+    }
+  }
+}
+
+// Wall layers by the mean through-wall position of a spring's ends (hand-placed nodes on a
+// straight tube, a = 3 mm, t = 1 mm) and κ halves by the tet centroid.
+TEST(StiffnessFit, WallLayerClassesFollowThePositionThroughTheWall) {
+  VesselParams tube;
+  tube.kind = VesselKind::straight;
+  tube.inner_radius = 3e-3;
+  tube.wall_thickness = 1e-3;
+  const auto at = [](double rho, double z) { return Vec3(rho, 0.0, z); };
+  SpringNetwork net;
+  // Axial springs on the inner wall, at mid-wall and on the outer wall; radial springs through
+  // the inner and the outer half.
+  net.nodes = {at(3e-3, 0), at(3e-3, 1e-3), at(3.5e-3, 0), at(3.5e-3, 1e-3),
+               at(4e-3, 0), at(4e-3, 1e-3)};
+  const std::pair<int, int> pairs[] = {{0, 1}, {2, 3}, {4, 5}, {0, 2}, {2, 4}};
+  for (const auto& [a, b] : pairs) {
+    Spring s;
+    s.a = a;
+    s.b = b;
+    s.family = SpringFamily::volume;
+    net.springs.push_back(s);
+  }
+  // Two tets: one with three nodes on the inner wall (centroid ξ = 0.125... < 1/2), one with
+  // three on the outer wall.
+  net.nodes.push_back(Vec3(3e-3 * std::cos(0.3), 3e-3 * std::sin(0.3), 0));    // 6, inner wall
+  net.nodes.push_back(Vec3(4e-3 * std::cos(0.3), 4e-3 * std::sin(0.3), 0));    // 7, outer wall
+  net.tets = {Tet{0, 1, 6, 2}, Tet{4, 5, 7, 2}};
+  EXPECT_EQ(spring_wall_layer_class(net, tube, 0), "volume/axial/inner");
+  EXPECT_EQ(spring_wall_layer_class(net, tube, 1), "volume/axial/middle");
+  EXPECT_EQ(spring_wall_layer_class(net, tube, 2), "volume/axial/outer");
+  EXPECT_EQ(spring_wall_layer_class(net, tube, 3), "volume/radial/inner");   // ξ̄ = 1/4
+  EXPECT_EQ(spring_wall_layer_class(net, tube, 4), "volume/radial/outer");   // ξ̄ = 3/4
+  // Edge types: the axis-aligned springs keep their direction; a radial–axial diagonal at 30°
+  // from the axis spans both (components 0.87 and 0.5 > 0.35) where the largest component says
+  // axial; one at 80° from the axis is radial alone (cos 80° = 0.17 < 0.35).
+  EXPECT_EQ(spring_wall_layer_class(net, tube, 0, true), "volume/axial/inner");
+  EXPECT_EQ(spring_wall_layer_class(net, tube, 3, true), "volume/radial/inner");
+  {
+    SpringNetwork diag;
+    const double r0 = 3.0e-3, l = 0.4e-3;
+    const double a30 = std::numbers::pi / 6.0, a80 = 80.0 * std::numbers::pi / 180.0;
+    diag.nodes = {at(r0, 0), at(r0 + l * std::sin(a30), l * std::cos(a30)),
+                  at(r0 + l * std::sin(a80), l * std::cos(a80))};
+    for (const int b : {1, 2}) {
+      Spring sp;
+      sp.a = 0;
+      sp.b = b;
+      sp.family = SpringFamily::volume;
+      diag.springs.push_back(sp);
+    }
+    EXPECT_EQ(spring_wall_layer_class(diag, tube, 0, true), "volume/radial+axial/inner");
+    EXPECT_EQ(spring_wall_layer_class(diag, tube, 0, false), "volume/axial/inner");
+    EXPECT_EQ(spring_wall_layer_class(diag, tube, 1, true), "volume/radial/inner");
+  }
+  const StiffnessParameters p = wall_layer_parameters(net, tube, true);
+  ASSERT_EQ(p.of_tet.size(), 2u);
+  EXPECT_EQ(p.names[static_cast<std::size_t>(p.of_tet[0])], "kappa/inner");
+  EXPECT_EQ(p.names[static_cast<std::size_t>(p.of_tet[1])], "kappa/outer");
+  EXPECT_EQ(p.kappa, -1);
+  EXPECT_EQ(p.size(), 5 + 2);
+  // Applying the factors scales each tet's κ through the per-tet factors.
+  std::optional<double> kappa = 2.0;
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(p.size());
+  theta[p.of_tet[0]] = std::log(3.0);
+  theta[p.of_tet[1]] = std::log(0.5);
+  apply_stiffness_factors(net, kappa, p, theta);
+  EXPECT_DOUBLE_EQ(*kappa, 2.0);
+  ASSERT_EQ(net.tet_kappa_factors.size(), 2u);
+  EXPECT_DOUBLE_EQ(net.tet_kappa_factors[0], 3.0);
+  EXPECT_DOUBLE_EQ(net.tet_kappa_factors[1], 0.5);
 }

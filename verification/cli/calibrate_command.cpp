@@ -18,6 +18,8 @@ struct Options {
   std::string scene;
   std::string model;
   std::string granularity = "groups";
+  std::string weights = "equal";
+  double gravity = CalibrateOptions{}.gravity;
   std::vector<std::string> train;
   std::vector<std::string> held_out_scenes;
   double nu = -1.0;
@@ -44,6 +46,8 @@ void run(const Options& o) {
   CalibrateOptions c;
   c.model = o.model;
   c.granularity = parse_calibration_granularity(o.granularity);
+  c.weights = parse_case_weights(o.weights);
+  c.gravity = o.gravity;
   for (const auto& k : o.train) c.train.push_back(parse_kind(k));
   for (const auto& f : o.held_out_scenes) c.other_vessels.push_back(read_scene(f));
   if (o.nu >= 0.0) c.poisson_ratio = o.nu;
@@ -89,16 +93,31 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
                   "The scene's mass-spring model to calibrate (default: its hybrid volume model, "
                   "else its first mass-spring model)");
   cmd->add_option("--granularity", o->granularity,
-                  "groups: a factor per spring class and kappa; per-spring: a factor per spring "
-                  "and kappa, with a smoothness regulariser")
-      ->check(CLI::IsMember({"groups", "per-spring"}))
+                  "groups: a factor per spring class (direction x boundary) and kappa; "
+                  "wall-layers: a factor per spring class (direction x layer through the wall: "
+                  "inner, middle, outer third) and a kappa per half of the wall; edge-types: the "
+                  "same with the edge's type (the frame directions it spans, diagonals apart) "
+                  "instead of its largest direction; per-spring: a factor per spring and kappa, "
+                  "with a smoothness regulariser")
+      ->check(CLI::IsMember({"groups", "wall-layers", "edge-types", "per-spring"}))
+      ->capture_default_str();
+  cmd->add_option("--weights", o->weights,
+                  "How the training loads weigh in the fit: equal (each load's squared relative "
+                  "L2 error alike) or p1 (each divided by P1's squared error on that load: the "
+                  "fit minimises the mean squared ratio to P1)")
+      ->check(CLI::IsMember({"equal", "p1"}))
+      ->capture_default_str();
+  cmd->add_option("--gravity", o->gravity,
+                  "Magnitude (g) of the gravity load cases, training or held out, on scenes whose "
+                  "own load is not gravity")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--train", o->train,
                   "Load types fitted on (contact, pressure, gravity; default the scene's); the "
                   "others are held out")
       ->delimiter(',');
   cmd->add_option("--held-out-scene", o->held_out_scenes,
-                  "Scenes whose loads are held-out cases on another vessel (groups only)")
+                  "Scenes whose loads are held-out cases on another vessel (not per-spring)")
       ->check(CLI::ExistingFile)
       ->delimiter(',');
   cmd->add_option("--nu", o->nu, "Poisson's ratio (default 0.45 if the scene has it, else its first)")

@@ -21,13 +21,30 @@
 namespace vessel {
 
 std::string to_string(CalibrationGranularity g) {
-  return g == CalibrationGranularity::groups ? "groups" : "per_spring";
+  switch (g) {
+    case CalibrationGranularity::groups: return "groups";
+    case CalibrationGranularity::wall_layers: return "wall_layers";
+    case CalibrationGranularity::edge_types: return "edge_types";
+    case CalibrationGranularity::per_spring: return "per_spring";
+  }
+  return "groups";
 }
 
 CalibrationGranularity parse_calibration_granularity(const std::string& name) {
   if (name == "groups") return CalibrationGranularity::groups;
+  if (name == "wall_layers" || name == "wall-layers") return CalibrationGranularity::wall_layers;
+  if (name == "edge_types" || name == "edge-types") return CalibrationGranularity::edge_types;
   if (name == "per_spring" || name == "per-spring") return CalibrationGranularity::per_spring;
-  throw InputError("granularity: found \"" + name + "\", expected groups or per-spring");
+  throw InputError("granularity: found \"" + name +
+                   "\", expected groups, wall-layers, edge-types or per-spring");
+}
+
+std::string to_string(CaseWeights w) { return w == CaseWeights::equal ? "equal" : "p1"; }
+
+CaseWeights parse_case_weights(const std::string& name) {
+  if (name == "equal") return CaseWeights::equal;
+  if (name == "p1") return CaseWeights::p1;
+  throw InputError("weights: found \"" + name + "\", expected equal or p1");
 }
 
 namespace {
@@ -40,7 +57,6 @@ constexpr double kOutsideTolerance = 0.25;
 constexpr double kContactRadius = 1.0e-3;
 constexpr double kContactForce = 5.0e-4;
 constexpr double kPressure = 10.0;  ///< Pa: pressure_lame's load
-constexpr double kGravity = 1.0;    ///< g
 
 struct LoadCase {
   std::string name;
@@ -101,19 +117,19 @@ double training_magnitude(const Scene& s) {
   return m[m.size() / 2];
 }
 
-double default_magnitude(const Scene& s, LoadKind kind) {
+double default_magnitude(const Scene& s, LoadKind kind, double gravity) {
   if (s.load.kind == kind) return training_magnitude(s);
   switch (kind) {
     case LoadKind::contact: return kContactForce;
     case LoadKind::pressure: return kPressure;
-    case LoadKind::gravity: return kGravity;
+    case LoadKind::gravity: return gravity;
   }
   return 1.0;
 }
 
 /// The load cases of a scene: training ones for the kinds in `train`, the rest held out.
 std::vector<LoadCase> load_cases(const Scene& s, const std::vector<LoadKind>& train,
-                                 bool other_vessel) {
+                                 bool other_vessel, double gravity) {
   std::vector<LoadCase> out;
   const auto trained = [&](LoadKind k) {
     return !other_vessel && std::find(train.begin(), train.end(), k) != train.end();
@@ -123,7 +139,7 @@ std::vector<LoadCase> load_cases(const Scene& s, const std::vector<LoadKind>& tr
   // quarter of the vessel along (held out).
   {
     const bool t = trained(LoadKind::contact);
-    const double m = default_magnitude(s, LoadKind::contact);
+    const double m = default_magnitude(s, LoadKind::contact, gravity);
     const Vec3 p0 = contact_point_of(s);
     const CentrelineCoordinates c = centreline_coordinates(s.vessel, p0);
     const double L = s.vessel.centreline_length();
@@ -141,8 +157,8 @@ std::vector<LoadCase> load_cases(const Scene& s, const std::vector<LoadKind>& tr
   }
   for (const LoadKind k : {LoadKind::pressure, LoadKind::gravity}) {
     const bool t = trained(k);
-    out.push_back({to_string(k), t, t ? "training" : other_type, k, default_magnitude(s, k),
-                   Vec3::Zero()});
+    out.push_back({to_string(k), t, t ? "training" : other_type, k,
+                   default_magnitude(s, k, gravity), Vec3::Zero()});
   }
   return out;
 }
@@ -314,21 +330,45 @@ CalibrationCaseResult evaluate_case(VesselContext& v, const LoadCase& c, const M
   r.p1_solve_seconds = a.p1_seconds;
   const Scene cs = case_scene(*v.scene, c);
   const std::vector<Vec3> ref = scaled(a.reference_at_network, c.magnitude);
-  const ModelAnswer base = solve_model(cs, spec, v.base, v.mesh, c.magnitude);
-  r.base = compare_displacements(base.u, ref);
-  r.base_update_seconds = base.update_seconds;
+  // A solver failure on one case (e.g. Newton not converging) is that case's outcome, not the
+  // study's: recorded and shown, the other cases still evaluated.
+  try {
+    const ModelAnswer base = solve_model(cs, spec, v.base, v.mesh, c.magnitude);
+    r.base = compare_displacements(base.u, ref);
+    r.base_update_seconds = base.update_seconds;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    r.base_ok = false;
+    r.base_failure = e.what();
+  }
   if (calibrated) {
-    const ModelAnswer cal = solve_model(cs, spec, *calibrated, v.mesh, c.magnitude);
-    r.calibrated = compare_displacements(cal.u, ref);
-    r.calibrated_update_seconds = cal.update_seconds;
+    try {
+      const ModelAnswer cal = solve_model(cs, spec, *calibrated, v.mesh, c.magnitude);
+      r.calibrated = compare_displacements(cal.u, ref);
+      r.calibrated_update_seconds = cal.update_seconds;
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      r.ok = false;
+      r.failure = e.what();
+    }
   } else {
     r.ok = false;
     r.failure = why_not;
   }
   log << "  " << r.scene << " L" << r.level << " " << r.name << " (" << r.holds_out << ", "
-      << r.magnitude << "): relative L2 P1 " << r.p1.relative_l2 << ", base "
-      << r.base.relative_l2;
-  if (r.ok) log << ", calibrated " << r.calibrated.relative_l2;
+      << r.magnitude << "): relative L2 P1 " << r.p1.relative_l2 << ", base ";
+  if (r.base_ok) {
+    log << r.base.relative_l2;
+  } else {
+    log << "failed (" << r.base_failure << ")";
+  }
+  if (r.ok) {
+    log << ", calibrated " << r.calibrated.relative_l2;
+  } else {
+    log << ", calibrated failed (" << r.failure << ")";
+  }
   log << "\n";
   return r;
 }
@@ -360,7 +400,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   VesselContext main = make_context(scene, spec, level, reference_level, nu, o);
 
   // The cases: the fixed list, plus the scene's other magnitudes at its point.
-  std::vector<LoadCase> cases = load_cases(scene, train, false);
+  std::vector<LoadCase> cases = load_cases(scene, train, false, o.gravity);
   {
     const LoadCase& first = cases.front();  // contact θ+0°
     LoadCase own = first;
@@ -385,6 +425,10 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   msm::StiffnessParameters params =
       o.granularity == CalibrationGranularity::groups
           ? msm::group_parameters(main.base.network, main.vessel, has_kappa)
+      : o.granularity == CalibrationGranularity::wall_layers ||
+              o.granularity == CalibrationGranularity::edge_types
+          ? msm::wall_layer_parameters(main.base.network, main.vessel, has_kappa,
+                                       o.granularity == CalibrationGranularity::edge_types)
           : msm::per_spring_parameters(main.base.network, has_kappa);
   std::vector<msm::FitCase> fit_cases;
   std::vector<char> fixed;
@@ -399,13 +443,24 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
     for (std::size_t i = 0; i < a.reference_at_network.size(); ++i) {
       r.segment<3>(3 * static_cast<Eigen::Index>(i)) = c.magnitude * a.reference_at_network[i];
     }
-    fit_cases.push_back({c.name, p.external_force, r});
+    double weight = 1.0;
+    if (o.weights == CaseWeights::p1) {
+      // P1's relative error on this case (linear: the same at every magnitude).
+      const double e = compare_displacements(a.p1, a.reference_at_mesh).relative_l2;
+      weight = 1.0 / (e * e);
+    }
+    fit_cases.push_back({c.name, p.external_force, r, weight});
     cal.training_loads.push_back({c.name, c.kind, c.magnitude, c.point});
   }
   if (fit_cases.empty()) throw InputError("calibrate: no training load; expected --train kinds");
+  {
+    double mean = 0.0;
+    for (const auto& fc : fit_cases) mean += fc.weight / static_cast<double>(fit_cases.size());
+    for (auto& fc : fit_cases) fc.weight /= mean;
+  }
   // Groups: the ridge alone (without it a contact-only fit drove the circumferential classes to
   // ~0 and κ up 12×, which fitted contact and failed pressure by 4× P1; docs/msm_calibration.md).
-  const msm::Regulariser reg = o.granularity == CalibrationGranularity::groups
+  const msm::Regulariser reg = o.granularity != CalibrationGranularity::per_spring
                                    ? msm::Regulariser{0.0, o.regulariser.ridge}
                                    : o.regulariser;
   const msm::LinearisedFit fit(main.base.network, main.base.volume_kappa, fixed, params,
@@ -453,8 +508,18 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
          << reference_level << "), model linearised at rest, adjoint gradients, L-BFGS; "
          << (o.granularity == CalibrationGranularity::groups
                  ? "a factor per spring class and kappa, ridge on the log factors"
+             : o.granularity == CalibrationGranularity::wall_layers
+                 ? "a factor per spring class (direction x layer through the wall) and per half "
+                   "of the wall for kappa, ridge on the log factors"
+             : o.granularity == CalibrationGranularity::edge_types
+                 ? "a factor per spring class (edge type x layer through the wall) and per half "
+                   "of the wall for kappa, ridge on the log factors"
                  : "a factor per spring and kappa, smoothness regulariser on log k over springs "
                    "sharing a node");
+  if (o.weights == CaseWeights::p1) {
+    method << "; training cases weighted by 1/(P1's relative L2 error)^2 (the fit minimises the "
+              "mean squared ratio to P1)";
+  }
   cal.method = method.str();
   cal.smoothness = reg.smoothness;
   cal.ridge = reg.ridge;
@@ -495,7 +560,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
       why = e.what();
       use = nullptr;
     }
-    for (const LoadCase& c : load_cases(other_scene, train, true)) {
+    for (const LoadCase& c : load_cases(other_scene, train, true, o.gravity)) {
       study.cases.push_back(evaluate_case(other, c, spec, use, why, nu, log));
     }
   }
@@ -518,17 +583,19 @@ std::string load_text(const CalibrationCaseResult& c) {
 
 void case_table(std::ostream& out, const std::vector<CalibrationCaseResult>& cases, bool training) {
   out << "| scene | level | case | holds out | load | P1 | base | calibrated | calibrated / P1 | "
-         "base s/update | calibrated s/update | P1 solve s |\n"
-      << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "base s/update | calibrated s/update | P1 solve s | reference max strain |\n"
+      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : cases) {
     if (c.training != training) continue;
     out << "| " << c.scene << " | " << c.level << " | " << c.name << " | " << c.holds_out << " | "
-        << load_text(c) << " | " << fixed3(c.p1.relative_l2) << " | " << fixed3(c.base.relative_l2)
+        << load_text(c) << " | " << fixed3(c.p1.relative_l2) << " | "
+        << (c.base_ok ? fixed3(c.base.relative_l2) : "—")
         << " | " << (c.ok ? fixed3(c.calibrated.relative_l2) : "—") << " | "
         << (c.ok ? fixed3(c.calibrated.relative_l2 / c.p1.relative_l2) : "—") << " | "
-        << std::setprecision(3) << c.base_update_seconds << " | "
+        << std::setprecision(3) << (c.base_ok ? c.base_update_seconds : 0.0) << " | "
         << (c.ok ? std::to_string(c.calibrated_update_seconds).substr(0, 7) : std::string("—"))
-        << " | " << c.p1_solve_seconds << " |\n";
+        << " | " << c.p1_solve_seconds << " | " << std::setprecision(2)
+        << 100.0 * c.max_strain_reference << " % |\n";
   }
 }
 
@@ -544,7 +611,7 @@ void write_calibration_markdown(std::ostream& out, const CalibrationStudy& st,
       << "Fit: " << c.method << ". " << c.names.size() << " parameters, " << c.iterations
       << " iterations (" << c.stop_reason << "), " << fixed3(st.fit_seconds)
       << " s; objective " << c.objective_before << " → " << c.objective_after << ".\n\n";
-  if (c.granularity == "groups") {
+  if (c.granularity != "per_spring") {
     out << "| parameter | factor |\n|---|---|\n";
     for (std::size_t i = 0; i < c.names.size(); ++i) {
       out << "| " << c.names[i] << " | " << fixed3(c.factors[i]) << " |\n";
@@ -562,11 +629,16 @@ void write_calibration_markdown(std::ostream& out, const CalibrationStudy& st,
   case_table(out, st.cases, true);
   out << "\n## Held-out loads\n\n";
   case_table(out, st.cases, false);
+  std::string last_failure;
   for (const auto& cs : st.cases) {
-    if (!cs.ok) {
-      out << "\n" << cs.scene << " " << cs.name << ": calibrated model not evaluated: " << cs.failure
-          << "\n";
-      break;
+    if (!cs.ok && cs.failure != last_failure) {  // a transfer's refusal once, not per case
+      out << "\n" << cs.scene << " " << cs.name << " (" << load_text(cs)
+          << "): calibrated model not evaluated: " << cs.failure << "\n";
+      last_failure = cs.failure;
+    }
+    if (!cs.base_ok) {
+      out << "\n" << cs.scene << " " << cs.name << " (" << load_text(cs)
+          << "): uncalibrated model not evaluated: " << cs.base_failure << "\n";
     }
   }
 }

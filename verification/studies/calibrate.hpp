@@ -37,9 +37,20 @@ class SolutionCache;
 
 namespace vessel {
 
-enum class CalibrationGranularity { groups, per_spring };
-std::string to_string(CalibrationGranularity g);  ///< "groups" | "per_spring"
+/// groups: msm::group_parameters; wall_layers and edge_types: msm::wall_layer_parameters
+/// (direction by the largest component, or by the edge's type); per_spring:
+/// msm::per_spring_parameters.
+enum class CalibrationGranularity { groups, wall_layers, edge_types, per_spring };
+/// "groups" | "wall_layers" | "edge_types" | "per_spring"
+std::string to_string(CalibrationGranularity g);
 CalibrationGranularity parse_calibration_granularity(const std::string& name);  ///< InputError
+
+/// How the training cases weigh in the fit: equal (each case's squared relative L2 error alike)
+/// or p1 (each divided by P1's squared relative L2 error on that case, normalised to a mean
+/// weight of 1: the fit then minimises the mean squared *ratio to P1*, the metric).
+enum class CaseWeights { equal, p1 };
+std::string to_string(CaseWeights w);            ///< "equal" | "p1"
+CaseWeights parse_case_weights(const std::string& name);  ///< InputError
 
 struct CalibrateOptions {
   /// The scene's mass-spring model to calibrate; empty: its hybrid volume model
@@ -50,9 +61,12 @@ struct CalibrateOptions {
   std::optional<int> reference_level;   ///< default: the scene's
   CalibrationGranularity granularity = CalibrationGranularity::groups;
   std::vector<LoadKind> train;  ///< load types fitted on; default: the scene's load type
-  /// Per-spring fits: both terms; group fits: the ridge alone. Defaults: msm::Regulariser's doc.
+  /// Per-spring fits: both terms; the class granularities: the ridge alone. Defaults: msm::Regulariser's doc.
   msm::Regulariser regulariser{1e-2, 1e-3};
   int max_iterations = 200;
+  CaseWeights weights = CaseWeights::equal;
+  /// The gravity cases' magnitude (g) on scenes whose own load is not gravity.
+  double gravity = 1.0;
   /// Further scenes whose own loads are held-out cases on another vessel (group calibrations).
   std::vector<Scene> other_vessels;
   std::filesystem::path cache_dir;  ///< generated meshes (empty: none)
@@ -75,7 +89,10 @@ struct CalibrationCaseResult {
   double base_update_seconds = 0.0, calibrated_update_seconds = 0.0;  ///< per update (ramp median)
   double max_strain_reference = 0.0;  ///< reference's largest principal strain at this load
   bool ok = true;
-  std::string failure;  ///< why the calibrated model could not be evaluated
+  std::string failure;  ///< why the calibrated model could not be evaluated (a refused
+                        ///< transfer, or its solver's failure on this case)
+  bool base_ok = true;
+  std::string base_failure;  ///< why the uncalibrated model could not be (its solver's failure)
 };
 
 struct CalibrationStudy {
