@@ -90,9 +90,12 @@ struct SolverOptions {
   /// automatic: direct at or below this many DoFs (CHOLMOD for the displacement system, UMFPACK
   /// for the mixed one), else CG-AMG. Measured on this machine (2 cores, OpenBLAS), default tube,
   /// contact: P1 level 1 (32k DoFs) CHOLMOD 0.75 s vs AMG 1.46 s; P2 level 1 (204k DoFs) CHOLMOD
-  /// 11.3 s vs AMG 18.3 s (91 iterations). Above ~250k DoFs the factor's memory grows faster
-  /// than AMG's.
-  std::size_t direct_max_dofs = 250000;
+  /// 11.3 s vs AMG 18.3 s (91 iterations); the structured arch, P2 level 1 (272k DoFs, ν = 0.45,
+  /// `vesselverify fem --vessel arch --structured --level 1 --degree 2 --bc clamped`): CHOLMOD
+  /// 20.0 s solve and 3.7 GB peak against AMG's 42.1 s (205 iterations) and 2.2 GB. The factor's
+  /// memory grows faster than AMG's (~n^4/3): about 6 GB at this limit, so two references solved
+  /// side by side fit a 24 GB machine.
+  std::size_t direct_max_dofs = 400000;
   /// automatic, mixed system: UMFPACK at or below this many DoFs, else gmres_block. Measured
   /// (docs/fem_measurements.md): level 0 (34–47k DoFs) UMFPACK 4–11 s vs FGMRES 8–21 s; level 1
   /// (214k / 241k) UMFPACK 102 s, 4.6 GB / 426 s, 13.4 GB vs FGMRES 51 s / 216 s at ~2 GB (contact).
@@ -104,6 +107,11 @@ struct SolverOptions {
   /// gmres_block: Krylov basis size before FGMRES restarts (memory: 2 × this many vectors).
   unsigned gmres_restart = 100;
   unsigned max_iterations = 5000;
+  /// direct (CHOLMOD) displacement solve: keep the factor for the next solve of the identical
+  /// matrix (solve_spd_cholmod_keeping_factor: the references of several loads on one vessel
+  /// factorise once). Changes no result, so it is not part of the solution cache's key. Off by
+  /// default: a timed FEM model must pay for its factorisation each time.
+  bool keep_factor = false;
 };
 
 struct ElasticityProblem {
