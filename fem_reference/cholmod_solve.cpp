@@ -1,6 +1,12 @@
 #include "fem_reference/cholmod_solve.hpp"
 
 #include <Eigen/CholmodSupport>
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <list>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
 
 #include "meshes/solver_threads.hpp"
@@ -30,6 +36,66 @@ CholmodFactor::CholmodFactor(const Eigen::SparseMatrix<double>& K)
 }
 
 CholmodFactor::~CholmodFactor() = default;
+
+namespace {
+
+/// A kept factor with the matrix it factorises; `solving` serialises its solves (CHOLMOD's
+/// workspace in the factor object is not safe for concurrent solves).
+struct KeptFactor {
+  Eigen::SparseMatrix<double> K;
+  std::unique_ptr<CholmodFactor> factor;
+  std::mutex solving;
+};
+
+constexpr std::size_t kKeptFactors = 4;
+std::mutex kept_mutex;
+std::list<std::shared_ptr<KeptFactor>> kept;  // most recently used first
+std::atomic<long> hits{0};
+
+bool identical(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix<double>& b) {
+  if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros()) return false;
+  const auto n = static_cast<std::size_t>(a.nonZeros());
+  const auto outer = static_cast<std::size_t>(a.outerSize() + 1);
+  return std::memcmp(a.outerIndexPtr(), b.outerIndexPtr(), outer * sizeof(int)) == 0 &&
+         std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), n * sizeof(int)) == 0 &&
+         std::memcmp(a.valuePtr(), b.valuePtr(), n * sizeof(double)) == 0;
+}
+
+}  // namespace
+
+Eigen::VectorXd solve_spd_cholmod_keeping_factor(const Eigen::SparseMatrix<double>& K,
+                                                 const Eigen::VectorXd& b) {
+  Eigen::SparseMatrix<double> compressed = K;
+  compressed.makeCompressed();
+  std::shared_ptr<KeptFactor> entry;
+  {
+    const std::lock_guard lock(kept_mutex);
+    const auto it = std::find_if(kept.begin(), kept.end(),
+                                 [&](const auto& e) { return identical(e->K, compressed); });
+    if (it != kept.end()) {
+      entry = *it;
+      kept.splice(kept.begin(), kept, it);
+      ++hits;
+    }
+  }
+  if (!entry) {  // factorise outside the lock: another thread may factorise another matrix
+    entry = std::make_shared<KeptFactor>();
+    entry->factor = std::make_unique<CholmodFactor>(compressed);
+    entry->K = std::move(compressed);
+    const std::lock_guard lock(kept_mutex);
+    kept.push_front(entry);
+    if (kept.size() > kKeptFactors) kept.pop_back();
+  }
+  const std::lock_guard solving(entry->solving);
+  return entry->factor->solve(b);
+}
+
+void release_kept_factors() {
+  const std::lock_guard lock(kept_mutex);
+  kept.clear();
+}
+
+long kept_factor_hits() { return hits.load(); }
 
 Eigen::VectorXd CholmodFactor::solve(const Eigen::VectorXd& b) const {
   apply_solver_threads();

@@ -11,6 +11,18 @@ namespace vessel::fem {
 /// std::runtime_error if the factorisation fails (K not positive definite).
 Eigen::VectorXd solve_spd_cholmod(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& b);
 
+/// As solve_spd_cholmod, with the factor of an earlier call on an identical K (same size,
+/// pattern and values, compared exactly) when one is kept, else a new factor that is then kept:
+/// the linear references of several loads on one vessel (a scene's contact, another's gravity)
+/// factorise once. Keeps the factors of the four matrices used last (each with a copy of its K);
+/// thread-safe. Not for matrices that change every call (a Newton tangent).
+Eigen::VectorXd solve_spd_cholmod_keeping_factor(const Eigen::SparseMatrix<double>& K,
+                                                 const Eigen::VectorXd& b);
+/// Frees the kept factors (their memory: gigabytes at the reference levels).
+void release_kept_factors();
+/// How many solve_spd_cholmod_keeping_factor calls found their factor kept, since the start.
+long kept_factor_hits();
+
 /// A CHOLMOD supernodal Cholesky factor kept for repeated solves (the Newmark transient factorises
 /// K + 4/dt² M once and reuses it every step).
 class CholmodFactor {

@@ -59,7 +59,7 @@ LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dof
 
 }  // namespace
 
-void ElasticitySolver::Impl::solve_linear(bool symmetric) {
+void ElasticitySolver::Impl::solve_linear(bool symmetric, bool keep_factor) {
   LinearSolver s = chosen_solver(problem.options, mixed, dof.n_dofs());
   if (!symmetric && !mixed && s == LinearSolver::cg_amg) {
     if (problem.options.solver == LinearSolver::cg_amg) {
@@ -73,7 +73,7 @@ void ElasticitySolver::Impl::solve_linear(bool symmetric) {
   if (rhs.l2_norm() == 0.0) {
     solution = 0.0;  // no load and homogeneous constraints: u = 0
   } else if (s == LinearSolver::direct && !mixed && symmetric) {
-    solve_displacement_direct();
+    solve_displacement_direct(keep_factor);
   } else if (s == LinearSolver::direct) {
     // UMFPACK for the indefinite mixed (Taylor–Hood) system and for a nonsymmetric matrix.
     apply_solver_threads();  // UMFPACK's dense kernels are OpenBLAS's
@@ -88,7 +88,7 @@ void ElasticitySolver::Impl::solve_linear(bool symmetric) {
   constraints.distribute(solution);
 }
 
-void ElasticitySolver::Impl::solve_displacement_direct() {
+void ElasticitySolver::Impl::solve_displacement_direct(bool keep_factor) {
   // CHOLMOD (supernodal Cholesky) for the SPD displacement system: the constraints keep K
   // symmetric with positive diagonal entries on constrained rows.
   const Index n = dof.n_dofs();
@@ -103,8 +103,9 @@ void ElasticitySolver::Impl::solve_displacement_direct() {
   }
   Eigen::SparseMatrix<double> K(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
   K.setFromTriplets(entries.begin(), entries.end());
-  const Eigen::VectorXd x = solve_spd_cholmod(
-      K, Eigen::Map<const Eigen::VectorXd>(rhs.begin(), static_cast<Eigen::Index>(n)));
+  const Eigen::Map<const Eigen::VectorXd> b(rhs.begin(), static_cast<Eigen::Index>(n));
+  const Eigen::VectorXd x =
+      keep_factor ? solve_spd_cholmod_keeping_factor(K, b) : solve_spd_cholmod(K, b);
   std::copy(x.data(), x.data() + x.size(), solution.begin());
 }
 

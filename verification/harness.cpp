@@ -20,6 +20,7 @@
 #include <thread>
 #include <tuple>
 
+#include "fem_reference/cholmod_solve.hpp"
 #include "fem_reference/convergence.hpp"
 #include "fem_reference/elasticity.hpp"
 #include "fem_reference/hyperelastic.hpp"
@@ -232,11 +233,13 @@ double interpolate(const std::vector<double>& t, const std::vector<double>& v, d
   return (1.0 - w) * v[hi - 1] + w * v[hi];
 }
 
-/// A reference solve on `mesh`, from the solution cache when it has it.
+/// A reference solve on `mesh`, from the solution cache when it has it. The references are
+/// untimed, so a CHOLMOD factor is kept for another load on the same vessel (contact_straight's
+/// and gravity_sag's level-1 references share one).
 const fem::ElasticityResult& solve_reference(std::unique_ptr<fem::ElasticitySolver>& solver,
-                                             const TetMesh& mesh,
-                                             const fem::ElasticityProblem& problem,
+                                             const TetMesh& mesh, fem::ElasticityProblem problem,
                                              fem::SolutionCache* cache) {
+  problem.options.keep_factor = true;
   solver = std::make_unique<fem::ElasticitySolver>(mesh, problem);
   return fem::solve_with(cache, *solver, mesh, problem);
 }
@@ -1322,25 +1325,29 @@ void run_all_transients(std::vector<std::unique_ptr<SceneReferences>>& refs,
 }
 
 /// Every scene's references, `o.jobs` solves at a time, the cores shared among the solves running
-/// (parallel_solves). Scenes whose fine problems are equal (the same key in the solution cache)
-/// are solved in one task, one after the other, so that the later ones read the first's entry.
-/// Then the dynamic models' FEM transients (run_all_transients).
+/// (parallel_solves). Scenes whose fine problems have the same matrix (mesh, material, supports:
+/// the solution cache's key without the loads) are solved in one task, one after the other, so
+/// that the later ones read the first's solution cache entry (the same loads) or reuse its kept
+/// CHOLMOD factor (other loads: contact_straight's and gravity_sag's). Then the dynamic models'
+/// FEM transients (run_all_transients).
 void solve_all_references(std::vector<std::unique_ptr<SceneReferences>>& refs,
                           const HarnessOptions& o, std::ostream& log) {
   std::vector<std::pair<std::size_t, std::size_t>> cases;  // (scene, ν index)
   for (std::size_t i = 0; i < refs.size(); ++i) {
     for (std::size_t k = 0; k < refs[i]->scene.poisson_ratios.size(); ++k) cases.emplace_back(i, k);
   }
-  std::map<std::string, std::vector<std::size_t>> by_key;  // cases sharing a fine problem
+  std::map<std::string, std::vector<std::size_t>> by_key;  // cases sharing a fine matrix
   std::vector<std::vector<std::size_t>> tasks;
   for (std::size_t c = 0; c < cases.size(); ++c) {
     const auto [i, k] = cases[c];
-    const std::optional<std::string> key =
-        o.solution_cache && o.solution_cache->enabled()
-            ? fem::solution_cache_key(refs[i]->fine_mesh,
-                                      fem_problem(refs[i]->scene, refs[i]->fine_mesh,
-                                                  refs[i]->scene.poisson_ratios[k], 2))
-            : std::nullopt;
+    fem::ElasticityProblem unloaded = fem_problem(refs[i]->scene, refs[i]->fine_mesh,
+                                                  refs[i]->scene.poisson_ratios[k], 2);
+    unloaded.pressures.clear();
+    unloaded.patches.clear();
+    unloaded.gravity = Vec3::Zero();
+    unloaded.body_force = nullptr;
+    for (fem::DirichletCondition& d : unloaded.dirichlet) d.value = nullptr;  // rhs only
+    const std::optional<std::string> key = fem::solution_cache_key(refs[i]->fine_mesh, unloaded);
     if (key) {
       by_key[*key].push_back(c);
     } else {
@@ -1416,6 +1423,7 @@ std::vector<SceneResult> run_scenes(const std::vector<Scene>& scenes, const Harn
   std::vector<std::unique_ptr<SceneReferences>> refs;
   for (const Scene& s : scenes) refs.push_back(scene_meshes(s, o, log));
   solve_all_references(refs, o, log);
+  fem::release_kept_factors();  // gigabytes at the reference levels; the models pass needs none
   for (std::size_t i = 0; i < scenes.size(); ++i) {
     Stopwatch clock;
     log_scene_header(log, scenes[i], i, scenes.size());

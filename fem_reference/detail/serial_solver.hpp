@@ -66,8 +66,11 @@ struct ElasticitySolver::Impl {
   /// Solves matrix · solution = rhs and distributes the constraints. `symmetric` false (the
   /// finite-strain tangent with follower pressure): UMFPACK instead of CHOLMOD, and automatic
   /// never picks CG-AMG.
-  void solve_linear(bool symmetric = true);
-  void solve_displacement_direct();
+  /// `keep_factor`: a direct displacement solve keeps CHOLMOD's factor for the next solve of an
+  /// identical matrix (solve_spd_cholmod_keeping_factor; the linear reference, not a Newton
+  /// tangent).
+  void solve_linear(bool symmetric = true, bool keep_factor = false);
+  void solve_displacement_direct(bool keep_factor);
   void solve_displacement_cg_amg();
   void postprocess();
   /// Per DoF: its component (0..2 displacement, 3 pressure).
