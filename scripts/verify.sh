@@ -19,11 +19,12 @@
 # Usage: scripts/verify.sh [--quick | --full] [--retime] [output-dir]   (default: results/)
 #   default  the scenes' own levels, loads and sweeps (contact up to 1 mN, where the linear
 #            reference holds; seed 000's range is the validity study's, against the
-#            finite-strain reference); the stability table at levels 0-1 with a 2·10^5-step long
-#            run; level-0 recommendation candidates
-#   --quick  models at level 0, reference at level 1, smallest and largest load, the quick
-#            stability study (~8 min from an empty cache, most of it the validity study
-#            and the FEM transients, which it does not shorten; ~1 min once cached)
+#            finite-strain reference, to 70 mN); the stability table at levels 0-1 with a
+#            2·10^5-step long run; level-0 recommendation candidates (~5 min from an empty
+#            cache on 2 cores, ~25 s once cached)
+#   --quick  models at level 0, reference at level 1, smallest and largest load, the validity
+#            study at 0.1, 1 and 10 mN, the quick stability study (~3 min from an empty cache,
+#            a third of it the level-1 references; ~25 s once cached)
 #   --full   the default plus the stability table at level 2, the 10^6-step long run, the
 #            level-1 recommendation candidates and the validity study at the scenes' reference
 #            level on the dense ladder (not measured: P2 level 1 costs ~10 s per Newton
