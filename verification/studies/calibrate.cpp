@@ -332,27 +332,22 @@ CalibrationCaseResult evaluate_case(VesselContext& v, const LoadCase& c, const M
   const std::vector<Vec3> ref = scaled(a.reference_at_network, c.magnitude);
   // A solver failure on one case (e.g. Newton not converging) is that case's outcome, not the
   // study's: recorded and shown, the other cases still evaluated.
-  try {
-    const ModelAnswer base = solve_model(cs, spec, v.base, v.mesh, c.magnitude);
-    r.base = compare_displacements(base.u, ref);
-    r.base_update_seconds = base.update_seconds;
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::runtime_error& e) {
-    r.base_ok = false;
-    r.base_failure = e.what();
-  }
-  if (calibrated) {
+  const auto evaluate = [&](const auto& model, auto& errors, double& update_seconds, bool& ok,
+                            std::string& failure) {
     try {
-      const ModelAnswer cal = solve_model(cs, spec, *calibrated, v.mesh, c.magnitude);
-      r.calibrated = compare_displacements(cal.u, ref);
-      r.calibrated_update_seconds = cal.update_seconds;
+      const ModelAnswer answer = solve_model(cs, spec, model, v.mesh, c.magnitude);
+      errors = compare_displacements(answer.u, ref);
+      update_seconds = answer.update_seconds;
     } catch (const InputError&) {
       throw;
     } catch (const std::runtime_error& e) {
-      r.ok = false;
-      r.failure = e.what();
+      ok = false;
+      failure = e.what();
     }
+  };
+  evaluate(v.base, r.base, r.base_update_seconds, r.base_ok, r.base_failure);
+  if (calibrated) {
+    evaluate(*calibrated, r.calibrated, r.calibrated_update_seconds, r.ok, r.failure);
   } else {
     r.ok = false;
     r.failure = why_not;
