@@ -1222,6 +1222,7 @@ SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& pr
     if (solve_here) {
       progress.begin(reference_label(s, nu));
       solve_reference_at(s, r, k, o);
+      fem::release_kept_factors();  // the timed models below run without gigabytes held
       progress.end();
       if (r.modal_reference_mesh) {
         progress.begin(modal_label(s, r, nu));
