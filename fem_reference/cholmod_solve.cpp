@@ -7,6 +7,7 @@
 #include <list>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 
 #include "meshes/solver_threads.hpp"
@@ -65,8 +66,13 @@ bool identical(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix<d
 
 Eigen::VectorXd solve_spd_cholmod_keeping_factor(const Eigen::SparseMatrix<double>& K,
                                                  const Eigen::VectorXd& b) {
-  Eigen::SparseMatrix<double> compressed = K;
-  compressed.makeCompressed();
+  // The comparison reads the compressed arrays; a matrix built by setFromTriplets already is.
+  std::optional<Eigen::SparseMatrix<double>> compressed_copy;
+  if (!K.isCompressed()) {
+    compressed_copy.emplace(K);
+    compressed_copy->makeCompressed();
+  }
+  const Eigen::SparseMatrix<double>& compressed = compressed_copy ? *compressed_copy : K;
   std::shared_ptr<KeptFactor> entry;
   {
     const std::lock_guard lock(kept_mutex);
@@ -81,7 +87,7 @@ Eigen::VectorXd solve_spd_cholmod_keeping_factor(const Eigen::SparseMatrix<doubl
   if (!entry) {  // factorise outside the lock: another thread may factorise another matrix
     entry = std::make_shared<KeptFactor>();
     entry->factor = std::make_unique<CholmodFactor>(compressed);
-    entry->K = std::move(compressed);
+    entry->K = compressed;  // the one copy: kept to recognise the matrix next time
     const std::lock_guard lock(kept_mutex);
     kept.push_front(entry);
     if (kept.size() > kKeptFactors) kept.pop_back();

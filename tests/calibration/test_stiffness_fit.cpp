@@ -182,6 +182,35 @@ TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
   }
 }
 
+namespace {
+
+/// Data the nonlinear model generates with the `planted` factors (four random loads at strain
+/// ~1e-5, i.e. linear), then the L-BFGS fit of those factors from zero: the fitted θ and the fit's
+/// relative errors per case.
+std::pair<Eigen::VectorXd, std::vector<double>> fit_planted_factors(
+    const BuiltNetwork& built, const std::vector<char>& fixed, const StiffnessParameters& params,
+    const Eigen::VectorXd& planted, unsigned seed, int max_iterations) {
+  BuiltNetwork truth = built;
+  apply_stiffness_factors(truth.network, truth.volume_kappa, params, planted);
+  std::mt19937 rng(seed);
+  std::vector<FitCase> cases;
+  for (int c = 0; c < 4; ++c) {
+    const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
+    cases.push_back({"case" + std::to_string(c), f, static_displacement(truth, fixed, f)});
+  }
+  const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases);
+  const Objective f = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
+    return fit.objective(x, g);
+  };
+  LbfgsOptions o;
+  o.max_iterations = max_iterations;
+  o.gradient_tolerance = 1e-12;
+  const LbfgsResult r = minimize_lbfgs(f, Eigen::VectorXd::Zero(params.size()), o);
+  return {r.x, fit.relative_errors(r.x)};
+}
+
+}  // namespace
+
 TEST(StiffnessFit, RecoversPlantedGroupFactorsFromTheModelsOwnData) {
   const TetMesh mesh = block_mesh(3, 1e-3);
   const BuiltNetwork built = hybrid(mesh, 0.45);
@@ -193,27 +222,12 @@ TEST(StiffnessFit, RecoversPlantedGroupFactorsFromTheModelsOwnData) {
   for (Eigen::Index p = 0; p < planted.size(); ++p) {
     planted[p] = std::log(0.5) + std::log(4.0) * static_cast<double>(p) / (planted.size() - 1);
   }
-  BuiltNetwork truth = built;
-  apply_stiffness_factors(truth.network, truth.volume_kappa, params, planted);
-  std::mt19937 rng(11);
-  std::vector<FitCase> cases;
-  for (int c = 0; c < 4; ++c) {
-    const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);  // strain ~1e-5: linear
-    cases.push_back({"case" + std::to_string(c), f, static_displacement(truth, fixed, f)});
-  }
-  const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases);
-  const Objective f = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
-    return fit.objective(x, g);
-  };
-  LbfgsOptions o;
-  o.max_iterations = 500;
-  o.gradient_tolerance = 1e-12;
-  const LbfgsResult r = minimize_lbfgs(f, Eigen::VectorXd::Zero(params.size()), o);
+  const auto [x, errors] = fit_planted_factors(built, fixed, params, planted, 11, 500);
   for (Eigen::Index p = 0; p < planted.size(); ++p) {
-    EXPECT_NEAR(std::exp(r.x[p]), std::exp(planted[p]), 2e-3 * std::exp(planted[p]))
+    EXPECT_NEAR(std::exp(x[p]), std::exp(planted[p]), 2e-3 * std::exp(planted[p]))
         << params.names[static_cast<std::size_t>(p)];
   }
-  for (const double e : fit.relative_errors(r.x)) EXPECT_LT(e, 1e-4);
+  for (const double e : errors) EXPECT_LT(e, 1e-4);
 }
 
 // The wall-layer granularity, with its two κ halves, recovers factors planted in data the
@@ -232,24 +246,9 @@ TEST(StiffnessFit, RecoversPlantedWallLayerFactorsFromTheModelsOwnData) {
     planted[p] = std::log(0.5) + std::log(4.0) * static_cast<double>((3 * p) % planted.size()) /
                                      (planted.size() - 1);
   }
-  BuiltNetwork truth = built;
-  apply_stiffness_factors(truth.network, truth.volume_kappa, params, planted);
-  std::mt19937 rng(13);
-  std::vector<FitCase> cases;
-  for (int c = 0; c < 4; ++c) {
-    const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
-    cases.push_back({"case" + std::to_string(c), f, static_displacement(truth, fixed, f)});
-  }
-  const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases);
-  const Objective f = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
-    return fit.objective(x, g);
-  };
-  LbfgsOptions o;
-  o.max_iterations = 1000;
-  o.gradient_tolerance = 1e-12;
-  const LbfgsResult r = minimize_lbfgs(f, Eigen::VectorXd::Zero(params.size()), o);
+  const auto [x, errors] = fit_planted_factors(built, fixed, params, planted, 13, 1000);
   for (Eigen::Index p = 0; p < planted.size(); ++p) {
-    EXPECT_NEAR(std::exp(r.x[p]), std::exp(planted[p]), 5e-3 * std::exp(planted[p]))
+    EXPECT_NEAR(std::exp(x[p]), std::exp(planted[p]), 5e-3 * std::exp(planted[p]))
         << params.names[static_cast<std::size_t>(p)];
   }
 }
