@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iomanip>
 #include <map>
+#include <mutex>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
@@ -16,10 +17,11 @@ namespace vessel {
 
 namespace {
 
-/// gmsh is a process-wide singleton: initialise it for one generation and always finalise.
+/// gmsh is a process-wide singleton: one session at a time (studies mesh from several threads),
+/// initialised for one generation and always finalised.
 class GmshSession {
  public:
-  explicit GmshSession(const MeshingOptions& options) {
+  explicit GmshSession(const MeshingOptions& options) : lock_(session_mutex()) {
     gmsh::initialize(0, nullptr, /*readConfigFiles=*/false);
     gmsh::option::setNumber("General.Terminal", options.verbose ? 1 : 0);
     gmsh::option::setNumber("General.NumThreads", 1);
@@ -28,6 +30,13 @@ class GmshSession {
   ~GmshSession() { gmsh::finalize(); }
   GmshSession(const GmshSession&) = delete;
   GmshSession& operator=(const GmshSession&) = delete;
+
+ private:
+  static std::mutex& session_mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::unique_lock<std::mutex> lock_;
 };
 
 /// A point of the inlet cross-section at local polar coordinates (ρ, θ) around the centreline.

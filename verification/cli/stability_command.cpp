@@ -84,7 +84,8 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--max-level", o->max_level, "Highest mesh level of the step table");
   add_jobs_option(*cmd, o->jobs,
                   "Rows of the critical-step table computed at a time, one (level, model) per "
-                  "thread (default: the core count); the hard cases run one after another");
+                  "thread, and hard cases (default: the core count); the long run, whose steps are "
+                  "timed, runs alone");
   cmd->add_flag("--no-hard-cases", o->no_hard_cases, "Only the critical-step table");
   cmd->add_option("--hard-case", o->only_cases,
                   "Run only this hard case (repeatable): poisson, youngs_modulus, sliver, "

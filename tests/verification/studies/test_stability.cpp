@@ -109,6 +109,50 @@ TEST(Stability, TheStepTableIsTheSameComputedOneRowAtATimeOrInParallel) {
   }
 }
 
+TEST(Stability, HardCasesSideBySideGiveWhatTheyGiveOneAtATime) {
+  // Cheap cases, two of them meshing (gmsh is one session at a time across threads), on the
+  // meshes of one cache; the long run is timed and runs alone after the others. Every outcome
+  // but the measured seconds is deterministic, so two threads must reproduce one, in order.
+  test::TempDir cache;
+  StabilityOptions o;
+  o.cache_dir = cache.path();
+  o.max_level = 0;
+  o.trial_steps = 50;
+  o.long_run_steps = 500;
+  o.only_cases = {"zero_length", "long_run", "inverting_load", "tight_bend"};
+  o.jobs = 1;
+  const StabilityReport one = run_stability(o);
+  o.jobs = 2;
+  const StabilityReport two = run_stability(o);
+  EXPECT_EQ(one.hard_cases_at_a_time, 1);
+  EXPECT_EQ(two.hard_cases_at_a_time, 2);
+  ASSERT_EQ(one.hard_cases.size(), 4u);
+  ASSERT_EQ(two.hard_cases.size(), 4u);
+  const std::vector<std::string> order{"inverting_load", "long_run", "tight_bend", "zero_length"};
+  for (std::size_t c = 0; c < 4; ++c) {
+    EXPECT_EQ(one.hard_cases[c].id, order[c]);
+    EXPECT_EQ(two.hard_cases[c].id, order[c]);
+    ASSERT_EQ(one.hard_cases[c].outcomes.size(), two.hard_cases[c].outcomes.size()) << order[c];
+    for (std::size_t i = 0; i < one.hard_cases[c].outcomes.size(); ++i) {
+      const HardCaseOutcome& a = one.hard_cases[c].outcomes[i];
+      const HardCaseOutcome& b = two.hard_cases[c].outcomes[i];
+      EXPECT_EQ(a.model, b.model);
+      EXPECT_EQ(a.finished, b.finished) << a.model;
+      EXPECT_EQ(a.converged, b.converged) << a.model;
+      EXPECT_EQ(a.bounded, b.bounded) << a.model;
+      for (const auto& [key, value] : a.values) {
+        if (key == "seconds") continue;
+        // Round-off apart: a direct solve's threads (shared among the running cases) change the
+        // order of its sums.
+        EXPECT_NEAR(value, b.values.at(key), 1e-10 * std::abs(value))
+            << order[c] << " " << a.model << " " << key;
+      }
+    }
+  }
+  EXPECT_NE(stability_markdown(two).find("ran 2 at a time"), std::string::npos);
+  EXPECT_EQ(stability_markdown(one).find("at a time"), std::string::npos);
+}
+
 TEST(Stability, ASecondRunReadsTheRowsFromTheOutcomeCacheWithTheirTimings) {
   test::TempDir cache;
   std::ostringstream log;

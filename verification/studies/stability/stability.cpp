@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "meshes/errors.hpp"
 #include "meshes/vessel_geometry.hpp"
 #include "verification/outcome_cache.hpp"
+#include "verification/parallel.hpp"
 #include "verification/studies/stability/study_models.hpp"
 #include "verification/timing.hpp"
 
@@ -98,6 +101,88 @@ HardCase run_case(HardCase (*fn)(const StabilityOptions&, std::ostream&), const 
   return hc;
 }
 
+using CaseFn = HardCase (*)(const StabilityOptions&, std::ostream&);
+
+struct HardCaseEntry {
+  const char* what;
+  CaseFn fn;
+  /// Its outcomes include a measured time (the long run's seconds): it runs alone, after the
+  /// others, which may run side by side.
+  bool timed;
+};
+
+/// Hard case `i` (kHardCaseIds), numbered k: computed, or read from the outcome cache.
+HardCase run_or_recall_case(const HardCaseEntry& c, std::size_t i, std::size_t k,
+                            const StabilityOptions& o, std::ostream& log, TimingProvenance& p) {
+  if (!o.outcome_cache || !o.outcome_cache->enabled()) {
+    p = {false, utc_now()};
+    return run_case(c.fn, c.what, k, o, log);
+  }
+  // The options a case reads (the mode, its steps; the rest is code, in the key as the
+  // executable's identity).
+  const std::string key = "stability-case " + std::string(kHardCaseIds[i]) +
+                          " quick=" + std::to_string(o.quick) +
+                          " trial_steps=" + std::to_string(o.trial_steps) +
+                          " long_run_steps=" + std::to_string(o.long_run_steps) +
+                          " max_level=" + std::to_string(o.max_level);
+  HardCase hc = deserialise_case(o.outcome_cache->get(
+      key, [&] { return serialise_case(run_case(c.fn, c.what, k, o, log)); }, p));
+  if (p.cached) log << "  from the outcome cache (measured " << p.measured_at << ")\n";
+  return hc;
+}
+
+/// The hard cases (all, or o.only_cases) in kHardCaseIds' order. Those without a measured time
+/// run o.jobs at a time, each logging into its own buffer (printed when it ends); the timed ones
+/// then run alone.
+void run_hard_cases(const StabilityOptions& o, const Stopwatch& clock, std::ostream& log,
+                    StabilityReport& rep, std::vector<TimingProvenance>& provenance) {
+  const HardCaseEntry all_cases[] = {
+      {"ν → 0.5", case_poisson, false},          {"E sweep", case_youngs_modulus, false},
+      {"sliver tets", case_sliver, false},       {"refined contact patch", case_refined_patch, false},
+      {"inverting load", case_inverting_load, false}, {"long run", case_long_run, true},
+      {"tight bend", case_tight_bend, false},    {"zero-length springs", case_zero_length, false}};
+  static_assert(std::size(all_cases) == kHardCaseIds.size());
+  std::vector<std::size_t> cases;
+  for (std::size_t i = 0; i < kHardCaseIds.size(); ++i) {
+    if (o.only_cases.empty() || std::find(o.only_cases.begin(), o.only_cases.end(),
+                                          kHardCaseIds[i]) != o.only_cases.end()) {
+      cases.push_back(i);
+    }
+  }
+  std::vector<std::size_t> side_by_side;  // positions in `cases`
+  std::vector<std::size_t> alone;
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    (all_cases[cases[k]].timed ? alone : side_by_side).push_back(k);
+  }
+  std::vector<HardCase> done(cases.size());
+  std::vector<TimingProvenance> done_provenance(cases.size());
+  const auto header = [&](std::size_t k) {
+    std::ostringstream h;
+    h << "[stability] hard case " << k + 1 << "/" << cases.size() << ": "
+      << all_cases[cases[k]].what;
+    return h.str();
+  };
+  rep.hard_cases_at_a_time = std::max(1, std::min(o.jobs, static_cast<int>(side_by_side.size())));
+  std::mutex log_mutex;
+  parallel_solves(side_by_side.size(), o.jobs, [&](std::size_t t) {
+    const std::size_t k = side_by_side[t];
+    std::ostringstream case_log;
+    done[k] = run_or_recall_case(all_cases[cases[k]], cases[k], k + 1, o, case_log,
+                                 done_provenance[k]);
+    const std::lock_guard lock(log_mutex);
+    log << header(k) << ", done in " << fmt(done[k].seconds, 3) << " s (" << fmt(clock.seconds(), 3)
+        << " s so far)\n" << case_log.str() << std::flush;
+  });
+  for (const std::size_t k : alone) {
+    log << header(k) << ", alone (" << fmt(clock.seconds(), 3) << " s so far)" << std::endl;
+    done[k] = run_or_recall_case(all_cases[cases[k]], cases[k], k + 1, o, log, done_provenance[k]);
+  }
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    rep.hard_cases.push_back(std::move(done[k]));
+    provenance.push_back(done_provenance[k]);
+  }
+}
+
 }  // namespace
 
 StabilityReport run_stability(const StabilityOptions& o) {
@@ -124,46 +209,7 @@ StabilityReport run_stability(const StabilityOptions& o) {
   std::vector<TimingProvenance> provenance;
   rep.rows = critical_step_table(o, max_level, rep.trial_steps, log, provenance);
   rep.fits = refinement_fits(rep.rows);
-  if (o.hard_cases) {
-    using CaseFn = HardCase (*)(const StabilityOptions&, std::ostream&);
-    const std::pair<const char*, CaseFn> all_cases[] = {
-        {"ν → 0.5", case_poisson},          {"E sweep", case_youngs_modulus},
-        {"sliver tets", case_sliver},       {"refined contact patch", case_refined_patch},
-        {"inverting load", case_inverting_load}, {"long run", case_long_run},
-        {"tight bend", case_tight_bend},    {"zero-length springs", case_zero_length}};
-    static_assert(std::size(all_cases) == kHardCaseIds.size());
-    std::vector<std::size_t> cases;
-    for (std::size_t i = 0; i < kHardCaseIds.size(); ++i) {
-      if (o.only_cases.empty() || std::find(o.only_cases.begin(), o.only_cases.end(),
-                                            kHardCaseIds[i]) != o.only_cases.end()) {
-        cases.push_back(i);
-      }
-    }
-    std::size_t k = 0;
-    for (const std::size_t i : cases) {
-      const auto& [what, fn] = all_cases[i];
-      ++k;
-      log << "[stability] hard case " << k << "/" << std::size(cases) << ": " << what << " ("
-          << fmt(clock.seconds(), 3) << " s so far)" << std::endl;
-      if (!o.outcome_cache || !o.outcome_cache->enabled()) {
-        rep.hard_cases.push_back(run_case(fn, what, k, o, log));
-        provenance.push_back({false, utc_now()});
-        continue;
-      }
-      // The options a case reads (the mode, its steps; the rest is code, in the key as the
-      // executable's identity).
-      const std::string key = "stability-case " + std::string(kHardCaseIds[i]) +
-                              " quick=" + std::to_string(o.quick) +
-                              " trial_steps=" + std::to_string(o.trial_steps) +
-                              " long_run_steps=" + std::to_string(o.long_run_steps) +
-                              " max_level=" + std::to_string(o.max_level);
-      TimingProvenance p;
-      rep.hard_cases.push_back(deserialise_case(o.outcome_cache->get(
-          key, [&] { return serialise_case(run_case(fn, what, k, o, log)); }, p)));
-      if (p.cached) log << "  from the outcome cache (measured " << p.measured_at << ")\n";
-      provenance.push_back(p);
-    }
-  }
+  if (o.hard_cases) run_hard_cases(o, clock, log, rep, provenance);
   rep.timed_items = provenance.size();
   for (const TimingProvenance& p : provenance) {
     if (p.cached) rep.cached_at.push_back(p.measured_at);

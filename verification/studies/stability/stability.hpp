@@ -33,8 +33,8 @@ struct StabilityOptions {
   long long long_run_steps = 0;
   int max_level = -1;
   bool hard_cases = true;  ///< false: only the critical-step table
-  /// Rows of the critical-step table computed at a time (each (level, model) on its own thread);
-  /// the hard cases run one after another.
+  /// Rows of the critical-step table, and hard cases without a measured time, computed at a time
+  /// (each on its own thread); the timed hard case (the long run) runs alone after them.
   int jobs = 1;
   /// Ids of the hard cases to run (poisson, youngs_modulus, sliver, refined_patch,
   /// inverting_load, long_run, tight_bend, zero_length); empty: all of them.
@@ -109,6 +109,9 @@ struct StabilityReport {
   std::vector<CriticalStepRow> rows;
   std::vector<RefinementFit> fits;
   std::vector<HardCase> hard_cases;
+  /// Hard cases run side by side (their seconds are wall times on a shared machine); the long run
+  /// ran alone.
+  int hard_cases_at_a_time = 1;
   double seconds = 0.0;
   /// Items timed (each level's model rows, each hard case) and the measurement times of those
   /// read from the outcome cache.
