@@ -110,4 +110,48 @@ Eigen::VectorXd CholmodFactor::solve(const Eigen::VectorXd& b) const {
   return x;
 }
 
+struct CholmodSamePattern::Impl {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  Eigen::SparseMatrix<double> pattern;  ///< the analysed matrix's structure (values unused)
+  int analyses = 0;
+};
+
+CholmodSamePattern::CholmodSamePattern() : impl_(std::make_unique<Impl>()) {
+  impl_->llt.cholmod().print = 0;  // as in CholmodFactor: failures are reported by exception
+}
+
+CholmodSamePattern::~CholmodSamePattern() = default;
+
+int CholmodSamePattern::analyses() const { return impl_->analyses; }
+
+Eigen::VectorXd CholmodSamePattern::solve(const Eigen::SparseMatrix<double>& K,
+                                          const Eigen::VectorXd& b) {
+  std::optional<Eigen::SparseMatrix<double>> compressed_copy;
+  if (!K.isCompressed()) {
+    compressed_copy.emplace(K);
+    compressed_copy->makeCompressed();
+  }
+  const Eigen::SparseMatrix<double>& A = compressed_copy ? *compressed_copy : K;
+  apply_solver_threads();
+  const Eigen::SparseMatrix<double>& P = impl_->pattern;
+  const bool same = impl_->analyses > 0 && P.rows() == A.rows() && P.nonZeros() == A.nonZeros() &&
+                    std::memcmp(P.outerIndexPtr(), A.outerIndexPtr(),
+                                static_cast<std::size_t>(A.outerSize() + 1) * sizeof(int)) == 0 &&
+                    std::memcmp(P.innerIndexPtr(), A.innerIndexPtr(),
+                                static_cast<std::size_t>(A.nonZeros()) * sizeof(int)) == 0;
+  if (!same) {
+    impl_->llt.analyzePattern(A);
+    impl_->pattern = A;
+    ++impl_->analyses;
+  }
+  impl_->llt.factorize(A);
+  if (impl_->llt.info() != Eigen::Success) {
+    throw std::runtime_error(
+        "CHOLMOD could not factorise the displacement system: it is not positive definite");
+  }
+  Eigen::VectorXd x = impl_->llt.solve(b);
+  if (impl_->llt.info() != Eigen::Success) throw std::runtime_error("CHOLMOD solve failed");
+  return x;
+}
+
 }  // namespace vessel::fem

@@ -191,7 +191,7 @@ const ElasticityResult& ElasticitySolver::solve() {
   im.assemble();
   im.result.timings.assembly = seconds_since(t0);
   t0 = Clock::now();
-  im.solve_linear(true, im.problem.options.keep_factor);
+  im.solve_linear(true, im.problem.options.keep_factor ? DirectReuse::factor : DirectReuse::nothing);
   im.result.timings.solve = seconds_since(t0);
   t0 = Clock::now();
   im.postprocess();

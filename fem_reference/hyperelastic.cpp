@@ -372,7 +372,7 @@ struct HyperelasticSolver::Impl {
       const auto t0 = Clock::now();
       try {
         try {
-          d.solve_linear(symmetric);
+          d.solve_linear(symmetric, DirectReuse::analysis);
         } catch (const std::exception&) {
           // Away from equilibrium (a Newton iterate after a large increment) the symmetric
           // tangent can be indefinite, which CHOLMOD refuses: LU (UMFPACK) solves it.
@@ -506,6 +506,7 @@ struct HyperelasticSolver::Impl {
       }
       ds = step * 0.5;
     }
+    d.release_same_pattern();  // the last tangent's factor: gigabytes at level 1
     result.load_factor = s;
     set_prescribed_increment(0.0);
     const auto t0 = Clock::now();

@@ -59,7 +59,7 @@ LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dof
 
 }  // namespace
 
-void ElasticitySolver::Impl::solve_linear(bool symmetric, bool keep_factor) {
+void ElasticitySolver::Impl::solve_linear(bool symmetric, DirectReuse reuse) {
   LinearSolver s = chosen_solver(problem.options, mixed, dof.n_dofs());
   if (!symmetric && !mixed && s == LinearSolver::cg_amg) {
     if (problem.options.solver == LinearSolver::cg_amg) {
@@ -73,7 +73,7 @@ void ElasticitySolver::Impl::solve_linear(bool symmetric, bool keep_factor) {
   if (rhs.l2_norm() == 0.0) {
     solution = 0.0;  // no load and homogeneous constraints: u = 0
   } else if (s == LinearSolver::direct && !mixed && symmetric) {
-    solve_displacement_direct(keep_factor);
+    solve_displacement_direct(reuse);
   } else if (s == LinearSolver::direct) {
     // UMFPACK for the indefinite mixed (Taylor–Hood) system and for a nonsymmetric matrix.
     apply_solver_threads();  // UMFPACK's dense kernels are OpenBLAS's
@@ -88,24 +88,37 @@ void ElasticitySolver::Impl::solve_linear(bool symmetric, bool keep_factor) {
   constraints.distribute(solution);
 }
 
-void ElasticitySolver::Impl::solve_displacement_direct(bool keep_factor) {
+void ElasticitySolver::Impl::solve_displacement_direct(DirectReuse reuse) {
   // CHOLMOD (supernodal Cholesky) for the SPD displacement system: the constraints keep K
   // symmetric with positive diagonal entries on constrained rows.
   const Index n = dof.n_dofs();
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(matrix.n_nonzero_elements());
+  // The entries: the nonzero values; for a sequence of one pattern (DirectReuse::analysis), every
+  // coupling of two free DoFs whatever its value, so that the pattern stays that of the first
+  // matrix (a tangent at u = 0 has zeros a deformed one fills in) and is analysed once.
+  const bool structural = reuse == DirectReuse::analysis;
   for (Index row = 0; row < n; ++row) {
+    const bool row_free = !constraints.is_constrained(row);
     for (auto it = matrix.begin(row); it != matrix.end(row); ++it) {
-      if (it->value() != 0.0) {
-        entries.emplace_back(static_cast<int>(row), static_cast<int>(it->column()), it->value());
-      }
+      const Index col = it->column();
+      const bool keep = structural ? (row == col || (row_free && !constraints.is_constrained(col)))
+                                   : it->value() != 0.0;
+      if (keep) entries.emplace_back(static_cast<int>(row), static_cast<int>(col), it->value());
     }
   }
   Eigen::SparseMatrix<double> K(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
   K.setFromTriplets(entries.begin(), entries.end());
   const Eigen::Map<const Eigen::VectorXd> b(rhs.begin(), static_cast<Eigen::Index>(n));
-  const Eigen::VectorXd x =
-      keep_factor ? solve_spd_cholmod_keeping_factor(K, b) : solve_spd_cholmod(K, b);
+  Eigen::VectorXd x;
+  if (reuse == DirectReuse::factor) {
+    x = solve_spd_cholmod_keeping_factor(K, b);
+  } else if (reuse == DirectReuse::analysis) {
+    if (!same_pattern) same_pattern = std::make_unique<CholmodSamePattern>();
+    x = same_pattern->solve(K, b);
+  } else {
+    x = solve_spd_cholmod(K, b);
+  }
   std::copy(x.data(), x.data() + x.size(), solution.begin());
 }
 

@@ -15,6 +15,7 @@
 #include <memory>
 #include <vector>
 
+#include "fem_reference/cholmod_solve.hpp"
 #include "fem_reference/detail/amg.hpp"
 #include "fem_reference/detail/boundary.hpp"
 #include "fem_reference/detail/postprocess.hpp"
@@ -25,6 +26,12 @@
 namespace vessel::fem {
 
 namespace dl = dealii;
+
+/// What a direct displacement solve keeps for the next: nothing; the factor, for an identical
+/// matrix (solve_spd_cholmod_keeping_factor: a linear reference's other loads); or the symbolic
+/// analysis, for the next matrix of the same pattern (a Newton method's tangents; held in
+/// Impl::same_pattern until release_same_pattern()).
+enum class DirectReuse { nothing, factor, analysis };
 using detail::kDim;
 using Index = dealii::types::global_dof_index;
 
@@ -66,11 +73,12 @@ struct ElasticitySolver::Impl {
   /// Solves matrix · solution = rhs and distributes the constraints. `symmetric` false (the
   /// finite-strain tangent with follower pressure): UMFPACK instead of CHOLMOD, and automatic
   /// never picks CG-AMG.
-  /// `keep_factor`: a direct displacement solve keeps CHOLMOD's factor for the next solve of an
-  /// identical matrix (solve_spd_cholmod_keeping_factor; the linear reference, not a Newton
-  /// tangent).
-  void solve_linear(bool symmetric = true, bool keep_factor = false);
-  void solve_displacement_direct(bool keep_factor);
+  /// `reuse`: what a direct displacement solve (CHOLMOD) keeps for the next one.
+  void solve_linear(bool symmetric = true, DirectReuse reuse = DirectReuse::nothing);
+  void solve_displacement_direct(DirectReuse reuse);
+  /// The analysis DirectReuse::analysis keeps (with its last factor): freed here.
+  std::unique_ptr<CholmodSamePattern> same_pattern;
+  void release_same_pattern() { same_pattern.reset(); }
   void solve_displacement_cg_amg();
   void postprocess();
   /// Per DoF: its component (0..2 displacement, 3 pressure).

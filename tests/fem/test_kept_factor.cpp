@@ -125,3 +125,38 @@ TEST(KeptFactor, TwoLoadsOnOneVesselFactoriseOnceAndEqualSeparateSolves) {
   EXPECT_EQ(kept_factor_hits(), hits0 + 1);  // gravity found pressure's factor
   release_kept_factors();
 }
+
+// CHOLMOD's symbolic analysis kept across the matrices of one pattern (the finite-strain Newton's
+// tangents): each matrix is solved as K x = b (residual), one analysis serves every matrix of the
+// pattern, another pattern is analysed again, and a matrix that is not positive definite is
+// refused without spoiling the next solve.
+TEST(CholmodSamePattern, OneAnalysisServesEveryMatrixOfThePattern) {
+  const int n = 300;
+  const Eigen::SparseMatrix<double> K1 = random_spd(n, 3);
+  Eigen::SparseMatrix<double> K2 = K1;  // the same pattern, other values (still SPD)
+  for (int k = 0; k < K2.outerSize(); ++k) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(K2, k); it; ++it) {
+      if (it.row() == it.col()) it.valueRef() *= 1.5;
+    }
+  }
+  const Eigen::VectorXd b = Eigen::VectorXd::Random(n);
+  CholmodSamePattern solver;
+  const Eigen::VectorXd x1 = solver.solve(K1, b);
+  const Eigen::VectorXd x2 = solver.solve(K2, b);
+  EXPECT_EQ(solver.analyses(), 1);
+  EXPECT_LT((K1 * x1 - b).norm(), 1e-12 * b.norm());
+  EXPECT_LT((K2 * x2 - b).norm(), 1e-12 * b.norm());
+  EXPECT_GT((x1 - x2).norm(), 1e-3 * x1.norm());  // the second matrix was factorised anew
+
+  Eigen::SparseMatrix<double> indefinite = K1;
+  indefinite.coeffRef(5, 5) = -100.0;  // an existing entry: the pattern is unchanged
+  EXPECT_THROW((void)solver.solve(indefinite, b), std::runtime_error);
+  const Eigen::VectorXd again = solver.solve(K1, b);
+  EXPECT_LT((K1 * again - b).norm(), 1e-12 * b.norm());
+  EXPECT_EQ(solver.analyses(), 1);
+
+  const Eigen::SparseMatrix<double> other = random_spd(n, 4);  // another pattern
+  const Eigen::VectorXd x3 = solver.solve(other, b);
+  EXPECT_EQ(solver.analyses(), 2);
+  EXPECT_LT((other * x3 - b).norm(), 1e-12 * b.norm());
+}
