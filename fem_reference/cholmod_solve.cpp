@@ -14,6 +14,29 @@
 
 namespace vessel::fem {
 
+namespace {
+
+/// Both compressed: the same size and the same stored entries (values aside).
+bool same_pattern(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix<double>& b) {
+  if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros()) return false;
+  const auto n = static_cast<std::size_t>(a.nonZeros());
+  const auto outer = static_cast<std::size_t>(a.outerSize() + 1);
+  return std::memcmp(a.outerIndexPtr(), b.outerIndexPtr(), outer * sizeof(int)) == 0 &&
+         std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), n * sizeof(int)) == 0;
+}
+
+/// K itself when compressed (a matrix built by setFromTriplets is), else a compressed copy held in
+/// `copy`: the comparisons read the compressed arrays.
+const Eigen::SparseMatrix<double>& compressed(const Eigen::SparseMatrix<double>& K,
+                                              std::optional<Eigen::SparseMatrix<double>>& copy) {
+  if (K.isCompressed()) return K;
+  copy.emplace(K);
+  copy->makeCompressed();
+  return *copy;
+}
+
+}  // namespace
+
 Eigen::VectorXd solve_spd_cholmod(const Eigen::SparseMatrix<double>& K, const Eigen::VectorXd& b) {
   return CholmodFactor(K).solve(b);
 }
@@ -54,30 +77,22 @@ std::list<std::shared_ptr<KeptFactor>> kept;  // most recently used first
 std::atomic<long> hits{0};
 
 bool identical(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix<double>& b) {
-  if (a.rows() != b.rows() || a.cols() != b.cols() || a.nonZeros() != b.nonZeros()) return false;
-  const auto n = static_cast<std::size_t>(a.nonZeros());
-  const auto outer = static_cast<std::size_t>(a.outerSize() + 1);
-  return std::memcmp(a.outerIndexPtr(), b.outerIndexPtr(), outer * sizeof(int)) == 0 &&
-         std::memcmp(a.innerIndexPtr(), b.innerIndexPtr(), n * sizeof(int)) == 0 &&
-         std::memcmp(a.valuePtr(), b.valuePtr(), n * sizeof(double)) == 0;
+  return same_pattern(a, b) &&
+         std::memcmp(a.valuePtr(), b.valuePtr(),
+                     static_cast<std::size_t>(a.nonZeros()) * sizeof(double)) == 0;
 }
 
 }  // namespace
 
 Eigen::VectorXd solve_spd_cholmod_keeping_factor(const Eigen::SparseMatrix<double>& K,
                                                  const Eigen::VectorXd& b) {
-  // The comparison reads the compressed arrays; a matrix built by setFromTriplets already is.
-  std::optional<Eigen::SparseMatrix<double>> compressed_copy;
-  if (!K.isCompressed()) {
-    compressed_copy.emplace(K);
-    compressed_copy->makeCompressed();
-  }
-  const Eigen::SparseMatrix<double>& compressed = compressed_copy ? *compressed_copy : K;
+  std::optional<Eigen::SparseMatrix<double>> copy;
+  const Eigen::SparseMatrix<double>& A = compressed(K, copy);
   std::shared_ptr<KeptFactor> entry;
   {
     const std::lock_guard lock(kept_mutex);
     const auto it = std::find_if(kept.begin(), kept.end(),
-                                 [&](const auto& e) { return identical(e->K, compressed); });
+                                 [&](const auto& e) { return identical(e->K, A); });
     if (it != kept.end()) {
       entry = *it;
       kept.splice(kept.begin(), kept, it);
@@ -86,8 +101,8 @@ Eigen::VectorXd solve_spd_cholmod_keeping_factor(const Eigen::SparseMatrix<doubl
   }
   if (!entry) {  // factorise outside the lock: another thread may factorise another matrix
     entry = std::make_shared<KeptFactor>();
-    entry->factor = std::make_unique<CholmodFactor>(compressed);
-    entry->K = compressed;  // the one copy: kept to recognise the matrix next time
+    entry->factor = std::make_unique<CholmodFactor>(A);
+    entry->K = A;  // the one copy: kept to recognise the matrix next time
     const std::lock_guard lock(kept_mutex);
     kept.push_front(entry);
     if (kept.size() > kKeptFactors) kept.pop_back();
@@ -126,20 +141,10 @@ int CholmodSamePattern::analyses() const { return impl_->analyses; }
 
 Eigen::VectorXd CholmodSamePattern::solve(const Eigen::SparseMatrix<double>& K,
                                           const Eigen::VectorXd& b) {
-  std::optional<Eigen::SparseMatrix<double>> compressed_copy;
-  if (!K.isCompressed()) {
-    compressed_copy.emplace(K);
-    compressed_copy->makeCompressed();
-  }
-  const Eigen::SparseMatrix<double>& A = compressed_copy ? *compressed_copy : K;
+  std::optional<Eigen::SparseMatrix<double>> copy;
+  const Eigen::SparseMatrix<double>& A = compressed(K, copy);
   apply_solver_threads();
-  const Eigen::SparseMatrix<double>& P = impl_->pattern;
-  const bool same = impl_->analyses > 0 && P.rows() == A.rows() && P.nonZeros() == A.nonZeros() &&
-                    std::memcmp(P.outerIndexPtr(), A.outerIndexPtr(),
-                                static_cast<std::size_t>(A.outerSize() + 1) * sizeof(int)) == 0 &&
-                    std::memcmp(P.innerIndexPtr(), A.innerIndexPtr(),
-                                static_cast<std::size_t>(A.nonZeros()) * sizeof(int)) == 0;
-  if (!same) {
+  if (impl_->analyses == 0 || !same_pattern(impl_->pattern, A)) {
     impl_->llt.analyzePattern(A);
     impl_->pattern = A;
     ++impl_->analyses;
