@@ -412,38 +412,9 @@ std::vector<ModelSpec> outside_model(TableReader& r, ModelSpec m) {
   return {m};
 }
 
-/// One [[models]] table. `stiffness`, `mass`, `solver`, `dt` and `roi_radius` (and `degree` for
-/// FEM) may be arrays: the table then stands for every combination (a sweep), each named after the
-/// table's name plus the swept values, e.g. "volume[stiffness=lloyd;dt=2e-05]".
-std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind load) {
-  ModelSpec m;
-  const std::string kind = r.string_or(
-      "kind", "", {"fem", "surface_msm", "volume_msm", "network", "external", "displacements"});
-  if (kind.empty()) {
-    r.fail(nullptr, "kind",
-           "missing; expected one of fem, surface_msm, volume_msm, network, external, "
-           "displacements");
-  }
-  m.kind = kind == "fem"             ? ModelKind::fem
-           : kind == "surface_msm"   ? ModelKind::surface_msm
-           : kind == "network"       ? ModelKind::network
-           : kind == "external"      ? ModelKind::external
-           : kind == "displacements" ? ModelKind::displacements
-                                     : ModelKind::volume_msm;
-  m.name = r.string_or("name", kind + "_" + std::to_string(index + 1));
-  if (m.kind == ModelKind::fem) return fem_models(r, m);
-  if (m.kind == ModelKind::external || m.kind == ModelKind::displacements) {
-    return outside_model(r, m);
-  }
-  const bool network = m.kind == ModelKind::network;
-  if (network) {
-    // A spring network from a file: its springs, masses and supports come from the file, so the
-    // stiffness, mass, topology and calibration keys are unknown here.
-    m.network_file = r.string_or("file", "");
-    if (m.network_file.empty()) {
-      r.fail(nullptr, "file", "missing; expected the spring-network file (.json or .vtu)");
-    }
-  }
+/// A mass-spring table's wall keys: `surface`, `topology` and `bending` (surface models),
+/// `volume_term` and `volume_moduli` (volume models).
+void read_wall_options(TableReader& r, ModelSpec& m) {
   if (m.kind == ModelKind::surface_msm) {
     m.surface = msm::parse_wall_surface(r.name_or("surface", msm::to_string(m.surface), msm::parse_wall_surface));
     m.topology = msm::parse_topology(r.name_or("topology", "auto", msm::parse_topology));
@@ -456,8 +427,8 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
              "\"auto\" (the hinges replace the triangle topology's bend springs)");
     }
   }
-  if (m.kind == ModelKind::volume_msm) m.volume_term = r.boolean_or("volume_term", false);
   if (m.kind == ModelKind::volume_msm) {
+    m.volume_term = r.boolean_or("volume_term", false);
     // volume_moduli = "golec" | "homogenised": the volume term's (E_s, κ) rule.
     m.volume_moduli =
         msm::parse_volume_moduli(r.name_or("volume_moduli", "golec", msm::parse_volume_moduli));
@@ -467,51 +438,33 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
                  "\" without volume_term = true; expected volume_term = true with it");
     }
   }
-  const auto stiffness = network ? std::vector<std::string>{msm::to_string(m.stiffness)} :
-      r.names_or("stiffness",
-                 m.kind == ModelKind::volume_msm
-                     ? (m.volume_term ? "van-gelder" : "seed001")
-                     : (m.bending != msm::Bending::none ? "van-gelder" : "seed000"),
-                 msm::parse_stiffness_rule);
-  if (m.volume_term) {
-    for (const auto& k : stiffness) {
-      if (msm::parse_stiffness_rule(k) != msm::StiffnessRule::van_gelder) {
-        r.fail(r.table().get("stiffness"), "stiffness",
-               "found \"" + k + "\" with volume_term = true; expected \"van-gelder\" (the hybrid "
-               "volume model's κ = λ − μ assumes van-gelder springs, whose λ = μ)");
-      }
-    }
-  }
-  const auto mass = network ? std::vector<std::string>{msm::to_string(m.mass)}
-                            : r.names_or("mass", "consistent", msm::parse_mass_rule);
-  const auto solvers = r.names_or("solver", "static", msm::parse_solver);
-  if (network && std::find(solvers.begin(), solvers.end(), "pbd") != solvers.end()) {
-    r.fail(r.table().get("solver"), "solver",
+}
+
+/// Refuses PBD where it cannot run: on a network file, a volume model or with bending.
+void check_pbd(TableReader& r, const ModelSpec& m, const std::vector<std::string>& solvers) {
+  if (std::find(solvers.begin(), solvers.end(), "pbd") == solvers.end()) return;
+  const toml::node* key = r.table().get("solver");
+  if (m.kind == ModelKind::network) {
+    r.fail(key, "solver",
            "found \"pbd\" on a network model; expected another solver (seed 002's constraints "
            "need a surface network's triangles, which a network file does not give)");
   }
-  if (m.kind == ModelKind::volume_msm &&
-      std::find(solvers.begin(), solvers.end(), "pbd") != solvers.end()) {
-    r.fail(r.table().get("solver"), "solver",
+  if (m.kind == ModelKind::volume_msm) {
+    r.fail(key, "solver",
            "found \"pbd\" on a volume model; expected it on a surface_msm model (seed 002's "
            "constraints act on a surface network)");
   }
-  if (m.bending != msm::Bending::none &&
-      std::find(solvers.begin(), solvers.end(), "pbd") != solvers.end()) {
-    r.fail(r.table().get("solver"), "solver",
+  if (m.bending != msm::Bending::none) {
+    r.fail(key, "solver",
            "found \"pbd\" with bending = \"discrete-shells\"; expected another solver (PBD "
            "projects its own constraints and would ignore the bending energy)");
   }
-  m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
-  if (!network) {
-    m.calibration = r.string_or("calibration", "");
-    m.calibration_transfer = r.boolean_or("calibration_transfer", false);
-  }
-  if (m.calibration_transfer && m.calibration.empty()) {
-    r.fail(r.get("calibration_transfer"), "calibration_transfer",
-           "found without a calibration file; expected calibration = \"file.json\" beside it");
-  }
-  const std::vector<double> radii = roi_radii(r, load);
+}
+
+/// The time steps of a table with a dynamic solver (`dt`, required > 0, and `steps` into m), and
+/// `iterations` of local-global-euler; {0} for static solvers alone.
+std::vector<double> read_time_stepping(TableReader& r, ModelSpec& m,
+                                       const std::vector<std::string>& solvers) {
   std::vector<double> dts{0.0};
   const auto dynamic = std::find_if(solvers.begin(), solvers.end(), is_dynamic);
   if (dynamic != solvers.end()) {
@@ -534,7 +487,15 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
     m.solver.local_global.iterations = static_cast<int>(
         r.integer_or("iterations", m.solver.local_global.iterations, 1, 1'000'000L));
   }
-  r.finish();
+  return dts;
+}
+
+/// Every combination of the swept values, each named after m's name plus the values that vary,
+/// e.g. "volume[stiffness=lloyd;dt=2e-05]".
+std::vector<ModelSpec> sweep(const ModelSpec& m, const std::vector<std::string>& stiffness,
+                             const std::vector<std::string>& mass,
+                             const std::vector<std::string>& solvers,
+                             const std::vector<double>& dts, const std::vector<double>& radii) {
   std::vector<ModelSpec> out;
   for (const auto& k : stiffness) {
     for (const auto& ms : mass) {
@@ -566,6 +527,72 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
     }
   }
   return out;
+}
+
+/// One [[models]] table. `stiffness`, `mass`, `solver`, `dt` and `roi_radius` (and `degree` for
+/// FEM) may be arrays: the table then stands for every combination (a sweep, see `sweep`).
+std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind load) {
+  ModelSpec m;
+  const std::string kind = r.string_or(
+      "kind", "", {"fem", "surface_msm", "volume_msm", "network", "external", "displacements"});
+  if (kind.empty()) {
+    r.fail(nullptr, "kind",
+           "missing; expected one of fem, surface_msm, volume_msm, network, external, "
+           "displacements");
+  }
+  m.kind = kind == "fem"             ? ModelKind::fem
+           : kind == "surface_msm"   ? ModelKind::surface_msm
+           : kind == "network"       ? ModelKind::network
+           : kind == "external"      ? ModelKind::external
+           : kind == "displacements" ? ModelKind::displacements
+                                     : ModelKind::volume_msm;
+  m.name = r.string_or("name", kind + "_" + std::to_string(index + 1));
+  if (m.kind == ModelKind::fem) return fem_models(r, m);
+  if (m.kind == ModelKind::external || m.kind == ModelKind::displacements) {
+    return outside_model(r, m);
+  }
+  const bool network = m.kind == ModelKind::network;
+  if (network) {
+    // A spring network from a file: its springs, masses and supports come from the file, so the
+    // stiffness, mass, topology and calibration keys are unknown here.
+    m.network_file = r.string_or("file", "");
+    if (m.network_file.empty()) {
+      r.fail(nullptr, "file", "missing; expected the spring-network file (.json or .vtu)");
+    }
+  }
+  read_wall_options(r, m);
+  const auto stiffness = network ? std::vector<std::string>{msm::to_string(m.stiffness)} :
+      r.names_or("stiffness",
+                 m.kind == ModelKind::volume_msm
+                     ? (m.volume_term ? "van-gelder" : "seed001")
+                     : (m.bending != msm::Bending::none ? "van-gelder" : "seed000"),
+                 msm::parse_stiffness_rule);
+  if (m.volume_term) {
+    for (const auto& k : stiffness) {
+      if (msm::parse_stiffness_rule(k) != msm::StiffnessRule::van_gelder) {
+        r.fail(r.table().get("stiffness"), "stiffness",
+               "found \"" + k + "\" with volume_term = true; expected \"van-gelder\" (the hybrid "
+               "volume model's κ = λ − μ assumes van-gelder springs, whose λ = μ)");
+      }
+    }
+  }
+  const auto mass = network ? std::vector<std::string>{msm::to_string(m.mass)}
+                            : r.names_or("mass", "consistent", msm::parse_mass_rule);
+  const auto solvers = r.names_or("solver", "static", msm::parse_solver);
+  check_pbd(r, m, solvers);
+  m.damping = r.number_or("damping", 0.0, 0.0, HUGE_VAL, "N·s/m");
+  if (!network) {
+    m.calibration = r.string_or("calibration", "");
+    m.calibration_transfer = r.boolean_or("calibration_transfer", false);
+  }
+  if (m.calibration_transfer && m.calibration.empty()) {
+    r.fail(r.get("calibration_transfer"), "calibration_transfer",
+           "found without a calibration file; expected calibration = \"file.json\" beside it");
+  }
+  const std::vector<double> radii = roi_radii(r, load);
+  const std::vector<double> dts = read_time_stepping(r, m, solvers);
+  r.finish();
+  return sweep(m, stiffness, mass, solvers, dts, radii);
 }
 
 LoadSpec read_load(TableReader r) {
