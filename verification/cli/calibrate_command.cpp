@@ -97,9 +97,13 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
                   "wall-layers: a factor per spring class (direction x layer through the wall: "
                   "inner, middle, outer third) and a kappa per half of the wall; edge-types: the "
                   "same with the edge's type (the frame directions it spans, diagonals apart) "
-                  "instead of its largest direction; per-spring: a factor per spring and kappa, "
+                  "instead of its largest direction; edge-types-metric: the edge types with "
+                  "each factor times m^alpha, m = (R + rho cos theta)/R the arch's local axial "
+                  "metric ratio (1 on a straight tube), one exponent alpha per edge type and "
+                  "one for kappa; per-spring: a factor per spring and kappa, "
                   "with a smoothness regulariser")
-      ->check(CLI::IsMember({"groups", "wall-layers", "edge-types", "per-spring"}))
+      ->check(CLI::IsMember(
+          {"groups", "wall-layers", "edge-types", "edge-types-metric", "per-spring"}))
       ->capture_default_str();
   cmd->add_option("--weights", o->weights,
                   "How the training loads weigh in the fit: equal (each load's squared relative "

@@ -25,6 +25,7 @@ std::string to_string(CalibrationGranularity g) {
     case CalibrationGranularity::groups: return "groups";
     case CalibrationGranularity::wall_layers: return "wall_layers";
     case CalibrationGranularity::edge_types: return "edge_types";
+    case CalibrationGranularity::edge_types_metric: return "edge_types_metric";
     case CalibrationGranularity::per_spring: return "per_spring";
   }
   return "groups";
@@ -34,9 +35,12 @@ CalibrationGranularity parse_calibration_granularity(const std::string& name) {
   if (name == "groups") return CalibrationGranularity::groups;
   if (name == "wall_layers" || name == "wall-layers") return CalibrationGranularity::wall_layers;
   if (name == "edge_types" || name == "edge-types") return CalibrationGranularity::edge_types;
+  if (name == "edge_types_metric" || name == "edge-types-metric") {
+    return CalibrationGranularity::edge_types_metric;
+  }
   if (name == "per_spring" || name == "per-spring") return CalibrationGranularity::per_spring;
   throw InputError("granularity: found \"" + name +
-                   "\", expected groups, wall-layers, edge-types or per-spring");
+                   "\", expected groups, wall-layers, edge-types, edge-types-metric or per-spring");
 }
 
 std::string to_string(CaseWeights w) { return w == CaseWeights::equal ? "equal" : "p1"; }
@@ -424,6 +428,8 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
               o.granularity == CalibrationGranularity::edge_types
           ? msm::wall_layer_parameters(main.base.network, main.vessel, has_kappa,
                                        o.granularity == CalibrationGranularity::edge_types)
+      : o.granularity == CalibrationGranularity::edge_types_metric
+          ? msm::edge_types_metric_parameters(main.base.network, main.vessel, has_kappa)
           : msm::per_spring_parameters(main.base.network, has_kappa);
   std::vector<msm::FitCase> fit_cases;
   std::vector<char> fixed;
@@ -496,8 +502,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   cal.nodes = main.base.network.nodes.size();
   cal.springs = main.base.network.springs.size();
   cal.tets = main.base.network.tets.size();
-  cal.names = params.names;
-  for (Eigen::Index p = 0; p < res.x.size(); ++p) cal.factors.push_back(std::exp(res.x[p]));
+  set_calibration_parameters(cal, params, res.x);
   std::ostringstream method;
   method << "least squares on nodal displacements against the P2 reference (level "
          << reference_level << "), model linearised at rest, adjoint gradients, L-BFGS; "
@@ -509,6 +514,11 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
              : o.granularity == CalibrationGranularity::edge_types
                  ? "a factor per spring class (edge type x layer through the wall) and per half "
                    "of the wall for kappa, ridge on the log factors"
+             : o.granularity == CalibrationGranularity::edge_types_metric
+                 ? "a factor per spring class (edge type x layer through the wall) and per half "
+                   "of the wall for kappa, each times m^alpha (m the local axial metric ratio, "
+                   "an exponent alpha per edge type and for kappa), ridge on the log factors and "
+                   "exponents"
                  : "a factor per spring and kappa, smoothness regulariser on log k over springs "
                    "sharing a node");
   if (o.weights == CaseWeights::p1) {
@@ -610,6 +620,9 @@ void write_calibration_markdown(std::ostream& out, const CalibrationStudy& st,
     out << "| parameter | factor |\n|---|---|\n";
     for (std::size_t i = 0; i < c.names.size(); ++i) {
       out << "| " << c.names[i] << " | " << fixed3(c.factors[i]) << " |\n";
+    }
+    for (std::size_t i = 0; i < c.exponent_names.size(); ++i) {
+      out << "| " << c.exponent_names[i] << " | " << fixed3(c.exponents[i]) << " (exponent) |\n";
     }
     out << "\n";
   } else {

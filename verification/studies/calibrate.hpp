@@ -38,10 +38,10 @@ class SolutionCache;
 namespace vessel {
 
 /// groups: msm::group_parameters; wall_layers and edge_types: msm::wall_layer_parameters
-/// (direction by the largest component, or by the edge's type); per_spring:
-/// msm::per_spring_parameters.
-enum class CalibrationGranularity { groups, wall_layers, edge_types, per_spring };
-/// "groups" | "wall_layers" | "edge_types" | "per_spring"
+/// (direction by the largest component, or by the edge's type); edge_types_metric:
+/// msm::edge_types_metric_parameters; per_spring: msm::per_spring_parameters.
+enum class CalibrationGranularity { groups, wall_layers, edge_types, edge_types_metric, per_spring };
+/// "groups" | "wall_layers" | "edge_types" | "edge_types_metric" | "per_spring"
 std::string to_string(CalibrationGranularity g);
 CalibrationGranularity parse_calibration_granularity(const std::string& name);  ///< InputError
 
