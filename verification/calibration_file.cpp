@@ -1,5 +1,6 @@
 #include "verification/calibration_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -91,16 +92,20 @@ void write_calibration(const std::filesystem::path& path, const Calibration& c) 
     std::vector<double> springs;
     double kappa = 1.0;
     bool has_kappa = false;
+    nlohmann::ordered_json halves = nlohmann::ordered_json::object();  // κ per half of the wall
     for (std::size_t i = 0; i < c.names.size(); ++i) {
       if (c.names[i] == "kappa") {
         kappa = c.factors[i];
         has_kappa = true;
+      } else if (c.names[i].rfind("kappa/", 0) == 0) {
+        halves[c.names[i]] = c.factors[i];
       } else {
         springs.push_back(c.factors[i]);
       }
     }
     j["spring_factors"] = springs;
     if (has_kappa) j["kappa_factor"] = kappa;
+    if (!halves.empty()) j["kappa_factors"] = halves;
   }
   nlohmann::ordered_json loads = nlohmann::ordered_json::array();
   for (const auto& l : c.training_loads) {
@@ -148,10 +153,10 @@ Calibration read_calibration(const std::filesystem::path& path) {
   c.granularity = member<std::string>(j, "granularity", file);
   if (c.granularity != "groups" && c.granularity != "wall_layers" &&
       c.granularity != "edge_types" && c.granularity != "edge_types_metric" &&
-      c.granularity != "per_spring") {
+      c.granularity != "per_section_spring" && c.granularity != "per_spring") {
     throw InputError(file + ": key \"granularity\": found \"" + c.granularity +
                      "\", expected \"groups\", \"wall_layers\", \"edge_types\", "
-                     "\"edge_types_metric\" or \"per_spring\"");
+                     "\"edge_types_metric\", \"per_section_spring\" or \"per_spring\"");
   }
   const auto model = member<nlohmann::json>(j, "model", file);
   const std::string mfile = file + ": model";
@@ -206,6 +211,17 @@ Calibration read_calibration(const std::filesystem::path& path) {
     if (j.contains("kappa_factor")) {
       c.names.emplace_back("kappa");
       c.factors.push_back(member<double>(j, "kappa_factor", file));
+    }
+    if (j.contains("kappa_factors")) {  // κ per half of the wall
+      const auto k = member<nlohmann::json>(j, "kappa_factors", file);
+      for (const char* name : {"kappa/inner", "kappa/outer"}) {
+        if (!k.is_object() || !k.contains(name) || !k[name].is_number()) {
+          throw InputError(file + ": key \"kappa_factors\": expected numbers \"kappa/inner\" and "
+                           "\"kappa/outer\"");
+        }
+        c.names.emplace_back(name);
+        c.factors.push_back(k[name].get<double>());
+      }
     }
   }
   for (std::size_t i = 0; i < c.factors.size(); ++i) {
@@ -270,10 +286,11 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
   }
   msm::StiffnessParameters params;
   if (c.granularity == "per_spring") {
-    params = msm::per_spring_parameters(built.network, has_kappa);
+    const bool halves = std::find(c.names.begin(), c.names.end(), "kappa/inner") != c.names.end();
+    params = msm::per_spring_parameters(built.network, has_kappa, halves ? &vessel : nullptr);
     if (c.factors.size() != static_cast<std::size_t>(params.size())) {
       throw InputError(source + ": spring_factors has " +
-                       std::to_string(c.factors.size() - (has_kappa ? 1 : 0)) +
+                       std::to_string(c.factors.size() - (has_kappa ? (halves ? 2 : 1) : 0)) +
                        " factors, the model's network has " +
                        std::to_string(built.network.springs.size()) + " springs");
     }
@@ -282,6 +299,9 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
                                         c.granularity == "edge_types");
   } else if (c.granularity == "edge_types_metric") {
     params = msm::edge_types_metric_parameters(built.network, vessel, has_kappa);
+  } else if (c.granularity == "per_section_spring") {
+    const bool halves = std::find(c.names.begin(), c.names.end(), "kappa/inner") != c.names.end();
+    params = msm::per_section_spring_parameters(built.network, vessel, has_kappa, halves);
   } else {
     params = msm::group_parameters(built.network, vessel, has_kappa);
   }
@@ -370,9 +390,9 @@ void apply_calibration(const Calibration& c, const std::string& source, msm::Bui
                        "); expected the same mesh, or calibration_transfer = true for a group "
                        "calibration");
     }
-    if (c.granularity == "per_spring") {
-      throw InputError(source + ": mesh.hash: a per-spring calibration (mesh " + c.mesh_hash +
-                       ") cannot transfer to another mesh (" + hash +
+    if (c.granularity == "per_spring" || c.granularity == "per_section_spring") {
+      throw InputError(source + ": mesh.hash: a " + c.granularity + " calibration (mesh " +
+                       c.mesh_hash + ") cannot transfer to another mesh (" + hash +
                        "): its factors are indexed by that mesh's springs");
     }
   }

@@ -28,6 +28,7 @@ struct Options {
   double smoothness = CalibrateOptions{}.regulariser.smoothness;
   double ridge = CalibrateOptions{}.regulariser.ridge;
   int iterations = CalibrateOptions{}.max_iterations;
+  std::string prior;
   std::filesystem::path output = "calibration.json";
   std::filesystem::path summary;
   CacheOptions cache;
@@ -55,6 +56,10 @@ void run(const Options& o) {
   if (o.reference_level >= 0) c.reference_level = o.reference_level;
   c.regulariser = {o.smoothness, o.ridge};
   c.max_iterations = o.iterations;
+  if (!o.prior.empty()) {
+    c.prior = read_calibration(o.prior);
+    c.prior_source = o.prior;
+  }
   c.cache_dir = o.cache.mesh_dir();
   const auto solution_cache = o.cache.solution_cache(std::cout);
   c.solution_cache = solution_cache.get();
@@ -100,10 +105,12 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
                   "instead of its largest direction; edge-types-metric: the edge types with "
                   "each factor times m^alpha, m = (R + rho cos theta)/R the arch's local axial "
                   "metric ratio (1 on a straight tube), one exponent alpha per edge type and "
-                  "one for kappa; per-spring: a factor per spring and kappa, "
-                  "with a smoothness regulariser")
-      ->check(CLI::IsMember(
-          {"groups", "wall-layers", "edge-types", "edge-types-metric", "per-spring"}))
+                  "one for kappa; per-section-spring: a factor per spring of a cross-section, "
+                  "shared by its images along the centreline, and kappa (this mesh only); "
+                  "per-spring: a factor per spring and kappa (this mesh only); both with a "
+                  "smoothness regulariser")
+      ->check(CLI::IsMember({"groups", "wall-layers", "edge-types", "edge-types-metric",
+                             "per-section-spring", "per-spring"}))
       ->capture_default_str();
   cmd->add_option("--weights", o->weights,
                   "How the training loads weigh in the fit: equal (each load's squared relative "
@@ -139,6 +146,12 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--ridge", o->ridge, "Per-spring: weight beta of the ridge on log factors")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_option("--prior", o->prior,
+                  "Per-spring, per-section-spring: a class calibration file (groups, wall-layers, "
+                  "edge-types) of the "
+                  "same model and mesh to start from; the smoothness and the ridge then act on "
+                  "each spring's departure from its factor (its kappa halves stay apart)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--iterations", o->iterations, "L-BFGS iterations at most")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
