@@ -82,11 +82,6 @@ void write_calibration(const std::filesystem::path& path, const Calibration& c) 
     nlohmann::ordered_json f = nlohmann::ordered_json::object();
     for (std::size_t i = 0; i < c.names.size(); ++i) f[c.names[i]] = c.factors[i];
     j["factors"] = f;
-    if (!c.exponent_names.empty()) {
-      nlohmann::ordered_json e = nlohmann::ordered_json::object();
-      for (std::size_t i = 0; i < c.exponent_names.size(); ++i) e[c.exponent_names[i]] = c.exponents[i];
-      j["metric_exponents"] = e;
-    }
   } else {
     // Per spring, in the network's spring order; kappa apart.
     std::vector<double> springs;
@@ -152,11 +147,11 @@ Calibration read_calibration(const std::filesystem::path& path) {
   Calibration c;
   c.granularity = member<std::string>(j, "granularity", file);
   if (c.granularity != "groups" && c.granularity != "wall_layers" &&
-      c.granularity != "edge_types" && c.granularity != "edge_types_metric" &&
-      c.granularity != "per_section_spring" && c.granularity != "per_spring") {
+      c.granularity != "edge_types" && c.granularity != "per_section_spring" &&
+      c.granularity != "per_spring") {
     throw InputError(file + ": key \"granularity\": found \"" + c.granularity +
                      "\", expected \"groups\", \"wall_layers\", \"edge_types\", "
-                     "\"edge_types_metric\", \"per_section_spring\" or \"per_spring\"");
+                     "\"per_section_spring\" or \"per_spring\"");
   }
   const auto model = member<nlohmann::json>(j, "model", file);
   const std::string mfile = file + ": model";
@@ -188,19 +183,6 @@ Calibration read_calibration(const std::filesystem::path& path) {
       if (!v.is_number()) throw InputError(file + ": factors." + name + ": expected a number");
       c.names.push_back(name);
       c.factors.push_back(v.get<double>());
-    }
-    if (c.granularity == "edge_types_metric") {
-      const auto e = member<nlohmann::json>(j, "metric_exponents", file);
-      if (!e.is_object() || e.empty()) {
-        throw InputError(file + ": key \"metric_exponents\": expected an object of name: exponent");
-      }
-      for (const auto& [name, v] : e.items()) {
-        if (!v.is_number() || !std::isfinite(v.get<double>())) {
-          throw InputError(file + ": metric_exponents." + name + ": expected a finite number");
-        }
-        c.exponent_names.push_back(name);
-        c.exponents.push_back(v.get<double>());
-      }
     }
   } else {
     const auto f = member<std::vector<double>>(j, "spring_factors", file);
@@ -259,20 +241,9 @@ Calibration read_calibration(const std::filesystem::path& path) {
 
 void set_calibration_parameters(Calibration& c, const msm::StiffnessParameters& params,
                                 const Eigen::VectorXd& theta) {
-  c.names.clear();
+  c.names = params.names;
   c.factors.clear();
-  c.exponent_names.clear();
-  c.exponents.clear();
-  for (int p = 0; p < params.size(); ++p) {
-    const std::string& name = params.names[static_cast<std::size_t>(p)];
-    if (params.is_exponent(p)) {
-      c.exponent_names.push_back(name);
-      c.exponents.push_back(theta[p]);
-    } else {
-      c.names.push_back(name);
-      c.factors.push_back(std::exp(theta[p]));
-    }
-  }
+  for (int p = 0; p < params.size(); ++p) c.factors.push_back(std::exp(theta[p]));
 }
 
 std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
@@ -297,8 +268,6 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
   } else if (c.granularity == "wall_layers" || c.granularity == "edge_types") {
     params = msm::wall_layer_parameters(built.network, vessel, has_kappa,
                                         c.granularity == "edge_types");
-  } else if (c.granularity == "edge_types_metric") {
-    params = msm::edge_types_metric_parameters(built.network, vessel, has_kappa);
   } else if (c.granularity == "per_section_spring") {
     const bool halves = std::find(c.names.begin(), c.names.end(), "kappa/inner") != c.names.end();
     params = msm::per_section_spring_parameters(built.network, vessel, has_kappa, halves);
@@ -307,12 +276,7 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
   }
   std::map<std::string, double> by_name;
   for (std::size_t i = 0; i < c.names.size(); ++i) by_name[c.names[i]] = c.factors[i];
-  std::map<std::string, double> exponent_by_name;
-  for (std::size_t i = 0; i < c.exponent_names.size(); ++i) {
-    exponent_by_name[c.exponent_names[i]] = c.exponents[i];
-  }
-  if (c.granularity == "wall_layers" || c.granularity == "edge_types" ||
-      c.granularity == "edge_types_metric") {
+  if (c.granularity == "wall_layers" || c.granularity == "edge_types") {
     // A layer class the fitted mesh did not have (a level-0 mesh has two element layers through
     // the wall, so e.g. no radial edge has its mean in the middle third; a level-1 mesh does):
     // the geometric mean of the same direction's factors in the layers the file has (log factors
@@ -334,16 +298,6 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
   }
   Eigen::VectorXd theta(params.size());
   for (int p = 0; p < params.size(); ++p) {
-    if (params.is_exponent(p)) {
-      const auto it = exponent_by_name.find(params.names[static_cast<std::size_t>(p)]);
-      if (it == exponent_by_name.end()) {
-        throw InputError(source + ": metric_exponents: no exponent \"" +
-                         params.names[static_cast<std::size_t>(p)] +
-                         "\" for this model's network; expected one per edge type and kappa");
-      }
-      theta[p] = it->second;
-      continue;
-    }
     const auto it = by_name.find(params.names[static_cast<std::size_t>(p)]);
     if (it == by_name.end()) {
       throw InputError(source + ": factors: no factor for the spring class \"" +

@@ -9,10 +9,9 @@
 /// Granularities: "groups" (a factor per spring class and κ; msm::group_parameters),
 /// "wall_layers" (a factor per spring class by direction and layer through the wall, and a κ per
 /// half of the wall; msm::wall_layer_parameters), "edge_types" (the same with the edge's type,
-/// diagonals apart), "edge_types_metric" (the edge types with each factor times m^α, m the
-/// arch's local axial metric ratio and α an exponent per edge type and for κ, kept in
-/// "metric_exponents"; msm::edge_types_metric_parameters) and "per_spring" (a factor per spring
-/// and κ).
+/// diagonals apart), "per_section_spring" (a factor per spring of a cross-section, shared by
+/// its images along the centreline; msm::per_section_spring_parameters) and "per_spring" (a
+/// factor per spring and κ, or κ per half of the wall: "kappa_factors").
 /// The mesh hash must match the model's mesh, unless the model says `calibration_transfer =
 /// true`, which a group or wall-layer calibration allows (its classes are defined by the
 /// vessel's geometry) and a per-spring one refuses (its factors are indexed by the springs of one
@@ -50,7 +49,7 @@ struct CalibrationFitCase {
 };
 
 struct Calibration {
-  /// "groups" | "wall_layers" | "edge_types" | "edge_types_metric" | "per_spring"
+  /// "groups" | "wall_layers" | "edge_types" | "per_section_spring" | "per_spring"
   std::string granularity = "groups";
   // The model it applies to.
   std::string scene;       ///< scene name it was fitted on
@@ -69,10 +68,6 @@ struct Calibration {
   // The factors: exp(θ) per parameter, in the order of `names`.
   std::vector<std::string> names;
   std::vector<double> factors;
-  // The exponents α of edge_types_metric ("metric_exponent/<type>", "metric_exponent/kappa"):
-  // plain numbers (any sign), in the order of `exponent_names`.
-  std::vector<std::string> exponent_names;
-  std::vector<double> exponents;
   // The fit.
   std::string method;  ///< how it was fitted (linearised at rest, L-BFGS, regulariser)
   double smoothness = 0.0, ridge = 0.0;
@@ -89,7 +84,7 @@ void write_calibration(const std::filesystem::path& path, const Calibration& c);
 /// bad JSON, another schema or version, a missing or mistyped key, non-positive factors.
 Calibration read_calibration(const std::filesystem::path& path);
 
-/// Records fitted parameters θ of `params` in c: exp(θ) in factors, exponents as they are.
+/// Records fitted parameters θ of `params` in c: their names, and exp(θ) as factors.
 void set_calibration_parameters(Calibration& c, const msm::StiffnessParameters& params,
                                 const Eigen::VectorXd& theta);
 
@@ -102,7 +97,7 @@ void apply_calibration(const Calibration& c, const std::string& source, msm::Bui
                        double youngs_modulus, double nu, bool transfer);
 
 /// The stiffness parameterisation and log factors θ a calibration describes on `built`. For
-/// wall_layers, edge_types and edge_types_metric, a class of `built` that the file lacks (a layer the fitted mesh
+/// wall_layers and edge_types, a class of `built` that the file lacks (a layer the fitted mesh
 /// had no edges in: e.g. radial edges in the middle third on a level-0 mesh) takes the geometric
 /// mean of the same direction's factors in the other layers; a direction the file lacks
 /// altogether is an InputError.

@@ -160,55 +160,6 @@ StiffnessParameters wall_layer_parameters(const SpringNetwork& net, const Vessel
   return p;
 }
 
-double axial_metric_ratio(const VesselParams& vessel, const Vec3& p) {
-  if (vessel.kind != VesselKind::arch) return 1.0;
-  // The point's distance from the arch's axis (z) over the centreline's: a material line along
-  // the tangent at p has length (R + ρ cos θ)·dφ against the centreline's R·dφ.
-  const CentrelineCoordinates c = centreline_coordinates(vessel, p);
-  return (vessel.bend_radius + c.rho * std::cos(c.theta)) / vessel.bend_radius;
-}
-
-StiffnessParameters edge_types_metric_parameters(const SpringNetwork& net,
-                                                 const VesselParams& vessel, bool with_kappa) {
-  StiffnessParameters p = wall_layer_parameters(net, vessel, with_kappa, true);
-  // One exponent per edge type: the class name "volume/<type>/<layer>" without its layer.
-  std::map<std::string, int> exponent;
-  for (std::size_t s = 0; s < net.springs.size(); ++s) {
-    if (net.springs[s].family != SpringFamily::volume) continue;
-    const std::string& cls = p.names[static_cast<std::size_t>(p.of_spring[s])];
-    exponent.emplace(cls.substr(std::string("volume/").size(),
-                                cls.rfind('/') - std::string("volume/").size()),
-                     0);
-  }
-  for (auto& [type, index] : exponent) {
-    index = p.size();
-    p.names.push_back("metric_exponent/" + type);
-  }
-  p.exponent_of_spring.assign(net.springs.size(), -1);
-  p.spring_log_metric.assign(net.springs.size(), 0.0);
-  for (std::size_t s = 0; s < net.springs.size(); ++s) {
-    if (net.springs[s].family != SpringFamily::volume) continue;
-    const std::string& cls = p.names[static_cast<std::size_t>(p.of_spring[s])];
-    p.exponent_of_spring[s] = exponent.at(cls.substr(
-        std::string("volume/").size(), cls.rfind('/') - std::string("volume/").size()));
-    const Vec3 mid = 0.5 * (net.nodes[static_cast<std::size_t>(net.springs[s].a)] +
-                            net.nodes[static_cast<std::size_t>(net.springs[s].b)]);
-    p.spring_log_metric[s] = std::log(axial_metric_ratio(vessel, mid));
-  }
-  if (with_kappa && !net.tets.empty()) {
-    const int q = p.size();
-    p.names.emplace_back("metric_exponent/kappa");
-    p.exponent_of_tet.assign(net.tets.size(), q);
-    p.tet_log_metric.resize(net.tets.size());
-    for (std::size_t e = 0; e < net.tets.size(); ++e) {
-      Vec3 centroid = Vec3::Zero();
-      for (const int n : net.tets[e]) centroid += 0.25 * net.nodes[static_cast<std::size_t>(n)];
-      p.tet_log_metric[e] = std::log(axial_metric_ratio(vessel, centroid));
-    }
-  }
-  return p;
-}
-
 StiffnessParameters group_parameters(const SpringNetwork& net, const VesselParams& vessel,
                                      bool with_kappa) {
   const std::vector<char> boundary =
@@ -326,26 +277,6 @@ void check_parameters(const SpringNetwork& net, const StiffnessParameters& param
       }
     }
   }
-  const auto check_exponents = [&](const std::vector<int>& of, const std::vector<double>& coef,
-                                   std::size_t n, const char* what) {
-    if (of.empty() && coef.empty()) return;
-    if (of.size() != n || coef.size() != n) {
-      throw InputError(std::string("stiffness parameters: exponents for ") +
-                       std::to_string(of.size()) + " " + what + " (coefficients for " +
-                       std::to_string(coef.size()) + "), the network has " + std::to_string(n));
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      if (of[i] < -1 || of[i] >= params.size() || !std::isfinite(coef[i])) {
-        throw InputError(std::string("stiffness parameters: one of the ") + what +
-                         " names exponent parameter " + std::to_string(of[i]) +
-                         " (coefficient " + std::to_string(coef[i]) + "), expected one of the " +
-                         std::to_string(params.size()) + " with a finite coefficient");
-      }
-    }
-  };
-  check_exponents(params.exponent_of_spring, params.spring_log_metric, net.springs.size(),
-                  "springs");
-  check_exponents(params.exponent_of_tet, params.tet_log_metric, net.tets.size(), "tets");
   if (params.scales_kappa() && !kappa) {
     throw InputError("stiffness parameters: a factor for the volume term's kappa, but the model "
                      "has no volume term (expected a hybrid volume model, volume_term = true)");
@@ -358,17 +289,19 @@ void apply_stiffness_factors(SpringNetwork& net, std::optional<double>& kappa,
                              const StiffnessParameters& params, const VectorXd& theta) {
   check_parameters(net, params, kappa, theta.size());
   for (std::size_t s = 0; s < net.springs.size(); ++s) {
-    const double factor = std::exp(params.spring_log_factor(theta, s));
+    const int p = params.of_spring[s];
+    if (p < 0) continue;
+    const double factor = std::exp(theta[p]);
     net.springs[s].law.k1 *= factor;
     net.springs[s].law.k2 *= factor;
   }
-  if (params.kappa >= 0 && params.exponent_of_tet.empty()) {
-    *kappa *= std::exp(theta[params.kappa]);
-  } else if (params.scales_kappa()) {
+  if (params.kappa >= 0) *kappa *= std::exp(theta[params.kappa]);
+  if (!params.of_tet.empty()) {
     // A κ per tet: through the per-tet factors the volume term already reads (springs.hpp).
     if (net.tet_kappa_factors.empty()) net.tet_kappa_factors.assign(net.tets.size(), 1.0);
     for (std::size_t e = 0; e < net.tets.size(); ++e) {
-      net.tet_kappa_factors[e] *= std::exp(params.tet_log_factor(theta, e));
+      const int p = params.of_tet[e];
+      if (p >= 0) net.tet_kappa_factors[e] *= std::exp(theta[p]);
     }
   }
 }
@@ -403,12 +336,7 @@ LinearisedFit::LinearisedFit(const SpringNetwork& net, std::optional<double> kap
     const Spring& sp = net.springs[s];
     const Vec3 d = (net.nodes[static_cast<std::size_t>(sp.b)] -
                     net.nodes[static_cast<std::size_t>(sp.a)]).normalized();
-    RestSpring rest{sp.a, sp.b, params_.of_spring[s], d, sp.law.k1};
-    if (!params_.exponent_of_spring.empty()) {
-      rest.exponent = params_.exponent_of_spring[s];
-      rest.log_metric = params_.spring_log_metric[s];
-    }
-    springs_.push_back(rest);
+    springs_.push_back({sp.a, sp.b, params_.of_spring[s], d, sp.law.k1});
   }
   if (kappa) {
     kappa0_ = *kappa;
@@ -418,13 +346,8 @@ LinearisedFit::LinearisedFit(const SpringNetwork& net, std::optional<double> kap
       for (int i = 0; i < 4; ++i) x[i] = net.nodes[static_cast<std::size_t>(t[i])];
       // κ_e/|V₀| (the homogenised rule's per-tet κ factor, springs.hpp), as VolumeTerm.
       const double factor = net.tet_kappa_factors.empty() ? 1.0 : net.tet_kappa_factors[e];
-      RestTet rest{t, tet_volume_gradient(x), factor / std::abs(tet_signed_volume(x)),
-                   params_.kappa_of_tet(e)};
-      if (!params_.exponent_of_tet.empty()) {
-        rest.exponent = params_.exponent_of_tet[e];
-        rest.log_metric = params_.tet_log_metric[e];
-      }
-      tets_.push_back(rest);
+      tets_.push_back({t, tet_volume_gradient(x), factor / std::abs(tet_signed_volume(x)),
+                       params_.kappa_of_tet(e)});
     }
   }
   node_springs_.resize(net.nodes.size());
@@ -459,7 +382,7 @@ SparseMatrix LinearisedFit::stiffness(const VectorXd& theta) const {
     if (i >= 0 && j >= 0) triplets.emplace_back(i, j, v);
   };
   for (const RestSpring& s : springs_) {
-    const double k = s.k * std::exp(log_factor(theta, s.param, s.exponent, s.log_metric));
+    const double k = s.param >= 0 ? s.k * std::exp(theta[s.param]) : s.k;
     const Eigen::Matrix3d block = k * s.d * s.d.transpose();
     const int nodes[2] = {s.a, s.b};
     for (int I = 0; I < 2; ++I) {
@@ -473,7 +396,7 @@ SparseMatrix LinearisedFit::stiffness(const VectorXd& theta) const {
   }
   if (!tets_.empty()) {
     for (const RestTet& t : tets_) {
-      const double kappa = kappa0_ * std::exp(log_factor(theta, t.param, t.exponent, t.log_metric));
+      const double kappa = t.param >= 0 ? kappa0_ * std::exp(theta[t.param]) : kappa0_;
       const Eigen::Matrix<double, 12, 12> block = kappa * t.inv_volume * t.g * t.g.transpose();
       for (int I = 0; I < 12; ++I) {
         for (int J = 0; J < 12; ++J) {
@@ -584,28 +507,23 @@ double LinearisedFit::objective(const VectorXd& theta, VectorXd& gradient) const
   for (std::size_t c = 0; c < e.u.size(); ++c) {
     const VectorXd& u = e.u[c];
     const VectorXd& l = e.lambda[c];
-    // ∂J/∂(log k_s) = −k_s (d·Δλ)(d·Δu); a parameter's gradient is that times ∂(log k_s)/∂θ_p:
-    // 1 for the class factor, log m_s for the exponent (chain rule).
     for (const RestSpring& s : springs_) {
-      if (s.param < 0 && s.exponent < 0) continue;
-      const double k = s.k * std::exp(log_factor(theta, s.param, s.exponent, s.log_metric));
+      if (s.param < 0) continue;
+      const double k = s.k * std::exp(theta[s.param]);
       const double du = s.d.dot(node(u, s.b) - node(u, s.a));
       const double dl = s.d.dot(node(l, s.b) - node(l, s.a));
-      if (s.param >= 0) gradient[s.param] -= k * du * dl;
-      if (s.exponent >= 0) gradient[s.exponent] -= s.log_metric * k * du * dl;
+      gradient[s.param] -= k * du * dl;
     }
     for (const RestTet& t : tets_) {
-      if (t.param < 0 && t.exponent < 0) continue;
-      const double kappa = kappa0_ * std::exp(log_factor(theta, t.param, t.exponent, t.log_metric));
+      if (t.param < 0) continue;
+      const double kappa = kappa0_ * std::exp(theta[t.param]);
       double gu = 0.0, gl = 0.0;
       for (int i = 0; i < 4; ++i) {
         const Vec3 gi = t.g.segment<3>(3 * i);
         gu += gi.dot(node(u, t.nodes[i]));
         gl += gi.dot(node(l, t.nodes[i]));
       }
-      const double d_log = kappa * t.inv_volume * gu * gl;
-      if (t.param >= 0) gradient[t.param] -= d_log;
-      if (t.exponent >= 0) gradient[t.exponent] -= t.log_metric * d_log;
+      gradient[t.param] -= kappa * t.inv_volume * gu * gl;
     }
   }
   return e.misfit + regulariser_value(theta, &gradient);

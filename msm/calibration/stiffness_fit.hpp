@@ -15,12 +15,9 @@
 /// adjoint gradient (one extra solve per case with the same factorisation):
 ///   K λ_c = w_c (u_c − r_c),   ∂J/∂θ_p = −Σ_c λ_cᵀ (∂K/∂θ_p) u_c
 ///   = −Σ_c [Σ_{s∈p} k_s (d·Δλ_s)(d·Δu_s) + (p = κ) Σ_t κ/|V₀| (g_t·λ_t)(g_t·u_t)],
-/// Δ the difference of the spring's two end nodes. An exponent parameter q (k_s = c·m_s^α_q,
-/// StiffnessParameters::exponent_of_spring) enters log k_s with coefficient log m_s, so by the
-/// chain rule its gradient is the same sum with each term multiplied by log m_s. The loads of the scenes are in the linear
+/// Δ the difference of the spring's two end nodes. The loads of the scenes are in the linear
 /// regime, so the linearised fit is what the calibrated model does to first order; the
 /// calibrated model is then evaluated as the scene solves it (nonlinear), by the caller.
-#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -44,44 +41,19 @@ struct StiffnessParameters {
   [[nodiscard]] int size() const { return static_cast<int>(names.size()); }
   /// Whether any parameter scales κ.
   [[nodiscard]] bool scales_kappa() const {
-    return kappa >= 0 || !of_tet.empty() || !exponent_of_tet.empty();
+    return kappa >= 0 || !of_tet.empty();
   }
   /// The parameter of tet e's κ, −1: none.
   [[nodiscard]] int kappa_of_tet(std::size_t e) const {
     return of_tet.empty() ? kappa : of_tet[e];
   }
-  /// Optional second term of the log factors (edge_types_metric_parameters): a parameter whose
-  /// value multiplies a fixed per-spring (per-tet) coefficient,
-  ///   log(k_s/k_s0) = θ[of_spring[s]] + spring_log_metric[s]·θ[exponent_of_spring[s]],
-  ///   log(κ_e/κ0f_e) = θ[kappa_of_tet(e)] + tet_log_metric[e]·θ[exponent_of_tet[e]];
-  /// with spring_log_metric = log m, the factor is c·m^α. Empty: no such term; −1: none for that
-  /// spring (tet).
-  std::vector<int> exponent_of_spring;
-  std::vector<double> spring_log_metric;
-  std::vector<int> exponent_of_tet;
-  std::vector<double> tet_log_metric;
   /// log(k_s/k_s0) and log(κ_e/(κ0·f_e)) at θ.
   [[nodiscard]] double spring_log_factor(const VectorXd& theta, std::size_t s) const {
-    const int p = of_spring[s];
-    double v = p >= 0 ? theta[p] : 0.0;
-    if (!exponent_of_spring.empty() && exponent_of_spring[s] >= 0) {
-      v += spring_log_metric[s] * theta[exponent_of_spring[s]];
-    }
-    return v;
+    return of_spring[s] >= 0 ? theta[of_spring[s]] : 0.0;
   }
   [[nodiscard]] double tet_log_factor(const VectorXd& theta, std::size_t e) const {
     const int p = kappa_of_tet(e);
-    double v = p >= 0 ? theta[p] : 0.0;
-    if (!exponent_of_tet.empty() && exponent_of_tet[e] >= 0) {
-      v += tet_log_metric[e] * theta[exponent_of_tet[e]];
-    }
-    return v;
-  }
-  /// Whether parameter p is an exponent (a coefficient's multiplier) rather than a log factor.
-  [[nodiscard]] bool is_exponent(int p) const {
-    return std::find(exponent_of_spring.begin(), exponent_of_spring.end(), p) !=
-               exponent_of_spring.end() ||
-           std::find(exponent_of_tet.begin(), exponent_of_tet.end(), p) != exponent_of_tet.end();
+    return p >= 0 ? theta[p] : 0.0;
   }
 };
 
@@ -130,23 +102,6 @@ std::string spring_wall_layer_class(const SpringNetwork& network, const VesselPa
 /// circumferential diagonals get their own types, while the radial–axial diagonals (radial
 /// component ≈ 0.27) count as axial.
 inline constexpr double kEdgeTypeComponent = 0.35;
-
-/// The local axial metric ratio of a parametric vessel at p: m = (R + ρ cos θ)/R on an arch (R the
-/// bend radius, ρ and θ the centreline coordinates, θ = 0 on the outer bend): the length along
-/// the centreline's tangent of a material line at p per unit length of centreline, so a
-/// structured cell's axial edge at p is m times the centreline's spacing (0.73–1.27 on the
-/// shipped arch's outer wall). 1 on a straight tube.
-double axial_metric_ratio(const VesselParams& vessel, const Vec3& p);
-
-/// Edge types that follow the bend ("edge_types_metric"; our own extension of the edge types for
-/// the arch, whose cells change shape from the inner to the outer bend): the edge-types classes
-/// of wall_layer_parameters (class factors c_k, κ per half of the wall), each spring's factor
-/// multiplied by m^α_d, m = axial_metric_ratio at the spring's midpoint and α_d one exponent per
-/// edge type d ("metric_exponent/<type>", shared by the type's three layers); with with_kappa,
-/// each tet's κ factor by m^α_κ at its centroid ("metric_exponent/kappa"). m ≡ 1 on a straight
-/// tube, where this is the edge types (the exponents see no data; the ridge keeps them at 0).
-StiffnessParameters edge_types_metric_parameters(const SpringNetwork& network,
-                                                 const VesselParams& vessel, bool with_kappa);
 
 /// One parameter per spring of a cross-section ("per_section_spring"; our own, for a vessel whose
 /// geometry repeats along its centreline — the straight tube along z, the arch round its axis):
@@ -232,22 +187,13 @@ class LinearisedFit {
     int a, b, param;
     Vec3 d;
     double k;
-    int exponent = -1;        ///< exponent parameter, −1: none
-    double log_metric = 0.0;  ///< its coefficient in log k
   };
   struct RestTet {
     std::array<int, 4> nodes;
     Eigen::Matrix<double, 12, 1> g;  ///< ∂V/∂x at rest
     double inv_volume;               ///< κ factor f_e/|V₀|
     int param;                       ///< κ's parameter for this tet, −1: none
-    int exponent = -1;               ///< exponent parameter, −1: none
-    double log_metric = 0.0;         ///< its coefficient in log κ
   };
-  /// log(k_s/k_s0), log(κ_e/(κ0·f_e)) at θ.
-  [[nodiscard]] static double log_factor(const VectorXd& theta, int param, int exponent,
-                                         double log_metric) {
-    return (param >= 0 ? theta[param] : 0.0) + (exponent >= 0 ? log_metric * theta[exponent] : 0.0);
-  }
   std::vector<RestSpring> springs_;
   std::vector<RestTet> tets_;
   double kappa0_ = 0.0;

@@ -187,77 +187,6 @@ TEST(CalibrationFile, WallLayerCalibrationRoundTripsAndScalesSpringsAndEachTetsK
                                     true));
 }
 
-// Edge types following the bend: the class factors and the exponents (kept apart, any sign) go
-// through the file and land on each spring as c·m^α (m at its midpoint, here on an arch of bend
-// radius 2 mm around the block, m = 1.5–2.7) and on each tet's κ factor; a file without its
-// exponents is refused.
-TEST(CalibrationFile, BendFollowingCalibrationRoundTripsItsExponents) {
-  const TetMesh mesh = block_mesh(2, 1e-3);
-  VesselParams bend;
-  bend.kind = VesselKind::arch;
-  bend.bend_radius = 2e-3;
-  bend.inner_radius = 1.2e-3;
-  bend.wall_thickness = 2.0e-3;
-  const msm::BuiltNetwork base = hybrid(mesh);
-  const msm::StiffnessParameters p = msm::edge_types_metric_parameters(base.network, bend, true);
-  Eigen::VectorXd theta(p.size());
-  for (int i = 0; i < p.size(); ++i) {
-    theta[i] = p.is_exponent(i) ? -1.0 + 0.4 * (i % 5) : std::log(1.0 + 0.1 * (i + 1));
-  }
-  Calibration c = make_calibration(mesh, base, false);
-  c.granularity = "edge_types_metric";
-  set_calibration_parameters(c, p, theta);
-  ASSERT_FALSE(c.exponent_names.empty());
-  EXPECT_EQ(c.names.size() + c.exponent_names.size(), static_cast<std::size_t>(p.size()));
-  const auto path = temp_file("edge_types_metric.json");
-  write_calibration(path, c);
-  const Calibration r = read_calibration(path);
-  EXPECT_EQ(r.granularity, "edge_types_metric");
-  ASSERT_EQ(r.exponent_names.size(), c.exponent_names.size());
-  for (std::size_t i = 0; i < c.exponent_names.size(); ++i) {
-    const auto it = std::find(r.exponent_names.begin(), r.exponent_names.end(), c.exponent_names[i]);
-    ASSERT_NE(it, r.exponent_names.end()) << c.exponent_names[i];
-    EXPECT_DOUBLE_EQ(r.exponents[static_cast<std::size_t>(it - r.exponent_names.begin())],
-                     c.exponents[i]);
-  }
-  msm::BuiltNetwork applied = base;
-  apply_calibration(r, "test", applied, mesh, bend, hybrid_spec(), kE, 0.45, false);
-  int varied = 0;
-  for (std::size_t s = 0; s < base.network.springs.size(); ++s) {
-    const auto& sp = base.network.springs[s];
-    const Vec3 mid = 0.5 * (base.network.nodes[static_cast<std::size_t>(sp.a)] +
-                            base.network.nodes[static_cast<std::size_t>(sp.b)]);
-    const double m = std::hypot(mid.x(), mid.y()) / bend.bend_radius;  // distance from the axis / R
-    const double factor = std::exp(theta[p.of_spring[s]]) * std::pow(m, theta[p.exponent_of_spring[s]]);
-    EXPECT_NEAR(applied.network.springs[s].law.k1, factor * sp.law.k1, 1e-10 * factor * sp.law.k1);
-    varied += std::abs(std::log(m)) > 0.1 ? 1 : 0;
-  }
-  EXPECT_GT(varied, 10);
-  ASSERT_EQ(applied.network.tet_kappa_factors.size(), base.network.tets.size());
-  for (std::size_t e = 0; e < base.network.tets.size(); ++e) {
-    Vec3 centroid = Vec3::Zero();
-    for (const int n : base.network.tets[e]) centroid += 0.25 * base.network.nodes[static_cast<std::size_t>(n)];
-    const double m = std::hypot(centroid.x(), centroid.y()) / bend.bend_radius;
-    const double base_factor =
-        base.network.tet_kappa_factors.empty() ? 1.0 : base.network.tet_kappa_factors[e];
-    const double factor = std::exp(theta[p.of_tet[e]]) * std::pow(m, theta[p.exponent_of_tet[e]]);
-    EXPECT_NEAR(applied.network.tet_kappa_factors[e], factor * base_factor, 1e-10 * factor);
-  }
-  // Without its exponents the file is refused, naming the key.
-  {
-    std::ifstream in(path);
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string json = text.str();
-    const auto at = json.find("\"metric_exponents\"");
-    ASSERT_NE(at, std::string::npos);
-    json.replace(at, std::string("\"metric_exponents\"").size(), "\"no_exponents\"");
-    const auto bad = temp_file("edge_types_metric_bad.json");
-    std::ofstream(bad) << json;
-    expect_input_error([&] { read_calibration(bad); }, "metric_exponents");
-  }
-}
-
 // A per-spring calibration with κ per half of the wall (a fit on top of an edge-types one)
 // keeps its two κ factors through the file, and they land on each tet's κ factor.
 TEST(CalibrationFile, PerSpringCalibrationKeepsItsKappaHalves) {
@@ -290,6 +219,43 @@ TEST(CalibrationFile, PerSpringCalibrationKeepsItsKappaHalves) {
     EXPECT_NEAR(applied.network.tet_kappa_factors[e],
                 c.factors[static_cast<std::size_t>(p.of_tet[e])] * base_factor, 1e-12);
   }
+}
+
+// A per-section-spring calibration goes through the file onto each spring by its section class,
+// and, indexed by one mesh's cross-section, is refused on another mesh even with transfer.
+TEST(CalibrationFile, PerSectionSpringCalibrationAppliesOnItsMeshOnly) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  VesselParams tube;
+  tube.inner_radius = 3.5e-3;
+  tube.wall_thickness = 1.0e-3;
+  const msm::BuiltNetwork base = hybrid(mesh);
+  const msm::StiffnessParameters p =
+      msm::per_section_spring_parameters(base.network, tube, true, false);
+  ASSERT_LT(p.size(), static_cast<int>(base.network.springs.size()));
+  Calibration c = make_calibration(mesh, base, false);
+  c.granularity = "per_section_spring";
+  Eigen::VectorXd theta(p.size());
+  for (int i = 0; i < p.size(); ++i) theta[i] = 0.1 * std::sin(1.0 + i);
+  set_calibration_parameters(c, p, theta);
+  const auto path = temp_file("per_section_spring.json");
+  write_calibration(path, c);
+  const Calibration r = read_calibration(path);
+  EXPECT_EQ(r.granularity, "per_section_spring");
+  msm::BuiltNetwork applied = base;
+  apply_calibration(r, "test", applied, mesh, tube, hybrid_spec(), kE, 0.45, false);
+  for (std::size_t s = 0; s < base.network.springs.size(); ++s) {
+    const double factor = std::exp(theta[p.of_spring[s]]);
+    EXPECT_NEAR(applied.network.springs[s].law.k1, factor * base.network.springs[s].law.k1,
+                1e-12 * factor * base.network.springs[s].law.k1);
+  }
+  EXPECT_NEAR(*applied.volume_kappa, std::exp(theta[p.kappa]) * *base.volume_kappa,
+              1e-12 * *base.volume_kappa);
+  TetMesh moved = mesh;
+  moved.nodes[5].x() += 1e-6;
+  msm::BuiltNetwork on_moved = hybrid(moved);
+  expect_input_error(
+      [&] { apply_calibration(r, "cal.json", on_moved, moved, tube, hybrid_spec(), kE, 0.45, true); },
+      "mesh.hash");
 }
 
 // A wall-layer class the fitted mesh did not have gets the geometric mean of its direction's

@@ -156,27 +156,19 @@ TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
   VesselParams wall;
   wall.inner_radius = 3.5e-3;
   wall.wall_thickness = 1.0e-3;
-  // Edge types following the bend (granularity 4): the block on an arch of bend radius 2 mm
-  // (axis z), so that its points lie 1–3.9 mm from the centreline and the axial metric ratio m
-  // varies over 1.5–2.7 across the block: log m weighs each exponent's terms differently.
+  // Per section spring (granularity 6) on an arch of bend radius 2 mm round the block.
   const VesselParams bend = bend_around_block();
   // Granularity 5: per spring with κ per half of the wall and a regulariser centred on random
   // log factors (a per-spring fit on top of a class calibration).
   // Granularity 6: a factor per spring of a cross-section of the arch (bend), κ per half.
-  for (const int granularity : {0, 1, 2, 3, 4, 5, 6}) {
+  for (const int granularity : {0, 1, 2, 3, 5, 6}) {
     const bool per_spring = granularity == 1 || granularity == 5 || granularity == 6;
     const StiffnessParameters params =
         granularity == 0   ? group_parameters(built.network, VesselParams{}, true)
         : granularity == 6 ? per_section_spring_parameters(built.network, bend, true, true)
         : granularity == 1 ? per_spring_parameters(built.network, true)
         : granularity == 5 ? per_spring_parameters(built.network, true, &wall)
-        : granularity == 4 ? edge_types_metric_parameters(built.network, bend, true)
                            : wall_layer_parameters(built.network, wall, true, granularity == 3);
-    if (granularity == 4) {
-      ASSERT_FALSE(params.exponent_of_spring.empty());
-      ASSERT_FALSE(params.exponent_of_tet.empty());
-      EXPECT_EQ(std::count(params.names.begin(), params.names.end(), "metric_exponent/kappa"), 1);
-    }
     if (granularity >= 2) {
       ASSERT_FALSE(params.of_tet.empty());
       EXPECT_EQ(std::count(params.names.begin(), params.names.end(), "kappa/inner"), 1);
@@ -206,7 +198,6 @@ TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
               : granularity == 1 ? "per spring, "
               : granularity == 2 ? "wall layers, "
               : granularity == 3 ? "edge types, "
-              : granularity == 4 ? "edge types following the bend, "
               : granularity == 5 ? "per spring from a centre, "
                                  : "per section spring, ")
           << params.names[static_cast<std::size_t>(p)];
@@ -285,125 +276,6 @@ TEST(StiffnessFit, RecoversPlantedWallLayerFactorsFromTheModelsOwnData) {
     EXPECT_NEAR(std::exp(x[p]), std::exp(planted[p]), 5e-3 * std::exp(planted[p]))
         << params.names[static_cast<std::size_t>(p)];
   }
-}
-
-// Edge types following the bend: class factors and exponents planted together (the factor of
-// a spring c_k·m^α_d, m from 1.5 to 2.7 across the block) are recovered from data the nonlinear
-// model generated with them: the factors within 1 %, the exponents within 0.01.
-TEST(StiffnessFit, RecoversPlantedBendFollowingFactorsAndExponentsFromTheModelsOwnData) {
-  const TetMesh mesh = block_mesh(3, 1e-3);
-  const BuiltNetwork built = hybrid(mesh, 0.45);
-  const std::vector<char> fixed = bottom_fixed(built.network);
-  const StiffnessParameters params =
-      edge_types_metric_parameters(built.network, bend_around_block(), true);
-  int exponents = 0;
-  Eigen::VectorXd planted(params.size());
-  for (int p = 0; p < params.size(); ++p) {
-    if (params.is_exponent(p)) {
-      planted[p] = exponents % 2 == 0 ? -0.8 + 0.3 * exponents : 0.6;  // exponents −0.8 … 0.7
-      ++exponents;
-    } else {
-      planted[p] = std::log(0.5) + std::log(4.0) * static_cast<double>((3 * p) % params.size()) /
-                                       (params.size() - 1);
-    }
-  }
-  ASSERT_GE(exponents, 4);  // several edge types and κ
-  const auto [x, errors] = fit_planted_factors(built, fixed, params, planted, 17, 2000);
-  // A class whose springs all join held nodes (the bottom face) sees no data: not checked.
-  std::vector<char> seen(static_cast<std::size_t>(params.size()), 0);
-  for (std::size_t s = 0; s < built.network.springs.size(); ++s) {
-    const Spring& sp = built.network.springs[s];
-    if (fixed[3 * static_cast<std::size_t>(sp.a)] && fixed[3 * static_cast<std::size_t>(sp.b)]) continue;
-    seen[static_cast<std::size_t>(params.of_spring[s])] = 1;
-    seen[static_cast<std::size_t>(params.exponent_of_spring[s])] = 1;
-  }
-  for (std::size_t e = 0; e < built.network.tets.size(); ++e) {
-    seen[static_cast<std::size_t>(params.of_tet[e])] = 1;
-    seen[static_cast<std::size_t>(params.exponent_of_tet[e])] = 1;
-  }
-  for (int p = 0; p < params.size(); ++p) {
-    if (!seen[static_cast<std::size_t>(p)]) continue;
-    if (params.is_exponent(p)) {
-      EXPECT_NEAR(x[p], planted[p], 1e-2) << params.names[static_cast<std::size_t>(p)];
-    } else {
-      // 1 %: the axial inner class (few springs with a free end) comes back within 0.9 %, every
-      // other within 0.4 %.
-      EXPECT_NEAR(std::exp(x[p]), std::exp(planted[p]), 1e-2 * std::exp(planted[p]))
-          << params.names[static_cast<std::size_t>(p)];
-    }
-  }
-  for (const double e : errors) EXPECT_LT(e, 1e-4);
-}
-
-// The axial metric ratio, worked out by hand: on an arch of bend radius R a point at distance ρ
-// from the centreline on the outer bend lies R + ρ from the arch's axis, on the inner bend R − ρ,
-// at the top of the section R; a straight tube has m = 1. Each spring's factor is then c·m^α
-// at its midpoint, and each tet's κ factor c_κ·m^α_κ at its centroid.
-TEST(StiffnessFit, BendFollowingFactorsScaleByTheLocalAxialMetric) {
-  VesselParams arch;
-  arch.kind = VesselKind::arch;
-  arch.bend_radius = 15e-3;
-  arch.inner_radius = 3e-3;
-  arch.wall_thickness = 1e-3;
-  const double phi = 0.7;
-  const Vec3 outward(std::cos(phi), std::sin(phi), 0.0);
-  const Vec3 tangent(-std::sin(phi), std::cos(phi), 0.0);
-  const Vec3 centre = arch.bend_radius * outward;
-  EXPECT_NEAR(axial_metric_ratio(arch, centre + 3.5e-3 * outward), 18.5 / 15.0, 1e-12);
-  EXPECT_NEAR(axial_metric_ratio(arch, centre - 3.5e-3 * outward), 11.5 / 15.0, 1e-12);
-  EXPECT_NEAR(axial_metric_ratio(arch, centre + 3.5e-3 * Vec3::UnitZ()), 1.0, 1e-12);
-  VesselParams tube = arch;
-  tube.kind = VesselKind::straight;
-  EXPECT_EQ(axial_metric_ratio(tube, Vec3(3.5e-3, 1e-3, 4e-3)), 1.0);
-
-  // Two axial springs of length h at mid-wall (ξ̄ = 1/2), centred on the outer and on the inner
-  // bend, and one tet on the outer bend.
-  const double h = 0.2e-3;
-  SpringNetwork net;
-  for (const double side : {1.0, -1.0}) {
-    const Vec3 mid = centre + side * 3.5e-3 * outward;
-    net.nodes.push_back(mid - 0.5 * h * tangent);
-    net.nodes.push_back(mid + 0.5 * h * tangent);
-    Spring s;
-    s.a = static_cast<int>(net.nodes.size()) - 2;
-    s.b = s.a + 1;
-    s.family = SpringFamily::volume;
-    s.rest_length = h;
-    s.law.k1 = s.law.k2 = 1.0;
-    net.springs.push_back(s);
-  }
-  const Vec3 t0 = centre + 3.2e-3 * outward;
-  net.nodes.push_back(t0 + 0.5e-3 * outward);
-  net.nodes.push_back(t0 + 0.5e-3 * Vec3::UnitZ());
-  net.tets = {Tet{0, 1, 4, 5}};
-  const StiffnessParameters p = edge_types_metric_parameters(net, arch, true);
-  ASSERT_EQ(p.of_spring[0], p.of_spring[1]);
-  EXPECT_EQ(p.names[static_cast<std::size_t>(p.of_spring[0])], "volume/axial/middle");
-  ASSERT_EQ(p.exponent_of_spring[0], p.exponent_of_spring[1]);
-  EXPECT_EQ(p.names[static_cast<std::size_t>(p.exponent_of_spring[0])], "metric_exponent/axial");
-  EXPECT_EQ(p.names[static_cast<std::size_t>(p.exponent_of_tet[0])], "metric_exponent/kappa");
-  Eigen::VectorXd theta = Eigen::VectorXd::Zero(p.size());
-  const double c = 1.7, alpha = -1.3, c_kappa = 0.6, alpha_kappa = 2.1;
-  theta[p.of_spring[0]] = std::log(c);
-  theta[p.exponent_of_spring[0]] = alpha;
-  theta[p.of_tet[0]] = std::log(c_kappa);
-  theta[p.exponent_of_tet[0]] = alpha_kappa;
-  std::optional<double> kappa = 2.0;
-  apply_stiffness_factors(net, kappa, p, theta);
-  // The springs' midpoints are R ± ρ = 18.5 and 11.5 mm from the arch's axis.
-  const double r_out = 18.5e-3, r_in = 11.5e-3;
-  EXPECT_NEAR(net.springs[0].law.k1, c * std::pow(r_out / 15e-3, alpha), 1e-12);
-  EXPECT_NEAR(net.springs[1].law.k1, c * std::pow(r_in / 15e-3, alpha), 1e-12);
-  // The tet's centroid: mean of its four nodes' distances along outward and z.
-  const Vec3 centroid = 0.25 * (net.nodes[0] + net.nodes[1] + net.nodes[4] + net.nodes[5]);
-  const double m_tet = std::hypot(centroid.x(), centroid.y()) / 15e-3;
-  EXPECT_DOUBLE_EQ(*kappa, 2.0);
-  ASSERT_EQ(net.tet_kappa_factors.size(), 1u);
-  EXPECT_NEAR(net.tet_kappa_factors[0], c_kappa * std::pow(m_tet, alpha_kappa), 1e-12);
-  // On the straight tube every log m is 0: the factors are the edge types' alone.
-  const StiffnessParameters q = edge_types_metric_parameters(net, tube, true);
-  for (const double l : q.spring_log_metric) EXPECT_EQ(l, 0.0);
-  for (const double l : q.tet_log_metric) EXPECT_EQ(l, 0.0);
 }
 
 // The regulariser with a centre θ_c acts on δ = θ − θ_c: zero at the centre; for every spring
@@ -546,7 +418,7 @@ TEST(StiffnessFit, PerSpringFitReducesTheMisfitOfPlantedData) {
   const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
   const LinearisedFit fit(built.network, built.volume_kappa, fixed,
                           per_spring_parameters(built.network, true),
-                          {{"c", f, static_displacement(truth, fixed, f)}}, Regulariser{1e-4, 1e-6});
+                          {{"c", f, static_displacement(truth, fixed, f)}}, Regulariser{1e-4, 1e-6, {}});
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(fit.parameters().size());
   const double before = fit.misfit(zero);
   const Objective obj = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) {

@@ -54,7 +54,7 @@ void run(const Options& o) {
   if (o.nu >= 0.0) c.poisson_ratio = o.nu;
   if (o.level >= 0) c.level = o.level;
   if (o.reference_level >= 0) c.reference_level = o.reference_level;
-  c.regulariser = {o.smoothness, o.ridge};
+  c.regulariser = {o.smoothness, o.ridge, {}};
   c.max_iterations = o.iterations;
   if (!o.prior.empty()) {
     c.prior = read_calibration(o.prior);
@@ -102,15 +102,13 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
                   "wall-layers: a factor per spring class (direction x layer through the wall: "
                   "inner, middle, outer third) and a kappa per half of the wall; edge-types: the "
                   "same with the edge's type (the frame directions it spans, diagonals apart) "
-                  "instead of its largest direction; edge-types-metric: the edge types with "
-                  "each factor times m^alpha, m = (R + rho cos theta)/R the arch's local axial "
-                  "metric ratio (1 on a straight tube), one exponent alpha per edge type and "
-                  "one for kappa; per-section-spring: a factor per spring of a cross-section, "
-                  "shared by its images along the centreline, and kappa (this mesh only); "
+                  "instead of its largest direction; per-section-spring: a factor per spring of "
+                  "a cross-section, shared by its images along the centreline, and kappa (this "
+                  "mesh only); "
                   "per-spring: a factor per spring and kappa (this mesh only); both with a "
                   "smoothness regulariser")
-      ->check(CLI::IsMember({"groups", "wall-layers", "edge-types", "edge-types-metric",
-                             "per-section-spring", "per-spring"}))
+      ->check(CLI::IsMember({"groups", "wall-layers", "edge-types", "per-section-spring",
+                             "per-spring"}))
       ->capture_default_str();
   cmd->add_option("--weights", o->weights,
                   "How the training loads weigh in the fit: equal (each load's squared relative "

@@ -25,7 +25,6 @@ std::string to_string(CalibrationGranularity g) {
     case CalibrationGranularity::groups: return "groups";
     case CalibrationGranularity::wall_layers: return "wall_layers";
     case CalibrationGranularity::edge_types: return "edge_types";
-    case CalibrationGranularity::edge_types_metric: return "edge_types_metric";
     case CalibrationGranularity::per_section_spring: return "per_section_spring";
     case CalibrationGranularity::per_spring: return "per_spring";
   }
@@ -36,16 +35,13 @@ CalibrationGranularity parse_calibration_granularity(const std::string& name) {
   if (name == "groups") return CalibrationGranularity::groups;
   if (name == "wall_layers" || name == "wall-layers") return CalibrationGranularity::wall_layers;
   if (name == "edge_types" || name == "edge-types") return CalibrationGranularity::edge_types;
-  if (name == "edge_types_metric" || name == "edge-types-metric") {
-    return CalibrationGranularity::edge_types_metric;
-  }
   if (name == "per_section_spring" || name == "per-section-spring") {
     return CalibrationGranularity::per_section_spring;
   }
   if (name == "per_spring" || name == "per-spring") return CalibrationGranularity::per_spring;
   throw InputError("granularity: found \"" + name +
-                   "\", expected groups, wall-layers, edge-types, edge-types-metric, "
-                   "per-section-spring or per-spring");
+                   "\", expected groups, wall-layers, edge-types, per-section-spring or "
+                   "per-spring");
 }
 
 std::string to_string(CaseWeights w) { return w == CaseWeights::equal ? "equal" : "p1"; }
@@ -443,8 +439,6 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
               o.granularity == CalibrationGranularity::edge_types
           ? msm::wall_layer_parameters(main.base.network, main.vessel, has_kappa,
                                        o.granularity == CalibrationGranularity::edge_types)
-      : o.granularity == CalibrationGranularity::edge_types_metric
-          ? msm::edge_types_metric_parameters(main.base.network, main.vessel, has_kappa)
       : o.granularity == CalibrationGranularity::per_section_spring
           ? msm::per_section_spring_parameters(main.base.network, main.vessel, has_kappa,
                                                prior_halves)
@@ -559,11 +553,6 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
                  ? "a factor per spring of a cross-section (springs that are images of each "
                    "other along the centreline share it) and kappa, smoothness regulariser on "
                    "log k over springs sharing a node"
-             : o.granularity == CalibrationGranularity::edge_types_metric
-                 ? "a factor per spring class (edge type x layer through the wall) and per half "
-                   "of the wall for kappa, each times m^alpha (m the local axial metric ratio, "
-                   "an exponent alpha per edge type and for kappa), ridge on the log factors and "
-                   "exponents"
                  : "a factor per spring and kappa, smoothness regulariser on log k over springs "
                    "sharing a node");
   if (o.prior) {
@@ -670,9 +659,6 @@ void write_calibration_markdown(std::ostream& out, const CalibrationStudy& st,
     out << "| parameter | factor |\n|---|---|\n";
     for (std::size_t i = 0; i < c.names.size(); ++i) {
       out << "| " << c.names[i] << " | " << fixed3(c.factors[i]) << " |\n";
-    }
-    for (std::size_t i = 0; i < c.exponent_names.size(); ++i) {
-      out << "| " << c.exponent_names[i] << " | " << fixed3(c.exponents[i]) << " (exponent) |\n";
     }
     out << "\n";
   } else {

@@ -38,19 +38,17 @@ class SolutionCache;
 namespace vessel {
 
 /// groups: msm::group_parameters; wall_layers and edge_types: msm::wall_layer_parameters
-/// (direction by the largest component, or by the edge's type); edge_types_metric:
-/// msm::edge_types_metric_parameters; per_section_spring: msm::per_section_spring_parameters;
+/// (direction by the largest component, or by the edge's type); per_section_spring:
+/// msm::per_section_spring_parameters;
 /// per_spring: msm::per_spring_parameters.
 enum class CalibrationGranularity {
   groups,
   wall_layers,
   edge_types,
-  edge_types_metric,
   per_section_spring,
   per_spring
 };
-/// "groups" | "wall_layers" | "edge_types" | "edge_types_metric" | "per_section_spring" |
-/// "per_spring"
+/// "groups" | "wall_layers" | "edge_types" | "per_section_spring" | "per_spring"
 std::string to_string(CalibrationGranularity g);
 CalibrationGranularity parse_calibration_granularity(const std::string& name);  ///< InputError
 
@@ -71,7 +69,7 @@ struct CalibrateOptions {
   CalibrationGranularity granularity = CalibrationGranularity::groups;
   std::vector<LoadKind> train;  ///< load types fitted on; default: the scene's load type
   /// Per-spring fits: both terms; the class granularities: the ridge alone. Defaults: msm::Regulariser's doc.
-  msm::Regulariser regulariser{1e-2, 1e-3};
+  msm::Regulariser regulariser{1e-2, 1e-3, {}};
   /// Per-spring and per-section-spring fits: a class calibration of the same model and mesh to
   /// start from and to
   /// regularise towards (msm::Regulariser::centre: smoothness and ridge act on each spring's
