@@ -1,5 +1,6 @@
 #include "verification/calibration_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -86,16 +87,20 @@ void write_calibration(const std::filesystem::path& path, const Calibration& c) 
     std::vector<double> springs;
     double kappa = 1.0;
     bool has_kappa = false;
+    nlohmann::ordered_json halves = nlohmann::ordered_json::object();  // κ per half of the wall
     for (std::size_t i = 0; i < c.names.size(); ++i) {
       if (c.names[i] == "kappa") {
         kappa = c.factors[i];
         has_kappa = true;
+      } else if (c.names[i].rfind("kappa/", 0) == 0) {
+        halves[c.names[i]] = c.factors[i];
       } else {
         springs.push_back(c.factors[i]);
       }
     }
     j["spring_factors"] = springs;
     if (has_kappa) j["kappa_factor"] = kappa;
+    if (!halves.empty()) j["kappa_factors"] = halves;
   }
   nlohmann::ordered_json loads = nlohmann::ordered_json::array();
   for (const auto& l : c.training_loads) {
@@ -142,10 +147,11 @@ Calibration read_calibration(const std::filesystem::path& path) {
   Calibration c;
   c.granularity = member<std::string>(j, "granularity", file);
   if (c.granularity != "groups" && c.granularity != "wall_layers" &&
-      c.granularity != "edge_types" && c.granularity != "per_spring") {
+      c.granularity != "edge_types" && c.granularity != "per_section_spring" &&
+      c.granularity != "per_spring") {
     throw InputError(file + ": key \"granularity\": found \"" + c.granularity +
-                     "\", expected \"groups\", \"wall_layers\", \"edge_types\" or "
-                     "\"per_spring\"");
+                     "\", expected \"groups\", \"wall_layers\", \"edge_types\", "
+                     "\"per_section_spring\" or \"per_spring\"");
   }
   const auto model = member<nlohmann::json>(j, "model", file);
   const std::string mfile = file + ": model";
@@ -188,6 +194,17 @@ Calibration read_calibration(const std::filesystem::path& path) {
       c.names.emplace_back("kappa");
       c.factors.push_back(member<double>(j, "kappa_factor", file));
     }
+    if (j.contains("kappa_factors")) {  // κ per half of the wall
+      const auto k = member<nlohmann::json>(j, "kappa_factors", file);
+      for (const char* name : {"kappa/inner", "kappa/outer"}) {
+        if (!k.is_object() || !k.contains(name) || !k[name].is_number()) {
+          throw InputError(file + ": key \"kappa_factors\": expected numbers \"kappa/inner\" and "
+                           "\"kappa/outer\"");
+        }
+        c.names.emplace_back(name);
+        c.factors.push_back(k[name].get<double>());
+      }
+    }
   }
   for (std::size_t i = 0; i < c.factors.size(); ++i) {
     if (!(c.factors[i] > 0.0) || !std::isfinite(c.factors[i])) {
@@ -222,6 +239,13 @@ Calibration read_calibration(const std::filesystem::path& path) {
   return c;
 }
 
+void set_calibration_parameters(Calibration& c, const msm::StiffnessParameters& params,
+                                const Eigen::VectorXd& theta) {
+  c.names = params.names;
+  c.factors.clear();
+  for (int p = 0; p < params.size(); ++p) c.factors.push_back(std::exp(theta[p]));
+}
+
 std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
     const Calibration& c, const std::string& source, const msm::BuiltNetwork& built,
     const VesselParams& vessel) {
@@ -233,16 +257,20 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
   }
   msm::StiffnessParameters params;
   if (c.granularity == "per_spring") {
-    params = msm::per_spring_parameters(built.network, has_kappa);
+    const bool halves = std::find(c.names.begin(), c.names.end(), "kappa/inner") != c.names.end();
+    params = msm::per_spring_parameters(built.network, has_kappa, halves ? &vessel : nullptr);
     if (c.factors.size() != static_cast<std::size_t>(params.size())) {
       throw InputError(source + ": spring_factors has " +
-                       std::to_string(c.factors.size() - (has_kappa ? 1 : 0)) +
+                       std::to_string(c.factors.size() - (has_kappa ? (halves ? 2 : 1) : 0)) +
                        " factors, the model's network has " +
                        std::to_string(built.network.springs.size()) + " springs");
     }
   } else if (c.granularity == "wall_layers" || c.granularity == "edge_types") {
     params = msm::wall_layer_parameters(built.network, vessel, has_kappa,
                                         c.granularity == "edge_types");
+  } else if (c.granularity == "per_section_spring") {
+    const bool halves = std::find(c.names.begin(), c.names.end(), "kappa/inner") != c.names.end();
+    params = msm::per_section_spring_parameters(built.network, vessel, has_kappa, halves);
   } else {
     params = msm::group_parameters(built.network, vessel, has_kappa);
   }
@@ -316,9 +344,9 @@ void apply_calibration(const Calibration& c, const std::string& source, msm::Bui
                        "); expected the same mesh, or calibration_transfer = true for a group "
                        "calibration");
     }
-    if (c.granularity == "per_spring") {
-      throw InputError(source + ": mesh.hash: a per-spring calibration (mesh " + c.mesh_hash +
-                       ") cannot transfer to another mesh (" + hash +
+    if (c.granularity == "per_spring" || c.granularity == "per_section_spring") {
+      throw InputError(source + ": mesh.hash: a " + c.granularity + " calibration (mesh " +
+                       c.mesh_hash + ") cannot transfer to another mesh (" + hash +
                        "): its factors are indexed by that mesh's springs");
     }
   }

@@ -9,7 +9,9 @@
 /// Granularities: "groups" (a factor per spring class and κ; msm::group_parameters),
 /// "wall_layers" (a factor per spring class by direction and layer through the wall, and a κ per
 /// half of the wall; msm::wall_layer_parameters), "edge_types" (the same with the edge's type,
-/// diagonals apart) and "per_spring" (a factor per spring and κ).
+/// diagonals apart), "per_section_spring" (a factor per spring of a cross-section, shared by
+/// its images along the centreline; msm::per_section_spring_parameters) and "per_spring" (a
+/// factor per spring and κ, or κ per half of the wall: "kappa_factors").
 /// The mesh hash must match the model's mesh, unless the model says `calibration_transfer =
 /// true`, which a group or wall-layer calibration allows (its classes are defined by the
 /// vessel's geometry) and a per-spring one refuses (its factors are indexed by the springs of one
@@ -47,7 +49,7 @@ struct CalibrationFitCase {
 };
 
 struct Calibration {
-  /// "groups" | "wall_layers" | "edge_types" | "per_spring"
+  /// "groups" | "wall_layers" | "edge_types" | "per_section_spring" | "per_spring"
   std::string granularity = "groups";
   // The model it applies to.
   std::string scene;       ///< scene name it was fitted on
@@ -81,6 +83,10 @@ void write_calibration(const std::filesystem::path& path, const Calibration& c);
 /// Reads and validates a calibration file; InputError naming the file and key for a missing file,
 /// bad JSON, another schema or version, a missing or mistyped key, non-positive factors.
 Calibration read_calibration(const std::filesystem::path& path);
+
+/// Records fitted parameters θ of `params` in c: their names, and exp(θ) as factors.
+void set_calibration_parameters(Calibration& c, const msm::StiffnessParameters& params,
+                                const Eigen::VectorXd& theta);
 
 /// Applies a calibration to a network built for `spec` on `mesh` (vessel at the model's level,
 /// ν): checks that the calibration was fitted for this kind of model (kind, stiffness rule,

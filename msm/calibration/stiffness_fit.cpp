@@ -130,6 +130,25 @@ std::string spring_wall_layer_class(const SpringNetwork& net, const VesselParams
   return "volume/" + type + layer;
 }
 
+namespace {
+
+/// κ per half of the wall by the tet's centroid ξ: "kappa/inner" ξ < 1/2, "kappa/outer".
+void add_kappa_halves(StiffnessParameters& p, const SpringNetwork& net, const VesselParams& vessel) {
+  const int inner = p.size();
+  p.names.emplace_back("kappa/inner");
+  p.names.emplace_back("kappa/outer");
+  p.of_tet.resize(net.tets.size());
+  for (std::size_t e = 0; e < net.tets.size(); ++e) {
+    double xi = 0.0;
+    for (const int n : net.tets[e]) {
+      xi += 0.25 * through_wall_position(vessel, net.nodes[static_cast<std::size_t>(n)]);
+    }
+    p.of_tet[e] = xi < 0.5 ? inner : inner + 1;
+  }
+}
+
+}  // namespace
+
 StiffnessParameters wall_layer_parameters(const SpringNetwork& net, const VesselParams& vessel,
                                           bool with_kappa, bool edge_types) {
   std::vector<std::string> classes(net.springs.size());
@@ -137,19 +156,7 @@ StiffnessParameters wall_layer_parameters(const SpringNetwork& net, const Vessel
     classes[s] = spring_wall_layer_class(net, vessel, s, edge_types);
   }
   StiffnessParameters p = parameters_from_classes(classes);
-  if (with_kappa && !net.tets.empty()) {
-    const int inner = p.size();
-    p.names.emplace_back("kappa/inner");
-    p.names.emplace_back("kappa/outer");
-    p.of_tet.resize(net.tets.size());
-    for (std::size_t e = 0; e < net.tets.size(); ++e) {
-      double xi = 0.0;
-      for (const int n : net.tets[e]) {
-        xi += 0.25 * through_wall_position(vessel, net.nodes[static_cast<std::size_t>(n)]);
-      }
-      p.of_tet[e] = xi < 0.5 ? inner : inner + 1;
-    }
-  }
+  if (with_kappa && !net.tets.empty()) add_kappa_halves(p, net, vessel);
   return p;
 }
 
@@ -169,7 +176,54 @@ StiffnessParameters group_parameters(const SpringNetwork& net, const VesselParam
   return p;
 }
 
-StiffnessParameters per_spring_parameters(const SpringNetwork& net, bool with_kappa) {
+StiffnessParameters per_section_spring_parameters(const SpringNetwork& net,
+                                                  const VesselParams& vessel, bool with_kappa,
+                                                  bool kappa_halves) {
+  // The key of a spring's image class along the centreline: midpoint (ρ, θ) and the unit
+  // vector's components in the local frame (sign fixed: the spring's ends are unordered),
+  // quantised (1 nm, 1 µrad, 1e-6).
+  using Key = std::array<long long, 5>;
+  std::map<Key, int> index;
+  std::vector<Key> keys(net.springs.size());
+  for (std::size_t s = 0; s < net.springs.size(); ++s) {
+    const Vec3 a = net.nodes[static_cast<std::size_t>(net.springs[s].a)];
+    const Vec3 b = net.nodes[static_cast<std::size_t>(net.springs[s].b)];
+    const Vec3 mid = 0.5 * (a + b);
+    const CentrelineCoordinates c = centreline_coordinates(vessel, mid);
+    const auto frame = centreline_frame(vessel, mid);
+    Vec3 d((b - a).normalized().dot(frame[0]), (b - a).normalized().dot(frame[1]),
+           (b - a).normalized().dot(frame[2]));
+    for (int i = 0; i < 3; ++i) {
+      if (std::abs(d[i]) > 1e-9) {
+        if (d[i] < 0.0) d = -d;
+        break;
+      }
+    }
+    // θ is periodic: −π and π are the same angle.
+    double theta = c.theta;
+    if (theta <= -std::numbers::pi + 5e-7) theta += 2.0 * std::numbers::pi;
+    keys[s] = {std::llround(c.rho * 1e9), std::llround(theta * 1e6), std::llround(d[0] * 1e6),
+               std::llround(d[1] * 1e6), std::llround(d[2] * 1e6)};
+    index.emplace(keys[s], 0);
+  }
+  StiffnessParameters p;
+  for (auto& [key, i] : index) {
+    i = static_cast<int>(p.names.size());
+    p.names.push_back("section/" + std::to_string(i));
+  }
+  p.of_spring.resize(net.springs.size());
+  for (std::size_t s = 0; s < net.springs.size(); ++s) p.of_spring[s] = index.at(keys[s]);
+  if (with_kappa && kappa_halves && !net.tets.empty()) {
+    add_kappa_halves(p, net, vessel);
+  } else if (with_kappa) {
+    p.kappa = static_cast<int>(p.names.size());
+    p.names.emplace_back("kappa");
+  }
+  return p;
+}
+
+StiffnessParameters per_spring_parameters(const SpringNetwork& net, bool with_kappa,
+                                          const VesselParams* kappa_halves) {
   StiffnessParameters p;
   p.names.reserve(net.springs.size() + 1);
   p.of_spring.resize(net.springs.size());
@@ -177,7 +231,9 @@ StiffnessParameters per_spring_parameters(const SpringNetwork& net, bool with_ka
     p.of_spring[s] = static_cast<int>(s);
     p.names.push_back("spring/" + std::to_string(s));
   }
-  if (with_kappa) {
+  if (with_kappa && kappa_halves && !net.tets.empty()) {
+    add_kappa_halves(p, net, *kappa_halves);
+  } else if (with_kappa) {
     p.kappa = static_cast<int>(p.names.size());
     p.names.emplace_back("kappa");
   }
@@ -267,6 +323,11 @@ LinearisedFit::LinearisedFit(const SpringNetwork& net, std::optional<double> kap
                      " dofs, the network has " + std::to_string(num_dofs_));
   }
   if (cases_.empty()) throw InputError("calibration: expected at least one load case to fit");
+  if (regulariser_.centre.size() != 0 && regulariser_.centre.size() != params_.size()) {
+    throw InputError("calibration: the regulariser's centre has " +
+                     std::to_string(regulariser_.centre.size()) + " values, expected one per parameter (" +
+                     std::to_string(params_.size()) + ")");
+  }
   free_index_.assign(static_cast<std::size_t>(num_dofs_), -1);
   for (int i = 0; i < num_dofs_; ++i) {
     if (!fixed[static_cast<std::size_t>(i)]) free_index_[static_cast<std::size_t>(i)] = num_free_++;
@@ -387,7 +448,10 @@ LinearisedFit::Evaluation LinearisedFit::evaluate(const VectorXd& theta, bool ad
   return e;
 }
 
-double LinearisedFit::regulariser_value(const VectorXd& theta, VectorXd* gradient) const {
+double LinearisedFit::regulariser_value(const VectorXd& theta_in, VectorXd* gradient) const {
+  // Both terms act on the departure from the centre, δ = θ − θ_c (Regulariser's doc); ∂δ/∂θ = 1.
+  const VectorXd theta =
+      regulariser_.centre.size() > 0 ? VectorXd(theta_in - regulariser_.centre) : theta_in;
   double value = 0.0;
   const double alpha = regulariser_.smoothness / std::max<double>(1.0, static_cast<double>(springs_.size()));
   if (alpha > 0.0) {

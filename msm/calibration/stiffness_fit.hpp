@@ -40,10 +40,20 @@ struct StiffnessParameters {
   std::vector<int> of_tet;
   [[nodiscard]] int size() const { return static_cast<int>(names.size()); }
   /// Whether any parameter scales κ.
-  [[nodiscard]] bool scales_kappa() const { return kappa >= 0 || !of_tet.empty(); }
+  [[nodiscard]] bool scales_kappa() const {
+    return kappa >= 0 || !of_tet.empty();
+  }
   /// The parameter of tet e's κ, −1: none.
   [[nodiscard]] int kappa_of_tet(std::size_t e) const {
     return of_tet.empty() ? kappa : of_tet[e];
+  }
+  /// log(k_s/k_s0) and log(κ_e/(κ0·f_e)) at θ.
+  [[nodiscard]] double spring_log_factor(const VectorXd& theta, std::size_t s) const {
+    return of_spring[s] >= 0 ? theta[of_spring[s]] : 0.0;
+  }
+  [[nodiscard]] double tet_log_factor(const VectorXd& theta, std::size_t e) const {
+    const int p = kappa_of_tet(e);
+    return p >= 0 ? theta[p] : 0.0;
   }
 };
 
@@ -93,9 +103,25 @@ std::string spring_wall_layer_class(const SpringNetwork& network, const VesselPa
 /// component ≈ 0.27) count as axial.
 inline constexpr double kEdgeTypeComponent = 0.35;
 
+/// One parameter per spring of a cross-section ("per_section_spring"; our own, for a vessel whose
+/// geometry repeats along its centreline — the straight tube along z, the arch round its axis):
+/// springs that are images of each other along the centreline (the same midpoint ρ and θ in
+/// centreline coordinates, the same direction in the local centreline frame; compared to 1 nm,
+/// 1 µrad and 1e-6) share a factor ("section/<k>", k in the order of those keys). A fit then
+/// moves the stiffness alike at every position along the vessel, so what it learns at the
+/// training loads' positions holds at another position along it. κ as per_spring_parameters
+/// (kappa_halves: per half of the wall). Its classes are indexed by one mesh's cross-section:
+/// such a calibration belongs to this mesh only. InputError for a mesh-file vessel.
+StiffnessParameters per_section_spring_parameters(const SpringNetwork& network,
+                                                  const VesselParams& vessel, bool with_kappa,
+                                                  bool kappa_halves);
+
 /// One parameter per spring ("spring/<index>"), plus "kappa" when with_kappa. Such a
-/// calibration belongs to this network only.
-StiffnessParameters per_spring_parameters(const SpringNetwork& network, bool with_kappa);
+/// calibration belongs to this network only. With `kappa_halves` (a parametric vessel), κ per
+/// half of the wall instead ("kappa/inner", "kappa/outer", as wall_layer_parameters): a
+/// per-spring fit on top of a wall-layer or edge-types one keeps its two κ factors apart.
+StiffnessParameters per_spring_parameters(const SpringNetwork& network, bool with_kappa,
+                                          const VesselParams* kappa_halves = nullptr);
 
 /// Scales network's spring laws (k1 and k2) and *kappa by the factors exp(θ). InputError if the
 /// sizes do not match the network, or θ names κ while kappa is empty.
@@ -114,14 +140,17 @@ struct FitCase {
 };
 
 /// The smoothness regulariser of a per-spring fit:
-///   R(θ) = α/(2·N_s) · Σ_nodes Σ_{s∋n} (θ_{p(s)} − θ̄_n)²  +  β/(2·P) · Σ_p θ_p²,
-/// θ̄_n the mean of θ over the springs meeting at node n. The first term is, per node, 1/m_n
-/// times the sum over all pairs of its m_n springs of (log k_s/k_s0 − log k_t/k_t0)²/2: springs
-/// sharing a node are pushed towards the same correction of their base rule. The ridge β keeps
-/// the fit well posed where the data see nothing.
+///   R(θ) = α/(2·N_s) · Σ_nodes Σ_{s∋n} (δ_{p(s)} − δ̄_n)²  +  β/(2·P) · Σ_p δ_p²,   δ = θ − θ_c,
+/// δ̄_n the mean of δ over the springs meeting at node n, θ_c the centre (0: the base rule). The
+/// first term is, per node, 1/m_n times the sum over all pairs of its m_n springs of
+/// (δ_s − δ_t)²/2: springs sharing a node are pushed towards the same correction of the centre's
+/// stiffness. The ridge β keeps the fit well posed where the data see nothing. A centre from a
+/// class calibration (a per-spring fit on top of it) makes both terms act on the per-spring
+/// departures from that calibration's factors, which differ a lot between neighbouring classes.
 struct Regulariser {
   double smoothness = 0.0;  ///< α
   double ridge = 0.0;       ///< β
+  VectorXd centre;          ///< θ_c (empty: 0)
 };
 
 /// The linearised least-squares fit and its adjoint gradient (header comment).

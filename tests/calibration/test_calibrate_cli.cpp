@@ -144,3 +144,54 @@ calibration_transfer = true
   const auto results = nlohmann::json::parse(read_text(dir / "out1" / "results.json"));
   EXPECT_NE(results.dump().find("cal.json"), std::string::npos);
 }
+
+// A per-spring fit on top of an edge-types one (--prior): it starts where the prior ended (the
+// linearised training errors before the fit are the prior's after it), keeps the prior's two κ
+// halves apart, does not end worse than it started, and says so in its method. A prior with
+// another granularity than per-spring, or fitted on another mesh, is refused naming the option
+// or the key.
+TEST(CalibrateCli, PerSpringOnTopOfAnEdgeTypesCalibrationStartsFromIt) {
+  const TempDir dir;
+  write_text(dir / "scene.toml", scene_text(0, ""));
+  const std::string common = " --gravity 0.1 --train contact,pressure --cache-dir " +
+                             (dir / "cache").string();
+  const auto prior = vv("calibrate " + (dir / "scene.toml").string() +
+                        " --granularity edge-types --output " + (dir / "prior.json").string() +
+                        common);
+  ASSERT_EQ(prior.exit_code, 0) << prior.output;
+  const auto r = vv("calibrate " + (dir / "scene.toml").string() +
+                    " --granularity per-spring --smoothness 0.001 --iterations 30 --prior " +
+                    (dir / "prior.json").string() + " --output " + (dir / "spring.json").string() +
+                    common);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto p = nlohmann::json::parse(read_text(dir / "prior.json"));
+  const auto j = nlohmann::json::parse(read_text(dir / "spring.json"));
+  EXPECT_EQ(j["granularity"], "per_spring");
+  ASSERT_TRUE(j.contains("kappa_factors"));
+  EXPECT_TRUE(j["kappa_factors"].contains("kappa/inner"));
+  EXPECT_NE(j["fit"]["method"].get<std::string>().find("regularised towards"), std::string::npos);
+  const auto& pc = p["fit"]["training_cases_linearised"];
+  const auto& sc = j["fit"]["training_cases_linearised"];
+  ASSERT_EQ(pc.size(), sc.size());
+  double before = 0.0, after = 0.0;
+  for (std::size_t i = 0; i < pc.size(); ++i) {
+    EXPECT_NEAR(sc[i]["relative_l2_before"].get<double>(), pc[i]["relative_l2_after"].get<double>(),
+                1e-9)
+        << sc[i]["case"];
+    before += std::pow(sc[i]["relative_l2_before"].get<double>(), 2);
+    after += std::pow(sc[i]["relative_l2_after"].get<double>(), 2);
+  }
+  EXPECT_LE(after, before);
+
+  const auto wrong = vv("calibrate " + (dir / "scene.toml").string() + " --prior " +
+                        (dir / "prior.json").string() + " --output " +
+                        (dir / "x.json").string() + common);
+  EXPECT_NE(wrong.exit_code, 0);
+  EXPECT_NE(wrong.output.find("--prior"), std::string::npos) << wrong.output;
+  write_text(dir / "level1.toml", scene_text(1, ""));
+  const auto other_mesh = vv("calibrate " + (dir / "level1.toml").string() +
+                             " --granularity per-spring --prior " + (dir / "prior.json").string() +
+                             " --output " + (dir / "y.json").string() + common);
+  EXPECT_NE(other_mesh.exit_code, 0);
+  EXPECT_NE(other_mesh.output.find("mesh.hash"), std::string::npos) << other_mesh.output;
+}

@@ -3,6 +3,7 @@
 // and bad files; the scene keys that refer to a file.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -184,6 +185,77 @@ TEST(CalibrationFile, WallLayerCalibrationRoundTripsAndScalesSpringsAndEachTetsK
   msm::BuiltNetwork on_moved = hybrid(moved);
   EXPECT_NO_THROW(apply_calibration(r, "cal.json", on_moved, moved, wall, hybrid_spec(), kE, 0.45,
                                     true));
+}
+
+// A per-spring calibration with κ per half of the wall (a fit on top of an edge-types one)
+// keeps its two κ factors through the file, and they land on each tet's κ factor.
+TEST(CalibrationFile, PerSpringCalibrationKeepsItsKappaHalves) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  VesselParams wall;  // the block spans ρ = 3–5.4 mm
+  wall.inner_radius = 3.5e-3;
+  wall.wall_thickness = 1.0e-3;
+  const msm::BuiltNetwork base = hybrid(mesh);
+  const msm::StiffnessParameters p = msm::per_spring_parameters(base.network, true, &wall);
+  ASSERT_EQ(p.of_tet.size(), base.network.tets.size());
+  Calibration c = make_calibration(mesh, base, true);
+  c.names = p.names;
+  c.factors.clear();
+  for (int i = 0; i < p.size(); ++i) c.factors.push_back(1.0 + 0.05 * (i % 11));
+  const auto path = temp_file("per_spring_halves.json");
+  write_calibration(path, c);
+  const Calibration r = read_calibration(path);
+  ASSERT_EQ(r.names.size(), c.names.size());
+  msm::BuiltNetwork applied = base;
+  apply_calibration(r, "test", applied, mesh, wall, hybrid_spec(), kE, 0.45, false);
+  for (std::size_t s = 0; s < base.network.springs.size(); ++s) {
+    EXPECT_NEAR(applied.network.springs[s].law.k1, c.factors[s] * base.network.springs[s].law.k1,
+                1e-12 * base.network.springs[s].law.k1);
+  }
+  EXPECT_DOUBLE_EQ(*applied.volume_kappa, *base.volume_kappa);
+  ASSERT_EQ(applied.network.tet_kappa_factors.size(), base.network.tets.size());
+  for (std::size_t e = 0; e < base.network.tets.size(); ++e) {
+    const double base_factor =
+        base.network.tet_kappa_factors.empty() ? 1.0 : base.network.tet_kappa_factors[e];
+    EXPECT_NEAR(applied.network.tet_kappa_factors[e],
+                c.factors[static_cast<std::size_t>(p.of_tet[e])] * base_factor, 1e-12);
+  }
+}
+
+// A per-section-spring calibration goes through the file onto each spring by its section class,
+// and, indexed by one mesh's cross-section, is refused on another mesh even with transfer.
+TEST(CalibrationFile, PerSectionSpringCalibrationAppliesOnItsMeshOnly) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  VesselParams tube;
+  tube.inner_radius = 3.5e-3;
+  tube.wall_thickness = 1.0e-3;
+  const msm::BuiltNetwork base = hybrid(mesh);
+  const msm::StiffnessParameters p =
+      msm::per_section_spring_parameters(base.network, tube, true, false);
+  ASSERT_LT(p.size(), static_cast<int>(base.network.springs.size()));
+  Calibration c = make_calibration(mesh, base, false);
+  c.granularity = "per_section_spring";
+  Eigen::VectorXd theta(p.size());
+  for (int i = 0; i < p.size(); ++i) theta[i] = 0.1 * std::sin(1.0 + i);
+  set_calibration_parameters(c, p, theta);
+  const auto path = temp_file("per_section_spring.json");
+  write_calibration(path, c);
+  const Calibration r = read_calibration(path);
+  EXPECT_EQ(r.granularity, "per_section_spring");
+  msm::BuiltNetwork applied = base;
+  apply_calibration(r, "test", applied, mesh, tube, hybrid_spec(), kE, 0.45, false);
+  for (std::size_t s = 0; s < base.network.springs.size(); ++s) {
+    const double factor = std::exp(theta[p.of_spring[s]]);
+    EXPECT_NEAR(applied.network.springs[s].law.k1, factor * base.network.springs[s].law.k1,
+                1e-12 * factor * base.network.springs[s].law.k1);
+  }
+  EXPECT_NEAR(*applied.volume_kappa, std::exp(theta[p.kappa]) * *base.volume_kappa,
+              1e-12 * *base.volume_kappa);
+  TetMesh moved = mesh;
+  moved.nodes[5].x() += 1e-6;
+  msm::BuiltNetwork on_moved = hybrid(moved);
+  expect_input_error(
+      [&] { apply_calibration(r, "cal.json", on_moved, moved, tube, hybrid_spec(), kE, 0.45, true); },
+      "mesh.hash");
 }
 
 // A wall-layer class the fitted mesh did not have gets the geometric mean of its direction's

@@ -94,6 +94,17 @@ Eigen::VectorXd static_displacement(const BuiltNetwork& built, const std::vector
   return r.x - p.rest;
 }
 
+/// An arch of bend radius 2 mm about the z axis whose wall (ρ = 1.2–3.2 mm) covers block_mesh's
+/// nodes (x ≥ 3 mm, y, z ≥ 0): 1–3.9 mm from its centreline circle.
+VesselParams bend_around_block() {
+  VesselParams v;
+  v.kind = VesselKind::arch;
+  v.bend_radius = 2e-3;
+  v.inner_radius = 1.2e-3;
+  v.wall_thickness = 2.0e-3;
+  return v;
+}
+
 }  // namespace
 
 TEST(StiffnessFit, LinearisedStiffnessIsTheModelsHessianAtRest) {
@@ -145,20 +156,32 @@ TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
   VesselParams wall;
   wall.inner_radius = 3.5e-3;
   wall.wall_thickness = 1.0e-3;
-  for (const int granularity : {0, 1, 2, 3}) {
-    const bool per_spring = granularity == 1;
+  // Per section spring (granularity 6) on an arch of bend radius 2 mm round the block.
+  const VesselParams bend = bend_around_block();
+  // Granularity 5: per spring with κ per half of the wall and a regulariser centred on random
+  // log factors (a per-spring fit on top of a class calibration).
+  // Granularity 6: a factor per spring of a cross-section of the arch (bend), κ per half.
+  for (const int granularity : {0, 1, 2, 3, 5, 6}) {
+    const bool per_spring = granularity == 1 || granularity == 5 || granularity == 6;
     const StiffnessParameters params =
         granularity == 0   ? group_parameters(built.network, VesselParams{}, true)
+        : granularity == 6 ? per_section_spring_parameters(built.network, bend, true, true)
         : granularity == 1 ? per_spring_parameters(built.network, true)
+        : granularity == 5 ? per_spring_parameters(built.network, true, &wall)
                            : wall_layer_parameters(built.network, wall, true, granularity == 3);
     if (granularity >= 2) {
       ASSERT_FALSE(params.of_tet.empty());
       EXPECT_EQ(std::count(params.names.begin(), params.names.end(), "kappa/inner"), 1);
       EXPECT_EQ(std::count(params.names.begin(), params.names.end(), "kappa/outer"), 1);
     }
-    const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases,
-                            per_spring ? Regulariser{0.3, 1e-3} : Regulariser{});
     std::uniform_real_distribution<double> u(-0.5, 0.5);
+    Regulariser reg = per_spring ? Regulariser{0.3, 1e-3, {}} : Regulariser{};
+    if (granularity == 5) {
+      ASSERT_EQ(params.of_tet.size(), built.network.tets.size());
+      reg.centre.resize(params.size());
+      for (Eigen::Index i = 0; i < reg.centre.size(); ++i) reg.centre[i] = u(rng);
+    }
+    const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases, reg);
     Eigen::VectorXd theta(params.size());
     for (Eigen::Index i = 0; i < theta.size(); ++i) theta[i] = u(rng);
     Eigen::VectorXd g;
@@ -174,7 +197,9 @@ TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
           << (granularity == 0   ? "groups, "
               : granularity == 1 ? "per spring, "
               : granularity == 2 ? "wall layers, "
-                                 : "edge types, ")
+              : granularity == 3 ? "edge types, "
+              : granularity == 5 ? "per spring from a centre, "
+                                 : "per section spring, ")
           << params.names[static_cast<std::size_t>(p)];
       ++checked;
     }
@@ -253,6 +278,133 @@ TEST(StiffnessFit, RecoversPlantedWallLayerFactorsFromTheModelsOwnData) {
   }
 }
 
+// The regulariser with a centre θ_c acts on δ = θ − θ_c: zero at the centre; for every spring
+// shifted by the same c from it the smoothness term vanishes (each node's springs depart alike)
+// and the ridge is β/(2P)·P·c² = β·c²/2 (hand-derived); and a per-spring fit on top of planted
+// group factors, started at them, has nothing left to fit.
+TEST(StiffnessFit, ARegulariserCentreMovesBothTermsToTheDepartureFromIt) {
+  const TetMesh mesh = block_mesh(2, 1e-3);
+  const BuiltNetwork built = hybrid(mesh, 0.45);
+  const std::vector<char> fixed = bottom_fixed(built.network);
+  const StiffnessParameters params = per_spring_parameters(built.network, true);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Regulariser reg{0.7, 0.3, Eigen::VectorXd(params.size())};
+  for (Eigen::Index i = 0; i < reg.centre.size(); ++i) reg.centre[i] = u(rng);
+  const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
+  const LinearisedFit fit(built.network, built.volume_kappa, fixed, params,
+                          {{"c", f, static_displacement(built, fixed, f)}}, reg);
+  EXPECT_NEAR(fit.regularisation(reg.centre), 0.0, 1e-15);
+  const double c = 0.4;
+  const Eigen::VectorXd shifted = reg.centre.array() + c;
+  EXPECT_NEAR(fit.regularisation(shifted), 0.5 * 0.3 * c * c, 1e-12);
+  Regulariser bad = reg;
+  bad.centre.resize(3);
+  EXPECT_THROW(LinearisedFit(built.network, built.volume_kappa, fixed, params,
+                             {{"c", f, static_displacement(built, fixed, f)}}, bad),
+               InputError);
+
+  // Data from planted group factors; the per-spring parameters at those factors fit it exactly.
+  const StiffnessParameters groups = group_parameters(built.network, VesselParams{}, true);
+  Eigen::VectorXd planted(groups.size());
+  for (Eigen::Index p = 0; p < planted.size(); ++p) planted[p] = 0.3 * std::sin(1.0 + p);
+  BuiltNetwork truth = built;
+  apply_stiffness_factors(truth.network, truth.volume_kappa, groups, planted);
+  Eigen::VectorXd start(params.size());
+  for (std::size_t s = 0; s < built.network.springs.size(); ++s) {
+    start[params.of_spring[s]] = groups.spring_log_factor(planted, s);
+  }
+  start[params.kappa] = planted[groups.kappa];
+  const LinearisedFit on_top(built.network, built.volume_kappa, fixed, params,
+                             {{"c", f, static_displacement(truth, fixed, f)}},
+                             Regulariser{0.7, 0.3, start});
+  EXPECT_LT(on_top.relative_errors(start)[0], 1e-3);  // linearised against nonlinear data (1e-4)
+  EXPECT_GT(on_top.relative_errors(Eigen::VectorXd::Zero(params.size()))[0], 1e-2);
+}
+
+// Springs that are images of each other along the centreline share a factor, others do not:
+// hand-placed springs on the arch (R = 15 mm) at two arch angles φ, on the outer bend and at the
+// top of the section, along the tangent and radially, one with its ends swapped; and axial
+// springs at two heights of the straight tube.
+TEST(StiffnessFit, PerSectionSpringClassesAreImagesAlongTheCentreline) {
+  VesselParams arch;
+  arch.kind = VesselKind::arch;
+  arch.bend_radius = 15e-3;
+  arch.inner_radius = 3e-3;
+  arch.wall_thickness = 1e-3;
+  const double h = 0.2e-3;
+  SpringNetwork net;
+  const auto add = [&](const Vec3& a, const Vec3& b) {
+    net.nodes.push_back(a);
+    net.nodes.push_back(b);
+    Spring sp;
+    sp.a = static_cast<int>(net.nodes.size()) - 2;
+    sp.b = sp.a + 1;
+    sp.family = SpringFamily::volume;
+    net.springs.push_back(sp);
+  };
+  for (const double phi : {0.3, 1.1}) {
+    const Vec3 outward(std::cos(phi), std::sin(phi), 0.0);
+    const Vec3 tangent(-std::sin(phi), std::cos(phi), 0.0);
+    const Vec3 centre = arch.bend_radius * outward;
+    const Vec3 outer = centre + 3.5e-3 * outward, top = centre + 3.5e-3 * Vec3::UnitZ();
+    add(outer - 0.5 * h * tangent, outer + 0.5 * h * tangent);   // 0, 4: tangent, outer bend
+    add(top - 0.5 * h * tangent, top + 0.5 * h * tangent);       // 1, 5: tangent, top
+    add(outer - 0.5 * h * outward, outer + 0.5 * h * outward);   // 2, 6: radial, outer bend
+    if (phi < 1.0) {
+      add(outer - 0.5 * h * outward, outer + 0.5 * h * outward);  // 3: as 2
+    } else {
+      add(outer + 0.5 * h * outward, outer - 0.5 * h * outward);  // 7: as 2, ends swapped
+    }
+  }
+  const StiffnessParameters p = per_section_spring_parameters(net, arch, false, false);
+  EXPECT_EQ(p.size(), 3);
+  EXPECT_EQ(p.of_spring[0], p.of_spring[4]);
+  EXPECT_EQ(p.of_spring[1], p.of_spring[5]);
+  EXPECT_EQ(p.of_spring[2], p.of_spring[6]);
+  EXPECT_EQ(p.of_spring[2], p.of_spring[3]);
+  EXPECT_EQ(p.of_spring[2], p.of_spring[7]);
+  EXPECT_NE(p.of_spring[0], p.of_spring[1]);
+  EXPECT_NE(p.of_spring[0], p.of_spring[2]);
+  // The straight tube: axial springs at z = 1 and 5 mm at the same (ρ, θ) share a factor; one
+  // at another θ does not.
+  SpringNetwork tube_net;
+  net = tube_net;
+  add(Vec3(3.5e-3, 0, 1e-3), Vec3(3.5e-3, 0, 1.2e-3));
+  add(Vec3(3.5e-3, 0, 5e-3), Vec3(3.5e-3, 0, 5.2e-3));
+  add(Vec3(0, 3.5e-3, 5e-3), Vec3(0, 3.5e-3, 5.2e-3));
+  VesselParams tube = arch;
+  tube.kind = VesselKind::straight;
+  const StiffnessParameters q = per_section_spring_parameters(net, tube, false, false);
+  EXPECT_EQ(q.of_spring[0], q.of_spring[1]);
+  EXPECT_NE(q.of_spring[0], q.of_spring[2]);
+}
+
+// Factors planted per cross-section spring of the block (repeated along z on the straight tube:
+// each height's springs are images of the others) are recovered from data the nonlinear model
+// generated with them.
+TEST(StiffnessFit, RecoversPlantedPerSectionSpringFactorsFromTheModelsOwnData) {
+  const TetMesh mesh = block_mesh(3, 1e-3);
+  const BuiltNetwork built = hybrid(mesh, 0.45);
+  const std::vector<char> fixed = bottom_fixed(built.network);
+  VesselParams tube;
+  tube.inner_radius = 3.5e-3;
+  tube.wall_thickness = 1.5e-3;
+  const StiffnessParameters params = per_section_spring_parameters(built.network, tube, true, false);
+  ASSERT_LT(params.size(), static_cast<int>(built.network.springs.size()) / 2);  // shared along z
+  Eigen::VectorXd planted(params.size());
+  for (int p = 0; p < params.size(); ++p) planted[p] = 0.5 * std::sin(0.7 + 1.3 * p);  // 0.6–1.65
+  const auto [x, errors] = fit_planted_factors(built, fixed, params, planted, 19, 3000);
+  int checked = 0;
+  for (int p = 0; p < params.size(); ++p) {
+    EXPECT_NEAR(std::exp(x[p]), std::exp(planted[p]), 1e-2 * std::exp(planted[p]))
+        << params.names[static_cast<std::size_t>(p)];
+    ++checked;
+  }
+  EXPECT_GT(checked, 20);
+  for (const double e : errors) EXPECT_LT(e, 1e-4);
+}
+
 TEST(StiffnessFit, PerSpringFitReducesTheMisfitOfPlantedData) {
   const TetMesh mesh = block_mesh(2, 1e-3);
   const BuiltNetwork built = hybrid(mesh, 0.45);
@@ -266,7 +418,7 @@ TEST(StiffnessFit, PerSpringFitReducesTheMisfitOfPlantedData) {
   const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
   const LinearisedFit fit(built.network, built.volume_kappa, fixed,
                           per_spring_parameters(built.network, true),
-                          {{"c", f, static_displacement(truth, fixed, f)}}, Regulariser{1e-4, 1e-6});
+                          {{"c", f, static_displacement(truth, fixed, f)}}, Regulariser{1e-4, 1e-6, {}});
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(fit.parameters().size());
   const double before = fit.misfit(zero);
   const Objective obj = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) {

@@ -28,6 +28,7 @@ struct Options {
   double smoothness = CalibrateOptions{}.regulariser.smoothness;
   double ridge = CalibrateOptions{}.regulariser.ridge;
   int iterations = CalibrateOptions{}.max_iterations;
+  std::string prior;
   std::filesystem::path output = "calibration.json";
   std::filesystem::path summary;
   CacheOptions cache;
@@ -53,8 +54,12 @@ void run(const Options& o) {
   if (o.nu >= 0.0) c.poisson_ratio = o.nu;
   if (o.level >= 0) c.level = o.level;
   if (o.reference_level >= 0) c.reference_level = o.reference_level;
-  c.regulariser = {o.smoothness, o.ridge};
+  c.regulariser = {o.smoothness, o.ridge, {}};
   c.max_iterations = o.iterations;
+  if (!o.prior.empty()) {
+    c.prior = read_calibration(o.prior);
+    c.prior_source = o.prior;
+  }
   c.cache_dir = o.cache.mesh_dir();
   const auto solution_cache = o.cache.solution_cache(std::cout);
   c.solution_cache = solution_cache.get();
@@ -97,9 +102,13 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
                   "wall-layers: a factor per spring class (direction x layer through the wall: "
                   "inner, middle, outer third) and a kappa per half of the wall; edge-types: the "
                   "same with the edge's type (the frame directions it spans, diagonals apart) "
-                  "instead of its largest direction; per-spring: a factor per spring and kappa, "
-                  "with a smoothness regulariser")
-      ->check(CLI::IsMember({"groups", "wall-layers", "edge-types", "per-spring"}))
+                  "instead of its largest direction; per-section-spring: a factor per spring of "
+                  "a cross-section, shared by its images along the centreline, and kappa (this "
+                  "mesh only); "
+                  "per-spring: a factor per spring and kappa (this mesh only); both with a "
+                  "smoothness regulariser")
+      ->check(CLI::IsMember({"groups", "wall-layers", "edge-types", "per-section-spring",
+                             "per-spring"}))
       ->capture_default_str();
   cmd->add_option("--weights", o->weights,
                   "How the training loads weigh in the fit: equal (each load's squared relative "
@@ -135,6 +144,12 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--ridge", o->ridge, "Per-spring: weight beta of the ridge on log factors")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_option("--prior", o->prior,
+                  "Per-spring, per-section-spring: a class calibration file (groups, wall-layers, "
+                  "edge-types) of the "
+                  "same model and mesh to start from; the smoothness and the ridge then act on "
+                  "each spring's departure from its factor (its kappa halves stay apart)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--iterations", o->iterations, "L-BFGS iterations at most")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();

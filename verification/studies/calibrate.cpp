@@ -25,6 +25,7 @@ std::string to_string(CalibrationGranularity g) {
     case CalibrationGranularity::groups: return "groups";
     case CalibrationGranularity::wall_layers: return "wall_layers";
     case CalibrationGranularity::edge_types: return "edge_types";
+    case CalibrationGranularity::per_section_spring: return "per_section_spring";
     case CalibrationGranularity::per_spring: return "per_spring";
   }
   return "groups";
@@ -34,9 +35,13 @@ CalibrationGranularity parse_calibration_granularity(const std::string& name) {
   if (name == "groups") return CalibrationGranularity::groups;
   if (name == "wall_layers" || name == "wall-layers") return CalibrationGranularity::wall_layers;
   if (name == "edge_types" || name == "edge-types") return CalibrationGranularity::edge_types;
+  if (name == "per_section_spring" || name == "per-section-spring") {
+    return CalibrationGranularity::per_section_spring;
+  }
   if (name == "per_spring" || name == "per-spring") return CalibrationGranularity::per_spring;
   throw InputError("granularity: found \"" + name +
-                   "\", expected groups, wall-layers, edge-types or per-spring");
+                   "\", expected groups, wall-layers, edge-types, per-section-spring or "
+                   "per-spring");
 }
 
 std::string to_string(CaseWeights w) { return w == CaseWeights::equal ? "equal" : "p1"; }
@@ -380,11 +385,13 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   if (o.poisson_ratio) nu = *o.poisson_ratio;
   const int level = o.level.value_or(s.model_levels.front());
   const int reference_level = o.reference_level.value_or(s.reference_level);
-  if (o.granularity == CalibrationGranularity::per_spring && !o.other_vessels.empty()) {
+  const bool mesh_indexed = o.granularity == CalibrationGranularity::per_spring ||
+                            o.granularity == CalibrationGranularity::per_section_spring;
+  if (mesh_indexed && !o.other_vessels.empty()) {
     throw InputError(
-        "calibrate: --held-out-scene with --granularity per-spring: a per-spring calibration "
-        "cannot transfer to another mesh (its factors are indexed by one mesh's springs); use "
-        "--granularity groups for another vessel");
+        "calibrate: --held-out-scene with --granularity " + to_string(o.granularity) +
+        ": such a calibration cannot transfer to another mesh (its factors are indexed by one "
+        "mesh's springs); use --granularity groups for another vessel");
   }
   std::vector<LoadKind> train = o.train.empty() ? std::vector<LoadKind>{s.load.kind} : o.train;
   Scene scene = s;
@@ -417,6 +424,14 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
 
   // The fit on the training cases.
   const bool has_kappa = main.base.volume_kappa.has_value();
+  if (o.prior && !mesh_indexed) {
+    throw InputError("calibrate: --prior " + o.prior_source + " with --granularity " +
+                     to_string(o.granularity) + ": expected --granularity per-spring or "
+                     "per-section-spring (a prior is what their factors depart from)");
+  }
+  const bool prior_halves =
+      o.prior && std::find(o.prior->names.begin(), o.prior->names.end(), "kappa/inner") !=
+                     o.prior->names.end();
   msm::StiffnessParameters params =
       o.granularity == CalibrationGranularity::groups
           ? msm::group_parameters(main.base.network, main.vessel, has_kappa)
@@ -424,7 +439,11 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
               o.granularity == CalibrationGranularity::edge_types
           ? msm::wall_layer_parameters(main.base.network, main.vessel, has_kappa,
                                        o.granularity == CalibrationGranularity::edge_types)
-          : msm::per_spring_parameters(main.base.network, has_kappa);
+      : o.granularity == CalibrationGranularity::per_section_spring
+          ? msm::per_section_spring_parameters(main.base.network, main.vessel, has_kappa,
+                                               prior_halves)
+          : msm::per_spring_parameters(main.base.network, has_kappa,
+                                       prior_halves ? &main.vessel : nullptr);
   std::vector<msm::FitCase> fit_cases;
   std::vector<char> fixed;
   Calibration cal;
@@ -455,14 +474,36 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   }
   // Groups: the ridge alone (without it a contact-only fit drove the circumferential classes to
   // ~0 and κ up 12×, which fitted contact and failed pressure by 4× P1; docs/msm_calibration.md).
-  const msm::Regulariser reg = o.granularity != CalibrationGranularity::per_spring
-                                   ? msm::Regulariser{0.0, o.regulariser.ridge}
-                                   : o.regulariser;
+  msm::Regulariser reg = !mesh_indexed ? msm::Regulariser{0.0, o.regulariser.ridge, {}}
+                                       : o.regulariser;
+  Eigen::VectorXd theta0 = Eigen::VectorXd::Zero(params.size());
+  if (o.prior) {
+    // The prior's log factors on this network (refused, naming the file and key, if it belongs
+    // to another model or mesh): each parameter's, the mean over its springs (or tets for κ):
+    // one value when the prior's classes are unions of these (geometric classes, κ halves).
+    msm::BuiltNetwork check = main.base;
+    apply_calibration(*o.prior, o.prior_source, check, main.mesh, main.vessel, spec,
+                      s.youngs_modulus, nu, false);
+    const auto [pp, pt] = calibration_parameters(*o.prior, o.prior_source, main.base, main.vessel);
+    std::map<int, std::pair<double, int>> mean;
+    for (std::size_t sp = 0; sp < params.of_spring.size(); ++sp) {
+      mean[params.of_spring[sp]].first += pp.spring_log_factor(pt, sp);
+      mean[params.of_spring[sp]].second += 1;
+    }
+    for (std::size_t e = 0; e < main.base.network.tets.size(); ++e) {
+      const int q = params.kappa_of_tet(e);
+      if (q < 0) continue;
+      mean[q].first += pp.tet_log_factor(pt, e);
+      mean[q].second += 1;
+    }
+    for (const auto& [q, sum] : mean) theta0[q] = sum.first / sum.second;
+    reg.centre = theta0;
+  }
   const msm::LinearisedFit fit(main.base.network, main.base.volume_kappa, fixed, params,
                                fit_cases, reg);
   log << "  fitting " << params.size() << " parameters on " << fit_cases.size()
-      << " training loads (model linearised at rest, adjoint gradients, L-BFGS)\n";
-  const Eigen::VectorXd theta0 = Eigen::VectorXd::Zero(params.size());
+      << " training loads (model linearised at rest, adjoint gradients, L-BFGS"
+      << (o.prior ? ", from and towards " + o.prior_source : std::string()) << ")\n";
   const std::vector<double> before = fit.relative_errors(theta0);
   msm::LbfgsOptions lo;
   lo.max_iterations = o.max_iterations;
@@ -496,8 +537,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   cal.nodes = main.base.network.nodes.size();
   cal.springs = main.base.network.springs.size();
   cal.tets = main.base.network.tets.size();
-  cal.names = params.names;
-  for (Eigen::Index p = 0; p < res.x.size(); ++p) cal.factors.push_back(std::exp(res.x[p]));
+  set_calibration_parameters(cal, params, res.x);
   std::ostringstream method;
   method << "least squares on nodal displacements against the P2 reference (level "
          << reference_level << "), model linearised at rest, adjoint gradients, L-BFGS; "
@@ -509,8 +549,17 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
              : o.granularity == CalibrationGranularity::edge_types
                  ? "a factor per spring class (edge type x layer through the wall) and per half "
                    "of the wall for kappa, ridge on the log factors"
+             : o.granularity == CalibrationGranularity::per_section_spring
+                 ? "a factor per spring of a cross-section (springs that are images of each "
+                   "other along the centreline share it) and kappa, smoothness regulariser on "
+                   "log k over springs sharing a node"
                  : "a factor per spring and kappa, smoothness regulariser on log k over springs "
                    "sharing a node");
+  if (o.prior) {
+    method << "; started from and regularised towards the " << o.prior->granularity
+           << " calibration " << o.prior_source
+           << " (smoothness and ridge on each factor's departure from it)";
+  }
   if (o.weights == CaseWeights::p1) {
     method << "; training cases weighted by 1/(P1's relative L2 error)^2 (the fit minimises the "
               "mean squared ratio to P1)";
@@ -606,7 +655,7 @@ void write_calibration_markdown(std::ostream& out, const CalibrationStudy& st,
       << "Fit: " << c.method << ". " << c.names.size() << " parameters, " << c.iterations
       << " iterations (" << c.stop_reason << "), " << fixed3(st.fit_seconds)
       << " s; objective " << c.objective_before << " → " << c.objective_after << ".\n\n";
-  if (c.granularity != "per_spring") {
+  if (c.granularity != "per_spring" && c.granularity != "per_section_spring") {
     out << "| parameter | factor |\n|---|---|\n";
     for (std::size_t i = 0; i < c.names.size(); ++i) {
       out << "| " << c.names[i] << " | " << fixed3(c.factors[i]) << " |\n";
@@ -615,7 +664,8 @@ void write_calibration_markdown(std::ostream& out, const CalibrationStudy& st,
   } else {
     std::vector<double> f = c.factors;
     std::sort(f.begin(), f.end());
-    out << "Per-spring factors: min " << fixed3(f.front()) << ", median "
+    out << (c.granularity == "per_spring" ? "Per-spring" : "Per-section-spring")
+        << " factors (kappa included): min " << fixed3(f.front()) << ", median "
         << fixed3(f[f.size() / 2]) << ", max " << fixed3(f.back()) << ".\n\n";
   }
   out << "Relative L2 errors against the P2 reference at the model's nodes (P1 at its mesh's "

@@ -38,10 +38,17 @@ class SolutionCache;
 namespace vessel {
 
 /// groups: msm::group_parameters; wall_layers and edge_types: msm::wall_layer_parameters
-/// (direction by the largest component, or by the edge's type); per_spring:
-/// msm::per_spring_parameters.
-enum class CalibrationGranularity { groups, wall_layers, edge_types, per_spring };
-/// "groups" | "wall_layers" | "edge_types" | "per_spring"
+/// (direction by the largest component, or by the edge's type); per_section_spring:
+/// msm::per_section_spring_parameters;
+/// per_spring: msm::per_spring_parameters.
+enum class CalibrationGranularity {
+  groups,
+  wall_layers,
+  edge_types,
+  per_section_spring,
+  per_spring
+};
+/// "groups" | "wall_layers" | "edge_types" | "per_section_spring" | "per_spring"
 std::string to_string(CalibrationGranularity g);
 CalibrationGranularity parse_calibration_granularity(const std::string& name);  ///< InputError
 
@@ -62,7 +69,14 @@ struct CalibrateOptions {
   CalibrationGranularity granularity = CalibrationGranularity::groups;
   std::vector<LoadKind> train;  ///< load types fitted on; default: the scene's load type
   /// Per-spring fits: both terms; the class granularities: the ridge alone. Defaults: msm::Regulariser's doc.
-  msm::Regulariser regulariser{1e-2, 1e-3};
+  msm::Regulariser regulariser{1e-2, 1e-3, {}};
+  /// Per-spring and per-section-spring fits: a class calibration of the same model and mesh to
+  /// start from and to
+  /// regularise towards (msm::Regulariser::centre: smoothness and ridge act on each spring's
+  /// departure from its factor); its κ halves, if it has them, stay apart. prior_source names
+  /// it in errors.
+  std::optional<Calibration> prior;
+  std::string prior_source;
   int max_iterations = 200;
   CaseWeights weights = CaseWeights::equal;
   /// The gravity cases' magnitude (g) on scenes whose own load is not gravity.
