@@ -25,7 +25,7 @@
 #   --quick  models and the P2 reference on level 0 (the models' own mesh, so no estimate of
 #            the reference's uncertainty), smallest and largest load, the validity study at 0.1,
 #            1 and 10 mN, the quick stability study, recommendations against P2 on level 0
-#            (~2 min from an empty cache; ~25 s once cached)
+#            (~100 s from an empty cache; ~25 s once cached)
 #   --full   the default plus the stability table at level 2, the 10^6-step long run, the
 #            level-1 recommendation candidates and the validity study at the scenes' reference
 #            level on the dense ladder (not measured: P2 level 1 costs ~10 s per Newton
