@@ -105,6 +105,16 @@ VesselParams bend_around_block() {
   return v;
 }
 
+/// The arch the hand-placed spring tests use: R = 15 mm, inner radius 3 mm, wall 1 mm.
+VesselParams hand_placed_arch() {
+  VesselParams arch;
+  arch.kind = VesselKind::arch;
+  arch.bend_radius = 15e-3;
+  arch.inner_radius = 3e-3;
+  arch.wall_thickness = 1e-3;
+  return arch;
+}
+
 }  // namespace
 
 TEST(StiffnessFit, LinearisedStiffnessIsTheModelsHessianAtRest) {
@@ -327,11 +337,7 @@ TEST(StiffnessFit, ARegulariserCentreMovesBothTermsToTheDepartureFromIt) {
 // top of the section, along the tangent and radially, one with its ends swapped; and axial
 // springs at two heights of the straight tube.
 TEST(StiffnessFit, PerSectionSpringClassesAreImagesAlongTheCentreline) {
-  VesselParams arch;
-  arch.kind = VesselKind::arch;
-  arch.bend_radius = 15e-3;
-  arch.inner_radius = 3e-3;
-  arch.wall_thickness = 1e-3;
+  const VesselParams arch = hand_placed_arch();
   const double h = 0.2e-3;
   SpringNetwork net;
   const auto add = [&](const Vec3& a, const Vec3& b) {
@@ -488,11 +494,7 @@ SpringNetwork star_network(const Vec3& centre, const std::vector<Vec3>& ends) {
 // section angles; a fixed z axis (the straight tube's frame) would call the tangential springs
 // "circumferential" or "radial".
 TEST(StiffnessFit, ArchEdgeClassesUseTheLocalCentrelineFrame) {
-  VesselParams arch;
-  arch.kind = VesselKind::arch;
-  arch.bend_radius = 15e-3;
-  arch.inner_radius = 3e-3;
-  arch.wall_thickness = 1e-3;
+  const VesselParams arch = hand_placed_arch();
   const double h = 0.2e-3;  // spring length
   for (const double phi : {std::numbers::pi / 6, std::numbers::pi / 2, 0.8 * std::numbers::pi}) {
     const Vec3 outward(std::cos(phi), std::sin(phi), 0.0);
