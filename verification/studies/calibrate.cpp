@@ -373,6 +373,25 @@ CalibrationCaseResult evaluate_case(VesselContext& v, const LoadCase& c, const M
   return r;
 }
 
+/// The fitted parameters of a granularity on `net`; `kappa_halves`: κ per half of the wall (a
+/// prior with them) for the mesh-indexed granularities.
+msm::StiffnessParameters fit_parameters(CalibrationGranularity g, const msm::SpringNetwork& net,
+                                        const VesselParams& vessel, bool has_kappa,
+                                        bool kappa_halves) {
+  switch (g) {
+    case CalibrationGranularity::groups: return msm::group_parameters(net, vessel, has_kappa);
+    case CalibrationGranularity::wall_layers:
+    case CalibrationGranularity::edge_types:
+      return msm::wall_layer_parameters(net, vessel, has_kappa,
+                                        g == CalibrationGranularity::edge_types);
+    case CalibrationGranularity::per_section_spring:
+      return msm::per_section_spring_parameters(net, vessel, has_kappa, kappa_halves);
+    case CalibrationGranularity::per_spring:
+      return msm::per_spring_parameters(net, has_kappa, kappa_halves ? &vessel : nullptr);
+  }
+  throw std::logic_error("fit_parameters: unknown granularity");
+}
+
 }  // namespace
 
 CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
@@ -433,17 +452,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
       o.prior && std::find(o.prior->names.begin(), o.prior->names.end(), "kappa/inner") !=
                      o.prior->names.end();
   msm::StiffnessParameters params =
-      o.granularity == CalibrationGranularity::groups
-          ? msm::group_parameters(main.base.network, main.vessel, has_kappa)
-      : o.granularity == CalibrationGranularity::wall_layers ||
-              o.granularity == CalibrationGranularity::edge_types
-          ? msm::wall_layer_parameters(main.base.network, main.vessel, has_kappa,
-                                       o.granularity == CalibrationGranularity::edge_types)
-      : o.granularity == CalibrationGranularity::per_section_spring
-          ? msm::per_section_spring_parameters(main.base.network, main.vessel, has_kappa,
-                                               prior_halves)
-          : msm::per_spring_parameters(main.base.network, has_kappa,
-                                       prior_halves ? &main.vessel : nullptr);
+      fit_parameters(o.granularity, main.base.network, main.vessel, has_kappa, prior_halves);
   std::vector<msm::FitCase> fit_cases;
   std::vector<char> fixed;
   Calibration cal;
