@@ -86,6 +86,25 @@ void apply_bending(BuiltNetwork& built, const NetworkOptions& o) {
   built.topology += " without bend springs + discrete-shell hinges (Grinspun et al. 2003)";
 }
 
+/// The edge-pair model's network changes: the springs go (the tets' edge-pair energy, which holds
+/// their edges' own terms, replaces them), λ and μ recorded.
+void apply_edge_pairs(BuiltNetwork& built, const NetworkOptions& o) {
+  if (!o.edge_pairs) return;
+  if (o.model != ModelType::volume) {
+    throw InputError("edge_pairs: the edge-pair model lives on tetrahedra; expected the volume "
+                     "model, got the surface model");
+  }
+  if (o.volume_term) {
+    throw InputError("edge_pairs: the edge-pair model is StVK P1 on the tets' edges and reaches "
+                     "any ν < 0.5 by itself; expected volume_term = false with it");
+  }
+  built.edge_pairs = lame_parameters(o.stiffness_params.youngs_modulus,
+                                     o.stiffness_params.poisson_ratio);
+  built.network.springs.clear();
+  built.topology += " coupled in tetrahedron-sharing edge pairs (Kikuuwe et al. 2009: StVK P1 "
+                    "on edges, no springs of their own)";
+}
+
 /// Stiffness, axial damping and masses: the same for every topology. With the volume term, the
 /// springs carry μ (E_s = 2.5μ) and κ = λ − μ is recorded (model_factory.hpp).
 void assign_laws_and_masses(BuiltNetwork& built, const NetworkOptions& o) {
@@ -151,6 +170,7 @@ BuiltNetwork build_network(const TetMesh& mesh, const VesselParams& params,
     }
   }
   apply_bending(built, o);
+  apply_edge_pairs(built, o);
   assign_laws_and_masses(built, o);
   return built;
 }
@@ -177,6 +197,7 @@ BuiltNetwork build_surface_network(const TriangleSurface& surface, double thickn
   built.network = build_triangle_network(surface, thickness, o.two_ring);
   built.topology = triangle_topology_name(o.two_ring);
   apply_bending(built, o);
+  apply_edge_pairs(built, o);
   assign_laws_and_masses(built, o);
   return built;
 }

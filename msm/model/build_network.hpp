@@ -8,6 +8,7 @@
 
 #include "meshes/tet_mesh.hpp"
 #include "meshes/vessel_geometry.hpp"
+#include "msm/model/edge_pair_term.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 #include "msm/topology/springs.hpp"
@@ -63,6 +64,12 @@ struct NetworkOptions {
   /// the triangle edges are the membrane (van-gelder: E·t·ΣA/L²). Needs the triangle topology
   /// (auto picks it); InputError with the volume model or the grid topology.
   Bending bending = Bending::none;
+  /// Volume model only: the springs of each tet coupled in its tetrahedron-sharing edge pairs, the
+  /// edge-based StVK tetrahedron of Kikuuwe et al. (2009) (msm/model/edge_pair_term.hpp) with λ and
+  /// μ from stiffness_params' E and ν: P1 FEM written on the tets' edges. It replaces the springs
+  /// (their stiffness rule does not apply). InputError with the surface model, the volume term or
+  /// at ν = 0.5.
+  bool edge_pairs = false;
 };
 
 /// The supports a spring-network file gives (msm/model/network_file.hpp): nodes held in every
@@ -82,6 +89,8 @@ struct BuiltNetwork {
   /// D (N·m) of the Discrete Shells bending term on network.triangles (options.bending); none: no
   /// bending term.
   std::optional<double> bending_rigidity;
+  /// The StVK material of the edge-pair term on network.tets (options.edge_pairs); none: no term.
+  std::optional<LameParameters> edge_pairs;
   /// A network read from a file: its own supports (the problem holds exactly those), and the file
   /// for messages. Unset for built-in networks.
   std::optional<NetworkSupports> file_supports;

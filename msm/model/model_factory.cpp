@@ -35,7 +35,8 @@ HybridModuli hybrid_moduli(double E, double nu) {
 
 MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damping,
                                  std::optional<double> volume_kappa,
-                                 std::optional<double> bending_rigidity)
+                                 std::optional<double> bending_rigidity,
+                                 std::optional<LameParameters> edge_pairs)
     : springs_(network, point_damping) {
   if (volume_kappa) {
     if (network.tets.empty()) {
@@ -52,7 +53,13 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
     }
     bending_ = std::make_unique<BendingTerm>(network.nodes, network.triangles, *bending_rigidity);
   }
-  if (!volume_ && !bending_) return;
+  if (edge_pairs) {
+    if (network.tets.empty()) {
+      throw InputError("edge pairs: the network has no tetrahedra; expected a volume network");
+    }
+    edge_pairs_ = std::make_unique<EdgePairTerm>(network.nodes, network.tets, *edge_pairs);
+  }
+  if (!volume_ && !bending_ && !edge_pairs_) return;
   SparseMatrix Hs;
   springs_.hessian(flatten(network.nodes), Hs, false);
   auto missing = [](const std::vector<int>& slots) {
@@ -60,13 +67,16 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
   };
   if (volume_) volume_slots_ = volume_->slots_in(Hs);
   if (bending_) bending_slots_ = bending_->slots_in(Hs);
-  if (!missing(volume_slots_) && !missing(bending_slots_)) return;
+  if (edge_pairs_) edge_pair_slots_ = edge_pairs_->slots_in(Hs);
+  if (!missing(volume_slots_) && !missing(bending_slots_) && !missing(edge_pair_slots_)) return;
   // Some term entries are not in the springs' pattern (a region of interest drops the springs
   // between two held nodes; a hinge couples its two opposite vertices, which no spring joins once
-  // the bend springs are dropped): assemble into the union of the patterns.
+  // the bend springs are dropped; the edge-pair model has no springs): assemble into the union of
+  // the patterns.
   union_pattern_ = Hs;
   if (volume_) union_pattern_ += volume_->pattern();
   if (bending_) union_pattern_ += bending_->pattern();
+  if (edge_pairs_) union_pattern_ += edge_pairs_->pattern();
   union_pattern_.makeCompressed();
   std::fill(union_pattern_.valuePtr(), union_pattern_.valuePtr() + union_pattern_.nonZeros(), 0.0);
   for (int col = 0; col < Hs.outerSize(); ++col) {
@@ -76,17 +86,24 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
   }
   if (volume_) volume_slots_ = volume_->slots_in(union_pattern_);
   if (bending_) bending_slots_ = bending_->slots_in(union_pattern_);
+  if (edge_pairs_) edge_pair_slots_ = edge_pairs_->slots_in(union_pattern_);
+}
+
+double MassSpringModel::max_strain(const VectorXd& x) const {
+  const double springs = springs_.max_strain(x);
+  return edge_pairs_ ? std::max(springs, edge_pairs_->max_strain(x)) : springs;
 }
 
 double MassSpringModel::energy(const VectorXd& x) const {
   return springs_.energy(x) + (volume_ ? volume_->energy(x) : 0.0) +
-         (bending_ ? bending_->energy(x) : 0.0);
+         (bending_ ? bending_->energy(x) : 0.0) + (edge_pairs_ ? edge_pairs_->energy(x) : 0.0);
 }
 
 void MassSpringModel::gradient(const VectorXd& x, VectorXd& g) const {
   springs_.gradient(x, g);
   if (volume_) volume_->add_gradient(x, g);
   if (bending_) bending_->add_gradient(x, g);
+  if (edge_pairs_) edge_pairs_->add_gradient(x, g);
 }
 
 double MassSpringModel::energy_gradient(const VectorXd& x, VectorXd& g) const {
@@ -99,11 +116,15 @@ double MassSpringModel::energy_gradient(const VectorXd& x, VectorXd& g) const {
     bending_->add_gradient(x, g);
     e += bending_->energy(x);
   }
+  if (edge_pairs_) {
+    edge_pairs_->add_gradient(x, g);
+    e += edge_pairs_->energy(x);
+  }
   return e;
 }
 
 void MassSpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
-  if (!volume_ && !bending_) {
+  if (!volume_ && !bending_ && !edge_pairs_) {
     springs_.hessian(x, H, project_psd);
     return;
   }
@@ -122,6 +143,7 @@ void MassSpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_p
   // Each term's blocks are projected separately (per spring, per tet, per hinge).
   if (volume_) volume_->add_hessian(x, H.valuePtr(), volume_slots_, project_psd);
   if (bending_) bending_->add_hessian(x, H.valuePtr(), bending_slots_, project_psd);
+  if (edge_pairs_) edge_pairs_->add_hessian(x, H.valuePtr(), edge_pair_slots_, project_psd);
 }
 
 void MassSpringModel::damping_force(const VectorXd& x, const VectorXd& v, VectorXd& f) const {
@@ -135,18 +157,23 @@ void MassSpringModel::damping_jacobian(const VectorXd& x, SparseMatrix& D) const
 std::unique_ptr<MassSpringModel> make_model(const SpringNetwork& network,
                                             std::optional<double> volume_kappa,
                                             double point_damping,
-                                            std::optional<double> bending_rigidity) {
-  return std::make_unique<MassSpringModel>(network, point_damping, volume_kappa, bending_rigidity);
+                                            std::optional<double> bending_rigidity,
+                                            std::optional<LameParameters> edge_pairs) {
+  return std::make_unique<MassSpringModel>(network, point_damping, volume_kappa, bending_rigidity,
+                                           edge_pairs);
 }
 
 std::unique_ptr<MassSpringModel> make_model(const BuiltNetwork& built, double point_damping) {
-  return make_model(built.network, built.volume_kappa, point_damping, built.bending_rigidity);
+  return make_model(built.network, built.volume_kappa, point_damping, built.bending_rigidity,
+                    built.edge_pairs);
 }
 
 const SpringModel* plain_spring_model(const Form& form) {
   if (const auto* springs = dynamic_cast<const SpringModel*>(&form)) return springs;
   if (const auto* model = dynamic_cast<const MassSpringModel*>(&form)) {
-    if (!model->volume_term() && !model->bending_term()) return &model->springs();
+    if (!model->volume_term() && !model->bending_term() && !model->edge_pair_term()) {
+      return &model->springs();
+    }
   }
   return nullptr;
 }

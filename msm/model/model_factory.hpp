@@ -29,6 +29,7 @@
 
 #include "msm/model/bending_term.hpp"
 #include "msm/model/build_network.hpp"
+#include "msm/model/edge_pair_term.hpp"
 #include "msm/model/spring_model.hpp"
 #include "msm/model/volume_term.hpp"
 
@@ -51,11 +52,13 @@ HybridModuli hybrid_moduli(double E, double nu);
 class MassSpringModel : public Form {
  public:
   /// volume_kappa: κ (Pa) of the volume term on network.tets; bending_rigidity: D (N·m) of the
-  /// bending term on network.triangles; none: without that term. InputError if the network lacks
-  /// the tets or triangles a term needs.
+  /// bending term on network.triangles; edge_pairs: the StVK material of the edge-pair term
+  /// (edge_pair_term.hpp) on network.tets; none: without that term. InputError if the network
+  /// lacks the tets or triangles a term needs.
   MassSpringModel(const SpringNetwork& network, double point_damping,
                   std::optional<double> volume_kappa,
-                  std::optional<double> bending_rigidity = std::nullopt);
+                  std::optional<double> bending_rigidity = std::nullopt,
+                  std::optional<LameParameters> edge_pairs = std::nullopt);
 
   [[nodiscard]] int num_dofs() const override { return springs_.num_dofs(); }
   [[nodiscard]] double energy(const VectorXd& x) const override;
@@ -72,13 +75,16 @@ class MassSpringModel : public Form {
   [[nodiscard]] const VolumeTerm* volume_term() const { return volume_.get(); }
   /// The bending term, or nullptr.
   [[nodiscard]] const BendingTerm* bending_term() const { return bending_.get(); }
-  /// Largest spring strain |L − l|/l at x.
-  [[nodiscard]] double max_strain(const VectorXd& x) const { return springs_.max_strain(x); }
+  /// The edge-pair term, or nullptr.
+  [[nodiscard]] const EdgePairTerm* edge_pair_term() const { return edge_pairs_.get(); }
+  /// Largest spring (or, with the edge-pair term, tet edge) strain |L − l|/l at x.
+  [[nodiscard]] double max_strain(const VectorXd& x) const;
 
  private:
   SpringModel springs_;
   std::unique_ptr<VolumeTerm> volume_;
   std::unique_ptr<BendingTerm> bending_;
+  std::unique_ptr<EdgePairTerm> edge_pairs_;
   /// Hessian pattern when the springs' lacks some tet or hinge entries (a region of interest drops
   /// the springs between two held nodes; no spring joins a hinge's opposite vertices): the union,
   /// and where each spring value goes in it.
@@ -86,20 +92,21 @@ class MassSpringModel : public Form {
   std::vector<int> spring_to_union_;
   std::vector<int> volume_slots_;   ///< in the springs' pattern, or in union_pattern_
   std::vector<int> bending_slots_;  ///< likewise
+  std::vector<int> edge_pair_slots_;  ///< likewise
 };
 
 /// The springs alone of a Form that is nothing but springs: a SpringModel, or a MassSpringModel
-/// without a volume or bending term; nullptr for any other Form (solvers that need a plain spring
+/// without a volume, bending or edge-pair term; nullptr for any other Form (solvers that need a plain spring
 /// network, such as the local-global method, refuse those).
 const SpringModel* plain_spring_model(const Form& form);
 
-/// The model of a network (volume_kappa and bending_rigidity as in BuiltNetwork), point damping
-/// k_v in N·s/m per node.
-std::unique_ptr<MassSpringModel> make_model(const SpringNetwork& network,
-                                            std::optional<double> volume_kappa,
-                                            double point_damping = 0.0,
-                                            std::optional<double> bending_rigidity = std::nullopt);
-/// The model of a built network (its volume and bending terms if it has them).
+/// The model of a network (volume_kappa, bending_rigidity and edge_pairs as in BuiltNetwork),
+/// point damping k_v in N·s/m per node.
+std::unique_ptr<MassSpringModel> make_model(
+    const SpringNetwork& network, std::optional<double> volume_kappa, double point_damping = 0.0,
+    std::optional<double> bending_rigidity = std::nullopt,
+    std::optional<LameParameters> edge_pairs = std::nullopt);
+/// The model of a built network (its volume, bending and edge-pair terms if it has them).
 std::unique_ptr<MassSpringModel> make_model(const BuiltNetwork& built, double point_damping = 0.0);
 
 }  // namespace vessel::msm
