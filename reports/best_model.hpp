@@ -20,7 +20,9 @@ struct BestModelRow {
   double magnitude = 0.0;
   std::string load_unit;
   /// The mass-spring model (kind other than fem) that finished with the lowest relative L2 error
-  /// (ties: the faster); empty when none finished.
+  /// (ties: the faster); empty when none finished. Edge-pair models (P1 FEM written on the tets'
+  /// edges, msm/model/edge_pair_term.hpp) are not candidates: they are the bound a spring model
+  /// is measured against, shown apart in edge_pair_*.
   std::string best_model;
   double best_relative_l2 = 0.0;
   /// solve_seconds: for static and linear mass-spring models the time per update (after set-up),
@@ -33,6 +35,9 @@ struct BestModelRow {
   /// best / P1 (nullopt without a finished P1 or a best model): error ratio ≤ 1 means as
   /// accurate as P1; time ratio < 1 means faster than P1.
   std::optional<double> error_ratio, time_ratio;
+  /// The best edge-pair model on the same case, its error and time over P1's (when both ran).
+  std::string edge_pair_model;
+  std::optional<double> edge_pair_error_ratio, edge_pair_time_ratio;
 };
 
 /// One row per scene, ν and model level that has outcomes at the scene's representative load, in

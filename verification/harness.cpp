@@ -470,7 +470,8 @@ SolvedSystem solved_system(const msm::Problem& full, const msm::MassSpringModel&
   sys.roi = std::make_unique<msm::RoiNetwork>(
       msm::restrict_network(network, held, built.bending_rigidity.has_value()));
   sys.roi_model =
-      msm::make_model(sys.roi->network, built.volume_kappa, spec.damping, built.bending_rigidity);
+      msm::make_model(sys.roi->network, built.volume_kappa, spec.damping, built.bending_rigidity,
+                      built.edge_pairs);
   sys.roi_problem =
       std::make_unique<msm::Problem>(msm::restrict_problem(full, *sys.roi, held, *sys.roi_model));
   sys.problem = sys.roi_problem.get();
@@ -539,6 +540,9 @@ std::string msm_detail(const std::string& topology, const ModelSpec& spec) {
   std::ostringstream d;
   if (spec.kind == ModelKind::network) {  // its springs and masses are the file's own
     d << topology << ", " << msm::to_string(spec.solver);
+  } else if (spec.edge_pairs) {  // no springs, so no stiffness rule
+    d << topology << ", " << msm::to_string(spec.mass) << " masses, "
+      << msm::to_string(spec.solver);
   } else {
     d << topology << ", " << msm::to_string(spec.stiffness) << " stiffness, "
       << msm::to_string(spec.mass) << " masses, " << msm::to_string(spec.solver);
@@ -594,8 +598,9 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
                    const HarnessOptions& o, Progress& progress, ModelOutcome base,
                    SceneResult& result) {
   // The hybrid model refuses ν outside [1/4, 1/2) (κ = λ − μ negative or infinite), the
-  // homogenised one ν = 1/2 and ν below its mesh's floor (found when its network is built):
-  // recorded as failed, as P1 is at ν = 0.5, not fatal to the run.
+  // homogenised one ν = 1/2 and ν below its mesh's floor (found when its network is built), the
+  // edge-pair model ν = 1/2 (λ infinite): recorded as failed, as P1 is at ν = 0.5, not fatal to
+  // the run.
   const MemoryProbe setup_memory;
   Stopwatch setup;  // the homogenised rule's fit is part of the set-up
   std::string why;
@@ -609,6 +614,13 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
       } else {
         built_or.emplace(scene_network(s, spec, mesh, vessel, nu));
       }
+    } catch (const InputError& e) {
+      why = e.what();
+    }
+  }
+  if (spec.edge_pairs && nu >= 0.5) {
+    try {
+      (void)msm::lame_parameters(s.youngs_modulus, nu);
     } catch (const InputError& e) {
       why = e.what();
     }
@@ -1105,7 +1117,8 @@ std::vector<TransientRequest> transient_requests(const Scene& s, const SceneRefe
       if (spec.kind == ModelKind::fem || !spec.solver.is_dynamic() || spec.roi_radius > 0.0 ||
           spec.solver.dt <= 0.0 ||
           (spec.volume_term &&
-           (nu >= 0.5 || (nu < 0.25 && spec.volume_moduli == msm::VolumeModuli::golec)))) {
+           (nu >= 0.5 || (nu < 0.25 && spec.volume_moduli == msm::VolumeModuli::golec))) ||
+          (spec.edge_pairs && nu >= 0.5)) {
         continue;
       }
       VesselParams vessel = s.vessel;

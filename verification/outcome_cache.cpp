@@ -345,6 +345,7 @@ std::string model_run_key(const Scene& s, const ModelSpec& m, double nu, int lev
   h.integer(static_cast<int>(m.surface)).integer(static_cast<int>(m.topology));
   h.integer(static_cast<int>(m.stiffness)).integer(m.volume_term);
   h.integer(static_cast<int>(m.volume_moduli)).integer(static_cast<int>(m.bending));
+  h.integer(m.edge_pairs);
   h.integer(static_cast<int>(m.mass));
   hash_solver(h, m.solver);
   h.real(m.damping).real(m.roi_radius).integer(m.calibration_transfer);

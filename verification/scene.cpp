@@ -413,7 +413,7 @@ std::vector<ModelSpec> outside_model(TableReader& r, ModelSpec m) {
 }
 
 /// A mass-spring table's wall keys: `surface`, `topology` and `bending` (surface models),
-/// `volume_term` and `volume_moduli` (volume models).
+/// `volume_term`, `volume_moduli` and `edge_pairs` (volume models).
 void read_wall_options(TableReader& r, ModelSpec& m) {
   if (m.kind == ModelKind::surface_msm) {
     m.surface = msm::parse_wall_surface(r.name_or("surface", msm::to_string(m.surface), msm::parse_wall_surface));
@@ -436,6 +436,19 @@ void read_wall_options(TableReader& r, ModelSpec& m) {
       r.fail(r.table().get("volume_moduli"), "volume_moduli",
              "found \"" + msm::to_string(m.volume_moduli) +
                  "\" without volume_term = true; expected volume_term = true with it");
+    }
+    // edge_pairs = true: the springs coupled in each tet's edge pairs (Kikuuwe et al. 2009), StVK
+    // P1 on the edges; it has no springs of its own, so no stiffness rule and no volume term.
+    m.edge_pairs = r.boolean_or("edge_pairs", false);
+    if (m.edge_pairs && m.volume_term) {
+      r.fail(r.table().get("edge_pairs"), "edge_pairs",
+             "found true with volume_term = true; expected one of them (the edge-pair model "
+             "reaches any ν < 0.5 by itself)");
+    }
+    if (m.edge_pairs && r.table().get("stiffness")) {
+      r.fail(r.table().get("stiffness"), "stiffness",
+             "found with edge_pairs = true; expected no stiffness key (the edge-pair model's "
+             "coefficients come from each tet's StVK energy, not from a spring rule)");
     }
   }
 }
@@ -588,6 +601,11 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
   if (m.calibration_transfer && m.calibration.empty()) {
     r.fail(r.get("calibration_transfer"), "calibration_transfer",
            "found without a calibration file; expected calibration = \"file.json\" beside it");
+  }
+  if (m.edge_pairs && !m.calibration.empty()) {
+    r.fail(r.get("calibration"), "calibration",
+           "found with edge_pairs = true; expected none (a calibration scales springs, and the "
+           "edge-pair model has none)");
   }
   const std::vector<double> radii = roi_radii(r, load);
   const std::vector<double> dts = read_time_stepping(r, m, solvers);

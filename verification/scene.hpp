@@ -63,6 +63,9 @@ struct ModelSpec {
   bool volume_term = false;
   /// volume_term's rule for (E_s, κ): golec (default) or homogenised (msm/model/build_network.hpp).
   msm::VolumeModuli volume_moduli = msm::VolumeModuli::golec;
+  /// volume_msm: each tet's springs coupled in its tetrahedron-sharing edge pairs, the edge-based
+  /// StVK tetrahedron of Kikuuwe et al. 2009 (msm/model/edge_pair_term.hpp): P1 FEM on the edges.
+  bool edge_pairs = false;
   /// surface msm: discrete_shells adds the Discrete Shells hinge energy (Grinspun et al. 2003) with
   /// D = E·t³/(12(1 − ν²)) and drops the bend springs (msm/model/build_network.hpp).
   msm::Bending bending = msm::Bending::none;

@@ -143,6 +143,7 @@ msm::NetworkOptions network_options(const Scene& s, const ModelSpec& model, doub
   o.volume_term = model.volume_term;
   o.volume_moduli = model.volume_moduli;
   o.bending = model.bending;
+  o.edge_pairs = model.edge_pairs;
   o.stiffness_params.youngs_modulus = s.youngs_modulus;
   o.stiffness_params.poisson_ratio = nu;
   o.mass = model.mass;

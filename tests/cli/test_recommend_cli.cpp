@@ -55,8 +55,9 @@ TEST(RecommendCli, NamesACandidateThatMeetsTheBudgetWithItsEvidence) {
   EXPECT_EQ(j["budget"]["quantity"], "patch");
   EXPECT_DOUBLE_EQ(j["budget"]["seconds_per_update"].get<double>(), 1.0 / 30.0);
   // FEM P1 + (2 kinds × 6 rules + the hybrid volume model under its two moduli rules + the
-  // discrete-shells surface model) × (static, linear, R = 4 mm), level 0.
-  ASSERT_EQ(j["candidates"].size(), 46u);
+  // edge-pair volume model + the discrete-shells surface model) × (static, linear, R = 4 mm),
+  // level 0.
+  ASSERT_EQ(j["candidates"].size(), 49u);
   const double tol = 0.05, budget = 1.0 / 30.0;
   ASSERT_FALSE(j["recommended"].is_null()) << read_text(out / "recommend.md");
   const std::string best = j["recommended"];

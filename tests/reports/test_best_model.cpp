@@ -45,6 +45,10 @@ ResultsFile synthetic() {
                 row("A", "volume_msm", "", 0.3, 0, L, 0.50, 0.02),
                 row("B", "surface_msm", "", 0.3, 0, L, 0.25, 0.08),
                 row("C", "volume_msm", "", 0.3, 0, L, 0.0, 0.001, false),
+                // the edge-pair model (P1 on the edges) beats B but is shown apart, not as best
+                row("E", "volume_msm",
+                    "tetrahedral edges (seed 001) coupled in tetrahedron-sharing edge pairs", 0.3,
+                    0, L, 0.11, 0.04),
                 // another load: ignored (A would win there)
                 row("A", "volume_msm", "", 0.3, 0, 1e-3, 0.001, 0.02),
                 row("p1", "fem", "P1, direct (CHOLMOD)", 0.3, 0, 1e-3, 0.10, 0.40),
@@ -80,6 +84,12 @@ TEST(BestModel, RatiosToP1OnTheSameLevelByHand) {
   EXPECT_DOUBLE_EQ(*rows[0].error_ratio, 2.5);
   EXPECT_DOUBLE_EQ(*rows[0].time_ratio, 0.2);
   EXPECT_EQ(rows[0].p1_model.value_or(""), "p1");
+  // Its edge-pair model apart: 0.11 / 0.10 = 1.1, 0.04 / 0.40 = 0.1.
+  EXPECT_EQ(rows[0].edge_pair_model, "E");
+  ASSERT_TRUE(rows[0].edge_pair_error_ratio && rows[0].edge_pair_time_ratio);
+  EXPECT_DOUBLE_EQ(*rows[0].edge_pair_error_ratio, 0.11 / 0.10);
+  EXPECT_DOUBLE_EQ(*rows[0].edge_pair_time_ratio, 0.04 / 0.40);
+  EXPECT_FALSE(rows[1].edge_pair_error_ratio.has_value());
   // level 1: the tie at 0.04 goes to the faster B; 0.04 / 0.05 = 0.8, 0.2 / 1.6 = 0.125.
   EXPECT_EQ(rows[1].level, 1);
   EXPECT_EQ(rows[1].best_model, "B");
@@ -100,6 +110,9 @@ TEST(BestModel, RatiosToP1OnTheSameLevelByHand) {
   EXPECT_EQ(t.rows[0][4], "B");
   EXPECT_EQ(t.rows[0][7], "2.5");
   EXPECT_EQ(t.rows[0][10], "0.2");
+  EXPECT_EQ(t.rows[0][11], "1.1");
+  EXPECT_EQ(t.rows[0][12], "0.1");
+  EXPECT_EQ(t.rows[1][11], "–");
   EXPECT_EQ(t.rows[0][3], "0.5 mN");
   EXPECT_EQ(t.rows[2][6], "no P1");
   EXPECT_EQ(t.rows[2][7], "–");
@@ -110,7 +123,7 @@ TEST(BestModel, TheReportCarriesTheTable) {
   const Document doc = build_report(synthetic(), std::nullopt, "test");
   const std::string md = doc.markdown_text("figures");
   EXPECT_NE(md.find("## Best mass-spring model against P1"), std::string::npos);
-  EXPECT_NE(md.find("| s1 | 0.3 | 1 | 0.5 mN | B | 0.04 | 0.05 | 0.8 | 0.2 | 1.6 | 0.125 |"),
+  EXPECT_NE(md.find("| s1 | 0.3 | 1 | 0.5 mN | B | 0.04 | 0.05 | 0.8 | 0.2 | 1.6 | 0.125 | – | – |"),
             std::string::npos)
       << md;
 }

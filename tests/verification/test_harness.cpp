@@ -60,6 +60,11 @@ stiffness = "seed001"
 solver = "explicit-euler"
 dt = 1.0
 steps = 50
+[[models]]
+name = "edge_pairs_linear"
+kind = "volume_msm"
+edge_pairs = true
+solver = "linear"
 )";
 
 /// The Lamé tube with natural frequencies ([modes]): P2 on the reference's mesh, P1, and two
@@ -183,7 +188,21 @@ TEST_F(HarnessLame, ADivergingModelIsRecordedAsFailedAndTheOthersStillRun) {
   EXPECT_NE(o.failure.find("step"), std::string::npos) << o.failure;
   EXPECT_TRUE(find(*result_, "volume_linear", 20.0).ok);
   EXPECT_EQ(result_->references.size(), 1u);
-  EXPECT_EQ(result_->outcomes.size(), 8u);
+  EXPECT_EQ(result_->outcomes.size(), 10u);
+}
+
+TEST_F(HarnessLame, TheEdgePairModelSolvedLinearlyIsDealIIsP1) {
+  // Linearised at rest the edge-pair model's stiffness is P1's element stiffness (unit tests), on
+  // the same tets; its pressure load, roller ends and nodes are the mass-spring side's own. So it
+  // reproduces deal.II's P1 solve, which checks that the two pipelines pose the same problem.
+  for (const double p : {10.0, 20.0}) {
+    const ModelOutcome& pairs = find(*result_, "edge_pairs_linear", p);
+    const ModelOutcome& p1 = find(*result_, "p1", p);
+    ASSERT_TRUE(pairs.ok && p1.ok) << pairs.failure;
+    EXPECT_NEAR(pairs.error.relative_l2, p1.error.relative_l2, 1e-6 * p1.error.relative_l2);
+    EXPECT_NEAR(pairs.error.max_mm, p1.error.max_mm, 1e-6 * p1.error.max_mm);
+    EXPECT_NEAR(pairs.qoi_displacement_mm, p1.qoi_displacement_mm, 1e-6 * p1.qoi_displacement_mm);
+  }
 }
 
 TEST_F(HarnessLame, ResultsJsonHasEveryFieldItsSchemaRequires) {
@@ -210,7 +229,7 @@ TEST_F(HarnessLame, ResultsJsonHasEveryFieldItsSchemaRequires) {
   }
   // One CSV row per outcome plus the header, every row with the header's number of fields.
   const std::string csv = test::read_text(dir / "results.csv");
-  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 8);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 10);
   std::istringstream rows(csv);
   std::string header;
   std::getline(rows, header);

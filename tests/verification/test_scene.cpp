@@ -277,6 +277,33 @@ TEST(Scene, VolumeModuliSelectsTheHomogenisedRule) {
   EXPECT_NE(alone.find("volume_term = true"), std::string::npos) << alone;
 }
 
+TEST(Scene, EdgePairsSelectsTheEdgePairModel) {
+  const Scene s = parse_scene(std::string(kMinimal) +
+                                  "[[models]]\nname = \"pairs\"\nkind = \"volume_msm\"\n"
+                                  "edge_pairs = true\n",
+                              "scene.toml");
+  EXPECT_TRUE(s.models.back().edge_pairs);
+  EXPECT_FALSE(s.models.back().volume_term);
+  // With a stiffness rule, the volume term or a calibration: refused, naming the key; on a
+  // surface model the key is unknown.
+  const auto rule = error_of(std::string(kMinimal) +
+                             "[[models]]\nkind = \"volume_msm\"\nedge_pairs = true\n"
+                             "stiffness = \"lloyd\"\n");
+  EXPECT_NE(rule.find("models[1].stiffness"), std::string::npos) << rule;
+  EXPECT_NE(rule.find("edge_pairs"), std::string::npos) << rule;
+  const auto both = error_of(std::string(kMinimal) +
+                             "[[models]]\nkind = \"volume_msm\"\nedge_pairs = true\n"
+                             "volume_term = true\n");
+  EXPECT_NE(both.find("models[1].edge_pairs"), std::string::npos) << both;
+  const auto calibrated = error_of(std::string(kMinimal) +
+                                   "[[models]]\nkind = \"volume_msm\"\nedge_pairs = true\n"
+                                   "calibration = \"c.json\"\n");
+  EXPECT_NE(calibrated.find("models[1].calibration"), std::string::npos) << calibrated;
+  const auto surface = error_of(std::string(kMinimal) +
+                                "[[models]]\nkind = \"surface_msm\"\nedge_pairs = true\n");
+  EXPECT_NE(surface.find("edge_pairs"), std::string::npos) << surface;
+}
+
 TEST(Scene, ModesTableIsReadAndCheckedNamingTheKey) {
   EXPECT_EQ(parse_scene(kMinimal, "scene.toml").modes.count, 0);  // off unless asked for
   const Scene s = parse_scene(std::string(kMinimal) + "[modes]\ncount = 6\nreference_level = 0\n",

@@ -38,6 +38,7 @@ struct MsmOptions {
   bool two_ring = false;
   std::string stiffness;  ///< empty: seed000, or van-gelder with --volume-term or --bending
   bool volume_term = false;
+  bool edge_pairs = false;
   std::string volume_moduli = "golec";
   std::string bending = "none";
   msm::StiffnessParams stiffness_params;
@@ -221,6 +222,7 @@ msm::BuiltNetwork command_network(const MsmOptions& o, const Scene& s, const Tet
   n.two_ring = o.two_ring;
   n.stiffness = msm::parse_stiffness_rule(o.stiffness);
   n.volume_term = o.volume_term;
+  n.edge_pairs = o.edge_pairs;
   n.volume_moduli = msm::parse_volume_moduli(o.volume_moduli);
   n.bending = msm::parse_bending(o.bending);
   n.stiffness_params = o.stiffness_params;
@@ -503,6 +505,10 @@ void add_model_options(CLI::App* cmd, MsmOptions& o) {
                 "Hybrid volume model (Golec et al. 2020), volume model only: van-gelder springs "
                 "carrying the shear modulus plus a volume energy per tet, κ = λ − μ, so that the "
                 "network has the material's ν (< 0.5)");
+  cmd->add_flag("--edge-pairs", o.edge_pairs,
+                "Volume model only: each tet's springs coupled in its edge pairs, the edge-based "
+                "StVK tetrahedron of Kikuuwe et al. 2009 (P1 FEM written on the edges, any ν < "
+                "0.5); replaces the springs, so --stiffness does not apply");
   cmd->add_option("--volume-moduli", o.volume_moduli,
                   "With --volume-term: golec (default; E_s = 2.5μ, κ = λ − μ) or homogenised "
                   "((E_s, κ) fitted so that this mesh's network, under uniform boundary "

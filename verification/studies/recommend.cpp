@@ -162,12 +162,16 @@ struct SpringChoice {
   bool volume_term = false;
   msm::Bending bending = msm::Bending::none;
   msm::VolumeModuli volume_moduli = msm::VolumeModuli::golec;  ///< with volume_term
-  [[nodiscard]] bool plain() const { return !volume_term && bending == msm::Bending::none; }
+  bool edge_pairs = false;  ///< the springs coupled in edge pairs (msm/model/edge_pair_term.hpp)
+  [[nodiscard]] bool plain() const {
+    return !volume_term && !edge_pairs && bending == msm::Bending::none;
+  }
 };
 
 /// The spring models of a kind: every stiffness rule; for volume networks also the hybrid volume
-/// model (van-gelder springs + volume term, msm/model/model_factory.hpp); for surface networks
-/// also the Discrete Shells model (van-gelder membrane + hinge energy, msm/model/bending_term.hpp).
+/// model (van-gelder springs + volume term, msm/model/model_factory.hpp) and the edge-pair model
+/// (P1 on the tets' edges, msm/model/edge_pair_term.hpp); for surface networks also the Discrete
+/// Shells model (van-gelder membrane + hinge energy, msm/model/bending_term.hpp).
 std::vector<SpringChoice> spring_rules(ModelKind kind) {
   std::vector<SpringChoice> out;
   for (const msm::StiffnessRule rule : msm::kAllStiffnessRules) out.push_back({rule});
@@ -176,6 +180,8 @@ std::vector<SpringChoice> spring_rules(ModelKind kind) {
     // The homogenised rule's (E_s, κ) (msm/model/volume_term_homogenised.hpp).
     out.push_back(
         {msm::StiffnessRule::van_gelder, true, msm::Bending::none, msm::VolumeModuli::homogenised});
+    out.push_back({msm::StiffnessRule::seed001, false, msm::Bending::none,
+                   msm::VolumeModuli::golec, true});
   }
   if (kind == ModelKind::surface_msm) {
     out.push_back({msm::StiffnessRule::van_gelder, false, msm::Bending::discrete_shells});
@@ -184,6 +190,7 @@ std::vector<SpringChoice> spring_rules(ModelKind kind) {
 }
 
 std::string rule_label(const SpringChoice& c) {
+  if (c.edge_pairs) return "edge-pairs";
   if (c.volume_term) {
     return c.volume_moduli == msm::VolumeModuli::homogenised ? "hybrid-volume-homogenised"
                                                              : "hybrid-volume";
@@ -215,6 +222,7 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
         m.volume_term = choice.volume_term;
         m.volume_moduli = choice.volume_moduli;
         m.bending = choice.bending;
+        m.edge_pairs = choice.edge_pairs;
         m.mass = msm::MassRule::consistent;  // irrelevant to a static answer
         const std::string rule_name = rule_label(choice);
         for (const std::string solver : {"static", "linear"}) {
@@ -270,6 +278,7 @@ std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double
           m.volume_term = choice.volume_term;
           m.volume_moduli = choice.volume_moduli;
           m.bending = choice.bending;
+          m.edge_pairs = choice.edge_pairs;
           m.mass = msm::MassRule::consistent;  // the FEM transient's mass
           m.solver.kind = msm::SolverKind::integrator;
           m.solver.integrator = integrator;

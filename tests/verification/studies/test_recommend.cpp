@@ -200,8 +200,8 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   s.models = {m};
   const std::vector<ModelSpec> c = candidate_models(s, {4e-3, 8e-3});
   // FEM P1 + (2 kinds × every rule + the hybrid volume model under both rules for its moduli +
-  // the discrete-shells surface model) × (static, linear, 2 radii).
-  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 3;
+  // the edge-pair volume model + the discrete-shells surface model) × (static, linear, 2 radii).
+  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 4;
   ASSERT_EQ(c.size(), 1 + spring_models * 4);
   std::set<std::string> names, rules;
   for (const auto& x : c) {
@@ -214,7 +214,9 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   EXPECT_TRUE(names.count("volume/hybrid-volume/static"));
   EXPECT_TRUE(names.count("volume/hybrid-volume-homogenised/static"));
   EXPECT_TRUE(names.count("surface/discrete-shells/static/R=8mm"));
+  EXPECT_TRUE(names.count("volume/edge-pairs/linear"));
   for (const auto& x : c) {
+    EXPECT_EQ(x.edge_pairs, x.name.starts_with("volume/edge-pairs/")) << x.name;
     if (x.name.starts_with("surface/discrete-shells/")) {
       EXPECT_EQ(x.bending, msm::Bending::discrete_shells) << x.name;
       EXPECT_EQ(x.stiffness, msm::StiffnessRule::van_gelder) << x.name;
@@ -242,11 +244,13 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   s.models = {e, i};
   const std::vector<ModelSpec> d = candidate_models(s, {4e-3});
   // Every integrator on every spring model, plus local-global-euler on the plain spring networks
-  // (all but the two hybrid volume and the discrete-shells models), at the implicit step.
-  ASSERT_EQ(d.size(), spring_models * msm::kAllIntegrators.size() + spring_models - 3);
+  // (all but the two hybrid volume, the edge-pair and the discrete-shells models), at the
+  // implicit step.
+  ASSERT_EQ(d.size(), spring_models * msm::kAllIntegrators.size() + spring_models - 4);
   for (const auto& x : d) {
     if (x.solver.kind == msm::SolverKind::local_global_euler) {
       EXPECT_FALSE(x.volume_term) << x.name;
+      EXPECT_FALSE(x.edge_pairs) << x.name;
       EXPECT_EQ(x.bending, msm::Bending::none) << x.name;
       EXPECT_DOUBLE_EQ(x.solver.dt, 1e-3) << x.name;
       EXPECT_EQ(x.solver.steps, 200) << x.name;
@@ -271,7 +275,7 @@ TEST(Candidates, IncludeTheScenesCalibratedModels) {
   m.calibration_transfer = true;
   s.models = {m};
   const std::vector<ModelSpec> c = candidate_models(s, {4e-3});
-  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 3;  // as above
+  const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 4;  // as above
   ASSERT_EQ(c.size(), 1 + spring_models * 3 + 2);
   int calibrated = 0;
   for (const auto& x : c) {

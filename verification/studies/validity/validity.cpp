@@ -172,7 +172,7 @@ std::vector<const ModelSpec*> chosen_models(const Scene& s, const ValidityOption
   }
   for (const ModelSpec& m : s.models) {
     if (!eligible(m)) continue;
-    const bool seed = !m.volume_term && m.bending == msm::Bending::none &&
+    const bool seed = !m.volume_term && !m.edge_pairs && m.bending == msm::Bending::none &&
                       m.calibration.empty() &&
                       (m.stiffness == msm::StiffnessRule::seed000 ||
                        m.stiffness == msm::StiffnessRule::seed001);
