@@ -165,30 +165,20 @@ std::vector<std::array<int, 4>> interior_hinges(const std::vector<Triangle>& tri
   return out;
 }
 
-namespace {
-
-std::vector<std::array<int, 4>> hinge_nodes(const std::vector<Hinge>& hinges) {
-  std::vector<std::array<int, 4>> nodes;
-  nodes.reserve(hinges.size());
-  for (const Hinge& h : hinges) nodes.push_back(h.nodes);
-  return nodes;
-}
-
-}  // namespace
-
 BendingTerm::BendingTerm(const std::vector<Vec3>& nodes, const std::vector<Triangle>& triangles,
                          double bending_rigidity)
-    : num_nodes_(static_cast<int>(nodes.size())), rigidity_(bending_rigidity) {
+    : FourNodeTerm(static_cast<int>(nodes.size())), rigidity_(bending_rigidity) {
+  const int num_nodes = static_cast<int>(nodes.size());
   if (!std::isfinite(bending_rigidity) || bending_rigidity < 0.0) {
     throw InputError("bending term: expected a finite bending rigidity D >= 0 N·m, got " +
                      std::to_string(bending_rigidity));
   }
   for (std::size_t f = 0; f < triangles.size(); ++f) {
     for (int v : triangles[f]) {
-      if (v < 0 || v >= num_nodes_) {
+      if (v < 0 || v >= num_nodes) {
         throw InputError("bending term: triangle " + std::to_string(f) + " refers to node " +
                          std::to_string(v) + ", expected an index below " +
-                         std::to_string(num_nodes_));
+                         std::to_string(num_nodes));
       }
     }
   }
@@ -203,51 +193,23 @@ BendingTerm::BendingTerm(const std::vector<Vec3>& nodes, const std::vector<Trian
     hinges_.push_back(
         {q, dihedral_angle(x), discrete_shells_hinge_stiffness(bending_rigidity, L, A)});
   }
-  pattern_ = four_node_block_pattern(num_dofs(), hinge_nodes(hinges_));
-  slots_ = slots_in(pattern_);
+  std::vector<std::array<int, 4>> elements;
+  elements.reserve(hinges_.size());
+  for (const Hinge& h : hinges_) elements.push_back(h.nodes);
+  set_elements(std::move(elements));
 }
 
-std::array<Vec3, 4> BendingTerm::corners(const VectorXd& x, const Hinge& h) const {
-  const auto& q = h.nodes;
-  return {x.segment<3>(3 * q[0]), x.segment<3>(3 * q[1]), x.segment<3>(3 * q[2]),
-          x.segment<3>(3 * q[3])};
+double BendingTerm::element_energy(std::size_t k, const std::array<Vec3, 4>& x) const {
+  return hinge_energy(x, hinges_[k].rest_angle, hinges_[k].stiffness);
 }
 
-double BendingTerm::energy(const VectorXd& x) const {
-  double e = 0.0;
-  for (const Hinge& h : hinges_) e += hinge_energy(corners(x, h), h.rest_angle, h.stiffness);
-  return e;
+Vec12 BendingTerm::element_gradient(std::size_t k, const std::array<Vec3, 4>& x) const {
+  return hinge_gradient(x, hinges_[k].rest_angle, hinges_[k].stiffness);
 }
 
-void BendingTerm::add_gradient(const VectorXd& x, VectorXd& g) const {
-  for (const Hinge& h : hinges_) {
-    const Vec12 gk = hinge_gradient(corners(x, h), h.rest_angle, h.stiffness);
-    for (int a = 0; a < 4; ++a) g.segment<3>(3 * h.nodes[a]) += gk.segment<3>(3 * a);
-  }
-}
-
-void BendingTerm::gradient(const VectorXd& x, VectorXd& g) const {
-  g.setZero(num_dofs());
-  add_gradient(x, g);
-}
-
-std::vector<int> BendingTerm::slots_in(const SparseMatrix& pattern) const {
-  return four_node_block_slots(pattern, hinge_nodes(hinges_));
-}
-
-void BendingTerm::add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,
-                              bool project_psd) const {
-  const int* s = slots.data();
-  for (const Hinge& h : hinges_) {
-    add_four_node_block(hinge_hessian(corners(x, h), h.rest_angle, h.stiffness, project_psd), s,
-                        values);
-  }
-}
-
-void BendingTerm::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
-  H = pattern_;
-  std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
-  add_hessian(x, H.valuePtr(), slots_, project_psd);
+Mat12 BendingTerm::element_hessian(std::size_t k, const std::array<Vec3, 4>& x,
+                                   bool project_psd) const {
+  return hinge_hessian(x, hinges_[k].rest_angle, hinges_[k].stiffness, project_psd);
 }
 
 }  // namespace vessel::msm

@@ -75,7 +75,7 @@ struct Hinge {
 std::vector<std::array<int, 4>> interior_hinges(const std::vector<Triangle>& triangles);
 
 /// The Discrete Shells bending term of a triangle surface as a Form (no damping).
-class BendingTerm : public Form {
+class BendingTerm : public FourNodeTerm {
  public:
   /// `nodes`: rest positions (m); `triangles` index them; D the plate bending rigidity (N·m).
   /// Throws InputError for a non-finite or negative D, an index out of range, or a degenerate
@@ -83,32 +83,17 @@ class BendingTerm : public Form {
   BendingTerm(const std::vector<Vec3>& nodes, const std::vector<Triangle>& triangles,
               double bending_rigidity);
 
-  [[nodiscard]] int num_dofs() const override { return 3 * num_nodes_; }
-  [[nodiscard]] double energy(const VectorXd& x) const override;
-  void gradient(const VectorXd& x, VectorXd& g) const override;
-  void hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const override;
-
-  /// g += ∇W (g already sized).
-  void add_gradient(const VectorXd& x, VectorXd& g) const;
-  /// Per hinge, the 144 value indices of its 12×12 block in `pattern` (−1 where missing).
-  [[nodiscard]] std::vector<int> slots_in(const SparseMatrix& pattern) const;
-  /// Adds every hinge's Hessian block into `values` at `slots` (from slots_in, none −1).
-  void add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,
-                   bool project_psd) const;
-  /// The sparsity pattern of the term's Hessian (hinge blocks plus the full diagonal), values 0.
-  [[nodiscard]] const SparseMatrix& pattern() const { return pattern_; }
-
   [[nodiscard]] double bending_rigidity() const { return rigidity_; }
   [[nodiscard]] const std::vector<Hinge>& hinges() const { return hinges_; }
 
  private:
-  [[nodiscard]] std::array<Vec3, 4> corners(const VectorXd& x, const Hinge& h) const;
+  [[nodiscard]] double element_energy(std::size_t k, const std::array<Vec3, 4>& x) const override;
+  [[nodiscard]] Vec12 element_gradient(std::size_t k, const std::array<Vec3, 4>& x) const override;
+  [[nodiscard]] Mat12 element_hessian(std::size_t k, const std::array<Vec3, 4>& x,
+                                      bool project_psd) const override;
 
-  int num_nodes_ = 0;
   double rigidity_ = 0.0;
   std::vector<Hinge> hinges_;
-  SparseMatrix pattern_;
-  std::vector<int> slots_;
 };
 
 }  // namespace vessel::msm

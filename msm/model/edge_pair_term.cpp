@@ -100,85 +100,50 @@ Mat12 edge_pair_hessian(const std::array<Vec3, 4>& x, const std::array<Vec3, 4>&
 
 EdgePairTerm::EdgePairTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets,
                            const LameParameters& lame)
-    : rest_(nodes), tets_(std::move(tets)), lame_(lame) {
-  coefficients_.reserve(tets_.size());
-  const int n = static_cast<int>(rest_.size());
-  for (std::size_t e = 0; e < tets_.size(); ++e) {
-    for (int v : tets_[e]) {
+    : FourNodeTerm(static_cast<int>(nodes.size())), lame_(lame) {
+  const int n = static_cast<int>(nodes.size());
+  rest_corners_.reserve(tets.size());
+  coefficients_.reserve(tets.size());
+  for (std::size_t e = 0; e < tets.size(); ++e) {
+    for (int v : tets[e]) {
       if (v < 0 || v >= n) {
         throw InputError("edge pairs: tet " + std::to_string(e) + " refers to node " +
                          std::to_string(v) + ", expected an index below " + std::to_string(n));
       }
     }
+    const Tet& t = tets[e];
+    rest_corners_.push_back({nodes[t[0]], nodes[t[1]], nodes[t[2]], nodes[t[3]]});
     try {
-      coefficients_.push_back(edge_pair_coefficients(rest_corners(tets_[e]), lame_));
+      coefficients_.push_back(edge_pair_coefficients(rest_corners_.back(), lame_));
     } catch (const InputError&) {
       throw InputError("edge pairs: tet " + std::to_string(e) +
                        " has zero rest volume; expected a non-degenerate tetrahedron");
     }
   }
-  pattern_ = four_node_block_pattern(num_dofs(), tets_);
-  slots_ = slots_in(pattern_);
+  set_elements(std::move(tets));
 }
 
-std::array<Vec3, 4> EdgePairTerm::corners(const VectorXd& x, const Tet& t) const {
-  return {x.segment<3>(3 * t[0]), x.segment<3>(3 * t[1]), x.segment<3>(3 * t[2]),
-          x.segment<3>(3 * t[3])};
+double EdgePairTerm::element_energy(std::size_t k, const std::array<Vec3, 4>& x) const {
+  return edge_pair_energy(x, rest_corners_[k], coefficients_[k]);
 }
 
-std::array<Vec3, 4> EdgePairTerm::rest_corners(const Tet& t) const {
-  return {rest_[t[0]], rest_[t[1]], rest_[t[2]], rest_[t[3]]};
+Vec12 EdgePairTerm::element_gradient(std::size_t k, const std::array<Vec3, 4>& x) const {
+  return edge_pair_gradient(x, rest_corners_[k], coefficients_[k]);
 }
 
-double EdgePairTerm::energy(const VectorXd& x) const {
-  double e = 0.0;
-  for (std::size_t k = 0; k < tets_.size(); ++k) {
-    e += edge_pair_energy(corners(x, tets_[k]), rest_corners(tets_[k]), coefficients_[k]);
-  }
-  return e;
-}
-
-void EdgePairTerm::add_gradient(const VectorXd& x, VectorXd& g) const {
-  for (std::size_t k = 0; k < tets_.size(); ++k) {
-    const Tet& t = tets_[k];
-    const Vec12 gk = edge_pair_gradient(corners(x, t), rest_corners(t), coefficients_[k]);
-    for (int a = 0; a < 4; ++a) g.segment<3>(3 * t[a]) += gk.segment<3>(3 * a);
-  }
-}
-
-void EdgePairTerm::gradient(const VectorXd& x, VectorXd& g) const {
-  g.setZero(num_dofs());
-  add_gradient(x, g);
-}
-
-std::vector<int> EdgePairTerm::slots_in(const SparseMatrix& pattern) const {
-  return four_node_block_slots(pattern, tets_);
-}
-
-void EdgePairTerm::add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,
-                               bool project_psd) const {
-  const int* s = slots.data();
-  for (std::size_t k = 0; k < tets_.size(); ++k) {
-    const Tet& t = tets_[k];
-    add_four_node_block(
-        edge_pair_hessian(corners(x, t), rest_corners(t), coefficients_[k], project_psd), s,
-        values);
-  }
-}
-
-void EdgePairTerm::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
-  H = pattern_;
-  std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
-  add_hessian(x, H.valuePtr(), slots_, project_psd);
+Mat12 EdgePairTerm::element_hessian(std::size_t k, const std::array<Vec3, 4>& x,
+                                    bool project_psd) const {
+  return edge_pair_hessian(x, rest_corners_[k], coefficients_[k], project_psd);
 }
 
 double EdgePairTerm::max_strain(const VectorXd& x) const {
   double m = 0.0;
-  for (const Tet& t : tets_) {
+  for (std::size_t k = 0; k < elements().size(); ++k) {
+    const std::array<Vec3, 4> c = corners(x, k);
+    const std::array<Vec3, 4>& r = rest_corners_[k];
     for (const auto& [a, b] : kTetEdges) {
-      const double L = (rest_[t[b]] - rest_[t[a]]).norm();
-      const double l = (x.segment<3>(3 * t[b]) - x.segment<3>(3 * t[a])).norm();
-      m = std::max(m, std::abs(l - L) / L);
+      const double L = (r[b] - r[a]).norm();
+      m = std::max(m, std::abs((c[b] - c[a]).norm() - L) / L);
     }
   }
   return m;

@@ -59,40 +59,25 @@ Mat12 edge_pair_hessian(const std::array<Vec3, 4>& x, const std::array<Vec3, 4>&
                         bool project_psd);
 
 /// Every tet's pair term as a Form (no damping).
-class EdgePairTerm : public Form {
+class EdgePairTerm : public FourNodeTerm {
  public:
   /// `nodes`: rest positions (m); `tets` index them. InputError for a tet with an out-of-range
   /// node or zero rest volume.
   EdgePairTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, const LameParameters& lame);
 
-  [[nodiscard]] int num_dofs() const override { return 3 * static_cast<int>(rest_.size()); }
-  [[nodiscard]] double energy(const VectorXd& x) const override;
-  void gradient(const VectorXd& x, VectorXd& g) const override;
-  void hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const override;
-
-  /// g += ∇W (g already sized).
-  void add_gradient(const VectorXd& x, VectorXd& g) const;
-  /// Per tet, the 144 value indices of its 12×12 block in `pattern`; −1 where it lacks an entry.
-  [[nodiscard]] std::vector<int> slots_in(const SparseMatrix& pattern) const;
-  /// Adds every tet's Hessian block into `values` at `slots` (from slots_in, none −1).
-  void add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,
-                   bool project_psd) const;
-  /// The Hessian's sparsity pattern (tet blocks plus the full diagonal), values 0.
-  [[nodiscard]] const SparseMatrix& pattern() const { return pattern_; }
   /// Largest edge strain |l − L|/L over the tets' edges at x.
   [[nodiscard]] double max_strain(const VectorXd& x) const;
   [[nodiscard]] const LameParameters& lame() const { return lame_; }
 
  private:
-  [[nodiscard]] std::array<Vec3, 4> corners(const VectorXd& x, const Tet& t) const;
-  [[nodiscard]] std::array<Vec3, 4> rest_corners(const Tet& t) const;
+  [[nodiscard]] double element_energy(std::size_t k, const std::array<Vec3, 4>& x) const override;
+  [[nodiscard]] Vec12 element_gradient(std::size_t k, const std::array<Vec3, 4>& x) const override;
+  [[nodiscard]] Mat12 element_hessian(std::size_t k, const std::array<Vec3, 4>& x,
+                                      bool project_psd) const override;
 
-  std::vector<Vec3> rest_;
-  std::vector<Tet> tets_;
   LameParameters lame_;
-  std::vector<Mat6> coefficients_;  ///< C per tet
-  SparseMatrix pattern_;
-  std::vector<int> slots_;
+  std::vector<std::array<Vec3, 4>> rest_corners_;  ///< per tet
+  std::vector<Mat6> coefficients_;                 ///< C per tet
 };
 
 }  // namespace vessel::msm

@@ -59,24 +59,25 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
     }
     edge_pairs_ = std::make_unique<EdgePairTerm>(network.nodes, network.tets, *edge_pairs);
   }
-  if (!volume_ && !bending_ && !edge_pairs_) return;
+  if (volume_) terms_.push_back(volume_.get());
+  if (bending_) terms_.push_back(bending_.get());
+  if (edge_pairs_) terms_.push_back(edge_pairs_.get());
+  if (terms_.empty()) return;
   SparseMatrix Hs;
   springs_.hessian(flatten(network.nodes), Hs, false);
-  auto missing = [](const std::vector<int>& slots) {
-    return std::find(slots.begin(), slots.end(), -1) != slots.end();
-  };
-  if (volume_) volume_slots_ = volume_->slots_in(Hs);
-  if (bending_) bending_slots_ = bending_->slots_in(Hs);
-  if (edge_pairs_) edge_pair_slots_ = edge_pairs_->slots_in(Hs);
-  if (!missing(volume_slots_) && !missing(bending_slots_) && !missing(edge_pair_slots_)) return;
+  bool missing = false;
+  for (const FourNodeTerm* t : terms_) {
+    term_slots_.push_back(t->slots_in(Hs));
+    missing = missing || std::find(term_slots_.back().begin(), term_slots_.back().end(), -1) !=
+                             term_slots_.back().end();
+  }
+  if (!missing) return;
   // Some term entries are not in the springs' pattern (a region of interest drops the springs
   // between two held nodes; a hinge couples its two opposite vertices, which no spring joins once
   // the bend springs are dropped; the edge-pair model has no springs): assemble into the union of
   // the patterns.
   union_pattern_ = Hs;
-  if (volume_) union_pattern_ += volume_->pattern();
-  if (bending_) union_pattern_ += bending_->pattern();
-  if (edge_pairs_) union_pattern_ += edge_pairs_->pattern();
+  for (const FourNodeTerm* t : terms_) union_pattern_ += t->pattern();
   union_pattern_.makeCompressed();
   std::fill(union_pattern_.valuePtr(), union_pattern_.valuePtr() + union_pattern_.nonZeros(), 0.0);
   for (int col = 0; col < Hs.outerSize(); ++col) {
@@ -84,9 +85,9 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
       spring_to_union_.push_back(pattern_slot(union_pattern_, static_cast<int>(it.row()), col));
     }
   }
-  if (volume_) volume_slots_ = volume_->slots_in(union_pattern_);
-  if (bending_) bending_slots_ = bending_->slots_in(union_pattern_);
-  if (edge_pairs_) edge_pair_slots_ = edge_pairs_->slots_in(union_pattern_);
+  for (std::size_t k = 0; k < terms_.size(); ++k) {
+    term_slots_[k] = terms_[k]->slots_in(union_pattern_);
+  }
 }
 
 double MassSpringModel::max_strain(const VectorXd& x) const {
@@ -95,39 +96,26 @@ double MassSpringModel::max_strain(const VectorXd& x) const {
 }
 
 double MassSpringModel::energy(const VectorXd& x) const {
-  return springs_.energy(x) + (volume_ ? volume_->energy(x) : 0.0) +
-         (bending_ ? bending_->energy(x) : 0.0) + (edge_pairs_ ? edge_pairs_->energy(x) : 0.0);
+  double e = springs_.energy(x);
+  for (const FourNodeTerm* t : terms_) e += t->energy(x);
+  return e;
 }
 
 void MassSpringModel::gradient(const VectorXd& x, VectorXd& g) const {
   springs_.gradient(x, g);
-  if (volume_) volume_->add_gradient(x, g);
-  if (bending_) bending_->add_gradient(x, g);
-  if (edge_pairs_) edge_pairs_->add_gradient(x, g);
+  for (const FourNodeTerm* t : terms_) t->add_gradient(x, g);
 }
 
 double MassSpringModel::energy_gradient(const VectorXd& x, VectorXd& g) const {
   double e = springs_.energy_gradient(x, g);
-  if (volume_) {
-    volume_->add_gradient(x, g);
-    e += volume_->energy(x);
-  }
-  if (bending_) {
-    bending_->add_gradient(x, g);
-    e += bending_->energy(x);
-  }
-  if (edge_pairs_) {
-    edge_pairs_->add_gradient(x, g);
-    e += edge_pairs_->energy(x);
+  for (const FourNodeTerm* t : terms_) {
+    t->add_gradient(x, g);
+    e += t->energy(x);
   }
   return e;
 }
 
 void MassSpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
-  if (!volume_ && !bending_ && !edge_pairs_) {
-    springs_.hessian(x, H, project_psd);
-    return;
-  }
   if (spring_to_union_.empty()) {
     springs_.hessian(x, H, project_psd);
   } else {
@@ -141,9 +129,9 @@ void MassSpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_p
     }
   }
   // Each term's blocks are projected separately (per spring, per tet, per hinge).
-  if (volume_) volume_->add_hessian(x, H.valuePtr(), volume_slots_, project_psd);
-  if (bending_) bending_->add_hessian(x, H.valuePtr(), bending_slots_, project_psd);
-  if (edge_pairs_) edge_pairs_->add_hessian(x, H.valuePtr(), edge_pair_slots_, project_psd);
+  for (std::size_t k = 0; k < terms_.size(); ++k) {
+    terms_[k]->add_hessian(x, H.valuePtr(), term_slots_[k], project_psd);
+  }
 }
 
 void MassSpringModel::damping_force(const VectorXd& x, const VectorXd& v, VectorXd& f) const {

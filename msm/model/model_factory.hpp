@@ -85,14 +85,14 @@ class MassSpringModel : public Form {
   std::unique_ptr<VolumeTerm> volume_;
   std::unique_ptr<BendingTerm> bending_;
   std::unique_ptr<EdgePairTerm> edge_pairs_;
+  std::vector<const FourNodeTerm*> terms_;  ///< the above that exist, summed with the springs
   /// Hessian pattern when the springs' lacks some tet or hinge entries (a region of interest drops
   /// the springs between two held nodes; no spring joins a hinge's opposite vertices): the union,
   /// and where each spring value goes in it.
   SparseMatrix union_pattern_;
   std::vector<int> spring_to_union_;
-  std::vector<int> volume_slots_;   ///< in the springs' pattern, or in union_pattern_
-  std::vector<int> bending_slots_;  ///< likewise
-  std::vector<int> edge_pair_slots_;  ///< likewise
+  /// Per term, where its blocks go: in the springs' pattern, or in union_pattern_.
+  std::vector<std::vector<int>> term_slots_;
 };
 
 /// The springs alone of a Form that is nothing but springs: a SpringModel, or a MassSpringModel

@@ -78,16 +78,15 @@ Mat12 volume_hessian(const std::array<Vec3, 4>& x, double rest_volume, double ka
 
 VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, double kappa,
                        std::vector<double> tet_factors)
-    : num_nodes_(static_cast<int>(nodes.size())),
-      tets_(std::move(tets)),
+    : FourNodeTerm(static_cast<int>(nodes.size())),
       kappa_(kappa),
       tet_factors_(std::move(tet_factors)) {
   if (!std::isfinite(kappa)) {
     throw InputError("volume term: expected a finite bulk stiffness κ (Pa), got " +
                      std::to_string(kappa));
   }
-  if (!tet_factors_.empty() && tet_factors_.size() != tets_.size()) {
-    throw InputError("volume term: expected one κ factor per tet (" + std::to_string(tets_.size()) +
+  if (!tet_factors_.empty() && tet_factors_.size() != tets.size()) {
+    throw InputError("volume term: expected one κ factor per tet (" + std::to_string(tets.size()) +
                      "), got " + std::to_string(tet_factors_.size()));
   }
   for (double f : tet_factors_) {
@@ -95,14 +94,15 @@ VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, do
       throw InputError("volume term: expected finite per-tet κ factors, got " + std::to_string(f));
     }
   }
-  rest_volumes_.reserve(tets_.size());
-  for (std::size_t e = 0; e < tets_.size(); ++e) {
-    const Tet& tet = tets_[e];
+  const int num_nodes = static_cast<int>(nodes.size());
+  rest_volumes_.reserve(tets.size());
+  for (std::size_t e = 0; e < tets.size(); ++e) {
+    const Tet& tet = tets[e];
     for (int v : tet) {
-      if (v < 0 || v >= num_nodes_) {
+      if (v < 0 || v >= num_nodes) {
         throw InputError("volume term: tet " + std::to_string(e) + " refers to node " +
                          std::to_string(v) + ", expected an index below " +
-                         std::to_string(num_nodes_));
+                         std::to_string(num_nodes));
       }
     }
     const double v0 =
@@ -113,54 +113,20 @@ VolumeTerm::VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, do
     }
     rest_volumes_.push_back(v0);
   }
-  pattern_ = four_node_block_pattern(num_dofs(), tets_);
-  slots_ = slots_in(pattern_);
+  set_elements(std::move(tets));
 }
 
-std::array<Vec3, 4> VolumeTerm::corners(const VectorXd& x, const Tet& t) const {
-  return {x.segment<3>(3 * t[0]), x.segment<3>(3 * t[1]), x.segment<3>(3 * t[2]),
-          x.segment<3>(3 * t[3])};
+double VolumeTerm::element_energy(std::size_t k, const std::array<Vec3, 4>& x) const {
+  return volume_energy(x, rest_volumes_[k], tet_kappa(k));
 }
 
-double VolumeTerm::energy(const VectorXd& x) const {
-  double e = 0.0;
-  for (std::size_t k = 0; k < tets_.size(); ++k) {
-    e += volume_energy(corners(x, tets_[k]), rest_volumes_[k], tet_kappa(k));
-  }
-  return e;
+Vec12 VolumeTerm::element_gradient(std::size_t k, const std::array<Vec3, 4>& x) const {
+  return volume_gradient(x, rest_volumes_[k], tet_kappa(k));
 }
 
-void VolumeTerm::add_gradient(const VectorXd& x, VectorXd& g) const {
-  for (std::size_t k = 0; k < tets_.size(); ++k) {
-    const Tet& t = tets_[k];
-    const Vec12 gk = volume_gradient(corners(x, t), rest_volumes_[k], tet_kappa(k));
-    for (int a = 0; a < 4; ++a) g.segment<3>(3 * t[a]) += gk.segment<3>(3 * a);
-  }
-}
-
-void VolumeTerm::gradient(const VectorXd& x, VectorXd& g) const {
-  g.setZero(num_dofs());
-  add_gradient(x, g);
-}
-
-std::vector<int> VolumeTerm::slots_in(const SparseMatrix& pattern) const {
-  return four_node_block_slots(pattern, tets_);
-}
-
-void VolumeTerm::add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,
-                             bool project_psd) const {
-  const int* s = slots.data();
-  for (std::size_t k = 0; k < tets_.size(); ++k) {
-    add_four_node_block(
-        volume_hessian(corners(x, tets_[k]), rest_volumes_[k], tet_kappa(k), project_psd), s,
-        values);
-  }
-}
-
-void VolumeTerm::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
-  H = pattern_;
-  std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
-  add_hessian(x, H.valuePtr(), slots_, project_psd);
+Mat12 VolumeTerm::element_hessian(std::size_t k, const std::array<Vec3, 4>& x,
+                                  bool project_psd) const {
+  return volume_hessian(x, rest_volumes_[k], tet_kappa(k), project_psd);
 }
 
 }  // namespace vessel::msm

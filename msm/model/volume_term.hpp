@@ -41,7 +41,7 @@ Mat12 volume_hessian(const std::array<Vec3, 4>& x, double rest_volume, double ka
                      bool project_psd);
 
 /// The volume term of a tet mesh as a Form (no damping).
-class VolumeTerm : public Form {
+class VolumeTerm : public FourNodeTerm {
  public:
   /// `nodes`: rest positions (m) of num_nodes nodes; `tets` index them; κ in Pa. tet_factors: per
   /// tet, a factor f_e on κ (tet e's bulk stiffness is κ·f_e; empty: all 1; the homogenised rule's
@@ -50,40 +50,23 @@ class VolumeTerm : public Form {
   VolumeTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, double kappa,
              std::vector<double> tet_factors = {});
 
-  [[nodiscard]] int num_dofs() const override { return 3 * num_nodes_; }
-  [[nodiscard]] double energy(const VectorXd& x) const override;
-  void gradient(const VectorXd& x, VectorXd& g) const override;
-  void hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const override;
-
-  /// g += ∇W (g already sized).
-  void add_gradient(const VectorXd& x, VectorXd& g) const;
-  /// Per tet, the 144 value indices of its 12×12 block in `pattern` (compressed, column-major);
-  /// −1 where the pattern lacks an entry.
-  [[nodiscard]] std::vector<int> slots_in(const SparseMatrix& pattern) const;
-  /// Adds every tet's Hessian block into `values` at `slots` (from slots_in, none −1).
-  void add_hessian(const VectorXd& x, double* values, const std::vector<int>& slots,
-                   bool project_psd) const;
-  /// The sparsity pattern of the term's Hessian (tet blocks plus the full diagonal), values 0.
-  [[nodiscard]] const SparseMatrix& pattern() const { return pattern_; }
-
   [[nodiscard]] double kappa() const { return kappa_; }
   /// κ of tet e (κ·f_e), Pa.
   [[nodiscard]] double tet_kappa(std::size_t e) const {
     return tet_factors_.empty() ? kappa_ : kappa_ * tet_factors_[e];
   }
-  [[nodiscard]] const std::vector<Tet>& tets() const { return tets_; }
+  [[nodiscard]] const std::vector<Tet>& tets() const { return elements(); }
   [[nodiscard]] const std::vector<double>& rest_volumes() const { return rest_volumes_; }
 
  private:
-  [[nodiscard]] std::array<Vec3, 4> corners(const VectorXd& x, const Tet& t) const;
+  [[nodiscard]] double element_energy(std::size_t k, const std::array<Vec3, 4>& x) const override;
+  [[nodiscard]] Vec12 element_gradient(std::size_t k, const std::array<Vec3, 4>& x) const override;
+  [[nodiscard]] Mat12 element_hessian(std::size_t k, const std::array<Vec3, 4>& x,
+                                      bool project_psd) const override;
 
-  int num_nodes_ = 0;
-  std::vector<Tet> tets_;
   std::vector<double> rest_volumes_;
   double kappa_ = 0.0;
   std::vector<double> tet_factors_;  ///< empty: all 1
-  SparseMatrix pattern_;
-  std::vector<int> slots_;
 };
 
 }  // namespace vessel::msm

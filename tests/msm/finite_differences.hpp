@@ -5,6 +5,8 @@
 #include <Eigen/Dense>
 #include <functional>
 
+#include "msm/model/form.hpp"
+
 namespace vessel::msm::test {
 
 using Eigen::MatrixXd;
@@ -56,6 +58,22 @@ inline DerivativeCheck check_derivatives(const std::function<double(const Vector
   c.hessian_error = (H - H_fd).norm() / std::max(H_fd.norm(), 1e-30);
   c.hessian_asymmetry = (H - H.transpose()).norm() / std::max(H.norm(), 1e-30);
   return c;
+}
+
+/// The same check of a Form's energy, gradient and (unprojected, densified) Hessian.
+inline DerivativeCheck check_form_derivatives(const Form& form, const VectorXd& x, double h) {
+  return check_derivatives([&form](const VectorXd& y) { return form.energy(y); },
+                           [&form](const VectorXd& y) -> VectorXd {
+                             VectorXd g;
+                             form.gradient(y, g);
+                             return g;
+                           },
+                           [&form](const VectorXd& y) -> MatrixXd {
+                             SparseMatrix H;
+                             form.hessian(y, H, false);
+                             return MatrixXd(H);
+                           },
+                           x, h);
 }
 
 }  // namespace vessel::msm::test
