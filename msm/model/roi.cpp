@@ -40,6 +40,12 @@ RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& 
   for (const Spring& s : full.springs) {
     if (!held[s.a] || !held[s.b]) keep[s.a] = keep[s.b] = 1;  // the boundary ring
   }
+  // Likewise a tet with a moving node: its held nodes bound it (the volume and edge-pair terms;
+  // the edge-pair model has no springs to find them by).
+  for (const Tet& t : full.tets) {
+    if (held[t[0]] && held[t[1]] && held[t[2]] && held[t[3]]) continue;
+    for (int v : t) keep[v] = 1;
+  }
   // Triangles for the bending term: a hinge moves when any of its four nodes does, and its two
   // triangles are then one with a moving node and one sharing an edge with it.
   std::vector<Triangle> carried;
@@ -79,20 +85,13 @@ RoiNetwork restrict_network(const SpringNetwork& full, const std::vector<char>& 
   for (const Triangle& t : carried) {
     roi.network.triangles.push_back({to_roi[t[0]], to_roi[t[1]], to_roi[t[2]]});
   }
-  // Tets with a moving node are carried, for the volume term (their other nodes are kept: a volume
-  // network has a spring on every tet edge). Triangles only with carry_triangles (above): the
-  // spring model and the solvers other than PBD use springs only.
+  // Tets with a moving node are carried (their nodes are all kept, above), for the volume and
+  // edge-pair terms. Triangles only with carry_triangles (above): the spring model and the solvers
+  // other than PBD use springs only.
   for (std::size_t e = 0; e < full.tets.size(); ++e) {
     const Tet& t = full.tets[e];
     if (held[t[0]] && held[t[1]] && held[t[2]] && held[t[3]]) continue;
-    Tet r{};
-    bool kept = true;
-    for (int a = 0; a < 4; ++a) {
-      r[a] = to_roi[t[a]];
-      kept = kept && r[a] >= 0;
-    }
-    if (!kept) continue;
-    roi.network.tets.push_back(r);
+    roi.network.tets.push_back({to_roi[t[0]], to_roi[t[1]], to_roi[t[2]], to_roi[t[3]]});
     if (!full.tet_kappa_factors.empty()) {
       roi.network.tet_kappa_factors.push_back(full.tet_kappa_factors[e]);
     }

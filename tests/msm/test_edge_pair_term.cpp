@@ -14,6 +14,7 @@
 #include "msm/model/build_network.hpp"
 #include "msm/model/edge_pair_term.hpp"
 #include "msm/model/model_factory.hpp"
+#include "msm/model/roi.hpp"
 #include "msm/solvers/solve.hpp"
 #include "tests/fem/cube_mesh.hpp"
 
@@ -88,8 +89,15 @@ Eigen::VectorXd stacked(const std::array<Vec3, 4>& x) {
   return v;
 }
 
-std::array<Vec3, 4> unstacked(const Eigen::VectorXd& v) {
-  return {v.segment<3>(0), v.segment<3>(3), v.segment<3>(6), v.segment<3>(9)};
+/// The network's problem at rest: unit-ish masses, no load, nothing held.
+Problem problem_at_rest(const Form& form, const SpringNetwork& network) {
+  Problem p;
+  p.form = &form;
+  p.rest = flatten(network.nodes);
+  p.mass = Eigen::VectorXd::Constant(p.rest.size(), 1e-6);
+  p.external_force = Eigen::VectorXd::Zero(p.rest.size());
+  p.fixed.assign(static_cast<std::size_t>(p.rest.size()), 0);
+  return p;
 }
 
 NetworkOptions edge_pair_options(double nu) {
@@ -138,21 +146,18 @@ TEST(EdgePairTerm, KernelMatchesFiniteDifferences) {
   std::mt19937 rng(11);
   for (double nu : {0.0, 0.45}) {
     const Mat6 C = edge_pair_coefficients(X, lame_parameters(kE, nu));
-    const Eigen::VectorXd x = stacked(deformed(X, rng, 0.1e-3));
-    const auto c = msm::test::check_derivatives(
-        [&](const Eigen::VectorXd& y) { return edge_pair_energy(unstacked(y), X, C); },
-        [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
-          return edge_pair_gradient(unstacked(y), X, C);
-        },
-        [&](const Eigen::VectorXd& y) -> Eigen::MatrixXd {
-          return edge_pair_hessian(unstacked(y), X, C, false);
-        },
-        x, 1e-9);
+    const std::array<Vec3, 4> corners = deformed(X, rng, 0.1e-3);
+    const Eigen::VectorXd x = stacked(corners);
+    using Corners = std::array<Vec3, 4>;
+    const auto c = msm::test::check_element_derivatives(
+        [&](const Corners& y) { return edge_pair_energy(y, X, C); },
+        [&](const Corners& y) { return edge_pair_gradient(y, X, C); },
+        [&](const Corners& y) { return edge_pair_hessian(y, X, C, false); }, x, 1e-9);
     EXPECT_LT(c.gradient_error, 1e-6) << "ν " << nu;
     EXPECT_LT(c.hessian_error, 1e-6) << "ν " << nu;
     EXPECT_LT(c.hessian_asymmetry, 1e-12) << "ν " << nu;
     // Forces along the edges sum to zero (translation invariance).
-    const Vec12 g = edge_pair_gradient(unstacked(x), X, C);
+    const Vec12 g = edge_pair_gradient(corners, X, C);
     EXPECT_LT((g.segment<3>(0) + g.segment<3>(3) + g.segment<3>(6) + g.segment<3>(9)).norm(),
               1e-12 * g.norm());
   }
@@ -192,12 +197,7 @@ TEST(EdgePairTerm, PassesThePatchTestWhichSpringsFail) {
   auto interior_error = [&](const NetworkOptions& o) {
     const BuiltNetwork built = build_network(mesh, VesselParams{}, o);
     const auto model = make_model(built);
-    Problem p;
-    p.form = model.get();
-    p.rest = flatten(built.network.nodes);
-    p.mass = Eigen::VectorXd::Constant(p.rest.size(), 1e-6);
-    p.external_force = Eigen::VectorXd::Zero(p.rest.size());
-    p.fixed.assign(static_cast<std::size_t>(p.rest.size()), 0);
+    Problem p = problem_at_rest(*model, built.network);
     Eigen::VectorXd affine = p.rest;
     std::vector<int> interior;
     for (std::size_t i = 0; i < built.network.nodes.size(); ++i) {
@@ -272,4 +272,44 @@ TEST(EdgePairTerm, RefusesWhatItCannotBe) {
   std::array<Vec3, 4> flat = rest_tet();
   flat[3] = flat[1] + flat[2] - flat[0];  // coplanar
   EXPECT_THROW((void)edge_pair_coefficients(flat, lame_parameters(kE, 0.3)), InputError);
+}
+
+TEST(EdgePairTerm, RegionOfInterestSolvesWhatTheWholeModelSolvesWithTheSameNodesHeld) {
+  // A 3 mm block, base fixed, a small load on the top face; nodes with x > 2 mm held. The region
+  // of interest (restrict_network, restrict_problem) must give, at its nodes, what the whole
+  // model gives with the same nodes fixed. The edge-pair model has no springs, so the region
+  // finds the held nodes that bound its moving tets through the tets themselves.
+  const TetMesh mesh = vessel::test::cube_mesh(3, 3e-3);
+  const BuiltNetwork built = build_network(mesh, VesselParams{}, edge_pair_options(0.45));
+  const auto model = make_model(built);
+  Problem full = problem_at_rest(*model, built.network);
+  std::vector<char> held(built.network.nodes.size(), 0);
+  for (std::size_t i = 0; i < built.network.nodes.size(); ++i) {
+    const Vec3& n = built.network.nodes[i];
+    if (n.z() < 1e-9) full.fixed[3 * i] = full.fixed[3 * i + 1] = full.fixed[3 * i + 2] = 1;
+    if (n.z() > 3e-3 - 1e-9) full.external_force[3 * i + 2] = -1e-6;  // N
+    held[i] = n.x() > 2e-3 + 1e-9 || n.z() < 1e-9;
+  }
+  Problem whole = full;
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    if (held[i]) whole.fixed[3 * i] = whole.fixed[3 * i + 1] = whole.fixed[3 * i + 2] = 1;
+  }
+  const SolveResult a = solve(whole, parse_solver("static"));
+  const RoiNetwork roi = restrict_network(built.network, held);
+  std::size_t moving_tets = 0;
+  for (const Tet& t : built.network.tets) {
+    moving_tets += !(held[t[0]] && held[t[1]] && held[t[2]] && held[t[3]]);
+  }
+  EXPECT_EQ(roi.network.tets.size(), moving_tets);
+  const auto roi_model = make_model(roi.network, std::nullopt, 0.0, std::nullopt, built.edge_pairs);
+  const Problem part = restrict_problem(full, roi, held, *roi_model);
+  const SolveResult b = solve(part, parse_solver("static"));
+  const double u = (a.x - whole.rest).lpNorm<Eigen::Infinity>();
+  ASSERT_GT(u, 0.0);
+  for (std::size_t k = 0; k < roi.full_index.size(); ++k) {
+    const auto i = static_cast<Eigen::Index>(roi.full_index[k]);
+    EXPECT_LT((b.x.segment<3>(3 * static_cast<Eigen::Index>(k)) - a.x.segment<3>(3 * i)).norm(),
+              1e-8 * u)
+        << "node " << i;
+  }
 }
