@@ -3,6 +3,7 @@
 /// differences of the energy give the gradient, central differences of the gradient give the
 /// Hessian; both are compared with the analytic ones.
 #include <Eigen/Dense>
+#include <array>
 #include <functional>
 
 #include "msm/model/form.hpp"
@@ -58,6 +59,21 @@ inline DerivativeCheck check_derivatives(const std::function<double(const Vector
   c.hessian_error = (H - H_fd).norm() / std::max(H_fd.norm(), 1e-30);
   c.hessian_asymmetry = (H - H.transpose()).norm() / std::max(H.norm(), 1e-30);
   return c;
+}
+
+/// The same check of one four-node element's kernel (a tet's or a hinge's energy, gradient and
+/// 12×12 Hessian as functions of its four corners), at the corners stacked in x (12 values).
+template <class Energy, class Gradient, class Hessian>
+DerivativeCheck check_element_derivatives(Energy energy, Gradient gradient, Hessian hessian,
+                                          const VectorXd& x, double h) {
+  using Corners = std::array<Eigen::Vector3d, 4>;
+  auto corners = [](const VectorXd& y) {
+    return Corners{y.segment<3>(0), y.segment<3>(3), y.segment<3>(6), y.segment<3>(9)};
+  };
+  return check_derivatives([&](const VectorXd& y) { return energy(corners(y)); },
+                           [&](const VectorXd& y) -> VectorXd { return gradient(corners(y)); },
+                           [&](const VectorXd& y) -> MatrixXd { return hessian(corners(y)); }, x,
+                           h);
 }
 
 /// The same check of a Form's energy, gradient and (unprojected, densified) Hessian.

@@ -89,29 +89,20 @@ TEST(BendingTerm, DihedralAngleAndHingeMatchFiniteDifferences) {
         Vec3(0.6e-3 + 0.5e-3 * u(rng), -h3 * std::cos(fold), -h3 * std::sin(fold))};
     Eigen::VectorXd x = perturbed(stacked(rest), rng, 0.05e-3);
     const double theta = dihedral_angle(corners(x));
-    const auto c =
-        test::check_derivatives([](const Eigen::VectorXd& y) { return dihedral_angle(corners(y)); },
-                                [](const Eigen::VectorXd& y) -> Eigen::VectorXd {
-                                  return dihedral_angle_gradient(corners(y));
-                                },
-                                [](const Eigen::VectorXd& y) -> Eigen::MatrixXd {
-                                  return dihedral_angle_hessian(corners(y));
-                                },
-                                x, 1e-9);
+    using C = std::array<Vec3, 4>;
+    const auto c = test::check_element_derivatives(
+        [](const C& y) { return dihedral_angle(y); },
+        [](const C& y) { return dihedral_angle_gradient(y); },
+        [](const C& y) { return dihedral_angle_hessian(y); }, x, 1e-9);
     EXPECT_LT(c.gradient_error, 1e-6) << "theta " << theta;
     EXPECT_LT(c.hessian_error, 1e-5) << "theta " << theta;
     EXPECT_LT(c.hessian_asymmetry, 1e-10) << "theta " << theta;
     // The hinge energy with a rest angle θ̄ ≠ θ and its stiffness.
     const double k = 3e-9, rest_angle = theta + 0.3 * u(rng);
-    const auto w = test::check_derivatives(
-        [&](const Eigen::VectorXd& y) { return hinge_energy(corners(y), rest_angle, k); },
-        [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
-          return hinge_gradient(corners(y), rest_angle, k);
-        },
-        [&](const Eigen::VectorXd& y) -> Eigen::MatrixXd {
-          return hinge_hessian(corners(y), rest_angle, k, false);
-        },
-        x, 1e-9);
+    const auto w = test::check_element_derivatives(
+        [&](const C& y) { return hinge_energy(y, rest_angle, k); },
+        [&](const C& y) { return hinge_gradient(y, rest_angle, k); },
+        [&](const C& y) { return hinge_hessian(y, rest_angle, k, false); }, x, 1e-9);
     EXPECT_LT(w.gradient_error, 1e-6);
     EXPECT_LT(w.hessian_error, 1e-5);
     // Projected: PSD; at θ = θ̄ the exact block k∇θ∇θᵀ is PSD and kept as it is.

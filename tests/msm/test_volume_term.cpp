@@ -80,15 +80,11 @@ TEST(VolumeTerm, KernelMatchesFiniteDifferencesForBothSignsOfKappa) {
   };
   for (double kappa : {5e4, -3e3}) {
     const Eigen::VectorXd x = perturbed(x0, rng, 0.1e-3);
-    const auto c = test::check_derivatives(
-        [&](const Eigen::VectorXd& y) { return volume_energy(corners(y), v0, kappa); },
-        [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
-          return volume_gradient(corners(y), v0, kappa);
-        },
-        [&](const Eigen::VectorXd& y) -> Eigen::MatrixXd {
-          return volume_hessian(corners(y), v0, kappa, false);
-        },
-        x, 1e-8);
+    using C = std::array<Vec3, 4>;
+    const auto c = test::check_element_derivatives(
+        [&](const C& y) { return volume_energy(y, v0, kappa); },
+        [&](const C& y) { return volume_gradient(y, v0, kappa); },
+        [&](const C& y) { return volume_hessian(y, v0, kappa, false); }, x, 1e-8);
     EXPECT_LT(c.gradient_error, 1e-6) << kappa;
     EXPECT_LT(c.hessian_error, 1e-6) << kappa;
     EXPECT_LT(c.hessian_asymmetry, 1e-12) << kappa;
