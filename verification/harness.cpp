@@ -593,38 +593,38 @@ void run_msm_load(const Scene& s, const ModelSpec& spec, const msm::BuiltNetwork
 }
 
 /// A mass-spring model at every load magnitude.
-void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
-                   const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
-                   const HarnessOptions& o, Progress& progress, ModelOutcome base,
-                   SceneResult& result) {
-  // The hybrid model refuses ν outside [1/4, 1/2) (κ = λ − μ negative or infinite), the
-  // homogenised one ν = 1/2 and ν below its mesh's floor (found when its network is built), the
-  // edge-pair model ν = 1/2 (λ infinite): recorded as failed, as P1 is at ν = 0.5, not fatal to
-  // the run.
-  const MemoryProbe setup_memory;
-  Stopwatch setup;  // the homogenised rule's fit is part of the set-up
-  std::string why;
-  std::optional<msm::BuiltNetwork> built_or;
-  VesselParams vessel = s.vessel;
-  vessel.level = base.level;
-  if (spec.volume_term && (nu < 0.25 || nu >= 0.5)) {
-    try {
+/// Why a model with a ν-limited term cannot run at this ν (empty: it can): the hybrid model
+/// refuses ν outside [1/4, 1/2) (κ = λ − μ negative or infinite), the homogenised one ν = 1/2 and
+/// ν below its mesh's floor (found when its network is built, which is then kept in built_or),
+/// the edge-pair model ν = 1/2 (λ infinite).
+std::string refusal_at(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
+                       const VesselParams& vessel, std::optional<msm::BuiltNetwork>& built_or) {
+  try {
+    if (spec.volume_term && (nu < 0.25 || nu >= 0.5)) {
       if (spec.volume_moduli == msm::VolumeModuli::golec || nu >= 0.5) {
         (void)msm::hybrid_moduli(s.youngs_modulus, nu);
       } else {
         built_or.emplace(scene_network(s, spec, mesh, vessel, nu));
       }
-    } catch (const InputError& e) {
-      why = e.what();
     }
+    if (spec.edge_pairs && nu >= 0.5) (void)msm::lame_parameters(s.youngs_modulus, nu);
+  } catch (const InputError& e) {
+    return e.what();
   }
-  if (spec.edge_pairs && nu >= 0.5) {
-    try {
-      (void)msm::lame_parameters(s.youngs_modulus, nu);
-    } catch (const InputError& e) {
-      why = e.what();
-    }
-  }
+  return {};
+}
+
+void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
+                   const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
+                   const HarnessOptions& o, Progress& progress, ModelOutcome base,
+                   SceneResult& result) {
+  // A ν the model refuses is recorded as failed, as P1 is at ν = 0.5, not fatal to the run.
+  const MemoryProbe setup_memory;
+  Stopwatch setup;  // the homogenised rule's fit is part of the set-up
+  std::optional<msm::BuiltNetwork> built_or;
+  VesselParams vessel = s.vessel;
+  vessel.level = base.level;
+  const std::string why = refusal_at(s, spec, nu, mesh, vessel, built_or);
   if (!why.empty()) {
     for (const double mag : s.load.magnitudes) {
       ModelOutcome out = base;
