@@ -213,6 +213,20 @@ class ElasticitySolver {
 
   /// Assembles and solves; returns the result (also kept in result()).
   const ElasticityResult& solve();
+
+  /// Linear FEM as a simulator runs it: solve() with the direct solver (CHOLMOD), keeping K's
+  /// factor in this solver, so that assembly and factorisation are paid once, as set-up. Then
+  /// update(f) solves K u = f·(the problem's loads) with that factor: one forward and one back
+  /// substitution, the cost of each update. InputError unless the formulation is displacement
+  /// (the mixed system is not SPD). The result is solve()'s.
+  const ElasticityResult& solve_keeping_factor();
+  /// One update with the kept factor for the loads scaled by `load_factor`: afterwards
+  /// solution_dofs() is that update's solution (result() stays solve_keeping_factor's: no
+  /// post-processing, which a simulator would not pay either). Returns its wall time, s.
+  /// std::logic_error before solve_keeping_factor(); std::invalid_argument for load_factor ≠ 1
+  /// with prescribed nonzero displacements (their condensed load would not scale).
+  double update(double load_factor = 1.0);
+
   [[nodiscard]] const ElasticityResult& result() const;
 
   /// The solved DoF values (displacement, and pressure for the mixed formulation), in this

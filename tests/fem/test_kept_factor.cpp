@@ -6,9 +6,10 @@
 #include <random>
 #include <thread>
 
-#include "fem_reference/cholmod_solve.hpp"
 #include "cube_mesh.hpp"
+#include "fem_reference/cholmod_solve.hpp"
 #include "fem_reference/elasticity.hpp"
+#include "meshes/errors.hpp"
 
 using namespace vessel::fem;
 
@@ -49,7 +50,7 @@ TEST(KeptFactor, IdenticalMatricesShareAFactorAndGiveTheFreshAnswer) {
   const Eigen::VectorXd b1 = Eigen::VectorXd::Random(400), b2 = Eigen::VectorXd::Random(400);
   const long hits0 = kept_factor_hits();
   const Eigen::VectorXd x1 = solve_spd_cholmod_keeping_factor(K, b1);
-  EXPECT_EQ(kept_factor_hits(), hits0);  // the first solve factorises
+  EXPECT_EQ(kept_factor_hits(), hits0);        // the first solve factorises
   const Eigen::SparseMatrix<double> same = K;  // another object, the same matrix
   const Eigen::VectorXd x2 = solve_spd_cholmod_keeping_factor(same, b2);
   EXPECT_EQ(kept_factor_hits(), hits0 + 1);
@@ -124,6 +125,53 @@ TEST(KeptFactor, TwoLoadsOnOneVesselFactoriseOnceAndEqualSeparateSolves) {
   }
   EXPECT_EQ(kept_factor_hits(), hits0 + 1);  // gravity found pressure's factor
   release_kept_factors();
+}
+
+TEST(KeptFactor, SimulatorUpdatesSolveTheLoadsScaledWithTheFactorOfTheFirstSolve) {
+  // Linear FEM as a simulator runs it (the harness's P1 and P2 models): solve_keeping_factor
+  // factorises once, each update() substitutes. Checked against separate solvers that assemble
+  // and factorise afresh: the same load (update(1)) and the load scaled in the problem itself
+  // (update(0.25) against a pressure of 25 Pa), on the displacement formulation at P1 and P2.
+  const vessel::TetMesh mesh = vessel::test::cube_mesh(3, 1e-3);
+  auto problem = [](int degree, double pressure) {
+    ElasticityProblem p;
+    p.material.poisson_ratio = 0.45;
+    p.options.degree = degree;
+    p.dirichlet = {DirichletCondition::clamped("x0")};
+    p.pressures = {{"x1", pressure}};
+    p.gravity = vessel::Vec3(0, 0, -9.81 * pressure / 100.0);
+    return p;
+  };
+  auto max_difference = [](const std::vector<double>& a, const std::vector<double>& b) {
+    double diff = 0.0, norm = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      diff = std::max(diff, std::abs(a[i] - b[i]));
+      norm = std::max(norm, std::abs(b[i]));
+    }
+    EXPECT_GT(norm, 0.0);
+    return diff / norm;
+  };
+  for (const int degree : {1, 2}) {
+    ElasticitySolver simulator(mesh, problem(degree, 100.0));
+    EXPECT_THROW((void)simulator.update(), std::logic_error);
+    const ElasticityResult& r = simulator.solve_keeping_factor();
+    ElasticitySolver full(mesh, problem(degree, 100.0)), quarter(mesh, problem(degree, 25.0));
+    full.solve();
+    quarter.solve();
+    EXPECT_EQ(r.solver, LinearSolver::direct);
+    EXPECT_LT(max_difference(simulator.solution_dofs(), full.solution_dofs()), 1e-12);
+    EXPECT_GT(simulator.update(0.25), 0.0);
+    EXPECT_LT(max_difference(simulator.solution_dofs(), quarter.solution_dofs()), 1e-12)
+        << "P" << degree;
+    (void)simulator.update();
+    EXPECT_LT(max_difference(simulator.solution_dofs(), full.solution_dofs()), 1e-12)
+        << "P" << degree;
+  }
+  ElasticityProblem mixed = problem(2, 100.0);
+  mixed.material.poisson_ratio = 0.5;
+  mixed.options.formulation = Formulation::mixed;
+  ElasticitySolver taylor_hood(mesh, mixed);
+  EXPECT_THROW((void)taylor_hood.solve_keeping_factor(), vessel::InputError);
 }
 
 // CHOLMOD's symbolic analysis kept across the matrices of one pattern (the finite-strain Newton's
