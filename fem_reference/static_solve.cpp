@@ -137,24 +137,16 @@ const ElasticityResult& ElasticitySolver::solve_keeping_factor() {
         "a kept factor is for the displacement formulation (SPD); the mixed (Taylor-Hood) "
         "system is indefinite");
   }
-  auto t0 = Clock::now();
-  im.assemble();
-  im.result.timings.assembly = seconds_since(t0);
-  t0 = Clock::now();
-  im.update_factor = std::make_unique<CholmodFactor>(im.direct_matrix(false));
-  im.update_rhs =
-      Eigen::Map<const Eigen::VectorXd>(im.rhs.begin(), static_cast<Eigen::Index>(im.rhs.size()));
-  const Eigen::VectorXd x = im.update_factor->solve(im.update_rhs);
-  std::copy(x.data(), x.data() + x.size(), im.solution.begin());
-  im.constraints.distribute(im.solution);
-  im.result.solver = LinearSolver::direct;
-  im.result.iterations = 0;
-  im.result.timings.solve = seconds_since(t0);
-  t0 = Clock::now();
-  im.postprocess();
-  im.result.timings.postprocess = seconds_since(t0);
-  im.solved = true;
-  return im.result;
+  return im.timed_solve([&im] {
+    im.update_factor = std::make_unique<CholmodFactor>(im.direct_matrix(false));
+    im.update_rhs = Eigen::Map<const Eigen::VectorXd>(im.rhs.begin(),
+                                                      static_cast<Eigen::Index>(im.rhs.size()));
+    const Eigen::VectorXd x = im.update_factor->solve(im.update_rhs);
+    std::copy(x.data(), x.data() + x.size(), im.solution.begin());
+    im.constraints.distribute(im.solution);
+    im.result.solver = LinearSolver::direct;
+    im.result.iterations = 0;
+  });
 }
 
 double ElasticitySolver::update(double load_factor) {

@@ -12,6 +12,7 @@
 #include <deal.II/lac/vector.h>
 
 #include <Eigen/SparseCore>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -67,6 +68,10 @@ struct ElasticitySolver::Impl {
   void build_triangulation();
   void setup_dofs();
   void setup_curved_mapping();
+
+  /// Assembles, runs `linear_solve` and post-processes, each phase timed into result.timings
+  /// (elasticity.cpp).
+  const ElasticityResult& timed_solve(const std::function<void()>& linear_solve);
 
   // static_solve.cpp
   void assemble();
