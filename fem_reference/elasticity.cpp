@@ -185,27 +185,19 @@ ElasticitySolver::ElasticitySolver(const TetMesh& mesh, ElasticityProblem proble
 
 ElasticitySolver::~ElasticitySolver() = default;
 
-const ElasticityResult& ElasticitySolver::Impl::timed_solve(
-    const std::function<void()>& linear_solve) {
-  auto t0 = Clock::now();
-  assemble();
-  result.timings.assembly = seconds_since(t0);
-  t0 = Clock::now();
-  linear_solve();
-  result.timings.solve = seconds_since(t0);
-  t0 = Clock::now();
-  postprocess();
-  result.timings.postprocess = seconds_since(t0);
-  solved = true;
-  return result;
-}
-
 const ElasticityResult& ElasticitySolver::solve() {
   auto& im = *impl_;
-  return im.timed_solve([&im] {
-    im.solve_linear(true,
-                    im.problem.options.keep_factor ? DirectReuse::factor : DirectReuse::nothing);
-  });
+  auto t0 = Clock::now();
+  im.assemble();
+  im.result.timings.assembly = seconds_since(t0);
+  t0 = Clock::now();
+  im.solve_linear(true, im.problem.options.keep_factor ? DirectReuse::factor : DirectReuse::nothing);
+  im.result.timings.solve = seconds_since(t0);
+  t0 = Clock::now();
+  im.postprocess();
+  im.result.timings.postprocess = seconds_since(t0);
+  im.solved = true;
+  return im.result;
 }
 
 const ElasticityResult& ElasticitySolver::result() const { return impl_->result; }

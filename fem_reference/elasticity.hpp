@@ -3,6 +3,8 @@
 /// simplex elements (P1, P2, Taylor–Hood P2–P1 for ν → 0.5). Plain data only: deal.II stays inside
 /// fem_reference's .cpp files and its private detail/ headers (pimpl), so including this header
 /// compiles no deal.II. SI units throughout.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <array>
 #include <cstddef>
 #include <filesystem>
@@ -201,6 +203,15 @@ struct TransientResult {
 };
 
 /// Solves a linear-elastic problem on one mesh and keeps the solution for point evaluation.
+/// The displacement system on its unconstrained DoFs, K u = f: what a simulator running linear FEM
+/// factorises once and solves at every update (the constraints condensed, prescribed values moved
+/// into f).
+struct FreeDisplacementSystem {
+  Eigen::SparseMatrix<double> K;  ///< N/m, symmetric positive definite, both triangles stored
+  Eigen::VectorXd f;              ///< N
+  std::vector<int> free_index;    ///< per DoF (this solver's numbering) its row, −1 if constrained
+};
+
 class ElasticitySolver {
  public:
   /// Validates the problem (InputError naming the parameter or group: E ≤ 0, ν ∉ [0, 0.5],
@@ -214,19 +225,9 @@ class ElasticitySolver {
   /// Assembles and solves; returns the result (also kept in result()).
   const ElasticityResult& solve();
 
-  /// Linear FEM as a simulator runs it: solve() with the direct solver (CHOLMOD), keeping K's
-  /// factor in this solver, so that assembly and factorisation are paid once, as set-up. Then
-  /// update(f) solves K u = f·(the problem's loads) with that factor: one forward and one back
-  /// substitution, the cost of each update. InputError unless the formulation is displacement
-  /// (the mixed system is not SPD). The result is solve()'s.
-  const ElasticityResult& solve_keeping_factor();
-  /// One update with the kept factor for the loads scaled by `load_factor`: afterwards
-  /// solution_dofs() is that update's solution (result() stays solve_keeping_factor's: no
-  /// post-processing, which a simulator would not pay either). Returns its wall time, s.
-  /// std::logic_error before solve_keeping_factor(); std::invalid_argument for load_factor ≠ 1
-  /// with prescribed nonzero displacements (their condensed load would not scale).
-  double update(double load_factor = 1.0);
-
+  /// Assembles the displacement formulation's system on its unconstrained DoFs (no solve; does
+  /// not need solve()). InputError for the mixed formulation (its system is indefinite).
+  [[nodiscard]] FreeDisplacementSystem free_displacement_system() const;
   [[nodiscard]] const ElasticityResult& result() const;
 
   /// The solved DoF values (displacement, and pressure for the mixed formulation), in this

@@ -1,8 +1,10 @@
 /// The serial displacement system on its unconstrained DoFs as Eigen matrices (stiffness,
-/// consistent mass, load), for the modal analysis and the Newmark transient.
+/// consistent mass, load), for the modal analysis, the Newmark transient and a simulator's
+/// prefactored linear FEM (free_displacement_system).
 #include <stdexcept>
 
 #include "fem_reference/detail/serial_solver.hpp"
+#include "meshes/errors.hpp"
 
 namespace vessel::fem {
 
@@ -92,6 +94,16 @@ ElasticitySolver::Impl::FreeSystem ElasticitySolver::Impl::assemble_free_system(
     if (out.free_index[d] >= 0) out.f[out.free_index[d]] = fd(d);
   }
   return out;
+}
+
+FreeDisplacementSystem ElasticitySolver::free_displacement_system() const {
+  if (impl_->mixed) {
+    throw InputError(
+        "the free displacement system is for the displacement formulation; the mixed "
+        "(Taylor-Hood) system is indefinite");
+  }
+  Impl::FreeSystem sys = impl_->assemble_free_system(false);
+  return {std::move(sys.K), std::move(sys.f), std::move(sys.free_index)};
 }
 
 }  // namespace vessel::fem

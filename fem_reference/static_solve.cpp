@@ -11,16 +11,12 @@
 #include <sstream>
 
 #include "fem_reference/cholmod_solve.hpp"
-#include "fem_reference/detail/common.hpp"
 #include "fem_reference/detail/constraints.hpp"
 #include "fem_reference/detail/serial_solver.hpp"
 #include "meshes/errors.hpp"
 #include "meshes/solver_threads.hpp"
 
 namespace vessel::fem {
-
-using detail::Clock;
-using detail::seconds_since;
 
 void ElasticitySolver::Impl::assemble() {
   detail::CellValues values(*mapping, *fe, degree);
@@ -92,11 +88,16 @@ void ElasticitySolver::Impl::solve_linear(bool symmetric, DirectReuse reuse) {
   constraints.distribute(solution);
 }
 
-Eigen::SparseMatrix<double> ElasticitySolver::Impl::direct_matrix(bool structural) const {
-  // The constraints keep K symmetric with positive diagonal entries on constrained rows.
+void ElasticitySolver::Impl::solve_displacement_direct(DirectReuse reuse) {
+  // CHOLMOD (supernodal Cholesky) for the SPD displacement system: the constraints keep K
+  // symmetric with positive diagonal entries on constrained rows.
   const Index n = dof.n_dofs();
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(matrix.n_nonzero_elements());
+  // The entries: the nonzero values; for a sequence of one pattern (DirectReuse::analysis), every
+  // coupling of two free DoFs whatever its value, so that the pattern stays that of the first
+  // matrix (a tangent at u = 0 has zeros a deformed one fills in) and is analysed once.
+  const bool structural = reuse == DirectReuse::analysis;
   for (Index row = 0; row < n; ++row) {
     const bool row_free = !constraints.is_constrained(row);
     for (auto it = matrix.begin(row); it != matrix.end(row); ++it) {
@@ -108,16 +109,7 @@ Eigen::SparseMatrix<double> ElasticitySolver::Impl::direct_matrix(bool structura
   }
   Eigen::SparseMatrix<double> K(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
   K.setFromTriplets(entries.begin(), entries.end());
-  return K;
-}
-
-void ElasticitySolver::Impl::solve_displacement_direct(DirectReuse reuse) {
-  // CHOLMOD (supernodal Cholesky) for the SPD displacement system. For a sequence of one pattern
-  // (DirectReuse::analysis) every coupling of two free DoFs is an entry, so that the pattern
-  // stays that of the first matrix (a tangent at u = 0 has zeros a deformed one fills in) and is
-  // analysed once.
-  const Eigen::SparseMatrix<double> K = direct_matrix(reuse == DirectReuse::analysis);
-  const Eigen::Map<const Eigen::VectorXd> b(rhs.begin(), K.rows());
+  const Eigen::Map<const Eigen::VectorXd> b(rhs.begin(), static_cast<Eigen::Index>(n));
   Eigen::VectorXd x;
   if (reuse == DirectReuse::factor) {
     x = solve_spd_cholmod_keeping_factor(K, b);
@@ -128,40 +120,6 @@ void ElasticitySolver::Impl::solve_displacement_direct(DirectReuse reuse) {
     x = solve_spd_cholmod(K, b);
   }
   std::copy(x.data(), x.data() + x.size(), solution.begin());
-}
-
-const ElasticityResult& ElasticitySolver::solve_keeping_factor() {
-  auto& im = *impl_;
-  if (im.mixed) {
-    throw InputError(
-        "a kept factor is for the displacement formulation (SPD); the mixed (Taylor-Hood) "
-        "system is indefinite");
-  }
-  return im.timed_solve([&im] {
-    im.update_factor = std::make_unique<CholmodFactor>(im.direct_matrix(false));
-    im.update_rhs = Eigen::Map<const Eigen::VectorXd>(im.rhs.begin(),
-                                                      static_cast<Eigen::Index>(im.rhs.size()));
-    const Eigen::VectorXd x = im.update_factor->solve(im.update_rhs);
-    std::copy(x.data(), x.data() + x.size(), im.solution.begin());
-    im.constraints.distribute(im.solution);
-    im.result.solver = LinearSolver::direct;
-    im.result.iterations = 0;
-  });
-}
-
-double ElasticitySolver::update(double load_factor) {
-  auto& im = *impl_;
-  if (!im.update_factor) throw std::logic_error("update called before solve_keeping_factor()");
-  if (load_factor != 1.0 && im.constraints.has_inhomogeneities()) {
-    throw std::invalid_argument(
-        "update: prescribed nonzero displacements do not scale with the load; only "
-        "load_factor = 1 is defined");
-  }
-  const auto t0 = Clock::now();
-  const Eigen::VectorXd x = im.update_factor->solve(load_factor * im.update_rhs);
-  std::copy(x.data(), x.data() + x.size(), im.solution.begin());
-  im.constraints.distribute(im.solution);
-  return seconds_since(t0);
 }
 
 std::vector<unsigned> ElasticitySolver::Impl::dof_components() const {
@@ -201,8 +159,8 @@ void ElasticitySolver::Impl::solve_displacement_cg_amg() {
   dl::TrilinosWrappers::PreconditionAMG amg;
   std::vector<double> modes_storage;  // must outlive amg
   detail::initialize_elasticity_amg(amg, trilinos_matrix, displacement_rows({}),
-                                    detail::node_centroid(mesh), degree > 1, o.amg_rigid_body_modes,
-                                    modes_storage);
+                                    detail::node_centroid(mesh), degree > 1,
+                                    o.amg_rigid_body_modes, modes_storage);
   dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs.l2_norm());
   dl::SolverCG<dl::Vector<double>> cg(control);
   try {
@@ -275,9 +233,8 @@ void ElasticitySolver::Impl::postprocess() {
     if (std::find(seen.begin(), seen.end(), bc.group) != seen.end()) continue;
     seen.push_back(bc.group);
     result.reactions.push_back(
-        {bc.group,
-         detail::group_reaction(dof, constraints, detail::group_boundary_id(mesh, bc.group), all,
-                                residual)});
+        {bc.group, detail::group_reaction(dof, constraints, detail::group_boundary_id(mesh, bc.group),
+                                          all, residual)});
   }
 }
 

@@ -12,7 +12,6 @@
 #include <deal.II/lac/vector.h>
 
 #include <Eigen/SparseCore>
-#include <functional>
 #include <memory>
 #include <vector>
 
@@ -69,10 +68,6 @@ struct ElasticitySolver::Impl {
   void setup_dofs();
   void setup_curved_mapping();
 
-  /// Assembles, runs `linear_solve` and post-processes, each phase timed into result.timings
-  /// (elasticity.cpp).
-  const ElasticityResult& timed_solve(const std::function<void()>& linear_solve);
-
   // static_solve.cpp
   void assemble();
   /// Solves matrix · solution = rhs and distributes the constraints. `symmetric` false (the
@@ -81,12 +76,6 @@ struct ElasticitySolver::Impl {
   /// `reuse`: what a direct displacement solve (CHOLMOD) keeps for the next one.
   void solve_linear(bool symmetric = true, DirectReuse reuse = DirectReuse::nothing);
   void solve_displacement_direct(DirectReuse reuse);
-  /// The assembled displacement system for CHOLMOD (both triangles): its nonzero entries, or with
-  /// `structural` every coupling of two free DoFs whatever its value (a Newton sequence's pattern).
-  [[nodiscard]] Eigen::SparseMatrix<double> direct_matrix(bool structural) const;
-  /// solve_keeping_factor's factor and load vector, for ElasticitySolver::update.
-  std::unique_ptr<CholmodFactor> update_factor;
-  Eigen::VectorXd update_rhs;
   /// The analysis DirectReuse::analysis keeps (with its last factor): freed here.
   std::unique_ptr<CholmodSamePattern> same_pattern;
   void release_same_pattern() { same_pattern.reset(); }
