@@ -202,7 +202,6 @@ struct TransientResult {
   std::vector<double> kinetic_energy, strain_energy, load_work;
 };
 
-/// Solves a linear-elastic problem on one mesh and keeps the solution for point evaluation.
 /// The displacement system on its unconstrained DoFs, K u = f: what a simulator running linear FEM
 /// factorises once and solves at every update (the constraints condensed, prescribed values moved
 /// into f).
@@ -212,6 +211,7 @@ struct FreeDisplacementSystem {
   std::vector<int> free_index;    ///< per DoF (this solver's numbering) its row, −1 if constrained
 };
 
+/// Solves a linear-elastic problem on one mesh and keeps the solution for point evaluation.
 class ElasticitySolver {
  public:
   /// Validates the problem (InputError naming the parameter or group: E ≤ 0, ν ∉ [0, 0.5],
@@ -228,6 +228,7 @@ class ElasticitySolver {
   /// Assembles the displacement formulation's system on its unconstrained DoFs (no solve; does
   /// not need solve()). InputError for the mixed formulation (its system is indefinite).
   [[nodiscard]] FreeDisplacementSystem free_displacement_system() const;
+
   [[nodiscard]] const ElasticityResult& result() const;
 
   /// The solved DoF values (displacement, and pressure for the mixed formulation), in this

@@ -623,7 +623,6 @@ void run_msm_load(const Scene& s, const ModelSpec& spec, const msm::BuiltNetwork
   }
 }
 
-/// A mass-spring model at every load magnitude.
 /// Why a model with a ν-limited term cannot run at this ν (empty: it can): the hybrid model
 /// refuses ν outside [1/4, 1/2) (κ = λ − μ negative or infinite), the homogenised one ν = 1/2 and
 /// ν below its mesh's floor (found when its network is built, which is then kept in built_or),
@@ -645,6 +644,7 @@ std::string refusal_at(const Scene& s, const ModelSpec& spec, double nu, const T
   return {};
 }
 
+/// A mass-spring model at every load magnitude.
 void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
                    const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
                    const HarnessOptions& o, Progress& progress, ModelOutcome base,
