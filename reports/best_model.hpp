@@ -31,7 +31,7 @@ struct BestModelRow {
   /// P1 FEM (kind fem, element P1) on the same level, ν and load, when it ran and finished.
   std::optional<std::string> p1_model;
   double p1_relative_l2 = 0.0;
-  double p1_solve_seconds = 0.0;  ///< P1's median update with its factor kept
+  double p1_solve_seconds = 0.0;  ///< P1's median update, prepared as linear models are
   /// best / P1 (nullopt without a finished P1 or a best model): error ratio ≤ 1 means as
   /// accurate as P1; time ratio < 1 means faster than P1.
   std::optional<double> error_ratio, time_ratio;

@@ -6,8 +6,8 @@
 /// machine does not count — grew beyond a noise-tolerant ratio. The solve time is results.json's
 /// solve_seconds, set-up excluded: for static and linear mass-spring models the time per update
 /// (median over the load ramp's warm-started updates), for integrators the run's steps, for FEM
-/// the ramp's median update with its factor kept. Set-up (build, assembly and factorisation at
-/// rest) is not gated.
+/// the ramp's median update prepared as linear models are. Set-up (build, assembly and
+/// factorisation at rest) is not gated.
 #include <string>
 #include <vector>
 

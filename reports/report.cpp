@@ -425,8 +425,8 @@ void scene_section(Document& doc, const SceneRows& s) {
                 "and factorisation at rest); solve s is the time after it: per update for static "
                 "and linear mass-spring models (the median over a load ramp of warm-started "
                 "updates ending at the row's load, as a simulator runs them), the run's steps for "
-                "integrators, and for FEM the same ramp's median update with its "
-                "factorisation kept (one forward and back substitution):");
+                "integrators, and for FEM the same ramp's median update, prepared as the linear "
+                "mass-spring models are (factorised once at set-up):");
   doc.table(statistics_table(s));
   const std::string provenance = scene_timing_provenance(s);
   if (!provenance.empty()) doc.paragraph("Timings: " + provenance + ".");

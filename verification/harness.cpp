@@ -32,9 +32,9 @@
 #include "msm/model/build_network.hpp"
 #include "msm/model/model_factory.hpp"
 #include "msm/model/network_file.hpp"
+#include "msm/model/quadratic_form.hpp"
 #include "msm/model/roi.hpp"
 #include "msm/solvers/integrators.hpp"
-#include "msm/solvers/linear_solver.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/solvers/updates.hpp"
 #include "reports/representative_load.hpp"
@@ -360,35 +360,29 @@ VtuCells network_cells(const msm::SpringNetwork& n) {
   return cells;
 }
 
-/// Linear FEM timed as a simulator runs it, with the direct solver the mass-spring models' timed
-/// updates use (msm::CholmodSolver): set-up assembles the system on the free DoFs and factorises
-/// it once; each update of the load ramp (f·j/updates, j = 1 … updates, `repeats` times) is one
-/// forward and back substitution (solve_into).
+/// Linear FEM timed as a simulator runs it, by the procedure that times the mass-spring models
+/// (timed_updates with the "linear" updater, msm/solvers/updates.hpp): its system on the free DoFs
+/// as a Form (msm::QuadraticForm), factorised once at set-up (with, for a load on few DoFs such as
+/// a contact patch, the responses to them: Cotin et al. 1999's precomputation, as for the springs'
+/// linear models), then each update of the load ramp.
 struct FemUpdates {
-  double setup_seconds = 0.0;   ///< assembly of K and f, and the factorisation, s
+  double setup_seconds = 0.0;   ///< assembly of K and f, factorisation and responses, s
   double update_seconds = 0.0;  ///< median update, s
 };
 FemUpdates timed_fem_updates(const fem::ElasticitySolver& solver, int updates, int repeats) {
-  FemUpdates out;
-  Stopwatch setup;
-  const fem::FreeDisplacementSystem sys = solver.free_displacement_system();
-  msm::CholmodSolver factor;
-  if (!factor.try_factorize(sys.K)) {
-    throw std::runtime_error("the FEM stiffness on the free DoFs is not positive definite");
-  }
-  out.setup_seconds = setup.seconds();
-  Eigen::VectorXd f(sys.f.size()), x;
-  std::vector<double> times;
-  for (int k = 0; k < repeats; ++k) {
-    for (int j = 1; j <= updates; ++j) {
-      f = sys.f * (static_cast<double>(j) / updates);  // the load, as the models' ramp builds it
-      Stopwatch update;
-      factor.solve_into(f, x);
-      times.push_back(update.seconds());
-    }
-  }
-  out.update_seconds = median(times);
-  return out;
+  Stopwatch assembly;
+  fem::FreeDisplacementSystem sys = solver.free_displacement_system();
+  const auto n = sys.f.size();
+  const msm::QuadraticForm form(std::move(sys.K), Eigen::VectorXd::Zero(n));
+  msm::Problem p;
+  p.form = &form;
+  p.rest = Eigen::VectorXd::Zero(n);  // the state is the displacement on the free DoFs
+  p.external_force = std::move(sys.f);
+  p.mass = Eigen::VectorXd::Ones(n);  // unused by a static answer
+  p.fixed.assign(static_cast<std::size_t>(n), 0);
+  const double assembly_seconds = assembly.seconds();
+  const UpdateSequence seq = timed_updates(p, msm::parse_solver("linear"), updates, repeats);
+  return {assembly_seconds + seq.setup_seconds, seq.update_seconds};
 }
 
 /// A FEM model: always the displacement formulation of its degree, so that P1's locking near

@@ -143,14 +143,14 @@ struct ModelOutcome {
   /// Model build, plus for mass-spring models the solver's preparation (static and linear:
   /// assembly and factorisation at rest, msm::prepare_updates; implicit-euler-rest its
   /// factorisation), for FEM models the solver's construction, the assembly of its system on the
-  /// free DoFs and its factorisation (timed_fem_updates), s; median over repeats where timed per
-  /// repeat.
+  /// free DoFs and the "linear" updater's preparation (timed_fem_updates), s; median over repeats
+  /// where timed per repeat.
   double setup_seconds = 0.0;
   /// The solver's time after set-up, s. Static and linear mass-spring models: the time per
   /// update, the median over the warm-started updates of a load ramp to the case's magnitude
   /// (timed_updates); dynamic ones: the run's steps (median over repeats); FEM: the median
-  /// update of the same ramp with K's factor kept, one solve_into of the models' own
-  /// msm::CholmodSolver (timed_fem_updates).
+  /// update of the same ramp by the "linear" updater the mass-spring models' linear solver uses
+  /// (timed_fem_updates: K factorised once).
   double solve_seconds = 0.0;
   /// Static and linear mass-spring models and FEM: the ramp's updates (0: timed as one solve),
   /// and per update the mean Newton iterations and CHOLMOD factorisations (last repeat).

@@ -325,8 +325,9 @@ void write_summary_markdown(const std::filesystem::path& path,
            "model build and the solver's preparation (assembly, factorisation at rest), done once. "
            "*solve s*: static and linear mass-spring models the time per update (median over a "
            "load ramp of warm-started updates ending at the row's load); integrators the run's "
-           "steps; FEM the same ramp's median update with its factor kept (assembly and "
-           "factorisation are its set-up); models outside the suite (external, displacements) "
+           "steps; FEM the same ramp's median update, prepared as the linear mass-spring models "
+           "are (assembly and factorisation are its set-up); models outside the suite "
+           "(external, displacements) "
            "the simulator's own times from its timing.json, else its process's wall time "
            "(start-up and file I/O included), as marked.\n\n";
     out << std::setprecision(3);
