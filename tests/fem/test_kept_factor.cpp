@@ -1,10 +1,7 @@
 // CHOLMOD factors kept between solves of an identical matrix (the harness's references of several
 // loads on one vessel): the answers equal fresh factorisations', identical matrices hit, a matrix
-// differing in one value misses, and two threads solving with one kept factor agree. And the
-// free displacement system a simulator would factorise once.
+// differing in one value misses, and two threads solving with one kept factor agree.
 #include <gtest/gtest.h>
-
-#include <Eigen/SparseCholesky>
 
 #include <random>
 #include <thread>
@@ -12,7 +9,6 @@
 #include "fem_reference/cholmod_solve.hpp"
 #include "cube_mesh.hpp"
 #include "fem_reference/elasticity.hpp"
-#include "meshes/errors.hpp"
 
 using namespace vessel::fem;
 
@@ -128,47 +124,6 @@ TEST(KeptFactor, TwoLoadsOnOneVesselFactoriseOnceAndEqualSeparateSolves) {
   }
   EXPECT_EQ(kept_factor_hits(), hits0 + 1);  // gravity found pressure's factor
   release_kept_factors();
-}
-
-TEST(FreeDisplacementSystem, SolvedByASecondSolverItGivesTheStaticSolution) {
-  // What the harness factorises to time P1 and P2 as a simulator runs them: the system on the
-  // free DoFs, solved here by Eigen's LDLT, must give solve()'s displacements (CHOLMOD on the
-  // constrained full system) at every free DoF, on the displacement formulation at P1 and P2.
-  const vessel::TetMesh mesh = vessel::test::cube_mesh(3, 1e-3);
-  for (const int degree : {1, 2}) {
-    ElasticityProblem p;
-    p.material.poisson_ratio = 0.45;
-    p.options.degree = degree;
-    p.dirichlet = {DirichletCondition::clamped("x0")};
-    p.pressures = {{"x1", 100.0}};
-    p.gravity = vessel::Vec3(0, 0, -9.81);
-    ElasticitySolver solver(mesh, p);
-    const FreeDisplacementSystem sys = solver.free_displacement_system();
-    solver.solve();
-    const std::vector<double> u = solver.solution_dofs();
-    ASSERT_EQ(sys.free_index.size(), u.size());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(sys.K);
-    ASSERT_EQ(ldlt.info(), Eigen::Success);
-    const Eigen::VectorXd x = ldlt.solve(sys.f);
-    double diff = 0.0, norm = 0.0;
-    int free = 0;
-    for (std::size_t d = 0; d < u.size(); ++d) {
-      if (sys.free_index[d] < 0) continue;
-      ++free;
-      diff = std::max(diff, std::abs(x[sys.free_index[d]] - u[d]));
-      norm = std::max(norm, std::abs(u[d]));
-    }
-    EXPECT_EQ(free, sys.K.rows());
-    EXPECT_LT(free, static_cast<int>(u.size()));  // the clamped face's DoFs are not in it
-    EXPECT_GT(norm, 0.0);
-    EXPECT_LE(diff, 1e-10 * norm) << "P" << degree;
-  }
-  ElasticityProblem mixed;
-  mixed.material.poisson_ratio = 0.5;
-  mixed.options.degree = 2;
-  mixed.options.formulation = Formulation::mixed;
-  mixed.dirichlet = {DirichletCondition::clamped("x0")};
-  EXPECT_THROW((void)ElasticitySolver(mesh, mixed).free_displacement_system(), vessel::InputError);
 }
 
 // CHOLMOD's symbolic analysis kept across the matrices of one pattern (the finite-strain Newton's
