@@ -6,6 +6,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git
+  ccache                                  # compiler cache: rebuilds and fresh clones reuse objects
   libeigen3-dev libsuitesparse-dev        # msm: Eigen, CHOLMOD
   libopenblas0-pthread                    # BLAS for CHOLMOD, UMFPACK, eigen-solves (4x faster)
   libgmsh-dev                             # meshes: gmsh C++ API
