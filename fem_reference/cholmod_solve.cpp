@@ -10,7 +10,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "meshes/solver_threads.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 
 namespace vessel::fem {
 

@@ -44,7 +44,7 @@
 #include "fem_reference/detail/tet_locator.hpp"
 #include "fem_reference/detail/validation.hpp"
 #include "fem_reference/detail/weak_form.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::fem {
 

@@ -25,7 +25,7 @@
 #include "fem_reference/detail/constraints.hpp"
 #include "fem_reference/detail/serial_solver.hpp"
 #include "fem_reference/detail/validation.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::fem {
 

@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 #include "fem_reference/detail/serial_solver.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::fem {
 

@@ -15,7 +15,7 @@
 #include <sstream>
 
 #include "fem_reference/detail/serial_solver.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/self_contact.hpp"
 
 namespace vessel::fem {

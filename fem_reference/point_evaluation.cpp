@@ -3,7 +3,7 @@
 #include <sstream>
 
 #include "fem_reference/detail/serial_solver.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::fem {
 

@@ -15,17 +15,14 @@
 #include <vector>
 
 #include "fem_reference/reference_code_version.hpp"
-#include "meshes/atomic_file.hpp"
-#include "meshes/content_hash.hpp"
+#include "meshes/foundation/atomic_file.hpp"
+#include "meshes/foundation/content_hash.hpp"
 
 namespace vessel::fem {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr std::string_view kMagic = "vesselverify-fem-solution\n";
-constexpr std::uint32_t kFormatVersion = 1;
 
 /// Two FNV-1a streams fed the same bytes from different starting states: a 128-bit key.
 struct KeyHash {
@@ -248,48 +245,6 @@ TransientResult deserialise_transient(std::string_view bytes) {
   return r;
 }
 
-/// The entry's file: magic, format version, key, payload size, payload, FNV-1a of the payload.
-std::string entry_file(const std::string& key, const std::string& payload) {
-  Writer w;
-  w.pod(kFormatVersion);
-  w.text(key);
-  w.text(payload);
-  w.pod(fnv1a(payload));
-  return std::string(kMagic) + w.bytes();
-}
-
-enum class EntryState { missing, ok, corrupt, other_key };
-
-/// Reads the entry at `path` for `key`; `why` says what is wrong with a corrupt one.
-EntryState read_entry(const fs::path& path, const std::string& key, std::string& payload,
-                      std::string& why) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return EntryState::missing;
-  const std::string file((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  if (file.compare(0, kMagic.size(), kMagic) != 0) {
-    why = "not a vesselverify FEM solution";
-    return EntryState::corrupt;
-  }
-  try {
-    Reader in(std::string_view(file).substr(kMagic.size()));
-    if (in.pod<std::uint32_t>() != kFormatVersion) return EntryState::other_key;
-    if (in.text() != key) return EntryState::other_key;  // a hash collision: never trusted
-    payload = in.text();
-    if (in.pod<std::uint64_t>() != fnv1a(payload) || !in.done()) {
-      why = "checksum mismatch";
-      return EntryState::corrupt;
-    }
-  } catch (const Truncated&) {
-    why = "truncated";
-    return EntryState::corrupt;
-  }
-  return EntryState::ok;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 }  // namespace
 
 std::optional<std::string> solution_cache_key(const TetMesh& mesh, const ElasticityProblem& p) {
@@ -325,54 +280,13 @@ std::optional<std::string> solution_cache_key(const TetMesh& mesh, const Elastic
 }
 
 SolutionCache::SolutionCache(fs::path dir, std::ostream* log, std::string name)
-    : dir_(std::move(dir)), log_(log), name_(std::move(name)) {}
-
-void SolutionCache::lookup(const std::string& key,
-                           const std::function<double(std::string_view)>& use,
-                           const std::function<std::string()>& compute, bool refresh) {
-  // The file name is a hash of the key; the file holds the key itself, so a collision of names
-  // is a miss, never a wrong answer.
-  const fs::path path = dir_ / ("entry-" + ContentHash().text(key).hex() + ".bin");
-  const auto t0 = std::chrono::steady_clock::now();
-  std::string payload, why;
-  const EntryState state = refresh ? EntryState::missing : read_entry(path, key, payload, why);
-  if (state == EntryState::ok) {
-    try {
-      const double original_seconds = use(payload);
-      const std::lock_guard lock(mutex_);
-      ++stats_.hits;
-      stats_.seconds_saved += original_seconds - seconds_since(t0);
-      return;
-    } catch (const std::exception& e) {  // Truncated, or a DoF count this solver does not have
-      why = e.what();
-    }
-  }
-  const bool corrupt = state == EntryState::corrupt || state == EntryState::ok;
-  if (corrupt) {
-    (log_ ? *log_ : std::cerr) << name_ << ": entry " << path.string() << " is corrupt ("
-                               << why << "); computing it again and replacing it\n";
-  }
-  const std::string file = entry_file(key, compute());
-  try {
-    write_file_atomically(
-        path, [&](std::ostream& out) { out << file; }, true);
-  } catch (const std::exception& e) {  // a read-only cache costs time, not the result
-    (log_ ? *log_ : std::cerr) << name_ << ": cannot store " << path.string() << " ("
-                               << e.what() << "); continuing without it\n";
-  }
-  const std::lock_guard lock(mutex_);
-  ++stats_.misses;
-  if (corrupt) ++stats_.corrupt;
-}
+    : store_(std::move(dir), log, std::move(name)) {}
 
 std::optional<std::string> SolutionCache::key_or_count(const TetMesh& mesh,
                                                        const ElasticityProblem& problem) {
   if (!enabled()) return std::nullopt;
   std::optional<std::string> key = solution_cache_key(mesh, problem);
-  if (!key) {
-    const std::lock_guard lock(mutex_);
-    ++stats_.uncacheable;
-  }
+  if (!key) store_.count_uncacheable();
   return key;
 }
 
@@ -380,7 +294,7 @@ const ElasticityResult& SolutionCache::solve(ElasticitySolver& solver, const Tet
                                              const ElasticityProblem& problem) {
   const std::optional<std::string> key = key_or_count(mesh, problem);
   if (!key) return solver.solve();
-  lookup(
+  store_.lookup(
       *key,
       [&](std::string_view payload) {
         auto [result, dofs] = deserialise(payload);
@@ -405,7 +319,7 @@ TransientResult SolutionCache::transient(const ElasticitySolver& solver, const T
   h.real(options.outside_tolerance);
   for (const Vec3& p : options.probe_points) h.point(p);
   TransientResult result;
-  lookup(
+  store_.lookup(
       *solution_key + " transient=" + h.a.hex() + h.b.hex(),
       [&](std::string_view payload) {
         result = deserialise_transient(payload);
@@ -436,48 +350,9 @@ std::optional<std::string> continuation_cache_key(const TetMesh& mesh,
   return *base + " continuation=" + h.a.hex() + h.b.hex();
 }
 
-std::string SolutionCache::payload(const std::string& key,
-                                   const std::function<std::string()>& compute,
-                                   const std::function<double(std::string_view)>& original_seconds,
-                                   bool refresh) {
-  if (!enabled()) return compute();
-  std::string out;
-  lookup(
-      key,
-      [&](std::string_view stored) {
-        const double seconds = original_seconds(stored);
-        out = std::string(stored);
-        return seconds;
-      },
-      [&] {
-        out = compute();
-        return out;
-      },
-      refresh);
-  return out;
-}
-
 const ElasticityResult& solve_with(SolutionCache* cache, ElasticitySolver& solver,
                                    const TetMesh& mesh, const ElasticityProblem& problem) {
   return cache ? cache->solve(solver, mesh, problem) : solver.solve();
-}
-
-SolutionCacheStatistics SolutionCache::statistics() const {
-  const std::lock_guard lock(mutex_);
-  return stats_;
-}
-
-std::string SolutionCache::summary() const {
-  const SolutionCacheStatistics s = statistics();
-  std::ostringstream o;
-  if (!enabled()) return name_ + ": off (--no-cache)";
-  o.precision(3);
-  o << name_ << " (" << dir_.string() << "): " << s.hits << " hits, " << s.misses
-    << " misses";
-  if (s.corrupt > 0) o << " (" << s.corrupt << " corrupt entries recomputed)";
-  if (s.uncacheable > 0) o << ", " << s.uncacheable << " problems not cacheable";
-  o << ", " << s.seconds_saved << " s of computing saved";
-  return o.str();
 }
 
 }  // namespace vessel::fem

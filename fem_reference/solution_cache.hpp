@@ -4,13 +4,11 @@
 /// everything that determines the solution: the mesh (nodes, elements, groups), the problem
 /// (material, supports, pins, loads with their quadrature points, curved walls, gravity, solver
 /// options) and the version of the reference code (a hash of fem_reference's sources, made at build
-/// time). Each file stores its full key and a checksum of its contents: a corrupt or truncated
-/// entry is detected, reported and recomputed. Entries are written atomically (write, then rename),
-/// so concurrent writers never leave a partial file.
+/// time). The entries live in the project's checksummed store (meshes/foundation/content_store.hpp):
+/// a corrupt or truncated entry is detected, reported and recomputed.
 #include <cstddef>
 #include <filesystem>
 #include <functional>
-#include <mutex>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -18,18 +16,9 @@
 
 #include "fem_reference/elasticity.hpp"
 #include "fem_reference/hyperelastic.hpp"
+#include "meshes/foundation/content_store.hpp"
 
 namespace vessel::fem {
-
-/// What a cache did over its life.
-struct SolutionCacheStatistics {
-  int hits = 0;
-  int misses = 0;   ///< solved and stored (including the corrupt entries below)
-  int corrupt = 0;  ///< entries found unreadable or failing their checksum, recomputed
-  int uncacheable =
-      0;  ///< problems with a load or support given as a function (solved, not stored)
-  double seconds_saved = 0.0;  ///< the hits' original assembly + solve time, less their reading
-};
 
 /// The canonical key of (mesh, problem), or nullopt when the problem cannot be keyed: a body
 /// force or a prescribed Dirichlet value given as a function. A curved wall's projection is keyed
@@ -65,35 +54,24 @@ class SolutionCache {
                             const ElasticityProblem& problem, const TransientOptions& options);
 
   /// A payload of the caller's own (e.g. what a finite-strain continuation gave at its
-  /// checkpoints) under `key` (from continuation_cache_key): the stored one when `original_seconds`
-  /// accepts it (it returns the seconds computing it took, and throws std::exception for a
-  /// payload it cannot read, which is then recomputed as a corrupt entry), else compute()'s,
-  /// stored. With the cache disabled, compute()'s. `refresh`: compute and replace the entry
-  /// without reading it (counted as a miss).
+  /// checkpoints) under `key` (from continuation_cache_key): ContentStore::payload.
   std::string payload(const std::string& key, const std::function<std::string()>& compute,
                       const std::function<double(std::string_view)>& original_seconds,
-                      bool refresh = false);
+                      bool refresh = false) {
+    return store_.payload(key, compute, original_seconds, refresh);
+  }
 
-  [[nodiscard]] bool enabled() const { return !dir_.empty(); }
-  [[nodiscard]] const std::filesystem::path& directory() const { return dir_; }
-  [[nodiscard]] SolutionCacheStatistics statistics() const;
-  /// One line: "<name> (DIR): H hits, M misses, C corrupt entries recomputed, S s
-  /// saved".
-  [[nodiscard]] std::string summary() const;
+  [[nodiscard]] bool enabled() const { return store_.enabled(); }
+  [[nodiscard]] const std::filesystem::path& directory() const { return store_.directory(); }
+  [[nodiscard]] ContentStoreStatistics statistics() const { return store_.statistics(); }
+  /// One line: "<name> (DIR): H hits, M misses, C corrupt entries recomputed, S s saved".
+  [[nodiscard]] std::string summary() const { return store_.summary(); }
 
  private:
   /// The problem's key, or nullopt (counted as uncacheable when the cache is on).
   std::optional<std::string> key_or_count(const TetMesh& mesh, const ElasticityProblem& problem);
-  /// The entry for `key`: `use(payload)` restores a good one and returns the seconds its
-  /// computation took; otherwise `compute()` computes and returns the payload, which is stored.
-  void lookup(const std::string& key, const std::function<double(std::string_view)>& use,
-              const std::function<std::string()>& compute, bool refresh = false);
 
-  std::filesystem::path dir_;
-  std::ostream* log_;
-  std::string name_;
-  mutable std::mutex mutex_;  // statistics only: entries are files written atomically
-  SolutionCacheStatistics stats_;
+  ContentStore store_;
 };
 
 /// cache->solve(solver, mesh, problem), or solver.solve() without a cache.

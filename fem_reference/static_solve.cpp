@@ -13,8 +13,8 @@
 #include "fem_reference/cholmod_solve.hpp"
 #include "fem_reference/detail/constraints.hpp"
 #include "fem_reference/detail/serial_solver.hpp"
-#include "meshes/errors.hpp"
-#include "meshes/solver_threads.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 
 namespace vessel::fem {
 

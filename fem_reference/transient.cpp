@@ -5,7 +5,7 @@
 
 #include "fem_reference/cholmod_solve.hpp"
 #include "fem_reference/detail/serial_solver.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::fem {
 

@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel {
 

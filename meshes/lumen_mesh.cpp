@@ -8,7 +8,7 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/vessel_geometry.hpp"
 
 namespace vessel {

@@ -8,8 +8,8 @@
 #include <iostream>
 #include <sstream>
 
-#include "meshes/content_hash.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/content_hash.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/lumen_mesh.hpp"
 #include "meshes/msh_io.hpp"
 

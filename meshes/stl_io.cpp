@@ -9,8 +9,8 @@
 #include <numeric>
 #include <sstream>
 
-#include "meshes/atomic_file.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/atomic_file.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel {
 

@@ -6,7 +6,7 @@
 #include <set>
 #include <sstream>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel {
 

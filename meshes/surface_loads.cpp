@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "meshes/disc_quadrature.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel {
 

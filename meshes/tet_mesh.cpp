@@ -10,7 +10,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel {
 

@@ -4,7 +4,7 @@
 #include <numbers>
 #include <sstream>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel {
 

@@ -21,7 +21,7 @@ struct BestModelRow {
   std::string load_unit;
   /// The mass-spring model (kind other than fem) that finished with the lowest relative L2 error
   /// (ties: the faster); empty when none finished. Edge-pair models (P1 FEM written on the tets'
-  /// edges, msm/model/edge_pair_term.hpp) are not candidates: they are the bound a spring model
+  /// edges, msm/terms/edge_pair_term.hpp) are not candidates: they are the bound a spring model
   /// is measured against, shown apart in edge_pair_*.
   std::string best_model;
   double best_relative_l2 = 0.0;

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <string>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::reports::json_fields {
 

@@ -9,8 +9,8 @@
 #include <set>
 #include <sstream>
 
-#include "meshes/atomic_file.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/atomic_file.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "reports/best_model.hpp"
 #include "reports/modal_section.hpp"
 #include "reports/representative_load.hpp"

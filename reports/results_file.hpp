@@ -50,7 +50,7 @@ struct ReferenceRow {
 };
 
 /// One model's (or the modal reference's) lowest natural frequencies at one ν and level (the
-/// scene's "modes" block; verification/harness.hpp ModalOutcome).
+/// scene's "modes" block; verification/harness/harness.hpp ModalOutcome).
 struct ModalRow {
   std::string model, kind, detail;
   double poisson_ratio = 0.0;

@@ -99,7 +99,7 @@ void stability_section(Document& doc, const StabilityFile& s) {
       "every eigenvalue of the damped system solves λ² + γλ + ω² = 0 for some ω ∈ [ω_min, ω_max] "
       "and γ between the extreme eigenvalues of M⁻¹C (here c/m_max and c/m_min), so the smallest "
       "critical step over that rectangle is safe for explicit and symplectic Euler "
-      "(`msm/stability/critical_step.hpp`; none is proven for damped Verlet). Use it, not the "
+      "(`msm/solvers/critical_step.hpp`; none is proven for damped Verlet). Use it, not the "
       "prediction, as a safe damped step. Steps in µs.");
   doc.table(critical_step_table(s));
   doc.paragraph("Explicit Euler without damping is not in the table: it is unstable at every step "

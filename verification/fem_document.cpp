@@ -4,7 +4,7 @@
 #include <iomanip>
 #include <nlohmann/json.hpp>
 
-#include "meshes/atomic_file.hpp"
+#include "meshes/foundation/atomic_file.hpp"
 #include "meshes/vtu_io.hpp"
 
 namespace vessel {

@@ -2,7 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "meshes/atomic_file.hpp"
+#include "meshes/foundation/atomic_file.hpp"
 
 namespace vessel {
 

@@ -7,10 +7,11 @@
 #include <sstream>
 #include <toml++/toml.h>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
+#include "verification/model_capabilities.hpp"
 
 namespace vessel {
 
@@ -361,7 +362,7 @@ std::string short_number(double v) {
 }
 
 /// An `external` or `displacements` [[models]] table (a model outside the suite,
-/// verification/external_model.hpp): the nodes it is given, and its command and time limit, or
+/// verification/harness/external_model.hpp): the nodes it is given, and its command and time limit, or
 /// the folder of answers computed elsewhere; `dt` and `steps` make the problem dynamic.
 std::vector<ModelSpec> outside_model(TableReader& r, ModelSpec m) {
   ExternalSpec& e = m.external;
@@ -419,7 +420,7 @@ void read_wall_options(TableReader& r, ModelSpec& m) {
     m.surface = msm::parse_wall_surface(r.name_or("surface", msm::to_string(m.surface), msm::parse_wall_surface));
     m.topology = msm::parse_topology(r.name_or("topology", "auto", msm::parse_topology));
     // `bending = "discrete-shells"`: the hinge energy of Grinspun et al. 2003 on the triangles
-    // (msm/model/bending_term.hpp), membrane springs van-gelder by default.
+    // (msm/terms/bending_term.hpp), membrane springs van-gelder by default.
     m.bending = msm::parse_bending(r.name_or("bending", "none", msm::parse_bending));
     if (m.bending != msm::Bending::none && m.topology == msm::Topology::grid) {
       r.fail(r.table().get("topology"), "topology",
@@ -811,7 +812,9 @@ Scene read_scene(const std::filesystem::path& path) {
   if (!in) throw InputError(path.string() + ": cannot open scene file");
   std::ostringstream text;
   text << in.rdbuf();
-  return parse_scene(text.str(), path.string());
+  Scene scene = parse_scene(text.str(), path.string());
+  check_model_inputs(scene);  // the files its models read: found now, not minutes into a run
+  return scene;
 }
 
 std::string to_string(LoadKind kind) {

@@ -18,7 +18,7 @@
 namespace vessel {
 
 enum class LoadKind { contact, pressure, gravity };
-/// network: a spring network read from a file (msm/model/network_file.hpp), run by the suite's
+/// network: a spring network read from a file (msm/formats/network_file.hpp), run by the suite's
 /// own solvers like the built-in mass-spring models; external and displacements: models outside
 /// the suite (ExternalSpec).
 enum class ModelKind { fem, surface_msm, volume_msm, network, external, displacements };
@@ -29,7 +29,7 @@ enum class ModelKind { fem, surface_msm, volume_msm, network, external, displace
 enum class ExchangeNodes { volume, surface };
 std::string to_string(ExchangeNodes nodes);  ///< "volume" | "surface"
 
-/// A model outside the suite (verification/external_model.hpp): `external` runs `command` once per
+/// A model outside the suite (verification/harness/external_model.hpp): `external` runs `command` once per
 /// case on an exchange directory; `displacements` reads answers computed elsewhere from
 /// `directory`, one case folder each as `vesselverify export` names them.
 struct ExternalSpec {
@@ -58,13 +58,13 @@ struct ModelSpec {
   msm::WallSurface surface = msm::NetworkOptions{}.surface;  ///< surface msm: which wall
   msm::Topology topology = msm::Topology::automatic;      ///< surface msm
   msm::StiffnessRule stiffness = msm::StiffnessRule::seed000;
-  /// volume_msm: the hybrid volume model (Golec et al. 2020; msm/model/model_factory.hpp):
+  /// volume_msm: the hybrid volume model (Golec et al. 2020; msm/model/model.hpp):
   /// van-gelder springs carrying μ plus a volume energy per tet with κ = λ − μ (any ν < 0.5).
   bool volume_term = false;
   /// volume_term's rule for (E_s, κ): golec (default) or homogenised (msm/model/build_network.hpp).
   msm::VolumeModuli volume_moduli = msm::VolumeModuli::golec;
   /// volume_msm: each tet's springs coupled in its tetrahedron-sharing edge pairs, the edge-based
-  /// StVK tetrahedron of Kikuuwe et al. 2009 (msm/model/edge_pair_term.hpp): P1 FEM on the edges.
+  /// StVK tetrahedron of Kikuuwe et al. 2009 (msm/terms/edge_pair_term.hpp): P1 FEM on the edges.
   bool edge_pairs = false;
   /// surface msm: discrete_shells adds the Discrete Shells hinge energy (Grinspun et al. 2003) with
   /// D = E·t³/(12(1 − ν²)) and drops the bend springs (msm/model/build_network.hpp).

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <limits>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/mesh_cache.hpp"
-#include "msm/model/network_file.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/formats/network_file.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "verification/calibration_file.hpp"
 
 namespace vessel {

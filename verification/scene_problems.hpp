@@ -9,7 +9,7 @@
 
 #include "fem_reference/elasticity.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 #include "verification/scene.hpp"
 
 namespace vessel {

@@ -7,7 +7,7 @@
 #include <limits>
 #include <sstream>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::fem::detail {
 

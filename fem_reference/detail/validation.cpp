@@ -4,7 +4,7 @@
 #include <sstream>
 #include <string>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::fem::detail {
 

@@ -30,9 +30,9 @@
 #include "meshes/mesh_cache.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
-#include "msm/solvers/linear_solver.hpp"
+#include "msm/linalg/linear_solver.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;

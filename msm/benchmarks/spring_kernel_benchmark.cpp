@@ -40,7 +40,7 @@
 #include "msm/kernels/fast_springs.hpp"
 #include "msm/kernels/node_springs.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/terms/spring_model.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;

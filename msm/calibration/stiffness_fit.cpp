@@ -7,9 +7,9 @@
 #include <map>
 #include <numbers>
 
-#include "meshes/errors.hpp"
-#include "msm/model/volume_term.hpp"
-#include "msm/solvers/linear_solver.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/terms/volume_term.hpp"
+#include "msm/linalg/linear_solver.hpp"
 
 namespace vessel::msm {
 

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "meshes/vessel_geometry.hpp"
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 #include "msm/topology/springs.hpp"
 
 namespace vessel::msm {

@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "meshes/errors.hpp"
-#include "msm/solvers/linear_solver.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/linalg/linear_solver.hpp"
 
 namespace vessel::msm {
 

@@ -11,7 +11,7 @@
 /// transverse motion, which only tension stiffens) show as ω ≈ 0 and are counted.
 #include <vector>
 
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 
 namespace vessel::msm {
 

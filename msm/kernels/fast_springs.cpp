@@ -11,7 +11,8 @@
 #include <thread>
 #include <utility>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/kernels/thread_parts.hpp"
 
 namespace vessel::msm {
 
@@ -401,25 +402,9 @@ double FastSprings::run_part(const Part& p, const double* x, double* g) const {
 template <bool kGradient, bool kEnergy>
 double FastSprings::run(const double* x, double* g) const {
   if (threads_ == 1) return run_part<kGradient, kEnergy>(parts_[0], x, g);
-  std::vector<double> partial(static_cast<std::size_t>(threads_), 0.0);
-  // set_solver_threads(1) sets max-active-levels to 0 on this thread so that CHOLMOD's regions run
-  // serially; that would serialise this region too, so it is lifted here and restored after.
-  const int saved_levels = omp_get_max_active_levels();
-  if (saved_levels < 1) omp_set_max_active_levels(1);
-#pragma omp parallel num_threads(threads_)
-  {
-    // A smaller team than asked (OMP_THREAD_LIMIT, nesting) still covers every part.
-    const int team = omp_get_num_threads();
-    if (omp_get_thread_num() == 0) last_team_.store(team, std::memory_order_relaxed);
-    for (int t = omp_get_thread_num(); t < threads_; t += team) {
-      partial[static_cast<std::size_t>(t)] =
-          run_part<kGradient, kEnergy>(parts_[static_cast<std::size_t>(t)], x, g);
-    }
-  }
-  if (saved_levels < 1) omp_set_max_active_levels(saved_levels);
-  double e = 0.0;
-  for (double p : partial) e += p;
-  return e;
+  return sum_over_thread_parts(threads_, last_team_, [&](int t) {
+    return run_part<kGradient, kEnergy>(parts_[static_cast<std::size_t>(t)], x, g);
+  });
 }
 
 double FastSprings::energy(const double* x) const { return run<false, true>(x, nullptr); }

@@ -9,7 +9,8 @@
 #include <string>
 #include <utility>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/kernels/thread_parts.hpp"
 #include "msm/kernels/fast_springs.hpp"
 
 namespace vessel::msm {
@@ -365,24 +366,10 @@ template <bool kGradient, bool kEnergy>
 double NodeSprings::run(const double* x, double* g) const {
   // Every spring is summed from both ends: ¼ Σ 2ψ over the entries is Σ ψ.
   if (threads_ == 1) return 0.25 * run_chunks<kGradient, kEnergy>(0, thread_chunks_[1], x, g);
-  std::vector<double> partial(static_cast<std::size_t>(threads_), 0.0);
-  // As in FastSprings::run: set_solver_threads(1) leaves max-active-levels at 0 for CHOLMOD,
-  // which would serialise this region; lifted here and restored after.
-  const int saved_levels = omp_get_max_active_levels();
-  if (saved_levels < 1) omp_set_max_active_levels(1);
-#pragma omp parallel num_threads(threads_)
-  {
-    const int team = omp_get_num_threads();
-    if (omp_get_thread_num() == 0) last_team_.store(team, std::memory_order_relaxed);
-    for (int t = omp_get_thread_num(); t < threads_; t += team) {
-      const auto u = static_cast<std::size_t>(t);
-      partial[u] = run_chunks<kGradient, kEnergy>(thread_chunks_[u], thread_chunks_[u + 1], x, g);
-    }
-  }
-  if (saved_levels < 1) omp_set_max_active_levels(saved_levels);
-  double e = 0.0;
-  for (double p : partial) e += p;
-  return 0.25 * e;
+  return 0.25 * sum_over_thread_parts(threads_, last_team_, [&](int t) {
+    const auto u = static_cast<std::size_t>(t);
+    return run_chunks<kGradient, kEnergy>(thread_chunks_[u], thread_chunks_[u + 1], x, g);
+  });
 }
 
 double NodeSprings::energy(const double* x) const { return run<false, true>(x, nullptr); }

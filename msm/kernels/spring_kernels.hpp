@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 #include <limits>
 
+#include "msm/topology/springs.hpp"
+
 namespace vessel::msm {
 
 using Vec3 = Eigen::Vector3d;
@@ -20,15 +22,6 @@ struct LengthProfile {
   double ddpsi = 0.0;
 };
 
-/// Material law of one spring: Hooke (seed 000 eq. 3.2) when `threshold` is infinite, else the
-/// bilinear spring of seed 001 eq. (1): stiffness k1 up to the threshold elongation Δx_c (m),
-/// k2 beyond it. Compression (negative elongation) always uses k1, as in the seed, whose
-/// threshold is on the elongation.
-struct SpringLaw {
-  double k1 = 0.0;                                             ///< N/m
-  double k2 = 0.0;                                             ///< N/m, used beyond the threshold
-  double threshold = std::numeric_limits<double>::infinity();  ///< Δx_c, m
-};
 
 /// Hooke's spring: ψ = ½ k (L − l)², whose force −∇ψ is seed 000 eq. (3.2):
 /// f_a = −k_s (xa − xb)/|xa − xb| (|xa − xb| − l).

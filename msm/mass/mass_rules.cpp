@@ -3,7 +3,7 @@
 #include <cmath>
 #include <numeric>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::msm {
 

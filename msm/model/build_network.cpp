@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "meshes/errors.hpp"
-#include "msm/model/model_factory.hpp"
-#include "msm/model/volume_term_homogenised.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/model/model.hpp"
+#include "msm/terms/volume_term_homogenised.hpp"
 
 namespace vessel::msm {
 

@@ -8,7 +8,7 @@
 
 #include "meshes/tet_mesh.hpp"
 #include "meshes/vessel_geometry.hpp"
-#include "msm/model/edge_pair_term.hpp"
+#include "msm/terms/edge_pair_term.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 #include "msm/topology/springs.hpp"
@@ -27,7 +27,7 @@ std::string to_string(Topology topology);             ///< "auto" | "grid" | "tr
 Topology parse_topology(const std::string& name);     ///< InputError if unknown
 
 /// A surface model's bending: none beyond its springs, or the Discrete Shells hinge energy
-/// (Grinspun et al. 2003; msm/model/bending_term.hpp) with the wall's plate rigidity.
+/// (Grinspun et al. 2003; msm/terms/bending_term.hpp) with the wall's plate rigidity.
 enum class Bending { none, discrete_shells };
 std::string to_string(Bending bending);          ///< "none" | "discrete-shells"
 Bending parse_bending(const std::string& name);  ///< InputError if unknown
@@ -65,14 +65,14 @@ struct NetworkOptions {
   /// (auto picks it); InputError with the volume model or the grid topology.
   Bending bending = Bending::none;
   /// Volume model only: the springs of each tet coupled in its tetrahedron-sharing edge pairs, the
-  /// edge-based StVK tetrahedron of Kikuuwe et al. (2009) (msm/model/edge_pair_term.hpp) with λ and
+  /// edge-based StVK tetrahedron of Kikuuwe et al. (2009) (msm/terms/edge_pair_term.hpp) with λ and
   /// μ from stiffness_params' E and ν: P1 FEM written on the tets' edges. It replaces the springs
   /// (their stiffness rule does not apply). InputError with the surface model, the volume term or
   /// at ν = 0.5.
   bool edge_pairs = false;
 };
 
-/// The supports a spring-network file gives (msm/model/network_file.hpp): nodes held in every
+/// The supports a spring-network file gives (msm/formats/network_file.hpp): nodes held in every
 /// component, and the mesh's surface groups whose supports (clamped, roller) hold the nodes lying
 /// on them. Built-in networks have none: they follow every support through their source nodes.
 struct NetworkSupports {

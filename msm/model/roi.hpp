@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 #include "msm/topology/springs.hpp"
 
 namespace vessel::msm {

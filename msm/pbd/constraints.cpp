@@ -6,8 +6,8 @@
 #include <limits>
 #include <map>
 
-#include "meshes/errors.hpp"
-#include "msm/solvers/integrators.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/form/divergence_error.hpp"
 
 namespace vessel::msm {
 

@@ -6,7 +6,7 @@
 #include <functional>
 #include <vector>
 
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 #include "msm/topology/springs.hpp"
 
 namespace vessel::msm {

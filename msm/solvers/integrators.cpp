@@ -5,8 +5,8 @@
 #include <iomanip>
 #include <sstream>
 
-#include "meshes/errors.hpp"
-#include "msm/solvers/linear_solver.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/linalg/linear_solver.hpp"
 
 namespace vessel::msm {
 
@@ -43,14 +43,6 @@ std::string to_string(Integrator i) {
   }
   return "unknown";
 }
-
-DivergenceError::DivergenceError(int step_, int node_, double energy_, const std::string& why)
-    : std::runtime_error("diverged at step " + std::to_string(step_) + ", node " +
-                         std::to_string(node_) + ", energy " + sci(energy_) + " J: " +
-                         why + " (reduce the time step or use implicit-euler); no result written"),
-      step(step_),
-      node(node_),
-      energy(energy_) {}
 
 namespace {
 

@@ -6,7 +6,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "msm/model/form.hpp"
+#include "msm/form/divergence_error.hpp"
+#include "msm/form/form.hpp"
 #include "msm/solvers/pcg.hpp"
 
 namespace vessel::msm {
@@ -40,15 +41,6 @@ enum class ImplicitMatrix {
 // (K(x) − K(rest), e.g. the surface membrane's tension-borne transverse stiffness, zero at rest) is
 // integrated explicitly. On the level-0 surface models it diverged at the default 10× critical
 // step (step 7–10) but ran at 1 ms; on the volume model it ran at both.
-
-/// A run that blew up: a non-finite value, or the energy beyond the limit.
-class DivergenceError : public std::runtime_error {
- public:
-  DivergenceError(int step, int node, double energy, const std::string& why);
-  int step;
-  int node;
-  double energy;  ///< J
-};
 
 struct DynamicOptions {
   Integrator integrator = Integrator::symplectic_euler;

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "meshes/errors.hpp"
-#include "msm/model/model_factory.hpp"
-#include "msm/model/spring_model.hpp"
-#include "msm/solvers/linear_solver.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/model/model.hpp"
+#include "msm/terms/spring_model.hpp"
+#include "msm/linalg/linear_solver.hpp"
 
 namespace vessel::msm {
 

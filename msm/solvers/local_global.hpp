@@ -18,7 +18,7 @@
 #include <functional>
 #include <memory>
 
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/static_solver.hpp"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <utility>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::msm {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 
 namespace vessel::msm {
 

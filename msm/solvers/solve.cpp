@@ -2,10 +2,10 @@
 
 #include <algorithm>
 
-#include "meshes/errors.hpp"
-#include "msm/model/model_factory.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/model/model.hpp"
 #include "msm/solvers/local_global.hpp"
-#include "msm/stability/critical_step.hpp"
+#include "msm/solvers/critical_step.hpp"
 
 namespace vessel::msm {
 

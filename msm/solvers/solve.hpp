@@ -8,7 +8,7 @@
 #include <string>
 #include <variant>
 
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 #include "msm/pbd/constraints.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/static_solver.hpp"

@@ -5,11 +5,11 @@
 #include <ostream>
 #include <string>
 
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 
 namespace vessel::msm {
 
-class CholmodSolver;  // msm/solvers/linear_solver.hpp
+class CholmodSolver;  // msm/linalg/linear_solver.hpp
 
 /// How static Newton makes each step a descent that converges.
 enum class StaticGlobalisation {

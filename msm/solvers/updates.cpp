@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "meshes/errors.hpp"
-#include "msm/solvers/linear_solver.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/linalg/linear_solver.hpp"
 #include "msm/solvers/static_solver.hpp"
 
 namespace vessel::msm {

@@ -21,7 +21,7 @@
 /// Updater made by prepare_updates from its SolverSpec.
 #include <memory>
 
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 #include "msm/solvers/solve.hpp"
 
 namespace vessel::msm {

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <functional>
 
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 #include "msm/solvers/integrators.hpp"
 
 namespace vessel::msm {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <map>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::msm {
 

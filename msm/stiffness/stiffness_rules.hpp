@@ -79,8 +79,8 @@ double van_gelder_stiffness(double E, double measure_around_edge, double L);
 /// E·t·A/L² = (√3/4)·E·t for the equilateral one, so on triangles this rule equals van_gelder.
 /// Source check (2026-11): only the paper's abstract and introduction could be retrieved with the
 /// project's search corpora ("analytical expressions for the spring parameters ... for triangle,
-/// rectangle and tetrahedron meshes"); the two constants above are the issue's and DESIGN.md's
-/// quotation, not checked against the paper's equations (no equation numbers cited). The tests
+/// rectangle and tetrahedron meshes"); the two constants above are quoted from the project's
+/// design notes, not checked against the paper's equations (no equation numbers cited). The tests
 /// check the hand-derived values on one element (tests/msm/test_stiffness_rules_by_hand.cpp).
 double lloyd_tet_edge_stiffness(double E, double volume, double L);
 double lloyd_triangle_edge_stiffness(double E, double thickness, double area, double L);

@@ -7,7 +7,7 @@
 #include <set>
 #include <utility>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::msm {
 

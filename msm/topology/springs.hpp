@@ -3,15 +3,25 @@
 /// Built on a tetrahedral mesh (seed 001, volume model) or on a wall surface (seeds 000 and 002,
 /// surface model). Stiffness and masses are assigned separately (stiffness/, mass/).
 #include <array>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "meshes/stl_io.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "meshes/vessel_geometry.hpp"
-#include "msm/kernels/spring_kernels.hpp"
 
 namespace vessel::msm {
+
+/// Material law of one spring: Hooke (seed 000 eq. 3.2) when `threshold` is infinite, else the
+/// bilinear spring of seed 001 eq. (1): stiffness k1 up to the threshold elongation Δx_c (m),
+/// k2 beyond it. Compression (negative elongation) always uses k1, as in the seed, whose
+/// threshold is on the elongation.
+struct SpringLaw {
+  double k1 = 0.0;                                             ///< N/m
+  double k2 = 0.0;                                             ///< N/m, used beyond the threshold
+  double threshold = std::numeric_limits<double>::infinity();  ///< Δx_c, m
+};
 
 /// Spring families. Surface model (seed 000 §II.B): structural (grid neighbours / mesh edges),
 /// shear ("twisted", grid diagonals), bend ("stretch", grid neighbours one node apart; on a
@@ -42,7 +52,7 @@ struct SpringNetwork {
   std::vector<Triangle> triangles;
   std::vector<Tet> tets;   ///< tets of the volume model (empty for surfaces)
   /// Per tet, a factor on the volume term's κ (the homogenised rule's stability clip,
-  /// msm/model/volume_term_homogenised.hpp); empty: all 1.
+  /// msm/terms/volume_term_homogenised.hpp); empty: all 1.
   std::vector<double> tet_kappa_factors;
   double thickness = 0.0;  ///< wall thickness t carried by a surface model, m
   [[nodiscard]] std::size_t count(SpringFamily family) const;

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/model/build_network.hpp"
 #include "verification/calibration_file.hpp"
 #include "verification/scene.hpp"

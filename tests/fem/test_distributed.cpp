@@ -11,7 +11,7 @@
 
 #include "fem_reference/distributed_elasticity.hpp"
 #include "fem_reference/elasticity.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
 

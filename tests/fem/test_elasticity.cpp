@@ -13,7 +13,7 @@
 #include "fem_reference/elasticity.hpp"
 #include "cube_mesh.hpp"
 #include "fem_test_meshes.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/surface_loads.hpp"
 
 using namespace vessel;

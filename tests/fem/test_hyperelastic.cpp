@@ -10,7 +10,7 @@
 #include "cube_mesh.hpp"
 #include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/rivlin.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 using namespace vessel;
 using namespace vessel::fem;

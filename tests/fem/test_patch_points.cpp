@@ -10,7 +10,7 @@
 
 #include "fem_reference/elasticity.hpp"
 #include "fem_test_meshes.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/surface_loads.hpp"
 
 using namespace vessel;

@@ -67,7 +67,7 @@ TEST(SolutionCache, AHitRestoresTheFreshSolveBitwise) {
   fem::ElasticitySolver first(mesh, problem), second(mesh, problem);
   cache.solve(first, mesh, problem);
   cache.solve(second, mesh, problem);
-  const fem::SolutionCacheStatistics s = cache.statistics();
+  const ContentStoreStatistics s = cache.statistics();
   EXPECT_EQ(s.misses, 1);
   EXPECT_EQ(s.hits, 1);
   EXPECT_EQ(s.corrupt, 0);
@@ -163,7 +163,7 @@ TEST(SolutionCache, ACorruptOrTruncatedEntryIsRecomputedWithAMessage) {
   expect_same_solution(fresh, after_truncation);
   EXPECT_NE(log.str().find("corrupt (truncated)"), std::string::npos) << log.str();
 
-  const fem::SolutionCacheStatistics s = cache.statistics();
+  const ContentStoreStatistics s = cache.statistics();
   EXPECT_EQ(s.misses, 3);
   EXPECT_EQ(s.corrupt, 2);
   EXPECT_EQ(s.hits, 0);

@@ -15,7 +15,7 @@
 #include <numbers>
 
 #include "fem_reference/elasticity.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 
 using namespace vessel;

@@ -2,7 +2,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/stl_io.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -7,7 +7,7 @@
 
 #include "../lumen_fixture.hpp"
 #include "../test_helpers.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/lumen_mesh.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "meshes/mesh_quality.hpp"

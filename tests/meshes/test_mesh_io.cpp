@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "../test_helpers.hpp"
-#include "meshes/atomic_file.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/atomic_file.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "meshes/msh_io.hpp"

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/self_contact.hpp"
 

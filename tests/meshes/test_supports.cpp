@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <numeric>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/supports.hpp"
 

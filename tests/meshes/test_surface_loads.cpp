@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
 

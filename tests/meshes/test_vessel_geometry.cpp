@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/vessel_geometry.hpp"
 
 using namespace vessel;

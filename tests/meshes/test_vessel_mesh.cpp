@@ -6,7 +6,7 @@
 #include <cmath>
 #include <set>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/mesh_quality.hpp"
 

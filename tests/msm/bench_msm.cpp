@@ -6,9 +6,9 @@
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/mass/mass_rules.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
-#include "msm/solvers/linear_solver.hpp"
+#include "msm/linalg/linear_solver.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 
 using namespace vessel;

@@ -12,7 +12,7 @@
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/solvers/updates.hpp"
 

@@ -6,7 +6,7 @@
 #include <array>
 #include <functional>
 
-#include "msm/model/form.hpp"
+#include "msm/form/form.hpp"
 
 namespace vessel::msm::test {
 

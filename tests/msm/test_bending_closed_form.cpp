@@ -18,7 +18,7 @@
 #include <numbers>
 
 #include "msm/model/build_network.hpp"
-#include "msm/model/model_factory.hpp"
+#include "msm/model/model.hpp"
 #include "msm/solvers/solve.hpp"
 #include "shell_meshes.hpp"
 

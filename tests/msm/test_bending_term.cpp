@@ -12,14 +12,14 @@
 #include <random>
 
 #include "finite_differences.hpp"
-#include "meshes/errors.hpp"
-#include "msm/model/bending_term.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/terms/bending_term.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model_factory.hpp"
+#include "msm/model/model.hpp"
 #include "msm/model/roi.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/solve.hpp"
-#include "msm/stability/critical_step.hpp"
+#include "msm/solvers/critical_step.hpp"
 #include "shell_meshes.hpp"
 
 using namespace vessel;

@@ -10,10 +10,10 @@
 #include <random>
 
 #include "finite_differences.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/edge_pair_term.hpp"
-#include "msm/model/model_factory.hpp"
+#include "msm/terms/edge_pair_term.hpp"
+#include "msm/model/model.hpp"
 #include "msm/model/roi.hpp"
 #include "msm/solvers/solve.hpp"
 #include "tests/fem/cube_mesh.hpp"

@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <map>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model_factory.hpp"
+#include "msm/model/model.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 

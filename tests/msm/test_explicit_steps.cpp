@@ -7,7 +7,7 @@
 
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
 
 using namespace vessel;

@@ -10,13 +10,13 @@
 #include <random>
 #include <type_traits>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/kernels/fast_springs.hpp"
 #include "msm/kernels/node_springs.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/spring_model.hpp"
-#include "msm/solvers/linear_solver.hpp"
+#include "msm/terms/spring_model.hpp"
+#include "msm/linalg/linear_solver.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;

@@ -8,10 +8,10 @@
 #include <algorithm>
 #include <vector>
 
-#include "meshes/errors.hpp"
-#include "msm/model/spring_model.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
-#include "msm/solvers/linear_solver.hpp"
+#include "msm/linalg/linear_solver.hpp"
 #include "msm/solvers/solve.hpp"
 
 using namespace vessel;

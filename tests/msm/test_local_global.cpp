@@ -7,12 +7,12 @@
 #include <memory>
 #include <vector>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/mass/mass_rules.hpp"
-#include "msm/model/model_factory.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/model/model.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/solvers/local_global.hpp"
 #include "msm/solvers/solve.hpp"
 #include "msm/solvers/static_solver.hpp"

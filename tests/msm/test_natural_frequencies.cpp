@@ -8,11 +8,12 @@
 #include <cmath>
 #include <numbers>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/dynamics/natural_frequencies.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model_factory.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/model/model.hpp"
+#include "msm/terms/spring_model.hpp"
+#include "tests/fixtures/kuhn_block.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;
@@ -162,27 +163,7 @@ TEST(NaturalFrequencies, HybridVolumeModelAgreesWithDenseGeneralisedSolver) {
   // A 3 × 3 × 4 mm block of Kuhn tets, base held, the hybrid volume model at ν = 0.45 (its volume
   // term in K) with consistent masses: Lanczos against Eigen's dense K x = ω² M x on the same
   // free-dof K and M; the springs-only model (κ dropped) is softer in every compared mode.
-  TetMesh mesh;
-  const int nx = 3, nz = 4;
-  const double h = 1e-3;
-  auto id = [&](int i, int j, int l) { return (l * (nx + 1) + j) * (nx + 1) + i; };
-  for (int l = 0; l <= nz; ++l)
-    for (int j = 0; j <= nx; ++j)
-      for (int i = 0; i <= nx; ++i) mesh.nodes.emplace_back(i * h, j * h, l * h);
-  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7},
-                          {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
-  for (int l = 0; l < nz; ++l)
-    for (int j = 0; j < nx; ++j)
-      for (int i = 0; i < nx; ++i)
-        for (const auto& t : kuhn) {
-          Tet tet{};
-          for (int a = 0; a < 4; ++a) {
-            const int cnr = t[a];
-            tet[a] = id(i + (cnr & 1), j + ((cnr >> 1) & 1), l + ((cnr >> 2) & 1));
-          }
-          mesh.tets.push_back(tet);
-        }
-  orient_tets(mesh);
+  TetMesh mesh = vessel::test::kuhn_block(3, 3, 4, 1e-3);
   NetworkOptions no;
   no.model = ModelType::volume;
   no.stiffness = StiffnessRule::van_gelder;

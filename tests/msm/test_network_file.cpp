@@ -1,4 +1,4 @@
-// Spring-network files (msm/model/network_file.hpp): a hand-written file read back to the values
+// Spring-network files (msm/formats/network_file.hpp): a hand-written file read back to the values
 // written by hand, JSON and VTU round trips bit for bit, and every refusal named (file, item,
 // what was expected).
 #include <gtest/gtest.h>
@@ -8,9 +8,9 @@
 #include <string>
 
 #include "../test_helpers.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/vtu_io.hpp"
-#include "msm/model/network_file.hpp"
+#include "msm/formats/network_file.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;

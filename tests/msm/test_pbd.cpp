@@ -10,8 +10,8 @@
 #include <random>
 
 #include "finite_differences.hpp"
-#include "meshes/errors.hpp"
-#include "msm/model/spring_model.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/pbd/constraints.hpp"
 #include "msm/solvers/integrators.hpp"
 

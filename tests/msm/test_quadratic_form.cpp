@@ -9,8 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "meshes/errors.hpp"
-#include "msm/model/quadratic_form.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/form/quadratic_form.hpp"
 #include "msm/solvers/updates.hpp"
 #include "tests/msm/finite_differences.hpp"
 

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "msm/model/spring_model.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/model/roi.hpp"
 

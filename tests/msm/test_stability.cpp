@@ -9,8 +9,8 @@
 #include <random>
 
 #include "msm/mass/mass_rules.hpp"
-#include "msm/model/spring_model.hpp"
-#include "msm/stability/critical_step.hpp"
+#include "msm/terms/spring_model.hpp"
+#include "msm/solvers/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 

@@ -10,7 +10,7 @@
 #include "meshes/mesh_cache.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/solvers/static_solver.hpp"
 
 using namespace vessel;

@@ -8,7 +8,7 @@
 
 #include <cmath>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 #include "msm/topology/springs.hpp"
 

@@ -6,7 +6,7 @@
 #include <numbers>
 #include <numeric>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"

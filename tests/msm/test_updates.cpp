@@ -7,11 +7,11 @@
 #include <random>
 #include <utility>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/mass/mass_rules.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/solvers/updates.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"

@@ -8,13 +8,14 @@
 #include <random>
 
 #include "finite_differences.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model_factory.hpp"
+#include "msm/model/model.hpp"
 #include "msm/model/roi.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/solve.hpp"
-#include "msm/stability/critical_step.hpp"
+#include "msm/solvers/critical_step.hpp"
+#include "tests/fixtures/kuhn_block.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;
@@ -24,29 +25,7 @@ namespace {
 constexpr double kE = 14.24e3;
 
 /// An n×n×n block of cubes of side h, each cut into six tets (Kuhn), positively oriented.
-TetMesh block_mesh(int n, double h) {
-  TetMesh m;
-  auto id = [n](int i, int j, int k) { return (k * (n + 1) + j) * (n + 1) + i; };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) m.nodes.emplace_back(i * h, j * h, k * h);
-  // The six tets of the unit cube along the diagonal 0 → 7 (corners numbered by bits x, y, z).
-  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7},
-                          {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (const auto& t : kuhn) {
-          Tet tet{};
-          for (int a = 0; a < 4; ++a) {
-            const int c = t[a];
-            tet[a] = id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1));
-          }
-          m.tets.push_back(tet);
-        }
-  orient_tets(m);
-  return m;
-}
+TetMesh block_mesh(int n, double h) { return vessel::test::kuhn_block(n, n, n, h); }
 
 BuiltNetwork hybrid(const TetMesh& mesh, double nu) {
   NetworkOptions o;

@@ -1,4 +1,4 @@
-// The homogenised hybrid volume model (msm/model/volume_term_homogenised.hpp): each tet's
+// The homogenised hybrid volume model (msm/terms/volume_term_homogenised.hpp): each tet's
 // stability limit against hand-derived values, the traction homogenisation of a single tet against
 // its strain-space stiffness (E_s·G + κ·m mᵀ, derived independently here), positive-definiteness
 // detection at the analytic limit, the fit's refusals, and the per-tet κ factors in the energy
@@ -9,11 +9,12 @@
 #include <random>
 
 #include "finite_differences.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model_factory.hpp"
+#include "msm/model/model.hpp"
 #include "msm/model/roi.hpp"
-#include "msm/model/volume_term_homogenised.hpp"
+#include "msm/terms/volume_term_homogenised.hpp"
+#include "tests/fixtures/kuhn_block.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;
@@ -46,28 +47,7 @@ std::array<Vec3, 4> regular_tet(double a) {
 }
 
 /// An n×n×n block of cubes of side h, each cut into six tets (Kuhn), positively oriented.
-TetMesh block_mesh(int n, double h) {
-  TetMesh m;
-  auto id = [n](int i, int j, int k) { return (k * (n + 1) + j) * (n + 1) + i; };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) m.nodes.emplace_back(i * h, j * h, k * h);
-  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7},
-                          {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (const auto& t : kuhn) {
-          Tet tet{};
-          for (int a = 0; a < 4; ++a) {
-            const int c = t[a];
-            tet[a] = id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1));
-          }
-          m.tets.push_back(tet);
-        }
-  orient_tets(m);
-  return m;
-}
+TetMesh block_mesh(int n, double h) { return vessel::test::kuhn_block(n, n, n, h); }
 
 }  // namespace
 

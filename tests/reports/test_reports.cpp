@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "reports/document.hpp"
 #include "reports/gate.hpp"
 #include "reports/report.hpp"

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "verification/scene.hpp"
 
 using namespace vessel;

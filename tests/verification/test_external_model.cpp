@@ -1,4 +1,4 @@
-// Models outside the suite (verification/external_model.hpp): the exchange written for a case
+// Models outside the suite (verification/harness/external_model.hpp): the exchange written for a case
 // against independent truth (the loads' totals: the contact force, the wall's weight ρ·π(b²−a²)L;
 // the clamped ends' nodes), the answers read back and every refusal, the process runner's
 // exit codes and time-out (the whole process group killed), and in the harness: every failure
@@ -16,10 +16,11 @@
 
 #include "../test_helpers.hpp"
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/vtu_io.hpp"
-#include "verification/external_model.hpp"
-#include "verification/harness.hpp"
+#include "verification/harness/external_model.hpp"
+#include "verification/harness/harness.hpp"
+#include "verification/harness/results.hpp"
 #include "verification/scene_problems.hpp"
 
 using namespace vessel;

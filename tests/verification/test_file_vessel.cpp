@@ -7,7 +7,7 @@
 
 #include "../lumen_fixture.hpp"
 #include "../test_helpers.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "meshes/msh_io.hpp"
 #include "verification/scene.hpp"

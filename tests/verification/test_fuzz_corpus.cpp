@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "../test_helpers.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/msh_io.hpp"
 #include "meshes/stl_io.hpp"
 #include "verification/scene.hpp"

@@ -11,14 +11,17 @@
 
 #include "../test_helpers.hpp"
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/mass/mass_rules.hpp"
-#include "msm/model/spring_model.hpp"
+#include "msm/terms/spring_model.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 #include "fem_reference/solution_cache.hpp"
-#include "verification/harness.hpp"
+#include "verification/harness/harness.hpp"
+#include "verification/harness/metrics.hpp"
+#include "verification/harness/timed_updates.hpp"
+#include "verification/harness/results.hpp"
 
 using namespace vessel;
 

@@ -9,7 +9,7 @@
 
 #include "fem_reference/hyperelastic.hpp"
 #include "meshes/gmsh_vessel.hpp"
-#include "verification/harness.hpp"
+#include "verification/harness/harness.hpp"
 #include "verification/scene_problems.hpp"
 
 using namespace vessel;

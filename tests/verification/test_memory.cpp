@@ -4,7 +4,7 @@
 #include <cstring>
 #include <vector>
 
-#include "verification/memory.hpp"
+#include "verification/harness/memory.hpp"
 
 using namespace vessel;
 

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "verification/metrics.hpp"
-#include "verification/progress.hpp"
-#include "verification/timing.hpp"
+#include "verification/harness/metrics.hpp"
+#include "verification/harness/progress.hpp"
+#include "verification/harness/timing.hpp"
 
 using namespace vessel;
 

@@ -8,11 +8,11 @@
 #include <string>
 
 #include "../test_helpers.hpp"
-#include "meshes/errors.hpp"
-#include "msm/model/model_factory.hpp"
-#include "msm/model/network_file.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/model/model.hpp"
+#include "msm/formats/network_file.hpp"
 #include "msm/solvers/solve.hpp"
-#include "verification/harness.hpp"
+#include "verification/harness/harness.hpp"
 #include "verification/scene_problems.hpp"
 
 using namespace vessel;

@@ -11,8 +11,8 @@
 #include "../test_helpers.hpp"
 
 #include "fem_reference/solution_cache.hpp"
-#include "verification/harness.hpp"
-#include "verification/outcome_cache.hpp"
+#include "verification/harness/harness.hpp"
+#include "verification/harness/outcome_cache.hpp"
 
 using namespace vessel;
 

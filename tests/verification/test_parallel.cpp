@@ -10,8 +10,8 @@
 #include <thread>
 #include <vector>
 
-#include "meshes/solver_threads.hpp"
-#include "verification/parallel.hpp"
+#include "meshes/foundation/solver_threads.hpp"
+#include "verification/harness/parallel.hpp"
 
 using namespace vessel;
 

@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "../test_helpers.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_problems.hpp"
 

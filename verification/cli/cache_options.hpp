@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "fem_reference/solution_cache.hpp"
-#include "verification/outcome_cache.hpp"
+#include "verification/harness/outcome_cache.hpp"
 
 namespace vessel::cli {
 

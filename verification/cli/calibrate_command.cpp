@@ -4,8 +4,8 @@
 #include <iostream>
 #include <sstream>
 
-#include "meshes/atomic_file.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/atomic_file.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/studies/calibrate.hpp"

@@ -1,12 +1,12 @@
 /// `vesselverify export`: writes the exchange folders of a scene's outside models (kinds external
 /// and displacements) without running anything, for users who run their simulator by hand and
-/// read its answers back with a `displacements` model (verification/external_model.hpp).
+/// read its answers back with a `displacements` model (verification/harness/external_model.hpp).
 #include <iostream>
 
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/external_model.hpp"
-#include "verification/harness.hpp"
+#include "verification/harness/external_model.hpp"
+#include "verification/harness/harness.hpp"
 
 namespace vessel::cli {
 

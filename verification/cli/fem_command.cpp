@@ -13,7 +13,7 @@
 #include "fem_reference/elasticity.hpp"
 #include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/reference_checks.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/cli/vessel_options.hpp"
 #include "verification/fem_document.hpp"

@@ -7,13 +7,14 @@
 #include <iostream>
 #include <sstream>
 
-#include "meshes/atomic_file.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/atomic_file.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "reports/gate.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/harness.hpp"
+#include "verification/harness/harness.hpp"
+#include "verification/harness/results.hpp"
 
 namespace vessel::cli {
 

@@ -2,7 +2,7 @@
 /// mechanics? One program, one subcommand per stage.
 #include <iostream>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "verification/cli/commands.hpp"
 
 int main(int argc, char** argv) {

@@ -3,8 +3,8 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "meshes/atomic_file.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/atomic_file.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/mesh_quality.hpp"
 #include "meshes/msh_io.hpp"
 #include "meshes/stl_io.hpp"

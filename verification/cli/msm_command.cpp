@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/msh_io.hpp"
 #include "meshes/stl_io.hpp"
-#include "msm/model/model_factory.hpp"
-#include "msm/model/network_file.hpp"
+#include "msm/model/model.hpp"
+#include "msm/formats/network_file.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/cli/vessel_options.hpp"
 #include "verification/msm_document.hpp"

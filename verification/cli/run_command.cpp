@@ -2,11 +2,13 @@
 #include <algorithm>
 #include <iostream>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/harness.hpp"
+#include "verification/harness/harness.hpp"
+#include "verification/harness/timed_updates.hpp"
+#include "verification/harness/results.hpp"
 
 namespace vessel::cli {
 

@@ -4,7 +4,7 @@
 #include <fstream>
 #include <iostream>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/jobs_option.hpp"

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <iostream>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/cli/jobs_option.hpp"

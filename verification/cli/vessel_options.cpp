@@ -2,7 +2,7 @@
 
 #include <iomanip>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::cli {
 

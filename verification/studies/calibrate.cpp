@@ -9,14 +9,16 @@
 
 #include "fem_reference/elasticity.hpp"
 #include "fem_reference/solution_cache.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/calibration/lbfgs.hpp"
-#include "msm/model/model_factory.hpp"
+#include "msm/model/model.hpp"
 #include "msm/solvers/updates.hpp"
 #include "reports/representative_load.hpp"
-#include "verification/harness.hpp"
+#include "verification/harness/harness.hpp"
+#include "verification/harness/metrics.hpp"
+#include "verification/harness/timed_updates.hpp"
 #include "verification/scene_problems.hpp"
-#include "verification/timing.hpp"
+#include "verification/harness/timing.hpp"
 
 namespace vessel {
 

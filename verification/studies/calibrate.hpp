@@ -15,7 +15,7 @@
 /// - Every case is solved as the scene solves the model (the nonlinear static model with its
 ///   solver, a ramp of warm-started updates as the harness times it), for the base model, the
 ///   calibrated one and FEM P1 on the model's mesh, all against the P2 reference at the model's
-///   nodes (the harness's metric, verification/metrics.hpp). Training and held-out errors are
+///   nodes (the harness's metric, verification/harness/metrics.hpp). Training and held-out errors are
 ///   reported apart.
 /// - The FEM solutions of each load shape (P2, P1) come from the FEM solution cache
 ///   (fem::SolutionCache) when given one; a cached P1 keeps the solve time measured when it was
@@ -28,7 +28,7 @@
 
 #include "msm/calibration/stiffness_fit.hpp"
 #include "verification/calibration_file.hpp"
-#include "verification/metrics.hpp"
+#include "verification/harness/metrics.hpp"
 #include "verification/scene.hpp"
 
 namespace vessel::fem {

@@ -9,8 +9,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "meshes/atomic_file.hpp"
-#include "meshes/errors.hpp"
+#include "meshes/foundation/atomic_file.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 #include "reports/study_sections.hpp"
@@ -162,22 +162,22 @@ struct SpringChoice {
   bool volume_term = false;
   msm::Bending bending = msm::Bending::none;
   msm::VolumeModuli volume_moduli = msm::VolumeModuli::golec;  ///< with volume_term
-  bool edge_pairs = false;  ///< the springs coupled in edge pairs (msm/model/edge_pair_term.hpp)
+  bool edge_pairs = false;  ///< the springs coupled in edge pairs (msm/terms/edge_pair_term.hpp)
   [[nodiscard]] bool plain() const {
     return !volume_term && !edge_pairs && bending == msm::Bending::none;
   }
 };
 
 /// The spring models of a kind: every stiffness rule; for volume networks also the hybrid volume
-/// model (van-gelder springs + volume term, msm/model/model_factory.hpp) and the edge-pair model
-/// (P1 on the tets' edges, msm/model/edge_pair_term.hpp); for surface networks also the Discrete
-/// Shells model (van-gelder membrane + hinge energy, msm/model/bending_term.hpp).
+/// model (van-gelder springs + volume term, msm/model/model.hpp) and the edge-pair model
+/// (P1 on the tets' edges, msm/terms/edge_pair_term.hpp); for surface networks also the Discrete
+/// Shells model (van-gelder membrane + hinge energy, msm/terms/bending_term.hpp).
 std::vector<SpringChoice> spring_rules(ModelKind kind) {
   std::vector<SpringChoice> out;
   for (const msm::StiffnessRule rule : msm::kAllStiffnessRules) out.push_back({rule});
   if (kind == ModelKind::volume_msm) {
     out.push_back({msm::StiffnessRule::van_gelder, true});
-    // The homogenised rule's (E_s, κ) (msm/model/volume_term_homogenised.hpp).
+    // The homogenised rule's (E_s, κ) (msm/terms/volume_term_homogenised.hpp).
     out.push_back(
         {msm::StiffnessRule::van_gelder, true, msm::Bending::none, msm::VolumeModuli::homogenised});
     out.push_back({msm::StiffnessRule::seed001, false, msm::Bending::none,

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "verification/harness.hpp"
+#include "verification/harness/harness.hpp"
 #include "verification/scene.hpp"
 
 namespace vessel {

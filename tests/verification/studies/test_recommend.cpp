@@ -8,6 +8,8 @@
 
 #include "msm/solvers/integrators.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
+#include "verification/harness/budget.hpp"
+#include "verification/harness/metrics.hpp"
 #include "verification/studies/recommend.hpp"
 
 using namespace vessel;

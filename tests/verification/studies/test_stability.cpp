@@ -8,8 +8,8 @@
 #include <sstream>
 
 #include "../../test_helpers.hpp"
-#include "meshes/errors.hpp"
-#include "verification/outcome_cache.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "verification/harness/outcome_cache.hpp"
 #include "verification/studies/stability/stability.hpp"
 
 using namespace vessel;

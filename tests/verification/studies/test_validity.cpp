@@ -9,7 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
 #include "verification/studies/validity/validity.hpp"

@@ -1,9 +1,9 @@
 // Hard case: a long run of the smallest model, energy watched.
 #include "verification/studies/stability/study_models.hpp"
 
-#include "msm/stability/critical_step.hpp"
+#include "msm/solvers/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
-#include "verification/timing.hpp"
+#include "verification/harness/timing.hpp"
 
 namespace vessel::stability_study {
 

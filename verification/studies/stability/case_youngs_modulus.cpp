@@ -1,7 +1,7 @@
 // Hard case: E from 1 kPa to 1 MPa at a fixed step.
 #include "verification/studies/stability/study_models.hpp"
 
-#include "msm/stability/critical_step.hpp"
+#include "msm/solvers/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
 
 namespace vessel::stability_study {

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <limits>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/mesh_quality.hpp"
-#include "msm/stability/critical_step.hpp"
+#include "msm/solvers/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
 
 namespace vessel::stability_study {

@@ -6,11 +6,11 @@
 #include <set>
 #include <tuple>
 
-#include "msm/stability/critical_step.hpp"
+#include "msm/solvers/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
-#include "verification/outcome_cache.hpp"
-#include "verification/parallel.hpp"
-#include "verification/timing.hpp"
+#include "verification/harness/outcome_cache.hpp"
+#include "verification/harness/parallel.hpp"
+#include "verification/harness/timing.hpp"
 
 namespace vessel::stability_study {
 

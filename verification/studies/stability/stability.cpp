@@ -6,12 +6,12 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/vessel_geometry.hpp"
-#include "verification/outcome_cache.hpp"
-#include "verification/parallel.hpp"
+#include "verification/harness/outcome_cache.hpp"
+#include "verification/harness/parallel.hpp"
 #include "verification/studies/stability/study_models.hpp"
-#include "verification/timing.hpp"
+#include "verification/harness/timing.hpp"
 
 namespace vessel {
 

@@ -20,7 +20,7 @@
 
 namespace vessel {
 
-class OutcomeCache;  // verification/outcome_cache.hpp
+class OutcomeCache;  // verification/harness/outcome_cache.hpp
 
 struct StabilityOptions {
   bool quick = true;  ///< levels 0..1 and a scaled-down long run; else levels 0..2 and 10⁶ steps

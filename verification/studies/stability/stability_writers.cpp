@@ -4,7 +4,7 @@
 #include <optional>
 #include <sstream>
 
-#include "meshes/atomic_file.hpp"
+#include "meshes/foundation/atomic_file.hpp"
 #include "reports/results_file.hpp"
 #include "verification/studies/stability/stability.hpp"
 #include "verification/studies/stability/study_models.hpp"
@@ -123,7 +123,7 @@ std::string stability_markdown(const StabilityReport& r) {
         "solves λ² + γλ + ω² = 0 for some ω ∈ [ω_min, ω_max] and γ between the extreme "
         "eigenvalues of M⁻¹C (here c/m_max and c/m_min), so the smallest critical step over "
         "that rectangle is safe for explicit and symplectic Euler "
-        "(`msm/stability/critical_step.hpp`; none is proven for damped Verlet). Use it, not the "
+        "(`msm/solvers/critical_step.hpp`; none is proven for damped Verlet). Use it, not the "
         "prediction, as a safe damped step. Steps in µs.\n\n"
      << "| model | integrator | ζ | level | nodes | ω_max (rad/s) | Gershgorin bound | predicted "
         "(µs) | guaranteed (µs) | found stable (µs) | found / predicted | found / guaranteed |\n"

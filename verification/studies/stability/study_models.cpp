@@ -5,10 +5,10 @@
 #include <sstream>
 
 #include "msm/solvers/static_solver.hpp"
-#include "msm/stability/critical_step.hpp"
+#include "msm/solvers/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
 #include "verification/scene_problems.hpp"
-#include "verification/timing.hpp"
+#include "verification/harness/timing.hpp"
 
 namespace vessel::stability_study {
 

@@ -8,9 +8,9 @@
 
 #include "fem_reference/elasticity.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model_factory.hpp"
+#include "msm/model/model.hpp"
 #include "msm/solvers/integrators.hpp"
-#include "verification/harness.hpp"
+#include "verification/harness/harness.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_problems.hpp"
 #include "verification/studies/stability/stability.hpp"

@@ -9,14 +9,14 @@
 #include <stdexcept>
 
 #include "fem_reference/elasticity.hpp"
-#include "meshes/atomic_file.hpp"
-#include "meshes/content_hash.hpp"
+#include "meshes/foundation/atomic_file.hpp"
+#include "meshes/foundation/content_hash.hpp"
 #include "meshes/self_contact.hpp"
-#include "meshes/errors.hpp"
-#include "msm/model/model_factory.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/model/model.hpp"
 #include "msm/solvers/updates.hpp"
-#include "verification/metrics.hpp"
-#include "verification/parallel.hpp"
+#include "verification/harness/metrics.hpp"
+#include "verification/harness/parallel.hpp"
 #include "verification/scene_problems.hpp"
 
 namespace vessel {

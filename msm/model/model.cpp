@@ -1,0 +1,172 @@
+#include "msm/model/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "meshes/foundation/errors.hpp"
+#include "msm/terms/four_node_blocks.hpp"
+
+namespace vessel::msm {
+
+std::string hybrid_refusal(double E, double nu) {
+  if (!(E > 0) || !std::isfinite(E)) {
+    return "hybrid volume model: expected Young's modulus E > 0 Pa, got " + std::to_string(E);
+  }
+  if (!(nu >= 0.25 && nu < 0.5)) {
+    return "hybrid volume model (volume_term): poisson_ratio ν must be in [0.25, 0.5), got " +
+        std::to_string(nu) +
+        (nu >= 0.5 ? "; at ν = 0.5 the volume term's κ = λ − μ is infinite (an incompressibility "
+                     "constraint, which this penalty model does not offer)"
+                   : "; below 1/4 the volume term's κ = λ − μ is negative, and a negative volume "
+                     "energy makes sliver tets unstable (the static solver diverged on a gmsh "
+                     "cube at ν = 0 and 0.1); volume_moduli = \"homogenised\" reaches lower "
+                     "ν with a per-tet stability clip");
+  }
+  return {};
+}
+
+HybridModuli hybrid_moduli(double E, double nu) {
+  if (std::string why = hybrid_refusal(E, nu); !why.empty()) throw InputError(why);
+  HybridModuli m;
+  m.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+  m.mu = E / (2 * (1 + nu));
+  m.spring_youngs_modulus = 2.5 * m.mu;  // van-gelder: λ_s = μ_s = 0.4·E_s (header)
+  m.kappa = m.lambda - m.mu;
+  return m;
+}
+
+MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damping,
+                                 std::optional<double> volume_kappa,
+                                 std::optional<double> bending_rigidity,
+                                 std::optional<LameParameters> edge_pairs)
+    : springs_(network, point_damping) {
+  if (volume_kappa) {
+    if (network.tets.empty()) {
+      throw InputError("volume term: the network has no tetrahedra; expected a volume network");
+    }
+    volume_ = std::make_unique<VolumeTerm>(network.nodes, network.tets, *volume_kappa,
+                                           network.tet_kappa_factors);
+  }
+  if (bending_rigidity) {
+    if (network.triangles.empty()) {
+      throw InputError(
+          "bending term (discrete-shells): the network has no triangles; expected a surface "
+          "network");
+    }
+    bending_ = std::make_unique<BendingTerm>(network.nodes, network.triangles, *bending_rigidity);
+  }
+  if (edge_pairs) {
+    if (network.tets.empty()) {
+      throw InputError("edge pairs: the network has no tetrahedra; expected a volume network");
+    }
+    edge_pairs_ = std::make_unique<EdgePairTerm>(network.nodes, network.tets, *edge_pairs);
+  }
+  if (volume_) terms_.push_back(volume_.get());
+  if (bending_) terms_.push_back(bending_.get());
+  if (edge_pairs_) terms_.push_back(edge_pairs_.get());
+  if (terms_.empty()) return;
+  SparseMatrix Hs;
+  springs_.hessian(flatten(network.nodes), Hs, false);
+  bool missing = false;
+  for (const FourNodeTerm* t : terms_) {
+    term_slots_.push_back(t->slots_in(Hs));
+    missing = missing || std::find(term_slots_.back().begin(), term_slots_.back().end(), -1) !=
+                             term_slots_.back().end();
+  }
+  if (!missing) return;
+  // Some term entries are not in the springs' pattern (a region of interest drops the springs
+  // between two held nodes; a hinge couples its two opposite vertices, which no spring joins once
+  // the bend springs are dropped; the edge-pair model has no springs): assemble into the union of
+  // the patterns.
+  union_pattern_ = Hs;
+  for (const FourNodeTerm* t : terms_) union_pattern_ += t->pattern();
+  union_pattern_.makeCompressed();
+  std::fill(union_pattern_.valuePtr(), union_pattern_.valuePtr() + union_pattern_.nonZeros(), 0.0);
+  for (int col = 0; col < Hs.outerSize(); ++col) {
+    for (SparseMatrix::InnerIterator it(Hs, col); it; ++it) {
+      spring_to_union_.push_back(pattern_slot(union_pattern_, static_cast<int>(it.row()), col));
+    }
+  }
+  for (std::size_t k = 0; k < terms_.size(); ++k) {
+    term_slots_[k] = terms_[k]->slots_in(union_pattern_);
+  }
+}
+
+double MassSpringModel::max_strain(const VectorXd& x) const {
+  const double springs = springs_.max_strain(x);
+  return edge_pairs_ ? std::max(springs, edge_pairs_->max_strain(x)) : springs;
+}
+
+double MassSpringModel::energy(const VectorXd& x) const {
+  double e = springs_.energy(x);
+  for (const FourNodeTerm* t : terms_) e += t->energy(x);
+  return e;
+}
+
+void MassSpringModel::gradient(const VectorXd& x, VectorXd& g) const {
+  springs_.gradient(x, g);
+  for (const FourNodeTerm* t : terms_) t->add_gradient(x, g);
+}
+
+double MassSpringModel::energy_gradient(const VectorXd& x, VectorXd& g) const {
+  double e = springs_.energy_gradient(x, g);
+  for (const FourNodeTerm* t : terms_) {
+    t->add_gradient(x, g);
+    e += t->energy(x);
+  }
+  return e;
+}
+
+void MassSpringModel::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const {
+  if (spring_to_union_.empty()) {
+    springs_.hessian(x, H, project_psd);
+  } else {
+    SparseMatrix Hs;
+    springs_.hessian(x, Hs, project_psd);
+    H = union_pattern_;
+    double* values = H.valuePtr();
+    const double* spring_values = Hs.valuePtr();
+    for (std::size_t k = 0; k < spring_to_union_.size(); ++k) {
+      values[spring_to_union_[k]] += spring_values[k];
+    }
+  }
+  // Each term's blocks are projected separately (per spring, per tet, per hinge).
+  for (std::size_t k = 0; k < terms_.size(); ++k) {
+    terms_[k]->add_hessian(x, H.valuePtr(), term_slots_[k], project_psd);
+  }
+}
+
+void MassSpringModel::damping_force(const VectorXd& x, const VectorXd& v, VectorXd& f) const {
+  springs_.damping_force(x, v, f);
+}
+
+void MassSpringModel::damping_jacobian(const VectorXd& x, SparseMatrix& D) const {
+  springs_.damping_jacobian(x, D);
+}
+
+std::unique_ptr<MassSpringModel> make_model(const SpringNetwork& network,
+                                            std::optional<double> volume_kappa,
+                                            double point_damping,
+                                            std::optional<double> bending_rigidity,
+                                            std::optional<LameParameters> edge_pairs) {
+  return std::make_unique<MassSpringModel>(network, point_damping, volume_kappa, bending_rigidity,
+                                           edge_pairs);
+}
+
+std::unique_ptr<MassSpringModel> make_model(const BuiltNetwork& built, double point_damping) {
+  return make_model(built.network, built.volume_kappa, point_damping, built.bending_rigidity,
+                    built.edge_pairs);
+}
+
+const SpringModel* plain_spring_model(const Form& form) {
+  if (const auto* springs = dynamic_cast<const SpringModel*>(&form)) return springs;
+  if (const auto* model = dynamic_cast<const MassSpringModel*>(&form)) {
+    if (!model->volume_term() && !model->bending_term() && !model->edge_pair_term()) {
+      return &model->springs();
+    }
+  }
+  return nullptr;
+}
+
+}  // namespace vessel::msm
