@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "meshes/foundation/errors.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/kernels/thread_parts.hpp"
 
 namespace vessel::msm {

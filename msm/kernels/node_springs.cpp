@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "meshes/foundation/errors.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/kernels/thread_parts.hpp"
 #include "msm/kernels/fast_springs.hpp"
 

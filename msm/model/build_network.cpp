@@ -4,7 +4,9 @@
 #include <cmath>
 
 #include "meshes/foundation/errors.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/model/model.hpp"
+#include "msm/stiffness/hybrid_moduli.hpp"
 #include "msm/terms/volume_term_homogenised.hpp"
 
 namespace vessel::msm {
@@ -106,7 +108,7 @@ void apply_edge_pairs(BuiltNetwork& built, const NetworkOptions& o) {
 }
 
 /// Stiffness, axial damping and masses: the same for every topology. With the volume term, the
-/// springs carry μ (E_s = 2.5μ) and κ = λ − μ is recorded (model_factory.hpp).
+/// springs carry μ (E_s = 2.5μ) and κ = λ − μ is recorded (msm/stiffness/hybrid_moduli.hpp).
 void assign_laws_and_masses(BuiltNetwork& built, const NetworkOptions& o) {
   StiffnessParams params = o.stiffness_params;
   if (o.volume_term) {

@@ -33,9 +33,10 @@ std::string to_string(Bending bending);          ///< "none" | "discrete-shells"
 Bending parse_bending(const std::string& name);  ///< InputError if unknown
 
 /// How the hybrid volume model picks its springs' E_s and its κ: `golec` (Golec et al. 2020's
-/// affine rule, E_s = 2.5μ, κ = λ − μ; model_factory.hpp) or `homogenised` (our extension: the
-/// (E_s, κ) for which this mesh's own network, loaded by uniform boundary tractions, has the
-/// target E and ν, with a per-tet stability clip on a negative κ; volume_term_homogenised.hpp).
+/// affine rule, E_s = 2.5μ, κ = λ − μ; msm/stiffness/hybrid_moduli.hpp) or `homogenised` (our
+/// extension: the (E_s, κ) for which this mesh's own network, loaded by uniform boundary tractions,
+/// has the target E and ν, with a per-tet stability clip on a negative κ;
+/// volume_term_homogenised.hpp).
 enum class VolumeModuli { golec, homogenised };
 std::string to_string(VolumeModuli rule);                   ///< "golec" | "homogenised"
 VolumeModuli parse_volume_moduli(const std::string& name);  ///< InputError if unknown
@@ -50,10 +51,10 @@ struct NetworkOptions {
   MassRule mass = MassRule::consistent;
   double density = kVesselDensity;  ///< kg/m³
   double axial_damping = 0.0;       ///< k_d of seed 000 eq. (3.4), N·s/m, every spring
-  /// The hybrid volume model (Golec et al. 2020; model_factory.hpp): volume model only, van-gelder
-  /// springs carrying μ (E replaced by 2.5μ) plus a volume term κ = λ − μ on every tet, so that
-  /// the network reaches the material's ν. InputError with another model or stiffness rule, or at
-  /// ν = 0.5.
+  /// The hybrid volume model (Golec et al. 2020; msm/stiffness/hybrid_moduli.hpp): volume model
+  /// only, van-gelder springs carrying μ (E replaced by 2.5μ) plus a volume term κ = λ − μ on every
+  /// tet, so that the network reaches the material's ν. InputError with another model or stiffness
+  /// rule, or at ν = 0.5.
   bool volume_term = false;
   /// The volume term's rule (with volume_term only; InputError otherwise). `homogenised` covers
   /// ν from the mesh's floor (≈ 0.06 on a gmsh cube) to below 1/2.

@@ -75,7 +75,7 @@ class Updater {
 
 /// Whether prepare_updates supports the solver: "static" and "linear". Dynamic solvers are run
 /// step by step (their time per update is the time per step × the steps one update period
-/// needs; harness.hpp's time_per_update); dynamic relaxation has no prepared form.
+/// needs; verification/harness/budget.hpp's time_per_update); dynamic relaxation has no prepared form.
 [[nodiscard]] bool supports_updates(const SolverSpec& spec);
 
 /// Prepares the updates of `problem` with the solver of `spec`. Each update brings its own load;

@@ -25,6 +25,7 @@
 
 #include "meshes/tet_mesh.hpp"
 #include "msm/form/form.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/terms/four_node_blocks.hpp"
 
 namespace vessel::msm {

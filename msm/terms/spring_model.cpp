@@ -6,16 +6,9 @@
 #include <stdexcept>
 
 #include "meshes/foundation/errors.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 
 namespace vessel::msm {
-
-void apply_dirichlet(SparseMatrix& A, const std::vector<char>& fixed) {
-  for (int k = 0; k < A.outerSize(); ++k) {
-    for (SparseMatrix::InnerIterator it(A, k); it; ++it) {
-      if (fixed[it.row()] || fixed[it.col()]) it.valueRef() = it.row() == it.col() ? 1.0 : 0.0;
-    }
-  }
-}
 
 namespace {
 inline Vec3 node(const VectorXd& x, int i) { return x.segment<3>(3 * i); }

@@ -11,7 +11,7 @@
 ///   ∇²W = κ/V₀ · ∇V ∇Vᵀ + κ·(V − V₀)/V₀ · ∇²V.
 /// Under a small uniform strain ε, V − V₀ = V₀·tr ε, so W = ½·κ·V₀·(tr ε)²: the term adds exactly κ
 /// to the network's λ and nothing to μ, on every tet whatever its shape (derivation of κ for the
-/// network in model/model_factory.hpp). Source check (2026-11): the paper's abstract was retrieved
+/// network in model/model.hpp). Source check (2026-11): the paper's abstract was retrieved
 /// ("supplement the spring deformation energy with an energy depending on the volume only,
 /// insensitive to change of shape"); its own formulation (equations) was not, so this quadratic
 /// form is the issue's, W = ½κV₀(V/V₀ − 1)², and the paper's equation numbers are not cited.
@@ -36,7 +36,7 @@ Mat12 tet_volume_hessian(const std::array<Vec3, 4>& x);
 double volume_energy(const std::array<Vec3, 4>& x, double rest_volume, double kappa);
 Vec12 volume_gradient(const std::array<Vec3, 4>& x, double rest_volume, double kappa);
 /// 12×12 Hessian; with project_psd, projected onto the positive semi-definite cone (eigenvalues
-/// clamped at zero). For κ < 0 (ν < 1/4, see model_factory.hpp) the projection at rest is zero.
+/// clamped at zero). For κ < 0 (ν < 1/4, see msm/stiffness/hybrid_moduli.hpp) the projection at rest is zero.
 Mat12 volume_hessian(const std::array<Vec3, 4>& x, double rest_volume, double kappa,
                      bool project_psd);
 

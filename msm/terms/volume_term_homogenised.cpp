@@ -234,7 +234,7 @@ HomogenisedModuli homogenised_moduli(const std::vector<Vec3>& nodes, const std::
     out.golec_youngs_modulus = g ? g->youngs_modulus : std::nan("");
     out.golec_poisson_ratio = g ? g->poisson_ratio : std::nan("");
   }
-  // r = κ/E_s through the nominal ν_n of the affine estimate (model_factory.hpp), x = ν_n.
+  // r = κ/E_s through the nominal ν_n of the affine estimate (msm/stiffness/hybrid_moduli.hpp), x = ν_n.
   auto ratio = [](double x) { return (1.6 * x - 0.4) / (1.0 - 2.0 * x); };
   struct Point {
     double x, f;

@@ -2,11 +2,12 @@
 /// The mesh-homogenised hybrid volume model (our extension of Golec et al. 2020; rule name
 /// "homogenised", scene key volume_moduli = "homogenised", `msm --volume-moduli homogenised`).
 ///
-/// Same model as the hybrid (model_factory.hpp): van-gelder springs k = E_s·ΣV_e/L² plus the volume
-/// energy W = ½κV₀(V/V₀ − 1)² per tet. Golec's rule picks E_s = 2.5μ, κ = λ − μ from the affine,
-/// isotropic average of the springs' energy; on a real (irregular, bounded) network the springs
-/// relax non-affinely and the cube measures E and ν a few per cent off (docs/msm_accuracy.md). This
-/// rule instead measures the network's own linear response and solves for (E_s, κ):
+/// Same model as the hybrid (msm/stiffness/hybrid_moduli.hpp): van-gelder springs k = E_s·ΣV_e/L²
+/// plus the volume energy W = ½κV₀(V/V₀ − 1)² per tet. Golec's rule picks E_s = 2.5μ, κ = λ − μ
+/// from the affine, isotropic average of the springs' energy; on a real (irregular, bounded)
+/// network the springs relax non-affinely and the cube measures E and ν a few per cent off
+/// (docs/msm_accuracy.md). This rule instead measures the network's own linear response and solves
+/// for (E_s, κ):
 ///
 /// 1. Homogenisation under uniform boundary traction. The rest stiffness is
 ///    K(E_s, κ) = E_s·K₁ + κ·K_V (K₁: the springs at E_s = 1, K_V: the volume term at κ = 1; both

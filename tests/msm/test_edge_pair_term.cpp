@@ -11,6 +11,7 @@
 
 #include "finite_differences.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/terms/edge_pair_term.hpp"
 #include "msm/model/model.hpp"

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "meshes/gmsh_vessel.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/terms/spring_model.hpp"
 #include "msm/solvers/integrators.hpp"

@@ -14,6 +14,7 @@
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/kernels/fast_springs.hpp"
 #include "msm/kernels/node_springs.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/terms/spring_model.hpp"
 #include "msm/linalg/linear_solver.hpp"

@@ -10,6 +10,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/model/model.hpp"
 #include "msm/terms/spring_model.hpp"

@@ -11,6 +11,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "meshes/vtu_io.hpp"
 #include "msm/formats/network_file.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 #include "msm/topology/springs.hpp"
 

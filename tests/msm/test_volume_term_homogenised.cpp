@@ -10,6 +10,7 @@
 
 #include "finite_differences.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/model/model.hpp"
 #include "msm/model/roi.hpp"

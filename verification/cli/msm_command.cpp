@@ -17,6 +17,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "meshes/msh_io.hpp"
 #include "meshes/stl_io.hpp"
+#include "msm/kernels/spring_kernels.hpp"
 #include "msm/model/model.hpp"
 #include "msm/formats/network_file.hpp"
 #include "verification/cli/commands.hpp"

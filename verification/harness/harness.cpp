@@ -15,6 +15,7 @@
 #include "verification/harness/progress.hpp"
 #include "verification/harness/references.hpp"
 #include "verification/harness/timing.hpp"
+#include "verification/scene_problems.hpp"
 
 namespace vessel {
 

@@ -5,8 +5,11 @@
 #include <tuple>
 
 #include "meshes/tet_locator.hpp"
+#include "reports/representative_load.hpp"
 #include "verification/harness/budget.hpp"
+#include "verification/harness/external_model.hpp"
 #include "verification/harness/metrics.hpp"
+#include "verification/scene_problems.hpp"
 
 namespace vessel {
 

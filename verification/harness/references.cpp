@@ -9,6 +9,7 @@
 #include "fem_reference/solution_cache.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "msm/model/model.hpp"
+#include "reports/representative_load.hpp"
 #include "verification/harness/budget.hpp"
 #include "verification/harness/modal.hpp"
 #include "verification/harness/parallel.hpp"

@@ -22,7 +22,6 @@
 
 namespace vessel {
 
-
 /// Barycentric tolerance for evaluating the reference at model nodes: a node on the exact curved
 /// wall lies outside the reference's straight-sided tets by up to the chord's sagitta ℓ²/(8r),
 /// a few per cent of a tet's height at the levels used; the FE polynomial is extended there.
@@ -35,6 +34,8 @@ struct ReferenceAtPoints {
   bool has_uncertainty = false;
 };
 
+/// The linear reference of one (scene, ν): the fine level and the one below, the FEM transient's
+/// solver, and the finite-strain reference solved on demand.
 struct ReferenceSolvers {
   std::unique_ptr<fem::ElasticitySolver> fine;
   std::unique_ptr<fem::ElasticitySolver> coarse;

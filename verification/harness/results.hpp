@@ -11,8 +11,7 @@
 
 namespace vessel {
 
-/// run_scenes, then writes
-/// results.json (with reference_kernel_seconds() timed first), results.csv and summary.md into
+/// run_scenes, then writes results.json (with reference_kernel_seconds() timed first), results.csv and summary.md into
 /// `output_dir`, which is created and checked writable before anything runs (InputError).
 std::vector<SceneResult> run_and_write(const std::vector<Scene>& scenes,
                                        const HarnessOptions& options,
@@ -29,6 +28,5 @@ void write_results_json(const std::filesystem::path& path, const std::vector<Sce
 void write_results_csv(const std::filesystem::path& path, const std::vector<SceneResult>& results);
 void write_summary_markdown(const std::filesystem::path& path,
                             const std::vector<SceneResult>& results, const std::string& command);
-
 
 }  // namespace vessel

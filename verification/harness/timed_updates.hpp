@@ -27,7 +27,6 @@ struct UpdateSequence {
 UpdateSequence timed_updates(const msm::Problem& problem, const msm::SolverSpec& solver,
                              int updates, int repeats);
 
-
 /// Linear FEM timed by the procedure that times the mass-spring models (timed_updates with the
 /// "linear" updater): its system on the free DoFs as a Form (msm::QuadraticForm), factorised once
 /// at set-up (with, for a load on few DoFs such as a contact patch, the responses to them: Cotin
