@@ -26,7 +26,9 @@ def help_text(program, args):
     if run.returncode != 0:
         raise SystemExit(f"gen_command_reference.py: `{program} {' '.join(args)} --help` exited "
                          f"{run.returncode}: {run.stderr.strip()}")
-    text = run.stdout.replace(program, "vesselverify")
+    # The program's path and the checkout's (defaults such as --scenes-dir) say where it was
+    # built, not what it does.
+    text = run.stdout.replace(program, "vesselverify").replace(ROOT, "<source-dir>")
     return "\n".join(line.rstrip() for line in text.strip("\n").splitlines())
 
 
