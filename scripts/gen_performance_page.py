@@ -32,6 +32,19 @@ def cmake_files():
     return found
 
 
+def first_sentence(text):
+    """A comment's first sentence, without the issue it was written for."""
+    text = re.sub(r"\s*\(issues? [^()]*\)", "", " ".join(text.split()))
+    end = re.search(r"(?<!e\.g)(?<!i\.e)\.(\s|$)", text)
+    text = text[:end.start()] if end else text
+    if "issue" in text:  # a clause naming an issue: keep what comes before it
+        text = text[:text.index("issue")].rsplit(", ", 1)[0]
+    if len(text) > 200:
+        cut = [m.start() for m in re.finditer(r"[:;] ", text) if m.start() >= 40]
+        text = text[:cut[0]] if cut else text
+    return text.strip().rstrip(",:;")
+
+
 def source_description(executable):
     """The first sentence of the first comment of the source the executable is built from."""
     name = os.path.basename(executable)
@@ -46,10 +59,7 @@ def source_description(executable):
             if not line.startswith("//"):
                 break
             lines.append(line.lstrip("/ ").strip())
-        text = " ".join(" ".join(lines).split())
-        text = re.sub(r"\s*\(issues? [^()]*\)", "", text)
-        end = re.search(r"[.:](\s|$)", text)
-        return os.path.relpath(source, ROOT), (text[:end.start()] if end else text)
+        return os.path.relpath(source, ROOT), first_sentence(" ".join(lines))
     return None, ""
 
 
@@ -78,14 +88,16 @@ def rows(benchmarks):
     chosen = medians or [b for b in benchmarks if b.get("run_type", "iteration") == "iteration"]
     skip = {"name", "run_name", "run_type", "aggregate_name", "aggregate_unit", "family_index",
             "per_family_instance_index", "repetitions", "repetition_index", "threads",
-            "iterations", "real_time", "cpu_time", "time_unit", "error_occurred", "error_message"}
+            "iterations", "real_time", "cpu_time", "time_unit", "error_occurred", "error_message",
+            "label"}
     out = []
     for b in chosen:
         name = b.get("run_name", b["name"])
         cv = cvs.get(name, {}).get("real_time")
         counters = ", ".join(f"{k} {number_text(v)}" for k, v in sorted(b.items())
                              if k not in skip and isinstance(v, (int, float)))
-        out.append(f"| `{name}` | {seconds_text(b['real_time'], b['time_unit'])} | "
+        label = f" ({b['label']})" if b.get("label") else ""
+        out.append(f"| `{name}`{label} | {seconds_text(b['real_time'], b['time_unit'])} | "
                    f"{'' if cv is None else f'{100 * cv:.1f} %'} | {counters} |")
     return out
 
