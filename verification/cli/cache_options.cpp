@@ -33,9 +33,8 @@ void add_cache_options(CLI::App& cmd, CacheOptions& o) {
   o.cache_dir = default_cache_dir();
   cmd.add_option("--cache-dir", o.cache_dir,
                  "Cache of generated meshes, solved FEM references (<dir>/fem-solutions) and "
-                 "measured model outcomes (<dir>/model-outcomes); "
-                 "env VESSELVERIFY_CACHE_DIR")
-      ->capture_default_str();
+                 "measured model outcomes (<dir>/model-outcomes); default $VESSELVERIFY_CACHE_DIR, "
+                 "else $XDG_CACHE_HOME/vesselverify, else ~/.cache/vesselverify");
   cmd.add_flag("--no-cache", o.no_cache,
                "Neither read nor write the cache: mesh every vessel, solve every reference and "
                "measure every model");

@@ -536,7 +536,7 @@ void add_material_options(CLI::App* cmd, FemCommandOptions& o) {
   cmd->add_option("--reference", o.reference,
                   "linear (small strain) or finite-strain (compressible neo-Hookean with the same "
                   "E and nu, total Lagrangian, Newton with load stepping; mixed u-p as above; "
-                  "docs/finite_strain.md)")
+                  "docs/physics/finite_strain.md)")
       ->check(CLI::IsMember({"linear", "finite-strain"}))
       ->capture_default_str();
   cmd->add_flag("--dead-pressure", o.dead_pressure,

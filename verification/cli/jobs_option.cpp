@@ -9,9 +9,9 @@ int default_jobs() { return static_cast<int>(std::max(1U, std::thread::hardware_
 
 void add_jobs_option(CLI::App& cmd, int& jobs, const std::string& what) {
   jobs = default_jobs();
-  cmd.add_option("--jobs,-j", jobs, what)
-      ->check(CLI::Range(1, 1024))
-      ->capture_default_str();
+  // The default is this machine's core count, which each `what` states in words: printing the
+  // number would make the help (and the command reference generated from it) machine-dependent.
+  cmd.add_option("--jobs,-j", jobs, what)->check(CLI::Range(1, 1024));
 }
 
 void add_timing_options(CLI::App& cmd, int& repeats, int& updates) {

@@ -641,7 +641,7 @@ void add_solver_tuning_options(CLI::App* cmd, MsmOptions& o) {
   cmd->add_option("--json", o.json, "Write the results as JSON (atomically)");
   cmd->add_option("--export-network", o.export_network,
                   "Write the built network (after its stiffness and mass rules) as a spring-network "
-                  "file, .json or .vtu (docs/network_format.md), which a scene runs with "
+                  "file, .json or .vtu (docs/user_guide/network_format.md), which a scene runs with "
                   "kind = \"network\"");
 }
 

@@ -71,8 +71,8 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
       ->capture_default_str();
   cmd->add_option("--cache-dir", o->cache_dir,
                   "Cache directory: meshes, and the measured rows and hard cases "
-                  "(<dir>/model-outcomes); env VESSELVERIFY_CACHE_DIR")
-      ->capture_default_str();
+                  "(<dir>/model-outcomes); default $VESSELVERIFY_CACHE_DIR, else "
+                  "$XDG_CACHE_HOME/vesselverify, else ~/.cache/vesselverify");
   cmd->add_flag("--no-cache", o->no_cache,
                 "Do not read or write the cache (meshes, and the rows and hard cases measured "
                 "before)");

@@ -30,8 +30,8 @@ void add_vessel_options(CLI::App& cmd, VesselOptions& o) {
       ->check(CLI::IsMember({"m", "mm"}))
       ->capture_default_str();
   cmd.add_option("--cache-dir", o.cache_dir,
-                 "Directory of cached generated meshes (env VESSELVERIFY_CACHE_DIR)")
-      ->capture_default_str();
+                 "Directory of cached generated meshes; default $VESSELVERIFY_CACHE_DIR, else "
+                 "$XDG_CACHE_HOME/vesselverify, else ~/.cache/vesselverify");
   cmd.add_flag("--no-cache", o.no_cache, "Always generate; neither read nor write the cache");
   cmd.add_flag("--gmsh-log", o.meshing.verbose, "Show gmsh's own log");
 }
