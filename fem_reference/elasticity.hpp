@@ -85,7 +85,7 @@ struct SolverOptions {
   Formulation formulation = Formulation::automatic;
   /// automatic: mixed Taylor–Hood when ν ≥ this (and always at ν = 0.5). Below 0.49 P2
   /// displacement elements do not lock appreciably, while the saddle-point system costs minutes
-  /// and gigabytes at reference levels (docs/fem_measurements.md). The one default the harness,
+  /// and gigabytes at reference levels (docs/measurements/fem_measurements.md). The one default the harness,
   /// the scenes and the `fem` command (--mixed-threshold) use.
   double mixed_threshold = 0.49;
   LinearSolver solver = LinearSolver::automatic;
@@ -99,7 +99,7 @@ struct SolverOptions {
   /// side by side fit a 24 GB machine.
   std::size_t direct_max_dofs = 400000;
   /// automatic, mixed system: UMFPACK at or below this many DoFs, else gmres_block. Measured
-  /// (docs/fem_measurements.md): level 0 (34–47k DoFs) UMFPACK 4–11 s vs FGMRES 8–21 s; level 1
+  /// (docs/measurements/fem_measurements.md): level 0 (34–47k DoFs) UMFPACK 4–11 s vs FGMRES 8–21 s; level 1
   /// (214k / 241k) UMFPACK 102 s, 4.6 GB / 426 s, 13.4 GB vs FGMRES 51 s / 216 s at ~2 GB (contact).
   std::size_t direct_max_mixed_dofs = 100000;
   /// CG-AMG: give ML all six rigid-body modes (translations and rotations) as near-null space;

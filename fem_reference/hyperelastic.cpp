@@ -2,7 +2,7 @@
 /// (displacement or mixed u–p, dead loads from the linear reference's weak form, follower
 /// pressure on the deformed faces), and Newton with a line search inside adaptive load stepping.
 /// The discretisation (triangulation, DoFs, supports, linear solvers, point evaluation) is the
-/// linear reference's (ElasticitySolver::Impl). Derivations: docs/finite_strain.md.
+/// linear reference's (ElasticitySolver::Impl). Derivations: docs/physics/finite_strain.md.
 #include "fem_reference/hyperelastic.hpp"
 
 #include <deal.II/fe/fe_values.h>

@@ -4,7 +4,7 @@
 /// discretisation it reuses). Compressible neo-Hookean with P1 or P2 displacement, or a mixed
 /// displacement–pressure form with Taylor–Hood P2–P1 for ν → 0.5 (and ν = 0.5). Newton with a
 /// line search, adaptive load stepping. Plain data only (no deal.II). SI units. The formulas are
-/// derived in docs/finite_strain.md.
+/// derived in docs/physics/finite_strain.md.
 #include <Eigen/Core>
 #include <functional>
 #include <memory>

@@ -1,6 +1,6 @@
 #pragma once
 /// Rivlin's inflation of a thick-walled incompressible neo-Hookean tube in plane strain: the
-/// finite-strain reference's closed-form check. Derivation in docs/finite_strain.md. SI units.
+/// finite-strain reference's closed-form check. Derivation in docs/physics/finite_strain.md. SI units.
 #include "meshes/tet_mesh.hpp"
 
 namespace vessel::fem {

@@ -314,7 +314,7 @@ void validity_section(Document& doc, const ValidityFile& v) {
   doc.paragraph(
       "The linear FEM reference scaled to each load against the finite-strain one (compressible "
       "neo-Hookean with the same E and ν, same mesh, elements, supports and dead loads; one load "
-      "continuation through the ladder, docs/finite_strain.md). *QoI difference* is "
+      "continuation through the ladder, docs/physics/finite_strain.md). *QoI difference* is "
       "|u_lin − u_fs| / |u_fs| at the scene's QoI point, *L2 difference* the same over the "
       "reference mesh's nodes. The loads where they part by 1, 5 and 10 % are interpolated "
       "between the two ladder loads that bracket the threshold, ln F linear in ln d (exact for a "

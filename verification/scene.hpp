@@ -84,7 +84,7 @@ struct ModelSpec {
   /// Apply a group calibration to a mesh other than the one it was fitted on (its hash differs).
   bool calibration_transfer = false;
   ExternalSpec external;  ///< kinds external and displacements only
-  /// kind network: the spring-network file (.json or .vtu; docs/network_format.md), relative
+  /// kind network: the spring-network file (.json or .vtu; docs/user_guide/network_format.md), relative
   /// paths resolved against the scene file's folder. Its springs, masses and supports replace
   /// the stiffness, mass and topology keys.
   std::filesystem::path network_file;

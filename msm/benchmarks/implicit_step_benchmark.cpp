@@ -11,7 +11,7 @@
 // of A, the bandwidth bound measured in the same run: the solve alone on 1 and N threads against
 // two reads of as many numbers as the factor holds, on 1 and N threads (the sweeps read the
 // factor once each; the median of 9). Release build; a measurement driver, not a test
-// (docs/msm_measurements.md).
+// (docs/measurements/msm_measurements.md).
 //
 //   implicit_step_benchmark LEVEL STEPS_REST STEPS_CURRENT [TOLERANCE ...] [threads=N]
 //   (STEPS_CURRENT = 0 skips the current-state pair; default tolerances 1e-4 1e-6 1e-8; "none":

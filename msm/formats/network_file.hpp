@@ -1,5 +1,5 @@
 #pragma once
-/// Spring networks from files, and built-in networks written to them (docs/network_format.md):
+/// Spring networks from files, and built-in networks written to them (docs/user_guide/network_format.md):
 /// a user's own mass-spring model as nodes (rest positions), springs (two nodes, stiffness, rest
 /// length, optionally seed 001's bilinear k2 and threshold, axial damping), nodal masses, and
 /// supports (fixed nodes, or the mesh groups whose supports the nodes on them follow).

@@ -17,7 +17,7 @@
 ///   regions is evaluated by both threads, each adding only its own end's force (and half the
 ///   energy). No atomics, no per-thread buffers, no reduction of g.
 /// Measured against the memory-bandwidth roofline by msm/benchmarks/spring_kernel_benchmark.cpp
-/// (docs/msm_kernel_benchmark.md).
+/// (docs/measurements/spring_kernel_notes.md).
 /// The thread count is fixed when the layout is built (it decides the split); it is this object's
 /// own setting, independent of set_solver_threads (the OpenMP limits set there for CHOLMOD are
 /// overridden for the kernel's own parallel region and restored after it).
@@ -31,7 +31,7 @@ namespace vessel::msm {
 
 /// Threads of the spring force pass of models built from now on (SpringModel); default 1, like
 /// set_solver_threads: timings stay per core, and on a machine shared with other work a
-/// fork–join pass waits for descheduled threads (docs/msm_kernel_benchmark.md, "Under
+/// fork–join pass waits for descheduled threads (docs/measurements/spring_kernel_notes.md, "Under
 /// contention"). InputError if n < 1.
 void set_spring_kernel_threads(int n);
 [[nodiscard]] int spring_kernel_threads();

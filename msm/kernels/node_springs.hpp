@@ -21,7 +21,7 @@
 ///   default target vectorises); the binary runs on any x86-64;
 /// - threads over the cores: each thread owns a run of chunks (balanced by slots), computes its
 ///   nodes' forces and writes them; no colouring, no atomics, no buffers, no reduction of g.
-/// Bytes streamed per spring (docs/msm_kernel_benchmark.md): 2 × (4 + 8 + 8) = 40 B of spring
+/// Bytes streamed per spring (docs/measurements/spring_kernel_notes.md): 2 × (4 + 8 + 8) = 40 B of spring
 /// data (each spring stored at both ends) plus padding, each node's position read once as the
 /// chunk's own and its force written once (48 B × nodes / springs); the other ends' positions are
 /// re-read from cache.

@@ -48,7 +48,7 @@ class CholmodSolver {
   /// of the supernodal elimination tree (the top of the tree, where the subtrees meet, on one
   /// thread): CHOLMOD 3 (SuiteSparse 5.12) solves on one thread whatever the setting, and a solve
   /// is bound by reading the factor twice, which two cores do faster than one
-  /// (docs/msm_measurements.md). Same numbers up to rounding.
+  /// (docs/measurements/msm_measurements.md). Same numbers up to rounding.
   void solve_into(const VectorXd& b, VectorXd& x) const;
   /// The smallest factor (numbers stored) solved on several threads; default 4 M (32 MB, beyond
   /// the caches, where the sweeps are bound by memory bandwidth). Below it one thread.

@@ -39,7 +39,7 @@ struct StaticOptions {
   // The options below belong to line_search.
   /// Where the exact Hessian is indefinite: power iterations for a direction of negative
   /// curvature (0: off, plain projected Newton). Off by default: fewer iterations on the level
-  /// 0–1 surface models, but more (and more time) on the level-2 grid; docs/msm_measurements.md.
+  /// 0–1 surface models, but more (and more time) on the level-2 grid; docs/measurements/msm_measurements.md.
   int curvature_iterations = 0;
   /// After the exact Hessian fails to factorise (indefinite), skip the attempt for 1, 2, 4 …
   /// iterations, at most this many (0: try every iteration).

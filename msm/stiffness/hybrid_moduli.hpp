@@ -14,7 +14,7 @@
 /// lengths, so a negative volume energy outweighs its springs there (volume term ∝ κ·A·δ²/h against
 /// springs ∝ E_s·A·h³·δ²/L⁴ for a sliver of height h ≪ L): measured, the static solver diverged on
 /// the gmsh cube at ν = 0 and 0.1. So the model covers ν ∈ [1/4, 1/2).
-/// Measured (tests/msm/test_effective_moduli.cpp, docs/msm_accuracy.md): the formula is the
+/// Measured (tests/msm/test_effective_moduli.cpp, docs/physics/accuracy.md): the formula is the
 /// affine, isotropic-average one; the real network relaxes non-affinely (van-gelder alone gives
 /// ν = 0.235, not 0.25, on the cube) and the volume term stiffens it towards ν = 1/2, so effective
 /// E and ν deviate from the target by a few per cent (not within the 2 %). The homogenised

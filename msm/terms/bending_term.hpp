@@ -8,7 +8,7 @@
 ///   Discrete Shells:  W = k_B·(θ − θ̄)²·‖ē‖/h̄,  h̄ = a third of the mean of the two triangles'
 ///                     heights over ē = Ā/(3‖ē‖),  so W = k_B·3‖ē‖²/Ā·(θ − θ̄)²;
 ///   our constant:     k_B = D/6,  i.e.  W = ½·k_h·(θ − θ̄)² with k_h = D·‖ē‖²/Ā  (N·m).
-/// Why D/6 (derivation in docs/discrete_shells.md, checked by the tests): a cylinder of radius R
+/// Why D/6 (derivation in docs/physics/discrete_shells.md, checked by the tests): a cylinder of radius R
 /// meshed by a grid of a × b quads split into two triangles bends only at the axial edges, each by
 /// the exterior angle a/R between neighbouring chord planes, so each quad (area ab) stores
 /// k_B·3b²/(ab)·(a/R)² = 3k_B·ab/R²: energy density 3k_B/R², which equals the plate's D/(2R²) for

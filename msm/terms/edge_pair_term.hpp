@@ -5,7 +5,7 @@
 /// Graphics 28(1), article 8. Their formulation "reduces to that of a spring-network model by
 /// simply ignoring all the tetrahedron-sharing edge pairs": a spring network plus these pair
 /// terms is linear P1 FEM's StVK tetrahedron, exactly. The suite uses it to show what a spring
-/// network lacks to be as accurate as P1 (docs/msm_accuracy.md).
+/// network lacks to be as accurate as P1 (docs/physics/accuracy.md).
 ///
 /// Per tet, with reference edge vectors D_k and current ones d_k (k = the six node pairs
 /// (0,1), (0,2), (0,3), (1,2), (1,3), (2,3), D_k = X_b − X_a), the edge's squared-length change

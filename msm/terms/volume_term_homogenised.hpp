@@ -6,7 +6,7 @@
 /// plus the volume energy W = ½κV₀(V/V₀ − 1)² per tet. Golec's rule picks E_s = 2.5μ, κ = λ − μ
 /// from the affine, isotropic average of the springs' energy; on a real (irregular, bounded)
 /// network the springs relax non-affinely and the cube measures E and ν a few per cent off
-/// (docs/msm_accuracy.md). This rule instead measures the network's own linear response and solves
+/// (docs/physics/accuracy.md). This rule instead measures the network's own linear response and solves
 /// for (E_s, κ):
 ///
 /// 1. Homogenisation under uniform boundary traction. The rest stiffness is

@@ -13,7 +13,7 @@
 
 namespace vessel::test {
 
-/// Rivlin's pressure for the hoop stretch a/A = 1.3: 0.1627 μ (docs/finite_strain.md).
+/// Rivlin's pressure for the hoop stretch a/A = 1.3: 0.1627 μ (docs/physics/finite_strain.md).
 inline double rivlin_test_pressure(const fem::RivlinTube& t) {
   return t.pressure(1.3 * t.inner_radius);
 }

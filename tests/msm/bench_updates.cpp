@@ -3,7 +3,7 @@
 // level-0 surface model (seed 000's structured grid, uniform k; target ≤ 0.1 ms per update) and
 // the level-1 volume model (seed 001; target ≤ 5 ms), structured straight tube, contact patch at
 // mid-length. Set-up (assembly, factorisation at rest) is outside the timed loop. Not a test:
-// run build/tests/msm/updates_bench by hand (Release); the figures go in docs/msm_measurements.md.
+// run build/tests/msm/updates_bench by hand (Release); the figures go in docs/measurements/msm_measurements.md.
 #include <benchmark/benchmark.h>
 
 #include <map>

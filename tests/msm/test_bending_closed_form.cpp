@@ -10,7 +10,7 @@
 // Measured and left out of the assertion: with free ends (u_z free) the same rings come out 10–25 %
 // softer than the plane-strain answer, and the gap closes only slowly with length (1.23 at L =
 // 0.4R, 1.17 at 2R, 1.10 at 4R, 1.04 at 8R with 64–128 nodes around), because the uniform-diagonal
-// mesh folds partly along its diagonals near a free edge (docs/discrete_shells.md).
+// mesh folds partly along its diagonals near a free edge (docs/physics/discrete_shells.md).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -185,7 +185,7 @@ TEST(BendingTerm, RolledSheetStoresThePlateEnergy) {
   // (the plate's ½D(κ₁ + κ₂)² with κ₂ = 0). The energy per area is read from interior hinges only:
   // per edge direction, the mean hinge energy times that direction's edges per area, 1/(2A_t) (one
   // edge of each direction per pair of triangles). Right-triangle grid rolled about its y axis:
-  // exact by construction of k_B = D/6 (docs/discrete_shells.md). Equilateral triangles at three
+  // exact by construction of k_B = D/6 (docs/physics/discrete_shells.md). Equilateral triangles at three
   // orientations to the axis: the isotropy the derivation claims, to O((a/R)²).
   const double R = 5e-3, D = 1e-6, a = 0.1e-3;
   const double plate = 0.5 * D / (R * R);

@@ -1,6 +1,6 @@
 // Slow (label slow, ~40 s of CPU): the trust-region static Newton on the level-2 surface
 // membrane (issue 13, item 6). Before it, the line-search Newton stopped at its 200-iteration
-// limit on this model (docs/msm_measurements.md, 2026-11-21: residual 4.9e-8 N, target
+// limit on this model (docs/measurements/msm_measurements.md, 2026-11-21: residual 4.9e-8 N, target
 // 2.5e-12 N); today it needs 188 iterations and 360 factorisations, the trust region 129 and 129.
 #include <gtest/gtest.h>
 

@@ -484,7 +484,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
     for (auto& fc : fit_cases) fc.weight /= mean;
   }
   // Groups: the ridge alone (without it a contact-only fit drove the circumferential classes to
-  // ~0 and κ up 12×, which fitted contact and failed pressure by 4× P1; docs/msm_calibration.md).
+  // ~0 and κ up 12×, which fitted contact and failed pressure by 4× P1; docs/physics/calibration.md).
   msm::Regulariser reg = !mesh_indexed ? msm::Regulariser{0.0, o.regulariser.ridge, {}}
                                        : o.regulariser;
   Eigen::VectorXd theta0 = Eigen::VectorXd::Zero(params.size());

@@ -2,7 +2,7 @@
 // mass-spring models of a scene (default verification/scenes/contact_straight.toml): the static
 // problem (local-global vs solve_static) and one implicit Euler step (local-global-euler vs the
 // same step solved by Newton to convergence, implicit_euler_step_newton), with set-up and
-// per-iteration times. Prints Markdown tables (docs/msm_measurements.md). Release build.
+// per-iteration times. Prints Markdown tables (docs/measurements/msm_measurements.md). Release build.
 //
 //   local_global_accuracy [scene.toml] [force N] [dt s]
 #include <algorithm>
