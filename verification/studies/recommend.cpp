@@ -1,5 +1,7 @@
 #include "verification/studies/recommend.hpp"
 
+#include "verification/harness/results.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
