@@ -240,9 +240,11 @@ std::vector<std::pair<int, int>> crossing_triangles(const std::vector<Vec3>& x,
   return found;
 }
 
-std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view source_view) {
-  const std::string source(source_view);
-  if (lumen.triangles.empty()) throw InputError(source + ": the lumen surface has no triangles");
+namespace {
+
+/// InputError unless the lumen's bounding box is the size of a vessel in metres (a file in
+/// millimetres read as metres, or the reverse, is off by 1e3).
+void check_lumen_size(const TriangleSurface& lumen, const std::string& source) {
   Eigen::AlignedBox3d box;
   for (const Vec3& p : lumen.nodes) box.extend(p);
   const Vec3 size = box.sizes();
@@ -261,8 +263,10 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
                      num(kMinVesselSize) +
                      " m): is the file in metres but read with units = \"mm\"?");
   }
+}
 
-  // Edge manifold and consistently oriented.
+/// InputError unless the surface is edge manifold and consistently oriented.
+void check_lumen_edges(const TriangleSurface& lumen, const std::string& source) {
   for (const auto& [edge, uses] : edge_uses(lumen.triangles)) {
     if (uses.size() > 2) {
       std::string facets;
@@ -280,6 +284,15 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
                        " the same way); expected every normal on the same side of the surface");
     }
   }
+}
+
+}  // namespace
+
+std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view source_view) {
+  const std::string source(source_view);
+  if (lumen.triangles.empty()) throw InputError(source + ": the lumen surface has no triangles");
+  check_lumen_size(lumen, source);
+  check_lumen_edges(lumen, source);
 
   // Ends: every boundary loop must look like a cut end of the vessel.
   const std::vector<std::vector<int>> loops = boundary_loops(lumen, source);
