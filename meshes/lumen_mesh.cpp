@@ -240,9 +240,11 @@ std::vector<std::pair<int, int>> crossing_triangles(const std::vector<Vec3>& x,
   return found;
 }
 
-std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view source_view) {
-  const std::string source(source_view);
-  if (lumen.triangles.empty()) throw InputError(source + ": the lumen surface has no triangles");
+namespace {
+
+/// InputError unless the lumen's bounding box is the size of a vessel in metres (a file in
+/// millimetres read as metres, or the reverse, is off by 1e3).
+void check_lumen_size(const TriangleSurface& lumen, const std::string& source) {
   Eigen::AlignedBox3d box;
   for (const Vec3& p : lumen.nodes) box.extend(p);
   const Vec3 size = box.sizes();
@@ -261,8 +263,10 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
                      num(kMinVesselSize) +
                      " m): is the file in metres but read with units = \"mm\"?");
   }
+}
 
-  // Edge manifold and consistently oriented.
+/// InputError unless the surface is edge manifold and consistently oriented.
+void check_lumen_edges(const TriangleSurface& lumen, const std::string& source) {
   for (const auto& [edge, uses] : edge_uses(lumen.triangles)) {
     if (uses.size() > 2) {
       std::string facets;
@@ -280,6 +284,15 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
                        " the same way); expected every normal on the same side of the surface");
     }
   }
+}
+
+}  // namespace
+
+std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view source_view) {
+  const std::string source(source_view);
+  if (lumen.triangles.empty()) throw InputError(source + ": the lumen surface has no triangles");
+  check_lumen_size(lumen, source);
+  check_lumen_edges(lumen, source);
 
   // Ends: every boundary loop must look like a cut end of the vessel.
   const std::vector<std::vector<int>> loops = boundary_loops(lumen, source);
@@ -378,25 +391,33 @@ int inlet_end(const std::vector<LumenEnd>& ends) {
   return inlet;
 }
 
-TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>& ends,
-                      double thickness, int layers, std::string_view source_view) {
-  const std::string source(source_view);
-  if (!(thickness > 0.0) || !std::isfinite(thickness)) {
-    throw InputError(source + ": wall_thickness: expected a finite value > 0 m, got " +
-                     num(thickness));
-  }
-  if (layers < 1) throw InputError(source + ": expected at least one layer through the wall");
-  const int n = static_cast<int>(lumen.nodes.size());
-  std::vector<Vec3> normal = vertex_normals(lumen.nodes, lumen.triangles);
+namespace {
+
+/// Each lumen node's end (its index in `ends`), −1 for a node on no end's loop.
+std::vector<int> end_of_nodes(int n, const std::vector<LumenEnd>& ends) {
   std::vector<int> end_of(n, -1);
   for (int e = 0; e < static_cast<int>(ends.size()); ++e) {
-    for (const int i : ends[e].loop) {
-      end_of[i] = e;
-      normal[i] -= normal[i].dot(ends[e].normal) * ends[e].normal;  // stay in the end's plane
+    for (const int i : ends[e].loop) end_of[i] = e;
+  }
+  return end_of;
+}
+
+/// The directions the lumen's nodes are extruded along: the vertex normals, those on an end's
+/// loop turned into the end's plane so that the end stays flat.
+std::vector<Vec3> extrusion_normals(const TriangleSurface& lumen,
+                                    const std::vector<LumenEnd>& ends) {
+  std::vector<Vec3> normal = vertex_normals(lumen.nodes, lumen.triangles);
+  for (const LumenEnd& end : ends) {
+    for (const int i : end.loop) {
+      normal[i] -= normal[i].dot(end.normal) * end.normal;  // stay in the end's plane
       normal[i].normalize();
     }
   }
-  // Lumen neighbours of each node (for smoothing the normals at a crease).
+  return normal;
+}
+
+/// Lumen neighbours of each node (for smoothing the normals at a crease).
+std::vector<std::vector<int>> lumen_neighbours(const TriangleSurface& lumen, int n) {
   std::vector<std::vector<int>> neighbours(n);
   for (const Triangle& t : lumen.triangles) {
     for (int k = 0; k < 3; ++k) {
@@ -404,75 +425,92 @@ TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>&
       neighbours[t[k]].push_back(t[(k + 2) % 3]);
     }
   }
-  const auto id = [n](int layer, int i) { return layer * n + i; };
+  return neighbours;
+}
+
+/// A wall extruded along given normals, and what its tets say about them.
+struct Extrusion {
   TetMesh mesh;
-  std::size_t inverted = 0;
-  Vec3 first_inverted = Vec3::Zero();
-  for (int pass = 0;; ++pass) {
-    mesh = TetMesh{};
-    mesh.nodes.reserve(static_cast<std::size_t>(n) * (layers + 1));
-    for (int k = 0; k <= layers; ++k) {
-      const double offset = thickness * k / layers;
-      for (int i = 0; i < n; ++i) mesh.nodes.push_back(lumen.nodes[i] + offset * normal[i]);
-    }
-    inverted = 0;
-    std::vector<char> near_flat(n, 0);
-    for (int k = 0; k < layers; ++k) {
-      for (const Triangle& t : lumen.triangles) {
-        const std::array<int, 6> g{id(k, t[0]),     id(k, t[1]),     id(k, t[2]),
-                                   id(k + 1, t[0]), id(k + 1, t[1]), id(k + 1, t[2])};
-        for (const auto& slots : prism_tets(g)) {
-          const Tet tet{g[slots[0]], g[slots[1]], g[slots[2]], g[slots[3]]};
-          const Vec3 &a = mesh.nodes[tet[0]], &b = mesh.nodes[tet[1]], &c = mesh.nodes[tet[2]],
-                     &d = mesh.nodes[tet[3]];
-          double longest = 0.0;
-          for (const auto& [p, q] : {std::pair{&a, &b}, {&a, &c}, {&a, &d}, {&b, &c},
-                                     {&b, &d}, {&c, &d}}) {
-            longest = std::max(longest, (*p - *q).norm());
-          }
-          const double v = signed_volume(a, b, c, d), l3 = longest * longest * longest;
-          if (v <= kZeroVolumeTolerance * l3 && inverted++ == 0) {
-            first_inverted = 0.25 * (a + b + c + d);
-          }
-          if (v <= kNearFlatPrismTet * l3) {
-            for (const int i : t) near_flat[i] = 1;
-          }
-          mesh.tets.push_back(tet);
+  std::size_t inverted = 0;             ///< tets of (near) zero or negative volume
+  Vec3 first_inverted = Vec3::Zero();  ///< the first one's centroid
+  std::vector<char> near_flat;         ///< per lumen node: in a prism with a near-flat tet
+};
+
+/// The wall as `layers` layers of prisms (three tets each) between the lumen and its offset by
+/// `thickness` along `normal`; node (layer k, lumen node i) is k·n + i.
+Extrusion extrude_along(const TriangleSurface& lumen, const std::vector<Vec3>& normal,
+                        double thickness, int layers) {
+  const int n = static_cast<int>(lumen.nodes.size());
+  const auto id = [n](int layer, int i) { return layer * n + i; };
+  Extrusion x;
+  TetMesh& mesh = x.mesh;
+  mesh.nodes.reserve(static_cast<std::size_t>(n) * (layers + 1));
+  for (int k = 0; k <= layers; ++k) {
+    const double offset = thickness * k / layers;
+    for (int i = 0; i < n; ++i) mesh.nodes.push_back(lumen.nodes[i] + offset * normal[i]);
+  }
+  x.near_flat.assign(n, 0);
+  for (int k = 0; k < layers; ++k) {
+    for (const Triangle& t : lumen.triangles) {
+      const std::array<int, 6> g{id(k, t[0]),     id(k, t[1]),     id(k, t[2]),
+                                 id(k + 1, t[0]), id(k + 1, t[1]), id(k + 1, t[2])};
+      for (const auto& slots : prism_tets(g)) {
+        const Tet tet{g[slots[0]], g[slots[1]], g[slots[2]], g[slots[3]]};
+        const Vec3 &a = mesh.nodes[tet[0]], &b = mesh.nodes[tet[1]], &c = mesh.nodes[tet[2]],
+                   &d = mesh.nodes[tet[3]];
+        double longest = 0.0;
+        for (const auto& [p, q] : {std::pair{&a, &b}, {&a, &c}, {&a, &d}, {&b, &c},
+                                   {&b, &d}, {&c, &d}}) {
+          longest = std::max(longest, (*p - *q).norm());
         }
+        const double v = signed_volume(a, b, c, d), l3 = longest * longest * longest;
+        if (v <= kZeroVolumeTolerance * l3 && x.inverted++ == 0) {
+          x.first_inverted = 0.25 * (a + b + c + d);
+        }
+        if (v <= kNearFlatPrismTet * l3) {
+          for (const int i : t) x.near_flat[i] = 1;
+        }
+        mesh.tets.push_back(tet);
       }
     }
-    if (std::find(near_flat.begin(), near_flat.end(), 1) == near_flat.end() ||
-        pass == kMaxNormalSmoothingPasses) {
-      break;
-    }
-    // A crease (where a branch leaves) turns the normals faster than the wall is thick: average
-    // the normals there and around with their neighbours', keeping the ends' in their planes.
-    std::vector<char> smooth = near_flat;
-    for (int i = 0; i < n; ++i) {
-      if (near_flat[i]) {
-        for (const int j : neighbours[i]) smooth[j] = 1;
-      }
-    }
-    std::vector<Vec3> averaged = normal;
-    for (int i = 0; i < n; ++i) {
-      if (!smooth[i]) continue;
-      for (const int j : neighbours[i]) averaged[i] += normal[j];
-      if (end_of[i] >= 0) {
-        const Vec3& e = ends[end_of[i]].normal;
-        averaged[i] -= averaged[i].dot(e) * e;
-      }
-      averaged[i].normalize();
-    }
-    normal = std::move(averaged);
   }
-  if (inverted > 0) {
-    throw InputError(source + ": extruding the lumen outward by wall_thickness = " +
-                     num(thickness * 1e3) + " mm folds the wall over itself near " +
-                     mm(first_inverted) + " (" + std::to_string(inverted) +
-                     " inverted or flat tets, after " + std::to_string(kMaxNormalSmoothingPasses) +
-                     " passes of smoothing the normals there): the lumen curves more tightly "
-                     "than the wall is thick there; expected a thinner wall or a smoother lumen");
+  return x;
+}
+
+/// A crease (where a branch leaves) turns the normals faster than the wall is thick: the
+/// normals at near-flat prisms and around them averaged with their neighbours', keeping the
+/// ends' in their planes.
+std::vector<Vec3> smoothed_at_creases(const std::vector<Vec3>& normal,
+                                      const std::vector<char>& near_flat,
+                                      const std::vector<std::vector<int>>& neighbours,
+                                      const std::vector<int>& end_of,
+                                      const std::vector<LumenEnd>& ends) {
+  const int n = static_cast<int>(normal.size());
+  std::vector<char> smooth = near_flat;
+  for (int i = 0; i < n; ++i) {
+    if (near_flat[i]) {
+      for (const int j : neighbours[i]) smooth[j] = 1;
+    }
   }
+  std::vector<Vec3> averaged = normal;
+  for (int i = 0; i < n; ++i) {
+    if (!smooth[i]) continue;
+    for (const int j : neighbours[i]) averaged[i] += normal[j];
+    if (end_of[i] >= 0) {
+      const Vec3& e = ends[end_of[i]].normal;
+      averaged[i] -= averaged[i].dot(e) * e;
+    }
+    averaged[i].normalize();
+  }
+  return averaged;
+}
+
+/// InputError if the outer wall (the last layer) crosses itself: two parts of the vessel closer
+/// than twice the wall's thickness.
+void check_outer_wall(const TetMesh& mesh, const TriangleSurface& lumen, int layers,
+                      double thickness, const std::string& source) {
+  const int n = static_cast<int>(lumen.nodes.size());
+  const auto id = [n](int layer, int i) { return layer * n + i; };
   std::vector<Triangle> outer;
   for (const Triangle& t : lumen.triangles) outer.push_back({id(layers, t[0]), id(layers, t[1]), id(layers, t[2])});
   const auto crossing = crossing_triangles(mesh.nodes, outer, 1);
@@ -484,8 +522,13 @@ TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>&
                      ": two parts of the vessel are closer than twice the wall's thickness; "
                      "expected a thinner wall");
   }
+}
 
-  // Boundary groups: lumen layer → inner wall, last layer → outer wall, else the end of its loop.
+/// Boundary groups: lumen layer → inner wall, last layer → outer wall, else the end of its loop
+/// (the inlet or an outlet); every tet in the wall.
+void add_vessel_groups(TetMesh& mesh, const std::vector<LumenEnd>& ends,
+                       const std::vector<int>& end_of, int layers) {
+  const int n = static_cast<int>(end_of.size());
   const int inlet = inlet_end(ends);
   std::map<std::string_view, PhysicalGroup> groups;
   for (const auto& spec : kVesselGroups) {
@@ -513,6 +556,43 @@ TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>&
     groups[group_names::wall].elements.push_back(t);
   }
   for (const auto& spec : kVesselGroups) mesh.groups.push_back(std::move(groups[spec.name]));
+}
+
+}  // namespace
+
+TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>& ends,
+                      double thickness, int layers, std::string_view source_view) {
+  const std::string source(source_view);
+  if (!(thickness > 0.0) || !std::isfinite(thickness)) {
+    throw InputError(source + ": wall_thickness: expected a finite value > 0 m, got " +
+                     num(thickness));
+  }
+  if (layers < 1) throw InputError(source + ": expected at least one layer through the wall");
+  const int n = static_cast<int>(lumen.nodes.size());
+  std::vector<Vec3> normal = extrusion_normals(lumen, ends);
+  const std::vector<int> end_of = end_of_nodes(n, ends);
+  const std::vector<std::vector<int>> neighbours = lumen_neighbours(lumen, n);
+  // Extruded again with the normals smoothed at creases while a prism has a near-flat tet.
+  Extrusion x;
+  for (int pass = 0;; ++pass) {
+    x = extrude_along(lumen, normal, thickness, layers);
+    if (std::find(x.near_flat.begin(), x.near_flat.end(), 1) == x.near_flat.end() ||
+        pass == kMaxNormalSmoothingPasses) {
+      break;
+    }
+    normal = smoothed_at_creases(normal, x.near_flat, neighbours, end_of, ends);
+  }
+  if (x.inverted > 0) {
+    throw InputError(source + ": extruding the lumen outward by wall_thickness = " +
+                     num(thickness * 1e3) + " mm folds the wall over itself near " +
+                     mm(x.first_inverted) + " (" + std::to_string(x.inverted) +
+                     " inverted or flat tets, after " + std::to_string(kMaxNormalSmoothingPasses) +
+                     " passes of smoothing the normals there): the lumen curves more tightly "
+                     "than the wall is thick there; expected a thinner wall or a smoother lumen");
+  }
+  TetMesh mesh = std::move(x.mesh);
+  check_outer_wall(mesh, lumen, layers, thickness, source);
+  add_vessel_groups(mesh, ends, end_of, layers);
   sort_elements(mesh);
   orient_boundary_outward(mesh);
   require_vessel_groups(mesh, source);

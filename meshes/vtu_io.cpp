@@ -191,49 +191,7 @@ class VtuParser {
         n_cells = count_attribute(tag, "NumberOfCells", tag_pos);
       } else if (tag.name == "DataArray") {
         const std::string section = stack.empty() ? "" : stack.back();
-        VtuField f;
-        f.name = attribute(tag, "Name");
-        const std::string comps = attribute(tag, "NumberOfComponents");
-        f.components = comps.empty() ? 1 : static_cast<int>(count_attribute(tag, "NumberOfComponents", tag_pos));
-        if (f.components < 1) fail(tag_pos, "DataArray \"" + f.name + "\": NumberOfComponents 0; expected >= 1");
-        const std::string format = attribute(tag, "format");
-        if (format != "ascii") {
-          fail(tag_pos, "DataArray \"" + f.name + "\" has format \"" + format +
-                            "\"; expected format=\"ascii\" (in ParaView: Save Data with Data "
-                            "Mode \"Ascii\")");
-        }
-        if (!tag.self_closing) {
-          const std::size_t end = text_.find("</DataArray>", pos);
-          if (end == std::string::npos) fail(tag_pos, "DataArray \"" + f.name + "\" is not closed");
-          f.values = numbers(pos, end, f.name);
-          pos = end + std::string("</DataArray>").size();
-        }
-        if (f.values.size() % static_cast<std::size_t>(f.components) != 0) {
-          fail(tag_pos, "DataArray \"" + f.name + "\" has " + std::to_string(f.values.size()) +
-                            " values, not a multiple of its " + std::to_string(f.components) +
-                            " components");
-        }
-        if (section == "PointData") {
-          d.point_fields.push_back(std::move(f));
-        } else if (section == "CellData") {
-          d.cell_fields.push_back(std::move(f));
-        } else if (section == "FieldData") {
-          d.field_data.push_back(std::move(f));
-        } else if (section == "Points") {
-          if (f.components != 3) fail(tag_pos, "Points: expected 3 components per point");
-          has_points = true;
-          for (std::size_t i = 0; i < f.values.size(); i += 3) {
-            d.points.emplace_back(f.values[i], f.values[i + 1], f.values[i + 2]);
-          }
-        } else if (section == "Cells") {
-          if (f.name == "connectivity") {
-            d.connectivity = indices(f, tag_pos);
-          } else if (f.name == "offsets") {
-            d.offsets = indices(f, tag_pos);
-          } else if (f.name == "types") {
-            for (const std::size_t t : indices(f, tag_pos)) d.types.push_back(static_cast<int>(t));
-          }
-        }
+        store_array(read_data_array(tag, tag_pos, pos), section, tag_pos, d, has_points);
         continue;
       }
       if (!tag.self_closing) stack.push_back(tag.name);
@@ -241,6 +199,78 @@ class VtuParser {
     if (!seen_file) fail(0, "no <VTKFile> element; expected a VTK XML unstructured grid (.vtu)");
     if (!seen_piece) fail(0, "no <Piece>; expected one piece with points and cells");
     if (!has_points) fail(piece_pos, "no <Points> data array");
+    check_piece(d, n_points, n_cells, piece_pos);
+    return d;
+  }
+
+ private:
+  struct Tag {
+    std::string name;
+    bool closing = false;
+    bool self_closing = false;
+    std::map<std::string, std::string> attributes;
+  };
+
+  /// The DataArray whose start tag `tag` was just read (pos after it): its name, components and
+  /// ASCII values; pos ends after its end tag.
+  VtuField read_data_array(const Tag& tag, std::size_t tag_pos, std::size_t& pos) const {
+    VtuField f;
+    f.name = attribute(tag, "Name");
+    const std::string comps = attribute(tag, "NumberOfComponents");
+    f.components = comps.empty() ? 1 : static_cast<int>(count_attribute(tag, "NumberOfComponents", tag_pos));
+    if (f.components < 1) fail(tag_pos, "DataArray \"" + f.name + "\": NumberOfComponents 0; expected >= 1");
+    const std::string format = attribute(tag, "format");
+    if (format != "ascii") {
+      fail(tag_pos, "DataArray \"" + f.name + "\" has format \"" + format +
+                        "\"; expected format=\"ascii\" (in ParaView: Save Data with Data "
+                        "Mode \"Ascii\")");
+    }
+    if (!tag.self_closing) {
+      const std::size_t end = text_.find("</DataArray>", pos);
+      if (end == std::string::npos) fail(tag_pos, "DataArray \"" + f.name + "\" is not closed");
+      f.values = numbers(pos, end, f.name);
+      pos = end + std::string("</DataArray>").size();
+    }
+    if (f.values.size() % static_cast<std::size_t>(f.components) != 0) {
+      fail(tag_pos, "DataArray \"" + f.name + "\" has " + std::to_string(f.values.size()) +
+                        " values, not a multiple of its " + std::to_string(f.components) +
+                        " components");
+    }
+    return f;
+  }
+
+  /// Puts a data array where its section says: point, cell or field data, the points, or the
+  /// cells' connectivity, offsets and types.
+  void store_array(VtuField f, const std::string& section, std::size_t tag_pos, VtuData& d,
+                   bool& has_points) const {
+    if (section == "PointData") {
+      d.point_fields.push_back(std::move(f));
+    } else if (section == "CellData") {
+      d.cell_fields.push_back(std::move(f));
+    } else if (section == "FieldData") {
+      d.field_data.push_back(std::move(f));
+    } else if (section == "Points") {
+      if (f.components != 3) fail(tag_pos, "Points: expected 3 components per point");
+      has_points = true;
+      for (std::size_t i = 0; i < f.values.size(); i += 3) {
+        d.points.emplace_back(f.values[i], f.values[i + 1], f.values[i + 2]);
+      }
+    } else if (section == "Cells") {
+      if (f.name == "connectivity") {
+        d.connectivity = indices(f, tag_pos);
+      } else if (f.name == "offsets") {
+        d.offsets = indices(f, tag_pos);
+      } else if (f.name == "types") {
+        for (const std::size_t t : indices(f, tag_pos)) d.types.push_back(static_cast<int>(t));
+      }
+    }
+  }
+
+  /// The piece against its declared sizes: as many points and cells as it says, ascending cell
+  /// offsets that end at the connectivity's length, connectivity naming existing points, and
+  /// point and cell data with one tuple per point and per cell.
+  void check_piece(const VtuData& d, std::size_t n_points, std::size_t n_cells,
+                   std::size_t piece_pos) const {
     if (d.points.size() != n_points) {
       fail(piece_pos, "NumberOfPoints=" + std::to_string(n_points) + " but the Points array has " +
                           std::to_string(d.points.size()) + " points");
@@ -271,16 +301,7 @@ class VtuParser {
     }
     for (const auto& f : d.point_fields) check_count(f, n_points, "point", piece_pos);
     for (const auto& f : d.cell_fields) check_count(f, n_cells, "cell", piece_pos);
-    return d;
   }
-
- private:
-  struct Tag {
-    std::string name;
-    bool closing = false;
-    bool self_closing = false;
-    std::map<std::string, std::string> attributes;
-  };
 
   std::size_t skip_to(std::size_t pos, const char* end) const {
     const std::size_t e = text_.find(end, pos);

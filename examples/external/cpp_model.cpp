@@ -19,6 +19,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -73,41 +74,57 @@ struct Spring {
   Vec n;  ///< unit direction a → b at rest
 };
 
-int run(const std::filesystem::path& manifest_path) {
-  const auto start = std::chrono::steady_clock::now();
-  const std::filesystem::path dir = std::filesystem::absolute(manifest_path).parent_path();
+/// One case's static problem, as the manifest and problem.vtu give it.
+struct Case {
+  std::filesystem::path dir;  ///< the manifest's folder, where the answer goes
+  double E = 0.0;             ///< Young's modulus, Pa
+  std::vector<double> xyz, conn, load, fixed;
+  std::size_t n = 0;  ///< points
+};
+
+/// The case of a manifest, or nothing (with the reason on stderr) if this model does not
+/// answer it: another schema, a dynamic problem, cells other than tetra, mismatched arrays.
+std::optional<Case> read_case(const std::filesystem::path& manifest_path) {
+  Case c;
+  c.dir = std::filesystem::absolute(manifest_path).parent_path();
   const std::string manifest = read_text(manifest_path);
   if (json_value(manifest, "schema").find("vesselverify.exchange") == std::string::npos) {
     std::cerr << "expected a vesselverify.exchange manifest\n";
-    return 2;
+    return std::nullopt;
   }
   if (json_value(manifest, "type").find("static") == std::string::npos) {
     std::cerr << "this example answers static problems only\n";
-    return 2;
+    return std::nullopt;
   }
   if (json_value(manifest, "cell_type").find("tetra") == std::string::npos) {
     std::cerr << "this example needs tetra cells (nodes = \"volume\")\n";
-    return 2;
+    return std::nullopt;
   }
-  const double E = std::stod(json_value(manifest, "youngs_modulus_pa"));
-  const std::string vtu = read_text(dir / "problem.vtu");
-  const std::vector<double> xyz = data_array(vtu, "<Points>");
-  const std::vector<double> conn = data_array(vtu, "Name=\"connectivity\"");
-  const std::vector<double> load = data_array(vtu, "Name=\"load_N\"");
-  const std::vector<double> fixed = data_array(vtu, "Name=\"fixed\"");
-  const std::size_t n = xyz.size() / 3;
-  if (load.size() != 3 * n || fixed.size() != 3 * n || conn.size() % 4 != 0) {
-    std::cerr << "problem.vtu: array sizes do not match " << n << " points\n";
-    return 2;
+  c.E = std::stod(json_value(manifest, "youngs_modulus_pa"));
+  const std::string vtu = read_text(c.dir / "problem.vtu");
+  c.xyz = data_array(vtu, "<Points>");
+  c.conn = data_array(vtu, "Name=\"connectivity\"");
+  c.load = data_array(vtu, "Name=\"load_N\"");
+  c.fixed = data_array(vtu, "Name=\"fixed\"");
+  c.n = c.xyz.size() / 3;
+  if (c.load.size() != 3 * c.n || c.fixed.size() != 3 * c.n || c.conn.size() % 4 != 0) {
+    std::cerr << "problem.vtu: array sizes do not match " << c.n << " points\n";
+    return std::nullopt;
   }
-  const auto point = [&](std::size_t i) { return Vec{xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}; };
+  return c;
+}
 
-  // Σ V_tet per edge, then k = (24/25)·E·ΣV/L² (Lloyd et al. 2007, per element).
+/// One spring per tetrahedron edge: Σ V_tet per edge, then k = (24/25)·E·ΣV/L² (Lloyd et al.
+/// 2007, per element).
+std::vector<Spring> edge_springs(const Case& c) {
+  const auto point = [&](std::size_t i) {
+    return Vec{c.xyz[3 * i], c.xyz[3 * i + 1], c.xyz[3 * i + 2]};
+  };
   std::map<std::pair<int, int>, double> volume_around;
   constexpr int kPairs[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-  for (std::size_t t = 0; t < conn.size(); t += 4) {
+  for (std::size_t t = 0; t < c.conn.size(); t += 4) {
     int v[4];
-    for (int i = 0; i < 4; ++i) v[i] = static_cast<int>(conn[t + i]);
+    for (int i = 0; i < 4; ++i) v[i] = static_cast<int>(c.conn[t + i]);
     const Vec x0 = point(v[0]);
     const double V =
         std::abs(dot(cross(sub(point(v[1]), x0), sub(point(v[2]), x0)), sub(point(v[3]), x0))) / 6.0;
@@ -120,21 +137,32 @@ int run(const std::filesystem::path& manifest_path) {
   for (const auto& [edge, V] : volume_around) {
     const Vec d = sub(point(edge.second), point(edge.first));
     const double L = std::sqrt(dot(d, d));
-    springs.push_back({edge.first, edge.second, 24.0 / 25.0 * E * V / (L * L),
+    springs.push_back({edge.first, edge.second, 24.0 / 25.0 * c.E * V / (L * L),
                        {d[0] / L, d[1] / L, d[2] / L}});
   }
-  const auto set_up = std::chrono::steady_clock::now();
+  return springs;
+}
 
-  // Conjugate gradients on K u = f, Jacobi preconditioner, fixed components zero.
-  const std::size_t m = 3 * n;
+/// The displacements from conjugate gradients, or nothing if they did not converge.
+struct CgSolution {
+  std::vector<double> u;
+  long iterations = 0;
+  bool converged = true;
+};
+
+/// Conjugate gradients on K u = f (K = Σ k n nᵀ), Jacobi preconditioner, fixed components zero;
+/// stops at ‖r‖ ≤ 1e-10 ‖f‖, fails after 20 × (unknowns) iterations.
+CgSolution solve_cg(const std::vector<Spring>& springs, const Case& c) {
+  const std::vector<double>& fixed = c.fixed;
+  const std::size_t m = 3 * c.n;
   const auto apply = [&](const std::vector<double>& u, std::vector<double>& out) {
     std::fill(out.begin(), out.end(), 0.0);
     for (const Spring& s : springs) {
       double stretch = 0.0;
-      for (int c = 0; c < 3; ++c) stretch += s.n[c] * (u[3 * s.b + c] - u[3 * s.a + c]);
-      for (int c = 0; c < 3; ++c) {
-        out[3 * s.b + c] += s.k * stretch * s.n[c];
-        out[3 * s.a + c] -= s.k * stretch * s.n[c];
+      for (int j = 0; j < 3; ++j) stretch += s.n[j] * (u[3 * s.b + j] - u[3 * s.a + j]);
+      for (int j = 0; j < 3; ++j) {
+        out[3 * s.b + j] += s.k * stretch * s.n[j];
+        out[3 * s.a + j] -= s.k * stretch * s.n[j];
       }
     }
     for (std::size_t i = 0; i < m; ++i) {
@@ -143,15 +171,18 @@ int run(const std::filesystem::path& manifest_path) {
   };
   std::vector<double> diagonal(m, 0.0);
   for (const Spring& s : springs) {
-    for (int c = 0; c < 3; ++c) {
-      diagonal[3 * s.a + c] += s.k * s.n[c] * s.n[c];
-      diagonal[3 * s.b + c] += s.k * s.n[c] * s.n[c];
+    for (int j = 0; j < 3; ++j) {
+      diagonal[3 * s.a + j] += s.k * s.n[j] * s.n[j];
+      diagonal[3 * s.b + j] += s.k * s.n[j] * s.n[j];
     }
   }
-  std::vector<double> u(m, 0.0), r(m), z(m), p(m), q(m);
+  CgSolution out;
+  std::vector<double>& u = out.u;
+  u.assign(m, 0.0);
+  std::vector<double> r(m), z(m), p(m), q(m);
   double norm_f = 0.0;
   for (std::size_t i = 0; i < m; ++i) {
-    r[i] = fixed[i] != 0.0 ? 0.0 : load[i];
+    r[i] = fixed[i] != 0.0 ? 0.0 : c.load[i];
     norm_f += r[i] * r[i];
   }
   norm_f = std::sqrt(norm_f);
@@ -162,7 +193,6 @@ int run(const std::filesystem::path& manifest_path) {
   p = z;
   double rz = 0.0;
   for (std::size_t i = 0; i < m; ++i) rz += r[i] * z[i];
-  long iterations = 0;
   while (norm_f > 0.0) {
     apply(p, q);
     double pq = 0.0;
@@ -174,11 +204,13 @@ int run(const std::filesystem::path& manifest_path) {
       r[i] -= alpha * q[i];
       norm_r += r[i] * r[i];
     }
-    ++iterations;
+    ++out.iterations;
     if (std::sqrt(norm_r) <= 1e-10 * norm_f) break;
-    if (iterations > 20 * static_cast<long>(m)) {
-      std::cerr << "conjugate gradients did not converge in " << iterations << " iterations\n";
-      return 1;
+    if (out.iterations > 20 * static_cast<long>(m)) {
+      std::cerr << "conjugate gradients did not converge in " << out.iterations
+                << " iterations\n";
+      out.converged = false;
+      return out;
     }
     precondition();
     double rz_new = 0.0;
@@ -186,9 +218,13 @@ int run(const std::filesystem::path& manifest_path) {
     for (std::size_t i = 0; i < m; ++i) p[i] = z[i] + rz_new / rz * p[i];
     rz = rz_new;
   }
-  const auto solved = std::chrono::steady_clock::now();
+  return out;
+}
 
-  // The answer, written under a temporary name and renamed: never half a file.
+/// displacements.csv (node,ux,uy,uz in m), written under a temporary name and renamed: never
+/// half a file.
+void write_displacements(const std::filesystem::path& dir, const std::vector<double>& u,
+                         std::size_t n) {
   {
     std::ofstream out(dir / "displacements.csv.tmp");
     out.precision(17);
@@ -198,14 +234,26 @@ int run(const std::filesystem::path& manifest_path) {
     }
   }
   std::filesystem::rename(dir / "displacements.csv.tmp", dir / "displacements.csv");
+}
+
+int run(const std::filesystem::path& manifest_path) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::optional<Case> c = read_case(manifest_path);
+  if (!c) return 2;
+  const std::vector<Spring> springs = edge_springs(*c);
+  const auto set_up = std::chrono::steady_clock::now();
+  const CgSolution solution = solve_cg(springs, *c);
+  if (!solution.converged) return 1;
+  const auto solved = std::chrono::steady_clock::now();
+  write_displacements(c->dir, solution.u, c->n);
   {
     const auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
-    std::ofstream out(dir / "timing.json");
+    std::ofstream out(c->dir / "timing.json");
     out.precision(9);
     out << "{\"setup_seconds\": " << seconds(start, set_up)
         << ", \"solve_seconds\": " << seconds(set_up, solved) << "}\n";
   }
-  std::cout << n << " nodes, " << springs.size() << " springs, CG " << iterations
+  std::cout << c->n << " nodes, " << springs.size() << " springs, CG " << solution.iterations
             << " iterations\n";
   return 0;
 }

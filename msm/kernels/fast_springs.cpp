@@ -4,6 +4,7 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -205,9 +206,11 @@ std::vector<std::int32_t> morton_order(const std::vector<Vec3>& positions) {
   return order;
 }
 
-FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int threads,
-                         const std::vector<Vec3>& rest_positions)
-    : num_nodes_(num_nodes), threads_(threads), num_springs_(springs.size()) {
+namespace {
+
+/// InputError unless threads ≥ 1, the nodes fit 32-bit offsets 3·node and every spring joins
+/// two of them.
+void check_layout_input(const std::vector<Spring>& springs, int num_nodes, int threads) {
   if (threads < 1) {
     throw InputError("spring kernel threads: expected >= 1, got " + std::to_string(threads));
   }
@@ -215,7 +218,6 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
     throw InputError("FastSprings: " + std::to_string(num_nodes) +
                      " nodes, expected 0 to 2^31/3 (32-bit offsets 3·node)");
   }
-  const int T = threads;
   for (std::size_t s = 0; s < springs.size(); ++s) {
     const Spring& sp = springs[s];
     if (sp.a < 0 || sp.b < 0 || sp.a >= num_nodes || sp.b >= num_nodes) {
@@ -224,11 +226,13 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
                        ", expected indices below " + std::to_string(num_nodes));
     }
   }
-  parts_.resize(static_cast<std::size_t>(T));
-  // The order nodes are walked in: along a Morton (Z-order) curve of the rest positions when they
-  // are given, so that each thread's nodes form a compact region (few springs cross between
-  // threads) and consecutive springs touch nearby nodes (their positions and forces stay in
-  // cache); else the index order.
+}
+
+/// The order nodes are walked in: along a Morton (Z-order) curve of the rest positions when they
+/// are given, so that each thread's nodes form a compact region (few springs cross between
+/// threads) and consecutive springs touch nearby nodes (their positions and forces stay in
+/// cache); else the index order.
+std::vector<std::int32_t> walk_order(int num_nodes, const std::vector<Vec3>& rest_positions) {
   std::vector<std::int32_t> order(static_cast<std::size_t>(num_nodes));
   for (int v = 0; v < num_nodes; ++v) order[static_cast<std::size_t>(v)] = v;
   if (!rest_positions.empty()) {
@@ -239,41 +243,52 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
     }
     order = morton_order(rest_positions);
   }
-  std::vector<std::int32_t> rank(static_cast<std::size_t>(num_nodes));
-  for (int r = 0; r < num_nodes; ++r) rank[static_cast<std::size_t>(order[r])] = r;
-  // Threads own consecutive runs of that order, balanced by the springs whose first end in the
-  // order lies in them.
+  return order;
+}
+
+/// The thread owning each node: threads own consecutive runs of the walk order, balanced by the
+/// springs whose first end in the order lies in them.
+std::vector<int> balance_owners(const std::vector<Spring>& springs,
+                                const std::vector<std::int32_t>& order,
+                                const std::vector<std::int32_t>& rank, int T) {
+  const int num_nodes = static_cast<int>(order.size());
   std::vector<std::size_t> per_rank(static_cast<std::size_t>(num_nodes), 0);
   for (const Spring& sp : springs) {
     ++per_rank[static_cast<std::size_t>(
         std::min(rank[static_cast<std::size_t>(sp.a)], rank[static_cast<std::size_t>(sp.b)]))];
   }
   std::vector<int> owner(static_cast<std::size_t>(num_nodes), T - 1);
-  {
-    std::size_t seen = 0;
-    int t = 0;
-    for (int r = 0; r < num_nodes; ++r) {
-      while (t + 1 < T && seen >= (springs.size() * static_cast<std::size_t>(t + 1)) / T) ++t;
-      owner[static_cast<std::size_t>(order[r])] = t;
-      seen += per_rank[static_cast<std::size_t>(r)];
-    }
-    // Each thread's nodes in index order (it zeroes their gradient entries).
-    std::vector<std::vector<std::int32_t>> owned(static_cast<std::size_t>(T));
-    for (int v = 0; v < num_nodes; ++v) owned[owner[static_cast<std::size_t>(v)]].push_back(v);
-    owned_nodes_.clear();
-    owned_nodes_.reserve(static_cast<std::size_t>(num_nodes));
-    for (int u = 0; u < T; ++u) {
-      parts_[u].nodes[0] = owned_nodes_.size();
-      owned_nodes_.insert(owned_nodes_.end(), owned[u].begin(), owned[u].end());
-      parts_[u].nodes[1] = owned_nodes_.size();
-    }
+  std::size_t seen = 0;
+  int t = 0;
+  for (int r = 0; r < num_nodes; ++r) {
+    while (t + 1 < T && seen >= (springs.size() * static_cast<std::size_t>(t + 1)) / T) ++t;
+    owner[static_cast<std::size_t>(order[r])] = t;
+    seen += per_rank[static_cast<std::size_t>(r)];
   }
-  // Per thread: full springs and halves of split springs.
-  struct Item {
-    std::int32_t i, j;
-    std::size_t s;
-  };
-  std::vector<std::vector<Item>> hf(T), hh(T), bf(T), bh(T);
+  return owner;
+}
+
+/// A spring (or half of a split one) as a thread lists it: the end it writes first.
+struct Item {
+  std::int32_t i, j;
+  std::size_t s;
+};
+using ThreadItems = std::vector<std::vector<Item>>;  // one list per thread
+
+/// Per thread: Hooke and bilinear springs with both ends in its nodes ("full") and the halves of
+/// springs split between two threads (each thread writes its own end).
+struct ThreadLists {
+  ThreadItems hooke_full, hooke_half, bilinear_full, bilinear_half;
+  std::size_t bilinear = 0, split = 0;
+};
+
+ThreadLists split_by_owner(const std::vector<Spring>& springs, const std::vector<int>& owner,
+                           int T) {
+  ThreadLists out;
+  out.hooke_full.resize(T);
+  out.hooke_half.resize(T);
+  out.bilinear_full.resize(T);
+  out.bilinear_half.resize(T);
   for (std::size_t s = 0; s < springs.size(); ++s) {
     const Spring& sp = springs[s];
     // Hooke for an infinite threshold (as spring_profile decides) and for a NaN one (which
@@ -281,16 +296,20 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
     const bool bilinear = std::isfinite(sp.law.threshold);
     const int oa = owner[static_cast<std::size_t>(sp.a)];
     const int ob = owner[static_cast<std::size_t>(sp.b)];
-    num_bilinear_ += bilinear;
+    out.bilinear += bilinear;
     if (oa == ob) {
-      (bilinear ? bf : hf)[oa].push_back({sp.a, sp.b, s});
+      (bilinear ? out.bilinear_full : out.hooke_full)[oa].push_back({sp.a, sp.b, s});
     } else {
-      ++num_split_;
-      (bilinear ? bh : hh)[oa].push_back({sp.a, sp.b, s});
-      (bilinear ? bh : hh)[ob].push_back({sp.b, sp.a, s});
+      ++out.split;
+      (bilinear ? out.bilinear_half : out.hooke_half)[oa].push_back({sp.a, sp.b, s});
+      (bilinear ? out.bilinear_half : out.hooke_half)[ob].push_back({sp.b, sp.a, s});
     }
   }
-  // Springs in the order of their first end along the node order (then the second end).
+  return out;
+}
+
+/// Springs in the order of their first end along the node order (then the second end).
+void sort_by_rank(ThreadLists& lists, const std::vector<std::int32_t>& rank) {
   auto by_rank = [&](const Item& x, const Item& y) {
     const auto key = [&](const Item& it) {
       const std::int32_t ri = rank[static_cast<std::size_t>(it.i)];
@@ -299,19 +318,22 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
     };
     return key(x) < key(y);
   };
-  if (!rest_positions.empty()) {
-    for (auto* lists : {&hf, &hh, &bf, &bh}) {
-      for (auto& l : *lists) std::stable_sort(l.begin(), l.end(), by_rank);
-    }
+  for (ThreadItems* items : {&lists.hooke_full, &lists.hooke_half, &lists.bilinear_full,
+                             &lists.bilinear_half}) {
+    for (auto& l : *items) std::stable_sort(l.begin(), l.end(), by_rank);
   }
-  // Sorted, consecutive springs share their first end: the scatter's read-modify-write of that
-  // node's force would chain from one spring to the next through memory (store-to-load
-  // forwarding, several cycles a link). Each chunk of kBlock springs is read column-wise as a
-  // kStride × (kBlock/kStride) table, so neighbours in the loop are kBlock/kStride springs apart
-  // in the sorted order: other nodes, still within the chunk's small region.
+}
+
+/// Sorted, consecutive springs share their first end: the scatter's read-modify-write of that
+/// node's force would chain from one spring to the next through memory (store-to-load
+/// forwarding, several cycles a link). Each chunk of kBlock springs is read column-wise as a
+/// kStride × (kBlock/kStride) table, so neighbours in the loop are kBlock/kStride springs apart
+/// in the sorted order: other nodes, still within the chunk's small region.
+void interleave_chunks(ThreadLists& lists) {
   constexpr std::size_t kStride = 8;
-  for (auto* lists : {&hf, &hh, &bf, &bh}) {
-    for (auto& l : *lists) {
+  for (ThreadItems* items : {&lists.hooke_full, &lists.hooke_half, &lists.bilinear_full,
+                             &lists.bilinear_half}) {
+    for (auto& l : *items) {
       std::vector<Item> chunk;
       for (std::size_t c0 = 0; c0 + kBlock <= l.size(); c0 += kBlock) {
         chunk.assign(l.begin() + static_cast<std::ptrdiff_t>(c0),
@@ -322,44 +344,92 @@ FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int 
       }
     }
   }
-  auto fill_hooke = [&](std::vector<std::vector<Item>>& lists, HookeSet& set, int range) {
-    std::size_t total = 0;
-    for (const auto& l : lists) total += l.size();
-    reserve_set(set, total);
+}
+
+/// Each thread's [begin, end) in a set filled thread by thread.
+using ThreadRanges = std::vector<std::array<std::size_t, 2>>;
+
+/// Appends the Hooke springs of `lists` to `set`, thread by thread.
+ThreadRanges fill_hooke(const ThreadItems& lists, const std::vector<Spring>& springs,
+                        FastSprings::HookeSet& set) {
+  std::size_t total = 0;
+  for (const auto& l : lists) total += l.size();
+  reserve_set(set, total);
+  ThreadRanges ranges(lists.size());
+  for (std::size_t t = 0; t < lists.size(); ++t) {
+    ranges[t][0] = set.i.size();
+    for (const Item& it : lists[t]) {
+      set.i.push_back(3 * it.i);
+      set.j.push_back(3 * it.j);
+      set.rest.push_back(springs[it.s].rest_length);
+      set.k.push_back(springs[it.s].law.k1);
+    }
+    ranges[t][1] = set.i.size();
+  }
+  return ranges;
+}
+
+/// Appends the bilinear springs of `lists` to `set`, thread by thread.
+ThreadRanges fill_bilinear(const ThreadItems& lists, const std::vector<Spring>& springs,
+                           FastSprings::BilinearSet& set) {
+  std::size_t total = 0;
+  for (const auto& l : lists) total += l.size();
+  reserve_set(set, total);
+  set.k2.reserve(total);
+  set.threshold.reserve(total);
+  ThreadRanges ranges(lists.size());
+  for (std::size_t t = 0; t < lists.size(); ++t) {
+    ranges[t][0] = set.i.size();
+    for (const Item& it : lists[t]) {
+      set.i.push_back(3 * it.i);
+      set.j.push_back(3 * it.j);
+      set.rest.push_back(springs[it.s].rest_length);
+      set.k.push_back(springs[it.s].law.k1);
+      set.k2.push_back(springs[it.s].law.k2);
+      set.threshold.push_back(springs[it.s].law.threshold);
+    }
+    ranges[t][1] = set.i.size();
+  }
+  return ranges;
+}
+
+}  // namespace
+
+FastSprings::FastSprings(const std::vector<Spring>& springs, int num_nodes, int threads,
+                         const std::vector<Vec3>& rest_positions)
+    : num_nodes_(num_nodes), threads_(threads), num_springs_(springs.size()) {
+  check_layout_input(springs, num_nodes, threads);
+  const int T = threads;
+  parts_.resize(static_cast<std::size_t>(T));
+  const std::vector<std::int32_t> order = walk_order(num_nodes, rest_positions);
+  std::vector<std::int32_t> rank(static_cast<std::size_t>(num_nodes));
+  for (int r = 0; r < num_nodes; ++r) rank[static_cast<std::size_t>(order[r])] = r;
+  const std::vector<int> owner = balance_owners(springs, order, rank, T);
+  // Each thread's nodes in index order (it zeroes their gradient entries).
+  std::vector<std::vector<std::int32_t>> owned(static_cast<std::size_t>(T));
+  for (int v = 0; v < num_nodes; ++v) owned[owner[static_cast<std::size_t>(v)]].push_back(v);
+  owned_nodes_.clear();
+  owned_nodes_.reserve(static_cast<std::size_t>(num_nodes));
+  for (int u = 0; u < T; ++u) {
+    parts_[u].nodes[0] = owned_nodes_.size();
+    owned_nodes_.insert(owned_nodes_.end(), owned[u].begin(), owned[u].end());
+    parts_[u].nodes[1] = owned_nodes_.size();
+  }
+  ThreadLists lists = split_by_owner(springs, owner, T);
+  num_bilinear_ += lists.bilinear;
+  num_split_ += lists.split;
+  if (!rest_positions.empty()) sort_by_rank(lists, rank);
+  interleave_chunks(lists);
+  auto assign = [&](Range range, const ThreadRanges& ranges) {
     for (int t = 0; t < T; ++t) {
-      parts_[t].range[range][0] = set.i.size();
-      for (const Item& it : lists[t]) {
-        set.i.push_back(3 * it.i);
-        set.j.push_back(3 * it.j);
-        set.rest.push_back(springs[it.s].rest_length);
-        set.k.push_back(springs[it.s].law.k1);
-      }
-      parts_[t].range[range][1] = set.i.size();
+      parts_[t].range[range][0] = ranges[t][0];
+      parts_[t].range[range][1] = ranges[t][1];
     }
   };
-  auto fill_bilinear = [&](std::vector<std::vector<Item>>& lists, BilinearSet& set, int range) {
-    std::size_t total = 0;
-    for (const auto& l : lists) total += l.size();
-    reserve_set(set, total);
-    set.k2.reserve(total);
-    set.threshold.reserve(total);
-    for (int t = 0; t < T; ++t) {
-      parts_[t].range[range][0] = set.i.size();
-      for (const Item& it : lists[t]) {
-        set.i.push_back(3 * it.i);
-        set.j.push_back(3 * it.j);
-        set.rest.push_back(springs[it.s].rest_length);
-        set.k.push_back(springs[it.s].law.k1);
-        set.k2.push_back(springs[it.s].law.k2);
-        set.threshold.push_back(springs[it.s].law.threshold);
-      }
-      parts_[t].range[range][1] = set.i.size();
-    }
-  };
-  fill_hooke(hf, hooke_full_, kHookeFull);
-  fill_hooke(hh, hooke_half_, kHookeHalf);
-  fill_bilinear(bf, bil_full_, kBilinearFull);
-  fill_bilinear(bh, bil_half_, kBilinearHalf);
+  assign(kHookeFull, fill_hooke(lists.hooke_full, springs, hooke_full_));
+  assign(kHookeHalf, fill_hooke(lists.hooke_half, springs, hooke_half_));
+  assign(kBilinearFull, fill_bilinear(lists.bilinear_full, springs, bil_full_));
+  assign(kBilinearHalf, fill_bilinear(lists.bilinear_half, springs, bil_half_));
 }
 
 FastSprings& FastSprings::operator=(const FastSprings& o) {

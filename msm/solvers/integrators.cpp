@@ -163,6 +163,140 @@ void implicit_euler_update(const Problem& p, double h, const SparseMatrix& D, bo
   x += h * v;
 }
 
+/// Zero velocity and rest positions on the fixed dofs.
+void hold_fixed_state(const Problem& p, VectorXd& x, VectorXd& v) {
+  for (int i = 0; i < p.num_dofs(); ++i) {
+    if (p.fixed[i]) {
+      x[i] = p.rest[i];
+      v[i] = 0.0;
+    }
+  }
+}
+
+/// Vectors every step reuses (no allocation per step).
+struct StepBuffers {
+  VectorXd f, scratch, rhs, dv;
+  explicit StepBuffers(int n) : f(n), scratch(n), rhs(n), dv(n) {}
+};
+
+/// One step of an explicit integrator from (r.x, r.v), with ∇E there in `grad`. Verlet
+/// evaluates E and ∇E at its new positions (into form_energy and grad) for its second half-kick.
+void explicit_step(const Problem& p, Integrator integrator, double h, const VectorXd& inv_mass,
+                   VectorXd& grad, double& form_energy, DynamicResult& r, StepBuffers& b) {
+  switch (integrator) {
+    case Integrator::explicit_euler: {
+      // seed 000 eq. (3.7), both updates from the state at the start of the step.
+      explicit_force(p, grad, r.x, r.v, b.f, b.scratch);
+      r.x += h * r.v;
+      r.v += h * inv_mass.cwiseProduct(b.f);
+      break;
+    }
+    case Integrator::symplectic_euler: {
+      explicit_force(p, grad, r.x, r.v, b.f, b.scratch);
+      r.v += h * inv_mass.cwiseProduct(b.f);
+      r.x += h * r.v;
+      break;
+    }
+    case Integrator::verlet: {
+      explicit_force(p, grad, r.x, r.v, b.f, b.scratch);
+      const VectorXd v_half = r.v + 0.5 * h * inv_mass.cwiseProduct(b.f);
+      r.x += h * v_half;
+      hold_fixed_positions(p, r.x);  // (v_half is 0 there: x is unchanged, as before)
+      form_energy = p.form->energy_gradient(r.x, grad);  // at the state checked below
+      explicit_force(p, grad, r.x, v_half, b.f, b.scratch);
+      r.v = v_half + 0.5 * h * inv_mass.cwiseProduct(b.f);
+      break;
+    }
+    case Integrator::implicit_euler:
+      break;  // implicit_step
+  }
+}
+
+/// Implicit Euler's linear algebra, and what it keeps from one step to the next.
+struct ImplicitState {
+  CholmodSolver solver;
+  PcgSolver pcg;
+  SparseMatrix K, D;
+  VectorXd dv_previous;  ///< PCG's warm start
+  bool prefactored = false;     ///< implicit-euler-rest: A factorised once, at rest
+  bool rest_iterative = false;  ///< implicit-euler-rest-pcg: A and its preconditioner at rest
+  bool iterative = false;       ///< by PCG (at rest or at each step's state)
+  bool damped = false;          ///< D (at rest, or at the step's state) is not zero
+
+  ImplicitState(const DynamicOptions& o, int n) : dv_previous(VectorXd::Zero(n)) {
+    const bool implicit = o.integrator == Integrator::implicit_euler;
+    prefactored = implicit && o.implicit_matrix == ImplicitMatrix::rest_prefactored;
+    rest_iterative = implicit && o.implicit_matrix == ImplicitMatrix::rest_pcg;
+    iterative = rest_iterative || (implicit && o.implicit_matrix == ImplicitMatrix::current_pcg);
+  }
+};
+
+/// Set-up of implicit-euler-rest(-pcg): K and D at rest, A factorised once for every step (or,
+/// -pcg, A and its preconditioner built once). Returns its time, s (0 for the other methods).
+double prepare_at_rest(const Problem& p, const DynamicOptions& o, ImplicitState& s) {
+  if (!s.prefactored && !s.rest_iterative) return 0.0;
+  const double t_setup = now();
+  p.form->hessian(p.rest, s.K, o.project_psd);
+  p.form->damping_jacobian(p.rest, s.D);
+  s.damped = s.D.cwiseAbs().sum() > 0.0;
+  if (s.prefactored) {
+    s.solver.factorize(implicit_euler_matrix(p, o.dt, s.K, s.D));
+  } else {
+    s.pcg.compute(implicit_euler_matrix(p, o.dt, s.K, s.D), o.pcg);
+  }
+  return now() - t_setup;
+}
+
+/// The implicit Euler step A Δv = h (f − h K v) by PCG from the previous step's Δv (the
+/// velocity change varies slowly from step to step); f, the total force at (x, v), in b.f.
+void implicit_pcg_step(const Problem& p, const DynamicOptions& o, int step, ImplicitState& s,
+                       DynamicResult& r, StepBuffers& b) {
+  const double h = o.dt;
+  const int n = p.num_dofs();
+  if (!s.rest_iterative) {
+    p.form->hessian(r.x, s.K, o.project_psd);
+    p.form->damping_jacobian(r.x, s.D);
+    s.pcg.compute(implicit_euler_matrix(p, h, s.K, s.D), o.pcg);
+  }
+  b.rhs.noalias() = s.K.transpose() * r.v;  // = K v (symmetric), walked as rows
+  b.rhs = h * b.f - (h * h) * b.rhs;
+  for (int i = 0; i < n; ++i) {
+    if (p.fixed[i]) b.rhs[i] = 0.0;
+  }
+  b.dv = s.dv_previous;
+  const PcgResult cg = s.pcg.solve(b.rhs, b.dv);
+  if (!cg.converged) {
+    throw std::runtime_error("implicit Euler (PCG): conjugate gradients stopped at step " +
+                             std::to_string(step) + " after " + std::to_string(cg.iterations) +
+                             " iterations with relative residual " + sci(cg.relative_residual) +
+                             " (tolerance " + sci(o.pcg.tolerance) + ")");
+  }
+  r.linear_iterations += cg.iterations;
+  r.max_linear_iterations = std::max(r.max_linear_iterations, cg.iterations);
+  s.dv_previous = b.dv;
+  r.v += b.dv;
+  r.x += h * r.v;
+}
+
+/// One implicit Euler step from (r.x, r.v), with ∇E there in `grad`: by PCG, or by CHOLMOD with
+/// A at rest (factorised once) or at this step's state (refactorised).
+void implicit_step(const Problem& p, const DynamicOptions& o, int step, const VectorXd& grad,
+                   ImplicitState& s, DynamicResult& r, StepBuffers& b) {
+  const double h = o.dt;
+  explicit_force(p, grad, r.x, r.v, b.f, b.scratch);  // the total force at (x, v)
+  if (s.iterative) {
+    implicit_pcg_step(p, o, step, s, r, b);
+    return;
+  }
+  if (!s.prefactored) {  // K and D at this step's state, A refactorised
+    p.form->hessian(r.x, s.K, o.project_psd);
+    p.form->damping_jacobian(r.x, s.D);
+    s.damped = s.D.cwiseAbs().sum() > 0.0;
+    s.solver.factorize(implicit_euler_matrix(p, h, s.K, s.D));
+  }
+  implicit_euler_update(p, h, s.D, s.damped, s.solver, b.f, r.x, r.v, b.rhs, b.dv);
+}
+
 }  // namespace
 
 double total_energy(const Problem& p, const VectorXd& x, const VectorXd& v) {
@@ -179,41 +313,15 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
   DynamicResult r;
   r.x = x0.size() == n ? x0 : p.rest;
   r.v = v0.size() == n ? v0 : VectorXd::Zero(n);
-  for (int i = 0; i < n; ++i) {
-    if (p.fixed[i]) {
-      r.x[i] = p.rest[i];
-      r.v[i] = 0.0;
-    }
-  }
+  hold_fixed_state(p, r.x, r.v);
   const double h = o.dt;
   const double H0 = total_energy(p, r.x, r.v);
   const double scale = std::max(std::abs(H0), p.external_force.norm() * bbox_diagonal(p.rest));
   const double limit = std::abs(H0) + o.blowup_factor * std::max(scale, 1e-300);
   const VectorXd inv_mass = p.mass.cwiseInverse();
-  VectorXd f(n), scratch(n), rhs(n), dv(n);
-  CholmodSolver solver;
-  SparseMatrix K, D;
-  const bool implicit = o.integrator == Integrator::implicit_euler;
-  const bool prefactored = implicit && o.implicit_matrix == ImplicitMatrix::rest_prefactored;
-  const bool rest_iterative = implicit && o.implicit_matrix == ImplicitMatrix::rest_pcg;
-  const bool iterative = rest_iterative || (implicit && o.implicit_matrix == ImplicitMatrix::current_pcg);
-  PcgSolver pcg;
-  VectorXd dv_previous = VectorXd::Zero(n);  // PCG's warm start
-  bool damped = false;                       // D (at rest, or at the step's state) is not zero
-  if (prefactored || rest_iterative) {
-    // Set-up of implicit-euler-rest(-pcg): K and D at rest, A factorised once for every step
-    // (or, -pcg, A and its preconditioner built once).
-    const double t_setup = now();
-    p.form->hessian(p.rest, K, o.project_psd);
-    p.form->damping_jacobian(p.rest, D);
-    damped = D.cwiseAbs().sum() > 0.0;
-    if (prefactored) {
-      solver.factorize(implicit_euler_matrix(p, h, K, D));
-    } else {
-      pcg.compute(implicit_euler_matrix(p, h, K, D), o.pcg);
-    }
-    r.setup_seconds = now() - t_setup;
-  }
+  StepBuffers buffers(n);
+  ImplicitState implicit(o, n);
+  r.setup_seconds = prepare_at_rest(p, o, implicit);
   const double t0 = now();
   double energy = H0;
   // Every integrator: ∇E at the state a step starts from comes from the previous step's
@@ -224,77 +332,12 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
   double form_energy = 0.0;  // E at r.x, with grad, once a step has been checked
   if (o.steps > 0) p.form->gradient(r.x, grad);
   for (int step = 1; step <= o.steps; ++step) {
-    switch (o.integrator) {
-      case Integrator::explicit_euler: {
-        // seed 000 eq. (3.7), both updates from the state at the start of the step.
-        explicit_force(p, grad, r.x, r.v, f, scratch);
-        r.x += h * r.v;
-        r.v += h * inv_mass.cwiseProduct(f);
-        break;
-      }
-      case Integrator::symplectic_euler: {
-        explicit_force(p, grad, r.x, r.v, f, scratch);
-        r.v += h * inv_mass.cwiseProduct(f);
-        r.x += h * r.v;
-        break;
-      }
-      case Integrator::verlet: {
-        explicit_force(p, grad, r.x, r.v, f, scratch);
-        const VectorXd v_half = r.v + 0.5 * h * inv_mass.cwiseProduct(f);
-        r.x += h * v_half;
-        hold_fixed_positions(p, r.x);  // (v_half is 0 there: x is unchanged, as before)
-        form_energy = p.form->energy_gradient(r.x, grad);  // at the state checked below
-        explicit_force(p, grad, r.x, v_half, f, scratch);
-        r.v = v_half + 0.5 * h * inv_mass.cwiseProduct(f);
-        break;
-      }
-      case Integrator::implicit_euler: {
-        explicit_force(p, grad, r.x, r.v, f, scratch);  // the total force at (x, v)
-        if (iterative) {
-          // The same step as implicit-euler(-rest), A Δv = h (f − h K v), by PCG from the
-          // previous step's Δv (the velocity change varies slowly from step to step).
-          if (!rest_iterative) {
-            p.form->hessian(r.x, K, o.project_psd);
-            p.form->damping_jacobian(r.x, D);
-            pcg.compute(implicit_euler_matrix(p, h, K, D), o.pcg);
-          }
-          rhs.noalias() = K.transpose() * r.v;  // = K v (symmetric), walked as rows
-          rhs = h * f - (h * h) * rhs;
-          for (int i = 0; i < n; ++i) {
-            if (p.fixed[i]) rhs[i] = 0.0;
-          }
-          dv = dv_previous;
-          const PcgResult cg = pcg.solve(rhs, dv);
-          if (!cg.converged) {
-            throw std::runtime_error(
-                "implicit Euler (PCG): conjugate gradients stopped at step " +
-                std::to_string(step) + " after " + std::to_string(cg.iterations) +
-                " iterations with relative residual " + sci(cg.relative_residual) +
-                " (tolerance " + sci(o.pcg.tolerance) + ")");
-          }
-          r.linear_iterations += cg.iterations;
-          r.max_linear_iterations = std::max(r.max_linear_iterations, cg.iterations);
-          dv_previous = dv;
-          r.v += dv;
-          r.x += h * r.v;
-          break;
-        }
-        if (!prefactored) {  // K and D at this step's state, A refactorised
-          p.form->hessian(r.x, K, o.project_psd);
-          p.form->damping_jacobian(r.x, D);
-          damped = D.cwiseAbs().sum() > 0.0;
-          solver.factorize(implicit_euler_matrix(p, h, K, D));
-        }
-        implicit_euler_update(p, h, D, damped, solver, f, r.x, r.v, rhs, dv);
-        break;
-      }
+    if (o.integrator == Integrator::implicit_euler) {
+      implicit_step(p, o, step, grad, implicit, r, buffers);
+    } else {
+      explicit_step(p, o.integrator, h, inv_mass, grad, form_energy, r, buffers);
     }
-    for (int i = 0; i < n; ++i) {
-      if (p.fixed[i]) {
-        r.x[i] = p.rest[i];
-        r.v[i] = 0.0;
-      }
-    }
+    hold_fixed_state(p, r.x, r.v);
     check_finite(p, step, r.x, r.v);
     // E and ∇E at the new state; ∇E is the next step's (Verlet evaluated both above).
     if (o.integrator != Integrator::verlet) form_energy = p.form->energy_gradient(r.x, grad);
@@ -304,8 +347,8 @@ DynamicResult integrate(const Problem& p, const DynamicOptions& o, const VectorX
     if (o.on_step) o.on_step(step, r.x, r.v);
   }
   r.seconds = now() - t0;
-  r.numeric_factorisations = solver.numeric_factorisations();
-  r.factor_entries = solver.factor_entries();
+  r.numeric_factorisations = implicit.solver.numeric_factorisations();
+  r.factor_entries = implicit.solver.factor_entries();
   r.energy = energy;
   return r;
 }

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "meshes/foundation/errors.hpp"
@@ -28,6 +29,141 @@ struct LgSpring {
   double k = 0.0;       ///< N/m
   double length = 0.0;  ///< rest length l, m
 };
+
+/// The model's springs as the local and global steps read them. InputError for what the
+/// constant matrix cannot hold: a bilinear spring, axial damping, a negative stiffness.
+std::vector<LgSpring> hooke_springs(const SpringModel& model, const std::string& who) {
+  std::vector<LgSpring> out;
+  out.reserve(model.springs().size());
+  for (std::size_t i = 0; i < model.springs().size(); ++i) {
+    const Spring& s = model.springs()[i];
+    if (std::isfinite(s.law.threshold)) {
+      throw InputError(who + "spring " + std::to_string(i) +
+                       " is bilinear (seed 001 eq. 1, threshold " +
+                       std::to_string(s.law.threshold) +
+                       " m); the local-global method (Liu et al. 2013) needs Hooke springs, whose "
+                       "energy is the distance to the sphere of the rest length; use static or "
+                       "implicit-euler");
+    }
+    if (s.damping != 0.0) {
+      throw InputError(who + "spring " + std::to_string(i) +
+                       " has axial damping k_d = " + std::to_string(s.damping) +
+                       " N·s/m, which depends on the spring's direction and so cannot enter the "
+                       "constant matrix; use point damping or implicit-euler");
+    }
+    if (!(s.law.k1 >= 0.0)) {
+      throw InputError(who + "spring " + std::to_string(i) +
+                       ": expected a stiffness >= 0 N/m, got " + std::to_string(s.law.k1));
+    }
+    out.push_back({s.a, s.b, s.law.k1, s.rest_length});
+  }
+  return out;
+}
+
+/// Per node: its lumped mass and point damping and its row of A (−1 if fixed).
+struct NodeRows {
+  std::vector<int> free_index;
+  int free_nodes = 0;
+  VectorXd mass;     ///< kg
+  VectorXd damping;  ///< N·s/m
+};
+
+/// The nodes' rows, masses and point damping. The global matrix is the same for x, y and z, so
+/// a node's three dofs must be fixed together and share one mass.
+NodeRows node_rows(const Problem& p, double h, int nodes, const std::string& who) {
+  // Point damping: C is the damping Jacobian, constant and diagonal without axial damping.
+  SparseMatrix C;
+  p.form->damping_jacobian(p.rest, C);
+  const VectorXd c = C.diagonal();
+  NodeRows m;
+  m.free_index.assign(static_cast<std::size_t>(nodes), -1);
+  m.mass.resize(nodes);
+  m.damping.resize(nodes);
+  for (int i = 0; i < nodes; ++i) {
+    const bool fx = p.fixed[3 * i];
+    if (p.fixed[3 * i + 1] != fx || p.fixed[3 * i + 2] != fx) {
+      throw InputError(who + "node " + std::to_string(i) +
+                       " has only some of its dofs fixed; the local-global solver holds whole "
+                       "nodes (its matrix is the same for x, y and z)");
+    }
+    if (p.mass[3 * i + 1] != p.mass[3 * i] || p.mass[3 * i + 2] != p.mass[3 * i]) {
+      throw InputError(
+          who + "node " + std::to_string(i) +
+          " has different masses on its three dofs; expected one lumped mass per node");
+    }
+    if (h > 0.0 && !fx && !(p.mass[3 * i] > 0.0)) {
+      throw InputError(who + "node " + std::to_string(i) + ": expected a mass > 0 kg, got " +
+                       std::to_string(p.mass[3 * i]));
+    }
+    m.mass[i] = p.mass[3 * i];
+    m.damping[i] = c[3 * i];
+    if (!fx) m.free_index[i] = m.free_nodes++;
+  }
+  if (m.free_nodes == 0) throw InputError(who + "every node is fixed; nothing can move");
+  return m;
+}
+
+/// A = L (+ M/h² + C/h) on the free nodes, per coordinate (the 3n × 3n matrix is A ⊗ I3):
+/// L = Σ_s k_s A_s A_sᵀ with A_s the incidence vector of spring s (Liu et al.'s L). The springs
+/// to fixed nodes go to `fixed_coupling` (−A_fc x_c) instead.
+SparseMatrix global_matrix(const Problem& p, double h, const std::vector<LgSpring>& springs,
+                           const NodeRows& rows, Eigen::MatrixX3d& fixed_coupling) {
+  const int nodes = static_cast<int>(rows.free_index.size());
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(4 * springs.size() + static_cast<std::size_t>(rows.free_nodes));
+  fixed_coupling = Eigen::MatrixX3d::Zero(rows.free_nodes, 3);
+  for (int i = 0; i < nodes; ++i) {
+    const int f = rows.free_index[i];
+    if (f < 0) continue;
+    const double diag = h > 0.0 ? rows.mass[i] / (h * h) + rows.damping[i] / h : 0.0;
+    t.emplace_back(f, f, diag);
+  }
+  for (const LgSpring& s : springs) {
+    const int fa = rows.free_index[s.a], fb = rows.free_index[s.b];
+    if (fa >= 0) t.emplace_back(fa, fa, s.k);
+    if (fb >= 0) t.emplace_back(fb, fb, s.k);
+    if (fa >= 0 && fb >= 0) {
+      t.emplace_back(fa, fb, -s.k);
+      t.emplace_back(fb, fa, -s.k);
+    } else if (fa >= 0) {
+      fixed_coupling.row(fa) += s.k * p.rest.segment<3>(3 * s.b).transpose();
+    } else if (fb >= 0) {
+      fixed_coupling.row(fb) += s.k * p.rest.segment<3>(3 * s.a).transpose();
+    }
+  }
+  SparseMatrix A(rows.free_nodes, rows.free_nodes);
+  A.setFromTriplets(t.begin(), t.end());
+  A.makeCompressed();
+  return A;
+}
+
+/// Statics: L on the free nodes is singular exactly when a connected part of the network (by
+/// springs with k > 0) holds no fixed node. Checked on the graph (union-find): rounding can let
+/// CHOLMOD factorise a singular Laplacian with a tiny positive pivot.
+void check_statics_held(const std::vector<LgSpring>& springs, const std::vector<int>& free_index,
+                        const std::string& who) {
+  const int nodes = static_cast<int>(free_index.size());
+  std::vector<int> parent(static_cast<std::size_t>(nodes));
+  for (int i = 0; i < nodes; ++i) parent[i] = i;
+  const auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (const LgSpring& s : springs) {
+    if (s.k > 0.0) parent[root(s.a)] = root(s.b);
+  }
+  std::vector<char> held(static_cast<std::size_t>(nodes), 0);
+  for (int i = 0; i < nodes; ++i) {
+    if (free_index[i] < 0) held[root(i)] = 1;
+  }
+  for (int i = 0; i < nodes; ++i) {
+    if (!held[root(i)]) {
+      throw InputError(who + "the static matrix L is singular: node " + std::to_string(i) +
+                       " belongs to a part of the network that no fixed node holds (statics "
+                       "needs supports)");
+    }
+  }
+}
 
 }  // namespace
 
@@ -58,113 +194,16 @@ LocalGlobalSystem::LocalGlobalSystem(const Problem& p, double h, const std::stri
                      "of Hooke springs); this problem's model is another Form (e.g. springs with a "
                      "volume term), whose energy the local step cannot write as spring directions");
   }
-  const SpringModel& model = *springs;
   Impl& m = *impl_;
   m.nodes = p.num_dofs() / 3;
-  m.springs.reserve(model.springs().size());
-  for (std::size_t i = 0; i < model.springs().size(); ++i) {
-    const Spring& s = model.springs()[i];
-    if (std::isfinite(s.law.threshold)) {
-      throw InputError(who + "spring " + std::to_string(i) +
-                       " is bilinear (seed 001 eq. 1, threshold " +
-                       std::to_string(s.law.threshold) +
-                       " m); the local-global method (Liu et al. 2013) needs Hooke springs, whose "
-                       "energy is the distance to the sphere of the rest length; use static or "
-                       "implicit-euler");
-    }
-    if (s.damping != 0.0) {
-      throw InputError(who + "spring " + std::to_string(i) +
-                       " has axial damping k_d = " + std::to_string(s.damping) +
-                       " N·s/m, which depends on the spring's direction and so cannot enter the "
-                       "constant matrix; use point damping or implicit-euler");
-    }
-    if (!(s.law.k1 >= 0.0)) {
-      throw InputError(who + "spring " + std::to_string(i) +
-                       ": expected a stiffness >= 0 N/m, got " + std::to_string(s.law.k1));
-    }
-    m.springs.push_back({s.a, s.b, s.law.k1, s.rest_length});
-  }
-  // Point damping: C is the damping Jacobian, constant and diagonal without axial damping.
-  SparseMatrix C;
-  p.form->damping_jacobian(p.rest, C);
-  const VectorXd c = C.diagonal();
-  m.free_index.assign(static_cast<std::size_t>(m.nodes), -1);
-  m.node_mass.resize(m.nodes);
-  m.node_damping.resize(m.nodes);
-  for (int i = 0; i < m.nodes; ++i) {
-    const bool fx = p.fixed[3 * i];
-    if (p.fixed[3 * i + 1] != fx || p.fixed[3 * i + 2] != fx) {
-      throw InputError(who + "node " + std::to_string(i) +
-                       " has only some of its dofs fixed; the local-global solver holds whole "
-                       "nodes (its matrix is the same for x, y and z)");
-    }
-    if (p.mass[3 * i + 1] != p.mass[3 * i] || p.mass[3 * i + 2] != p.mass[3 * i]) {
-      throw InputError(
-          who + "node " + std::to_string(i) +
-          " has different masses on its three dofs; expected one lumped mass per node");
-    }
-    if (h > 0.0 && !fx && !(p.mass[3 * i] > 0.0)) {
-      throw InputError(who + "node " + std::to_string(i) + ": expected a mass > 0 kg, got " +
-                       std::to_string(p.mass[3 * i]));
-    }
-    m.node_mass[i] = p.mass[3 * i];
-    m.node_damping[i] = c[3 * i];
-    if (!fx) m.free_index[i] = m.free_nodes++;
-  }
-  if (m.free_nodes == 0) throw InputError(who + "every node is fixed; nothing can move");
-
-  // A = L (+ M/h² + C/h) on the free nodes, per coordinate (the 3n × 3n matrix is A ⊗ I3):
-  // L = Σ_s k_s A_s A_sᵀ with A_s the incidence vector of spring s (Liu et al.'s L).
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(4 * m.springs.size() + static_cast<std::size_t>(m.free_nodes));
-  m.fixed_coupling = Eigen::MatrixX3d::Zero(m.free_nodes, 3);
-  for (int i = 0; i < m.nodes; ++i) {
-    const int f = m.free_index[i];
-    if (f < 0) continue;
-    const double diag = h > 0.0 ? m.node_mass[i] / (h * h) + m.node_damping[i] / h : 0.0;
-    t.emplace_back(f, f, diag);
-  }
-  for (const LgSpring& s : m.springs) {
-    const int fa = m.free_index[s.a], fb = m.free_index[s.b];
-    if (fa >= 0) t.emplace_back(fa, fa, s.k);
-    if (fb >= 0) t.emplace_back(fb, fb, s.k);
-    if (fa >= 0 && fb >= 0) {
-      t.emplace_back(fa, fb, -s.k);
-      t.emplace_back(fb, fa, -s.k);
-    } else if (fa >= 0) {
-      m.fixed_coupling.row(fa) += s.k * p.rest.segment<3>(3 * s.b).transpose();
-    } else if (fb >= 0) {
-      m.fixed_coupling.row(fb) += s.k * p.rest.segment<3>(3 * s.a).transpose();
-    }
-  }
-  SparseMatrix A(m.free_nodes, m.free_nodes);
-  A.setFromTriplets(t.begin(), t.end());
-  A.makeCompressed();
-  // Statics: L on the free nodes is singular exactly when a connected part of the network (by
-  // springs with k > 0) holds no fixed node. Checked on the graph: rounding can let CHOLMOD
-  // factorise a singular Laplacian with a tiny positive pivot.
-  if (h == 0.0) {
-    std::vector<int> parent(static_cast<std::size_t>(m.nodes));
-    for (int i = 0; i < m.nodes; ++i) parent[i] = i;
-    const auto root = [&](int i) {
-      while (parent[i] != i) i = parent[i] = parent[parent[i]];
-      return i;
-    };
-    for (const LgSpring& s : m.springs) {
-      if (s.k > 0.0) parent[root(s.a)] = root(s.b);
-    }
-    std::vector<char> held(static_cast<std::size_t>(m.nodes), 0);
-    for (int i = 0; i < m.nodes; ++i) {
-      if (m.free_index[i] < 0) held[root(i)] = 1;
-    }
-    for (int i = 0; i < m.nodes; ++i) {
-      if (!held[root(i)]) {
-        throw InputError(who + "the static matrix L is singular: node " + std::to_string(i) +
-                         " belongs to a part of the network that no fixed node holds (statics "
-                         "needs supports)");
-      }
-    }
-  }
+  m.springs = hooke_springs(*springs, who);
+  NodeRows rows = node_rows(p, h, m.nodes, who);
+  const SparseMatrix A = global_matrix(p, h, m.springs, rows, m.fixed_coupling);
+  m.free_index = std::move(rows.free_index);
+  m.free_nodes = rows.free_nodes;
+  m.node_mass = std::move(rows.mass);
+  m.node_damping = std::move(rows.damping);
+  if (h == 0.0) check_statics_held(m.springs, m.free_index, who);
   if (!m.solver.try_factorize(A)) {
     throw InputError(who + "the " + std::string(h > 0.0 ? "implicit Euler" : "static") +
                      " matrix is not positive definite");

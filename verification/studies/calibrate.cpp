@@ -394,130 +394,109 @@ msm::StiffnessParameters fit_parameters(CalibrationGranularity g, const msm::Spr
   throw std::logic_error("fit_parameters: unknown granularity");
 }
 
-}  // namespace
-
-CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
-  std::ostream null_stream(nullptr);
-  std::ostream& log = o.log ? *o.log : null_stream;
-  const ModelSpec& spec = pick_model(s, o.model);
+/// ν of the study: the option's, else 0.45 where the scene lists it, else the scene's first.
+double study_poisson_ratio(const Scene& s, const CalibrateOptions& o) {
   double nu = s.poisson_ratios.front();
   if (std::find(s.poisson_ratios.begin(), s.poisson_ratios.end(), 0.45) != s.poisson_ratios.end())
     nu = 0.45;
   if (o.poisson_ratio) nu = *o.poisson_ratio;
-  const int level = o.level.value_or(s.model_levels.front());
-  const int reference_level = o.reference_level.value_or(s.reference_level);
-  const bool mesh_indexed = o.granularity == CalibrationGranularity::per_spring ||
-                            o.granularity == CalibrationGranularity::per_section_spring;
-  if (mesh_indexed && !o.other_vessels.empty()) {
-    throw InputError(
-        "calibrate: --held-out-scene with --granularity " + to_string(o.granularity) +
-        ": such a calibration cannot transfer to another mesh (its factors are indexed by one "
-        "mesh's springs); use --granularity groups for another vessel");
-  }
-  std::vector<LoadKind> train = o.train.empty() ? std::vector<LoadKind>{s.load.kind} : o.train;
-  Scene scene = s;
-  scene.reference_level = reference_level;
+  return nu;
+}
 
-  log << "calibrate " << spec.name << " of " << s.name << " (ν = " << nu << ", level " << level
-      << ", reference P2 level " << reference_level << ", " << to_string(o.granularity) << ")\n";
-  VesselContext main = make_context(scene, spec, level, reference_level, nu, o);
-
-  // The cases: the fixed list, plus the scene's other magnitudes at its point.
-  std::vector<LoadCase> cases = load_cases(scene, train, false, o.gravity);
-  {
-    const LoadCase& first = cases.front();  // contact θ+0°
-    LoadCase own = first;
-    for (const LoadCase& c : cases) {
-      if (c.kind == scene.load.kind) {
-        own = c;
-        break;
-      }
-    }
-    const ShapeAnswer& a = shape_answer(main, own, nu, log);
-    for (const double m : other_magnitudes(scene, a.strain_unit)) {
-      LoadCase c = own;
-      c.training = false;
-      c.holds_out = "other magnitude";
-      c.magnitude = m;
-      cases.push_back(c);
+/// Held-out cases at the scene's other magnitudes, at the point of its own load kind (else the
+/// first case's, contact θ+0°).
+void add_other_magnitudes(std::vector<LoadCase>& cases, VesselContext& main, const Scene& scene,
+                          double nu, std::ostream& log) {
+  const LoadCase& first = cases.front();  // contact θ+0°
+  LoadCase own = first;
+  for (const LoadCase& c : cases) {
+    if (c.kind == scene.load.kind) {
+      own = c;
+      break;
     }
   }
-
-  // The fit on the training cases.
-  const bool has_kappa = main.base.volume_kappa.has_value();
-  if (o.prior && !mesh_indexed) {
-    throw InputError("calibrate: --prior " + o.prior_source + " with --granularity " +
-                     to_string(o.granularity) + ": expected --granularity per-spring or "
-                     "per-section-spring (a prior is what their factors depart from)");
+  const ShapeAnswer& a = shape_answer(main, own, nu, log);
+  for (const double m : other_magnitudes(scene, a.strain_unit)) {
+    LoadCase c = own;
+    c.training = false;
+    c.holds_out = "other magnitude";
+    c.magnitude = m;
+    cases.push_back(c);
   }
-  const bool prior_halves =
-      o.prior && std::find(o.prior->names.begin(), o.prior->names.end(), "kappa/inner") !=
-                     o.prior->names.end();
-  msm::StiffnessParameters params =
-      fit_parameters(o.granularity, main.base.network, main.vessel, has_kappa, prior_halves);
-  std::vector<msm::FitCase> fit_cases;
-  std::vector<char> fixed;
-  Calibration cal;
+}
+
+/// The fit's cases: each training load's force and reference displacements on the network.
+struct TrainingSet {
+  std::vector<msm::FitCase> cases;
+  std::vector<char> fixed;  ///< the model's fixed dofs (the same for every case)
+};
+
+/// The training cases (recorded in cal.training_loads), weighted equally or by 1/(P1's relative
+/// error)², the weights scaled to a mean of 1. InputError if there is none.
+TrainingSet training_set(VesselContext& main, const Scene& scene,
+                         const std::vector<LoadCase>& cases, double nu, CaseWeights weights,
+                         Calibration& cal, std::ostream& log) {
+  TrainingSet t;
   for (const LoadCase& c : cases) {
     if (!c.training) continue;
     const ShapeAnswer& a = shape_answer(main, c, nu, log);
     const auto model = msm::make_model(main.base);
     const msm::Problem p = msm_problem(case_scene(scene, c), *model, main.base, main.mesh, c.magnitude);
-    fixed = p.fixed;
+    t.fixed = p.fixed;
     Eigen::VectorXd r(p.num_dofs());
     for (std::size_t i = 0; i < a.reference_at_network.size(); ++i) {
       r.segment<3>(3 * static_cast<Eigen::Index>(i)) = c.magnitude * a.reference_at_network[i];
     }
     double weight = 1.0;
-    if (o.weights == CaseWeights::p1) {
+    if (weights == CaseWeights::p1) {
       // P1's relative error on this case (linear: the same at every magnitude).
       const double e = compare_displacements(a.p1, a.reference_at_mesh).relative_l2;
       weight = 1.0 / (e * e);
     }
-    fit_cases.push_back({c.name, p.external_force, r, weight});
+    t.cases.push_back({c.name, p.external_force, r, weight});
     cal.training_loads.push_back({c.name, c.kind, c.magnitude, c.point});
   }
-  if (fit_cases.empty()) throw InputError("calibrate: no training load; expected --train kinds");
-  {
-    double mean = 0.0;
-    for (const auto& fc : fit_cases) mean += fc.weight / static_cast<double>(fit_cases.size());
-    for (auto& fc : fit_cases) fc.weight /= mean;
-  }
-  // Groups: the ridge alone (without it a contact-only fit drove the circumferential classes to
-  // ~0 and κ up 12×, which fitted contact and failed pressure by 4× P1; docs/physics/calibration.md).
-  msm::Regulariser reg = !mesh_indexed ? msm::Regulariser{0.0, o.regulariser.ridge, {}}
-                                       : o.regulariser;
+  if (t.cases.empty()) throw InputError("calibrate: no training load; expected --train kinds");
+  double mean = 0.0;
+  for (const auto& fc : t.cases) mean += fc.weight / static_cast<double>(t.cases.size());
+  for (auto& fc : t.cases) fc.weight /= mean;
+  return t;
+}
+
+/// The fit's start: zero log factors, or with a prior its log factors on this network
+/// (refused, naming the file and key, if it belongs to another model or mesh): each
+/// parameter's, the mean over its springs (or tets for κ): one value when the prior's classes
+/// are unions of these (geometric classes, κ halves).
+Eigen::VectorXd prior_start(const CalibrateOptions& o, const VesselContext& main,
+                            const ModelSpec& spec, double youngs_modulus, double nu,
+                            const msm::StiffnessParameters& params) {
   Eigen::VectorXd theta0 = Eigen::VectorXd::Zero(params.size());
-  if (o.prior) {
-    // The prior's log factors on this network (refused, naming the file and key, if it belongs
-    // to another model or mesh): each parameter's, the mean over its springs (or tets for κ):
-    // one value when the prior's classes are unions of these (geometric classes, κ halves).
-    msm::BuiltNetwork check = main.base;
-    apply_calibration(*o.prior, o.prior_source, check, main.mesh, main.vessel, spec,
-                      s.youngs_modulus, nu, false);
-    const auto [pp, pt] = calibration_parameters(*o.prior, o.prior_source, main.base, main.vessel);
-    std::map<int, std::pair<double, int>> mean;
-    for (std::size_t sp = 0; sp < params.of_spring.size(); ++sp) {
-      mean[params.of_spring[sp]].first += pp.spring_log_factor(pt, sp);
-      mean[params.of_spring[sp]].second += 1;
-    }
-    for (std::size_t e = 0; e < main.base.network.tets.size(); ++e) {
-      const int q = params.kappa_of_tet(e);
-      if (q < 0) continue;
-      mean[q].first += pp.tet_log_factor(pt, e);
-      mean[q].second += 1;
-    }
-    for (const auto& [q, sum] : mean) theta0[q] = sum.first / sum.second;
-    reg.centre = theta0;
+  if (!o.prior) return theta0;
+  msm::BuiltNetwork check = main.base;
+  apply_calibration(*o.prior, o.prior_source, check, main.mesh, main.vessel, spec,
+                    youngs_modulus, nu, false);
+  const auto [pp, pt] = calibration_parameters(*o.prior, o.prior_source, main.base, main.vessel);
+  std::map<int, std::pair<double, int>> mean;
+  for (std::size_t sp = 0; sp < params.of_spring.size(); ++sp) {
+    mean[params.of_spring[sp]].first += pp.spring_log_factor(pt, sp);
+    mean[params.of_spring[sp]].second += 1;
   }
-  const msm::LinearisedFit fit(main.base.network, main.base.volume_kappa, fixed, params,
-                               fit_cases, reg);
-  log << "  fitting " << params.size() << " parameters on " << fit_cases.size()
-      << " training loads (model linearised at rest, adjoint gradients, L-BFGS"
-      << (o.prior ? ", from and towards " + o.prior_source : std::string()) << ")\n";
-  const std::vector<double> before = fit.relative_errors(theta0);
+  for (std::size_t e = 0; e < main.base.network.tets.size(); ++e) {
+    const int q = params.kappa_of_tet(e);
+    if (q < 0) continue;
+    mean[q].first += pp.tet_log_factor(pt, e);
+    mean[q].second += 1;
+  }
+  for (const auto& [q, sum] : mean) theta0[q] = sum.first / sum.second;
+  return theta0;
+}
+
+/// L-BFGS on the linearised fit from theta0, logging every tenth iteration; its time in
+/// `seconds`.
+msm::LbfgsResult run_fit(const msm::LinearisedFit& fit, const Eigen::VectorXd& theta0,
+                         int max_iterations, std::ostream& log, double& seconds) {
   msm::LbfgsOptions lo;
-  lo.max_iterations = o.max_iterations;
+  lo.max_iterations = max_iterations;
   lo.gradient_tolerance = 1e-6;
   lo.relative_decrease = 1e-10;
   lo.on_iteration = [&](int it, double f, double g) {
@@ -527,13 +506,15 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   const msm::LbfgsResult res = msm::minimize_lbfgs(
       [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) { return fit.objective(x, g); }, theta0,
       lo);
-  CalibrationStudy study;
-  study.fit_seconds = fit_clock.seconds();
-  const std::vector<double> after = fit.relative_errors(res.x);
-  log << "  fit: J " << fit.misfit(theta0) << " → " << res.f << " in " << res.iterations
-      << " iterations (" << res.stop_reason << "), " << study.fit_seconds << " s\n";
+  seconds = fit_clock.seconds();
+  return res;
+}
 
-  cal.granularity = to_string(o.granularity);
+/// The model and mesh a calibration belongs to, as its file records them.
+void describe_calibrated_model(Calibration& cal, const Scene& s, const ModelSpec& spec,
+                               const VesselContext& main, CalibrationGranularity granularity,
+                               double nu, int level) {
+  cal.granularity = to_string(granularity);
   cal.scene = s.name;
   cal.model = spec.name;
   cal.model_kind = to_string(spec.kind);
@@ -548,7 +529,10 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   cal.nodes = main.base.network.nodes.size();
   cal.springs = main.base.network.springs.size();
   cal.tets = main.base.network.tets.size();
-  set_calibration_parameters(cal, params, res.x);
+}
+
+/// The calibration file's sentence on how it was fitted.
+std::string calibration_method(const CalibrateOptions& o, int reference_level) {
   std::ostringstream method;
   method << "least squares on nodal displacements against the P2 reference (level "
          << reference_level << "), model linearised at rest, adjoint gradients, L-BFGS; "
@@ -575,32 +559,14 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
     method << "; training cases weighted by 1/(P1's relative L2 error)^2 (the fit minimises the "
               "mean squared ratio to P1)";
   }
-  cal.method = method.str();
-  cal.smoothness = reg.smoothness;
-  cal.ridge = reg.ridge;
-  cal.objective_before = fit.misfit(theta0) + fit.regularisation(theta0);
-  cal.objective_after = res.f;
-  cal.iterations = res.iterations;
-  cal.stop_reason = res.stop_reason;
-  for (std::size_t i = 0; i < fit_cases.size(); ++i) {
-    cal.fit_cases.push_back({fit_cases[i].name, before[i], after[i]});
-  }
-  study.calibration = cal;
+  return method.str();
+}
 
-  // The calibrated network through the file's own path (apply_calibration), then every case.
-  msm::BuiltNetwork calibrated = main.base;
-  apply_calibration(cal, "calibration", calibrated, main.mesh, main.vessel, spec, s.youngs_modulus,
-                    nu, false);
-  std::ostringstream detail;
-  detail << msm::to_string(spec.stiffness)
-         << (spec.volume_term ? " + volume term (" + msm::to_string(spec.volume_moduli) + ")" : "")
-         << ", " << msm::to_string(spec.solver);
-  study.model_detail = detail.str();
-  for (const LoadCase& c : cases) {
-    study.cases.push_back(evaluate_case(main, c, spec, &calibrated, "", nu, log));
-  }
-
-  // Other vessels: the group calibration applied to their meshes (calibration_transfer).
+/// Other vessels: the group calibration applied to their meshes (calibration_transfer), each
+/// case evaluated; a calibration that does not transfer is each case's failure.
+void add_transfer_cases(CalibrationStudy& study, const CalibrateOptions& o, const ModelSpec& spec,
+                        const Calibration& cal, const std::vector<LoadKind>& train, double nu,
+                        std::ostream& log) {
   for (const Scene& other_scene : o.other_vessels) {
     const int other_level = other_scene.model_levels.front();
     VesselContext other =
@@ -619,6 +585,96 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
       study.cases.push_back(evaluate_case(other, c, spec, use, why, nu, log));
     }
   }
+}
+
+}  // namespace
+
+CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
+  std::ostream null_stream(nullptr);
+  std::ostream& log = o.log ? *o.log : null_stream;
+  const ModelSpec& spec = pick_model(s, o.model);
+  const double nu = study_poisson_ratio(s, o);
+  const int level = o.level.value_or(s.model_levels.front());
+  const int reference_level = o.reference_level.value_or(s.reference_level);
+  const bool mesh_indexed = o.granularity == CalibrationGranularity::per_spring ||
+                            o.granularity == CalibrationGranularity::per_section_spring;
+  if (mesh_indexed && !o.other_vessels.empty()) {
+    throw InputError(
+        "calibrate: --held-out-scene with --granularity " + to_string(o.granularity) +
+        ": such a calibration cannot transfer to another mesh (its factors are indexed by one "
+        "mesh's springs); use --granularity groups for another vessel");
+  }
+  std::vector<LoadKind> train = o.train.empty() ? std::vector<LoadKind>{s.load.kind} : o.train;
+  Scene scene = s;
+  scene.reference_level = reference_level;
+
+  log << "calibrate " << spec.name << " of " << s.name << " (ν = " << nu << ", level " << level
+      << ", reference P2 level " << reference_level << ", " << to_string(o.granularity) << ")\n";
+  VesselContext main = make_context(scene, spec, level, reference_level, nu, o);
+
+  // The cases: the fixed list, plus the scene's other magnitudes at its point.
+  std::vector<LoadCase> cases = load_cases(scene, train, false, o.gravity);
+  add_other_magnitudes(cases, main, scene, nu, log);
+
+  // The fit on the training cases.
+  const bool has_kappa = main.base.volume_kappa.has_value();
+  if (o.prior && !mesh_indexed) {
+    throw InputError("calibrate: --prior " + o.prior_source + " with --granularity " +
+                     to_string(o.granularity) + ": expected --granularity per-spring or "
+                     "per-section-spring (a prior is what their factors depart from)");
+  }
+  const bool prior_halves =
+      o.prior && std::find(o.prior->names.begin(), o.prior->names.end(), "kappa/inner") !=
+                     o.prior->names.end();
+  msm::StiffnessParameters params =
+      fit_parameters(o.granularity, main.base.network, main.vessel, has_kappa, prior_halves);
+  Calibration cal;
+  const TrainingSet training = training_set(main, scene, cases, nu, o.weights, cal, log);
+  // Groups: the ridge alone (without it a contact-only fit drove the circumferential classes to
+  // ~0 and κ up 12×, which fitted contact and failed pressure by 4× P1; docs/physics/calibration.md).
+  msm::Regulariser reg = !mesh_indexed ? msm::Regulariser{0.0, o.regulariser.ridge, {}}
+                                       : o.regulariser;
+  const Eigen::VectorXd theta0 = prior_start(o, main, spec, s.youngs_modulus, nu, params);
+  if (o.prior) reg.centre = theta0;
+  const msm::LinearisedFit fit(main.base.network, main.base.volume_kappa, training.fixed, params,
+                               training.cases, reg);
+  log << "  fitting " << params.size() << " parameters on " << training.cases.size()
+      << " training loads (model linearised at rest, adjoint gradients, L-BFGS"
+      << (o.prior ? ", from and towards " + o.prior_source : std::string()) << ")\n";
+  const std::vector<double> before = fit.relative_errors(theta0);
+  CalibrationStudy study;
+  const msm::LbfgsResult res = run_fit(fit, theta0, o.max_iterations, log, study.fit_seconds);
+  const std::vector<double> after = fit.relative_errors(res.x);
+  log << "  fit: J " << fit.misfit(theta0) << " → " << res.f << " in " << res.iterations
+      << " iterations (" << res.stop_reason << "), " << study.fit_seconds << " s\n";
+
+  describe_calibrated_model(cal, s, spec, main, o.granularity, nu, level);
+  set_calibration_parameters(cal, params, res.x);
+  cal.method = calibration_method(o, reference_level);
+  cal.smoothness = reg.smoothness;
+  cal.ridge = reg.ridge;
+  cal.objective_before = fit.misfit(theta0) + fit.regularisation(theta0);
+  cal.objective_after = res.f;
+  cal.iterations = res.iterations;
+  cal.stop_reason = res.stop_reason;
+  for (std::size_t i = 0; i < training.cases.size(); ++i) {
+    cal.fit_cases.push_back({training.cases[i].name, before[i], after[i]});
+  }
+  study.calibration = cal;
+
+  // The calibrated network through the file's own path (apply_calibration), then every case.
+  msm::BuiltNetwork calibrated = main.base;
+  apply_calibration(cal, "calibration", calibrated, main.mesh, main.vessel, spec, s.youngs_modulus,
+                    nu, false);
+  std::ostringstream detail;
+  detail << msm::to_string(spec.stiffness)
+         << (spec.volume_term ? " + volume term (" + msm::to_string(spec.volume_moduli) + ")" : "")
+         << ", " << msm::to_string(spec.solver);
+  study.model_detail = detail.str();
+  for (const LoadCase& c : cases) {
+    study.cases.push_back(evaluate_case(main, c, spec, &calibrated, "", nu, log));
+  }
+  add_transfer_cases(study, o, spec, cal, train, nu, log);
   return study;
 }
 
