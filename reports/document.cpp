@@ -112,6 +112,14 @@ void Document::slot(std::string id) {
   blocks_.push_back(std::move(b));
 }
 
+void Document::details(std::string summary, std::string text) {
+  Block b;
+  b.kind = Block::Kind::details;
+  b.summary = std::move(summary);
+  b.text = std::move(text);
+  blocks_.push_back(std::move(b));
+}
+
 void Document::text_only() {
   if (!blocks_.empty()) blocks_.back().text_only = true;
 }
@@ -159,6 +167,10 @@ std::string Document::markdown_text(const std::string& figures_dir) const {
       }
       case Block::Kind::slot:
         break;
+      case Block::Kind::details:
+        out << "<details><summary>" << escape_xml(b.summary) << "</summary>\n\n<pre>"
+            << escape_xml(b.text) << "</pre>\n</details>\n\n";
+        break;
     }
   }
   return out.str();
@@ -184,6 +196,10 @@ std::string block_html(const Block& b) {
       out << "<pre>" << escape_xml(b.text) << "</pre>\n";
       break;
     case Block::Kind::slot:
+      break;
+    case Block::Kind::details:
+      out << "<details class=\"vv-failure\"><summary>" << inline_html(b.summary)
+          << "</summary><p>" << escape_xml(b.text) << "</p></details>\n";
       break;
   }
   return out.str();

@@ -22,9 +22,10 @@ struct Table {
 struct Block {
   /// slot: a place report.html fills with something interactive ("cards", "view:<scene>");
   /// Markdown and the page without scripts leave it out.
-  enum class Kind { heading, paragraph, table, figure, code, slot };
+  enum class Kind { heading, paragraph, table, figure, code, slot, details };
   Kind kind = Kind::paragraph;
   int level = 2;          ///< heading level
+  std::string summary;    ///< details: the line shown folded (its text: the body)
   std::string text;       ///< heading or paragraph (inline Markdown: `code`, **bold**, *italic*),
                           ///< caption, or a preformatted line (kind code, e.g. a command)
   Table table;
@@ -45,6 +46,9 @@ class Document {
   /// A figure with the plot it draws (rendered as SVG here).
   void figure(std::string file_name, const Plot& plot, std::string caption);
   void slot(std::string id);
+  /// A folded block: `summary` shown, `text` (preformatted) on demand; in Markdown an HTML
+  /// <details> element, which Markdown viewers fold too.
+  void details(std::string summary, std::string text);
   /// Marks the last block as text_only.
   void text_only();
   /// Preformatted text shown as it is (a command line): indented in Markdown, <pre> in HTML.

@@ -175,12 +175,23 @@ void speed_error_figure(const FigureContext& c) {
   tolerance.x = {*xmin, *xmax};
   tolerance.y = {c.scene.tolerance_mm, c.scene.tolerance_mm};
   plot.series.push_back(tolerance);
+  // A simulator's budgets per update: 30 Hz (visual) and 1 kHz (haptic).
+  const auto [ymin, ymax] = std::minmax_element(ys.begin(), ys.end());
+  for (const auto& [rate, label] : {std::pair{30.0, "30 Hz (visual): 33 ms per update"},
+                                    std::pair{1000.0, "1 kHz (haptic): 1 ms per update"}}) {
+    Series line = grey_dashed(label);
+    line.colour = rate < 100 ? "#b07aa1" : "#9c755f";
+    line.x = {1.0 / rate, 1.0 / rate};
+    line.y = {std::min(*ymin, c.scene.tolerance_mm) * 0.8, std::max(*ymax, c.scene.tolerance_mm) * 1.25};
+    plot.series.push_back(line);
+  }
   c.doc.figure(file_safe(c.scene.name) + "_speed_error.svg", plot,
                "Speed against error, " + c.scene.name + ", load " +
                    load_text(c.magnitude, c.scene) +
                    ": one point per model, Poisson's ratio and level. The black line joins the "
                    "Pareto front (no other point is both faster and more accurate): " + names +
-                   ". Dashed: the scene's tolerance.");
+                   ". Dashed: the scene's tolerance, and the time per update at 30 Hz (visual) and 1 kHz "
+                   "(haptic).");
 }
 
 void error_vs_nu_figure(const FigureContext& c) {
@@ -390,7 +401,7 @@ Table statistics_table(const SceneRows& s) {
     std::vector<std::string> row{o.model, significant(o.poisson_ratio), std::to_string(o.level),
                                  load_text(o.magnitude, s) + (o.beyond_linear_regime ? " ⚠" : "")};
     if (!o.ok) {
-      row.push_back("**failed**: " + o.failure);
+      row.push_back("**failed**: " + first_sentence(o.failure));
       row.resize(t.header.size());
       row[12] = significant(o.solve_seconds);
       row[13] = significant(o.setup_seconds);
@@ -446,6 +457,14 @@ void scene_section(Document& doc, const SceneRows& s, SeriesStyles& styles) {
                 "integrators, and for FEM the same ramp's median update, prepared as the linear "
                 "mass-spring models are (factorised once at set-up):");
   doc.table(statistics_table(s));
+  // Each failure's whole message once, folded, below the table that gives its first sentence.
+  std::set<std::string> messages;
+  for (const OutcomeRow& o : s.outcomes) {
+    if (o.ok || !messages.insert(o.model + "\n" + o.failure).second) continue;
+    doc.details("Failed: " + o.model + " (level " + std::to_string(o.level) + ", ν = " +
+                    significant(o.poisson_ratio) + "): " + first_sentence(o.failure),
+                o.failure);
+  }
   const std::string provenance = scene_timing_provenance(s);
   if (!provenance.empty()) doc.paragraph("Timings: " + provenance + ".");
 }

@@ -146,6 +146,7 @@ std::string view_html(const SceneViews& v, std::size_t index) {
       << "<label>deformation × <input class=\"vv-scale\" type=\"range\" min=\"0\" max=\"3\" "
          "step=\"0.05\" value=\"1\"><span class=\"vv-scale-text\"></span></label> "
       << "<label><input class=\"vv-ghost\" type=\"checkbox\" checked> reference (ghost)</label>"
+      << "<label><input class=\"vv-log\" type=\"checkbox\"> log colour scale</label>"
       << "</div>\n<div class=\"vv-panes\"><div class=\"vv-pane\" data-pane=\"0\"></div>"
       << "<div class=\"vv-pane\" data-pane=\"1\"></div></div>\n<div class=\"vv-colourbar\"></div>\n"
       << "<p class=\"vv-view-caption\">Each model's wall at " << escape_xml(v.load_text)

@@ -246,7 +246,7 @@
     const d = m.decoded;
     const colours = new Float32Array(d.err.length * 3);
     for (let k = 0; k < d.err.length; ++k) {
-      const c = viridis(d.err[k] * m.step / view.scaleMax);
+      const c = viridis(scaleAt(view, d.err[k] * m.step));
       colours[3 * k] = c[0]; colours[3 * k + 1] = c[1]; colours[3 * k + 2] = c[2];
     }
     const geom = new THREE.BufferGeometry();
@@ -288,8 +288,17 @@
     requestRender();
   }
 
+  /// Where an error sits on the colour scale, 0 to 1: linear from 0 to the scene's largest error,
+  /// or logarithmic over its three decades below it.
+  function scaleAt(view, e) {
+    if (!view.logScale) return e / view.scaleMax;
+    const lo = view.scaleMax * 1e-3;
+    return Math.log10(Math.max(e, lo) / lo) / 3;
+  }
+
   function colourBar(view) {
     const bar = view.section.querySelector('.vv-colourbar');
+    bar.textContent = '';
     const stops = VIRIDIS.map((c, i) => 'rgb(' + c.join(',') + ') ' + (100 * i / 10) + '%');
     bar.style.background = 'linear-gradient(to right,' + stops.join(',') + ')';
     const tick = (at, text, cls) => {
@@ -299,15 +308,19 @@
       if (cls) s.className = cls;
       bar.appendChild(s);
     };
-    tick(0, '0 mm');
+    tick(0, view.logScale ? '≤ ' + fmt(view.scaleMax * 1e-3) + ' mm' : '0 mm');
+    if (view.logScale) {
+      tick(1 / 3, fmt(view.scaleMax * 1e-2) + ' mm');
+      tick(2 / 3, fmt(view.scaleMax * 1e-1) + ' mm');
+    }
     tick(1, fmt(view.scaleMax) + ' mm');
     const tol = view.data.tolerance_mm;
     if (tol < view.scaleMax) {
       const line = document.createElement('div');
       line.className = 'vv-tol';
-      line.style.left = (100 * tol / view.scaleMax) + '%';
+      line.style.left = (100 * scaleAt(view, tol)) + '%';
       bar.appendChild(line);
-      tick(tol / view.scaleMax, 'tolerance ' + fmt(tol) + ' mm', 'vv-tol-label');
+      tick(scaleAt(view, tol), 'tolerance ' + fmt(tol) + ' mm', 'vv-tol-label');
     } else {
       tick(1, 'tolerance ' + fmt(tol) + ' mm (all within)', 'vv-tol-label');
     }
@@ -435,6 +448,11 @@
       requestRender();
     });
     colourBar(view);
+    section.querySelector('.vv-log').addEventListener('change', (e) => {
+      view.logScale = e.target.checked;
+      colourBar(view);
+      view.panes.forEach((p) => showModel(view, p, p.model));
+    });
     addOrbit(view);
     report.views.push(view);
     return view;
