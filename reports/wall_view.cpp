@@ -56,14 +56,18 @@ std::filesystem::path fields_file(const std::string& scene, const OutcomeRow& o)
   return std::filesystem::path(scene) / name.str();
 }
 
-std::vector<std::uint32_t> boundary_faces(const std::vector<std::size_t>& tets) {
-  // A face of a tet opposite vertex k, oriented as the tet lists it; keyed by its sorted nodes.
-  static constexpr std::array<std::array<int, 3>, 4> kFaces{
-      {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+std::vector<std::uint32_t> boundary_faces(const std::vector<std::size_t>& tets,
+                                          const std::vector<Vec3>& points) {
+  // The face opposite vertex f[3]; keyed by its sorted nodes.
+  static constexpr std::array<std::array<int, 4>, 4> kFaces{
+      {{1, 2, 3, 0}, {0, 3, 2, 1}, {0, 1, 3, 2}, {0, 2, 1, 3}}};
   std::map<std::array<std::size_t, 3>, std::pair<int, std::array<std::size_t, 3>>> faces;
   for (std::size_t t = 0; t + 3 < tets.size(); t += 4) {
     for (const auto& f : kFaces) {
-      const std::array<std::size_t, 3> face{tets[t + f[0]], tets[t + f[1]], tets[t + f[2]]};
+      std::array<std::size_t, 3> face{tets[t + f[0]], tets[t + f[1]], tets[t + f[2]]};
+      const Vec3& a = points[face[0]];
+      const Vec3 normal = (points[face[1]] - a).cross(points[face[2]] - a);
+      if (normal.dot(points[tets[t + f[3]]] - a) > 0.0) std::swap(face[1], face[2]);  // outwards
       auto key = face;
       std::sort(key.begin(), key.end());
       auto [it, inserted] = faces.try_emplace(key, 0, face);
@@ -85,7 +89,7 @@ WallView wall_view(const VtuData& vtu, const std::string& source) {
   WallView v;
   std::vector<std::uint32_t> cells;
   if (const auto tets = cells_of_type(vtu, 10, 4); !tets.empty()) {
-    cells = boundary_faces(tets);
+    cells = boundary_faces(tets, vtu.points);
   } else if (const auto tris = cells_of_type(vtu, 5, 3); !tris.empty()) {
     cells.assign(tris.begin(), tris.end());
     v.network_faces = true;

@@ -40,9 +40,11 @@ std::filesystem::path fields_file(const std::string& scene, const OutcomeRow& ou
 /// cells are of a type the view cannot draw.
 WallView wall_view(const VtuData& vtu, const std::string& source);
 
-/// Faces of a tet mesh that belong to one tet only (its boundary), each as the tet lists it;
-/// `connectivity` holds 4 node indices per tet.
-std::vector<std::uint32_t> boundary_faces(const std::vector<std::size_t>& connectivity);
+/// Faces of a tet mesh that belong to one tet only (its boundary), each wound so that its normal
+/// (right-hand rule) points out of its tet, whatever the tet's own orientation; `connectivity`
+/// holds 4 indices into `points` per tet.
+std::vector<std::uint32_t> boundary_faces(const std::vector<std::size_t>& connectivity,
+                                          const std::vector<Vec3>& points);
 
 /// RFC 4648 base64 of raw bytes (the page decodes typed arrays from it) and its inverse
 /// (InputError on a character outside the alphabet).

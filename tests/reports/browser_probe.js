@@ -50,9 +50,19 @@
       await sleep(200);
       report.renderNow();
       const gl = report.gl;
-      out.views.push({scene: view.data.name, models: view.data.views.length,
+      const entry = {scene: view.data.name, models: [],
         panes: view.panes.map((p) => Object.assign(panePixels(gl, p.el),
-          {model: view.data.views[p.model].model}))});
+          {model: view.data.views[p.model].model}))};
+      // Every model through the left pane's picker, as a reader would choose it.
+      const pick = view.section.querySelector('.vv-pick[data-pane="0"]');
+      for (let i = 0; i < view.data.views.length; ++i) {
+        pick.value = String(i);
+        pick.dispatchEvent(new Event('change'));
+        report.renderNow();
+        entry.models.push(Object.assign(panePixels(gl, view.panes[0].el),
+          {model: view.data.views[i].model, springs: view.data.views[i].springs}));
+      }
+      out.views.push(entry);
       if (!out.node_hover) {
         const r = view.panes[0].el.getBoundingClientRect();
         for (let k = 0; k < 400 && !out.node_hover; ++k) {  // a spiral from the centre

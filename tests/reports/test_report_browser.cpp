@@ -97,7 +97,20 @@ TEST_F(ReportInBrowser, EachThreeDViewDrawsItsModels) {
   ASSERT_EQ(probe()["views"].size(), results.scenes.size());
   for (const auto& view : probe()["views"]) {
     ASSERT_EQ(view["panes"].size(), 2U) << view["scene"];
-    for (const auto& pane : view["panes"]) {
+    // Every finished model of the scene has a wall to draw (the fixture has a VTU for each).
+    std::size_t finished = 0;
+    for (const SceneRows& s : results.scenes) {
+      if (s.name != view["scene"]) continue;
+      std::set<std::string> models;
+      for (const OutcomeRow& o : s.outcomes) {
+        if (o.ok && o.magnitude == representative_load(s)) models.insert(o.model);
+      }
+      finished = models.size();
+    }
+    EXPECT_EQ(view["models"].size(), finished) << view["scene"];
+    auto panes = view["panes"];
+    for (const auto& m : view["models"]) panes.push_back(m);
+    for (const auto& pane : panes) {
       // The wall covers part of the pane (not all background) and is shaded and coloured by the
       // error (many colours, not one flat fill).
       const double pixels = pane["pixels"];

@@ -78,7 +78,8 @@ TEST(Base64, MatchesRfc4648TestVectors) {
 
 TEST(BoundaryFaces, TwoTetsSharingAFaceKeepTheOtherSix) {
   // Tets (0,1,2,3) and (1,2,3,4) share face {1,2,3}.
-  const auto faces = boundary_faces({0, 1, 2, 3, 1, 2, 3, 4});
+  const std::vector<Vec3> p{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+  const auto faces = boundary_faces({0, 1, 2, 3, 1, 2, 3, 4}, p);
   ASSERT_EQ(faces.size(), 18U);
   for (std::size_t f = 0; f < faces.size(); f += 3) {
     std::array<std::uint32_t, 3> k{faces[f], faces[f + 1], faces[f + 2]};
@@ -87,16 +88,19 @@ TEST(BoundaryFaces, TwoTetsSharingAFaceKeepTheOtherSix) {
   }
 }
 
-TEST(BoundaryFaces, FacesOfAPositiveTetPointOutwards) {
-  // Unit tet with positive orientation: each face's normal (right-hand rule) points away from
-  // the opposite vertex.
+TEST(BoundaryFaces, FacesPointOutwardsWhateverTheTetsOrientation) {
+  // The unit tet listed with positive and with negative orientation: each face's normal
+  // (right-hand rule) points away from the tet's centroid.
   const std::vector<Vec3> p{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  const auto faces = boundary_faces({0, 1, 2, 3});
-  ASSERT_EQ(faces.size(), 12U);
   const Vec3 centroid = (p[0] + p[1] + p[2] + p[3]) / 4.0;
-  for (std::size_t f = 0; f < faces.size(); f += 3) {
-    const Vec3 n = (p[faces[f + 1]] - p[faces[f]]).cross(p[faces[f + 2]] - p[faces[f]]);
-    EXPECT_GT(n.dot(p[faces[f]] - centroid), 0.0);
+  for (const std::vector<std::size_t>& tet : {std::vector<std::size_t>{0, 1, 2, 3},
+                                              std::vector<std::size_t>{0, 2, 1, 3}}) {
+    const auto faces = boundary_faces(tet, p);
+    ASSERT_EQ(faces.size(), 12U);
+    for (std::size_t f = 0; f < faces.size(); f += 3) {
+      const Vec3 n = (p[faces[f + 1]] - p[faces[f]]).cross(p[faces[f + 2]] - p[faces[f]]);
+      EXPECT_GT(n.dot(p[faces[f]] - centroid), 0.0);
+    }
   }
 }
 
