@@ -188,7 +188,7 @@ void speed_error_figure(const FigureContext& c) {
   c.doc.figure(file_safe(c.scene.name) + "_speed_error.svg", plot,
                "Speed against error, " + c.scene.name + ", load " +
                    load_text(c.magnitude, c.scene) +
-                   ": one point per model, Poisson's ratio and level. The black line joins the "
+                   ": one point per model, Poisson's ratio and level. The purple line joins the "
                    "Pareto front (no other point is both faster and more accurate): " + names +
                    ". Dashed: the scene's tolerance, and the time per update at 30 Hz (visual) and 1 kHz "
                    "(haptic).");

@@ -60,7 +60,10 @@ json view_json(const WallView& v) {
           {"rest", b64(v.rest_mm)},
           {"um", b64(v.u_model_mm)},
           {"ur", b64(v.u_reference_mm)},
-          {"idx", b64(v.indices)},
+          {"idx", v.rest_mm.size() / 3 <= 65536 ? b64(std::vector<std::uint16_t>(
+                                                       v.indices.begin(), v.indices.end()))
+                                                 : b64(v.indices)},
+          {"idx_bytes", v.rest_mm.size() / 3 <= 65536 ? 2 : 4},
           {"err", b64(v.error_code)},
           {"step", v.error_step_mm},
           {"max", v.max_error_mm}};
@@ -209,9 +212,12 @@ SceneViews read_scene_views(const SceneRows& s, const std::filesystem::path& fie
   const double nu = s.references.empty()
                         ? (s.outcomes.empty() ? 0.0 : s.outcomes.front().poisson_ratio)
                         : s.references.front().poisson_ratio;
+  // The finest level only, as the cards judge it: a level-1 wall has about 4 times the
+  // level-0 wall's nodes, so coarser levels would add little but size.
+  const int finest = s.model_levels.empty() ? 0 : s.model_levels.back();
   std::set<std::pair<std::string, int>> seen;
   for (const OutcomeRow& o : s.outcomes) {
-    if (!o.ok || o.magnitude != load || o.poisson_ratio != nu) continue;
+    if (!o.ok || o.magnitude != load || o.poisson_ratio != nu || o.level != finest) continue;
     if (!seen.emplace(o.model, o.level).second) continue;
     const std::filesystem::path path = fields_dir / fields_file(s.name, o);
     if (!std::filesystem::exists(path)) {

@@ -48,9 +48,9 @@ struct SceneViews {
   std::vector<std::string> missing;  ///< outcomes whose VTU was not found (their paths)
 };
 
-/// The walls of each finished outcome of `scene` at its representative load and first ν, read
-/// from `fields_dir` (fields_file); an absent file is listed in `missing`, an unreadable one is an
-/// InputError.
+/// The walls of each finished outcome of `scene` at its representative load, first ν and finest
+/// model level, read from `fields_dir` (fields_file); an absent file is listed in `missing`, an
+/// unreadable one is an InputError.
 SceneViews read_scene_views(const SceneRows& scene, const std::filesystem::path& fields_dir);
 
 /// A picture of the scene for its card: the vessel's outline seen along its thinnest extent, the

@@ -182,7 +182,8 @@
     const m = view.data.views[i];
     if (!m.decoded) {
       m.decoded = {rest: decode(m.rest, Float32Array), um: decode(m.um, Float32Array),
-        ur: decode(m.ur, Float32Array), idx: decode(m.idx, Uint32Array),
+        ur: decode(m.ur, Float32Array),
+        idx: decode(m.idx, m.idx_bytes === 2 ? Uint16Array : Uint32Array),
         err: decode(m.err, Uint16Array)};
     }
     return m;
@@ -198,7 +199,7 @@
         if (!seen.has(key)) { seen.add(key); out.push(a, b); }
       }
     }
-    return new Uint32Array(out);
+    return idx instanceof Uint16Array ? new Uint16Array(out) : new Uint32Array(out);
   }
 
   function deformed(m, u, factor) {
