@@ -41,6 +41,8 @@
 
   // ---------------------------------------------------------------------------------- plots --
   function makeChart(box, plot, index) {
+    if (box.vvChart) return;
+    box.vvChart = true;
     const canvas = box.querySelector('canvas');
     const datasets = plot.series.map((s) => {
       const data = [];
@@ -398,6 +400,7 @@
 
   function initView(section) {
     if (section.vvView) return section.vvView;
+    const start = performance.now();
     ensureRenderer();
     const index = section.dataset.sceneIndex;
     const data = JSON.parse(document.getElementById('vv-scene-' + index).textContent);
@@ -456,6 +459,7 @@
     });
     addOrbit(view);
     report.views.push(view);
+    view.initMs = performance.now() - start;  // decoding, geometry, first draw requested
     return view;
   }
   report.initView = initView;
@@ -475,10 +479,8 @@
 
   // ------------------------------------------------------------------------------- start --
   const plots = JSON.parse(document.getElementById('vv-plots').textContent);
-  document.querySelectorAll('.vv-chart').forEach((box) => {
-    const i = +box.dataset.plot;
-    whenVisible(box, () => makeChart(box, plots[i], i));
-  });
+  report.initChart = (box) => makeChart(box, plots[+box.dataset.plot], +box.dataset.plot);
+  document.querySelectorAll('.vv-chart').forEach((box) => whenVisible(box, () => report.initChart(box)));
   document.querySelectorAll('.vv-view').forEach((section) => {
     if (section.querySelector('.vv-pane')) whenVisible(section, () => initView(section));
   });

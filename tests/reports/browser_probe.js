@@ -41,16 +41,21 @@
       dom_content_loaded_ms: nav ? nav.domContentLoadedEventEnd : null,
       load_ms: nav ? nav.loadEventEnd : null, views: [], charts: [], hover: null,
       node_hover: null};
+    // Each plot and 3D view scrolled into view, where the page sets it up. --dump-dom draws no
+    // frames, so the IntersectionObserver that notices the scroll is not always run: what it
+    // would have called is then called here (the page's own set-up, the same code).
     for (const el of document.querySelectorAll('.vv-chart, .vv-view')) {
       el.scrollIntoView({block: 'center'});
       await sleep(150);
+      if (el.classList.contains('vv-chart')) report.initChart(el);
+      else if (el.querySelector('.vv-pane')) report.initView(el);
     }
     for (const view of report.views) {
       view.section.scrollIntoView({block: 'center'});
       await sleep(200);
       report.renderNow();
       const gl = report.gl;
-      const entry = {scene: view.data.name, models: [],
+      const entry = {scene: view.data.name, init_ms: view.initMs, models: [],
         panes: view.panes.map((p) => Object.assign(panePixels(gl, p.el),
           {model: view.data.views[p.model].model}))};
       // Every model through the left pane's picker, as a reader would choose it.
