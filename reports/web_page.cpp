@@ -154,7 +154,8 @@ std::string view_html(const SceneViews& v, std::size_t index) {
       << "<div class=\"vv-pane\" data-pane=\"1\"></div></div>\n<div class=\"vv-colourbar\"></div>\n"
       << "<p class=\"vv-view-caption\">Each model's wall at " << escape_xml(v.load_text)
       << ", deformed by its own displacement and coloured by |model − reference| at its nodes "
-         "(viridis, one scale for every model of the scene; the tick marks the tolerance, "
+         "(viridis, one scale for every model of the scene, logarithmic when their errors span "
+         "more than a decade; the tick marks the tolerance, "
       << significant(v.tolerance_mm) << " mm). Grey ghost: the reference's deformed wall. Red "
          "sphere: the QoI point. Drag to turn, wheel to zoom; both panes share the camera; hover "
          "a node for its error and both displacements.</p>\n";

@@ -421,7 +421,16 @@
     for (let i = 0; i < g.ur.length; i += 3) umax = Math.max(umax, Math.hypot(g.ur[i], g.ur[i + 1], g.ur[i + 2]));
     view.factor = umax > 0 ? Math.max(1, 0.1 * view.radius / umax) : 1;
     view.camera = new THREE.PerspectiveCamera(35, 1.5, view.radius * 0.01, view.radius * 20);
+    // Looking at the QoI point's side of the vessel, a little from above and askew.
     view.orbit = {r: view.radius * 2.6, theta: 0.9, phi: 1.1};
+    if (data.qoi_mm) {
+      const dx = data.qoi_mm[0] - view.centre.x, dy = data.qoi_mm[1] - view.centre.y;
+      const dz = data.qoi_mm[2] - view.centre.z, d = Math.hypot(dx, dy, dz);
+      if (d > 1e-9 * view.radius) {
+        view.orbit.theta = Math.atan2(dx, dz) + 0.45;
+        view.orbit.phi = Math.min(2.6, Math.max(0.5, Math.acos(dy / d) - 0.35));
+      }
+    }
     section.querySelectorAll('.vv-pane').forEach((el) => view.panes.push({el: el}));
     view.panes.forEach((p) => buildPane(view, p));
     // Left: the most accurate model that is not FEM; right: P1 FEM when there, else the next.
@@ -451,6 +460,11 @@
       view.panes.forEach((p) => { if (p.ghost) p.ghost.visible = e.target.checked; });
       requestRender();
     });
+    // Errors spanning more than a decade between the models: a log scale shows them all.
+    const smallest = Math.min(...data.views.map((m) => m.max).filter((e) => e > 0));
+    view.logScale = view.scaleMax > 10 * smallest;
+    section.querySelector('.vv-log').checked = view.logScale;
+    if (view.logScale) view.panes.forEach((p) => showModel(view, p, p.model));
     colourBar(view);
     section.querySelector('.vv-log').addEventListener('change', (e) => {
       view.logScale = e.target.checked;

@@ -459,8 +459,8 @@ void check_options(const FemCommandOptions& o) {
                                            : nullptr;
     if (other) {
       throw InputError(std::string(other) +
-                       " is available with the linear reference only: drop it or --reference "
-                       "finite-strain");
+                       " is available with the linear reference only: drop it, or drop "
+                       "--reference finite-strain");
     }
   } else if (o.dead_pressure) {
     throw InputError("--dead-pressure is for --reference finite-strain (the linear reference's "
