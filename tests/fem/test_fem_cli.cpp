@@ -9,11 +9,16 @@
 #include <nlohmann/json.hpp>
 
 #include "../test_helpers.hpp"
+#include "meshes/vtu_io.hpp"
 
 using vessel::test::CommandResult;
 using vessel::test::run_command;
 using vessel::test::TempDir;
 using vessel::test::vv;
+using vessel::Vec3;
+using vessel::VtuData;
+using vessel::VtuField;
+using vessel::read_vtu;
 
 namespace {
 
@@ -161,6 +166,34 @@ TEST(FemCli, FiniteStrainReferenceAgreesWithTheLinearOneAtASmallLoad) {
   ASSERT_GT(linear, 0.0) << r.output;
   EXPECT_NEAR(finite, linear, 0.03 * linear) << r.output;
   EXPECT_NE(finite, linear) << r.output;
+}
+
+TEST(FemCli, FiniteStrainWritesItsDisplacementFieldAsVtu) {
+  // At 0.1 mN the neo-Hookean field is within a few per cent of the linear reference's, which
+  // the linear solver writes to its own VTU: the largest nodal difference against the largest
+  // displacement.
+  TempDir dir;
+  const std::string load = "--load contact --force 1e-4 --contact-point 0.003 0 0.001 ";
+  const auto f = vv("fem " + kTube + load + "--reference finite-strain --vtu " +
+                    (dir / "finite.vtu").string());
+  ASSERT_EQ(f.exit_code, 0) << f.output;
+  const auto l = vv("fem " + kTube + load + "--vtu " + (dir / "linear.vtu").string());
+  ASSERT_EQ(l.exit_code, 0) << l.output;
+  const VtuData finite = read_vtu(dir / "finite.vtu"), linear = read_vtu(dir / "linear.vtu");
+  const VtuField* uf = VtuData::find(finite.point_fields, "displacement");
+  const VtuField* ul = VtuData::find(linear.point_fields, "displacement");
+  ASSERT_TRUE(uf && ul);
+  ASSERT_EQ(uf->values.size(), ul->values.size());
+  double largest = 0.0, difference = 0.0;
+  for (std::size_t i = 0; i < ul->values.size(); i += 3) {
+    const Vec3 a{uf->values[i], uf->values[i + 1], uf->values[i + 2]};
+    const Vec3 b{ul->values[i], ul->values[i + 1], ul->values[i + 2]};
+    largest = std::max(largest, b.norm());
+    difference = std::max(difference, (a - b).norm());
+  }
+  ASSERT_GT(largest, 0.0);
+  EXPECT_LT(difference, 0.03 * largest);
+  EXPECT_GT(difference, 0.0);  // a different solver, not the linear field copied
 }
 
 TEST(FemCli, FiniteStrainRefusesOptionsOfTheLinearReferenceOnly) {
