@@ -100,6 +100,30 @@ void Document::figure(std::string file_name, std::string svg, std::string captio
   blocks_.push_back(std::move(b));
 }
 
+void Document::figure(std::string file_name, const Plot& plot, std::string caption) {
+  figure(std::move(file_name), render_svg(plot), std::move(caption));
+  blocks_.back().plot = plot;
+}
+
+void Document::slot(std::string id) {
+  Block b;
+  b.kind = Block::Kind::slot;
+  b.text = std::move(id);
+  blocks_.push_back(std::move(b));
+}
+
+void Document::details(std::string summary, std::string text) {
+  Block b;
+  b.kind = Block::Kind::details;
+  b.summary = std::move(summary);
+  b.text = std::move(text);
+  blocks_.push_back(std::move(b));
+}
+
+void Document::text_only() {
+  if (!blocks_.empty()) blocks_.back().text_only = true;
+}
+
 void Document::code(std::string text) {
   Block b;
   b.kind = Block::Kind::code;
@@ -141,35 +165,53 @@ std::string Document::markdown_text(const std::string& figures_dir) const {
         out << '\n';
         break;
       }
+      case Block::Kind::slot:
+        break;
+      case Block::Kind::details:
+        out << "<details><summary>" << escape_xml(b.summary) << "</summary>\n\n<pre>"
+            << escape_xml(b.text) << "</pre>\n</details>\n\n";
+        break;
     }
   }
   return out.str();
 }
 
+std::string block_html(const Block& b) {
+  std::ostringstream out;
+  switch (b.kind) {
+    case Block::Kind::heading:
+      out << "<h" << b.level << ">" << inline_html(b.text) << "</h" << b.level << ">\n";
+      break;
+    case Block::Kind::paragraph:
+      out << "<p>" << inline_html(b.text) << "</p>\n";
+      break;
+    case Block::Kind::table:
+      out << table_html(b.table);
+      break;
+    case Block::Kind::figure:
+      out << "<figure>\n" << b.svg << "<figcaption>" << inline_html(b.text)
+          << "</figcaption>\n</figure>\n";
+      break;
+    case Block::Kind::code:
+      out << "<pre>" << escape_xml(b.text) << "</pre>\n";
+      break;
+    case Block::Kind::slot:
+      break;
+    case Block::Kind::details:
+      out << "<details class=\"vv-failure\"><summary>" << inline_html(b.summary)
+          << "</summary><p>" << escape_xml(b.text) << "</p></details>\n";
+      break;
+  }
+  return out.str();
+}
+
+const char* document_style() { return kStyle; }
+
 std::string Document::html_text(const std::string& title) const {
   std::ostringstream out;
   out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>"
       << escape_xml(title) << "</title>\n<style>" << kStyle << "</style>\n</head>\n<body>\n";
-  for (const Block& b : blocks_) {
-    switch (b.kind) {
-      case Block::Kind::heading:
-        out << "<h" << b.level << ">" << inline_html(b.text) << "</h" << b.level << ">\n";
-        break;
-      case Block::Kind::paragraph:
-        out << "<p>" << inline_html(b.text) << "</p>\n";
-        break;
-      case Block::Kind::table:
-        out << table_html(b.table);
-        break;
-      case Block::Kind::figure:
-        out << "<figure>\n" << b.svg << "<figcaption>" << inline_html(b.text)
-            << "</figcaption>\n</figure>\n";
-        break;
-      case Block::Kind::code:
-        out << "<pre>" << escape_xml(b.text) << "</pre>\n";
-        break;
-    }
-  }
+  for (const Block& b : blocks_) out << block_html(b);
   out << "</body>\n</html>\n";
   return out.str();
 }

@@ -2,8 +2,11 @@
 /// A report as a list of blocks, rendered once as Markdown (figures as linked .svg files) and once
 /// as a self-contained HTML page (figures inlined), so both say the same thing.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "reports/svg_plot.hpp"
 
 namespace vessel::reports {
 
@@ -17,14 +20,21 @@ struct Table {
 };
 
 struct Block {
-  enum class Kind { heading, paragraph, table, figure, code };
+  /// slot: a place report.html fills with something interactive ("cards", "view:<scene>");
+  /// Markdown and the page without scripts leave it out.
+  enum class Kind { heading, paragraph, table, figure, code, slot, details };
   Kind kind = Kind::paragraph;
   int level = 2;          ///< heading level
+  std::string summary;    ///< details: the line shown folded (its text: the body)
   std::string text;       ///< heading or paragraph (inline Markdown: `code`, **bold**, *italic*),
                           ///< caption, or a preformatted line (kind code, e.g. a command)
   Table table;
   std::string svg;        ///< figure
   std::string file_name;  ///< figure: its .svg file beside the Markdown report
+  std::optional<Plot> plot;  ///< figure: the data the SVG draws, for report.html's plots
+  /// Shown in Markdown and the page without scripts; report.html with its libraries shows the
+  /// slot that says the same instead.
+  bool text_only = false;
 };
 
 class Document {
@@ -33,6 +43,14 @@ class Document {
   void paragraph(std::string text);
   void table(Table table);
   void figure(std::string file_name, std::string svg, std::string caption);
+  /// A figure with the plot it draws (rendered as SVG here).
+  void figure(std::string file_name, const Plot& plot, std::string caption);
+  void slot(std::string id);
+  /// A folded block: `summary` shown, `text` (preformatted) on demand; in Markdown an HTML
+  /// <details> element, which Markdown viewers fold too.
+  void details(std::string summary, std::string text);
+  /// Marks the last block as text_only.
+  void text_only();
   /// Preformatted text shown as it is (a command line): indented in Markdown, <pre> in HTML.
   void code(std::string text);
 
@@ -45,6 +63,12 @@ class Document {
  private:
   std::vector<Block> blocks_;
 };
+
+/// One block as HTML (a slot: nothing), as html_text writes it.
+std::string block_html(const Block& block);
+
+/// The report's stylesheet.
+const char* document_style();
 
 /// Inline Markdown (`code`, **bold**, *italic*) of escaped text as HTML.
 std::string inline_html(const std::string& markdown);

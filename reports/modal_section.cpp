@@ -25,7 +25,7 @@ std::string file_safe(const std::string& name) {
 
 }  // namespace
 
-void natural_frequency_section(Document& doc, const SceneRows& s) {
+void natural_frequency_section(Document& doc, const SceneRows& s, SeriesStyles& styles) {
   if (s.reference_modes.empty() && s.model_modes.empty()) return;
   doc.heading(3, "Natural frequencies");
   std::string reference_text = "the modal reference";
@@ -70,6 +70,7 @@ void natural_frequency_section(Document& doc, const SceneRows& s) {
     Series series;
     series.label = m.model + (s.model_levels.size() > 1 ? " (L" + std::to_string(m.level) + ")" : "");
     series.lines = true;
+    styles.apply(series, m.model);
     for (std::size_t k = 0; k < m.ratio_to_reference.size(); ++k) {
       series.x.push_back(static_cast<double>(k + 1));
       series.y.push_back(m.ratio_to_reference[k]);
@@ -83,11 +84,11 @@ void natural_frequency_section(Document& doc, const SceneRows& s) {
   one.lines = true;
   one.markers = false;
   one.emphasis = true;
-  one.colour = "#000000";
+  one.colour = kReferenceColour;
   one.x = {1.0, static_cast<double>(modes)};
   one.y = {1.0, 1.0};
   plot.series.insert(plot.series.begin(), one);
-  doc.figure(file_safe(s.name) + "_natural_frequencies.svg", render_svg(plot),
+  doc.figure(file_safe(s.name) + "_natural_frequencies.svg", plot,
              "Natural frequencies of each model over the FEM reference's, mode by mode (k-th "
              "lowest against k-th lowest), ν = " + significant(nu) +
                  ". Above 1: stiffer (or lighter) than the continuum in that mode; a zero-frequency "

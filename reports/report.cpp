@@ -14,8 +14,11 @@
 #include "reports/best_model.hpp"
 #include "reports/modal_section.hpp"
 #include "reports/representative_load.hpp"
+#include "reports/scene_card.hpp"
+#include "reports/series_style.hpp"
 #include "reports/study_sections.hpp"
 #include "reports/svg_plot.hpp"
+#include "reports/web_page.hpp"
 
 namespace vessel::reports {
 
@@ -100,7 +103,7 @@ Series black_line(std::string label, std::vector<double> x = {}, std::vector<dou
   s.x = std::move(x);
   s.y = std::move(y);
   s.emphasis = true;
-  s.colour = "#000000";
+  s.colour = kReferenceColour;
   return s;
 }
 
@@ -117,6 +120,15 @@ struct FigureContext {
   const SceneRows& scene;
   double magnitude;
   double nu;
+  SeriesStyles& styles;
+
+  /// A model's series in its own colour and marker.
+  [[nodiscard]] Series model_series(const std::string& model, std::string label, bool lines,
+                                    bool markers = true) const {
+    Series s = series(std::move(label), lines, markers);
+    styles.apply(s, model);
+    return s;
+  }
 };
 
 void speed_error_figure(const FigureContext& c) {
@@ -135,17 +147,22 @@ void speed_error_figure(const FigureContext& c) {
     const std::string label = variant(*o, c.scene);
     if (!series_of.count(label)) {
       series_of[label] = plot.series.size();
-      plot.series.push_back(series(label, false));
+      plot.series.push_back(c.model_series(o->model, label, false));
     }
     Series& s = plot.series[series_of[label]];
     s.x.push_back(std::max(o->solve_seconds, 1e-6));
     s.y.push_back(o->max_mm);
+    s.point_labels.push_back(o->model + ", ν = " + significant(o->poisson_ratio) + ", level " +
+                             std::to_string(o->level) + ", load " +
+                             load_text(o->magnitude, c.scene));
+    s.point_views.push_back(c.scene.name + "|" + o->model + "|" + std::to_string(o->level));
     xs.push_back(std::max(o->solve_seconds, 1e-6));
     ys.push_back(o->max_mm);
     labels.push_back(label + (c.scene.references.size() > 1 ? " ν=" + significant(o->poisson_ratio) : ""));
   }
   const auto front = pareto_front(xs, ys);
   Series pareto = black_line("Pareto front");
+  pareto.colour = kParetoColour;
   std::string names;
   for (const std::size_t i : front) {
     pareto.x.push_back(xs[i]);
@@ -158,12 +175,23 @@ void speed_error_figure(const FigureContext& c) {
   tolerance.x = {*xmin, *xmax};
   tolerance.y = {c.scene.tolerance_mm, c.scene.tolerance_mm};
   plot.series.push_back(tolerance);
-  c.doc.figure(file_safe(c.scene.name) + "_speed_error.svg", render_svg(plot),
+  // A simulator's budgets per update: 30 Hz (visual) and 1 kHz (haptic).
+  const auto [ymin, ymax] = std::minmax_element(ys.begin(), ys.end());
+  for (const auto& [rate, label] : {std::pair{30.0, "30 Hz (visual): 33 ms per update"},
+                                    std::pair{1000.0, "1 kHz (haptic): 1 ms per update"}}) {
+    Series line = grey_dashed(label);
+    line.colour = rate < 100 ? "#b07aa1" : "#9c755f";
+    line.x = {1.0 / rate, 1.0 / rate};
+    line.y = {std::min(*ymin, c.scene.tolerance_mm) * 0.8, std::max(*ymax, c.scene.tolerance_mm) * 1.25};
+    plot.series.push_back(line);
+  }
+  c.doc.figure(file_safe(c.scene.name) + "_speed_error.svg", plot,
                "Speed against error, " + c.scene.name + ", load " +
                    load_text(c.magnitude, c.scene) +
-                   ": one point per model, Poisson's ratio and level. The black line joins the "
+                   ": one point per model, Poisson's ratio and level. The purple line joins the "
                    "Pareto front (no other point is both faster and more accurate): " + names +
-                   ". Dashed: the scene's tolerance.");
+                   ". Dashed: the scene's tolerance, and the time per update at 30 Hz (visual) and 1 kHz "
+                   "(haptic).");
 }
 
 void error_vs_nu_figure(const FigureContext& c) {
@@ -173,7 +201,7 @@ void error_vs_nu_figure(const FigureContext& c) {
   plot.x = {"Poisson's ratio ν", Scale::linear};
   plot.y = {"relative L2 error", Scale::log};
   for (const auto& name : model_names(c.scene)) {
-    Series s = series(name, true);
+    Series s = c.model_series(name, name, true);
     for (const OutcomeRow* o : select(c.scene, [&](const OutcomeRow& r) {
            return r.ok && r.model == name && r.magnitude == c.magnitude &&
                   r.level == finest_level(c.scene);
@@ -183,7 +211,7 @@ void error_vs_nu_figure(const FigureContext& c) {
     }
     plot.series.push_back(s);
   }
-  c.doc.figure(file_safe(c.scene.name) + "_error_vs_nu.svg", render_svg(plot),
+  c.doc.figure(file_safe(c.scene.name) + "_error_vs_nu.svg", plot,
                "Relative L2 error of the nodal displacement against ν, load " +
                    load_text(c.magnitude, c.scene) + ", level " +
                    std::to_string(finest_level(c.scene)) +
@@ -199,7 +227,7 @@ void error_vs_level_figure(const FigureContext& c) {
   plot.y = {"max nodal error (mm)", Scale::log};
   Series unc = grey_dashed("reference uncertainty (max)", true);
   for (const auto& name : model_names(c.scene)) {
-    Series s = series(name, true);
+    Series s = c.model_series(name, name, true);
     for (const OutcomeRow* o : select(c.scene, [&](const OutcomeRow& r) {
            return r.ok && r.model == name && r.magnitude == c.magnitude &&
                   r.poisson_ratio == c.nu;
@@ -214,7 +242,7 @@ void error_vs_level_figure(const FigureContext& c) {
     plot.series.push_back(s);
   }
   if (!unc.x.empty()) plot.series.push_back(unc);
-  c.doc.figure(file_safe(c.scene.name) + "_error_vs_level.svg", render_svg(plot),
+  c.doc.figure(file_safe(c.scene.name) + "_error_vs_level.svg", plot,
                "Convergence: max nodal error against mesh level, ν = " + significant(c.nu) + ", load " +
                    load_text(c.magnitude, c.scene) +
                    ". FEM errors fall with refinement; a mass-spring error that does not fall is "
@@ -232,7 +260,7 @@ void load_displacement_figure(const FigureContext& c) {
   Series reference = black_line("FEM reference");
   std::set<double> magnitudes;
   for (const auto& name : model_names(c.scene)) {
-    Series s = series(name, true);
+    Series s = c.model_series(name, name, true);
     for (const OutcomeRow* o : select(c.scene, [&](const OutcomeRow& r) {
            return r.ok && r.model == name && r.poisson_ratio == c.nu &&
                   r.level == finest_level(c.scene);
@@ -269,7 +297,7 @@ void load_displacement_figure(const FigureContext& c) {
     caption += " Dashed grey: the line seed 000 compared its model against (x = F/k with its "
                "k = E·A/h₀ = 41.106 N/m, eq. 4.2), which is not the vessel's contact stiffness.";
   }
-  c.doc.figure(file_safe(c.scene.name) + "_load_displacement.svg", render_svg(plot), caption);
+  c.doc.figure(file_safe(c.scene.name) + "_load_displacement.svg", plot, caption);
 }
 
 void wall_profile_figure(const FigureContext& c) {
@@ -290,12 +318,12 @@ void wall_profile_figure(const FigureContext& c) {
   std::set<std::string> seen;
   for (const OutcomeRow* o : rows) {
     if (!seen.insert(o->model).second) continue;
-    Series m = series(o->model, true);
+    Series m = c.model_series(o->model, o->model, true);
     m.x = o->profile_s_mm;
     m.y = o->profile_model_mm;
     plot.series.push_back(m);
   }
-  c.doc.figure(file_safe(c.scene.name) + "_wall_profile.svg", render_svg(plot),
+  c.doc.figure(file_safe(c.scene.name) + "_wall_profile.svg", plot,
                "Radial displacement along the wall line through the QoI point (each model's "
                "nodes at its angle around the centreline), load " +
                    load_text(c.magnitude, c.scene) + ", ν = " + significant(c.nu) +
@@ -325,7 +353,7 @@ void history_figure(const FigureContext& c) {
                                     o->history_reference_mm));
       reference_drawn = true;
     }
-    Series m = series(o->model, true, false);
+    Series m = c.model_series(o->model, o->model, true, false);
     m.x = o->history_time_s;
     m.y = o->history_model_mm;
     plot.series.push_back(m);
@@ -341,7 +369,7 @@ void history_figure(const FigureContext& c) {
                       reference_drawn ? significant(o->history_max_error_mm) : "–", significant(o->max_mm),
                       significant(o->mass_damping_per_s)});
   }
-  c.doc.figure(file_safe(c.scene.name) + "_history.svg", render_svg(plot),
+  c.doc.figure(file_safe(c.scene.name) + "_history.svg", plot,
                "The contact force applied as a step at t = 0: displacement of the QoI point over "
                "time for each integrator" +
                    (reference_drawn ? ", against the FEM transient (Newmark, average "
@@ -373,7 +401,7 @@ Table statistics_table(const SceneRows& s) {
     std::vector<std::string> row{o.model, significant(o.poisson_ratio), std::to_string(o.level),
                                  load_text(o.magnitude, s) + (o.beyond_linear_regime ? " ⚠" : "")};
     if (!o.ok) {
-      row.push_back("**failed**: " + o.failure);
+      row.push_back("**failed**: " + first_sentence(o.failure));
       row.resize(t.header.size());
       row[12] = significant(o.solve_seconds);
       row[13] = significant(o.setup_seconds);
@@ -392,7 +420,7 @@ Table statistics_table(const SceneRows& s) {
   return t;
 }
 
-void scene_section(Document& doc, const SceneRows& s) {
+void scene_section(Document& doc, const SceneRows& s, SeriesStyles& styles) {
   doc.heading(2, "Scene `" + s.name + "`");
   doc.paragraph(s.description + (s.description.empty() ? "" : ". ") + s.vessel + ". Load: " +
                 s.load + ". Models at level(s) " + [&] {
@@ -411,14 +439,15 @@ void scene_section(Document& doc, const SceneRows& s) {
                          r.gci_finite.empty() ? "–" : r.gci_finite});
   }
   doc.table(refs);
-  const FigureContext c{doc, s, representative_load(s), first_nu(s)};
+  doc.slot("view:" + s.name);
+  const FigureContext c{doc, s, representative_load(s), first_nu(s), styles};
   speed_error_figure(c);
   error_vs_nu_figure(c);
   error_vs_level_figure(c);
   load_displacement_figure(c);
   wall_profile_figure(c);
   history_figure(c);
-  natural_frequency_section(doc, s);
+  natural_frequency_section(doc, s, styles);
   doc.paragraph("Seed 000's statistics of the nodal displacement error for every model, Poisson's "
                 "ratio, level and load (⚠: the reference strains beyond 5 % there). Set-up is "
                 "done once (model build; for static and linear mass-spring models also assembly "
@@ -428,6 +457,14 @@ void scene_section(Document& doc, const SceneRows& s) {
                 "integrators, and for FEM the same ramp's median update, prepared as the linear "
                 "mass-spring models are (factorised once at set-up):");
   doc.table(statistics_table(s));
+  // Each failure's whole message once, folded, below the table that gives its first sentence.
+  std::set<std::string> messages;
+  for (const OutcomeRow& o : s.outcomes) {
+    if (o.ok || !messages.insert(o.model + "\n" + o.failure).second) continue;
+    doc.details("Failed: " + o.model + " (level " + std::to_string(o.level) + ", ν = " +
+                    significant(o.poisson_ratio) + "): " + first_sentence(o.failure),
+                o.failure);
+  }
   const std::string provenance = scene_timing_provenance(s);
   if (!provenance.empty()) doc.paragraph("Timings: " + provenance + ".");
 }
@@ -486,7 +523,16 @@ Document build_report(const ResultsFile& r, const std::optional<StabilityFile>& 
   Document doc;
   doc.heading(1, "vesselverify report");
   doc.paragraph("How wrong, and how fast, is each mass-spring vessel model against linear-elastic "
-                "FEM? Results `" + r.path.filename().string() + "` were produced " + r.date +
+                "FEM? Per scene, at its representative load and first Poisson's ratio: the "
+                "recommended model (the fastest that meets the scene's [budget], else its max-error "
+                "tolerance) and the most accurate mass-spring model on the finest level, with their "
+                "max nodal error (× P1: relative L2 error over P1 FEM's), time per update and "
+                "verdict; then each model that failed, with the reason.");
+  doc.slot("cards");
+  doc.table(scene_card_table(scene_cards(r)));
+  doc.text_only();
+  doc.heading(2, "How these results were made");
+  doc.paragraph("Results `" + r.path.filename().string() + "` were produced " + r.date +
                 " on `" + r.host + "` (" + std::to_string(r.hardware_threads) +
                 " hardware threads), built with " + r.compiler + ", by");
   doc.code(r.command);
@@ -509,7 +555,8 @@ Document build_report(const ResultsFile& r, const std::optional<StabilityFile>& 
                 "otherwise).");
   doc.table(summary_table(r));
   best_model_section(doc, r);
-  for (const auto& s : r.scenes) scene_section(doc, s);
+  SeriesStyles styles(r);
+  for (const auto& s : r.scenes) scene_section(doc, s, styles);
   for (const auto& recommendation : recommendations) recommendation_section(doc, recommendation);
   if (validity) validity_section(doc, *validity);
   if (stability) {
@@ -561,8 +608,13 @@ void write_report(const ReportOptions& o) {
   }
   write_file_atomically(o.output_dir / "report.md",
                         [&](std::ostream& out) { out << doc.markdown_text("figures"); });
+  // report.html: the run's fields (fields/ beside results.json) drawn in 3D per scene.
+  const std::filesystem::path fields_dir = o.results.parent_path() / "fields";
+  std::vector<SceneViews> views;
+  for (const SceneRows& s : results.scenes) views.push_back(read_scene_views(s, fields_dir));
+  const WebLibraries libraries = load_web_libraries(default_javascript_dir());
   write_file_atomically(o.output_dir / "report.html", [&](std::ostream& out) {
-    out << doc.html_text("vesselverify report");
+    out << interactive_html(doc, scene_cards(results), views, libraries, "vesselverify report");
   });
 }
 

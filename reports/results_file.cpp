@@ -36,6 +36,8 @@ OutcomeRow read_outcome(const json& j, const std::string& where) {
     o.failure = field<std::string>(j, "failure", where);
     return o;
   }
+  o.budget_error = json_fields::optional_field<double>(j, "budget_error", where);
+  o.update_seconds = json_fields::optional_field<double>(j, "update_seconds", where);
   const json e = field<json>(j, "error", where);
   o.max_mm = field<double>(e, "max_mm", where + ".error");
   o.mean_mm = field<double>(e, "mean_mm", where + ".error");
@@ -134,8 +136,18 @@ ResultsFile parse_results(const std::string& text, const std::filesystem::path& 
     sr.reference_level = field<int>(s, "reference_level", where);
     sr.tolerance_mm = field_or<double>(s, "tolerance_max_error_mm", 0.1, where);
     sr.seconds = field<double>(s, "seconds", where);
+    if (const auto q = s.find("qoi_point_mm"); q != s.end() && q->is_array() && q->size() == 3) {
+      sr.qoi_point_mm = q->get<std::vector<double>>();
+    }
     if (const auto b = s.find("budget"); b != s.end() && !b->is_null()) {
       sr.budget_magnitude = json_fields::optional_field<double>(*b, "magnitude", where + ".budget");
+      BudgetRow budget;
+      budget.quantity = field<std::string>(*b, "quantity", where + ".budget");
+      budget.unit = field<std::string>(*b, "unit", where + ".budget");
+      budget.tolerance = field<double>(*b, "tolerance", where + ".budget");
+      budget.rate_hz = json_fields::optional_field<double>(*b, "rate_hz", where + ".budget");
+      budget.seconds_per_update = field<double>(*b, "seconds_per_update", where + ".budget");
+      sr.budget = budget;
     }
     for (const json& ref : field<json>(s, "references", where)) {
       ReferenceRow rr;

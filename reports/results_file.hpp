@@ -34,6 +34,18 @@ struct OutcomeRow {
   double history_max_error_mm = 0.0, simulated_s = 0.0, mass_damping_per_s = 0.0;
   std::optional<int> history_reference_level;  ///< the FEM transient's mesh level (older files: none)
   long steps = 0;
+  /// Scenes with a budget: the error on the budget's quantity (its unit) and the compute time per
+  /// update at its rate (s); nullopt without a budget.
+  std::optional<double> budget_error, update_seconds;
+};
+
+/// A scene's [budget] as results.json states it.
+struct BudgetRow {
+  std::string quantity;  ///< contact_point | patch | field | reaction
+  std::string unit;      ///< mm, or mN for reaction
+  double tolerance = 0.0;
+  std::optional<double> rate_hz;
+  double seconds_per_update = 0.0;
 };
 
 struct ReferenceRow {
@@ -73,6 +85,9 @@ struct SceneRows {
   /// The load the scene's [budget] applies at (scene's load unit); nullopt without a budget, or
   /// when the budget leaves it to the representative load.
   std::optional<double> budget_magnitude;
+  std::optional<BudgetRow> budget;
+  /// The QoI point (for contact loads the contact point), mm; nullopt in files without it.
+  std::optional<std::vector<double>> qoi_point_mm;
   std::vector<ReferenceRow> references;
   std::vector<OutcomeRow> outcomes;
   /// Natural frequencies (absent from runs without [modes]): the reference per ν, the models.

@@ -24,6 +24,12 @@ struct Series {
   bool emphasis = false;  ///< thicker line, larger markers (e.g. the reference, the Pareto front)
   /// Colour as "#rrggbb"; empty: the palette colour of the series' index.
   std::string colour;
+  /// Marker shape in report.html's plots (circle, triangle, rect, rectRot, star, crossRot, cross,
+  /// rectRounded); the SVG draws circles.
+  std::string marker = "circle";
+  /// Optional, one per point: what hovering the point names (model, ν, level, load), and the
+  /// 3D view it opens when clicked ("<scene>|<model>|<level>").
+  std::vector<std::string> point_labels, point_views;
 };
 
 struct Plot {

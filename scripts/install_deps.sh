@@ -16,6 +16,7 @@ packages=(
   libspectra-dev
   openmpi-bin                             # mpirun: fem --distributed and its tests
   python3-matplotlib python3-numpy        # reports (use /usr/bin/python3)
+  libjs-three libjs-chart.js              # report.html: 3D views and plots, inlined when written
   "$@"
 )
 

@@ -5,6 +5,8 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="$root/build"
 
+# chromium: the `browser` tests open report.html in it (headless, WebGL by SwiftShader).
+"$root/scripts/install_deps.sh" chromium
 "$root/scripts/build.sh" "$build"
 select=(-LE slow)
 if [ "${1:-}" = "--all" ]; then select=(); fi

@@ -120,6 +120,47 @@ void write_fem_json(const std::filesystem::path& path, const FemRunRecord& run) 
   write_file_atomically(path, [&](std::ostream& out) { out << text; });
 }
 
+std::string finite_strain_json(const FemRunRecord& run, const fem::HyperelasticResult& r) {
+  double max_u = 0.0;
+  for (const auto& u : r.nodal_displacement) max_u = std::max(max_u, u.norm());
+  nlohmann::json j{
+      {"schema", "vesselverify.fem_finite_strain"},
+      {"schema_version", 1},
+      {"units", {{"length", "mm"}, {"force", "mN"}, {"energy", "mJ"}, {"time", "s"}}},
+      {"vessel", describe(run.vessel)},
+      {"mesh", {{"nodes", run.mesh_nodes}, {"tets", run.mesh_tets}, {"cache_hit", run.cache_hit}}},
+      {"material",
+       {{"E_Pa", run.youngs_modulus}, {"nu", run.poisson_ratio}, {"density_kg_m3", run.density}}},
+      {"loads", run.loads},
+      {"ends", run.ends},
+      {"reference", "finite-strain (compressible neo-Hookean)"},
+      {"element", r.element},
+      {"formulation", fem::to_string(r.formulation)},
+      {"solver", fem::to_string(r.solver)},
+      {"dofs", r.n_dofs},
+      {"load_factor", r.load_factor},
+      {"completed", r.completed},
+      {"stop_reason", r.stop_reason},
+      {"load_steps", r.steps.size()},
+      {"rejected_steps", r.rejected_steps},
+      {"newton_iterations", r.newton_iterations},
+      {"max_displacement_mm", max_u * 1e3},
+      {"strain_energy_mJ", r.strain_energy * 1e3},
+      {"max_abs_principal_green_lagrange_strain", r.max_abs_principal_strain},
+      {"min_jacobian", r.min_jacobian},
+      {"timings_s",
+       {{"mesh", run.mesh_seconds}, {"setup", r.timings.setup}, {"assembly", r.timings.assembly},
+        {"solve", r.timings.solve}, {"postprocess", r.timings.postprocess}}}};
+  if (run.contact) j["contact"] = contact_json(*run.contact);
+  return j.dump(2) + "\n";
+}
+
+void write_finite_strain_json(const std::filesystem::path& path, const FemRunRecord& run,
+                              const fem::HyperelasticResult& result) {
+  const std::string text = finite_strain_json(run, result);
+  write_file_atomically(path, [&](std::ostream& out) { out << text; });
+}
+
 void write_fem_vtu(const std::filesystem::path& path, const TetMesh& mesh,
                    const FemRunRecord& run) {
   const fem::ElasticityResult& r = run.result;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fem_reference/elasticity.hpp"
+#include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/reference_checks.hpp"
 #include "verification/scene.hpp"
 
@@ -62,6 +63,13 @@ struct FemRunRecord {
 /// The run as JSON text.
 std::string fem_json(const FemRunRecord& run);
 void write_fem_json(const std::filesystem::path& path, const FemRunRecord& run);
+/// The finite-strain reference's run (`fem --reference finite-strain --json`; schema
+/// "vesselverify.fem_finite_strain", version 1): the problem as fem_json gives it, the load factor
+/// reached and why it stopped, load steps and Newton iterations, the largest displacement and the
+/// contact point's (mm), strain energy (mJ), the largest principal Green–Lagrange strain, min J.
+std::string finite_strain_json(const FemRunRecord& run, const fem::HyperelasticResult& result);
+void write_finite_strain_json(const std::filesystem::path& path, const FemRunRecord& run,
+                              const fem::HyperelasticResult& result);
 /// Displacement and mode shapes at the nodes, strain and stress per tet (when the solve has them).
 void write_fem_vtu(const std::filesystem::path& path, const TetMesh& mesh, const FemRunRecord& run);
 /// The transient's probe displacement (mm) and energies (mJ) at every step.

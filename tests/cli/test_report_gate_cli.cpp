@@ -66,7 +66,10 @@ TEST(ReportCli, WritesMarkdownHtmlAndEveryFigure) {
     ++figures;
   }
   EXPECT_GE(figures, 6u);  // at least speed-error and wall profile per scene
-  EXPECT_EQ(count(html, "<svg"), figures);  // self-contained: every figure inline
+  // Self-contained: every figure inline, as an interactive plot (its data in the page) or, without
+  // the JavaScript libraries, as its SVG.
+  EXPECT_EQ(count(html, "<figure"), figures);
+  EXPECT_EQ(count(html, "<figure class=\"vv-plot\">") + count(html, "<figure>\n<svg"), figures);
   EXPECT_FALSE(contains(html, "src=\""));    // and nothing linked
 }
 

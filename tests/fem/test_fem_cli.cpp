@@ -9,11 +9,16 @@
 #include <nlohmann/json.hpp>
 
 #include "../test_helpers.hpp"
+#include "meshes/vtu_io.hpp"
 
 using vessel::test::CommandResult;
 using vessel::test::run_command;
 using vessel::test::TempDir;
 using vessel::test::vv;
+using vessel::Vec3;
+using vessel::VtuData;
+using vessel::VtuField;
+using vessel::read_vtu;
 
 namespace {
 
@@ -163,10 +168,60 @@ TEST(FemCli, FiniteStrainReferenceAgreesWithTheLinearOneAtASmallLoad) {
   EXPECT_NE(finite, linear) << r.output;
 }
 
+TEST(FemCli, FiniteStrainWritesItsDisplacementFieldAsVtu) {
+  // At 0.1 mN the neo-Hookean field is within a few per cent of the linear reference's, which
+  // the linear solver writes to its own VTU: the largest nodal difference against the largest
+  // displacement.
+  TempDir dir;
+  const std::string load = "--load contact --force 1e-4 --contact-point 0.003 0 0.001 ";
+  const auto f = vv("fem " + kTube + load + "--reference finite-strain --vtu " +
+                    (dir / "finite.vtu").string());
+  ASSERT_EQ(f.exit_code, 0) << f.output;
+  const auto l = vv("fem " + kTube + load + "--vtu " + (dir / "linear.vtu").string());
+  ASSERT_EQ(l.exit_code, 0) << l.output;
+  const VtuData finite = read_vtu(dir / "finite.vtu"), linear = read_vtu(dir / "linear.vtu");
+  const VtuField* uf = VtuData::find(finite.point_fields, "displacement");
+  const VtuField* ul = VtuData::find(linear.point_fields, "displacement");
+  ASSERT_TRUE(uf && ul);
+  ASSERT_EQ(uf->values.size(), ul->values.size());
+  double largest = 0.0, difference = 0.0;
+  for (std::size_t i = 0; i < ul->values.size(); i += 3) {
+    const Vec3 a{uf->values[i], uf->values[i + 1], uf->values[i + 2]};
+    const Vec3 b{ul->values[i], ul->values[i + 1], ul->values[i + 2]};
+    largest = std::max(largest, b.norm());
+    difference = std::max(difference, (a - b).norm());
+  }
+  ASSERT_GT(largest, 0.0);
+  EXPECT_LT(difference, 0.03 * largest);
+  EXPECT_GT(difference, 0.0);  // a different solver, not the linear field copied
+}
+
+TEST(FemCli, FiniteStrainJsonGivesTheLoadReachedAndTheContactDisplacement) {
+  TempDir dir;
+  const auto r = vv("fem " + kTube + "--load contact --force 1e-4 --contact-point 0.003 0 0.001 "
+                    "--reference finite-strain --json " + (dir / "f.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(vessel::test::read_text(dir / "f.json"));
+  EXPECT_EQ(j["schema"], "vesselverify.fem_finite_strain");
+  EXPECT_EQ(j["load_factor"], 1.0);
+  EXPECT_TRUE(j["completed"].get<bool>());
+  // The contact point's displacement along the patch normal, as the command printed it (mm).
+  double along = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    along += j["contact"]["displacement_mm"][c].get<double>() *
+             j["contact"]["inward_normal"][c].get<double>();
+  }
+  EXPECT_NEAR(along, number_after(r.output, "along the patch normal "), 1e-5 * std::abs(along));
+  // And, at 0.1 mN, within 3 % of the linear reference's (another solver; printed beside it).
+  const double linear = number_after(r.output, "linear reference at the same load ");
+  EXPECT_NEAR(along, linear, 0.03 * std::abs(linear));
+  EXPECT_GE(j["max_displacement_mm"].get<double>(), std::abs(along));
+}
+
 TEST(FemCli, FiniteStrainRefusesOptionsOfTheLinearReferenceOnly) {
-  const auto r = vv("fem " + kTube + "--reference finite-strain --json x.json");
+  const auto r = vv("fem " + kTube + "--reference finite-strain --modes 3");
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_TRUE(contains(r.output, "--json is available with the linear reference only")) << r.output;
+  EXPECT_TRUE(contains(r.output, "--modes is available with the linear reference only")) << r.output;
   const auto d = vv("fem " + kTube + "--dead-pressure");
   EXPECT_EQ(d.exit_code, 1) << d.output;
   EXPECT_TRUE(contains(d.output, "--dead-pressure is for --reference finite-strain")) << d.output;

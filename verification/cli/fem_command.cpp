@@ -14,6 +14,7 @@
 #include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/reference_checks.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "meshes/vtu_io.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/cli/vessel_options.hpp"
 #include "verification/fem_document.hpp"
@@ -431,6 +432,7 @@ void run_finite_strain(const FemCommandOptions& o, const fem::ElasticityProblem&
             << ":\n  max |u|                 " << max_u * 1e3 << " mm\n";
   if (run.contact) {
     const Vec3 u = solver.displacement_at({run.contact->point})[0];
+    run.contact->displacement = u;
     fem::ElasticitySolver linear(mesh, problem);
     linear.solve();
     const Vec3 ul = linear.displacement_at({run.contact->point})[0] * r.load_factor;
@@ -445,7 +447,16 @@ void run_finite_strain(const FemCommandOptions& o, const fem::ElasticityProblem&
   std::cout << std::fixed << std::setprecision(3) << "timings (s): mesh " << run.mesh_seconds
             << ", setup " << r.timings.setup << ", assembly " << r.timings.assembly << ", solve "
             << r.timings.solve << ", postprocess " << r.timings.postprocess << std::defaultfloat
-            << "\n";
+            << "\n";  if (!o.vtu.empty()) {  // the displacement at the load factor reached, as the linear --vtu
+    VtuField disp{"displacement", 3, {}};
+    for (const Vec3& u : r.nodal_displacement) disp.values.insert(disp.values.end(), {u.x(), u.y(), u.z()});
+    write_vtu(o.vtu, mesh, {disp});
+    std::cout << "wrote " << o.vtu.string() << "\n";
+  }
+  if (!o.json.empty()) {
+    write_finite_strain_json(o.json, run, r);
+    std::cout << "wrote " << o.json.string() << "\n";
+  }
 }
 
 void check_options(const FemCommandOptions& o) {
@@ -454,13 +465,11 @@ void check_options(const FemCommandOptions& o) {
                         : o.modes > 0      ? "--modes"
                         : o.transient      ? "--transient"
                         : o.richardson     ? "--richardson"
-                        : !o.vtu.empty()   ? "--vtu"
-                        : !o.json.empty()  ? "--json"
                                            : nullptr;
     if (other) {
       throw InputError(std::string(other) +
-                       " is available with the linear reference only: drop it or --reference "
-                       "finite-strain");
+                       " is available with the linear reference only: drop it, or drop "
+                       "--reference finite-strain");
     }
   } else if (o.dead_pressure) {
     throw InputError("--dead-pressure is for --reference finite-strain (the linear reference's "
@@ -632,8 +641,11 @@ void add_study_options(CLI::App* cmd, FemCommandOptions& o) {
                   "Transient: write the contact point's displacement (mm) and the energies (mJ) "
                   "at every step as CSV");
   cmd->add_option("--vtu", o.vtu,
-                  "Write displacement and mode shapes (nodes), strain and stress (tets) as VTU");
-  cmd->add_option("--json", o.json, "Write a JSON summary");
+                  "Write displacement and mode shapes (nodes), strain and stress (tets) as VTU; "
+                  "with --reference finite-strain the displacement at the load factor reached");
+  cmd->add_option("--json", o.json,
+                  "Write a JSON summary (with --reference finite-strain: the load factor reached, "
+                  "Newton iterations, displacements, strain energy and strains)");
 }
 
 }  // namespace

@@ -13,7 +13,10 @@ void add_report_command(CLI::App& app, const std::string& command_line) {
   CLI::App* cmd = app.add_subcommand(
       "report",
       "Turn results into a report: report.md (figures as .svg files under figures/) and "
-      "report.html (self-contained, figures inline): a summary table, and per scene speed "
+      "report.html (one file, no network: a card per scene with the recommended and the best "
+      "mass-spring model, each scene's models in 3D coloured by their error, read from the "
+      "run's fields/ beside results.json, and interactive plots; Debian's three.js and Chart.js "
+      "inlined, else the SVG figures): a summary table, and per scene speed "
       "against error with the Pareto front, error against nu and against mesh level, load "
       "against contact displacement beside the FEM and seed 000's Hooke line, the radial "
       "displacement along the wall, dynamic histories, and seed 000's statistics for every "

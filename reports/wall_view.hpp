@@ -1,0 +1,54 @@
+#pragma once
+/// One model's deformed wall as report.html draws it in 3D, read from the VTU fields that
+/// `vesselverify run` writes (fields/<scene>/*.vtu: displacement_model_m, displacement_reference_m,
+/// error_magnitude_mm at the model's nodes), reduced to what is drawn: the boundary faces of a tet
+/// mesh, a surface network's triangles, else its springs as lines, and only their nodes.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "meshes/vtu_io.hpp"
+#include "reports/results_file.hpp"
+
+namespace vessel::reports {
+
+struct WallView {
+  std::string model, kind;  ///< kind: the outcome's (fem, volume_msm, surface_msm, ...)
+  int level = 0;
+  double poisson_ratio = 0.0, magnitude = 0.0;
+  bool lines = false;  ///< springs as line segments (a network without faces); else triangles
+  bool network_faces = false;  ///< the triangles are a surface network's own (their edges: springs)
+  std::vector<float> rest_mm;         ///< x, y, z per drawn node, mm
+  std::vector<float> u_model_mm;      ///< the model's displacement per drawn node, mm
+  std::vector<float> u_reference_mm;  ///< the reference's displacement at the same nodes, mm
+  std::vector<std::uint32_t> indices;  ///< 3 per triangle or 2 per line, into the drawn nodes
+  /// |error| per drawn node quantised: error ≈ error_code · error_step_mm (rounded to nearest,
+  /// so within half a step of the VTU's value).
+  std::vector<std::uint16_t> error_code;
+  double error_step_mm = 0.0;
+  double max_error_mm = 0.0;  ///< the largest |error| over the drawn nodes
+};
+
+/// Where `vesselverify run` writes an outcome's fields, relative to its fields/ directory
+/// (verification/harness.cpp fields_file: "<scene>/<model>_nu<ν>_L<level>_load<magnitude>.vtu",
+/// numbers in the stream's default format).
+std::filesystem::path fields_file(const std::string& scene, const OutcomeRow& outcome);
+
+/// The drawn part of a VTU as above. InputError naming `source` when a field is missing or the
+/// cells are of a type the view cannot draw.
+WallView wall_view(const VtuData& vtu, const std::string& source);
+
+/// Faces of a tet mesh that belong to one tet only (its boundary), each wound so that its normal
+/// (right-hand rule) points out of its tet, whatever the tet's own orientation; `connectivity`
+/// holds 4 indices into `points` per tet.
+std::vector<std::uint32_t> boundary_faces(const std::vector<std::size_t>& connectivity,
+                                          const std::vector<Vec3>& points);
+
+/// RFC 4648 base64 of raw bytes (the page decodes typed arrays from it) and its inverse
+/// (InputError on a character outside the alphabet).
+std::string base64_encode(const void* data, std::size_t bytes);
+std::vector<std::uint8_t> base64_decode(const std::string& text);
+
+}  // namespace vessel::reports

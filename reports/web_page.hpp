@@ -1,0 +1,65 @@
+#pragma once
+/// report.html with its answers first and its figures interactive: a card per scene, each scene's
+/// models in 3D (their deformed walls coloured by the displacement error, read from the run's
+/// fields/*.vtu), and the plots drawn by Chart.js with hover, series toggles and zoom. The
+/// libraries are Debian's (libjs-three, libjs-chart.js), read when the report is written and
+/// inlined, so the page is one file that needs no network. Without them the page keeps the static
+/// SVG figures and says which library was missing.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "reports/document.hpp"
+#include "reports/results_file.hpp"
+#include "reports/scene_card.hpp"
+#include "reports/wall_view.hpp"
+
+namespace vessel::reports {
+
+struct WebLibrary {
+  std::string name;     ///< "three.js", "Chart.js"
+  std::string version;  ///< read from the file ("r111", "3.9.1"); empty if not found
+  std::string licence;  ///< the footer's line: licence and copyright
+  std::filesystem::path path;
+  std::string code;
+};
+
+struct WebLibraries {
+  std::vector<WebLibrary> found;
+  std::vector<std::string> missing;  ///< "three.js (libjs-three: <path>)" per library not found
+  [[nodiscard]] bool complete() const { return missing.empty(); }
+};
+
+/// Where Debian installs the libraries; the environment variable VESSELVERIFY_JS_DIR replaces it
+/// (tests point it at an empty directory to see the page without them).
+std::filesystem::path default_javascript_dir();
+
+/// three.js (three/three.min.js) and Chart.js (chart.js/chart.min.js) under `dir`.
+WebLibraries load_web_libraries(const std::filesystem::path& dir);
+
+/// One scene's 3D data: its models' walls at the representative load and first ν.
+struct SceneViews {
+  std::string scene;
+  double tolerance_mm = 0.1;
+  std::optional<std::vector<double>> qoi_mm;
+  std::string load_text;
+  std::vector<WallView> views;
+  std::vector<std::string> missing;  ///< outcomes whose VTU was not found (their paths)
+};
+
+/// The walls of each finished outcome of `scene` at its representative load, first ν and finest
+/// model level, read from `fields_dir` (fields_file); an absent file is listed in `missing`, an
+/// unreadable one is an InputError.
+SceneViews read_scene_views(const SceneRows& scene, const std::filesystem::path& fields_dir);
+
+/// A picture of the scene for its card: the vessel's outline seen along its thinnest extent, the
+/// QoI point and the load, as a small <svg> (empty without a wall to draw).
+std::string scene_picture_svg(const SceneViews& views, const std::string& load);
+
+/// The whole page. `views` in the order of results.scenes (one per scene).
+std::string interactive_html(const Document& doc, const std::vector<SceneCard>& cards,
+                             const std::vector<SceneViews>& views, const WebLibraries& libraries,
+                             const std::string& title);
+
+}  // namespace vessel::reports

@@ -1,0 +1,115 @@
+// Injected at the top of a copy of report.html by report_browser_tests: records console errors,
+// then, once the page has loaded, scrolls through it and writes what it found as JSON into
+// <pre id="vv-probe"> for chromium --dump-dom: each 3D pane's pixels read back, each plot's points
+// per series, the tooltip of a hovered point, and when the page became interactive.
+(function () {
+  'use strict';
+  // chromium --dump-dom runs the page on virtual time and draws no frames, so animation frames
+  // never come: timers stand in for them (Chart.js handles mouse events, and the page renders its
+  // 3D views, in animation frames).
+  window.requestAnimationFrame = (callback) => setTimeout(() => callback(performance.now()), 16);
+  const probe = {errors: []};
+  const error = console.error;
+  console.error = function () {
+    probe.errors.push('console.error: ' + Array.from(arguments).join(' '));
+    error.apply(console, arguments);
+  };
+  window.addEventListener('error', (e) => probe.errors.push('error: ' + e.message));
+  window.addEventListener('unhandledrejection', (e) => probe.errors.push('rejection: ' + e.reason));
+  const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+  function panePixels(gl, el) {
+    const r = el.getBoundingClientRect();
+    const w = Math.floor(r.width) - 4, h = Math.floor(r.height) - 4;
+    const x = Math.ceil(r.left) + 2, y = Math.ceil(window.innerHeight - r.bottom) + 2;
+    const px = new Uint8Array(w * h * 4);
+    gl.readPixels(x, y, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    const colours = new Set();
+    let drawn = 0;
+    for (let i = 0; i < px.length; i += 4) {
+      const background = px[i] === 246 && px[i + 1] === 246 && px[i + 2] === 246;
+      if (!background) ++drawn;
+      colours.add((px[i] << 16) | (px[i + 1] << 8) | px[i + 2]);
+    }
+    return {pixels: w * h, drawn: drawn, colours: colours.size};
+  }
+
+  async function run() {
+    const report = window.vvReport;
+    const nav = performance.getEntriesByType('navigation')[0];
+    const out = {errors: probe.errors, interactive_ms: report ? report.interactiveMs : null,
+      dom_content_loaded_ms: nav ? nav.domContentLoadedEventEnd : null,
+      load_ms: nav ? nav.loadEventEnd : null, views: [], charts: [], hover: null,
+      node_hover: null};
+    // Each plot and 3D view scrolled into view, where the page sets it up. --dump-dom draws no
+    // frames, so the IntersectionObserver that notices the scroll is not always run: what it
+    // would have called is then called here (the page's own set-up, the same code).
+    for (const el of document.querySelectorAll('.vv-chart, .vv-view')) {
+      el.scrollIntoView({block: 'center'});
+      await sleep(150);
+      if (el.classList.contains('vv-chart')) report.initChart(el);
+      else if (el.querySelector('.vv-pane')) report.initView(el);
+    }
+    for (const view of report.views) {
+      view.section.scrollIntoView({block: 'center'});
+      await sleep(200);
+      report.renderNow();
+      const gl = report.gl;
+      const entry = {scene: view.data.name, init_ms: view.initMs, models: [],
+        panes: view.panes.map((p) => Object.assign(panePixels(gl, p.el),
+          {model: view.data.views[p.model].model}))};
+      // Every model through the left pane's picker, as a reader would choose it.
+      const pick = view.section.querySelector('.vv-pick[data-pane="0"]');
+      for (let i = 0; i < view.data.views.length; ++i) {
+        pick.value = String(i);
+        pick.dispatchEvent(new Event('change'));
+        report.renderNow();
+        entry.models.push(Object.assign(panePixels(gl, view.panes[0].el),
+          {model: view.data.views[i].model, springs: view.data.views[i].springs}));
+      }
+      out.views.push(entry);
+      if (!out.node_hover) {
+        const r = view.panes[0].el.getBoundingClientRect();
+        for (let k = 0; k < 400 && !out.node_hover; ++k) {  // a spiral from the centre
+          const a = k * 0.5, d = k * 0.4;
+          out.node_hover = report.nodeAt(view, view.panes[0], r.left + r.width / 2 + d * Math.cos(a),
+            r.top + r.height / 2 + d * Math.sin(a));
+        }
+      }
+    }
+    for (const c of report.charts) {
+      out.charts.push({index: c.index, title: c.title, series: c.chart.data.datasets.map((d) => ({
+        label: d.label, points: d.data.length, labelled: d.data.filter((p) => p.label).length}))});
+    }
+    // Hover the first labelled point of the first plot that has one: a real mouse move at its place.
+    for (const c of report.charts) {
+      const chart = c.chart;
+      const d = chart.data.datasets.findIndex((s) => s.data.some((p) => p.label));
+      if (d < 0) continue;
+      chart.canvas.scrollIntoView({block: 'center'});
+      await sleep(150);
+      const el = chart.getDatasetMeta(d).data[0];
+      const r = chart.canvas.getBoundingClientRect();
+      chart.canvas.dispatchEvent(new MouseEvent('mousemove', {clientX: r.left + el.x,
+        clientY: r.top + el.y, bubbles: true}));
+      await sleep(200);
+      const lines = (chart.tooltip.body || []).map((b) => b.lines.join(' '));
+      out.hover = {plot: c.title, dataset: chart.data.datasets[d].label,
+        visible: chart.tooltip.opacity > 0, text: lines.join(' | ')};
+      break;
+    }
+    const pre = document.createElement('pre');
+    pre.id = 'vv-probe';
+    pre.textContent = JSON.stringify(out);
+    document.body.appendChild(pre);
+  }
+  window.addEventListener('load', () => {
+    setTimeout(() => run().catch((e) => {
+      probe.errors.push('probe: ' + e);
+      const pre = document.createElement('pre');
+      pre.id = 'vv-probe';
+      pre.textContent = JSON.stringify({errors: probe.errors});
+      document.body.appendChild(pre);
+    }), 50);
+  });
+})();

@@ -1,0 +1,194 @@
+// report.html in a real browser: Debian's chromium, headless, WebGL by SwiftShader
+// (scripts/headless_chromium.sh). The report of a small committed results folder is written, a
+// copy gets tests/reports/browser_probe.js at the top of its <head>, and chromium's --dump-dom
+// returns what the probe found. The expected counts come from results.json, not from the page.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "reports/report.hpp"
+#include "../test_helpers.hpp"
+
+using namespace vessel;
+using namespace vessel::reports;
+
+namespace {
+
+const std::filesystem::path kFixture = VESSEL_REPORT_FIXTURE;
+const std::filesystem::path kProbe = VESSEL_BROWSER_PROBE;
+const std::filesystem::path kScreenshots = VESSEL_SCREENSHOT_SCRIPT;
+
+std::filesystem::path headless_chromium() {
+  return kScreenshots.parent_path() / "headless_chromium.sh";
+}
+
+/// The fixture's report written and probed in chromium once, on first use; the probe's JSON.
+/// (Done in the first test that asks, not in SetUpTestSuite, so a failure here fails tests
+/// rather than skipping them.)
+struct Probed {
+  test::TempDir dir;
+  nlohmann::json probe;
+  std::string problem;  ///< why there is no probe, else empty
+};
+
+Probed& probed() {
+  static Probed* p = [] {
+    auto* p = new Probed();
+    ReportOptions o;
+    o.results = kFixture / "results.json";
+    o.output_dir = p->dir.path();
+    o.command = "report_browser_tests";
+    write_report(o);
+    std::string page = test::read_text(p->dir / "report.html");
+    const auto head = page.find("<head>");
+    page.insert(head + 6, "<script>" + test::read_text(kProbe) + "</script>");
+    test::write_text(p->dir / "probed.html", page);
+    // stdout (the DOM) to a file of its own: chromium's log lines on stderr would interleave.
+    const test::CommandResult r = test::run_command(
+        headless_chromium().string() + " --window-size=1280,900 --virtual-time-budget=30000 "
+        "--dump-dom file://" + (p->dir / "probed.html").string() + " > " +
+        (p->dir / "dom.html").string() + " 2> " + (p->dir / "chromium.log").string());
+    if (r.exit_code != 0) {
+      p->problem = "chromium failed (" + std::to_string(r.exit_code) + "): " + r.output +
+                   test::read_text(p->dir / "chromium.log");
+      return p;
+    }
+    const std::string dom = test::read_text(p->dir / "dom.html");
+    const std::string open = "<pre id=\"vv-probe\">";
+    const auto at = dom.rfind(open);
+    if (at == std::string::npos) {
+      p->problem = "the probe wrote nothing; chromium's log:\n" + test::read_text(p->dir / "chromium.log");
+      return p;
+    }
+    const auto start = at + open.size();
+    std::string text = dom.substr(start, dom.find("</pre>", start) - start);
+    // --dump-dom escapes &, < and > in text.
+    for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+             {"&lt;", "<"}, {"&gt;", ">"}, {"&amp;", "&"}}) {
+      for (auto q = text.find(from); q != std::string::npos; q = text.find(from, q + 1)) {
+        text.replace(q, from.size(), to);
+      }
+    }
+    p->probe = nlohmann::json::parse(text);
+    return p;
+  }();
+  return *p;
+}
+
+class ReportInBrowser : public ::testing::Test {
+ protected:
+  void SetUp() override { ASSERT_EQ(probed().problem, ""); }
+  static const nlohmann::json& probe() { return probed().probe; }
+  static const std::filesystem::path& dir() { return probed().dir.path(); }
+};
+
+}  // namespace
+
+TEST_F(ReportInBrowser, NoConsoleError) {
+  ASSERT_TRUE(probe().contains("errors"));
+  EXPECT_TRUE(probe()["errors"].empty()) << probe()["errors"].dump(1);
+}
+
+TEST_F(ReportInBrowser, EachThreeDViewDrawsItsModels) {
+  const ResultsFile results = read_results(kFixture / "results.json");
+  ASSERT_EQ(probe()["views"].size(), results.scenes.size());
+  for (const auto& view : probe()["views"]) {
+    ASSERT_EQ(view["panes"].size(), 2U) << view["scene"];
+    // Every finished model of the scene has a wall to draw (the fixture has a VTU for each).
+    std::size_t finished = 0;
+    for (const SceneRows& s : results.scenes) {
+      if (s.name != view["scene"]) continue;
+      std::set<std::string> models;
+      for (const OutcomeRow& o : s.outcomes) {
+        if (o.ok && o.magnitude == representative_load(s)) models.insert(o.model);
+      }
+      finished = models.size();
+    }
+    EXPECT_EQ(view["models"].size(), finished) << view["scene"];
+    auto panes = view["panes"];
+    for (const auto& m : view["models"]) panes.push_back(m);
+    for (const auto& pane : panes) {
+      // The wall covers part of the pane (not all background) and is shaded and coloured by the
+      // error (many colours, not one flat fill).
+      const double pixels = pane["pixels"];
+      EXPECT_GT(pane["drawn"].get<double>(), 0.02 * pixels) << view["scene"] << " " << pane["model"];
+      EXPECT_LT(pane["drawn"].get<double>(), pixels) << view["scene"] << " " << pane["model"];
+      EXPECT_GT(pane["colours"].get<int>(), 20) << view["scene"] << " " << pane["model"];
+    }
+  }
+}
+
+TEST_F(ReportInBrowser, HoveringTheWallGivesTheNodesErrorAndDisplacements) {
+  const auto& n = probe()["node_hover"];
+  ASSERT_TRUE(n.is_object()) << "no node found under the pointer in the first pane";
+  EXPECT_GE(n["error_mm"].get<double>(), 0.0);
+  ASSERT_EQ(n["u_model_mm"].size(), 3U);
+  ASSERT_EQ(n["u_reference_mm"].size(), 3U);
+  // |u_model − u_reference| is the error the page shows, within its quantisation and float32.
+  double d2 = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const double d = n["u_model_mm"][c].get<double>() - n["u_reference_mm"][c].get<double>();
+    d2 += d * d;
+  }
+  EXPECT_NEAR(std::sqrt(d2), n["error_mm"].get<double>(), 1e-3 + 1e-3 * std::sqrt(d2));
+}
+
+TEST_F(ReportInBrowser, SpeedErrorPlotHasAPointPerFinishedOutcome) {
+  const ResultsFile results = read_results(kFixture / "results.json");
+  for (const SceneRows& s : results.scenes) {
+    const double load = representative_load(s);
+    std::size_t expected = 0;
+    for (const OutcomeRow& o : s.outcomes) expected += o.ok && o.magnitude == load;
+    bool found = false;
+    for (const auto& chart : probe()["charts"]) {
+      if (chart["title"].get<std::string>().rfind(s.name + ": speed against error", 0) != 0) continue;
+      found = true;
+      std::size_t points = 0;
+      for (const auto& series : chart["series"]) points += series["labelled"].get<std::size_t>();
+      EXPECT_EQ(points, expected) << s.name;
+    }
+    EXPECT_TRUE(found) << "no speed-error plot for " << s.name;
+  }
+}
+
+TEST_F(ReportInBrowser, EveryPlotOfTheReportIsDrawnWithItsSeries) {
+  // Every figure with data becomes a chart, and each series keeps its points.
+  const std::string page = test::read_text(dir() / "report.html");
+  std::size_t figures = 0;
+  for (auto at = page.find("class=\"vv-chart\""); at != std::string::npos;
+       at = page.find("class=\"vv-chart\"", at + 1)) {
+    ++figures;
+  }
+  EXPECT_EQ(probe()["charts"].size(), figures);
+  for (const auto& chart : probe()["charts"]) {
+    std::size_t points = 0;
+    for (const auto& series : chart["series"]) points += series["points"].get<std::size_t>();
+    EXPECT_GT(points, 1U) << chart["title"];
+  }
+}
+
+TEST_F(ReportInBrowser, HoverOnAPointNamesItsModel) {
+  const auto& h = probe()["hover"];
+  ASSERT_TRUE(h.is_object());
+  EXPECT_TRUE(h["visible"].get<bool>());
+  const std::string dataset = h["dataset"];
+  const std::string model = dataset.substr(0, dataset.find(" (L"));
+  EXPECT_NE(h["text"].get<std::string>().find(model), std::string::npos) << h.dump();
+  EXPECT_NE(h["text"].get<std::string>().find("ν ="), std::string::npos) << h.dump();
+}
+
+TEST_F(ReportInBrowser, ScreenshotScriptWritesTheFirstScreenAndAThreeDView) {
+  const std::filesystem::path out = dir() / "shots";
+  const test::CommandResult r = test::run_command(
+      kScreenshots.string() + " " + (dir() / "report.html").string() + " " + out.string() +
+      " " + read_results(kFixture / "results.json").scenes.front().name);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* png : {"report_first_screen.png", "report_3d_view.png"}) {
+    const std::string bytes = test::read_text(out / png);
+    ASSERT_GT(bytes.size(), 10000U) << png;
+    EXPECT_EQ(bytes.substr(1, 3), "PNG") << png;
+  }
+}
