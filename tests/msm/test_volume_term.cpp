@@ -60,7 +60,7 @@ TEST(VolumeTerm, KernelMatchesFiniteDifferencesForBothSignsOfKappa) {
   for (double kappa : {5e4, -3e3}) {
     const Eigen::VectorXd x = perturbed(x0, rng, 0.1e-3);
     using C = std::array<Vec3, 4>;
-    const auto c = test::check_element_derivatives(
+    const auto c = msm::test::check_element_derivatives(
         [&](const C& y) { return volume_energy(y, v0, kappa); },
         [&](const C& y) { return volume_gradient(y, v0, kappa); },
         [&](const C& y) { return volume_hessian(y, v0, kappa, false); }, x, 1e-8);
@@ -114,7 +114,7 @@ TEST(VolumeTerm, HybridModelIsTheSumOfItsTermsAndMatchesFiniteDifferences) {
       return g;
     };
   };
-  const auto c = test::check_derivatives([&](const Eigen::VectorXd& y) { return model->energy(y); },
+  const auto c = msm::test::check_derivatives([&](const Eigen::VectorXd& y) { return model->energy(y); },
                                          grad(*model), dense_hessian(*model, false), x, 1e-9);
   EXPECT_LT(c.gradient_error, 1e-6);
   EXPECT_LT(c.hessian_error, 1e-6);
@@ -132,7 +132,7 @@ TEST(VolumeTerm, HybridModelIsTheSumOfItsTermsAndMatchesFiniteDifferences) {
   const auto roi_model = make_model(roi.network, built.volume_kappa);
   const Eigen::VectorXd xr = perturbed(flatten(roi.network.nodes), rng, 0.05e-3);
   const auto cr =
-      test::check_derivatives([&](const Eigen::VectorXd& y) { return roi_model->energy(y); },
+      msm::test::check_derivatives([&](const Eigen::VectorXd& y) { return roi_model->energy(y); },
                               grad(*roi_model), dense_hessian(*roi_model, false), xr, 1e-9);
   EXPECT_LT(cr.gradient_error, 1e-6);
   EXPECT_LT(cr.hessian_error, 1e-6);

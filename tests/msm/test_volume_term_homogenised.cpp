@@ -174,7 +174,7 @@ TEST(VolumeTermHomogenised, PerTetFactorsEnterTheEnergyAndSurviveARegionOfIntere
   Eigen::VectorXd x = flatten(built.network.nodes);
   std::uniform_real_distribution<double> u(-0.03e-3, 0.03e-3);
   for (Eigen::Index i = 0; i < x.size(); ++i) x[i] += u(rng);
-  const auto c = test::check_form_derivatives(*model, x, 1e-9);
+  const auto c = msm::test::check_form_derivatives(*model, x, 1e-9);
   EXPECT_LT(c.gradient_error, 1e-6);
   EXPECT_LT(c.hessian_error, 1e-6);
   // At rest the assembled Hessian (no projection) is positive definite on the non-rigid motions:
