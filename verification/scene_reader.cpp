@@ -82,8 +82,10 @@ void TableReader::enter(const std::string& variant) {
       fail(&node, k, "unknown key; expected one of: " + join(scene_key_names(section_, variant_)));
     }
   }
+  // Required sections are checked when read (sub), so that a section's own errors come first.
   for (const SceneKey& k : scene_keys()) {
-    if (k.section == section_ && k.required && k.applies_to(variant_) && !table_.get(k.name)) {
+    if (k.section == section_ && k.required && k.applies_to(variant_) && !table_.get(k.name) &&
+        k.type != KeyType::table && k.type != KeyType::tables) {
       fail(nullptr, k.name, missing_text(k));
     }
   }
@@ -255,6 +257,7 @@ Vec3 TableReader::vector3(const toml::node& n, const std::string& key) const {
 
 TableReader TableReader::sub(const std::string& key) const {
   const toml::node* n = get(key);
+  if (!n && spec(key).required) fail(nullptr, key, missing_text(spec(key)));
   if (!n) return TableReader(empty_, key, prefix_ + key + ".", file_);
   if (!n->is_table()) fail_value(*n, key, show(*n));
   return TableReader(*n->as_table(), key, prefix_ + key + ".", file_);

@@ -23,7 +23,8 @@ class TableReader {
   TableReader(const toml::table& table, std::string section, std::string prefix, std::string file);
 
   /// Sets the variant (a model's kind, a load's type, the vessel's form) and checks the table:
-  /// its first key not in the variant is an unknown key, a required key absent is missing.
+  /// its first key not in the variant is an unknown key, a required value absent is missing (a
+  /// required section is checked when read, by sub).
   void enter(const std::string& variant);
 
   [[noreturn]] void fail(const toml::node* node, const std::string& key,
@@ -60,7 +61,7 @@ class TableReader {
   std::vector<std::string> string_array(const std::string& key) const;
   Vec3 vector3(const toml::node& n, const std::string& key) const;
 
-  /// The sub-table `key` (an empty one when absent).
+  /// The sub-table `key` (an empty one when absent; missing if required).
   TableReader sub(const std::string& key) const;
 
   const toml::table& table() const { return table_; }
