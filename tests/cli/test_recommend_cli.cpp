@@ -2,7 +2,8 @@
 // against a level-0 reference: a few seconds). The answer is checked against the budget's
 // definition from the written evidence: the recommended candidate meets the tolerance and the
 // time per update, and every candidate faster than it (beyond the 5 % timing tie) misses one;
-// the report embeds the section.
+// the report embeds the section. The first test's time budget (10 s per update) is one every
+// candidate meets, so what it checks does not depend on the machine's speed.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -45,7 +46,9 @@ rate_hz = 30
 
 TEST(RecommendCli, NamesACandidateThatMeetsTheBudgetWithItsEvidence) {
   TempDir dir;
-  write_text(dir / "scene.toml", kScene);
+  std::string scene = kScene;
+  scene.replace(scene.find("rate_hz = 30"), 12, "time_budget_s = 10");
+  write_text(dir / "scene.toml", scene);
   const auto out = dir / "rec";
   const CommandResult r = vv("recommend --quick --repeats 1 --roi-radii 0.004 --output-dir " +
                              out.string() + " " + (dir / "scene.toml").string());
@@ -53,12 +56,12 @@ TEST(RecommendCli, NamesACandidateThatMeetsTheBudgetWithItsEvidence) {
   const nlohmann::json j = nlohmann::json::parse(read_text(out / "recommend.json"));
   EXPECT_EQ(j["schema"], "vesselverify.recommend");
   EXPECT_EQ(j["budget"]["quantity"], "patch");
-  EXPECT_DOUBLE_EQ(j["budget"]["seconds_per_update"].get<double>(), 1.0 / 30.0);
+  EXPECT_DOUBLE_EQ(j["budget"]["seconds_per_update"].get<double>(), 10.0);
   // FEM P1 + (2 kinds × 6 rules + the hybrid volume model under its two moduli rules + the
   // edge-pair volume model + the discrete-shells surface model) × (static, linear, R = 4 mm),
   // level 0.
   ASSERT_EQ(j["candidates"].size(), 49u);
-  const double tol = 0.05, budget = 1.0 / 30.0;
+  const double tol = 0.05, budget = 10.0;
   ASSERT_FALSE(j["recommended"].is_null()) << read_text(out / "recommend.md");
   const std::string best = j["recommended"];
   double best_time = 0.0;

@@ -3,6 +3,7 @@
 /// (incompressible, follower pressure) and a manufactured solution of compressible neo-Hookean,
 /// each returning its relative L2 error on one level of the short structured tube.
 #include <array>
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <stdexcept>
@@ -57,25 +58,53 @@ inline Vec3 manufactured_u(const Vec3& p) {
   return kManufacturedScale * Vec3(x * x * y, y * y * z, z * z * x);
 }
 
-/// b = −Div P(F(X)): Div P_a = Σ_J ∂P_aJ/∂X_J = Σ_{J,b,L} (∂P/∂F)_aJbL ∂²u_b/∂X_L∂X_J, with
-/// u's second derivatives by hand (u_0: ∂xx = 2sy, ∂xy = 2sx; u_1: ∂yy = 2sz, ∂yz = 2sy;
-/// u_2: ∂zz = 2sx, ∂zx = 2sz) and ∂P/∂F the kernel's tangent (checked against finite differences
-/// of the energy in test_hyperelastic.cpp).
-inline Vec3 manufactured_body_force(const Vec3& p, const fem::NeoHookean& nh) {
+/// F = I + ∇u of manufactured_u, by hand.
+inline fem::Mat3 manufactured_F(const Vec3& p) {
   const double s = kManufacturedScale, x = p.x(), y = p.y(), z = p.z();
-  fem::Mat3 F = fem::Mat3::Identity();
-  F +=
-      s * (fem::Mat3() << 2 * x * y, x * x, 0, 0, 2 * y * z, y * y, z * z, 0, 2 * z * x).finished();
-  std::array<fem::Mat3, 3> H;
+  return fem::Mat3::Identity() +
+         s * (fem::Mat3() << 2 * x * y, x * x, 0, 0, 2 * y * z, y * y, z * z, 0, 2 * z * x)
+                 .finished();
+}
+
+/// ∂F/∂X_J of manufactured_u, by hand: (∂F/∂X_J)_aL = ∂²u_a/∂X_L∂X_J (u_0: ∂xx = 2sy,
+/// ∂xy = 2sx; u_1: ∂yy = 2sz, ∂yz = 2sy; u_2: ∂zz = 2sx, ∂zx = 2sz).
+inline std::array<fem::Mat3, 3> manufactured_dF(const Vec3& p) {
+  const double s = kManufacturedScale, x = p.x(), y = p.y(), z = p.z();
+  std::array<fem::Mat3, 3> H;  // H[a](L, J) = ∂²u_a/∂X_L∂X_J
   H[0] << 2 * s * y, 2 * s * x, 0, 2 * s * x, 0, 0, 0, 0, 0;
   H[1] << 0, 0, 0, 0, 2 * s * z, 2 * s * y, 0, 2 * s * y, 0;
   H[2] << 0, 0, 2 * s * z, 0, 0, 0, 2 * s * z, 0, 2 * s * x;
-  const fem::Mat9 A = nh.tangent(F);
+  std::array<fem::Mat3, 3> dF;
+  for (int J = 0; J < 3; ++J)
+    for (int a = 0; a < 3; ++a)
+      for (int L = 0; L < 3; ++L) dF[J](a, L) = H[a](L, J);
+  return dF;
+}
+
+/// Compressible neo-Hookean's first Piola–Kirchhoff stress written here, apart from the product:
+/// Ψ = μ/2 (tr FᵀF − 3) − μ ln J + λ/2 (ln J)², P = ∂Ψ/∂F = μ F + (λ ln J − μ) F⁻ᵀ (Bonet & Wood,
+/// Nonlinear Continuum Mechanics for FEA, 2nd ed., eq. 6.28). test_hyperelastic_verification.cpp
+/// checks it against finite differences of the product's energy.
+inline fem::Mat3 neo_hookean_stress(const fem::Mat3& F, double mu, double lambda) {
+  const fem::Mat3 F_invT = F.inverse().transpose();
+  return mu * F + (lambda * std::log(F.determinant()) - mu) * F_invT;
+}
+
+/// b = −Div P(F(X)), Div P_a = Σ_J ∂P_aJ/∂X_J, by the chain rule on neo_hookean_stress:
+/// ∂_J P = μ ∂_J F + λ tr(F⁻¹ ∂_J F) F⁻ᵀ − (λ ln J − μ) F⁻ᵀ (∂_J F)ᵀ F⁻ᵀ (∂_J ln J = tr(F⁻¹ ∂_J F),
+/// ∂_J F⁻ᵀ = −F⁻ᵀ (∂_J F)ᵀ F⁻ᵀ). Independent of the product's stress and tangent.
+inline Vec3 manufactured_body_force(const Vec3& p, double mu, double lambda) {
+  const fem::Mat3 F = manufactured_F(p);
+  const fem::Mat3 F_inv = F.inverse();
+  const fem::Mat3 F_invT = F_inv.transpose();
+  const double c = lambda * std::log(F.determinant()) - mu;
+  const auto dF = manufactured_dF(p);
   Vec3 div = Vec3::Zero();
-  for (int a = 0; a < 3; ++a)
-    for (int J = 0; J < 3; ++J)
-      for (int b = 0; b < 3; ++b)
-        for (int L = 0; L < 3; ++L) div[a] += A(3 * a + J, 3 * b + L) * H[b](L, J);
+  for (int J = 0; J < 3; ++J) {
+    const fem::Mat3 dP = mu * dF[J] + lambda * (F_inv * dF[J]).trace() * F_invT -
+                         c * F_invT * dF[J].transpose() * F_invT;
+    div += dP.col(J);
+  }
   return -div;
 }
 
@@ -85,8 +114,8 @@ inline FiniteRun manufactured_run(int degree, int level) {
   p.material.poisson_ratio = 0.3;
   p.options.degree = degree;
   p.options.formulation = fem::Formulation::displacement;
-  const fem::NeoHookean nh = fem::NeoHookean::of(p.material);
-  p.body_force = [nh](const Vec3& x) { return manufactured_body_force(x, nh); };
+  const double mu = p.material.mu(), lambda = p.material.lambda();
+  p.body_force = [mu, lambda](const Vec3& x) { return manufactured_body_force(x, mu, lambda); };
   for (const char* g : {"inlet", "outlet", "inner_wall", "outer_wall"})
     p.dirichlet.push_back(fem::DirichletCondition::clamped(g, manufactured_u));
   fem::HyperelasticSolver s(short_tube_mesh(level), p);

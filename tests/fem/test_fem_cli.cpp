@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 #include <filesystem>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "../test_helpers.hpp"
@@ -88,28 +89,54 @@ TEST(FemCli, BadInputExitsOneWithAClearMessageAndWritesNothing) {
 
 TEST(FemCli, ModesArePrintedAndWritten) {
   TempDir dir;
-  const auto r =
-      vv("fem " + kTube + "--bc clamped-inlet --modes 4 --json " + (dir / "m.json").string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_TRUE(contains(r.output, "f (Hz):")) << r.output;
-  const auto j = nlohmann::json::parse(vessel::test::read_text(dir / "m.json"));
-  ASSERT_EQ(j["modal"]["frequencies_hz"].size(), 4u);
-  EXPECT_GT(j["modal"]["frequencies_hz"][0].get<double>(), 0.0);
+  const auto modes = [&](const std::string& material, const std::string& name) {
+    const auto json = dir / name;
+    const auto r = vv("fem " + kTube + "--bc clamped-inlet --modes 4 " + material + " --json " +
+                      json.string());
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "f (Hz):")) << r.output;
+    return nlohmann::json::parse(vessel::test::read_text(json))["modal"]["frequencies_hz"];
+  };
+  const auto f = modes("", "m.json");
+  ASSERT_EQ(f.size(), 4u);
+  EXPECT_GT(f[0].get<double>(), 0.0);
+  // K ∝ E and M ∝ ρ, so f ∝ √(E/ρ): 4 E doubles every frequency, 4 ρ halves it.
+  const auto stiff = modes("--E 56.96e3", "stiff.json");
+  const auto heavy = modes("--density 4240", "heavy.json");
+  ASSERT_EQ(stiff.size(), 4u);
+  ASSERT_EQ(heavy.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const double fi = f[i].get<double>();
+    EXPECT_NEAR(stiff[i].get<double>(), 2.0 * fi, 1e-9 * fi) << i;  // measured 2e-15
+    EXPECT_NEAR(heavy[i].get<double>(), 0.5 * fi, 1e-9 * fi) << i;
+    if (i > 0) EXPECT_GE(fi, f[i - 1].get<double>());
+  }
 }
 
 TEST(FemCli, TransientPrintsTheHistoryAndWritesTheCsv) {
   TempDir dir;
   const auto csv = dir / "h.csv";
-  const auto r = vv("fem " + kTube +
-                    "--load contact --contact-point 0.003 0 0.001 --transient --dt 2e-4 --steps "
-                    "30 --mass-damping 50 --history-csv " +
+  const std::string load = "--load contact --contact-point 0.003 0 0.001 ";
+  // Mass damping 1e4 /s: the step response has settled after 300 steps (60 ms).
+  const auto r = vv("fem " + kTube + load +
+                    "--transient --dt 2e-4 --steps 300 --mass-damping 1e4 --history-csv " +
                     csv.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "Newmark")) << r.output;
   EXPECT_TRUE(contains(r.output, "ms/step")) << r.output;
   const std::string text = vessel::test::read_text(csv);
-  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 32);  // header + steps + 1 rows
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 302);  // header + steps + 1 rows
   EXPECT_EQ(text.rfind("t_s,ux_mm", 0), 0u) << text.substr(0, 80);
+  // Heavily damped, the step response settles on the static solve of the same load (measured
+  // agreement: the CSV's 12 digits).
+  const auto s = vv("fem " + kTube + load + "--json " + (dir / "s.json").string());
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const auto j = nlohmann::json::parse(vessel::test::read_text(dir / "s.json"));
+  const double ux_static = j["contact"]["displacement_mm"][0].get<double>();
+  const std::string last = text.substr(text.rfind('\n', text.size() - 2) + 1);
+  const double ux_end = std::stod(last.substr(last.find(',') + 1));
+  std::cout << "  transient end ux " << ux_end << " mm, static " << ux_static << " mm\n";
+  EXPECT_NEAR(ux_end, ux_static, 1e-8 * std::abs(ux_static));
 }
 
 TEST(FemCli, TransientRefusesABadTimeStepAndWritesNothing) {

@@ -5,6 +5,8 @@
 // The closed-form ring is in test_bending_closed_form.cpp.
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <map>
@@ -345,12 +347,18 @@ TEST(BendingTerm, EverySolverRunsOnTheShellModelAndAgrees) {
   const double u = (x_static - p.rest).norm();
   ASSERT_GT(u, 0.0);
   EXPECT_LT((solve(q, parse_solver("linear")).x - x_static).norm(), 0.02 * u);
-  EXPECT_LT((solve(q, parse_solver("relaxation")).x - x_static).norm(), 0.01 * u);
+  const double relaxation = (solve(q, parse_solver("relaxation")).x - x_static).norm() / u;
+  std::cout << "  relaxation: |x - x_static| / |u| = " << relaxation << "\n";
+  // Relaxation stops at ‖∇Π‖ ≤ 1e-8 ‖f‖: measured 4.7e-8 of |u| here; the integrators run to rest
+  // (1.8e-10 of |u|, the static solve's own tolerance).
+  EXPECT_LT(relaxation, 5e-7);
   for (const char* name : {"symplectic-euler", "verlet", "implicit-euler", "implicit-euler-rest"}) {
     SolverSpec s = parse_solver(name);
     s.steps = std::string(name).starts_with("implicit") ? 400 : 20000;
     const SolveResult r = solve(p, s);
-    EXPECT_LT((r.x - x_static).norm(), 0.05 * u) << name << " dt " << r.dt;
+    const double rel = (r.x - x_static).norm() / u;
+    std::cout << "  " << name << " dt " << r.dt << ": |x - x_static| / |u| = " << rel << "\n";
+    EXPECT_LT(rel, 1e-8) << name << " dt " << r.dt;
   }
   EXPECT_THROW((void)solve(q, parse_solver("local-global")), InputError);
   SolverSpec pbd = parse_solver("pbd");

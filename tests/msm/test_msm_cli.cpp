@@ -2,7 +2,9 @@
 // statically and dynamically; bad input and divergence give a clear message, exit 1, no file.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "../test_helpers.hpp"
@@ -71,26 +73,59 @@ TEST_F(MsmCli, StructuredGridHasSeed000FamiliesAndEveryDynamicSolverRuns) {
   const auto g = vv("--structured --surface mid --solver linear --patch-radius 1.5e-3");
   ASSERT_EQ(g.exit_code, 0) << g.output;
   EXPECT_TRUE(contains(g.output, "structural 1080 shear 1056 bend 1056")) << g.output;
-  for (const std::string solver :
-       {"explicit-euler", "symplectic-euler", "verlet", "implicit-euler", "pbd"}) {
-    const auto r = vv("--structured --patch-radius 1.5e-3 --solver " + solver + " --steps 20");
-    EXPECT_EQ(r.exit_code, 0) << solver << "\n" << r.output;
+  // The integrators' first steps from rest under the step load, closed forms with a0 = M⁻¹F
+  // (the springs exert nothing at rest): explicit Euler x1 = x0, x2 = x0 + h²a0; symplectic
+  // Euler x1 = x0 + h²a0; Verlet x1 = x0 + h²a0/2. The contact point's displacement is linear
+  // in x − x0, so it follows the same ratios.
+  const auto displacement = [&](const std::string& args, const std::string& name) {
+    const auto json = dir / (name + ".json");
+    const auto r = vv(args + " --dt 1e-6 --json " + json.string());
+    EXPECT_EQ(r.exit_code, 0) << args << "\n" << r.output;
     EXPECT_TRUE(contains(r.output, "per step")) << r.output;
-  }
-  const auto vol = vv("--model volume --solver verlet --steps 20");
-  EXPECT_EQ(vol.exit_code, 0) << vol.output;
-  // The prefactored variant on the model whose stiffness at rest it relies on (on the surface
-  // membrane the tension-borne transverse stiffness is missing from it: see README).
-  const auto rest = vv("--model volume --solver implicit-euler-rest --steps 20");
+    if (r.exit_code != 0) return std::nan("");
+    return nlohmann::json::parse(read_text(json))["contact_displacement_along_load_mm"].get<double>();
+  };
+  const std::string grid = "--structured --patch-radius 1.5e-3 --solver ";
+  const double ee1 = displacement(grid + "explicit-euler --steps 1", "ee1");
+  const double ee2 = displacement(grid + "explicit-euler --steps 2", "ee2");
+  const double se1 = displacement(grid + "symplectic-euler --steps 1", "se1");
+  const double vv1 = displacement(grid + "verlet --steps 1", "vv1");
+  EXPECT_GT(se1, 0.0);
+  EXPECT_EQ(ee1, 0.0);
+  EXPECT_NEAR(ee2, se1, 1e-9 * se1);  // measured: equal to the last digit
+  EXPECT_NEAR(vv1, 0.5 * se1, 1e-9 * se1);
+  const auto pbd = vv(grid + "pbd --steps 20");
+  EXPECT_EQ(pbd.exit_code, 0) << pbd.output;
+  EXPECT_TRUE(contains(pbd.output, "per step")) << pbd.output;
+  // The volume model: Verlet's first step half symplectic Euler's again; implicit Euler by its
+  // direct solve and by conjugate gradients (to relative residual 1e-8) take the same steps, on
+  // the current and on the rest matrix.
+  const double vol_se = displacement("--model volume --solver symplectic-euler --steps 1", "vse");
+  const double vol_vv = displacement("--model volume --solver verlet --steps 1", "vvv");
+  EXPECT_GT(vol_se, 0.0);
+  EXPECT_NEAR(vol_vv, 0.5 * vol_se, 1e-9 * vol_se);
+  const auto rest = vv("--model volume --solver implicit-euler-rest --steps 5 --dt 1e-6");
   EXPECT_EQ(rest.exit_code, 0) << rest.output;
   EXPECT_TRUE(contains(rest.output, "set-up (assembly and factorisation at rest)")) << rest.output;
-  // The same steps by conjugate gradients, which print their iterations per step.
-  for (const std::string solver : {"implicit-euler-pcg", "implicit-euler-rest-pcg"}) {
-    const auto cg = vv("--model volume --solver " + solver +
-                       " --steps 5 --cg-tolerance 1e-8 --cg-preconditioner jacobi");
-    EXPECT_EQ(cg.exit_code, 0) << solver << "\n" << cg.output;
-    EXPECT_TRUE(contains(cg.output, "conjugate gradients to relative residual 1e-08")) << cg.output;
+  const std::string cg = " --steps 5 --cg-tolerance 1e-8 --cg-preconditioner jacobi";
+  std::map<std::string, double> direct_of;
+  for (const std::string solver : {"implicit-euler", "implicit-euler-rest"}) {
+    const double direct = displacement("--model volume --steps 5 --solver " + solver, solver);
+    direct_of[solver] = direct;
+    const auto pcg = dir / (solver + "-pcg.json");
+    const auto r = vv("--model volume --dt 1e-6 --solver " + solver + "-pcg" + cg + " --json " +
+                      pcg.string());
+    EXPECT_EQ(r.exit_code, 0) << solver << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, "conjugate gradients to relative residual 1e-08")) << r.output;
+    const double iterative =
+        nlohmann::json::parse(read_text(pcg))["contact_displacement_along_load_mm"].get<double>();
+    EXPECT_GT(direct, 0.0) << solver;
+    EXPECT_NEAR(iterative, direct, 1e-8 * direct) << solver;  // measured 2.7e-10
   }
+  // Five steps of 1 µs from rest move the wall by ~3e-8 mm: the current matrix is the rest one
+  // to ~1e-9 (measured 1.9e-9 apart).
+  EXPECT_NEAR(direct_of["implicit-euler-rest"], direct_of["implicit-euler"],
+              1e-7 * direct_of["implicit-euler"]);
 }
 
 TEST_F(MsmCli, BadInputNamesTheParameterAndExitsOne) {

@@ -3,6 +3,8 @@
 // the per-element PSD projection, the critical-step bound, a region of interest, and every solver.
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <random>
@@ -195,12 +197,18 @@ TEST(VolumeTerm, EverySolverRunsOnTheHybridModelAndAgrees) {
   const double u = (x_static - p.rest).norm();
   ASSERT_GT(u, 0.0);
   EXPECT_LT((solve(q, parse_solver("linear")).x - x_static).norm(), 0.02 * u);
-  EXPECT_LT((solve(q, parse_solver("relaxation")).x - x_static).norm(), 0.01 * u);
+  const double relaxation = (solve(q, parse_solver("relaxation")).x - x_static).norm() / u;
+  std::cout << "  relaxation: |x - x_static| / |u| = " << relaxation << "\n";
+  // Relaxation stops at ‖∇Π‖ ≤ 1e-8 ‖f‖: measured 5.7e-8 of |u| here; the integrators run to rest
+  // (4e-13 to 5.4e-13 of |u|, the static solve's own tolerance).
+  EXPECT_LT(relaxation, 5e-7);
   for (const char* name : {"symplectic-euler", "verlet", "implicit-euler", "implicit-euler-rest"}) {
     SolverSpec s = parse_solver(name);
     s.steps = std::string(name).starts_with("implicit") ? 400 : 20000;
     const SolveResult r = solve(p, s);
-    EXPECT_LT((r.x - x_static).norm(), 0.05 * u) << name << " dt " << r.dt;
+    const double rel = (r.x - x_static).norm() / u;
+    std::cout << "  " << name << " dt " << r.dt << ": |x - x_static| / |u| = " << rel << "\n";
+    EXPECT_LT(rel, 1e-8) << name << " dt " << r.dt;
   }
   EXPECT_THROW((void)solve(p, parse_solver("pbd")), InputError);
 }

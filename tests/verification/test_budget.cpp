@@ -151,7 +151,7 @@ TEST(Roi, RadiusIsReadAndAnArraySweepsIt) {
 TEST(Roi, RefusedWhereItMeansNothing) {
   std::string zero = kContact;
   zero.insert(zero.find("solver"), "roi_radius = 0.0\n");
-  EXPECT_NE(error_of(zero).find("models[0].roi_radius': found 0, expected a radius > 0 m"),
+  EXPECT_NE(error_of(zero).find("models[0].roi_radius': found 0, expected a number > 0 m"),
             std::string::npos)
       << error_of(zero);
   std::string pressure = kPressure;

@@ -3,6 +3,8 @@
 // linear scaling, and a diverging model recorded as failed while the others still run.
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -170,8 +172,11 @@ TEST_F(HarnessLame, AModelIdenticalToTheReferenceHasZeroError) {
 TEST_F(HarnessLame, P1IsLessAccurateThanTheReferenceButClose) {
   const ModelOutcome& o = find(*result_, "p1", 10.0);
   ASSERT_TRUE(o.ok);
-  EXPECT_GT(o.error.relative_l2, 1e-4);
-  EXPECT_LT(o.error.relative_l2, 0.3);
+  std::cout << "  P1 against P2 on level 0: relative L2 error " << o.error.relative_l2 << "\n";
+  // Measured 0.162 (structured level 0, ν = 0.3, against P2 on the same mesh): P1's
+  // discretisation error there, so a P1 that lost accuracy or a metric gone wrong moves it.
+  EXPECT_GT(o.error.relative_l2, 0.14);
+  EXPECT_LT(o.error.relative_l2, 0.18);
 }
 
 TEST_F(HarnessLame, LinearModelsScaleExactlyWithTheLoad) {

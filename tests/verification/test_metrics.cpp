@@ -1,6 +1,9 @@
 // Error statistics and timing helpers against hand-computed values.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
 #include <cmath>
 #include <sstream>
 
@@ -53,10 +56,16 @@ TEST(Timing, TimeMedianRunsWarmupPlusRepeats) {
 TEST(Progress, CountsCasesAndPrintsWhatIsLeft) {
   std::ostringstream out;
   Progress p(out, 2);
+  EXPECT_EQ(p.estimated_remaining_s(), 0.0);  // nothing done: no estimate
   p.begin("case A");
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
   p.end();
   EXPECT_EQ(p.done(), 1u);
   EXPECT_NE(out.str().find("[1/2] case A"), std::string::npos);
   EXPECT_NE(out.str().find("done 1/2"), std::string::npos);
-  EXPECT_GE(p.estimated_remaining_s(), 0.0);
+  // One case of two took at least the 20 ms slept: about as long again is left.
+  EXPECT_GE(p.estimated_remaining_s(), 0.020);
+  p.begin("case B");
+  p.end();
+  EXPECT_EQ(p.estimated_remaining_s(), 0.0);  // all done
 }

@@ -3,6 +3,7 @@
 
 #include "verification/cli/commands.hpp"
 #include "verification/scene.hpp"
+#include "verification/scene_keys.hpp"
 
 namespace vessel::cli {
 
@@ -26,13 +27,22 @@ void print_scene(const Scene& s) {
 
 void add_scene_command(CLI::App& app) {
   auto files = std::make_shared<std::vector<std::string>>();
+  auto schema = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand(
       "scene",
       "Validate scene files (TOML) and print what each would run. Unknown keys, wrong types and "
-      "out-of-range values are reported with file, line and key.\n"
-      "Example:\n  vesselverify scene verification/scenes/*.toml");
-  cmd->add_option("files", *files, "Scene files")->required();
-  cmd->callback([files] {
+      "out-of-range values are reported with file, line and key. --schema prints every key "
+      "(type, default, unit, range, meaning) as JSON Schema; docs/scene_reference.md is made "
+      "from it.\n"
+      "Examples:\n  vesselverify scene verification/scenes/*.toml\n  vesselverify scene --schema");
+  cmd->add_option("files", *files, "Scene files");
+  cmd->add_flag("--schema", *schema, "Print the scene files' JSON Schema and exit");
+  cmd->callback([files, schema] {
+    if (*schema) {
+      std::cout << scene_json_schema();
+      return;
+    }
+    if (files->empty()) throw CLI::RequiredError("files (or --schema)");
     for (const auto& f : *files) print_scene(read_scene(f));
   });
 }
