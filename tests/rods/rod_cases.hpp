@@ -33,5 +33,7 @@ class RodAdapter {
 };
 
 std::unique_ptr<RodAdapter> make_der_adapter();
+/// CORDE with alignment penalty κ (N; ≤ 0: the section's shear stiffness 0.9 G A).
+std::unique_ptr<RodAdapter> make_corde_adapter(double alignment = 0.0);
 
 }  // namespace vessel::msm::rods::test

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "../msm/finite_differences.hpp"
+#include "msm/rods/corde_rod.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "msm/rods/rod_loads.hpp"
 #include "rod_cases.hpp"
@@ -68,6 +69,49 @@ TEST(RodDerivatives, PlanarEndMomentAgreesWithFiniteDifferences) {
   moment.set_moment(0.7);
   const VectorXd x = perturbed(rod.rest_state(), 5e-3, 4);
   const auto c = check_form_derivatives(moment, x, 1e-7);
+  EXPECT_LT(c.gradient_error, 1e-6);
+  EXPECT_LT(c.hessian_error, 1e-6);
+}
+
+}  // namespace
+}  // namespace vessel::msm::rods::test
+
+namespace vessel::msm::rods::test {
+namespace {
+
+using vessel::msm::test::check_derivatives;
+using vessel::msm::test::check_form_derivatives;
+
+TEST(RodDerivatives, CordeEnergyGradientHessianAgreeWithFiniteDifferences) {
+  const CordeRod rod(make_layout(small_rod()));
+  const VectorXd x = perturbed(rod.rest_state(), 3e-3, 5);
+  const auto c = check_form_derivatives(rod, x, 1e-7);
+  EXPECT_LT(c.gradient_error, 1e-6);
+  EXPECT_LT(c.hessian_error, 1e-6);
+}
+
+TEST(RodDerivatives, CordeConstraintJacobianAndWeightedHessian) {
+  const CordeRod rod(make_layout(small_rod()));
+  const VectorXd x = perturbed(rod.rest_state(), 3e-3, 6);
+  const VectorXd lambda = perturbed(VectorXd::Zero(rod.num_constraints()), 1.0, 7);
+  // λ·c(x) as a scalar function: its gradient is Jᵀλ, its Hessian Σ λ_k ∇²c_k.
+  const auto c = check_derivatives(
+      [&](const VectorXd& y) {
+        VectorXd cy;
+        rod.evaluate(y, cy);
+        return lambda.dot(cy);
+      },
+      [&](const VectorXd& y) -> VectorXd {
+        SparseMatrix J;
+        rod.jacobian(y, J);
+        return J.transpose() * lambda;
+      },
+      [&](const VectorXd& y) -> Eigen::MatrixXd {
+        SparseMatrix H;
+        rod.weighted_hessian(y, lambda, H);
+        return Eigen::MatrixXd(H);
+      },
+      x, 1e-7);
   EXPECT_LT(c.gradient_error, 1e-6);
   EXPECT_LT(c.hessian_error, 1e-6);
 }
