@@ -86,7 +86,7 @@ ConstrainedResult solve_constrained(const ConstrainedProblem& problem, const Vec
     const double g = r.gradient.norm();
     // Converged at the tolerance, or at the round-off floor: a stiff penalty (κ ≫ EI/L²) leaves
     // ∇L at about ε·κ; there a Newton step no longer halves it.
-    const bool stalled = g <= 1e-6 * fs && g > 0.5 * previous;
+    const bool stalled = g <= 1e-4 * fs && g > 0.5 * previous;
     previous = g;
     if ((g <= options.tolerance * fs || stalled) && cmax <= options.constraint_tolerance) {
       result.x = x;

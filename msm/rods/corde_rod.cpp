@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "msm/rods/cosserat_terms.hpp"
 #include "msm/rods/element_assembly.hpp"
 #include "msm/rods/rod_loads.hpp"
 #include "msm/rods/vec3.hpp"
@@ -12,26 +13,17 @@ namespace vessel::msm::rods {
 
 namespace {
 
-/// Bending and torsion at a vertex: q_a (4), q_b (4); Ω = (2/l̄)(w_a v_b − w_b v_a − v_a × v_b).
+/// Bending and torsion at a vertex: q_a (4), q_b (4).
 template <class T>
 T darboux_energy(const std::array<T, 8>& q, double lbar, double EI, double GJ) {
-  const V3<T> va(q[1], q[2], q[3]), vb(q[5], q[6], q[7]);
-  const V3<T> im = q[0] * vb - q[4] * va - cross(va, vb);
-  const V3<T> omega = (2.0 / lbar) * im;
+  const V3<T> omega = darboux_vector(q, lbar);
   return 0.5 * lbar * (EI * (omega.x * omega.x + omega.y * omega.y) + GJ * omega.z * omega.z);
 }
 
-/// d3 of quaternion (w, x, y, z): its rotation of e3.
-template <class T>
-V3<T> director3(const T& w, const T& x, const T& y, const T& z) {
-  return {2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y)};
-}
-
-/// (κ/2) l |(P1 − P0)/l − d3(q)|²: P0 (3), P1 (3), q (4).
+/// (κ/2) l |Γ|²: P0 (3), P1 (3), q (4).
 template <class T>
 T alignment_energy(const std::array<T, 10>& q, double kappa, double l) {
-  const V3<T> e = V3<T>(q[3], q[4], q[5]) - V3<T>(q[0], q[1], q[2]);
-  const V3<T> d = (1.0 / l) * e - director3(q[6], q[7], q[8], q[9]);
+  const V3<T> d = stretch_shear_strain(q, l);
   return 0.5 * kappa * l * dot(d, d);
 }
 
@@ -55,7 +47,8 @@ std::array<int, N> consecutive(int first) {
 
 }  // namespace
 
-CordeRod::CordeRod(RodLayout layout, double alignment) : layout_(std::move(layout)) {
+CordeRod::CordeRod(RodLayout layout, double alignment, bool inextensible)
+    : layout_(std::move(layout)), inextensible_(inextensible) {
   // GJ = G·2I = G·A d²/8 → G·A = 8 GJ/d², the first material edge's d² = 16 I/A = 16 EI/EA.
   const SectionStiffness& s = layout_.section[1];
   const double d2 = 16.0 * s.EI / s.EA;
@@ -177,20 +170,20 @@ void CordeRod::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) con
 int CordeRod::num_constraints() const {
   int material = 0;
   for (char g : layout_.ghost) material += g ? 0 : 1;
-  return 2 * material;
+  return (inextensible_ ? 2 : 1) * material;
 }
 
 namespace {
 
-/// Visits each material edge's two constraints: (row, stretch dofs, rest length), (row + 1, q dofs).
+/// Visits each material edge's constraints: (row, stretch dofs, rest length) if inextensible,
+/// then (next row, q dofs).
 template <class Stretch, class Unit>
 void for_each_constraint(const CordeRod& rod, Stretch&& stretch, Unit&& unit) {
   int row = 0;
   for (int j = 0; j < rod.layout().num_edges(); ++j) {
     if (rod.layout().ghost[j]) continue;
-    stretch(row, consecutive<6>(3 * j), rod.layout().length[j]);
-    unit(row + 1, consecutive<4>(rod.quaternion_dof(j)));
-    row += 2;
+    if (rod.inextensible()) stretch(row++, consecutive<6>(3 * j), rod.layout().length[j]);
+    unit(row++, consecutive<4>(rod.quaternion_dof(j)));
   }
 }
 

@@ -24,7 +24,9 @@ class CordeRod : public Form, public EqualityConstraints {
  public:
   /// `alignment`: κ, N. Default (≤ 0): the section's shear stiffness 0.9·G·A (Timoshenko's
   /// coefficient of a solid circle), which makes CORDE a shearable Cosserat rod.
-  CordeRod(RodLayout layout, double alignment = 0.0);
+  /// `inextensible` false: the unit quaternions are the only constraints (the XPBD rod's energy,
+  /// whose stretch is the alignment penalty's).
+  CordeRod(RodLayout layout, double alignment = 0.0, bool inextensible = true);
 
   [[nodiscard]] int num_dofs() const override;
   [[nodiscard]] double energy(const VectorXd& x) const override;
@@ -39,6 +41,7 @@ class CordeRod : public Form, public EqualityConstraints {
   [[nodiscard]] const RodLayout& layout() const { return layout_; }
   [[nodiscard]] int num_nodes() const { return layout_.num_nodes(); }
   [[nodiscard]] double alignment() const { return kappa_; }
+  [[nodiscard]] bool inextensible() const { return inextensible_; }
   /// Index of edge j's quaternion (w, x, y, z) in x.
   [[nodiscard]] int quaternion_dof(int edge) const { return 3 * num_nodes() + 4 * edge; }
   [[nodiscard]] VectorXd rest_state() const;
@@ -54,6 +57,7 @@ class CordeRod : public Form, public EqualityConstraints {
  private:
   RodLayout layout_;
   double kappa_;
+  bool inextensible_ = true;
   Eigen::Quaterniond frame0_;
 };
 
