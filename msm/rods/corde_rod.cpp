@@ -146,10 +146,10 @@ void CordeRod::gradient(const VectorXd& x, VectorXd& g) const {
   for_each_energy(
       *this,
       [&](const std::array<int, 8>& d, double lbar, double EI, double GJ) {
-        scatter_gradient<8>(darboux_energy(jet_inputs<8>(x, d), lbar, EI, GJ), d, g);
+        scatter_gradient<8, false>(darboux_energy(jet_inputs<8, false>(x, d), lbar, EI, GJ), d, g);
       },
       [&](const std::array<int, 10>& d, double l) {
-        scatter_gradient<10>(alignment_energy(jet_inputs<10>(x, d), kappa_, l), d, g);
+        scatter_gradient<10, false>(alignment_energy(jet_inputs<10, false>(x, d), kappa_, l), d, g);
       });
 }
 

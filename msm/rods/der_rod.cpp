@@ -158,10 +158,10 @@ void DerRod::gradient(const VectorXd& x, VectorXd& g) const {
   for_each_element(
       layout_, ref_t_, ref_u_,
       [&](const std::array<int, 11>& dofs, const VertexData& d) {
-        scatter_gradient<11>(vertex_energy(jet_inputs<11>(x, dofs), d), dofs, g);
+        scatter_gradient<11, false>(vertex_energy(jet_inputs<11, false>(x, dofs), d), dofs, g);
       },
       [&](const std::array<int, 6>& dofs, double EA, double l) {
-        scatter_gradient<6>(stretch_energy(jet_inputs<6>(x, dofs), EA, l), dofs, g);
+        scatter_gradient<6, false>(stretch_energy(jet_inputs<6, false>(x, dofs), EA, l), dofs, g);
       });
 }
 

@@ -11,8 +11,8 @@
 
 namespace vessel::msm::rods {
 
-template <int N>
-void scatter_gradient(const Jet<N>& e, const std::array<int, N>& dofs, Eigen::VectorXd& g) {
+template <int N, bool S>
+void scatter_gradient(const Jet<N, S>& e, const std::array<int, N>& dofs, Eigen::VectorXd& g) {
   for (int a = 0; a < N; ++a) g[dofs[a]] += e.g[a];
 }
 
@@ -30,11 +30,11 @@ void scatter_hessian(const Jet<N>& e, const std::array<int, N>& dofs, bool proje
   }
 }
 
-/// Variables 0..N−1 of a Jet<N> from the entries of x at `dofs`.
-template <int N>
-std::array<Jet<N>, N> jet_inputs(const Eigen::VectorXd& x, const std::array<int, N>& dofs) {
-  std::array<Jet<N>, N> q;
-  for (int a = 0; a < N; ++a) q[a] = Jet<N>::variable(x[dofs[a]], a);
+/// Variables 0..N−1 of a Jet<N> from the entries of x at `dofs` (Second = false: gradients only).
+template <int N, bool Second = true>
+std::array<Jet<N, Second>, N> jet_inputs(const Eigen::VectorXd& x, const std::array<int, N>& dofs) {
+  std::array<Jet<N, Second>, N> q;
+  for (int a = 0; a < N; ++a) q[a] = Jet<N, Second>::variable(x[dofs[a]], a);
   return q;
 }
 

@@ -70,7 +70,7 @@ void PlanarEndMoment::gradient(const VectorXd& x, VectorXd& g) const {
   g.setZero(num_dofs_);
   for (int i = first_vertex_; i <= last_vertex_; ++i) {
     const auto dofs = vertex_dofs(i);
-    scatter_gradient<9>(-moment_ * turning_angle(jet_inputs<9>(x, dofs), axis_), dofs, g);
+    scatter_gradient<9, false>(-moment_ * turning_angle(jet_inputs<9, false>(x, dofs), axis_), dofs, g);
   }
 }
 

@@ -14,7 +14,7 @@ namespace {
 template <int N, class F>
 void constraint_and_jacobian(const F& f, const Eigen::VectorXd& x, const std::array<int, N>& dofs,
                              Eigen::Vector3d& c, Eigen::Matrix<double, 3, N>& J) {
-  const V3<Jet<N>> r = f(jet_inputs<N>(x, dofs));
+  const V3<Jet<N, false>> r = f(jet_inputs<N, false>(x, dofs));
   c << r.x.v, r.y.v, r.z.v;
   J.row(0) = r.x.g.transpose();
   J.row(1) = r.y.g.transpose();
