@@ -14,6 +14,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libspectra-dev
+  libboost-dev                            # rod_theory: Boost.Math elliptic integrals, Odeint
   openmpi-bin                             # mpirun: fem --distributed and its tests
   python3-matplotlib python3-numpy        # reports (use /usr/bin/python3)
   libjs-three libjs-chart.js              # report.html: 3D views and plots, inlined when written

@@ -14,7 +14,9 @@ using SparseMatrix = Eigen::SparseMatrix<double>;
 class Form {
  public:
   virtual ~Form() = default;
-  /// Number of degrees of freedom (3 × nodes).
+  /// Number of degrees of freedom (3 × nodes for the mass-spring models; the rods of msm/rods
+  /// append their frames' dofs after the 3 × nodes positions: a twist angle per edge for DER, a
+  /// quaternion per edge for CORDE).
   [[nodiscard]] virtual int num_dofs() const = 0;
   /// Potential energy at x, J.
   [[nodiscard]] virtual double energy(const VectorXd& x) const = 0;

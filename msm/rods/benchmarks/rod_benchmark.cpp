@@ -1,0 +1,109 @@
+// Time per update of each rod model at N = 50, 200, 1000 segments, set-up apart (Google
+// Benchmark; Release build). A 1 m, 1 mm nitinol-like cantilever held at α = PL²/EI = 1:
+//  - *NewtonUpdate: the tip load moves by 1 % and the static equilibrium is solved again from
+//    the previous one (what a quasi-static haptic loop does each frame);
+//  - XpbdStep: one XPBD step (h = 1 ms, 4 Gauss–Seidel sweeps) under the same load;
+//  - DerImplicitStep: one implicit Euler step (msm/solvers/integrators, implicit-euler: the
+//    stiffness at the step's state, refactorised each step), dt = 1 ms, the same tip load. The
+//    prefactored variant (implicit-euler-rest) diverges here (N = 50, step 18): the stiffness at
+//    rest lacks the bent rod's geometric stiffness.
+#include <benchmark/benchmark.h>
+
+#include "msm/rods/corde_rod.hpp"
+#include "msm/rods/der_rod.hpp"
+#include "msm/rods/rod_statics.hpp"
+#include "msm/rods/xpbd_rod.hpp"
+#include "msm/solvers/integrators.hpp"
+
+namespace {
+
+using namespace vessel::msm;
+using namespace vessel::msm::rods;
+
+const RodMaterial kMaterial{50e9, 50e9 / 2.66, 6450.0};
+constexpr double kLength = 1.0, kDiameter = 1e-3;
+
+double tip_load(double alpha) {
+  return alpha * solid_section(kMaterial, kDiameter).EI / (kLength * kLength);
+}
+
+void BM_DerNewtonUpdate(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  DerRod rod(make_layout(uniform_rod(kMaterial, kLength, kDiameter, n)));
+  RodStaticLoad load;
+  load.force = VectorXd::Zero(rod.num_dofs());
+  const int tip = 3 * rod.layout().tip_node + 1;
+  load.force[tip] = tip_load(1.0);
+  load.start = solve_der_static(rod, load).x;
+  int iterations = 0, k = 0;
+  for (auto _ : state) {
+    load.force[tip] = tip_load(++k % 2 ? 1.01 : 1.0);
+    const RodStaticResult r = solve_der_static(rod, load);
+    load.start = r.x;
+    iterations += r.newton_iterations;
+  }
+  state.counters["newton_per_update"] =
+      benchmark::Counter(iterations, benchmark::Counter::kAvgIterations);
+}
+
+void BM_CordeNewtonUpdate(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const CordeRod rod(make_layout(uniform_rod(kMaterial, kLength, kDiameter, n)));
+  CordeStaticLoad load;
+  load.force = VectorXd::Zero(rod.num_dofs());
+  const int tip = 3 * rod.layout().tip_node + 1;
+  load.force[tip] = tip_load(1.0);
+  load.start = solve_corde_static(rod, load).x;
+  int iterations = 0, k = 0;
+  for (auto _ : state) {
+    load.force[tip] = tip_load(++k % 2 ? 1.01 : 1.0);
+    const ConstrainedResult r = solve_corde_static(rod, load);
+    load.start = r.x;
+    iterations += r.iterations;
+  }
+  state.counters["newton_per_update"] =
+      benchmark::Counter(iterations, benchmark::Counter::kAvgIterations);
+}
+
+void BM_DerImplicitStep(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  DerRod rod(make_layout(uniform_rod(kMaterial, kLength, kDiameter, n)));
+  Problem problem;
+  problem.form = &rod;
+  problem.rest = rod.rest_state();
+  problem.mass = rod.lumped_mass();
+  problem.fixed = rod.clamp_fixed();
+  problem.external_force = VectorXd::Zero(rod.num_dofs());
+  problem.external_force[3 * rod.layout().tip_node + 1] = tip_load(1.0);
+  DynamicOptions options;
+  options.integrator = Integrator::implicit_euler;
+  options.implicit_matrix = ImplicitMatrix::current_state;
+  options.dt = 1e-3;
+  constexpr int kSteps = 20;
+  options.steps = kSteps;
+  VectorXd x = problem.rest, v = VectorXd::Zero(problem.rest.size());
+  for (auto _ : state) {
+    const DynamicResult r = integrate(problem, options, x, v);  // set-up timed apart
+    state.SetIterationTime(r.seconds / kSteps);
+    x = r.x;
+    v = r.v;
+  }
+}
+
+void BM_XpbdStep(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  XpbdRod rod(make_layout(uniform_rod(kMaterial, kLength, kDiameter, n)));
+  VectorXd force = VectorXd::Zero(rod.state().size());
+  force[3 * rod.tip_node() + 1] = tip_load(1.0);
+  for (auto _ : state) rod.step(1e-3, force);
+}
+
+}  // namespace
+
+BENCHMARK(BM_XpbdStep)->Arg(50)->Arg(200)->Arg(1000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DerNewtonUpdate)->Arg(50)->Arg(200)->Arg(1000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_CordeNewtonUpdate)->Arg(50)->Arg(200)->Arg(1000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DerImplicitStep)
+    ->Arg(50)->Arg(200)->Arg(1000)->UseManualTime()->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();

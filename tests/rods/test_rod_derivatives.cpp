@@ -1,0 +1,120 @@
+// Energy, gradient and Hessian of every rod term against central finite differences, at bent,
+// stretched and twisted 3D states away from the rest state and from the stored reference frames.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "../msm/finite_differences.hpp"
+#include "msm/rods/corde_rod.hpp"
+#include "msm/rods/der_rod.hpp"
+#include "msm/rods/rod_loads.hpp"
+#include "rod_cases.hpp"
+
+namespace vessel::msm::rods::test {
+namespace {
+
+using vessel::msm::test::check_form_derivatives;
+
+/// A rod of 5 segments (0.1 m), clamped at both ends, with a tapered tip section.
+RodSpec small_rod() {
+  RodSpec spec;
+  spec.material = test_material();
+  spec.sections = {{0.06, 1e-3, 1e-3, 3}, {0.04, 1e-3, 0.5e-3, 2}};
+  spec.clamp_end = true;
+  return spec;
+}
+
+VectorXd perturbed(const VectorXd& x, double scale, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  VectorXd y = x;
+  for (Eigen::Index i = 0; i < y.size(); ++i) y[i] += scale * u(rng);
+  return y;
+}
+
+TEST(RodDerivatives, DerEnergyGradientHessianAgreeWithFiniteDifferences) {
+  DerRod rod(make_layout(small_rod()));
+  VectorXd x = perturbed(rod.rest_state(), 4e-3, 1);
+  rod.update_reference(x);  // stored frames off the rest tangents
+  x = perturbed(x, 2e-3, 2);
+  for (int j = 0; j < rod.layout().num_edges(); ++j) x[rod.twist_dof(j)] = 0.3 * j - 0.5;
+  const auto c = check_form_derivatives(rod, x, 1e-7);
+  EXPECT_LT(c.gradient_error, 1e-6);
+  EXPECT_LT(c.hessian_error, 1e-6);
+  EXPECT_LT(c.hessian_asymmetry, 1e-12);
+}
+
+TEST(RodDerivatives, DerRestStateCarriesNoForce) {
+  // A rest shape with an offset (a second section) must not load the rod (SOFA BeamAdapter's
+  // "exploding" multi-section wires).
+  const DerRod rod(make_layout(small_rod()));
+  VectorXd g;
+  rod.gradient(rod.rest_state(), g);
+  const double EA = rod.layout().section[1].EA;  // round-off of the rest lengths: ε·EA
+  EXPECT_LT(rod.energy(rod.rest_state()), 1e-24);
+  EXPECT_LT(g.norm(), 1e-14 * EA);
+}
+
+TEST(RodDerivatives, DerUpdateReferenceKeepsTheEnergy) {
+  DerRod rod(make_layout(small_rod()));
+  VectorXd x = perturbed(rod.rest_state(), 1e-2, 3);
+  const double before = rod.energy(x);
+  rod.update_reference(x);
+  EXPECT_NEAR(rod.energy(x), before, 1e-12 * std::abs(before));
+}
+
+TEST(RodDerivatives, PlanarEndMomentAgreesWithFiniteDifferences) {
+  const DerRod rod(make_layout(small_rod()));
+  PlanarEndMoment moment(rod.layout(), rod.num_dofs(), Eigen::Vector3d::UnitZ());
+  moment.set_moment(0.7);
+  const VectorXd x = perturbed(rod.rest_state(), 5e-3, 4);
+  const auto c = check_form_derivatives(moment, x, 1e-7);
+  EXPECT_LT(c.gradient_error, 1e-6);
+  EXPECT_LT(c.hessian_error, 1e-6);
+}
+
+}  // namespace
+}  // namespace vessel::msm::rods::test
+
+namespace vessel::msm::rods::test {
+namespace {
+
+using vessel::msm::test::check_derivatives;
+using vessel::msm::test::check_form_derivatives;
+
+TEST(RodDerivatives, CordeEnergyGradientHessianAgreeWithFiniteDifferences) {
+  const CordeRod rod(make_layout(small_rod()));
+  const VectorXd x = perturbed(rod.rest_state(), 3e-3, 5);
+  const auto c = check_form_derivatives(rod, x, 1e-7);
+  EXPECT_LT(c.gradient_error, 1e-6);
+  EXPECT_LT(c.hessian_error, 1e-6);
+}
+
+TEST(RodDerivatives, CordeConstraintJacobianAndWeightedHessian) {
+  const CordeRod rod(make_layout(small_rod()));
+  const VectorXd x = perturbed(rod.rest_state(), 3e-3, 6);
+  const VectorXd lambda = perturbed(VectorXd::Zero(rod.num_constraints()), 1.0, 7);
+  // λ·c(x) as a scalar function: its gradient is Jᵀλ, its Hessian Σ λ_k ∇²c_k.
+  const auto c = check_derivatives(
+      [&](const VectorXd& y) {
+        VectorXd cy;
+        rod.evaluate(y, cy);
+        return lambda.dot(cy);
+      },
+      [&](const VectorXd& y) -> VectorXd {
+        SparseMatrix J;
+        rod.jacobian(y, J);
+        return J.transpose() * lambda;
+      },
+      [&](const VectorXd& y) -> Eigen::MatrixXd {
+        SparseMatrix H;
+        rod.weighted_hessian(y, lambda, H);
+        return Eigen::MatrixXd(H);
+      },
+      x, 1e-7);
+  EXPECT_LT(c.gradient_error, 1e-6);
+  EXPECT_LT(c.hessian_error, 1e-6);
+}
+
+}  // namespace
+}  // namespace vessel::msm::rods::test
