@@ -5,7 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 
 namespace vessel::scene_detail {
 

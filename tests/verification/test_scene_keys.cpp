@@ -10,7 +10,7 @@
 #include <sstream>
 #include <toml++/toml.h>
 
-#include "meshes/errors.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/solvers/solve.hpp"
