@@ -12,32 +12,14 @@
 #include "msm/model/build_network.hpp"
 #include "verification/calibration_file.hpp"
 #include "verification/scene.hpp"
+#include "tests/fixtures/kuhn_block.hpp"
 
 using namespace vessel;
 
 namespace {
 
 TetMesh block_mesh(int n, double h) {
-  TetMesh m;
-  auto id = [n](int i, int j, int k) { return (k * (n + 1) + j) * (n + 1) + i; };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) m.nodes.emplace_back(3e-3 + i * h, j * h, k * h);
-  const int kuhn[6][4] = {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7},
-                          {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}};
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (const auto& t : kuhn) {
-          Tet tet{};
-          for (int a = 0; a < 4; ++a) {
-            const int c = t[a];
-            tet[a] = id(i + (c & 1), j + ((c >> 1) & 1), k + ((c >> 2) & 1));
-          }
-          m.tets.push_back(tet);
-        }
-  orient_tets(m);
-  return m;
+  return vessel::test::kuhn_block(n, n, n, h, Vec3(3e-3, 0.0, 0.0));
 }
 
 constexpr double kE = 14.24e3;

@@ -24,27 +24,14 @@
 #include "verification/harness/metrics.hpp"
 #include "verification/harness/timed_updates.hpp"
 #include "verification/harness/results.hpp"
+#include "tests/fixtures/lame_tube_scene.hpp"
 
 using namespace vessel;
 
 namespace {
 
 /// Straight structured tube, level 0, internal pressure 10 Pa, roller ends (plane strain).
-const char* kLame = R"(name = "lame_test"
-[vessel]
-kind = "straight"
-mesh = "structured"
-level = 0
-reference_level = 0
-[material]
-E = 14.24e3
-nu = 0.3
-[boundary]
-inlet = "roller"
-outlet = "roller"
-[load]
-type = "pressure"
-magnitudes = [10.0, 20.0]
+const std::string kLame = vessel::test::lame_tube_scene("lame_test", "0.3", "[10.0, 20.0]") + R"(
 [[models]]
 name = "p2_same_as_reference"
 kind = "fem"
@@ -74,21 +61,7 @@ solver = "linear"
 
 /// The Lamé tube with natural frequencies ([modes]): P2 on the reference's mesh, P1, and two
 /// seed001 volume models that differ in their solver only.
-const char* kLameModes = R"(name = "lame_modes_test"
-[vessel]
-kind = "straight"
-mesh = "structured"
-level = 0
-reference_level = 0
-[material]
-E = 14.24e3
-nu = 0.3
-[boundary]
-inlet = "roller"
-outlet = "roller"
-[load]
-type = "pressure"
-magnitudes = [10.0]
+const std::string kLameModes = vessel::test::lame_tube_scene("lame_modes_test") + R"(
 [modes]
 count = 4
 [[models]]

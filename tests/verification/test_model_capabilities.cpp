@@ -15,6 +15,7 @@
 #include "verification/harness/harness.hpp"
 #include "verification/model_capabilities.hpp"
 #include "verification/scene.hpp"
+#include "tests/fixtures/lame_tube_scene.hpp"
 
 using namespace vessel;
 
@@ -107,21 +108,7 @@ TEST(ModelCapabilities, ASceneCopiedWithoutItsCalibrationFileFailsTheSceneCheck)
 TEST(ModelCapabilities, AModelWhoseCalibrationFileTurnsBadDuringARunFailsAlone) {
   const auto dir = fresh_dir("bad-calibration");
   std::ofstream(dir / "bad.json") << "{ not json";
-  const std::string text = R"(name = "bad_calibration"
-[vessel]
-kind = "straight"
-mesh = "structured"
-level = 0
-reference_level = 0
-[material]
-E = 14.24e3
-nu = 0.3
-[boundary]
-inlet = "roller"
-outlet = "roller"
-[load]
-type = "pressure"
-magnitudes = [10.0]
+  const std::string text = vessel::test::lame_tube_scene("bad_calibration") + R"(
 [[models]]
 name = "plain"
 kind = "volume_msm"
