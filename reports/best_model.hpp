@@ -1,7 +1,7 @@
 #pragma once
-/// The report's answer to issue 14's question, per scene and Poisson's ratio: which mass-spring
-/// model is best (the lowest relative L2 error), how its error compares with P1 FEM's on the same
-/// mesh level, and how its speed compares with P1's. Computed from results.json data alone.
+/// The report's answer, per scene and Poisson's ratio, to which mass-spring model is best (the
+/// lowest relative L2 error), how its error compares with P1 FEM's on the same mesh level, and how
+/// its speed compares with P1's. Computed from results.json data alone.
 #include <optional>
 #include <string>
 #include <vector>
