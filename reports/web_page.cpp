@@ -166,8 +166,9 @@ std::string view_html(const SceneViews& v, std::size_t index) {
          "more than a decade; the tick marks the tolerance, "
       << significant(v.tolerance_mm) << " mm). " << escape_xml(v.reference_note)
       << "Grey ghost: the reference's deformed wall. Red sphere: the QoI point"
-      << (v.contact_patch ? "; red ring: the contact patch the force is spread over" : "")
-      << " (both at rest, drawn through the wall). Drag to turn, wheel to zoom; both panes share "
+      << (v.contact_patch ? "; red disc: the contact patch the force is spread over (both"
+                          : " (")
+      << " at rest, drawn through the wall). Drag to turn, wheel to zoom; both panes share "
          "the camera; hover a node for its error and both displacements.</p>\n";
   if (!v.missing.empty()) {
     out << "<p class=\"vv-note\">" << v.missing.size() << " finished model(s) have no VTU here ("
