@@ -1,8 +1,8 @@
 #pragma once
-/// The FEM reference in parallel with MPI: the displacement formulation (P1, P2: CG with ML AMG,
-/// all six rigid-body modes as near-null space) and the mixed Taylor–Hood one (ν up to 0.5:
-/// FGMRES with the block-triangular AMG / pressure-mass preconditioner) on deal.II's fully
-/// distributed triangulation with Trilinos matrices and vectors. Plain data only: deal.II and mpi.h stay inside
+/// The FEM reference in parallel with MPI, P1, P2 and Taylor–Hood on deal.II's fully distributed
+/// triangulation with Trilinos matrices and vectors. The displacement formulation by CG with ML
+/// AMG (all six rigid-body modes as near-null space), the mixed one (ν up to 0.5) by FGMRES with
+/// the block-triangular AMG / pressure-mass preconditioner. Plain data only: deal.II and mpi.h stay inside
 /// fem_reference's .cpp files and detail/ headers. SI units throughout.
 ///
 /// Every function here is collective over MPI_COMM_WORLD (or over the single calling rank with
