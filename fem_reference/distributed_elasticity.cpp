@@ -1,7 +1,7 @@
 /// deal.II/MPI implementation of the distributed FEM reference: the MPI session, the mesh sent from
-/// rank 0, and the solver's triangulation, displacement system (CG-AMG) and post-processing. The
-/// serial mesh is partitioned with METIS on every rank, each rank then keeps its part plus one
-/// ghost layer in a parallel::fullydistributed::Triangulation; assembly into Trilinos matrices as in
+/// rank 0, and the solver's triangulation, displacement system (CG-AMG) and post-processing. Rank 0
+/// partitions the serial mesh with METIS and sends each rank its part plus one ghost layer, kept
+/// in a parallel::fullydistributed::Triangulation; assembly into Trilinos matrices as in
 /// step-40. The mixed system is in distributed_mixed.cpp, what rank 0 gathers in
 /// distributed_gather.cpp. The validation, boundary tagging, constraints, element integrals, AMG and
 /// post-processing are the serial solver's own (detail/), so one rank, many ranks and the serial
@@ -254,17 +254,18 @@ Vec3 Distributed::sum_over_ranks(const Vec3& v) const {
 }
 
 void Distributed::build_triangulation() {
-  {
-    // The serial coarse mesh on every rank (the cells in TetMesh order, so a cell's coarse cell
-    // id is its tet index), partitioned by METIS; each rank then keeps its own cells and ghosts.
-    dl::Triangulation<kDim> serial;
-    create_coarse_triangulation(mesh_, serial);
-    dl::GridTools::partition_triangulation(n_ranks_, serial);
-    const auto description =
-        dl::TriangulationDescription::Utilities::create_description_from_triangulation(serial,
-                                                                                       comm_);
-    tria_.create_triangulation(description);
-  }
+  // Rank 0 alone builds the serial coarse triangulation (the cells in TetMesh order, so a cell's
+  // coarse cell id is its tet index) and partitions it with METIS; each rank receives the
+  // description of its own cells and ghosts (one group of all ranks).
+  const auto description = dl::TriangulationDescription::Utilities::
+      create_description_from_triangulation_in_groups<kDim, kDim>(
+          [&](dl::Triangulation<kDim>& serial) { create_coarse_triangulation(mesh_, serial); },
+          [](dl::Triangulation<kDim>& serial, const MPI_Comm& comm, unsigned) {
+            dl::GridTools::partition_triangulation(dl::Utilities::MPI::n_mpi_processes(comm),
+                                                   serial);
+          },
+          comm_, static_cast<int>(n_ranks_));
+  tria_.create_triangulation(description);
   mesh_map_ = match_and_tag_boundary(tria_, mesh_);
 }
 

@@ -73,9 +73,10 @@ struct DistributedResult {
   std::vector<double> serial_dofs;
 };
 
-/// Solves `problem` on `mesh` distributed over the ranks: the mesh is partitioned with METIS
-/// (GridTools::partition_triangulation) and each rank keeps only its cells and one layer of ghosts
-/// (parallel::fullydistributed::Triangulation); CG with Trilinos ML AMG to
+/// Solves `problem` on `mesh` distributed over the ranks: rank 0 partitions the mesh with METIS
+/// (GridTools::partition_triangulation, on rank 0's serial triangulation only) and each rank
+/// receives only its cells and one layer of ghosts (parallel::fullydistributed::Triangulation;
+/// the TetMesh itself is still needed on every rank); CG with Trilinos ML AMG to
 /// options.cg_relative_tolerance (the mixed system: FGMRES to the same relative residual of the
 /// scaled system, as the serial gmres_block). Supports P1 and P2 displacement elements and the
 /// Taylor–Hood element (chosen as the serial solver chooses: options.formulation and

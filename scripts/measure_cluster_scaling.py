@@ -5,7 +5,7 @@ largest rank, and the load average before and after each run (the figures mean l
 machine: rerun it on an idle one).
 
 Usage: /usr/bin/python3 scripts/measure_cluster_scaling.py [--program build/verification/vesselverify]
-           [--levels 1] [--ranks 1,2] [--cases p2,th] [--out table.md]
+           [--levels 1] [--ranks 1,2] [--cases p2,th] [--no-serial] [--out table.md]
 Cases: p2 = P2 at nu = 0.45; th = Taylor-Hood at nu = 0.5 (serial: UMFPACK and FGMRES). Needs
 mpirun and /usr/bin/time (scripts/install_deps.sh)."""
 import argparse
@@ -45,6 +45,7 @@ def main():
     ap.add_argument("--levels", default="1")
     ap.add_argument("--ranks", default="1,2")
     ap.add_argument("--cases", default="p2,th")
+    ap.add_argument("--no-serial", action="store_true", help="the distributed runs only")
     ap.add_argument("--out", default="")
     a = ap.parse_args()
     timed = ["/usr/bin/time", "-f", "peak_kb %M", a.program]
@@ -56,7 +57,8 @@ def main():
         for case in a.cases.split(","):
             for level in a.levels.split(","):
                 base = ["fem", "--level", level, "--load", "contact", "--json", out] + CASES[case]
-                runs = [(name, 1, timed + base + ["--solver", s]) for name, s in SERIAL[case]]
+                runs = [] if a.no_serial else [(name, 1, timed + base + ["--solver", s])
+                                               for name, s in SERIAL[case]]
                 runs += [("distributed", int(n), MPIRUN + ["-np", n] + timed + base +
                           ["--distributed"]) for n in a.ranks.split(",")]
                 for name, n, command in runs:

@@ -44,7 +44,10 @@ CONF
 
 # munged on its own socket, then the two Slurm daemons; each stopped by its pid on exit.
 pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done  # their last state written
+}
 trap cleanup EXIT
 munged --foreground --force --socket="$work/munge/socket" --pid-file="$work/munge/pid" \
   --log-file="$work/munge/log" --seed-file="$work/munge/seed" &

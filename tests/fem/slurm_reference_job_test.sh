@@ -7,7 +7,7 @@ set -euo pipefail
 vv=$1
 src=$2
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+trap 'rm -rf "$work" || true' EXIT
 export VESSELVERIFY="$vv" OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 "$src/scripts/slurm_localhost.sh" "$work/slurm" --nodes=1 --ntasks-per-node=2 \
   "$src/scripts/slurm_reference_job.sbatch" "$work/cache" "$work/out" \

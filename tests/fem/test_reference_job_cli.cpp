@@ -1,9 +1,11 @@
 // The reference job end to end: `mpirun -np 2 vesselverify reference` fills the FEM solution
 // cache, a serial `run` on that cache restores every reference (no FEM solve of its own), and its
 // results.json agrees with a plain serial run's (its own direct solves) to 1e-8 relative
-// (scripts/compare_results.py), for P2 (ν = 0.3) and Taylor–Hood (ν = 0.5).
+// (scripts/compare_results.py), for P2 (ν = 0.3) and Taylor–Hood (ν = 0.5), on the short tube of
+// tests/fixtures/short_contact.toml.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <regex>
 
 #include "../test_helpers.hpp"
@@ -23,41 +25,6 @@ bool contains(const std::string& s, const std::string& what) {
   return s.find(what) != std::string::npos;
 }
 
-/// A short straight tube under a contact patch: models at level 0, the reference at level 1
-/// (its Richardson uncertainty from level 0), a second or two per solve.
-const char* const kScene = R"(name = "short_contact"
-[vessel]
-kind = "straight"
-inner_radius = 3.0e-3
-wall_thickness = 1.0e-3
-length = 4.0e-3
-mesh = "structured"
-level = 0
-reference_level = 1
-[material]
-E = 14.24e3
-nu = [0.3, 0.5]
-[boundary]
-inlet = "clamped"
-outlet = "clamped"
-[load]
-type = "contact"
-magnitudes = [1.0e-4]
-point = [3.0e-3, 0.0, 2.0e-3]
-patch_radius = 1.0e-3
-surface = "inner_wall"
-[[models]]
-name = "fem_p1"
-kind = "fem"
-degree = 1
-[[models]]
-name = "surface_seed000"
-kind = "surface_msm"
-surface = "mid"
-stiffness = "seed000"
-mass = "uniform"
-solver = "static"
-)";
 
 /// (hits, misses) from the run's "FEM solution cache (...): H hits, M misses" line.
 std::pair<int, int> fem_cache_counts(const std::string& output) {
@@ -71,8 +38,7 @@ std::pair<int, int> fem_cache_counts(const std::string& output) {
 
 TEST(ReferenceJobCli, TwoRankJobThenSerialRunGivesTheSerialRunsResults) {
   TempDir dir;
-  const auto scene = dir / "short_contact.toml";
-  vessel::test::write_text(scene, kScene);
+  const std::filesystem::path scene = SHORT_SCENE;
   const std::string job_cache = " --cache-dir " + (dir / "job_cache").string() + " ";
 
   const auto job = mpi_vv(2, "reference" + job_cache + scene.string());
@@ -105,9 +71,7 @@ TEST(ReferenceJobCli, TwoRankJobThenSerialRunGivesTheSerialRunsResults) {
 }
 
 TEST(ReferenceJobCli, RefusesToRunWithoutTheCache) {
-  TempDir dir;
-  const auto scene = dir / "s.toml";
-  vessel::test::write_text(scene, kScene);
+  const std::filesystem::path scene = SHORT_SCENE;
   const auto r = vv("reference --no-cache " + scene.string());
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_TRUE(contains(r.output, "--no-cache leaves nothing")) << r.output;
