@@ -3,7 +3,9 @@
 /// serial program restores a distributed solve), and the field at arbitrary points.
 #include <deal.II/grid/tria.h>
 
+#include <cmath>
 #include <cstdint>
+#include <string>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -78,8 +80,23 @@ std::vector<double> Distributed::gather_serial_dofs() const {
   }
   const std::vector<std::int64_t> all_where = gather_on_rank0(where, MPI_INT64_T, comm_);
   const std::vector<double> all_value = gather_on_rank0(value, MPI_DOUBLE, comm_);
-  if (rank_ != 0) return {};
+  std::vector<double> out;
+  std::string failure;
+  if (rank_ == 0) out = place_in_serial_numbering(all_where, all_value, failure);
+  // Every rank learns whether rank 0 placed every DoF, so that none is left waiting.
+  int failed = failure.empty() ? 0 : 1;
+  MPI_Bcast(&failed, 1, MPI_INT, 0, comm_);
+  if (failed) {
+    throw std::logic_error("gather_serial_dofs: " +
+                           (rank_ == 0 ? failure : std::string("rank 0 could not place the DoFs")));
+  }
+  return out;
+}
 
+std::vector<double> Distributed::place_in_serial_numbering(const std::vector<std::int64_t>& where,
+                                                           const std::vector<double>& value,
+                                                           std::string& failure) const {
+  const unsigned n = fe_->n_dofs_per_cell();
   dl::Triangulation<kDim> serial;
   create_coarse_triangulation(mesh_, serial);
   const auto fe = make_element(degree_, mixed_);
@@ -88,18 +105,18 @@ std::vector<double> Distributed::gather_serial_dofs() const {
   std::vector<dl::DoFHandler<kDim>::active_cell_iterator> cells(mesh_.tets.size());
   for (const auto& cell : dof.active_cell_iterators()) cells[cell->active_cell_index()] = cell;
   std::vector<double> out(dof.n_dofs(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<dl::types::global_dof_index> dofs(n);
   std::size_t placed = 0;
-  for (std::size_t k = 0; k < all_where.size(); ++k) {
-    const auto tet = static_cast<std::size_t>(all_where[k] / n);
-    const auto i = static_cast<unsigned>(all_where[k] % n);
+  for (std::size_t k = 0; k < where.size(); ++k) {
+    const auto tet = static_cast<std::size_t>(where[k] / n);
+    const auto i = static_cast<unsigned>(where[k] % n);
     cells[tet]->get_dof_indices(dofs);
     placed += std::isnan(out[dofs[i]]) ? 1 : 0;
-    out[dofs[i]] = all_value[k];
+    out[dofs[i]] = value[k];
   }
-  if (placed != out.size() || all_where.size() != out.size()) {
-    throw std::logic_error("gather_serial_dofs: " + std::to_string(placed) + " of " +
-                           std::to_string(out.size()) + " serial DoFs placed from " +
-                           std::to_string(all_where.size()) + " distributed ones");
+  if (placed != out.size() || where.size() != out.size()) {
+    failure = std::to_string(placed) + " of " + std::to_string(out.size()) +
+              " serial DoFs placed from " + std::to_string(where.size()) + " distributed ones";
   }
   return out;
 }

@@ -16,7 +16,9 @@
 #include <deal.II/lac/trilinos_vector.h>
 #include <mpi.h>
 
+#include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "fem_reference/detail/amg.hpp"
@@ -60,6 +62,12 @@ class Distributed {
   void gather_nodal_displacement();
   /// Rank 0: the solution in the serial ElasticitySolver's DoF numbering (empty elsewhere).
   [[nodiscard]] std::vector<double> gather_serial_dofs() const;
+  /// Rank 0: `value[k]` put at the serial DoF of (tet, local index) `where[k]` = tet·n + i, on a
+  /// serial DoFHandler numbered as ElasticitySolver's; `failure` says so if not every serial DoF
+  /// got exactly one value.
+  [[nodiscard]] std::vector<double> place_in_serial_numbering(const std::vector<std::int64_t>& where,
+                                                              const std::vector<double>& value,
+                                                              std::string& failure) const;
   /// Every rank: u at `points` (the tet found by TetLocator, evaluated by the rank owning it).
   [[nodiscard]] std::vector<Vec3> evaluate(const std::vector<Vec3>& points, double tol) const;
 
