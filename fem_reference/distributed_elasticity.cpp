@@ -1,9 +1,11 @@
-/// deal.II/MPI implementation of the distributed FEM reference (issue #3). The serial mesh is
-/// partitioned with METIS on every rank, each rank then keeps its part plus one ghost layer in a
-/// parallel::fullydistributed::Triangulation; assembly into Trilinos matrices as in step-40. The
-/// validation, boundary tagging, constraints, element integrals, AMG and post-processing are the
-/// serial solver's own (detail/), so one rank, many ranks and the serial solver solve the same
-/// discrete system.
+/// deal.II/MPI implementation of the distributed FEM reference: the MPI session, the mesh sent from
+/// rank 0, and the solver's triangulation, displacement system (CG-AMG) and post-processing. Rank 0
+/// partitions the serial mesh with METIS and sends each rank its part plus one ghost layer, kept
+/// in a parallel::fullydistributed::Triangulation; assembly into Trilinos matrices as in
+/// step-40. The mixed system is in distributed_mixed.cpp, what rank 0 gathers in
+/// distributed_gather.cpp. The validation, boundary tagging, constraints, element integrals, AMG and
+/// post-processing are the serial solver's own (detail/), so one rank, many ranks and the serial
+/// solver solve the same discrete system.
 #include "fem_reference/distributed_elasticity.hpp"
 
 #include <deal.II/base/index_set.h>
@@ -41,7 +43,7 @@
 #include "fem_reference/detail/boundary.hpp"
 #include "fem_reference/detail/constraints.hpp"
 #include "fem_reference/detail/postprocess.hpp"
-#include "fem_reference/detail/tet_locator.hpp"
+#include "fem_reference/detail/distributed_solver.hpp"
 #include "fem_reference/detail/validation.hpp"
 #include "fem_reference/detail/weak_form.hpp"
 #include "meshes/foundation/errors.hpp"
@@ -209,113 +211,84 @@ TetMesh make_mesh_on_rank0(const std::function<TetMesh()>& make) {
 
 namespace {
 
-using detail::Clock;
-using detail::seconds_since;
-using CellIt = detail::CellIterator;
-using VectorT = dl::TrilinosWrappers::MPI::Vector;
-
-/// InputError (the same on every rank) for what the distributed solver does not do: the mixed
-/// Taylor–Hood formulation, curved surfaces, the direct solver.
+/// InputError (the same on every rank) for what the distributed solver does not do: curved
+/// surfaces and the direct solver.
 void validate_distributable(const ElasticityProblem& p) {
-  const auto& m = p.material;
-  const auto& o = p.options;
   std::ostringstream msg;
-  if (detail::uses_mixed_formulation(p)) {
-    msg << "the distributed (MPI) solver has the displacement formulation (P1, P2) only; nu = "
-        << m.poisson_ratio << " with formulation '" << to_string(o.formulation)
-        << "' needs the mixed Taylor-Hood system (automatic for nu >= the mixed threshold "
-        << o.mixed_threshold << "): run it without --distributed, or use nu below the threshold";
-  } else if (!p.curved_surfaces.empty()) {
+  if (!p.curved_surfaces.empty()) {
     msg << "the distributed (MPI) solver has straight-sided (affine) tets only; curved surfaces "
            "(--curved) need the serial solver";
-  } else if (o.solver == LinearSolver::direct) {
-    msg << "the distributed (MPI) solver uses CG with algebraic multigrid; solver 'direct' is "
-           "serial only: use cg-amg or auto";
+  } else if (p.options.solver == LinearSolver::direct) {
+    msg << "the distributed (MPI) solver is iterative (CG with algebraic multigrid, FGMRES with "
+           "the block preconditioner for the mixed system); solver 'direct' is serial only: use "
+           "auto, cg-amg or gmres-block";
   }
   if (!msg.str().empty()) throw InputError(msg.str());
 }
 
-class Distributed {
- public:
-  Distributed(const TetMesh& mesh, const ElasticityProblem& problem, MPI_Comm comm)
-      : mesh_(mesh),
-        problem_(problem),
-        comm_(comm),
-        rank_(dl::Utilities::MPI::this_mpi_process(comm)),
-        n_ranks_(dl::Utilities::MPI::n_mpi_processes(comm)),
-        degree_(problem.options.degree),
-        linear_(1),
-        mapping_(linear_),
-        tria_(comm) {}
+}  // namespace
 
-  DistributedResult run(const std::vector<Vec3>& points);
+namespace detail {
 
- private:
-  void build_triangulation();
-  void setup_dofs();
-  void assemble();
-  void solve_linear();
-  [[nodiscard]] detail::DisplacementRows owned_rows() const;
-  void postprocess();
-  void gather_nodal_displacement();
-  [[nodiscard]] VectorT residual(detail::StrainSummary& strain) const;
-  std::vector<Vec3> evaluate(const std::vector<Vec3>& points) const;
-  [[nodiscard]] double max_over_ranks(double v) const { return dl::Utilities::MPI::max(v, comm_); }
-  [[nodiscard]] Vec3 sum_over_ranks(const Vec3& v) const {
-    Vec3 s;
-    for (int c = 0; c < 3; ++c) s[c] = dl::Utilities::MPI::sum(v[c], comm_);
-    return s;
-  }
+using CellIt = CellIterator;
 
-  const TetMesh& mesh_;
-  const ElasticityProblem& problem_;
-  MPI_Comm comm_;
-  unsigned rank_, n_ranks_;
-  int degree_;
+Distributed::Distributed(const TetMesh& mesh, const ElasticityProblem& problem, MPI_Comm comm,
+                         bool mixed)
+    : mesh_(mesh),
+      problem_(problem),
+      comm_(comm),
+      rank_(dl::Utilities::MPI::this_mpi_process(comm)),
+      n_ranks_(dl::Utilities::MPI::n_mpi_processes(comm)),
+      mixed_(mixed),
+      degree_(mixed ? 2 : problem.options.degree),
+      linear_(1),
+      mapping_(linear_),
+      tria_(comm) {}
 
-  dl::FE_SimplexP<kDim> linear_;
-  dl::MappingFE<kDim> mapping_;
-  dl::parallel::fullydistributed::Triangulation<kDim> tria_;
-  detail::MeshCorrespondence mesh_map_;  // for the local cells (ghosts included)
-  std::unique_ptr<detail::WeakForm> form_;
-  std::unique_ptr<dl::FiniteElement<kDim>> fe_;
-  dl::DoFHandler<kDim> dof_;
-  dl::IndexSet owned_, relevant_;
-  dl::AffineConstraints<double> constraints_;
-  dl::TrilinosWrappers::SparseMatrix matrix_;
-  VectorT rhs_, solution_, ghosted_;
+double Distributed::max_over_ranks(double v) const { return dl::Utilities::MPI::max(v, comm_); }
 
-  DistributedResult out_;
-};
+Vec3 Distributed::sum_over_ranks(const Vec3& v) const {
+  Vec3 s;
+  for (int c = 0; c < 3; ++c) s[c] = dl::Utilities::MPI::sum(v[c], comm_);
+  return s;
+}
 
 void Distributed::build_triangulation() {
-  {
-    // The serial coarse mesh on every rank (the cells in TetMesh order, so a cell's coarse cell
-    // id is its tet index), partitioned by METIS; each rank then keeps its own cells and ghosts.
-    dl::Triangulation<kDim> serial;
-    detail::create_coarse_triangulation(mesh_, serial);
-    dl::GridTools::partition_triangulation(n_ranks_, serial);
-    const auto description =
-        dl::TriangulationDescription::Utilities::create_description_from_triangulation(serial,
-                                                                                       comm_);
-    tria_.create_triangulation(description);
-  }
-  mesh_map_ = detail::match_and_tag_boundary(tria_, mesh_);
+  // Rank 0 alone builds the serial coarse triangulation (the cells in TetMesh order, so a cell's
+  // coarse cell id is its tet index) and partitions it with METIS; each rank receives the
+  // description of its own cells and ghosts (one group of all ranks).
+  const auto description = dl::TriangulationDescription::Utilities::
+      create_description_from_triangulation_in_groups<kDim, kDim>(
+          [&](dl::Triangulation<kDim>& serial) { create_coarse_triangulation(mesh_, serial); },
+          [](dl::Triangulation<kDim>& serial, const MPI_Comm& comm, unsigned) {
+            dl::GridTools::partition_triangulation(dl::Utilities::MPI::n_mpi_processes(comm),
+                                                   serial);
+          },
+          comm_, static_cast<int>(n_ranks_));
+  tria_.create_triangulation(description);
+  mesh_map_ = match_and_tag_boundary(tria_, mesh_);
+}
+
+void Distributed::setup_constraints() {
+  constraints_.clear();
+  constraints_.reinit(relevant_);
+  add_point_constraints(mesh_, problem_.point_constraints, dof_, mesh_map_.vertex_node,
+                        constraints_);
+  add_dirichlet_constraints(mesh_, problem_.dirichlet, mapping_, dof_, constraints_);
+  constraints_.close();
 }
 
 void Distributed::setup_dofs() {
-  fe_ = detail::make_element(degree_, false);
+  fe_ = make_element(degree_, mixed_);
   dof_.reinit(tria_);
   dof_.distribute_dofs(*fe_);
+  if (mixed_) {
+    setup_mixed_system();
+    return;
+  }
   owned_ = dof_.locally_owned_dofs();
   dl::DoFTools::extract_locally_relevant_dofs(dof_, relevant_);
-
-  constraints_.clear();
-  constraints_.reinit(relevant_);
-  detail::add_point_constraints(mesh_, problem_.point_constraints, dof_, mesh_map_.vertex_node,
-                                constraints_);
-  detail::add_dirichlet_constraints(mesh_, problem_.dirichlet, mapping_, dof_, constraints_);
-  constraints_.close();
+  setup_constraints();
 
   // step-40's distributed sparsity pattern.
   dl::DynamicSparsityPattern dsp(relevant_);
@@ -328,7 +301,11 @@ void Distributed::setup_dofs() {
 }
 
 void Distributed::assemble() {
-  detail::CellValues values(mapping_, *fe_, degree_);
+  if (mixed_) {
+    assemble_mixed();
+    return;
+  }
+  CellValues values(mapping_, *fe_, degree_);
   const unsigned n = fe_->n_dofs_per_cell();
   dl::FullMatrix<double> k(n, n);
   dl::Vector<double> f(n);
@@ -345,12 +322,12 @@ void Distributed::assemble() {
   out_.fem.applied_load = sum_over_ranks(applied);
 }
 
-detail::DisplacementRows Distributed::owned_rows() const {
+DisplacementRows Distributed::owned_rows(const dl::IndexSet& rows_set) const {
   // The locally owned rows in the row map's order (the owned DoFs' order within the IndexSet).
-  const std::size_t n_local = owned_.n_elements();
+  const std::size_t n_local = rows_set.n_elements();
   std::map<dl::types::global_dof_index, dl::Point<kDim>> x;
   dl::DoFTools::map_dofs_to_support_points(mapping_, dof_, x);
-  detail::DisplacementRows rows;
+  DisplacementRows rows;
   rows.support.resize(n_local);
   rows.component.assign(n_local, 0);
   std::vector<dl::types::global_dof_index> dofs(fe_->n_dofs_per_cell());
@@ -358,16 +335,21 @@ detail::DisplacementRows Distributed::owned_rows() const {
     if (!cell->is_locally_owned()) continue;
     cell->get_dof_indices(dofs);
     for (unsigned i = 0; i < dofs.size(); ++i) {
-      if (owned_.is_element(dofs[i]))
-        rows.component[owned_.index_within_set(dofs[i])] = fe_->system_to_component_index(i).first;
+      if (rows_set.is_element(dofs[i]))
+        rows.component[rows_set.index_within_set(dofs[i])] =
+            fe_->system_to_component_index(i).first;
     }
   }
   for (std::size_t l = 0; l < n_local; ++l)
-    rows.support[l] = x.at(owned_.nth_index_in_set(static_cast<dl::IndexSet::size_type>(l)));
+    rows.support[l] = x.at(rows_set.nth_index_in_set(static_cast<dl::IndexSet::size_type>(l)));
   return rows;
 }
 
 void Distributed::solve_linear() {
+  if (mixed_) {
+    solve_mixed();
+    return;
+  }
   const auto& o = problem_.options;
   out_.fem.solver = LinearSolver::cg_amg;
   const double rhs_norm = rhs_.l2_norm();
@@ -376,8 +358,8 @@ void Distributed::solve_linear() {
     // Rotations about the mesh's node centroid, the same point on every rank.
     dl::TrilinosWrappers::PreconditionAMG amg;
     std::vector<double> modes_storage;  // must outlive amg
-    detail::initialize_elasticity_amg(amg, matrix_, owned_rows(), detail::node_centroid(mesh_),
-                                      degree_ > 1, o.amg_rigid_body_modes, modes_storage);
+    initialize_elasticity_amg(amg, matrix_, owned_rows(owned_), node_centroid(mesh_), degree_ > 1,
+                              o.amg_rigid_body_modes, modes_storage);
     dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs_norm);
     dl::SolverCG<VectorT> cg(control);
     try {
@@ -395,43 +377,18 @@ void Distributed::solve_linear() {
   ghosted_ = solution_;
 }
 
-void Distributed::gather_nodal_displacement() {
-  // Each rank sends (node, u) for the vertices of its cells; rank 0 gathers.
-  std::vector<double> mine;
-  for (const auto& [node, u] : detail::vertex_values(
-           dof_, mesh_map_.vertex_node, [&](dl::types::global_dof_index d) { return ghosted_(d); })) {
-    mine.insert(mine.end(), {static_cast<double>(node), u[0], u[1], u[2]});
-  }
-  const int my_count = static_cast<int>(mine.size());
-  std::vector<int> counts(n_ranks_, 0), offsets(n_ranks_, 0);
-  MPI_Gather(&my_count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm_);
-  std::vector<double> all;
-  if (rank_ == 0) {
-    for (unsigned i = 1; i < n_ranks_; ++i) offsets[i] = offsets[i - 1] + counts[i - 1];
-    all.resize(static_cast<std::size_t>(offsets.back() + counts.back()));
-  }
-  MPI_Gatherv(mine.data(), my_count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
-              MPI_DOUBLE, 0, comm_);
-  if (rank_ == 0) {
-    auto& nodal = out_.fem.nodal_displacement;
-    nodal.assign(mesh_.nodes.size(), Vec3::Zero());
-    for (std::size_t i = 0; i + 4 <= all.size(); i += 4)
-      nodal[static_cast<std::size_t>(all[i])] = Vec3(all[i + 1], all[i + 2], all[i + 3]);
-  }
-}
-
-VectorT Distributed::residual(detail::StrainSummary& strain) const {
+VectorT Distributed::residual(StrainSummary& strain) const {
   // Energy and principal strains at the assembly quadrature points; residual K u − f of the
   // unconstrained system for the support reactions (as the serial solver computes them).
-  detail::CellValues values(mapping_, *fe_, degree_);
+  CellValues values(mapping_, *fe_, degree_);
   dl::Vector<double> r_local;
   std::vector<dl::types::global_dof_index> dofs;
   VectorT r(owned_, comm_);
   for (const auto& cell : dof_.active_cell_iterators()) {
     if (!cell->is_locally_owned()) continue;
     values.cell.reinit(cell);
-    detail::add_cell_strain(*form_, values.cell, ghosted_, strain);
-    detail::element_residual(*form_, cell, values, ghosted_, dofs, r_local);
+    add_cell_strain(*form_, values.cell, ghosted_, strain);
+    element_residual(*form_, cell, values, ghosted_, dofs, r_local);
     r.add(dofs, r_local);
   }
   r.compress(dl::VectorOperation::add);
@@ -441,7 +398,7 @@ VectorT Distributed::residual(detail::StrainSummary& strain) const {
 void Distributed::postprocess() {
   auto& r = out_.fem;
   gather_nodal_displacement();
-  detail::StrainSummary strain;
+  StrainSummary strain;
   const VectorT res = residual(strain);
   r.strain_energy = dl::Utilities::MPI::sum(strain.energy, comm_);
   r.max_principal_strain = dl::Utilities::MPI::max(strain.max_principal, comm_);
@@ -454,62 +411,20 @@ void Distributed::postprocess() {
   for (const auto& bc : problem_.dirichlet) {
     if (std::find(seen.begin(), seen.end(), bc.group) != seen.end()) continue;
     seen.push_back(bc.group);
-    const Vec3 mine = detail::group_reaction(
-        dof_, constraints_, detail::group_boundary_id(mesh_, bc.group), owned_, res);
+    const Vec3 mine =
+        group_reaction(dof_, constraints_, group_boundary_id(mesh_, bc.group), owned_, res);
     r.reactions.push_back({bc.group, sum_over_ranks(mine)});
   }
 }
 
-std::vector<Vec3> Distributed::evaluate(const std::vector<Vec3>& points) const {
-  std::vector<Vec3> out;
-  const unsigned n = fe_->n_dofs_per_cell();
-  std::vector<dl::types::global_dof_index> dofs(n);
-  for (const auto& x : points) {
-    // The owned cell whose tet has the largest smallest barycentric coordinate; then the best
-    // over the ranks (MAXLOC), which evaluates and broadcasts.
-    double best_min = -std::numeric_limits<double>::infinity();
-    CellIt best_cell;
-    for (const auto& cell : dof_.active_cell_iterators()) {
-      if (!cell->is_locally_owned()) continue;
-      const auto tet = static_cast<std::size_t>(mesh_map_.cell_tet[cell->active_cell_index()]);
-      const double lmin = detail::min_barycentric(mesh_, mesh_.tets[tet], x);
-      if (lmin > best_min) best_min = lmin, best_cell = cell;
-    }
-    struct {
-      double value;
-      int rank;
-    } mine{best_min, static_cast<int>(rank_)}, global{};
-    MPI_Allreduce(&mine, &global, 1, MPI_DOUBLE_INT, MPI_MAXLOC, comm_);
-    if (!(global.value >= -1e-9)) {
-      std::ostringstream m;
-      m << "point (" << x.x() * 1e3 << ", " << x.y() * 1e3 << ", " << x.z() * 1e3
-        << ") mm is outside the FEM mesh: expected a point inside the vessel wall";
-      throw InputError(m.str());
-    }
-    Vec3 u = Vec3::Zero();
-    if (global.rank == static_cast<int>(rank_)) {
-      const auto ref =
-          mapping_.transform_real_to_unit_cell(best_cell, dl::Point<kDim>(x.x(), x.y(), x.z()));
-      best_cell->get_dof_indices(dofs);
-      for (unsigned i = 0; i < n; ++i) {
-        const unsigned c = fe_->system_to_component_index(i).first;
-        u[static_cast<int>(c)] += ghosted_(dofs[i]) * fe_->shape_value(i, ref);
-      }
-    }
-    MPI_Bcast(u.data(), 3, MPI_DOUBLE, global.rank, comm_);
-    out.push_back(u);
-  }
-  return out;
-}
-
-DistributedResult Distributed::run(const std::vector<Vec3>& points) {
+DistributedResult Distributed::run(const DistributedOptions& options) {
   auto& r = out_.fem;
-  r.element = degree_ == 1 ? "P1" : "P2";
-  r.formulation = Formulation::displacement;
+  r.element = mixed_ ? "P2-P1 (Taylor-Hood)" : (degree_ == 1 ? "P1" : "P2");
+  r.formulation = mixed_ ? Formulation::mixed : Formulation::displacement;
   out_.n_ranks = static_cast<int>(n_ranks_);
   auto t0 = Clock::now();
   build_triangulation();
-  form_ = std::make_unique<detail::WeakForm>(mesh_, problem_, false, mesh_map_);
+  form_ = std::make_unique<WeakForm>(mesh_, problem_, mixed_, mesh_map_);
   setup_dofs();
   r.n_dofs = dof_.n_dofs();
   r.timings.setup = max_over_ranks(seconds_since(t0));
@@ -530,12 +445,13 @@ DistributedResult Distributed::run(const std::vector<Vec3>& points) {
   r.timings.solve = max_over_ranks(seconds_since(t0));
   t0 = Clock::now();
   postprocess();
-  out_.point_displacement = evaluate(points);
+  out_.point_displacement = evaluate(options.evaluation_points, options.outside_tolerance);
+  if (options.serial_dofs) out_.serial_dofs = gather_serial_dofs();
   r.timings.postprocess = max_over_ranks(seconds_since(t0));
   return std::move(out_);
 }
 
-}  // namespace
+}  // namespace detail
 
 DistributedResult solve_elasticity_distributed(const TetMesh& mesh,
                                                const ElasticityProblem& problem,
@@ -548,8 +464,9 @@ DistributedResult solve_elasticity_distributed(const TetMesh& mesh,
   }
   detail::validate_problem(mesh, problem);
   validate_distributable(problem);
-  Distributed solver(mesh, problem, options.self_only ? MPI_COMM_SELF : MPI_COMM_WORLD);
-  return solver.run(options.evaluation_points);
+  detail::Distributed solver(mesh, problem, options.self_only ? MPI_COMM_SELF : MPI_COMM_WORLD,
+                             detail::uses_mixed_formulation(problem));
+  return solver.run(options);
 }
 
 }  // namespace vessel::fem

@@ -1,7 +1,8 @@
 #pragma once
-/// The FEM reference in parallel with MPI (issue #3): the displacement formulation (P1, P2) on
-/// deal.II's fully distributed triangulation, Trilinos matrices and vectors, CG with ML AMG (all
-/// six rigid-body modes as near-null space). Plain data only: deal.II and mpi.h stay inside
+/// The FEM reference in parallel with MPI, P1, P2 and Taylor–Hood on deal.II's fully distributed
+/// triangulation with Trilinos matrices and vectors. The displacement formulation by CG with ML
+/// AMG (all six rigid-body modes as near-null space), the mixed one (ν up to 0.5) by FGMRES with
+/// the block-triangular AMG / pressure-mass preconditioner. Plain data only: deal.II and mpi.h stay inside
 /// fem_reference's .cpp files and detail/ headers. SI units throughout.
 ///
 /// Every function here is collective over MPI_COMM_WORLD (or over the single calling rank with
@@ -45,32 +46,44 @@ struct DistributedOptions {
   /// Solve on MPI_COMM_SELF (this rank alone) instead of MPI_COMM_WORLD: a one-rank reference
   /// inside a multi-rank run (the 1-vs-2-rank test). Not collective over the world then.
   bool self_only = false;
-  /// Points (m) at which the FE displacement is evaluated (e.g. the contact point), within a
-  /// barycentric tolerance of 1e-9 of a tet; InputError naming the first point outside the mesh.
+  /// Points (m) at which the FE displacement is evaluated (e.g. the contact point or a model's
+  /// nodes), in the tet ElasticitySolver::displacement_at would use; InputError naming the first
+  /// point outside the mesh by more than `outside_tolerance` (barycentric, as displacement_at's).
   std::vector<Vec3> evaluation_points;
+  double outside_tolerance = 1e-9;
+  /// Gather the solution on rank 0 in the serial ElasticitySolver's DoF numbering
+  /// (DistributedResult::serial_dofs).
+  bool serial_dofs = false;
 };
 
 struct DistributedResult {
   /// Same meaning as the serial result's fields, with these differences: nodal_displacement (every
   /// TetMesh node, m) is filled on rank 0 only (gathered there; empty on other ranks);
-  /// tet_strain and tet_stress are empty (not gathered); solver is always cg_amg; timings are
-  /// the slowest rank's per phase; applied_load, reactions, strain_energy and the principal
+  /// tet_strain and tet_stress are empty (not gathered); solver is cg_amg (displacement) or
+  /// gmres_block (mixed); timings are the slowest rank's per phase; applied_load, reactions, strain_energy and the principal
   /// strains are global (reduced over the ranks) on every rank.
   ElasticityResult fem;
   int n_ranks = 1;
   std::vector<std::size_t> cells_per_rank;  ///< locally owned tets of each rank (every rank)
   std::vector<std::size_t> dofs_per_rank;   ///< locally owned DoFs of each rank (every rank)
   std::vector<Vec3> point_displacement;     ///< at DistributedOptions::evaluation_points, m
+  /// With DistributedOptions::serial_dofs, on rank 0: the solved DoF values (displacement, and
+  /// pressure for the mixed formulation) in the numbering of ElasticitySolver(mesh, problem), so
+  /// that ElasticitySolver::restore(fem, serial_dofs) (and fem::SolutionCache) take them.
+  std::vector<double> serial_dofs;
 };
 
-/// Solves `problem` on `mesh` distributed over the ranks: the mesh is partitioned with METIS
-/// (GridTools::partition_triangulation) and each rank keeps only its cells and one layer of ghosts
-/// (parallel::fullydistributed::Triangulation); CG with Trilinos ML AMG to
-/// options.cg_relative_tolerance. Supports P1 and P2 displacement elements, clamped and roller
-/// Dirichlet groups, point constraints, pressures, traction patches, gravity and body forces.
-/// InputError (the same on every rank) for invalid parameters, a missing group, and what is not
-/// distributed: the mixed (Taylor–Hood) formulation (also ν ≥ the automatic mixed threshold),
-/// curved surfaces, and the direct solver. std::runtime_error if CG does not converge.
+/// Solves `problem` on `mesh` distributed over the ranks: rank 0 partitions the mesh with METIS
+/// (GridTools::partition_triangulation, on rank 0's serial triangulation only) and each rank
+/// receives only its cells and one layer of ghosts (parallel::fullydistributed::Triangulation;
+/// the TetMesh itself is still needed on every rank); CG with Trilinos ML AMG to
+/// options.cg_relative_tolerance (the mixed system: FGMRES to the same relative residual of the
+/// scaled system, as the serial gmres_block). Supports P1 and P2 displacement elements and the
+/// Taylor–Hood element (chosen as the serial solver chooses: options.formulation and
+/// mixed_threshold), clamped and roller Dirichlet groups, point constraints, pressures, traction
+/// patches, gravity and body forces. InputError (the same on every rank) for invalid parameters, a
+/// missing group, and what is not distributed: curved surfaces and the direct solver.
+/// std::runtime_error if the Krylov solver does not converge.
 DistributedResult solve_elasticity_distributed(const TetMesh& mesh,
                                                const ElasticityProblem& problem,
                                                const DistributedOptions& options = {});

@@ -309,6 +309,32 @@ const ElasticityResult& SolutionCache::solve(ElasticitySolver& solver, const Tet
   return solver.result();
 }
 
+bool SolutionCache::contains(const TetMesh& mesh, const ElasticityProblem& problem) {
+  const std::optional<std::string> key = key_or_count(mesh, problem);
+  if (!key) return false;
+  struct NotStored {};
+  try {
+    store_.lookup(
+        *key,
+        [](std::string_view payload) {
+          const auto [result, dofs] = deserialise(payload);  // throws for an unreadable entry
+          return result.timings.assembly + result.timings.solve;
+        },
+        []() -> std::string { throw NotStored{}; });
+  } catch (const NotStored&) {
+    return false;
+  }
+  return true;
+}
+
+void SolutionCache::store(const TetMesh& mesh, const ElasticityProblem& problem,
+                          const ElasticityResult& result, const std::vector<double>& dofs) {
+  const std::optional<std::string> key = key_or_count(mesh, problem);
+  if (!key) return;
+  store_.lookup(
+      *key, [](std::string_view) { return 0.0; }, [&] { return serialise(result, dofs); }, true);
+}
+
 TransientResult SolutionCache::transient(const ElasticitySolver& solver, const TetMesh& mesh,
                                          const ElasticityProblem& problem,
                                          const TransientOptions& options) {

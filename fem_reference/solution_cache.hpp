@@ -13,6 +13,7 @@
 #include <ostream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "fem_reference/elasticity.hpp"
 #include "fem_reference/hyperelastic.hpp"
@@ -48,6 +49,16 @@ class SolutionCache {
   /// The mesh and problem must be those `solver` was built from.
   const ElasticityResult& solve(ElasticitySolver& solver, const TetMesh& mesh,
                                 const ElasticityProblem& problem);
+
+  /// Whether a readable entry of (mesh, problem) is stored (false when the cache is off or the
+  /// problem cannot be keyed). A found entry counts as a hit.
+  bool contains(const TetMesh& mesh, const ElasticityProblem& problem);
+
+  /// Stores `result` and `dofs` (in the numbering of ElasticitySolver(mesh, problem)) as the
+  /// solution of (mesh, problem), replacing any entry: what a solve elsewhere (the distributed
+  /// solver's reference job) leaves for solve() to restore. Nothing when off or unkeyable.
+  void store(const TetMesh& mesh, const ElasticityProblem& problem, const ElasticityResult& result,
+             const std::vector<double>& dofs);
 
   /// solver.transient(options), or the stored history of the same mesh, problem and options.
   TransientResult transient(const ElasticitySolver& solver, const TetMesh& mesh,

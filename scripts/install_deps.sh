@@ -15,7 +15,9 @@ packages=(
   libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
   libspectra-dev
   libboost-dev                            # rod_theory: Boost.Math elliptic integrals, Odeint
-  openmpi-bin                             # mpirun: fem --distributed and its tests
+  openmpi-bin                             # mpirun: fem --distributed, the reference job, their tests
+  time                                    # /usr/bin/time: peak memory per rank (measure_cluster_scaling.py)
+  munge slurmctld slurmd slurm-client     # a one-node Slurm cluster for the sbatch test (slurm_localhost.sh)
   python3-matplotlib python3-numpy        # reports (use /usr/bin/python3)
   libjs-three libjs-chart.js              # report.html: 3D views and plots, inlined when written
   "$@"

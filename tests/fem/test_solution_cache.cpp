@@ -83,6 +83,37 @@ TEST(SolutionCache, AHitRestoresTheFreshSolveBitwise) {
   EXPECT_EQ(log.str(), "");
 }
 
+TEST(SolutionCache, AStoredSolutionIsFoundAndRestoredAsASolvedOne) {
+  // What the distributed reference job does: store a result and DoFs solved elsewhere (here a
+  // serial solve), then a serial solve() on the same cache restores them without solving.
+  const TetMesh& mesh = test::short_tube_mesh(0);
+  const fem::ElasticityProblem problem = test::lame_problem(0.3, 2, fem::Formulation::displacement);
+  fem::ElasticitySolver fresh(mesh, problem);
+  fresh.solve();
+  test::TempDir dir;
+  std::ostringstream log;
+  fem::SolutionCache cache(dir.path(), &log);
+  EXPECT_FALSE(cache.contains(mesh, problem));
+  cache.store(mesh, problem, fresh.result(), fresh.solution_dofs());
+  EXPECT_TRUE(cache.contains(mesh, problem));
+  fem::ElasticityProblem other = problem;
+  other.material.poisson_ratio = 0.31;
+  EXPECT_FALSE(cache.contains(mesh, other));
+
+  fem::SolutionCache later(dir.path(), &log);
+  fem::ElasticitySolver restored(mesh, problem);
+  later.solve(restored, mesh, problem);
+  EXPECT_EQ(later.statistics().hits, 1);
+  EXPECT_EQ(later.statistics().misses, 0);
+  expect_same_solution(fresh, restored);
+
+  // A corrupt entry is not "contained": the job solves and stores it again.
+  const fs::path entry = entries(dir.path()).at(0);
+  fs::resize_file(entry, fs::file_size(entry) - 100);
+  EXPECT_FALSE(later.contains(mesh, problem));
+  EXPECT_NE(log.str().find("corrupt (truncated)"), std::string::npos) << log.str();
+}
+
 TEST(SolutionCache, EveryChangedInputChangesTheKey) {
   const TetMesh& mesh = test::short_tube_mesh(0);
   const fem::ElasticityProblem base = curved_lame(0.3);

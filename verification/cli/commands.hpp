@@ -11,6 +11,9 @@ void add_scene_command(CLI::App& app);
 void add_export_command(CLI::App& app);
 /// `vesselverify run`; `command_line` is recorded in the results.
 void add_run_command(CLI::App& app, const std::string& command_line);
+/// `vesselverify reference`: scenes' references solved over MPI ranks into the FEM solution
+/// cache (reference_command.cpp).
+void add_reference_command(CLI::App& app);
 /// `vesselverify report`: results → Markdown and HTML report; `command_line` is recorded in it.
 void add_report_command(CLI::App& app, const std::string& command_line);
 /// `vesselverify gate`: the CI gate against a committed baseline.

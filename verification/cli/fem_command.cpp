@@ -640,9 +640,9 @@ void add_study_options(CLI::App* cmd, FemCommandOptions& o) {
   cmd->add_flag(
       "--distributed", o.distributed,
       "Solve in parallel over the MPI ranks (run under 'mpirun -np N'): fully distributed "
-      "mesh, Trilinos CG with ML AMG; P1/P2 displacement formulation only (no mixed, "
-      "--curved, --modes or --transient). Rank 0 prints and writes the files; --vtu gets the "
-      "nodal displacement only");
+      "mesh; P1/P2 by Trilinos CG with ML AMG, Taylor-Hood (nu >= --mixed-threshold) by FGMRES "
+      "with the block preconditioner; no --curved, --modes or --transient. Rank 0 prints and "
+      "writes the files; --vtu gets the nodal displacement only");
   cmd->add_flag("--transient", o.transient,
                 "Also run the step response: the loads applied at t = 0 to the body at rest, "
                 "Newmark average acceleration with the consistent mass; prints the contact "

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   std::string command_line;
   for (int i = 0; i < argc; ++i) command_line += (i ? " " : "") + std::string(argv[i]);
   vessel::cli::add_run_command(app, command_line);
+  vessel::cli::add_reference_command(app);
   vessel::cli::add_report_command(app, command_line);
   vessel::cli::add_gate_command(app, command_line);
   vessel::cli::add_recommend_command(app, command_line);

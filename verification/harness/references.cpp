@@ -113,13 +113,13 @@ const TetMesh& mesh_at_level(SceneReferences& r, int level, const HarnessOptions
 /// The GCI order of the scene's reference (fem::gci_order): observed from the QoI point's
 /// displacement along the fine level's direction there on three levels when the coarsest exists
 /// (solved here), else the assumed order of the scene's load.
-fem::GciOrder reference_gci_order(const Scene& s, const SceneReferences& r,
-                                  const ReferenceSolvers& ref, double nu) {
+fem::GciOrder reference_gci_order(const Scene& s, const std::vector<ReferenceSolve>& solves,
+                                  const ReferenceSolvers& ref) {
   const double assumed = s.load.kind == LoadKind::contact ? kAssumedReferenceOrderContact
                                                           : kAssumedReferenceOrderDistributed;
-  if (!r.coarsest_mesh) return fem::gci_order(std::nullopt, assumed);
+  if (solves.size() < 3) return fem::gci_order(std::nullopt, assumed);
   std::unique_ptr<fem::ElasticitySolver> coarsest;
-  solve_reference(coarsest, *r.coarsest_mesh, fem_problem(s, *r.coarsest_mesh, nu, 2), ref.cache);
+  solve_reference(coarsest, *solves[2].mesh, solves[2].problem, ref.cache);
   const Vec3 q = qoi_point(s);
   const Vec3 fine = ref.fine->displacement_at({q}, kOutsideTolerance)[0];
   const Vec3 dir = fine.norm() > 0.0 ? Vec3(fine.normalized()) : Vec3(1.0, 0.0, 0.0);
@@ -342,15 +342,28 @@ std::string modal_label(const Scene& s, const SceneReferences& r, double nu) {
          std::to_string(nu) + ", " + std::to_string(s.modes.count) + " modes)";
 }
 
+std::vector<ReferenceSolve> reference_solves(const SceneReferences& r, std::size_t k) {
+  const Scene& s = r.scene;
+  const double nu = s.poisson_ratios[k];
+  std::vector<ReferenceSolve> out;
+  out.push_back({&r.fine_mesh, s.reference_level, fem_problem(s, r.fine_mesh, nu, 2)});
+  const TetMesh* below[] = {r.coarse_mesh.get(), r.coarsest_mesh.get()};
+  for (int i = 0; i < 2 && below[i]; ++i) {
+    out.push_back({below[i], s.reference_level - 1 - i, fem_problem(s, *below[i], nu, 2)});
+  }
+  return out;
+}
+
 void solve_reference_at(const Scene& s, SceneReferences& r, std::size_t k,
                         const HarnessOptions& o) {
   Stopwatch clock;
   const double nu = s.poisson_ratios[k];
   SceneReferences::AtNu& a = r.at_nu[k];
   ReferenceSolvers& ref = a.ref;
+  std::vector<ReferenceSolve> solves = reference_solves(r, k);
   ref.cache = o.solution_cache;
   ref.fine_mesh = &r.fine_mesh;
-  ref.fine_problem = fem_problem(s, r.fine_mesh, nu, 2);
+  ref.fine_problem = solves[0].problem;
   const fem::ElasticityResult& fine =
       solve_reference(ref.fine, r.fine_mesh, ref.fine_problem, ref.cache);
   ref.transient_level = r.transient_level;
@@ -360,9 +373,9 @@ void solve_reference_at(const Scene& s, SceneReferences& r, std::size_t k,
     ref.transient_solver =
         std::make_unique<fem::ElasticitySolver>(*r.transient_mesh, ref.transient_problem);
   }
-  if (r.coarse_mesh) {
-    solve_reference(ref.coarse, *r.coarse_mesh, fem_problem(s, *r.coarse_mesh, nu, 2), ref.cache);
-    ref.gci = reference_gci_order(s, r, ref, nu);
+  if (solves.size() > 1) {
+    solve_reference(ref.coarse, *solves[1].mesh, solves[1].problem, ref.cache);
+    ref.gci = reference_gci_order(s, solves, ref);
     a.info.gci_order = ref.gci.order;
     a.info.gci_order_source = ref.gci.source;
     a.info.gci_safety_factor = ref.gci.safety_factor;

@@ -116,6 +116,19 @@ struct SceneReferences {
 std::unique_ptr<SceneReferences> scene_meshes(const Scene& scene, const HarnessOptions& o,
                                               std::ostream& log);
 
+/// One static linear solve of a scene's reference: its mesh, level and problem (unit load), the
+/// solution cache's key.
+struct ReferenceSolve {
+  const TetMesh* mesh = nullptr;
+  int level = 0;
+  fem::ElasticityProblem problem;
+};
+
+/// The static solves of the scene's reference at its k-th ν, as solve_reference_at makes them:
+/// the fine level, then the one below (Richardson) and the one below that (the GCI's observed
+/// order) where the scene has them. What a distributed reference job solves into the cache.
+std::vector<ReferenceSolve> reference_solves(const SceneReferences& r, std::size_t k);
+
 /// The scene's P2 reference at its k-th ν (unit load), on the fine level and the one below.
 void solve_reference_at(const Scene& s, SceneReferences& r, std::size_t k, const HarnessOptions& o);
 

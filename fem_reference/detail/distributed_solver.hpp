@@ -1,0 +1,101 @@
+#pragma once
+/// Private to fem_reference: the state of the distributed (MPI) solver, shared by the files that
+/// implement it: distributed_elasticity.cpp (triangulation, displacement system, CG-AMG, post-
+/// processing), distributed_mixed.cpp (Taylor–Hood on Trilinos block matrices, FGMRES) and
+/// distributed_gather.cpp (what rank 0 collects: nodal field, the solution in the serial solver's
+/// DoF numbering, point values).
+#include <deal.II/base/index_set.h>
+#include <deal.II/distributed/fully_distributed_tria.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_simplex_p.h>
+#include <deal.II/fe/mapping_fe.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_block_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <mpi.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fem_reference/detail/amg.hpp"
+#include "fem_reference/detail/boundary.hpp"
+#include "fem_reference/detail/postprocess.hpp"
+#include "fem_reference/detail/weak_form.hpp"
+#include "fem_reference/distributed_elasticity.hpp"
+
+namespace vessel::fem::detail {
+
+using VectorT = dl::TrilinosWrappers::MPI::Vector;
+using BlockVectorT = dl::TrilinosWrappers::MPI::BlockVector;
+
+class Distributed {
+ public:
+  Distributed(const TetMesh& mesh, const ElasticityProblem& problem, MPI_Comm comm, bool mixed);
+
+  DistributedResult run(const DistributedOptions& options);
+
+ private:
+  // distributed_elasticity.cpp
+  void build_triangulation();
+  void setup_dofs();
+  void setup_constraints();
+  void assemble();
+  void solve_linear();
+  /// The locally owned rows of `rows` (a set of displacement DoFs) in the row map's order.
+  [[nodiscard]] DisplacementRows owned_rows(const dl::IndexSet& rows) const;
+  void postprocess();
+  [[nodiscard]] VectorT residual(StrainSummary& strain) const;
+  [[nodiscard]] double max_over_ranks(double v) const;
+  [[nodiscard]] Vec3 sum_over_ranks(const Vec3& v) const;
+
+  // distributed_mixed.cpp: the Taylor–Hood system in two blocks (u, p), step-55's layout.
+  void setup_mixed_system();
+  void assemble_mixed();
+  void assemble_schur_approximation();
+  void solve_mixed();
+
+  // distributed_gather.cpp
+  void gather_nodal_displacement();
+  /// Rank 0: the solution in the serial ElasticitySolver's DoF numbering (empty elsewhere).
+  [[nodiscard]] std::vector<double> gather_serial_dofs() const;
+  /// Rank 0: `value[k]` put at the serial DoF of (tet, local index) `where[k]` = tet·n + i, on a
+  /// serial DoFHandler numbered as ElasticitySolver's; `failure` says so if not every serial DoF
+  /// got exactly one value.
+  [[nodiscard]] std::vector<double> place_in_serial_numbering(const std::vector<std::int64_t>& where,
+                                                              const std::vector<double>& value,
+                                                              std::string& failure) const;
+  /// Every rank: u at `points` (the tet found by TetLocator, evaluated by the rank owning it).
+  [[nodiscard]] std::vector<Vec3> evaluate(const std::vector<Vec3>& points, double tol) const;
+
+  const TetMesh& mesh_;
+  const ElasticityProblem& problem_;
+  MPI_Comm comm_;
+  unsigned rank_, n_ranks_;
+  bool mixed_;
+  int degree_;
+
+  dl::FE_SimplexP<kDim> linear_;
+  dl::MappingFE<kDim> mapping_;
+  dl::parallel::fullydistributed::Triangulation<kDim> tria_;
+  MeshCorrespondence mesh_map_;  // for the local cells (ghosts included)
+  std::unique_ptr<WeakForm> form_;
+  std::unique_ptr<dl::FiniteElement<kDim>> fe_;
+  dl::DoFHandler<kDim> dof_;
+  dl::IndexSet owned_, relevant_;
+  dl::AffineConstraints<double> constraints_;
+  // Displacement formulation: one matrix. Mixed: the (u, p) blocks and the Schur approximation.
+  dl::TrilinosWrappers::SparseMatrix matrix_;
+  std::vector<dl::IndexSet> owned_blocks_, relevant_blocks_;
+  dl::TrilinosWrappers::BlockSparseMatrix block_matrix_, schur_;
+  BlockVectorT block_rhs_;
+  // The solution (both formulations) in one vector for post-processing.
+  VectorT rhs_, solution_, ghosted_;
+
+  DistributedResult out_;
+};
+
+}  // namespace vessel::fem::detail
