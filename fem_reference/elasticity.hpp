@@ -156,7 +156,7 @@ struct ElasticityResult {
   unsigned iterations = 0;  ///< CG or FGMRES iterations (0 for direct)
   double inner_iterations = 0.0;  ///< gmres_block: mean CG iterations per pressure-mass solve
   std::size_t n_dofs = 0;
-  std::size_t n_pressure_dofs = 0;       ///< mixed only
+  std::size_t n_pressure_dofs = 0;       ///< mixed only: how many of n_dofs are pressure's
   std::vector<Vec3> nodal_displacement;  ///< at every TetMesh node, m
   std::vector<GroupReaction> reactions;  ///< one per Dirichlet group, in order of first mention
   Vec3 applied_load = Vec3::Zero();      ///< ∫ traction dA + ∫ ρg dV, N

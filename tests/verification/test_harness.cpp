@@ -3,6 +3,8 @@
 // linear scaling, and a diverging model recorded as failed while the others still run.
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <iostream>
 
 #include <algorithm>
@@ -24,6 +26,7 @@
 #include "verification/harness/metrics.hpp"
 #include "verification/harness/timed_updates.hpp"
 #include "verification/harness/results.hpp"
+#include "verification/scene_problems.hpp"
 #include "tests/fixtures/lame_tube_scene.hpp"
 
 using namespace vessel;
@@ -232,6 +235,27 @@ TEST_F(HarnessLame, ResultsJsonHasEveryFieldItsSchemaRequires) {
     }
   }
   EXPECT_NE(test::read_text(dir / "summary.md").find("| p1 | 0.3 | 0 | 10 |"), std::string::npos);
+}
+
+TEST(HarnessReferences, ATaylorHoodReferenceCountsEachDofOnce) {
+  // At ν = 0.5 the reference is P2–P1 (Taylor–Hood): 3 displacement DoFs per P2 node (the mesh's
+  // vertices and edge midpoints) and one pressure DoF per vertex.
+  const Scene s = parse_scene(vessel::test::lame_tube_scene("lame_taylor_hood", "0.5") +
+                                  "[[models]]\nname = \"p1\"\nkind = \"fem\"\ndegree = 1\n",
+                              "lame_taylor_hood.toml");
+  const SceneResult r = run_scene(s, HarnessOptions{});
+  ASSERT_EQ(r.references.size(), 1u);
+  const TetMesh mesh = scene_mesh(s, s.reference_level, "");
+  std::set<std::pair<std::size_t, std::size_t>> edges;
+  for (const auto& t : mesh.tets) {
+    for (int a = 0; a < 4; ++a) {
+      for (int b = a + 1; b < 4; ++b) {
+        const auto i = static_cast<std::size_t>(t[a]), j = static_cast<std::size_t>(t[b]);
+        edges.emplace(std::min(i, j), std::max(i, j));
+      }
+    }
+  }
+  EXPECT_EQ(r.references[0].dofs, 3 * (mesh.nodes.size() + edges.size()) + mesh.nodes.size());
 }
 
 TEST(HarnessModes, NaturalFrequenciesBesideTheModalReference) {

@@ -384,7 +384,7 @@ void solve_reference_at(const Scene& s, SceneReferences& r, std::size_t k,
   a.info.poisson_ratio = nu;
   a.info.element = fine.element;
   a.info.level = s.reference_level;
-  a.info.dofs = fine.n_dofs + fine.n_pressure_dofs;
+  a.info.dofs = fine.n_dofs;  // Taylor–Hood: displacement and pressure, each counted once
   a.info.solve_seconds = fine.timings.assembly + fine.timings.solve;
   a.info.max_abs_strain_unit = fine.max_abs_principal_strain;
   a.info.budget_magnitude = budget_magnitude(s, fine.max_abs_principal_strain);
