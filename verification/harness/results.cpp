@@ -10,6 +10,7 @@
 #include "meshes/foundation/atomic_file.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "verification/harness/results.hpp"
+#include "verification/harness/guidewire_coupling.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/harness/metrics.hpp"
 #include "verification/harness/outcome_cache.hpp"
@@ -193,7 +194,7 @@ nlohmann::json scene_json(const SceneResult& r) {
     }
     modes = {{"count", s.modes.count}, {"reference", reference}, {"models", models}};
   }
-  return {
+  nlohmann::json j = {
       {"name", s.name},
       {"source", s.source.string()},
       {"description", s.description},
@@ -210,6 +211,8 @@ nlohmann::json scene_json(const SceneResult& r) {
       {"references", refs},
       {"outcomes", outcomes},
       {"modes", modes}};
+  if (r.guidewire) j["guidewire"] = guidewire_json(*r.guidewire);
+  return j;
 }
 
 }  // namespace
