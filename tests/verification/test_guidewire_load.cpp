@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 
@@ -119,9 +120,38 @@ TEST(GuidewireCoupling, SeriesSpringsWithCompliancesFromSeparateSolves) {
   }
 }
 
+/// The continuum wire's tip force at fixed length L against a tube of centreline offset c:
+/// the tip's axial position z solves L = (L/z)(c/z)·z (shooting's length, secant on z).
+double continuum_force(double theta, double c, double L) {
+  double z0 = 0.98 * L, z1 = 0.99 * L;
+  const auto miss = [&](double z) { return rod_theory::straight_tube_contact(theta, c / z).length * z - L; };
+  double m0 = miss(z0), m1 = miss(z1);
+  for (int it = 0; it < 50 && std::abs(m1) > 1e-15; ++it) {
+    const double z2 = z1 - m1 * (z1 - z0) / (m1 - m0);
+    z0 = z1;
+    m0 = m1;
+    z1 = z2;
+    m1 = miss(z1);
+  }
+  return rod_theory::straight_tube_contact(theta, c / z1).force * kEI / (z1 * z1);
+}
+
+TEST(GuidewireCoupling, WireComplianceMatchesTheContinuumWire) {
+  const Scene s = parse_scene(straight_scene("tilt = 0.3"), "wire.toml");
+  GuidewireSolver solver(s.vessel, *s.load.guidewire);
+  (void)solver.solve_rigid();
+  const double Cr = solver.compliance();
+  const double c = kA - kD / 2, d = 1e-3 * c, L = 20.25e-3;
+  const double Cr_continuum =
+      -2.0 * d / (continuum_force(0.3, c + d, L) - continuum_force(0.3, c - d, L));
+  std::printf("GUIDEWIRE straight tube wire compliance %.6f m/N, continuum %.6f m/N\n", Cr,
+              Cr_continuum);
+  EXPECT_NEAR(Cr / Cr_continuum, 1.0, 1e-2);
+}
+
 TEST(GuidewireCoupling, RowsPerModelAndStiffnessFromTheOutcomesIndentation) {
   Scene s = parse_scene(straight_scene("tilt = 0.3\ncoupling = \"compliant\"\n"
-                                       "stiffness_sweep = [4e-7, 4e-6]"),
+                                       "stiffness_sweep = [4e-7, 4e-6, 4e-5]"),
                         "wire.toml");
   const double F = s.load.magnitudes[0];
   // Two walls seen through their indentation under the rigid wire's force: the model twice as

@@ -5,6 +5,7 @@
 /// F), beside the reference's (C_ref from the reference's indentation on the same nodal loads).
 /// Valid for linear walls: C is measured once, at the rigid wire's force.
 #include <nlohmann/json_fwd.hpp>
+#include <ostream>
 #include <vector>
 
 #include "verification/harness/guidewire_outcome.hpp"
@@ -15,6 +16,10 @@ namespace vessel {
 /// The scene's guidewire outcome from its run's outcomes (every ok static outcome with an
 /// indentation; the scene's EI first, then each of the spec's stiffness_sweep).
 GuidewireOutcome couple_guidewire(const Scene& scene, const std::vector<ModelOutcome>& outcomes);
+
+/// summary.md's guidewire section: the wire against the rigid lumen per EI, and the coupled
+/// contact force of each model beside the reference's (mN), with the contact displacements (mm).
+void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g);
 
 /// results.json's "guidewire" object.
 nlohmann::json guidewire_json(const GuidewireOutcome& g);

@@ -371,6 +371,7 @@ void write_summary_markdown(const std::filesystem::path& path,
       out << "\n";
       const std::string provenance = timing_provenance_line(r.outcomes);
       if (!provenance.empty()) out << "Timings: " << provenance << ".\n\n";
+      if (r.guidewire) write_guidewire_markdown(out, *r.guidewire);
       if (r.reference_modes.empty() && r.model_modes.empty()) continue;
       // Natural frequencies ([modes]): each model's beside the modal reference's, by rank.
       out << "Natural frequencies (Hz) at rest, the scene's supports held; f/f_ref mode by mode "
