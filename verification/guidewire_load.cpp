@@ -106,8 +106,8 @@ GuidewireSolver::~GuidewireSolver() = default;
 GuidewireSolution GuidewireSolver::solve_rigid() {
   Impl& m = *impl_;
   m.state.resize(0);
-  // Insertion in steps of at most a third of the lumen radius, each from the last shape.
-  const double step = m.vessel.inner_radius / 3.0;
+  // Insertion in steps of at most half the lumen radius, each from the last shape.
+  const double step = m.vessel.inner_radius / 2.0;
   const int n = std::max(2, static_cast<int>(std::ceil(m.spec.insertion / step)));
   GuidewireSolution s;
   for (int k = 1; k <= n; ++k) s = m.solve(m.spec.insertion * k / n, 0.0);
@@ -118,6 +118,7 @@ GuidewireSolution GuidewireSolver::solve_rigid() {
   }
   rigid_ = s;
   last_ = s;
+  compliance_ = 0.0;
   return s;
 }
 
@@ -128,11 +129,13 @@ GuidewireSolution GuidewireSolver::solve_with_give(double give) {
 }
 
 double GuidewireSolver::compliance() {
+  if (compliance_ > 0.0) return compliance_;
   const double d = 1e-4 * impl_->offset;
   const double f_plus = solve_with_give(d).force;
   const double f_minus = solve_with_give(-d).force;
   solve_with_give(0.0);
-  return -2.0 * d / (f_plus - f_minus);
+  compliance_ = -2.0 * d / (f_plus - f_minus);
+  return compliance_;
 }
 
 double GuidewireSolver::coupled_force(double C) {

@@ -38,7 +38,7 @@ class GuidewireSolver {
   /// solution (solve_rigid first).
   GuidewireSolution solve_with_give(double give);
   /// The wire's compliance at the contact, −dδ/dF by a central difference of solve_with_give
-  /// (m/N); restores the rigid state.
+  /// (m/N), computed once per solve_rigid; restores the rigid state.
   double compliance();
   /// The force F (N) with F = F_wire(C·F): the wire against a wall of compliance C (m/N), by a
   /// secant to |h| ≤ 1e-12 F_rigid. Leaves the coupled solution in `last()`.
@@ -50,6 +50,7 @@ class GuidewireSolver {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   GuidewireSolution rigid_, last_;
+  double compliance_ = 0.0;  ///< 0: not computed since the last solve_rigid
 };
 
 /// The inlet's clamp pose of the spec's tilt form: the inlet's centreline point and tangent,
