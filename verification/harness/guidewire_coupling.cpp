@@ -1,7 +1,6 @@
 #include "verification/harness/guidewire_coupling.hpp"
 
 #include <cmath>
-#include <string>
 #include <nlohmann/json.hpp>
 
 #include "msm/rods/rod_layout.hpp"
@@ -92,7 +91,9 @@ void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g) {
     const Vec3& p = r.solution.contact_point;
     out << "| " << r.bending_stiffness << " | " << r.solution.force * 1e3 << " | (" << p.x() * 1e3
         << ", " << p.y() * 1e3 << ", " << p.z() * 1e3 << ") | "
-        << (compliant ? std::to_string(r.wire_compliance) : std::string("–")) << " |\n";
+        << (compliant ? "" : "–");
+    if (compliant) out << r.wire_compliance;
+    out << " |\n";
   }
   out << "\n";
   if (g.rows.empty()) return;
