@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "meshes/tet_mesh.hpp"
 #include "verification/guidewire_spec.hpp"
 
 namespace vessel {
@@ -28,12 +29,15 @@ struct GuidewireCouplingRow {
   double reference_force_mN = 0.0;    ///< the reference's
   double displacement_mm = 0.0;       ///< the model's contact displacement C_v·F
   double reference_displacement_mm = 0.0;  ///< C_ref·F_ref
+  /// The wire's contact node in the model's coupled state, m (it slides along the wall as it gives).
+  Vec3 contact_point = Vec3::Zero();
   bool ok = false;
   std::string failure;
 };
 
 struct GuidewireOutcome {
   GuidewireSpec spec;
+  double patch_radius = 0.0;  ///< m: a coupled contact that slid farther has left the patch
   std::vector<GuidewireRigid> rigid;       ///< the scene's EI first, then the stiffness sweep's
   std::vector<GuidewireCouplingRow> rows;  ///< compliant coupling: per EI, per model outcome
 };
