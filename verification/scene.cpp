@@ -373,14 +373,14 @@ GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
   w.model = r.string_or("model");
   const toml::node* point = r.get("clamp_point");
   const toml::node* direction = r.get("clamp_direction");
+  if (point) w.clamp_point = r.vector3(*point, "clamp_point");
+  if (direction) w.clamp_direction = r.vector3(*direction, "clamp_direction");
   if (point || direction) {
     if (!point) r.fail(direction, "clamp_point", "missing; clamp_direction needs clamp_point");
     if (!direction) r.fail(point, "clamp_direction", "missing; clamp_point needs clamp_direction");
     for (const char* k : {"tilt", "tilt_towards"}) {
       if (const toml::node* n = r.get(k)) r.fail(n, k, "found with clamp_point; expected one pose");
     }
-    w.clamp_point = r.vector3(*point, "clamp_point");
-    w.clamp_direction = r.vector3(*direction, "clamp_direction");
     if (w.clamp_direction.norm() == 0.0) {
       r.fail(direction, "clamp_direction", "found [0, 0, 0], expected a non-zero vector");
     }
