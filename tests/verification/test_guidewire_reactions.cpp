@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "msm/model/model.hpp"
+#include "verification/harness/harness.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_problems.hpp"
@@ -51,6 +52,33 @@ TEST(GuidewireReactions, WireClampAndVesselSupportsSumToZero) {
     EXPECT_LT((sum - mismatch).norm(), 1e-9) << file;
     if (std::string(file) == "guidewire_straight.toml") EXPECT_LT(sum.norm(), 1e-9);
   }
+}
+
+// The harness's compliant coupling on a real wall: the model's compliance C_v comes from its own
+// solve in the run (its indentation under the rigid wire's patch), the wire's C_r from the wire's
+// solves; two springs in series give F = F_rigid·C_r/(C_r + C_v) within 1e-3 (the floppy wire,
+// C_v/C_r ≈ 0.08, where both are near linear).
+TEST(GuidewireCouplingRun, ModelForceIsTheSeriesSpringsOnTheModelsOwnCompliance) {
+  Scene s = read_scene(std::string(VESSEL_SCENES_DIR) + "/guidewire_straight.toml");
+  s.reference_level = 0;
+  std::vector<ModelSpec> keep;
+  for (const ModelSpec& m : s.models) {
+    if (m.name == "volume_hybrid") keep.push_back(m);
+  }
+  s.models = keep;
+  s.load.guidewire->stiffness_sweep.clear();
+  const SceneResult r = run_scene(s, HarnessOptions{});
+  ASSERT_TRUE(r.guidewire.has_value());
+  ASSERT_EQ(r.guidewire->rows.size(), 1u);
+  const GuidewireCouplingRow& row = r.guidewire->rows[0];
+  ASSERT_TRUE(row.ok) << row.failure;
+  const GuidewireRigid& wire = r.guidewire->rigid.at(0);
+  const double series = wire.solution.force * wire.wire_compliance /
+                        (wire.wire_compliance + row.wall_compliance);
+  std::printf("GUIDEWIRE volume_hybrid: C_v %.4f m/N, C_r %.4f m/N, F %.6e N, series %.6e N\n",
+              row.wall_compliance, wire.wire_compliance, row.force_mN * 1e-3, series);
+  EXPECT_NEAR(row.force_mN * 1e-3 / series, 1.0, 1e-3);
+  EXPECT_GT(row.wall_compliance, 0.0);
 }
 
 }  // namespace
