@@ -4,7 +4,8 @@
 #   1. the default vessels' mesh statistics;
 #   2. `vesselverify run`: every model of every shipped scene (contact on the straight tube and
 #      on the arch, Lamé pressure, gravity sag, the dynamic step contact, the region-of-interest
-#      radii) against the FEM reference → results.json, results.csv, summary.md, fields/;
+#      radii, the guidewire pushing the straight tube and the arch) against the FEM reference →
+#      results.json, results.csv, summary.md, fields/;
 #   3. `vesselverify validity` on the contact scenes and gravity: where the linear reference stops
 #      being valid, and the seed models against the finite-strain reference up to 70 mN and 1 g
 #      → validity.json;
@@ -72,7 +73,8 @@ reference=()
 if [ ${#mode[@]} -gt 0 ]; then reference=(--reference-level 0); fi
 "$vv" run "${mode[@]}" "${reference[@]}" "${retime[@]}" --output-dir "$out" "$scenes/contact_straight.toml" \
   "$scenes/pressure_lame.toml" "$scenes/contact_arch.toml" "$scenes/gravity_sag.toml" \
-  "$scenes/dynamic_contact.toml" "$scenes/contact_roi.toml"
+  "$scenes/dynamic_contact.toml" "$scenes/contact_roi.toml" "$scenes/guidewire_straight.toml" \
+  "$scenes/guidewire_arch.toml"
 phase "validity: the linear reference's limit, the seed models at finite strain"
 # P2 on level 0 and the ladder to 70 mN (--quick: 0.1, 1 and 10 mN; `vesselverify validity
 # --full` for the scenes' reference level, the full ladder to 140 mN and every static model).
@@ -106,5 +108,7 @@ done
 phase "report"
 "$vv" report "$out/results.json" --stability "$out/stability.json" "${recommendations[@]}" \
   --validity "$out/validity.json" --output-dir "$out"
+# The guidewire scenes' figures: the wire's shape and each model's coupled force over the EI sweep.
+/usr/bin/python3 "$root/scripts/guidewire_figures.py" "$out/results.json" "$out/figures"
 phase "done"
 echo "verification finished in $((SECONDS - start)) s; report: $out/report.html (and report.md)"

@@ -12,6 +12,7 @@
 #include "msm/solvers/integrators.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 #include "verification/model_capabilities.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/scene_reader.hpp"
 
 namespace vessel {
@@ -357,11 +358,64 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
   return sweep(m, stiffness, mass, solvers, dts, radii);
 }
 
-LoadSpec read_load(TableReader r) {
+/// The guidewire load's keys (verification/guidewire_spec.hpp); its solve is resolve_guidewire's.
+GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
+  GuidewireSpec w;
+  w.young = r.number(r.require("E"), "E");
+  const toml::node* G = r.get("G");
+  const toml::node* nu = r.get("nu");
+  if (G && nu) r.fail(nu, "nu", "found both G and nu; expected one of them");
+  w.shear = G ? r.number(*G, "G") : w.young / (2.0 * (1.0 + r.number_or("nu")));
+  w.density = r.number_or("density");
+  w.diameter = r.number(r.require("diameter"), "diameter");
+  w.insertion = r.number(r.require("insertion"), "insertion");
+  w.segments = static_cast<int>(r.integer_or("segments", 32));
+  w.model = r.string_or("model");
+  const toml::node* point = r.get("clamp_point");
+  const toml::node* direction = r.get("clamp_direction");
+  if (point) w.clamp_point = r.vector3(*point, "clamp_point");
+  if (direction) w.clamp_direction = r.vector3(*direction, "clamp_direction");
+  if (point || direction) {
+    if (!point) r.fail(direction, "clamp_point", "missing; clamp_direction needs clamp_point");
+    if (!direction) r.fail(point, "clamp_direction", "missing; clamp_point needs clamp_direction");
+    for (const char* k : {"tilt", "tilt_towards"}) {
+      if (const toml::node* n = r.get(k)) r.fail(n, k, "found with clamp_point; expected one pose");
+    }
+    if (w.clamp_direction.norm() == 0.0) {
+      r.fail(direction, "clamp_direction", "found [0, 0, 0], expected a non-zero vector");
+    }
+    w.clamp_direction.normalize();
+  } else {
+    const toml::node* towards = r.get("tilt_towards");
+    try {
+      set_tilted_clamp(vessel, r.number_or("tilt"),
+                       towards ? r.vector3(*towards, "tilt_towards") : Vec3::UnitX(), w);
+    } catch (const InputError& e) {
+      r.fail(towards, "tilt_towards", e.what());
+    }
+  }
+  w.coupling = r.string_or("coupling") == "compliant" ? GuidewireCoupling::compliant
+                                                       : GuidewireCoupling::rigid;
+  if (const toml::node* sweep = r.get("stiffness_sweep")) {
+    if (w.coupling != GuidewireCoupling::compliant) {
+      r.fail(sweep, "stiffness_sweep", "found with coupling = \"rigid\"; expected \"compliant\"");
+    }
+    w.stiffness_sweep = r.numbers(*sweep, "stiffness_sweep");
+  }
+  return w;
+}
+
+LoadSpec read_load(TableReader r, const VesselParams& vessel) {
   LoadSpec load;
   const std::string type = r.string_or("type", "");
   if (type.empty()) (void)r.require("type");
   r.enter(type);
+  if (type == "guidewire") {
+    load.guidewire = read_guidewire(r, vessel);
+    load.contact.radius = r.number_or("patch_radius");
+    resolve_guidewire(vessel, r.file(), load);
+    return load;
+  }
   load.kind = type == "contact" ? LoadKind::contact
                                 : (type == "pressure" ? LoadKind::pressure : LoadKind::gravity);
   load.magnitudes = r.numbers(r.require("magnitudes"), "magnitudes");
@@ -504,7 +558,7 @@ Scene parse_scene(std::string_view text, const std::string& source_name) {
     scene.boundary[group] = parse_end_condition(boundary.string_or(group));
   }
 
-  scene.load = read_load(r.sub("load"));
+  scene.load = read_load(r.sub("load"), scene.vessel);
   read_models(r, scene);
   scene.tolerances.max_error_mm = r.sub("tolerances").number_or("max_error_mm");
   if (r.get("budget")) scene.budget = read_budget(r.sub("budget"), scene);

@@ -4,10 +4,12 @@
 /// out-of-range values are InputErrors naming the file, line and key). SI units in the file.
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "meshes/supports.hpp"
+#include "verification/guidewire_spec.hpp"
 #include "meshes/surface_loads.hpp"
 #include "meshes/vessel_geometry.hpp"
 #include "msm/mass/mass_rules.hpp"
@@ -95,6 +97,10 @@ struct LoadSpec {
   std::vector<double> magnitudes;  ///< N (contact), Pa (pressure), multiples of g (gravity)
   ContactPatchSpec contact;        ///< point, radius, surface group (force set per magnitude)
   Vec3 gravity_direction = Vec3(0.0, -1.0, 0.0);
+  /// `type = "guidewire"`: the wire (a contact load whose one magnitude and point are those of
+  /// `wire`, its solve against the rigid lumen; verification/guidewire_load.hpp).
+  std::optional<GuidewireSpec> guidewire;
+  GuidewireSolution wire;
 };
 
 /// Standard gravity, m/s²: gravity magnitudes are multiples of it.

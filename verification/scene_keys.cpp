@@ -98,6 +98,49 @@ std::vector<SceneKey> top_and_vessel() {
   return out;
 }
 
+/// The guidewire load's keys (verification/guidewire_load.hpp).
+std::vector<Row> guidewire_rows() {
+  const std::vector<std::string> g{"guidewire"};
+  return {
+      Row("load", "E", KeyType::number, "The wire's Young's modulus").unit("Pa").positive()
+          .required().in(g),
+      Row("load", "G", KeyType::number, "The wire's shear modulus (give G or nu)").unit("Pa")
+          .note("E / (2 (1 + nu))").positive().in(g),
+      Row("load", "nu", KeyType::number, "The wire's Poisson's ratio (give G or nu)")
+          .dflt("0.33").range(0.0, 0.5).in(g),
+      Row("load", "density", KeyType::number, "The wire's density").dflt("6450.0").unit("kg/m³")
+          .positive().in(g),
+      Row("load", "diameter", KeyType::number, "The wire's diameter (a solid section)").unit("m")
+          .positive().required().in(g),
+      Row("load", "insertion", KeyType::number, "Length of wire beyond the clamp").unit("m")
+          .positive().required().in(g),
+      Row("load", "segments", KeyType::integer, "Segments of the discrete wire").dflt("32")
+          .range(4, 10000).in(g),
+      Row("load", "model", KeyType::string, "The rod model (msm/rods): Discrete Elastic Rods")
+          .dflt("\"der\"").one_of({"der"}).in(g),
+      Row("load", "clamp_point", KeyType::vector3,
+          "The clamp (with clamp_direction); absent: the inlet's centreline point")
+          .unit("m").in(g),
+      Row("load", "clamp_direction", KeyType::vector3,
+          "The wire's tangent at the clamp (normalised; with clamp_point)").in(g),
+      Row("load", "tilt", KeyType::number,
+          "Without clamp_point: the angle from the inlet's centreline tangent towards tilt_towards")
+          .dflt("0.0").unit("rad").range(0.0, 1.5).in(g),
+      Row("load", "tilt_towards", KeyType::vector3,
+          "Without clamp_point: the direction the wire tilts towards (its part normal to the "
+          "inlet's tangent)")
+          .dflt("[1.0, 0.0, 0.0]").in(g),
+      Row("load", "coupling", KeyType::string,
+          "rigid: every model gets the wire's force against the rigid lumen; compliant: also each "
+          "model's own force with its wall giving way (linear walls)")
+          .dflt("\"rigid\"").one_of({"rigid", "compliant"}).in(g),
+      Row("load", "stiffness_sweep", KeyType::number,
+          "Compliant coupling: wire bending stiffnesses EI the coupling is repeated at (E scaled), "
+          "with each wall's compliance of the run")
+          .unit("N·m²").positive().sweep().in(g),
+  };
+}
+
 std::vector<SceneKey> material_to_load() {
   const std::vector<std::string> walls{"inner_wall", "outer_wall"};
   const std::vector<std::string> ends{"clamped", "roller", "free"};
@@ -111,7 +154,8 @@ std::vector<SceneKey> material_to_load() {
           .one_of(ends),
       Row("boundary", "outlet", KeyType::string, "The outlet end's support").dflt("\"clamped\"")
           .one_of(ends),
-      Row("load", "type", KeyType::string, "The load").one_of({"contact", "pressure", "gravity"})
+      Row("load", "type", KeyType::string, "The load")
+          .one_of({"contact", "pressure", "gravity", "guidewire"})
           .required(),
       Row("load", "magnitudes", KeyType::number, "Contact forces the runs sweep, pushing into the wall")
           .unit("N").at_least(0.0).sweep().required().in({"contact"}),
@@ -122,12 +166,13 @@ std::vector<SceneKey> material_to_load() {
       Row("load", "point", KeyType::vector3, "The contact point on the wall").unit("m").required()
           .in({"contact"}),
       Row("load", "patch_radius", KeyType::number, "Radius of the contact patch").dflt("0.5e-3")
-          .unit("m").positive().in({"contact"}),
+          .unit("m").positive().in({"contact", "guidewire"}),
       Row("load", "surface", KeyType::string, "The wall the load acts on").dflt("\"inner_wall\"")
           .one_of(walls).in({"contact", "pressure"}),
       Row("load", "direction", KeyType::vector3, "Gravity's direction (normalised; not zero)")
           .dflt("[0.0, -1.0, 0.0]").in({"gravity"}),
   };
+  for (auto& r : guidewire_rows()) rows.push_back(std::move(r));
   std::vector<SceneKey> out;
   for (auto& r : rows) out.push_back(std::move(r.k));
   return out;
@@ -305,7 +350,7 @@ const std::vector<SceneSection>& scene_sections() {
       {"material", "Linear elastic, homogeneous", "", {}, ""},
       {"boundary", "Each end's support", "", {}, ""},
       {"load", "The load the runs sweep over its magnitudes; its type chooses the keys", "type",
-       {"contact", "pressure", "gravity"}, ""},
+       {"contact", "pressure", "gravity", "guidewire"}, ""},
       {"models",
        "One [[models]] table per model; array values of sweep keys stand for every combination",
        "kind", {"fem", "surface_msm", "volume_msm", "network", "external", "displacements"}, ""},

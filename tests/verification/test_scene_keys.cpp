@@ -37,6 +37,10 @@ Blocks base_scene(const std::string& section, const std::string& variant) {
   if (section == "load" && variant != "contact") {
     load = {{"type", "\"" + variant + "\""}, {"magnitudes", "[1.0]"}};
   }
+  if (section == "load" && variant == "guidewire") {  // EI = 4e-7 N·m², touching at z ≈ 20 mm
+    load = {{"type", "\"guidewire\""}, {"E", "5.073e8"}, {"diameter", "0.356e-3"},
+            {"insertion", "20.25e-3"}, {"coupling", "\"compliant\""}};
+  }
   std::map<std::string, std::string> model{{"kind", "\"fem\""}};
   if (section == "models") model = {{"kind", "\"" + variant + "\""}};
   if (section == "models" && variant == "network") model["file"] = "\"x.json\"";

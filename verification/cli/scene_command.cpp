@@ -18,7 +18,16 @@ void print_scene(const Scene& s) {
   std::cout << ", ρ = " << s.density << " kg/m³\n  boundary:";
   for (const auto& [group, bc] : s.boundary) std::cout << " " << group << "=" << to_string(bc);
   std::cout << "\n  load: " << to_string(s.load.kind) << ", " << s.load.magnitudes.size()
-            << " magnitude(s)\n  models:";
+            << " magnitude(s)";
+  if (s.load.guidewire) {
+    const GuidewireSolution& w = s.load.wire;
+    std::cout << " from a guidewire (" << s.load.guidewire->model << ", "
+              << s.load.guidewire->segments << " segments, EI = " << w.bending_stiffness
+              << " N·m²) against the rigid lumen: " << w.force * 1e3 << " mN at ("
+              << w.wall_point.x() * 1e3 << ", " << w.wall_point.y() * 1e3 << ", "
+              << w.wall_point.z() * 1e3 << ") mm";
+  }
+  std::cout << "\n  models:";
   for (const auto& m : s.models) std::cout << " " << m.name << " (" << to_string(m.kind) << ")";
   std::cout << "\n";
 }

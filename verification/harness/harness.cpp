@@ -9,6 +9,7 @@
 
 #include "fem_reference/cholmod_solve.hpp"
 #include "meshes/foundation/atomic_file.hpp"
+#include "verification/harness/guidewire_coupling.hpp"
 #include "verification/harness/model_readout.hpp"
 #include "verification/harness/model_runs.hpp"
 #include "verification/harness/outcome_cache.hpp"
@@ -172,6 +173,7 @@ SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& pr
       }
     }
   }
+  if (s.load.guidewire) result.guidewire = couple_guidewire(s, result.outcomes);
   return result;
 }
 

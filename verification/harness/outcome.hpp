@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
+#include "verification/harness/guidewire_outcome.hpp"
 #include "verification/scene.hpp"
 
 namespace vessel {
@@ -183,6 +184,8 @@ struct SceneResult {
   /// Natural frequencies (scene.modes.count > 0): the modal reference per ν, then each model's.
   std::vector<ModalOutcome> reference_modes;
   std::vector<ModalOutcome> model_modes;
+  /// A guidewire load: the wire and each model's coupled contact force (guidewire_coupling.hpp).
+  std::optional<GuidewireOutcome> guidewire;
   double seconds = 0.0;
 };
 

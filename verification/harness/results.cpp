@@ -10,6 +10,7 @@
 #include "meshes/foundation/atomic_file.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "verification/harness/results.hpp"
+#include "verification/harness/guidewire_coupling.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/harness/metrics.hpp"
 #include "verification/harness/outcome_cache.hpp"
@@ -215,7 +216,7 @@ nlohmann::json scene_json(const SceneResult& r, const std::filesystem::path& res
     }
     modes = {{"count", s.modes.count}, {"reference", reference}, {"models", models}};
   }
-  return {
+  nlohmann::json j = {
       {"name", s.name},
       {"source", s.source.string()},
       {"description", s.description},
@@ -233,6 +234,8 @@ nlohmann::json scene_json(const SceneResult& r, const std::filesystem::path& res
       {"references", refs},
       {"outcomes", outcomes},
       {"modes", modes}};
+  if (r.guidewire) j["guidewire"] = guidewire_json(*r.guidewire);
+  return j;
 }
 
 }  // namespace
@@ -391,6 +394,7 @@ void write_summary_markdown(const std::filesystem::path& path,
       out << "\n";
       const std::string provenance = timing_provenance_line(r.outcomes);
       if (!provenance.empty()) out << "Timings: " << provenance << ".\n\n";
+      if (r.guidewire) write_guidewire_markdown(out, *r.guidewire);
       if (r.reference_modes.empty() && r.model_modes.empty()) continue;
       // Natural frequencies ([modes]): each model's beside the modal reference's, by rank.
       out << "Natural frequencies (Hz) at rest, the scene's supports held; f/f_ref mode by mode "

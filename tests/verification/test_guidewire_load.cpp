@@ -1,0 +1,185 @@
+// The guidewire load: the scene's wire solved against the rigid lumen gives the contact patch
+// (checked against the continuum references of fem_reference/rod_theory), bad keys are refused
+// naming the file and key, and the compliant coupling meets the series-spring law with the
+// wire's and the wall's compliances from separate solves.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+#include "fem_reference/rod_theory/tube_contact.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "verification/guidewire_load.hpp"
+#include "verification/harness/guidewire_coupling.hpp"
+#include "verification/scene.hpp"
+
+using namespace vessel;
+
+namespace {
+
+constexpr double kA = 3e-3;          // lumen radius
+constexpr double kD = 0.356e-3;      // wire diameter
+constexpr double kEI = 4e-7;         // N·m²
+const double kE = kEI / (std::numbers::pi * std::pow(kD, 4) / 64.0);
+
+std::string straight_scene(const std::string& load_extra, double insertion = 20.25e-3,
+                           const std::string& vessel = "kind = \"straight\"") {
+  return "name = \"g\"\n[vessel]\n" + vessel + "\nmesh = \"structured\"\nlevel = 0\n" +
+         "[load]\ntype = \"guidewire\"\nE = " + std::to_string(kE) +
+         "\ndiameter = 0.356e-3\ninsertion = " + std::to_string(insertion) + "\n" + load_extra +
+         "\n[[models]]\nkind = \"fem\"\ndegree = 1\n";
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    (void)parse_scene(text, "wire.toml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(GuidewireLoad, StraightTubeForceMatchesShootingAtTheTip) {
+  const Scene s = parse_scene(straight_scene("tilt = 0.3"), "wire.toml");
+  ASSERT_EQ(s.load.kind, LoadKind::contact);
+  ASSERT_EQ(s.load.magnitudes.size(), 1u);
+  const GuidewireSolution& w = s.load.wire;
+  EXPECT_EQ(w.contact_nodes, 1);
+  // The continuum wire whose tip touches at the discrete wire's axial position z.
+  const double c = kA - kD / 2, z = w.contact_point.z();
+  const rod_theory::StraightTubeContact ref = rod_theory::straight_tube_contact(0.3, c / z);
+  EXPECT_NEAR(s.load.magnitudes[0] / (ref.force * kEI / (z * z)), 1.0, 1e-2);
+  EXPECT_NEAR(20.25e-3 / (ref.length * z), 1.0, 1e-3);
+  // The patch's point is on the wall, pushed radially outward in the tilt's plane (+x).
+  EXPECT_NEAR(std::hypot(w.wall_point.x(), w.wall_point.y()), kA, 1e-12);
+  EXPECT_NEAR(w.normal.x(), 1.0, 1e-6);
+  EXPECT_NEAR(s.load.contact.point.z(), z, 1e-15);
+  EXPECT_NEAR(s.load.contact.radius, 0.5e-3, 0.0);
+}
+
+TEST(GuidewireLoad, ArchApexForceMatchesQuarterWaveElastica) {
+  const double R = 15e-3;
+  const rod_theory::ArchApexContact ref = rod_theory::arch_apex_contact((R + kA - kD / 2) / R);
+  const Scene s = parse_scene(
+      straight_scene("", ref.length * R, "kind = \"arch\"\nbend_radius = 15e-3"), "wire.toml");
+  const GuidewireSolution& w = s.load.wire;
+  EXPECT_EQ(w.contact_nodes, 1);  // no second contact
+  EXPECT_NEAR(std::atan2(w.contact_point.y(), w.contact_point.x()), std::numbers::pi / 2, 2e-3);
+  EXPECT_NEAR(s.load.magnitudes[0] / (ref.force * kEI / (R * R)), 1.0, 1e-2);
+  EXPECT_NEAR(w.wall_point.norm(), R + kA, 1e-12);  // the outer wall at the apex
+}
+
+TEST(GuidewireLoad, ClampReactionBalancesTheWallForce) {
+  const Scene s = parse_scene(straight_scene("tilt = 0.3"), "wire.toml");
+  const GuidewireSolution& w = s.load.wire;
+  // The clamp holds the wire against the wall's push −F n; the wire pushes the wall by F n, the
+  // patch's total load. Σ of the wire's clamp reaction and the wall's load on the wire: 0.
+  EXPECT_LT((w.clamp_force - w.force * w.normal).norm(), 1e-9);
+}
+
+TEST(GuidewireLoad, BadKeysAreRefusedNamingFileAndKey) {
+  EXPECT_NE(error_of(straight_scene("tilt = 0.3\nnu = 0.3\nG = 1e9")).find("load.nu"),
+            std::string::npos);
+  const std::string short_wire = error_of(straight_scene("tilt = 0.3", 5e-3));
+  EXPECT_NE(short_wire.find("wire.toml"), std::string::npos) << short_wire;
+  EXPECT_NE(short_wire.find("load.insertion"), std::string::npos) << short_wire;
+  EXPECT_NE(short_wire.find("does not reach the wall"), std::string::npos) << short_wire;
+  EXPECT_NE(error_of(straight_scene("clamp_point = [0, 0, 0]")).find("load.clamp_direction"),
+            std::string::npos);
+  EXPECT_NE(error_of(straight_scene("tilt = 0.3\ntilt_towards = [0, 0, 1]")).find("load.tilt_towards"),
+            std::string::npos);
+  EXPECT_NE(error_of(straight_scene("tilt = 0.3\nsegments = 2")).find("load.segments"),
+            std::string::npos);
+  EXPECT_NE(error_of(straight_scene("tilt = 0.3\ncoupling = \"soft\"")).find("load.coupling"),
+            std::string::npos);
+  EXPECT_NE(error_of(straight_scene("tilt = 0.3\nstiffness_sweep = [1e-6]")).find("load.stiffness_sweep"),
+            std::string::npos);
+  const std::string outside = error_of(straight_scene("clamp_point = [0, 2.9e-3, 0]\nclamp_direction = [0, 0, 1]"));
+  EXPECT_NE(outside.find("load.clamp_point"), std::string::npos) << outside;
+  // A wire lying along the wall touches it at several nodes: refused, not averaged.
+  const std::string lying = error_of(straight_scene("tilt = 0.3", 38e-3));
+  EXPECT_NE(lying.find("load.insertion"), std::string::npos) << lying;
+}
+
+TEST(GuidewireCoupling, SeriesSpringsWithCompliancesFromSeparateSolves) {
+  const Scene s = parse_scene(straight_scene("tilt = 0.3"), "wire.toml");
+  GuidewireSolver solver(s.vessel, *s.load.guidewire);
+  const double F_rigid = solver.solve_rigid().force;
+  // The wire's compliance from its own solves against a wall moved by ±δ.
+  const double d = 1e-6;
+  const double Cr = -2.0 * d / (solver.solve_with_give(d).force - solver.solve_with_give(-d).force);
+  (void)solver.solve_rigid();
+  for (const double ratio : {0.01, 0.03, 0.07}) {
+    const double Cv = ratio * Cr;  // δ = Cv·F stays ≪ the wire's deflection: the linear regime
+    const double F = solver.coupled_force(Cv);
+    std::printf("GUIDEWIRE series Cv/Cr %.2f: coupled %.9e N, F_rigid Cr/(Cr + Cv) %.9e N\n",
+                ratio, F, F_rigid * Cr / (Cr + Cv));
+    EXPECT_NEAR(F / (F_rigid * Cr / (Cr + Cv)), 1.0, 1e-3) << "Cv/Cr = " << ratio;
+    // And the coupled state is an equilibrium of both springs: the wall gave Cv·F.
+    EXPECT_NEAR(solver.solve_with_give(Cv * F).force / F, 1.0, 1e-9);
+  }
+}
+
+/// The continuum wire's tip force at fixed length L against a tube of centreline offset c:
+/// the tip's axial position z solves L = (L/z)(c/z)·z (shooting's length, secant on z).
+double continuum_force(double theta, double c, double L) {
+  double z0 = 0.98 * L, z1 = 0.99 * L;
+  const auto miss = [&](double z) { return rod_theory::straight_tube_contact(theta, c / z).length * z - L; };
+  double m0 = miss(z0), m1 = miss(z1);
+  for (int it = 0; it < 50 && std::abs(m1) > 1e-15; ++it) {
+    const double z2 = z1 - m1 * (z1 - z0) / (m1 - m0);
+    z0 = z1;
+    m0 = m1;
+    z1 = z2;
+    m1 = miss(z1);
+  }
+  return rod_theory::straight_tube_contact(theta, c / z1).force * kEI / (z1 * z1);
+}
+
+TEST(GuidewireCoupling, WireComplianceMatchesTheContinuumWire) {
+  const Scene s = parse_scene(straight_scene("tilt = 0.3"), "wire.toml");
+  GuidewireSolver solver(s.vessel, *s.load.guidewire);
+  (void)solver.solve_rigid();
+  const double Cr = solver.compliance();
+  const double c = kA - kD / 2, d = 1e-3 * c, L = 20.25e-3;
+  const double Cr_continuum =
+      -2.0 * d / (continuum_force(0.3, c + d, L) - continuum_force(0.3, c - d, L));
+  std::printf("GUIDEWIRE straight tube wire compliance %.6f m/N, continuum %.6f m/N\n", Cr,
+              Cr_continuum);
+  EXPECT_NEAR(Cr / Cr_continuum, 1.0, 1e-2);
+}
+
+TEST(GuidewireCoupling, RowsPerModelAndStiffnessFromTheOutcomesIndentation) {
+  Scene s = parse_scene(straight_scene("tilt = 0.3\ncoupling = \"compliant\"\n"
+                                       "stiffness_sweep = [4e-7, 4e-6, 4e-5]"),
+                        "wire.toml");
+  const double F = s.load.magnitudes[0];
+  // Two walls seen through their indentation under the rigid wire's force: the model twice as
+  // compliant as the reference. C = 0.5 m/N is the straight tube's order of magnitude.
+  ModelOutcome o;
+  o.model = "m";
+  o.ok = true;
+  o.magnitude = F;
+  o.quantities.indentation_mm = 1.0 * F * 1e3;
+  o.quantities.indentation_reference_mm = 0.5 * F * 1e3;
+  const GuidewireOutcome g = couple_guidewire(s, {o});
+  ASSERT_EQ(g.rigid.size(), 3u);
+  ASSERT_EQ(g.rows.size(), 3u);
+  for (std::size_t k = 0; k < g.rows.size(); ++k) {
+    const GuidewireCouplingRow& r = g.rows[k];
+    ASSERT_TRUE(r.ok) << r.failure;
+    EXPECT_NEAR(r.wall_compliance, 1.0, 1e-12);
+    EXPECT_NEAR(r.reference_compliance, 0.5, 1e-12);
+    // The softer wall takes less force; both below the rigid wire's.
+    EXPECT_LT(r.force_mN, r.reference_force_mN);
+    EXPECT_LT(r.reference_force_mN, g.rigid[k].solution.force * 1e3);
+    EXPECT_NEAR(r.displacement_mm, r.wall_compliance * r.force_mN, 1e-12);
+  }
+  // A stiffer wire is closer to displacement control: its force falls further below the rigid one.
+  EXPECT_LT(g.rows[2].force_mN / (g.rigid[2].solution.force * 1e3),
+            g.rows[1].force_mN / (g.rigid[1].solution.force * 1e3));
+}
+
+}  // namespace

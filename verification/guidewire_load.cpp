@@ -1,0 +1,204 @@
+#include "verification/guidewire_load.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "meshes/foundation/errors.hpp"
+#include "msm/rods/der_rod.hpp"
+#include "msm/rods/rigid_wall.hpp"
+
+namespace vessel {
+
+namespace rods = msm::rods;
+
+struct GuidewireSolver::Impl {
+  VesselParams vessel;
+  GuidewireSpec spec;
+  std::string prefix;
+  rods::RodMaterial material;
+  double EI = 0.0;
+  double offset = 0.0;  ///< the centreline's allowed distance from the vessel's: a − r_wire
+  Eigen::VectorXd state;  ///< the last solution's DER state (empty before the first solve)
+  double state_length = 0.0;
+
+  [[nodiscard]] std::unique_ptr<rods::RigidLumen> lumen(double give) const {
+    if (vessel.kind == VesselKind::straight) {
+      return std::make_unique<rods::StraightTube>(Vec3::Zero(), Vec3::UnitZ(), offset + give);
+    }
+    return std::make_unique<rods::TorusBend>(Vec3::Zero(), Vec3::UnitZ(), vessel.bend_radius,
+                                             offset + give);
+  }
+
+  /// The wire of length L against the lumen grown by `give`, from the last state (scaled about
+  /// the clamp to L) or straight.
+  GuidewireSolution solve(double L, double give) {
+    rods::RodSpec rs = rods::uniform_rod(material, L, spec.diameter, spec.segments);
+    rs.origin = spec.clamp_point;
+    rs.direction = spec.clamp_direction;
+    rods::DerRod rod(rods::make_layout(rs));
+    Eigen::VectorXd x = rod.rest_state();
+    if (state.size() == x.size()) {
+      for (int i = 0; i < rod.num_nodes(); ++i) {
+        x.segment<3>(3 * i) =
+            rs.origin + (L / state_length) * (state.segment<3>(3 * i) - rs.origin);
+      }
+      rod.update_reference(x);
+    }
+    rods::ConstrainedOptions options;
+    options.force_scale = EI / (L * L);
+    const auto wall = lumen(give);
+    const int tip = rod.layout().tip_node;
+    const rods::ContactSolution c =
+        rods::solve_wall_contact(rod, nullptr, rod.clamp_fixed(), x, *wall, 2, tip, options);
+    state = c.x;
+    state_length = L;
+
+    GuidewireSolution s;
+    s.bending_stiffness = EI;
+    s.contact_nodes = static_cast<int>(c.nodes.size());
+    for (int i = rod.layout().first_node; i <= tip; ++i) s.centreline.push_back(c.x.segment<3>(3 * i));
+    if (!c.nodes.empty()) {
+      const int k = c.nodes.front();
+      const Vec3 p = c.x.segment<3>(3 * k);
+      Vec3 grad;
+      wall->gap(p, &grad, nullptr);
+      s.force = c.forces.front();
+      s.contact_point = p;
+      s.normal = -grad.normalized();  // the gap grows towards the centreline
+      s.wall_point = p + 0.5 * spec.diameter * s.normal;
+    }
+    // The clamp's force on the wire: the internal force at the held nodes (no load acts there).
+    Eigen::VectorXd g;
+    rod.gradient(c.x, g);
+    const std::vector<char> fixed = rod.clamp_fixed();
+    for (int i = 0; i < rod.num_nodes(); ++i) {
+      if (fixed[3 * i]) s.clamp_force += g.segment<3>(3 * i);
+    }
+    return s;
+  }
+};
+
+GuidewireSolver::GuidewireSolver(const VesselParams& vessel, const GuidewireSpec& spec,
+                                 const std::string& key_prefix)
+    : impl_(std::make_unique<Impl>()) {
+  require_parametric(vessel, "a guidewire load (its lumen is the vessel's centreline offset)");
+  Impl& m = *impl_;
+  m.vessel = vessel;
+  m.spec = spec;
+  m.prefix = key_prefix;
+  m.material = {spec.young, spec.shear, spec.density};
+  m.EI = rods::solid_section(m.material, spec.diameter).EI;
+  m.offset = vessel.inner_radius - 0.5 * spec.diameter;
+  if (m.offset <= 0.0) {
+    throw InputError(key_prefix + "diameter: found " + std::to_string(spec.diameter) +
+                     " m, expected less than the lumen's diameter " +
+                     std::to_string(2.0 * vessel.inner_radius) + " m");
+  }
+  const auto wall = m.lumen(0.0);
+  if (wall->gap(spec.clamp_point, nullptr, nullptr) < 0.0) {
+    throw InputError(key_prefix + "clamp_point: the clamp is outside the lumen (its distance "
+                     "from the vessel's centreline exceeds the lumen radius less the wire's)");
+  }
+}
+
+GuidewireSolver::~GuidewireSolver() = default;
+
+GuidewireSolution GuidewireSolver::solve_rigid() {
+  Impl& m = *impl_;
+  m.state.resize(0);
+  // Insertion in steps of at most half the lumen radius, each from the last shape.
+  const double step = m.vessel.inner_radius / 2.0;
+  const int n = std::max(2, static_cast<int>(std::ceil(m.spec.insertion / step)));
+  GuidewireSolution s;
+  for (int k = 1; k <= n; ++k) s = m.solve(m.spec.insertion * k / n, 0.0);
+  if (s.contact_nodes > 1) {
+    throw InputError(m.prefix + "insertion: the wire of " + std::to_string(m.spec.insertion) +
+                     " m touches the wall at " + std::to_string(s.contact_nodes) +
+                     " nodes; expected a single contact (a shorter insertion or another tilt)");
+  }
+  rigid_ = s;
+  last_ = s;
+  compliance_ = 0.0;
+  return s;
+}
+
+GuidewireSolution GuidewireSolver::solve_with_give(double give) {
+  Impl& m = *impl_;
+  last_ = m.solve(m.spec.insertion, give);
+  return last_;
+}
+
+double GuidewireSolver::compliance() {
+  if (compliance_ > 0.0) return compliance_;
+  const double d = 1e-4 * impl_->offset;
+  const double f_plus = solve_with_give(d).force;
+  const double f_minus = solve_with_give(-d).force;
+  solve_with_give(0.0);
+  compliance_ = -2.0 * d / (f_plus - f_minus);
+  return compliance_;
+}
+
+double GuidewireSolver::coupled_force(double C) {
+  const double F0 = rigid_.force;
+  if (F0 <= 0.0 || C <= 0.0) return F0;
+  const auto h = [&](double F) { return F - solve_with_give(C * F).force; };
+  // Start from the rigid force and the series-spring estimate with the wire's own compliance.
+  double a = F0, ha = h(a);
+  const double Cr = compliance();
+  double b = F0 * Cr / (Cr + C), hb = h(b);
+  for (int it = 0; it < 40 && std::abs(hb) > 1e-12 * F0; ++it) {
+    const double c = b - hb * (b - a) / (hb - ha);
+    a = b;
+    ha = hb;
+    b = std::max(c, 0.0);
+    hb = h(b);
+  }
+  if (std::abs(hb) > 1e-9 * F0) {
+    std::ostringstream msg;
+    msg << "guidewire: the coupling with a wall of compliance " << C
+        << " m/N did not converge (residual " << hb << " N)";
+    throw std::runtime_error(msg.str());
+  }
+  solve_with_give(C * b);
+  return b;
+}
+
+void set_tilted_clamp(const VesselParams& vessel, double tilt, const Vec3& towards,
+                      GuidewireSpec& spec) {
+  require_parametric(vessel, "a guidewire clamped at the inlet");
+  Vec3 tangent = Vec3::UnitZ();
+  spec.clamp_point = Vec3::Zero();
+  if (vessel.kind == VesselKind::arch) {
+    spec.clamp_point = Vec3(vessel.bend_radius, 0.0, 0.0);
+    tangent = Vec3::UnitY();
+  }
+  Vec3 normal = towards - towards.dot(tangent) * tangent;
+  if (normal.norm() < 1e-12 * std::max(1.0, towards.norm())) {
+    throw InputError("found a direction along the inlet's tangent; expected one "
+                     "with a part normal to it");
+  }
+  normal.normalize();
+  spec.clamp_direction = std::cos(tilt) * tangent + std::sin(tilt) * normal;
+}
+
+void resolve_guidewire(const VesselParams& vessel, const std::string& file, LoadSpec& load) {
+  try {
+    GuidewireSolver solver(vessel, *load.guidewire);
+    load.wire = solver.solve_rigid();
+  } catch (const InputError& e) {
+    throw InputError(file + ": " + e.what());
+  } catch (const std::runtime_error& e) {
+    throw InputError(file + ": load: the guidewire's solve failed: " + e.what());
+  }
+  if (load.wire.force <= 0.0) {
+    throw InputError(file + ": load.insertion: the wire of " +
+                     std::to_string(load.guidewire->insertion) +
+                     " m does not reach the wall; expected an insertion that makes it touch");
+  }
+  load.kind = LoadKind::contact;
+  load.magnitudes = {load.wire.force};
+  load.contact.point = load.wire.wall_point;
+  load.contact.surface_group = "inner_wall";
+}
+
+}  // namespace vessel

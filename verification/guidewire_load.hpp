@@ -1,0 +1,67 @@
+#pragma once
+/// The guidewire as the vessel's load: a Discrete Elastic Rod (msm/rods/der_rod.hpp) clamped at
+/// the inlet, inserted its length in steps, against the parametric vessel's lumen as a rigid,
+/// frictionless, one-sided wall (msm/rods/rigid_wall.hpp: the centreline keeps a − r_wire from the
+/// vessel's centreline). Its contact force and the wall point under its contact node become the
+/// scene's contact patch load (`resolve_guidewire`).
+///
+/// Compliant coupling (`GuidewireSolver::coupled_force`): a linear wall of compliance C (its
+/// displacement along the contact normal per unit force of the patch load) gives way by C·F under
+/// the wire's force F. The wire is solved against the lumen grown by that give (the whole lumen's
+/// offset, which equals a local give while the wire touches at one node), and F is found by a
+/// secant on h(F) = F − F_wire(C·F). Limits: the wall is linear (its compliance measured once, at
+/// the rigid wire's force), its give is normal to it at the rigid contact point, and the patch
+/// stays where the rigid wire put it (the contact node slides along a frictionless wall by a
+/// fraction of the give).
+#include <memory>
+
+#include "meshes/vessel_geometry.hpp"
+#include "verification/guidewire_spec.hpp"
+#include "verification/scene.hpp"
+
+namespace vessel {
+
+class GuidewireSolver {
+ public:
+  /// InputError (naming `key_prefix`'s keys) for a vessel that is not parametric, a clamp outside
+  /// the lumen or a spec out of range.
+  GuidewireSolver(const VesselParams& vessel, const GuidewireSpec& spec,
+                  const std::string& key_prefix = "load.");
+  ~GuidewireSolver();
+  GuidewireSolver(const GuidewireSolver&) = delete;
+  GuidewireSolver& operator=(const GuidewireSolver&) = delete;
+
+  /// The wire inserted in steps (each from the last shape) to the spec's insertion against the
+  /// rigid lumen. Throws InputError naming `insertion` if it touches at more than one node.
+  GuidewireSolution solve_rigid();
+  /// The inserted wire against the lumen grown by `give` (m) along its normal, from the last
+  /// solution (solve_rigid first).
+  GuidewireSolution solve_with_give(double give);
+  /// The wire's compliance at the contact, −dδ/dF by a central difference of solve_with_give
+  /// (m/N), computed once per solve_rigid; restores the rigid state.
+  double compliance();
+  /// The force F (N) with F = F_wire(C·F): the wire against a wall of compliance C (m/N), by a
+  /// secant to |h| ≤ 1e-12 F_rigid. Leaves the coupled solution in `last()`.
+  double coupled_force(double wall_compliance);
+  [[nodiscard]] const GuidewireSolution& last() const { return last_; }
+  [[nodiscard]] const GuidewireSolution& rigid() const { return rigid_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  GuidewireSolution rigid_, last_;
+  double compliance_ = 0.0;  ///< 0: not computed since the last solve_rigid
+};
+
+/// The inlet's clamp pose of the spec's tilt form: the inlet's centreline point and tangent,
+/// turned by `tilt` towards `towards` (its part normal to the tangent). InputError naming
+/// `load.tilt_towards` if that part is zero.
+void set_tilted_clamp(const VesselParams& vessel, double tilt, const Vec3& towards,
+                      GuidewireSpec& spec);
+
+/// Solves the scene's wire against the rigid lumen and makes its load the contact patch of the
+/// wire's force at the wall point under its contact node (magnitudes = {F}). InputError naming
+/// the scene file and `load.insertion` if the wire does not reach the wall.
+void resolve_guidewire(const VesselParams& vessel, const std::string& file, LoadSpec& load);
+
+}  // namespace vessel

@@ -1,0 +1,187 @@
+#include "verification/harness/guidewire_coupling.hpp"
+
+#include <cmath>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+#include "msm/rods/rod_layout.hpp"
+#include "verification/guidewire_load.hpp"
+
+namespace vessel {
+
+namespace {
+
+/// The spec with E (and G in proportion) scaled to bending stiffness EI.
+GuidewireSpec with_stiffness(GuidewireSpec spec, double EI) {
+  const double I = M_PI * std::pow(spec.diameter, 4) / 64.0;
+  const double scale = EI / (spec.young * I);
+  spec.young *= scale;
+  spec.shear *= scale;
+  return spec;
+}
+
+/// Outcomes a compliance can be read from: solved, static, with an indentation under a load.
+bool couplable(const ModelOutcome& o) {
+  return o.ok && o.magnitude > 0.0 && o.quantities.indentation_mm &&
+         o.quantities.indentation_reference_mm && o.history.time_s.empty();
+}
+
+void couple_at(const Scene& s, double EI, const std::vector<ModelOutcome>& outcomes,
+               GuidewireOutcome& g) {
+  const GuidewireSpec spec = with_stiffness(*s.load.guidewire, EI);
+  GuidewireSolver solver(s.vessel, spec);
+  GuidewireRigid rigid;
+  rigid.bending_stiffness = EI;
+  rigid.solution = solver.solve_rigid();
+  if (spec.coupling == GuidewireCoupling::compliant && rigid.solution.force > 0.0) {
+    rigid.wire_compliance = solver.compliance();
+  }
+  g.rigid.push_back(rigid);
+  if (spec.coupling != GuidewireCoupling::compliant) return;
+  for (const ModelOutcome& o : outcomes) {
+    if (!couplable(o)) continue;
+    GuidewireCouplingRow row;
+    row.model = o.model;
+    row.poisson_ratio = o.poisson_ratio;
+    row.level = o.level;
+    row.bending_stiffness = EI;
+    row.wall_compliance = *o.quantities.indentation_mm * 1e-3 / o.magnitude;
+    row.reference_compliance = *o.quantities.indentation_reference_mm * 1e-3 / o.magnitude;
+    try {
+      const double F = solver.coupled_force(row.wall_compliance);
+      row.contact_point = solver.last().contact_point;
+      const double Fref = solver.coupled_force(row.reference_compliance);
+      row.force_mN = F * 1e3;
+      row.reference_force_mN = Fref * 1e3;
+      row.displacement_mm = row.wall_compliance * F * 1e3;
+      row.reference_displacement_mm = row.reference_compliance * Fref * 1e3;
+      row.ok = true;
+    } catch (const std::exception& e) {
+      row.failure = e.what();
+    }
+    g.rows.push_back(row);
+  }
+}
+
+/// How far the wire's contact node slid along the wall from the rigid solve's, mm (the patch
+/// stays at the rigid one's).
+double slide_mm(const GuidewireOutcome& g, const GuidewireCouplingRow& r) {
+  for (const GuidewireRigid& rigid : g.rigid) {
+    if (rigid.bending_stiffness == r.bending_stiffness) {
+      const Vec3 d = r.contact_point - rigid.solution.contact_point;
+      return (d - d.dot(rigid.solution.normal) * rigid.solution.normal).norm() * 1e3;
+    }
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+nlohmann::json vec_mm(const Vec3& p) { return {p.x() * 1e3, p.y() * 1e3, p.z() * 1e3}; }
+
+}  // namespace
+
+GuidewireOutcome couple_guidewire(const Scene& s, const std::vector<ModelOutcome>& outcomes) {
+  GuidewireOutcome g;
+  g.spec = *s.load.guidewire;
+  g.patch_radius = s.load.contact.radius;
+  const double EI = msm::rods::solid_section({g.spec.young, g.spec.shear, g.spec.density},
+                                             g.spec.diameter).EI;
+  couple_at(s, EI, outcomes, g);
+  for (const double sweep_EI : g.spec.stiffness_sweep) {
+    if (std::abs(sweep_EI / EI - 1.0) > 1e-3) couple_at(s, sweep_EI, outcomes, g);
+  }
+  return g;
+}
+
+void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g) {
+  const bool compliant = g.spec.coupling == GuidewireCoupling::compliant;
+  out << "Guidewire (" << g.spec.model << ", " << g.spec.segments << " segments, d = "
+      << g.spec.diameter * 1e3 << " mm, insertion " << g.spec.insertion * 1e3
+      << " mm): against the rigid lumen, its force loads every model above"
+      << (compliant ? "; coupled, each wall gives way by its compliance C (its indentation per "
+                      "unit patch force, measured at that load; linear walls)"
+                    : "")
+      << ".\n\n| EI N·m² | rigid force mN | contact point mm | wire compliance m/N |\n"
+         "|---|---|---|---|\n";
+  for (const GuidewireRigid& r : g.rigid) {
+    const Vec3& p = r.solution.contact_point;
+    out << "| " << r.bending_stiffness << " | " << r.solution.force * 1e3 << " | (" << p.x() * 1e3
+        << ", " << p.y() * 1e3 << ", " << p.z() * 1e3 << ") | "
+        << (compliant ? "" : "–");
+    if (compliant) out << r.wire_compliance;
+    out << " |\n";
+  }
+  out << "\n";
+  if (g.rows.empty()) return;
+  out << "The lumen gives way as a whole, so the wire's contact node slides along the wall (slide); "
+         "⚠: it left the load's patch (radius "
+      << g.patch_radius * 1e3 << " mm), and the row is outside the coupling's validity.\n\n";
+  out << "| model | ν | level | EI N·m² | C m/N | C_ref m/N | force mN | reference mN | error mN | "
+         "contact displ. mm | reference mm | error mm | slide mm |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const GuidewireCouplingRow& r : g.rows) {
+    out << "| " << r.model << " | " << r.poisson_ratio << " | " << r.level << " | "
+        << r.bending_stiffness << " | ";
+    if (!r.ok) {
+      out << "FAILED: " << r.failure << " | | | | | | | | |\n";
+      continue;
+    }
+    out << r.wall_compliance << " | " << r.reference_compliance << " | " << r.force_mN << " | "
+        << r.reference_force_mN << " | " << r.force_mN - r.reference_force_mN << " | "
+        << r.displacement_mm << " | " << r.reference_displacement_mm << " | "
+        << r.displacement_mm - r.reference_displacement_mm << " | "
+        << slide_mm(g, r) << (slide_mm(g, r) > g.patch_radius * 1e3 ? " ⚠" : "") << " |\n";
+  }
+  out << "\n";
+}
+
+nlohmann::json guidewire_json(const GuidewireOutcome& g) {
+  const GuidewireSpec& w = g.spec;
+  nlohmann::json rigid = nlohmann::json::array();
+  for (const GuidewireRigid& r : g.rigid) {
+    const GuidewireSolution& s = r.solution;
+    nlohmann::json line = nlohmann::json::array();
+    for (const Vec3& p : s.centreline) line.push_back(vec_mm(p));
+    rigid.push_back({{"bending_stiffness_Nm2", r.bending_stiffness},
+                     {"contact_force_N", s.force},
+                     {"contact_point_mm", vec_mm(s.contact_point)},
+                     {"wall_point_mm", vec_mm(s.wall_point)},
+                     {"normal", {s.normal.x(), s.normal.y(), s.normal.z()}},
+                     {"clamp_force_N", {s.clamp_force.x(), s.clamp_force.y(), s.clamp_force.z()}},
+                     {"wire_compliance_m_per_N", r.wire_compliance},
+                     {"centreline_mm", line}});
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  for (const GuidewireCouplingRow& r : g.rows) {
+    rows.push_back({{"model", r.model},
+                    {"poisson_ratio", r.poisson_ratio},
+                    {"level", r.level},
+                    {"bending_stiffness_Nm2", r.bending_stiffness},
+                    {"wall_compliance_m_per_N", r.wall_compliance},
+                    {"reference_compliance_m_per_N", r.reference_compliance},
+                    {"force_mN", r.force_mN},
+                    {"reference_force_mN", r.reference_force_mN},
+                    {"force_error_mN", r.force_mN - r.reference_force_mN},
+                    {"contact_displacement_mm", r.displacement_mm},
+                    {"reference_contact_displacement_mm", r.reference_displacement_mm},
+                    {"contact_point_mm", vec_mm(r.contact_point)},
+                    {"slide_mm", slide_mm(g, r)},
+                    {"within_patch", slide_mm(g, r) <= g.patch_radius * 1e3},
+                    {"contact_displacement_error_mm", r.displacement_mm - r.reference_displacement_mm},
+                    {"ok", r.ok},
+                    {"failure", r.failure}});
+  }
+  return {{"model", w.model},
+          {"coupling", w.coupling == GuidewireCoupling::compliant ? "compliant" : "rigid"},
+          {"young_pa", w.young},
+          {"shear_pa", w.shear},
+          {"diameter_m", w.diameter},
+          {"insertion_m", w.insertion},
+          {"segments", w.segments},
+          {"clamp_point_mm", vec_mm(w.clamp_point)},
+          {"clamp_direction", {w.clamp_direction.x(), w.clamp_direction.y(), w.clamp_direction.z()}},
+          {"patch_radius_m", g.patch_radius},
+          {"rigid", rigid},
+          {"coupling_rows", rows}};
+}
+
+}  // namespace vessel

@@ -1,0 +1,27 @@
+#pragma once
+/// The guidewire load's records after a scene's run: the wire's rigid solve and, for compliant
+/// coupling, each model's own contact force (GuidewireSolver::coupled_force with the model's
+/// wall compliance C_v = d/F, d its work-conjugate indentation under the rigid wire's patch load
+/// F), beside the reference's (C_ref from the reference's indentation on the same nodal loads).
+/// Valid for linear walls: C is measured once, at the rigid wire's force.
+#include <nlohmann/json_fwd.hpp>
+#include <ostream>
+#include <vector>
+
+#include "verification/harness/guidewire_outcome.hpp"
+#include "verification/harness/outcome.hpp"
+
+namespace vessel {
+
+/// The scene's guidewire outcome from its run's outcomes (every ok static outcome with an
+/// indentation; the scene's EI first, then each of the spec's stiffness_sweep).
+GuidewireOutcome couple_guidewire(const Scene& scene, const std::vector<ModelOutcome>& outcomes);
+
+/// summary.md's guidewire section: the wire against the rigid lumen per EI, and the coupled
+/// contact force of each model beside the reference's (mN), with the contact displacements (mm).
+void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g);
+
+/// results.json's "guidewire" object.
+nlohmann::json guidewire_json(const GuidewireOutcome& g);
+
+}  // namespace vessel
