@@ -157,10 +157,9 @@ void answer(Document& doc, const RecommendFile& r) {
   if (const CandidateEntry* best = candidate_named(r, r.recommended)) {
     doc.paragraph("**Recommended: `" + best->name + "`** (" + best->detail + "): error " +
                   error_text(*best, r.unit) + ", " + ms(best->update_seconds.value_or(0.0)) +
-                  " per update" +
-                  (best->setup_seconds ? " (" + ms(*best->setup_seconds) + " set-up, once)" : "") +
-                  ", " + std::to_string(best->unknowns) + " unknowns" +
-                  (best->roi_radius_mm ? "" : ", the whole vessel") + ".");
+                  " per update, " + std::to_string(best->unknowns) + " unknowns." +
+                  (best->setup_seconds ? " Set-up " + ms(*best->setup_seconds) + ", once." : "") +
+                  (best->roi_radius_mm ? "" : " The whole vessel (no region of interest)."));
   } else if (const CandidateEntry* near = candidate_named(r, r.closest)) {
     doc.paragraph("**No candidate meets the budget.** The closest is `" + near->name + "` (" +
                   near->detail + "): error " + error_text(*near, r.unit) + ", " +

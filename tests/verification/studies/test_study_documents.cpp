@@ -116,7 +116,8 @@ TEST(RecommendDocument, ConformsToItsSchemaAndTheReportRendersRecommendMdFromIt)
   EXPECT_TRUE(has(md, "at ν = 0.45 the load is 50 mN (reference P2, level 2)")) << md;
   EXPECT_TRUE(has(md, "    vesselverify recommend hand_scene.toml\n")) << md;
   EXPECT_TRUE(has(md, "**Recommended: `whole @ L0`** (detail of whole @ L0): error 0.05 mm, "
-                      "20 ms per update (2 ms set-up, once), 300 unknowns, the whole vessel."))
+                      "20 ms per update, 300 unknowns. Set-up 2 ms, once. The whole vessel (no "
+                      "region of interest)."))
       << md;
   // The recommended one is whole-vessel: no separate whole-vessel line.
   EXPECT_FALSE(has(md, "Whole vessel (no region of interest)")) << md;
@@ -136,7 +137,7 @@ TEST(RecommendDocument, SaysWhenNoWholeVesselCandidateMeetsTheBudget) {
   const std::string md =
       reports::recommendation_markdown(reports::parse_recommend(text, "recommend.json"));
   EXPECT_TRUE(has(md, "**Recommended: `roi @ L0`** (detail of roi @ L0): error 0.5 mm, 1 ms per "
-                      "update (1 ms set-up, once), 300 unknowns.")) << md;
+                      "update, 300 unknowns. Set-up 1 ms, once.\n")) << md;
   EXPECT_TRUE(has(md, "No whole-vessel candidate (without a region of interest) meets the budget."))
       << md;
 }
