@@ -608,10 +608,19 @@ void write_report(const ReportOptions& o) {
   }
   write_file_atomically(o.output_dir / "report.md",
                         [&](std::ostream& out) { out << doc.markdown_text("figures"); });
-  // report.html: the run's fields (fields/ beside results.json) drawn in 3D per scene.
-  const std::filesystem::path fields_dir = o.results.parent_path() / "fields";
+  // report.html: the run's fields (the VTUs results.json names) drawn in 3D per scene.
   std::vector<SceneViews> views;
-  for (const SceneRows& s : results.scenes) views.push_back(read_scene_views(s, fields_dir));
+  for (const SceneRows& s : results.scenes) {
+    views.push_back(read_scene_views(s, o.results.parent_path()));
+  }
+  for (std::size_t i = 0; validity && i < validity->scenes.size(); ++i) {
+    const ValiditySceneEntry& s = validity->scenes[i];
+    double tolerance_mm = 0.1;  // seed 000's visual threshold, unless the run states the scene's
+    for (const SceneRows& r : results.scenes) {
+      if (r.name == s.scene) tolerance_mm = r.tolerance_mm;
+    }
+    views.push_back(validity_scene_views(s, o.validity.parent_path(), tolerance_mm));
+  }
   const WebLibraries libraries = load_web_libraries(default_javascript_dir());
   write_file_atomically(o.output_dir / "report.html", [&](std::ostream& out) {
     out << interactive_html(doc, scene_cards(results), views, libraries, "vesselverify report");

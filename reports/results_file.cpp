@@ -28,6 +28,7 @@ OutcomeRow read_outcome(const json& j, const std::string& where) {
   o.solve_seconds = field<double>(j, "solve_seconds", where);
   o.memory_mib = field_or<double>(j, "memory_mib", 0.0, where);
   o.timing_source = field_or<std::string>(j, "timing_source", "", where);
+  o.fields = field_or<std::string>(j, "fields", "", where);
   if (const auto t = j.find("timing_provenance"); t != j.end() && t->is_object()) {
     o.timing_cached = field<std::string>(*t, "source", where + ".timing_provenance") == "cache";
     o.timing_measured_at = field<std::string>(*t, "measured_at", where + ".timing_provenance");
@@ -138,6 +139,17 @@ ResultsFile parse_results(const std::string& text, const std::filesystem::path& 
     sr.seconds = field<double>(s, "seconds", where);
     if (const auto q = s.find("qoi_point_mm"); q != s.end() && q->is_array() && q->size() == 3) {
       sr.qoi_point_mm = q->get<std::vector<double>>();
+    }
+    if (const auto c = s.find("contact_patch"); c != s.end() && !c->is_null()) {
+      ContactPatchRow patch;
+      patch.point_mm = field<std::vector<double>>(*c, "point_mm", where + ".contact_patch");
+      patch.radius_mm = field<double>(*c, "radius_mm", where + ".contact_patch");
+      patch.outward_normal =
+          field<std::vector<double>>(*c, "outward_normal", where + ".contact_patch");
+      if (patch.point_mm.size() != 3 || patch.outward_normal.size() != 3) {
+        throw InputError(where + ".contact_patch: point_mm and outward_normal need 3 numbers each");
+      }
+      sr.contact_patch = patch;
     }
     if (const auto b = s.find("budget"); b != s.end() && !b->is_null()) {
       sr.budget_magnitude = json_fields::optional_field<double>(*b, "magnitude", where + ".budget");

@@ -37,6 +37,16 @@ struct OutcomeRow {
   /// Scenes with a budget: the error on the budget's quantity (its unit) and the compute time per
   /// update at its rate (s); nullopt without a budget.
   std::optional<double> budget_error, update_seconds;
+  /// The VTU of the case's fields, relative to the results file's folder; empty when the run
+  /// wrote none.
+  std::string fields;
+};
+
+/// Where a contact load acts (results.json's contact_patch), mm.
+struct ContactPatchRow {
+  std::vector<double> point_mm;
+  double radius_mm = 0.0;
+  std::vector<double> outward_normal;  ///< the wall's, unit
 };
 
 /// A scene's [budget] as results.json states it.
@@ -88,6 +98,7 @@ struct SceneRows {
   std::optional<BudgetRow> budget;
   /// The QoI point (for contact loads the contact point), mm; nullopt in files without it.
   std::optional<std::vector<double>> qoi_point_mm;
+  std::optional<ContactPatchRow> contact_patch;  ///< contact loads only
   std::vector<ReferenceRow> references;
   std::vector<OutcomeRow> outcomes;
   /// Natural frequencies (absent from runs without [modes]): the reference per ν, the models.

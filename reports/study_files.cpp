@@ -150,6 +150,7 @@ ValidityModelEntry read_validity_model(const json& j, const std::string& where) 
     e.max_error_mm = field<double>(j, "max_error_mm", where);
     e.qoi_error_mm = field<double>(j, "qoi_error_mm", where);
     e.qoi_relative = field<double>(j, "qoi_relative", where);
+    e.fields = json_fields::field_or<std::string>(j, "fields", "", where);
   } else {
     e.failure = field<std::string>(j, "failure", where);
   }
@@ -204,6 +205,10 @@ ValiditySceneEntry read_validity_scene(const json& j, const std::string& where) 
   e.qoi_limits = read_array(j, "qoi_limits", where, read_crossing);
   e.l2_limits = read_array(j, "l2_limits", where, read_crossing);
   e.rows = read_array(j, "rows", where, read_validity_row);
+  if (const auto q = j.find("qoi_point_mm"); q != j.end()) {
+    e.qoi_point_mm = field<std::vector<double>>(j, "qoi_point_mm", where);
+    if (e.qoi_point_mm->size() != 3) throw InputError(where + ": qoi_point_mm needs 3 numbers");
+  }
   return e;
 }
 
@@ -328,5 +333,7 @@ CalibrateFile parse_calibrate(const std::string& text, const std::filesystem::pa
 CalibrateFile read_calibrate(const std::filesystem::path& path) {
   return parse_calibrate(json_fields::read_text(path, "calibration study"), path);
 }
+
+std::string validity_view_slot(const std::string& scene) { return "view:validity-" + scene; }
 
 }  // namespace vessel::reports

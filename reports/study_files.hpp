@@ -119,6 +119,9 @@ struct ValidityModelEntry {
   bool ok = false;
   std::string failure;
   double relative_l2 = 0.0, max_error_mm = 0.0, qoi_error_mm = 0.0, qoi_relative = 0.0;
+  /// Its fields' VTU against the finite-strain reference, relative to the validity file's
+  /// folder (the largest load reached only); empty when none was written.
+  std::string fields;
 };
 
 struct ValidityRowEntry {
@@ -146,7 +149,11 @@ struct ValiditySceneEntry {
   bool from_cache = false;
   std::vector<ValidityCrossingEntry> qoi_limits, l2_limits;
   std::vector<ValidityRowEntry> rows;
+  std::optional<std::vector<double>> qoi_point_mm;  ///< absent from older files
 };
+
+/// The slot report.html fills with a validity scene's 3D view ("view:validity-<scene>").
+std::string validity_view_slot(const std::string& scene);
 
 struct ValidityFile {
   std::filesystem::path path;

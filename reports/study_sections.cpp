@@ -315,6 +315,7 @@ void validity_scene(Document& doc, const ValiditySceneEntry& v) {
     rows.rows.push_back(std::move(row));
   }
   doc.table(rows);
+  doc.slot(validity_view_slot(v.scene));  // report.html: the models against it in 3D
 }
 
 }  // namespace

@@ -4,23 +4,12 @@
 #include <array>
 #include <cmath>
 #include <map>
-#include <sstream>
 
 #include "meshes/foundation/errors.hpp"
 
 namespace vessel::reports {
 
 namespace {
-
-/// verification/external_model.cpp file_stem: characters other than alphanumerics, '-' and '.'
-/// become '_'.
-std::string stem(const std::string& name) {
-  std::string out = name;
-  for (char& c : out) {
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '_';
-  }
-  return out;
-}
 
 const VtuField& require(const VtuData& vtu, const char* name, int components,
                         const std::string& source) {
@@ -48,13 +37,6 @@ std::vector<std::size_t> cells_of_type(const VtuData& vtu, int type, std::size_t
 }
 
 }  // namespace
-
-std::filesystem::path fields_file(const std::string& scene, const OutcomeRow& o) {
-  std::ostringstream name;
-  name << stem(o.model) << "_nu" << o.poisson_ratio << "_L" << o.level << "_load" << o.magnitude
-       << ".vtu";
-  return std::filesystem::path(scene) / name.str();
-}
 
 std::vector<std::uint32_t> boundary_faces(const std::vector<std::size_t>& tets,
                                           const std::vector<Vec3>& points) {

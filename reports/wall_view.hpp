@@ -1,8 +1,9 @@
 #pragma once
-/// One model's deformed wall as report.html draws it in 3D, read from the VTU fields that
-/// `vesselverify run` writes (fields/<scene>/*.vtu: displacement_model_m, displacement_reference_m,
-/// error_magnitude_mm at the model's nodes), reduced to what is drawn: the boundary faces of a tet
-/// mesh, a surface network's triangles, else its springs as lines, and only their nodes.
+/// One model's deformed wall as report.html draws it in 3D, read from the VTU of fields that
+/// `vesselverify run` writes per case and names in results.json (displacement_model_m,
+/// displacement_reference_m, error_magnitude_mm at the model's nodes), reduced to what is drawn:
+/// the boundary faces of a tet mesh, a surface network's triangles, else its springs as lines,
+/// and only their nodes.
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -10,7 +11,6 @@
 #include <vector>
 
 #include "meshes/vtu_io.hpp"
-#include "reports/results_file.hpp"
 
 namespace vessel::reports {
 
@@ -30,11 +30,6 @@ struct WallView {
   double error_step_mm = 0.0;
   double max_error_mm = 0.0;  ///< the largest |error| over the drawn nodes
 };
-
-/// Where `vesselverify run` writes an outcome's fields, relative to its fields/ directory
-/// (verification/harness.cpp fields_file: "<scene>/<model>_nu<ν>_L<level>_load<magnitude>.vtu",
-/// numbers in the stream's default format).
-std::filesystem::path fields_file(const std::string& scene, const OutcomeRow& outcome);
 
 /// The drawn part of a VTU as above. InputError naming `source` when a field is missing or the
 /// cells are of a type the view cannot draw.

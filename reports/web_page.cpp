@@ -50,6 +50,14 @@ std::string b64(const std::vector<T>& v) {
   return base64_encode(v.data(), v.size() * sizeof(T));
 }
 
+/// The contact patch the page outlines on the wall: centre and radius, mm (null without one).
+json patch_json(const std::optional<ContactPatchRow>& patch) {
+  if (!patch) return nullptr;
+  return {{"point_mm", patch->point_mm},
+          {"radius_mm", patch->radius_mm},
+          {"normal", patch->outward_normal}};
+}
+
 json view_json(const WallView& v) {
   return {{"model", v.model},
           {"kind", v.kind},
@@ -139,8 +147,8 @@ std::string view_html(const SceneViews& v, std::size_t index) {
   out << "<section class=\"vv-view\" id=\"view-" << escape_xml(v.scene) << "\" data-scene-index=\""
       << index << "\">\n";
   if (v.views.empty()) {
-    out << "<p class=\"vv-note\">No fields/*.vtu for this scene at " << escape_xml(v.load_text)
-        << ": `vesselverify run` writes them unless --fields none.</p>\n</section>\n";
+    out << "<p class=\"vv-note\">No VTU fields for this scene at " << escape_xml(v.load_text)
+        << ": " << escape_xml(v.no_fields_note) << "</p>\n</section>\n";
     return out.str();
   }
   out << "<div class=\"vv-view-controls\">"
@@ -156,9 +164,12 @@ std::string view_html(const SceneViews& v, std::size_t index) {
       << ", deformed by its own displacement and coloured by |model − reference| at its nodes "
          "(viridis, one scale for every model of the scene, logarithmic when their errors span "
          "more than a decade; the tick marks the tolerance, "
-      << significant(v.tolerance_mm) << " mm). Grey ghost: the reference's deformed wall. Red "
-         "sphere: the QoI point. Drag to turn, wheel to zoom; both panes share the camera; hover "
-         "a node for its error and both displacements.</p>\n";
+      << significant(v.tolerance_mm) << " mm). " << escape_xml(v.reference_note)
+      << "Grey ghost: the reference's deformed wall. Red sphere: the QoI point"
+      << (v.contact_patch ? "; red disc: the contact patch the force is spread over (both"
+                          : " (")
+      << " at rest, drawn through the wall). Drag to turn, wheel to zoom; both panes share "
+         "the camera; hover a node for its error and both displacements.</p>\n";
   if (!v.missing.empty()) {
     out << "<p class=\"vv-note\">" << v.missing.size() << " finished model(s) have no VTU here ("
         << escape_xml(v.missing.front()) << (v.missing.size() > 1 ? ", …" : "") << ").</p>\n";
@@ -202,14 +213,48 @@ WebLibraries load_web_libraries(const std::filesystem::path& dir) {
   return out;
 }
 
-SceneViews read_scene_views(const SceneRows& s, const std::filesystem::path& fields_dir) {
+/// A load as the views' captions give it: contact forces in mN, else in the scene's unit.
+std::string load_text(double load, const std::string& unit) {
+  return unit == "N" ? significant(load * 1e3) + " mN" : significant(load) + " " + unit;
+}
+
+SceneViews validity_scene_views(const ValiditySceneEntry& s,
+                                const std::filesystem::path& validity_dir, double tolerance_mm) {
+  SceneViews out;
+  out.scene = "validity-" + s.scene;
+  out.tolerance_mm = tolerance_mm;
+  out.qoi_mm = s.qoi_point_mm;
+  out.reference_note = "Here the reference is the finite-strain (neo-Hookean) one. ";
+  out.no_fields_note = "`vesselverify validity` writes them unless --fields none.";
+  if (s.rows.empty()) return out;
+  const ValidityRowEntry& largest = s.rows.back();
+  out.load_text = load_text(largest.magnitude, s.load_unit);
+  for (const ValidityModelEntry& m : largest.models) {
+    if (!m.ok || m.fields.empty()) continue;
+    const std::filesystem::path path = validity_dir / m.fields;
+    if (!std::filesystem::exists(path)) {
+      out.missing.push_back(path.string());
+      continue;
+    }
+    WallView v = wall_view(read_vtu(path), path.string());
+    v.model = m.model;
+    v.kind = "msm";
+    v.level = s.model_level;
+    v.poisson_ratio = s.poisson_ratio;
+    v.magnitude = largest.magnitude;
+    out.views.push_back(std::move(v));
+  }
+  return out;
+}
+
+SceneViews read_scene_views(const SceneRows& s, const std::filesystem::path& results_dir) {
   SceneViews out;
   out.scene = s.name;
   out.tolerance_mm = s.tolerance_mm;
   out.qoi_mm = s.qoi_point_mm;
+  out.contact_patch = s.contact_patch;
   const double load = representative_load(s);
-  out.load_text = s.load_unit == "N" ? significant(load * 1e3) + " mN"
-                                     : significant(load) + " " + s.load_unit;
+  out.load_text = load_text(load, s.load_unit);
   const double nu = s.references.empty()
                         ? (s.outcomes.empty() ? 0.0 : s.outcomes.front().poisson_ratio)
                         : s.references.front().poisson_ratio;
@@ -220,7 +265,11 @@ SceneViews read_scene_views(const SceneRows& s, const std::filesystem::path& fie
   for (const OutcomeRow& o : s.outcomes) {
     if (!o.ok || o.magnitude != load || o.poisson_ratio != nu || o.level != finest) continue;
     if (!seen.emplace(o.model, o.level).second) continue;
-    const std::filesystem::path path = fields_dir / fields_file(s.name, o);
+    if (o.fields.empty()) {
+      out.missing.push_back(o.model + ": results.json names no fields file");
+      continue;
+    }
+    const std::filesystem::path path = results_dir / o.fields;
     if (!std::filesystem::exists(path)) {
       out.missing.push_back(path.string());
       continue;
@@ -351,6 +400,7 @@ std::string interactive_html(const Document& doc, const std::vector<SceneCard>& 
     for (std::size_t i = 0; i < views.size(); ++i) {
       json scene{{"name", views[i].scene}, {"tolerance_mm", views[i].tolerance_mm},
                  {"qoi_mm", views[i].qoi_mm ? json(*views[i].qoi_mm) : json(nullptr)},
+                 {"patch", patch_json(views[i].contact_patch)},
                  {"load", views[i].load_text}, {"views", json::array()}};
       for (const WallView& v : views[i].views) scene["views"].push_back(view_json(v));
       out << "<script type=\"application/json\" id=\"vv-scene-" << i << "\">"

@@ -13,6 +13,7 @@
 #include "reports/document.hpp"
 #include "reports/results_file.hpp"
 #include "reports/scene_card.hpp"
+#include "reports/study_files.hpp"
 #include "reports/wall_view.hpp"
 
 namespace vessel::reports {
@@ -38,20 +39,32 @@ std::filesystem::path default_javascript_dir();
 /// three.js (three/three.min.js) and Chart.js (chart.js/chart.min.js) under `dir`.
 WebLibraries load_web_libraries(const std::filesystem::path& dir);
 
-/// One scene's 3D data: its models' walls at the representative load and first ν.
+/// One scene's 3D data: its models' walls at the representative load and first ν (a validity
+/// scene's: at the largest load reached, against the finite-strain reference).
 struct SceneViews {
-  std::string scene;
+  std::string scene;  ///< the page's anchor (view-<scene>) and slot (view:<scene>)
+  std::string reference_note;  ///< a sentence naming the reference when it is not the run's
+  /// What the view says when it has no walls (no VTU written).
+  std::string no_fields_note = "`vesselverify run` writes them unless --fields none.";
   double tolerance_mm = 0.1;
   std::optional<std::vector<double>> qoi_mm;
+  std::optional<ContactPatchRow> contact_patch;
   std::string load_text;
   std::vector<WallView> views;
   std::vector<std::string> missing;  ///< outcomes whose VTU was not found (their paths)
 };
 
 /// The walls of each finished outcome of `scene` at its representative load, first ν and finest
-/// model level, read from `fields_dir` (fields_file); an absent file is listed in `missing`, an
-/// unreadable one is an InputError.
-SceneViews read_scene_views(const SceneRows& scene, const std::filesystem::path& fields_dir);
+/// model level, read from the VTU its `fields` names (relative to `results_dir`, the results
+/// file's folder); an outcome without one or whose file is absent is listed in `missing`, an
+/// unreadable file is an InputError.
+SceneViews read_scene_views(const SceneRows& scene, const std::filesystem::path& results_dir);
+
+/// The walls of each model the validity study judged, at the largest load it reached, read from
+/// the VTUs its `fields` name (relative to `validity_dir`, the validity file's folder); scene
+/// "validity-<scene>", the tolerance `tolerance_mm`. InputError for an unreadable file.
+SceneViews validity_scene_views(const ValiditySceneEntry& scene,
+                                const std::filesystem::path& validity_dir, double tolerance_mm);
 
 /// A picture of the scene for its card: the vessel's outline seen along its thinnest extent, the
 /// QoI point and the load, as a small <svg> (empty without a wall to draw).

@@ -152,6 +152,16 @@ std::string finite_strain_json(const FemRunRecord& run, const fem::HyperelasticR
        {{"mesh", run.mesh_seconds}, {"setup", r.timings.setup}, {"assembly", r.timings.assembly},
         {"solve", r.timings.solve}, {"postprocess", r.timings.postprocess}}}};
   if (run.contact) j["contact"] = contact_json(*run.contact);
+  if (const auto& q = run.finite_strain_qoi) {
+    const auto mm3 = [](const Vec3& v) {
+      return std::vector<double>{v.x() * 1e3, v.y() * 1e3, v.z() * 1e3};
+    };
+    j["qoi"] = {{"point_mm", mm3(q->point)},
+                {"direction", {q->direction.x(), q->direction.y(), q->direction.z()}},
+                {"displacement_mm", mm3(q->displacement)},
+                {"along_mm", q->displacement.dot(q->direction) * 1e3},
+                {"linear_along_mm", q->linear_displacement.dot(q->direction) * 1e3}};
+  }
   return j.dump(2) + "\n";
 }
 

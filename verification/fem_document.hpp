@@ -40,6 +40,13 @@ struct DistributedRecord {
 };
 
 /// Everything one `fem` run reports.
+/// A displacement read at one point along one direction, beside the linear reference's there.
+struct QoiReading {
+  Vec3 point = Vec3::Zero();      ///< m
+  Vec3 direction = Vec3::Zero();  ///< unit: the patch's inward normal, else radial
+  Vec3 displacement = Vec3::Zero(), linear_displacement = Vec3::Zero();  ///< m
+};
+
 struct FemRunRecord {
   VesselParams vessel;
   double youngs_modulus = 0.0, poisson_ratio = 0.0, density = 0.0;
@@ -55,6 +62,7 @@ struct FemRunRecord {
   std::optional<fem::TransientOptions> transient_options;
   std::optional<fem::TransientResult> transient;
   std::optional<DistributedRecord> distributed;
+  std::optional<QoiReading> finite_strain_qoi;  ///< --reference finite-strain
   double mesh_seconds = 0.0, output_seconds = 0.0;
 
   [[nodiscard]] double max_displacement() const;  ///< m, over the mesh nodes
@@ -66,7 +74,9 @@ void write_fem_json(const std::filesystem::path& path, const FemRunRecord& run);
 /// The finite-strain reference's run (`fem --reference finite-strain --json`; schema
 /// "vesselverify.fem_finite_strain", version 1): the problem as fem_json gives it, the load factor
 /// reached and why it stopped, load steps and Newton iterations, the largest displacement and the
-/// contact point's (mm), strain energy (mJ), the largest principal Green–Lagrange strain, min J.
+/// contact point's (mm), the QoI reading (mm: the contact point along the inward normal, else the
+/// scene's QoI point radially, beside the linear reference's), strain energy (mJ), the largest
+/// principal Green–Lagrange strain, min J.
 std::string finite_strain_json(const FemRunRecord& run, const fem::HyperelasticResult& result);
 void write_finite_strain_json(const std::filesystem::path& path, const FemRunRecord& run,
                               const fem::HyperelasticResult& result);

@@ -230,16 +230,48 @@
       pane.ghost = ghost;
       scene.add(ghost);
     }
+    // The QoI point and the contact patch at rest, drawn over the wall (they sit on the
+    // inner wall, which the wall itself hides).
     if (view.data.qoi_mm) {
-      const s = new THREE.Mesh(new THREE.SphereBufferGeometry(view.radius * 0.035, 16, 12),
-        new THREE.MeshBasicMaterial({color: 0xdd0000}));
+      // Small enough inside the patch for its rim to show around it.
+      const r = view.data.patch ? 0.25 * view.data.patch.radius_mm : view.radius * 0.035;
+      const s = new THREE.Mesh(new THREE.SphereBufferGeometry(r, 16, 12),
+        new THREE.MeshBasicMaterial({color: 0xdd0000, depthTest: false}));
       s.position.set(view.data.qoi_mm[0], view.data.qoi_mm[1], view.data.qoi_mm[2]);
+      s.renderOrder = 3;
       scene.add(s);
     }
+    if (view.data.patch) patchMarks(view.data.patch).forEach((m) => scene.add(m));
     const label = document.createElement('div');
     label.className = 'vv-pane-label';
     pane.el.appendChild(label);
     pane.label = label;
+  }
+
+  // The contact patch: a translucent disc of its radius about its centre in the wall's tangent
+  // plane (normal to the patch's outward normal), and its rim.
+  function patchMarks(patch) {
+    const n = new THREE.Vector3().fromArray(patch.normal).normalize();
+    const e1 = new THREE.Vector3(1, 0, 0);
+    if (Math.abs(n.x) > 0.9) e1.set(0, 1, 0);
+    e1.sub(n.clone().multiplyScalar(e1.dot(n))).normalize();
+    const e2 = n.clone().cross(e1);
+    const points = [];
+    for (let k = 0; k < 64; ++k) {
+      const a = 2 * Math.PI * k / 64, r = patch.radius_mm;
+      points.push(new THREE.Vector3().fromArray(patch.point_mm)
+        .addScaledVector(e1, r * Math.cos(a)).addScaledVector(e2, r * Math.sin(a)));
+    }
+    const ring = new THREE.LineLoop(new THREE.BufferGeometry().setFromPoints(points),
+      new THREE.LineBasicMaterial({color: 0xdd0000, depthTest: false}));
+    const fan = new THREE.BufferGeometry().setFromPoints(
+      [new THREE.Vector3().fromArray(patch.point_mm)].concat(points, [points[0]]));
+    fan.setIndex(points.map((p, k) => [0, k + 1, k + 2]).flat());  // r111: returns nothing
+    const disc = new THREE.Mesh(fan, new THREE.MeshBasicMaterial({color: 0xdd0000,
+      transparent: true, opacity: 0.3, depthTest: false, side: THREE.DoubleSide}));
+    ring.renderOrder = 3;
+    disc.renderOrder = 3;
+    return [disc, ring];
   }
 
   function showModel(view, pane, i) {

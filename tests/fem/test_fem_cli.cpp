@@ -245,6 +245,41 @@ TEST(FemCli, FiniteStrainJsonGivesTheLoadReachedAndTheContactDisplacement) {
   EXPECT_GE(j["max_displacement_mm"].get<double>(), std::abs(along));
 }
 
+TEST(FemCli, FiniteStrainUnderPressureGivesLamesDisplacementAtTheQoiPoint) {
+  // 10 Pa on the short tube with roller ends: strains near 0.1 %, so the neo-Hookean radial
+  // displacement at the QoI point (on the inner wall) is Lamé's plane-strain closed form within
+  // P2's discretisation error, and the linear reference's within O(strain).
+  TempDir dir;
+  const auto r = vv("fem " + kTube + "--degree 2 --reference finite-strain --json " +
+                    (dir / "f.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "u at QoI point")) << r.output;
+  const auto j = nlohmann::json::parse(vessel::test::read_text(dir / "f.json"));
+  ASSERT_TRUE(j.contains("qoi")) << j.dump();
+  const auto& q = j["qoi"];
+  const double E = j["material"]["E_Pa"], nu = j["material"]["nu"];
+  const double a = 3e-3, b = 4e-3, p = 10.0;  // the command's default tube and pressure
+  const double x = q["point_mm"][0].get<double>() * 1e-3, y = q["point_mm"][1].get<double>() * 1e-3;
+  const double radius = std::hypot(x, y);
+  EXPECT_NEAR(radius, a, 1e-6);
+  const double lame_mm = 1e3 * p * a * a / (E * (b * b - a * a)) *
+                         ((1 + nu) * (1 - 2 * nu) * radius + (1 + nu) * b * b / radius);
+  const double along = q["along_mm"];
+  EXPECT_NEAR(along, lame_mm, 0.02 * lame_mm);
+  EXPECT_NEAR(along, q["linear_along_mm"].get<double>(), 0.005 * lame_mm);
+  EXPECT_NEAR(along, number_after(r.output, "along the radial direction "), 1e-5 * lame_mm);
+}
+
+TEST(FemCli, FiniteStrainUnderGravityPrintsTheQoiPointBesideTheLinearReference) {
+  const auto r = vv("fem " + kTube + "--load gravity --reference finite-strain");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const double finite = number_after(r.output, "along the radial direction ");
+  const double linear = number_after(r.output, "linear reference at the same load ");
+  ASSERT_TRUE(std::isfinite(finite) && std::isfinite(linear)) << r.output;
+  ASSERT_NE(linear, 0.0) << r.output;
+  EXPECT_NEAR(finite, linear, 0.03 * std::abs(linear)) << r.output;  // 1 g: strains far below 1 %
+}
+
 TEST(FemCli, FiniteStrainRefusesOptionsOfTheLinearReferenceOnly) {
   const auto r = vv("fem " + kTube + "--reference finite-strain --modes 3");
   EXPECT_EQ(r.exit_code, 1) << r.output;

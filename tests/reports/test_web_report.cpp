@@ -151,14 +151,41 @@ TEST(WallView, MissingFieldNamesTheFile) {
   }
 }
 
-TEST(FieldsFile, NamesTheFileAsTheRunWritesIt) {
-  OutcomeRow o;
-  o.model = "surface seed/000";
-  o.poisson_ratio = 0.45;
-  o.level = 1;
-  o.magnitude = 0.001;
-  EXPECT_EQ(fields_file("contact_straight", o).string(),
-            "contact_straight/surface_seed_000_nu0.45_L1_load0.001.vtu");
+TEST(WebReport, ThePageCarriesTheContactPatchWhereResultsJsonPutsIt) {
+  test::TempDir dir;
+  const std::string page = write_fixture_report(dir.path(), default_javascript_dir().string());
+  const nlohmann::json scene = script_json(page, "vv-scene-0");
+  ASSERT_TRUE(scene["patch"].is_object()) << scene["patch"];
+  EXPECT_EQ(scene["patch"]["point_mm"], nlohmann::json({3, 0, 20}));  // the fixture's
+  EXPECT_EQ(scene["patch"]["radius_mm"], 1.5);
+  EXPECT_EQ(scene["patch"]["normal"], nlohmann::json({1, 0, 0}));
+}
+
+TEST(WebReport, TheValiditySectionDrawsTheModelsAgainstTheFiniteStrainReference) {
+  test::TempDir dir;
+  setenv("VESSELVERIFY_JS_DIR", default_javascript_dir().c_str(), 1);
+  ReportOptions o;
+  o.results = kFixture / "results.json";
+  o.validity = kFixture / "validity.json";
+  o.output_dir = dir.path();
+  o.command = "test";
+  write_report(o);
+  unsetenv("VESSELVERIFY_JS_DIR");
+  const std::string page = test::read_text(dir / "report.html");
+  // One view per results scene, then the validity scene's: its model at the largest load, read
+  // from the VTU validity.json names (the fixture's copy of the run's volume_springs field).
+  const nlohmann::json scene = script_json(page, "vv-scene-1");
+  ASSERT_FALSE(scene.is_null());
+  EXPECT_EQ(scene["name"], "validity-tube");
+  ASSERT_EQ(scene["views"].size(), 1u);
+  EXPECT_EQ(scene["views"][0]["model"], "volume_springs");
+  EXPECT_EQ(scene["load"], "1 mN");
+  EXPECT_EQ(count(page, "id=\"view-validity-tube\""), 1u) << "no section for the view";
+  EXPECT_EQ(count(page, "Here the reference is the finite-strain"), 1u) << "caption";
+  const nlohmann::json run_view = script_json(page, "vv-scene-0")["views"];
+  for (const auto& v : run_view) {
+    if (v["model"] == "volume_springs") EXPECT_EQ(v["err"], scene["views"][0]["err"]);
+  }
 }
 
 TEST(WebReport, DecodedErrorsEqualTheVtusWithinTheQuantisationStep) {
@@ -178,7 +205,8 @@ TEST(WebReport, DecodedErrorsEqualTheVtusWithinTheQuantisationStep) {
           o = r;
         }
       }
-      const VtuData vtu = read_vtu(kFixture / "fields" / fields_file(results.scenes[s].name, o));
+      ASSERT_FALSE(o.fields.empty()) << view["model"];
+      const VtuData vtu = read_vtu(kFixture / o.fields);
       const VtuField* err = VtuData::find(vtu.point_fields, "error_magnitude_mm");
       ASSERT_NE(err, nullptr);
       const auto rest = decode_as<float>(view["rest"]);

@@ -198,8 +198,14 @@ TEST_F(HarnessLame, ResultsJsonHasEveryFieldItsSchemaRequires) {
   const auto& scene = results["scenes"].at(0);
   for (const auto& key : scene_schema["required"]) EXPECT_TRUE(scene.contains(key)) << key;
   const auto& outcome_schema = scene_schema["properties"]["outcomes"]["items"];
+  EXPECT_TRUE(scene["contact_patch"].is_null());  // a pressure load
   for (const auto& outcome : scene["outcomes"]) {
     for (const auto& key : outcome_schema["required"]) EXPECT_TRUE(outcome.contains(key)) << key;
+    // The fields file, relative to results.json's folder (the fields are in another TempDir).
+    if (outcome.contains("fields")) {
+      EXPECT_TRUE(std::filesystem::exists(dir / outcome["fields"].get<std::string>()))
+          << outcome["fields"];
+    }
     if (outcome["ok"]) {
       for (const auto& key : outcome_schema["properties"]["error"]["required"]) {
         EXPECT_TRUE(outcome["error"].contains(key)) << key;
@@ -312,6 +318,14 @@ TEST_F(HarnessLame, VtuFieldsHoldLamesFieldAndTheModelsErrorAtTheRepresentativeL
   }
   EXPECT_FALSE(std::filesystem::exists(
       dir / "volume_explicit_euler_too_big_a_step_nu0.3_L0_load20.vtu"));
+  // Each outcome names the file it wrote, and only those.
+  for (const ModelOutcome& o : result_->outcomes) {
+    if (o.ok && o.magnitude == 20.0) {
+      EXPECT_EQ(o.fields_file, dir / (o.model + "_nu0.3_L0_load20.vtu")) << o.model;
+    } else {
+      EXPECT_TRUE(o.fields_file.empty()) << o.model << " at " << o.magnitude;
+    }
+  }
 
   // The reference field is Lamé's at every node (plane strain holds along the whole tube):
   // u = u_r(r) e_r, no axial or circumferential part.
@@ -392,6 +406,11 @@ TEST(HarnessDynamic, FemTransientSettlesOnTheStaticReferenceAndTheHistoryIsSampl
     max_diff = std::max(max_diff, std::abs(h.model_mm[k] - h.reference_mm[k]));
   }
   EXPECT_DOUBLE_EQ(h.max_error_mm, max_diff);
+  // The patch at (a, 0, z) on the inner wall: the wall's outward normal there points into the
+  // lumen, −x, up to the facets of the mesh.
+  EXPECT_NEAR(r.contact_normal.x(), -1.0, 1e-2);
+  EXPECT_NEAR(r.contact_normal.y(), 0.0, 0.1);
+  EXPECT_NEAR(r.contact_normal.z(), 0.0, 1e-9);
 }
 
 TEST(HarnessDynamic, TransientRunsOnTheLevelTheSceneNames) {

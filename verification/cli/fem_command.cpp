@@ -401,10 +401,28 @@ void run_distributed(const TetMesh& mesh,
   std::cout << "\n";
 }
 
+/// The finite-strain solution at the contact point along the patch's inward normal, or for
+/// gravity and pressure at the scene's QoI point along the radial direction (as --richardson
+/// reads it), beside the linear reference's at the same load factor.
+QoiReading finite_strain_qoi(const fem::HyperelasticSolver& solver, double load_factor,
+                             const Scene& scene, const TetMesh& mesh,
+                             const fem::ElasticityProblem& problem, const FemRunRecord& run) {
+  QoiReading q;
+  q.point = run.contact ? run.contact->point : qoi_point(scene);
+  q.direction = run.contact ? run.contact->inward_normal
+                            : Vec3(q.point.x(), q.point.y(), 0.0).normalized();
+  q.displacement = solver.displacement_at({q.point})[0];
+  fem::ElasticitySolver linear(mesh, problem);
+  linear.solve();
+  q.linear_displacement = linear.displacement_at({q.point})[0] * load_factor;
+  return q;
+}
+
 /// The finite-strain reference on the same problem: load steps, Newton iterations, how far the
-/// load got, the contact point's displacement beside the linear reference's, timings.
-void run_finite_strain(const FemCommandOptions& o, const fem::ElasticityProblem& problem,
-                       const TetMesh& mesh, FemRunRecord& run) {
+/// load got, the contact (else QoI) point's displacement beside the linear reference's, timings.
+void run_finite_strain(const FemCommandOptions& o, const Scene& scene,
+                       const fem::ElasticityProblem& problem, const TetMesh& mesh,
+                       FemRunRecord& run) {
   fem::HyperelasticOptions ho;
   ho.follower_pressure = !o.dead_pressure;
   fem::HyperelasticSolver solver(mesh, problem, ho);
@@ -430,17 +448,14 @@ void run_finite_strain(const FemCommandOptions& o, const fem::ElasticityProblem&
   for (const auto& u : r.nodal_displacement) max_u = std::max(max_u, u.norm());
   std::cout << std::setprecision(6) << "results (mm, mJ), at load factor " << r.load_factor
             << ":\n  max |u|                 " << max_u * 1e3 << " mm\n";
-  if (run.contact) {
-    const Vec3 u = solver.displacement_at({run.contact->point})[0];
-    run.contact->displacement = u;
-    fem::ElasticitySolver linear(mesh, problem);
-    linear.solve();
-    const Vec3 ul = linear.displacement_at({run.contact->point})[0] * r.load_factor;
-    const Vec3& n = run.contact->inward_normal;
-    std::cout << "  u at contact point      " << mm(u) << " mm, along the patch normal "
-              << u.dot(n) * 1e3 << " mm (linear reference at the same load " << ul.dot(n) * 1e3
-              << " mm)\n";
-  }
+  const QoiReading q = finite_strain_qoi(solver, r.load_factor, scene, mesh, problem, run);
+  if (run.contact) run.contact->displacement = q.displacement;
+  run.finite_strain_qoi = q;
+  std::cout << (run.contact ? "  u at contact point      " : "  u at QoI point         ")
+            << mm(q.displacement) << " mm, along the "
+            << (run.contact ? "patch normal " : "radial direction ")
+            << q.displacement.dot(q.direction) * 1e3 << " mm (linear reference at the same load "
+            << q.linear_displacement.dot(q.direction) * 1e3 << " mm)\n";
   std::cout << "  strain energy           " << r.strain_energy * 1e3 << " mJ\n"
             << "  max principal Green-Lagrange strain " << r.max_abs_principal_strain
             << ", min J " << r.min_jacobian << "\n";
@@ -511,7 +526,7 @@ void run(FemCommandOptions& o) {
   std::cout << std::setprecision(6) << "material: E " << o.youngs_modulus << " Pa, nu "
             << o.poisson_ratio << ", rho " << o.density << " kg/m³; ends: " << run.ends << "\n";
   if (o.reference == "finite-strain") {
-    run_finite_strain(o, problem, mesh, run);
+    run_finite_strain(o, scene, problem, mesh, run);
     return;
   }
   if (o.distributed) {

@@ -31,6 +31,7 @@ struct ValidityCli {
   // level 0 costs a second or more).
   int max_newton_iterations = 10;
   int jobs = 1;
+  std::string fields = "largest";
 };
 
 }  // namespace
@@ -74,6 +75,12 @@ void add_validity_command(CLI::App& app, const std::string& command_line) {
                   "Newton iterations per load step of the continuation")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
+  cmd->add_option("--fields", o->fields,
+                  "Each model's VTU fields against the finite-strain reference at the largest load "
+                  "reached, under OUTPUT-DIR/validity_fields/<scene>/ (the report draws them in "
+                  "3D): largest or none")
+      ->check(CLI::IsMember({"largest", "none"}))
+      ->capture_default_str();
   add_jobs_option(*cmd, o->jobs,
                   "Scenes studied at a time (default: the core count); the study times no model");
   cmd->callback([o, command_line] {
@@ -92,6 +99,7 @@ void add_validity_command(CLI::App& app, const std::string& command_line) {
     vo.ladder = o->ladder;
     vo.models = o->models;
     vo.mesh_cache_dir = o->cache.mesh_dir();
+    if (o->fields != "none") vo.fields_dir = o->output_dir / "validity_fields";
     vo.cache = cache.get();
     vo.finite.max_newton_iterations = o->max_newton_iterations;
     vo.log = &std::cout;

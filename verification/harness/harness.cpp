@@ -69,6 +69,10 @@ void run_through_cache(const Scene& s, const ModelSpec& spec, double nu, int lev
   const auto keep = [&](ModelRun run_result, const TimingProvenance& timing) {
     for (ModelOutcome& out : run_result.outcomes) {
       out.timing = timing;
+      const std::string file = fields_file(s, out).string();
+      for (const auto& written : run_result.field_files) {
+        if (written.first == file) out.fields_file = o.fields_dir / file;
+      }
       result.outcomes.push_back(std::move(out));
     }
     for (ModalOutcome& m : run_result.modes) result.model_modes.push_back(std::move(m));
@@ -117,6 +121,9 @@ SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& pr
   SceneResult result;
   result.scene = s;
   result.qoi_point = qoi_point(s);
+  if (s.load.kind == LoadKind::contact) {
+    result.contact_normal = scene_contact_patch(s.load, r.fine_mesh, 1.0).outward_normal;
+  }
   for (std::size_t k = 0; k < s.poisson_ratios.size(); ++k) {
     const double nu = s.poisson_ratios[k];
     SceneReferences::AtNu& a = r.at_nu[k];

@@ -92,6 +92,12 @@ std::filesystem::path fields_file(const Scene& s, const ModelOutcome& out) {
 void write_model_fields(const HarnessOptions& o, const Scene& s, const ModelOutcome& out,
                         const std::vector<Vec3>& nodes, const VtuCells& cells,
                         const std::vector<Vec3>& u_model, const std::vector<Vec3>& u_ref) {
+  write_fields_vtu(o.fields_dir / fields_file(s, out), nodes, cells, u_model, u_ref);
+}
+
+void write_fields_vtu(const std::filesystem::path& path, const std::vector<Vec3>& nodes,
+                      const VtuCells& cells, const std::vector<Vec3>& u_model,
+                      const std::vector<Vec3>& u_ref) {
   VtuField model{"displacement_model_m", 3, {}};
   VtuField reference{"displacement_reference_m", 3, {}};
   VtuField error{"error_m", 3, {}};
@@ -105,7 +111,6 @@ void write_model_fields(const HarnessOptions& o, const Scene& s, const ModelOutc
     }
     error_mm.values.push_back(e.norm() * 1e3);
   }
-  const std::filesystem::path path = o.fields_dir / fields_file(s, out);
   std::filesystem::create_directories(path.parent_path());
   write_vtu(path, nodes, cells, {model, reference, error, error_mm});
 }

@@ -58,9 +58,15 @@ bool wants_fields(const HarnessOptions& o, const Scene& s, double magnitude,
 /// Where write_model_fields writes an outcome's fields, relative to the fields directory.
 std::filesystem::path fields_file(const Scene& s, const ModelOutcome& out);
 
-/// One model's displacement fields at one load for ParaView: points at the model's rest nodes
-/// (m), vectors in m so that "Warp By Vector" at scale 1 shows the deformed state, and |error| in
-/// mm as the reports use.
+/// A model's displacement fields against a reference's, for ParaView and the report's 3D view:
+/// points at the model's rest nodes (m), displacement_model_m, displacement_reference_m and
+/// error_m in m (so that "Warp By Vector" at scale 1 shows the deformed state), and
+/// error_magnitude_mm. Creates the file's folder.
+void write_fields_vtu(const std::filesystem::path& path, const std::vector<Vec3>& nodes,
+                      const VtuCells& cells, const std::vector<Vec3>& u_model,
+                      const std::vector<Vec3>& u_ref);
+
+/// write_fields_vtu of one outcome at o.fields_dir / fields_file(s, out).
 void write_model_fields(const HarnessOptions& o, const Scene& s, const ModelOutcome& out,
                         const std::vector<Vec3>& nodes, const VtuCells& cells,
                         const std::vector<Vec3>& u_model, const std::vector<Vec3>& u_ref);

@@ -3,6 +3,7 @@
 /// model's outcome at one ν, level and load, natural frequencies) and the error statistics and
 /// quantities inside them. Plain data: the code that fills them is in references, metrics and
 /// the model runs; results.hpp writes them.
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <string>
@@ -148,6 +149,9 @@ struct ModelOutcome {
   /// needs (at least 1). Set-up is excluded. 0 without a budget rate.
   double update_seconds = 0.0;
   long steps_per_update = 0;  ///< integrators with a budget rate
+  /// The VTU the run wrote this case's fields to (model and reference displacements, error);
+  /// empty when it wrote none.
+  std::filesystem::path fields_file;
   TimingProvenance timing;  ///< measured in this run, or read from the outcome cache
 };
 
@@ -172,6 +176,8 @@ struct ModalOutcome {
 struct SceneResult {
   Scene scene;
   Vec3 qoi_point = Vec3::Zero();  ///< where the "contact-point displacement" is read
+  /// Contact loads: the patch's mean outward unit normal on the reference mesh's wall.
+  Vec3 contact_normal = Vec3::Zero();
   std::vector<ReferenceInfo> references;
   std::vector<ModelOutcome> outcomes;
   /// Natural frequencies (scene.modes.count > 0): the modal reference per ν, then each model's.

@@ -103,7 +103,95 @@ std::string joined(const std::vector<double>& v) {
   return s.str();
 }
 
-nlohmann::json scene_json(const SceneResult& r) {
+/// Where a contact load acts: the patch's centre and radius and the wall's outward normal there
+/// (its force per magnitude is the magnitude, N, along the inward normal); null for other loads.
+nlohmann::json contact_patch_json(const SceneResult& r) {
+  const Scene& s = r.scene;
+  if (s.load.kind != LoadKind::contact) return nullptr;
+  const Vec3& c = s.load.contact.point;
+  const Vec3& n = r.contact_normal;
+  return {{"point_mm", {c.x() * 1e3, c.y() * 1e3, c.z() * 1e3}},
+          {"radius_mm", s.load.contact.radius * 1e3},
+          {"outward_normal", {n.x(), n.y(), n.z()}}};
+}
+
+/// One outcome's record; `results_dir` is where results.json goes (its fields path is relative
+/// to it).
+nlohmann::json outcome_json(const ModelOutcome& o, const SceneResult& r,
+                            const std::filesystem::path& results_dir) {
+  nlohmann::json j{{"model", o.model},
+                   {"kind", o.kind},
+                   {"detail", o.detail},
+                   {"poisson_ratio", o.poisson_ratio},
+                   {"magnitude", o.magnitude},
+                   {"level", o.level},
+                   {"reference", o.reference},
+                   {"ok", o.ok},
+                   {"nodes", o.nodes},
+                   {"unknowns", o.unknowns},
+                   {"setup_seconds", o.setup_seconds},
+                   {"solve_seconds", o.solve_seconds},
+                   {"memory_mib", o.memory_mib}};
+  if (o.roi_radius > 0.0) j["roi_radius_mm"] = o.roi_radius * 1e3;
+  if (!o.timing_source.empty()) j["timing_source"] = o.timing_source;
+  if (!o.timing.measured_at.empty()) {
+    j["timing_provenance"] = {{"source", o.timing.cached ? "cache" : "measured"},
+                              {"measured_at", o.timing.measured_at}};
+  }
+  if (o.updates > 0) {
+    j["updates"] = {{"count", o.updates},
+                    {"iterations_per_update", o.iterations_per_update},
+                    {"factorisations_per_update", o.factorisations_per_update}};
+  }
+  if (o.ok) {
+    j["error"] = error_json(o.error);
+    if (o.has_reference_uncertainty) {
+      j["reference_uncertainty"] = {{"max_mm", o.reference_uncertainty.max_mm},
+                                    {"rms_mm", o.reference_uncertainty.rms_mm}};
+    } else {
+      j["reference_uncertainty"] = nullptr;  // the reference had no coarser level
+    }
+    j["qoi_displacement_mm"] = o.qoi_displacement_mm;
+    j["qoi_reference_mm"] = o.qoi_reference_mm;
+    j["max_strain"] = o.max_strain;
+    j["beyond_linear_regime"] = o.beyond_linear_regime;
+    const QuantityErrors& q = o.quantities;
+    j["quantities"] = {{"contact_point_mm", q.contact_point_mm},
+                       {"field_mm", q.field_mm},
+                       {"patch_mm", number_or_null(q.patch_mm)},
+                       {"indentation_mm", number_or_null(q.indentation_mm)},
+                       {"indentation_reference_mm", number_or_null(q.indentation_reference_mm)},
+                       {"reaction_mN", number_or_null(q.reaction_mN)}};
+    if (r.scene.budget.stated) {
+      j["budget_error"] = number_or_null(o.budget_error);
+      j["update_seconds"] = o.update_seconds;
+      if (o.steps_per_update > 0) j["steps_per_update"] = o.steps_per_update;
+    }
+    j["wall_profile"] = {{"s_mm", o.wall_profile.s_mm},
+                         {"model_mm", o.wall_profile.model_mm},
+                         {"reference_mm", o.wall_profile.reference_mm}};
+    if (!o.history.time_s.empty()) {
+      j["history"] = {{"time_s", o.history.time_s},
+                      {"model_mm", o.history.model_mm},
+                      {"reference_mm", o.history.reference_mm},
+                      {"max_error_mm", o.history.max_error_mm},
+                      {"steps", o.history.steps},
+                      {"simulated_s", o.history.simulated_s},
+                      {"mass_damping_per_s", o.history.mass_damping},
+                      {"reference_level", o.history.reference_level}};
+    }
+  } else {
+    j["failure"] = o.failure;
+  }
+  if (!o.fields_file.empty()) {
+    j["fields"] = std::filesystem::absolute(o.fields_file)
+                      .lexically_relative(std::filesystem::absolute(results_dir))
+                      .generic_string();
+  }
+  return j;
+}
+
+nlohmann::json scene_json(const SceneResult& r, const std::filesystem::path& results_dir) {
   nlohmann::json refs = nlohmann::json::array();
   for (const auto& ref : r.references) {
     refs.push_back({{"poisson_ratio", ref.poisson_ratio},
@@ -116,73 +204,7 @@ nlohmann::json scene_json(const SceneResult& r) {
                     {"uncertainty_order", uncertainty_order_json(r.scene, ref)}});
   }
   nlohmann::json outcomes = nlohmann::json::array();
-  for (const auto& o : r.outcomes) {
-    nlohmann::json j{{"model", o.model},
-                     {"kind", o.kind},
-                     {"detail", o.detail},
-                     {"poisson_ratio", o.poisson_ratio},
-                     {"magnitude", o.magnitude},
-                     {"level", o.level},
-                     {"reference", o.reference},
-                     {"ok", o.ok},
-                     {"nodes", o.nodes},
-                     {"unknowns", o.unknowns},
-                     {"setup_seconds", o.setup_seconds},
-                     {"solve_seconds", o.solve_seconds},
-                     {"memory_mib", o.memory_mib}};
-    if (o.roi_radius > 0.0) j["roi_radius_mm"] = o.roi_radius * 1e3;
-    if (!o.timing_source.empty()) j["timing_source"] = o.timing_source;
-    if (!o.timing.measured_at.empty()) {
-      j["timing_provenance"] = {{"source", o.timing.cached ? "cache" : "measured"},
-                                {"measured_at", o.timing.measured_at}};
-    }
-    if (o.updates > 0) {
-      j["updates"] = {{"count", o.updates},
-                      {"iterations_per_update", o.iterations_per_update},
-                      {"factorisations_per_update", o.factorisations_per_update}};
-    }
-    if (o.ok) {
-      j["error"] = error_json(o.error);
-      if (o.has_reference_uncertainty) {
-        j["reference_uncertainty"] = {{"max_mm", o.reference_uncertainty.max_mm},
-                                      {"rms_mm", o.reference_uncertainty.rms_mm}};
-      } else {
-        j["reference_uncertainty"] = nullptr;  // the reference had no coarser level
-      }
-      j["qoi_displacement_mm"] = o.qoi_displacement_mm;
-      j["qoi_reference_mm"] = o.qoi_reference_mm;
-      j["max_strain"] = o.max_strain;
-      j["beyond_linear_regime"] = o.beyond_linear_regime;
-      const QuantityErrors& q = o.quantities;
-      j["quantities"] = {{"contact_point_mm", q.contact_point_mm},
-                         {"field_mm", q.field_mm},
-                         {"patch_mm", number_or_null(q.patch_mm)},
-                         {"indentation_mm", number_or_null(q.indentation_mm)},
-                         {"indentation_reference_mm", number_or_null(q.indentation_reference_mm)},
-                         {"reaction_mN", number_or_null(q.reaction_mN)}};
-      if (r.scene.budget.stated) {
-        j["budget_error"] = number_or_null(o.budget_error);
-        j["update_seconds"] = o.update_seconds;
-        if (o.steps_per_update > 0) j["steps_per_update"] = o.steps_per_update;
-      }
-      j["wall_profile"] = {{"s_mm", o.wall_profile.s_mm},
-                           {"model_mm", o.wall_profile.model_mm},
-                           {"reference_mm", o.wall_profile.reference_mm}};
-      if (!o.history.time_s.empty()) {
-        j["history"] = {{"time_s", o.history.time_s},
-                        {"model_mm", o.history.model_mm},
-                        {"reference_mm", o.history.reference_mm},
-                        {"max_error_mm", o.history.max_error_mm},
-                        {"steps", o.history.steps},
-                        {"simulated_s", o.history.simulated_s},
-                        {"mass_damping_per_s", o.history.mass_damping},
-                        {"reference_level", o.history.reference_level}};
-      }
-    } else {
-      j["failure"] = o.failure;
-    }
-    outcomes.push_back(j);
-  }
+  for (const auto& o : r.outcomes) outcomes.push_back(outcome_json(o, r, results_dir));
   const Scene& s = r.scene;
   nlohmann::json modes = nullptr;
   if (s.modes.count > 0) {
@@ -204,6 +226,7 @@ nlohmann::json scene_json(const SceneResult& r) {
       {"load", to_string(s.load.kind)},
       {"load_unit", load_unit(s.load.kind)},
       {"qoi_point_mm", {r.qoi_point.x() * 1e3, r.qoi_point.y() * 1e3, r.qoi_point.z() * 1e3}},
+      {"contact_patch", contact_patch_json(r)},
       {"tolerance_max_error_mm", s.tolerances.max_error_mm},
       {"budget", s.budget.stated ? budget_json(s.budget) : nlohmann::json(nullptr)},
       {"seconds", r.seconds},
@@ -217,7 +240,7 @@ nlohmann::json scene_json(const SceneResult& r) {
 void write_results_json(const std::filesystem::path& path, const std::vector<SceneResult>& results,
                         const std::string& command, double reference_kernel_seconds) {
   nlohmann::json scenes = nlohmann::json::array();
-  for (const auto& r : results) scenes.push_back(scene_json(r));
+  for (const auto& r : results) scenes.push_back(scene_json(r, path.parent_path()));
   nlohmann::json j{{"schema", "vesselverify.results"},
                          {"schema_version", 2},
                          {"units", {{"displacement", "mm"}, {"time", "s"}, {"strain", "1"}}},

@@ -11,6 +11,7 @@
 
 #include "../../schema_check.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "meshes/vtu_io.hpp"
 #include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
 #include "verification/studies/validity/validity.hpp"
@@ -136,6 +137,54 @@ TEST(ValidityStudy, TheOnePercentCrossingIsWhatTheLoadSquaredDifferencePredicts)
   EXPECT_GT(v.newton_iterations, 0);
   EXPECT_EQ(v.rows.back().newton_iterations, v.newton_iterations);
   EXPECT_GE(v.load_steps, 6);
+}
+
+TEST(ValidityStudy, TheModelsFieldsAtTheLargestLoadAreItsErrorsAgainstTheFiniteStrainOne) {
+  const Scene s = parse_scene(kScene, "validity_test.toml");
+  ValidityOptions o = small_options();
+  o.ladder = {1e-4, 1e-3};
+  const std::filesystem::path dir = temp_dir("validity_fields");
+  o.fields_dir = dir / "validity_fields";
+  ValidityStudy study;
+  study.scenes = {run_validity_scene(s, o)};
+  const ValidityScene& v = study.scenes[0];
+  ASSERT_EQ(v.rows.size(), 2u);
+  EXPECT_TRUE(v.rows[0].models[0].fields_file.empty());  // the largest load only
+  const ValidityModelError& e = v.rows[1].models[0];
+  ASSERT_TRUE(e.ok) << e.failure;
+  EXPECT_EQ(e.fields_file, o.fields_dir / "validity_test" / "volume_mollemans_load0.001.vtu");
+  const VtuData vtu = read_vtu(e.fields_file);
+  const VtuField* um = VtuData::find(vtu.point_fields, "displacement_model_m");
+  const VtuField* ur = VtuData::find(vtu.point_fields, "displacement_reference_m");
+  const VtuField* err = VtuData::find(vtu.point_fields, "error_magnitude_mm");
+  ASSERT_TRUE(um && ur && err);
+  double largest = 0.0, nearest = 1e300;
+  std::size_t q = 0;
+  for (std::size_t i = 0; i < vtu.points.size(); ++i) {
+    const Vec3 d(um->values[3 * i] - ur->values[3 * i], um->values[3 * i + 1] - ur->values[3 * i + 1],
+                 um->values[3 * i + 2] - ur->values[3 * i + 2]);
+    EXPECT_NEAR(err->values[i], d.norm() * 1e3, 1e-12);
+    largest = std::max(largest, err->values[i]);
+    const double to_qoi = (vtu.points[i] - Vec3(3e-3, 0.0, 10e-3)).norm();
+    if (to_qoi < nearest) {
+      nearest = to_qoi;
+      q = i;
+    }
+  }
+  // The file holds the model and the reference the row judged: its largest error, and at the
+  // QoI node the model's displacement and the error there.
+  EXPECT_NEAR(largest, e.max_error_mm, 1e-9 * e.max_error_mm);
+  const Vec3 model_at_q(um->values[3 * q], um->values[3 * q + 1], um->values[3 * q + 2]);
+  EXPECT_NEAR(model_at_q.norm() * 1e3, e.qoi_model_mm, 1e-9 * e.qoi_model_mm);
+  EXPECT_NEAR(err->values[q], e.qoi_error_mm, 1e-9 * e.qoi_error_mm);
+  // validity.json names the file relative to its own folder.
+  write_validity_json(study, dir / "validity.json");
+  const auto j = nlohmann::json::parse(std::ifstream(dir / "validity.json"));
+  const auto& written = j["scenes"][0]["rows"][1]["models"][0];
+  ASSERT_TRUE(written.contains("fields")) << written.dump();
+  EXPECT_EQ(written["fields"], "validity_fields/validity_test/volume_mollemans_load0.001.vtu");
+  EXPECT_FALSE(j["scenes"][0]["rows"][0]["models"][0].contains("fields"));
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ValidityStudy, ANewtonFailureEndsTheRowsAtTheLargestLoadReached) {

@@ -15,7 +15,9 @@
 #include "meshes/foundation/errors.hpp"
 #include "msm/model/model.hpp"
 #include "msm/solvers/updates.hpp"
+#include "verification/harness/external_model.hpp"
 #include "verification/harness/metrics.hpp"
+#include "verification/harness/model_readout.hpp"
 #include "verification/harness/parallel.hpp"
 #include "verification/scene_problems.hpp"
 
@@ -25,22 +27,12 @@ namespace {
 
 using nlohmann::json;
 
-/// Barycentric tolerance of evaluating the references at model nodes (the harness's: a node on
-/// the exact curved wall lies slightly outside the straight-sided tets).
-constexpr double kOutsideTolerance = 0.25;
-
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 const char* load_unit(LoadKind k) {
   return k == LoadKind::contact ? "N" : (k == LoadKind::pressure ? "Pa" : "g");
-}
-
-std::vector<Vec3> scaled(const std::vector<Vec3>& u, double f) {
-  std::vector<Vec3> out(u.size());
-  for (std::size_t i = 0; i < u.size(); ++i) out[i] = f * u[i];
-  return out;
 }
 
 /// What the continuation gave at one checkpoint, at the points the study reads.
@@ -381,8 +373,11 @@ Continuation finite_continuation(const Scene& s, const ValidityOptions& o, const
 
 /// Model m's errors against the finite-strain sample x, updated from its previous state along
 /// the ladder (a continuation too); a failure is recorded and restarts it from rest.
+/// Model m's errors against the finite-strain reference at sample x; with `fields` non-empty,
+/// its fields written there.
 ValidityModelError model_error(const Scene& s, const StudyModels& models, std::size_t m,
-                               const Sample& x, std::unique_ptr<msm::Updater>& updater) {
+                               const Sample& x, std::unique_ptr<msm::Updater>& updater,
+                               const std::filesystem::path& fields) {
   ValidityModelError e;
   e.model = models.specs[m]->name;
   try {
@@ -405,6 +400,10 @@ ValidityModelError model_error(const Scene& s, const StudyModels& models, std::s
     e.qoi_model_mm = um[q].norm() * 1e3;
     e.qoi_relative = uref.norm() > 0.0 ? (um[q] - uref).norm() / uref.norm() : 0.0;
     e.ok = true;
+    if (!fields.empty()) {
+      write_fields_vtu(fields, nodes, network_cells(models.built[m].network), um, x.model_nodes[m]);
+      e.fields_file = fields;
+    }
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& ex) {
@@ -419,6 +418,7 @@ ValidityModelError model_error(const Scene& s, const StudyModels& models, std::s
 ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
   const auto t_scene = std::chrono::steady_clock::now();
   ValidityScene out = scene_settings(s, o);
+  out.qoi_point = qoi_point(s);
 
   // The references: one mesh, one problem at unit load.
   const TetMesh ref_mesh = scene_mesh(s, out.reference_level, o.mesh_cache_dir);
@@ -469,8 +469,15 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
     row.newton_iterations = x.newton_iterations;
     row.load_steps = x.load_steps;
     row.finite_seconds = x.seconds;
+    const bool largest = &x == &c.samples.back();
     for (std::size_t m = 0; m < models.specs.size(); ++m) {
-      row.models.push_back(model_error(s, models, m, x, updaters[m]));
+      std::filesystem::path fields;
+      if (largest && !o.fields_dir.empty()) {
+        std::ostringstream name;
+        name << file_stem(models.specs[m]->name) << "_load" << x.load << ".vtu";
+        fields = o.fields_dir / file_stem(s.name) / name.str();
+      }
+      row.models.push_back(model_error(s, models, m, x, updaters[m], fields));
     }
     out.rows.push_back(std::move(row));
   }
@@ -528,6 +535,27 @@ json crossing_json(const ThresholdCrossing& c) {
 
 }  // namespace
 
+/// A model's errors at one load; its fields path relative to `json_dir`, validity.json's folder.
+json model_error_json(const ValidityModelError& e, const std::filesystem::path& json_dir) {
+  json m{{"model", e.model}, {"ok", e.ok}};
+  if (!e.ok) {
+    m["failure"] = e.failure;
+    return m;
+  }
+  m.update({{"relative_l2", e.relative_l2},
+            {"max_error_mm", e.max_error_mm},
+            {"qoi_error_mm", e.qoi_error_mm},
+            {"qoi_relative", e.qoi_relative},
+            {"qoi_model_mm", e.qoi_model_mm},
+            {"iterations", e.iterations}});
+  if (!e.fields_file.empty()) {
+    m["fields"] = std::filesystem::absolute(e.fields_file)
+                      .lexically_relative(std::filesystem::absolute(json_dir))
+                      .generic_string();
+  }
+  return m;
+}
+
 void write_validity_json(const ValidityStudy& study, const std::filesystem::path& path) {
   json scenes = json::array();
   for (const ValidityScene& v : study.scenes) {
@@ -535,18 +563,7 @@ void write_validity_json(const ValidityStudy& study, const std::filesystem::path
     for (const ValidityRow& r : v.rows) {
       json models = json::array();
       for (const ValidityModelError& e : r.models) {
-        json m{{"model", e.model}, {"ok", e.ok}};
-        if (e.ok) {
-          m.update({{"relative_l2", e.relative_l2},
-                    {"max_error_mm", e.max_error_mm},
-                    {"qoi_error_mm", e.qoi_error_mm},
-                    {"qoi_relative", e.qoi_relative},
-                    {"qoi_model_mm", e.qoi_model_mm},
-                    {"iterations", e.iterations}});
-        } else {
-          m["failure"] = e.failure;
-        }
-        models.push_back(m);
+        models.push_back(model_error_json(e, path.parent_path()));
       }
       rows.push_back({{"magnitude", r.magnitude},
                       {"linear_qoi_mm", r.linear_qoi_mm},
@@ -577,6 +594,8 @@ void write_validity_json(const ValidityStudy& study, const std::filesystem::path
                       {"degree", v.degree},
                       {"element", v.element},
                       {"dofs", v.dofs},
+                      {"qoi_point_mm",
+                       {v.qoi_point.x() * 1e3, v.qoi_point.y() * 1e3, v.qoi_point.z() * 1e3}},
                       {"model_level", v.model_level},
                       {"ladder", v.ladder},
                       {"models", models},

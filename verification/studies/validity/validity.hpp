@@ -53,6 +53,9 @@ struct ValidityModelError {
   double qoi_relative = 0.0;     ///< that over |u_ref| there
   double qoi_model_mm = 0.0;     ///< |u_model| at its QoI node
   int iterations = 0;            ///< Newton iterations of its update
+  /// The VTU of its fields against the finite-strain reference (written at the largest load
+  /// reached when ValidityOptions::fields_dir is set); empty otherwise.
+  std::filesystem::path fields_file;
 };
 
 /// One load of the ladder.
@@ -84,6 +87,7 @@ struct ValidityScene {
   double poisson_ratio = 0.0;
   int reference_level = 0, degree = 2, model_level = 0;
   std::string element;          ///< e.g. "P2"
+  Vec3 qoi_point = Vec3::Zero();  ///< m, where the QoI columns are read
   std::size_t dofs = 0;
   std::vector<double> ladder;   ///< the loads asked for
   std::vector<ValidityModel> models;
@@ -116,6 +120,10 @@ struct ValidityOptions {
   std::vector<double> ladder;    ///< scene's unit; empty: as `full` says
   std::vector<std::string> models;  ///< model names; empty: as `full` says
   std::filesystem::path mesh_cache_dir;  ///< generated meshes ("" none)
+  /// Each model's fields against the finite-strain reference at the largest load reached, as
+  /// `vesselverify run` writes them (harness/model_readout.hpp write_fields_vtu), under
+  /// <fields_dir>/<scene>/; "" none.
+  std::filesystem::path fields_dir;
   fem::SolutionCache* cache = nullptr;   ///< the finite-strain continuation and linear solve
   fem::HyperelasticOptions finite;       ///< Newton settings (target and checkpoints: the study's)
   std::ostream* log = nullptr;
