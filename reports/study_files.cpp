@@ -8,6 +8,7 @@ namespace vessel::reports {
 namespace {
 
 using json_fields::field;
+using json_fields::field_or;
 using json_fields::optional_field;
 using nlohmann::json;
 
@@ -80,6 +81,7 @@ CandidateEntry read_candidate(const json& j, const std::string& where) {
   e.pareto = field<bool>(j, "pareto", where);
   e.verdict = field<std::string>(j, "verdict", where);
   e.reason = field<std::string>(j, "reason", where);
+  e.roi_radius_mm = optional_field<double>(j, "roi_radius_mm", where);
   if (e.ok) {
     e.error = optional_field<double>(j, "error", where);
     e.update_seconds = field<double>(j, "update_seconds", where);
@@ -94,6 +96,33 @@ BudgetLoadEntry read_load(const json& j, const std::string& where) {
   BudgetLoadEntry e;
   e.poisson_ratio = field<double>(j, "poisson_ratio", where);
   e.magnitude = field<double>(j, "magnitude", where);
+  e.reference_element = field_or<std::string>(j, "reference_element", "", where);
+  return e;
+}
+
+CalibrationParameterEntry read_parameter(const json& j, const std::string& where) {
+  return {field<std::string>(j, "name", where), field<double>(j, "factor", where)};
+}
+
+CalibrationCaseEntry read_calibration_case(const json& j, const std::string& where) {
+  CalibrationCaseEntry e;
+  e.scene = field<std::string>(j, "scene", where);
+  e.name = field<std::string>(j, "name", where);
+  e.holds_out = field<std::string>(j, "holds_out", where);
+  e.training = field<bool>(j, "training", where);
+  e.load_kind = field<std::string>(j, "load_kind", where);
+  e.load_unit = field<std::string>(j, "load_unit", where);
+  e.magnitude = field<double>(j, "magnitude", where);
+  e.level = field<int>(j, "level", where);
+  e.p1_relative_l2 = field<double>(j, "p1_relative_l2", where);
+  e.p1_solve_seconds = field<double>(j, "p1_solve_seconds", where);
+  e.max_strain_reference = field<double>(j, "max_strain_reference", where);
+  e.base_relative_l2 = optional_field<double>(j, "base_relative_l2", where);
+  e.base_update_seconds = optional_field<double>(j, "base_update_seconds", where);
+  e.calibrated_relative_l2 = optional_field<double>(j, "calibrated_relative_l2", where);
+  e.calibrated_update_seconds = optional_field<double>(j, "calibrated_update_seconds", where);
+  e.failure = field_or<std::string>(j, "failure", "", where);
+  e.base_failure = field_or<std::string>(j, "base_failure", "", where);
   return e;
 }
 
@@ -215,6 +244,7 @@ StabilityFile parse_stability(const std::string& text, const std::filesystem::pa
   s.critical_steps = read_array(j, "critical_steps", file, read_step);
   s.refinement = read_array(j, "refinement", file, read_refinement);
   s.hard_cases = read_array(j, "hard_cases", file, read_hard_case);
+  s.hard_cases_at_a_time = field_or<int>(j, "hard_cases_at_a_time", 1, file);
   if (const auto t = j.find("timing_provenance"); t != j.end() && t->is_object()) {
     const std::string where = file + ": timing_provenance";
     s.timing_provenance = timing_provenance_line(
@@ -250,6 +280,8 @@ RecommendFile parse_recommend(const std::string& text, const std::filesystem::pa
   r.recommended = optional_field<std::string>(j, "recommended", file);
   r.closest = optional_field<std::string>(j, "closest", file);
   r.whole_vessel = optional_field<std::string>(j, "whole_vessel", file);
+  r.whole_vessel_reported = j.contains("whole_vessel");
+  r.load_unit = field_or<std::string>(j, "load_unit", "", file);
   const auto results = optional_field<std::string>(j, "results", file);
   r.results = source.parent_path() / (results ? *results : std::string("results.json"));
   r.reference_contact_point_mm = field<double>(j, "reference_contact_point_mm", file);
@@ -259,6 +291,47 @@ RecommendFile parse_recommend(const std::string& text, const std::filesystem::pa
 
 RecommendFile read_recommend(const std::filesystem::path& path) {
   return parse_recommend(json_fields::read_text(path, "recommend file"), path);
+}
+
+CalibrateFile parse_calibrate(const std::string& text, const std::filesystem::path& source) {
+  const std::string file = source.string();
+  const json j = json_fields::parse_versioned(text, file, "vesselverify.calibrate", 1,
+                                              "calibration study", "vesselverify calibrate");
+  CalibrateFile c;
+  c.path = source;
+  c.command = field<std::string>(j, "command", file);
+  c.calibration_file = field<std::string>(j, "calibration_file", file);
+  c.scene = field<std::string>(j, "scene", file);
+  const json model = field<json>(j, "model", file);
+  const std::string mw = file + ": model";
+  c.model = field<std::string>(model, "name", mw);
+  c.model_detail = field<std::string>(model, "detail", mw);
+  c.poisson_ratio = field<double>(model, "poisson_ratio", mw);
+  c.vessel = field<std::string>(model, "vessel", mw);
+  c.mesh_hash = field<std::string>(model, "mesh_hash", mw);
+  c.nodes = field<std::size_t>(model, "nodes", mw);
+  c.springs = field<std::size_t>(model, "springs", mw);
+  const json fit = field<json>(j, "fit", file);
+  const std::string fw = file + ": fit";
+  c.granularity = field<std::string>(fit, "granularity", fw);
+  c.method = field<std::string>(fit, "method", fw);
+  c.iterations = field<int>(fit, "iterations", fw);
+  c.stop_reason = field<std::string>(fit, "stop_reason", fw);
+  c.fit_seconds = field<double>(fit, "seconds", fw);
+  c.objective_before = field<double>(fit, "objective_before", fw);
+  c.objective_after = field<double>(fit, "objective_after", fw);
+  c.parameter_count = field<std::size_t>(fit, "parameter_count", fw);
+  const json f = field<json>(fit, "factors", fw);
+  c.factor_min = field<double>(f, "min", fw + ".factors");
+  c.factor_median = field<double>(f, "median", fw + ".factors");
+  c.factor_max = field<double>(f, "max", fw + ".factors");
+  if (fit.contains("parameters")) c.parameters = read_array(fit, "parameters", fw, read_parameter);
+  c.cases = read_array(j, "cases", file, read_calibration_case);
+  return c;
+}
+
+CalibrateFile read_calibrate(const std::filesystem::path& path) {
+  return parse_calibrate(json_fields::read_text(path, "calibration study"), path);
 }
 
 std::string validity_view_slot(const std::string& scene) { return "view:validity-" + scene; }

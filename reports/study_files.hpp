@@ -1,8 +1,9 @@
 #pragma once
-/// The studies' result files read back into plain structs for the report, like results.json:
-/// stability.json (schema "vesselverify.stability", version 1; verification/studies/stability/stability.schema.json)
-/// of `vesselverify stability`, and recommend.json (schema "vesselverify.recommend", version 1) of
-/// `vesselverify recommend`. Only what the report shows is read.
+/// The studies' JSON documents read back into plain structs for the report, like results.json:
+/// stability.json of `vesselverify stability`, recommend.json of `vesselverify recommend`,
+/// validity.json of `vesselverify validity` and the calibration study of `vesselverify calibrate`
+/// (each "vesselverify.<study>", version 1, with its JSON Schema in its study's folder,
+/// verification/studies/<study>/<study>.schema.json). Only what the report shows is read.
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -51,6 +52,7 @@ struct StabilityFile {
   std::vector<CriticalStepEntry> critical_steps;
   std::vector<RefinementEntry> refinement;
   std::vector<HardCaseEntry> hard_cases;
+  int hard_cases_at_a_time = 1;  ///< how many hard cases ran at once (1 in older files)
   /// Which rows' and hard cases' timings came from the model outcome cache
   /// (timing_provenance_line); empty in a file without that record.
   std::string timing_provenance;
@@ -65,13 +67,16 @@ struct CandidateEntry {
   std::string verdict, reason, failure;
   std::optional<double> error, update_seconds;
   std::optional<double> setup_seconds;  ///< absent in files written before set-up was reported
+  std::optional<double> roi_radius_mm;  ///< the region of interest; absent: the whole vessel
 };
 
 /// The load the budget applies at for one Poisson's ratio (scene's load unit).
 struct BudgetLoadEntry {
   double poisson_ratio = 0.0;
   double magnitude = 0.0;
-  std::string reference_element;  ///< from the run's results.json (attach_run); "" if unknown
+  /// The reference's element: from recommend.json, else the run's results.json (attach_run);
+  /// "" if unknown.
+  std::string reference_element;
 };
 
 struct RecommendFile {
@@ -84,7 +89,8 @@ struct RecommendFile {
   double tolerance = 0.0, seconds_per_update = 0.0;
   std::optional<double> rate_hz, radius_mm;
   std::vector<BudgetLoadEntry> loads;
-  std::string load_unit;  ///< N, Pa or g, from the run's results.json (attach_run); "" if unknown
+  /// N, Pa or g: from recommend.json, else the run's results.json (attach_run); "" if unknown.
+  std::string load_unit;
   /// Which of the candidates' timings came from the model outcome cache (timing_provenance_line
   /// over the run's outcomes, attach_run); "" if all were measured or unknown.
   std::string timing_provenance;
@@ -94,6 +100,7 @@ struct RecommendFile {
   std::filesystem::path results;
   /// The cheapest whole-vessel candidate meeting the budget (absent in older files, or none).
   std::optional<std::string> whole_vessel;
+  bool whole_vessel_reported = false;  ///< the file has "whole_vessel" (null: none meets it)
   double reference_contact_point_mm = 0.0;  ///< the reference's largest QoI displacement
   std::vector<CandidateEntry> candidates;
 };
@@ -156,6 +163,43 @@ struct ValidityFile {
   std::vector<ValiditySceneEntry> scenes;
 };
 
+/// The calibration study of `vesselverify calibrate` (schema "vesselverify.calibrate", version 1;
+/// verification/studies/calibrate/calibrate.schema.json): the fit and every case's errors.
+struct CalibrationParameterEntry {
+  std::string name;
+  double factor = 1.0;
+};
+
+struct CalibrationCaseEntry {
+  std::string scene, name, holds_out;
+  bool training = false;
+  std::string load_kind, load_unit;  ///< contact | pressure | gravity; N, Pa or g
+  double magnitude = 0.0;
+  int level = 0;
+  double p1_relative_l2 = 0.0, p1_solve_seconds = 0.0, max_strain_reference = 0.0;
+  /// Absent where that model could not be evaluated (failure, base_failure say why).
+  std::optional<double> base_relative_l2, base_update_seconds;
+  std::optional<double> calibrated_relative_l2, calibrated_update_seconds;
+  std::string failure, base_failure;
+};
+
+struct CalibrateFile {
+  std::filesystem::path path;
+  std::string command, calibration_file;  ///< the calibration file written, as given
+  std::string scene, model, model_detail, granularity, vessel, mesh_hash;
+  double poisson_ratio = 0.0;
+  std::size_t nodes = 0, springs = 0;
+  std::string method, stop_reason;
+  int iterations = 0;
+  double fit_seconds = 0.0, objective_before = 0.0, objective_after = 0.0;
+  std::size_t parameter_count = 0;
+  double factor_min = 1.0, factor_median = 1.0, factor_max = 1.0;
+  /// Every factor by name for the class granularities; empty for per-spring ones (their
+  /// factors are in the calibration file).
+  std::vector<CalibrationParameterEntry> parameters;
+  std::vector<CalibrationCaseEntry> cases;
+};
+
 /// Reads and checks a stability file; InputError naming the file and what is wrong (missing file,
 /// not JSON, another schema or version, a missing field).
 StabilityFile read_stability(const std::filesystem::path& path);
@@ -168,5 +212,9 @@ RecommendFile parse_recommend(const std::string& text, const std::filesystem::pa
 /// Reads and checks a validity file; InputError as read_stability.
 ValidityFile read_validity(const std::filesystem::path& path);
 ValidityFile parse_validity(const std::string& text, const std::filesystem::path& source);
+
+/// Reads and checks a calibration study; InputError as read_stability.
+CalibrateFile read_calibrate(const std::filesystem::path& path);
+CalibrateFile parse_calibrate(const std::string& text, const std::filesystem::path& source);
 
 }  // namespace vessel::reports

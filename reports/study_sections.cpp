@@ -54,9 +54,15 @@ Table refinement_table(const StabilityFile& s) {
 void hard_cases(Document& doc, const StabilityFile& s) {
   if (s.hard_cases.empty()) return;
   doc.heading(3, "Hard cases");
-  doc.paragraph("Each case lists what every model did: finished (returned a result), converged "
-                "(static or linear solve), bounded (dynamic run), and what it reported. "
-                "Displacements in mm, loads in mN.");
+  std::string about = "Each case lists what every model did: finished (returned a result), "
+                      "converged (static or linear solve), bounded (dynamic run), and what it "
+                      "reported. Displacements in mm, loads in mN.";
+  if (s.hard_cases_at_a_time > 1) {
+    about += " The cases ran " + std::to_string(s.hard_cases_at_a_time) +
+             " at a time, so the time after each case's set-up is its wall time on a shared "
+             "machine; the long run, whose steps are timed, ran alone.";
+  }
+  doc.paragraph(about);
   for (const auto& hc : s.hard_cases) {
     doc.heading(4, hc.title);
     doc.paragraph(hc.setup + " (" + significant(hc.seconds, 3) + " s)");
@@ -151,7 +157,9 @@ void answer(Document& doc, const RecommendFile& r) {
   if (const CandidateEntry* best = candidate_named(r, r.recommended)) {
     doc.paragraph("**Recommended: `" + best->name + "`** (" + best->detail + "): error " +
                   error_text(*best, r.unit) + ", " + ms(best->update_seconds.value_or(0.0)) +
-                  " per update, " + std::to_string(best->unknowns) + " unknowns.");
+                  " per update, " + std::to_string(best->unknowns) + " unknowns." +
+                  (best->setup_seconds ? " Set-up " + ms(*best->setup_seconds) + ", once." : "") +
+                  (best->roi_radius_mm ? "" : " The whole vessel (no region of interest)."));
   } else if (const CandidateEntry* near = candidate_named(r, r.closest)) {
     doc.paragraph("**No candidate meets the budget.** The closest is `" + near->name + "` (" +
                   near->detail + "): error " + error_text(*near, r.unit) + ", " +
@@ -165,6 +173,8 @@ void answer(Document& doc, const RecommendFile& r) {
                   whole->detail + ") meets the budget too: error " + error_text(*whole, r.unit) +
                   ", " + ms(whole->update_seconds.value_or(0.0)) + " per update, " +
                   std::to_string(whole->unknowns) + " unknowns.");
+  } else if (!whole && r.whole_vessel_reported) {
+    doc.paragraph("No whole-vessel candidate (without a region of interest) meets the budget.");
   }
   // A tolerance at or above the reference's own contact displacement is met by a model that does
   // not move at all: the answer then says nothing about accuracy.
@@ -332,6 +342,108 @@ void validity_section(Document& doc, const ValidityFile& v) {
       std::string("`") + v.command + "`" + (v.full ? " (full)" : "") + " in " +
       significant(v.total_seconds, 3) + " s.");
   for (const ValiditySceneEntry& s : v.scenes) validity_scene(doc, s);
+}
+
+namespace {
+
+std::string fixed3(double v) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(3) << v;
+  return s.str();
+}
+
+std::string case_load(const CalibrationCaseEntry& c) {
+  return significant(c.magnitude, 6) + " " + c.load_unit;
+}
+
+Table calibration_case_table(const CalibrateFile& c, bool training) {
+  Table t;
+  t.header = {"scene", "level", "case", "holds out", "load", "P1", "base", "calibrated",
+              "calibrated / P1", "base s/update", "calibrated s/update", "P1 solve s",
+              "reference max strain"};
+  const auto or_dash = [](const std::optional<double>& x, auto&& show) {
+    return x ? show(*x) : std::string("—");
+  };
+  const auto s3 = [](double x) { return significant(x, 3); };
+  for (const CalibrationCaseEntry& e : c.cases) {
+    if (e.training != training) continue;
+    t.rows.push_back(
+        {e.scene, std::to_string(e.level), e.name, e.holds_out, case_load(e),
+         fixed3(e.p1_relative_l2), or_dash(e.base_relative_l2, fixed3),
+         or_dash(e.calibrated_relative_l2, fixed3),
+         or_dash(e.calibrated_relative_l2,
+                 [&](double x) { return fixed3(x / e.p1_relative_l2); }),
+         or_dash(e.base_update_seconds, s3), or_dash(e.calibrated_update_seconds, s3),
+         s3(e.p1_solve_seconds), significant(100.0 * e.max_strain_reference, 2) + " %"});
+  }
+  return t;
+}
+
+}  // namespace
+
+void calibration_section(Document& doc, const CalibrateFile& c) {
+  doc.heading(1, "Calibration of " + c.model + " (" + c.scene + ", " + c.granularity + ")");
+  doc.code(c.command);
+  doc.paragraph("Model: " + c.model_detail + ", ν = " + significant(c.poisson_ratio, 6) + ", " +
+                c.vessel + " (mesh " + c.mesh_hash + ", " + std::to_string(c.nodes) +
+                " nodes, " + std::to_string(c.springs) + " springs). Fit: " + c.method + ". " +
+                std::to_string(c.parameter_count) + " parameters, " +
+                std::to_string(c.iterations) + " iterations (" + c.stop_reason + "), " +
+                fixed3(c.fit_seconds) + " s; objective " + significant(c.objective_before, 6) +
+                " → " + significant(c.objective_after, 6) + ". Written to `" +
+                c.calibration_file + "`.");
+  if (!c.parameters.empty()) {
+    Table t;
+    t.header = {"parameter", "factor"};
+    for (const auto& p : c.parameters) t.rows.push_back({p.name, fixed3(p.factor)});
+    doc.table(t);
+  } else {
+    doc.paragraph(std::string(c.granularity == "per_spring" ? "Per-spring" : "Per-section-spring") +
+                  " factors (kappa included): min " + fixed3(c.factor_min) + ", median " +
+                  fixed3(c.factor_median) + ", max " + fixed3(c.factor_max) + ".");
+  }
+  doc.paragraph("Relative L2 errors against the P2 reference at the model's nodes (P1 at its "
+                "mesh's nodes), each model solved as the scene solves it; *s/update*: the median "
+                "time per update of a warm-started load ramp (set-up apart).");
+  doc.heading(2, "Training loads");
+  doc.table(calibration_case_table(c, true));
+  doc.heading(2, "Held-out loads");
+  doc.table(calibration_case_table(c, false));
+  std::string last_failure;
+  for (const CalibrationCaseEntry& e : c.cases) {
+    if (!e.failure.empty() && e.failure != last_failure) {  // a transfer's refusal once
+      doc.paragraph(e.scene + " " + e.name + " (" + case_load(e) +
+                    "): calibrated model not evaluated: " + e.failure);
+      last_failure = e.failure;
+    }
+    if (!e.base_failure.empty()) {
+      doc.paragraph(e.scene + " " + e.name + " (" + case_load(e) +
+                    "): uncalibrated model not evaluated: " + e.base_failure);
+    }
+  }
+}
+
+namespace {
+
+template <class File, class Section>
+std::string section_markdown(const File& file, Section&& section) {
+  Document doc;
+  section(doc, file);
+  return doc.markdown_text(".");
+}
+
+}  // namespace
+
+std::string stability_markdown(const StabilityFile& stability) {
+  return section_markdown(stability, stability_section);
+}
+
+std::string recommendation_markdown(const RecommendFile& recommendation) {
+  return section_markdown(recommendation, recommendation_section);
+}
+
+std::string calibration_markdown(const CalibrateFile& calibration) {
+  return section_markdown(calibration, calibration_section);
 }
 
 }  // namespace vessel::reports

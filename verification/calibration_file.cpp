@@ -127,32 +127,10 @@ void write_calibration(const std::filesystem::path& path, const Calibration& c) 
   write_file_atomically(path, [&](std::ostream& out) { out << j.dump(1) << "\n"; });
 }
 
-Calibration read_calibration(const std::filesystem::path& path) {
-  const std::string file = path.string();
-  std::ifstream in(path);
-  if (!in) throw InputError(file + ": cannot open the calibration file");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(file + ": not valid JSON (" + e.what() + ")");
-  }
-  if (!j.is_object()) throw InputError(file + ": expected a JSON object");
-  if (member<std::string>(j, "schema", file) != kSchema) {
-    throw InputError(file + ": key \"schema\": expected \"" + kSchema + "\"");
-  }
-  if (member<int>(j, "version", file) != kVersion) {
-    throw InputError(file + ": key \"version\": expected " + std::to_string(kVersion));
-  }
-  Calibration c;
-  c.granularity = member<std::string>(j, "granularity", file);
-  if (c.granularity != "groups" && c.granularity != "wall_layers" &&
-      c.granularity != "edge_types" && c.granularity != "per_section_spring" &&
-      c.granularity != "per_spring") {
-    throw InputError(file + ": key \"granularity\": found \"" + c.granularity +
-                     "\", expected \"groups\", \"wall_layers\", \"edge_types\", "
-                     "\"per_section_spring\" or \"per_spring\"");
-  }
+namespace {
+
+/// The model the calibration applies to and the mesh it belongs to.
+void read_model_and_mesh(const nlohmann::json& j, const std::string& file, Calibration& c) {
   const auto model = member<nlohmann::json>(j, "model", file);
   const std::string mfile = file + ": model";
   c.scene = member<std::string>(model, "scene", mfile);
@@ -174,6 +152,10 @@ Calibration read_calibration(const std::filesystem::path& path) {
   c.nodes = member<std::size_t>(mesh, "nodes", meshfile);
   c.springs = member<std::size_t>(mesh, "springs", meshfile);
   c.tets = member<std::size_t>(mesh, "tets", meshfile);
+}
+
+/// The factors: by class name, or per spring (with κ, or κ per half of the wall); each > 0.
+void read_factors(const nlohmann::json& j, const std::string& file, Calibration& c) {
   if (c.granularity != "per_spring") {
     const auto f = member<nlohmann::json>(j, "factors", file);
     if (!f.is_object() || f.empty()) {
@@ -212,6 +194,11 @@ Calibration read_calibration(const std::filesystem::path& path) {
                        std::to_string(c.factors[i]) + "; expected a finite factor > 0");
     }
   }
+}
+
+/// What the file records of the fit: its training loads and how it went (optional keys).
+void read_training_loads_and_fit(const nlohmann::json& j, const std::string& file,
+                                 Calibration& c) {
   if (j.contains("training_loads")) {
     for (const auto& l : j["training_loads"]) {
       CalibrationLoad load;
@@ -236,6 +223,39 @@ Calibration read_calibration(const std::filesystem::path& path) {
     c.iterations = fit.value("iterations", 0);
     c.stop_reason = fit.value("stop_reason", "");
   }
+}
+
+}  // namespace
+
+Calibration read_calibration(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::ifstream in(path);
+  if (!in) throw InputError(file + ": cannot open the calibration file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(file + ": not valid JSON (" + e.what() + ")");
+  }
+  if (!j.is_object()) throw InputError(file + ": expected a JSON object");
+  if (member<std::string>(j, "schema", file) != kSchema) {
+    throw InputError(file + ": key \"schema\": expected \"" + kSchema + "\"");
+  }
+  if (member<int>(j, "version", file) != kVersion) {
+    throw InputError(file + ": key \"version\": expected " + std::to_string(kVersion));
+  }
+  Calibration c;
+  c.granularity = member<std::string>(j, "granularity", file);
+  if (c.granularity != "groups" && c.granularity != "wall_layers" &&
+      c.granularity != "edge_types" && c.granularity != "per_section_spring" &&
+      c.granularity != "per_spring") {
+    throw InputError(file + ": key \"granularity\": found \"" + c.granularity +
+                     "\", expected \"groups\", \"wall_layers\", \"edge_types\", "
+                     "\"per_section_spring\" or \"per_spring\"");
+  }
+  read_model_and_mesh(j, file, c);
+  read_factors(j, file, c);
+  read_training_loads_and_fit(j, file, c);
   return c;
 }
 

@@ -191,12 +191,9 @@ const VtuField* vtu_scalar(const std::vector<VtuField>& fields, const std::strin
   return f;
 }
 
-NetworkFile read_network_vtu(const std::filesystem::path& path) {
-  const std::string source = path.string();
-  const VtuData d = read_vtu(path);
-  NetworkFile f;
-  f.network.nodes = d.points;
-  const std::size_t n = d.points.size(), m = d.types.size();
+/// Every cell a line of two points: one spring.
+void check_spring_cells(const VtuData& d, const std::string& source) {
+  const std::size_t m = d.types.size();
   for (std::size_t c = 0; c < m; ++c) {
     const std::size_t begin = c == 0 ? 0 : d.offsets[c - 1];
     if (d.types[c] != kVtkLine || d.offsets[c] - begin != 2) {
@@ -206,7 +203,10 @@ NetworkFile read_network_vtu(const std::filesystem::path& path) {
                " points, expected a line (type 3) of 2 points: one spring");
     }
   }
-  // Unknown arrays are refused, as unknown JSON keys are.
+}
+
+/// Unknown arrays are refused, as unknown JSON keys are.
+void check_array_names(const VtuData& d, const std::string& source) {
   const std::vector<std::string> point_names{"mass", "fixed"};
   const std::vector<std::string> cell_names{"stiffness", "rest_length", "k2", "threshold",
                                             "damping", "family"};
@@ -222,6 +222,11 @@ NetworkFile read_network_vtu(const std::filesystem::path& path) {
   };
   check_names(d.point_fields, point_names, "point");
   check_names(d.cell_fields, cell_names, "cell");
+}
+
+/// The nodal masses and the held nodes.
+void read_point_data(const VtuData& d, const std::string& source, NetworkFile& f) {
+  const std::size_t n = d.points.size();
   const VtuField* mass = vtu_scalar(d.point_fields, "mass", n, source, "point");
   if (!mass) fail(source, "point data \"mass\"", "missing; expected the nodal masses, kg");
   f.masses = mass->values;
@@ -235,6 +240,11 @@ NetworkFile read_network_vtu(const std::filesystem::path& path) {
       if (v == 1.0) f.supports.fixed_nodes.push_back(static_cast<int>(i));
     }
   }
+}
+
+/// The springs: stiffness, rest length, bilinear law, damping and family per cell.
+void read_springs(const VtuData& d, const std::string& source, NetworkFile& f) {
+  const std::size_t m = d.types.size();
   const VtuField* k = vtu_scalar(d.cell_fields, "stiffness", m, source, "cell");
   const VtuField* l = vtu_scalar(d.cell_fields, "rest_length", m, source, "cell");
   if (!k) fail(source, "cell data \"stiffness\"", "missing; expected each spring's stiffness, N/m");
@@ -274,6 +284,10 @@ NetworkFile read_network_vtu(const std::filesystem::path& path) {
     }
     f.network.springs.push_back(s);
   }
+}
+
+/// The format's version and the followed groups.
+void read_field_data(const VtuData& d, const std::string& source, NetworkFile& f) {
   for (const auto& fd : d.field_data) {
     if (fd.name == kVtuVersionArray) {
       if (fd.values.size() != 1 || fd.values[0] != kNetworkFormatVersion) {
@@ -292,6 +306,18 @@ NetworkFile read_network_vtu(const std::filesystem::path& path) {
                "<group>");
     }
   }
+}
+
+NetworkFile read_network_vtu(const std::filesystem::path& path) {
+  const std::string source = path.string();
+  const VtuData d = read_vtu(path);
+  NetworkFile f;
+  f.network.nodes = d.points;
+  check_spring_cells(d, source);
+  check_array_names(d, source);
+  read_point_data(d, source, f);
+  read_springs(d, source, f);
+  read_field_data(d, source, f);
   return f;
 }
 

@@ -186,27 +186,36 @@ std::array<double, 3> least_squares_fit_triangle_stiffness(const std::array<Vec3
   return lsq_springs<3>(fem_triangle_stiffness(x, E, nu, t), {x.begin(), x.end()}, kTriEdges);
 }
 
-void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessParams& p) {
+namespace {
+
+using Edge = std::pair<int, int>;
+Edge edge_key(int a, int b) { return a < b ? Edge{a, b} : Edge{b, a}; }
+
+/// What a rule needs of the network and the material, refused before any spring is set.
+void check_rule_inputs(const SpringNetwork& net, StiffnessRule rule, const StiffnessParams& p) {
   validate(p);
-  const double E = p.youngs_modulus;
   const bool volume = !net.tets.empty();
-  const bool fit = rule == StiffnessRule::least_squares_fit;
-  if (fit && volume && p.poisson_ratio >= 0.5) {
+  if (rule == StiffnessRule::least_squares_fit && volume && p.poisson_ratio >= 0.5) {
     // λ = Eν/((1+ν)(1−2ν)) is infinite at ν = 0.5: the FEM element matrix to fit does not exist.
     throw InputError(
         "stiffness rule least-squares-fit on tetrahedra: poisson_ratio ν = 0.5 makes λ infinite; "
         "expected ν < 0.5");
   }
-  const double t = net.thickness;
-  if (!volume && rule != StiffnessRule::uniform && !(t > 0)) {
+  if (!volume && rule != StiffnessRule::uniform && !(net.thickness > 0)) {
     throw InputError("assign_stiffness: a surface network needs a wall thickness t > 0");
   }
-  using Edge = std::pair<int, int>;
-  auto key = [](int a, int b) { return a < b ? Edge{a, b} : Edge{b, a}; };
-  // Element measure around each edge (Σ V, or t·Σ A) and the least-squares-fit sums.
-  std::map<Edge, double> measure;
-  std::map<Edge, double> fitted;
-  if (volume) {
+}
+
+/// Per element edge: the element measure around it (Σ V, or t·Σ A) and, for the
+/// least-squares-fit rule, the sum of the elements' fitted stiffnesses.
+struct EdgeMeasures {
+  std::map<Edge, double> measure, fitted;
+};
+
+EdgeMeasures edge_measures(const SpringNetwork& net, bool fit, const StiffnessParams& p) {
+  EdgeMeasures out;
+  const double E = p.youngs_modulus, t = net.thickness;
+  if (!net.tets.empty()) {
     for (const Tet& tet : net.tets) {
       std::array<Vec3, 4> x{net.nodes[tet[0]], net.nodes[tet[1]], net.nodes[tet[2]],
                             net.nodes[tet[3]]};
@@ -214,9 +223,9 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
       std::array<double, 6> kl{};
       if (fit) kl = least_squares_fit_tet_stiffness(x, E, p.poisson_ratio);
       for (int e = 0; e < 6; ++e) {
-        const Edge k = key(tet[kTetEdges[e].first], tet[kTetEdges[e].second]);
-        measure[k] += V;
-        fitted[k] += kl[e];
+        const Edge k = edge_key(tet[kTetEdges[e].first], tet[kTetEdges[e].second]);
+        out.measure[k] += V;
+        out.fitted[k] += kl[e];
       }
     }
   } else {
@@ -226,13 +235,65 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
       std::array<double, 3> kl{};
       if (fit) kl = least_squares_fit_triangle_stiffness(x, E, p.poisson_ratio, t);
       for (int e = 0; e < 3; ++e) {
-        const Edge k = key(tri[kTriEdges[e].first], tri[kTriEdges[e].second]);
-        measure[k] += t * A;
-        fitted[k] += kl[e];
+        const Edge k = edge_key(tri[kTriEdges[e].first], tri[kTriEdges[e].second]);
+        out.measure[k] += t * A;
+        out.fitted[k] += kl[e];
       }
     }
   }
-  const double k2_ratio = p.bilinear_ratio;
+  return out;
+}
+
+/// The rule's stiffness of one spring of rest length L: `is_edge` when it lies on an element
+/// edge (measure m around it, fitted its least-squares sum), else m is its surrogate measure.
+double rule_stiffness(StiffnessRule rule, const StiffnessParams& p, bool volume, double t,
+                      double L, bool is_edge, double m, double fitted) {
+  const double E = p.youngs_modulus;
+  switch (rule) {
+    case StiffnessRule::seed000:
+      return seed000_stiffness(E, volume ? L * L : t * L, L);
+    case StiffnessRule::seed001:
+      return seed001_stiffness(E, m, L);
+    case StiffnessRule::van_gelder:
+      return van_gelder_stiffness(E, m, L);
+    case StiffnessRule::lloyd:
+      // Σ over the elements sharing the edge of the per-element closed form; a non-edge spring
+      // takes the equilateral triangle's (√3/4)·E·t, as van_gelder.
+      if (!is_edge) return van_gelder_stiffness(E, m, L);
+      if (volume) return lloyd_tet_edge_stiffness(E, m, L);  // (24/25)·E·Σ V_e/L²
+      return lloyd_triangle_edge_stiffness(E, 1.0, m, L);     // m = t·Σ A_e already
+    case StiffnessRule::least_squares_fit:
+      return is_edge ? fitted : van_gelder_stiffness(E, m, L);
+    case StiffnessRule::uniform:
+      return p.uniform_k;
+  }
+  return 0.0;
+}
+
+/// The calibration factor of a spring family.
+double family_factor(SpringFamily family, const StiffnessParams& p) {
+  switch (family) {
+    case SpringFamily::structural:
+      return p.structural_factor;
+    case SpringFamily::shear:
+      return p.shear_factor;
+    case SpringFamily::bend:
+      return p.bend_factor;
+    case SpringFamily::two_ring:
+      return p.two_ring_factor;
+    case SpringFamily::volume:
+      return p.volume_factor;
+  }
+  return 1.0;
+}
+
+}  // namespace
+
+void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessParams& p) {
+  check_rule_inputs(net, rule, p);
+  const bool volume = !net.tets.empty();
+  const double t = net.thickness;
+  const EdgeMeasures edges = edge_measures(net, rule == StiffnessRule::least_squares_fit, p);
   for (Spring& s : net.springs) {
     const double L = s.rest_length;
     if (rule != StiffnessRule::uniform && !(L > 0.0)) {
@@ -241,63 +302,19 @@ void assign_stiffness(SpringNetwork& net, StiffnessRule rule, const StiffnessPar
                        std::to_string(s.a) + " and " + std::to_string(s.b) +
                        " has zero rest length (coincident nodes); expected distinct nodes");
     }
-    const auto it = measure.find(key(s.a, s.b));
+    const Edge key = edge_key(s.a, s.b);
+    const auto it = edges.measure.find(key);
     // Only structural and volume springs take their element measure: a shear spring on a grid
     // cell may or may not coincide with the diagonal the mesher cut the cell along, and both
     // diagonals must be treated alike.
-    const bool is_edge = it != measure.end() &&
+    const bool is_edge = it != edges.measure.end() &&
                          (s.family == SpringFamily::structural || s.family == SpringFamily::volume);
     // Surrogate measure of a non-edge spring: one equilateral triangle on it (see header).
     const double m = is_edge ? it->second : t * std::sqrt(3.0) / 4.0 * L * L;
-    double k = 0.0;
-    switch (rule) {
-      case StiffnessRule::seed000:
-        k = seed000_stiffness(E, volume ? L * L : t * L, L);
-        break;
-      case StiffnessRule::seed001:
-        k = seed001_stiffness(E, m, L);
-        break;
-      case StiffnessRule::van_gelder:
-        k = van_gelder_stiffness(E, m, L);
-        break;
-      case StiffnessRule::lloyd:
-        // Σ over the elements sharing the edge of the per-element closed form; a non-edge spring
-        // takes the equilateral triangle's (√3/4)·E·t, as van_gelder.
-        if (!is_edge) {
-          k = van_gelder_stiffness(E, m, L);
-        } else if (volume) {
-          k = lloyd_tet_edge_stiffness(E, m, L);  // (24/25)·E·Σ V_e/L²
-        } else {
-          k = lloyd_triangle_edge_stiffness(E, 1.0, m, L);  // m = t·Σ A_e already
-        }
-        break;
-      case StiffnessRule::least_squares_fit:
-        k = is_edge ? fitted.at(key(s.a, s.b)) : van_gelder_stiffness(E, m, L);
-        break;
-      case StiffnessRule::uniform:
-        k = p.uniform_k;
-        break;
-    }
-    double factor = 1.0;
-    switch (s.family) {
-      case SpringFamily::structural:
-        factor = p.structural_factor;
-        break;
-      case SpringFamily::shear:
-        factor = p.shear_factor;
-        break;
-      case SpringFamily::bend:
-        factor = p.bend_factor;
-        break;
-      case SpringFamily::two_ring:
-        factor = p.two_ring_factor;
-        break;
-      case SpringFamily::volume:
-        factor = p.volume_factor;
-        break;
-    }
-    s.law.k1 = factor * k;
-    s.law.k2 = k2_ratio * s.law.k1;
+    const double k = rule_stiffness(rule, p, volume, t, L, is_edge, m,
+                                    is_edge ? edges.fitted.at(key) : 0.0);
+    s.law.k1 = family_factor(s.family, p) * k;
+    s.law.k2 = p.bilinear_ratio * s.law.k1;
     s.law.threshold = p.bilinear_threshold_strain * L;  // infinite → Hooke
   }
 }

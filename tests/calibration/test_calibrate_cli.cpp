@@ -8,6 +8,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "schema_check.hpp"
 #include "test_helpers.hpp"
 
 using vessel::test::read_text;
@@ -60,6 +61,15 @@ TEST(CalibrateCli, FitsReportsHeldOutAndTheFileIsUsedOnItsMeshOnly) {
   const auto j = nlohmann::json::parse(read_text(dir / "cal.json"));
   EXPECT_EQ(j["schema"], "vesselverify.calibration");
   EXPECT_EQ(j["training_loads"].size(), 2u);
+  // The study's document beside it, as its schema says, with the training cases the file names.
+  const auto study = nlohmann::json::parse(read_text(dir / "cal.study.json"));
+  const auto problems = vessel::test::schema_problems(
+      study, nlohmann::json::parse(read_text(VESSEL_CALIBRATE_SCHEMA)));
+  EXPECT_TRUE(problems.empty()) << vessel::test::joined(problems);
+  EXPECT_EQ(study["calibration_file"], (dir / "cal.json").string());
+  std::size_t training = 0;
+  for (const auto& c : study["cases"]) training += c["training"].get<bool>() ? 1 : 0;
+  EXPECT_EQ(training, j["training_loads"].size());
   EXPECT_EQ(j["model"]["name"], "volume_hybrid");
   ASSERT_TRUE(j["factors"].contains("kappa"));
   // The fit lowered the training loads' error (linearised model, against the P2 reference).

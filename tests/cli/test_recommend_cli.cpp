@@ -9,6 +9,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "../schema_check.hpp"
 #include "../test_helpers.hpp"
 
 using vessel::test::CommandResult;
@@ -55,6 +56,9 @@ TEST(RecommendCli, NamesACandidateThatMeetsTheBudgetWithItsEvidence) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = nlohmann::json::parse(read_text(out / "recommend.json"));
   EXPECT_EQ(j["schema"], "vesselverify.recommend");
+  const auto problems = vessel::test::schema_problems(
+      j, nlohmann::json::parse(read_text(VESSEL_RECOMMEND_SCHEMA)));
+  EXPECT_TRUE(problems.empty()) << vessel::test::joined(problems);
   EXPECT_EQ(j["budget"]["quantity"], "patch");
   EXPECT_DOUBLE_EQ(j["budget"]["seconds_per_update"].get<double>(), 10.0);
   // FEM P1 + (2 kinds × 6 rules + the hybrid volume model under its two moduli rules + the

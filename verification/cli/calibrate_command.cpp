@@ -1,14 +1,15 @@
 /// `vesselverify calibrate`: a mass-spring model's stiffness fitted to the FEM reference on a
-/// scene's training loads, and checked on held-out loads (verification/studies/calibrate.hpp).
+/// scene's training loads, and checked on held-out loads (verification/studies/calibrate/calibrate.hpp).
 #include <fstream>
 #include <iostream>
-#include <sstream>
 
 #include "meshes/foundation/atomic_file.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "reports/study_files.hpp"
+#include "reports/study_sections.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/studies/calibrate.hpp"
+#include "verification/studies/calibrate/calibrate.hpp"
 
 namespace vessel::cli {
 
@@ -31,6 +32,7 @@ struct Options {
   std::string prior;
   std::filesystem::path output = "calibration.json";
   std::filesystem::path summary;
+  std::filesystem::path study;
   CacheOptions cache;
   std::string command;
 };
@@ -40,6 +42,13 @@ LoadKind parse_kind(const std::string& k) {
   if (k == "pressure") return LoadKind::pressure;
   if (k == "gravity") return LoadKind::gravity;
   throw InputError("--train: found \"" + k + "\", expected contact, pressure or gravity");
+}
+
+/// --study, or the calibration file's name with ".study.json" for its extension.
+std::filesystem::path study_output(const Options& o) {
+  if (!o.study.empty()) return o.study;
+  std::filesystem::path p = o.output;
+  return p.replace_extension(".study.json");
 }
 
 void run(const Options& o) {
@@ -66,13 +75,14 @@ void run(const Options& o) {
   c.log = &std::cout;
   const CalibrationStudy study = calibrate_scene(s, c);
   write_calibration(o.output, study.calibration);
-  std::ostringstream md;
-  write_calibration_markdown(md, study, o.command);
-  std::cout << "\n" << md.str();
+  const std::filesystem::path study_path = study_output(o);
+  write_calibration_study(study_path, study, o.command, o.output.string());
+  const std::string md = reports::calibration_markdown(reports::read_calibrate(study_path));
+  std::cout << "\n" << md;
   if (!o.summary.empty()) {
-    write_file_atomically(o.summary, [&](std::ostream& out) { out << md.str(); });
+    write_file_atomically(o.summary, [&](std::ostream& out) { out << md; });
   }
-  std::cout << "\nwrote " << o.output.string()
+  std::cout << "\nwrote " << o.output.string() << ", " << study_path.string()
             << (o.summary.empty() ? "" : " and " + o.summary.string()) << "\n";
   std::cout << solution_cache->summary() << "\n";
 }
@@ -154,7 +164,11 @@ void add_calibrate_command(CLI::App& app, const std::string& command_line) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--output", o->output, "Calibration file to write (JSON)")->capture_default_str();
-  cmd->add_option("--summary", o->summary, "Also write the Markdown tables here");
+  cmd->add_option("--study", o->study,
+                  "The study's JSON document (the fit and every case's errors; schema "
+                  "vesselverify.calibrate) (default: the --output file with .study.json)");
+  cmd->add_option("--summary", o->summary,
+                  "Also write the Markdown tables (rendered from the study's JSON) here");
   add_cache_options(*cmd, o->cache);
   cmd->callback([o] { run(*o); });
 }

@@ -6,7 +6,7 @@
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/studies/recommend.hpp"
+#include "verification/studies/recommend/recommend.hpp"
 
 namespace vessel::cli {
 

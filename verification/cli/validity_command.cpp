@@ -1,7 +1,6 @@
 /// `vesselverify validity`: the measured limit of the linear reference's validity and the
 /// mass-spring models against the finite-strain reference over a load ladder (issue 17);
 /// writes validity.json for the report.
-#include <chrono>
 #include <filesystem>
 #include <iostream>
 
@@ -91,7 +90,6 @@ void add_validity_command(CLI::App& app, const std::string& command_line) {
       throw InputError("--output-dir " + o->output_dir.string() + ": cannot create it (" +
                        ec.message() + ")");
     }
-    const auto t0 = std::chrono::steady_clock::now();
     const auto cache = o->cache.solution_cache(std::cout);
     ValidityOptions vo;
     vo.full = o->full;
@@ -105,14 +103,9 @@ void add_validity_command(CLI::App& app, const std::string& command_line) {
     vo.cache = cache.get();
     vo.finite.max_newton_iterations = o->max_newton_iterations;
     vo.log = &std::cout;
-    ValidityStudy study;
-    study.command = command_line;
-    study.full = o->full;
     std::vector<Scene> scenes;
     for (const fs::path& p : o->scenes) scenes.push_back(read_scene(p));
-    study.scenes = run_validity(scenes, vo, o->jobs);
-    study.total_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const ValidityStudy study = run_validity_study(scenes, vo, o->jobs, command_line);
     print_validity_summary(study, std::cout);
     write_validity_json(study, o->output_dir / "validity.json");
     std::cout << cache->summary() << "\n";

@@ -10,7 +10,7 @@
 #include "msm/stiffness/stiffness_rules.hpp"
 #include "verification/harness/budget.hpp"
 #include "verification/harness/metrics.hpp"
-#include "verification/studies/recommend.hpp"
+#include "verification/studies/recommend/recommend.hpp"
 
 using namespace vessel;
 

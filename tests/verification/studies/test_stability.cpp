@@ -1,5 +1,5 @@
 // The stability study's pieces: the refinement-exponent fit on exact power laws, the JSON against
-// its schema, and the Markdown section's title.
+// its schema, and the Markdown section the report renders from that JSON.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,7 +7,10 @@
 #include <numbers>
 #include <sstream>
 
+#include "../../schema_check.hpp"
 #include "../../test_helpers.hpp"
+#include "reports/study_files.hpp"
+#include "reports/study_sections.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "verification/harness/outcome_cache.hpp"
 #include "verification/studies/stability/stability.hpp"
@@ -46,9 +49,18 @@ StabilityReport sample_report() {
 }
 }  // namespace
 
+namespace {
+/// stability.md as the study writes it: the report's section drawn from the study's JSON.
+std::string stability_markdown(const StabilityReport& r) {
+  return reports::stability_markdown(reports::parse_stability(stability_json(r), "stability.json"));
+}
+}  // namespace
+
 TEST(Stability, JsonHasEveryFieldItsSchemaRequires) {
   const auto j = nlohmann::json::parse(stability_json(sample_report()));
   const auto schema = nlohmann::json::parse(test::read_text(VESSEL_STABILITY_SCHEMA));
+  const auto problems = test::schema_problems(j, schema);
+  EXPECT_TRUE(problems.empty()) << test::joined(problems);
   EXPECT_EQ(j["schema"], schema["properties"]["schema"]["const"]);
   for (const auto& key : schema["required"]) EXPECT_TRUE(j.contains(key)) << key;
   const auto& props = schema["properties"];

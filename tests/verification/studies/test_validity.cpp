@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "../../schema_check.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "meshes/vtu_io.hpp"
 #include "reports/study_files.hpp"
@@ -272,6 +273,9 @@ TEST(ValidityFile, WrittenThenReadBackByTheReportWithBadFieldsNamed) {
   // A missing field, a wrong status and another schema are refused naming what is wrong.
   std::ifstream in(dir / "validity.json");
   const nlohmann::json good = nlohmann::json::parse(in);
+  std::ifstream schema_in(VESSEL_VALIDITY_SCHEMA);
+  const auto problems = test::schema_problems(good, nlohmann::json::parse(schema_in));
+  EXPECT_TRUE(problems.empty()) << test::joined(problems);
   auto refused = [&](nlohmann::json j) {
     try {
       (void)reports::parse_validity(j.dump(), "bad.json");

@@ -49,21 +49,28 @@ double qoi(const msm::Problem& p, const Eigen::VectorXd& x, std::size_t node) {
       .norm();
 }
 
-void measure(const Scene& scene, const ModelSpec& spec, int level, double force, double dt) {
-  const TetMesh mesh = scene_mesh(scene, level, "");
-  VesselParams vessel = scene.vessel;
-  vessel.level = level;
-  const double nu = scene.poisson_ratios.front();
-  const msm::BuiltNetwork built =
-      msm::build_network(mesh, vessel, network_options(scene, spec, nu));
-  const msm::SpringModel model(built.network, spec.damping);
-  const msm::Problem p = msm_problem(scene, model, built, mesh, force);
-  const std::size_t node = nearest_node(built.network.nodes, qoi_point(scene));
-  std::cout << "\n### " << spec.name << ", level " << level << ": " << built.network.nodes.size()
-            << " nodes, " << built.network.springs.size() << " springs, force " << force
-            << " N\n\n";
+/// Time per local–global iteration (local step + global step), set-up apart: the median of 5
+/// runs of 10; `setup_seconds` receives the system's set-up time.
+double local_global_iteration_seconds(const msm::Problem& p, double& setup_seconds) {
+  const msm::LocalGlobalSystem sys(p, 0.0, "local-global");
+  const Eigen::VectorXd b = sys.constant_rhs(Eigen::VectorXd(), Eigen::VectorXd());
+  Eigen::VectorXd x = p.rest;
+  msm::SpringDirections d;
+  std::vector<double> ts;
+  for (int r = 0; r < 5; ++r) {
+    const double t = now();
+    for (int i = 0; i < 10; ++i) {
+      sys.local_step(x, d);
+      sys.global_step(d, b, x);
+    }
+    ts.push_back((now() - t) / 10);
+  }
+  setup_seconds = sys.setup_seconds();
+  return median(ts);
+}
 
-  // Statics.
+/// The static problem: local–global after kIterations iterations against Newton's solution.
+void statics_table(const msm::Problem& p, std::size_t node) {
   double t = now();
   const msm::StaticResult newton = msm::solve_static(p);
   const double newton_s = now() - t;
@@ -79,46 +86,32 @@ void measure(const Scene& scene, const ModelSpec& spec, int level, double force,
     at[static_cast<std::size_t>(k - kIterations.begin())] = {(x - newton.x).norm() / u.norm(),
                                                              std::abs(qoi(p, x, node) - q_ref)};
   };
-  msm::StaticResult lg;
   std::string converged;
   try {
-    lg = msm::solve_static_local_global(p, o);
+    const msm::StaticResult lg = msm::solve_static_local_global(p, o);
     converged = std::to_string(lg.iterations) + " iterations, " + sci(lg.seconds) + " s";
   } catch (const std::runtime_error& e) {
     converged = std::string("not within 20000 iterations");
   }
-  // Time per local–global iteration (local step + global step), set-up apart.
-  double per_iteration = 0.0;
-  {
-    const msm::LocalGlobalSystem sys(p, 0.0, "local-global");
-    const Eigen::VectorXd b = sys.constant_rhs(Eigen::VectorXd(), Eigen::VectorXd());
-    Eigen::VectorXd x = p.rest;
-    msm::SpringDirections d;
-    std::vector<double> ts;
-    for (int r = 0; r < 5; ++r) {
-      t = now();
-      for (int i = 0; i < 10; ++i) {
-        sys.local_step(x, d);
-        sys.global_step(d, b, x);
-      }
-      ts.push_back((now() - t) / 10);
-    }
-    per_iteration = median(ts);
-    std::cout << "Statics: Newton " << newton.iterations << " iterations, " << sci(newton_s)
-              << " s; QoI " << sci(q_ref * 1e3, 4) << " mm. Local-global set-up "
-              << sci(sys.setup_seconds()) << " s, " << sci(per_iteration * 1e3)
-              << " ms per iteration (median of 5 × 10), to the 1e-8 gradient tolerance: "
-              << converged << ".\n\n";
-  }
+  double setup = 0.0;
+  const double per_iteration = local_global_iteration_seconds(p, setup);
+  std::cout << "Statics: Newton " << newton.iterations << " iterations, " << sci(newton_s)
+            << " s; QoI " << sci(q_ref * 1e3, 4) << " mm. Local-global set-up " << sci(setup)
+            << " s, " << sci(per_iteration * 1e3)
+            << " ms per iteration (median of 5 × 10), to the 1e-8 gradient tolerance: "
+            << converged << ".\n\n";
   std::cout
       << "| iterations | rel. error ‖x − x_Newton‖/‖u‖ | QoI error (mm) |\n| --- | --- | --- |\n";
   for (std::size_t i = 0; i < kIterations.size(); ++i) {
     std::cout << "| " << kIterations[i] << " | " << sci(at[i].first) << " | "
               << sci(at[i].second * 1e3) << " |\n";
   }
+}
 
-  // One implicit Euler step of the load applied at t = 0: the state after 4 steps (Newton, to
-  // convergence) is the step's start, so the step has momentum as well as the load.
+/// One implicit Euler step of the load applied at t = 0: the state after 4 steps (Newton, to
+/// convergence) is the step's start, so the step has momentum as well as the load. The
+/// linearised step and local–global after kIterations iterations against Newton's step.
+void implicit_step_table(const msm::Problem& p, std::size_t node, double dt) {
   Eigen::VectorXd x = p.rest, v = Eigen::VectorXd::Zero(p.num_dofs());
   msm::StaticOptions tight;
   tight.tolerance = 1e-12;
@@ -127,7 +120,7 @@ void measure(const Scene& scene, const ModelSpec& spec, int level, double force,
     v = (x1 - x) / dt;
     x = x1;
   }
-  t = now();
+  const double t = now();
   const Eigen::VectorXd ref = msm::implicit_euler_step_newton(p, x, v, dt, tight);
   const double newton_step_s = now() - t;
   msm::DynamicOptions lin;
@@ -159,6 +152,23 @@ void measure(const Scene& scene, const ModelSpec& spec, int level, double force,
               << sci(std::abs(qoi(p, r.x, node) - qoi(p, ref, node)) * 1e3) << " | "
               << sci(median(ts) * 1e3) << " | " << sci(median(setups) * 1e3) << " |\n";
   }
+}
+
+void measure(const Scene& scene, const ModelSpec& spec, int level, double force, double dt) {
+  const TetMesh mesh = scene_mesh(scene, level, "");
+  VesselParams vessel = scene.vessel;
+  vessel.level = level;
+  const double nu = scene.poisson_ratios.front();
+  const msm::BuiltNetwork built =
+      msm::build_network(mesh, vessel, network_options(scene, spec, nu));
+  const msm::SpringModel model(built.network, spec.damping);
+  const msm::Problem p = msm_problem(scene, model, built, mesh, force);
+  const std::size_t node = nearest_node(built.network.nodes, qoi_point(scene));
+  std::cout << "\n### " << spec.name << ", level " << level << ": " << built.network.nodes.size()
+            << " nodes, " << built.network.springs.size() << " springs, force " << force
+            << " N\n\n";
+  statics_table(p, node);
+  implicit_step_table(p, node, dt);
 }
 
 }  // namespace

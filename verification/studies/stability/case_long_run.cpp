@@ -7,6 +7,72 @@
 
 namespace vessel::stability_study {
 
+namespace {
+
+/// One integrator's long run from `v0` at `fraction` × its predicted critical step (undamped
+/// explicit Euler, whose prediction is 0: 0.1 × 2/ω_max), energy sampled every 100 steps.
+HardCaseOutcome long_run(const StudyModel& base, const std::string& model,
+                         const IntegratorConfig& cfg, double fraction, double omega_max,
+                         const Eigen::VectorXd& v0, long long steps, long long early,
+                         std::ostream& log) {
+  const double c = 2.0 * cfg.zeta * omega_max * mean_mass(base.problem);
+  const auto m = with_damping(base, c);
+  const msm::Spectrum s = msm::analyse_spectrum(m->problem, {.lowest = c > 0});
+  double dt = fraction * msm::predicted_critical_step(cfg.integrator, s);
+  if (dt == 0.0) dt = 0.1 * 2.0 / s.omega_max;  // undamped explicit Euler: 0.1 × 2/ω_max
+  const std::string name = msm::to_string(cfg.integrator) +
+                           (c > 0 ? " (point damping, ζ " + fmt(cfg.zeta) + ")" : "");
+  log << "  " << name << ": " << steps << " steps of " << fmt(dt) << " s" << std::endl;
+  const double H0 = msm::total_energy(m->problem, m->problem.rest, v0);
+  double hmax = H0, hmin = H0, hmax_early = H0;
+  msm::DynamicOptions d;
+  d.integrator = cfg.integrator;
+  d.dt = dt;
+  d.steps = static_cast<int>(steps);
+  Stopwatch clock;
+  d.on_step = [&](int step, const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
+    if (step % 100 == 0) {
+      const double h = msm::total_energy(m->problem, x, v);
+      hmax = std::max(hmax, h);
+      hmin = std::min(hmin, h);
+      if (step <= early) hmax_early = hmax;
+    }
+    if (step % early == 0) {
+      const double t = clock.seconds();
+      log << "    step " << step << " / " << steps << ", H/H0 " << fmt(hmax / H0) << " max, "
+          << fmt(t, 3) << " s, ~" << fmt(t / step * static_cast<double>(steps - step), 2)
+          << " s to go" << std::endl;
+    }
+  };
+  HardCaseOutcome oc;
+  oc.model = model + ", " + name;
+  oc.values["dt_s"] = dt;
+  oc.values["steps"] = static_cast<double>(steps);
+  try {
+    const msm::DynamicResult r = msm::integrate(m->problem, d, m->problem.rest, v0);
+    const double secs = clock.seconds();
+    oc.finished = true;
+    oc.bounded = hmax <= 1.5 * hmax_early;
+    oc.reported = std::to_string(steps) + " steps of " + fmt(dt) + " s (" +
+                  fmt(dt * s.omega_max / 2.0, 3) + " × 2/ω_max): H/H₀ max " + fmt(hmax / H0) +
+                  " over the run (" + fmt(hmax_early / H0) + " over its first 10 %), min " +
+                  fmt(hmin / H0) + ", final " + fmt(r.energy / H0) + " (" + fmt(secs, 3) +
+                  " s, " + fmt(1e6 * secs / static_cast<double>(steps), 3) + " µs per step)";
+    oc.values["energy_max_over_initial"] = hmax / H0;
+    oc.values["energy_max_first_tenth_over_initial"] = hmax_early / H0;
+    oc.values["energy_final_over_initial"] = r.energy / H0;
+    oc.values["seconds"] = secs;
+  } catch (const msm::DivergenceError& e) {
+    oc.finished = false;
+    oc.bounded = false;
+    oc.reported = "stopped: " + short_error(e.what());
+    oc.values["diverged_at_step"] = e.step;
+  }
+  return oc;
+}
+
+}  // namespace
+
 HardCase case_long_run(const StabilityOptions& o, std::ostream& log) {
   HardCase hc;
   hc.id = "long_run";
@@ -51,60 +117,8 @@ HardCase case_long_run(const StabilityOptions& o, std::ostream& log) {
                          Run{{Integrator::verlet, 0.0}, 0.9},
                          Run{{Integrator::explicit_euler, 0.3}, 0.9},
                          Run{{Integrator::explicit_euler, 0.0}, 0.0}}) {
-    const double c = 2.0 * run.cfg.zeta * s0.omega_max * mean_mass(base->problem);
-    const auto m = with_damping(*base, c);
-    const msm::Spectrum s = msm::analyse_spectrum(m->problem, {.lowest = c > 0});
-    double dt = run.fraction * msm::predicted_critical_step(run.cfg.integrator, s);
-    if (dt == 0.0) dt = 0.1 * 2.0 / s.omega_max;  // undamped explicit Euler: 0.1 × 2/ω_max
-    const std::string name = msm::to_string(run.cfg.integrator) +
-                             (c > 0 ? " (point damping, ζ " + fmt(run.cfg.zeta) + ")" : "");
-    log << "  " << name << ": " << steps << " steps of " << fmt(dt) << " s" << std::endl;
-    const double H0 = msm::total_energy(m->problem, m->problem.rest, v0);
-    double hmax = H0, hmin = H0, hmax_early = H0;
-    msm::DynamicOptions d;
-    d.integrator = run.cfg.integrator;
-    d.dt = dt;
-    d.steps = static_cast<int>(steps);
-    Stopwatch clock;
-    d.on_step = [&](int step, const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
-      if (step % 100 == 0) {
-        const double h = msm::total_energy(m->problem, x, v);
-        hmax = std::max(hmax, h);
-        hmin = std::min(hmin, h);
-        if (step <= early) hmax_early = hmax;
-      }
-      if (step % early == 0) {
-        const double t = clock.seconds();
-        log << "    step " << step << " / " << steps << ", H/H0 " << fmt(hmax / H0) << " max, "
-            << fmt(t, 3) << " s, ~" << fmt(t / step * static_cast<double>(steps - step), 2)
-            << " s to go" << std::endl;
-      }
-    };
-    HardCaseOutcome oc;
-    oc.model = spec.name + ", " + name;
-    oc.values["dt_s"] = dt;
-    oc.values["steps"] = static_cast<double>(steps);
-    try {
-      const msm::DynamicResult r = msm::integrate(m->problem, d, m->problem.rest, v0);
-      const double secs = clock.seconds();
-      oc.finished = true;
-      oc.bounded = hmax <= 1.5 * hmax_early;
-      oc.reported = std::to_string(steps) + " steps of " + fmt(dt) + " s (" +
-                    fmt(dt * s.omega_max / 2.0, 3) + " × 2/ω_max): H/H₀ max " + fmt(hmax / H0) +
-                    " over the run (" + fmt(hmax_early / H0) + " over its first 10 %), min " +
-                    fmt(hmin / H0) + ", final " + fmt(r.energy / H0) + " (" + fmt(secs, 3) +
-                    " s, " + fmt(1e6 * secs / static_cast<double>(steps), 3) + " µs per step)";
-      oc.values["energy_max_over_initial"] = hmax / H0;
-      oc.values["energy_max_first_tenth_over_initial"] = hmax_early / H0;
-      oc.values["energy_final_over_initial"] = r.energy / H0;
-      oc.values["seconds"] = secs;
-    } catch (const msm::DivergenceError& e) {
-      oc.finished = false;
-      oc.bounded = false;
-      oc.reported = "stopped: " + short_error(e.what());
-      oc.values["diverged_at_step"] = e.step;
-    }
-    hc.outcomes.push_back(oc);
+    hc.outcomes.push_back(long_run(*base, spec.name, run.cfg, run.fraction, s0.omega_max, v0,
+                                   steps, early, log));
   }
   return hc;
 }

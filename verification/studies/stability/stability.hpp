@@ -124,9 +124,8 @@ StabilityReport run_stability(const StabilityOptions& options);
 
 /// The versioned JSON (schema "vesselverify.stability", version 1) as text.
 std::string stability_json(const StabilityReport& report);
-/// The self-contained Markdown section "## Numerical stability".
-std::string stability_markdown(const StabilityReport& report);
-/// Writes stability.json and stability.md into `dir` atomically (InputError if it cannot).
+/// Writes stability.json and stability.md (the report's section drawn from that JSON,
+/// reports::stability_markdown) into `dir` atomically (InputError if it cannot).
 void write_stability(const std::filesystem::path& dir, const StabilityReport& report);
 
 /// Least-squares slope of log(y) against log(x) (InputError unless ≥ 2 positive pairs).

@@ -512,6 +512,17 @@ std::vector<ValidityScene> run_validity(const std::vector<Scene>& scenes,
   return out;
 }
 
+ValidityStudy run_validity_study(const std::vector<Scene>& scenes, const ValidityOptions& options,
+                                 int jobs, const std::string& command) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ValidityStudy study;
+  study.command = command;
+  study.full = options.full;
+  study.scenes = run_validity(scenes, options, jobs);
+  study.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return study;
+}
+
 namespace {
 
 json crossing_json(const ThresholdCrossing& c) {

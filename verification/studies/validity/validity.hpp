@@ -153,6 +153,10 @@ struct ValidityStudy {
   std::vector<ValidityScene> scenes;
 };
 
+/// The study as one record: run_validity over `scenes`, its wall time, the command recorded.
+ValidityStudy run_validity_study(const std::vector<Scene>& scenes, const ValidityOptions& options,
+                                 int jobs, const std::string& command);
+
 /// validity.json (schema "vesselverify.validity", version 1), written atomically.
 void write_validity_json(const ValidityStudy& study, const std::filesystem::path& path);
 

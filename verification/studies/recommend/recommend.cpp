@@ -1,4 +1,4 @@
-#include "verification/studies/recommend.hpp"
+#include "verification/studies/recommend/recommend.hpp"
 
 #include "verification/harness/results.hpp"
 
@@ -15,6 +15,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
+#include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
 #include "reports/svg_plot.hpp"
 
@@ -25,9 +26,6 @@ using reports::significant;
 namespace {
 
 std::string ms(double seconds) { return significant(seconds * 1e3) + " ms"; }
-
-/// "30 Hz", "1000 Hz" (significant's 3 digits would print 1e+03).
-std::string hz(double rate) { return significant(rate, 6) + " Hz"; }
 
 bool is_integrator(const ModelSpec& m) { return m.solver.kind == msm::SolverKind::integrator; }
 
@@ -203,113 +201,137 @@ std::string rule_label(const SpringChoice& c) {
 
 }  // namespace
 
-std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double>& roi_radii) {
-  std::vector<ModelSpec> out;
-  const bool dynamic = std::any_of(s.models.begin(), s.models.end(),
-                                   [](const ModelSpec& m) { return m.solver.is_dynamic(); });
-  const std::vector<std::pair<ModelKind, std::string>> kinds{{ModelKind::surface_msm, "surface"},
-                                                             {ModelKind::volume_msm, "volume"}};
-  if (!dynamic) {
-    ModelSpec fem;
-    fem.name = "fem_p1";
-    fem.kind = ModelKind::fem;
-    fem.degree = 1;
-    out.push_back(fem);
-    for (const auto& [kind, kind_name] : kinds) {
-      for (const SpringChoice& choice : spring_rules(kind)) {
-        ModelSpec m;
-        m.kind = kind;
-        m.surface = msm::WallSurface::mid;
-        m.stiffness = choice.rule;
-        m.volume_term = choice.volume_term;
-        m.volume_moduli = choice.volume_moduli;
-        m.bending = choice.bending;
-        m.edge_pairs = choice.edge_pairs;
-        m.mass = msm::MassRule::consistent;  // irrelevant to a static answer
-        const std::string rule_name = rule_label(choice);
-        for (const std::string solver : {"static", "linear"}) {
-          m.solver = msm::parse_solver(solver);
-          m.name = kind_name + "/" + rule_name + "/" + solver;
-          out.push_back(m);
-        }
-        if (s.load.kind != LoadKind::contact) continue;
-        for (const double r : roi_radii) {
-          m.solver = msm::parse_solver("static");
-          m.roi_radius = r;
-          m.name = kind_name + "/" + rule_name + "/static/R=" + significant(r * 1e3) + "mm";
-          out.push_back(m);
-        }
-      }
-    }
-    // The scene's calibrated mass-spring models (`calibration = "file.json"`, vesselverify
-    // calibrate), with the same calibration, under both static solvers.
-    for (const ModelSpec& scene_model : s.models) {
-      if (scene_model.kind == ModelKind::fem || scene_model.calibration.empty()) continue;
-      ModelSpec m = scene_model;
-      m.roi_radius = 0.0;
+namespace {
+
+const std::vector<std::pair<ModelKind, std::string>> kKinds{{ModelKind::surface_msm, "surface"},
+                                                            {ModelKind::volume_msm, "volume"}};
+
+/// A mass-spring model of `kind` on the mid-surface with `choice`'s rule and terms, consistent
+/// masses (the FEM transient's; irrelevant to a static answer); solver and name to be set.
+ModelSpec spring_model(ModelKind kind, const SpringChoice& choice) {
+  ModelSpec m;
+  m.kind = kind;
+  m.surface = msm::WallSurface::mid;
+  m.stiffness = choice.rule;
+  m.volume_term = choice.volume_term;
+  m.volume_moduli = choice.volume_moduli;
+  m.bending = choice.bending;
+  m.edge_pairs = choice.edge_pairs;
+  m.mass = msm::MassRule::consistent;
+  return m;
+}
+
+/// Static scenes: FEM P1, every spring model under the static and linear solvers, and with
+/// contact loads the static solver on each region-of-interest radius.
+void add_static_candidates(const Scene& s, const std::vector<double>& roi_radii,
+                           std::vector<ModelSpec>& out) {
+  ModelSpec fem;
+  fem.name = "fem_p1";
+  fem.kind = ModelKind::fem;
+  fem.degree = 1;
+  out.push_back(fem);
+  for (const auto& [kind, kind_name] : kKinds) {
+    for (const SpringChoice& choice : spring_rules(kind)) {
+      ModelSpec m = spring_model(kind, choice);
+      const std::string rule_name = rule_label(choice);
       for (const std::string solver : {"static", "linear"}) {
         m.solver = msm::parse_solver(solver);
-        m.name = std::string(m.kind == ModelKind::volume_msm ? "volume" : "surface") +
-                 "/calibrated-" + scene_model.calibration.stem().string() + "/" + solver;
+        m.name = kind_name + "/" + rule_name + "/" + solver;
+        out.push_back(m);
+      }
+      if (s.load.kind != LoadKind::contact) continue;
+      for (const double r : roi_radii) {
+        m.solver = msm::parse_solver("static");
+        m.roi_radius = r;
+        m.name = kind_name + "/" + rule_name + "/static/R=" + significant(r * 1e3) + "mm";
         out.push_back(m);
       }
     }
-    return out;
   }
-  // Dynamic: the scene's time steps per integrator family, its longest simulated time, its damping.
-  std::set<double> explicit_dts, implicit_dts;
-  double duration = 0.0;
-  double damping = 0.0;
+}
+
+/// The scene's calibrated mass-spring models (`calibration = "file.json"`, vesselverify
+/// calibrate), with the same calibration, under both static solvers.
+void add_calibrated_candidates(const Scene& s, std::vector<ModelSpec>& out) {
+  for (const ModelSpec& scene_model : s.models) {
+    if (scene_model.kind == ModelKind::fem || scene_model.calibration.empty()) continue;
+    ModelSpec m = scene_model;
+    m.roi_radius = 0.0;
+    for (const std::string solver : {"static", "linear"}) {
+      m.solver = msm::parse_solver(solver);
+      m.name = std::string(m.kind == ModelKind::volume_msm ? "volume" : "surface") +
+               "/calibrated-" + scene_model.calibration.stem().string() + "/" + solver;
+      out.push_back(m);
+    }
+  }
+}
+
+/// The time steps the scene's integrators use, per family, its longest simulated time and its
+/// largest point damping.
+struct SceneSteps {
+  std::set<double> explicit_dts, implicit_dts, all;
+  double duration = 0.0, damping = 0.0;
+};
+
+SceneSteps scene_steps(const Scene& s) {
+  SceneSteps t;
   for (const ModelSpec& m : s.models) {
     if (!is_integrator(m)) continue;
-    (is_explicit(m.solver.integrator) ? explicit_dts : implicit_dts).insert(m.solver.dt);
-    duration = std::max(duration, m.solver.dt * static_cast<double>(m.solver.steps));
-    damping = std::max(damping, m.damping);
+    (is_explicit(m.solver.integrator) ? t.explicit_dts : t.implicit_dts).insert(m.solver.dt);
+    t.duration = std::max(t.duration, m.solver.dt * static_cast<double>(m.solver.steps));
+    t.damping = std::max(t.damping, m.damping);
   }
-  std::set<double> all = explicit_dts;
-  all.insert(implicit_dts.begin(), implicit_dts.end());
-  for (const auto& [kind, kind_name] : kinds) {
+  t.all = t.explicit_dts;
+  t.all.insert(t.implicit_dts.begin(), t.implicit_dts.end());
+  return t;
+}
+
+/// Dynamic scenes: every spring model under every integrator at its family's steps, and the
+/// local–global implicit Euler on the plain spring networks.
+void add_dynamic_candidates(const Scene& s, std::vector<ModelSpec>& out) {
+  const SceneSteps t = scene_steps(s);
+  const auto timed = [&](ModelSpec m, double dt, const std::string& name) {
+    m.solver.dt = dt;
+    m.solver.steps = std::max(1L, std::lround(t.duration / dt));
+    m.damping = t.damping;
+    m.name = name + "/dt=" + significant(dt);
+    out.push_back(m);
+  };
+  for (const auto& [kind, kind_name] : kKinds) {
     for (const SpringChoice& choice : spring_rules(kind)) {
       for (const msm::Integrator integrator : msm::kAllIntegrators) {
-        const std::set<double>& family = is_explicit(integrator) ? explicit_dts : implicit_dts;
-        for (const double dt : family.empty() ? all : family) {
-          ModelSpec m;
-          m.kind = kind;
-          m.surface = msm::WallSurface::mid;
-          m.stiffness = choice.rule;
-          m.volume_term = choice.volume_term;
-          m.volume_moduli = choice.volume_moduli;
-          m.bending = choice.bending;
-          m.edge_pairs = choice.edge_pairs;
-          m.mass = msm::MassRule::consistent;  // the FEM transient's mass
-          m.solver.kind = msm::SolverKind::integrator;
-          m.solver.integrator = integrator;
-          m.solver.dt = dt;
-          m.solver.steps = std::max(1L, std::lround(duration / dt));
-          m.damping = damping;
-          m.name = kind_name + "/" + rule_label(choice) + "/" + msm::to_string(integrator) +
-                   "/dt=" + significant(dt);
-          out.push_back(m);
+        const std::set<double>& family = is_explicit(integrator) ? t.explicit_dts : t.implicit_dts;
+        ModelSpec m = spring_model(kind, choice);
+        m.solver.kind = msm::SolverKind::integrator;
+        m.solver.integrator = integrator;
+        for (const double dt : family.empty() ? t.all : family) {
+          timed(m, dt, kind_name + "/" + rule_label(choice) + "/" + msm::to_string(integrator));
         }
       }
       // The real-time solver (Liu et al. 2013), implicit Euler with its default iterations per
       // step, at the implicit family's steps: plain spring networks only (no volume or bending
       // term).
       if (!choice.plain()) continue;
-      for (const double dt : implicit_dts.empty() ? all : implicit_dts) {
-        ModelSpec m;
-        m.kind = kind;
-        m.surface = msm::WallSurface::mid;
-        m.stiffness = choice.rule;
-        m.mass = msm::MassRule::consistent;
-        m.solver = msm::parse_solver("local-global-euler");
-        m.solver.dt = dt;
-        m.solver.steps = std::max(1L, std::lround(duration / dt));
-        m.damping = damping;
-        m.name = kind_name + "/" + rule_label(choice) + "/local-global-euler/dt=" + significant(dt);
-        out.push_back(m);
+      ModelSpec m = spring_model(kind, choice);
+      m.solver = msm::parse_solver("local-global-euler");
+      for (const double dt : t.implicit_dts.empty() ? t.all : t.implicit_dts) {
+        timed(m, dt, kind_name + "/" + rule_label(choice) + "/local-global-euler");
       }
     }
+  }
+}
+
+}  // namespace
+
+std::vector<ModelSpec> candidate_models(const Scene& s, const std::vector<double>& roi_radii) {
+  std::vector<ModelSpec> out;
+  const bool dynamic = std::any_of(s.models.begin(), s.models.end(),
+                                   [](const ModelSpec& m) { return m.solver.is_dynamic(); });
+  if (dynamic) {
+    add_dynamic_candidates(s, out);
+  } else {
+    add_static_candidates(s, roi_radii, out);
+    add_calibrated_candidates(s, out);
   }
   return out;
 }
@@ -412,123 +434,12 @@ Recommendation rejudged(const Recommendation& rec, double rate_hz) {
 
 void write_recommendation(const Recommendation& rec, const std::filesystem::path& output_dir,
                           const std::string& command) {
-  write_file_atomically(output_dir / "recommend.md",
-                        [&](std::ostream& out) { out << recommendation_markdown(rec, command); });
-  write_file_atomically(output_dir / "recommend.json",
-                        [&](std::ostream& out) { out << recommendation_json(rec, command, output_dir); });
-}
-
-namespace {
-
-std::string budget_text(const Scene& s, const SceneResult& r) {
-  const Budget& b = s.budget;
-  std::ostringstream t;
-  t << "the " << to_string(b.quantity);
-  if (b.quantity == BudgetQuantity::patch) t << " (within " << significant(b.radius * 1e3) << " mm)";
-  t << " error ≤ " << significant(b.tolerance) << " " << budget_unit(b.quantity) << ", and ≤ "
-    << ms(b.seconds_per_update()) << " of computation per update";
-  if (b.rate_hz > 0.0) t << " (" << hz(b.rate_hz) << ")";
-  const char* unit =
-      s.load.kind == LoadKind::contact ? "N" : (s.load.kind == LoadKind::pressure ? "Pa" : "g");
-  for (const ReferenceInfo& ref : r.references) {
-    t << "; at ν = " << ref.poisson_ratio << " the load is ";
-    if (s.load.kind == LoadKind::contact) {
-      t << significant(ref.budget_magnitude * 1e3) << " mN";
-    } else {
-      t << significant(ref.budget_magnitude) << " " << unit;
-    }
-    t << " (reference " << ref.element << ", level " << ref.level << ")";
-  }
-  return t.str();
-}
-
-}  // namespace
-
-std::string recommendation_markdown(const Recommendation& rec, const std::string& command) {
-  const Scene& s = rec.scene;
-  const Selection& sel = rec.selection;
-  const auto& c = rec.candidates;
-  const char* unit = budget_unit(s.budget.quantity);
-  std::ostringstream md;
-  md << "## Model recommendation: " << s.name;
-  // Headings differ per rate, so one report can embed the visual and the haptic answers.
-  if (s.budget.rate_hz > 0.0)
-    md << " at " << hz(s.budget.rate_hz);
-  else
-    md << ", " << ms(s.budget.time_budget_s) << " per update";
-  md << "\n\n";
-  md << "Budget: " << budget_text(s, rec.result) << ". " << c.size()
-     << " candidates (generated from the mass-spring library's stiffness rules and solvers, "
-        "surface and volume, mesh levels";
-  for (const int l : s.model_levels) md << " " << l;
-  md << ", regions of interest; FEM P1 for comparison) were run against the FEM reference by\n\n"
-     << "    " << command << "\n\n";
-  if (sel.recommended) {
-    const Candidate& best = c[*sel.recommended];
-    md << "**Recommended: `" << best.name << "`** (" << best.detail << "): error "
-       << significant(best.error) << " " << unit << ", " << ms(best.update_seconds) << " per update ("
-       << ms(best.setup_seconds) << " set-up, once), " << best.unknowns << " unknowns"
-       << (best.roi_radius > 0.0 ? "" : ", the whole vessel") << ".\n\n";
-  } else if (sel.closest) {
-    const Candidate& near = c[*sel.closest];
-    md << "**No candidate meets the budget.** The closest is `" << near.name << "` (" << near.detail
-       << "): error " << significant(near.error) << " " << unit << ", " << ms(near.update_seconds)
-       << " per update; " << sel.reasons[*sel.closest] << ".\n\n";
-  } else {
-    md << "**No candidate meets the budget**, and none finished.\n\n";
-  }
-  if (sel.whole_vessel && sel.whole_vessel != sel.recommended) {
-    const Candidate& w = c[*sel.whole_vessel];
-    md << "Whole vessel (no region of interest): `" << w.name << "` (" << w.detail << ") meets "
-       << "the budget too: error " << significant(w.error) << " " << unit << ", "
-       << ms(w.update_seconds) << " per update, " << w.unknowns << " unknowns.\n\n";
-  } else if (!sel.whole_vessel) {
-    md << "No whole-vessel candidate (without a region of interest) meets the budget.\n\n";
-  }
-  // A tolerance at or above the reference's own contact displacement is met by a model that does
-  // not move at all: say so, the answer then says nothing about accuracy.
-  double reference_qoi_mm = 0.0;
-  for (const ModelOutcome& o : rec.result.outcomes) {
-    if (o.ok) reference_qoi_mm = std::max(reference_qoi_mm, o.qoi_reference_mm);
-  }
-  if (s.budget.quantity != BudgetQuantity::reaction && reference_qoi_mm > 0.0 &&
-      s.budget.tolerance >= reference_qoi_mm) {
-    md << "⚠ **The tolerance does not discriminate**: at this load the reference's contact point "
-          "moves "
-       << significant(reference_qoi_mm) << " mm, no more than the " << significant(s.budget.tolerance)
-       << " mm tolerance, so a model that does not move at all would meet it. State a tighter "
-          "tolerance or a larger load (`magnitude`) for an answer about accuracy.\n\n";
-  }
-  md << reports::kTimePerUpdateText
-     << " Errors are the worst over the scene's Poisson's ratios, against the P2 reference at "
-        "each model node; region-of-interest models (R) hold every node farther than R from the "
-        "contact and are compared on the whole vessel. ★ marks the Pareto front (no other "
-        "candidate is both faster and more accurate).\n\n";
-  md << "| candidate | unknowns | error (" << unit
-     << ") | time per update (ms) | set-up (ms) | Pareto | verdict | "
-        "why |\n|---|---|---|---|---|---|---|---|\n";
-  // Winners first, then by time per update; failures last.
-  std::vector<std::size_t> order(c.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    const auto rank = [&](std::size_t i) {
-      return static_cast<int>(sel.verdicts[i]) > 1 ? 2 : static_cast<int>(sel.verdicts[i]);
-    };
-    const bool fa = sel.verdicts[a] == Verdict::failed, fb = sel.verdicts[b] == Verdict::failed;
-    if (fa != fb) return fb;
-    if (rank(a) != rank(b)) return rank(a) < rank(b);
-    return c[a].update_seconds < c[b].update_seconds;
-  });
-  for (const std::size_t i : order) {
-    const bool front = std::find(sel.pareto.begin(), sel.pareto.end(), i) != sel.pareto.end();
-    md << "| `" << c[i].name << "` | " << c[i].unknowns << " | "
-       << (c[i].ok && std::isfinite(c[i].error) ? significant(c[i].error) : "–") << " | "
-       << (c[i].ok ? significant(c[i].update_seconds * 1e3) : "–") << " | "
-       << (c[i].ok ? significant(c[i].setup_seconds * 1e3) : "–") << " | " << (front ? "★" : "") << " | "
-       << to_string(sel.verdicts[i]) << " | " << sel.reasons[i] << " |\n";
-  }
-  md << "\n";
-  return md.str();
+  const std::string json = recommendation_json(rec, command, output_dir);
+  // The Markdown is the report's section drawn from the document just written.
+  const std::string md =
+      reports::recommendation_markdown(reports::parse_recommend(json, output_dir / "recommend.json"));
+  write_file_atomically(output_dir / "recommend.json", [&](std::ostream& out) { out << json; });
+  write_file_atomically(output_dir / "recommend.md", [&](std::ostream& out) { out << md; });
 }
 
 std::string recommendation_json(const Recommendation& rec, const std::string& command,
@@ -570,7 +481,9 @@ std::string recommendation_json(const Recommendation& rec, const std::string& co
   if (s.budget.quantity == BudgetQuantity::patch) budget["radius_mm"] = s.budget.radius * 1e3;
   nlohmann::json loads = nlohmann::json::array();
   for (const ReferenceInfo& ref : rec.result.references) {
-    loads.push_back({{"poisson_ratio", ref.poisson_ratio}, {"magnitude", ref.budget_magnitude}});
+    loads.push_back({{"poisson_ratio", ref.poisson_ratio},
+                     {"magnitude", ref.budget_magnitude},
+                     {"reference_element", ref.element}});
   }
   double reference_qoi_mm = 0.0;
   for (const ModelOutcome& o : rec.result.outcomes) {
@@ -586,6 +499,9 @@ std::string recommendation_json(const Recommendation& rec, const std::string& co
                          {"reference_level", s.reference_level},
                          {"budget", budget},
                          {"loads", loads},
+                         {"load_unit", s.load.kind == LoadKind::contact    ? "N"
+                                       : s.load.kind == LoadKind::pressure ? "Pa"
+                                                                           : "g"},
                          {"recommended", name_of(sel.recommended)},
                          {"closest", name_of(sel.closest)},
                          {"whole_vessel", name_of(sel.whole_vessel)},

@@ -1,4 +1,4 @@
-#include "verification/studies/calibrate.hpp"
+#include "verification/studies/calibrate/calibrate.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -676,83 +676,6 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   }
   add_transfer_cases(study, o, spec, cal, train, nu, log);
   return study;
-}
-
-namespace {
-
-std::string fixed3(double v) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(3) << v;
-  return s.str();
-}
-
-std::string load_text(const CalibrationCaseResult& c) {
-  std::ostringstream s;
-  s << c.magnitude << (c.kind == LoadKind::contact ? " N" : c.kind == LoadKind::pressure ? " Pa" : " g");
-  return s.str();
-}
-
-void case_table(std::ostream& out, const std::vector<CalibrationCaseResult>& cases, bool training) {
-  out << "| scene | level | case | holds out | load | P1 | base | calibrated | calibrated / P1 | "
-         "base s/update | calibrated s/update | P1 solve s | reference max strain |\n"
-      << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  for (const auto& c : cases) {
-    if (c.training != training) continue;
-    out << "| " << c.scene << " | " << c.level << " | " << c.name << " | " << c.holds_out << " | "
-        << load_text(c) << " | " << fixed3(c.p1.relative_l2) << " | "
-        << (c.base_ok ? fixed3(c.base.relative_l2) : "—")
-        << " | " << (c.ok ? fixed3(c.calibrated.relative_l2) : "—") << " | "
-        << (c.ok ? fixed3(c.calibrated.relative_l2 / c.p1.relative_l2) : "—") << " | "
-        << std::setprecision(3) << (c.base_ok ? c.base_update_seconds : 0.0) << " | "
-        << (c.ok ? std::to_string(c.calibrated_update_seconds).substr(0, 7) : std::string("—"))
-        << " | " << c.p1_solve_seconds << " | " << std::setprecision(2)
-        << 100.0 * c.max_strain_reference << " % |\n";
-  }
-}
-
-}  // namespace
-
-void write_calibration_markdown(std::ostream& out, const CalibrationStudy& st,
-                                const std::string& command) {
-  const Calibration& c = st.calibration;
-  out << "# Calibration of " << c.model << " (" << c.scene << ", " << c.granularity << ")\n\n"
-      << "    " << command << "\n\n"
-      << "Model: " << st.model_detail << ", ν = " << c.poisson_ratio << ", " << c.vessel
-      << " (mesh " << c.mesh_hash << ", " << c.nodes << " nodes, " << c.springs << " springs).\n"
-      << "Fit: " << c.method << ". " << c.names.size() << " parameters, " << c.iterations
-      << " iterations (" << c.stop_reason << "), " << fixed3(st.fit_seconds)
-      << " s; objective " << c.objective_before << " → " << c.objective_after << ".\n\n";
-  if (c.granularity != "per_spring" && c.granularity != "per_section_spring") {
-    out << "| parameter | factor |\n|---|---|\n";
-    for (std::size_t i = 0; i < c.names.size(); ++i) {
-      out << "| " << c.names[i] << " | " << fixed3(c.factors[i]) << " |\n";
-    }
-    out << "\n";
-  } else {
-    std::vector<double> f = c.factors;
-    std::sort(f.begin(), f.end());
-    out << (c.granularity == "per_spring" ? "Per-spring" : "Per-section-spring")
-        << " factors (kappa included): min " << fixed3(f.front()) << ", median "
-        << fixed3(f[f.size() / 2]) << ", max " << fixed3(f.back()) << ".\n\n";
-  }
-  out << "Relative L2 errors against the P2 reference at the model's nodes (P1 at its mesh's "
-         "nodes), each model solved as the scene solves it; *s/update*: the median time per "
-         "update of a warm-started load ramp (set-up apart).\n\n## Training loads\n\n";
-  case_table(out, st.cases, true);
-  out << "\n## Held-out loads\n\n";
-  case_table(out, st.cases, false);
-  std::string last_failure;
-  for (const auto& cs : st.cases) {
-    if (!cs.ok && cs.failure != last_failure) {  // a transfer's refusal once, not per case
-      out << "\n" << cs.scene << " " << cs.name << " (" << load_text(cs)
-          << "): calibrated model not evaluated: " << cs.failure << "\n";
-      last_failure = cs.failure;
-    }
-    if (!cs.base_ok) {
-      out << "\n" << cs.scene << " " << cs.name << " (" << load_text(cs)
-          << "): uncalibrated model not evaluated: " << cs.base_failure << "\n";
-    }
-  }
 }
 
 }  // namespace vessel

@@ -1,5 +1,5 @@
 #pragma once
-/// `vesselverify calibrate` (issue 14 item 4): a mass-spring model's stiffness fitted to the FEM
+/// `vesselverify calibrate`: a mass-spring model's stiffness fitted to the FEM
 /// reference's displacements on a scene's training loads, then checked on held-out loads.
 ///
 /// - Fit: msm/calibration/stiffness_fit.hpp (least squares on nodal displacements of the model
@@ -120,9 +120,15 @@ struct CalibrationStudy {
 /// cannot give, or granularity per_spring with other vessels (reported as such, not silently).
 CalibrationStudy calibrate_scene(const Scene& scene, const CalibrateOptions& options);
 
-/// Markdown: the fit, then the cases with P1, base and calibrated relative L2 errors (training and
-/// held-out in separate tables) and the calibrated model's ratio to P1.
-void write_calibration_markdown(std::ostream& out, const CalibrationStudy& study,
-                                const std::string& command);
+/// The study as a JSON document (schema "vesselverify.calibrate", version 1;
+/// calibrate.schema.json beside this header): the model and its mesh, the fit (its factors by
+/// name for the class granularities, their range always), and every case's P1, base and
+/// calibrated relative L2 errors and times. `calibration_file` names the calibration file written
+/// from study.calibration (write_calibration). reports::calibration_markdown renders it.
+std::string calibration_study_json(const CalibrationStudy& study, const std::string& command,
+                                   const std::string& calibration_file);
+/// The same, written atomically to `path` (InputError if it cannot).
+void write_calibration_study(const std::filesystem::path& path, const CalibrationStudy& study,
+                             const std::string& command, const std::string& calibration_file);
 
 }  // namespace vessel

@@ -1,5 +1,5 @@
 #pragma once
-/// `vesselverify recommend` (issue #7): the cheapest model that meets a scene's budget. Candidate
+/// `vesselverify recommend`: the cheapest model that meets a scene's budget. Candidate
 /// models are generated from the msm library's own lists (every stiffness rule, surface and
 /// volume, static solvers or integrators, mesh levels, region-of-interest radii, plus FEM P1), run
 /// against the FEM reference at the budget's load, and judged on the budget's quantity and on the
@@ -112,13 +112,11 @@ bool rate_independent(const Recommendation& r);
 /// them again. std::logic_error unless rate_independent(r).
 Recommendation rejudged(const Recommendation& r, double rate_hz);
 
-/// recommend.md and recommend.json into `output_dir`.
+/// recommend.json into `output_dir`, and recommend.md: the report's section drawn from that
+/// JSON (reports::recommendation_markdown: the budget, the answer, and every candidate's error
+/// and time, Pareto front, verdict and reason).
 void write_recommendation(const Recommendation& r, const std::filesystem::path& output_dir,
                           const std::string& command);
-
-/// The Markdown section "## Model recommendation: <scene>" with the budget, the answer, and the
-/// evidence table (every candidate's error and time, Pareto front, verdict and reason).
-std::string recommendation_markdown(const Recommendation& r, const std::string& command);
 /// recommend.json (schema "vesselverify.recommend", version 1) as written into `output_dir`: its
 /// optional "results" names the candidates' results.json relative to that folder.
 std::string recommendation_json(const Recommendation& r, const std::string& command,
