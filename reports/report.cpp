@@ -12,6 +12,7 @@
 #include "meshes/foundation/atomic_file.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "reports/best_model.hpp"
+#include "reports/guidewire_section.hpp"
 #include "reports/modal_section.hpp"
 #include "reports/representative_load.hpp"
 #include "reports/scene_card.hpp"
@@ -440,6 +441,7 @@ void scene_section(Document& doc, const SceneRows& s, SeriesStyles& styles) {
   }
   doc.table(refs);
   doc.slot("view:" + s.name);
+  guidewire_section(doc, s);
   const FigureContext c{doc, s, representative_load(s), first_nu(s), styles};
   speed_error_figure(c);
   error_vs_nu_figure(c);

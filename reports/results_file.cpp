@@ -91,6 +91,39 @@ ModalRow read_modal(const json& j, const std::string& where) {
   return m;
 }
 
+GuidewireRows read_guidewire(const json& g, const std::string& where) {
+  GuidewireRows w;
+  w.model = field<std::string>(g, "model", where);
+  w.coupling = field<std::string>(g, "coupling", where);
+  for (const json& r : field<json>(g, "rigid", where)) {
+    w.rigid.push_back({field<double>(r, "bending_stiffness_Nm2", where + ".rigid"),
+                       field<double>(r, "contact_force_N", where + ".rigid") * 1e3,
+                       json_fields::optional_field<double>(r, "wire_compliance_m_per_N",
+                                                           where + ".rigid")});
+  }
+  for (const json& r : field_or<json>(g, "coupling_rows", json::array(), where)) {
+    const std::string rw = where + ".coupling_rows";
+    GuidewireCoupledRow c;
+    c.model = field<std::string>(r, "model", rw);
+    c.poisson_ratio = field<double>(r, "poisson_ratio", rw);
+    c.level = field<int>(r, "level", rw);
+    c.bending_stiffness = field<double>(r, "bending_stiffness_Nm2", rw);
+    c.ok = field<bool>(r, "ok", rw);
+    if (!c.ok) {
+      c.failure = field<std::string>(r, "failure", rw);
+    } else {
+      c.force_mN = field<double>(r, "force_mN", rw);
+      c.reference_force_mN = field<double>(r, "reference_force_mN", rw);
+      c.displacement_mm = field<double>(r, "contact_displacement_mm", rw);
+      c.reference_displacement_mm = field<double>(r, "reference_contact_displacement_mm", rw);
+      c.slide_mm = field<double>(r, "slide_mm", rw);
+      c.within_patch = field<bool>(r, "within_patch", rw);
+    }
+    w.coupled.push_back(std::move(c));
+  }
+  return w;
+}
+
 /// A reference's GCI order as the report shows it: "1 (assumed, Fs 3)", or "none".
 std::string gci_text(const json& j, const std::string& where) {
   const std::string source = field<std::string>(j, "source", where);
@@ -195,6 +228,9 @@ ResultsFile parse_results(const std::string& text, const std::filesystem::path& 
       for (std::size_t k = 0; k < models.size(); ++k) {
         sr.model_modes.push_back(read_modal(models[k], w + ".models[" + std::to_string(k) + "]"));
       }
+    }
+    if (const auto g = s.find("guidewire"); g != s.end() && !g->is_null()) {
+      sr.guidewire = read_guidewire(*g, where + ".guidewire");
     }
     r.scenes.push_back(std::move(sr));
   }

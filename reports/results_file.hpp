@@ -86,6 +86,27 @@ struct ModalRow {
   double seconds = 0.0;
 };
 
+/// A guidewire load (results.json's guidewire): the wire against the rigid lumen at each
+/// bending stiffness, and each model's contact force coupled through its wall compliance.
+struct GuidewireRigidRow {
+  double bending_stiffness = 0.0;  ///< N·m²
+  double force_mN = 0.0;
+  std::optional<double> wire_compliance;  ///< m/N, compliant coupling only
+};
+struct GuidewireCoupledRow {
+  std::string model, failure;
+  double poisson_ratio = 0.0, bending_stiffness = 0.0;
+  int level = 0;
+  bool ok = false, within_patch = true;
+  double force_mN = 0.0, reference_force_mN = 0.0;
+  double displacement_mm = 0.0, reference_displacement_mm = 0.0, slide_mm = 0.0;
+};
+struct GuidewireRows {
+  std::string model, coupling;  ///< the wire's rod model; rigid | compliant
+  std::vector<GuidewireRigidRow> rigid;
+  std::vector<GuidewireCoupledRow> coupled;
+};
+
 struct SceneRows {
   std::string name, description, vessel, load, load_unit;
   std::vector<int> model_levels;
@@ -99,6 +120,7 @@ struct SceneRows {
   /// The QoI point (for contact loads the contact point), mm; nullopt in files without it.
   std::optional<std::vector<double>> qoi_point_mm;
   std::optional<ContactPatchRow> contact_patch;  ///< contact loads only
+  std::optional<GuidewireRows> guidewire;         ///< guidewire loads only
   std::vector<ReferenceRow> references;
   std::vector<OutcomeRow> outcomes;
   /// Natural frequencies (absent from runs without [modes]): the reference per ν, the models.

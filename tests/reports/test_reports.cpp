@@ -13,6 +13,9 @@
 #include "reports/representative_load.hpp"
 #include "reports/study_files.hpp"
 #include "reports/svg_plot.hpp"
+#include "../test_helpers.hpp"
+
+#include <filesystem>
 
 using namespace vessel;
 using namespace vessel::reports;
@@ -402,4 +405,51 @@ TEST(Gate, TimingsAreComparedNormalisedByTheReferenceKernel) {
   // Below the floor (50 ms in the baseline) times are noise: not gated.
   const auto tiny = results_with({outcome("a", 1e-3, 0.1, 0.01)}, 0.010);
   EXPECT_TRUE(compare_with_baseline(tiny, results_with({outcome("a", 1e-3, 0.1, 0.1)}, 0.010)).passed());
+}
+
+TEST(GuidewireSection, TheWiresForcesAndEachModelsCoupledForceAsResultsJsonGivesThem) {
+  // The fixture's results with a guidewire block written by hand: two stiffnesses against the
+  // rigid lumen, a coupled row inside the patch, one that slid out of it, and a failed one.
+  auto j = nlohmann::json::parse(test::read_text(
+      std::filesystem::path(VESSEL_REPORT_FIXTURE) / "results.json"));
+  const auto row = [](const std::string& model, double ei, bool within) {
+    return nlohmann::json{{"model", model}, {"poisson_ratio", 0.45}, {"level", 0},
+                          {"bending_stiffness_Nm2", ei}, {"ok", true}, {"failure", ""},
+                          {"force_mN", 0.45}, {"reference_force_mN", 0.44},
+                          {"contact_displacement_mm", 0.15},
+                          {"reference_contact_displacement_mm", 0.21}, {"slide_mm", within ? 0.02 : 1.5},
+                          {"within_patch", within}};
+  };
+  nlohmann::json failed = row("volume_springs", 4e-5, true);
+  failed["ok"] = false;
+  failed["failure"] = "secant did not converge";
+  j["scenes"][0]["guidewire"] = {
+      {"model", "der"},
+      {"coupling", "compliant"},
+      {"rigid",
+       {{{"bending_stiffness_Nm2", 4e-7}, {"contact_force_N", 4.707e-4},
+         {"wire_compliance_m_per_N", 6.95}},
+        {{"bending_stiffness_Nm2", 4e-5}, {"contact_force_N", 4.707e-2},
+         {"wire_compliance_m_per_N", 0.0695}}}},
+      {"coupling_rows", {row("fem_p1", 4e-7, true), row("other_springs", 4e-5, false), failed}}};
+  const ResultsFile r = parse_results(j.dump(), "results.json");
+  ASSERT_TRUE(r.scenes[0].guidewire.has_value());
+  const GuidewireRows& g = *r.scenes[0].guidewire;
+  ASSERT_EQ(g.rigid.size(), 2u);
+  EXPECT_DOUBLE_EQ(g.rigid[1].force_mN, 47.07);
+  ASSERT_EQ(g.coupled.size(), 3u);
+  EXPECT_FALSE(g.coupled[1].within_patch);
+  const std::string md = build_report(r, std::nullopt, "test").markdown_text("figures");
+  EXPECT_EQ(count(md, "### The guidewire"), 1u) << md;
+  EXPECT_EQ(count(md, "| 4e-07 | 0.471 | 6.95 |"), 1u) << md;
+  EXPECT_EQ(count(md, "| fem_p1 | 0.45 | 0 | 4e-07 | 0.45 | 0.44 | 0.01 | 0.15 | 0.21 | 0.02 |"), 1u)
+      << md;
+  EXPECT_EQ(count(md, "| 1.5 ⚠ |"), 1u) << md;
+  EXPECT_EQ(count(md, "failed: secant did not converge"), 1u) << md;
+  // A scene without a wire has no such section.
+  j["scenes"][0].erase("guidewire");
+  EXPECT_EQ(count(build_report(parse_results(j.dump(), "r.json"), std::nullopt, "t")
+                      .markdown_text("figures"),
+                  "The guidewire"),
+            0u);
 }
