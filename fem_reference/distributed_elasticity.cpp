@@ -305,21 +305,7 @@ void Distributed::assemble() {
     assemble_mixed();
     return;
   }
-  CellValues values(mapping_, *fe_, degree_);
-  const unsigned n = fe_->n_dofs_per_cell();
-  dl::FullMatrix<double> k(n, n);
-  dl::Vector<double> f(n);
-  std::vector<dl::types::global_dof_index> dofs(n);
-  Vec3 applied = Vec3::Zero();
-  for (const auto& cell : dof_.active_cell_iterators()) {
-    if (!cell->is_locally_owned()) continue;
-    form_->local_system(cell, values, k, f, &applied);
-    cell->get_dof_indices(dofs);
-    constraints_.distribute_local_to_global(k, f, dofs, matrix_, rhs_);
-  }
-  matrix_.compress(dl::VectorOperation::add);
-  rhs_.compress(dl::VectorOperation::add);
-  out_.fem.applied_load = sum_over_ranks(applied);
+  assemble_into(matrix_, rhs_);
 }
 
 DisplacementRows Distributed::owned_rows(const dl::IndexSet& rows_set) const {

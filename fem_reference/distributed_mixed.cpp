@@ -110,21 +110,7 @@ void Distributed::setup_mixed_system() {
 }
 
 void Distributed::assemble_mixed() {
-  CellValues values(mapping_, *fe_, degree_);
-  const unsigned n = fe_->n_dofs_per_cell();
-  dl::FullMatrix<double> k(n, n);
-  dl::Vector<double> f(n);
-  std::vector<dl::types::global_dof_index> dofs(n);
-  Vec3 applied = Vec3::Zero();
-  for (const auto& cell : dof_.active_cell_iterators()) {
-    if (!cell->is_locally_owned()) continue;
-    form_->local_system(cell, values, k, f, &applied);
-    cell->get_dof_indices(dofs);
-    constraints_.distribute_local_to_global(k, f, dofs, block_matrix_, block_rhs_);
-  }
-  block_matrix_.compress(dl::VectorOperation::add);
-  block_rhs_.compress(dl::VectorOperation::add);
-  out_.fem.applied_load = sum_over_ranks(applied);
+  assemble_into(block_matrix_, block_rhs_);
   assemble_schur_approximation();
 }
 

@@ -44,6 +44,26 @@ class Distributed {
   void setup_dofs();
   void setup_constraints();
   void assemble();
+  /// The locally owned cells' weak form into `matrix` and `rhs` (plain or block, Trilinos),
+  /// compressed; the applied load summed over the ranks into out_.
+  template <class Matrix, class Vector>
+  void assemble_into(Matrix& matrix, Vector& rhs) {
+    CellValues values(mapping_, *fe_, degree_);
+    const unsigned n = fe_->n_dofs_per_cell();
+    dl::FullMatrix<double> k(n, n);
+    dl::Vector<double> f(n);
+    std::vector<dl::types::global_dof_index> dofs(n);
+    Vec3 applied = Vec3::Zero();
+    for (const auto& cell : dof_.active_cell_iterators()) {
+      if (!cell->is_locally_owned()) continue;
+      form_->local_system(cell, values, k, f, &applied);
+      cell->get_dof_indices(dofs);
+      constraints_.distribute_local_to_global(k, f, dofs, matrix, rhs);
+    }
+    matrix.compress(dl::VectorOperation::add);
+    rhs.compress(dl::VectorOperation::add);
+    out_.fem.applied_load = sum_over_ranks(applied);
+  }
   void solve_linear();
   /// The locally owned rows of `rows` (a set of displacement DoFs) in the row map's order.
   [[nodiscard]] DisplacementRows owned_rows(const dl::IndexSet& rows) const;
