@@ -272,7 +272,7 @@ std::pair<msm::StiffnessParameters, Eigen::VectorXd> calibration_parameters(
   const bool has_kappa = std::any_of(c.names.begin(), c.names.end(), [](const std::string& n) {
     return n == "kappa" || n.rfind("kappa/", 0) == 0;
   });
-  if (has_kappa && !built.volume_kappa) {
+  if (has_kappa && !built.terms.volume_kappa) {
     throw InputError(source + ": the calibration scales kappa, but the model has no volume term");
   }
   msm::StiffnessParameters params;
@@ -371,7 +371,7 @@ void apply_calibration(const Calibration& c, const std::string& source, msm::Bui
     }
   }
   auto [params, theta] = calibration_parameters(c, source, built, vessel);
-  msm::apply_stiffness_factors(built.network, built.volume_kappa, params, theta);
+  msm::apply_stiffness_factors(built.network, built.terms.volume_kappa, params, theta);
 }
 
 }  // namespace vessel

@@ -60,7 +60,7 @@ struct ModelSpec {
   msm::WallSurface surface = msm::NetworkOptions{}.surface;  ///< surface msm: which wall
   msm::Topology topology = msm::Topology::automatic;      ///< surface msm
   msm::StiffnessRule stiffness = msm::StiffnessRule::seed000;
-  /// volume_msm: the hybrid volume model (Golec et al. 2020; msm/model/model.hpp):
+  /// volume_msm: the hybrid volume model (Golec et al. 2020; msm/model/mass_spring_model.hpp):
   /// van-gelder springs carrying μ plus a volume energy per tet with κ = λ − μ (any ν < 0.5).
   bool volume_term = false;
   /// volume_term's rule for (E_s, κ): golec (default) or homogenised (msm/model/build_network.hpp).

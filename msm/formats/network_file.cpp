@@ -552,12 +552,12 @@ void write_network_file(const std::filesystem::path& path, const NetworkFile& fi
 
 NetworkFile network_file_of(const BuiltNetwork& built, NetworkSupports supports,
                             std::string description) {
-  if (built.volume_kappa) {
+  if (built.terms.volume_kappa) {
     throw InputError("export network: the hybrid volume model's volume term (κ per tet) is not a "
                      "spring; the network format holds springs only (export without "
                      "--volume-term)");
   }
-  if (built.bending_rigidity) {
+  if (built.terms.bending_rigidity) {
     throw InputError("export network: the discrete-shells bending term is not a spring; the "
                      "network format holds springs only (export with --bending none)");
   }

@@ -5,8 +5,9 @@
 
 #include "meshes/foundation/errors.hpp"
 #include "msm/kernels/spring_kernels.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/stiffness/hybrid_moduli.hpp"
+#include "msm/terms/bending_term.hpp"
 #include "msm/terms/volume_term_homogenised.hpp"
 
 namespace vessel::msm {
@@ -83,7 +84,7 @@ void apply_bending(BuiltNetwork& built, const NetworkOptions& o) {
   springs.erase(std::remove_if(springs.begin(), springs.end(),
                                [](const Spring& s) { return s.family == SpringFamily::bend; }),
                 springs.end());
-  built.bending_rigidity = plate_bending_rigidity(
+  built.terms.bending_rigidity = plate_bending_rigidity(
       o.stiffness_params.youngs_modulus, built.network.thickness, o.stiffness_params.poisson_ratio);
   built.topology += " without bend springs + discrete-shell hinges (Grinspun et al. 2003)";
 }
@@ -100,7 +101,7 @@ void apply_edge_pairs(BuiltNetwork& built, const NetworkOptions& o) {
     throw InputError("edge_pairs: the edge-pair model is StVK P1 on the tets' edges and reaches "
                      "any ν < 0.5 by itself; expected volume_term = false with it");
   }
-  built.edge_pairs = lame_parameters(o.stiffness_params.youngs_modulus,
+  built.terms.edge_pairs = lame_parameters(o.stiffness_params.youngs_modulus,
                                      o.stiffness_params.poisson_ratio);
   built.network.springs.clear();
   built.topology += " coupled in tetrahedron-sharing edge pairs (Kikuuwe et al. 2009: StVK P1 "
@@ -126,13 +127,13 @@ void assign_laws_and_masses(BuiltNetwork& built, const NetworkOptions& o) {
       const HomogenisedModuli m = homogenised_moduli(built.network.nodes, built.network.tets,
                                                      params.youngs_modulus, params.poisson_ratio);
       params.youngs_modulus = m.spring_youngs_modulus;
-      built.volume_kappa = m.kappa;
+      built.terms.volume_kappa = m.kappa;
       built.network.tet_kappa_factors = m.tet_factors;
       built.topology += " + volume term per tet, (E_s, κ) homogenised on this mesh";
     } else {
       const HybridModuli m = hybrid_moduli(params.youngs_modulus, params.poisson_ratio);
       params.youngs_modulus = m.spring_youngs_modulus;
-      built.volume_kappa = m.kappa;
+      built.terms.volume_kappa = m.kappa;
       built.topology += " + volume term per tet (Golec et al. 2020)";
     }
   } else if (o.volume_moduli != VolumeModuli::golec) {

@@ -8,8 +8,8 @@
 
 #include "meshes/tet_mesh.hpp"
 #include "meshes/vessel_geometry.hpp"
-#include "msm/terms/edge_pair_term.hpp"
 #include "msm/mass/mass_rules.hpp"
+#include "msm/model/model_terms.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 #include "msm/topology/springs.hpp"
 
@@ -85,13 +85,9 @@ struct BuiltNetwork {
   SpringNetwork network;      ///< springs with stiffness and damping assigned
   std::vector<double> masses;  ///< kg per network node
   std::string topology;        ///< human-readable description
-  /// κ (Pa) of the volume term on network.tets (options.volume_term); none: springs only.
-  std::optional<double> volume_kappa;
-  /// D (N·m) of the Discrete Shells bending term on network.triangles (options.bending); none: no
-  /// bending term.
-  std::optional<double> bending_rigidity;
-  /// The StVK material of the edge-pair term on network.tets (options.edge_pairs); none: no term.
-  std::optional<LameParameters> edge_pairs;
+  /// The energy terms the network carries besides its springs (options.volume_term, .bending,
+  /// .edge_pairs), with their parameters.
+  ModelTerms terms;
   /// A network read from a file: its own supports (the problem holds exactly those), and the file
   /// for messages. Unset for built-in networks.
   std::optional<NetworkSupports> file_supports;

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "meshes/foundation/errors.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/terms/spring_model.hpp"
 #include "msm/linalg/linear_solver.hpp"
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "meshes/foundation/errors.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/local_global.hpp"
 #include "msm/solvers/critical_step.hpp"
 

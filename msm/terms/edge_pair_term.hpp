@@ -71,7 +71,7 @@ class EdgePairTerm : public FourNodeTerm {
   EdgePairTerm(const std::vector<Vec3>& nodes, std::vector<Tet> tets, const LameParameters& lame);
 
   /// Largest edge strain |l − L|/L over the tets' edges at x.
-  [[nodiscard]] double max_strain(const VectorXd& x) const;
+  [[nodiscard]] double max_strain(const VectorXd& x) const override;
   [[nodiscard]] const LameParameters& lame() const { return lame_; }
 
  private:

@@ -51,6 +51,9 @@ class FourNodeTerm : public Form {
                    bool project_psd) const;
   /// The sparsity pattern of the term's Hessian (element blocks plus the full diagonal), values 0.
   [[nodiscard]] const SparseMatrix& pattern() const { return pattern_; }
+  /// The largest strain the term measures on its own elements at x (the edge-pair term's tet
+  /// edges); 0 for a term that measures none.
+  [[nodiscard]] virtual double max_strain(const VectorXd& /*x*/) const { return 0.0; }
   /// Each element's four node indices.
   [[nodiscard]] const std::vector<std::array<int, 4>>& elements() const { return elements_; }
 

@@ -11,7 +11,7 @@
 ///   ∇²W = κ/V₀ · ∇V ∇Vᵀ + κ·(V − V₀)/V₀ · ∇²V.
 /// Under a small uniform strain ε, V − V₀ = V₀·tr ε, so W = ½·κ·V₀·(tr ε)²: the term adds exactly κ
 /// to the network's λ and nothing to μ, on every tet whatever its shape (derivation of κ for the
-/// network in model/model.hpp). Source check (2026-11): the paper's abstract was retrieved
+/// network in model/mass_spring_model.hpp). Source check (2026-11): the paper's abstract was retrieved
 /// ("supplement the spring deformation energy with an energy depending on the volume only,
 /// insensitive to change of shape"); its own formulation (equations) was not, so this quadratic
 /// form is the issue's, W = ½κV₀(V/V₀ − 1)², and the paper's equation numbers are not cited.

@@ -118,8 +118,8 @@ TEST(CalibrationFile, RoundTripAndAppliedFactorsScaleEachSpringAndKappa) {
       EXPECT_NEAR(applied.network.springs[s].law.k1, factor * base.network.springs[s].law.k1,
                   1e-12 * base.network.springs[s].law.k1);
     }
-    EXPECT_NEAR(*applied.volume_kappa, c.factors.back() * *base.volume_kappa,
-                1e-12 * *base.volume_kappa);
+    EXPECT_NEAR(*applied.terms.volume_kappa, c.factors.back() * *base.terms.volume_kappa,
+                1e-12 * *base.terms.volume_kappa);
   }
 }
 
@@ -149,7 +149,7 @@ TEST(CalibrationFile, WallLayerCalibrationRoundTripsAndScalesSpringsAndEachTetsK
     EXPECT_NEAR(applied.network.springs[s].law.k1, factor * base.network.springs[s].law.k1,
                 1e-12 * base.network.springs[s].law.k1);
   }
-  EXPECT_DOUBLE_EQ(*applied.volume_kappa, *base.volume_kappa);  // κ scaled per tet instead
+  EXPECT_DOUBLE_EQ(*applied.terms.volume_kappa, *base.terms.volume_kappa);  // κ scaled per tet instead
   ASSERT_EQ(applied.network.tet_kappa_factors.size(), base.network.tets.size());
   int inner = 0, outer = 0;
   for (std::size_t e = 0; e < base.network.tets.size(); ++e) {
@@ -193,7 +193,7 @@ TEST(CalibrationFile, PerSpringCalibrationKeepsItsKappaHalves) {
     EXPECT_NEAR(applied.network.springs[s].law.k1, c.factors[s] * base.network.springs[s].law.k1,
                 1e-12 * base.network.springs[s].law.k1);
   }
-  EXPECT_DOUBLE_EQ(*applied.volume_kappa, *base.volume_kappa);
+  EXPECT_DOUBLE_EQ(*applied.terms.volume_kappa, *base.terms.volume_kappa);
   ASSERT_EQ(applied.network.tet_kappa_factors.size(), base.network.tets.size());
   for (std::size_t e = 0; e < base.network.tets.size(); ++e) {
     const double base_factor =
@@ -230,8 +230,8 @@ TEST(CalibrationFile, PerSectionSpringCalibrationAppliesOnItsMeshOnly) {
     EXPECT_NEAR(applied.network.springs[s].law.k1, factor * base.network.springs[s].law.k1,
                 1e-12 * factor * base.network.springs[s].law.k1);
   }
-  EXPECT_NEAR(*applied.volume_kappa, std::exp(theta[p.kappa]) * *base.volume_kappa,
-              1e-12 * *base.volume_kappa);
+  EXPECT_NEAR(*applied.terms.volume_kappa, std::exp(theta[p.kappa]) * *base.terms.volume_kappa,
+              1e-12 * *base.terms.volume_kappa);
   TetMesh moved = mesh;
   moved.nodes[5].x() += 1e-6;
   msm::BuiltNetwork on_moved = hybrid(moved);

@@ -15,7 +15,7 @@
 #include "msm/calibration/lbfgs.hpp"
 #include "msm/calibration/stiffness_fit.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/solve.hpp"
 #include "tests/fixtures/kuhn_block.hpp"
 
@@ -106,7 +106,7 @@ TEST(StiffnessFit, LinearisedStiffnessIsTheModelsHessianAtRest) {
   const StiffnessParameters params = group_parameters(built.network, VesselParams{}, true);
   std::mt19937 rng(1);
   const Eigen::VectorXd f = random_load(built.network, rng, 1e-6);
-  const LinearisedFit fit(built.network, built.volume_kappa, fixed, params,
+  const LinearisedFit fit(built.network, built.terms.volume_kappa, fixed, params,
                           {{"c", f, Eigen::VectorXd::Ones(f.size())}});
   const SparseMatrix K = fit.stiffness(Eigen::VectorXd::Zero(params.size()));
   const auto model = make_model(built);
@@ -173,7 +173,7 @@ TEST(StiffnessFit, AdjointGradientMatchesFiniteDifferences) {
       reg.centre.resize(params.size());
       for (Eigen::Index i = 0; i < reg.centre.size(); ++i) reg.centre[i] = u(rng);
     }
-    const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases, reg);
+    const LinearisedFit fit(built.network, built.terms.volume_kappa, fixed, params, cases, reg);
     Eigen::VectorXd theta(params.size());
     for (Eigen::Index i = 0; i < theta.size(); ++i) theta[i] = u(rng);
     Eigen::VectorXd g;
@@ -208,14 +208,14 @@ std::pair<Eigen::VectorXd, std::vector<double>> fit_planted_factors(
     const BuiltNetwork& built, const std::vector<char>& fixed, const StiffnessParameters& params,
     const Eigen::VectorXd& planted, unsigned seed, int max_iterations) {
   BuiltNetwork truth = built;
-  apply_stiffness_factors(truth.network, truth.volume_kappa, params, planted);
+  apply_stiffness_factors(truth.network, truth.terms.volume_kappa, params, planted);
   std::mt19937 rng(seed);
   std::vector<FitCase> cases;
   for (int c = 0; c < 4; ++c) {
     const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
     cases.push_back({"case" + std::to_string(c), f, static_displacement(truth, fixed, f)});
   }
-  const LinearisedFit fit(built.network, built.volume_kappa, fixed, params, cases);
+  const LinearisedFit fit(built.network, built.terms.volume_kappa, fixed, params, cases);
   const Objective f = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g) {
     return fit.objective(x, g);
   };
@@ -284,7 +284,7 @@ TEST(StiffnessFit, ARegulariserCentreMovesBothTermsToTheDepartureFromIt) {
   Regulariser reg{0.7, 0.3, Eigen::VectorXd(params.size())};
   for (Eigen::Index i = 0; i < reg.centre.size(); ++i) reg.centre[i] = u(rng);
   const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
-  const LinearisedFit fit(built.network, built.volume_kappa, fixed, params,
+  const LinearisedFit fit(built.network, built.terms.volume_kappa, fixed, params,
                           {{"c", f, static_displacement(built, fixed, f)}}, reg);
   EXPECT_NEAR(fit.regularisation(reg.centre), 0.0, 1e-15);
   const double c = 0.4;
@@ -292,7 +292,7 @@ TEST(StiffnessFit, ARegulariserCentreMovesBothTermsToTheDepartureFromIt) {
   EXPECT_NEAR(fit.regularisation(shifted), 0.5 * 0.3 * c * c, 1e-12);
   Regulariser bad = reg;
   bad.centre.resize(3);
-  EXPECT_THROW(LinearisedFit(built.network, built.volume_kappa, fixed, params,
+  EXPECT_THROW(LinearisedFit(built.network, built.terms.volume_kappa, fixed, params,
                              {{"c", f, static_displacement(built, fixed, f)}}, bad),
                InputError);
 
@@ -301,13 +301,13 @@ TEST(StiffnessFit, ARegulariserCentreMovesBothTermsToTheDepartureFromIt) {
   Eigen::VectorXd planted(groups.size());
   for (Eigen::Index p = 0; p < planted.size(); ++p) planted[p] = 0.3 * std::sin(1.0 + p);
   BuiltNetwork truth = built;
-  apply_stiffness_factors(truth.network, truth.volume_kappa, groups, planted);
+  apply_stiffness_factors(truth.network, truth.terms.volume_kappa, groups, planted);
   Eigen::VectorXd start(params.size());
   for (std::size_t s = 0; s < built.network.springs.size(); ++s) {
     start[params.of_spring[s]] = groups.spring_log_factor(planted, s);
   }
   start[params.kappa] = planted[groups.kappa];
-  const LinearisedFit on_top(built.network, built.volume_kappa, fixed, params,
+  const LinearisedFit on_top(built.network, built.terms.volume_kappa, fixed, params,
                              {{"c", f, static_displacement(truth, fixed, f)}},
                              Regulariser{0.7, 0.3, start});
   EXPECT_LT(on_top.relative_errors(start)[0], 1e-3);  // linearised against nonlinear data (1e-4)
@@ -401,10 +401,10 @@ TEST(StiffnessFit, PerSpringFitReducesTheMisfitOfPlantedData) {
   Eigen::VectorXd planted = Eigen::VectorXd::Zero(groups.size());
   planted[0] = std::log(1.8);
   BuiltNetwork truth = built;
-  apply_stiffness_factors(truth.network, truth.volume_kappa, groups, planted);
+  apply_stiffness_factors(truth.network, truth.terms.volume_kappa, groups, planted);
   std::mt19937 rng(2);
   const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
-  const LinearisedFit fit(built.network, built.volume_kappa, fixed,
+  const LinearisedFit fit(built.network, built.terms.volume_kappa, fixed,
                           per_spring_parameters(built.network, true),
                           {{"c", f, static_displacement(truth, fixed, f)}}, Regulariser{1e-4, 1e-6, {}});
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(fit.parameters().size());
@@ -427,7 +427,7 @@ TEST(StiffnessFit, AnIndefiniteStiffnessGivesAnInfiniteObjective) {
   std::mt19937 rng(3);
   const Eigen::VectorXd f = random_load(built.network, rng, 1e-7);
   const StiffnessParameters params = group_parameters(built.network, VesselParams{}, true);
-  const double kappa = -0.5 * *built.volume_kappa;  // negative, small enough to start stable
+  const double kappa = -0.5 * *built.terms.volume_kappa;  // negative, small enough to start stable
   const LinearisedFit fit(built.network, kappa, fixed, params,
                           {{"c", f, Eigen::VectorXd::Ones(f.size())}});
   Eigen::VectorXd theta = Eigen::VectorXd::Zero(params.size()), g;
@@ -444,7 +444,7 @@ TEST(StiffnessFit, RefusesMismatchedSizesAndKappaWithoutVolumeTerm) {
   EXPECT_THROW(apply_stiffness_factors(built.network, none, params,
                                        Eigen::VectorXd::Zero(params.size())),
                InputError);
-  EXPECT_THROW(apply_stiffness_factors(built.network, built.volume_kappa, params,
+  EXPECT_THROW(apply_stiffness_factors(built.network, built.terms.volume_kappa, params,
                                        Eigen::VectorXd::Zero(params.size() + 1)),
                InputError);
 }

@@ -18,7 +18,7 @@
 #include <numbers>
 
 #include "msm/model/build_network.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/solve.hpp"
 #include "shell_meshes.hpp"
 
@@ -47,7 +47,7 @@ RingResult pinched_ring(int n_circ) {
   o.bending = Bending::discrete_shells;
   const BuiltNetwork built = build_surface_network(ring, t, o);
   const auto model = make_model(built);
-  const double D = *built.bending_rigidity;
+  const double D = *built.terms.bending_rigidity;
   // F such that δ/R ≈ 1e-4 (linear regime).
   const double coefficient = std::numbers::pi / 4 - 2 / std::numbers::pi;
   const double F = 1e-4 * R * D * L / (coefficient * R * R * R);

@@ -17,7 +17,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "msm/terms/bending_term.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/model/roi.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/solve.hpp"
@@ -157,7 +157,7 @@ TEST(BendingTerm, RigidMotionsStoreNoEnergy) {
   const TriangleSurface tube = test::cylinder_surface(3e-3, 4e-3, 12, 3);
   const BuiltNetwork built = shell(tube, 1e-3, 0.45);
   const auto model = make_model(built);
-  ASSERT_NE(model->bending_term(), nullptr);
+  ASSERT_NE(model->term<BendingTerm>(), nullptr);
   EXPECT_EQ(built.network.count(SpringFamily::bend), 0u);  // the hinges replace them
   const Eigen::VectorXd rest = flatten(built.network.nodes);
   const Eigen::Matrix3d R =
@@ -169,7 +169,7 @@ TEST(BendingTerm, RigidMotionsStoreNoEnergy) {
   // Scale: the energy and force of a 1 % perturbation.
   std::mt19937 rng(5);
   const Eigen::VectorXd bent = perturbed(rest, rng, 0.03e-3);
-  const BendingTerm& term = *model->bending_term();
+  const BendingTerm& term = *model->term<BendingTerm>();
   Eigen::VectorXd g_bent, g_moved;
   term.gradient(bent, g_bent);
   ASSERT_GT(term.energy(bent), 0.0);
@@ -226,12 +226,12 @@ TEST(BendingTerm, RolledSheetStoresThePlateEnergy) {
 TEST(BendingTerm, SurfaceModelMatchesFiniteDifferencesAndProjectsPerHinge) {
   const TriangleSurface tube = test::cylinder_surface(3e-3, 3e-3, 8, 3);
   const BuiltNetwork built = shell(tube, 1e-3, 0.45);
-  ASSERT_TRUE(built.bending_rigidity.has_value());
-  EXPECT_NEAR(*built.bending_rigidity, kE * 1e-9 / (12 * (1 - 0.45 * 0.45)), 1e-12 * kE * 1e-9);
+  ASSERT_TRUE(built.terms.bending_rigidity.has_value());
+  EXPECT_NEAR(*built.terms.bending_rigidity, kE * 1e-9 / (12 * (1 - 0.45 * 0.45)), 1e-12 * kE * 1e-9);
   const auto model = make_model(built);
   std::mt19937 rng(3);
   const Eigen::VectorXd x = perturbed(flatten(built.network.nodes), rng, 0.2e-3);
-  EXPECT_NEAR(model->energy(x), model->springs().energy(x) + model->bending_term()->energy(x),
+  EXPECT_NEAR(model->energy(x), model->springs().energy(x) + model->term<BendingTerm>()->energy(x),
               1e-12 * model->energy(x));
   const auto c =
       test::check_derivatives([&](const Eigen::VectorXd& y) { return model->energy(y); },
@@ -250,7 +250,7 @@ TEST(BendingTerm, SurfaceModelMatchesFiniteDifferencesAndProjectsPerHinge) {
   std::vector<char> held(built.network.nodes.size(), 0);
   for (std::size_t i = 0; i < held.size(); ++i) held[i] = built.network.nodes[i].x() < 1e-3;
   const RoiNetwork roi = restrict_network(built.network, held, true);
-  const auto roi_model = make_model(roi.network, std::nullopt, 0.0, built.bending_rigidity);
+  const auto roi_model = make_model(roi.network, {.bending_rigidity = built.terms.bending_rigidity});
   Eigen::VectorXd xr = flatten(roi.network.nodes), xf = flatten(built.network.nodes);
   for (std::size_t k = 0; k < roi.full_index.size(); ++k) {
     if (held[roi.full_index[k]]) continue;
@@ -258,8 +258,8 @@ TEST(BendingTerm, SurfaceModelMatchesFiniteDifferencesAndProjectsPerHinge) {
     xr.segment<3>(3 * k) += d;
     xf.segment<3>(3 * roi.full_index[k]) += d;
   }
-  EXPECT_NEAR(roi_model->bending_term()->energy(xr), model->bending_term()->energy(xf),
-              1e-12 * model->bending_term()->energy(xf));
+  EXPECT_NEAR(roi_model->term<BendingTerm>()->energy(xr), model->term<BendingTerm>()->energy(xf),
+              1e-12 * model->term<BendingTerm>()->energy(xf));
   const auto cr =
       test::check_derivatives([&](const Eigen::VectorXd& y) { return roi_model->energy(y); },
                               gradient_of(*roi_model), dense_hessian(*roi_model, false), xr, 1e-9);
@@ -284,7 +284,7 @@ TEST(BendingTerm, BadInputIsRefusedByName) {
   // The bending term needs triangles: a volume network has none.
   SpringNetwork no_triangles;
   no_triangles.nodes = tube.nodes;
-  EXPECT_THROW((void)make_model(no_triangles, std::nullopt, 0.0, 1e-6), InputError);
+  EXPECT_THROW((void)make_model(no_triangles, {.bending_rigidity = 1e-6}), InputError);
 }
 
 TEST(BendingTerm, CriticalStepBoundAccountsForTheBendingTerm) {
@@ -294,7 +294,7 @@ TEST(BendingTerm, CriticalStepBoundAccountsForTheBendingTerm) {
   const TriangleSurface tube = test::cylinder_surface(3e-3, 2e-3, 24, 8);
   const BuiltNetwork built = shell(tube, 6e-3, 0.3);
   const auto model = make_model(built);
-  const auto springs = make_model(built.network, std::nullopt);
+  const auto springs = make_model(built.network);
   auto problem = [&](const Form& f) {
     Problem p;
     p.form = &f;
@@ -365,7 +365,7 @@ TEST(BendingTerm, EverySolverRunsOnTheShellModelAndAgrees) {
   pbd.steps = 10;
   EXPECT_THROW((void)solve(q, pbd, &built.network), InputError);
   // Without the bending term the same network is plain springs again and local-global runs.
-  const auto plain = make_model(built.network, std::nullopt);
+  const auto plain = make_model(built.network);
   EXPECT_NE(plain_spring_model(*plain), nullptr);
   EXPECT_EQ(plain_spring_model(*undamped), nullptr);
 }

@@ -14,7 +14,7 @@
 #include "msm/kernels/spring_kernels.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/terms/edge_pair_term.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/model/roi.hpp"
 #include "msm/solvers/solve.hpp"
 #include "tests/fem/cube_mesh.hpp"
@@ -238,8 +238,8 @@ TEST(EdgePairTerm, NetworkReplacesTheSpringsAndSumsToFiniteDifferences) {
   const TetMesh mesh = vessel::test::cube_mesh(2, 2e-3);
   const BuiltNetwork built = build_network(mesh, VesselParams{}, edge_pair_options(0.1));
   EXPECT_TRUE(built.network.springs.empty());
-  ASSERT_TRUE(built.edge_pairs.has_value());
-  EXPECT_NEAR(built.edge_pairs->mu, kE / 2.2, 1e-9 * kE);
+  ASSERT_TRUE(built.terms.edge_pairs.has_value());
+  EXPECT_NEAR(built.terms.edge_pairs->mu, kE / 2.2, 1e-9 * kE);
   // Masses as the springs' network of the same tets has them.
   NetworkOptions plain = edge_pair_options(0.1);
   plain.edge_pairs = false;
@@ -249,7 +249,7 @@ TEST(EdgePairTerm, NetworkReplacesTheSpringsAndSumsToFiniteDifferences) {
     EXPECT_DOUBLE_EQ(built.masses[i], springs.masses[i]);
   }
   const auto model = make_model(built);
-  ASSERT_NE(model->edge_pair_term(), nullptr);
+  ASSERT_NE(model->term<EdgePairTerm>(), nullptr);
   EXPECT_EQ(plain_spring_model(*model), nullptr);
   std::mt19937 rng(5);
   Eigen::VectorXd x = flatten(built.network.nodes);
@@ -302,7 +302,7 @@ TEST(EdgePairTerm, RegionOfInterestSolvesWhatTheWholeModelSolvesWithTheSameNodes
     moving_tets += !(held[t[0]] && held[t[1]] && held[t[2]] && held[t[3]]);
   }
   EXPECT_EQ(roi.network.tets.size(), moving_tets);
-  const auto roi_model = make_model(roi.network, std::nullopt, 0.0, std::nullopt, built.edge_pairs);
+  const auto roi_model = make_model(roi.network, {.edge_pairs = built.terms.edge_pairs});
   const Problem part = restrict_problem(full, roi, held, *roi_model);
   const SolveResult b = solve(part, parse_solver("static"));
   const double u = (a.x - whole.rest).lpNorm<Eigen::Infinity>();

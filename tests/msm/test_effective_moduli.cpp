@@ -12,7 +12,7 @@
 
 #include "meshes/foundation/errors.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
 
@@ -64,7 +64,7 @@ struct Moduli {
 /// y = L / L)/ε.
 Moduli measure(const SpringNetwork& net, double strain, std::optional<double> kappa = {},
                std::optional<LameParameters> edge_pairs = {}) {
-  const auto model_ptr = make_model(net, kappa, 0.0, std::nullopt, edge_pairs);
+  const auto model_ptr = make_model(net, {.volume_kappa = kappa, .edge_pairs = edge_pairs});
   const MassSpringModel& model = *model_ptr;
   Problem p;
   p.form = &model;
@@ -168,8 +168,8 @@ TEST(EffectiveModuli, HybridVolumeModelMovesNuTowardsTheTarget) {
     o.stiffness_params.poisson_ratio = nu;
     o.volume_term = true;
     const BuiltNetwork built = build_network(mesh, vessel, o);
-    ASSERT_TRUE(built.volume_kappa.has_value());
-    const Moduli m = measure(built.network, 1e-4, built.volume_kappa);
+    ASSERT_TRUE(built.terms.volume_kappa.has_value());
+    const Moduli m = measure(built.network, 1e-4, built.terms.volume_kappa);
     std::printf("hybrid volume model, target nu = %.2f: E_eff/E = %.4f, nu_eff = %.4f\n", nu,
                 m.E / E, m.nu);
     EXPECT_NEAR(m.E / E, 1.0, 0.06) << "ν = " << nu;
@@ -211,13 +211,13 @@ TEST(EffectiveModuli, HomogenisedVolumeModelHitsTheTargetModuli) {
     o.volume_term = true;
     o.volume_moduli = VolumeModuli::homogenised;
     const BuiltNetwork built = build_network(mesh, vessel, o);
-    ASSERT_TRUE(built.volume_kappa.has_value());
-    EXPECT_EQ(*built.volume_kappa < 0, nu < 0.25) << "ν = " << nu;
-    const Moduli m = measure(built.network, 1e-4, built.volume_kappa);
+    ASSERT_TRUE(built.terms.volume_kappa.has_value());
+    EXPECT_EQ(*built.terms.volume_kappa < 0, nu < 0.25) << "ν = " << nu;
+    const Moduli m = measure(built.network, 1e-4, built.terms.volume_kappa);
     std::printf(
         "homogenised volume model, target nu = %.2f: kappa/E = %+.4f, clipped tets %zu; "
         "E_eff/E = %.4f, nu_eff = %.4f\n",
-        nu, *built.volume_kappa / E,
+        nu, *built.terms.volume_kappa / E,
         static_cast<std::size_t>(std::count_if(built.network.tet_kappa_factors.begin(),
                                                built.network.tet_kappa_factors.end(),
                                                [](double f) { return f < 1.0; })),
@@ -257,7 +257,7 @@ TEST(EffectiveModuli, EdgePairModelHasTheTargetModuliAtEveryNu) {
     o.stiffness_params.poisson_ratio = nu;
     o.edge_pairs = true;
     const BuiltNetwork built = build_network(mesh, VesselParams{}, o);
-    const Moduli m = measure(built.network, 1e-4, std::nullopt, built.edge_pairs);
+    const Moduli m = measure(built.network, 1e-4, std::nullopt, built.terms.edge_pairs);
     std::printf("edge-pair model, target nu = %.2f: E_eff/E = %.6f, nu_eff = %.6f\n", nu, m.E / E,
                 m.nu);
     EXPECT_NEAR(m.E / E, 1.0, 1e-3) << "ν = " << nu;

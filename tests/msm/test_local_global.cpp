@@ -12,7 +12,7 @@
 #include "meshes/surface_loads.hpp"
 #include "msm/kernels/spring_kernels.hpp"
 #include "msm/mass/mass_rules.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/terms/spring_model.hpp"
 #include "msm/solvers/local_global.hpp"
 #include "msm/solvers/solve.hpp"
@@ -228,7 +228,7 @@ TEST(LocalGlobal, RunsOnTheFactorysSpringsOnlyModelAndRefusesItsVolumeTerm) {
   // The harness and the msm command build every model with make_model: without a volume term it
   // is the same springs, so local-global must give the SpringModel's answer bit for bit.
   const Lattice c = make_lattice(2e-4);
-  const auto factory_model = make_model(c.net, std::nullopt, 2e-4);
+  const auto factory_model = make_model(c.net, {}, 2e-4);
   Problem via_factory = c.problem;
   via_factory.form = factory_model.get();
   DynamicOptions d;
@@ -238,7 +238,7 @@ TEST(LocalGlobal, RunsOnTheFactorysSpringsOnlyModelAndRefusesItsVolumeTerm) {
                 .norm(),
             0.0);
   // With the hybrid model's volume term: refused, naming why.
-  const auto hybrid = make_model(tube().net, 1.0e3);
+  const auto hybrid = make_model(tube().net, {.volume_kappa = 1.0e3});
   Problem with_volume = tube().problem;
   with_volume.form = hybrid.get();
   const std::string e = error_of([&] { solve_static_local_global(with_volume); });

@@ -11,7 +11,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "msm/dynamics/natural_frequencies.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/terms/spring_model.hpp"
 #include "tests/fixtures/kuhn_block.hpp"
 
@@ -173,9 +173,9 @@ TEST(NaturalFrequencies, HybridVolumeModelAgreesWithDenseGeneralisedSolver) {
   no.mass = MassRule::consistent;
   no.density = 1060.0;
   const BuiltNetwork built = build_network(mesh, VesselParams{}, no);
-  ASSERT_TRUE(built.volume_kappa.has_value());
+  ASSERT_TRUE(built.terms.volume_kappa.has_value());
   const auto hybrid = make_model(built);
-  const auto springs = make_model(built.network, std::nullopt);
+  const auto springs = make_model(built.network);
   auto problem = [&](const Form& form) {
     Problem p;
     p.form = &form;

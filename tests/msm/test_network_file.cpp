@@ -310,10 +310,10 @@ TEST(NetworkFile, AVtuWithoutMassesOrStiffnessIsRefused) {
 TEST(NetworkFile, AModelWithAVolumeOrBendingTermIsNotExported) {
   BuiltNetwork built;
   built.network.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0)};
-  built.volume_kappa = 1.0;
+  built.terms.volume_kappa = 1.0;
   EXPECT_THROW((void)network_file_of(built, {}, ""), InputError);
-  built.volume_kappa.reset();
-  built.bending_rigidity = 1.0;
+  built.terms.volume_kappa.reset();
+  built.terms.bending_rigidity = 1.0;
   EXPECT_THROW((void)network_file_of(built, {}, ""), InputError);
 }
 

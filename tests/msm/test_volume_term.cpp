@@ -12,11 +12,12 @@
 #include "finite_differences.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/model/roi.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/solve.hpp"
 #include "msm/solvers/critical_step.hpp"
+#include "msm/terms/volume_term.hpp"
 #include "tests/fixtures/kuhn_block.hpp"
 
 using namespace vessel;
@@ -93,14 +94,14 @@ TEST(VolumeTerm, KernelMatchesFiniteDifferencesForBothSignsOfKappa) {
 TEST(VolumeTerm, HybridModelIsTheSumOfItsTermsAndMatchesFiniteDifferences) {
   const TetMesh mesh = block_mesh(2, 1e-3);
   const BuiltNetwork built = hybrid(mesh, 0.45);
-  ASSERT_TRUE(built.volume_kappa.has_value());
+  ASSERT_TRUE(built.terms.volume_kappa.has_value());
   // κ = λ − μ at ν = 0.45, by hand: λ = E·0.45/(1.45·0.1), μ = E/2.9.
-  EXPECT_NEAR(*built.volume_kappa, kE * (0.45 / 0.145 - 1 / 2.9), 1e-9 * kE);
+  EXPECT_NEAR(*built.terms.volume_kappa, kE * (0.45 / 0.145 - 1 / 2.9), 1e-9 * kE);
   const auto model = make_model(built);
-  ASSERT_NE(model->volume_term(), nullptr);
+  ASSERT_NE(model->term<VolumeTerm>(), nullptr);
   std::mt19937 rng(3);
   const Eigen::VectorXd x = perturbed(flatten(built.network.nodes), rng, 0.05e-3);
-  EXPECT_NEAR(model->energy(x), model->springs().energy(x) + model->volume_term()->energy(x),
+  EXPECT_NEAR(model->energy(x), model->springs().energy(x) + model->term<VolumeTerm>()->energy(x),
               1e-12 * model->energy(x));
   auto dense_hessian = [&](const Form& f, bool project) {
     return [&f, project](const Eigen::VectorXd& y) -> Eigen::MatrixXd {
@@ -131,7 +132,7 @@ TEST(VolumeTerm, HybridModelIsTheSumOfItsTermsAndMatchesFiniteDifferences) {
   for (std::size_t i = 0; i < held.size(); ++i) held[i] = built.network.nodes[i].x() > 1.5e-3;
   const RoiNetwork roi = restrict_network(built.network, held);
   ASSERT_FALSE(roi.network.tets.empty());
-  const auto roi_model = make_model(roi.network, built.volume_kappa);
+  const auto roi_model = make_model(roi.network, {.volume_kappa = built.terms.volume_kappa});
   const Eigen::VectorXd xr = perturbed(flatten(roi.network.nodes), rng, 0.05e-3);
   const auto cr =
       msm::test::check_derivatives([&](const Eigen::VectorXd& y) { return roi_model->energy(y); },
@@ -147,7 +148,7 @@ TEST(VolumeTerm, CriticalStepBoundAccountsForTheVolumeTerm) {
   const TetMesh mesh = block_mesh(3, 1e-3);
   const BuiltNetwork built = hybrid(mesh, 0.49);
   const auto model = make_model(built);
-  const auto springs = make_model(built.network, std::nullopt);
+  const auto springs = make_model(built.network);
   auto problem = [&](const Form& f) {
     Problem p;
     p.form = &f;

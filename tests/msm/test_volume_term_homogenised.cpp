@@ -12,8 +12,9 @@
 #include "meshes/foundation/errors.hpp"
 #include "msm/kernels/spring_kernels.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/model/roi.hpp"
+#include "msm/terms/volume_term.hpp"
 #include "msm/terms/volume_term_homogenised.hpp"
 #include "tests/fixtures/kuhn_block.hpp"
 
@@ -148,25 +149,25 @@ TEST(VolumeTermHomogenised, PerTetFactorsEnterTheEnergyAndSurviveARegionOfIntere
   o.volume_term = true;
   o.volume_moduli = VolumeModuli::homogenised;
   const BuiltNetwork built = build_network(mesh, VesselParams{}, o);
-  ASSERT_TRUE(built.volume_kappa.has_value());
-  EXPECT_LT(*built.volume_kappa, 0.0);
+  ASSERT_TRUE(built.terms.volume_kappa.has_value());
+  EXPECT_LT(*built.terms.volume_kappa, 0.0);
   ASSERT_EQ(built.network.tet_kappa_factors.size(), built.network.tets.size());
   const HomogenisedModuli h = homogenised_moduli(mesh.nodes, mesh.tets, 14.24e3, 0.0);
-  EXPECT_NEAR(*built.volume_kappa, h.kappa, 1e-12 * std::abs(h.kappa));
+  EXPECT_NEAR(*built.terms.volume_kappa, h.kappa, 1e-12 * std::abs(h.kappa));
   const auto model = make_model(built);
-  const VolumeTerm& v = *model->volume_term();
+  const VolumeTerm& v = *model->term<VolumeTerm>();
   // Each tet's κ is κ·f_e = max(κ, kStabilityMargin·c_e·E_s): never below the clip.
   bool some_clipped = false;
   for (std::size_t e = 0; e < v.tets().size(); ++e) {
     const Tet& t = v.tets()[e];
     const double c = volume_stability_limit(
         {mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]});
-    EXPECT_NEAR(v.tet_kappa(e), *built.volume_kappa * built.network.tet_kappa_factors[e],
-                1e-12 * std::abs(*built.volume_kappa));
+    EXPECT_NEAR(v.tet_kappa(e), *built.terms.volume_kappa * built.network.tet_kappa_factors[e],
+                1e-12 * std::abs(*built.terms.volume_kappa));
     some_clipped = some_clipped || built.network.tet_kappa_factors[e] < 1.0;
     EXPECT_NEAR(v.tet_kappa(e),
-                std::max(*built.volume_kappa, kStabilityMargin * c * h.spring_youngs_modulus),
-                1e-9 * std::abs(*built.volume_kappa));
+                std::max(*built.terms.volume_kappa, kStabilityMargin * c * h.spring_youngs_modulus),
+                1e-9 * std::abs(*built.terms.volume_kappa));
   }
   EXPECT_TRUE(some_clipped);
   // The model's energy with the factors against finite differences.
@@ -191,7 +192,7 @@ TEST(VolumeTermHomogenised, PerTetFactorsEnterTheEnergyAndSurviveARegionOfIntere
   const RoiNetwork roi = restrict_network(built.network, held, false);
   ASSERT_EQ(roi.network.tet_kappa_factors.size(), roi.network.tets.size());
   ASSERT_LT(roi.network.tets.size(), built.network.tets.size());
-  const auto roi_model = make_model(roi.network, built.volume_kappa);
+  const auto roi_model = make_model(roi.network, {.volume_kappa = built.terms.volume_kappa});
   // The ROI's energy at a displacement of the moving nodes equals the full model's minus the
   // held tets' (zero: held nodes stay at rest) — so compare both at the same moved state.
   Eigen::VectorXd full = flatten(built.network.nodes);
@@ -202,6 +203,6 @@ TEST(VolumeTermHomogenised, PerTetFactorsEnterTheEnergyAndSurviveARegionOfIntere
     full.segment<3>(3 * f) += Vec3(1e-5, -2e-5, 3e-5) * (1 + 0.1 * static_cast<double>(r % 7));
     part.segment<3>(3 * static_cast<int>(r)) = full.segment<3>(3 * f);
   }
-  EXPECT_NEAR(roi_model->volume_term()->energy(part), model->volume_term()->energy(full),
-              1e-9 * std::abs(model->volume_term()->energy(full)));
+  EXPECT_NEAR(roi_model->term<VolumeTerm>()->energy(part), model->term<VolumeTerm>()->energy(full),
+              1e-9 * std::abs(model->term<VolumeTerm>()->energy(full)));
 }

@@ -5,7 +5,7 @@
 // patch's direction (the faceted wall's mean normal) and the wire's (the exact lumen's).
 #include <gtest/gtest.h>
 
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "verification/harness/harness.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "verification/scene.hpp"

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "meshes/foundation/errors.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/stiffness/hybrid_moduli.hpp"
 #include "msm/terms/edge_pair_term.hpp"
 #include "msm/terms/volume_term_homogenised.hpp"

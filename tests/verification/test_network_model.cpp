@@ -10,7 +10,7 @@
 #include "../test_helpers.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "msm/kernels/spring_kernels.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/formats/network_file.hpp"
 #include "msm/solvers/solve.hpp"
 #include "verification/harness/harness.hpp"

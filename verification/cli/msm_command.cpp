@@ -18,7 +18,7 @@
 #include "meshes/msh_io.hpp"
 #include "meshes/stl_io.hpp"
 #include "msm/kernels/spring_kernels.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/formats/network_file.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/cli/vessel_options.hpp"

@@ -22,7 +22,7 @@
 
 #include "meshes/foundation/atomic_file.hpp"
 #include "meshes/foundation/errors.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "verification/scene_problems.hpp"
 #include "verification/harness/timing.hpp"
 

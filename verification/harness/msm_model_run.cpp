@@ -8,7 +8,7 @@
 
 #include "meshes/foundation/errors.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/formats/network_file.hpp"
 #include "msm/model/roi.hpp"
 #include "msm/solvers/solve.hpp"
@@ -57,10 +57,9 @@ SolvedSystem solved_system(const msm::Problem& full, const msm::MassSpringModel&
   if (spec.roi_radius <= 0.0) return sys;
   const std::vector<char> held = msm::held_nodes(full, qoi_point, spec.roi_radius);
   sys.roi = std::make_unique<msm::RoiNetwork>(
-      msm::restrict_network(network, held, built.bending_rigidity.has_value()));
+      msm::restrict_network(network, held, built.terms.bending_rigidity.has_value()));
   sys.roi_model =
-      msm::make_model(sys.roi->network, built.volume_kappa, spec.damping, built.bending_rigidity,
-                      built.edge_pairs);
+      msm::make_model(sys.roi->network, built.terms, spec.damping);
   sys.roi_problem =
       std::make_unique<msm::Problem>(msm::restrict_problem(full, *sys.roi, held, *sys.roi_model));
   sys.problem = sys.roi_problem.get();

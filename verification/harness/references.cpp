@@ -8,7 +8,7 @@
 
 #include "fem_reference/solution_cache.hpp"
 #include "meshes/foundation/errors.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "reports/representative_load.hpp"
 #include "verification/harness/budget.hpp"
 #include "verification/harness/modal.hpp"

@@ -11,7 +11,7 @@
 #include "fem_reference/solution_cache.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "msm/calibration/lbfgs.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/updates.hpp"
 #include "reports/representative_load.hpp"
 #include "verification/harness/harness.hpp"
@@ -617,7 +617,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
   add_other_magnitudes(cases, main, scene, nu, log);
 
   // The fit on the training cases.
-  const bool has_kappa = main.base.volume_kappa.has_value();
+  const bool has_kappa = main.base.terms.volume_kappa.has_value();
   if (o.prior && !mesh_indexed) {
     throw InputError("calibrate: --prior " + o.prior_source + " with --granularity " +
                      to_string(o.granularity) + ": expected --granularity per-spring or "
@@ -636,7 +636,7 @@ CalibrationStudy calibrate_scene(const Scene& s, const CalibrateOptions& o) {
                                        : o.regulariser;
   const Eigen::VectorXd theta0 = prior_start(o, main, spec, s.youngs_modulus, nu, params);
   if (o.prior) reg.centre = theta0;
-  const msm::LinearisedFit fit(main.base.network, main.base.volume_kappa, training.fixed, params,
+  const msm::LinearisedFit fit(main.base.network, main.base.terms.volume_kappa, training.fixed, params,
                                training.cases, reg);
   log << "  fitting " << params.size() << " parameters on " << training.cases.size()
       << " training loads (model linearised at rest, adjoint gradients, L-BFGS"

@@ -169,7 +169,7 @@ struct SpringChoice {
 };
 
 /// The spring models of a kind: every stiffness rule; for volume networks also the hybrid volume
-/// model (van-gelder springs + volume term, msm/model/model.hpp) and the edge-pair model
+/// model (van-gelder springs + volume term, msm/model/mass_spring_model.hpp) and the edge-pair model
 /// (P1 on the tets' edges, msm/terms/edge_pair_term.hpp); for surface networks also the Discrete
 /// Shells model (van-gelder membrane + hinge energy, msm/terms/bending_term.hpp).
 std::vector<SpringChoice> spring_rules(ModelKind kind) {

@@ -51,7 +51,7 @@ void add_zero_length_outcomes(HardCase& hc, const Scene& scene, const TetMesh& m
   auto m = build_model(scene, mesh, spec, 0.25);
   const int j = static_cast<int>(m->contact_node);
   const msm::SpringNetwork net = with_zero_length_spring(m->built.network, j);
-  const auto model = msm::make_model(net, std::nullopt);
+  const auto model = msm::make_model(net);
   msm::Problem p = with_extra_node(m->problem, net, j);
   p.form = model.get();
   HardCaseOutcome sp;
@@ -73,7 +73,7 @@ void add_zero_length_outcomes(HardCase& hc, const Scene& scene, const TetMesh& m
   StudyModel tmp;
   tmp.problem = p;
   tmp.contact_node = m->contact_node;
-  tmp.model = msm::make_model(net, std::nullopt);
+  tmp.model = msm::make_model(net);
   tmp.problem.form = tmp.model.get();
   hc.outcomes.push_back(static_outcome("volume / seed001 + zero-length spring: static", tmp));
   const double dt = 0.5 * msm::predicted_critical_step(

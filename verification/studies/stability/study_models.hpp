@@ -8,7 +8,7 @@
 
 #include "fem_reference/elasticity.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/scene.hpp"

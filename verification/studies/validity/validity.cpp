@@ -13,7 +13,7 @@
 #include "meshes/foundation/content_hash.hpp"
 #include "meshes/self_contact.hpp"
 #include "meshes/foundation/errors.hpp"
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/updates.hpp"
 #include "verification/harness/external_model.hpp"
 #include "verification/harness/metrics.hpp"

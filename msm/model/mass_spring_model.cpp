@@ -1,48 +1,21 @@
-#include "msm/model/model.hpp"
+#include "msm/model/mass_spring_model.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include "meshes/foundation/errors.hpp"
 #include "msm/terms/four_node_blocks.hpp"
 
 namespace vessel::msm {
 
 MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damping,
-                                 std::optional<double> volume_kappa,
-                                 std::optional<double> bending_rigidity,
-                                 std::optional<LameParameters> edge_pairs)
-    : springs_(network, point_damping) {
-  if (volume_kappa) {
-    if (network.tets.empty()) {
-      throw InputError("volume term: the network has no tetrahedra; expected a volume network");
-    }
-    volume_ = std::make_unique<VolumeTerm>(network.nodes, network.tets, *volume_kappa,
-                                           network.tet_kappa_factors);
-  }
-  if (bending_rigidity) {
-    if (network.triangles.empty()) {
-      throw InputError(
-          "bending term (discrete-shells): the network has no triangles; expected a surface "
-          "network");
-    }
-    bending_ = std::make_unique<BendingTerm>(network.nodes, network.triangles, *bending_rigidity);
-  }
-  if (edge_pairs) {
-    if (network.tets.empty()) {
-      throw InputError("edge pairs: the network has no tetrahedra; expected a volume network");
-    }
-    edge_pairs_ = std::make_unique<EdgePairTerm>(network.nodes, network.tets, *edge_pairs);
-  }
-  if (volume_) terms_.push_back(volume_.get());
-  if (bending_) terms_.push_back(bending_.get());
-  if (edge_pairs_) terms_.push_back(edge_pairs_.get());
+                                 const ModelTerms& terms)
+    : springs_(network, point_damping), terms_(make_terms(network, terms)) {
   if (terms_.empty()) return;
   SparseMatrix Hs;
   springs_.hessian(flatten(network.nodes), Hs, false);
   bool missing = false;
-  for (const FourNodeTerm* t : terms_) {
+  for (const auto& t : terms_) {
     term_slots_.push_back(t->slots_in(Hs));
     missing = missing || std::find(term_slots_.back().begin(), term_slots_.back().end(), -1) !=
                              term_slots_.back().end();
@@ -53,7 +26,7 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
   // the bend springs are dropped; the edge-pair model has no springs): assemble into the union of
   // the patterns.
   union_pattern_ = Hs;
-  for (const FourNodeTerm* t : terms_) union_pattern_ += t->pattern();
+  for (const auto& t : terms_) union_pattern_ += t->pattern();
   union_pattern_.makeCompressed();
   std::fill(union_pattern_.valuePtr(), union_pattern_.valuePtr() + union_pattern_.nonZeros(), 0.0);
   for (int col = 0; col < Hs.outerSize(); ++col) {
@@ -67,24 +40,25 @@ MassSpringModel::MassSpringModel(const SpringNetwork& network, double point_damp
 }
 
 double MassSpringModel::max_strain(const VectorXd& x) const {
-  const double springs = springs_.max_strain(x);
-  return edge_pairs_ ? std::max(springs, edge_pairs_->max_strain(x)) : springs;
+  double strain = springs_.max_strain(x);
+  for (const auto& t : terms_) strain = std::max(strain, t->max_strain(x));
+  return strain;
 }
 
 double MassSpringModel::energy(const VectorXd& x) const {
   double e = springs_.energy(x);
-  for (const FourNodeTerm* t : terms_) e += t->energy(x);
+  for (const auto& t : terms_) e += t->energy(x);
   return e;
 }
 
 void MassSpringModel::gradient(const VectorXd& x, VectorXd& g) const {
   springs_.gradient(x, g);
-  for (const FourNodeTerm* t : terms_) t->add_gradient(x, g);
+  for (const auto& t : terms_) t->add_gradient(x, g);
 }
 
 double MassSpringModel::energy_gradient(const VectorXd& x, VectorXd& g) const {
   double e = springs_.energy_gradient(x, g);
-  for (const FourNodeTerm* t : terms_) {
+  for (const auto& t : terms_) {
     t->add_gradient(x, g);
     e += t->energy(x);
   }
@@ -119,25 +93,18 @@ void MassSpringModel::damping_jacobian(const VectorXd& x, SparseMatrix& D) const
 }
 
 std::unique_ptr<MassSpringModel> make_model(const SpringNetwork& network,
-                                            std::optional<double> volume_kappa,
-                                            double point_damping,
-                                            std::optional<double> bending_rigidity,
-                                            std::optional<LameParameters> edge_pairs) {
-  return std::make_unique<MassSpringModel>(network, point_damping, volume_kappa, bending_rigidity,
-                                           edge_pairs);
+                                            const ModelTerms& terms, double point_damping) {
+  return std::make_unique<MassSpringModel>(network, point_damping, terms);
 }
 
 std::unique_ptr<MassSpringModel> make_model(const BuiltNetwork& built, double point_damping) {
-  return make_model(built.network, built.volume_kappa, point_damping, built.bending_rigidity,
-                    built.edge_pairs);
+  return make_model(built.network, built.terms, point_damping);
 }
 
 const SpringModel* plain_spring_model(const Form& form) {
   if (const auto* springs = dynamic_cast<const SpringModel*>(&form)) return springs;
   if (const auto* model = dynamic_cast<const MassSpringModel*>(&form)) {
-    if (!model->volume_term() && !model->bending_term() && !model->edge_pair_term()) {
-      return &model->springs();
-    }
+    if (model->springs_only()) return &model->springs();
   }
   return nullptr;
 }
