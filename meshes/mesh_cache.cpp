@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "meshes/foundation/content_hash.hpp"
+#include "meshes/foundation/content_store.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "meshes/lumen_mesh.hpp"
 #include "meshes/msh_io.hpp"
@@ -72,17 +73,6 @@ std::string mesh_cache_key(const VesselParams& p) {
   return key;
 }
 
-std::string mesh_cache_file_name(const VesselParams& p) {
-  char hash[17];
-  std::snprintf(hash, sizeof hash, "%016llx",
-                static_cast<unsigned long long>(fnv1a(mesh_cache_key(p))));
-  if (p.kind == VesselKind::lumen) {
-    return "lumen-" + p.file.stem().string() + "-L" + std::to_string(p.level) + "-" + hash + ".msh";
-  }
-  return to_string(p.kind) + "-" + to_string(p.style) + "-L" + std::to_string(p.level) + "-" +
-         hash + ".msh";
-}
-
 TetMesh load_or_generate_vessel(const VesselParams& params, const fs::path& cache_dir,
                                 const MeshingOptions& options, MeshSource* source) {
   validate(params);
@@ -95,29 +85,45 @@ TetMesh load_or_generate_vessel(const VesselParams& params, const fs::path& cach
     if (source) *source = info;
     return mesh;
   }
-  if (!cache_dir.empty()) {
-    info.path = cache_dir / mesh_cache_file_name(params);
-    if (fs::exists(info.path)) {
-      try {
-        TetMesh mesh = read_msh(info.path);
+  // As stored, so this run and a later one reading the cache solve the same problem.
+  const auto generate = [&] {
+    return as_stored(params.kind == VesselKind::lumen
+                         ? lumen_wall_mesh({params.file, params.wall_thickness, params.file_scale,
+                                            params.level})
+                         : generate_vessel_mesh(params, options));
+  };
+  if (cache_dir.empty()) {
+    TetMesh mesh = generate();
+    info.seconds = seconds_since(t0);
+    if (source) *source = info;
+    return mesh;
+  }
+  // The payload: the generation's seconds on its first line, then the mesh as .msh text.
+  ContentStore store(cache_dir / "meshes", &std::cerr, "mesh cache");
+  const std::string key = mesh_cache_key(params);
+  info.path = store.entry_path(key);
+  TetMesh mesh;
+  store.lookup(
+      key,
+      [&](std::string_view payload) {
+        std::istringstream in{std::string(payload)};
+        double generated_seconds = 0.0;
+        in >> generated_seconds;
+        in.ignore(1);
+        mesh = parse_msh(in, info.path.string());
         require_vessel_groups(mesh, info.path.string());
         info.cache_hit = true;
-        info.seconds = seconds_since(t0);
-        if (source) *source = info;
-        return mesh;
-      } catch (const InputError& e) {
-        std::cerr << "warning: ignoring unreadable cached mesh (" << e.what()
-                  << "); generating it again\n";
-      }
-    }
-  }
-  // As stored, so this run and a later one reading the cache solve the same problem.
-  TetMesh mesh = as_stored(params.kind == VesselKind::lumen
-                               ? lumen_wall_mesh({params.file, params.wall_thickness,
-                                                  params.file_scale, params.level})
-                               : generate_vessel_mesh(params, options));
+        return generated_seconds;
+      },
+      [&] {
+        mesh = generate();
+        std::ostringstream out;
+        out.precision(17);
+        out << seconds_since(t0) << "\n";
+        write_msh(out, mesh);
+        return out.str();
+      });
   info.seconds = seconds_since(t0);
-  if (!cache_dir.empty()) write_msh(info.path, mesh);
   if (source) *source = info;
   return mesh;
 }

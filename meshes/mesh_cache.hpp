@@ -1,6 +1,7 @@
 #pragma once
-/// Generated meshes cached on disk by a hash of everything that determines them, so each vessel
-/// and level is meshed once.
+/// Generated meshes cached by everything that determines them, so each vessel and level is meshed
+/// once: entries of the checksummed content store (meshes/foundation/content_store.hpp) in the
+/// cache directory's `meshes/`, each holding its key and the mesh as .msh text.
 #include <filesystem>
 #include <string>
 
@@ -16,18 +17,14 @@ std::filesystem::path default_cache_dir();
 /// precision, the style, the level, the generator and gmsh versions; for a lumen the hash of the
 /// STL's bytes instead of the shape parameters). InputError for a mesh file (never cached).
 std::string mesh_cache_key(const VesselParams& params);
-/// File name in the cache: "<kind>-<style>-L<level>-<16 hex digits of the key's hash>.msh"
-/// ("lumen-<file stem>-L<level>-<hash>.msh" for a lumen).
-std::string mesh_cache_file_name(const VesselParams& params);
-
 struct MeshSource {
-  std::filesystem::path path;  ///< cached .msh (empty if caching was off)
+  std::filesystem::path path;  ///< the cache entry (empty if caching was off)
   bool cache_hit = false;
   double seconds = 0.0;        ///< time to generate (miss) or to read (hit)
 };
 
 /// Returns the cached mesh for params, generating and caching it (atomically) on a miss or when
-/// the cached file cannot be read. An empty cache_dir disables caching. A lumen vessel is extruded
+/// the entry is corrupt or cannot be read (reported on std::cerr). An empty cache_dir disables caching. A lumen vessel is extruded
 /// from its STL (meshes/lumen_mesh.hpp), cached by a hash of the file's bytes, the unit scale, the
 /// thickness and the level; a mesh file is read as given (read_msh, the five groups required),
 /// never cached.

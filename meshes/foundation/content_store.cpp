@@ -19,6 +19,7 @@ namespace {
 
 // The entry file: magic, format version (uint32), key and payload (each a uint64 length then
 // the bytes), FNV-1a of the payload (uint64); native byte order: a store is a machine's own.
+// (The magic predates the other caches; kept so that existing stores stay readable.)
 constexpr std::string_view kMagic = "vesselverify-fem-solution\n";
 constexpr std::uint32_t kFormatVersion = 1;
 
@@ -73,7 +74,7 @@ EntryState read_entry(const fs::path& path, const std::string& key, std::string&
   if (!f) return EntryState::missing;
   const std::string file((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   if (file.compare(0, kMagic.size(), kMagic) != 0) {
-    why = "not a vesselverify FEM solution";
+    why = "not a vesselverify cache entry";
     return EntryState::corrupt;
   }
   EntryReader in(std::string_view(file).substr(kMagic.size()));
@@ -113,7 +114,7 @@ ContentStore::ContentStore(fs::path dir, std::ostream* log, std::string name)
 void ContentStore::lookup(const std::string& key,
                           const std::function<double(std::string_view)>& use,
                           const std::function<std::string()>& compute, bool refresh) {
-  const fs::path path = dir_ / ("entry-" + ContentHash().text(key).hex() + ".bin");
+  const fs::path path = entry_path(key);
   const auto t0 = std::chrono::steady_clock::now();
   std::string payload, why;
   const EntryState state = refresh ? EntryState::missing : read_entry(path, key, payload, why);
@@ -164,6 +165,10 @@ std::string ContentStore::payload(const std::string& key,
       },
       refresh);
   return out;
+}
+
+fs::path ContentStore::entry_path(const std::string& key) const {
+  return dir_ / ("entry-" + ContentHash().text(key).hex() + ".bin");
 }
 
 void ContentStore::count_uncacheable() {

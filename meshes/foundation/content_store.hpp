@@ -47,6 +47,8 @@ class ContentStore {
   void count_uncacheable();
 
   [[nodiscard]] bool enabled() const { return !dir_.empty(); }
+  /// The file that holds (or would hold) the entry of `key`.
+  [[nodiscard]] std::filesystem::path entry_path(const std::string& key) const;
   [[nodiscard]] const std::filesystem::path& directory() const { return dir_; }
   [[nodiscard]] ContentStoreStatistics statistics() const;
   /// One line: "<name> (DIR): H hits, M misses, C corrupt entries recomputed, S s saved".

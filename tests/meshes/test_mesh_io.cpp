@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 
 #include "../test_helpers.hpp"
 #include "meshes/foundation/atomic_file.hpp"
@@ -232,6 +233,33 @@ TEST(MeshCache, AGeneratedMeshIsTheMeshTheCacheGivesBackElementForElement) {
   // Without a cache the run uses the same mesh as with one.
   expect_same_mesh(load_or_generate_vessel(p, {}, {}), cached);
   EXPECT_EQ(load_or_generate_vessel(p, {}, {}).triangles, cached.triangles);
+}
+
+TEST(MeshCache, ACorruptEntryIsReportedAndTheMeshGeneratedAgain) {
+  // The mesh cache is an entry of the checksummed content store: a flipped byte in the stored
+  // mesh fails the checksum, so the mesh is generated again (and the entry replaced), never read
+  // wrong.
+  TempDir dir;
+  VesselParams p;
+  p.style = MeshStyle::structured;
+  p.length = 10e-3;
+  MeshSource first, second, third;
+  const TetMesh generated = load_or_generate_vessel(p, dir.path(), {}, &first);
+  ASSERT_FALSE(first.cache_hit);
+  ASSERT_TRUE(std::filesystem::exists(first.path)) << first.path;
+  EXPECT_EQ(first.path.parent_path(), dir.path() / "meshes");
+  std::string bytes = vessel::test::read_text(first.path);
+  bytes[bytes.size() / 2] ^= 0x20;
+  std::ofstream(first.path, std::ios::binary) << bytes;
+  testing::internal::CaptureStderr();
+  const TetMesh again = load_or_generate_vessel(p, dir.path(), {}, &second);
+  const std::string log = testing::internal::GetCapturedStderr();
+  EXPECT_FALSE(second.cache_hit);
+  EXPECT_NE(log.find("mesh cache: entry"), std::string::npos) << log;
+  EXPECT_NE(log.find("checksum mismatch"), std::string::npos) << log;
+  expect_same_mesh(generated, again);
+  (void)load_or_generate_vessel(p, dir.path(), {}, &third);
+  EXPECT_TRUE(third.cache_hit);
 }
 
 TEST(MshIo, ReadsFilesWrittenByGmshInBothFormats) {
