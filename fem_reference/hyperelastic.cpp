@@ -186,7 +186,6 @@ struct HyperelasticSolver::Impl {
         // p: the mixed field, or −λ ln J (compressible).
         const double p = mixed ? p_h[q] : -material.lambda * ln_j;
         const Mat3 P = NeoHookean::stress_at_pressure(F, p, material.mu);
-        const Mat3 f_inv_t = F.inverse().transpose();
         const double psi =
             0.5 * material.mu * (F.squaredNorm() - 3.0) - material.mu * ln_j +
             (mixed ? -p * ln_j - 0.5 * p * p * inv_lambda : 0.5 * material.lambda * ln_j * ln_j);
@@ -205,29 +204,7 @@ struct HyperelasticSolver::Impl {
             r_int(i) += r_p * fev.shape_value(i, q) * jxw;
           }
         }
-        if (!with_matrix) continue;
-        const Mat9 A =
-            mixed ? NeoHookean::tangent_at_pressure(F, p, material.mu) : material.tangent(F);
-        for (unsigned j = 0; j < n; ++j) {
-          if (comp[j] < 3) h[j] = A.middleCols<3>(3 * comp[j]) * g[j] * jxw;
-        }
-        for (unsigned i = 0; i < n; ++i) {
-          const double vi = comp[i] < 3 ? 0.0 : fev.shape_value(i, q);
-          for (unsigned j = 0; j < n; ++j) {
-            const double vj = comp[j] < 3 ? 0.0 : fev.shape_value(j, q);
-            double kij;
-            if (comp[i] < 3 && comp[j] < 3) {
-              kij = h[j].segment<3>(3 * comp[i]).dot(g[i]);
-            } else if (comp[i] < 3) {  // ∂R_u/∂p = −F⁻ᵀ : ∇v ψ
-              kij = -f_inv_t.row(comp[i]).dot(g[i]) * vj * jxw;
-            } else if (comp[j] < 3) {  // ∂R_p/∂u = −ψ F⁻ᵀ : ∇δu
-              kij = -vi * f_inv_t.row(comp[j]).dot(g[j]) * jxw;
-            } else {
-              kij = -vi * vj * inv_lambda * jxw;
-            }
-            k(i, j) += kij;
-          }
-        }
+        if (with_matrix) add_point_tangent(F, p, fev, q, jxw, comp, g, h, k);
       }
       r = r_int;
       r.add(-s, f_dead);
@@ -244,6 +221,39 @@ struct HyperelasticSolver::Impl {
       sink(dofs, k, r, r_int);
     }
     return stats;
+  }
+
+  /// Adds one quadrature point's tangent ∂r/∂w to k: the displacement block ∇vᵀ A ∇δu, and with
+  /// the mixed field the couplings ∂R_u/∂p = −F⁻ᵀ : ∇v ψ, ∂R_p/∂u = −ψ F⁻ᵀ : ∇δu and −ψψ/λ.
+  /// g holds the point's shape gradients (pass fills them); h is scratch.
+  void add_point_tangent(const Mat3& F, double p, const dl::FEValues<kDim>& fev, unsigned q,
+                         double jxw, const std::vector<unsigned>& comp,
+                         const std::vector<Eigen::Vector3d>& g,
+                         std::vector<Eigen::Matrix<double, 9, 1>>& h,
+                         dl::FullMatrix<double>& k) const {
+    const unsigned n = comp.size();
+    const Mat3 f_inv_t = F.inverse().transpose();
+    const Mat9 A = mixed ? NeoHookean::tangent_at_pressure(F, p, material.mu) : material.tangent(F);
+    for (unsigned j = 0; j < n; ++j) {
+      if (comp[j] < 3) h[j] = A.middleCols<3>(3 * comp[j]) * g[j] * jxw;
+    }
+    for (unsigned i = 0; i < n; ++i) {
+      const double vi = comp[i] < 3 ? 0.0 : fev.shape_value(i, q);
+      for (unsigned j = 0; j < n; ++j) {
+        const double vj = comp[j] < 3 ? 0.0 : fev.shape_value(j, q);
+        double kij;
+        if (comp[i] < 3 && comp[j] < 3) {
+          kij = h[j].segment<3>(3 * comp[i]).dot(g[i]);
+        } else if (comp[i] < 3) {
+          kij = -f_inv_t.row(comp[i]).dot(g[i]) * vj * jxw;
+        } else if (comp[j] < 3) {
+          kij = -vi * f_inv_t.row(comp[j]).dot(g[j]) * jxw;
+        } else {
+          kij = -vi * vj * inv_lambda * jxw;
+        }
+        k(i, j) += kij;
+      }
+    }
   }
 
   /// The follower pressure on one face: f_ext = −p J F⁻ᵀ N dA (Nanson's n da = J F⁻ᵀ N dA),
