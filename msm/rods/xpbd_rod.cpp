@@ -9,11 +9,6 @@
 
 namespace vessel::msm::rods {
 
-namespace {
-// Couplings of the chain-ordered blocks reach two blocks: 3·2 + 2 rows below the diagonal.
-constexpr int kBandwidth = 8;
-}  // namespace
-
 XpbdRod::XpbdRod(RodLayout layout, double alignment, XpbdOptions options)
     : model_(std::move(layout), alignment, false), options_(options) {
   if (options_.warm_start && options_.solver == XpbdSolver::gauss_seidel) {
@@ -49,8 +44,11 @@ XpbdRod::XpbdRod(RodLayout layout, double alignment, XpbdOptions options)
   force_lambda_.assign(n, Eigen::Vector3d::Zero());
   jacobians_.assign(n, BlockJacobian::Zero());
   residuals_.assign(n, Eigen::Vector3d::Zero());
-  band_.resize(3 * static_cast<int>(n), kBandwidth);
-  rhs_ = VectorXd::Zero(3 * static_cast<int>(n));
+  // Constraint blocks two by two (6 rows): couplings reach two blocks, so only neighbouring
+  // pairs couple, and the system is block tridiagonal.
+  const int pairs = (static_cast<int>(n) + 1) / 2;
+  system_.resize(pairs);
+  rhs_ = VectorXd::Zero(6 * pairs);
   contact_lambda_.assign(L.num_nodes(), 0.0);
   contact_force_lambda_.assign(L.num_nodes(), 0.0);
 }
@@ -170,7 +168,7 @@ void XpbdRod::gauss_seidel_sweep(double h) {
 
 void XpbdRod::direct_iteration(double h) {
   const int n = static_cast<int>(blocks_.size());
-  band_.set_zero();
+  system_.set_zero();
   for (int a = 0; a < n; ++a) evaluate(blocks_[a], residuals_[a], jacobians_[a]);
   for (int a = 0; a < n; ++a) {
     const Block& b = blocks_[a];
@@ -180,22 +178,29 @@ void XpbdRod::direct_iteration(double h) {
     const Eigen::Vector3d alpha = b.compliance / (h * h);
     Eigen::Matrix3d A = J * w.asDiagonal() * J.transpose();
     A.diagonal() += alpha;
-    for (int r = 0; r < 3; ++r) {
-      for (int s = 0; s <= r; ++s) band_.add(3 * a + r, 3 * a + s, A(r, s));
-    }
+    const int pair = a / 2, offset = 3 * (a % 2);
+    system_.diagonal(pair).block<3, 3>(offset, offset) += A;
     for (int d = 1; d <= 2 && a + d < n; ++d) {  // rows of block a+d, columns of block a
       Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
       for (const auto& [ka, kb] : couplings_[a][d - 1]) {
         M += inverse_mass_[b.dofs[ka]] * jacobians_[a + d].col(kb) * J.col(ka).transpose();
       }
-      for (int r = 0; r < 3; ++r) {
-        for (int s = 0; s < 3; ++s) band_.add(3 * (a + d) + r, 3 * a + s, M(r, s));
+      const int other = (a + d) / 2, other_offset = 3 * ((a + d) % 2);
+      if (other == pair) {
+        system_.diagonal(pair).block<3, 3>(other_offset, offset) += M;
+        system_.diagonal(pair).block<3, 3>(offset, other_offset) += M.transpose();
+      } else {  // other == pair + 1: a + d ≤ a + 2 ≤ 2·pair + 3
+        system_.sub(pair).block<3, 3>(other_offset, offset) += M;
       }
     }
     rhs_.segment<3>(3 * a) = -residuals_[a] - alpha.cwiseProduct(lambda_[a]);
   }
-  band_.factorize();
-  band_.solve(rhs_);
+  if (n % 2 == 1) {  // an odd count: the last pair's second half is a unit dummy
+    system_.diagonal(n / 2).block<3, 3>(3, 3) = Eigen::Matrix3d::Identity();
+    rhs_.segment<3>(3 * n).setZero();
+  }
+  system_.factorize();
+  system_.solve(rhs_);
   for (int a = 0; a < n; ++a) {
     const Eigen::Vector3d dl = rhs_.segment<3>(3 * a);
     apply(blocks_[a], jacobians_[a], dl);
@@ -225,7 +230,9 @@ void XpbdRod::predict(double h, const VectorXd& force) {
   const int n = static_cast<int>(blocks_.size());
   VectorXd shift = VectorXd::Zero(x_.size());
   if (options_.warm_start) {
-    // The carried constraint forces Jᵀλ at the step's start, in the prediction.
+    // The carried constraint forces Jᵀλ at the step's start, in the prediction. (J of the last
+    // iteration instead, one evaluation fewer, leaves a one-iteration step cycling about the
+    // equilibrium at α ≥ 3: measured.)
     for (int a = 0; a < n; ++a) {
       lambda_[a] = h * h * force_lambda_[a];
       Eigen::Vector3d c;

@@ -7,8 +7,8 @@
 ///   bend–twist     Ω_i = (2/l̄_i) Im(q̄_{i−1} q_i),    compliance diag(EI, EI, GJ)⁻¹/l̄_i,
 /// are solved for the step's multipliers λ (Δλ = −(J W Jᵀ + α/h²)⁻¹ (C + α λ/h²), Δx = W Jᵀ Δλ,
 /// quaternions renormalised), either block by block in Gauss–Seidel sweeps or all blocks at once
-/// (`XpbdSolver::direct`: one banded Cholesky per iteration of the chain-ordered blocks, whose
-/// couplings reach two blocks, as Deul et al. 2018's direct solver for rods).
+/// (`XpbdSolver::direct`: one block-tridiagonal Cholesky per iteration of the chain-ordered blocks
+/// taken two by two, as Deul et al. 2018's direct solver for rods).
 ///
 /// The quaternion columns of each block's Jacobian are projected onto the unit sphere's tangent
 /// space, J_q (I − q qᵀ): no correction (and no carried force) goes into |q|, which the
@@ -35,7 +35,7 @@
 #include <utility>
 #include <vector>
 
-#include "msm/rods/banded_cholesky.hpp"
+#include "msm/rods/block_tridiagonal_cholesky.hpp"
 #include "msm/rods/corde_rod.hpp"
 #include "msm/rods/rigid_wall.hpp"
 
@@ -108,7 +108,7 @@ class XpbdRod {
   std::vector<std::array<std::vector<std::pair<int, int>>, 2>> couplings_;
   std::vector<BlockJacobian> jacobians_;
   std::vector<Eigen::Vector3d> residuals_;
-  BandedCholesky band_;
+  BlockTridiagonalCholesky<6> system_;  ///< the direct solver's J W Jᵀ + α/h², blocks in pairs
   VectorXd rhs_;
   const RigidLumen* lumen_ = nullptr;
   int wall_first_ = 0, wall_last_ = -1;

@@ -14,7 +14,7 @@
 #include <cstdlib>
 
 #include "fem_reference/rod_theory/elastica.hpp"
-#include "msm/rods/banded_cholesky.hpp"
+#include "msm/rods/block_tridiagonal_cholesky.hpp"
 #include "msm/rods/cosserat_terms.hpp"
 #include "msm/rods/element_assembly.hpp"
 #include "msm/rods/xpbd_rod.hpp"
@@ -85,24 +85,27 @@ TEST(Xpbd, ClosedFormJacobiansMatchTheJetsOfTheSameFormulas) {
             1e-12);
 }
 
-TEST(Xpbd, BandedCholeskyAgreesWithADenseSolve) {
-  const int n = 30, b = 8;
+TEST(Xpbd, BlockTridiagonalCholeskyAgreesWithADenseSolve) {
+  constexpr int kB = 6, kBlocks = 5, n = kB * kBlocks;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);  // symmetric, block tridiagonal
   for (int i = 0; i < n; ++i) {
-    for (int j = std::max(0, i - b / 2); j <= i; ++j) B(i, j) = u(rng);
+    for (int j = 0; j <= i; ++j) {
+      if (i / kB - j / kB <= 1) A(i, j) = A(j, i) = u(rng);
+    }
   }
-  const Eigen::MatrixXd A = B * B.transpose() + Eigen::MatrixXd::Identity(n, n);  // band b
-  BandedCholesky band;
-  band.resize(n, b);
-  for (int i = 0; i < n; ++i) {
-    for (int j = std::max(0, i - b); j <= i; ++j) band.add(i, j, A(i, j));
+  A += 2.0 * n * Eigen::MatrixXd::Identity(n, n);  // diagonally dominant: positive definite
+  BlockTridiagonalCholesky<kB> system;
+  system.resize(kBlocks);
+  for (int b = 0; b < kBlocks; ++b) {
+    system.diagonal(b) = A.block<kB, kB>(kB * b, kB * b);
+    if (b + 1 < kBlocks) system.sub(b) = A.block<kB, kB>(kB * (b + 1), kB * b);
   }
   Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
   const Eigen::VectorXd exact = A.llt().solve(r);
-  band.factorize();
-  band.solve(r);
+  system.factorize();
+  system.solve(r);
   EXPECT_LT((r - exact).norm(), 1e-12 * exact.norm());
 }
 
