@@ -97,21 +97,50 @@ void XpbdRod::build_couplings() {
       throw std::logic_error("XpbdRod: a dof is shared by blocks more than two apart");
     }
   }
-  couplings_.assign(n, {});
-  for (int a = 0; a < n; ++a) {
-    for (int d = 1; d <= 2 && a + d < n; ++d) {
-      const Block& A = blocks_[a];
-      const Block& B = blocks_[a + d];
-      for (int ka = 0; ka < A.dofs_used; ++ka) {
-        for (int kb = 0; kb < B.dofs_used; ++kb) {
-          if (A.dofs[ka] == B.dofs[kb] && inverse_mass_[A.dofs[ka]] > 0.0) {
-            couplings_[a][d - 1].emplace_back(ka, kb);
+  // Runs of consecutive shared columns on one inverse mass (a node's 3, a quaternion's 4).
+  const auto runs = [this](const Block& A, const Block& B) {
+    std::vector<Shared> out;
+    for (int ka = 0; ka < A.dofs_used; ++ka) {
+      for (int kb = 0; kb < B.dofs_used; ++kb) {
+        const int dof = A.dofs[ka];
+        if (dof != B.dofs[kb] || inverse_mass_[dof] <= 0.0) continue;
+        if (!out.empty()) {
+          Shared& r = out.back();
+          if (r.col_a + r.width == ka && r.col_b + r.width == kb && r.width < 4 &&
+              inverse_mass_[r.dof] == inverse_mass_[dof] && (dof < 3 * model_.num_nodes()) ==
+                                                               (r.dof < 3 * model_.num_nodes())) {
+            ++r.width;
+            continue;
           }
         }
+        out.push_back({ka, kb, 1, dof});
       }
     }
+    return out;
+  };
+  couplings_.assign(n, {});
+  own_runs_.assign(n, {});
+  for (int a = 0; a < n; ++a) {
+    own_runs_[a] = runs(blocks_[a], blocks_[a]);
+    for (int d = 1; d <= 2 && a + d < n; ++d) couplings_[a][d - 1] = runs(blocks_[a], blocks_[a + d]);
   }
 }
+
+namespace {
+
+/// M += w · J_b(:, cb..cb+width) J_a(:, ca..ca+width)ᵀ (fixed sizes for a node and a quaternion).
+template <class J>
+void add_product(Eigen::Matrix3d& M, double w, const J& Jb, int cb, const J& Ja, int ca, int width) {
+  if (width == 4) {
+    M.noalias() += w * (Jb.template middleCols<4>(cb) * Ja.template middleCols<4>(ca).transpose());
+  } else if (width == 3) {
+    M.noalias() += w * (Jb.template middleCols<3>(cb) * Ja.template middleCols<3>(ca).transpose());
+  } else {
+    for (int k = 0; k < width; ++k) M.noalias() += w * Jb.col(cb + k) * Ja.col(ca + k).transpose();
+  }
+}
+
+}  // namespace
 
 void XpbdRod::evaluate(const Block& b, Eigen::Vector3d& c, BlockJacobian& J) const {
   // The quaternions live on the unit sphere: their columns are projected onto its tangent
@@ -173,17 +202,16 @@ void XpbdRod::direct_iteration(double h) {
   for (int a = 0; a < n; ++a) {
     const Block& b = blocks_[a];
     const BlockJacobian& J = jacobians_[a];
-    Eigen::Matrix<double, 10, 1> w;
-    for (int k = 0; k < 10; ++k) w[k] = k < b.dofs_used ? inverse_mass_[b.dofs[k]] : 0.0;
     const Eigen::Vector3d alpha = b.compliance / (h * h);
-    Eigen::Matrix3d A = J * w.asDiagonal() * J.transpose();
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    for (const Shared& r : own_runs_[a]) add_product(A, inverse_mass_[r.dof], J, r.col_a, J, r.col_a, r.width);
     A.diagonal() += alpha;
     const int pair = a / 2, offset = 3 * (a % 2);
     system_.diagonal(pair).block<3, 3>(offset, offset) += A;
     for (int d = 1; d <= 2 && a + d < n; ++d) {  // rows of block a+d, columns of block a
       Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-      for (const auto& [ka, kb] : couplings_[a][d - 1]) {
-        M += inverse_mass_[b.dofs[ka]] * jacobians_[a + d].col(kb) * J.col(ka).transpose();
+      for (const Shared& r : couplings_[a][d - 1]) {
+        add_product(M, inverse_mass_[r.dof], jacobians_[a + d], r.col_b, J, r.col_a, r.width);
       }
       const int other = (a + d) / 2, other_offset = 3 * ((a + d) % 2);
       if (other == pair) {

@@ -104,8 +104,15 @@ class XpbdRod {
   std::vector<Block> blocks_;                 ///< in chain order: bt_1, ss_1, bt_2, ss_2, ...
   std::vector<Eigen::Vector3d> lambda_;       ///< the step's multipliers (λ, scaled by h²)
   std::vector<Eigen::Vector3d> force_lambda_;  ///< carried multipliers as forces (λ/h²)
-  /// For blocks a and a+d (d = 1, 2): the pairs (k_a, k_b) of shared dofs.
-  std::vector<std::array<std::vector<std::pair<int, int>>, 2>> couplings_;
+  /// Columns width wide from col_a in one block's Jacobian and col_b in another's on the same
+  /// dofs (from `dof`) of one inverse mass.
+  struct Shared {
+    int col_a = 0, col_b = 0, width = 0, dof = 0;
+  };
+  /// A block's own columns in runs of one inverse mass (for J W Jᵀ).
+  std::vector<std::vector<Shared>> own_runs_;
+  /// For blocks a and a+d (d = 1, 2): their shared columns.
+  std::vector<std::array<std::vector<Shared>, 2>> couplings_;
   std::vector<BlockJacobian> jacobians_;
   std::vector<Eigen::Vector3d> residuals_;
   BlockTridiagonalCholesky<6> system_;  ///< the direct solver's J W Jᵀ + α/h², blocks in pairs
