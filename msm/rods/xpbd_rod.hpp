@@ -18,13 +18,16 @@
 /// λ (as a force, rescaled by h²) and the prediction includes that force, x̃ = x + h v +
 /// h² W (f + Jᵀ λ). A converged step is XPBD's step either way; a steady state with v = 0 is a
 /// fixed point only if C + α λ = 0 on every block and f + Jᵀ λ = 0, which is the static
-/// equilibrium of the energy whatever the number of sweeps. Restarting λ from zero every step
+/// equilibrium of the energy whatever the number of iterations. Restarting λ from zero every step
 /// (`warm_start = false`, Macklin et al.'s algorithm) leaves a steady state that depends on the
-/// sweep count and the step (tests/rods/test_xpbd.cpp measures both).
+/// sweep count and the step (tests/rods/test_xpbd.cpp measures both). Warm starts need the
+/// direct solver: with Gauss–Seidel sweeps the carried multipliers diverged (measured), so that
+/// combination is refused.
 ///
 /// With warm starts the frames' mass gets the diagonal of the carried force's geometric stiffness
-/// (h² K added; Andrews, Teichmann & Kry 2017), without which the light frames go unstable once
-/// h² K/m ≳ 1; a steady state does not depend on the masses.
+/// (h² K added; Andrews, Teichmann & Kry 2017): the warm start applies that force along the
+/// step's initial directions, and without the term the light frames diverged (the α = 3
+/// cantilever at N = 32 and 64, h = 10 ms). A steady state does not depend on the masses.
 ///
 /// Its energy is CordeRod(layout, κ, inextensible = false)'s. The frames carry the segment's
 /// rotary inertia ρA l³/12: with the section's ρI l alone they are ~10⁷ times lighter than the
@@ -100,9 +103,9 @@ class XpbdRod {
   CordeRod model_;
   XpbdOptions options_;
   VectorXd x_, v_, inverse_mass_;
-  std::vector<double> quaternion_mass_;  ///< per edge, per component (zero: held)
-  std::vector<Block> blocks_;                 ///< in chain order: bt_1, ss_1, bt_2, ss_2, ...
-  std::vector<Eigen::Vector3d> lambda_;       ///< the step's multipliers (λ, scaled by h²)
+  std::vector<double> quaternion_mass_;        ///< per edge, per component (zero: held)
+  std::vector<Block> blocks_;                  ///< in chain order: bt_1, ss_1, bt_2, ss_2, ...
+  std::vector<Eigen::Vector3d> lambda_;        ///< the step's multipliers (λ, scaled by h²)
   std::vector<Eigen::Vector3d> force_lambda_;  ///< carried multipliers as forces (λ/h²)
   /// Columns width wide from col_a in one block's Jacobian and col_b in another's on the same
   /// dofs (from `dof`) of one inverse mass.

@@ -8,10 +8,10 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <random>
 #include <stdexcept>
-#include <cstdlib>
 
 #include "fem_reference/rod_theory/elastica.hpp"
 #include "msm/rods/block_tridiagonal_cholesky.hpp"
@@ -23,7 +23,9 @@
 namespace vessel::msm::rods::test {
 namespace {
 
-RodLayout cantilever(int n) { return make_layout(uniform_rod(test_material(), kLength, kDiameter, n)); }
+RodLayout cantilever(int n) {
+  return make_layout(uniform_rod(test_material(), kLength, kDiameter, n));
+}
 
 VectorXd tip_force(int num_dofs, int tip, double alpha) {
   VectorXd f = VectorXd::Zero(num_dofs);
@@ -53,7 +55,8 @@ Eigen::Vector3d xpbd_tip(int n, double alpha, XpbdSolver solver, int iterations,
   options.warm_start = warm;
   options.damping = kStaticDamping;
   XpbdRod rod(cantilever(n), 0.0, options);
-  const int s = rod.relax(h, tip_force(rod.state().size(), rod.tip_node(), alpha), 1e-14, max_steps);
+  const int s =
+      rod.relax(h, tip_force(rod.state().size(), rod.tip_node(), alpha), 1e-14, max_steps);
   if (steps != nullptr) *steps = s;
   return rod.state().segment<3>(3 * rod.tip_node());
 }
@@ -123,9 +126,9 @@ TEST(Xpbd, StaticsEqualNewtonWhateverTheIterationCount) {
       double h;
       const char* name;
     };
-    for (const Run& run : {Run{XpbdSolver::direct, 1, 1e-2, "direct"},
-                           Run{XpbdSolver::direct, 2, 1e-2, "direct"},
-                           Run{XpbdSolver::direct, 5, 1e-2, "direct"}}) {
+    for (const Run& run :
+         {Run{XpbdSolver::direct, 1, 1e-2, "direct"}, Run{XpbdSolver::direct, 2, 1e-2, "direct"},
+          Run{XpbdSolver::direct, 5, 1e-2, "direct"}}) {
       int steps = 0;
       const Eigen::Vector3d tip =
           xpbd_tip(kN, alpha, run.solver, run.iterations, true, run.h, 200000, &steps);
@@ -159,8 +162,9 @@ TEST(Xpbd, WarmStartWithGaussSeidelIsRefused) {
 }
 
 /// Errors at N = 16, 32, 64 of XPBD's statics (direct solver) against a closed form.
-void xpbd_table_row(const char* name, double alpha, const std::function<double(const Eigen::Vector3d&)>& error,
-                    double target16, double target32) {
+void xpbd_table_row(const char* name, double alpha,
+                    const std::function<double(const Eigen::Vector3d&)>& error, double target16,
+                    double target32) {
   double e[3];
   const int ns[3] = {16, 32, 64};
   for (int k = 0; k < 3; ++k) {
@@ -179,18 +183,19 @@ TEST(Xpbd, ClosedFormsAtSixteenThirtyTwoSixtyFourSegments) {
   const double alpha_lin = 1e-3;
   const double kappa = CordeRod(cantilever(1), 0.0, false).alignment();
   const double exact = alpha_lin * (kLength / 3.0 + EI / (kLength * kappa));
-  xpbd_table_row("linear", alpha_lin, [&](const Eigen::Vector3d& tip) {
-    return std::abs(tip.y() - exact) / exact;
-  }, 2.5e-3, 6e-4);
+  xpbd_table_row(
+      "linear", alpha_lin,
+      [&](const Eigen::Vector3d& tip) { return std::abs(tip.y() - exact) / exact; }, 2.5e-3, 6e-4);
   for (double alpha : {1.0, 3.0, 10.0}) {
     const rod_theory::ElasticaTip ref = rod_theory::bisshopp_drucker(alpha);
     const Eigen::Vector2d tip_exact(kLength * (1.0 - ref.shortening), kLength * ref.deflection);
     // XPBD bends by CORDE's Darboux vector: at α = 10 it misses the target as CORDE does
     // (3.11e-3 and 8.21e-4 L), the chain's error with curvature 2 sin(φ/2).
     const bool gap = alpha > 5.0;
-    xpbd_table_row(("elastica_alpha" + std::to_string(int(alpha))).c_str(), alpha,
-                   [&](const Eigen::Vector3d& tip) { return (tip.head<2>() - tip_exact).norm() / kLength; },
-                   gap ? 3.2e-3 : 2.5e-3, gap ? 8.5e-4 : 6e-4);
+    xpbd_table_row(
+        ("elastica_alpha" + std::to_string(int(alpha))).c_str(), alpha,
+        [&](const Eigen::Vector3d& tip) { return (tip.head<2>() - tip_exact).norm() / kLength; },
+        gap ? 3.2e-3 : 2.5e-3, gap ? 8.5e-4 : 6e-4);
   }
 }
 
