@@ -15,8 +15,9 @@ namespace {
 
 /// Bending and torsion at a vertex: q_a (4), q_b (4).
 template <class T>
-T darboux_energy(const std::array<T, 8>& q, double lbar, double EI, double GJ) {
-  const V3<T> omega = darboux_vector(q, lbar);
+T darboux_energy(const std::array<T, 8>& q, double lbar, double EI, double GJ, DarbouxMeasure m) {
+  const V3<T> omega =
+      m == DarbouxMeasure::quaternion ? darboux_vector(q, lbar) : rotation_darboux_vector(q, lbar);
   return 0.5 * lbar * (EI * (omega.x * omega.x + omega.y * omega.y) + GJ * omega.z * omega.z);
 }
 
@@ -47,8 +48,8 @@ std::array<int, N> consecutive(int first) {
 
 }  // namespace
 
-CordeRod::CordeRod(RodLayout layout, double alignment, bool inextensible)
-    : layout_(std::move(layout)), inextensible_(inextensible) {
+CordeRod::CordeRod(RodLayout layout, double alignment, bool inextensible, DarbouxMeasure measure)
+    : layout_(std::move(layout)), inextensible_(inextensible), measure_(measure) {
   // GJ = G·2I = G·A d²/8 → G·A = 8 GJ/d², the first material edge's d² = 16 I/A = 16 EI/EA.
   const SectionStiffness& s = layout_.section[1];
   const double d2 = 16.0 * s.EI / s.EA;
@@ -133,7 +134,7 @@ double CordeRod::energy(const VectorXd& x) const {
   for_each_energy(
       *this,
       [&](const std::array<int, 8>& d, double lbar, double EI, double GJ) {
-        e += darboux_energy(double_inputs<8>(x, d), lbar, EI, GJ);
+        e += darboux_energy(double_inputs<8>(x, d), lbar, EI, GJ, measure_);
       },
       [&](const std::array<int, 10>& d, double l) {
         e += alignment_energy(double_inputs<10>(x, d), kappa_, l);
@@ -146,7 +147,7 @@ void CordeRod::gradient(const VectorXd& x, VectorXd& g) const {
   for_each_energy(
       *this,
       [&](const std::array<int, 8>& d, double lbar, double EI, double GJ) {
-        scatter_gradient<8, false>(darboux_energy(jet_inputs<8, false>(x, d), lbar, EI, GJ), d, g);
+        scatter_gradient<8, false>(darboux_energy(jet_inputs<8, false>(x, d), lbar, EI, GJ, measure_), d, g);
       },
       [&](const std::array<int, 10>& d, double l) {
         scatter_gradient<10, false>(alignment_energy(jet_inputs<10, false>(x, d), kappa_, l), d, g);
@@ -158,7 +159,7 @@ void CordeRod::hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) con
   for_each_energy(
       *this,
       [&](const std::array<int, 8>& d, double lbar, double EI, double GJ) {
-        scatter_hessian<8>(darboux_energy(jet_inputs<8>(x, d), lbar, EI, GJ), d, project_psd, t);
+        scatter_hessian<8>(darboux_energy(jet_inputs<8>(x, d), lbar, EI, GJ, measure_), d, project_psd, t);
       },
       [&](const std::array<int, 10>& d, double l) {
         scatter_hessian<10>(alignment_energy(jet_inputs<10>(x, d), kappa_, l), d, project_psd, t);

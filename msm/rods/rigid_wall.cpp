@@ -126,14 +126,18 @@ void ActiveContacts::weighted_hessian(const VectorXd& x, const VectorXd& lambda,
 ContactSolution solve_wall_contact(const Form& rod, const EqualityConstraints* rod_constraints,
                                    const std::vector<char>& fixed, const VectorXd& start,
                                    const RigidLumen& lumen, int first_node, int last_node,
-                                   const ConstrainedOptions& options, int max_changes) {
+                                   const ConstrainedOptions& options, int max_changes,
+                                   const std::function<void(VectorXd&)>& project,
+                                   const std::vector<int>& initial_nodes) {
   ActiveContacts contacts(lumen, rod_constraints, rod.num_dofs());
+  contacts.nodes = initial_nodes;
   ConstrainedProblem p;
   p.form = &rod;
   p.constraints = &contacts;
   p.rest = start;
   p.external_force = VectorXd::Zero(start.size());
   p.fixed = fixed;
+  p.project = project;
   ContactSolution s;
   VectorXd x = start;
   VectorXd lambda = VectorXd::Zero(contacts.num_constraints());

@@ -5,6 +5,7 @@
 /// Newton: the most penetrating node joins, a node whose multiplier would pull leaves, so the wall
 /// never pulls and carries no force at zero gap.
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -77,10 +78,14 @@ struct ContactSolution {
 
 /// Equilibrium of a rod Form (with its own equality constraints, or none) inside a rigid lumen,
 /// from `start`, the nodes `first_node`..`last_node` subject to contact. Throws
-/// std::runtime_error if the active set does not settle in `max_changes` changes.
+/// std::runtime_error if the active set does not settle in `max_changes` changes. `project` maps
+/// each Newton iterate back onto part of the rod's constraints (CORDE: unit quaternions), or is
+/// empty; `initial_nodes` start the active set (e.g. a nearby solution's contacts).
 ContactSolution solve_wall_contact(const Form& rod, const EqualityConstraints* rod_constraints,
                                    const std::vector<char>& fixed, const VectorXd& start,
                                    const RigidLumen& lumen, int first_node, int last_node,
-                                   const ConstrainedOptions& options, int max_changes = 40);
+                                   const ConstrainedOptions& options, int max_changes = 40,
+                                   const std::function<void(VectorXd&)>& project = {},
+                                   const std::vector<int>& initial_nodes = {});
 
 }  // namespace vessel::msm::rods

@@ -1,51 +1,28 @@
 #include "msm/rods/xpbd_rod.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <array>
+#include <stdexcept>
 
 #include "msm/rods/cosserat_terms.hpp"
-#include "msm/rods/element_assembly.hpp"
 
 namespace vessel::msm::rods {
 
-namespace {
-
-/// C (3) and ∂C/∂q (3 × N) of a vector constraint at the dofs' values.
-template <int N, class F>
-void constraint_and_jacobian(const F& f, const Eigen::VectorXd& x, const std::array<int, N>& dofs,
-                             Eigen::Vector3d& c, Eigen::Matrix<double, 3, N>& J) {
-  const V3<Jet<N, false>> r = f(jet_inputs<N, false>(x, dofs));
-  c << r.x.v, r.y.v, r.z.v;
-  J.row(0) = r.x.g.transpose();
-  J.row(1) = r.y.g.transpose();
-  J.row(2) = r.z.g.transpose();
-}
-
-/// One XPBD correction of a 3-row block with compliance diag(alpha) (already divided by h²).
-template <int N>
-void correct(Eigen::VectorXd& x, const Eigen::VectorXd& w, const std::array<int, N>& dofs,
-             const Eigen::Vector3d& c, const Eigen::Matrix<double, 3, N>& J,
-             const Eigen::Vector3d& alpha, Eigen::Vector3d& lambda) {
-  Eigen::Matrix<double, N, 1> wd;
-  for (int a = 0; a < N; ++a) wd[a] = w[dofs[a]];
-  Eigen::Matrix3d A = J * wd.asDiagonal() * J.transpose();
-  A.diagonal() += alpha;
-  const Eigen::Vector3d dl = A.ldlt().solve(-c - alpha.cwiseProduct(lambda));
-  const Eigen::Matrix<double, N, 1> dx = wd.asDiagonal() * (J.transpose() * dl);
-  for (int a = 0; a < N; ++a) x[dofs[a]] += dx[a];
-  lambda += dl;
-}
-
-}  // namespace
-
 XpbdRod::XpbdRod(RodLayout layout, double alignment, XpbdOptions options)
     : model_(std::move(layout), alignment, false), options_(options) {
+  if (options_.warm_start && options_.solver == XpbdSolver::gauss_seidel) {
+    throw std::invalid_argument(
+        "XpbdRod: warm-started multipliers need XpbdSolver::direct (with Gauss–Seidel sweeps the "
+        "carried multipliers diverge: tests/rods/test_xpbd.cpp)");
+  }
   x_ = model_.rest_state();
   v_ = VectorXd::Zero(x_.size());
   const VectorXd m = model_.lumped_mass();
   const auto fixed = model_.clamp_fixed();
   inverse_mass_ = VectorXd::Zero(x_.size());
-  for (int i = 0; i < m.size(); ++i) inverse_mass_[i] = (fixed[i] || m[i] <= 0.0) ? 0.0 : 1.0 / m[i];
+  for (int i = 0; i < m.size(); ++i)
+    inverse_mass_[i] = (fixed[i] || m[i] <= 0.0) ? 0.0 : 1.0 / m[i];
   // Quaternion inertia: the segment's own rotary inertia ρA l³/12 (as a rigid bar about its
   // midpoint), 4× per component; the section's ρI l alone makes the frames ~10⁷ times lighter
   // than the points and the Gauss–Seidel sweeps diverge.
@@ -56,69 +33,304 @@ XpbdRod::XpbdRod(RodLayout layout, double alignment, XpbdOptions options)
     const double mq = 4.0 * L.section[j].rhoA * l * l * l / 12.0;
     inverse_mass_.segment<4>(model_.quaternion_dof(j)).setConstant(1.0 / mq);
   }
-  lambda_ss_.assign(model_.layout().num_edges(), Eigen::Vector3d::Zero());
-  lambda_bt_.assign(model_.layout().num_nodes(), Eigen::Vector3d::Zero());
-}
-
-void XpbdRod::project_stretch_shear(int j, double h) {
-  const RodLayout& L = model_.layout();
-  const auto dofs = edge_dofs(j);
-  const double l = L.length[j];
-  Eigen::Vector3d c;
-  Eigen::Matrix<double, 3, 10> J;
-  constraint_and_jacobian<10>([l](const auto& q) { return stretch_shear_strain(q, l); }, x_, dofs, c, J);
-  const Eigen::Vector3d alpha = Eigen::Vector3d::Constant(1.0 / (model_.alignment() * l * h * h));
-  correct<10>(x_, inverse_mass_, dofs, c, J, alpha, lambda_ss_[j]);
-  x_.segment<4>(model_.quaternion_dof(j)).normalize();
-}
-
-void XpbdRod::project_bend_twist(int i, double h) {
-  const RodLayout& L = model_.layout();
-  const double lbar = L.voronoi_length(i);
-  const auto dofs = vertex_dofs(i);
-  Eigen::Vector3d c;
-  Eigen::Matrix<double, 3, 8> J;
-  constraint_and_jacobian<8>([lbar](const auto& q) { return darboux_vector(q, lbar); }, x_, dofs, c, J);
-  const double EI = L.vertex_mean(i, &SectionStiffness::EI);
-  const double GJ = L.vertex_mean(i, &SectionStiffness::GJ);
-  const Eigen::Vector3d alpha = Eigen::Vector3d(1.0 / EI, 1.0 / EI, 1.0 / GJ) / (lbar * h * h);
-  correct<8>(x_, inverse_mass_, dofs, c, J, alpha, lambda_bt_[i]);
-  x_.segment<4>(model_.quaternion_dof(i - 1)).normalize();
-  x_.segment<4>(model_.quaternion_dof(i)).normalize();
-}
-
-std::array<int, 10> XpbdRod::edge_dofs(int j) const {
-  std::array<int, 10> dofs{};
-  for (int k = 0; k < 6; ++k) dofs[k] = 3 * j + k;
-  for (int k = 0; k < 4; ++k) dofs[6 + k] = model_.quaternion_dof(j) + k;
-  return dofs;
-}
-
-std::array<int, 8> XpbdRod::vertex_dofs(int i) const {
-  std::array<int, 8> dofs{};
-  for (int k = 0; k < 4; ++k) {
-    dofs[k] = model_.quaternion_dof(i - 1) + k;
-    dofs[4 + k] = model_.quaternion_dof(i) + k;
+  quaternion_mass_.assign(L.num_edges(), 0.0);
+  for (int j = 0; j < L.num_edges(); ++j) {
+    const double w = inverse_mass_[model_.quaternion_dof(j)];
+    quaternion_mass_[j] = w > 0.0 ? 1.0 / w : 0.0;
   }
-  return dofs;
+  build_blocks();
+  build_couplings();
+  const std::size_t n = blocks_.size();
+  lambda_.assign(n, Eigen::Vector3d::Zero());
+  force_lambda_.assign(n, Eigen::Vector3d::Zero());
+  jacobians_.assign(n, BlockJacobian::Zero());
+  residuals_.assign(n, Eigen::Vector3d::Zero());
+  // Constraint blocks two by two (6 rows): couplings reach two blocks, so only neighbouring
+  // pairs couple, and the system is block tridiagonal.
+  const int pairs = (static_cast<int>(n) + 1) / 2;
+  system_.resize(pairs);
+  rhs_ = VectorXd::Zero(6 * pairs);
+  contact_lambda_.assign(L.num_nodes(), 0.0);
+  contact_force_lambda_.assign(L.num_nodes(), 0.0);
+}
+
+void XpbdRod::build_blocks() {
+  const RodLayout& L = model_.layout();
+  for (int i = 1; i < L.num_nodes(); ++i) {
+    if (i + 1 < L.num_nodes() && L.voronoi_length(i) > 0.0) {  // bend–twist at vertex i
+      Block b;
+      b.stretch = false;
+      b.dofs_used = 8;
+      for (int k = 0; k < 4; ++k) {
+        b.dofs[k] = model_.quaternion_dof(i - 1) + k;
+        b.dofs[4 + k] = model_.quaternion_dof(i) + k;
+      }
+      b.length = L.voronoi_length(i);
+      const double EI = L.vertex_mean(i, &SectionStiffness::EI);
+      const double GJ = L.vertex_mean(i, &SectionStiffness::GJ);
+      b.compliance = Eigen::Vector3d(1.0 / EI, 1.0 / EI, 1.0 / GJ) / b.length;
+      blocks_.push_back(b);
+    }
+    if (i < L.num_edges() && !L.ghost[i]) {  // stretch–shear of edge i
+      Block b;
+      for (int k = 0; k < 6; ++k) b.dofs[k] = 3 * i + k;
+      for (int k = 0; k < 4; ++k) b.dofs[6 + k] = model_.quaternion_dof(i) + k;
+      b.length = L.length[i];
+      b.compliance = Eigen::Vector3d::Constant(1.0 / (model_.alignment() * b.length));
+      blocks_.push_back(b);
+    }
+  }
+}
+
+void XpbdRod::build_couplings() {
+  const int n = static_cast<int>(blocks_.size());
+  // Every free dof must be shared by blocks at most two apart in the chain order (the band).
+  std::vector<int> first(x_.size(), n), last(x_.size(), -1);
+  for (int a = 0; a < n; ++a) {
+    for (int k = 0; k < blocks_[a].dofs_used; ++k) {
+      const int d = blocks_[a].dofs[k];
+      first[d] = std::min(first[d], a);
+      last[d] = std::max(last[d], a);
+    }
+  }
+  for (Eigen::Index d = 0; d < x_.size(); ++d) {
+    if (inverse_mass_[d] > 0.0 && last[d] - first[d] > 2) {
+      throw std::logic_error("XpbdRod: a dof is shared by blocks more than two apart");
+    }
+  }
+  // Runs of consecutive shared columns on one inverse mass (a node's 3, a quaternion's 4).
+  const auto runs = [this](const Block& A, const Block& B) {
+    std::vector<Shared> out;
+    for (int ka = 0; ka < A.dofs_used; ++ka) {
+      for (int kb = 0; kb < B.dofs_used; ++kb) {
+        const int dof = A.dofs[ka];
+        if (dof != B.dofs[kb] || inverse_mass_[dof] <= 0.0) continue;
+        if (!out.empty()) {
+          Shared& r = out.back();
+          if (r.col_a + r.width == ka && r.col_b + r.width == kb && r.width < 4 &&
+              inverse_mass_[r.dof] == inverse_mass_[dof] &&
+              (dof < 3 * model_.num_nodes()) == (r.dof < 3 * model_.num_nodes())) {
+            ++r.width;
+            continue;
+          }
+        }
+        out.push_back({ka, kb, 1, dof});
+      }
+    }
+    return out;
+  };
+  couplings_.assign(n, {});
+  own_runs_.assign(n, {});
+  for (int a = 0; a < n; ++a) {
+    own_runs_[a] = runs(blocks_[a], blocks_[a]);
+    for (int d = 1; d <= 2 && a + d < n; ++d)
+      couplings_[a][d - 1] = runs(blocks_[a], blocks_[a + d]);
+  }
+}
+
+namespace {
+
+/// M += w · J_b(:, cb..cb+width) J_a(:, ca..ca+width)ᵀ (fixed sizes for a node and a quaternion).
+template <class J>
+void add_product(Eigen::Matrix3d& M, double w, const J& Jb, int cb, const J& Ja, int ca,
+                 int width) {
+  if (width == 4) {
+    M.noalias() += w * (Jb.template middleCols<4>(cb) * Ja.template middleCols<4>(ca).transpose());
+  } else if (width == 3) {
+    M.noalias() += w * (Jb.template middleCols<3>(cb) * Ja.template middleCols<3>(ca).transpose());
+  } else {
+    for (int k = 0; k < width; ++k) M.noalias() += w * Jb.col(cb + k) * Ja.col(ca + k).transpose();
+  }
+}
+
+}  // namespace
+
+void XpbdRod::evaluate(const Block& b, Eigen::Vector3d& c, BlockJacobian& J) const {
+  // The quaternions live on the unit sphere: their columns are projected onto its tangent
+  // space, J_q (I − q qᵀ), so that no correction (and no carried force) goes into |q|, which
+  // the renormalisation would undo while λ kept it.
+  const auto tangent = [&J](int col, const Eigen::Vector4d& q) {
+    const Eigen::Vector3d radial = J.middleCols<4>(col) * q;
+    J.middleCols<4>(col) -= radial * q.transpose();
+  };
+  if (b.stretch) {
+    Eigen::Matrix<double, 10, 1> q;
+    for (int k = 0; k < 10; ++k) q[k] = x_[b.dofs[k]];
+    stretch_shear_with_jacobian(q, b.length, c, J);
+    tangent(6, q.tail<4>());
+  } else {
+    Eigen::Matrix<double, 8, 1> q;
+    for (int k = 0; k < 8; ++k) q[k] = x_[b.dofs[k]];
+    Eigen::Matrix<double, 3, 8> J8;
+    darboux_with_jacobian(q, b.length, c, J8);
+    J.leftCols<8>() = J8;
+    J.rightCols<2>().setZero();
+    tangent(0, q.head<4>());
+    tangent(4, q.segment<4>(4));
+  }
+}
+
+void XpbdRod::apply(const Block& b, const BlockJacobian& J, const Eigen::Vector3d& dl) {
+  for (int k = 0; k < b.dofs_used; ++k) {
+    x_[b.dofs[k]] += inverse_mass_[b.dofs[k]] * J.col(k).dot(dl);
+  }
+}
+
+void XpbdRod::gauss_seidel_sweep(double h) {
+  Eigen::Vector3d c;
+  BlockJacobian J;
+  for (std::size_t a = 0; a < blocks_.size(); ++a) {
+    const Block& b = blocks_[a];
+    evaluate(b, c, J);
+    Eigen::Matrix<double, 10, 1> w;
+    for (int k = 0; k < 10; ++k) w[k] = k < b.dofs_used ? inverse_mass_[b.dofs[k]] : 0.0;
+    const Eigen::Vector3d alpha = b.compliance / (h * h);
+    Eigen::Matrix3d A = J * w.asDiagonal() * J.transpose();
+    A.diagonal() += alpha;
+    const Eigen::Vector3d dl = A.ldlt().solve(-c - alpha.cwiseProduct(lambda_[a]));
+    apply(b, J, dl);
+    lambda_[a] += dl;
+    // renormalise the block's quaternions
+    const int q0 = b.stretch ? b.dofs[6] : b.dofs[0];
+    x_.segment<4>(q0).normalize();
+    if (!b.stretch) x_.segment<4>(b.dofs[4]).normalize();
+  }
+  project_contacts();
+}
+
+void XpbdRod::direct_iteration(double h) {
+  const int n = static_cast<int>(blocks_.size());
+  system_.set_zero();
+  for (int a = 0; a < n; ++a) evaluate(blocks_[a], residuals_[a], jacobians_[a]);
+  for (int a = 0; a < n; ++a) {
+    const Block& b = blocks_[a];
+    const BlockJacobian& J = jacobians_[a];
+    const Eigen::Vector3d alpha = b.compliance / (h * h);
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    for (const Shared& r : own_runs_[a])
+      add_product(A, inverse_mass_[r.dof], J, r.col_a, J, r.col_a, r.width);
+    A.diagonal() += alpha;
+    const int pair = a / 2, offset = 3 * (a % 2);
+    system_.diagonal(pair).block<3, 3>(offset, offset) += A;
+    for (int d = 1; d <= 2 && a + d < n; ++d) {  // rows of block a+d, columns of block a
+      Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+      for (const Shared& r : couplings_[a][d - 1]) {
+        add_product(M, inverse_mass_[r.dof], jacobians_[a + d], r.col_b, J, r.col_a, r.width);
+      }
+      const int other = (a + d) / 2, other_offset = 3 * ((a + d) % 2);
+      if (other == pair) {
+        system_.diagonal(pair).block<3, 3>(other_offset, offset) += M;
+        system_.diagonal(pair).block<3, 3>(offset, other_offset) += M.transpose();
+      } else {  // other == pair + 1: a + d ≤ a + 2 ≤ 2·pair + 3
+        system_.sub(pair).block<3, 3>(other_offset, offset) += M;
+      }
+    }
+    rhs_.segment<3>(3 * a) = -residuals_[a] - alpha.cwiseProduct(lambda_[a]);
+  }
+  if (n % 2 == 1) {  // an odd count: the last pair's second half is a unit dummy
+    system_.diagonal(n / 2).block<3, 3>(3, 3) = Eigen::Matrix3d::Identity();
+    rhs_.segment<3>(3 * n).setZero();
+  }
+  system_.factorize();
+  system_.solve(rhs_);
+  for (int a = 0; a < n; ++a) {
+    const Eigen::Vector3d dl = rhs_.segment<3>(3 * a);
+    apply(blocks_[a], jacobians_[a], dl);
+    lambda_[a] += dl;
+  }
+  model_.normalise_quaternions(x_);
+  project_contacts();
+}
+
+void XpbdRod::project_contacts() {
+  if (lumen_ == nullptr) return;
+  for (int i = wall_first_; i <= wall_last_; ++i) {
+    const double w = inverse_mass_[3 * i];
+    if (w <= 0.0) continue;
+    Eigen::Vector3d grad;
+    const double g = lumen_->gap(x_.segment<3>(3 * i), &grad, nullptr);
+    const double lambda = contact_lambda_[i];
+    if (g >= 0.0 && lambda <= 0.0) continue;
+    // A hard one-sided constraint: Δλ = −g/(w|∇g|²), the total kept ≥ 0 (pushing only).
+    const double updated = std::max(lambda - g / (w * grad.squaredNorm()), 0.0);
+    x_.segment<3>(3 * i) += w * (updated - lambda) * grad;
+    contact_lambda_[i] = updated;
+  }
+}
+
+void XpbdRod::predict(double h, const VectorXd& force) {
+  const int n = static_cast<int>(blocks_.size());
+  VectorXd shift = VectorXd::Zero(x_.size());
+  if (options_.warm_start) {
+    // The carried constraint forces Jᵀλ at the step's start, in the prediction. (J of the last
+    // iteration instead, one evaluation fewer, leaves a one-iteration step cycling about the
+    // equilibrium at α ≥ 3: measured.)
+    for (int a = 0; a < n; ++a) {
+      lambda_[a] = h * h * force_lambda_[a];
+      Eigen::Vector3d c;
+      BlockJacobian J;
+      evaluate(blocks_[a], c, J);
+      const Block& b = blocks_[a];
+      for (int k = 0; k < b.dofs_used; ++k) {
+        shift[b.dofs[k]] += inverse_mass_[b.dofs[k]] * J.col(k).dot(lambda_[a]);
+      }
+    }
+    for (int i = wall_first_; lumen_ != nullptr && i <= wall_last_; ++i) {
+      contact_lambda_[i] = h * h * contact_force_lambda_[i];
+      if (contact_lambda_[i] == 0.0) continue;
+      Eigen::Vector3d grad;
+      lumen_->gap(x_.segment<3>(3 * i), &grad, nullptr);
+      shift.segment<3>(3 * i) += inverse_mass_[3 * i] * contact_lambda_[i] * grad;
+    }
+  } else {
+    for (auto& l : lambda_) l.setZero();
+    std::fill(contact_lambda_.begin(), contact_lambda_.end(), 0.0);
+  }
+  x_ += h * v_ + h * h * inverse_mass_.cwiseProduct(force) + shift;
+  model_.normalise_quaternions(x_);
+}
+
+void XpbdRod::stabilise_quaternion_masses(double h) {
+  // The carried multipliers' force turns with the frames: its geometric stiffness, bounded per
+  // quaternion by Σ (2/l̄)|λ| (bend–twist, bilinear in q_a, q_b) and Σ 4|λ| (stretch–shear,
+  // quadratic in q), is treated explicitly by the warm start and made the light frames diverge
+  // (α = 3, N = 32, h = 10 ms). Its diagonal is added to the frames' mass (Andrews, Teichmann & Kry
+  // 2017, "Geometric stiffness for real-time constrained multibody dynamics"). A steady state does
+  // not depend on the masses, so statics are unchanged.
+  std::vector<double> k(quaternion_mass_.size(), 0.0);
+  const int first_q = model_.quaternion_dof(0);
+  for (std::size_t a = 0; a < blocks_.size(); ++a) {
+    const Block& b = blocks_[a];
+    const double lambda = force_lambda_[a].norm();
+    if (b.stretch) {
+      k[(b.dofs[6] - first_q) / 4] += 4.0 * lambda;
+    } else {
+      k[(b.dofs[0] - first_q) / 4] += 2.0 / b.length * lambda;
+      k[(b.dofs[4] - first_q) / 4] += 2.0 / b.length * lambda;
+    }
+  }
+  for (std::size_t j = 0; j < k.size(); ++j) {
+    if (quaternion_mass_[j] <= 0.0) continue;
+    inverse_mass_.segment<4>(first_q + 4 * static_cast<int>(j))
+        .setConstant(1.0 / (quaternion_mass_[j] + h * h * k[j]));
+  }
 }
 
 void XpbdRod::step(double h, const VectorXd& force) {
   const VectorXd previous = x_;
-  x_ += h * v_ + h * h * inverse_mass_.cwiseProduct(force);
-  for (int j = 0; j < model_.layout().num_edges(); ++j) {
-    x_.segment<4>(model_.quaternion_dof(j)).normalize();
-  }
-  const RodLayout& L = model_.layout();
-  for (auto& l : lambda_ss_) l.setZero();  // XPBD: the multipliers start at zero each step
-  for (auto& l : lambda_bt_) l.setZero();
+  if (options_.warm_start) stabilise_quaternion_masses(h);
+  predict(h, force);
   for (int it = 0; it < options_.iterations; ++it) {
-    for (int j = 0; j < L.num_edges(); ++j) {
-      if (!L.ghost[j]) project_stretch_shear(j, h);
+    if (options_.solver == XpbdSolver::direct) {
+      direct_iteration(h);
+    } else {
+      gauss_seidel_sweep(h);
     }
-    for (int i = 1; i + 1 < L.num_nodes(); ++i) {
-      if (L.voronoi_length(i) > 0.0) project_bend_twist(i, h);
-    }
+  }
+  // The step's multipliers as forces: the next step's warm start, and the wall's force.
+  for (std::size_t a = 0; a < blocks_.size(); ++a) force_lambda_[a] = lambda_[a] / (h * h);
+  for (std::size_t i = 0; i < contact_lambda_.size(); ++i) {
+    contact_force_lambda_[i] = contact_lambda_[i] / (h * h);
   }
   v_ = (1.0 - options_.damping) * (x_ - previous) / h;
 }
@@ -132,6 +344,33 @@ int XpbdRod::relax(double h, const VectorXd& force, double tolerance, int max_st
     if ((x_.head(np) - before).cwiseAbs().maxCoeff() <= tolerance * L) return s;
   }
   return max_steps;
+}
+
+void XpbdRod::set_wall(const RigidLumen* lumen, int first_node, int last_node) {
+  lumen_ = lumen;
+  wall_first_ = first_node;
+  wall_last_ = last_node;
+  std::fill(contact_lambda_.begin(), contact_lambda_.end(), 0.0);
+  std::fill(contact_force_lambda_.begin(), contact_force_lambda_.end(), 0.0);
+}
+
+std::vector<double> XpbdRod::wall_forces() const {
+  std::vector<double> f(contact_force_lambda_.size(), 0.0);
+  for (int i = wall_first_; lumen_ != nullptr && i <= wall_last_; ++i) {
+    if (contact_force_lambda_[i] <= 0.0) continue;
+    Eigen::Vector3d grad;
+    lumen_->gap(x_.segment<3>(3 * i), &grad, nullptr);
+    f[i] = contact_force_lambda_[i] * grad.norm();
+  }
+  return f;
+}
+
+void XpbdRod::set_state(const VectorXd& x) {
+  x_ = x;
+  model_.normalise_quaternions(x_);
+  v_.setZero();
+  for (auto& l : force_lambda_) l.setZero();
+  std::fill(contact_force_lambda_.begin(), contact_force_lambda_.end(), 0.0);
 }
 
 }  // namespace vessel::msm::rods

@@ -8,12 +8,14 @@ namespace {
 
 class CordeAdapter : public RodAdapter {
  public:
-  explicit CordeAdapter(double alignment) : alignment_(alignment) {}
-  [[nodiscard]] std::string name() const override { return "CORDE"; }
+  CordeAdapter(double alignment, DarbouxMeasure measure) : alignment_(alignment), measure_(measure) {}
+  [[nodiscard]] std::string name() const override {
+    return measure_ == DarbouxMeasure::quaternion ? "CORDE" : "CORDE-rotvec";
+  }
 
   CordeRod make(int segments) const {
     return CordeRod(make_layout(uniform_rod(test_material(), kLength, kDiameter, segments)),
-                    alignment_);
+                    alignment_, true, measure_);
   }
 
   Eigen::Vector2d tip(int segments, double fx, double fy, double moment, int steps) override {
@@ -67,12 +69,13 @@ class CordeAdapter : public RodAdapter {
 
  private:
   double alignment_;
+  DarbouxMeasure measure_;
 };
 
 }  // namespace
 
-std::unique_ptr<RodAdapter> make_corde_adapter(double alignment) {
-  return std::make_unique<CordeAdapter>(alignment);
+std::unique_ptr<RodAdapter> make_corde_adapter(double alignment, DarbouxMeasure measure) {
+  return std::make_unique<CordeAdapter>(alignment, measure);
 }
 
 }  // namespace vessel::msm::rods::test

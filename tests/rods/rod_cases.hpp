@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "msm/rods/corde_rod.hpp"
 #include "msm/rods/rod_layout.hpp"
 
 namespace vessel::msm::rods::test {
@@ -33,7 +34,9 @@ class RodAdapter {
 };
 
 std::unique_ptr<RodAdapter> make_der_adapter();
-/// CORDE with alignment penalty κ (N; ≤ 0: the section's shear stiffness 0.9 G A).
-std::unique_ptr<RodAdapter> make_corde_adapter(double alignment = 0.0);
+/// CORDE with alignment penalty κ (N; ≤ 0: the section's shear stiffness 0.9 G A) and Darboux
+/// measure (the paper's quaternion form, or the rotation vector: name "CORDE-rotvec").
+std::unique_ptr<RodAdapter> make_corde_adapter(double alignment = 0.0,
+                                               DarbouxMeasure measure = DarbouxMeasure::quaternion);
 
 }  // namespace vessel::msm::rods::test

@@ -1,14 +1,19 @@
 // Item 3: the wire against a rigid lumen (frictionless, one-sided), against the continuum
 // references of fem_reference/rod_theory: the straight tube (shooting) and the arch apex
-// (quarter-wave elastica). Rows printed as "ROD-WALL model case N F/F_ref-1 L/L_ref-1".
+// (quarter-wave elastica), on every rod model (XPBD: its steady state with the wall's multipliers
+// carried between steps). Rows printed as "ROD-WALL model case N F/F_ref-1 L/L_ref-1".
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 #include <numbers>
 
 #include "fem_reference/rod_theory/tube_contact.hpp"
+#include "msm/rods/corde_rod.hpp"
 #include "msm/rods/der_rod.hpp"
+#include "msm/rods/xpbd_rod.hpp"
 #include "msm/rods/rigid_wall.hpp"
 
 namespace vessel::msm::rods::test {
@@ -27,29 +32,84 @@ struct WallRun {
   double length = 0.0;
 };
 
-/// The DER wire of length L from the clamp (origin, direction) inside `lumen`, started from
-/// `start_shape` (node positions of a rod of the same N, scaled about the clamp by L/its length)
-/// or from the straight rest state.
-WallRun der_in_lumen(double length, int segments, const Eigen::Vector3d& origin,
-                     const Eigen::Vector3d& direction, const RigidLumen& lumen,
-                     const VectorXd& start_shape = {}, double start_length = 0.0) {
+enum class Model { der, corde, xpbd };
+const char* name(Model m) { return m == Model::der ? "DER" : m == Model::corde ? "CORDE" : "XPBD"; }
+
+/// The start state of `start_shape` (a state of the same model and N, of length start_length)
+/// scaled about the clamp to length L: positions scaled, the other dofs (DER's twists, the
+/// quaternions) kept; or `rest` if there is none.
+VectorXd scaled_start(const VectorXd& rest, int nodes, const Eigen::Vector3d& origin, double length,
+                      const VectorXd& start_shape, double start_length) {
+  if (start_shape.size() == 0) return rest;
+  VectorXd x = start_shape;
+  for (int i = 0; i < nodes; ++i) {
+    x.segment<3>(3 * i) = origin + (length / start_length) * (start_shape.segment<3>(3 * i) - origin);
+  }
+  return x;
+}
+
+// XPBD relaxes as a damped dynamic run: the wire's first period is ~1 ms.
+constexpr double kXpbdStep = 1e-4, kXpbdDamping = 0.3;
+
+/// XPBD's steady state inside the lumen (direct solver, warm-started multipliers).
+ContactSolution xpbd_in_lumen(const RodLayout& layout, const VectorXd& start, const RigidLumen& lumen) {
+  XpbdOptions options;
+  options.solver = XpbdSolver::direct;
+  options.iterations = 2;
+  options.damping = kXpbdDamping;
+  XpbdRod rod(layout, 0.0, options);
+  rod.set_state(start);
+  const int tip = rod.tip_node();
+  rod.set_wall(&lumen, 2, tip);
+  rod.relax(kXpbdStep, VectorXd::Zero(start.size()), 1e-14, 200000);
+  ContactSolution s;
+  s.x = rod.state();
+  const std::vector<double> f = rod.wall_forces();
+  s.min_gap = std::numeric_limits<double>::infinity();
+  for (int i = 2; i <= tip; ++i) {
+    if (f[i] > 0.0) {
+      s.nodes.push_back(i);
+      s.forces.push_back(f[i]);
+    }
+    s.min_gap = std::min(s.min_gap, lumen.gap(s.x.segment<3>(3 * i), nullptr, nullptr));
+  }
+  return s;
+}
+
+/// The wire (model m) of length L from the clamp (origin, direction) inside `lumen`, started from
+/// `start_shape` (see scaled_start) or from the straight rest state.
+WallRun wire_in_lumen(Model m, double length, int segments, const Eigen::Vector3d& origin,
+                      const Eigen::Vector3d& direction, const RigidLumen& lumen,
+                      const VectorXd& start_shape = {}, double start_length = 0.0) {
   RodSpec spec = uniform_rod(kNitinol, length, kWire, segments);
   spec.origin = origin;
   spec.direction = direction;
-  DerRod rod(make_layout(spec));
-  VectorXd x = rod.rest_state();
-  if (start_shape.size() > 0) {
-    for (int i = 0; i < rod.num_nodes(); ++i) {
-      x.segment<3>(3 * i) = origin + (length / start_length) * (start_shape.segment<3>(3 * i) - origin);
-    }
-    rod.update_reference(x);
-  }
+  const RodLayout layout = make_layout(spec);
   ConstrainedOptions options;
   options.force_scale = wire_EI() / (length * length);
   WallRun run;
-  run.contact = solve_wall_contact(rod, nullptr, rod.clamp_fixed(), x, lumen, 2,
-                                   rod.layout().tip_node, options);
-  run.tip = run.contact.x.segment<3>(3 * rod.layout().tip_node);
+  const int tip = layout.tip_node;
+  if (m == Model::der) {
+    DerRod rod(layout);
+    const VectorXd x = scaled_start(rod.rest_state(), rod.num_nodes(), origin, length, start_shape, start_length);
+    rod.update_reference(x);
+    run.contact = solve_wall_contact(rod, nullptr, rod.clamp_fixed(), x, lumen, 2, tip, options);
+  } else if (m == Model::corde) {
+    // KKT Newton takes full steps (the alignment penalty is stiff) and does not converge from
+    // a far start in the arch: it starts from XPBD's steady state on the same layout (CORDE's
+    // energy less inextensibility, a strain ~1e-6 away) and its contacts.
+    const CordeRod rod(layout);
+    const VectorXd x0 = scaled_start(rod.rest_state(), rod.num_nodes(), origin, length, start_shape, start_length);
+    const ContactSolution start = xpbd_in_lumen(layout, x0, lumen);
+    run.contact = solve_wall_contact(rod, &rod, rod.clamp_fixed(), start.x, lumen, 2, tip, options,
+                                     40, [&rod](VectorXd& y) { rod.normalise_quaternions(y); },
+                                     start.nodes);
+  } else {
+    const CordeRod rod(layout, 0.0, false);
+    const VectorXd x = scaled_start(rod.rest_state(), rod.num_nodes(), origin, length, start_shape, start_length);
+    run.contact = xpbd_in_lumen(layout, x, lumen);
+  }
+  run.tip = run.contact.x.segment<3>(3 * tip);
   run.length = length;
   return run;
 }
@@ -62,33 +122,36 @@ double total_force(const ContactSolution& c) {
 
 /// Secant on the length so that target(run) = 0, each solve warm-started from the last.
 template <class Target>
-WallRun secant_length(double L0, double L1, int segments, const Eigen::Vector3d& origin,
+WallRun secant_length(Model m, double L0, double L1, int segments, const Eigen::Vector3d& origin,
                       const Eigen::Vector3d& direction, const RigidLumen& lumen, WallRun previous,
                       const Target& target) {
-  WallRun a = der_in_lumen(L0, segments, origin, direction, lumen, previous.contact.x, previous.length);
-  WallRun b = der_in_lumen(L1, segments, origin, direction, lumen, a.contact.x, a.length);
+  WallRun a = wire_in_lumen(m, L0, segments, origin, direction, lumen, previous.contact.x, previous.length);
+  WallRun b = wire_in_lumen(m, L1, segments, origin, direction, lumen, a.contact.x, a.length);
   for (int it = 0; it < 30 && std::abs(target(b)) > 1e-12; ++it) {
     const double L = b.length - target(b) * (b.length - a.length) / (target(b) - target(a));
     a = b;
-    b = der_in_lumen(L, segments, origin, direction, lumen, a.contact.x, a.length);
+    b = wire_in_lumen(m, L, segments, origin, direction, lumen, a.contact.x, a.length);
   }
   return b;
 }
 
-TEST(RigidWall, StraightTubeTipContactMatchesShooting) {
+class RigidWall : public ::testing::TestWithParam<Model> {};
+
+TEST_P(RigidWall, StraightTubeTipContactMatchesShooting) {
+  const Model m = GetParam();
   const double z = 20e-3, theta = 0.3;
   const rod_theory::StraightTubeContact ref = rod_theory::straight_tube_contact(theta, kOffset / z);
   const StraightTube tube(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), kOffset);
   const Eigen::Vector3d dir(std::cos(theta), std::sin(theta), 0.0);
   for (int n : {16, 32, 64}) {
-    const WallRun start = der_in_lumen(ref.length * z, n, Eigen::Vector3d::Zero(), dir, tube);
-    const WallRun run = secant_length(ref.length * z, 1.001 * ref.length * z, n,
+    const WallRun start = wire_in_lumen(m, ref.length * z, n, Eigen::Vector3d::Zero(), dir, tube);
+    const WallRun run = secant_length(m, ref.length * z, 1.001 * ref.length * z, n,
                                       Eigen::Vector3d::Zero(), dir, tube, start,
                                       [&](const WallRun& r) { return r.tip.x() - z; });
     const double F = total_force(run.contact) * z * z / wire_EI();
     const double L = run.length / z;
-    std::printf("ROD-WALL DER straight_tube %d F %.6f (ref %.6f, %+.2e) L %.6f (ref %.6f, %+.2e)\n",
-                n, F, ref.force, F / ref.force - 1, L, ref.length, L / ref.length - 1);
+    std::printf("ROD-WALL %s straight_tube %d F %.6f (ref %.6f, %+.2e) L %.6f (ref %.6f, %+.2e)\n",
+                name(m), n, F, ref.force, F / ref.force - 1, L, ref.length, L / ref.length - 1);
     ASSERT_EQ(run.contact.nodes.size(), 1u);  // a tip contact only
     EXPECT_GE(run.contact.min_gap, -1e-12);
     if (n == 32) {
@@ -98,16 +161,17 @@ TEST(RigidWall, StraightTubeTipContactMatchesShooting) {
   }
 }
 
-TEST(RigidWall, NoForceAtZeroGapAndNeverPulling) {
+TEST_P(RigidWall, NoForceAtZeroGapAndNeverPulling) {
+  const Model m = GetParam();
   const double theta = 0.3;
   const StraightTube tube(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), kOffset);
   const Eigen::Vector3d dir(std::cos(theta), std::sin(theta), 0.0);
   const double touch = kOffset / std::sin(theta);  // the straight wire's tip on the wall
-  const WallRun at = der_in_lumen(touch * (1.0 - 1e-9), 32, Eigen::Vector3d::Zero(), dir, tube);
+  const WallRun at = wire_in_lumen(m, touch * (1.0 - 1e-9), 32, Eigen::Vector3d::Zero(), dir, tube);
   EXPECT_TRUE(at.contact.nodes.empty());
   // Just beyond: a small force, the linear cantilever's 3EI·Δy/(L³ cos²θ), pushing (never pulling).
   const double L = touch * (1.0 + 1e-5);
-  const WallRun beyond = der_in_lumen(L, 32, Eigen::Vector3d::Zero(), dir, tube);
+  const WallRun beyond = wire_in_lumen(m, L, 32, Eigen::Vector3d::Zero(), dir, tube);
   ASSERT_EQ(beyond.contact.forces.size(), 1u);
   const double dy = L * std::sin(theta) - kOffset;
   const double linear = 3.0 * wire_EI() * dy / (std::pow(L, 3) * std::cos(theta) * std::cos(theta));
@@ -115,7 +179,8 @@ TEST(RigidWall, NoForceAtZeroGapAndNeverPulling) {
   EXPECT_NEAR(beyond.contact.forces[0] / linear, 1.0, 5e-3);  // the discretisation's 1/(2N²)
 }
 
-TEST(RigidWall, ArchApexQuarterWaveElastica) {
+TEST_P(RigidWall, ArchApexQuarterWaveElastica) {
+  const Model m = GetParam();
   const double R = 15e-3;
   const double Ro = R + kOffset;
   const rod_theory::ArchApexContact ref = rod_theory::arch_apex_contact(Ro / R);
@@ -124,15 +189,15 @@ TEST(RigidWall, ArchApexQuarterWaveElastica) {
   for (int n : {16, 32, 64}) {
     // Insert the wire in steps (each solve from the last shape), then find the length whose tip
     // bears at the apex (polar angle π/2).
-    WallRun run = der_in_lumen(0.6 * R, n, clamp, dir, bend);
+    WallRun run = wire_in_lumen(m, 0.6 * R, n, clamp, dir, bend);
     for (double L = 0.7 * R; L < 1.5 * R; L += 0.1 * R) {
-      run = der_in_lumen(L, n, clamp, dir, bend, run.contact.x, run.length);
+      run = wire_in_lumen(m, L, n, clamp, dir, bend, run.contact.x, run.length);
     }
     const auto angle = [](const WallRun& r) { return std::atan2(r.tip.y(), r.tip.x()) - std::numbers::pi / 2; };
-    run = secant_length(1.55 * R, 1.6 * R, n, clamp, dir, bend, run, angle);
+    run = secant_length(m, 1.55 * R, 1.6 * R, n, clamp, dir, bend, run, angle);
     const double F = total_force(run.contact) * R * R / wire_EI();
     const double L = run.length / R;
-    std::printf("ROD-WALL DER arch_apex %d F %.6f (ref %.6f, %+.2e) L %.6f (ref %.6f, %+.2e)\n", n,
+    std::printf("ROD-WALL %s arch_apex %d F %.6f (ref %.6f, %+.2e) L %.6f (ref %.6f, %+.2e)\n", name(m), n,
                 F, ref.force, F / ref.force - 1, L, ref.length, L / ref.length - 1);
     ASSERT_EQ(run.contact.nodes.size(), 1u);  // no second contact
     EXPECT_GE(run.contact.min_gap, -1e-12);
@@ -142,6 +207,9 @@ TEST(RigidWall, ArchApexQuarterWaveElastica) {
     }
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Models, RigidWall, ::testing::Values(Model::der, Model::corde, Model::xpbd),
+                         [](const auto& info) { return std::string(name(info.param)); });
 
 }  // namespace
 }  // namespace vessel::msm::rods::test

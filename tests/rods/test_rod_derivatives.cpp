@@ -2,10 +2,13 @@
 // stretched and twisted 3D states away from the rest state and from the stored reference frames.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <cmath>
 #include <random>
 
 #include "../msm/finite_differences.hpp"
 #include "msm/rods/corde_rod.hpp"
+#include "msm/rods/cosserat_terms.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "msm/rods/rod_loads.hpp"
 #include "rod_cases.hpp"
@@ -88,6 +91,33 @@ TEST(RodDerivatives, CordeEnergyGradientHessianAgreeWithFiniteDifferences) {
   const auto c = check_form_derivatives(rod, x, 1e-7);
   EXPECT_LT(c.gradient_error, 1e-6);
   EXPECT_LT(c.hessian_error, 1e-6);
+}
+
+TEST(RodDerivatives, CordeRotationVectorEnergyAgreesWithFiniteDifferences) {
+  // Small relative rotations (the series branch of atan(s/w)/s) and large ones (closed form).
+  const CordeRod rod(make_layout(small_rod()), 0.0, true, DarbouxMeasure::rotation_vector);
+  for (double scale : {3e-3, 0.15}) {
+    VectorXd x = perturbed(rod.rest_state(), 3e-3, 5);
+    const VectorXd q = perturbed(rod.rest_state(), scale, 8);
+    x.tail(x.size() - 3 * rod.num_nodes()) = q.tail(x.size() - 3 * rod.num_nodes());
+    const auto c = check_form_derivatives(rod, x, 1e-7);
+    EXPECT_LT(c.gradient_error, 1e-6) << scale;
+    EXPECT_LT(c.hessian_error, 1e-6) << scale;
+  }
+}
+
+TEST(RodDerivatives, RotationDarbouxVectorIsTheTurningAngle) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
+  for (double phi : {1e-4, 0.05, 0.7, 2.5}) {
+    const Eigen::Quaterniond a(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX()));
+    const Eigen::Quaterniond b = a * Eigen::Quaterniond(Eigen::AngleAxisd(phi, axis));
+    const std::array<double, 8> q{a.w(), a.x(), a.y(), a.z(), b.w(), b.x(), b.y(), b.z()};
+    const V3<double> omega = rotation_darboux_vector(q, 0.5);
+    const Eigen::Vector3d o(omega.x, omega.y, omega.z);
+    EXPECT_LT((0.5 * o - phi * axis).norm(), 1e-14) << phi;  // in q_a's frame: the axis itself
+    const V3<double> paper = darboux_vector(q, 0.5);
+    EXPECT_NEAR(0.5 * std::sqrt(dot(paper, paper)), 2.0 * std::sin(phi / 2.0), 1e-14) << phi;
+  }
 }
 
 TEST(RodDerivatives, CordeConstraintJacobianAndWeightedHessian) {

@@ -1,0 +1,106 @@
+#pragma once
+/// Cholesky factorisation of a symmetric positive definite block-tridiagonal matrix of B × B
+/// blocks (diagonal blocks A(i, i), sub-diagonal blocks A(i+1, i)): L(i, i) = chol(A(i, i) −
+/// L(i, i−1) L(i, i−1)ᵀ), L(i+1, i) = A(i+1, i) L(i, i)⁻ᵀ; O(n B³) to factorise, O(n B²) to
+/// solve, in fixed-size blocks. The XPBD rod's direct solver uses it on its constraint blocks
+/// taken two by two along the chain (Deul, Kugelstadt, Weiler & Bender 2018 solve the same
+/// tree-structured system in linear time).
+#include <Eigen/Core>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace vessel::msm::rods {
+
+template <int B>
+class BlockTridiagonalCholesky {
+ public:
+  using Block = Eigen::Matrix<double, B, B>;
+  using Vector = Eigen::Matrix<double, B, 1>;
+
+  /// n diagonal blocks, all zero.
+  void resize(int n) {
+    diagonal_.assign(n, Block::Zero());
+    sub_.assign(n > 0 ? n - 1 : 0, Block::Zero());
+    inverse_diagonal_.assign(n, Vector::Zero());
+  }
+  void set_zero() {
+    for (auto& d : diagonal_) d.setZero();
+    for (auto& s : sub_) s.setZero();
+  }
+  [[nodiscard]] int size() const { return static_cast<int>(diagonal_.size()); }
+  /// A(i, i) (both triangles are read).
+  Block& diagonal(int i) { return diagonal_[i]; }
+  /// A(i+1, i).
+  Block& sub(int i) { return sub_[i]; }
+
+  /// Overwrites the blocks with the factor. Throws std::runtime_error if a diagonal block is not
+  /// positive definite.
+  void factorize() {
+    for (int i = 0; i < size(); ++i) {
+      if (i > 0) diagonal_[i].noalias() -= sub_[i - 1] * sub_[i - 1].transpose();
+      cholesky_in_place(diagonal_[i], inverse_diagonal_[i], i);
+      if (i + 1 < size()) {
+        // L(i+1, i) = A(i+1, i) L(i, i)⁻ᵀ: each row x solves L(i, i) xᵀ = (its row of A)ᵀ.
+        for (int r = 0; r < B; ++r) {
+          for (int j = 0; j < B; ++j) {
+            double v = sub_[i](r, j);
+            for (int k = 0; k < j; ++k) v -= diagonal_[i](j, k) * sub_[i](r, k);
+            sub_[i](r, j) = v * inverse_diagonal_[i][j];
+          }
+        }
+      }
+    }
+  }
+
+  /// Solves A x = r in place (r has B·n entries).
+  void solve(Eigen::VectorXd& r) const {
+    const int n = size();
+    for (int i = 0; i < n; ++i) {  // L y = r
+      Vector y = r.template segment<B>(B * i);
+      if (i > 0) y.noalias() -= sub_[i - 1] * r.template segment<B>(B * (i - 1));
+      for (int j = 0; j < B; ++j) {
+        double v = y[j];
+        for (int k = 0; k < j; ++k) v -= diagonal_[i](j, k) * y[k];
+        y[j] = v * inverse_diagonal_[i][j];
+      }
+      r.template segment<B>(B * i) = y;
+    }
+    for (int i = n - 1; i >= 0; --i) {  // Lᵀ x = y
+      Vector y = r.template segment<B>(B * i);
+      if (i + 1 < n) y.noalias() -= sub_[i].transpose() * r.template segment<B>(B * (i + 1));
+      for (int j = B - 1; j >= 0; --j) {
+        double v = y[j];
+        for (int k = j + 1; k < B; ++k) v -= diagonal_[i](k, j) * y[k];
+        y[j] = v * inverse_diagonal_[i][j];
+      }
+      r.template segment<B>(B * i) = y;
+    }
+  }
+
+ private:
+  /// The lower Cholesky factor of a (fixed-size, unrolled), 1/L(j, j) in inverse.
+  static void cholesky_in_place(Block& a, Vector& inverse, int block) {
+    for (int j = 0; j < B; ++j) {
+      double d = a(j, j);
+      for (int k = 0; k < j; ++k) d -= a(j, k) * a(j, k);
+      if (!(d > 0.0)) {
+        throw std::runtime_error("BlockTridiagonalCholesky: block " + std::to_string(block) +
+                                 " is not positive definite");
+      }
+      a(j, j) = std::sqrt(d);
+      inverse[j] = 1.0 / a(j, j);
+      for (int i = j + 1; i < B; ++i) {
+        double v = a(i, j);
+        for (int k = 0; k < j; ++k) v -= a(i, k) * a(j, k);
+        a(i, j) = v * inverse[j];
+      }
+    }
+  }
+
+  std::vector<Block> diagonal_, sub_;
+  std::vector<Vector> inverse_diagonal_;
+};
+
+}  // namespace vessel::msm::rods
