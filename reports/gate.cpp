@@ -1,6 +1,7 @@
 #include "reports/gate.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <sstream>
 #include <tuple>
@@ -34,6 +35,68 @@ GateFinding finding(const Key& k, std::string what, std::string baseline, std::s
                     bool failure) {
   return {std::get<0>(k), std::get<1>(k), std::get<2>(k), std::get<3>(k), std::get<4>(k),
           std::move(what), std::move(baseline), std::move(current), failure};
+}
+
+/// The guidewire's figures: the wire's force error against the continuum per EI, and each coupled
+/// row's contact-force error, may not grow (nor a finished row fail, nor a row disappear).
+void compare_guidewires(const ResultsFile& baseline, const ResultsFile& current,
+                        const GateTolerances& tol, GateOutcome& out) {
+  const auto grew = [&](double was, double is) {
+    return is > was * (1.0 + tol.error_relative) + tol.error_absolute_mN;
+  };
+  for (const SceneRows& b : baseline.scenes) {
+    if (!b.guidewire) continue;
+    const auto it = std::find_if(current.scenes.begin(), current.scenes.end(),
+                                 [&](const SceneRows& s) { return s.name == b.name; });
+    const std::string wire = "wire (" + b.guidewire->model + ")";
+    if (it == current.scenes.end()) continue;  // the scene's outcomes are reported missing
+    if (!it->guidewire) {
+      out.findings.push_back({b.name, wire, 0.0, 0, 0.0, "guidewire missing", "present", "absent", true});
+      continue;
+    }
+    const GuidewireRows& c = *it->guidewire;
+    for (const GuidewireRigidRow& r : b.guidewire->rigid) {
+      if (!r.force_error_mN) continue;
+      const auto now = std::find_if(c.rigid.begin(), c.rigid.end(), [&](const auto& x) {
+        return x.bending_stiffness == r.bending_stiffness;
+      });
+      ++out.compared;
+      if (now == c.rigid.end() || !now->force_error_mN) {
+        out.findings.push_back({b.name, wire, 0.0, 0, r.bending_stiffness,
+                                "wire force error (vs continuum) missing", num(*r.force_error_mN) + " mN",
+                                "absent", true});
+      } else if (grew(*r.force_error_mN, *now->force_error_mN)) {
+        out.findings.push_back({b.name, wire, 0.0, 0, r.bending_stiffness,
+                                "wire force error (vs continuum) grew", num(*r.force_error_mN) + " mN",
+                                num(*now->force_error_mN) + " mN", true});
+      }
+    }
+    for (const GuidewireCoupledRow& r : b.guidewire->coupled) {
+      const auto now = std::find_if(c.coupled.begin(), c.coupled.end(), [&](const auto& x) {
+        return x.model == r.model && x.poisson_ratio == r.poisson_ratio && x.level == r.level &&
+               x.bending_stiffness == r.bending_stiffness;
+      });
+      const std::string what = "coupled contact-force error |F − F_ref|";
+      ++out.compared;
+      if (now == c.coupled.end()) {
+        out.findings.push_back({b.name, r.model, r.poisson_ratio, r.level, r.bending_stiffness,
+                                what + " missing", "present", "absent", true});
+        continue;
+      }
+      if (!r.ok) continue;
+      if (!now->ok) {
+        out.findings.push_back({b.name, r.model, r.poisson_ratio, r.level, r.bending_stiffness,
+                                "coupled force now fails", "finished", now->failure, true});
+        continue;
+      }
+      const double was = std::abs(r.force_mN - r.reference_force_mN);
+      const double is = std::abs(now->force_mN - now->reference_force_mN);
+      if (grew(was, is)) {
+        out.findings.push_back({b.name, r.model, r.poisson_ratio, r.level, r.bending_stiffness,
+                                what + " grew", num(was) + " mN", num(is) + " mN", true});
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -91,6 +154,7 @@ GateOutcome compare_with_baseline(const ResultsFile& baseline, const ResultsFile
       }
     }
   }
+  compare_guidewires(baseline, current, tol, out);
   for (const auto& [k, c] : now) {
     if (!base.count(k)) out.findings.push_back(finding(k, "new, not in the baseline", "", c->ok ? "finished" : c->failure, false));
   }

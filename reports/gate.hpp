@@ -19,6 +19,7 @@ namespace vessel::reports {
 struct GateTolerances {
   double error_relative = 0.02;     ///< max and RMS error may grow by this fraction...
   double error_absolute_mm = 1e-6;  ///< ...plus this much (round-off of near-zero errors)
+  double error_absolute_mN = 1e-6;  ///< the same for the guidewire's force errors
   double timing_ratio = 2.5;        ///< normalised solve time may grow by this factor (shared, noisy machines)
   double timing_floor_s = 0.05;     ///< solves faster than this in the baseline are too noisy to gate
 };
@@ -40,7 +41,10 @@ struct GateOutcome {
   [[nodiscard]] bool passed() const;
 };
 
-/// Compares every (scene, model, ν, level, load) case of the baseline with this run's.
+/// Compares every (scene, model, ν, level, load) case of the baseline with this run's, and each
+/// guidewire scene's wire: per EI its force error against the continuum wire, and per coupled
+/// row (model, ν, level, EI) the contact-force error |F − F_ref| (their findings name the model
+/// "wire (<rod model>)" or the vessel model, with EI in the load column).
 /// Timings are compared only when both files carry reference_kernel_seconds.
 GateOutcome compare_with_baseline(const ResultsFile& baseline, const ResultsFile& current,
                                   const GateTolerances& tolerances = {});

@@ -95,11 +95,23 @@ GuidewireRows read_guidewire(const json& g, const std::string& where) {
   GuidewireRows w;
   w.model = field<std::string>(g, "model", where);
   w.coupling = field<std::string>(g, "coupling", where);
+  w.diameter_mm = field_or<double>(g, "diameter_m", 0.0, where) * 1e3;
+  using Line = std::vector<std::array<double, 3>>;
   for (const json& r : field<json>(g, "rigid", where)) {
-    w.rigid.push_back({field<double>(r, "bending_stiffness_Nm2", where + ".rigid"),
-                       field<double>(r, "contact_force_N", where + ".rigid") * 1e3,
-                       json_fields::optional_field<double>(r, "wire_compliance_m_per_N",
-                                                           where + ".rigid")});
+    const std::string rw = where + ".rigid";
+    GuidewireRigidRow row{field<double>(r, "bending_stiffness_Nm2", rw),
+                          field<double>(r, "contact_force_N", rw) * 1e3,
+                          json_fields::optional_field<double>(r, "wire_compliance_m_per_N", rw),
+                          field_or<Line>(r, "centreline_mm", {}, rw),
+                          {},
+                          "",
+                          json_fields::optional_field<double>(r, "force_error_mN", rw)};
+    const json coupled = field_or<json>(r, "reference_coupled", nullptr, rw);
+    if (coupled.is_object()) {
+      row.reference_centreline_mm = field<Line>(coupled, "centreline_mm", rw + ".reference_coupled");
+      row.reference_row = field<std::string>(coupled, "row", rw + ".reference_coupled");
+    }
+    w.rigid.push_back(std::move(row));
   }
   for (const json& r : field_or<json>(g, "coupling_rows", json::array(), where)) {
     const std::string rw = where + ".coupling_rows";

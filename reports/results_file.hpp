@@ -1,6 +1,7 @@
 #pragma once
 /// results.json (schema "vesselverify.results", version 2; verification/results.schema.json) read
 /// back into plain structs, for the report generator and the gate. Only what they use is read.
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -92,6 +93,13 @@ struct GuidewireRigidRow {
   double bending_stiffness = 0.0;  ///< N·m²
   double force_mN = 0.0;
   std::optional<double> wire_compliance;  ///< m/N, compliant coupling only
+  /// The wire's centreline against the rigid lumen, clamp to tip, mm (empty in files without it).
+  std::vector<std::array<double, 3>> centreline_mm;
+  /// Compliant coupling: the wire coupled with the reference's wall, mm (empty without one).
+  std::vector<std::array<double, 3>> reference_centreline_mm;
+  std::string reference_row;  ///< the coupling row whose loaded nodes C_ref was read on
+  /// |F − F_continuum| (mN): the rod model's error; absent without a continuum wire.
+  std::optional<double> force_error_mN;
 };
 struct GuidewireCoupledRow {
   std::string model, failure;
@@ -103,6 +111,7 @@ struct GuidewireCoupledRow {
 };
 struct GuidewireRows {
   std::string model, coupling;  ///< the wire's rod model; rigid | compliant
+  double diameter_mm = 0.0;     ///< 0 in files without it
   std::vector<GuidewireRigidRow> rigid;
   std::vector<GuidewireCoupledRow> coupled;
 };

@@ -72,6 +72,58 @@ HardCaseEntry read_hard_case(const json& j, const std::string& where) {
   return e;
 }
 
+RodStepEntry read_rod_step(const json& j, const std::string& where) {
+  RodStepEntry e;
+  e.model = field<std::string>(j, "model", where);
+  e.integrator = field<std::string>(j, "integrator", where);
+  e.failure = field<std::string>(j, "failure", where);
+  e.segments = field<int>(j, "segments", where);
+  e.h = field<double>(j, "h", where);
+  e.axial_dt = field<double>(j, "axial_dt", where);
+  e.twist_dt = field<double>(j, "twist_dt", where);
+  e.bending_dt = field<double>(j, "bending_dt", where);
+  e.closed_form_dt = field<double>(j, "closed_form_dt", where);
+  e.predicted_dt = optional_field<double>(j, "predicted_dt", where);
+  e.found_dt = optional_field<double>(j, "found_dt", where);
+  e.steps_tried = field<std::vector<double>>(j, "steps_tried", where);
+  e.bounded = field<std::vector<bool>>(j, "bounded", where);
+  if (e.bounded.size() != e.steps_tried.size()) {
+    throw InputError(where + ": 'bounded' and 'steps_tried' differ in length");
+  }
+  return e;
+}
+
+WireCandidateEntry read_wire_candidate(const json& j, const std::string& where) {
+  WireCandidateEntry e;
+  e.name = field<std::string>(j, "name", where);
+  e.verdict = field<std::string>(j, "verdict", where);
+  e.reason = field<std::string>(j, "reason", where);
+  e.ok = field<bool>(j, "ok", where);
+  if (!e.ok) {
+    e.failure = field<std::string>(j, "failure", where);
+    return e;
+  }
+  e.force_error_mN = field<double>(j, "force_error_mN", where);
+  e.contact_error_mm = field<double>(j, "contact_point_error_mm", where);
+  e.update_seconds = field<double>(j, "update_seconds", where);
+  e.setup_seconds = field<double>(j, "setup_seconds", where);
+  return e;
+}
+
+WireEntry read_wire(const json& j, const std::string& where) {
+  WireEntry w;
+  const json ref = field_or<json>(j, "reference", nullptr, where);
+  if (!ref.is_object()) {
+    w.no_reference = field<std::string>(j, "no_reference", where);
+    return w;
+  }
+  w.reference = field<std::string>(ref, "what", where + ".reference");
+  w.reference_force_N = field<double>(ref, "contact_force_N", where + ".reference");
+  w.recommended = optional_field<std::string>(j, "recommended", where);
+  w.candidates = read_array(j, "candidates", where, read_wire_candidate);
+  return w;
+}
+
 CandidateEntry read_candidate(const json& j, const std::string& where) {
   CandidateEntry e;
   e.name = field<std::string>(j, "name", where);
@@ -245,6 +297,16 @@ StabilityFile parse_stability(const std::string& text, const std::filesystem::pa
   s.refinement = read_array(j, "refinement", file, read_refinement);
   s.hard_cases = read_array(j, "hard_cases", file, read_hard_case);
   s.hard_cases_at_a_time = field_or<int>(j, "hard_cases_at_a_time", 1, file);
+  if (const auto rod = j.find("rod_critical_steps"); rod != j.end() && !rod->is_null()) {
+    const std::string where = file + ": rod_critical_steps";
+    const json w = field<json>(*rod, "wire", where);
+    s.rod_wire = RodWireEntry{field<double>(w, "length", where + ".wire"),
+                              field<double>(w, "diameter", where + ".wire"),
+                              field<double>(w, "young", where + ".wire"),
+                              field<double>(w, "shear", where + ".wire"),
+                              field<double>(w, "density", where + ".wire")};
+    s.rod_steps = read_array(*rod, "rows", where, read_rod_step);
+  }
   if (const auto t = j.find("timing_provenance"); t != j.end() && t->is_object()) {
     const std::string where = file + ": timing_provenance";
     s.timing_provenance = timing_provenance_line(
@@ -286,6 +348,9 @@ RecommendFile parse_recommend(const std::string& text, const std::filesystem::pa
   r.results = source.parent_path() / (results ? *results : std::string("results.json"));
   r.reference_contact_point_mm = field<double>(j, "reference_contact_point_mm", file);
   r.candidates = read_array(j, "candidates", file, read_candidate);
+  if (const auto w = j.find("wire"); w != j.end() && !w->is_null()) {
+    r.wire = read_wire(*w, file + ": wire");
+  }
   return r;
 }
 

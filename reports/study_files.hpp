@@ -30,6 +30,22 @@ struct RefinementEntry {
   double found_exponent = 0.0, predicted_exponent = 0.0;
 };
 
+/// One row of the guidewire's critical steps (s): closed forms, and the explicit rows' found step
+/// or the implicit rows' steps tried with whether each stayed bounded.
+struct RodStepEntry {
+  std::string model, integrator, failure;
+  int segments = 0;
+  double h = 0.0, axial_dt = 0.0, twist_dt = 0.0, bending_dt = 0.0, closed_form_dt = 0.0;
+  std::optional<double> predicted_dt, found_dt;
+  std::vector<double> steps_tried;
+  std::vector<bool> bounded;
+};
+
+/// The wire the rod rows are for (SI).
+struct RodWireEntry {
+  double length = 0.0, diameter = 0.0, young = 0.0, shear = 0.0, density = 0.0;
+};
+
 struct HardCaseOutcomeEntry {
   std::string model;
   bool finished = false;
@@ -52,6 +68,8 @@ struct StabilityFile {
   std::vector<CriticalStepEntry> critical_steps;
   std::vector<RefinementEntry> refinement;
   std::vector<HardCaseEntry> hard_cases;
+  std::optional<RodWireEntry> rod_wire;  ///< absent in files without the rod's rows
+  std::vector<RodStepEntry> rod_steps;
   int hard_cases_at_a_time = 1;  ///< how many hard cases ran at once (1 in older files)
   /// Which rows' and hard cases' timings came from the model outcome cache
   /// (timing_provenance_line); empty in a file without that record.
@@ -79,6 +97,20 @@ struct BudgetLoadEntry {
   std::string reference_element;
 };
 
+/// One rod model of a guidewire scene's wire candidates (recommend.json's "wire").
+struct WireCandidateEntry {
+  std::string name, verdict, reason, failure;
+  bool ok = false;
+  double force_error_mN = 0.0, contact_error_mm = 0.0, update_seconds = 0.0, setup_seconds = 0.0;
+};
+struct WireEntry {
+  std::string reference;  ///< the continuum wire; empty when there is none
+  std::string no_reference;
+  double reference_force_N = 0.0;
+  std::optional<std::string> recommended;
+  std::vector<WireCandidateEntry> candidates;
+};
+
 struct RecommendFile {
   std::filesystem::path path;
   std::string command, scene;
@@ -103,6 +135,7 @@ struct RecommendFile {
   bool whole_vessel_reported = false;  ///< the file has "whole_vessel" (null: none meets it)
   double reference_contact_point_mm = 0.0;  ///< the reference's largest QoI displacement
   std::vector<CandidateEntry> candidates;
+  std::optional<WireEntry> wire;  ///< guidewire scenes only
 };
 
 /// validity.json of `vesselverify validity` (schema "vesselverify.validity", version 1;

@@ -1,6 +1,7 @@
 #include "reports/study_sections.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <numeric>
 #include <sstream>
@@ -49,6 +50,64 @@ Table refinement_table(const StabilityFile& s) {
                       significant(f.predicted_exponent, 3)});
   }
   return t;
+}
+
+/// What an implicit rod row did at its steps: "bounded at every step tried" or the first that
+/// was not.
+std::string rod_ladder_text(const RodStepEntry& r) {
+  if (r.steps_tried.empty()) return "–";
+  for (std::size_t k = 0; k < r.steps_tried.size(); ++k) {
+    if (!r.bounded[k]) {
+      return "**unbounded at " + significant(r.steps_tried[k] * 1e6, 4) + " µs**" +
+             (r.failure.empty() ? "" : " (" + r.failure + ")");
+    }
+  }
+  return "bounded at every step tried, " + significant(r.steps_tried.front() * 1e6, 3) + " µs to " +
+         significant(r.steps_tried.back() * 1e3, 3) + " ms";
+}
+
+void rod_steps(Document& doc, const StabilityFile& s) {
+  if (!s.rod_wire || s.rod_steps.empty()) return;
+  const RodWireEntry& w = *s.rod_wire;
+  doc.heading(3, "The guidewire's critical step");
+  doc.paragraph(
+      "A metal wire clamped at one end (length " + significant(w.length * 1e3, 4) + " mm, d = " +
+      significant(w.diameter * 1e3, 4) + " mm, E = " + significant(w.young * 1e-9, 4) +
+      " GPa, G = " + significant(w.shear * 1e-9, 4) + " GPa, ρ = " + significant(w.density, 4) +
+      " kg/m³). At rest the straight discrete rod's axial, twist and bending waves decouple, "
+      "each with a closed-form highest frequency on segments of length h: axial (2/h)·√(E/ρ), a "
+      "chain of springs EA/h and masses ρA·h, so dt = 2/ω = h/c with c = √(E/ρ) (Courant); twist "
+      "(2/h)·√(G/ρ); bending (4/h²)·√(EI/ρA), from K = (EI/h³)·Δ⁴ (the turning angle "
+      "(w_{i+1} − 2w_i + w_{i−1})/h, energy EI/(2h) per vertex) whose symbol (2 − 2cos kh)² peaks "
+      "at 16 — the Euler–Bernoulli dispersion ω = k²√(EI/ρA) with k → 2 sin(kh/2)/h. Symplectic "
+      "Euler and Verlet are stable to 2/ω_max; the smallest of the three binds (for a slender wire "
+      "the axial one: bending's dt is the axial one times 2h/d). Found: bisection on the "
+      "integrator running the Discrete Elastic Rod (msm/rods/der_rod.hpp), as for the vessels. "
+      "The implicit integrators — DER by implicit Euler (linearised per step, CHOLMOD), seed "
+      "002's CORDE by its KKT implicit Euler step, the XPBD rod — ran at steps from 1 µs to a "
+      "30 Hz frame instead (from a 1 mm/s random velocity; XPBD from a released tip load): "
+      "bounded means the energy stayed within 1000× its start. Steps in µs.");
+  Table t;
+  t.header = {"model", "integrator", "N", "h (mm)", "axial h/c", "twist", "bending",
+              "closed form", "2/ω_max (Lanczos)", "found stable", "found / closed form"};
+  for (const RodStepEntry& r : s.rod_steps) {
+    const bool explicit_row = r.found_dt.has_value();
+    t.rows.push_back(
+        {r.model, r.integrator, std::to_string(r.segments), significant(r.h * 1e3, 4),
+         significant(r.axial_dt * 1e6, 4), significant(r.twist_dt * 1e6, 4),
+         significant(r.bending_dt * 1e6, 4), significant(r.closed_form_dt * 1e6, 4),
+         r.predicted_dt ? significant(*r.predicted_dt * 1e6, 4) : "–",
+         explicit_row ? significant(*r.found_dt * 1e6, 4) : rod_ladder_text(r),
+         explicit_row ? significant(*r.found_dt / r.closed_form_dt, 4) : "–"});
+  }
+  doc.table(t);
+  doc.paragraph(
+      "What each integrator needs: symplectic Euler and Verlet the closed-form step or less, about "
+      "h/c (" + significant(1e-3 / std::sqrt(w.young / w.density) * 1e6, 3) +
+      " µs per mm of segment for this wire), i.e. thousands of steps per 1 ms haptic frame; "
+      "explicit Euler no stable step at all without damping; implicit Euler (DER, CORDE) "
+      "and XPBD any step tried, at the price of numerical damping (implicit Euler) or of "
+      "stiffness lost with few sweeps per step (XPBD, measured in tests/rods/test_xpbd.cpp).");
 }
 
 void hard_cases(Document& doc, const StabilityFile& s) {
@@ -116,6 +175,7 @@ void stability_section(Document& doc, const StabilityFile& s) {
                 "size, halved per level; p = 1 expected for springs whose k scales like E·h and "
                 "masses like ρh³).");
   doc.table(refinement_table(s));
+  rod_steps(doc, s);
   hard_cases(doc, s);
 }
 
@@ -218,6 +278,39 @@ Table evidence_table(const RecommendFile& r) {
   return t;
 }
 
+/// A guidewire scene's wire candidates: each rod model against the continuum wire.
+void wire_candidates(Document& doc, const RecommendFile& r) {
+  if (!r.wire) return;
+  const WireEntry& w = *r.wire;
+  doc.heading(3, "The guidewire's rod model");
+  if (w.reference.empty()) {
+    doc.paragraph("No rod model judged: " + w.no_reference + ".");
+    return;
+  }
+  doc.paragraph(
+      "The wire against the rigid lumen, each rod model of msm/rods that solves wall contact "
+      "(Discrete Elastic Rods, seed 002's CORDE; the XPBD rod has none) at a few segment "
+      "counts, against the continuum wire (" + w.reference + ", F = " +
+      significant(w.reference_force_N * 1e3, 4) + " mN), judged on the " +
+      (r.unit == "mN" ? "contact force's error" : "contact point's error") + " and its time per "
+      "update (the wire moved by one update's travel at 10 mm/s and solved again from its last "
+      "equilibrium, median of 10), set-up apart. **Recommended: " +
+      (w.recommended ? "`" + *w.recommended + "`" : std::string("none")) + "**.");
+  Table t;
+  t.header = {"candidate", "force error (mN)", "contact point error (mm)", "time per update (ms)",
+              "set-up (ms)", "verdict", "why"};
+  for (const WireCandidateEntry& c : w.candidates) {
+    if (!c.ok) {
+      t.rows.push_back({"`" + c.name + "`", "–", "–", "–", "–", c.verdict, c.failure});
+      continue;
+    }
+    t.rows.push_back({"`" + c.name + "`", significant(c.force_error_mN, 3),
+                      significant(c.contact_error_mm, 3), significant(c.update_seconds * 1e3, 3),
+                      significant(c.setup_seconds * 1e3, 3), c.verdict, c.reason});
+  }
+  doc.table(t);
+}
+
 }  // namespace
 
 void recommendation_section(Document& doc, const RecommendFile& r) {
@@ -245,6 +338,7 @@ void recommendation_section(Document& doc, const RecommendFile& r) {
                 "From `" + r.path.filename().string() + "`.");
   doc.table(evidence_table(r));
   if (!r.timing_provenance.empty()) doc.paragraph("Timings: " + r.timing_provenance + ".");
+  wire_candidates(doc, r);
 }
 
 namespace {

@@ -77,6 +77,15 @@ json view_json(const WallView& v) {
           {"max", v.max_error_mm}};
 }
 
+/// The wire the view draws (null without one).
+json wire_json(const std::optional<WireView>& w) {
+  if (!w) return nullptr;
+  return {{"radius_mm", w->radius_mm},
+          {"rigid_mm", w->rigid_mm},
+          {"coupled_mm", w->coupled_mm.empty() ? json(nullptr) : json(w->coupled_mm)},
+          {"coupled_row", w->coupled_row}};
+}
+
 json plot_json(const Plot& p) {
   json series = json::array();
   for (const Series& s : p.series) {
@@ -142,6 +151,19 @@ std::string card_html(const SceneCard& c, const std::string& picture) {
   return out.str();
 }
 
+/// The caption's sentence on the guidewire (empty without one).
+std::string wire_caption(const SceneViews& v) {
+  if (!v.wire) return "";
+  if (v.wire->coupled_mm.empty()) {
+    return " Orange tube: the guidewire against the rigid lumen, whose contact force loads every "
+           "model (drawn through the wall).";
+  }
+  return " Orange tube: the guidewire coupled with the reference's wall (C_ref from " +
+         escape_xml(v.wire->coupled_row) +
+         "), its give from the rigid solve magnified as the walls are; dark line: the wire "
+         "against the rigid lumen (both drawn through the wall).";
+}
+
 std::string view_html(const SceneViews& v, std::size_t index) {
   std::ostringstream out;
   out << "<section class=\"vv-view\" id=\"view-" << escape_xml(v.scene) << "\" data-scene-index=\""
@@ -158,6 +180,8 @@ std::string view_html(const SceneViews& v, std::size_t index) {
          "step=\"0.05\" value=\"1\"><span class=\"vv-scale-text\"></span></label> "
       << "<label><input class=\"vv-ghost\" type=\"checkbox\" checked> reference (ghost)</label>"
       << "<label><input class=\"vv-log\" type=\"checkbox\"> log colour scale</label>"
+      << (v.wire ? "<label><input class=\"vv-wire\" type=\"checkbox\" checked> guidewire</label>"
+                 : "")
       << "</div>\n<div class=\"vv-panes\"><div class=\"vv-pane\" data-pane=\"0\"></div>"
       << "<div class=\"vv-pane\" data-pane=\"1\"></div></div>\n<div class=\"vv-colourbar\"></div>\n"
       << "<p class=\"vv-view-caption\">Each model's wall at " << escape_xml(v.load_text)
@@ -169,7 +193,8 @@ std::string view_html(const SceneViews& v, std::size_t index) {
       << (v.contact_patch ? "; red disc: the contact patch the force is spread over (both"
                           : " (")
       << " at rest, drawn through the wall). Drag to turn, wheel to zoom; both panes share "
-         "the camera; hover a node for its error and both displacements.</p>\n";
+         "the camera; hover a node for its error and both displacements."
+      << wire_caption(v) << "</p>\n";
   if (!v.missing.empty()) {
     out << "<p class=\"vv-note\">" << v.missing.size() << " finished model(s) have no VTU here ("
         << escape_xml(v.missing.front()) << (v.missing.size() > 1 ? ", …" : "") << ").</p>\n";
@@ -281,6 +306,17 @@ SceneViews read_scene_views(const SceneRows& s, const std::filesystem::path& res
     v.poisson_ratio = o.poisson_ratio;
     v.magnitude = o.magnitude;
     out.views.push_back(std::move(v));
+  }
+  if (s.guidewire && !s.guidewire->rigid.empty() && s.guidewire->rigid.front().centreline_mm.size() > 1) {
+    const GuidewireRigidRow& r = s.guidewire->rigid.front();
+    WireView w;
+    w.radius_mm = 0.5 * s.guidewire->diameter_mm;
+    w.rigid_mm = r.centreline_mm;
+    if (r.reference_centreline_mm.size() == r.centreline_mm.size()) {
+      w.coupled_mm = r.reference_centreline_mm;
+      w.coupled_row = r.reference_row;
+    }
+    out.wire = std::move(w);
   }
   return out;
 }
@@ -401,7 +437,8 @@ std::string interactive_html(const Document& doc, const std::vector<SceneCard>& 
       json scene{{"name", views[i].scene}, {"tolerance_mm", views[i].tolerance_mm},
                  {"qoi_mm", views[i].qoi_mm ? json(*views[i].qoi_mm) : json(nullptr)},
                  {"patch", patch_json(views[i].contact_patch)},
-                 {"load", views[i].load_text}, {"views", json::array()}};
+                 {"load", views[i].load_text}, {"wire", wire_json(views[i].wire)},
+                 {"views", json::array()}};
       for (const WallView& v : views[i].views) scene["views"].push_back(view_json(v));
       out << "<script type=\"application/json\" id=\"vv-scene-" << i << "\">"
           << script_safe(scene.dump()) << "</script>\n";

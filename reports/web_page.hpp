@@ -5,6 +5,7 @@
 /// libraries are Debian's (libjs-three, libjs-chart.js), read when the report is written and
 /// inlined, so the page is one file that needs no network. Without them the page keeps the static
 /// SVG figures and says which library was missing.
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -39,6 +40,16 @@ std::filesystem::path default_javascript_dir();
 /// three.js (three/three.min.js) and Chart.js (chart.js/chart.min.js) under `dir`.
 WebLibraries load_web_libraries(const std::filesystem::path& dir);
 
+/// A guidewire scene's wire as its 3D view draws it: the scene's own EI (results.json's first
+/// rigid entry), through the wall.
+struct WireView {
+  double radius_mm = 0.0;
+  std::vector<std::array<double, 3>> rigid_mm;  ///< against the rigid lumen, clamp to tip
+  /// Compliant coupling: coupled with the reference's wall (same nodes), else empty.
+  std::vector<std::array<double, 3>> coupled_mm;
+  std::string coupled_row;  ///< the coupling row whose C_ref the coupled wire used
+};
+
 /// One scene's 3D data: its models' walls at the representative load and first ν (a validity
 /// scene's: at the largest load reached, against the finite-strain reference).
 struct SceneViews {
@@ -51,6 +62,7 @@ struct SceneViews {
   std::optional<ContactPatchRow> contact_patch;
   std::string load_text;
   std::vector<WallView> views;
+  std::optional<WireView> wire;  ///< guidewire loads with a centreline in results.json
   std::vector<std::string> missing;  ///< outcomes whose VTU was not found (their paths)
 };
 

@@ -1,11 +1,17 @@
 #include "verification/guidewire_load.hpp"
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
 #include <sstream>
 
+#include "fem_reference/rod_theory/tube_contact.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "msm/rods/corde_rod.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "msm/rods/rigid_wall.hpp"
+#include "verification/wire_exchange.hpp"
 
 namespace vessel {
 
@@ -18,8 +24,9 @@ struct GuidewireSolver::Impl {
   rods::RodMaterial material;
   double EI = 0.0;
   double offset = 0.0;  ///< the centreline's allowed distance from the vessel's: a − r_wire
-  Eigen::VectorXd state;  ///< the last solution's DER state (empty before the first solve)
+  Eigen::VectorXd state;  ///< the last solution's rod state (empty before the first solve)
   double state_length = 0.0;
+  std::filesystem::path case_dir;  ///< model = "external": its case folder (made on first use)
 
   [[nodiscard]] std::unique_ptr<rods::RigidLumen> lumen(double give) const {
     if (vessel.kind == VesselKind::straight) {
@@ -35,31 +42,82 @@ struct GuidewireSolver::Impl {
     rods::RodSpec rs = rods::uniform_rod(material, L, spec.diameter, spec.segments);
     rs.origin = spec.clamp_point;
     rs.direction = spec.clamp_direction;
+    if (spec.model == "external") return solve_external(L, give);
+    if (spec.model == "corde") {
+      const rods::CordeRod rod(rods::make_layout(rs));
+      return solve_rod(rod, &rod, rod.rest_state(), rs.origin, L, give, [](const auto&) {});
+    }
     rods::DerRod rod(rods::make_layout(rs));
-    Eigen::VectorXd x = rod.rest_state();
+    return solve_rod(rod, nullptr, rod.rest_state(), rs.origin, L, give,
+                     [&rod](const Eigen::VectorXd& x) { rod.update_reference(x); });
+  }
+
+  /// The user's program on the wire of length L (verification/wire_exchange.hpp), in a folder of
+  /// its own that the solver removes.
+  GuidewireSolution solve_external(double L, double give) {
+    if (case_dir.empty()) {
+      std::string pattern =
+          (std::filesystem::temp_directory_path() / "vesselverify-wire-XXXXXX").string();
+      if (!mkdtemp(pattern.data())) throw std::runtime_error("guidewire: cannot make a case folder");
+      case_dir = pattern;
+    }
+    const WireLumen l{vessel.kind != VesselKind::straight, vessel.bend_radius, offset + give};
+    write_wire_case(case_dir, "", spec, L, l);
+    const WireAnswer a = run_wire_case(spec, case_dir, spec.segments + 1);
+    GuidewireSolution s;
+    s.bending_stiffness = EI;
+    s.centreline = a.centreline;
+    s.clamp_force.setConstant(std::numeric_limits<double>::quiet_NaN());  // not reported
+    if (a.force > 0.0) {
+      const auto wall = lumen(give);
+      const Vec3 p = a.centreline[static_cast<std::size_t>(a.node)];
+      Vec3 grad;
+      wall->gap(p, &grad, nullptr);
+      s.force = a.force;
+      s.contact_nodes = 1;
+      s.contact_point = p;
+      s.normal = -grad.normalized();
+      s.wall_point = p + 0.5 * spec.diameter * s.normal;
+    }
+    return s;
+  }
+
+  ~Impl() {
+    std::error_code ec;
+    if (!case_dir.empty()) std::filesystem::remove_all(case_dir, ec);
+  }
+
+  /// `rod` (DER, or CORDE with its constraints) against the lumen; `warm(x)` prepares the rod for
+  /// a start x other than its rest state (DER: its reference frames).
+  template <class Rod, class Warm>
+  GuidewireSolution solve_rod(const Rod& rod, const rods::EqualityConstraints* constraints,
+                              Eigen::VectorXd x, const Vec3& origin, double L, double give,
+                              Warm&& warm) {
     if (state.size() == x.size()) {
+      // The positions scaled about the clamp (the frames' directions are unchanged by it).
+      x = state;
       for (int i = 0; i < rod.num_nodes(); ++i) {
-        x.segment<3>(3 * i) =
-            rs.origin + (L / state_length) * (state.segment<3>(3 * i) - rs.origin);
+        x.template segment<3>(3 * i) =
+            origin + (L / state_length) * (state.template segment<3>(3 * i) - origin);
       }
-      rod.update_reference(x);
+      warm(x);
     }
     rods::ConstrainedOptions options;
     options.force_scale = EI / (L * L);
     const auto wall = lumen(give);
     const int tip = rod.layout().tip_node;
     const rods::ContactSolution c =
-        rods::solve_wall_contact(rod, nullptr, rod.clamp_fixed(), x, *wall, 2, tip, options);
+        rods::solve_wall_contact(rod, constraints, rod.clamp_fixed(), x, *wall, 2, tip, options);
     state = c.x;
     state_length = L;
 
     GuidewireSolution s;
     s.bending_stiffness = EI;
     s.contact_nodes = static_cast<int>(c.nodes.size());
-    for (int i = rod.layout().first_node; i <= tip; ++i) s.centreline.push_back(c.x.segment<3>(3 * i));
+    for (int i = rod.layout().first_node; i <= tip; ++i) s.centreline.push_back(c.x.template segment<3>(3 * i));
     if (!c.nodes.empty()) {
       const int k = c.nodes.front();
-      const Vec3 p = c.x.segment<3>(3 * k);
+      const Vec3 p = c.x.template segment<3>(3 * k);
       Vec3 grad;
       wall->gap(p, &grad, nullptr);
       s.force = c.forces.front();
@@ -68,11 +126,17 @@ struct GuidewireSolver::Impl {
       s.wall_point = p + 0.5 * spec.diameter * s.normal;
     }
     // The clamp's force on the wire: the internal force at the held nodes (no load acts there).
+    // CORDE's inextensibility constraints also act on the clamp node, and their multipliers are
+    // not returned: not measured (NaN).
+    if (constraints) {
+      s.clamp_force.setConstant(std::numeric_limits<double>::quiet_NaN());
+      return s;
+    }
     Eigen::VectorXd g;
     rod.gradient(c.x, g);
     const std::vector<char> fixed = rod.clamp_fixed();
     for (int i = 0; i < rod.num_nodes(); ++i) {
-      if (fixed[3 * i]) s.clamp_force += g.segment<3>(3 * i);
+      if (fixed[3 * i]) s.clamp_force += g.template segment<3>(3 * i);
     }
     return s;
   }
@@ -110,7 +174,10 @@ GuidewireSolution GuidewireSolver::solve_rigid() {
   const double step = m.vessel.inner_radius / 2.0;
   const int n = std::max(2, static_cast<int>(std::ceil(m.spec.insertion / step)));
   GuidewireSolution s;
-  for (int k = 1; k <= n; ++k) s = m.solve(m.spec.insertion * k / n, 0.0);
+  // The user's program solves the whole insertion itself.
+  for (int k = m.spec.model == "external" ? n : 1; k <= n; ++k) {
+    s = m.solve(m.spec.insertion * k / n, 0.0);
+  }
   if (s.contact_nodes > 1) {
     throw InputError(m.prefix + "insertion: the wire of " + std::to_string(m.spec.insertion) +
                      " m touches the wall at " + std::to_string(s.contact_nodes) +
@@ -125,6 +192,11 @@ GuidewireSolution GuidewireSolver::solve_rigid() {
 GuidewireSolution GuidewireSolver::solve_with_give(double give) {
   Impl& m = *impl_;
   last_ = m.solve(m.spec.insertion, give);
+  return last_;
+}
+
+GuidewireSolution GuidewireSolver::solve_at_insertion(double insertion) {
+  last_ = impl_->solve(insertion, 0.0);
   return last_;
 }
 
@@ -161,6 +233,85 @@ double GuidewireSolver::coupled_force(double C) {
   }
   solve_with_give(C * b);
   return b;
+}
+
+namespace {
+
+std::string number(double v) {
+  std::ostringstream s;
+  s.precision(7);
+  s << v;
+  return s.str();
+}
+
+/// The straight tube's continuum wire: clamp on the axis at the inlet (z = 0), tilted by θ from
+/// it; the tip touches at axial distance z_c, c = a − r_wire off the axis, in the tilt's plane.
+std::optional<WireReference> straight_reference(const VesselParams& v, const GuidewireSpec& w,
+                                                std::string& why) {
+  if (w.clamp_point.norm() > 1e-12) {
+    why = "the straight tube's continuum wire is clamped on the axis at the inlet; this clamp is "
+          "elsewhere";
+    return std::nullopt;
+  }
+  const Vec3 d = w.clamp_direction.normalized();
+  const Vec3 across(d.x(), d.y(), 0.0);
+  if (across.norm() < 1e-9 || d.z() <= 0.0) {
+    why = "the straight tube's continuum wire is tilted from the axis into the tube; this one is not";
+    return std::nullopt;
+  }
+  const double theta = std::atan2(across.norm(), d.z());
+  const double c = v.inner_radius - 0.5 * w.diameter;
+  const double z = rod_theory::straight_tube_contact_distance(theta, c, w.insertion);
+  const rod_theory::StraightTubeContact s = rod_theory::straight_tube_contact(theta, c / z);
+  const double EI = msm::rods::solid_section({w.young, w.shear, w.density}, w.diameter).EI;
+  WireReference r;
+  r.force = s.force * EI / (z * z);
+  r.contact_point = Vec3(0.0, 0.0, z) + c * across.normalized();
+  r.what = "Kirchhoff shooting, straight tube: θ_in = " + number(theta) + " rad, F·z²/EI = " +
+           number(s.force) + ", L/z = " + number(s.length) + " at z = " + number(z * 1e3) + " mm";
+  return r;
+}
+
+/// The arch's continuum wire: clamped tangentially on the centreline at the inlet, its tip on
+/// the outer wall (less the wire's radius) at the apex, a quarter turn on.
+std::optional<WireReference> arch_reference(const VesselParams& v, const GuidewireSpec& w,
+                                            std::string& why) {
+  const double R = v.bend_radius;
+  if ((w.clamp_point - Vec3(R, 0.0, 0.0)).norm() > 1e-12 * R ||
+      (w.clamp_direction.normalized() - Vec3::UnitY()).norm() > 1e-9) {
+    why = "the arch's continuum wire is clamped tangentially on the centreline at the inlet; "
+          "this clamp is not";
+    return std::nullopt;
+  }
+  const double outer = R + v.inner_radius - 0.5 * w.diameter;
+  const rod_theory::ArchApexContact a = rod_theory::arch_apex_contact(outer / R);
+  if (std::abs(w.insertion / (a.length * R) - 1.0) > 1e-3) {
+    why = "the arch's continuum wire touches at the apex at insertion " + number(a.length * R * 1e3) +
+          " mm; this wire is inserted " + number(w.insertion * 1e3) + " mm";
+    return std::nullopt;
+  }
+  const double EI = msm::rods::solid_section({w.young, w.shear, w.density}, w.diameter).EI;
+  WireReference r;
+  r.force = a.force * EI / (R * R);
+  r.contact_point = Vec3(0.0, outer, 0.0);
+  r.what = "quarter-wave elastica at the arch's apex: k = " + number(a.modulus) +
+           ", F·R²/EI = " + number(a.force) + ", L/R = " + number(a.length);
+  return r;
+}
+
+}  // namespace
+
+std::optional<WireReference> continuum_wire(const VesselParams& vessel, const GuidewireSpec& spec,
+                                            std::string& why) {
+  try {
+    if (vessel.kind == VesselKind::straight) return straight_reference(vessel, spec, why);
+    if (vessel.kind == VesselKind::arch) return arch_reference(vessel, spec, why);
+  } catch (const std::exception& e) {  // e.g. shooting without convergence: a wire short of the wall
+    why = std::string("the continuum wire could not be solved: ") + e.what();
+    return std::nullopt;
+  }
+  why = "no continuum wire for this vessel";
+  return std::nullopt;
 }
 
 void set_tilted_clamp(const VesselParams& vessel, double tilt, const Vec3& towards,

@@ -1,6 +1,6 @@
 #pragma once
-/// The guidewire as the vessel's load: a Discrete Elastic Rod (msm/rods/der_rod.hpp) clamped at
-/// the inlet, inserted its length in steps, against the parametric vessel's lumen as a rigid,
+/// The guidewire as the vessel's load: a Discrete Elastic Rod (msm/rods/der_rod.hpp), or seed
+/// 002's CORDE rod (msm/rods/corde_rod.hpp) with spec.model = "corde", clamped at the inlet, inserted its length in steps, against the parametric vessel's lumen as a rigid,
 /// frictionless, one-sided wall (msm/rods/rigid_wall.hpp: the centreline keeps a − r_wire from the
 /// vessel's centreline). Its contact force and the wall point under its contact node become the
 /// scene's contact patch load (`resolve_guidewire`).
@@ -14,6 +14,8 @@
 /// stays where the rigid wire put it (the contact node slides along a frictionless wall by a
 /// fraction of the give).
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "meshes/vessel_geometry.hpp"
 #include "verification/guidewire_spec.hpp"
@@ -37,6 +39,9 @@ class GuidewireSolver {
   /// The inserted wire against the lumen grown by `give` (m) along its normal, from the last
   /// solution (solve_rigid first).
   GuidewireSolution solve_with_give(double give);
+  /// The wire inserted to `insertion` (m) against the rigid lumen from the last solution: one
+  /// update of a simulator advancing the wire (solve_rigid first).
+  GuidewireSolution solve_at_insertion(double insertion);
   /// The wire's compliance at the contact, −dδ/dF by a central difference of solve_with_give
   /// (m/N), computed once per solve_rigid; restores the rigid state.
   double compliance();
@@ -52,6 +57,22 @@ class GuidewireSolver {
   GuidewireSolution rigid_, last_;
   double compliance_ = 0.0;  ///< 0: not computed since the last solve_rigid
 };
+
+/// The continuum wire (fem_reference/rod_theory) against the rigid lumen: its contact force and
+/// the centreline's contact point.
+struct WireReference {
+  std::string what;     ///< which continuum solution, with its dimensionless numbers
+  double force = 0.0;   ///< N
+  Vec3 contact_point = Vec3::Zero();  ///< m
+};
+
+/// The continuum wire of `spec` in `vessel`; nullopt (and `why`) when its clamp is not in a pose
+/// with one: on the straight tube's axis at the inlet, tilted into the tube (Kirchhoff shooting
+/// at the wire's length: rod_theory::straight_tube_contact_distance), or tangential on the arch's
+/// centreline at the inlet with the insertion that reaches the apex within 1e-3 (the quarter-wave
+/// elastica: rod_theory::arch_apex_contact).
+std::optional<WireReference> continuum_wire(const VesselParams& vessel, const GuidewireSpec& spec,
+                                            std::string& why);
 
 /// The inlet's clamp pose of the spec's tilt form: the inlet's centreline point and tangent,
 /// turned by `tilt` towards `towards` (its part normal to the tangent). InputError naming

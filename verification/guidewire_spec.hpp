@@ -3,6 +3,7 @@
 /// the inlet and inserted a given length; solved against the rigid lumen, its contact force and
 /// point become the contact patch every model and the reference get (verification/guidewire_load
 /// .hpp). Plain data; SI units.
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,12 @@ struct GuidewireSpec {
   double diameter = 0.0;  ///< m, solid circular section
   double insertion = 0.0;  ///< length of wire beyond the clamp, m
   int segments = 32;
-  std::string model = "der";
+  std::string model = "der";  ///< der | corde (msm/rods) | external (the user's program)
+  /// model = "external": the user's wire program (argv; the case's manifest path appended, run
+  /// in working_dir, the scene file's folder) and its time limit (verification/wire_exchange.hpp).
+  std::vector<std::string> command;
+  std::filesystem::path working_dir;
+  double timeout_s = 120.0;
   /// The clamp: a point and a unit tangent (set from `clamp_point`/`clamp_direction`, or from the
   /// inlet's centreline point and tangent tilted by `tilt` towards `tilt_towards`).
   Vec3 clamp_point = Vec3::Zero();

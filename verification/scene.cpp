@@ -371,6 +371,20 @@ GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
   w.insertion = r.number(r.require("insertion"), "insertion");
   w.segments = static_cast<int>(r.integer_or("segments", 32));
   w.model = r.string_or("model");
+  const toml::node* command = r.get("command");
+  if (w.model == "external") {
+    if (!command) (void)r.require("command");
+    w.command = r.string_array("command");
+    w.timeout_s = r.number_or("timeout_s");
+    w.working_dir = std::filesystem::path(r.file()).parent_path();
+  } else {
+    for (const char* key : {"command", "timeout_s"}) {
+      if (const toml::node* n = r.get(key)) {
+        if (std::string(key) == "timeout_s") (void)r.number(*n, key);  // its type first
+        r.fail(n, key, "found with model = \"" + w.model + "\"; expected model = \"external\"");
+      }
+    }
+  }
   const toml::node* point = r.get("clamp_point");
   const toml::node* direction = r.get("clamp_direction");
   if (point) w.clamp_point = r.vector3(*point, "clamp_point");

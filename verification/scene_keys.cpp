@@ -116,8 +116,16 @@ std::vector<Row> guidewire_rows() {
           .positive().required().in(g),
       Row("load", "segments", KeyType::integer, "Segments of the discrete wire").dflt("32")
           .range(4, 10000).in(g),
-      Row("load", "model", KeyType::string, "The rod model (msm/rods): Discrete Elastic Rods")
-          .dflt("\"der\"").one_of({"der"}).in(g),
+      Row("load", "model", KeyType::string,
+          "The rod model: der (Discrete Elastic Rods) or corde (seed 002's CORDE rod) of "
+          "msm/rods, or external (your own program, `command`)")
+          .dflt("\"der\"").one_of({"der", "corde", "external"}).in(g),
+      Row("load", "command", KeyType::strings,
+          "model = \"external\": your wire program and its arguments (the case's manifest path "
+          "is appended; it runs in the scene file's folder)").in(g),
+      Row("load", "timeout_s", KeyType::number,
+          "model = \"external\": each run of the wire program is killed after this").dflt("120.0")
+          .unit("s").positive().in(g),
       Row("load", "clamp_point", KeyType::vector3,
           "The clamp (with clamp_direction); absent: the inlet's centreline point")
           .unit("m").in(g),

@@ -43,6 +43,26 @@ StraightTubeContact straight_tube_contact(double theta_in, double offset_over_z)
   return {u[2], u[1], y[2], u[0]};
 }
 
+double straight_tube_contact_distance(double theta_in, double offset, double length) {
+  const auto miss = [&](double z) {
+    return straight_tube_contact(theta_in, offset / z).length * z - length;
+  };
+  double z0 = 0.98 * length, z1 = 0.99 * length;
+  double m0 = miss(z0), m1 = miss(z1);
+  for (int it = 0; it < 50 && std::abs(m1) > 1e-15 * length; ++it) {
+    const double z2 = z1 - m1 * (z1 - z0) / (m1 - m0);
+    z0 = z1;
+    m0 = m1;
+    z1 = z2;
+    m1 = miss(z1);
+  }
+  if (!(std::abs(m1) <= 1e-12 * length)) {
+    throw std::runtime_error("straight_tube_contact_distance: no convergence, length missed by " +
+                             std::to_string(m1));
+  }
+  return z1;
+}
+
 ArchApexContact arch_apex_contact(double outer_over_bend_radius) {
   using boost::math::ellint_1;
   using boost::math::ellint_2;

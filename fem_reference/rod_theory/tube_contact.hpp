@@ -14,6 +14,12 @@ struct StraightTubeContact {
 };
 StraightTubeContact straight_tube_contact(double theta_in, double offset_over_z);
 
+/// The straight-tube contact of a wire of given length L (its insertion beyond the clamp) against
+/// a tube of centreline offset c: the contact's axial distance z_c solves
+/// L = straight_tube_contact(θ_in, c/z_c).length · z_c (secant from z_c = 0.98 L, 0.99 L, to
+/// 1e-15 L). Returns z_c in the units of c and L; throws std::runtime_error without convergence.
+double straight_tube_contact_distance(double theta_in, double offset, double length);
+
 /// Arch apex: the wire clamped tangentially on the bend's centreline circle (radius R), its tip
 /// bearing on the outer wall (radius R_o from the bend centre, the wire's radius already taken
 /// off) a quarter turn on: a quarter-wave Euler elastica, crest at the clamp and inflection at the

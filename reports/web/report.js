@@ -242,6 +242,7 @@
       scene.add(s);
     }
     if (view.data.patch) patchMarks(view.data.patch).forEach((m) => scene.add(m));
+    if (view.data.wire) showWire(view, pane);
     const label = document.createElement('div');
     label.className = 'vv-pane-label';
     pane.el.appendChild(label);
@@ -272,6 +273,45 @@
     ring.renderOrder = 3;
     disc.renderOrder = 3;
     return [disc, ring];
+  }
+
+  // The guidewire's centreline at the deformation scale: the rigid wire, or with compliant
+  // coupling the rigid wire plus `factor` times the reference-coupled wire's give from it (so it
+  // stays on the wall drawn at the same scale).
+  function wirePoints(wire, factor, coupled) {
+    return wire.rigid_mm.map((p, k) => {
+      const v = new THREE.Vector3().fromArray(p);
+      if (coupled) v.addScaledVector(new THREE.Vector3().fromArray(wire.coupled_mm[k]).sub(v), factor);
+      return v;
+    });
+  }
+
+  // The wire as an orange tube drawn through the wall (no depth test: the wall does not hide it);
+  // with compliant coupling a dark line adds the wire against the rigid lumen.
+  function showWire(view, pane) {
+    const wire = view.data.wire;
+    for (const key of ['wire', 'rigidWire']) {
+      if (pane[key]) { pane.scene.remove(pane[key]); pane[key].geometry.dispose(); pane[key] = null; }
+    }
+    const coupled = !!wire.coupled_mm && wire.coupled_mm.length === wire.rigid_mm.length;
+    const curve = new THREE.CatmullRomCurve3(wirePoints(wire, view.factor, coupled));
+    const radius = Math.max(wire.radius_mm, 0.004 * view.radius);
+    const tube = new THREE.Mesh(new THREE.TubeBufferGeometry(curve, 4 * wire.rigid_mm.length,
+      radius, 10, false), new THREE.MeshLambertMaterial({color: 0xff8c00, depthTest: false,
+      depthWrite: false, transparent: true, opacity: 1}));
+    tube.renderOrder = 5;
+    pane.wire = tube;
+    pane.scene.add(tube);
+    if (coupled) {
+      const line = new THREE.Line(new THREE.BufferGeometry().setFromPoints(
+        wirePoints(wire, 0, false)), new THREE.LineBasicMaterial({color: 0x222222,
+        depthTest: false, transparent: true}));
+      line.renderOrder = 6;
+      pane.rigidWire = line;
+      pane.scene.add(line);
+    }
+    const shown = view.section.querySelector('.vv-wire');
+    if (shown) { tube.visible = shown.checked; if (pane.rigidWire) pane.rigidWire.visible = shown.checked; }
   }
 
   function showModel(view, pane, i) {
@@ -319,6 +359,7 @@
           deformed(view.data.views[view.ghost], 'ur', factor), 3));
       }
       if (pane.model !== undefined) showModel(view, pane, pane.model);
+      if (view.data.wire && view.data.wire.coupled_mm) showWire(view, pane);
     }
     requestRender();
   }
@@ -488,6 +529,16 @@
     slider.value = String(Math.log10(view.factor));
     slider.addEventListener('input', () => setFactor(view, Math.pow(10, +slider.value)));
     setFactor(view, view.factor);
+    const wireBox = section.querySelector('.vv-wire');
+    if (wireBox) {
+      wireBox.addEventListener('change', (e) => {
+        view.panes.forEach((p) => {
+          if (p.wire) p.wire.visible = e.target.checked;
+          if (p.rigidWire) p.rigidWire.visible = e.target.checked;
+        });
+        requestRender();
+      });
+    }
     section.querySelector('.vv-ghost').addEventListener('change', (e) => {
       view.panes.forEach((p) => { if (p.ghost) p.ghost.visible = e.target.checked; });
       requestRender();

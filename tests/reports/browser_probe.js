@@ -31,7 +31,37 @@
       if (!background) ++drawn;
       colours.add((px[i] << 16) | (px[i + 1] << 8) | px[i + 2]);
     }
-    return {pixels: w * h, drawn: drawn, colours: colours.size};
+    return {pixels: w * h, drawn: drawn, colours: colours.size, px: px};
+  }
+
+  // Orange pixels (the wire's hue at any shading: red high, green about half of it, no blue).
+  function orange(px) {
+    let n = 0;
+    for (let i = 0; i < px.length; i += 4) {
+      const r = px[i], g = px[i + 1], b = px[i + 2];
+      if (r > 100 && g > 0.35 * r && g < 0.7 * r && b < 0.15 * r) ++n;
+    }
+    return n;
+  }
+
+  // The wire's checkbox off and on again: the pixels of the left pane that change, and the
+  // orange ones with and without the wire.
+  function wireProbe(gl, view) {
+    const box = view.section.querySelector('.vv-wire');
+    if (!box) return null;
+    const shot = () => { window.vvReport.renderNow(); return panePixels(gl, view.panes[0].el).px; };
+    box.checked = false;
+    box.dispatchEvent(new Event('change'));
+    const off = shot();
+    box.checked = true;
+    box.dispatchEvent(new Event('change'));
+    const on = shot();
+    let changed = 0;
+    for (let i = 0; i < on.length; i += 4) {
+      if (on[i] !== off[i] || on[i + 1] !== off[i + 1] || on[i + 2] !== off[i + 2]) ++changed;
+    }
+    return {points: view.data.wire.rigid_mm.length, coupled: !!view.data.wire.coupled_mm,
+      changed: changed, orange_on: orange(on), orange_off: orange(off)};
   }
 
   async function run() {
@@ -67,6 +97,9 @@
         entry.models.push(Object.assign(panePixels(gl, view.panes[0].el),
           {model: view.data.views[i].model, springs: view.data.views[i].springs}));
       }
+      entry.wire = wireProbe(gl, view);
+      entry.panes.forEach((p) => delete p.px);
+      entry.models.forEach((p) => delete p.px);
       out.views.push(entry);
       if (!out.node_hover) {
         const r = view.panes[0].el.getBoundingClientRect();

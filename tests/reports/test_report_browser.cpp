@@ -121,6 +121,30 @@ TEST_F(ReportInBrowser, EachThreeDViewDrawsItsModels) {
   }
 }
 
+TEST_F(ReportInBrowser, TheGuidewireIsDrawnThroughTheWallWhereResultsJsonHasOne) {
+  const ResultsFile results = read_results(kFixture / "results.json");
+  std::size_t wires = 0;
+  for (const auto& view : probe()["views"]) {
+    for (const SceneRows& s : results.scenes) {
+      if (s.name != view["scene"]) continue;
+      if (!s.guidewire || s.guidewire->rigid.empty()) {
+        EXPECT_TRUE(view["wire"].is_null()) << s.name;
+        continue;
+      }
+      ++wires;
+      const auto& w = view["wire"];
+      ASSERT_TRUE(w.is_object()) << s.name << ": no wire drawn";
+      EXPECT_EQ(w["points"].get<std::size_t>(), s.guidewire->rigid[0].centreline_mm.size());
+      EXPECT_EQ(w["coupled"].get<bool>(), !s.guidewire->rigid[0].reference_centreline_mm.empty());
+      // Hiding the wire changes the pane (it is drawn over the wall, not hidden by it), and
+      // takes its orange away.
+      EXPECT_GT(w["changed"].get<int>(), 150) << w.dump();
+      EXPECT_GT(w["orange_on"].get<int>(), w["orange_off"].get<int>() + 100) << w.dump();
+    }
+  }
+  EXPECT_GE(wires, 1u) << "the fixture has a guidewire scene";
+}
+
 TEST_F(ReportInBrowser, HoveringTheWallGivesTheNodesErrorAndDisplacements) {
   const auto& n = probe()["node_hover"];
   ASSERT_TRUE(n.is_object()) << "no node found under the pointer in the first pane";

@@ -359,6 +359,55 @@ TEST(StudyFiles, MalformedOrForeignFilesAreClearErrorsNamingTheFile) {
       << error_of(recommend, bad_candidate);
 }
 
+namespace {
+/// results_with one model and a guidewire block: the wire's force error against the continuum
+/// (mN) at one EI, and one coupled row's force and the reference's (mN).
+ResultsFile with_wire(double wire_error_mN, double force_mN, bool coupled_ok = true) {
+  ResultsFile r = results_with({outcome("m", 1e-3, 0.1, 1.0)});
+  GuidewireRows g;
+  g.model = "der";
+  g.coupling = "compliant";
+  GuidewireRigidRow rigid;
+  rigid.bending_stiffness = 4e-7;
+  rigid.force_mN = 0.471;
+  rigid.force_error_mN = wire_error_mN;
+  g.rigid.push_back(rigid);
+  GuidewireCoupledRow row;
+  row.model = "m";
+  row.poisson_ratio = 0.45;
+  row.bending_stiffness = 4e-7;
+  row.ok = coupled_ok;
+  row.failure = coupled_ok ? "" : "secant did not converge";
+  row.force_mN = force_mN;
+  row.reference_force_mN = 0.44;
+  g.coupled.push_back(row);
+  r.scenes[0].guidewire = g;
+  return r;
+}
+}  // namespace
+
+TEST(Gate, TheWiresForceErrorAndEachCoupledForceErrorMayNotGrow) {
+  const auto base = with_wire(2.0e-4, 0.45);  // coupled error 0.01 mN
+  EXPECT_TRUE(compare_with_baseline(base, with_wire(2.0e-4, 0.45)).passed());
+  EXPECT_TRUE(compare_with_baseline(base, with_wire(1.0e-4, 0.4401)).passed());  // both better
+  // The rod model's error against the continuum grew by 10 %.
+  const GateOutcome wire = compare_with_baseline(base, with_wire(2.2e-4, 0.45));
+  ASSERT_FALSE(wire.passed());
+  EXPECT_EQ(wire.findings.front().model, "wire (der)");
+  EXPECT_NE(wire.findings.front().what.find("wire force error"), std::string::npos);
+  EXPECT_EQ(wire.findings.front().magnitude, 4e-7);  // the EI
+  // A vessel model's coupled contact-force error grew (0.01 → 0.02 mN), or its row now fails.
+  const GateOutcome coupled = compare_with_baseline(base, with_wire(2.0e-4, 0.46));
+  ASSERT_FALSE(coupled.passed());
+  EXPECT_EQ(coupled.findings.front().model, "m");
+  EXPECT_NE(coupled.findings.front().what.find("coupled contact-force error"), std::string::npos);
+  EXPECT_FALSE(compare_with_baseline(base, with_wire(2.0e-4, 0.45, false)).passed());
+  // The wire's block gone from a scene that had it.
+  auto gone = with_wire(2.0e-4, 0.45);
+  gone.scenes[0].guidewire.reset();
+  EXPECT_FALSE(compare_with_baseline(base, gone).passed());
+}
+
 TEST(Gate, IdenticalResultsPass) {
   const auto r = results_with({outcome("m", 1e-3, 0.1, 1.0)});
   const auto g = compare_with_baseline(r, r);

@@ -161,6 +161,31 @@ TEST(WebReport, ThePageCarriesTheContactPatchWhereResultsJsonPutsIt) {
   EXPECT_EQ(scene["patch"]["normal"], nlohmann::json({1, 0, 0}));
 }
 
+TEST(WebReport, ThePageCarriesTheWiresCentrelinesAsResultsJsonGivesThem) {
+  test::TempDir dir;
+  const std::string page = write_fixture_report(dir.path(), default_javascript_dir().string());
+  const nlohmann::json wire = script_json(page, "vv-scene-0")["wire"];
+  ASSERT_TRUE(wire.is_object()) << wire;
+  const nlohmann::json g =
+      nlohmann::json::parse(test::read_text(kFixture / "results.json"))["scenes"][0]["guidewire"];
+  EXPECT_EQ(wire["rigid_mm"], g["rigid"][0]["centreline_mm"]);
+  EXPECT_EQ(wire["coupled_mm"], g["rigid"][0]["reference_coupled"]["centreline_mm"]);
+  EXPECT_DOUBLE_EQ(wire["radius_mm"].get<double>(), 0.178);  // the fixture's 0.356 mm wire
+  EXPECT_EQ(wire["rigid_mm"].front(), nlohmann::json({0.0, 0.0, 0.0}));  // its clamp
+  EXPECT_NE(page.find("class=\"vv-wire\""), std::string::npos);
+  EXPECT_NE(page.find("Orange tube: the guidewire coupled with the reference"), std::string::npos);
+  // Without the reference's coupled wire (rigid coupling) the page draws the rigid one alone.
+  auto j = nlohmann::json::parse(test::read_text(kFixture / "results.json"));
+  j["scenes"][0]["guidewire"]["rigid"][0]["reference_coupled"] = nullptr;
+  const SceneViews v = read_scene_views(parse_results(j.dump(), "r.json").scenes[0], kFixture);
+  ASSERT_TRUE(v.wire.has_value());
+  EXPECT_TRUE(v.wire->coupled_mm.empty());
+  EXPECT_EQ(v.wire->rigid_mm.size(), g["rigid"][0]["centreline_mm"].size());
+  // A scene without a wire has none.
+  j["scenes"][0].erase("guidewire");
+  EXPECT_FALSE(read_scene_views(parse_results(j.dump(), "r.json").scenes[0], kFixture).wire);
+}
+
 TEST(WebReport, TheValiditySectionDrawsTheModelsAgainstTheFiniteStrainReference) {
   test::TempDir dir;
   setenv("VESSELVERIFY_JS_DIR", default_javascript_dir().c_str(), 1);

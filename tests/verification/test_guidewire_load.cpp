@@ -9,6 +9,10 @@
 #include <numbers>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "../schema_check.hpp"
+#include "../test_helpers.hpp"
 #include "fem_reference/rod_theory/tube_contact.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "verification/guidewire_load.hpp"
@@ -180,6 +184,49 @@ TEST(GuidewireCoupling, RowsPerModelAndStiffnessFromTheOutcomesIndentation) {
   // A stiffer wire is closer to displacement control: its force falls further below the rigid one.
   EXPECT_LT(g.rows[2].force_mN / (g.rigid[2].solution.force * 1e3),
             g.rows[1].force_mN / (g.rigid[1].solution.force * 1e3));
+}
+
+TEST(GuidewireResults, CentrelineRunsFromTheScenesClampToTheContactPointOnTheWall) {
+  const Scene s = parse_scene(straight_scene("tilt = 0.3\ncoupling = \"compliant\""), "wire.toml");
+  ModelOutcome o;  // a wall twice as compliant as the reference's (as above)
+  o.model = "m";
+  o.ok = true;
+  o.magnitude = s.load.magnitudes[0];
+  o.quantities.indentation_mm = 1.0 * o.magnitude * 1e3;
+  o.quantities.indentation_reference_mm = 0.5 * o.magnitude * 1e3;
+  const nlohmann::json g = guidewire_json(couple_guidewire(s, {o}));
+  const auto schema = nlohmann::json::parse(test::read_text(VESSEL_RESULTS_SCHEMA));
+  const auto problems = test::schema_problems(
+      g, schema["properties"]["scenes"]["items"]["properties"]["guidewire"]);
+  EXPECT_TRUE(problems.empty()) << test::joined(problems);
+  const nlohmann::json& rigid = g["rigid"][0];
+  const nlohmann::json& line = rigid["centreline_mm"];
+  ASSERT_EQ(line.size(), 33u);  // the scene's 32 segments: clamp node to tip
+  // The scene's clamp (tilt form on a straight tube: the inlet's centre, the origin).
+  EXPECT_EQ(line.front(), nlohmann::json({0.0, 0.0, 0.0}));
+  // Its tip is the contact point, on the lumen less the wire's radius: 3 − 0.178 mm off the axis,
+  // in the tilt's plane (+x).
+  EXPECT_EQ(line.back(), rigid["contact_point_mm"]);
+  const auto radial = [](const nlohmann::json& p) {
+    return std::hypot(p[0].get<double>(), p[1].get<double>());
+  };
+  EXPECT_NEAR(radial(line.back()), 3.0 - 0.178, 1e-9);
+  EXPECT_NEAR(line.back()[1].get<double>(), 0.0, 1e-9);
+  EXPECT_GT(line.back()[0].get<double>(), 0.0);
+  // Every node inside the lumen.
+  for (const auto& p : line) EXPECT_LE(radial(p), 3.0 - 0.178 + 1e-9);
+  // The wire coupled with the reference's wall (C_ref = 0.5 m/N) touches the lumen grown by
+  // its give C_ref·F_ref.
+  const nlohmann::json& ref = rigid["reference_coupled"];
+  ASSERT_TRUE(ref.is_object());
+  EXPECT_EQ(ref["row"], "m, ν 0, level 0");
+  const double F = ref["contact_force_N"].get<double>();
+  EXPECT_LT(F, rigid["contact_force_N"].get<double>());
+  EXPECT_EQ(ref["centreline_mm"].front(), nlohmann::json({0.0, 0.0, 0.0}));
+  EXPECT_NEAR(radial(ref["centreline_mm"].back()), 3.0 - 0.178 + 0.5 * F * 1e3, 1e-9);
+  // Rigid coupling: no reference-coupled wire.
+  const Scene r = parse_scene(straight_scene("tilt = 0.3"), "wire.toml");
+  EXPECT_TRUE(guidewire_json(couple_guidewire(r, {o}))["rigid"][0]["reference_coupled"].is_null());
 }
 
 }  // namespace

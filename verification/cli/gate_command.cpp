@@ -22,7 +22,7 @@ namespace {
 
 /// The shipped scenes the gate runs (quick variants), resolved in --scenes-dir.
 const std::vector<std::string> kGateScenes{"contact_straight.toml", "pressure_lame.toml",
-                                           "gravity_sag.toml"};
+                                           "gravity_sag.toml", "guidewire_straight.toml"};
 
 struct GateOptions {
   std::filesystem::path baseline;
@@ -138,8 +138,10 @@ void add_gate_command(CLI::App& app, const std::string& command_line) {
   CLI::App* cmd = app.add_subcommand(
       "gate",
       "CI gate of model changes: run the gate scenes (quick variants of contact_straight, "
-      "pressure_lame and gravity_sag) and compare with a committed baseline. Fails (exit 1) with "
-      "a table of what changed if any model's error grows beyond the tolerance, a model that "
+      "pressure_lame, gravity_sag and guidewire_straight) and compare with a committed baseline. "
+      "Fails (exit 1) with a table of what changed if any model's error grows beyond the "
+      "tolerance (in a guidewire scene also the wire's force error against the continuum wire and "
+      "each model's coupled contact-force error), a model that "
       "finished now fails, or a solve time normalised by a reference kernel grows beyond the "
       "timing ratio.\n"
       "Examples:\n"

@@ -27,6 +27,7 @@ struct StabilityCli {
   long long long_run_steps = 0;
   int max_level = -1;
   bool no_hard_cases = false;
+  bool no_rod_steps = false;
   std::vector<std::string> only_cases;
   int jobs = 1;
 };
@@ -87,6 +88,9 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
                   "thread, and hard cases (default: the core count); the long run, whose steps are "
                   "timed, runs alone");
   cmd->add_flag("--no-hard-cases", o->no_hard_cases, "Only the critical-step table");
+  cmd->add_flag("--no-rod-steps", o->no_rod_steps,
+                "Leave out the guidewire's critical steps (a metal wire at 50 and 200 segments: "
+                "about a minute)");
   cmd->add_option("--hard-case", o->only_cases,
                   "Run only this hard case (repeatable): poisson, youngs_modulus, sliver, "
                   "refined_patch, inverting_load, long_run, tight_bend, zero_length");
@@ -108,6 +112,7 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
     so.long_run_steps = o->long_run_steps;
     so.max_level = o->max_level;
     so.hard_cases = !o->no_hard_cases;
+    so.rod_steps = !o->no_rod_steps;
     so.only_cases = o->only_cases;
     so.jobs = o->jobs;
     OutcomeCache outcomes(o->no_cache ? fs::path() : outcome_cache_dir(o->cache_dir), o->retime,

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "meshes/foundation/process.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "meshes/vtu_io.hpp"
 #include "msm/model/build_network.hpp"
@@ -124,24 +125,6 @@ struct ExternalAnswer {
 /// answer, a malformed header or line, a node missing, repeated or out of range, a node count
 /// other than `nodes`, a value that is not finite.
 ExternalAnswer read_external_answer(const std::filesystem::path& case_dir, std::size_t nodes);
-
-/// How a process ended.
-struct ProcessResult {
-  int exit_code = -1;   ///< the exit status (−1 if killed by a signal)
-  int signal = 0;       ///< the signal that ended it, 0 if none
-  bool timed_out = false;
-  double wall_seconds = 0.0;
-};
-
-/// Runs argv[0] (looked up on PATH unless it contains a '/', then relative to `working_dir`) with argv in `working_dir`, with the extra environment
-/// variables `env`, stdout and stderr appended to `log`; its own process group, killed (SIGKILL
-/// to the group) when it runs longer than `timeout_s`; the group is killed after a normal exit
-/// too, so nothing it started outlives it. A program that cannot be executed (not found, not
-/// executable, no such working directory) gives exit code 127 and says why in the log.
-ProcessResult run_process(const std::vector<std::string>& argv,
-                          const std::filesystem::path& working_dir,
-                          const std::vector<std::pair<std::string, std::string>>& env,
-                          double timeout_s, const std::filesystem::path& log);
 
 /// Runs an external model's command on a written case folder: the command plus the manifest's
 /// absolute path as the last argument, in spec.working_dir, with VESSELVERIFY_MANIFEST and

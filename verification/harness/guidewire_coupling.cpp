@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "msm/rods/rod_layout.hpp"
@@ -26,6 +28,26 @@ bool couplable(const ModelOutcome& o) {
          o.quantities.indentation_reference_mm && o.history.time_s.empty();
 }
 
+/// The reference's coupled wire of one EI from its rows (from `first`): the finest level's first
+/// ok row at the first row's ν, whose walls report.html draws.
+void set_reference_wire(const std::vector<GuidewireCouplingRow>& rows, std::size_t first,
+                        const std::vector<std::vector<Vec3>>& lines, GuidewireRigid& rigid) {
+  std::optional<std::size_t> chosen;
+  for (std::size_t k = first; k < rows.size(); ++k) {
+    const GuidewireCouplingRow& r = rows[k];
+    if (!r.ok || r.poisson_ratio != rows[first].poisson_ratio) continue;
+    if (!chosen || r.level > rows[*chosen].level) chosen = k;
+  }
+  if (!chosen || *chosen - first >= lines.size()) return;
+  const GuidewireCouplingRow& r = rows[*chosen];
+  rigid.reference_centreline = lines[*chosen - first];
+  rigid.reference_force = r.reference_force_mN * 1e-3;
+  rigid.reference_compliance = r.reference_compliance;
+  std::ostringstream what;
+  what << r.model << ", ν " << r.poisson_ratio << ", level " << r.level;
+  rigid.reference_row = what.str();
+}
+
 void couple_at(const Scene& s, double EI, const std::vector<ModelOutcome>& outcomes,
                GuidewireOutcome& g) {
   const GuidewireSpec spec = with_stiffness(*s.load.guidewire, EI);
@@ -33,11 +55,17 @@ void couple_at(const Scene& s, double EI, const std::vector<ModelOutcome>& outco
   GuidewireRigid rigid;
   rigid.bending_stiffness = EI;
   rigid.solution = solver.solve_rigid();
+  std::string why;
+  if (const auto c = continuum_wire(s.vessel, spec, why)) rigid.continuum_force = c->force;
   if (spec.coupling == GuidewireCoupling::compliant && rigid.solution.force > 0.0) {
     rigid.wire_compliance = solver.compliance();
   }
-  g.rigid.push_back(rigid);
-  if (spec.coupling != GuidewireCoupling::compliant) return;
+  if (spec.coupling != GuidewireCoupling::compliant) {
+    g.rigid.push_back(rigid);
+    return;
+  }
+  const std::size_t first_row = g.rows.size();
+  std::vector<std::vector<Vec3>> reference_lines;  // per row of this EI: the reference's wire
   for (const ModelOutcome& o : outcomes) {
     if (!couplable(o)) continue;
     GuidewireCouplingRow row;
@@ -51,6 +79,8 @@ void couple_at(const Scene& s, double EI, const std::vector<ModelOutcome>& outco
       const double F = solver.coupled_force(row.wall_compliance);
       row.contact_point = solver.last().contact_point;
       const double Fref = solver.coupled_force(row.reference_compliance);
+      reference_lines.resize(g.rows.size() - first_row + 1);
+      reference_lines.back() = solver.last().centreline;
       row.force_mN = F * 1e3;
       row.reference_force_mN = Fref * 1e3;
       row.displacement_mm = row.wall_compliance * F * 1e3;
@@ -61,6 +91,8 @@ void couple_at(const Scene& s, double EI, const std::vector<ModelOutcome>& outco
     }
     g.rows.push_back(row);
   }
+  set_reference_wire(g.rows, first_row, reference_lines, rigid);
+  g.rigid.push_back(rigid);
 }
 
 /// How far the wire's contact node slid along the wall from the rigid solve's, mm (the patch
@@ -75,7 +107,22 @@ double slide_mm(const GuidewireOutcome& g, const GuidewireCouplingRow& r) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+nlohmann::json finite_or_null(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+}
+
 nlohmann::json vec_mm(const Vec3& p) { return {p.x() * 1e3, p.y() * 1e3, p.z() * 1e3}; }
+
+/// The wire coupled with the reference's wall at one EI (null without one).
+nlohmann::json reference_wire_json(const GuidewireRigid& r) {
+  if (r.reference_centreline.empty()) return nullptr;
+  nlohmann::json line = nlohmann::json::array();
+  for (const Vec3& p : r.reference_centreline) line.push_back(vec_mm(p));
+  return {{"row", r.reference_row},
+          {"wall_compliance_m_per_N", r.reference_compliance},
+          {"contact_force_N", r.reference_force},
+          {"centreline_mm", line}};
+}
 
 }  // namespace
 
@@ -148,7 +195,10 @@ nlohmann::json guidewire_json(const GuidewireOutcome& g) {
                      {"normal", {s.normal.x(), s.normal.y(), s.normal.z()}},
                      {"clamp_force_N", {s.clamp_force.x(), s.clamp_force.y(), s.clamp_force.z()}},
                      {"wire_compliance_m_per_N", r.wire_compliance},
-                     {"centreline_mm", line}});
+                     {"centreline_mm", line},
+                     {"continuum_force_N", finite_or_null(r.continuum_force)},
+                     {"force_error_mN", finite_or_null(std::abs(s.force - r.continuum_force) * 1e3)},
+                     {"reference_coupled", reference_wire_json(r)}});
   }
   nlohmann::json rows = nlohmann::json::array();
   for (const GuidewireCouplingRow& r : g.rows) {

@@ -2,6 +2,7 @@
 /// What a scene with a guidewire load records (verification/harness/guidewire_coupling.hpp): the
 /// wire against the rigid lumen and, with compliant coupling, each model's own contact force
 /// beside the reference's. Plain data; SI inside, mN and mm where the names say so.
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,16 @@ struct GuidewireRigid {
   double bending_stiffness = 0.0;  ///< EI, N·m²
   GuidewireSolution solution;
   double wire_compliance = 0.0;    ///< −dδ/dF at the contact, m/N (compliant coupling only)
+  /// The continuum wire's force at this EI (guidewire_load.hpp's continuum_wire), N; NaN when
+  /// the wire's pose has none.
+  double continuum_force = std::numeric_limits<double>::quiet_NaN();
+  /// Compliant coupling: the wire coupled with the reference's wall, its compliance C_ref read on
+  /// the loaded nodes of one coupling row (`reference_row`: the finest level's first row at the
+  /// first ν, the walls report.html draws); empty centreline when there is none.
+  std::vector<Vec3> reference_centreline;  ///< m, clamp to tip
+  double reference_force = 0.0;            ///< N
+  double reference_compliance = 0.0;       ///< m/N
+  std::string reference_row;               ///< "model, ν, level" of that row
 };
 
 /// One model (at one ν and level) coupled with the wire at one EI.

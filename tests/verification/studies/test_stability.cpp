@@ -103,6 +103,7 @@ TEST(Stability, TheStepTableIsTheSameComputedOneRowAtATimeOrInParallel) {
   StabilityOptions o;
   o.cache_dir = cache.path();
   o.hard_cases = false;
+  o.rod_steps = false;  // the vessel table only (test_rod_steps.cpp has the rod's)
   o.max_level = 0;
   o.trial_steps = 50;
   o.jobs = 1;
@@ -132,6 +133,7 @@ TEST(Stability, HardCasesSideBySideGiveWhatTheyGiveOneAtATime) {
   o.trial_steps = 50;
   o.long_run_steps = 500;
   o.only_cases = {"zero_length", "long_run", "inverting_load", "tight_bend"};
+  o.rod_steps = false;
   o.jobs = 1;
   const StabilityReport one = run_stability(o);
   o.jobs = 2;
@@ -172,6 +174,7 @@ TEST(Stability, ASecondRunReadsTheRowsFromTheOutcomeCacheWithTheirTimings) {
   StabilityOptions o;
   o.cache_dir = cache.path();
   o.hard_cases = false;
+  o.rod_steps = false;  // the vessel table only (test_rod_steps.cpp has the rod's)
   o.max_level = 0;
   o.trial_steps = 50;
   o.outcome_cache = &outcomes;

@@ -1,4 +1,5 @@
 #include "verification/studies/recommend/recommend.hpp"
+#include "verification/studies/recommend/wire_candidates.hpp"
 
 #include "verification/harness/results.hpp"
 
@@ -409,6 +410,10 @@ Recommendation recommend(const Scene& scene, const RecommendOptions& o,
   rec.candidates = collect_candidates(rec.result);
   rec.selection = select_model(rec.candidates, s.budget.tolerance, s.budget.seconds_per_update(),
                                budget_unit(s.budget.quantity));
+  if (s.load.guidewire) {
+    if (h.log) *h.log << "recommend " << s.name << ": the wire's candidates (DER, CORDE)\n";
+    rec.wire = std::make_shared<const WireRecommendation>(recommend_wire(s));
+  }
   write_recommendation(rec, output_dir, command);
   return rec;
 }
@@ -429,6 +434,11 @@ Recommendation rejudged(const Recommendation& rec, double rate_hz) {
   const Budget& b = out.scene.budget;
   out.selection =
       select_model(out.candidates, b.tolerance, b.seconds_per_update(), budget_unit(b.quantity));
+  if (out.wire) {
+    auto wire = std::make_shared<WireRecommendation>(*out.wire);
+    wire->selection = judge_wire(wire->candidates, b);
+    out.wire = wire;
+  }
   return out;
 }
 
@@ -506,6 +516,7 @@ std::string recommendation_json(const Recommendation& rec, const std::string& co
                          {"closest", name_of(sel.closest)},
                          {"whole_vessel", name_of(sel.whole_vessel)},
                          {"candidates", candidates}};
+  if (rec.wire) j["wire"] = wire_recommendation_json(*rec.wire);
   if (!rec.results_dir.empty()) {
     // The candidates' results.json, relative to recommend.json's folder.
     j["results"] =

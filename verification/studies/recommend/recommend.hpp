@@ -5,6 +5,7 @@
 /// against the FEM reference at the budget's load, and judged on the budget's quantity and on the
 /// compute time per update at its rate.
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -89,11 +90,15 @@ std::vector<ModelSpec> candidate_models(const Scene& scene, const std::vector<do
 /// budget's load (SceneResult run with budget_load_only).
 std::vector<Candidate> collect_candidates(const SceneResult& result);
 
+struct WireRecommendation;  // wire_candidates.hpp
+
 struct Recommendation {
   Scene scene;  ///< as run (budget, candidate models, levels)
   SceneResult result;
   std::vector<Candidate> candidates;
   Selection selection;
+  /// A guidewire scene's wire candidates (wire_candidates.hpp), judged apart: null otherwise.
+  std::shared_ptr<const WireRecommendation> wire;
   /// Where the candidates' run wrote results.json (a rate judged again shares the first's).
   std::filesystem::path results_dir;
 };

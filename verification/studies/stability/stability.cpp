@@ -10,6 +10,7 @@
 #include "meshes/vessel_geometry.hpp"
 #include "verification/harness/outcome_cache.hpp"
 #include "verification/harness/parallel.hpp"
+#include "verification/studies/stability/rod_steps.hpp"
 #include "verification/studies/stability/study_models.hpp"
 #include "verification/harness/timing.hpp"
 
@@ -209,6 +210,12 @@ StabilityReport run_stability(const StabilityOptions& o) {
   std::vector<TimingProvenance> provenance;
   rep.rows = critical_step_table(o, max_level, rep.trial_steps, log, provenance);
   rep.fits = refinement_fits(rep.rows);
+  if (o.rod_steps) {
+    log << "[stability] the guidewire's critical steps (a metal wire, DER / CORDE / XPBD)"
+        << std::endl;
+    rep.rod_wire = o.rod_wire;
+    rep.rod_rows = rod_critical_steps(o.rod_wire, rep.trial_steps, log);
+  }
   if (o.hard_cases) run_hard_cases(o, clock, log, rep, provenance);
   rep.timed_items = provenance.size();
   for (const TimingProvenance& p : provenance) {

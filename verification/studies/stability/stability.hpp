@@ -22,6 +22,16 @@ namespace vessel {
 
 class OutcomeCache;  // verification/harness/outcome_cache.hpp
 
+/// The guidewire of the rod rows: a metal wire (nitinol-like), clamped at one end.
+struct RodWire {
+  double length = 0.1;           ///< m
+  double diameter = 0.356e-3;    ///< m (0.014")
+  double young = 60e9;           ///< E, Pa
+  double shear = 60e9 / 2.66;    ///< G = E/(2(1 + ν)), ν = 0.33, Pa
+  double density = 6450.0;       ///< kg/m³
+  std::vector<int> segments{50, 200};
+};
+
 struct StabilityOptions {
   bool quick = true;  ///< levels 0..1 and a scaled-down long run; else levels 0..2 and 10⁶ steps
   std::filesystem::path cache_dir;  ///< mesh cache ("" disables it)
@@ -33,6 +43,8 @@ struct StabilityOptions {
   long long long_run_steps = 0;
   int max_level = -1;
   bool hard_cases = true;  ///< false: only the critical-step table
+  bool rod_steps = true;   ///< the guidewire's critical steps (rod_steps.hpp)
+  RodWire rod_wire;
   /// Rows of the critical-step table, and hard cases without a measured time, computed at a time
   /// (each on its own thread); the timed hard case (the long run) runs alone after them.
   int jobs = 1;
@@ -84,6 +96,26 @@ struct RefinementFit {
   double predicted_exponent = 0.0;
 };
 
+/// One row of the rod's critical-step table (verification/studies/stability/rod_steps.hpp).
+struct RodStepRow {
+  std::string model;       ///< der | corde | xpbd
+  std::string integrator;  ///< symplectic-euler | verlet | implicit-euler | xpbd
+  int segments = 0;
+  double h = 0.0;          ///< segment length, m
+  /// Closed forms of the straight discrete rod, s (the smallest: closed_form_dt).
+  double axial_dt = 0.0, twist_dt = 0.0, bending_dt = 0.0, closed_form_dt = 0.0;
+  /// Explicit rows: 2/ω_max (Lanczos on the rod at rest), the bisection's stable and unstable
+  /// steps, s; NaN on the implicit rows.
+  double omega_max = 0.0, predicted_dt = 0.0, found_dt = 0.0, unstable_dt = 0.0;
+  /// Implicit rows: the steps tried (s), whether each stayed bounded, and why one did not.
+  std::vector<double> steps_tried;
+  std::vector<bool> bounded;
+  std::string failure;
+  int steps_per_trial = 0;
+  int trials = 0;
+  double seconds = 0.0;
+};
+
 /// What one model did on a hard case.
 struct HardCaseOutcome {
   std::string model;
@@ -109,6 +141,8 @@ struct StabilityReport {
   std::vector<CriticalStepRow> rows;
   std::vector<RefinementFit> fits;
   std::vector<HardCase> hard_cases;
+  RodWire rod_wire;
+  std::vector<RodStepRow> rod_rows;  ///< empty when the options leave the rod out
   /// Hard cases run side by side (their seconds are wall times on a shared machine); the long run
   /// ran alone.
   int hard_cases_at_a_time = 1;

@@ -11,6 +11,46 @@
 
 namespace vessel {
 
+namespace {
+
+nlohmann::json finite_or_null(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json();
+}
+
+/// The guidewire's rows (rod_steps.hpp): the wire, then per model and integrator.
+nlohmann::json rod_json(const StabilityReport& r) {
+  const RodWire& w = r.rod_wire;
+  nlohmann::json rows = nlohmann::json::array();
+  for (const RodStepRow& row : r.rod_rows) {
+    nlohmann::json bounded = nlohmann::json::array();
+    for (const bool b : row.bounded) bounded.push_back(b);
+    rows.push_back({{"model", row.model},
+                    {"integrator", row.integrator},
+                    {"segments", row.segments},
+                    {"h", row.h},
+                    {"axial_dt", row.axial_dt},
+                    {"twist_dt", row.twist_dt},
+                    {"bending_dt", row.bending_dt},
+                    {"closed_form_dt", row.closed_form_dt},
+                    {"omega_max", finite_or_null(row.omega_max)},
+                    {"predicted_dt", finite_or_null(row.predicted_dt)},
+                    {"found_dt", finite_or_null(row.found_dt)},
+                    {"unstable_dt", finite_or_null(row.unstable_dt)},
+                    {"found_over_closed_form", finite_or_null(row.found_dt / row.closed_form_dt)},
+                    {"steps_tried", row.steps_tried},
+                    {"bounded", bounded},
+                    {"failure", row.failure},
+                    {"steps_per_trial", row.steps_per_trial},
+                    {"trials", row.trials},
+                    {"seconds", row.seconds}});
+  }
+  return {{"wire", {{"length", w.length}, {"diameter", w.diameter}, {"young", w.young},
+                    {"shear", w.shear}, {"density", w.density}, {"segments", w.segments}}},
+          {"rows", rows}};
+}
+
+}  // namespace
+
 std::string stability_json(const StabilityReport& r) {
   nlohmann::json j;
   j["schema"] = "vesselverify.stability";
@@ -57,6 +97,7 @@ std::string stability_json(const StabilityReport& r) {
                                {"found_exponent", f.exponent},
                                {"predicted_exponent", f.predicted_exponent}});
   }
+  if (!r.rod_rows.empty()) j["rod_critical_steps"] = rod_json(r);
   j["hard_cases"] = nlohmann::json::array();
   for (const auto& hc : r.hard_cases) {
     nlohmann::json c{{"id", hc.id}, {"title", hc.title}, {"setup", hc.setup},

@@ -1,0 +1,114 @@
+// A guidewire scene's wire candidates in `vesselverify recommend` (wire_candidates.hpp): the
+// continuum wire against the shooting values of the issue (F·z²/EI = 0.470968 at L/z = 1.012498;
+// the arch's quarter-wave F·R²/EI = 1.0648702), the rod models' errors falling with N, the
+// cheapest passing one recommended, and recommend.json's "wire" against its schema and in the
+// report's section.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "../../schema_check.hpp"
+#include "../../test_helpers.hpp"
+#include "reports/study_files.hpp"
+#include "reports/study_sections.hpp"
+#include "verification/studies/recommend/wire_candidates.hpp"
+
+using namespace vessel;
+
+namespace {
+
+// Both scenes' wire: E = 5.073e8 Pa on the solid 0.356 mm section, EI = E π d⁴/64 (≈ 4e-7 N·m²).
+const double kEI = 5.073e8 * std::numbers::pi * std::pow(0.356e-3, 4) / 64.0;
+
+Scene scene_with_budget(const std::string& file, double tolerance_mm) {
+  Scene s = read_scene(std::string(VESSEL_SCENES_DIR) + "/" + file);
+  s.budget.stated = true;
+  s.budget.quantity = BudgetQuantity::contact_point;
+  s.budget.tolerance = tolerance_mm;
+  s.budget.rate_hz = 1000.0;
+  return s;
+}
+
+}  // namespace
+
+TEST(WireCandidates, ContinuumWiresAreTheShootingAndElasticaValues) {
+  std::string why;
+  const Scene straight = scene_with_budget("guidewire_straight.toml", 0.05);
+  const auto s = continuum_wire(straight, why);
+  ASSERT_TRUE(s.has_value()) << why;
+  // The scene's insertion 20.25 mm is L/z = 1.012498 for z = 20 mm: F = 0.470968 EI/z².
+  const double z = 20.25e-3 / 1.012498;
+  EXPECT_NEAR(s->force / (0.470968 * kEI / (z * z)), 1.0, 2e-5);
+  EXPECT_NEAR(s->contact_point.z(), z, 1e-8);
+  EXPECT_NEAR(s->contact_point.x(), 3e-3 - 0.178e-3, 1e-15);  // tilted towards +x
+  EXPECT_NEAR(s->contact_point.y(), 0.0, 1e-15);
+
+  const Scene arch = scene_with_budget("guidewire_arch.toml", 0.05);
+  const auto a = continuum_wire(arch, why);
+  ASSERT_TRUE(a.has_value()) << why;
+  const double R = 15e-3;
+  EXPECT_NEAR(a->force / (1.0648702 * kEI / (R * R)), 1.0, 1e-7);
+  EXPECT_NEAR((a->contact_point - Vec3(0.0, 1.188133 * R, 0.0)).norm(), 0.0, 1e-8);
+
+  // A clamp off the axis has no continuum wire, and says why.
+  Scene off = straight;
+  off.load.guidewire->clamp_point = Vec3(0.5e-3, 0.0, 0.0);
+  EXPECT_FALSE(continuum_wire(off, why).has_value());
+  EXPECT_NE(why.find("clamped on the axis"), std::string::npos) << why;
+}
+
+TEST(WireCandidates, ErrorsFallWithSegmentsAndTheCheapestPassingOneIsRecommended) {
+  const Scene s = scene_with_budget("guidewire_straight.toml", 0.02);
+  const WireRecommendation w = recommend_wire(s, {"der", "corde"}, {8, 16, 32});
+  ASSERT_TRUE(w.reference.has_value()) << w.no_reference;
+  ASSERT_EQ(w.candidates.size(), 6u);
+  for (const WireCandidate& c : w.candidates) {
+    std::printf("WIRE-CANDIDATE %s: F %.6e N, force error %.4e mN, contact error %.4e mm, "
+                "update %.3e s, set-up %.3e s%s\n",
+                c.name.c_str(), c.force, c.force_error_mN, c.contact_error_mm, c.update_seconds,
+                c.setup_seconds, c.ok ? "" : (" FAILED: " + c.failure).c_str());
+  }
+  for (std::size_t m = 0; m < 2; ++m) {
+    const WireCandidate& n8 = w.candidates[3 * m];
+    const WireCandidate& n32 = w.candidates[3 * m + 2];
+    ASSERT_TRUE(n8.ok && n32.ok) << n8.failure << n32.failure;
+    // Second order: four doublings of N cut the force error by about 16 (at least 8 here).
+    EXPECT_LT(n32.force_error_mN, n8.force_error_mN / 8.0) << n8.name;
+    EXPECT_LT(n32.force_error_mN / (w.reference->force * 1e3), 2e-3) << n32.name;
+    EXPECT_EQ(n32.error, n32.contact_error_mm);  // a mm budget judges the contact point
+    EXPECT_GT(n32.update_seconds, 0.0);
+  }
+  // The recommendation: the least time per update among those meeting both (ties within 5 %).
+  std::optional<std::size_t> cheapest;
+  for (std::size_t i = 0; i < w.candidates.size(); ++i) {
+    const WireCandidate& c = w.candidates[i];
+    if (!c.ok || c.error > 0.02 || c.update_seconds > 1e-3) continue;
+    if (!cheapest || c.update_seconds < w.candidates[*cheapest].update_seconds) cheapest = i;
+  }
+  if (!cheapest) {
+    EXPECT_FALSE(w.selection.recommended.has_value());
+  } else {
+    ASSERT_TRUE(w.selection.recommended.has_value());
+    EXPECT_LE(w.candidates[*w.selection.recommended].update_seconds,
+              1.05 * w.candidates[*cheapest].update_seconds);
+  }
+
+  // recommend.json's "wire" meets the schema, and the report's section lists every candidate.
+  Recommendation rec;
+  rec.scene = s;
+  rec.wire = std::make_shared<const WireRecommendation>(w);
+  const std::string text = recommendation_json(rec, "vesselverify recommend", "out");
+  const auto schema = nlohmann::json::parse(test::read_text(VESSEL_RECOMMEND_SCHEMA));
+  const auto problems = test::schema_problems(nlohmann::json::parse(text), schema);
+  EXPECT_TRUE(problems.empty()) << test::joined(problems);
+  const reports::RecommendFile file = reports::parse_recommend(text, "out/recommend.json");
+  ASSERT_TRUE(file.wire.has_value());
+  const std::string md = reports::recommendation_markdown(file);
+  EXPECT_NE(md.find("### The guidewire's rod model"), std::string::npos) << md;
+  for (const WireCandidate& c : w.candidates) {
+    EXPECT_NE(md.find("`" + c.name + "`"), std::string::npos) << c.name;
+  }
+}
