@@ -18,7 +18,8 @@ struct CacheFill {
 
 /// Rank 0 looks (mesh, problem) up in `cache` (only rank 0's is used; the others pass nullptr);
 /// if it is missing, every rank solves it with solve_elasticity_distributed and rank 0 stores the
-/// solution. Every rank must call this with the same mesh and problem. InputError (on every rank)
+/// solution. Only rank 0's mesh and problem are read (as by solve_elasticity_distributed: the
+/// other ranks may pass an empty mesh and a default problem). InputError (on every rank)
 /// when the problem cannot be keyed or rank 0 has no enabled cache: a reference job that stores
 /// nothing would be wasted.
 CacheFill fill_solution_cache(SolutionCache* cache, const TetMesh& mesh,

@@ -13,12 +13,12 @@
 #include <deal.II/distributed/fully_distributed_tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/dofs/dof_tools.h>
-#include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/fe_simplex_p.h>
+#include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_fe.h>
 #include <deal.II/grid/grid_tools.h>
-#include <deal.II/grid/tria_description.h>
 #include <deal.II/grid/tria.h>
+#include <deal.II/grid/tria_description.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/solver_cg.h>
@@ -41,9 +41,11 @@
 
 #include "fem_reference/detail/amg.hpp"
 #include "fem_reference/detail/boundary.hpp"
+#include "fem_reference/detail/byte_buffer.hpp"
 #include "fem_reference/detail/constraints.hpp"
-#include "fem_reference/detail/postprocess.hpp"
 #include "fem_reference/detail/distributed_solver.hpp"
+#include "fem_reference/detail/memory_probe.hpp"
+#include "fem_reference/detail/postprocess.hpp"
 #include "fem_reference/detail/validation.hpp"
 #include "fem_reference/detail/weak_form.hpp"
 #include "meshes/foundation/errors.hpp"
@@ -88,63 +90,14 @@ int MpiSession::size() const {
 
 namespace {
 
-/// Byte buffer writer/reader for the mesh broadcast (all ranks run the same binary, so raw
-/// little-endian PODs are fine).
-struct Writer {
-  std::vector<char> bytes;
-  template <class T>
-  void pod(const T& v) {
-    const auto* p = reinterpret_cast<const char*>(&v);
-    bytes.insert(bytes.end(), p, p + sizeof(T));
-  }
-  template <class T>
-  void array(const std::vector<T>& v) {
-    pod<std::uint64_t>(v.size());
-    const auto* p = reinterpret_cast<const char*>(v.data());
-    bytes.insert(bytes.end(), p, p + v.size() * sizeof(T));
-  }
-};
-
-struct Reader {
-  const std::vector<char>& bytes;
-  std::size_t at = 0;
-  template <class T>
-  T pod() {
-    T v;
-    std::memcpy(&v, bytes.data() + at, sizeof(T));
-    at += sizeof(T);
-    return v;
-  }
-  template <class T>
-  std::vector<T> array() {
-    const auto n = pod<std::uint64_t>();
-    std::vector<T> v(n);
-    std::memcpy(static_cast<void*>(v.data()), bytes.data() + at, n * sizeof(T));
-    at += n * sizeof(T);
-    return v;
-  }
-};
-
-/// MPI_Bcast of a byte buffer in chunks (MPI counts are int).
-void broadcast_bytes(std::vector<char>& bytes, int root, MPI_Comm comm) {
-  std::uint64_t n = bytes.size();
-  MPI_Bcast(&n, 1, MPI_UINT64_T, root, comm);
-  bytes.resize(n);
-  constexpr std::uint64_t kChunk = 1u << 30;
-  for (std::uint64_t at = 0; at < n; at += kChunk) {
-    const int count = static_cast<int>(std::min(kChunk, n - at));
-    MPI_Bcast(bytes.data() + at, count, MPI_CHAR, root, comm);
-  }
-}
-
 std::vector<char> pack_mesh(const TetMesh& m) {
-  Writer w;
+  detail::ByteWriter w;
   w.array(m.nodes);
   w.array(m.tets);
   w.array(m.triangles);
   w.pod<std::uint64_t>(m.groups.size());
   for (const auto& g : m.groups) {
-    w.array(std::vector<char>(g.name.begin(), g.name.end()));
+    w.string(g.name);
     w.pod(g.dim);
     w.pod(g.tag);
     w.array(g.elements);
@@ -153,7 +106,7 @@ std::vector<char> pack_mesh(const TetMesh& m) {
 }
 
 TetMesh unpack_mesh(const std::vector<char>& bytes) {
-  Reader r{bytes};
+  detail::ByteReader r{bytes};
   TetMesh m;
   m.nodes = r.array<Vec3>();
   m.tets = r.array<Tet>();
@@ -161,8 +114,7 @@ TetMesh unpack_mesh(const std::vector<char>& bytes) {
   const auto n_groups = r.pod<std::uint64_t>();
   for (std::uint64_t i = 0; i < n_groups; ++i) {
     PhysicalGroup g;
-    const auto name = r.array<char>();
-    g.name.assign(name.begin(), name.end());
+    g.name = r.string();
     g.dim = r.pod<int>();
     g.tag = r.pod<int>();
     g.elements = r.array<int>();
@@ -173,35 +125,24 @@ TetMesh unpack_mesh(const std::vector<char>& bytes) {
 
 }  // namespace
 
+void run_on_rank0(const std::function<void()>& work) { detail::run_on_root(MPI_COMM_WORLD, work); }
+
+std::vector<int> broadcast_from_rank0(std::vector<int> values) {
+  std::uint64_t n = values.size();
+  MPI_Bcast(&n, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+  values.resize(n);
+  MPI_Bcast(values.data(), static_cast<int>(n), MPI_INT, 0, MPI_COMM_WORLD);
+  return values;
+}
+
 TetMesh make_mesh_on_rank0(const std::function<TetMesh()>& make) {
   const MPI_Comm comm = MPI_COMM_WORLD;
   const unsigned rank = dl::Utilities::MPI::this_mpi_process(comm);
   TetMesh mesh;
-  std::exception_ptr failure;
-  std::vector<char> message;
-  if (rank == 0) {
-    try {
-      mesh = make();
-    } catch (const std::exception& e) {
-      failure = std::current_exception();
-      const std::string what = e.what();
-      message.assign(what.begin(), what.end());
-    } catch (...) {
-      failure = std::current_exception();
-      const std::string what = "meshing failed on rank 0";
-      message.assign(what.begin(), what.end());
-    }
-  }
-  int failed = failure ? 1 : 0;
-  MPI_Bcast(&failed, 1, MPI_INT, 0, comm);
-  if (failed) {
-    broadcast_bytes(message, 0, comm);
-    if (rank == 0) std::rethrow_exception(failure);
-    throw InputError(std::string(message.begin(), message.end()));
-  }
+  detail::run_on_root(comm, [&] { mesh = make(); });
   std::vector<char> bytes;
   if (rank == 0) bytes = pack_mesh(mesh);
-  broadcast_bytes(bytes, 0, comm);
+  detail::broadcast_bytes(bytes, 0, comm);
   if (rank != 0) mesh = unpack_mesh(bytes);
   return mesh;
 }
@@ -232,15 +173,12 @@ namespace detail {
 
 using CellIt = CellIterator;
 
-Distributed::Distributed(const TetMesh& mesh, const ElasticityProblem& problem, MPI_Comm comm,
-                         bool mixed)
-    : mesh_(mesh),
-      problem_(problem),
+Distributed::Distributed(const TetMesh& mesh, const ElasticityProblem& problem, MPI_Comm comm)
+    : input_(mesh),
+      input_problem_(problem),
       comm_(comm),
       rank_(dl::Utilities::MPI::this_mpi_process(comm)),
       n_ranks_(dl::Utilities::MPI::n_mpi_processes(comm)),
-      mixed_(mixed),
-      degree_(mixed ? 2 : problem.options.degree),
       linear_(1),
       mapping_(linear_),
       tria_(comm) {}
@@ -253,20 +191,49 @@ Vec3 Distributed::sum_over_ranks(const Vec3& v) const {
   return s;
 }
 
-void Distributed::build_triangulation() {
+void Distributed::build_triangulation(const DistributedOptions& options) {
   // Rank 0 alone builds the serial coarse triangulation (the cells in TetMesh order, so a cell's
   // coarse cell id is its tet index) and partitions it with METIS; each rank receives the
-  // description of its own cells and ghosts (one group of all ranks).
-  const auto description = dl::TriangulationDescription::Utilities::
-      create_description_from_triangulation_in_groups<kDim, kDim>(
-          [&](dl::Triangulation<kDim>& serial) { create_coarse_triangulation(mesh_, serial); },
-          [](dl::Triangulation<kDim>& serial, const MPI_Comm& comm, unsigned) {
-            dl::GridTools::partition_triangulation(dl::Utilities::MPI::n_mpi_processes(comm),
-                                                   serial);
-          },
-          comm_, static_cast<int>(n_ranks_));
-  tria_.create_triangulation(description);
-  mesh_map_ = match_and_tag_boundary(tria_, mesh_);
+  // description of its own cells and ghosts (one group of all ranks). The serial triangulation
+  // lives only inside this call.
+  std::vector<unsigned> owner;  // rank 0: per tet, its rank
+  {
+    const auto description =
+        dl::TriangulationDescription::Utilities::create_description_from_triangulation_in_groups<
+            kDim, kDim>(
+            [&](dl::Triangulation<kDim>& serial) { create_coarse_triangulation(input_, serial); },
+            [&](dl::Triangulation<kDim>& serial, const MPI_Comm& comm, unsigned) {
+              dl::GridTools::partition_triangulation(dl::Utilities::MPI::n_mpi_processes(comm),
+                                                     serial);
+              owner.resize(serial.n_active_cells());
+              for (const auto& cell : serial.active_cell_iterators())
+                owner[cell->active_cell_index()] = cell->subdomain_id();
+              report_memory(static_cast<int>(rank_), "serial triangulation partitioned");
+            },
+            comm_, static_cast<int>(n_ranks_));
+    tria_.create_triangulation(description);
+  }
+  release_free_memory();
+  report_memory(static_cast<int>(rank_), "distributed triangulation");
+  // Then each rank's part of the mesh and problem, cut by rank 0 along the same partition.
+  const bool mixed = rank_ == 0 && uses_mixed_formulation(input_problem_);
+  part_ = distribute_parts(input_, input_problem_, owner, options, mixed, comm_);
+  std::vector<unsigned>().swap(owner);
+  mixed_ = part_.mixed;
+  degree_ = mixed_ ? 2 : problem_.options.degree;
+  mesh_map_ = match_and_tag_boundary(tria_, mesh_, part_.global_tet);
+  release_free_memory();
+  report_memory(static_cast<int>(rank_), "mesh part received");
+}
+
+void Distributed::release_system() {
+  matrix_.clear();
+  block_matrix_.clear();
+  schur_.clear();
+  rhs_.clear();
+  block_rhs_.reinit(0);
+  solution_.clear();
+  release_free_memory();
 }
 
 void Distributed::setup_constraints() {
@@ -344,8 +311,9 @@ void Distributed::solve_linear() {
     // Rotations about the mesh's node centroid, the same point on every rank.
     dl::TrilinosWrappers::PreconditionAMG amg;
     std::vector<double> modes_storage;  // must outlive amg
-    initialize_elasticity_amg(amg, matrix_, owned_rows(owned_), node_centroid(mesh_), degree_ > 1,
+    initialize_elasticity_amg(amg, matrix_, owned_rows(owned_), part_.centroid, degree_ > 1,
                               o.amg_rigid_body_modes, modes_storage);
+    report_memory(static_cast<int>(rank_), "AMG hierarchy built");
     dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs_norm);
     dl::SolverCG<VectorT> cg(control);
     try {
@@ -405,35 +373,45 @@ void Distributed::postprocess() {
 
 DistributedResult Distributed::run(const DistributedOptions& options) {
   auto& r = out_.fem;
+  out_.n_ranks = static_cast<int>(n_ranks_);
+  const int rank = static_cast<int>(rank_);
+  report_memory(rank, "start");
+  auto t0 = Clock::now();
+  build_triangulation(options);
   r.element = mixed_ ? "P2-P1 (Taylor-Hood)" : (degree_ == 1 ? "P1" : "P2");
   r.formulation = mixed_ ? Formulation::mixed : Formulation::displacement;
-  out_.n_ranks = static_cast<int>(n_ranks_);
-  auto t0 = Clock::now();
-  build_triangulation();
   form_ = std::make_unique<WeakForm>(mesh_, problem_, mixed_, mesh_map_);
   setup_dofs();
   r.n_dofs = dof_.n_dofs();
   r.timings.setup = max_over_ranks(seconds_since(t0));
+  report_memory(rank, "DoFs, sparsity and matrix set up");
 
   std::size_t owned_cells = 0;
   for (const auto& cell : tria_.active_cell_iterators()) owned_cells += cell->is_locally_owned();
-  const auto cells = dl::Utilities::MPI::all_gather(comm_, owned_cells);
-  const auto dofs =
-      dl::Utilities::MPI::all_gather(comm_, static_cast<std::size_t>(owned_.n_elements()));
-  out_.cells_per_rank.assign(cells.begin(), cells.end());
-  out_.dofs_per_rank.assign(dofs.begin(), dofs.end());
+  const auto all = [&](std::size_t mine) {
+    const auto v = dl::Utilities::MPI::all_gather(comm_, mine);
+    return std::vector<std::size_t>(v.begin(), v.end());
+  };
+  out_.cells_per_rank = all(owned_cells);
+  out_.dofs_per_rank = all(static_cast<std::size_t>(owned_.n_elements()));
+  out_.local_tets_per_rank = all(mesh_.tets.size());
 
   t0 = Clock::now();
   assemble();
   r.timings.assembly = max_over_ranks(seconds_since(t0));
+  report_memory(rank, "assembled");
   t0 = Clock::now();
   solve_linear();
   r.timings.solve = max_over_ranks(seconds_since(t0));
+  report_memory(rank, "solved");
+  release_system();
   t0 = Clock::now();
   postprocess();
-  out_.point_displacement = evaluate(options.evaluation_points, options.outside_tolerance);
-  if (options.serial_dofs) out_.serial_dofs = gather_serial_dofs();
+  out_.point_displacement = evaluate(out_.point_rank);
+  if (part_.serial_dofs) out_.serial_dofs = gather_serial_dofs();
   r.timings.postprocess = max_over_ranks(seconds_since(t0));
+  report_memory(rank, "post-processed and gathered");
+  out_.peak_memory_per_rank = all(memory_use().peak);
   return std::move(out_);
 }
 
@@ -448,10 +426,13 @@ DistributedResult solve_elasticity_distributed(const TetMesh& mesh,
     throw std::logic_error(
         "solve_elasticity_distributed needs MPI: create a fem::MpiSession first");
   }
-  detail::validate_problem(mesh, problem);
-  validate_distributable(problem);
-  detail::Distributed solver(mesh, problem, options.self_only ? MPI_COMM_SELF : MPI_COMM_WORLD,
-                             detail::uses_mixed_formulation(problem));
+  const MPI_Comm comm = options.self_only ? MPI_COMM_SELF : MPI_COMM_WORLD;
+  // Only rank 0 has the mesh to check the problem against: its InputError reaches every rank.
+  detail::run_on_root(comm, [&] {
+    detail::validate_problem(mesh, problem);
+    validate_distributable(problem);
+  });
+  detail::Distributed solver(mesh, problem, comm);
   return solver.run(options);
 }
 

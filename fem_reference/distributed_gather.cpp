@@ -5,14 +5,11 @@
 
 #include <cmath>
 #include <cstdint>
-#include <string>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "fem_reference/detail/distributed_solver.hpp"
-#include "fem_reference/detail/tet_locator.hpp"
-#include "meshes/foundation/errors.hpp"
 
 namespace vessel::fem::detail {
 
@@ -40,16 +37,17 @@ std::vector<T> gather_on_rank0(const std::vector<T>& mine, MPI_Datatype type, MP
 }  // namespace
 
 void Distributed::gather_nodal_displacement() {
-  // Each rank sends (node, u) for the vertices of its cells; rank 0 gathers.
+  // Each rank sends (node of the whole mesh, u) for the vertices of its cells; rank 0 gathers.
   std::vector<double> mine;
   for (const auto& [node, u] : vertex_values(
            dof_, mesh_map_.vertex_node, [&](dl::types::global_dof_index d) { return ghosted_(d); })) {
-    mine.insert(mine.end(), {static_cast<double>(node), u[0], u[1], u[2]});
+    const int global = part_.global_node[static_cast<std::size_t>(node)];
+    mine.insert(mine.end(), {static_cast<double>(global), u[0], u[1], u[2]});
   }
   const std::vector<double> all = gather_on_rank0(mine, MPI_DOUBLE, comm_);
   if (rank_ == 0) {
     auto& nodal = out_.fem.nodal_displacement;
-    nodal.assign(mesh_.nodes.size(), Vec3::Zero());
+    nodal.assign(part_.n_nodes, Vec3::Zero());
     for (std::size_t i = 0; i + 4 <= all.size(); i += 4)
       nodal[static_cast<std::size_t>(all[i])] = Vec3(all[i + 1], all[i + 2], all[i + 3]);
   }
@@ -68,7 +66,8 @@ std::vector<double> Distributed::gather_serial_dofs() const {
   for (const auto& cell : dof_.active_cell_iterators()) {
     if (!cell->is_locally_owned()) continue;
     cell->get_dof_indices(dofs);
-    const std::int64_t tet = mesh_map_.cell_tet[cell->active_cell_index()];
+    const std::int64_t tet =
+        part_.global_tet[static_cast<std::size_t>(mesh_map_.cell_tet[cell->active_cell_index()])];
     for (unsigned i = 0; i < n; ++i) {
       if (!owned_.is_element(dofs[i])) continue;
       char& s = sent[owned_.index_within_set(dofs[i])];
@@ -98,11 +97,11 @@ std::vector<double> Distributed::place_in_serial_numbering(const std::vector<std
                                                            std::string& failure) const {
   const unsigned n = fe_->n_dofs_per_cell();
   dl::Triangulation<kDim> serial;
-  create_coarse_triangulation(mesh_, serial);
+  create_coarse_triangulation(input_, serial);  // rank 0 holds the whole mesh
   const auto fe = make_element(degree_, mixed_);
   dl::DoFHandler<kDim> dof(serial);
   dof.distribute_dofs(*fe);
-  std::vector<dl::DoFHandler<kDim>::active_cell_iterator> cells(mesh_.tets.size());
+  std::vector<dl::DoFHandler<kDim>::active_cell_iterator> cells(input_.tets.size());
   for (const auto& cell : dof.active_cell_iterators()) cells[cell->active_cell_index()] = cell;
   std::vector<double> out(dof.n_dofs(), std::numeric_limits<double>::quiet_NaN());
   std::vector<dl::types::global_dof_index> dofs(n);
@@ -121,45 +120,41 @@ std::vector<double> Distributed::place_in_serial_numbering(const std::vector<std
   return out;
 }
 
-std::vector<Vec3> Distributed::evaluate(const std::vector<Vec3>& points, double tol) const {
-  if (points.empty()) return {};
-  // The tet of each point is found the serial solver's way (TetLocator on the whole mesh, the
-  // same answer on every rank: the owner is decided without messages); the rank owning that tet
-  // evaluates, and one sum over the ranks gives every rank every value.
-  std::vector<CellIterator> owned_cell(mesh_.tets.size());
-  std::vector<char> is_owned(mesh_.tets.size(), 0);
+std::vector<Vec3> Distributed::evaluate(std::vector<int>& point_rank) const {
+  point_rank.clear();
+  if (part_.n_points == 0) return {};
+  // Rank 0 located each point in the whole mesh once (TetLocator, as the serial solver's
+  // displacement_at) and sent it to the rank owning its tet; that rank evaluates, and one sum over
+  // the ranks gives every rank every value.
+  std::vector<CellIterator> cell_of_tet(mesh_.tets.size());
   for (const auto& cell : dof_.active_cell_iterators()) {
     if (!cell->is_locally_owned()) continue;
-    const auto t = static_cast<std::size_t>(mesh_map_.cell_tet[cell->active_cell_index()]);
-    owned_cell[t] = cell;
-    is_owned[t] = 1;
+    cell_of_tet[static_cast<std::size_t>(mesh_map_.cell_tet[cell->active_cell_index()])] = cell;
   }
-  const TetLocator locator(mesh_);
   const unsigned n = fe_->n_dofs_per_cell();
   std::vector<dl::types::global_dof_index> dofs(n);
-  std::vector<double> mine(3 * points.size(), 0.0), all(3 * points.size(), 0.0);
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    const Vec3& x = points[k];
-    const int t = locator.find(x, tol);
-    if (t < 0) {
-      std::ostringstream m;
-      m << "point (" << x.x() * 1e3 << ", " << x.y() * 1e3 << ", " << x.z() * 1e3
-        << ") mm is outside the FEM mesh: expected a point inside the vessel wall";
-      throw InputError(m.str());
-    }
-    if (!is_owned[static_cast<std::size_t>(t)]) continue;
-    const auto& cell = owned_cell[static_cast<std::size_t>(t)];
+  const std::size_t n_points = part_.n_points;
+  std::vector<double> mine(3 * n_points, 0.0), all(3 * n_points, 0.0);
+  std::vector<int> rank_of(n_points, 0);
+  for (const RankPart::Point& p : part_.points) {
+    const auto k = static_cast<std::size_t>(p.index);
+    const auto& cell = cell_of_tet[static_cast<std::size_t>(p.tet)];
     const auto ref =
-        mapping_.transform_real_to_unit_cell(cell, dl::Point<kDim>(x.x(), x.y(), x.z()));
+        mapping_.transform_real_to_unit_cell(cell, dl::Point<kDim>(p.x.x(), p.x.y(), p.x.z()));
     cell->get_dof_indices(dofs);
     for (unsigned i = 0; i < n; ++i) {
       const unsigned c = fe_->system_to_component_index(i).first;
       if (c < 3) mine[3 * k + c] += ghosted_(dofs[i]) * fe_->shape_value(i, ref);
     }
+    rank_of[k] = static_cast<int>(rank_);
   }
   MPI_Allreduce(mine.data(), all.data(), static_cast<int>(all.size()), MPI_DOUBLE, MPI_SUM, comm_);
-  std::vector<Vec3> out(points.size());
-  for (std::size_t k = 0; k < points.size(); ++k) out[k] = Vec3(all[3 * k], all[3 * k + 1], all[3 * k + 2]);
+  point_rank.assign(n_points, 0);
+  MPI_Allreduce(rank_of.data(), point_rank.data(), static_cast<int>(n_points), MPI_INT, MPI_SUM,
+                comm_);
+  std::vector<Vec3> out(n_points);
+  for (std::size_t k = 0; k < n_points; ++k)
+    out[k] = Vec3(all[3 * k], all[3 * k + 1], all[3 * k + 2]);
   return out;
 }
 

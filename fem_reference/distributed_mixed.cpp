@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "fem_reference/detail/distributed_solver.hpp"
+#include "fem_reference/detail/memory_probe.hpp"
 
 namespace vessel::fem::detail {
 
@@ -160,8 +161,9 @@ void Distributed::solve_mixed() {
 
   dl::TrilinosWrappers::PreconditionAMG amg;
   std::vector<double> modes_storage;  // must outlive amg
-  initialize_elasticity_amg(amg, a, owned_rows(owned_blocks_[0]), node_centroid(mesh_), true,
+  initialize_elasticity_amg(amg, a, owned_rows(owned_blocks_[0]), part_.centroid, true,
                             o.amg_rigid_body_modes, modes_storage);
+  report_memory(static_cast<int>(rank_), "AMG hierarchy built");
   const BlockPreconditioner prec(block_matrix_.block(0, 1), amg, s, omega, owned_blocks_[0],
                                  comm_);
   BlockVectorT y(owned_blocks_, comm_);

@@ -109,7 +109,9 @@ std::string fem_json(const FemRunRecord& run) {
   if (run.distributed) {
     j["distributed"] = {{"mpi_ranks", run.distributed->ranks},
                         {"tets_per_rank", run.distributed->tets_per_rank},
-                        {"dofs_per_rank", run.distributed->dofs_per_rank}};
+                        {"dofs_per_rank", run.distributed->dofs_per_rank},
+                        {"local_tets_per_rank", run.distributed->local_tets_per_rank},
+                        {"peak_memory_mb_per_rank", run.distributed->peak_memory_mb_per_rank}};
   }
   if (run.contact) j["contact"] = contact_json(*run.contact);
   return j.dump(2) + "\n";

@@ -36,7 +36,9 @@ struct RichardsonRecord {
 /// The MPI decomposition of a distributed solve.
 struct DistributedRecord {
   int ranks = 1;
-  std::vector<std::size_t> tets_per_rank, dofs_per_rank;
+  std::vector<std::size_t> tets_per_rank, dofs_per_rank;  ///< owned by each rank
+  std::vector<std::size_t> local_tets_per_rank;           ///< held by each rank (owned and ghosts)
+  std::vector<double> peak_memory_mb_per_rank;            ///< VmHWM at the end of the solve, MB
 };
 
 /// Everything one `fem` run reports.

@@ -54,7 +54,8 @@ int node_at(const TetMesh& mesh, const Tet& tet, const dl::Point<kDim>& x) {
 
 }  // namespace
 
-MeshCorrespondence match_and_tag_boundary(dl::Triangulation<kDim>& tria, const TetMesh& mesh) {
+MeshCorrespondence match_and_tag_boundary(dl::Triangulation<kDim>& tria, const TetMesh& mesh,
+                                          const std::vector<int>& global_tet) {
   MeshCorrespondence m;
   m.triangle_tag = triangle_group_tags(mesh);
   std::map<Face, int> face_to_triangle;
@@ -67,7 +68,14 @@ MeshCorrespondence match_and_tag_boundary(dl::Triangulation<kDim>& tria, const T
   m.vertex_node.assign(tria.n_vertices(), -1);
   for (const auto& cell : tria.active_cell_iterators()) {
     if (cell->is_artificial()) continue;
-    const auto coarse = cell->id().get_coarse_cell_id();
+    auto coarse = static_cast<std::size_t>(cell->id().get_coarse_cell_id());
+    if (!global_tet.empty()) {
+      const auto it =
+          std::lower_bound(global_tet.begin(), global_tet.end(), static_cast<int>(coarse));
+      coarse = it != global_tet.end() && *it == static_cast<int>(coarse)
+                   ? static_cast<std::size_t>(it - global_tet.begin())
+                   : mesh.tets.size();
+    }
     if (coarse >= mesh.tets.size()) throw std::logic_error("triangulation cell with unknown tet");
     const auto idx = cell->active_cell_index();
     const auto& tet = mesh.tets[coarse];

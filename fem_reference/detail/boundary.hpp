@@ -25,10 +25,13 @@ struct MeshCorrespondence {
 };
 
 /// Matches the non-artificial cells of `tria` (made by create_coarse_triangulation, possibly
-/// distributed) to the mesh: tets by coarse cell id, vertices by position (std::logic_error if a
+/// distributed) to the mesh: tets by coarse cell id (with `global_tet`, the ascending coarse cell
+/// id of each of `mesh`'s tets: a distributed rank's part of the whole mesh; empty: the tet index
+/// is the coarse cell id), vertices by position (std::logic_error if a
 /// vertex is not one of its tet's nodes), boundary faces by their node sets; and sets each
 /// boundary face's id to the gmsh tag of the surface group of its triangle (unlabelled: 0).
-MeshCorrespondence match_and_tag_boundary(dl::Triangulation<kDim>& tria, const TetMesh& mesh);
+MeshCorrespondence match_and_tag_boundary(dl::Triangulation<kDim>& tria, const TetMesh& mesh,
+                                          const std::vector<int>& global_tet = {});
 
 /// The local vertex (0..3) of `cell` that is mesh node `node` (std::logic_error if none).
 unsigned cell_vertex_of_node(const dl::CellAccessor<kDim>& cell, const std::vector<int>& vertex_node,

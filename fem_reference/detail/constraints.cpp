@@ -3,6 +3,7 @@
 #include <deal.II/fe/component_mask.h>
 #include <deal.II/numerics/vector_tools.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -34,22 +35,30 @@ std::size_t node_at_point(const TetMesh& mesh, const std::vector<char>& used, co
 
 }  // namespace
 
-void add_point_constraints(const TetMesh& mesh, const std::vector<PointConstraint>& points,
-                           const dl::DoFHandler<kDim>& dof, const std::vector<int>& vertex_node,
-                           dl::AffineConstraints<double>& constraints) {
-  if (points.empty()) return;
+std::vector<int> point_constraint_nodes(const TetMesh& mesh,
+                                        const std::vector<PointConstraint>& points) {
+  if (points.empty()) return {};
   const double tol = 1e-6 * std::cbrt(mesh_volume(mesh) /
                                       static_cast<double>(std::max<std::size_t>(mesh.tets.size(), 1)));
   std::vector<char> used(mesh.nodes.size(), 0);
   for (const auto& tet : mesh.tets)
     for (int n : tet) used[static_cast<std::size_t>(n)] = 1;
-  for (const auto& pc : points) {
-    const auto node = static_cast<int>(node_at_point(mesh, used, pc.point, tol));
+  std::vector<int> nodes;
+  for (const auto& pc : points)
+    nodes.push_back(static_cast<int>(node_at_point(mesh, used, pc.point, tol)));
+  return nodes;
+}
+
+void add_point_constraints(const TetMesh& mesh, const std::vector<PointConstraint>& points,
+                           const dl::DoFHandler<kDim>& dof, const std::vector<int>& vertex_node,
+                           dl::AffineConstraints<double>& constraints) {
+  const std::vector<int> nodes = point_constraint_nodes(mesh, points);
+  for (std::size_t k = 0; k < points.size(); ++k) {
     for (const auto& cell : dof.active_cell_iterators()) {
       if (cell->is_artificial()) continue;
       for (unsigned v = 0; v < 4; ++v) {
-        if (vertex_node[cell->vertex_index(v)] != node) continue;
-        const auto d = cell->vertex_dof_index(v, static_cast<unsigned>(pc.component));
+        if (vertex_node[cell->vertex_index(v)] != nodes[k]) continue;
+        const auto d = cell->vertex_dof_index(v, static_cast<unsigned>(points[k].component));
         if (!constraints.is_constrained(d)) constraints.add_line(d);
       }
     }
@@ -57,7 +66,10 @@ void add_point_constraints(const TetMesh& mesh, const std::vector<PointConstrain
 }
 
 dl::types::boundary_id group_boundary_id(const TetMesh& mesh, const std::string& group) {
-  return static_cast<dl::types::boundary_id>(mesh.require_group(group, 2, "FEM").tag);
+  if (const PhysicalGroup* g = mesh.find_group(group, 2)) {
+    return static_cast<dl::types::boundary_id>(g->tag);
+  }
+  return static_cast<dl::types::boundary_id>(mesh.require_group(group, 2, "FEM").tag);  // throws
 }
 
 void add_dirichlet_constraints(const TetMesh& mesh, const std::vector<DirichletCondition>& groups,

@@ -10,9 +10,9 @@
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/mapping_fe.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_block_sparse_matrix.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
-#include <deal.II/lac/trilinos_block_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <mpi.h>
 
@@ -24,6 +24,7 @@
 #include "fem_reference/detail/amg.hpp"
 #include "fem_reference/detail/boundary.hpp"
 #include "fem_reference/detail/postprocess.hpp"
+#include "fem_reference/detail/rank_part.hpp"
 #include "fem_reference/detail/weak_form.hpp"
 #include "fem_reference/distributed_elasticity.hpp"
 
@@ -34,13 +35,19 @@ using BlockVectorT = dl::TrilinosWrappers::MPI::BlockVector;
 
 class Distributed {
  public:
-  Distributed(const TetMesh& mesh, const ElasticityProblem& problem, MPI_Comm comm, bool mixed);
+  /// `mesh` and `problem`: the whole mesh and the problem on rank 0 (validated); other ranks'
+  /// mesh is not read and their problem only supplies the functions (rank_part.hpp).
+  Distributed(const TetMesh& mesh, const ElasticityProblem& problem, MPI_Comm comm);
 
   DistributedResult run(const DistributedOptions& options);
 
  private:
   // distributed_elasticity.cpp
-  void build_triangulation();
+  /// Rank 0 partitions the whole mesh (METIS) and sends each rank its cells with a ghost layer
+  /// and its part of the mesh and problem (part_); the whole mesh is read on rank 0 only.
+  void build_triangulation(const DistributedOptions& options);
+  /// Frees what the solve needed and the post-processing does not (the matrices).
+  void release_system();
   void setup_dofs();
   void setup_constraints();
   void assemble();
@@ -88,15 +95,19 @@ class Distributed {
   [[nodiscard]] std::vector<double> place_in_serial_numbering(const std::vector<std::int64_t>& where,
                                                               const std::vector<double>& value,
                                                               std::string& failure) const;
-  /// Every rank: u at `points` (the tet found by TetLocator, evaluated by the rank owning it).
-  [[nodiscard]] std::vector<Vec3> evaluate(const std::vector<Vec3>& points, double tol) const;
+  /// Every rank: u at every evaluation point (each evaluated by the rank owning its tet, found
+  /// once by rank 0), and which rank evaluated it.
+  [[nodiscard]] std::vector<Vec3> evaluate(std::vector<int>& point_rank) const;
 
-  const TetMesh& mesh_;
-  const ElasticityProblem& problem_;
+  const TetMesh& input_;                    // the whole mesh: rank 0 only
+  const ElasticityProblem& input_problem_;  // rank 0's problem; elsewhere its functions only
+  RankPart part_;                           // this rank's part (distributed_parts.cpp)
+  const TetMesh& mesh_ = part_.mesh;
+  const ElasticityProblem& problem_ = part_.problem;
   MPI_Comm comm_;
   unsigned rank_, n_ranks_;
-  bool mixed_;
-  int degree_;
+  bool mixed_ = false;
+  int degree_ = 1;
 
   dl::FE_SimplexP<kDim> linear_;
   dl::MappingFE<kDim> mapping_;

@@ -9,6 +9,8 @@
 #include <array>
 #include <cmath>
 
+#include "fem_reference/detail/constraints.hpp"
+
 namespace vessel::fem::detail {
 
 dl::Quadrature<kDim> cell_quadrature(int degree) {
@@ -45,8 +47,7 @@ WeakForm::WeakForm(const TetMesh& mesh, const ElasticityProblem& problem, bool m
       lambda_(problem.material.lambda()),
       mu_(problem.material.mu()) {
   for (const auto& pr : problem.pressures) {
-    pressure_tags_.emplace_back(mesh.require_group(pr.group, 2, "FEM pressure load").tag,
-                                pr.pressure);
+    pressure_tags_.emplace_back(group_boundary_id(mesh, pr.group), pr.pressure);
   }
   triangle_points_.assign(mesh.triangles.size(), {});
   for (const auto& patch : problem.patches) {

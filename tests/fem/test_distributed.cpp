@@ -2,14 +2,16 @@
 /// a direct factorisation (CHOLMOD; UMFPACK for Taylor–Hood), on the same mesh and problem, at the
 /// mesh's nodes and at points where a model's nodes sit; the gathered DoFs restored into a serial
 /// solver (what the solution cache stores); and the solve on one rank
-/// (MPI_COMM_SELF) against the solve on every rank. Run by ctest under `mpirun -np 2` (see
-/// CMakeLists.txt); every comparison is made on rank 0, and any rank's failure fails the run.
+/// (MPI_COMM_SELF) against the solve on every rank; the ranks other than 0 given no mesh at all.
+/// Run by ctest under `mpirun -np 2` (see CMakeLists.txt); every comparison is made on rank 0, and
+/// any rank's failure fails the run.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 
 #include "fem_reference/distributed_elasticity.hpp"
@@ -248,6 +250,87 @@ TEST(DistributedElasticity, P2PressureRollersAndPinsMatchCholmod) {
 }
 TEST(DistributedElasticity, P2PressureAndGravityClampedInletMatchCholmod) {
   check_against_serial(Load::pressure_gravity, 2);
+}
+
+TEST(DistributedElasticity, OtherRanksGetOnlyTheirPartAndEvaluateTheirPointsAsTheSerialSolver) {
+  // Rank 0 alone passes the mesh, the problem and the points; the others pass an empty mesh and a
+  // default problem, so whatever they solve came from rank 0's partition.
+  const bool root = world_rank() == 0;
+  const std::size_t n_tets = tube().tets.size();  // collective: the test's mesh, made on rank 0
+  const TetMesh empty;
+  const ElasticityProblem problem = root ? make_problem(Load::contact, 2) : ElasticityProblem{};
+  DistributedOptions opt;
+  if (root) {
+    opt.evaluation_points = model_like_points();
+    opt.outside_tolerance = kModelNodeTolerance;
+  }
+  const DistributedResult d = solve_elasticity_distributed(root ? tube() : empty, problem, opt);
+  const std::size_t n_points = model_like_points().size();
+  ASSERT_EQ(d.point_displacement.size(), n_points);
+  ASSERT_EQ(d.point_rank.size(), n_points);
+  ASSERT_EQ(d.local_tets_per_rank.size(), static_cast<std::size_t>(world_size()));
+  std::size_t total = 0;
+  for (auto c : d.cells_per_rank) total += c;
+  EXPECT_EQ(total, n_tets);
+  for (int r = 0; r < world_size(); ++r) {
+    const auto held = d.local_tets_per_rank[static_cast<std::size_t>(r)];
+    EXPECT_GE(held, d.cells_per_rank[static_cast<std::size_t>(r)]) << "rank " << r;
+    if (world_size() > 1) {
+      EXPECT_LT(held, total) << "rank " << r << " holds the whole mesh";
+    }
+  }
+  // The serial direct solve on rank 0, sent to every rank: each rank checks every point, the
+  // points of the other ranks' cells included.
+  std::vector<double> serial(3 * n_points, 0.0);
+  if (root) {
+    ElasticityProblem direct = problem;
+    direct.options.solver = LinearSolver::direct;
+    ElasticitySolver solver(tube(), direct);
+    solver.solve();
+    const auto u = solver.displacement_at(model_like_points(), kModelNodeTolerance);
+    for (std::size_t k = 0; k < n_points; ++k)
+      for (int c = 0; c < 3; ++c) serial[3 * k + static_cast<std::size_t>(c)] = u[k][c];
+  }
+  MPI_Bcast(serial.data(), static_cast<int>(serial.size()), MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  std::vector<Vec3> expected(n_points), mine, others, mine_expected, others_expected;
+  for (std::size_t k = 0; k < n_points; ++k) {
+    expected[k] = Vec3(serial[3 * k], serial[3 * k + 1], serial[3 * k + 2]);
+    const bool by_me = d.point_rank[k] == world_rank();
+    (by_me ? mine : others).push_back(d.point_displacement[k]);
+    (by_me ? mine_expected : others_expected).push_back(expected[k]);
+  }
+  if (world_size() > 1) {
+    EXPECT_FALSE(others.empty()) << "every point fell in rank " << world_rank() << "'s cells";
+    EXPECT_FALSE(mine.empty()) << "no point fell in rank " << world_rank() << "'s cells";
+  }
+  const double scale = max_norm(expected);
+  const auto diff = [&](const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+    double m = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, (a[i] - b[i]).norm());
+    return m / scale;
+  };
+  EXPECT_LT(diff(mine, mine_expected), kAgreement) << "rank " << world_rank() << ", own points";
+  EXPECT_LT(diff(others, others_expected), kAgreement)
+      << "rank " << world_rank() << ", the other ranks' points";
+}
+
+TEST(DistributedElasticity, AFunctionOnlyRankZeroHasIsRefusedOnEveryRank) {
+  // A prescribed displacement is a function: it cannot be sent, so every rank must pass it.
+  ElasticityProblem p = make_problem(Load::contact, 1);
+  if (world_rank() == 0) {
+    p.dirichlet[0].value = [](const Vec3&) { return Vec3(0.0, 0.0, 1e-6); };
+  }
+  std::string msg;
+  try {
+    (void)solve_elasticity_distributed(tube(), p);
+  } catch (const std::logic_error& e) {
+    msg = e.what();
+  }
+  if (world_size() > 1) {
+    EXPECT_NE(msg.find("prescribed displacement on 'inlet'"), std::string::npos) << msg;
+  } else {
+    EXPECT_EQ(msg, "");  // one rank: its own function
+  }
 }
 
 TEST(DistributedElasticity, GravityLoadIsTheWeightAndReactionsBalanceIt) {

@@ -53,6 +53,14 @@ TEST(FemDistributedCli, TwoRanksMatchTheSerialDirectSolveAndPrintOnce) {
   const auto s = nlohmann::json::parse(vessel::test::read_text(dir / "serial.json"));
   const auto m = nlohmann::json::parse(vessel::test::read_text(dir / "mpi.json"));
   EXPECT_EQ(m["distributed"]["mpi_ranks"], 2);
+  // Neither rank held the whole mesh: each only its own tets and their ghost layer.
+  const auto& dist = m["distributed"];
+  ASSERT_EQ(dist["local_tets_per_rank"].size(), 2u);
+  const int tets = dist["tets_per_rank"][0].get<int>() + dist["tets_per_rank"][1].get<int>();
+  for (int r = 0; r < 2; ++r) {
+    EXPECT_LT(dist["local_tets_per_rank"][r].get<int>(), tets) << "rank " << r;
+    EXPECT_GT(dist["peak_memory_mb_per_rank"][r].get<double>(), 0.0) << "rank " << r;
+  }
   EXPECT_EQ(m["solver"], "cg-amg");
   EXPECT_EQ(m["dofs"], s["dofs"]);
   EXPECT_GT(m["cg_iterations"].get<int>(), 0);

@@ -390,15 +390,46 @@ void run_distributed(const TetMesh& mesh,
   std::cout << "solving distributed ..." << std::flush;
   const auto d = fem::solve_elasticity_distributed(mesh, problem, dopt);
   run.result = d.fem;
-  run.distributed = DistributedRecord{d.n_ranks, d.cells_per_rank, d.dofs_per_rank};
+  std::vector<double> peak_mb;
+  for (auto b : d.peak_memory_per_rank) peak_mb.push_back(static_cast<double>(b) / 1e6);
+  run.distributed = DistributedRecord{d.n_ranks, d.cells_per_rank, d.dofs_per_rank,
+                                      d.local_tets_per_rank, peak_mb};
   if (run.contact) run.contact->displacement = d.point_displacement.at(0);
   std::cout << " " << d.n_ranks << " MPI rank(s)\n";
-  std::cout << "element " << run.result.element << ": " << run.result.n_dofs << " DoFs; cg-amg, "
-            << run.result.iterations << " CG iterations\n  per rank: tets";
+  std::cout << "element " << run.result.element << ": " << run.result.n_dofs << " DoFs; "
+            << fem::to_string(run.result.solver) << ", " << run.result.iterations
+            << " iterations\n  per rank: tets owned";
   for (auto c : d.cells_per_rank) std::cout << " " << c;
+  std::cout << ", held (with ghosts)";
+  for (auto c : d.local_tets_per_rank) std::cout << " " << c;
   std::cout << "; DoFs";
   for (auto c : d.dofs_per_rank) std::cout << " " << c;
+  std::cout << "; peak memory MB";
+  for (double m : peak_mb) std::cout << " " << static_cast<long>(m + 0.5);
   std::cout << "\n";
+}
+
+/// --distributed: rank 0 meshes, builds the problem, prints and writes; every rank solves its
+/// part, and the other ranks never hold the whole mesh (solve_elasticity_distributed sends them
+/// theirs).
+void run_distributed_command(FemCommandOptions& o, bool root) {
+  const auto t0 = Clock::now();
+  TetMesh mesh;
+  fem::ElasticityProblem problem;
+  FemRunRecord run;
+  fem::run_on_rank0([&] {
+    MeshSource source;
+    mesh = mesh_vessel(o.vessel, std::cout, &source);
+    run = run_record(o, mesh, source.cache_hit, since(t0));
+    std::cout << "mesh: " << mesh.nodes.size() << " nodes, " << mesh.tets.size() << " tets\n";
+    const Scene scene = resolve_file_vessel(command_scene(o), mesh);
+    problem = command_problem(o, scene, mesh);
+    run.contact = contact_record(scene, problem);
+    std::cout << std::setprecision(6) << "material: E " << o.youngs_modulus << " Pa, nu "
+              << o.poisson_ratio << ", rho " << o.density << " kg/m³; ends: " << run.ends << "\n";
+  });
+  run_distributed(mesh, problem, run);
+  if (root) write_outputs(o, mesh, run);
 }
 
 /// The finite-strain solution at the contact point along the patch's inward normal, or for
@@ -503,20 +534,18 @@ void check_options(const FemCommandOptions& o) {
 
 void run(FemCommandOptions& o) {
   check_options(o);
-  // --distributed: MPI lives for this command only (the serial program never initialises it
-  // unless CG-AMG needs Trilinos); rank 0 meshes and prints, every rank solves its part.
-  std::unique_ptr<fem::MpiSession> mpi;
-  static NullBuffer null_buffer;
   if (o.distributed) {
-    mpi = std::make_unique<fem::MpiSession>();
-    if (mpi->rank() != 0) std::cout.rdbuf(&null_buffer);
+    // MPI lives for this command only (the serial program never initialises it unless CG-AMG
+    // needs Trilinos); rank 0 meshes and prints, every rank solves its part.
+    const fem::MpiSession mpi;
+    static NullBuffer null_buffer;
+    if (mpi.rank() != 0) std::cout.rdbuf(&null_buffer);
+    run_distributed_command(o, mpi.rank() == 0);
+    return;
   }
   const auto t0 = Clock::now();
   MeshSource source;
-  const TetMesh mesh =
-      o.distributed
-          ? fem::make_mesh_on_rank0([&] { return mesh_vessel(o.vessel, std::cout, &source); })
-          : mesh_vessel(o.vessel, std::cout, &source);
+  const TetMesh mesh = mesh_vessel(o.vessel, std::cout, &source);
   FemRunRecord run = run_record(o, mesh, source.cache_hit, since(t0));
   std::cout << "mesh: " << mesh.nodes.size() << " nodes, " << mesh.tets.size() << " tets\n";
   // A vessel from a file: the contact point moves onto the chosen wall of its mesh.
@@ -529,12 +558,7 @@ void run(FemCommandOptions& o) {
     run_finite_strain(o, scene, problem, mesh, run);
     return;
   }
-  if (o.distributed) {
-    run_distributed(mesh, problem, run);
-    if (run.result.nodal_displacement.empty()) return;  // not rank 0: nothing to write
-  } else {
-    run_serial(o, scene, mesh, problem, run);
-  }
+  run_serial(o, scene, mesh, problem, run);
   write_outputs(o, mesh, run);
 }
 

@@ -17,8 +17,9 @@ struct ReferenceJobSummary {
 };
 
 /// Collective over MPI_COMM_WORLD (a fem::MpiSession must exist): every rank calls it with the
-/// same scenes. Rank 0 (`root`) reads or generates the meshes (mesh cache o.cache_dir) and sends
-/// them to the others, owns o.solution_cache (the other ranks' is ignored) and prints to `log`.
+/// same scenes. Rank 0 (`root`) alone reads or generates the meshes (mesh cache o.cache_dir) and
+/// makes the problems (the solver sends each other rank its cells and their loads), owns
+/// o.solution_cache (the other ranks' is ignored) and prints to `log`.
 /// For each scene and ν, the solves of reference_solves (fine level, the level below, the one
 /// below that) are looked up and, when missing, solved distributed and stored. InputError (every
 /// rank) without a solution cache; an exception on any solve ends the job on every rank.
