@@ -21,8 +21,8 @@
 #   default  the scenes' own levels, loads and sweeps (contact up to 1 mN, where the linear
 #            reference holds; seed 000's range is the validity study's, against the
 #            finite-strain reference, to 70 mN); the stability table at levels 0-1 with a
-#            2·10^5-step long run; level-0 recommendation candidates (~5 min from an empty
-#            cache on 2 cores, ~25 s once cached)
+#            2·10^5-step long run; level-0 recommendation candidates (~8 min from an empty
+#            cache on 2 cores, ~70 s once cached)
 #   --quick  models and the P2 reference on level 0 (the models' own mesh, so no estimate of
 #            the reference's uncertainty), smallest and largest load, the validity study at 0.1,
 #            1 and 10 mN, the quick stability study, recommendations against P2 on level 0
