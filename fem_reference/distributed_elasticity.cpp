@@ -92,35 +92,13 @@ namespace {
 
 std::vector<char> pack_mesh(const TetMesh& m) {
   detail::ByteWriter w;
-  w.array(m.nodes);
-  w.array(m.tets);
-  w.array(m.triangles);
-  w.pod<std::uint64_t>(m.groups.size());
-  for (const auto& g : m.groups) {
-    w.string(g.name);
-    w.pod(g.dim);
-    w.pod(g.tag);
-    w.array(g.elements);
-  }
+  detail::write_mesh(w, m);
   return std::move(w.bytes);
 }
 
 TetMesh unpack_mesh(const std::vector<char>& bytes) {
   detail::ByteReader r{bytes};
-  TetMesh m;
-  m.nodes = r.array<Vec3>();
-  m.tets = r.array<Tet>();
-  m.triangles = r.array<Triangle>();
-  const auto n_groups = r.pod<std::uint64_t>();
-  for (std::uint64_t i = 0; i < n_groups; ++i) {
-    PhysicalGroup g;
-    g.name = r.string();
-    g.dim = r.pod<int>();
-    g.tag = r.pod<int>();
-    g.elements = r.array<int>();
-    m.groups.push_back(std::move(g));
-  }
-  return m;
+  return detail::read_mesh(r);
 }
 
 }  // namespace

@@ -245,16 +245,7 @@ ElasticityProblem unpack_problem(ByteReader& r, const ElasticityProblem& own,
 
 std::vector<char> pack_part(const RankPart& part) {
   ByteWriter w;
-  w.array(part.mesh.nodes);
-  w.array(part.mesh.tets);
-  w.array(part.mesh.triangles);
-  w.pod<std::uint64_t>(part.mesh.groups.size());
-  for (const auto& g : part.mesh.groups) {
-    w.string(g.name);
-    w.pod(g.dim);
-    w.pod(g.tag);
-    w.array(g.elements);
-  }
+  write_mesh(w, part.mesh);
   w.array(part.global_tet);
   w.array(part.global_node);
   pack_problem(w, part.problem);
@@ -272,18 +263,7 @@ RankPart unpack_part(const std::vector<char>& bytes, const ElasticityProblem& ow
                      std::string& missing) {
   ByteReader r{bytes};
   RankPart part;
-  part.mesh.nodes = r.array<Vec3>();
-  part.mesh.tets = r.array<Tet>();
-  part.mesh.triangles = r.array<Triangle>();
-  const auto n_groups = r.pod<std::uint64_t>();
-  for (std::uint64_t i = 0; i < n_groups; ++i) {
-    PhysicalGroup g;
-    g.name = r.string();
-    g.dim = r.pod<int>();
-    g.tag = r.pod<int>();
-    g.elements = r.array<int>();
-    part.mesh.groups.push_back(std::move(g));
-  }
+  part.mesh = read_mesh(r);
   part.global_tet = r.array<int>();
   part.global_node = r.array<int>();
   part.problem = unpack_problem(r, own, missing);

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "meshes/tet_mesh.hpp"
+
 namespace vessel::fem::detail {
 
 struct ByteWriter {
@@ -84,6 +86,37 @@ inline std::vector<char> receive_bytes(int from, int tag, MPI_Comm comm) {
     MPI_Recv(bytes.data() + at, count, MPI_CHAR, from, tag, comm, MPI_STATUS_IGNORE);
   }
   return bytes;
+}
+
+/// A TetMesh's nodes, elements and groups, written and read in the same order.
+inline void write_mesh(ByteWriter& w, const TetMesh& m) {
+  w.array(m.nodes);
+  w.array(m.tets);
+  w.array(m.triangles);
+  w.pod<std::uint64_t>(m.groups.size());
+  for (const auto& g : m.groups) {
+    w.string(g.name);
+    w.pod(g.dim);
+    w.pod(g.tag);
+    w.array(g.elements);
+  }
+}
+
+inline TetMesh read_mesh(ByteReader& r) {
+  TetMesh m;
+  m.nodes = r.array<Vec3>();
+  m.tets = r.array<Tet>();
+  m.triangles = r.array<Triangle>();
+  const auto n_groups = r.pod<std::uint64_t>();
+  for (std::uint64_t i = 0; i < n_groups; ++i) {
+    PhysicalGroup g;
+    g.name = r.string();
+    g.dim = r.pod<int>();
+    g.tag = r.pod<int>();
+    g.elements = r.array<int>();
+    m.groups.push_back(std::move(g));
+  }
+  return m;
 }
 
 }  // namespace vessel::fem::detail
