@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "meshes/foundation/csv.hpp"
 #include "meshes/foundation/atomic_file.hpp"
 #include "meshes/foundation/process.hpp"
 #include "msm/rods/rod_layout.hpp"
@@ -31,23 +32,12 @@ double number(const std::string& text, const std::string& where) {
   return v;
 }
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream s(line);
-  std::string f;
-  while (std::getline(s, f, ',')) {
-    const auto a = f.find_first_not_of(" \t\r");
-    const auto b = f.find_last_not_of(" \t\r");
-    out.push_back(a == std::string::npos ? "" : f.substr(a, b - a + 1));
-  }
-  return out;
-}
 
 std::vector<Vec3> read_centreline(const std::filesystem::path& path, int nodes) {
   std::ifstream in(path);
   if (!in) throw WireModelError(path.string() + ": no answer (expected node,x,y,z per node)");
   std::string line;
-  if (!std::getline(in, line) || split(line) != std::vector<std::string>{"node", "x", "y", "z"}) {
+  if (!std::getline(in, line) || csv_fields(line) != std::vector<std::string>{"node", "x", "y", "z"}) {
     throw WireModelError(path.string() + ":1: expected the header \"node,x,y,z\"");
   }
   std::vector<Vec3> p(static_cast<std::size_t>(nodes), Vec3::Constant(NAN));
@@ -55,7 +45,7 @@ std::vector<Vec3> read_centreline(const std::filesystem::path& path, int nodes) 
   for (int number_of_line = 2; std::getline(in, line); ++number_of_line) {
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     const std::string where = path.string() + ":" + std::to_string(number_of_line);
-    const std::vector<std::string> f = split(line);
+    const std::vector<std::string> f = csv_fields(line);
     if (f.size() != 4) throw WireModelError(where + ": expected 4 fields (node,x,y,z)");
     const double k = number(f[0], where);
     if (k != std::floor(k) || k < 0 || k >= nodes) {

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "meshes/foundation/csv.hpp"
 #include "meshes/foundation/atomic_file.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "msm/model/mass_spring_model.hpp"
@@ -50,18 +51,6 @@ std::string read_text(const std::filesystem::path& p) {
   return s.str();
 }
 
-/// Splits a CSV line at commas, trimming spaces and a trailing '\r'.
-std::vector<std::string> fields(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream s(line);
-  std::string f;
-  while (std::getline(s, f, ',')) {
-    const auto a = f.find_first_not_of(" \t\r");
-    const auto b = f.find_last_not_of(" \t\r");
-    out.push_back(a == std::string::npos ? "" : f.substr(a, b - a + 1));
-  }
-  return out;
-}
 
 double parse_number(const std::string& text, const std::string& where, const std::string& what) {
   char* stop = nullptr;
@@ -86,7 +75,7 @@ std::vector<std::vector<std::string>> read_csv(const std::filesystem::path& path
   if (!std::getline(in, line)) {
     throw ExternalModelError(path.string() + ": empty; expected the header \"" + expected + "\"");
   }
-  if (fields(line) != header) {
+  if (csv_fields(line) != header) {
     throw ExternalModelError(path.string() + ":1: found header \"" + line + "\", expected \"" +
                              expected + "\"");
   }
@@ -95,7 +84,7 @@ std::vector<std::vector<std::string>> read_csv(const std::filesystem::path& path
   while (std::getline(in, line)) {
     ++number;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    std::vector<std::string> f = fields(line);
+    std::vector<std::string> f = csv_fields(line);
     if (f.size() != header.size()) {
       throw ExternalModelError(path.string() + ":" + std::to_string(number) + ": found " +
                                std::to_string(f.size()) + " fields, expected " +
