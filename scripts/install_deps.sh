@@ -7,6 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   ccache                                  # compiler cache: rebuilds and fresh clones reuse objects
+  mold                                    # fast linker (cmake/fast_linker.cmake)
   libeigen3-dev libsuitesparse-dev        # msm: Eigen, CHOLMOD
   libopenblas0-pthread                    # BLAS for CHOLMOD, UMFPACK, eigen-solves (4x faster)
   libgmsh-dev                             # meshes: gmsh C++ API
