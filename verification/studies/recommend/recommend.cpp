@@ -1,6 +1,7 @@
 #include "verification/studies/recommend/recommend.hpp"
 #include "verification/studies/recommend/wire_candidates.hpp"
 
+#include "verification/harness/harness.hpp"
 #include "verification/harness/results.hpp"
 
 #include <algorithm>

@@ -11,7 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "verification/harness/harness.hpp"
+#include "verification/harness/options.hpp"
+#include "verification/harness/outcome.hpp"
 #include "verification/scene.hpp"
 
 namespace vessel {
