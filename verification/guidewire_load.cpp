@@ -125,15 +125,15 @@ struct GuidewireSolver::Impl {
       s.normal = -grad.normalized();  // the gap grows towards the centreline
       s.wall_point = p + 0.5 * spec.diameter * s.normal;
     }
-    // The clamp's force on the wire: the internal force at the held nodes (no load acts there).
-    // CORDE's inextensibility constraints also act on the clamp node, and their multipliers are
-    // not returned: not measured (NaN).
-    if (constraints) {
-      s.clamp_force.setConstant(std::numeric_limits<double>::quiet_NaN());
-      return s;
-    }
+    // The clamp's force on the wire: the internal force at the held nodes (no load acts there),
+    // ∇Π plus, for CORDE, its inextensibility constraints' force Jᵀλ there.
     Eigen::VectorXd g;
     rod.gradient(c.x, g);
+    if (constraints) {
+      msm::SparseMatrix J;
+      constraints->jacobian(c.x, J);
+      g += J.transpose() * c.rod_multipliers;
+    }
     const std::vector<char> fixed = rod.clamp_fixed();
     for (int i = 0; i < rod.num_nodes(); ++i) {
       if (fixed[3 * i]) s.clamp_force += g.template segment<3>(3 * i);

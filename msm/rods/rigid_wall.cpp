@@ -177,6 +177,7 @@ ContactSolution solve_wall_contact(const Form& rod, const EqualityConstraints* r
     if (deepest < 0) {
       s.x = x;
       s.nodes = contacts.nodes;
+      s.rod_multipliers = lambda.head(contacts.base_rows());
       for (std::size_t k = 0; k < contacts.nodes.size(); ++k) {
         Eigen::Vector3d g;
         lumen.gap(x.segment<3>(3 * contacts.nodes[k]), &g, nullptr);

@@ -72,6 +72,9 @@ struct ContactSolution {
   VectorXd x;
   std::vector<int> nodes;      ///< nodes in contact
   std::vector<double> forces;  ///< the wall's normal force on each, N (≥ 0)
+  /// The multipliers of the rod's own equality constraints (none without them), in the
+  /// Lagrangian Π + λᵀc: the constraint force on the dofs is −J(x)ᵀλ.
+  VectorXd rod_multipliers;
   int active_set_changes = 0;
   double min_gap = 0.0;        ///< over all material nodes at the end, m
 };
