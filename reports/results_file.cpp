@@ -130,6 +130,8 @@ GuidewireRows read_guidewire(const json& g, const std::string& where) {
       c.reference_displacement_mm = field<double>(r, "reference_contact_displacement_mm", rw);
       c.slide_mm = field<double>(r, "slide_mm", rw);
       c.within_patch = field<bool>(r, "within_patch", rw);
+      c.field_relative_l2_rigid = json_fields::optional_field<double>(r, "field_relative_l2_rigid", rw);
+      c.field_relative_l2 = json_fields::optional_field<double>(r, "field_relative_l2", rw);
     }
     w.coupled.push_back(std::move(c));
   }

@@ -108,6 +108,8 @@ struct GuidewireCoupledRow {
   bool ok = false, within_patch = true;
   double force_mN = 0.0, reference_force_mN = 0.0;
   double displacement_mm = 0.0, reference_displacement_mm = 0.0, slide_mm = 0.0;
+  /// The field's relative L2 error at the rigid wire's force and at each wall's coupled force.
+  std::optional<double> field_relative_l2_rigid, field_relative_l2;
 };
 struct GuidewireRows {
   std::string model, coupling;  ///< the wire's rod model; rigid | compliant

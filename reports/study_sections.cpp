@@ -288,13 +288,15 @@ void wire_candidates(Document& doc, const RecommendFile& r) {
     return;
   }
   doc.paragraph(
-      "The wire against the rigid lumen, each rod model of msm/rods that solves wall contact "
-      "(Discrete Elastic Rods, seed 002's CORDE; the XPBD rod has none) at a few segment "
-      "counts, against the continuum wire (" + w.reference + ", F = " +
+      "The wire against the rigid lumen, each rod model of msm/rods (Discrete Elastic Rods, "
+      "seed 002's CORDE, the XPBD rod's steady state) at a few segment counts, against the "
+      "continuum wire (" + w.reference + ", F = " +
       significant(w.reference_force_N * 1e3, 4) + " mN), judged on the " +
       (r.unit == "mN" ? "contact force's error" : "contact point's error") + " and its time per "
-      "update (the wire moved by one update's travel at 10 mm/s and solved again from its last "
-      "equilibrium, median of 10), set-up apart. **Recommended: " +
+      "update, set-up apart (median of 10): for DER and CORDE the wire moved by one update's "
+      "travel at 10 mm/s and solved again from its last equilibrium, for XPBD one step of the "
+      "update period (its error is its steady state's, reached once the wire is at rest). "
+      "**Recommended: " +
       (w.recommended ? "`" + *w.recommended + "`" : std::string("none")) + "**.");
   Table t;
   t.header = {"candidate", "force error (mN)", "contact point error (mm)", "time per update (ms)",

@@ -11,11 +11,20 @@
 #include "msm/rods/corde_rod.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "msm/rods/rigid_wall.hpp"
+#include "msm/rods/xpbd_rod.hpp"
 #include "verification/wire_exchange.hpp"
 
 namespace vessel {
 
 namespace rods = msm::rods;
+
+// XPBD's static solve is a damped dynamic run to rest, 30 % of the velocity removed per step,
+// in steps of a haptic frame. Its steady state does not depend on the step (the same force to 7
+// digits at 0.2, 0.3, 0.5 and 1 ms, N = 8-32, guidewire_straight); at 0.1 ms and N = 32 the
+// stepwise insertion oscillated without settling (tip moving ~0.4 mm per step).
+constexpr double kXpbdRelaxStep = 1e-3;
+constexpr double kXpbdRelaxDamping = 0.3;
+constexpr int kXpbdMaxRelaxSteps = 20000;  // ≤ 900 taken on the guidewire scenes
 
 struct GuidewireSolver::Impl {
   VesselParams vessel;
@@ -27,6 +36,9 @@ struct GuidewireSolver::Impl {
   Eigen::VectorXd state;  ///< the last solution's rod state (empty before the first solve)
   double state_length = 0.0;
   std::filesystem::path case_dir;  ///< model = "external": its case folder (made on first use)
+  /// model = "xpbd": the last solve's rod and the lumen it is held in (step() advances them).
+  std::unique_ptr<rods::XpbdRod> xpbd;
+  std::unique_ptr<rods::RigidLumen> xpbd_wall;
 
   [[nodiscard]] std::unique_ptr<rods::RigidLumen> lumen(double give) const {
     if (vessel.kind == VesselKind::straight) {
@@ -43,6 +55,7 @@ struct GuidewireSolver::Impl {
     rs.origin = spec.clamp_point;
     rs.direction = spec.clamp_direction;
     if (spec.model == "external") return solve_external(L, give);
+    if (spec.model == "xpbd") return solve_xpbd(rods::make_layout(rs), rs.origin, L, give);
     if (spec.model == "corde") {
       const rods::CordeRod rod(rods::make_layout(rs));
       return solve_rod(rod, &rod, rod.rest_state(), rs.origin, L, give, [](const auto&) {});
@@ -82,6 +95,51 @@ struct GuidewireSolver::Impl {
     return s;
   }
 
+  /// XPBD's steady state against the lumen: the damped dynamic run (kXpbdRelaxStep) until a
+  /// step moves no node by more than 1e-14 L, from the last state scaled to L. The rod stays in
+  /// `xpbd` for step().
+  GuidewireSolution solve_xpbd(const rods::RodLayout& layout, const Vec3& origin, double L,
+                               double give) {
+    rods::XpbdOptions options;  // direct, 2 iterations, warm-started multipliers
+    options.damping = kXpbdRelaxDamping;
+    auto rod = std::make_unique<rods::XpbdRod>(layout, 0.0, options);
+    if (state.size() == rod->state().size()) {
+      rod->set_state(scaled_state(origin, L, rod->energy_model().num_nodes()));
+    }
+    xpbd_wall = lumen(give);
+    rod->set_wall(xpbd_wall.get(), 2, rod->tip_node());
+    const int steps = rod->relax(kXpbdRelaxStep, Eigen::VectorXd::Zero(rod->state().size()),
+                                 1e-14, kXpbdMaxRelaxSteps);
+    if (steps == kXpbdMaxRelaxSteps) {
+      throw std::runtime_error("guidewire: the XPBD wire did not settle in " +
+                               std::to_string(kXpbdMaxRelaxSteps) + " steps");
+    }
+    xpbd = std::move(rod);
+    state = xpbd->state();
+    state_length = L;
+    return xpbd_solution();
+  }
+
+  /// The XPBD rod's current state as a solution: its wall forces from the carried contact
+  /// multipliers; the clamp's force is ∇Π at the held nodes (its constraints are compliant
+  /// energy terms, so at a steady state the held nodes' internal force is the clamp's).
+  GuidewireSolution xpbd_solution() const {
+    const rods::CordeRod& model = xpbd->energy_model();
+    const Eigen::VectorXd& x = xpbd->state();
+    const std::vector<double> f = xpbd->wall_forces();
+    rods::ContactSolution c;
+    c.x = x;
+    for (int i = 0; i < static_cast<int>(f.size()); ++i) {
+      if (f[i] > 0.0) {
+        c.nodes.push_back(i);
+        c.forces.push_back(f[i]);
+      }
+    }
+    Eigen::VectorXd g;
+    model.gradient(x, g);
+    return solution_from(model, c, g, *xpbd_wall);
+  }
+
   ~Impl() {
     std::error_code ec;
     if (!case_dir.empty()) std::filesystem::remove_all(case_dir, ec);
@@ -94,12 +152,7 @@ struct GuidewireSolver::Impl {
                               Eigen::VectorXd x, const Vec3& origin, double L, double give,
                               Warm&& warm) {
     if (state.size() == x.size()) {
-      // The positions scaled about the clamp (the frames' directions are unchanged by it).
-      x = state;
-      for (int i = 0; i < rod.num_nodes(); ++i) {
-        x.template segment<3>(3 * i) =
-            origin + (L / state_length) * (state.template segment<3>(3 * i) - origin);
-      }
+      x = scaled_state(origin, L, rod.num_nodes());
       warm(x);
     }
     rods::ConstrainedOptions options;
@@ -110,21 +163,6 @@ struct GuidewireSolver::Impl {
         rods::solve_wall_contact(rod, constraints, rod.clamp_fixed(), x, *wall, 2, tip, options);
     state = c.x;
     state_length = L;
-
-    GuidewireSolution s;
-    s.bending_stiffness = EI;
-    s.contact_nodes = static_cast<int>(c.nodes.size());
-    for (int i = rod.layout().first_node; i <= tip; ++i) s.centreline.push_back(c.x.template segment<3>(3 * i));
-    if (!c.nodes.empty()) {
-      const int k = c.nodes.front();
-      const Vec3 p = c.x.template segment<3>(3 * k);
-      Vec3 grad;
-      wall->gap(p, &grad, nullptr);
-      s.force = c.forces.front();
-      s.contact_point = p;
-      s.normal = -grad.normalized();  // the gap grows towards the centreline
-      s.wall_point = p + 0.5 * spec.diameter * s.normal;
-    }
     // The clamp's force on the wire: the internal force at the held nodes (no load acts there),
     // ∇Π plus, for CORDE, its inextensibility constraints' force Jᵀλ there.
     Eigen::VectorXd g;
@@ -134,9 +172,42 @@ struct GuidewireSolver::Impl {
       constraints->jacobian(c.x, J);
       g += J.transpose() * c.rod_multipliers;
     }
+    return solution_from(rod, c, g, *wall);
+  }
+
+  /// The last state's positions scaled about the clamp to length L (the frames' directions are
+  /// unchanged by it).
+  Eigen::VectorXd scaled_state(const Vec3& origin, double L, int nodes) const {
+    Eigen::VectorXd x = state;
+    for (int i = 0; i < nodes; ++i) {
+      x.segment<3>(3 * i) = origin + (L / state_length) * (state.segment<3>(3 * i) - origin);
+    }
+    return x;
+  }
+
+  /// The solution record of a rod's contact solution `c`, with `internal` its internal force
+  /// (whose sum over the held nodes is the clamp's force on the wire).
+  template <class Rod>
+  GuidewireSolution solution_from(const Rod& rod, const rods::ContactSolution& c,
+                                  const Eigen::VectorXd& internal, const rods::RigidLumen& wall) const {
+    GuidewireSolution s;
+    s.bending_stiffness = EI;
+    s.contact_nodes = static_cast<int>(c.nodes.size());
+    const int tip = rod.layout().tip_node;
+    for (int i = rod.layout().first_node; i <= tip; ++i) s.centreline.push_back(c.x.template segment<3>(3 * i));
+    if (!c.nodes.empty()) {
+      const int k = c.nodes.front();
+      const Vec3 p = c.x.template segment<3>(3 * k);
+      Vec3 grad;
+      wall.gap(p, &grad, nullptr);
+      s.force = c.forces.front();
+      s.contact_point = p;
+      s.normal = -grad.normalized();  // the gap grows towards the centreline
+      s.wall_point = p + 0.5 * spec.diameter * s.normal;
+    }
     const std::vector<char> fixed = rod.clamp_fixed();
     for (int i = 0; i < rod.num_nodes(); ++i) {
-      if (fixed[3 * i]) s.clamp_force += g.template segment<3>(3 * i);
+      if (fixed[3 * i]) s.clamp_force += internal.template segment<3>(3 * i);
     }
     return s;
   }
@@ -197,6 +268,14 @@ GuidewireSolution GuidewireSolver::solve_with_give(double give) {
 
 GuidewireSolution GuidewireSolver::solve_at_insertion(double insertion) {
   last_ = impl_->solve(insertion, 0.0);
+  return last_;
+}
+
+GuidewireSolution GuidewireSolver::step(double h) {
+  Impl& m = *impl_;
+  if (!m.xpbd) throw std::logic_error("GuidewireSolver::step: no XPBD wire solved yet");
+  m.xpbd->step(h, Eigen::VectorXd::Zero(m.xpbd->state().size()));
+  last_ = m.xpbd_solution();
   return last_;
 }
 

@@ -23,7 +23,7 @@ struct GuidewireSpec {
   double diameter = 0.0;  ///< m, solid circular section
   double insertion = 0.0;  ///< length of wire beyond the clamp, m
   int segments = 32;
-  std::string model = "der";  ///< der | corde (msm/rods) | external (the user's program)
+  std::string model = "der";  ///< der | corde | xpbd (msm/rods) | external (the user's program)
   /// model = "external": the user's wire program (argv; the case's manifest path appended, run
   /// in working_dir, the scene file's folder) and its time limit (verification/wire_exchange.hpp).
   std::vector<std::string> command;

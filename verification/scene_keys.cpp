@@ -117,9 +117,10 @@ std::vector<Row> guidewire_rows() {
       Row("load", "segments", KeyType::integer, "Segments of the discrete wire").dflt("32")
           .range(4, 10000).in(g),
       Row("load", "model", KeyType::string,
-          "The rod model: der (Discrete Elastic Rods) or corde (seed 002's CORDE rod) of "
-          "msm/rods, or external (your own program, `command`)")
-          .dflt("\"der\"").one_of({"der", "corde", "external"}).in(g),
+          "The rod model: der (Discrete Elastic Rods), corde (seed 002's CORDE rod) or xpbd "
+          "(the XPBD Cosserat rod's steady state) of msm/rods, or external (your own program, "
+          "`command`)")
+          .dflt("\"der\"").one_of({"der", "corde", "xpbd", "external"}).in(g),
       Row("load", "command", KeyType::strings,
           "model = \"external\": your wire program and its arguments (the case's manifest path "
           "is appended; it runs in the scene file's folder)").in(g),

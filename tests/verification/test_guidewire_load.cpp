@@ -76,9 +76,10 @@ TEST(GuidewireLoad, ArchApexForceMatchesQuarterWaveElastica) {
 }
 
 TEST(GuidewireLoad, ClampReactionBalancesTheWallForce) {
-  // DER: the energy's gradient at the held nodes; CORDE: plus its inextensibility multipliers'
-  // force there (without them the balance misses by the constraint force).
-  for (const char* model : {"der", "corde"}) {
+  // DER and XPBD (whose constraints are compliant energy terms): the energy's gradient at the
+  // held nodes; CORDE: plus its inextensibility multipliers' force there (without them the
+  // balance misses by the constraint force).
+  for (const char* model : {"der", "corde", "xpbd"}) {
     SCOPED_TRACE(model);
     const Scene s = parse_scene(
         straight_scene(std::string("tilt = 0.3\nmodel = \"") + model + "\""), "wire.toml");
@@ -175,6 +176,9 @@ TEST(GuidewireCoupling, RowsPerModelAndStiffnessFromTheOutcomesIndentation) {
   o.magnitude = F;
   o.quantities.indentation_mm = 1.0 * F * 1e3;
   o.quantities.indentation_reference_mm = 0.5 * F * 1e3;
+  // Its whole field twice the reference's at the same load: |u − u_ref| = |u_ref|, |u| = 2|u_ref|.
+  o.error.relative_l2 = 1.0;
+  o.error.model_l2_over_reference = 2.0;
   const GuidewireOutcome g = couple_guidewire(s, {o});
   ASSERT_EQ(g.rigid.size(), 3u);
   ASSERT_EQ(g.rows.size(), 3u);
@@ -187,6 +191,11 @@ TEST(GuidewireCoupling, RowsPerModelAndStiffnessFromTheOutcomesIndentation) {
     EXPECT_LT(r.force_mN, r.reference_force_mN);
     EXPECT_LT(r.reference_force_mN, g.rigid[k].solution.force * 1e3);
     EXPECT_NEAR(r.displacement_mm, r.wall_compliance * r.force_mN, 1e-12);
+    // Each wall under its own force: 2 u_ref F/F_rigid against u_ref F_ref/F_rigid, a relative
+    // error |2 F/F_ref − 1|, below the rigid force's 1 since the softer wall takes less force.
+    EXPECT_EQ(r.field_relative_l2_rigid, 1.0);
+    EXPECT_NEAR(r.field_relative_l2, std::abs(2.0 * r.force_mN / r.reference_force_mN - 1.0), 1e-9);
+    EXPECT_LT(r.field_relative_l2, 1.0);
   }
   // A stiffer wire is closer to displacement control: its force falls further below the rigid one.
   EXPECT_LT(g.rows[2].force_mN / (g.rigid[2].solution.force * 1e3),

@@ -28,6 +28,8 @@ TEST(Metrics, SeedStatisticsByHand) {
   EXPECT_NEAR(s.stddev_mm, std::sqrt(26.0) / 3.0, 1e-12);
   // sqrt(25e-6 / 3e-4) = sqrt(1/12).
   EXPECT_NEAR(s.relative_l2, std::sqrt(1.0 / 12.0), 1e-12);
+  // |u|² = 0.013² + 0.006² + 0.01² = 3.05e-4 against the reference's 3e-4.
+  EXPECT_NEAR(s.model_l2_over_reference, std::sqrt(3.05 / 3.0), 1e-12);
 }
 
 TEST(Metrics, IdenticalFieldsHaveZeroErrorAndSizeMismatchThrows) {

@@ -22,6 +22,13 @@ GuidewireSpec with_stiffness(GuidewireSpec spec, double EI) {
   return spec;
 }
 
+/// The relative L2 error of r·u against u_ref, from e = |u − u_ref|/|u_ref| and
+/// a = |u|/|u_ref| (the same nodes): |r u − u_ref|²/|u_ref|² = r²a² − r(a² + 1 − e²) + 1, the
+/// inner product ⟨u, u_ref⟩/|u_ref|² = (a² + 1 − e²)/2 read off |u − u_ref|².
+double scaled_relative_l2(double r, double e, double a) {
+  return std::sqrt(std::max(0.0, r * r * a * a - r * (a * a + 1.0 - e * e) + 1.0));
+}
+
 /// Outcomes a compliance can be read from: solved, static, with an indentation under a load.
 bool couplable(const ModelOutcome& o) {
   return o.ok && o.magnitude > 0.0 && o.quantities.indentation_mm &&
@@ -85,6 +92,11 @@ void couple_at(const Scene& s, double EI, const std::vector<ModelOutcome>& outco
       row.reference_force_mN = Fref * 1e3;
       row.displacement_mm = row.wall_compliance * F * 1e3;
       row.reference_displacement_mm = row.reference_compliance * Fref * 1e3;
+      if (o.error.model_l2_over_reference > 0.0) {
+        row.field_relative_l2_rigid = o.error.relative_l2;
+        row.field_relative_l2 =
+            scaled_relative_l2(F / Fref, o.error.relative_l2, o.error.model_l2_over_reference);
+      }
       row.ok = true;
     } catch (const std::exception& e) {
       row.failure = e.what();
@@ -163,20 +175,22 @@ void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g) {
          "⚠: it left the load's patch (radius "
       << g.patch_radius * 1e3 << " mm), and the row is outside the coupling's validity.\n\n";
   out << "| model | ν | level | EI N·m² | C m/N | C_ref m/N | force mN | reference mN | error mN | "
-         "contact displ. mm | reference mm | error mm | slide mm |\n"
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "contact displ. mm | reference mm | error mm | slide mm | field rel. L2 rigid | "
+         "field rel. L2 coupled |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const GuidewireCouplingRow& r : g.rows) {
     out << "| " << r.model << " | " << r.poisson_ratio << " | " << r.level << " | "
         << r.bending_stiffness << " | ";
     if (!r.ok) {
-      out << "FAILED: " << r.failure << " | | | | | | | | |\n";
+      out << "FAILED: " << r.failure << " | | | | | | | | | | |\n";
       continue;
     }
     out << r.wall_compliance << " | " << r.reference_compliance << " | " << r.force_mN << " | "
         << r.reference_force_mN << " | " << r.force_mN - r.reference_force_mN << " | "
         << r.displacement_mm << " | " << r.reference_displacement_mm << " | "
         << r.displacement_mm - r.reference_displacement_mm << " | "
-        << slide_mm(g, r) << (slide_mm(g, r) > g.patch_radius * 1e3 ? " ⚠" : "") << " |\n";
+        << slide_mm(g, r) << (slide_mm(g, r) > g.patch_radius * 1e3 ? " ⚠" : "") << " | "
+        << r.field_relative_l2_rigid << " | " << r.field_relative_l2 << " |\n";
   }
   out << "\n";
 }
@@ -217,6 +231,8 @@ nlohmann::json guidewire_json(const GuidewireOutcome& g) {
                     {"slide_mm", slide_mm(g, r)},
                     {"within_patch", slide_mm(g, r) <= g.patch_radius * 1e3},
                     {"contact_displacement_error_mm", r.displacement_mm - r.reference_displacement_mm},
+                    {"field_relative_l2_rigid", finite_or_null(r.field_relative_l2_rigid)},
+                    {"field_relative_l2", finite_or_null(r.field_relative_l2)},
                     {"ok", r.ok},
                     {"failure", r.failure}});
   }

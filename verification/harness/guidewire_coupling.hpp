@@ -3,7 +3,8 @@
 /// coupling, each model's own contact force (GuidewireSolver::coupled_force with the model's
 /// wall compliance C_v = d/F, d its work-conjugate indentation under the rigid wire's patch load
 /// F), beside the reference's (C_ref from the reference's indentation on the same nodal loads).
-/// Valid for linear walls: C is measured once, at the rigid wire's force.
+/// Valid for linear walls: C is measured once, at the rigid wire's force, and the field error
+/// with each wall under its own force is the rigid force's field scaled (scaled_relative_l2).
 #include <nlohmann/json_fwd.hpp>
 #include <ostream>
 #include <vector>

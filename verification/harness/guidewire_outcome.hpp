@@ -40,6 +40,12 @@ struct GuidewireCouplingRow {
   double reference_force_mN = 0.0;    ///< the reference's
   double displacement_mm = 0.0;       ///< the model's contact displacement C_v·F
   double reference_displacement_mm = 0.0;  ///< C_ref·F_ref
+  /// The model's relative L2 field error at the rigid wire's force (both walls under the same
+  /// load: results.json's error), and with each wall under its own coupled force (linear walls:
+  /// the model's field scaled by F/F_rigid against the reference's by F_ref/F_rigid); NaN when
+  /// the outcome has no field norms.
+  double field_relative_l2_rigid = std::numeric_limits<double>::quiet_NaN();
+  double field_relative_l2 = std::numeric_limits<double>::quiet_NaN();
   /// The wire's contact node in the model's coupled state, m (it slides along the wall as it gives).
   Vec3 contact_point = Vec3::Zero();
   bool ok = false;

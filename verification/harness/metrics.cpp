@@ -23,12 +23,14 @@ ErrorStatistics compare_displacements(const std::vector<Vec3>& model,
   double sum = 0.0;
   double sum_sq = 0.0;
   double ref_sq = 0.0;
+  double model_sq = 0.0;
   for (std::size_t i = 0; i < model.size(); ++i) {
     const double e = (model[i] - reference[i]).norm();
     s.max_mm = std::max(s.max_mm, e);
     sum += e;
     sum_sq += e * e;
     ref_sq += reference[i].squaredNorm();
+    model_sq += model[i].squaredNorm();
   }
   const double mean = sum / n;
   constexpr double kMm = 1e3;
@@ -37,6 +39,7 @@ ErrorStatistics compare_displacements(const std::vector<Vec3>& model,
   s.rms_mm = std::sqrt(sum_sq / n) * kMm;
   s.stddev_mm = std::sqrt(std::max(0.0, sum_sq / n - mean * mean)) * kMm;
   s.relative_l2 = ref_sq > 0.0 ? std::sqrt(sum_sq / ref_sq) : 0.0;
+  s.model_l2_over_reference = ref_sq > 0.0 ? std::sqrt(model_sq / ref_sq) : 0.0;
   return s;
 }
 

@@ -24,6 +24,9 @@ struct ErrorStatistics {
   double rms_mm = 0.0;     ///< sqrt(mean |e_i|²)
   double relative_l2 = 0.0;  ///< sqrt(Σ|e_i|²) / sqrt(Σ|u_ref,i|²) (0 if the reference is 0)
   std::size_t points = 0;
+  /// sqrt(Σ|u_i|²) / sqrt(Σ|u_ref,i|²) (0 if the reference is 0): with relative_l2 it gives the
+  /// relative L2 error of the model's field scaled against the reference's (guidewire coupling).
+  double model_l2_over_reference = 0.0;
 };
 
 /// The reference's answer for one ν (at unit load; scale by the magnitude).

@@ -32,11 +32,13 @@ std::string file_contents(const std::filesystem::path& path) {
 }
 
 Json error_json(const ErrorStatistics& e) {
-  return {e.max_mm, e.mean_mm, e.stddev_mm, e.rms_mm, e.relative_l2, e.points};
+  return {e.max_mm, e.mean_mm, e.stddev_mm, e.rms_mm, e.relative_l2, e.points,
+          e.model_l2_over_reference};
 }
 ErrorStatistics error_from(const Json& j) {
   return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>(),
-          j.at(3).get<double>(), j.at(4).get<double>(), j.at(5).get<std::size_t>()};
+          j.at(3).get<double>(), j.at(4).get<double>(), j.at(5).get<std::size_t>(),
+          j.at(6).get<double>()};
 }
 
 Json optional_json(const std::optional<double>& v) { return v ? Json(*v) : Json(nullptr); }

@@ -62,16 +62,16 @@ TEST(WireCandidates, ContinuumWiresAreTheShootingAndElasticaValues) {
 
 TEST(WireCandidates, ErrorsFallWithSegmentsAndTheCheapestPassingOneIsRecommended) {
   const Scene s = scene_with_budget("guidewire_straight.toml", 0.02);
-  const WireRecommendation w = recommend_wire(s, {"der", "corde"}, {8, 16, 32});
+  const WireRecommendation w = recommend_wire(s, {"der", "corde", "xpbd"}, {8, 16, 32});
   ASSERT_TRUE(w.reference.has_value()) << w.no_reference;
-  ASSERT_EQ(w.candidates.size(), 6u);
+  ASSERT_EQ(w.candidates.size(), 9u);
   for (const WireCandidate& c : w.candidates) {
     std::printf("WIRE-CANDIDATE %s: F %.6e N, force error %.4e mN, contact error %.4e mm, "
                 "update %.3e s, set-up %.3e s%s\n",
                 c.name.c_str(), c.force, c.force_error_mN, c.contact_error_mm, c.update_seconds,
                 c.setup_seconds, c.ok ? "" : (" FAILED: " + c.failure).c_str());
   }
-  for (std::size_t m = 0; m < 2; ++m) {
+  for (std::size_t m = 0; m < 3; ++m) {
     const WireCandidate& n8 = w.candidates[3 * m];
     const WireCandidate& n32 = w.candidates[3 * m + 2];
     ASSERT_TRUE(n8.ok && n32.ok) << n8.failure << n32.failure;
@@ -80,6 +80,14 @@ TEST(WireCandidates, ErrorsFallWithSegmentsAndTheCheapestPassingOneIsRecommended
     EXPECT_LT(n32.force_error_mN / (w.reference->force * 1e3), 2e-3) << n32.name;
     EXPECT_EQ(n32.error, n32.contact_error_mm);  // a mm budget judges the contact point
     EXPECT_GT(n32.update_seconds, 0.0);
+  }
+  // XPBD's steady state is CORDE's energy without the inextensibility constraint (strains ~1e-6
+  // under 0.5 mN): the same force as CORDE's Newton solve; its update is one step, not a solve.
+  for (std::size_t k = 0; k < 3; ++k) {
+    const WireCandidate& corde = w.candidates[3 + k];
+    const WireCandidate& xpbd = w.candidates[6 + k];
+    EXPECT_NEAR(xpbd.force / corde.force, 1.0, 1e-5) << xpbd.name;
+    EXPECT_NE(xpbd.update.find("one XPBD step"), std::string::npos) << xpbd.update;
   }
   // The recommendation: the least time per update among those meeting both (ties within 5 %).
   std::optional<std::size_t> cheapest;

@@ -1,11 +1,14 @@
 #pragma once
 /// The guidewire's candidates of `vesselverify recommend`, for scenes whose load is a guidewire:
-/// the rod models msm/rods solves against the rigid lumen (Discrete Elastic Rods and seed 002's
-/// CORDE rod; the XPBD rod has no wall contact) at a few segment counts, each judged against the
+/// the rod models msm/rods solves against the rigid lumen (Discrete Elastic Rods, seed 002's
+/// CORDE rod, the XPBD rod's steady state) at a few segment counts, each judged against the
 /// continuum wire (fem_reference/rod_theory: Kirchhoff shooting in the straight tube, the
-/// quarter-wave elastica at the arch's apex) and on its time per update: the wire moved by the
-/// distance it travels in one update at 10 mm/s, solved again from its last equilibrium (median
-/// of 10 such updates), set-up (the first insertion) apart. The error is the one the budget's
+/// quarter-wave elastica at the arch's apex) and on its time per update, set-up (the first
+/// insertion) apart, the median of 10 updates. A static model's update is what a quasi-static
+/// simulator pays: the wire moved by the distance it travels in one update at 10 mm/s, solved
+/// again from its last equilibrium. XPBD's is what a dynamic simulator pays: one step of the
+/// update period (2 direct iterations); its error is its steady state's, which a simulator sees
+/// once the wire has come to rest. The error is the one the budget's
 /// unit asks for: the contact force's (mN) for a reaction budget, else the contact point's (mm).
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
@@ -24,7 +27,7 @@ std::optional<WireReference> continuum_wire(const Scene& scene, std::string& why
 
 struct WireCandidate {
   std::string name;   ///< "wire/der @ N32"
-  std::string model;  ///< der | corde
+  std::string model;  ///< der | corde | xpbd
   int segments = 0;
   bool ok = false;
   std::string failure;
@@ -33,6 +36,7 @@ struct WireCandidate {
   double contact_error_mm = 0.0;  ///< |p − p_continuum|
   double error = 0.0;             ///< the one the budget's unit asks for
   double update_seconds = 0.0;    ///< median of the timed updates
+  std::string update;             ///< what one timed update is
   double setup_seconds = 0.0;     ///< the first insertion
 };
 
@@ -45,7 +49,7 @@ struct WireRecommendation {
 
 /// The wire's candidates of `scene` (a guidewire load and a stated budget): models × segments.
 WireRecommendation recommend_wire(const Scene& scene,
-                                  const std::vector<std::string>& models = {"der", "corde"},
+                                  const std::vector<std::string>& models = {"der", "corde", "xpbd"},
                                   const std::vector<int>& segments = {8, 16, 32, 64});
 
 /// The same candidates judged against another budget (time per update, tolerance, unit).
