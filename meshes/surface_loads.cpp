@@ -69,8 +69,8 @@ void validate(const ContactPatchSpec& spec) {
     m << "contact patch radius = " << spec.radius << " m is invalid: expected a finite value > 0";
     throw InputError(m.str());
   }
-  if (!std::isfinite(spec.force) || !spec.point.allFinite()) {
-    throw InputError("contact force and point must be finite numbers");
+  if (!std::isfinite(spec.force) || !spec.point.allFinite() || !spec.direction.allFinite()) {
+    throw InputError("contact force, point and direction must be finite numbers");
   }
 }
 
@@ -136,7 +136,21 @@ TractionPatch contact_patch(const TetMesh& mesh, const ContactPatchSpec& spec) {
     throw InputError(m.str());
   }
   patch.outward_normal = weighted_normal.normalized();
-  patch.traction = -spec.force / patch.area * patch.outward_normal;
+  if (spec.direction.isZero(0.0)) {
+    patch.traction = -spec.force / patch.area * patch.outward_normal;
+    return patch;
+  }
+  const Vec3 d = spec.direction.normalized();
+  if (d.dot(patch.outward_normal) > -0.5) {
+    std::ostringstream m;
+    m << "contact direction (" << d.x() << ", " << d.y() << ", " << d.z() << ") at "
+      << mm_text(plane.centre) << " mm is not into the wall '" << spec.surface_group
+      << "' (its inward normal there is (" << -patch.outward_normal.x() << ", "
+      << -patch.outward_normal.y() << ", " << -patch.outward_normal.z()
+      << ")); expected one within 60 degrees of it";
+    throw InputError(m.str());
+  }
+  patch.traction = spec.force / patch.area * d;
   return patch;
 }
 

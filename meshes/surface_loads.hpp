@@ -16,6 +16,9 @@ struct ContactPatchSpec {
   Vec3 point = Vec3::Zero();
   double radius = 0.5e-3;
   double force = 0.0;  ///< N, pushing into the wall (positive) along the patch's inward normal
+  /// The force's direction into the wall, when it is given by what pushes (a guidewire pushes
+  /// along the exact lumen's normal); zero: the patch's inward mean normal.
+  Vec3 direction = Vec3::Zero();
   std::string surface_group = "inner_wall";
 };
 

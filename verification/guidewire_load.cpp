@@ -428,6 +428,7 @@ void resolve_guidewire(const VesselParams& vessel, const std::string& file, Load
   load.kind = LoadKind::contact;
   load.magnitudes = {load.wire.force};
   load.contact.point = load.wire.wall_point;
+  load.contact.direction = load.wire.normal;  // the wire's push, along the exact lumen's normal
   load.contact.surface_group = "inner_wall";
 }
 

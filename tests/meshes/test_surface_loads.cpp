@@ -37,6 +37,27 @@ TEST(SurfaceLoads, ContactPatchCarriesExactlyTheForceInwardIntoTheWall) {
   EXPECT_NEAR((total - (-0.05) * patch.outward_normal).norm(), 0.0, 1e-14);
 }
 
+TEST(SurfaceLoads, ContactPatchPushesAlongAGivenDirection) {
+  // A guidewire pushes along the exact lumen's normal, not the faceted wall's mean normal.
+  ContactPatchSpec spec;
+  spec.point = Vec3(3e-3, 0.0, 20e-3);
+  spec.radius = 1e-3;
+  spec.force = 0.05;
+  spec.direction = Vec3(1.0, 0.01, 0.0);  // not unit: normalised
+  const TractionPatch patch = contact_patch(tube(), spec);
+  const Vec3 total = total_load(traction_nodal_loads(tube(), patch));
+  EXPECT_NEAR((total - 0.05 * spec.direction.normalized()).norm(), 0.0, 1e-14);
+  // A direction out of the wall (into the lumen) is refused, naming the group.
+  spec.direction = Vec3(-1.0, 0.0, 0.0);
+  try {
+    (void)contact_patch(tube(), spec);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not into the wall 'inner_wall'"), std::string::npos)
+        << e.what();
+  }
+}
+
 namespace {
 /// A flat square wall of side 4 mm in z = 0, split into n × n squares of two triangles, facing +z,
 /// as the group "inner_wall" (no tets: the patch needs only the surface).
