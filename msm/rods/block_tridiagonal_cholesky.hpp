@@ -30,7 +30,7 @@ class BlockTridiagonalCholesky {
     for (auto& s : sub_) s.setZero();
   }
   [[nodiscard]] int size() const { return static_cast<int>(diagonal_.size()); }
-  /// A(i, i) (both triangles are read).
+  /// A(i, i) (only its lower triangle is read).
   Block& diagonal(int i) { return diagonal_[i]; }
   /// A(i+1, i).
   Block& sub(int i) { return sub_[i]; }
@@ -39,13 +39,16 @@ class BlockTridiagonalCholesky {
   /// positive definite.
   void factorize() {
     for (int i = 0; i < size(); ++i) {
-      if (i > 0) diagonal_[i].noalias() -= sub_[i - 1] * sub_[i - 1].transpose();
+      if (i > 0) subtract_lower_gram(sub_[i - 1], diagonal_[i]);
       cholesky_in_place(diagonal_[i], inverse_diagonal_[i], i);
       if (i + 1 < size()) {
         // L(i+1, i) = A(i+1, i) L(i, i)⁻ᵀ: each row x solves L(i, i) xᵀ = (its row of A)ᵀ.
+#pragma GCC unroll 8
         for (int r = 0; r < B; ++r) {
+#pragma GCC unroll 8
           for (int j = 0; j < B; ++j) {
             double v = sub_[i](r, j);
+#pragma GCC unroll 8
             for (int k = 0; k < j; ++k) v -= diagonal_[i](j, k) * sub_[i](r, k);
             sub_[i](r, j) = v * inverse_diagonal_[i][j];
           }
@@ -60,8 +63,10 @@ class BlockTridiagonalCholesky {
     for (int i = 0; i < n; ++i) {  // L y = r
       Vector y = r.template segment<B>(B * i);
       if (i > 0) y.noalias() -= sub_[i - 1] * r.template segment<B>(B * (i - 1));
+#pragma GCC unroll 8
       for (int j = 0; j < B; ++j) {
         double v = y[j];
+#pragma GCC unroll 8
         for (int k = 0; k < j; ++k) v -= diagonal_[i](j, k) * y[k];
         y[j] = v * inverse_diagonal_[i][j];
       }
@@ -70,8 +75,10 @@ class BlockTridiagonalCholesky {
     for (int i = n - 1; i >= 0; --i) {  // Lᵀ x = y
       Vector y = r.template segment<B>(B * i);
       if (i + 1 < n) y.noalias() -= sub_[i].transpose() * r.template segment<B>(B * (i + 1));
+#pragma GCC unroll 8
       for (int j = B - 1; j >= 0; --j) {
         double v = y[j];
+#pragma GCC unroll 8
         for (int k = j + 1; k < B; ++k) v -= diagonal_[i](k, j) * y[k];
         y[j] = v * inverse_diagonal_[i][j];
       }
@@ -80,23 +87,47 @@ class BlockTridiagonalCholesky {
   }
 
  private:
-  /// The lower Cholesky factor of a (fixed-size, unrolled), 1/L(j, j) in inverse.
+  /// The lower triangle of a −= s sᵀ (the only triangle the factorisation reads).
+  static void subtract_lower_gram(const Block& s, Block& a) {
+#pragma GCC unroll 8
+    for (int c = 0; c < B; ++c) {
+#pragma GCC unroll 8
+      for (int r = c; r < B; ++r) {
+        double v = 0.0;
+#pragma GCC unroll 8
+        for (int k = 0; k < B; ++k) v += s(r, k) * s(c, k);
+        a(r, c) -= v;
+      }
+    }
+  }
+
+  /// The lower Cholesky factor of a's lower triangle (fixed-size, unrolled), 1/L(j, j) in
+  /// inverse. 1/√d is taken as √d · (1/d): the square root and the division both start from d
+  /// and run side by side instead of one after the other (the factorisation is one dependency
+  /// chain through the pivots).
   static void cholesky_in_place(Block& a, Vector& inverse, int block) {
+#pragma GCC unroll 8
     for (int j = 0; j < B; ++j) {
       double d = a(j, j);
+#pragma GCC unroll 8
       for (int k = 0; k < j; ++k) d -= a(j, k) * a(j, k);
-      if (!(d > 0.0)) {
-        throw std::runtime_error("BlockTridiagonalCholesky: block " + std::to_string(block) +
-                                 " is not positive definite");
-      }
-      a(j, j) = std::sqrt(d);
-      inverse[j] = 1.0 / a(j, j);
+      if (!(d > 0.0)) throw_not_positive_definite(block);
+      const double root = std::sqrt(d), reciprocal = 1.0 / d;
+      a(j, j) = root;
+      inverse[j] = root * reciprocal;
+#pragma GCC unroll 8
       for (int i = j + 1; i < B; ++i) {
         double v = a(i, j);
+#pragma GCC unroll 8
         for (int k = 0; k < j; ++k) v -= a(i, k) * a(j, k);
         a(i, j) = v * inverse[j];
       }
     }
+  }
+
+  [[noreturn]] static void throw_not_positive_definite(int block) {
+    throw std::runtime_error("BlockTridiagonalCholesky: block " + std::to_string(block) +
+                             " is not positive definite");
   }
 
   std::vector<Block> diagonal_, sub_;

@@ -130,14 +130,32 @@ void XpbdRod::build_couplings() {
 
 namespace {
 
-/// M += w · J_b(:, cb..cb+width) J_a(:, ca..ca+width)ᵀ (fixed sizes for a node and a quaternion).
+/// M += w · J_b(:, cb..cb+W) J_a(:, ca..ca+W)ᵀ for W columns (a node's 3, a quaternion's 4),
+/// unrolled on the Jacobians' column-major storage.
+template <int W>
+void add_product(Eigen::Matrix3d& M, double w, const double* Jb, const double* Ja) {
+#pragma GCC unroll 4
+  for (int c = 0; c < 3; ++c) {
+#pragma GCC unroll 4
+    for (int r = 0; r < 3; ++r) {
+      double v = 0.0;
+#pragma GCC unroll 4
+      for (int k = 0; k < W; ++k) v += Jb[3 * k + r] * Ja[3 * k + c];
+      M(r, c) += w * v;
+    }
+  }
+}
+
+/// M += w · J_b(:, cb..cb+width) J_a(:, ca..ca+width)ᵀ.
 template <class J>
 void add_product(Eigen::Matrix3d& M, double w, const J& Jb, int cb, const J& Ja, int ca,
                  int width) {
+  const double* b = Jb.data() + 3 * cb;
+  const double* a = Ja.data() + 3 * ca;
   if (width == 4) {
-    M.noalias() += w * (Jb.template middleCols<4>(cb) * Ja.template middleCols<4>(ca).transpose());
+    add_product<4>(M, w, b, a);
   } else if (width == 3) {
-    M.noalias() += w * (Jb.template middleCols<3>(cb) * Ja.template middleCols<3>(ca).transpose());
+    add_product<3>(M, w, b, a);
   } else {
     for (int k = 0; k < width; ++k) M.noalias() += w * Jb.col(cb + k) * Ja.col(ca + k).transpose();
   }
@@ -149,24 +167,15 @@ void XpbdRod::evaluate(const Block& b, Eigen::Vector3d& c, BlockJacobian& J) con
   // The quaternions live on the unit sphere: their columns are projected onto its tangent
   // space, J_q (I − q qᵀ), so that no correction (and no carried force) goes into |q|, which
   // the renormalisation would undo while λ kept it.
-  const auto tangent = [&J](int col, const Eigen::Vector4d& q) {
-    const Eigen::Vector3d radial = J.middleCols<4>(col) * q;
-    J.middleCols<4>(col) -= radial * q.transpose();
-  };
   if (b.stretch) {
     Eigen::Matrix<double, 10, 1> q;
     for (int k = 0; k < 10; ++k) q[k] = x_[b.dofs[k]];
-    stretch_shear_with_jacobian(q, b.length, c, J);
-    tangent(6, q.tail<4>());
+    stretch_shear_with_jacobian<true>(q, b.length, c, J);
   } else {
     Eigen::Matrix<double, 8, 1> q;
     for (int k = 0; k < 8; ++k) q[k] = x_[b.dofs[k]];
-    Eigen::Matrix<double, 3, 8> J8;
-    darboux_with_jacobian(q, b.length, c, J8);
-    J.leftCols<8>() = J8;
+    darboux_with_jacobian<true>(q, b.length, c, J);
     J.rightCols<2>().setZero();
-    tangent(0, q.head<4>());
-    tangent(4, q.segment<4>(4));
   }
 }
 
