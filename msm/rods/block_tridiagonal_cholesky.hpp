@@ -5,6 +5,12 @@
 /// solve, in fixed-size blocks. The XPBD rod's direct solver uses it on its constraint blocks
 /// taken two by two along the chain (Deul, Kugelstadt, Weiler & Bender 2018 solve the same
 /// tree-structured system in linear time).
+///
+/// Z > 0 declares the sub-diagonal blocks' lower-left Z × Z corner (rows B−Z.., columns ..Z−1)
+/// zero, as when the blocks pair up constraints that couple only up to two apart (the XPBD
+/// rod: 3-row constraints, B = 6, Z = 3). L(i+1, i) keeps that corner zero (each of its rows
+/// solves a lower-triangular system whose leading right-hand sides are zero), so the corner is
+/// never read or written, and the products skip it.
 #include <Eigen/Core>
 #include <cmath>
 #include <stdexcept>
@@ -13,8 +19,10 @@
 
 namespace vessel::msm::rods {
 
-template <int B>
+template <int B, int Z = 0>
 class BlockTridiagonalCholesky {
+  static_assert(Z >= 0 && Z <= B, "the zero corner must fit in a block");
+
  public:
   using Block = Eigen::Matrix<double, B, B>;
   using Vector = Eigen::Matrix<double, B, 1>;
@@ -32,7 +40,7 @@ class BlockTridiagonalCholesky {
   [[nodiscard]] int size() const { return static_cast<int>(diagonal_.size()); }
   /// A(i, i) (only its lower triangle is read).
   Block& diagonal(int i) { return diagonal_[i]; }
-  /// A(i+1, i).
+  /// A(i+1, i) (its zero corner, if Z > 0, is not read).
   Block& sub(int i) { return sub_[i]; }
 
   /// Overwrites the blocks with the factor. Throws std::runtime_error if a diagonal block is not
@@ -46,10 +54,10 @@ class BlockTridiagonalCholesky {
 #pragma GCC unroll 8
         for (int r = 0; r < B; ++r) {
 #pragma GCC unroll 8
-          for (int j = 0; j < B; ++j) {
+          for (int j = first_column(r); j < B; ++j) {
             double v = sub_[i](r, j);
 #pragma GCC unroll 8
-            for (int k = 0; k < j; ++k) v -= diagonal_[i](j, k) * sub_[i](r, k);
+            for (int k = first_column(r); k < j; ++k) v -= diagonal_[i](j, k) * sub_[i](r, k);
             sub_[i](r, j) = v * inverse_diagonal_[i][j];
           }
         }
@@ -62,7 +70,15 @@ class BlockTridiagonalCholesky {
     const int n = size();
     for (int i = 0; i < n; ++i) {  // L y = r
       Vector y = r.template segment<B>(B * i);
-      if (i > 0) y.noalias() -= sub_[i - 1] * r.template segment<B>(B * (i - 1));
+      if (i > 0) {
+#pragma GCC unroll 8
+        for (int row = 0; row < B; ++row) {
+          double v = 0.0;
+#pragma GCC unroll 8
+          for (int k = first_column(row); k < B; ++k) v += sub_[i - 1](row, k) * r[B * (i - 1) + k];
+          y[row] -= v;
+        }
+      }
 #pragma GCC unroll 8
       for (int j = 0; j < B; ++j) {
         double v = y[j];
@@ -74,7 +90,17 @@ class BlockTridiagonalCholesky {
     }
     for (int i = n - 1; i >= 0; --i) {  // Lᵀ x = y
       Vector y = r.template segment<B>(B * i);
-      if (i + 1 < n) y.noalias() -= sub_[i].transpose() * r.template segment<B>(B * (i + 1));
+      if (i + 1 < n) {
+#pragma GCC unroll 8
+        for (int col = 0; col < B; ++col) {
+          double v = 0.0;
+#pragma GCC unroll 8
+          for (int row = 0; row < B; ++row) {
+            if (col >= first_column(row)) v += sub_[i](row, col) * r[B * (i + 1) + row];
+          }
+          y[col] -= v;
+        }
+      }
 #pragma GCC unroll 8
       for (int j = B - 1; j >= 0; --j) {
         double v = y[j];
@@ -87,7 +113,11 @@ class BlockTridiagonalCholesky {
   }
 
  private:
-  /// The lower triangle of a −= s sᵀ (the only triangle the factorisation reads).
+  /// The first column of row r of a sub-diagonal block that is not in the zero corner.
+  static constexpr int first_column(int r) { return r >= B - Z ? Z : 0; }
+
+  /// The lower triangle of a −= s sᵀ (the only triangle the factorisation reads), s a
+  /// sub-diagonal block.
   static void subtract_lower_gram(const Block& s, Block& a) {
 #pragma GCC unroll 8
     for (int c = 0; c < B; ++c) {
@@ -95,33 +125,39 @@ class BlockTridiagonalCholesky {
       for (int r = c; r < B; ++r) {
         double v = 0.0;
 #pragma GCC unroll 8
-        for (int k = 0; k < B; ++k) v += s(r, k) * s(c, k);
+        for (int k = first_column(r); k < B; ++k) v += s(r, k) * s(c, k);
         a(r, c) -= v;
       }
     }
   }
 
   /// The lower Cholesky factor of a's lower triangle (fixed-size, unrolled), 1/L(j, j) in
-  /// inverse. 1/√d is taken as √d · (1/d): the square root and the division both start from d
-  /// and run side by side instead of one after the other (the factorisation is one dependency
-  /// chain through the pivots).
+  /// inverse. The recursion runs on the unscaled columns u(i, j) = L(i, j) L(j, j) and
+  /// 1/d_j = 1/L(j, j)² (as LDLᵀ does): d_j = a(j, j) − Σ_k u(j, k)² / d_k and
+  /// u(i, j) = a(i, j) − Σ_k u(i, k) u(j, k) / d_k, so the chain from one pivot to the next
+  /// holds one division and no square root; L(i, j) = u(i, j) · √d_j / d_j.
   static void cholesky_in_place(Block& a, Vector& inverse, int block) {
+    double u[B][B];
+    double reciprocal[B];
 #pragma GCC unroll 8
     for (int j = 0; j < B; ++j) {
       double d = a(j, j);
 #pragma GCC unroll 8
-      for (int k = 0; k < j; ++k) d -= a(j, k) * a(j, k);
+      for (int k = 0; k < j; ++k) d -= u[j][k] * u[j][k] * reciprocal[k];
       if (!(d > 0.0)) throw_not_positive_definite(block);
-      const double root = std::sqrt(d), reciprocal = 1.0 / d;
-      a(j, j) = root;
-      inverse[j] = root * reciprocal;
+      reciprocal[j] = 1.0 / d;
 #pragma GCC unroll 8
       for (int i = j + 1; i < B; ++i) {
         double v = a(i, j);
 #pragma GCC unroll 8
-        for (int k = 0; k < j; ++k) v -= a(i, k) * a(j, k);
-        a(i, j) = v * inverse[j];
+        for (int k = 0; k < j; ++k) v -= u[i][k] * u[j][k] * reciprocal[k];
+        u[i][j] = v;
       }
+      const double root = std::sqrt(d);
+      a(j, j) = root;
+      inverse[j] = root * reciprocal[j];
+#pragma GCC unroll 8
+      for (int i = j + 1; i < B; ++i) a(i, j) = u[i][j] * inverse[j];
     }
   }
 

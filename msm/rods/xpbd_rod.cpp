@@ -52,6 +52,9 @@ XpbdRod::XpbdRod(RodLayout layout, double alignment, XpbdOptions options)
   rhs_ = VectorXd::Zero(6 * pairs);
   contact_lambda_.assign(L.num_nodes(), 0.0);
   contact_force_lambda_.assign(L.num_nodes(), 0.0);
+  previous_ = VectorXd::Zero(x_.size());
+  scratch_ = VectorXd::Zero(x_.size());
+  quaternion_stiffness_.assign(quaternion_mass_.size(), 0.0);
 }
 
 void XpbdRod::build_blocks() {
@@ -114,7 +117,7 @@ void XpbdRod::build_couplings() {
             continue;
           }
         }
-        out.push_back({ka, kb, 1, dof});
+        out.push_back({ka, kb, 1, dof, dof < 3 * model_.num_nodes()});
       }
     }
     return out;
@@ -130,34 +133,46 @@ void XpbdRod::build_couplings() {
 
 namespace {
 
-/// M += w · J_b(:, cb..cb+W) J_a(:, ca..ca+W)ᵀ for W columns (a node's 3, a quaternion's 4),
-/// unrolled on the Jacobians' column-major storage.
-template <int W>
-void add_product(Eigen::Matrix3d& M, double w, const double* Jb, const double* Ja) {
-#pragma GCC unroll 4
+/// M += w · J_b(:, cb..cb+W) J_a(:, ca..ca+W)ᵀ for W columns, unrolled on the Jacobians'
+/// column-major storage; Symmetric (J_b = J_a): the lower triangle, mirrored.
+template <int W, bool Symmetric>
+inline void add_dense_product(Eigen::Matrix3d& M, double w, const double* Jb, const double* Ja) {
+  double v[3][3];
+#pragma GCC unroll 3
   for (int c = 0; c < 3; ++c) {
+#pragma GCC unroll 3
+    for (int r = Symmetric ? c : 0; r < 3; ++r) {
+      double s = 0.0;
 #pragma GCC unroll 4
-    for (int r = 0; r < 3; ++r) {
-      double v = 0.0;
-#pragma GCC unroll 4
-      for (int k = 0; k < W; ++k) v += Jb[3 * k + r] * Ja[3 * k + c];
-      M(r, c) += w * v;
+      for (int k = 0; k < W; ++k) s += Jb[3 * k + r] * Ja[3 * k + c];
+      v[r][c] = w * s;
     }
+  }
+#pragma GCC unroll 3
+  for (int c = 0; c < 3; ++c) {
+#pragma GCC unroll 3
+    for (int r = 0; r < 3; ++r) M(r, c) += Symmetric && r < c ? v[c][r] : v[r][c];
   }
 }
 
-/// M += w · J_b(:, cb..cb+width) J_a(:, ca..ca+width)ᵀ.
-template <class J>
-void add_product(Eigen::Matrix3d& M, double w, const J& Jb, int cb, const J& Ja, int ca,
-                 int width) {
-  const double* b = Jb.data() + 3 * cb;
-  const double* a = Ja.data() + 3 * ca;
-  if (width == 4) {
-    add_product<4>(M, w, b, a);
-  } else if (width == 3) {
-    add_product<3>(M, w, b, a);
+/// M += w · J_b(:, run) J_a(:, run)ᵀ over one run of shared columns (Symmetric: J_b = J_a).
+template <bool Symmetric, class J, class Run>
+inline void add_run_product(Eigen::Matrix3d& M, double w, const J& Jb, const J& Ja, const Run& r) {
+  if (r.position) {  // columns ±e_k/l: the product is diagonal, row k = the column's component
+    for (int t = 0; t < r.width; ++t) {
+      const int k = (r.col_a + t) % 3;
+      M(k, k) += w * Jb(k, r.col_b + t) * Ja(k, r.col_a + t);
+    }
+    return;
+  }
+  const double* b = Jb.data() + 3 * r.col_b;
+  const double* a = Ja.data() + 3 * r.col_a;
+  if (r.width == 4) {
+    add_dense_product<4, Symmetric>(M, w, b, a);
   } else {
-    for (int k = 0; k < width; ++k) M.noalias() += w * Jb.col(cb + k) * Ja.col(ca + k).transpose();
+    for (int k = 0; k < r.width; ++k) {
+      M.noalias() += w * Jb.col(r.col_b + k) * Ja.col(r.col_a + k).transpose();
+    }
   }
 }
 
@@ -216,16 +231,14 @@ void XpbdRod::direct_iteration(double h) {
     const BlockJacobian& J = jacobians_[a];
     const Eigen::Vector3d alpha = b.compliance / (h * h);
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    for (const Shared& r : own_runs_[a])
-      add_product(A, inverse_mass_[r.dof], J, r.col_a, J, r.col_a, r.width);
+    for (const Shared& r : own_runs_[a]) add_run_product<true>(A, inverse_mass_[r.dof], J, J, r);
     A.diagonal() += alpha;
     const int pair = a / 2, offset = 3 * (a % 2);
     system_.diagonal(pair).block<3, 3>(offset, offset) += A;
     for (int d = 1; d <= 2 && a + d < n; ++d) {  // rows of block a+d, columns of block a
       Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-      for (const Shared& r : couplings_[a][d - 1]) {
-        add_product(M, inverse_mass_[r.dof], jacobians_[a + d], r.col_b, J, r.col_a, r.width);
-      }
+      for (const Shared& r : couplings_[a][d - 1])
+        add_run_product<false>(M, inverse_mass_[r.dof], jacobians_[a + d], J, r);
       const int other = (a + d) / 2, other_offset = 3 * ((a + d) % 2);
       if (other == pair) {
         system_.diagonal(pair).block<3, 3>(other_offset, offset) += M;
@@ -269,7 +282,8 @@ void XpbdRod::project_contacts() {
 
 void XpbdRod::predict(double h, const VectorXd& force) {
   const int n = static_cast<int>(blocks_.size());
-  VectorXd shift = VectorXd::Zero(x_.size());
+  VectorXd& shift = scratch_;
+  shift.setZero();
   if (options_.warm_start) {
     // The carried constraint forces Jᵀλ at the step's start, in the prediction. (J of the last
     // iteration instead, one evaluation fewer, leaves a one-iteration step cycling about the
@@ -306,7 +320,8 @@ void XpbdRod::stabilise_quaternion_masses(double h) {
   // (α = 3, N = 32, h = 10 ms). Its diagonal is added to the frames' mass (Andrews, Teichmann & Kry
   // 2017, "Geometric stiffness for real-time constrained multibody dynamics"). A steady state does
   // not depend on the masses, so statics are unchanged.
-  std::vector<double> k(quaternion_mass_.size(), 0.0);
+  std::vector<double>& k = quaternion_stiffness_;
+  std::fill(k.begin(), k.end(), 0.0);
   const int first_q = model_.quaternion_dof(0);
   for (std::size_t a = 0; a < blocks_.size(); ++a) {
     const Block& b = blocks_[a];
@@ -326,7 +341,7 @@ void XpbdRod::stabilise_quaternion_masses(double h) {
 }
 
 void XpbdRod::step(double h, const VectorXd& force) {
-  const VectorXd previous = x_;
+  previous_ = x_;
   if (options_.warm_start) stabilise_quaternion_masses(h);
   predict(h, force);
   for (int it = 0; it < options_.iterations; ++it) {
@@ -341,7 +356,7 @@ void XpbdRod::step(double h, const VectorXd& force) {
   for (std::size_t i = 0; i < contact_lambda_.size(); ++i) {
     contact_force_lambda_[i] = contact_lambda_[i] / (h * h);
   }
-  v_ = (1.0 - options_.damping) * (x_ - previous) / h;
+  v_ = (1.0 - options_.damping) * (x_ - previous_) / h;
 }
 
 int XpbdRod::relax(double h, const VectorXd& force, double tolerance, int max_steps) {
