@@ -33,10 +33,6 @@ class BlockTridiagonalCholesky {
     sub_.assign(n > 0 ? n - 1 : 0, Block::Zero());
     inverse_diagonal_.assign(n, Vector::Zero());
   }
-  void set_zero() {
-    for (auto& d : diagonal_) d.setZero();
-    for (auto& s : sub_) s.setZero();
-  }
   [[nodiscard]] int size() const { return static_cast<int>(diagonal_.size()); }
   /// A(i, i) (only its lower triangle is read).
   Block& diagonal(int i) { return diagonal_[i]; }

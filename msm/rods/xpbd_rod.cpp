@@ -133,11 +133,24 @@ void XpbdRod::build_couplings() {
 
 namespace {
 
-/// M += w · J_b(:, cb..cb+W) J_a(:, ca..ca+W)ᵀ for W columns, unrolled on the Jacobians'
+/// A 3 × 3 block of J W Jᵀ summed in scalars and stored entry by entry: an Eigen matrix
+/// written by scalar stores and copied with packet loads stalls on store forwarding.
+struct Product3 {
+  double m[3][3] = {};
+  template <class Destination>
+  void store_to(Destination&& d) const {
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; ++c) {
+#pragma GCC unroll 3
+      for (int r = 0; r < 3; ++r) d(r, c) = m[r][c];
+    }
+  }
+};
+
+/// P += w · J_b(:, cb..cb+W) J_a(:, ca..ca+W)ᵀ for W columns, unrolled on the Jacobians'
 /// column-major storage; Symmetric (J_b = J_a): the lower triangle, mirrored.
 template <int W, bool Symmetric>
-inline void add_dense_product(Eigen::Matrix3d& M, double w, const double* Jb, const double* Ja) {
-  double v[3][3];
+inline void add_dense_product(Product3& P, double w, const double* Jb, const double* Ja) {
 #pragma GCC unroll 3
   for (int c = 0; c < 3; ++c) {
 #pragma GCC unroll 3
@@ -145,33 +158,31 @@ inline void add_dense_product(Eigen::Matrix3d& M, double w, const double* Jb, co
       double s = 0.0;
 #pragma GCC unroll 4
       for (int k = 0; k < W; ++k) s += Jb[3 * k + r] * Ja[3 * k + c];
-      v[r][c] = w * s;
+      P.m[r][c] += w * s;
+      if (Symmetric && r != c) P.m[c][r] += w * s;
     }
-  }
-#pragma GCC unroll 3
-  for (int c = 0; c < 3; ++c) {
-#pragma GCC unroll 3
-    for (int r = 0; r < 3; ++r) M(r, c) += Symmetric && r < c ? v[c][r] : v[r][c];
   }
 }
 
-/// M += w · J_b(:, run) J_a(:, run)ᵀ over one run of shared columns (Symmetric: J_b = J_a).
+/// P += w · J_b(:, run) J_a(:, run)ᵀ over one run of shared columns (Symmetric: J_b = J_a).
 template <bool Symmetric, class J, class Run>
-inline void add_run_product(Eigen::Matrix3d& M, double w, const J& Jb, const J& Ja, const Run& r) {
+inline void add_run_product(Product3& P, double w, const J& Jb, const J& Ja, const Run& r) {
   if (r.position) {  // columns ±e_k/l: the product is diagonal, row k = the column's component
     for (int t = 0; t < r.width; ++t) {
       const int k = (r.col_a + t) % 3;
-      M(k, k) += w * Jb(k, r.col_b + t) * Ja(k, r.col_a + t);
+      P.m[k][k] += w * Jb(k, r.col_b + t) * Ja(k, r.col_a + t);
     }
     return;
   }
   const double* b = Jb.data() + 3 * r.col_b;
   const double* a = Ja.data() + 3 * r.col_a;
   if (r.width == 4) {
-    add_dense_product<4, Symmetric>(M, w, b, a);
+    add_dense_product<4, Symmetric>(P, w, b, a);
   } else {
     for (int k = 0; k < r.width; ++k) {
-      M.noalias() += w * Jb.col(r.col_b + k) * Ja.col(r.col_a + k).transpose();
+      for (int c = 0; c < 3; ++c) {
+        for (int i = 0; i < 3; ++i) P.m[i][c] += w * b[3 * k + i] * a[3 * k + c];
+      }
     }
   }
 }
@@ -224,27 +235,31 @@ void XpbdRod::gauss_seidel_sweep(double h) {
 
 void XpbdRod::direct_iteration(double h) {
   const int n = static_cast<int>(blocks_.size());
-  system_.set_zero();
+  const double inverse_h2 = 1.0 / (h * h);
   for (int a = 0; a < n; ++a) evaluate(blocks_[a], residuals_[a], jacobians_[a]);
+  // J W Jᵀ + α/h²: every entry the factorisation reads (the diagonal blocks' lower triangles,
+  // the sub-diagonal blocks less their zero corner) is assigned once per iteration.
   for (int a = 0; a < n; ++a) {
     const Block& b = blocks_[a];
     const BlockJacobian& J = jacobians_[a];
-    const Eigen::Vector3d alpha = b.compliance / (h * h);
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    const Eigen::Vector3d alpha = b.compliance * inverse_h2;
+    Product3 A;
     for (const Shared& r : own_runs_[a]) add_run_product<true>(A, inverse_mass_[r.dof], J, J, r);
-    A.diagonal() += alpha;
+    for (int k = 0; k < 3; ++k) A.m[k][k] += alpha[k];
     const int pair = a / 2, offset = 3 * (a % 2);
-    system_.diagonal(pair).block<3, 3>(offset, offset) += A;
-    for (int d = 1; d <= 2 && a + d < n; ++d) {  // rows of block a+d, columns of block a
-      Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-      for (const Shared& r : couplings_[a][d - 1])
-        add_run_product<false>(M, inverse_mass_[r.dof], jacobians_[a + d], J, r);
+    A.store_to(system_.diagonal(pair).block<3, 3>(offset, offset));
+    for (int d = 1; d <= 2; ++d) {  // rows of block a+d, columns of block a
       const int other = (a + d) / 2, other_offset = 3 * ((a + d) % 2);
+      if (other >= system_.size()) break;
+      Product3 M;  // a + d = n: the odd count's dummy, zero
+      if (a + d < n) {
+        for (const Shared& r : couplings_[a][d - 1])
+          add_run_product<false>(M, inverse_mass_[r.dof], jacobians_[a + d], J, r);
+      }
       if (other == pair) {
-        system_.diagonal(pair).block<3, 3>(other_offset, offset) += M;
-        system_.diagonal(pair).block<3, 3>(offset, other_offset) += M.transpose();
+        M.store_to(system_.diagonal(pair).block<3, 3>(other_offset, offset));
       } else {  // other == pair + 1: a + d ≤ a + 2 ≤ 2·pair + 3
-        system_.sub(pair).block<3, 3>(other_offset, offset) += M;
+        M.store_to(system_.sub(pair).block<3, 3>(other_offset, offset));
       }
     }
     rhs_.segment<3>(3 * a) = -residuals_[a] - alpha.cwiseProduct(lambda_[a]);
