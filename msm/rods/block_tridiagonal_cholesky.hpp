@@ -42,75 +42,102 @@ class BlockTridiagonalCholesky {
   /// Overwrites the blocks with the factor. Throws std::runtime_error if a diagonal block is not
   /// positive definite.
   void factorize() {
-    for (int i = 0; i < size(); ++i) {
-      if (i > 0) subtract_lower_gram(sub_[i - 1], diagonal_[i]);
-      cholesky_in_place(diagonal_[i], inverse_diagonal_[i], i);
-      if (i + 1 < size()) {
-        // L(i+1, i) = A(i+1, i) L(i, i)⁻ᵀ: each row x solves L(i, i) xᵀ = (its row of A)ᵀ.
-#pragma GCC unroll 8
-        for (int r = 0; r < B; ++r) {
-#pragma GCC unroll 8
-          for (int j = first_column(r); j < B; ++j) {
-            double v = sub_[i](r, j);
-#pragma GCC unroll 8
-            for (int k = first_column(r); k < j; ++k) v -= diagonal_[i](j, k) * sub_[i](r, k);
-            sub_[i](r, j) = v * inverse_diagonal_[i][j];
-          }
-        }
-      }
-    }
+    for (int i = 0; i < size(); ++i) factor_row(i);
   }
 
-  /// Solves A x = r in place (r has B·n entries).
+  /// Solves A x = r in place with the factor (r has B·n entries).
   void solve(Eigen::VectorXd& r) const {
-    const int n = size();
-    for (int i = 0; i < n; ++i) {  // L y = r
-      Vector y = r.template segment<B>(B * i);
-      if (i > 0) {
-#pragma GCC unroll 8
-        for (int row = 0; row < B; ++row) {
-          double v = 0.0;
-#pragma GCC unroll 8
-          for (int k = first_column(row); k < B; ++k) v += sub_[i - 1](row, k) * r[B * (i - 1) + k];
-          y[row] -= v;
-        }
-      }
-#pragma GCC unroll 8
-      for (int j = 0; j < B; ++j) {
-        double v = y[j];
-#pragma GCC unroll 8
-        for (int k = 0; k < j; ++k) v -= diagonal_[i](j, k) * y[k];
-        y[j] = v * inverse_diagonal_[i][j];
-      }
-      r.template segment<B>(B * i) = y;
+    for (int i = 0; i < size(); ++i) forward_row(i, r.data());
+    for (int i = size() - 1; i >= 0; --i) backward_row(i, r.data());
+  }
+
+  /// Assembles, factorises and solves A x = r in one sweep each way: fill(i) sets A(i, i),
+  /// A(i+1, i) and r's block i just before block row i is factorised and its forward
+  /// substitution done (the two dependency chains and the filling overlap); done(i) is called
+  /// as soon as x's block i is solved (in r), from the last block to the first.
+  template <class Fill, class Done>
+  void assemble_factorize_solve(Eigen::VectorXd& r, Fill&& fill, Done&& done) {
+    for (int i = 0; i < size(); ++i) {
+      fill(i);
+      factor_row(i);
+      forward_row(i, r.data());
     }
-    for (int i = n - 1; i >= 0; --i) {  // Lᵀ x = y
-      Vector y = r.template segment<B>(B * i);
-      if (i + 1 < n) {
-#pragma GCC unroll 8
-        for (int col = 0; col < B; ++col) {
-          double v = 0.0;
-#pragma GCC unroll 8
-          for (int row = 0; row < B; ++row) {
-            if (col >= first_column(row)) v += sub_[i](row, col) * r[B * (i + 1) + row];
-          }
-          y[col] -= v;
-        }
-      }
-#pragma GCC unroll 8
-      for (int j = B - 1; j >= 0; --j) {
-        double v = y[j];
-#pragma GCC unroll 8
-        for (int k = j + 1; k < B; ++k) v -= diagonal_[i](k, j) * y[k];
-        y[j] = v * inverse_diagonal_[i][j];
-      }
-      r.template segment<B>(B * i) = y;
+    for (int i = size() - 1; i >= 0; --i) {
+      backward_row(i, r.data());
+      done(i);
     }
   }
 
  private:
   /// The first column of row r of a sub-diagonal block that is not in the zero corner.
   static constexpr int first_column(int r) { return r >= B - Z ? Z : 0; }
+
+  /// Block row i of the factor: L(i, i) and L(i+1, i).
+  void factor_row(int i) {
+    if (i > 0) subtract_lower_gram(sub_[i - 1], diagonal_[i]);
+    cholesky_in_place(diagonal_[i], inverse_diagonal_[i], i);
+    if (i + 1 == size()) return;
+    // L(i+1, i) = A(i+1, i) L(i, i)⁻ᵀ: each row x solves L(i, i) xᵀ = (its row of A)ᵀ.
+    Block& s = sub_[i];
+    const Block& d = diagonal_[i];
+#pragma GCC unroll 8
+    for (int r = 0; r < B; ++r) {
+#pragma GCC unroll 8
+      for (int j = first_column(r); j < B; ++j) {
+        double v = s(r, j);
+#pragma GCC unroll 8
+        for (int k = first_column(r); k < j; ++k) v -= d(j, k) * s(r, k);
+        s(r, j) = v * inverse_diagonal_[i][j];
+      }
+    }
+  }
+
+  /// Block row i of L y = r (y over r; rows before i already solved). Scalar loads and stores
+  /// only: packet copies of entries just stored one by one stall on store forwarding.
+  void forward_row(int i, double* r) const {
+    double* y = r + B * i;
+    if (i > 0) {
+      const double* previous = r + B * (i - 1);
+#pragma GCC unroll 8
+      for (int row = 0; row < B; ++row) {
+        double v = 0.0;
+#pragma GCC unroll 8
+        for (int k = first_column(row); k < B; ++k) v += sub_[i - 1](row, k) * previous[k];
+        y[row] -= v;
+      }
+    }
+#pragma GCC unroll 8
+    for (int j = 0; j < B; ++j) {
+      double v = y[j];
+#pragma GCC unroll 8
+      for (int k = 0; k < j; ++k) v -= diagonal_[i](j, k) * y[k];
+      y[j] = v * inverse_diagonal_[i][j];
+    }
+  }
+
+  /// Block row i of Lᵀ x = y (x over y; rows after i already solved).
+  void backward_row(int i, double* r) const {
+    double* y = r + B * i;
+    if (i + 1 < size()) {
+      const double* next = r + B * (i + 1);
+#pragma GCC unroll 8
+      for (int col = 0; col < B; ++col) {
+        double v = 0.0;
+#pragma GCC unroll 8
+        for (int row = 0; row < B; ++row) {
+          if (col >= first_column(row)) v += sub_[i](row, col) * next[row];
+        }
+        y[col] -= v;
+      }
+    }
+#pragma GCC unroll 8
+    for (int j = B - 1; j >= 0; --j) {
+      double v = y[j];
+#pragma GCC unroll 8
+      for (int k = j + 1; k < B; ++k) v -= diagonal_[i](k, j) * y[k];
+      y[j] = v * inverse_diagonal_[i][j];
+    }
+  }
 
   /// The lower triangle of a −= s sᵀ (the only triangle the factorisation reads), s a
   /// sub-diagonal block.

@@ -205,9 +205,9 @@ void XpbdRod::evaluate(const Block& b, Eigen::Vector3d& c, BlockJacobian& J) con
   }
 }
 
-void XpbdRod::apply(const Block& b, const BlockJacobian& J, const Eigen::Vector3d& dl) {
+void XpbdRod::apply(const Block& b, const BlockJacobian& J, const double* dl) {
   for (int k = 0; k < b.dofs_used; ++k) {
-    x_[b.dofs[k]] += inverse_mass_[b.dofs[k]] * J.col(k).dot(dl);
+    x_[b.dofs[k]] += inverse_mass_[b.dofs[k]] * (J(0, k) * dl[0] + J(1, k) * dl[1] + J(2, k) * dl[2]);
   }
 }
 
@@ -223,7 +223,7 @@ void XpbdRod::gauss_seidel_sweep(double h) {
     Eigen::Matrix3d A = J * w.asDiagonal() * J.transpose();
     A.diagonal() += alpha;
     const Eigen::Vector3d dl = A.ldlt().solve(-c - alpha.cwiseProduct(lambda_[a]));
-    apply(b, J, dl);
+    apply(b, J, dl.data());
     lambda_[a] += dl;
     // renormalise the block's quaternions
     const int q0 = b.stretch ? b.dofs[6] : b.dofs[0];
@@ -233,48 +233,56 @@ void XpbdRod::gauss_seidel_sweep(double h) {
   project_contacts();
 }
 
+void XpbdRod::assemble(int a, double inverse_h2) {
+  const int n = static_cast<int>(blocks_.size());
+  const int pair = a / 2, offset = 3 * (a % 2);
+  if (a == n) {  // an odd count: the last pair's second half is a unit dummy
+    system_.diagonal(pair).block<3, 3>(offset, offset) = Eigen::Matrix3d::Identity();
+    rhs_.segment<3>(3 * a).setZero();
+    return;
+  }
+  const Block& b = blocks_[a];
+  const BlockJacobian& J = jacobians_[a];
+  const Eigen::Vector3d alpha = b.compliance * inverse_h2;
+  Product3 A;
+  for (const Shared& r : own_runs_[a]) add_run_product<true>(A, inverse_mass_[r.dof], J, J, r);
+  for (int k = 0; k < 3; ++k) A.m[k][k] += alpha[k];
+  A.store_to(system_.diagonal(pair).block<3, 3>(offset, offset));
+  for (int d = 1; d <= 2; ++d) {  // rows of block a+d, columns of block a
+    const int other = (a + d) / 2, other_offset = 3 * ((a + d) % 2);
+    if (other >= system_.size()) break;
+    Product3 M;  // a + d = n: the odd count's dummy, zero
+    if (a + d < n) {
+      for (const Shared& r : couplings_[a][d - 1])
+        add_run_product<false>(M, inverse_mass_[r.dof], jacobians_[a + d], J, r);
+    }
+    if (other == pair) {
+      M.store_to(system_.diagonal(pair).block<3, 3>(other_offset, offset));
+    } else {  // other == pair + 1: a + d ≤ a + 2 ≤ 2·pair + 3
+      M.store_to(system_.sub(pair).block<3, 3>(other_offset, offset));
+    }
+  }
+  for (int k = 0; k < 3; ++k) rhs_[3 * a + k] = -residuals_[a][k] - alpha[k] * lambda_[a][k];
+}
+
 void XpbdRod::direct_iteration(double h) {
   const int n = static_cast<int>(blocks_.size());
   const double inverse_h2 = 1.0 / (h * h);
   for (int a = 0; a < n; ++a) evaluate(blocks_[a], residuals_[a], jacobians_[a]);
-  // J W Jᵀ + α/h²: every entry the factorisation reads (the diagonal blocks' lower triangles,
-  // the sub-diagonal blocks less their zero corner) is assigned once per iteration.
-  for (int a = 0; a < n; ++a) {
-    const Block& b = blocks_[a];
-    const BlockJacobian& J = jacobians_[a];
-    const Eigen::Vector3d alpha = b.compliance * inverse_h2;
-    Product3 A;
-    for (const Shared& r : own_runs_[a]) add_run_product<true>(A, inverse_mass_[r.dof], J, J, r);
-    for (int k = 0; k < 3; ++k) A.m[k][k] += alpha[k];
-    const int pair = a / 2, offset = 3 * (a % 2);
-    A.store_to(system_.diagonal(pair).block<3, 3>(offset, offset));
-    for (int d = 1; d <= 2; ++d) {  // rows of block a+d, columns of block a
-      const int other = (a + d) / 2, other_offset = 3 * ((a + d) % 2);
-      if (other >= system_.size()) break;
-      Product3 M;  // a + d = n: the odd count's dummy, zero
-      if (a + d < n) {
-        for (const Shared& r : couplings_[a][d - 1])
-          add_run_product<false>(M, inverse_mass_[r.dof], jacobians_[a + d], J, r);
-      }
-      if (other == pair) {
-        M.store_to(system_.diagonal(pair).block<3, 3>(other_offset, offset));
-      } else {  // other == pair + 1: a + d ≤ a + 2 ≤ 2·pair + 3
-        M.store_to(system_.sub(pair).block<3, 3>(other_offset, offset));
-      }
+  // Block row p of J W Jᵀ + α/h² is assembled (every entry the factorisation reads assigned
+  // once) just before it is factorised, and each pair's Δλ applied as soon as it is solved:
+  // the solver's dependency chains overlap with that work.
+  const auto fill = [&](int p) {
+    for (int a = 2 * p; a <= std::min(2 * p + 1, n); ++a) assemble(a, inverse_h2);
+  };
+  const auto done = [&](int p) {
+    for (int a = 2 * p; a <= std::min(2 * p + 1, n - 1); ++a) {
+      const double* dl = rhs_.data() + 3 * a;
+      apply(blocks_[a], jacobians_[a], dl);
+      for (int k = 0; k < 3; ++k) lambda_[a][k] += dl[k];
     }
-    rhs_.segment<3>(3 * a) = -residuals_[a] - alpha.cwiseProduct(lambda_[a]);
-  }
-  if (n % 2 == 1) {  // an odd count: the last pair's second half is a unit dummy
-    system_.diagonal(n / 2).block<3, 3>(3, 3) = Eigen::Matrix3d::Identity();
-    rhs_.segment<3>(3 * n).setZero();
-  }
-  system_.factorize();
-  system_.solve(rhs_);
-  for (int a = 0; a < n; ++a) {
-    const Eigen::Vector3d dl = rhs_.segment<3>(3 * a);
-    apply(blocks_[a], jacobians_[a], dl);
-    lambda_[a] += dl;
-  }
+  };
+  system_.assemble_factorize_solve(rhs_, fill, done);
   model_.normalise_quaternions(x_);
   project_contacts();
 }

@@ -92,8 +92,11 @@ class XpbdRod {
   void build_blocks();
   void build_couplings();
   void evaluate(const Block& b, Eigen::Vector3d& c, BlockJacobian& J) const;
-  /// x += W Jᵀ dl for block b.
-  void apply(const Block& b, const BlockJacobian& J, const Eigen::Vector3d& dl);
+  /// x += W Jᵀ dl for block b (dl: 3 entries).
+  void apply(const Block& b, const BlockJacobian& J, const double* dl);
+  /// Block a's rows of J W Jᵀ + α/h² (its diagonal block and its couplings to blocks a+1, a+2)
+  /// and of the right-hand side into the direct solver; a = the block count: the dummy.
+  void assemble(int a, double inverse_h2);
   void gauss_seidel_sweep(double h);
   void direct_iteration(double h);
   void project_contacts();
