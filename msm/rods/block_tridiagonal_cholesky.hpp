@@ -72,23 +72,38 @@ class BlockTridiagonalCholesky {
   /// The first column of row r of a sub-diagonal block that is not in the zero corner.
   static constexpr int first_column(int r) { return r >= B - Z ? Z : 0; }
 
-  /// Block row i of the factor: L(i, i) and L(i+1, i).
+  /// Block row i of the factor: L(i, i) and L(i+1, i), computed in local arrays (which the
+  /// compiler knows alias nothing) and stored once.
   void factor_row(int i) {
-    if (i > 0) subtract_lower_gram(sub_[i - 1], diagonal_[i]);
-    cholesky_in_place(diagonal_[i], inverse_diagonal_[i], i);
+    double a[B][B], l[B][B], inverse[B];
+#pragma GCC unroll 8
+    for (int c = 0; c < B; ++c) {
+#pragma GCC unroll 8
+      for (int r = c; r < B; ++r) a[r][c] = diagonal_[i](r, c);
+    }
+    if (i > 0) subtract_lower_gram(sub_[i - 1], a);
+    cholesky(a, l, inverse, i);
+#pragma GCC unroll 8
+    for (int c = 0; c < B; ++c) {
+      inverse_diagonal_[i][c] = inverse[c];
+#pragma GCC unroll 8
+      for (int r = c; r < B; ++r) diagonal_[i](r, c) = l[r][c];
+    }
     if (i + 1 == size()) return;
     // L(i+1, i) = A(i+1, i) L(i, i)⁻ᵀ: each row x solves L(i, i) xᵀ = (its row of A)ᵀ.
     Block& s = sub_[i];
-    const Block& d = diagonal_[i];
 #pragma GCC unroll 8
     for (int r = 0; r < B; ++r) {
+      double x[B];
 #pragma GCC unroll 8
       for (int j = first_column(r); j < B; ++j) {
         double v = s(r, j);
 #pragma GCC unroll 8
-        for (int k = first_column(r); k < j; ++k) v -= d(j, k) * s(r, k);
-        s(r, j) = v * inverse_diagonal_[i][j];
+        for (int k = first_column(r); k < j; ++k) v -= l[j][k] * x[k];
+        x[j] = v * inverse[j];
       }
+#pragma GCC unroll 8
+      for (int j = first_column(r); j < B; ++j) s(r, j) = x[j];
     }
   }
 
@@ -141,46 +156,53 @@ class BlockTridiagonalCholesky {
 
   /// The lower triangle of a −= s sᵀ (the only triangle the factorisation reads), s a
   /// sub-diagonal block.
-  static void subtract_lower_gram(const Block& s, Block& a) {
+  static void subtract_lower_gram(const Block& s, double (&a)[B][B]) {
+    double t[B][B];
+#pragma GCC unroll 8
+    for (int r = 0; r < B; ++r) {
+#pragma GCC unroll 8
+      for (int k = first_column(r); k < B; ++k) t[r][k] = s(r, k);
+    }
 #pragma GCC unroll 8
     for (int c = 0; c < B; ++c) {
 #pragma GCC unroll 8
       for (int r = c; r < B; ++r) {
         double v = 0.0;
 #pragma GCC unroll 8
-        for (int k = first_column(r); k < B; ++k) v += s(r, k) * s(c, k);
-        a(r, c) -= v;
+        for (int k = first_column(r); k < B; ++k) v += t[r][k] * t[c][k];
+        a[r][c] -= v;
       }
     }
   }
 
-  /// The lower Cholesky factor of a's lower triangle (fixed-size, unrolled), 1/L(j, j) in
-  /// inverse. The recursion runs on the unscaled columns u(i, j) = L(i, j) L(j, j) and
-  /// 1/d_j = 1/L(j, j)² (as LDLᵀ does): d_j = a(j, j) − Σ_k u(j, k)² / d_k and
+  /// The lower Cholesky factor l of a's lower triangle (fixed-size, unrolled), 1/l(j, j) in
+  /// inverse. The recursion runs on the unscaled columns u(i, j) = l(i, j) l(j, j) and
+  /// 1/d_j = 1/l(j, j)² (as LDLᵀ does): d_j = a(j, j) − Σ_k u(j, k)² / d_k and
   /// u(i, j) = a(i, j) − Σ_k u(i, k) u(j, k) / d_k, so the chain from one pivot to the next
-  /// holds one division and no square root; L(i, j) = u(i, j) · √d_j / d_j.
-  static void cholesky_in_place(Block& a, Vector& inverse, int block) {
+  /// holds one division and no square root; l(i, j) = u(i, j) · √d_j / d_j.
+  static void cholesky(const double (&a)[B][B], double (&l)[B][B], double (&inverse)[B],
+                       int block) {
     double u[B][B];
     double reciprocal[B];
 #pragma GCC unroll 8
     for (int j = 0; j < B; ++j) {
-      double d = a(j, j);
+      double d = a[j][j];
 #pragma GCC unroll 8
       for (int k = 0; k < j; ++k) d -= u[j][k] * u[j][k] * reciprocal[k];
       if (!(d > 0.0)) throw_not_positive_definite(block);
       reciprocal[j] = 1.0 / d;
 #pragma GCC unroll 8
       for (int i = j + 1; i < B; ++i) {
-        double v = a(i, j);
+        double v = a[i][j];
 #pragma GCC unroll 8
         for (int k = 0; k < j; ++k) v -= u[i][k] * u[j][k] * reciprocal[k];
         u[i][j] = v;
       }
       const double root = std::sqrt(d);
-      a(j, j) = root;
+      l[j][j] = root;
       inverse[j] = root * reciprocal[j];
 #pragma GCC unroll 8
-      for (int i = j + 1; i < B; ++i) a(i, j) = u[i][j] * inverse[j];
+      for (int i = j + 1; i < B; ++i) l[i][j] = u[i][j] * inverse[j];
     }
   }
 

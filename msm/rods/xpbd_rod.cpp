@@ -151,16 +151,27 @@ struct Product3 {
 /// column-major storage; Symmetric (J_b = J_a): the lower triangle, mirrored.
 template <int W, bool Symmetric>
 inline void add_dense_product(Product3& P, double w, const double* Jb, const double* Ja) {
+  // Operands and sums in locals first: stores into P could alias the Jacobians for the compiler.
+  double b[3 * W], a[3 * W], v[3][3];
+#pragma GCC unroll 12
+  for (int k = 0; k < 3 * W; ++k) {
+    b[k] = Jb[k];
+    a[k] = Symmetric ? Jb[k] : Ja[k];
+  }
 #pragma GCC unroll 3
   for (int c = 0; c < 3; ++c) {
 #pragma GCC unroll 3
     for (int r = Symmetric ? c : 0; r < 3; ++r) {
-      double s = 0.0;
+      double sum = 0.0;
 #pragma GCC unroll 4
-      for (int k = 0; k < W; ++k) s += Jb[3 * k + r] * Ja[3 * k + c];
-      P.m[r][c] += w * s;
-      if (Symmetric && r != c) P.m[c][r] += w * s;
+      for (int k = 0; k < W; ++k) sum += b[3 * k + r] * a[3 * k + c];
+      v[r][c] = w * sum;
     }
+  }
+#pragma GCC unroll 3
+  for (int c = 0; c < 3; ++c) {
+#pragma GCC unroll 3
+    for (int r = 0; r < 3; ++r) P.m[r][c] += Symmetric && r < c ? v[c][r] : v[r][c];
   }
 }
 
