@@ -218,7 +218,8 @@ void XpbdRod::evaluate(const Block& b, Eigen::Vector3d& c, BlockJacobian& J) con
 
 void XpbdRod::apply(const Block& b, const BlockJacobian& J, const double* dl) {
   for (int k = 0; k < b.dofs_used; ++k) {
-    x_[b.dofs[k]] += inverse_mass_[b.dofs[k]] * (J(0, k) * dl[0] + J(1, k) * dl[1] + J(2, k) * dl[2]);
+    const double jt_dl = J(0, k) * dl[0] + J(1, k) * dl[1] + J(2, k) * dl[2];
+    x_[b.dofs[k]] += inverse_mass_[b.dofs[k]] * jt_dl;
   }
 }
 
