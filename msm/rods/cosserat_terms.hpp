@@ -80,38 +80,71 @@ V3<T> stretch_shear_strain(const std::array<T, 10>& q, double l) {
 
 /// Γ and ∂Γ/∂(P0, P1, q) (3 × 10) in closed form, for the XPBD sweeps (the templated
 /// stretch_shear_strain above is the same formula; tests compare the two).
+///
+/// With Tangent, the quaternion columns are projected onto the unit sphere's tangent space,
+/// J_q (I − q qᵀ) (what the XPBD rod solves with); J_q q is then taken in closed form,
+/// J_q q = (−2 d3x, −2 d3y, 4(x² + y²)) (so J_q (I − q qᵀ) q = 0 when |q| = 1). Each entry is
+/// computed once and stored once (no read-back of J).
+template <bool Tangent = false>
 inline void stretch_shear_with_jacobian(const Eigen::Matrix<double, 10, 1>& q, double l,
                                         Eigen::Vector3d& c, Eigen::Matrix<double, 3, 10>& J) {
   const double w = q[6], x = q[7], y = q[8], z = q[9];
-  const Eigen::Vector3d d3(2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y));
-  c = (q.segment<3>(3) - q.segment<3>(0)) / l - d3;
-  J.setZero();
-  J.block<3, 3>(0, 0).diagonal().setConstant(-1.0 / l);
-  J.block<3, 3>(0, 3).diagonal().setConstant(1.0 / l);
-  J.col(6) << -2.0 * y, 2.0 * x, 0.0;   // −∂d3/∂w
-  J.col(7) << -2.0 * z, 2.0 * w, 4.0 * x;  // −∂d3/∂x
-  J.col(8) << -2.0 * w, -2.0 * z, 4.0 * y;  // −∂d3/∂y
-  J.col(9) << -2.0 * x, -2.0 * y, 0.0;  // −∂d3/∂z
+  const double d0 = 2.0 * (x * z + w * y), d1 = 2.0 * (y * z - w * x);
+  const double d2 = 1.0 - 2.0 * (x * x + y * y);
+  const double il = 1.0 / l;
+  c = Eigen::Vector3d((q[3] - q[0]) * il - d0, (q[4] - q[1]) * il - d1, (q[5] - q[2]) * il - d2);
+  // −∂d3/∂w, −∂d3/∂x, −∂d3/∂y, −∂d3/∂z, row by row
+  double g[3][4] = {{-2.0 * y, -2.0 * z, -2.0 * w, -2.0 * x},
+                    {2.0 * x, 2.0 * w, -2.0 * z, -2.0 * y},
+                    {0.0, 4.0 * x, 4.0 * y, 0.0}};
+  if constexpr (Tangent) {
+    const double radial[3] = {-2.0 * d0, -2.0 * d1, 4.0 * (x * x + y * y)};
+    const double qv[4] = {w, x, y, z};
+    for (int r = 0; r < 3; ++r) {
+      for (int k = 0; k < 4; ++k) g[r][k] -= radial[r] * qv[k];
+    }
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) {
+      J(r, k) = r == k ? -il : 0.0;
+      J(r, 3 + k) = r == k ? il : 0.0;
+    }
+    for (int k = 0; k < 4; ++k) J(r, 6 + k) = g[r][k];
+  }
 }
 
-/// Ω and ∂Ω/∂(q_a, q_b) (3 × 8) in closed form: with Ω = (2/l̄)(w_a v_b − w_b v_a − v_a × v_b),
+/// Ω and ∂Ω/∂(q_a, q_b) (3 × 8, in J's first 8 columns) in closed form: with
+/// Ω = (2/l̄)(w_a v_b − w_b v_a − v_a × v_b),
 /// ∂Ω/∂w_a = (2/l̄) v_b, ∂Ω/∂v_a = (2/l̄)(−w_b I + [v_b]×), ∂Ω/∂w_b = −(2/l̄) v_a,
 /// ∂Ω/∂v_b = (2/l̄)(w_a I − [v_a]×).
+/// With Tangent, each quaternion's columns are projected onto the unit sphere's tangent space,
+/// J_a (I − q_a q_aᵀ) and J_b (I − q_b q_bᵀ); J_a q_a = J_b q_b = Ω (Ω is bilinear in q_a, q_b).
+template <bool Tangent = false, class Jacobian>
 inline void darboux_with_jacobian(const Eigen::Matrix<double, 8, 1>& q, double lbar,
-                                  Eigen::Vector3d& c, Eigen::Matrix<double, 3, 8>& J) {
+                                  Eigen::Vector3d& c, Jacobian& J) {
   const double s = 2.0 / lbar;
-  const double wa = q[0], wb = q[4];
-  const Eigen::Vector3d va = q.segment<3>(1), vb = q.segment<3>(5);
-  c = s * (wa * vb - wb * va - va.cross(vb));
-  const auto skew = [](const Eigen::Vector3d& a) {
-    Eigen::Matrix3d m;
-    m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
-    return m;
-  };
-  J.col(0) = s * vb;
-  J.block<3, 3>(0, 1) = s * (skew(vb) - wb * Eigen::Matrix3d::Identity());
-  J.col(4) = -s * va;
-  J.block<3, 3>(0, 5) = s * (wa * Eigen::Matrix3d::Identity() - skew(va));
+  const double wa = q[0], ax = q[1], ay = q[2], az = q[3];
+  const double wb = q[4], bx = q[5], by = q[6], bz = q[7];
+  // va × vb
+  const double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
+  const double o[3] = {s * (wa * bx - wb * ax - cx), s * (wa * by - wb * ay - cy),
+                       s * (wa * bz - wb * az - cz)};
+  c = Eigen::Vector3d(o[0], o[1], o[2]);
+  // rows of [∂Ω/∂q_a | ∂Ω/∂q_b] / s; [v]× = [[0, −vz, vy], [vz, 0, −vx], [−vy, vx, 0]]
+  double g[3][8] = {{bx, -wb, -bz, by, -ax, wa, az, -ay},
+                    {by, bz, -wb, -bx, -ay, -az, wa, ax},
+                    {bz, -by, bx, -wb, -az, ay, -ax, wa}};
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 8; ++k) g[r][k] *= s;
+  }
+  if constexpr (Tangent) {
+    for (int r = 0; r < 3; ++r) {
+      for (int k = 0; k < 8; ++k) g[r][k] -= o[r] * q[k];
+    }
+  }
+  for (int k = 0; k < 8; ++k) {
+    for (int r = 0; r < 3; ++r) J(r, k) = g[r][k];
+  }
 }
 
 }  // namespace vessel::msm::rods

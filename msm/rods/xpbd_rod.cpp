@@ -52,6 +52,9 @@ XpbdRod::XpbdRod(RodLayout layout, double alignment, XpbdOptions options)
   rhs_ = VectorXd::Zero(6 * pairs);
   contact_lambda_.assign(L.num_nodes(), 0.0);
   contact_force_lambda_.assign(L.num_nodes(), 0.0);
+  previous_ = VectorXd::Zero(x_.size());
+  scratch_ = VectorXd::Zero(x_.size());
+  quaternion_stiffness_.assign(quaternion_mass_.size(), 0.0);
 }
 
 void XpbdRod::build_blocks() {
@@ -114,7 +117,7 @@ void XpbdRod::build_couplings() {
             continue;
           }
         }
-        out.push_back({ka, kb, 1, dof});
+        out.push_back({ka, kb, 1, dof, dof < 3 * model_.num_nodes()});
       }
     }
     return out;
@@ -130,16 +133,68 @@ void XpbdRod::build_couplings() {
 
 namespace {
 
-/// M += w · J_b(:, cb..cb+width) J_a(:, ca..ca+width)ᵀ (fixed sizes for a node and a quaternion).
-template <class J>
-void add_product(Eigen::Matrix3d& M, double w, const J& Jb, int cb, const J& Ja, int ca,
-                 int width) {
-  if (width == 4) {
-    M.noalias() += w * (Jb.template middleCols<4>(cb) * Ja.template middleCols<4>(ca).transpose());
-  } else if (width == 3) {
-    M.noalias() += w * (Jb.template middleCols<3>(cb) * Ja.template middleCols<3>(ca).transpose());
+/// A 3 × 3 block of J W Jᵀ summed in scalars and stored entry by entry: an Eigen matrix
+/// written by scalar stores and copied with packet loads stalls on store forwarding.
+struct Product3 {
+  double m[3][3] = {};
+  template <class Destination>
+  void store_to(Destination&& d) const {
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; ++c) {
+#pragma GCC unroll 3
+      for (int r = 0; r < 3; ++r) d(r, c) = m[r][c];
+    }
+  }
+};
+
+/// P += w · J_b(:, cb..cb+W) J_a(:, ca..ca+W)ᵀ for W columns, unrolled on the Jacobians'
+/// column-major storage; Symmetric (J_b = J_a): the lower triangle, mirrored.
+template <int W, bool Symmetric>
+inline void add_dense_product(Product3& P, double w, const double* Jb, const double* Ja) {
+  // Operands and sums in locals first: stores into P could alias the Jacobians for the compiler.
+  double b[3 * W], a[3 * W], v[3][3];
+#pragma GCC unroll 12
+  for (int k = 0; k < 3 * W; ++k) {
+    b[k] = Jb[k];
+    a[k] = Symmetric ? Jb[k] : Ja[k];
+  }
+#pragma GCC unroll 3
+  for (int c = 0; c < 3; ++c) {
+#pragma GCC unroll 3
+    for (int r = Symmetric ? c : 0; r < 3; ++r) {
+      double sum = 0.0;
+#pragma GCC unroll 4
+      for (int k = 0; k < W; ++k) sum += b[3 * k + r] * a[3 * k + c];
+      v[r][c] = w * sum;
+    }
+  }
+#pragma GCC unroll 3
+  for (int c = 0; c < 3; ++c) {
+#pragma GCC unroll 3
+    for (int r = 0; r < 3; ++r) P.m[r][c] += Symmetric && r < c ? v[c][r] : v[r][c];
+  }
+}
+
+/// P += w · J_b(:, run) J_a(:, run)ᵀ over one run of shared columns (Symmetric: J_b = J_a).
+template <bool Symmetric, class J, class Run>
+inline void add_run_product(Product3& P, double w, const J& Jb, const J& Ja, const Run& r) {
+  if (r.position) {  // columns ±e_k/l: the product is diagonal, row k = the column's component
+    for (int t = 0; t < r.width; ++t) {
+      const int k = (r.col_a + t) % 3;
+      P.m[k][k] += w * Jb(k, r.col_b + t) * Ja(k, r.col_a + t);
+    }
+    return;
+  }
+  const double* b = Jb.data() + 3 * r.col_b;
+  const double* a = Ja.data() + 3 * r.col_a;
+  if (r.width == 4) {
+    add_dense_product<4, Symmetric>(P, w, b, a);
   } else {
-    for (int k = 0; k < width; ++k) M.noalias() += w * Jb.col(cb + k) * Ja.col(ca + k).transpose();
+    for (int k = 0; k < r.width; ++k) {
+      for (int c = 0; c < 3; ++c) {
+        for (int i = 0; i < 3; ++i) P.m[i][c] += w * b[3 * k + i] * a[3 * k + c];
+      }
+    }
   }
 }
 
@@ -149,30 +204,22 @@ void XpbdRod::evaluate(const Block& b, Eigen::Vector3d& c, BlockJacobian& J) con
   // The quaternions live on the unit sphere: their columns are projected onto its tangent
   // space, J_q (I − q qᵀ), so that no correction (and no carried force) goes into |q|, which
   // the renormalisation would undo while λ kept it.
-  const auto tangent = [&J](int col, const Eigen::Vector4d& q) {
-    const Eigen::Vector3d radial = J.middleCols<4>(col) * q;
-    J.middleCols<4>(col) -= radial * q.transpose();
-  };
   if (b.stretch) {
     Eigen::Matrix<double, 10, 1> q;
     for (int k = 0; k < 10; ++k) q[k] = x_[b.dofs[k]];
-    stretch_shear_with_jacobian(q, b.length, c, J);
-    tangent(6, q.tail<4>());
+    stretch_shear_with_jacobian<true>(q, b.length, c, J);
   } else {
     Eigen::Matrix<double, 8, 1> q;
     for (int k = 0; k < 8; ++k) q[k] = x_[b.dofs[k]];
-    Eigen::Matrix<double, 3, 8> J8;
-    darboux_with_jacobian(q, b.length, c, J8);
-    J.leftCols<8>() = J8;
+    darboux_with_jacobian<true>(q, b.length, c, J);
     J.rightCols<2>().setZero();
-    tangent(0, q.head<4>());
-    tangent(4, q.segment<4>(4));
   }
 }
 
-void XpbdRod::apply(const Block& b, const BlockJacobian& J, const Eigen::Vector3d& dl) {
+void XpbdRod::apply(const Block& b, const BlockJacobian& J, const double* dl) {
   for (int k = 0; k < b.dofs_used; ++k) {
-    x_[b.dofs[k]] += inverse_mass_[b.dofs[k]] * J.col(k).dot(dl);
+    const double jt_dl = J(0, k) * dl[0] + J(1, k) * dl[1] + J(2, k) * dl[2];
+    x_[b.dofs[k]] += inverse_mass_[b.dofs[k]] * jt_dl;
   }
 }
 
@@ -188,7 +235,7 @@ void XpbdRod::gauss_seidel_sweep(double h) {
     Eigen::Matrix3d A = J * w.asDiagonal() * J.transpose();
     A.diagonal() += alpha;
     const Eigen::Vector3d dl = A.ldlt().solve(-c - alpha.cwiseProduct(lambda_[a]));
-    apply(b, J, dl);
+    apply(b, J, dl.data());
     lambda_[a] += dl;
     // renormalise the block's quaternions
     const int q0 = b.stretch ? b.dofs[6] : b.dofs[0];
@@ -198,46 +245,56 @@ void XpbdRod::gauss_seidel_sweep(double h) {
   project_contacts();
 }
 
+void XpbdRod::assemble(int a, double inverse_h2) {
+  const int n = static_cast<int>(blocks_.size());
+  const int pair = a / 2, offset = 3 * (a % 2);
+  if (a == n) {  // an odd count: the last pair's second half is a unit dummy
+    system_.diagonal(pair).block<3, 3>(offset, offset) = Eigen::Matrix3d::Identity();
+    rhs_.segment<3>(3 * a).setZero();
+    return;
+  }
+  const Block& b = blocks_[a];
+  const BlockJacobian& J = jacobians_[a];
+  const Eigen::Vector3d alpha = b.compliance * inverse_h2;
+  Product3 A;
+  for (const Shared& r : own_runs_[a]) add_run_product<true>(A, inverse_mass_[r.dof], J, J, r);
+  for (int k = 0; k < 3; ++k) A.m[k][k] += alpha[k];
+  A.store_to(system_.diagonal(pair).block<3, 3>(offset, offset));
+  for (int d = 1; d <= 2; ++d) {  // rows of block a+d, columns of block a
+    const int other = (a + d) / 2, other_offset = 3 * ((a + d) % 2);
+    if (other >= system_.size()) break;
+    Product3 M;  // a + d = n: the odd count's dummy, zero
+    if (a + d < n) {
+      for (const Shared& r : couplings_[a][d - 1])
+        add_run_product<false>(M, inverse_mass_[r.dof], jacobians_[a + d], J, r);
+    }
+    if (other == pair) {
+      M.store_to(system_.diagonal(pair).block<3, 3>(other_offset, offset));
+    } else {  // other == pair + 1: a + d ≤ a + 2 ≤ 2·pair + 3
+      M.store_to(system_.sub(pair).block<3, 3>(other_offset, offset));
+    }
+  }
+  for (int k = 0; k < 3; ++k) rhs_[3 * a + k] = -residuals_[a][k] - alpha[k] * lambda_[a][k];
+}
+
 void XpbdRod::direct_iteration(double h) {
   const int n = static_cast<int>(blocks_.size());
-  system_.set_zero();
+  const double inverse_h2 = 1.0 / (h * h);
   for (int a = 0; a < n; ++a) evaluate(blocks_[a], residuals_[a], jacobians_[a]);
-  for (int a = 0; a < n; ++a) {
-    const Block& b = blocks_[a];
-    const BlockJacobian& J = jacobians_[a];
-    const Eigen::Vector3d alpha = b.compliance / (h * h);
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    for (const Shared& r : own_runs_[a])
-      add_product(A, inverse_mass_[r.dof], J, r.col_a, J, r.col_a, r.width);
-    A.diagonal() += alpha;
-    const int pair = a / 2, offset = 3 * (a % 2);
-    system_.diagonal(pair).block<3, 3>(offset, offset) += A;
-    for (int d = 1; d <= 2 && a + d < n; ++d) {  // rows of block a+d, columns of block a
-      Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-      for (const Shared& r : couplings_[a][d - 1]) {
-        add_product(M, inverse_mass_[r.dof], jacobians_[a + d], r.col_b, J, r.col_a, r.width);
-      }
-      const int other = (a + d) / 2, other_offset = 3 * ((a + d) % 2);
-      if (other == pair) {
-        system_.diagonal(pair).block<3, 3>(other_offset, offset) += M;
-        system_.diagonal(pair).block<3, 3>(offset, other_offset) += M.transpose();
-      } else {  // other == pair + 1: a + d ≤ a + 2 ≤ 2·pair + 3
-        system_.sub(pair).block<3, 3>(other_offset, offset) += M;
-      }
+  // Block row p of J W Jᵀ + α/h² is assembled (every entry the factorisation reads assigned
+  // once) just before it is factorised, and each pair's Δλ applied as soon as it is solved:
+  // the solver's dependency chains overlap with that work.
+  const auto fill = [&](int p) {
+    for (int a = 2 * p; a <= std::min(2 * p + 1, n); ++a) assemble(a, inverse_h2);
+  };
+  const auto done = [&](int p) {
+    for (int a = 2 * p; a <= std::min(2 * p + 1, n - 1); ++a) {
+      const double* dl = rhs_.data() + 3 * a;
+      apply(blocks_[a], jacobians_[a], dl);
+      for (int k = 0; k < 3; ++k) lambda_[a][k] += dl[k];
     }
-    rhs_.segment<3>(3 * a) = -residuals_[a] - alpha.cwiseProduct(lambda_[a]);
-  }
-  if (n % 2 == 1) {  // an odd count: the last pair's second half is a unit dummy
-    system_.diagonal(n / 2).block<3, 3>(3, 3) = Eigen::Matrix3d::Identity();
-    rhs_.segment<3>(3 * n).setZero();
-  }
-  system_.factorize();
-  system_.solve(rhs_);
-  for (int a = 0; a < n; ++a) {
-    const Eigen::Vector3d dl = rhs_.segment<3>(3 * a);
-    apply(blocks_[a], jacobians_[a], dl);
-    lambda_[a] += dl;
-  }
+  };
+  system_.assemble_factorize_solve(rhs_, fill, done);
   model_.normalise_quaternions(x_);
   project_contacts();
 }
@@ -260,7 +317,8 @@ void XpbdRod::project_contacts() {
 
 void XpbdRod::predict(double h, const VectorXd& force) {
   const int n = static_cast<int>(blocks_.size());
-  VectorXd shift = VectorXd::Zero(x_.size());
+  VectorXd& shift = scratch_;
+  shift.setZero();
   if (options_.warm_start) {
     // The carried constraint forces Jᵀλ at the step's start, in the prediction. (J of the last
     // iteration instead, one evaluation fewer, leaves a one-iteration step cycling about the
@@ -297,7 +355,8 @@ void XpbdRod::stabilise_quaternion_masses(double h) {
   // (α = 3, N = 32, h = 10 ms). Its diagonal is added to the frames' mass (Andrews, Teichmann & Kry
   // 2017, "Geometric stiffness for real-time constrained multibody dynamics"). A steady state does
   // not depend on the masses, so statics are unchanged.
-  std::vector<double> k(quaternion_mass_.size(), 0.0);
+  std::vector<double>& k = quaternion_stiffness_;
+  std::fill(k.begin(), k.end(), 0.0);
   const int first_q = model_.quaternion_dof(0);
   for (std::size_t a = 0; a < blocks_.size(); ++a) {
     const Block& b = blocks_[a];
@@ -317,7 +376,7 @@ void XpbdRod::stabilise_quaternion_masses(double h) {
 }
 
 void XpbdRod::step(double h, const VectorXd& force) {
-  const VectorXd previous = x_;
+  previous_ = x_;
   if (options_.warm_start) stabilise_quaternion_masses(h);
   predict(h, force);
   for (int it = 0; it < options_.iterations; ++it) {
@@ -332,7 +391,7 @@ void XpbdRod::step(double h, const VectorXd& force) {
   for (std::size_t i = 0; i < contact_lambda_.size(); ++i) {
     contact_force_lambda_[i] = contact_lambda_[i] / (h * h);
   }
-  v_ = (1.0 - options_.damping) * (x_ - previous) / h;
+  v_ = (1.0 - options_.damping) * (x_ - previous_) / h;
 }
 
 int XpbdRod::relax(double h, const VectorXd& force, double tolerance, int max_steps) {

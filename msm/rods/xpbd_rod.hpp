@@ -92,8 +92,11 @@ class XpbdRod {
   void build_blocks();
   void build_couplings();
   void evaluate(const Block& b, Eigen::Vector3d& c, BlockJacobian& J) const;
-  /// x += W Jᵀ dl for block b.
-  void apply(const Block& b, const BlockJacobian& J, const Eigen::Vector3d& dl);
+  /// x += W Jᵀ dl for block b (dl: 3 entries).
+  void apply(const Block& b, const BlockJacobian& J, const double* dl);
+  /// Block a's rows of J W Jᵀ + α/h² (its diagonal block and its couplings to blocks a+1, a+2)
+  /// and of the right-hand side into the direct solver; a = the block count: the dummy.
+  void assemble(int a, double inverse_h2);
   void gauss_seidel_sweep(double h);
   void direct_iteration(double h);
   void project_contacts();
@@ -108,9 +111,12 @@ class XpbdRod {
   std::vector<Eigen::Vector3d> lambda_;        ///< the step's multipliers (λ, scaled by h²)
   std::vector<Eigen::Vector3d> force_lambda_;  ///< carried multipliers as forces (λ/h²)
   /// Columns width wide from col_a in one block's Jacobian and col_b in another's on the same
-  /// dofs (from `dof`) of one inverse mass.
+  /// dofs (from `dof`) of one inverse mass. On positions (only stretch–shear blocks have
+  /// them) each column is ±e_k/l, one nonzero in the row of the dof's component, so the run's
+  /// product is diagonal.
   struct Shared {
     int col_a = 0, col_b = 0, width = 0, dof = 0;
+    bool position = false;
   };
   /// A block's own columns in runs of one inverse mass (for J W Jᵀ).
   std::vector<std::vector<Shared>> own_runs_;
@@ -118,12 +124,17 @@ class XpbdRod {
   std::vector<std::array<std::vector<Shared>, 2>> couplings_;
   std::vector<BlockJacobian> jacobians_;
   std::vector<Eigen::Vector3d> residuals_;
-  BlockTridiagonalCholesky<6> system_;  ///< the direct solver's J W Jᵀ + α/h², blocks in pairs
+  /// The direct solver's J W Jᵀ + α/h², blocks in pairs; a pair's first block and the next
+  /// pair's second are three apart and do not couple (the zero corner).
+  BlockTridiagonalCholesky<6, 3> system_;
   VectorXd rhs_;
   const RigidLumen* lumen_ = nullptr;
   int wall_first_ = 0, wall_last_ = -1;
   std::vector<double> contact_lambda_;        ///< per node, the step's (scaled by h²)
   std::vector<double> contact_force_lambda_;  ///< per node, carried (λ/h²)
+  // Per-step scratch, kept to avoid allocating each step.
+  VectorXd previous_, scratch_;
+  std::vector<double> quaternion_stiffness_;
 };
 
 }  // namespace vessel::msm::rods

@@ -112,6 +112,37 @@ TEST(Xpbd, BlockTridiagonalCholeskyAgreesWithADenseSolve) {
   EXPECT_LT((r - exact).norm(), 1e-12 * exact.norm());
 }
 
+TEST(Xpbd, BlockTridiagonalCholeskyWithAZeroCornerAgreesWithADenseSolve) {
+  // 3 × 3 blocks coupled up to two apart (the XPBD rod's constraints), paired into 6 × 6 blocks:
+  // the sub-diagonal blocks' lower-left 3 × 3 corner is zero. The corner's storage is filled
+  // with garbage: the solver must neither read it nor need it.
+  constexpr int kB = 6, kBlocks = 5, n = kB * kBlocks;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j <= i; ++j) {
+      if (i / 3 - j / 3 <= 2) A(i, j) = A(j, i) = u(rng);
+    }
+  }
+  A += 2.0 * n * Eigen::MatrixXd::Identity(n, n);
+  BlockTridiagonalCholesky<kB, 3> system;
+  system.resize(kBlocks);
+  for (int b = 0; b < kBlocks; ++b) {
+    system.diagonal(b) = A.block<kB, kB>(kB * b, kB * b);
+    if (b + 1 < kBlocks) {
+      EXPECT_EQ((A.block<3, 3>(kB * (b + 1) + 3, kB * b).norm()), 0.0);
+      system.sub(b) = A.block<kB, kB>(kB * (b + 1), kB * b);
+      system.sub(b).block<3, 3>(3, 0).setConstant(1e300);
+    }
+  }
+  Eigen::VectorXd r = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);
+  const Eigen::VectorXd exact = A.llt().solve(r);
+  system.factorize();
+  system.solve(r);
+  EXPECT_LT((r - exact).norm(), 1e-12 * exact.norm());
+}
+
 TEST(Xpbd, StaticsEqualNewtonWhateverTheIterationCount) {
   constexpr int kN = 16;
   for (double alpha : {1.0, 3.0, 10.0}) {
