@@ -88,6 +88,44 @@ TEST(Xpbd, ClosedFormJacobiansMatchTheJetsOfTheSameFormulas) {
             1e-12);
 }
 
+TEST(Xpbd, TangentJacobiansAreTheJetsProjectedOntoTheUnitSphere) {
+  // The XPBD rod's Jacobians: each quaternion's columns times (I − q qᵀ), for unit quaternions,
+  // against the jets of the same formulas projected explicitly.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::Matrix<double, 10, 1> q;
+  for (int k = 0; k < 10; ++k) q[k] = u(rng);
+  q.segment<4>(6).normalize();
+  const auto project = [](Eigen::MatrixXd J, int col, const Eigen::Vector4d& quat) {
+    J.middleCols<4>(col) = J.middleCols<4>(col) * (Eigen::Matrix4d::Identity() - quat * quat.transpose());
+    return J;
+  };
+  Eigen::VectorXd x = q;
+  std::array<int, 10> d10{};
+  for (int k = 0; k < 10; ++k) d10[k] = k;
+  Eigen::Vector3d c;
+  Eigen::Matrix<double, 3, 10> J;
+  stretch_shear_with_jacobian<true>(q, 0.3, c, J);
+  const auto ss = stretch_shear_strain(jet_inputs<10, false>(x, d10), 0.3);
+  Eigen::MatrixXd Jss(3, 10);
+  Jss << ss.x.g.transpose(), ss.y.g.transpose(), ss.z.g.transpose();
+  EXPECT_LT((J - project(Jss, 6, q.segment<4>(6))).norm(), 1e-13);
+
+  Eigen::Matrix<double, 8, 1> p;
+  for (int k = 0; k < 8; ++k) p[k] = u(rng);
+  p.head<4>().normalize();
+  p.tail<4>().normalize();
+  Eigen::VectorXd y = p;
+  std::array<int, 8> d8{};
+  for (int k = 0; k < 8; ++k) d8[k] = k;
+  Eigen::Matrix<double, 3, 8> K;
+  darboux_with_jacobian<true>(p, 0.2, c, K);
+  const auto om = darboux_vector(jet_inputs<8, false>(y, d8), 0.2);
+  Eigen::MatrixXd Jom(3, 8);
+  Jom << om.x.g.transpose(), om.y.g.transpose(), om.z.g.transpose();
+  EXPECT_LT((K - project(project(Jom, 0, p.head<4>()), 4, p.tail<4>())).norm(), 1e-12);
+}
+
 TEST(Xpbd, BlockTridiagonalCholeskyAgreesWithADenseSolve) {
   constexpr int kB = 6, kBlocks = 5, n = kB * kBlocks;
   std::mt19937 rng(3);
