@@ -290,7 +290,7 @@ void Distributed::solve_linear() {
     dl::TrilinosWrappers::PreconditionAMG amg;
     std::vector<double> modes_storage;  // must outlive amg
     initialize_elasticity_amg(amg, matrix_, owned_rows(owned_), part_.centroid, degree_ > 1,
-                              o.amg_rigid_body_modes, modes_storage);
+                              o.amg_rigid_body_modes, AmgProlongator::plain, modes_storage);
     release_free_memory();  // ML's set-up temporaries
     report_memory(static_cast<int>(rank_), "AMG hierarchy built");
     dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs_norm);

@@ -31,7 +31,7 @@ def load_average():
 
 
 def run(command, json_path, log):
-    """Runs `command` (each process under /usr/bin/time); returns (json, "peak MB of each rank",
+    """Runs `command` (each process under /usr/bin/time); returns (json, "peak MiB of each rank",
     the ranks' peaks together in bytes)."""
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     p = subprocess.run(command, capture_output=True, text=True, env=env)
@@ -60,7 +60,7 @@ def main():
     a = ap.parse_args()
     timed = ["/usr/bin/time", "-f", "peak_kb %M", a.program]
     rows = ["| case | level | solver | ranks | DoFs | iterations | setup s | assembly s | solve s | "
-            "peak MB per rank | kB per DoF (all ranks) | load avg before/after |",
+            "peak MiB per rank | kB per DoF (all ranks) | load avg before/after |",
             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "fem.json")
