@@ -290,7 +290,8 @@ void Distributed::solve_linear() {
     dl::TrilinosWrappers::PreconditionAMG amg;
     std::vector<double> modes_storage;  // must outlive amg
     initialize_elasticity_amg(amg, matrix_, owned_rows(owned_), part_.centroid, degree_ > 1,
-                              o.amg_rigid_body_modes, modes_storage);
+                              o.amg_rigid_body_modes, AmgProlongator::plain, modes_storage);
+    release_free_memory();  // ML's set-up temporaries
     report_memory(static_cast<int>(rank_), "AMG hierarchy built");
     dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs_norm);
     dl::SolverCG<VectorT> cg(control);
@@ -360,6 +361,7 @@ DistributedResult Distributed::run(const DistributedOptions& options) {
   r.formulation = mixed_ ? Formulation::mixed : Formulation::displacement;
   form_ = std::make_unique<WeakForm>(mesh_, problem_, mixed_, mesh_map_);
   setup_dofs();
+  release_free_memory();  // the sparsity pattern's pages, before the AMG set-up's peak
   r.n_dofs = dof_.n_dofs();
   r.timings.setup = max_over_ranks(seconds_since(t0));
   report_memory(rank, "DoFs, sparsity and matrix set up");

@@ -162,7 +162,8 @@ void Distributed::solve_mixed() {
   dl::TrilinosWrappers::PreconditionAMG amg;
   std::vector<double> modes_storage;  // must outlive amg
   initialize_elasticity_amg(amg, a, owned_rows(owned_blocks_[0]), part_.centroid, true,
-                            o.amg_rigid_body_modes, modes_storage);
+                            o.amg_rigid_body_modes, AmgProlongator::smoothed, modes_storage);
+  release_free_memory();  // ML's set-up temporaries
   report_memory(static_cast<int>(rank_), "AMG hierarchy built");
   const BlockPreconditioner prec(block_matrix_.block(0, 1), amg, s, omega, owned_blocks_[0],
                                  comm_);

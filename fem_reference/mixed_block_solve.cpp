@@ -102,7 +102,7 @@ void ElasticitySolver::Impl::solve_mixed_iterative() {
   std::vector<double> modes_storage;
   detail::initialize_elasticity_amg(amg, a_trilinos, displacement_rows(blocks.u_dofs),
                                     detail::node_centroid(mesh), true, o.amg_rigid_body_modes,
-                                    modes_storage);
+                                    detail::AmgProlongator::smoothed, modes_storage);
 
   dl::SparsityPattern p_pattern;
   dl::SparseMatrix<double> schur;

@@ -160,7 +160,8 @@ void ElasticitySolver::Impl::solve_displacement_cg_amg() {
   std::vector<double> modes_storage;  // must outlive amg
   detail::initialize_elasticity_amg(amg, trilinos_matrix, displacement_rows({}),
                                     detail::node_centroid(mesh), degree > 1,
-                                    o.amg_rigid_body_modes, modes_storage);
+                                    o.amg_rigid_body_modes, detail::AmgProlongator::plain,
+                                    modes_storage);
   dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs.l2_norm());
   dl::SolverCG<dl::Vector<double>> cg(control);
   try {

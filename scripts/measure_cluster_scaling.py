@@ -1,12 +1,14 @@
 #!/usr/bin/python3
 """Times the straight tube's FEM reference serially and on 1 and 2 MPI ranks, with each run's peak
 memory and the load average. Serially: CHOLMOD or UMFPACK, AMG-CG or FGMRES. Per run: DoFs, Krylov iterations, set-up / assembly / solve seconds, peak memory of the
-largest rank, and the load average before and after each run (the figures mean little on a busy
-machine: rerun it on an idle one).
+largest rank, the peak memory of all ranks together per DoF, and the load average before and after
+each run (the figures mean little on a busy machine: rerun it on an idle one).
 
 Usage: /usr/bin/python3 scripts/measure_cluster_scaling.py [--program build/verification/vesselverify]
-           [--levels 1] [--ranks 1,2] [--cases p2,th] [--no-serial] [--out table.md]
-Cases: p2 = P2 at nu = 0.45; th = Taylor-Hood at nu = 0.5 (serial: UMFPACK and FGMRES). Needs
+           [--levels 1] [--ranks 1,2] [--cases p2,th] [--no-serial] [--length 0.04] [--out table.md]
+           [--log-dir DIR]
+Cases: p2 = P2 at nu = 0.45; th = Taylor-Hood at nu = 0.5 (serial: UMFPACK and FGMRES). --length
+gives a longer tube (metres; `fem`'s default 0.04), labelled in the case column. Needs
 mpirun and /usr/bin/time (scripts/install_deps.sh)."""
 import argparse
 import json
@@ -28,15 +30,20 @@ def load_average():
         return f.read().split()[0]
 
 
-def run(command, json_path):
-    """Runs `command` (each process under /usr/bin/time); returns (json, "peak MB of each rank")."""
+def run(command, json_path, log):
+    """Runs `command` (each process under /usr/bin/time); returns (json, "peak MiB of each rank",
+    the ranks' peaks together in bytes)."""
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     p = subprocess.run(command, capture_output=True, text=True, env=env)
+    if log:
+        with open(log, "w") as f:
+            f.write(" ".join(command) + "\n" + p.stdout + p.stderr)
     if p.returncode != 0:
         sys.exit(f"failed ({p.returncode}): {' '.join(command)}\n{p.stdout}\n{p.stderr}")
     peaks = [int(k) for k in re.findall(r"peak_kb (\d+)", p.stderr)]
     with open(json_path) as f:
-        return json.load(f), "/".join(f"{k / 1024.0:.0f}" for k in sorted(peaks, reverse=True))
+        return (json.load(f), "/".join(f"{k / 1024.0:.0f}" for k in sorted(peaks, reverse=True)),
+                1024 * sum(peaks))
 
 
 def main():
@@ -46,28 +53,38 @@ def main():
     ap.add_argument("--ranks", default="1,2")
     ap.add_argument("--cases", default="p2,th")
     ap.add_argument("--no-serial", action="store_true", help="the distributed runs only")
+    ap.add_argument("--length", default="", help="tube length in metres (default: fem's)")
     ap.add_argument("--out", default="")
+    ap.add_argument("--log-dir", default="", help="keep each run's command, stdout and stderr here "
+                    "(with VESSELVERIFY_MEMORY=1 in the environment: each rank's memory by phase)")
     a = ap.parse_args()
     timed = ["/usr/bin/time", "-f", "peak_kb %M", a.program]
     rows = ["| case | level | solver | ranks | DoFs | iterations | setup s | assembly s | solve s | "
-            "peak MB per rank | load avg before/after |",
-            "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+            "peak MiB per rank | kB per DoF (all ranks) | load avg before/after |",
+            "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "fem.json")
         for case in a.cases.split(","):
             for level in a.levels.split(","):
                 base = ["fem", "--level", level, "--load", "contact", "--json", out] + CASES[case]
+                label = case
+                if a.length:
+                    base += ["--length", a.length]
+                    label = f"{case} ({a.length} m)"
                 runs = [] if a.no_serial else [(name, 1, timed + base + ["--solver", s])
                                                for name, s in SERIAL[case]]
                 runs += [("distributed", int(n), MPIRUN + ["-np", n] + timed + base +
                           ["--distributed"]) for n in a.ranks.split(",")]
                 for name, n, command in runs:
                     before = load_average()
-                    j, peak = run(command, out)
+                    log = (os.path.join(a.log_dir, f"{case}-l{level}-{name.lower()}-np{n}.log")
+                           if a.log_dir else "")
+                    j, peak, total = run(command, out, log)
                     t = j["timings_s"]
-                    rows.append(f"| {case} | {level} | {name} ({j['solver']}) | {n} | {j['dofs']} | "
+                    rows.append(f"| {label} | {level} | {name} ({j['solver']}) | {n} | {j['dofs']} | "
                                 f"{j['cg_iterations']} | {t['setup']:.2f} | {t['assembly']:.2f} | "
-                                f"{t['solve']:.2f} | {peak} | {before}/{load_average()} |")
+                                f"{t['solve']:.2f} | {peak} | {total / 1e3 / j['dofs']:.2f} | "
+                                f"{before}/{load_average()} |")
                     print(rows[-1], flush=True)
     table = "\n".join(rows) + "\n"
     if a.out:

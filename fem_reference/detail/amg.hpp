@@ -22,7 +22,14 @@ struct DisplacementRows {
   std::vector<unsigned> component;
 };
 
-/// Smoothed-aggregation AMG (Vaněk, Mandel & Brezina 1996) of `matrix`. With `rigid_body_modes`
+/// How ML builds the prolongators from the aggregates. `plain`: the tentative prolongator itself
+/// (unsmoothed aggregation): sparse coarse operators and a small set-up, for the displacement
+/// system's CG. `smoothed`: one damped Jacobi step on it (Vaněk, Mandel & Brezina 1996), a
+/// stronger single V-cycle, for the Taylor–Hood block preconditioner (measured in
+/// docs/measurements/cluster_scaling.md).
+enum class AmgProlongator { smoothed, plain };
+
+/// Aggregation AMG (ML) of `matrix`, its prolongators as `prolongator` says. With `rigid_body_modes`
 /// all six rigid-body modes of `rows` (translations, rotations about `centre`) are ML's
 /// near-null space (AdditionalData only passes constant modes, so the ML parameter list is filled
 /// first and the modes added as pre-computed vectors; `storage` holds them and must outlive
@@ -30,7 +37,8 @@ struct DisplacementRows {
 void initialize_elasticity_amg(dl::TrilinosWrappers::PreconditionAMG& amg,
                                const dl::TrilinosWrappers::SparseMatrix& matrix,
                                const DisplacementRows& rows, const Vec3& centre, bool higher_order,
-                               bool rigid_body_modes, std::vector<double>& storage);
+                               bool rigid_body_modes, AmgProlongator prolongator,
+                               std::vector<double>& storage);
 
 /// The centroid of the mesh's nodes: the rotation centre of the rigid-body modes (the same point
 /// on every MPI rank).
