@@ -106,8 +106,8 @@ struct GuidewireSolver::Impl {
     if (state.size() == rod->state().size()) {
       rod->set_state(scaled_state(origin, L, rod->energy_model().num_nodes()));
     }
-    xpbd_wall = lumen(give);
-    rod->set_wall(xpbd_wall.get(), 2, rod->tip_node());
+    auto wall = lumen(give);  // kept with the rod only once it has settled
+    rod->set_wall(wall.get(), 2, rod->tip_node());
     const int steps = rod->relax(kXpbdRelaxStep, Eigen::VectorXd::Zero(rod->state().size()),
                                  1e-14, kXpbdMaxRelaxSteps);
     if (steps == kXpbdMaxRelaxSteps) {
@@ -115,6 +115,7 @@ struct GuidewireSolver::Impl {
                                std::to_string(kXpbdMaxRelaxSteps) + " steps");
     }
     xpbd = std::move(rod);
+    xpbd_wall = std::move(wall);
     state = xpbd->state();
     state_length = L;
     return xpbd_solution();
