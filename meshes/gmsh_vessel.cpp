@@ -253,9 +253,11 @@ TetMesh generate_vessel_mesh(const VesselParams& params, const MeshingOptions& o
     gmsh::option::setNumber("Mesh.MeshSizeMin", 0.5 * h);
     gmsh::option::setNumber("Mesh.MeshSizeMax", h);
     gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
-    // HXT (algorithm 10) on one thread: deterministic, 3× faster than the default Delaunay at
-    // level 2 here (3.3 s vs 10.5 s) and better shaped (min dihedral 14° vs 6°). More threads make
-    // the node count vary from run to run, which the mesh cache must not allow.
+    // HXT (algorithm 10): 3× faster than the default Delaunay at level 2 here (3.3 s vs 10.5 s)
+    // and better shaped (min dihedral 14° vs 6°). Its mesh is not reproducible, though: it varies
+    // with the process's OpenMP threads and between two generations in one process (7777 then
+    // 7775 tets at level 0), which General.NumThreads = 1 does not prevent and the mesh cache's
+    // key cannot see; Delaunay (algorithm 1) gives the same mesh every time.
     gmsh::option::setNumber("Mesh.Algorithm3D", 10);
   }
   gmsh::model::mesh::generate(3);
