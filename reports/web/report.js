@@ -164,7 +164,12 @@
     renderer.clear();
     renderer.setScissorTest(true);
     for (const view of report.views) {
+      // The camera is in no scene, so render() would not update its world matrix in time for
+      // the first pane drawn.
+      view.camera.updateMatrixWorld();
       for (const pane of view.panes) {
+        pane.light.position.copy(view.camera.localToWorld(new THREE.Vector3(0, 1, 0)));
+        pane.light.target.position.copy(view.centre);
         const r = pane.el.getBoundingClientRect();
         if (r.bottom < 0 || r.top > height || r.width <= 2) continue;
         const w = r.width - 2, h = r.height - 2;  // inside the border
@@ -213,9 +218,10 @@
   function buildPane(view, pane) {
     const scene = new THREE.Scene();
     scene.add(new THREE.AmbientLight(0xffffff, 0.55));
-    const light = new THREE.DirectionalLight(0xffffff, 0.6);
-    view.camera.add(light);
-    scene.add(view.camera);
+    // A headlight per pane, placed at the shared camera before each frame (renderAll): the
+    // camera cannot be a child of both panes' scenes, three.js keeps an object in one parent.
+    pane.light = new THREE.DirectionalLight(0xffffff, 0.6);
+    scene.add(pane.light, pane.light.target);
     pane.scene = scene;
     if (view.ghost >= 0) {
       const g = modelData(view, view.ghost);

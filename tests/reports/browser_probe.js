@@ -8,6 +8,10 @@
   // never come: timers stand in for them (Chart.js handles mouse events, and the page renders its
   // 3D views, in animation frames).
   window.requestAnimationFrame = (callback) => setTimeout(() => callback(performance.now()), 16);
+  // Nor does it always run the IntersectionObserver that sets up a plot or a view scrolled into
+  // sight: the probe sets each one up itself (the page's own set-up, the same code), so that a
+  // view's first frame is the probe's to read.
+  window.IntersectionObserver = class { observe() {} unobserve() {} disconnect() {} };
   const probe = {errors: []};
   const error = console.error;
   console.error = function () {
@@ -32,6 +36,17 @@
       colours.add((px[i] << 16) | (px[i + 1] << 8) | px[i + 2]);
     }
     return {pixels: w * h, drawn: drawn, colours: colours.size, px: px};
+  }
+
+  // Two pane reads compared pixel by pixel: how many differ by more than a shading step.
+  function differing(a, b) {
+    if (a.pixels !== b.pixels) return {pixels: a.pixels, other_pixels: b.pixels, differing: a.pixels};
+    let n = 0;
+    for (let i = 0; i < a.px.length; i += 4) {
+      if (Math.abs(a.px[i] - b.px[i]) + Math.abs(a.px[i + 1] - b.px[i + 1]) +
+          Math.abs(a.px[i + 2] - b.px[i + 2]) > 12) ++n;
+    }
+    return {pixels: a.pixels, other_pixels: b.pixels, differing: n};
   }
 
   // Orange pixels (the wire's hue at any shading: red high, green about half of it, no blue).
@@ -71,14 +86,17 @@
       dom_content_loaded_ms: nav ? nav.domContentLoadedEventEnd : null,
       load_ms: nav ? nav.loadEventEnd : null, views: [], charts: [], hover: null,
       node_hover: null};
-    // Each plot and 3D view scrolled into view, where the page sets it up. --dump-dom draws no
-    // frames, so the IntersectionObserver that notices the scroll is not always run: what it
-    // would have called is then called here (the page's own set-up, the same code).
+    // Each plot and 3D view scrolled into view and set up; a view's first frame read at once.
     for (const el of document.querySelectorAll('.vv-chart, .vv-view')) {
       el.scrollIntoView({block: 'center'});
       await sleep(150);
       if (el.classList.contains('vv-chart')) report.initChart(el);
-      else if (el.querySelector('.vv-pane')) report.initView(el);
+      else if (el.querySelector('.vv-pane')) {
+        const view = report.initView(el);
+        report.renderNow();
+        view.firstFrame = view.panes.map((p) => Object.assign(panePixels(report.gl, p.el),
+          {model: view.data.views[p.model].model}));
+      }
     }
     for (const view of report.views) {
       view.section.scrollIntoView({block: 'center'});
@@ -86,8 +104,14 @@
       report.renderNow();
       const gl = report.gl;
       const entry = {scene: view.data.name, init_ms: view.initMs, models: [],
-        panes: view.panes.map((p) => Object.assign(panePixels(gl, p.el),
-          {model: view.data.views[p.model].model}))};
+        panes: view.firstFrame};
+      // The right pane's model in the left pane too: one camera, one model, the same picture.
+      const right = view.panes[1].model;
+      view.section.querySelector('.vv-pick[data-pane="0"]').value = String(right);
+      view.section.querySelector('.vv-pick[data-pane="0"]').dispatchEvent(new Event('change'));
+      report.renderNow();
+      entry.twin = Object.assign(differing(panePixels(gl, view.panes[0].el),
+        panePixels(gl, view.panes[1].el)), {model: view.data.views[right].model});
       // Every model through the left pane's picker, as a reader would choose it.
       const pick = view.section.querySelector('.vv-pick[data-pane="0"]');
       for (let i = 0; i < view.data.views.length; ++i) {

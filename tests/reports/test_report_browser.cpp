@@ -121,6 +121,18 @@ TEST_F(ReportInBrowser, EachThreeDViewDrawsItsModels) {
   }
 }
 
+TEST_F(ReportInBrowser, BothPanesDrawOneModelAlike) {
+  // The two panes share one camera and are the same size, so one model in both is one picture
+  // (lit alike: each pane has its own headlight), up to the pixel the panes' edges round to.
+  ASSERT_FALSE(probe()["views"].empty());
+  for (const auto& view : probe()["views"]) {
+    const auto& twin = view["twin"];
+    ASSERT_EQ(twin["pixels"], twin["other_pixels"]) << view["scene"];
+    EXPECT_LT(twin["differing"].get<double>(), 0.01 * twin["pixels"].get<double>())
+        << view["scene"] << " " << twin.dump();
+  }
+}
+
 TEST_F(ReportInBrowser, TheGuidewireIsDrawnThroughTheWallWhereResultsJsonHasOne) {
   const ResultsFile results = read_results(kFixture / "results.json");
   std::size_t wires = 0;
