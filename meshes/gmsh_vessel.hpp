@@ -12,9 +12,8 @@ struct MeshingOptions {
 
 /// Generates the tetrahedral wall mesh with the groups of kVesselGroups, tets positively oriented
 /// and boundary triangles outward, elements in canonical order. The same params give the same
-/// mesh in every fresh process; a repeat call in the same process may differ in a few tets of the
-/// unstructured mesh (gmsh's HXT keeps state between calls), which is why meshes are cached. Throws InputError for invalid params (see validate) and
-/// std::runtime_error if gmsh fails.
+/// mesh, whatever the process has meshed before and however many threads it runs. Throws
+/// InputError for invalid params (see validate) and std::runtime_error if gmsh fails.
 TetMesh generate_vessel_mesh(const VesselParams& params, const MeshingOptions& options = {});
 
 /// A straight tube meshed with gmsh's OpenCASCADE kernel (a cylinder cut from a cylinder), the

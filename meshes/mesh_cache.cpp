@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /// Bumped whenever the generator's output for the same params changes.
-constexpr int kGeneratorVersion = 2;
+constexpr int kGeneratorVersion = 3;
 /// Bumped whenever the lumen extrusion's output for the same file and params changes.
 constexpr int kLumenGeneratorVersion = 1;
 

@@ -36,7 +36,7 @@ int world_size() {
   return s;
 }
 
-/// A short unstructured tube (a = 3 mm, t = 1 mm, L = 6 mm, gmsh HXT level 0), meshed on rank 0
+/// A short unstructured tube (a = 3 mm, t = 1 mm, L = 6 mm, gmsh level 0), meshed on rank 0
 /// and sent to the others.
 constexpr double kLength = 6e-3;
 const TetMesh& tube() {

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "meshes/foundation/errors.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/mesh_quality.hpp"
 
@@ -163,6 +164,30 @@ INSTANTIATE_TEST_SUITE_P(AllVessels, VesselMesh,
                                            Case{VesselKind::arch, MeshStyle::unstructured},
                                            Case{VesselKind::arch, MeshStyle::structured}),
                          case_name);
+
+TEST(UnstructuredVessel, SameParamsGiveTheSameMeshWhateverWasMeshedBeforeAndOnAnyThreads) {
+  // The mesh cache and the baselines key on the params alone, so the mesh must be theirs alone:
+  // not the heap's history (another vessel meshed in between) nor the OpenMP threads.
+  const auto mesh_on = [](int threads, const VesselParams& p) {
+    const int saved = solver_threads();
+    set_solver_threads(threads);
+    apply_solver_threads();
+    TetMesh m = generate_vessel_mesh(p);
+    set_solver_threads(saved);
+    apply_solver_threads();
+    return m;
+  };
+  const VesselParams tube;
+  VesselParams arch;
+  arch.kind = VesselKind::arch;
+  const TetMesh first = mesh_on(1, tube);
+  mesh_on(1, arch);
+  const TetMesh again = mesh_on(4, tube);
+  ASSERT_EQ(first.nodes.size(), again.nodes.size());
+  ASSERT_EQ(first.tets.size(), again.tets.size());
+  for (std::size_t i = 0; i < first.nodes.size(); ++i) ASSERT_EQ(first.nodes[i], again.nodes[i]) << i;
+  for (std::size_t i = 0; i < first.tets.size(); ++i) ASSERT_EQ(first.tets[i], again.tets[i]) << i;
+}
 
 TEST(StructuredVessel, NodeCountsMatchTheGridAndGrowAbout8xPerLevel) {
   VesselParams p;

@@ -13,7 +13,7 @@ void add_vessel_options(CLI::App& cmd, VesselOptions& o) {
       ->capture_default_str();
   cmd.add_flag("--structured", o.structured,
                "Structured (transfinite, extruded) mesh: circumferential × axial × radial layers "
-               "doubled per level. Default: unstructured tets (gmsh HXT) of size t/2^level");
+               "doubled per level. Default: unstructured tets (gmsh Delaunay) of size t/2^level");
   cmd.add_option("--level", p.level, "Refinement level 0..4 (each level halves the element size)")
       ->capture_default_str();
   cmd.add_option("--inner-radius", p.inner_radius, "Inner radius a, metres")->capture_default_str();

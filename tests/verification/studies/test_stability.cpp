@@ -96,9 +96,8 @@ TEST(Stability, WritesBothFilesAtomicallyAndRefusesAnUnwritableDirectory) {
 }
 
 TEST(Stability, TheStepTableIsTheSameComputedOneRowAtATimeOrInParallel) {
-  // Level 0 only, short trials, both runs on the same mesh (the cache's: gmsh's parallel HXT
-  // mesher does not give the same mesh twice). The search is deterministic, so the table computed
-  // on two threads equals the one computed on one, row for row.
+  // Level 0 only, short trials. The search is deterministic, so the table computed on two
+  // threads equals the one computed on one, row for row.
   test::TempDir cache;
   StabilityOptions o;
   o.cache_dir = cache.path();
