@@ -155,6 +155,17 @@ double roundoff_floor(const Problem& p, const SparseMatrix& H) {
          std::sqrt(static_cast<double>(p.num_dofs()));
 }
 
+/// Round-off of Π itself, J: a spring's energy carries its tension times the round-off of its
+/// length, ε·L, and the tensions balance the load, so Π is uncertain by about ε·(model size)·
+/// (load) — with a margin of 1e3 for the many springs that carry it. At small loads this is far
+/// above 1e-12·|Π| (Π falls with the load squared, its round-off only with the load), and an
+/// energy comparison cannot judge a step near the solution.
+double energy_roundoff(const Problem& p, const VectorXd& g) {
+  const double size = (p.rest.maxCoeff() - p.rest.minCoeff());
+  return 1e3 * std::numeric_limits<double>::epsilon() * size *
+         (p.external_force.lpNorm<1>() + g.lpNorm<1>());
+}
+
 /// Throws the solver's "did not converge" error naming the iteration, residual and target.
 [[noreturn]] void throw_not_converged(const char* solver_name, const StaticResult& r,
                                       double target) {
@@ -386,11 +397,12 @@ struct LineSearch {
 };
 
 /// Backtracking (Armijo) line search on Π from x along dx. Near the solution the energy change
-/// drops below round-off (|ΔΠ| ≲ 1e-12 |Π|): there a step is accepted if it reduces the residual
-/// instead.
+/// drops below round-off (|ΔΠ| ≲ 1e-12 |Π| or energy_roundoff): there a step is accepted if it
+/// reduces the residual instead.
 LineSearch armijo_search(const Problem& p, const VectorXd& x, const VectorXd& dx,
                          const VectorXd& g, double energy, double residual) {
   const double slope = g.dot(dx);
+  const double noise = std::max(1e-12 * std::abs(energy), energy_roundoff(p, g));
   LineSearch l;
   VectorXd gt;
   l.trial_energy = energy;
@@ -405,7 +417,7 @@ LineSearch armijo_search(const Problem& p, const VectorXd& x, const VectorXd& dx
       l.accepted = true;
       break;
     }
-    if (std::abs(l.trial_energy - energy) <= 1e-12 * std::abs(energy)) {
+    if (std::abs(l.trial_energy - energy) <= noise) {
       p.potential_gradient(l.trial, gt);
       if (gt.norm() < residual) {
         l.accepted = true;
