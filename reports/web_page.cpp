@@ -323,7 +323,9 @@ SceneViews read_scene_views(const SceneRows& s, const std::filesystem::path& res
 
 std::string scene_picture_svg(const SceneViews& v, const std::string& load) {
   // The wall with the most nodes, seen along its bounding box's thinnest axis: per bin along the
-  // longest axis, the lowest and highest extent along the other, joined into an outline.
+  // longest axis, the lowest and highest extent along the other of its cells' edges (sampled at
+  // least once per bin, so a coarse mesh's long edges leave no bin to a few inner nodes), joined
+  // into an outline.
   const WallView* wall = nullptr;
   for (const WallView& w : v.views) {
     if (!wall || w.rest_mm.size() > wall->rest_mm.size()) wall = &w;
@@ -341,10 +343,22 @@ std::string scene_picture_svg(const SceneViews& v, const std::string& load) {
   constexpr double kWidth = 260, kHeight = 110, kPad = 14;
   std::vector<double> bmin(kBins, 1e300), bmax(kBins, -1e300);
   const double span_u = std::max(hi[u] - lo[u], 1e-9), span_w = std::max(hi[w] - lo[w], 1e-9);
-  for (std::size_t i = 0; i + 2 < wall->rest_mm.size(); i += 3) {
-    const int b = std::min(kBins - 1, int((wall->rest_mm[i + u] - lo[u]) / span_u * kBins));
-    bmin[b] = std::min(bmin[b], double(wall->rest_mm[i + w]));
-    bmax[b] = std::max(bmax[b], double(wall->rest_mm[i + w]));
+  const auto add = [&](double cu, double cw) {
+    const int b = std::clamp(int((cu - lo[u]) / span_u * kBins), 0, kBins - 1);
+    bmin[b] = std::min(bmin[b], cw);
+    bmax[b] = std::max(bmax[b], cw);
+  };
+  const auto coord = [&](std::uint32_t node, int axis) { return double(wall->rest_mm[3 * node + axis]); };
+  const std::size_t corners = wall->lines ? 2 : 3, edges = wall->lines ? 1 : 3;
+  for (std::size_t c = 0; c + corners <= wall->indices.size(); c += corners) {
+    for (std::size_t k = 0; k < edges; ++k) {
+      const std::uint32_t a = wall->indices[c + k], e = wall->indices[c + (k + 1) % corners];
+      const int samples = 1 + int(std::abs(coord(e, u) - coord(a, u)) / span_u * 2 * kBins);
+      for (int j = 0; j <= samples; ++j) {
+        const double t = double(j) / samples;
+        add((1 - t) * coord(a, u) + t * coord(e, u), (1 - t) * coord(a, w) + t * coord(e, w));
+      }
+    }
   }
   const double scale = std::min((kWidth - 2 * kPad) / span_u, (kHeight - 2 * kPad) / span_w);
   const auto px = [&](double a) { return kPad + (a - lo[u]) * scale; };

@@ -383,3 +383,52 @@ TEST(SceneCards, FirstSentenceCutsLongMessagesWithoutSplittingACharacter) {
   EXPECT_EQ(cut.substr(cut.size() - 3), "…");
   EXPECT_EQ((cut.size() - 3) % 2, 0U);
 }
+
+TEST(ScenePicture, ACoarseArchsOutlineFollowsItsOuterWallInEveryBin) {
+  // A half annulus (radii 1 and 1.3 mm) of 6 sectors in z = 0, seen along z: the card's outline
+  // takes the highest point per bin along x. Its top must follow the outer wall's chords: no bin
+  // left to an inner node (a dip of up to 0.3 mm), none left empty.
+  constexpr int kSectors = 6;
+  constexpr double kInner = 1.0, kOuter = 1.3, kPi = 3.14159265358979323846;
+  WallView w;
+  for (int i = 0; i <= kSectors; ++i) {
+    const double a = kPi * i / kSectors;
+    for (const double r : {kInner, kOuter}) {
+      w.rest_mm.insert(w.rest_mm.end(), {float(r * std::cos(a)), float(r * std::sin(a)), 0.0F});
+    }
+  }
+  for (std::uint32_t i = 0; i < kSectors; ++i) {  // node 2i inner, 2i + 1 outer
+    w.indices.insert(w.indices.end(), {2 * i, 2 * i + 1, 2 * i + 3, 2 * i, 2 * i + 3, 2 * i + 2});
+  }
+  SceneViews views;
+  views.views.push_back(w);
+  const std::string svg = scene_picture_svg(views, "pressure");
+  // The outline: 40 bins along the top, then back along the bottom; the drawing's scale from
+  // its extent (x from −1.3 to 1.3 mm over the first and last bins' centres).
+  const std::string d = svg.substr(svg.find("d=\"") + 3);
+  std::vector<std::pair<double, double>> points;
+  const std::regex pair(R"(([-0-9.e]+),([-0-9.e]+))");
+  for (auto it = std::sregex_iterator(d.begin(), d.begin() + d.find('"'), pair);
+       it != std::sregex_iterator(); ++it) {
+    points.emplace_back(std::stod((*it)[1]), std::stod((*it)[2]));
+  }
+  ASSERT_EQ(points.size(), 80U);
+  const double bin = 2 * kOuter / 40, scale = (points[39].first - points[0].first) / (39 * bin);
+  const double base_y = points[40].second;  // the bottom's last bin: y = 0 in the drawing
+  const auto outer_chord = [&](double x) {  // the outer polygon's height above x
+    for (int i = 0; i < kSectors; ++i) {
+      const double a0 = kPi * (i + 1) / kSectors, a1 = kPi * i / kSectors;  // x rising
+      const double x0 = kOuter * std::cos(a0), x1 = kOuter * std::cos(a1);
+      if (x >= x0 && x <= x1) {
+        const double t = (x - x0) / (x1 - x0);
+        return kOuter * ((1 - t) * std::sin(a0) + t * std::sin(a1));
+      }
+    }
+    return 0.0;
+  };
+  for (int b = 2; b < 38; ++b) {  // away from the ends, where the wall is steep within a bin
+    const double x = -kOuter + (b + 0.5) * bin;
+    const double height = (base_y - points[b].second) / scale;
+    EXPECT_NEAR(height, outer_chord(x), 0.05) << "bin " << b << " at x = " << x;
+  }
+}
