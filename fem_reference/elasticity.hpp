@@ -90,13 +90,13 @@ struct SolverOptions {
   double mixed_threshold = 0.49;
   LinearSolver solver = LinearSolver::automatic;
   /// automatic: direct at or below this many DoFs (CHOLMOD for the displacement system, UMFPACK
-  /// for the mixed one), else CG-AMG. Measured on this machine (2 cores, OpenBLAS), default tube,
-  /// contact: P1 level 1 (32k DoFs) CHOLMOD 0.75 s vs AMG 1.46 s; P2 level 1 (204k DoFs) CHOLMOD
-  /// 11.3 s vs AMG 18.3 s (91 iterations); the structured arch, P2 level 1 (272k DoFs, ν = 0.45,
-  /// `vesselverify fem --vessel arch --structured --level 1 --degree 2 --bc clamped`): CHOLMOD
-  /// 20.0 s solve and 3.7 GB peak against AMG's 42.1 s (205 iterations) and 2.2 GB. The factor's
-  /// memory grows faster than AMG's (~n^4/3): about 6 GB at this limit, so two references solved
-  /// side by side fit a 24 GB machine.
+  /// for the mixed one), else CG-AMG. Measured on this machine (2 cores for CHOLMOD's OpenBLAS,
+  /// idle, contact, P2 level 1): unstructured tube 211k DoFs CHOLMOD 13.7 s vs AMG-CG 23.4 s
+  /// (152 iterations); structured tube 231k, 35.6 s vs 46.0 s; structured arch, clamped, 272k
+  /// (`vesselverify fem --vessel arch --structured --level 1 --degree 2 --bc clamped`), 40.6 s
+  /// and 3.6 GB peak vs 48.9 s (245 iterations) and 1.2 GB. On one core AMG-CG wins from ~230k
+  /// (docs/physics/fem_reference.md). The factor's memory grows faster than AMG's (~n^4/3):
+  /// about 6 GB at this limit, so two references solved side by side fit a 24 GB machine.
   std::size_t direct_max_dofs = 400000;
   /// automatic, mixed system: UMFPACK at or below this many DoFs, else gmres_block. Measured
   /// (docs/measurements/fem_measurements.md): level 0 (34–47k DoFs) UMFPACK 4–11 s vs FGMRES 8–21 s; level 1

@@ -14,8 +14,10 @@
 #include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/reference_checks.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 #include "meshes/vtu_io.hpp"
 #include "verification/cli/commands.hpp"
+#include "verification/cli/jobs_option.hpp"
 #include "verification/cli/vessel_options.hpp"
 #include "verification/fem_document.hpp"
 #include "verification/scene_problems.hpp"
@@ -360,7 +362,10 @@ void run_serial(const FemCommandOptions& o, const Scene& s, const TetMesh& mesh,
   std::cout << "element " << pre.element << (pre.curved ? " on curved walls" : "") << ": "
             << pre.n_dofs << " DoFs";
   if (pre.n_pressure_dofs) std::cout << " (" << pre.n_pressure_dofs << " pressure)";
-  std::cout << "\nsolving ..." << std::flush;
+  // One problem: its direct solvers' BLAS (CHOLMOD, UMFPACK) get every core, as the harness
+  // gives a reference solved alone.
+  set_solver_threads(default_jobs());
+  std::cout << "\nsolving on " << solver_threads() << " thread(s) ..." << std::flush;
   run.result = solver.solve();
   print_solver(run.result);
   if (run.contact) run.contact->displacement = solver.displacement_at({run.contact->point})[0];
