@@ -321,59 +321,81 @@ SceneViews read_scene_views(const SceneRows& s, const std::filesystem::path& res
   return out;
 }
 
+namespace {
+
+/// A wall's outline seen along its bounding box's thinnest axis: per bin along the longest axis
+/// (u), the lowest and highest extent along the other (w) of its cells' edges, each sampled at
+/// least twice per bin, so a coarse mesh's long edges leave no bin to a few inner nodes.
+struct WallOutline {
+  static constexpr int kBins = 40;
+  int u = 0, w = 1;
+  double lo_u = 0.0, lo_w = 0.0, span_u = 1.0, span_w = 1.0;
+  std::vector<double> low = std::vector<double>(kBins, 1e300), high = std::vector<double>(kBins, -1e300);
+};
+
+WallOutline wall_outline(const WallView& wall) {
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (std::size_t i = 0; i < wall.rest_mm.size(); ++i) {
+    lo[i % 3] = std::min(lo[i % 3], double(wall.rest_mm[i]));
+    hi[i % 3] = std::max(hi[i % 3], double(wall.rest_mm[i]));
+  }
+  int axes[3] = {0, 1, 2};
+  std::sort(axes, axes + 3, [&](int a, int b) { return hi[a] - lo[a] > hi[b] - lo[b]; });
+  WallOutline o;
+  o.u = axes[0];
+  o.w = axes[1];
+  o.lo_u = lo[o.u];
+  o.lo_w = lo[o.w];
+  o.span_u = std::max(hi[o.u] - lo[o.u], 1e-9);
+  o.span_w = std::max(hi[o.w] - lo[o.w], 1e-9);
+  const auto coord = [&](std::uint32_t node, int axis) { return double(wall.rest_mm[3 * node + axis]); };
+  const std::size_t corners = wall.lines ? 2 : 3, edges = wall.lines ? 1 : 3;
+  for (std::size_t c = 0; c + corners <= wall.indices.size(); c += corners) {
+    for (std::size_t k = 0; k < edges; ++k) {
+      const std::uint32_t a = wall.indices[c + k], e = wall.indices[c + (k + 1) % corners];
+      const int samples = 1 + int(std::abs(coord(e, o.u) - coord(a, o.u)) / o.span_u * 2 * o.kBins);
+      for (int j = 0; j <= samples; ++j) {
+        const double t = double(j) / samples;
+        const double cu = (1 - t) * coord(a, o.u) + t * coord(e, o.u);
+        const double cw = (1 - t) * coord(a, o.w) + t * coord(e, o.w);
+        const int b = std::clamp(int((cu - o.lo_u) / o.span_u * o.kBins), 0, o.kBins - 1);
+        o.low[b] = std::min(o.low[b], cw);
+        o.high[b] = std::max(o.high[b], cw);
+      }
+    }
+  }
+  return o;
+}
+
+}  // namespace
+
 std::string scene_picture_svg(const SceneViews& v, const std::string& load) {
-  // The wall with the most nodes, seen along its bounding box's thinnest axis: per bin along the
-  // longest axis, the lowest and highest extent along the other of its cells' edges (sampled at
-  // least once per bin, so a coarse mesh's long edges leave no bin to a few inner nodes), joined
-  // into an outline.
+  // The wall with the most nodes, drawn as its outline (wall_outline).
   const WallView* wall = nullptr;
   for (const WallView& w : v.views) {
     if (!wall || w.rest_mm.size() > wall->rest_mm.size()) wall = &w;
   }
   if (!wall || wall->rest_mm.empty()) return "";
-  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-  for (std::size_t i = 0; i < wall->rest_mm.size(); ++i) {
-    lo[i % 3] = std::min(lo[i % 3], double(wall->rest_mm[i]));
-    hi[i % 3] = std::max(hi[i % 3], double(wall->rest_mm[i]));
-  }
-  int axes[3] = {0, 1, 2};
-  std::sort(axes, axes + 3, [&](int a, int b) { return hi[a] - lo[a] > hi[b] - lo[b]; });
-  const int u = axes[0], w = axes[1];
-  constexpr int kBins = 40;
+  const WallOutline outline = wall_outline(*wall);
+  const int u = outline.u, w = outline.w, kBins = WallOutline::kBins;
+  const double lo_u = outline.lo_u, lo_w = outline.lo_w, span_u = outline.span_u;
+  const std::vector<double>& bmin = outline.low;
+  const std::vector<double>& bmax = outline.high;
   constexpr double kWidth = 260, kHeight = 110, kPad = 14;
-  std::vector<double> bmin(kBins, 1e300), bmax(kBins, -1e300);
-  const double span_u = std::max(hi[u] - lo[u], 1e-9), span_w = std::max(hi[w] - lo[w], 1e-9);
-  const auto add = [&](double cu, double cw) {
-    const int b = std::clamp(int((cu - lo[u]) / span_u * kBins), 0, kBins - 1);
-    bmin[b] = std::min(bmin[b], cw);
-    bmax[b] = std::max(bmax[b], cw);
-  };
-  const auto coord = [&](std::uint32_t node, int axis) { return double(wall->rest_mm[3 * node + axis]); };
-  const std::size_t corners = wall->lines ? 2 : 3, edges = wall->lines ? 1 : 3;
-  for (std::size_t c = 0; c + corners <= wall->indices.size(); c += corners) {
-    for (std::size_t k = 0; k < edges; ++k) {
-      const std::uint32_t a = wall->indices[c + k], e = wall->indices[c + (k + 1) % corners];
-      const int samples = 1 + int(std::abs(coord(e, u) - coord(a, u)) / span_u * 2 * kBins);
-      for (int j = 0; j <= samples; ++j) {
-        const double t = double(j) / samples;
-        add((1 - t) * coord(a, u) + t * coord(e, u), (1 - t) * coord(a, w) + t * coord(e, w));
-      }
-    }
-  }
-  const double scale = std::min((kWidth - 2 * kPad) / span_u, (kHeight - 2 * kPad) / span_w);
-  const auto px = [&](double a) { return kPad + (a - lo[u]) * scale; };
-  const auto py = [&](double b) { return kHeight - kPad - (b - lo[w]) * scale; };
+  const double scale = std::min((kWidth - 2 * kPad) / span_u, (kHeight - 2 * kPad) / outline.span_w);
+  const auto px = [&](double a) { return kPad + (a - lo_u) * scale; };
+  const auto py = [&](double b) { return kHeight - kPad - (b - lo_w) * scale; };
   std::ostringstream path;
   bool first = true;
   for (int b = 0; b < kBins; ++b) {
     if (bmax[b] < bmin[b]) continue;
-    path << (first ? "M" : "L") << significant(px(lo[u] + (b + 0.5) * span_u / kBins), 4) << ","
+    path << (first ? "M" : "L") << significant(px(lo_u + (b + 0.5) * span_u / kBins), 4) << ","
          << significant(py(bmax[b]), 4);
     first = false;
   }
   for (int b = kBins - 1; b >= 0; --b) {
     if (bmax[b] < bmin[b]) continue;
-    path << "L" << significant(px(lo[u] + (b + 0.5) * span_u / kBins), 4) << ","
+    path << "L" << significant(px(lo_u + (b + 0.5) * span_u / kBins), 4) << ","
          << significant(py(bmin[b]), 4);
   }
   std::ostringstream out;
