@@ -19,9 +19,8 @@ namespace vessel {
 namespace rods = msm::rods;
 
 // XPBD's static solve is a damped dynamic run to rest, 30 % of the velocity removed per step,
-// in steps of a haptic frame. Its steady state does not depend on the step (the same force to 7
-// digits at 0.2, 0.3, 0.5 and 1 ms, N = 8-32, guidewire_straight); at 0.1 ms and N = 32 the
-// stepwise insertion oscillated without settling (tip moving ~0.4 mm per step).
+// in steps of a haptic frame. Its steady state does not depend on the step (the same force to 8
+// digits from 0.05 to 2 ms, N = 32, guidewire_straight; tests/rods/test_rigid_wall.cpp).
 constexpr double kXpbdRelaxStep = 1e-3;
 constexpr double kXpbdRelaxDamping = 0.3;
 constexpr int kXpbdMaxRelaxSteps = 20000;  // ≤ 900 taken on the guidewire scenes

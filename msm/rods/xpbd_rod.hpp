@@ -33,7 +33,8 @@
 /// rotary inertia ρA l³/12: with the section's ρI l alone they are ~10⁷ times lighter than the
 /// points and the sweeps diverge. An optional rigid lumen adds one-sided, frictionless node
 /// contacts g(P) ≥ 0 (no compliance; their multipliers kept ≥ 0, so the wall never pulls),
-/// projected after each sweep or direct iteration.
+/// projected after each sweep, or before each direct iteration (a step ends on the direct
+/// solve; the carried contact force in the prediction keeps the penetration at rounding level).
 #include <array>
 #include <utility>
 #include <vector>
