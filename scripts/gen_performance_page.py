@@ -112,7 +112,7 @@ def section(path):
         out += [f"{description} (`{source}`).", ""]
     reps = {b.get("repetitions", 1) for b in run.get("benchmarks", [])}
     load = ", ".join(f"{x:.1f}" for x in ctx.get("load_avg", []))
-    out += [f"Run {ctx.get('date', '?')} on `{ctx.get('host_name', '?')}`: {ctx.get('num_cpus', '?')}"
+    out += [f"Run on `{ctx.get('host_name', '?')}`: {ctx.get('num_cpus', '?')}"
             f" CPUs at {ctx.get('mhz_per_cpu', '?')} MHz, load average {load or '?'} at the start; "
             f"{max(reps)} repetition(s), medians shown; raw run: `{path}`.", ""]
     standard = {"date", "host_name", "executable", "num_cpus", "mhz_per_cpu",
