@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <string>
 
+#include "test_paths.hpp"
+
 namespace vessel::test {
 
 /// A fresh, empty directory under the system temp dir, unique per test; removed on destruction.
@@ -30,12 +32,9 @@ struct CommandResult {
 /// Runs a shell command and captures its combined output and exit code.
 CommandResult run_command(const std::string& command);
 
-#ifdef VESSELVERIFY_EXE
-/// Runs the vesselverify program built with the tests (its path is the target's compile
-/// definition VESSELVERIFY_EXE) with `args`.
+/// Runs the vesselverify program built with the tests (test_paths.hpp) with `args`.
 inline CommandResult vv(const std::string& args) {
-  return run_command(std::string(VESSELVERIFY_EXE) + " " + args);
+  return run_command(VESSELVERIFY_EXE + " " + args);
 }
-#endif
 
 }  // namespace vessel::test

@@ -63,7 +63,7 @@ TEST(ReferenceJobCli, TwoRankJobThenSerialRunGivesTheSerialRunsResults) {
   ASSERT_EQ(serial.exit_code, 0) << serial.output;
   EXPECT_EQ(fem_cache_counts(serial.output), std::make_pair(0, 4)) << serial.output;
 
-  const auto compare = run_command("/usr/bin/python3 " COMPARE_RESULTS " " +
+  const auto compare = run_command("/usr/bin/python3 " + COMPARE_RESULTS + " " +
                                    (dir / "serial" / "results.json").string() + " " +
                                    (dir / "after_job" / "results.json").string() +
                                    " --rtol 1e-8");

@@ -9,6 +9,7 @@
 #include "msm/solvers/static_solver.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_problems.hpp"
+#include "test_paths.hpp"
 
 using namespace vessel;
 

@@ -16,6 +16,7 @@
 #include "verification/model_capabilities.hpp"
 #include "verification/scene.hpp"
 #include "tests/fixtures/lame_tube_scene.hpp"
+#include "test_paths.hpp"
 
 using namespace vessel;
 

@@ -17,6 +17,7 @@
 #include "msm/stiffness/stiffness_rules.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_keys.hpp"
+#include "test_paths.hpp"
 
 using namespace vessel;
 using Json = nlohmann::json;

@@ -17,7 +17,7 @@ using namespace vessel;
 
 namespace {
 
-nlohmann::json schema(const char* path) { return nlohmann::json::parse(test::read_text(path)); }
+nlohmann::json schema(const std::string& path) { return nlohmann::json::parse(test::read_text(path)); }
 
 bool has(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;

@@ -15,6 +15,7 @@
 #include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
 #include "verification/studies/validity/validity.hpp"
+#include "test_paths.hpp"
 
 using namespace vessel;
 
