@@ -13,6 +13,7 @@ std::string vesselverify_exe();     ///< the vesselverify program built with the
 std::string cpp_model_exe();        ///< examples/external's C++ model, built with the tests
 std::string source_dir();           ///< the checkout's root
 std::string tests_dir();            ///< the checkout's tests/ folder
+std::string test_cache_dir();       ///< the build tree's cache for the tests (never the user's)
 }  // namespace vessel::test::paths
 
 #define VESSELVERIFY_EXE (::vessel::test::paths::vesselverify_exe())
