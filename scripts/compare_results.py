@@ -10,13 +10,17 @@ import json
 import math
 import sys
 
-# Keys whose values are measurements of the run, not results of the models.
-VOLATILE = ("seconds", "memory", "command", "machine", "date", "build", "timing", "update_ms",
-            "kernel", "steps_per_second", "real_time")
+# Keys whose values are measurements of the run, not results of the models: a key is one when one of
+# its underscore-separated words is a volatile word (`setup_seconds`, `timing_source`,
+# `peak_memory_mb_per_rank`) or it is one of the named keys; whole words only, so that `updates`
+# and `steps_per_update` (results) are compared although they contain "date" and "update".
+VOLATILE_WORDS = frozenset({"seconds", "second", "memory", "timing", "timings", "machine", "date",
+                            "build", "command", "kernel"})
+VOLATILE_KEYS = frozenset({"update_ms", "update_s", "timings_s", "real_time", "cpu_time"})
 
 
 def volatile(key):
-    return any(v in key for v in VOLATILE)
+    return key in VOLATILE_KEYS or any(w in VOLATILE_WORDS for w in key.split("_"))
 
 
 def walk(a, b, path, rtol, atol, out):
