@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <unordered_map>
 
@@ -15,11 +16,15 @@ namespace vessel {
 
 namespace {
 
+/// v rounded to 1e-6, so that round-off prints as 0.
+double cleaned(double v) { return std::round(v * 1e6) / 1e6 + 0.0; }
+
 /// "(x, y, z) mm", for messages.
 std::string mm(const Vec3& p) {
   std::ostringstream s;
   s.precision(4);
-  s << "(" << p.x() * 1e3 << ", " << p.y() * 1e3 << ", " << p.z() * 1e3 << ") mm";
+  s << "(" << cleaned(p.x() * 1e3) << ", " << cleaned(p.y() * 1e3) << ", "
+    << cleaned(p.z() * 1e3) << ") mm";
   return s.str();
 }
 
@@ -153,7 +158,8 @@ std::vector<std::vector<int>> boundary_loops(const TriangleSurface& surface,
   return loops;
 }
 
-LumenEnd describe_end(const std::vector<Vec3>& nodes, std::vector<int> loop) {
+LumenEnd describe_end(const std::vector<Vec3>& nodes, std::vector<int> loop,
+                      const std::vector<Triangle>* triangles) {
   LumenEnd e;
   for (const int i : loop) e.centre += nodes[i];
   e.centre /= static_cast<double>(loop.size());
@@ -174,8 +180,38 @@ LumenEnd describe_end(const std::vector<Vec3>& nodes, std::vector<int> loop) {
     e.planarity = std::max(e.planarity, std::abs((nodes[i] - e.centre).dot(e.normal)));
   }
   if (e.radius > 0.0) e.planarity /= e.radius;
+  if (triangles) {
+    // The third node of the triangle on each loop edge (u → v, as the triangle traverses it).
+    std::map<Edge, int> third;
+    for (const Triangle& t : *triangles) {
+      for (int k = 0; k < 3; ++k) third[{t[k], t[(k + 1) % 3]}] = t[(k + 2) % 3];
+    }
+    double weighted = 0.0, length = 0.0;
+    for (std::size_t k = 0; k < loop.size(); ++k) {
+      const int u = loop[k], v = loop[(k + 1) % loop.size()];
+      const auto it = third.find({u, v});
+      if (it == third.end()) continue;
+      const Vec3 edge = nodes[v] - nodes[u];
+      const Vec3 along = edge.normalized();
+      Vec3 across = nodes[it->second] - 0.5 * (nodes[u] + nodes[v]);
+      across -= across.dot(along) * along;
+      if (across.norm() == 0.0) continue;
+      weighted += edge.norm() * std::abs(across.normalized().dot(e.normal));
+      length += edge.norm();
+    }
+    if (length > 0.0) e.steepness = weighted / length;
+  }
   e.loop = std::move(loop);
   return e;
+}
+
+std::string format_end(const LumenEnd& e) {
+  std::ostringstream s;
+  s.precision(4);
+  s << mm(e.centre) << ", radius " << e.radius * 1e3 << " mm, normal (" << cleaned(e.normal.x())
+    << ", " << cleaned(e.normal.y()) << ", " << cleaned(e.normal.z()) << "), area "
+    << e.area * 1e6 << " mm²";
+  return s.str();
 }
 
 std::vector<std::pair<int, int>> crossing_triangles(const std::vector<Vec3>& x,
@@ -303,7 +339,7 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
   std::vector<LumenEnd> ends;
   double largest = 0.0;
   for (const auto& loop : loops) {
-    ends.push_back(describe_end(lumen.nodes, loop));
+    ends.push_back(describe_end(lumen.nodes, loop, &lumen.triangles));
     largest = std::max(largest, ends.back().radius);
   }
   for (const LumenEnd& e : ends) {
@@ -318,6 +354,15 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
           std::to_string(kMinEndEdges) + " edges, within " + num(100.0 * kMaxEndPlanarity, 3) +
           " % of one plane, radius at least " + num(100.0 * kMinEndRadiusRatio, 3) +
           " % of the largest end's " + num(largest * 1e3) + " mm): fill the hole or cut the end flat");
+    }
+    if (e.steepness < kMinEndSteepness) {
+      const double angle = std::asin(std::clamp(e.steepness, 0.0, 1.0)) * 180.0 / std::numbers::pi;
+      throw InputError(
+          source + ": a hole where no end should be: the open loop around " + mm(e.centre) +
+          ", radius " + num(e.radius * 1e3) + " mm, lies in the vessel's wall (the surface meets "
+          "its plane at " + num(angle, 3) + "°, not across it; an end is a cut across the vessel, "
+          "which the wall leaves at more than 45°); expected every open loop to be an end of the "
+          "vessel: fill the hole in the surface, or, if it is an end, cut it square to the vessel");
     }
   }
   if (ends.size() < 2) {
@@ -597,6 +642,19 @@ TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>&
   orient_boundary_outward(mesh);
   require_vessel_groups(mesh, source);
   return mesh;
+}
+
+std::vector<std::pair<std::string, LumenEnd>> lumen_file_ends(const std::filesystem::path& file,
+                                                              double scale) {
+  TriangleSurface lumen = read_stl(file);
+  for (Vec3& x : lumen.nodes) x *= scale;
+  const std::vector<LumenEnd> ends = check_lumen(lumen, file.string());
+  const int inlet = inlet_end(ends);
+  std::vector<std::pair<std::string, LumenEnd>> named;
+  for (int e = 0; e < static_cast<int>(ends.size()); ++e) {
+    named.emplace_back(std::string(e == inlet ? group_names::inlet : group_names::outlet), ends[e]);
+  }
+  return named;
 }
 
 int lumen_wall_layers(int level) { return 2 << level; }

@@ -22,15 +22,26 @@ struct LumenEnd {
   double radius = 0.0;      ///< mean distance of the loop's nodes from its centre, m
   double area = 0.0;        ///< area of the loop's (vector) polygon, m²
   double planarity = 0.0;   ///< largest distance of a node from the best-fit plane / radius
+  /// How steeply the surface leaves the loop: the mean (weighted by edge length) of |n · d|, d the
+  /// unit direction from each loop edge into its triangle, across the edge. 1 where the wall runs
+  /// along the normal (a tube cut square), sin α where the surface meets the plane at α (a hole cut
+  /// in a wall: the wall around it lies nearly in its plane).
+  double steepness = 0.0;
 };
 
 /// Criteria that tell an end from a hole (a boundary loop where no end should be). An end is a
-/// roughly planar cut of the vessel: at least kMinEndEdges edges, its nodes within
-/// kMaxEndPlanarity × its radius of one plane, and a radius at least kMinEndRadiusRatio × the
-/// largest loop's (a missing facet or a tear leaves a small or crooked loop).
+/// roughly planar cut across the vessel: at least kMinEndEdges edges, its nodes within
+/// kMaxEndPlanarity × its radius of one plane, a radius at least kMinEndRadiusRatio × the
+/// largest loop's (a missing facet or a tear leaves a small or crooked loop), and a steepness of
+/// at least kMinEndSteepness: the wall leaves an end's plane at more than 45° (a tube cut square:
+/// 90°), while around a hole cut in the wall the surface lies near the hole's plane (a planar hole
+/// of radius ρ in a wall of radius R meets its plane at asin(ρ/R): 26° for 1.3 mm in 3 mm). The
+/// steepness is local (the triangles along the loop), so it holds for any vessel's shape; a hole
+/// wider than 0.7 R (a stub of a branch) passes it.
 inline constexpr int kMinEndEdges = 6;
 inline constexpr double kMaxEndPlanarity = 0.15;
 inline constexpr double kMinEndRadiusRatio = 0.1;
+inline constexpr double kMinEndSteepness = 0.7071067811865476;  // sin 45°
 
 /// A vessel is expected to fit in kMaxVesselSize metres (bounding-box diagonal): a file larger
 /// than that was almost certainly written in millimetres. Below kMinVesselSize it is too small to
@@ -60,8 +71,13 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
 std::vector<std::vector<int>> boundary_loops(const TriangleSurface& surface,
                                              std::string_view source);
 
-/// The loop's centre, plane, radius, area and planarity.
-LumenEnd describe_end(const std::vector<Vec3>& nodes, std::vector<int> loop);
+/// The loop's centre, plane, radius, area, planarity and (given the surface's triangles; without
+/// them 0) steepness.
+LumenEnd describe_end(const std::vector<Vec3>& nodes, std::vector<int> loop,
+                      const std::vector<Triangle>* triangles = nullptr);
+
+/// "(x, y, z) mm, radius r mm, normal (nx, ny, nz), area A mm²": one end, for listings.
+std::string format_end(const LumenEnd& end);
 
 /// Pairs of triangles that share no vertex and cross (an edge of one passes strictly through the
 /// other), at most `limit` of them, each as (i, j) with i < j. Coplanar overlaps are not found.
@@ -106,6 +122,11 @@ struct LumenWallParams {
   double scale = 1.0;      ///< file units → m (1e-3 for a file in millimetres)
   int level = 0;           ///< 0..kMaxMeshLevel: subdivided `level` times, 2·2^level layers
 };
+
+/// The ends of the lumen file (read, scaled by `scale` to metres, checked by check_lumen), each
+/// with its group: inlet (inlet_end) or outlet. InputError as check_lumen.
+std::vector<std::pair<std::string, LumenEnd>> lumen_file_ends(const std::filesystem::path& file,
+                                                              double scale);
 
 /// Layers through the wall at `level`: 2·2^level (the generated vessels' t/2 at level 0).
 int lumen_wall_layers(int level);

@@ -23,7 +23,7 @@ namespace {
 /// Bumped whenever the generator's output for the same params changes.
 constexpr int kGeneratorVersion = 3;
 /// Bumped whenever the lumen extrusion's output for the same file and params changes.
-constexpr int kLumenGeneratorVersion = 1;
+constexpr int kLumenGeneratorVersion = 2;  // 2: holes in the wall refused (steepness)
 
 /// The hash of a file's bytes (InputError naming it if it cannot be read).
 std::string file_hash(const fs::path& path) {

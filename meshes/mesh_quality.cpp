@@ -140,4 +140,35 @@ std::string format_quality(const MeshQuality& q) {
   return s.str();
 }
 
+SliverReport find_slivers(const TetMesh& mesh) {
+  SliverReport r;
+  for (const Tet& t : mesh.tets) {
+    const auto angles = dihedral_angles_deg(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]],
+                                            mesh.nodes[t[3]]);
+    const double lo = *std::min_element(angles.begin(), angles.end());
+    const double hi = *std::max_element(angles.begin(), angles.end());
+    if (lo >= kSliverMinDihedralDeg && hi <= kSliverMaxDihedralDeg) continue;
+    ++r.count;
+    if (lo < r.worst_min_dihedral_deg) {
+      r.worst_min_dihedral_deg = lo;
+      r.worst_max_dihedral_deg = hi;
+      r.worst_centroid = 0.25 * (mesh.nodes[t[0]] + mesh.nodes[t[1]] + mesh.nodes[t[2]] +
+                                 mesh.nodes[t[3]]);
+    }
+  }
+  return r;
+}
+
+std::string sliver_warning(const SliverReport& r) {
+  if (r.count == 0) return "";
+  std::ostringstream s;
+  s << std::setprecision(4) << "WARNING: " << r.count
+    << " sliver tets (a dihedral angle below " << kSliverMinDihedralDeg << "° or above "
+    << kSliverMaxDihedralDeg << "°); the worst, at (" << r.worst_centroid.x() * 1e3 << ", "
+    << r.worst_centroid.y() * 1e3 << ", " << r.worst_centroid.z() * 1e3 << ") mm, has angles "
+    << r.worst_min_dihedral_deg << "° to " << r.worst_max_dihedral_deg
+    << "°: results on this mesh include the mesh's error (P1 elements there can be far from P2)";
+  return s.str();
+}
+
 }  // namespace vessel

@@ -288,5 +288,67 @@ TEST(LumenMesh, ProjectsAPointOntoTheChosenWall) {
   EXPECT_NEAR(estimate_wall_thickness(m, "t"), t, 0.02 * t);
 }
 
+
+TEST(LumenMesh, YBifurcationEndsAreItsThreeCutsWithTheirConstructedGeometry) {
+  const test::YBifurcationSpec spec;
+  const TriangleSurface lumen = test::y_bifurcation_lumen(spec);
+  const std::vector<LumenEnd> ends = check_lumen(lumen, "y.stl");
+  ASSERT_EQ(ends.size(), 3u);
+  // The construction's ends: the parent at z = −L, the daughters L along ±half_angle from z.
+  const double L = spec.length, a = spec.half_angle;
+  const std::array<Vec3, 3> centres{Vec3(0, 0, -L), Vec3(-L * std::sin(a), 0, L * std::cos(a)),
+                                    Vec3(L * std::sin(a), 0, L * std::cos(a))};
+  const std::array<double, 3> radii{spec.parent_radius, spec.daughter_radius, spec.daughter_radius};
+  for (int c = 0; c < 3; ++c) {
+    int found = 0;
+    for (const LumenEnd& e : ends) {
+      if ((e.centre - centres[c]).norm() > 1e-6) continue;
+      ++found;
+      // Nodes on the circle: the mean distance is the radius; a polygon's area is under the circle's.
+      EXPECT_NEAR(e.radius, radii[c], 1e-6);
+      EXPECT_NEAR(e.area, kPi * radii[c] * radii[c], 0.05 * kPi * radii[c] * radii[c]);
+      EXPECT_NEAR(std::abs(e.normal.dot(centres[c].normalized())), 1.0, 1e-6);
+      EXPECT_GT(e.steepness, 0.95);  // a square cut of a tube
+    }
+    EXPECT_EQ(found, 1) << "no end at the construction's end " << c;
+  }
+}
+
+TEST(LumenMesh, YBifurcationWithHolesInItsJunctionIsRefusedNamingAHole) {
+  test::YBifurcationSpec spec;
+  spec.holes = true;
+  const TriangleSurface lumen = test::y_bifurcation_lumen(spec);
+  // Five loops: the three ends, and the two holes at y = ±√(R_j² − ρ²) of radius ρ, whose wall
+  // meets their plane at asin(ρ / R_j) = 22° (the facets next to the loop tilt it by a few more).
+  const double rho = spec.hole_radius, Rj = spec.junction_radius;
+  const double cut = std::sqrt(Rj * Rj - rho * rho);
+  int holes = 0, ends = 0;
+  for (const auto& loop : boundary_loops(lumen, "holed.stl")) {
+    const LumenEnd e = describe_end(lumen.nodes, loop, &lumen.triangles);
+    if (std::abs(std::abs(e.centre.y()) - cut) < 1e-6) {
+      ++holes;
+      EXPECT_NEAR(e.radius, rho, 1e-6);
+      EXPECT_NEAR(std::abs(e.normal.y()), 1.0, 1e-9);
+      EXPECT_NEAR(e.steepness, rho / Rj, 0.15);
+      EXPECT_LT(e.steepness, kMinEndSteepness);
+    } else {
+      ++ends;
+      EXPECT_GT(e.steepness, 0.95);
+    }
+  }
+  EXPECT_EQ(holes, 2);
+  EXPECT_EQ(ends, 3);
+  const std::string message = refusal(lumen, "holed.stl");
+  // Either hole, whichever loop comes first.
+  EXPECT_NE(message.find("holed.stl: a hole where no end should be: the open loop around (0, "),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("3.25, 0) mm, radius 1.3 mm"), std::string::npos) << message;
+  EXPECT_NE(message.find("radius 1.3 mm, lies in the vessel's wall"), std::string::npos) << message;
+  EXPECT_NE(message.find("fill the hole in the surface, or, if it is an end, cut it square"),
+            std::string::npos)
+      << message;
+}
+
 }  // namespace
 }  // namespace vessel

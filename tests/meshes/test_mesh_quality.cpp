@@ -61,3 +61,31 @@ TEST(MeshQuality, OrientTetsFlipsOnlyAnAllNegativeConvention) {
   orient_tets(mesh);
   EXPECT_EQ(compute_quality(mesh).inverted, 1u);
 }
+
+TEST(MeshQuality, ASliverIsFoundWithItsAnglesAndPositionAndAGoodMeshIsNot) {
+  // Corner tets of the unit cube (dihedral 54.7° to 90°) and, 10 m away, a sliver: a = (±1, 0, 0),
+  // c, d = (0, ±1, h). Across edge ab the faces' directions (0, 1, h) and (0, −1, h) make
+  // 180° − 2·atan(h) (and across cd likewise); the other four are near 0°.
+  TetMesh mesh;
+  mesh.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1)};
+  mesh.tets = {{0, 1, 2, 3}, {4, 2, 1, 3}};
+  SliverReport none = find_slivers(mesh);
+  EXPECT_EQ(none.count, 0u);
+  EXPECT_EQ(sliver_warning(none), "");
+  const double h = 0.01;
+  const Vec3 o(10, 0, 0);
+  const int base = static_cast<int>(mesh.nodes.size());
+  for (const Vec3& p : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, h), Vec3(0, -1, h)}) {
+    mesh.nodes.push_back(o + p);
+  }
+  mesh.tets.push_back({base, base + 1, base + 2, base + 3});
+  const SliverReport one = find_slivers(mesh);
+  EXPECT_EQ(one.count, 1u);
+  EXPECT_NEAR(one.worst_max_dihedral_deg, 180.0 - 2.0 * std::atan(h) * kDeg, 1e-9);
+  EXPECT_LT(one.worst_min_dihedral_deg, kSliverMinDihedralDeg);
+  EXPECT_NEAR((one.worst_centroid - (o + Vec3(0, 0, 0.5 * h))).norm(), 0.0, 1e-12);
+  const std::string w = sliver_warning(one);
+  EXPECT_NE(w.find("WARNING: 1 sliver tets"), std::string::npos) << w;
+  EXPECT_NE(w.find("at (1e+04, 0, 5) mm"), std::string::npos) << w;
+  EXPECT_NE(w.find("include the mesh's error"), std::string::npos) << w;
+}
