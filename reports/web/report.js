@@ -164,6 +164,7 @@
     renderer.clear();
     renderer.setScissorTest(true);
     for (const view of report.views) {
+      placeCamera(view);
       // The camera is in no scene, so render() would not update its world matrix in time for
       // the first pane drawn.
       view.camera.updateMatrixWorld();
@@ -320,6 +321,51 @@
     if (shown) { tube.visible = shown.checked; if (pane.rigidWire) pane.rigidWire.visible = shown.checked; }
   }
 
+  /// The smallest sphere about the box centre of everything the view's panes draw (the models
+  /// and the ghost as deformed now, the wire): the camera keeps it all in sight.
+  function fitSphere(view) {
+    const arrays = [];
+    for (const pane of view.panes) {
+      for (const o of [pane.mesh, pane.ghost, pane.wire, pane.rigidWire]) {
+        if (o) arrays.push(o.geometry.getAttribute('position').array);
+      }
+    }
+    const box = new THREE.Box3();
+    arrays.forEach((a) => box.union(new THREE.Box3().setFromArray(a)));
+    const centre = box.getCenter(new THREE.Vector3());
+    let r2 = 0;
+    for (const a of arrays) {
+      for (let k = 0; k < a.length; k += 3) {
+        const dx = a[k] - centre.x, dy = a[k + 1] - centre.y, dz = a[k + 2] - centre.z;
+        r2 = Math.max(r2, dx * dx + dy * dy + dz * dz);
+      }
+    }
+    view.fit = {centre: centre, radius: Math.max(Math.sqrt(r2), 1e-9 * view.radius)};
+    view.centre = centre;
+    requestRender();
+  }
+
+  /// The shared camera on its orbit about the fitted sphere, at the distance where the sphere
+  /// fills the narrower of the panes' two fields of view (half-angle a: distance R / sin a), with
+  /// a margin, times the reader's dolly.
+  function placeCamera(view) {
+    const c = view.camera, o = view.orbit, fit = view.fit;
+    let aspect = Infinity;
+    for (const pane of view.panes) {
+      const r = pane.el.getBoundingClientRect();
+      if (r.width > 2 && r.height > 2) aspect = Math.min(aspect, (r.width - 2) / (r.height - 2));
+    }
+    if (!isFinite(aspect)) aspect = 1.5;
+    const half = Math.min(c.fov / 2, Math.atan(Math.tan(c.fov / 2 * Math.PI / 180) * aspect) *
+      180 / Math.PI) * Math.PI / 180;
+    const d = 1.1 * fit.radius / Math.sin(half) * o.zoom;
+    c.position.set(fit.centre.x + d * Math.sin(o.phi) * Math.sin(o.theta),
+      fit.centre.y + d * Math.cos(o.phi), fit.centre.z + d * Math.sin(o.phi) * Math.cos(o.theta));
+    c.near = Math.max(d - 2 * fit.radius, d * 1e-3);
+    c.far = d + 2 * fit.radius;
+    c.lookAt(fit.centre);
+  }
+
   function showModel(view, pane, i) {
     const m = modelData(view, i);
     if (pane.mesh) { pane.scene.remove(pane.mesh); pane.mesh.geometry.dispose(); }
@@ -353,7 +399,7 @@
     pane.scene.add(pane.mesh);
     pane.model = i;
     pane.label.textContent = m.model + ' (L' + m.level + '), max error ' + fmt(m.max) + ' mm';
-    requestRender();
+    fitSphere(view);
   }
 
   function setFactor(view, factor) {
@@ -367,7 +413,7 @@
       if (pane.model !== undefined) showModel(view, pane, pane.model);
       if (view.data.wire && view.data.wire.coupled_mm) showWire(view, pane);
     }
-    requestRender();
+    fitSphere(view);
   }
 
   /// Where an error sits on the colour scale, 0 to 1: linear from 0 to the scene's largest error,
@@ -411,13 +457,7 @@
   // Orbit by dragging, dolly by the wheel: one camera for both panes.
   function addOrbit(view) {
     let drag = null;
-    const place = () => {
-      const o = view.orbit, c = view.camera;
-      c.position.set(view.centre.x + o.r * Math.sin(o.phi) * Math.sin(o.theta),
-        view.centre.y + o.r * Math.cos(o.phi), view.centre.z + o.r * Math.sin(o.phi) * Math.cos(o.theta));
-      c.lookAt(view.centre);
-      requestRender();
-    };
+    const place = () => requestRender();  // renderAll places the camera (placeCamera)
     for (const pane of view.panes) {
       pane.el.addEventListener('pointerdown', (e) => { drag = {x: e.clientX, y: e.clientY};
         pane.el.setPointerCapture(e.pointerId); });
@@ -435,7 +475,7 @@
       pane.el.addEventListener('pointerleave', () => { tip.style.display = 'none'; });
       pane.el.addEventListener('wheel', (e) => {
         e.preventDefault();
-        view.orbit.r *= Math.exp(e.deltaY * 0.001);
+        view.orbit.zoom *= Math.exp(e.deltaY * 0.001);
         place();
       }, {passive: false});
     }
@@ -500,8 +540,9 @@
     for (let i = 0; i < g.ur.length; i += 3) umax = Math.max(umax, Math.hypot(g.ur[i], g.ur[i + 1], g.ur[i + 2]));
     view.factor = umax > 0 ? Math.max(1, 0.1 * view.radius / umax) : 1;
     view.camera = new THREE.PerspectiveCamera(35, 1.5, view.radius * 0.01, view.radius * 20);
+    view.fit = {centre: view.centre, radius: view.radius};  // until the models are shown
     // Looking at the QoI point's side of the vessel, a little from above and askew.
-    view.orbit = {r: view.radius * 2.6, theta: 0.9, phi: 1.1};
+    view.orbit = {zoom: 1, theta: 0.9, phi: 1.1};
     if (data.qoi_mm) {
       const dx = data.qoi_mm[0] - view.centre.x, dy = data.qoi_mm[1] - view.centre.y;
       const dz = data.qoi_mm[2] - view.centre.z, d = Math.hypot(dx, dy, dz);

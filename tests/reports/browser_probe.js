@@ -1,7 +1,8 @@
 // Injected at the top of a copy of report.html by report_browser_tests: records console errors,
 // then, once the page has loaded, scrolls through it and writes what it found as JSON into
-// <pre id="vv-probe"> for chromium --dump-dom: each 3D pane's pixels read back, each plot's points
-// per series, the tooltip of a hovered point, and when the page became interactive.
+// <pre id="vv-probe"> for chromium --dump-dom: each 3D pane's pixels read back (those on its edge
+// counted apart), each plot's points per series, the tooltip of a hovered point, and when the page
+// became interactive.
 (function () {
   'use strict';
   // chromium --dump-dom runs the page on virtual time and draws no frames, so animation frames
@@ -29,13 +30,17 @@
     const px = new Uint8Array(w * h * 4);
     gl.readPixels(x, y, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
     const colours = new Set();
-    let drawn = 0;
+    let drawn = 0, edge = 0;  // edge: drawn pixels on the outermost rows and columns read
     for (let i = 0; i < px.length; i += 4) {
       const background = px[i] === 246 && px[i + 1] === 246 && px[i + 2] === 246;
-      if (!background) ++drawn;
+      const k = i / 4, col = k % w, row = Math.floor(k / w);
+      if (!background) {
+        ++drawn;
+        if (col === 0 || col === w - 1 || row === 0 || row === h - 1) ++edge;
+      }
       colours.add((px[i] << 16) | (px[i + 1] << 8) | px[i + 2]);
     }
-    return {pixels: w * h, drawn: drawn, colours: colours.size, px: px};
+    return {pixels: w * h, drawn: drawn, edge_drawn: edge, colours: colours.size, px: px};
   }
 
   // Two pane reads compared pixel by pixel: how many differ by more than a shading step.

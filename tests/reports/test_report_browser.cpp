@@ -4,8 +4,12 @@
 // returns what the probe found. The expected counts come from results.json, not from the page.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <cstdlib>
+#include <iterator>
 #include <set>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -25,6 +29,86 @@ std::filesystem::path headless_chromium() {
   return kScreenshots.parent_path() / "headless_chromium.sh";
 }
 
+/// A point of a straight tube along z (its length `length`) bent into an arch standing on two
+/// legs in the y-z plane: a leg up (0.3 of the length), a half circle over the top (0.4), a leg
+/// down (0.3). The tube's x stays x, its y follows the arch's outward normal; `vector` turns a
+/// vector at the point instead of moving the point.
+std::array<double, 3> on_arch(const std::array<double, 3>& p, double length, bool vector = false,
+                              const std::array<double, 3>& at = {}) {
+  const double s = vector ? at[2] : p[2], leg = 0.3 * length, rb = 0.4 * length / M_PI;
+  std::array<double, 3> c{}, t{}, n{};  // centreline point, tangent, outward normal
+  if (s < leg) {
+    c = {0, s, 0}, t = {0, 1, 0}, n = {0, 0, -1};
+  } else if (s < leg + M_PI * rb) {
+    const double th = (s - leg) / rb;
+    c = {0, leg + rb * std::sin(th), rb * (1 - std::cos(th))};
+    t = {0, std::cos(th), std::sin(th)}, n = {0, std::sin(th), -std::cos(th)};
+  } else {
+    c = {0, leg - (s - leg - M_PI * rb), 2 * rb}, t = {0, -1, 0}, n = {0, 0, 1};
+  }
+  if (vector) c = {0, 0, 0};
+  const double along = vector ? p[2] : 0.0;
+  return {c[0] + p[0], c[1] + p[1] * n[1] + along * t[1], c[2] + p[1] * n[2] + along * t[2]};
+}
+
+/// The fixture's tube scene as a second scene, "arch": its VTU fields' points bent by on_arch
+/// and their displacements turned with them, its QoI point and contact patch moved alike, no
+/// guidewire. A shape whose bounding box is a poor guess of its extent on screen.
+void add_arch_scene(const std::filesystem::path& results_dir) {
+  auto results = nlohmann::json::parse(test::read_text(results_dir / "results.json"));
+  nlohmann::json arch = results["scenes"][0];
+  const std::string tube = arch["name"];
+  arch["name"] = "arch";
+  arch["guidewire"] = nullptr;
+  const double length_mm = 40.0;  // the fixture tube's z from 0 to 40 mm
+  auto moved = [&](const nlohmann::json& mm) {
+    const auto q = on_arch({mm[0].get<double>(), mm[1].get<double>(), mm[2].get<double>()}, length_mm);
+    return nlohmann::json::array({q[0], q[1], q[2]});
+  };
+  arch["qoi_point_mm"] = moved(arch["qoi_point_mm"]);
+  if (arch["contact_patch"].is_object()) {
+    const auto p = arch["contact_patch"]["point_mm"];
+    arch["contact_patch"]["point_mm"] = moved(p);
+    const auto& n = arch["contact_patch"]["outward_normal"];
+    const auto q = on_arch({n[0].get<double>(), n[1].get<double>(), n[2].get<double>()}, length_mm,
+                           true, {p[0].get<double>(), p[1].get<double>(), p[2].get<double>()});
+    arch["contact_patch"]["outward_normal"] = {q[0], q[1], q[2]};
+  }
+  results["scenes"].push_back(arch);
+  test::write_text(results_dir / "results.json", results.dump(1));
+  std::filesystem::create_directories(results_dir / "fields" / "arch");
+  for (const auto& entry : std::filesystem::directory_iterator(results_dir / "fields" / tube)) {
+    std::istringstream in(test::read_text(entry.path()));
+    std::ostringstream out;
+    std::string line;
+    std::vector<std::array<double, 3>> points;  // the tube's, to turn the displacements at
+    enum { kNone, kPoints, kVectors } next = kNone;
+    while (std::getline(in, line)) {
+      if (next != kNone) {
+        std::istringstream values(line);
+        std::vector<double> v{std::istream_iterator<double>(values), std::istream_iterator<double>()};
+        std::ostringstream bent;
+        bent.precision(12);
+        for (std::size_t i = 0; i + 2 < v.size(); i += 3) {
+          const std::array<double, 3> x{v[i], v[i + 1], v[i + 2]};
+          if (next == kPoints) points.push_back(x);
+          const auto q = next == kPoints ? on_arch(x, length_mm * 1e-3)
+                                         : on_arch(x, length_mm * 1e-3, true, points.at(i / 3));
+          bent << q[0] << ' ' << q[1] << ' ' << q[2] << ' ';
+        }
+        line = bent.str();
+        next = kNone;
+      } else if (line.rfind("<DataArray", 0) == 0 && line.find("Name=") == std::string::npos) {
+        next = kPoints;  // the <Points> array, which alone has no name
+      } else if (line.rfind("<DataArray", 0) == 0 && line.find("Name=\"displacement_") != std::string::npos) {
+        next = kVectors;
+      }
+      out << line << '\n';
+    }
+    test::write_text(results_dir / "fields" / "arch" / entry.path().filename(), out.str());
+  }
+}
+
 /// The fixture's report written and probed in chromium once, on first use; the probe's JSON.
 /// (Done in the first test that asks, not in SetUpTestSuite, so a failure here fails tests
 /// rather than skipping them.)
@@ -37,8 +121,10 @@ struct Probed {
 Probed& probed() {
   static Probed* p = [] {
     auto* p = new Probed();
+    std::filesystem::copy(kFixture, p->dir / "results", std::filesystem::copy_options::recursive);
+    add_arch_scene(p->dir / "results");
     ReportOptions o;
-    o.results = kFixture / "results.json";
+    o.results = p->dir / "results" / "results.json";
     o.output_dir = p->dir.path();
     o.command = "report_browser_tests";
     write_report(o);
@@ -93,7 +179,7 @@ TEST_F(ReportInBrowser, NoConsoleError) {
 }
 
 TEST_F(ReportInBrowser, EachThreeDViewDrawsItsModels) {
-  const ResultsFile results = read_results(kFixture / "results.json");
+  const ResultsFile results = read_results(dir() / "results" / "results.json");
   ASSERT_EQ(probe()["views"].size(), results.scenes.size());
   for (const auto& view : probe()["views"]) {
     ASSERT_EQ(view["panes"].size(), 2U) << view["scene"];
@@ -121,6 +207,22 @@ TEST_F(ReportInBrowser, EachThreeDViewDrawsItsModels) {
   }
 }
 
+TEST_F(ReportInBrowser, EachThreeDViewShowsItsWholeVessel) {
+  // The camera fits the models' bounding sphere: no drawn pixel on the pane's outermost rows and
+  // columns, for every model in every view, the arch (legs far from its bounding box's centre)
+  // included.
+  bool arch = false;
+  for (const auto& view : probe()["views"]) {
+    arch = arch || view["scene"] == "arch";
+    auto panes = view["panes"];
+    for (const auto& m : view["models"]) panes.push_back(m);
+    for (const auto& pane : panes) {
+      EXPECT_EQ(pane["edge_drawn"].get<int>(), 0) << view["scene"] << " " << pane["model"];
+    }
+  }
+  EXPECT_TRUE(arch) << "the arch scene has no view";
+}
+
 TEST_F(ReportInBrowser, BothPanesDrawOneModelAlike) {
   // The two panes share one camera and are the same size, so one model in both is one picture
   // (lit alike: each pane has its own headlight), up to the pixel the panes' edges round to.
@@ -134,7 +236,7 @@ TEST_F(ReportInBrowser, BothPanesDrawOneModelAlike) {
 }
 
 TEST_F(ReportInBrowser, TheGuidewireIsDrawnThroughTheWallWhereResultsJsonHasOne) {
-  const ResultsFile results = read_results(kFixture / "results.json");
+  const ResultsFile results = read_results(dir() / "results" / "results.json");
   std::size_t wires = 0;
   for (const auto& view : probe()["views"]) {
     for (const SceneRows& s : results.scenes) {
@@ -173,7 +275,7 @@ TEST_F(ReportInBrowser, HoveringTheWallGivesTheNodesErrorAndDisplacements) {
 }
 
 TEST_F(ReportInBrowser, SpeedErrorPlotHasAPointPerFinishedOutcome) {
-  const ResultsFile results = read_results(kFixture / "results.json");
+  const ResultsFile results = read_results(dir() / "results" / "results.json");
   for (const SceneRows& s : results.scenes) {
     const double load = representative_load(s);
     std::size_t expected = 0;
@@ -220,7 +322,7 @@ TEST_F(ReportInBrowser, ScreenshotScriptWritesTheFirstScreenAndAThreeDView) {
   const std::filesystem::path out = dir() / "shots";
   const test::CommandResult r = test::run_command(
       kScreenshots.string() + " " + (dir() / "report.html").string() + " " + out.string() +
-      " " + read_results(kFixture / "results.json").scenes.front().name);
+      " " + read_results(dir() / "results" / "results.json").scenes.front().name);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   for (const char* png : {"report_first_screen.png", "report_3d_view.png"}) {
     const std::string bytes = test::read_text(out / png);
