@@ -20,7 +20,7 @@ using vessel::test::write_text;
 
 namespace {
 
-const std::filesystem::path kExamples = VESSEL_EXAMPLES_DIR;
+const std::filesystem::path kExamples = std::filesystem::path(VESSEL_EXAMPLES_DIR) / "external";
 
 bool contains(const std::string& s, const std::string& what) {
   return s.find(what) != std::string::npos;
