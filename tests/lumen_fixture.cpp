@@ -18,6 +18,34 @@ Vec3 on_centreline(double R, const Vec3& p) {
   return planar.norm() > 0.0 ? Vec3(R * planar.normalized()) : Vec3(R, 0.0, 0.0);
 }
 
+/// The 3-node triangles of gmsh surface `tag`, their nodes added to `s` once each (`index` maps
+/// gmsh's node tags to `s`'s indices across faces).
+std::vector<Triangle> face_triangles(int tag, std::map<std::size_t, int>& index, TriangleSurface& s) {
+  std::vector<int> types;
+  std::vector<std::vector<std::size_t>> elements, nodes;
+  gmsh::model::mesh::getElements(types, elements, nodes, 2, tag);
+  std::vector<Triangle> face;
+  for (std::size_t k = 0; k < types.size(); ++k) {
+    if (types[k] != 2) continue;  // 3-node triangles
+    for (std::size_t e = 0; e + 2 < nodes[k].size(); e += 3) {
+      Triangle t{};
+      for (int c = 0; c < 3; ++c) {
+        const std::size_t node = nodes[k][e + c];
+        auto [it, inserted] = index.emplace(node, static_cast<int>(s.nodes.size()));
+        if (inserted) {
+          std::vector<double> x, param;
+          gmsh::model::mesh::getNode(node, x, param);
+          s.nodes.emplace_back(x[0], x[1], x[2]);
+          s.source_node.push_back(-1);
+        }
+        t[c] = it->second;
+      }
+      face.push_back(t);
+    }
+  }
+  return face;
+}
+
 }  // namespace
 
 TriangleSurface bifurcation_lumen(const BifurcationSpec& b) {
@@ -50,28 +78,7 @@ TriangleSurface bifurcation_lumen(const BifurcationSpec& b) {
     std::string type;
     gmsh::model::getType(dim, tag, type);
     if (type == "Plane") continue;  // the three caps: the ends stay open
-    std::vector<int> types;
-    std::vector<std::vector<std::size_t>> elements, nodes;
-    gmsh::model::mesh::getElements(types, elements, nodes, 2, tag);
-    std::vector<Triangle> face;
-    for (std::size_t k = 0; k < types.size(); ++k) {
-      if (types[k] != 2) continue;  // 3-node triangles
-      for (std::size_t e = 0; e + 2 < nodes[k].size(); e += 3) {
-        Triangle t{};
-        for (int c = 0; c < 3; ++c) {
-          const std::size_t node = nodes[k][e + c];
-          auto [it, inserted] = index.emplace(node, static_cast<int>(s.nodes.size()));
-          if (inserted) {
-            std::vector<double> x, param;
-            gmsh::model::mesh::getNode(node, x, param);
-            s.nodes.emplace_back(x[0], x[1], x[2]);
-            s.source_node.push_back(-1);
-          }
-          t[c] = it->second;
-        }
-        face.push_back(t);
-      }
-    }
+    const std::vector<Triangle> face = face_triangles(tag, index, s);
     // A face lies on the torus or on the branch's cylinder: whichever its triangles are nearer.
     double to_torus = 0.0, to_branch = 0.0;
     for (const Triangle& t : face) {
@@ -146,28 +153,7 @@ TriangleSurface y_bifurcation_lumen(const YBifurcationSpec& y) {
     std::string type;
     gmsh::model::getType(dim, tag, type);
     if (type == "Plane") continue;  // the end caps and the holes' discs: left open
-    std::vector<int> types;
-    std::vector<std::vector<std::size_t>> elements, nodes;
-    gmsh::model::mesh::getElements(types, elements, nodes, 2, tag);
-    std::vector<Triangle> face;
-    for (std::size_t k = 0; k < types.size(); ++k) {
-      if (types[k] != 2) continue;
-      for (std::size_t e = 0; e + 2 < nodes[k].size(); e += 3) {
-        Triangle t{};
-        for (int c = 0; c < 3; ++c) {
-          const std::size_t node = nodes[k][e + c];
-          auto [it, inserted] = index.emplace(node, static_cast<int>(s.nodes.size()));
-          if (inserted) {
-            std::vector<double> x, param;
-            gmsh::model::mesh::getNode(node, x, param);
-            s.nodes.emplace_back(x[0], x[1], x[2]);
-            s.source_node.push_back(-1);
-          }
-          t[c] = it->second;
-        }
-        face.push_back(t);
-      }
-    }
+    const std::vector<Triangle> face = face_triangles(tag, index, s);
     std::array<double, 4> sum{};
     for (const Triangle& t : face) {
       const Vec3 c = (s.nodes[t[0]] + s.nodes[t[1]] + s.nodes[t[2]]) / 3.0;
