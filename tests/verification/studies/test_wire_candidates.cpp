@@ -103,10 +103,11 @@ TEST(WireCandidates, ErrorsFallWithSegmentsAndTheCheapestPassingOneIsRecommended
   ASSERT_TRUE(w.reference.has_value()) << w.no_reference;
   ASSERT_EQ(w.candidates.size(), 9u);
   for (const WireCandidate& c : w.candidates) {
-    std::printf("WIRE-CANDIDATE %s: F %.6e N, force error %.4e mN, contact error %.4e mm, "
-                "update %.3e s, set-up %.3e s%s\n",
-                c.name.c_str(), c.force, c.force_error_mN, c.contact_error_mm, c.update_seconds,
-                c.setup_seconds, c.ok ? "" : (" FAILED: " + c.failure).c_str());
+    std::printf(
+        "WIRE-CANDIDATE %s: F %.6e N, force error %.4e mN, contact error %.4e mm, "
+        "update %.3e s, set-up %.3e s%s\n",
+        c.name.c_str(), c.force, c.force_error_mN, c.contact_error_mm, c.update_seconds,
+        c.setup_seconds, c.ok ? "" : (" FAILED: " + c.failure).c_str());
   }
   for (std::size_t m = 0; m < 3; ++m) {
     const WireCandidate& n8 = w.candidates[3 * m];
