@@ -25,6 +25,14 @@ constexpr double kXpbdRelaxStep = 1e-3;
 constexpr double kXpbdRelaxDamping = 0.3;
 constexpr int kXpbdMaxRelaxSteps = 20000;  // ≤ 900 taken on the guidewire scenes
 
+/// The parametric vessel's lumen for a centreline kept within `offset` (m) of the vessel's.
+std::unique_ptr<rods::RigidLumen> rigid_lumen(const VesselParams& vessel, double offset) {
+  if (vessel.kind == VesselKind::straight) {
+    return std::make_unique<rods::StraightTube>(Vec3::Zero(), Vec3::UnitZ(), offset);
+  }
+  return std::make_unique<rods::TorusBend>(Vec3::Zero(), Vec3::UnitZ(), vessel.bend_radius, offset);
+}
+
 struct GuidewireSolver::Impl {
   VesselParams vessel;
   GuidewireSpec spec;
@@ -40,11 +48,7 @@ struct GuidewireSolver::Impl {
   std::unique_ptr<rods::RigidLumen> xpbd_wall;
 
   [[nodiscard]] std::unique_ptr<rods::RigidLumen> lumen(double give) const {
-    if (vessel.kind == VesselKind::straight) {
-      return std::make_unique<rods::StraightTube>(Vec3::Zero(), Vec3::UnitZ(), offset + give);
-    }
-    return std::make_unique<rods::TorusBend>(Vec3::Zero(), Vec3::UnitZ(), vessel.bend_radius,
-                                             offset + give);
+    return rigid_lumen(vessel, offset + give);
   }
 
   /// The wire of length L against the lumen grown by `give`, from the last state (scaled about
@@ -216,7 +220,7 @@ struct GuidewireSolver::Impl {
 GuidewireSolver::GuidewireSolver(const VesselParams& vessel, const GuidewireSpec& spec,
                                  const std::string& key_prefix)
     : impl_(std::make_unique<Impl>()) {
-  require_parametric(vessel, "a guidewire load (its lumen is the vessel's centreline offset)");
+  check_guidewire(vessel, spec, key_prefix);
   Impl& m = *impl_;
   m.vessel = vessel;
   m.spec = spec;
@@ -224,13 +228,18 @@ GuidewireSolver::GuidewireSolver(const VesselParams& vessel, const GuidewireSpec
   m.material = {spec.young, spec.shear, spec.density};
   m.EI = rods::solid_section(m.material, spec.diameter).EI;
   m.offset = vessel.inner_radius - 0.5 * spec.diameter;
-  if (m.offset <= 0.0) {
+}
+
+void check_guidewire(const VesselParams& vessel, const GuidewireSpec& spec,
+                     const std::string& key_prefix) {
+  require_parametric(vessel, "a guidewire load (its lumen is the vessel's centreline offset)");
+  const double offset = vessel.inner_radius - 0.5 * spec.diameter;
+  if (offset <= 0.0) {
     throw InputError(key_prefix + "diameter: found " + std::to_string(spec.diameter) +
                      " m, expected less than the lumen's diameter " +
                      std::to_string(2.0 * vessel.inner_radius) + " m");
   }
-  const auto wall = m.lumen(0.0);
-  if (wall->gap(spec.clamp_point, nullptr, nullptr) < 0.0) {
+  if (rigid_lumen(vessel, offset)->gap(spec.clamp_point, nullptr, nullptr) < 0.0) {
     throw InputError(key_prefix + "clamp_point: the clamp is outside the lumen (its distance "
                      "from the vessel's centreline exceeds the lumen radius less the wire's)");
   }
@@ -411,25 +420,46 @@ void set_tilted_clamp(const VesselParams& vessel, double tilt, const Vec3& towar
   spec.clamp_direction = std::cos(tilt) * tangent + std::sin(tilt) * normal;
 }
 
-void resolve_guidewire(const VesselParams& vessel, const std::string& file, LoadSpec& load) {
+void solve_guidewire_load(Scene& scene) {
+  LoadSpec& load = scene.load;
+  if (!load.guidewire || load.wire) return;
+  const std::string file = scene.source.string();
+  GuidewireSolution wire;
   try {
-    GuidewireSolver solver(vessel, *load.guidewire);
-    load.wire = solver.solve_rigid();
+    GuidewireSolver solver(scene.vessel, *load.guidewire);
+    wire = solver.solve_rigid();
   } catch (const InputError& e) {
     throw InputError(file + ": " + e.what());
   } catch (const std::runtime_error& e) {
     throw InputError(file + ": load: the guidewire's solve failed: " + e.what());
   }
-  if (load.wire.force <= 0.0) {
+  if (wire.force <= 0.0) {
     throw InputError(file + ": load.insertion: the wire of " +
                      std::to_string(load.guidewire->insertion) +
                      " m does not reach the wall; expected an insertion that makes it touch");
   }
-  load.kind = LoadKind::contact;
-  load.magnitudes = {load.wire.force};
-  load.contact.point = load.wire.wall_point;
-  load.contact.direction = load.wire.normal;  // the wire's push, along the exact lumen's normal
-  load.contact.surface_group = "inner_wall";
+  load.wire = wire;
+  load.magnitudes = {wire.force};
+  load.contact.point = wire.wall_point;
+  load.contact.direction = wire.normal;  // the wire's push, along the exact lumen's normal
+}
+
+std::string describe_guidewire_solve(const GuidewireSpec& spec) {
+  std::ostringstream s;
+  if (spec.model == "external") {
+    s << "external program `";
+    for (std::size_t i = 0; i < spec.command.size(); ++i) s << (i ? " " : "") << spec.command[i];
+    s << " <manifest>` (in " << (spec.working_dir.empty() ? "." : spec.working_dir.string())
+      << ", time limit " << spec.timeout_s
+      << " s) would be run by `vesselverify run` (and the other commands that solve the "
+         "scene); not run now";
+  } else {
+    s << "the " << spec.model << " rod (" << spec.segments << " segments, EI = "
+      << rods::solid_section({spec.young, spec.shear, spec.density}, spec.diameter).EI
+      << " N·m²) against the rigid lumen would be solved by `vesselverify run` (and the other "
+         "commands that solve the scene); not solved now";
+  }
+  return s.str();
 }
 
 }  // namespace vessel

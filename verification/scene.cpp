@@ -358,7 +358,8 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
   return sweep(m, stiffness, mass, solvers, dts, radii);
 }
 
-/// The guidewire load's keys (verification/guidewire_spec.hpp); its solve is resolve_guidewire's.
+/// The guidewire load's keys (verification/guidewire_spec.hpp), checked; its solve is
+/// solve_guidewire_load's, on the run path.
 GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
   GuidewireSpec w;
   w.young = r.number(r.require("E"), "E");
@@ -427,8 +428,13 @@ LoadSpec read_load(TableReader r, const VesselParams& vessel) {
   if (type == "guidewire") {
     load.guidewire = read_guidewire(r, vessel);
     load.contact.radius = r.number_or("patch_radius");
-    resolve_guidewire(vessel, r.file(), load);
-    return load;
+    load.contact.surface_group = "inner_wall";
+    try {
+      check_guidewire(vessel, *load.guidewire);
+    } catch (const InputError& e) {
+      throw InputError(r.file() + ": " + e.what());
+    }
+    return load;  // its magnitude and point: solve_guidewire_load, on the run path
   }
   load.kind = type == "contact" ? LoadKind::contact
                                 : (type == "pressure" ? LoadKind::pressure : LoadKind::gravity);
@@ -527,6 +533,11 @@ Budget read_budget(TableReader r, const Scene& scene) {
   b.time_budget_s = r.number_or("time_budget_s", 0.0);
   if (const toml::node* m = r.get("magnitude")) {
     b.magnitude = r.number(*m, "magnitude");
+    if (scene.load.guidewire) {
+      r.fail(m, "magnitude",
+             "found with a guidewire load; expected none (its one magnitude is the wire's force, "
+             "found when the wire is solved)");
+    }
     const auto& mags = scene.load.magnitudes;
     if (std::none_of(mags.begin(), mags.end(), [&](double v) {
           return std::abs(v - b.magnitude) <= 1e-12 * std::max(std::abs(v), 1e-300);

@@ -97,10 +97,12 @@ struct LoadSpec {
   std::vector<double> magnitudes;  ///< N (contact), Pa (pressure), multiples of g (gravity)
   ContactPatchSpec contact;        ///< point, radius, surface group (force set per magnitude)
   Vec3 gravity_direction = Vec3(0.0, -1.0, 0.0);
-  /// `type = "guidewire"`: the wire (a contact load whose one magnitude and point are those of
-  /// `wire`, its solve against the rigid lumen; verification/guidewire_load.hpp).
+  /// `type = "guidewire"`: the wire, a contact load on the inner wall whose one magnitude and
+  /// point are those of `wire`, its solve against the rigid lumen. Parsing leaves `wire` empty
+  /// (and `magnitudes` with it); solve_guidewire_load (verification/guidewire_load.hpp) fills
+  /// both on the run path, where the references are computed.
   std::optional<GuidewireSpec> guidewire;
-  GuidewireSolution wire;
+  std::optional<GuidewireSolution> wire;
 };
 
 /// Standard gravity, m/s²: gravity magnitudes are multiples of it.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
 
 #include "meshes/foundation/errors.hpp"
 #include "meshes/mesh_cache.hpp"
@@ -21,7 +22,21 @@ Vec3 default_contact_point(const VesselParams& v, const std::string& surface_gro
   return {0.0, v.bend_radius + r, 0.0};
 }
 
+namespace {
+
+/// A guidewire load has its point and magnitude only once solved (solve_guidewire_load); a
+/// problem built before that would put the load nowhere.
+void require_solved(const LoadSpec& load) {
+  if (load.guidewire && !load.wire) {
+    throw std::logic_error("the scene's guidewire is not solved yet: call solve_guidewire_load "
+                           "(verification/guidewire_load.hpp) before building its problems");
+  }
+}
+
+}  // namespace
+
 Vec3 qoi_point(const Scene& s) {
+  require_solved(s.load);
   if (s.load.kind == LoadKind::contact || !s.vessel.parametric()) return s.load.contact.point;
   return default_contact_point(s.vessel, std::string(group_names::inner_wall));
 }
@@ -71,6 +86,7 @@ Supports scene_supports(const Scene& s) {
 }
 
 TractionPatch scene_contact_patch(const LoadSpec& load, const TetMesh& mesh, double force) {
+  require_solved(load);
   ContactPatchSpec spec = load.contact;
   spec.force = force;
   return contact_patch(mesh, spec);

@@ -36,9 +36,16 @@ std::string straight_scene(const std::string& load_extra, double insertion = 20.
          "\n[[models]]\nkind = \"fem\"\ndegree = 1\n";
 }
 
+/// The scene parsed, then its wire solved (as the run path does).
+Scene solved_scene(const std::string& text) {
+  Scene s = parse_scene(text, "wire.toml");
+  solve_guidewire_load(s);
+  return s;
+}
+
 std::string error_of(const std::string& text) {
   try {
-    (void)parse_scene(text, "wire.toml");
+    (void)solved_scene(text);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -46,10 +53,10 @@ std::string error_of(const std::string& text) {
 }
 
 TEST(GuidewireLoad, StraightTubeForceMatchesShootingAtTheTip) {
-  const Scene s = parse_scene(straight_scene("tilt = 0.3"), "wire.toml");
+  const Scene s = solved_scene(straight_scene("tilt = 0.3"));
   ASSERT_EQ(s.load.kind, LoadKind::contact);
   ASSERT_EQ(s.load.magnitudes.size(), 1u);
-  const GuidewireSolution& w = s.load.wire;
+  const GuidewireSolution& w = s.load.wire.value();
   EXPECT_EQ(w.contact_nodes, 1);
   // The continuum wire whose tip touches at the discrete wire's axial position z.
   const double c = kA - kD / 2, z = w.contact_point.z();
@@ -67,9 +74,9 @@ TEST(GuidewireLoad, StraightTubeForceMatchesShootingAtTheTip) {
 TEST(GuidewireLoad, ArchApexForceMatchesQuarterWaveElastica) {
   const double R = 15e-3;
   const rod_theory::ArchApexContact ref = rod_theory::arch_apex_contact((R + kA - kD / 2) / R);
-  const Scene s = parse_scene(
-      straight_scene("", ref.length * R, "kind = \"arch\"\nbend_radius = 15e-3"), "wire.toml");
-  const GuidewireSolution& w = s.load.wire;
+  const Scene s =
+      solved_scene(straight_scene("", ref.length * R, "kind = \"arch\"\nbend_radius = 15e-3"));
+  const GuidewireSolution& w = s.load.wire.value();
   EXPECT_EQ(w.contact_nodes, 1);  // no second contact
   // Bounds at about 1.5x what the scene's 32 segments reach: 1.4e-5 rad, 5.6e-4.
   EXPECT_NEAR(std::atan2(w.contact_point.y(), w.contact_point.x()), std::numbers::pi / 2, 2.2e-5);
@@ -83,9 +90,9 @@ TEST(GuidewireLoad, ClampReactionBalancesTheWallForce) {
   // balance misses by the constraint force).
   for (const char* model : {"der", "corde", "xpbd"}) {
     SCOPED_TRACE(model);
-    const Scene s = parse_scene(
-        straight_scene(std::string("tilt = 0.3\nmodel = \"") + model + "\""), "wire.toml");
-    const GuidewireSolution& w = s.load.wire;
+    const Scene s =
+        solved_scene(straight_scene(std::string("tilt = 0.3\nmodel = \"") + model + "\""));
+    const GuidewireSolution& w = s.load.wire.value();
     // The clamp holds the wire against the wall's push −F n; the wire pushes the wall by F n,
     // the patch's total load. Σ of the wire's clamp reaction and the wall's load on the wire: 0.
     ASSERT_GT(w.force, 0.0);
@@ -166,9 +173,8 @@ TEST(GuidewireCoupling, WireComplianceMatchesTheContinuumWire) {
 }
 
 TEST(GuidewireCoupling, RowsPerModelAndStiffnessFromTheOutcomesIndentation) {
-  Scene s = parse_scene(straight_scene("tilt = 0.3\ncoupling = \"compliant\"\n"
-                                       "stiffness_sweep = [4e-7, 4e-6, 4e-5]"),
-                        "wire.toml");
+  Scene s = solved_scene(straight_scene("tilt = 0.3\ncoupling = \"compliant\"\n"
+                                       "stiffness_sweep = [4e-7, 4e-6, 4e-5]"));
   const double F = s.load.magnitudes[0];
   // Two walls seen through their indentation under the rigid wire's force: the model twice as
   // compliant as the reference. C = 0.5 m/N is the straight tube's order of magnitude.
@@ -205,7 +211,7 @@ TEST(GuidewireCoupling, RowsPerModelAndStiffnessFromTheOutcomesIndentation) {
 }
 
 TEST(GuidewireResults, CentrelineRunsFromTheScenesClampToTheContactPointOnTheWall) {
-  const Scene s = parse_scene(straight_scene("tilt = 0.3\ncoupling = \"compliant\""), "wire.toml");
+  const Scene s = solved_scene(straight_scene("tilt = 0.3\ncoupling = \"compliant\""));
   ModelOutcome o;  // a wall twice as compliant as the reference's (as above)
   o.model = "m";
   o.ok = true;
@@ -243,7 +249,7 @@ TEST(GuidewireResults, CentrelineRunsFromTheScenesClampToTheContactPointOnTheWal
   EXPECT_EQ(ref["centreline_mm"].front(), nlohmann::json({0.0, 0.0, 0.0}));
   EXPECT_NEAR(radial(ref["centreline_mm"].back()), 3.0 - 0.178 + 0.5 * F * 1e3, 1e-9);
   // Rigid coupling: no reference-coupled wire.
-  const Scene r = parse_scene(straight_scene("tilt = 0.3"), "wire.toml");
+  const Scene r = solved_scene(straight_scene("tilt = 0.3"));
   EXPECT_TRUE(guidewire_json(couple_guidewire(r, {o}))["rigid"][0]["reference_coupled"].is_null());
 }
 

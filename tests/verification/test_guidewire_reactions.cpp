@@ -7,6 +7,7 @@
 #include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "test_paths.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_problems.hpp"
@@ -17,7 +18,8 @@ namespace {
 
 TEST(GuidewireReactions, WireClampAndVesselSupportsSumToZero) {
   for (const char* file : {"guidewire_straight.toml", "guidewire_arch.toml"}) {
-    const Scene s = read_scene(std::string(VESSEL_SCENES_DIR) + "/" + file);
+    Scene s = read_scene(std::string(VESSEL_SCENES_DIR) + "/" + file);
+    solve_guidewire_load(s);
     const TetMesh mesh = scene_mesh(s, 0, "");
     const ModelSpec* spec = nullptr;
     for (const ModelSpec& m : s.models) {
@@ -38,10 +40,11 @@ TEST(GuidewireReactions, WireClampAndVesselSupportsSumToZero) {
     for (int i = 0; i < p.num_dofs(); ++i) {
       if (p.fixed[i]) supports[i % 3] += g[i] - p.external_force[i];
     }
-    const Vec3 sum = s.load.wire.clamp_force + supports;
+    const Vec3 clamp = s.load.wire.value().clamp_force;
+    const Vec3 sum = clamp + supports;
     std::printf(
         "GUIDEWIRE %s: clamp (%.3e, %.3e, %.3e) N, supports (%.3e, %.3e, %.3e) N, |sum| %.2e N\n",
-        file, s.load.wire.clamp_force.x(), s.load.wire.clamp_force.y(), s.load.wire.clamp_force.z(),
+        file, clamp.x(), clamp.y(), clamp.z(),
         supports.x(), supports.y(), supports.z(), sum.norm());
     // The patch pushes along the wire's normal (the exact lumen's), not the faceted wall's mean
     // normal, which at the arch's apex parts from it by ~5e-6 rad (a 1e-8 N imbalance).
@@ -55,6 +58,7 @@ TEST(GuidewireReactions, WireClampAndVesselSupportsSumToZero) {
 // C_v/C_r ≈ 0.08, where both are near linear).
 TEST(GuidewireCouplingRun, ModelForceIsTheSeriesSpringsOnTheModelsOwnCompliance) {
   Scene s = read_scene(std::string(VESSEL_SCENES_DIR) + "/guidewire_straight.toml");
+  solve_guidewire_load(s);
   s.reference_level = 0;
   std::vector<ModelSpec> keep;
   for (const ModelSpec& m : s.models) {

@@ -6,6 +6,7 @@
 
 #include "../test_helpers.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_problems.hpp"
 
@@ -56,9 +57,15 @@ TEST(Scene, EveryShippedSceneParsesAndValidates) {
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".toml") continue;
     SCOPED_TRACE(entry.path().string());
-    const Scene s = read_scene(entry.path());
+    Scene s = read_scene(entry.path());
     EXPECT_EQ(s.name, entry.path().stem().string());
     EXPECT_FALSE(s.models.empty());
+    if (s.load.guidewire) {  // its one magnitude is the wire's force, solved on the run path
+      EXPECT_FALSE(s.load.wire.has_value());
+      solve_guidewire_load(s);
+      ASSERT_EQ(s.load.magnitudes.size(), 1u);
+      EXPECT_GT(s.load.magnitudes[0], 0.0);
+    }
     EXPECT_FALSE(s.load.magnitudes.empty());
     ++count;
   }

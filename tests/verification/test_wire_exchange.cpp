@@ -12,6 +12,7 @@
 #include "../schema_check.hpp"
 #include "../test_helpers.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/scene.hpp"
 #include "verification/wire_exchange.hpp"
 
@@ -30,6 +31,13 @@ std::string wire_scene(const std::string& model_keys) {
 std::string python_wire() {
   return "model = \"external\"\ncommand = [\"/usr/bin/python3\", \"" +
          (kExamples / "external" / "wire_model.py").string() + "\"]";
+}
+
+/// The scene parsed, then its wire solved (as the run path does).
+Scene solved_scene(const std::string& text) {
+  Scene s = parse_scene(text, "wire.toml");
+  solve_guidewire_load(s);
+  return s;
 }
 
 GuidewireSpec straight_spec() {
@@ -93,8 +101,8 @@ TEST(WireExchange, BadAnswersAreRefusedNamingTheFile) {
 
 TEST(WireExchange, TheExampleProgramIsTheScenesWireAndMeetsTheContinuumWire) {
   // The scene's load runs the user's program: its force and contact become the patch.
-  const Scene s = parse_scene(wire_scene(python_wire()), "wire.toml");
-  const GuidewireSolution& w = s.load.wire;
+  const Scene s = solved_scene(wire_scene(python_wire()));
+  const GuidewireSolution& w = s.load.wire.value();
   const double EI = 5.073e8 * std::numbers::pi * std::pow(0.356e-3, 4) / 64.0;  // E π d⁴/64
   const double z = 20.25e-3 / 1.012498;
   std::printf("WIRE-EXTERNAL example: F %.9e N (continuum %.9e N), contact (%.6e, %.6e, %.6e)\n",
@@ -107,11 +115,11 @@ TEST(WireExchange, TheExampleProgramIsTheScenesWireAndMeetsTheContinuumWire) {
   ASSERT_EQ(w.centreline.size(), 33u);
   EXPECT_EQ(w.centreline.front(), Vec3::Zero());
   // The suite's own DER on the same wire: within its discretisation error (4e-4 at N = 32).
-  const Scene der = parse_scene(wire_scene(""), "wire.toml");
-  EXPECT_NEAR(w.force / der.load.wire.force, 1.0, 1e-3);
+  const Scene der = solved_scene(wire_scene(""));
+  EXPECT_NEAR(w.force / der.load.wire.value().force, 1.0, 1e-3);
   // A failing program is the scene's error, naming the file and the program's output.
   try {
-    (void)parse_scene(wire_scene("model = \"external\"\ncommand = [\"/bin/false\"]"), "wire.toml");
+    (void)solved_scene(wire_scene("model = \"external\"\ncommand = [\"/bin/false\"]"));
     ADD_FAILURE() << "a failing wire program was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("wire.toml"), std::string::npos) << e.what();
@@ -124,4 +132,21 @@ TEST(WireExchange, TheExampleProgramIsTheScenesWireAndMeetsTheContinuumWire) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("load.command"), std::string::npos) << e.what();
   }
+}
+
+// Parsing a scene checks it and runs nothing: a wire program that would leave a marker file
+// leaves none after parse_scene (what `vesselverify scene` calls), and does when the wire is
+// solved on the run path (solve_guidewire_load).
+TEST(WireExchange, ParsingASceneRunsNoProgram) {
+  test::TempDir dir;
+  const std::filesystem::path marker = dir / "ran";
+  const std::string program =
+      "model = \"external\"\ncommand = [\"/bin/sh\", \"-c\", \"touch " + marker.string() +
+      "; exit 1\", \"sh\"]";
+  Scene s = parse_scene(wire_scene(program), "wire.toml");
+  EXPECT_FALSE(s.load.wire.has_value());
+  EXPECT_TRUE(s.load.magnitudes.empty());
+  EXPECT_FALSE(std::filesystem::exists(marker)) << "parsing the scene ran its wire program";
+  EXPECT_THROW(solve_guidewire_load(s), InputError);  // the program exits 1
+  EXPECT_TRUE(std::filesystem::exists(marker)) << "the run path did not run the wire program";
 }

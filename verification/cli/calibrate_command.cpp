@@ -9,6 +9,7 @@
 #include "reports/study_sections.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/studies/calibrate/calibrate.hpp"
 
 namespace vessel::cli {
@@ -52,14 +53,18 @@ std::filesystem::path study_output(const Options& o) {
 }
 
 void run(const Options& o) {
-  const Scene s = read_scene(o.scene);
+  Scene s = read_scene(o.scene);
+  solve_guidewire_load(s);
   CalibrateOptions c;
   c.model = o.model;
   c.granularity = parse_calibration_granularity(o.granularity);
   c.weights = parse_case_weights(o.weights);
   c.gravity = o.gravity;
   for (const auto& k : o.train) c.train.push_back(parse_kind(k));
-  for (const auto& f : o.held_out_scenes) c.other_vessels.push_back(read_scene(f));
+  for (const auto& f : o.held_out_scenes) {
+    c.other_vessels.push_back(read_scene(f));
+    solve_guidewire_load(c.other_vessels.back());
+  }
   if (o.nu >= 0.0) c.poisson_ratio = o.nu;
   if (o.level >= 0) c.level = o.level;
   if (o.reference_level >= 0) c.reference_level = o.reference_level;

@@ -5,6 +5,7 @@
 
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/harness/external_model.hpp"
 #include "verification/harness/harness.hpp"
 
@@ -21,6 +22,7 @@ struct ExportOptions {
 
 void export_scene(const ExportOptions& o) {
   Scene s = read_scene(o.scene);
+  solve_guidewire_load(s);
   if (o.quick) s = quick_variant(std::move(s));
   std::cout << "exchange folders of " << s.name << " under " << o.output_dir.string() << ":\n";
   const std::size_t cases = export_exchange(s, o.cache.mesh_dir(), o.output_dir, &std::cout);

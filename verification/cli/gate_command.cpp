@@ -13,6 +13,7 @@
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/harness/results.hpp"
 
@@ -80,6 +81,7 @@ void gate(const GateOptions& o) {
         scenes.push_back(o.quick ? quick_variant(std::move(s)) : std::move(s));
       }
     }
+    for (Scene& s : scenes) solve_guidewire_load(s);  // every wire before anything runs
     HarnessOptions h;
     h.cache_dir = o.cache.mesh_dir();
     const auto solution_cache = o.cache.solution_cache(std::cout);

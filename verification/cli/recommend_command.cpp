@@ -6,6 +6,7 @@
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/studies/recommend/recommend.hpp"
 
 namespace vessel::cli {
@@ -69,6 +70,7 @@ std::filesystem::path rate_dir(const Options& o, double rate_hz) {
 
 void run(const Options& o) {
   Scene s = read_scene(o.scene);
+  solve_guidewire_load(s);
   if (!s.budget.stated) {
     // No [budget]: the defaults of issue #7 (contact point, the scene's tolerance, 30 Hz visual).
     s.budget.stated = true;

@@ -8,6 +8,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/harness/distributed_references.hpp"
 #include "verification/harness/harness.hpp"
 
@@ -47,6 +48,7 @@ void run(const ReferenceOptions& o) {
   // --reference-level; the other sweeps of `run` change the models, not the references).
   std::vector<Scene> scenes;
   for (const auto& f : o.scenes) scenes.push_back(read_scene(f));
+  for (Scene& s : scenes) solve_guidewire_load(s);  // the load's point sets the references' patch
   for (Scene& s : scenes) {
     if (o.quick) s = quick_variant(std::move(s));
     if (!o.poisson_ratios.empty()) s.poisson_ratios = o.poisson_ratios;

@@ -5,6 +5,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/jobs_option.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/harness/timed_updates.hpp"
@@ -56,6 +57,7 @@ void apply_sweeps(const RunOptions& o, Scene& s) {
 void run(const RunOptions& o) {
   std::vector<Scene> scenes;
   for (const auto& f : o.scenes) scenes.push_back(read_scene(f));  // validate all before running
+  for (Scene& s : scenes) solve_guidewire_load(s);  // a wire that cannot load its vessel stops here
   for (Scene& s : scenes) {
     if (o.quick) s = quick_variant(std::move(s));
     apply_sweeps(o, s);

@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "verification/cli/commands.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_keys.hpp"
 
@@ -17,15 +18,12 @@ void print_scene(const Scene& s) {
   for (double nu : s.poisson_ratios) std::cout << " " << nu;
   std::cout << ", ρ = " << s.density << " kg/m³\n  boundary:";
   for (const auto& [group, bc] : s.boundary) std::cout << " " << group << "=" << to_string(bc);
-  std::cout << "\n  load: " << to_string(s.load.kind) << ", " << s.load.magnitudes.size()
-            << " magnitude(s)";
   if (s.load.guidewire) {
-    const GuidewireSolution& w = s.load.wire;
-    std::cout << " from a guidewire (" << s.load.guidewire->model << ", "
-              << s.load.guidewire->segments << " segments, EI = " << w.bending_stiffness
-              << " N·m²) against the rigid lumen: " << w.force * 1e3 << " mN at ("
-              << w.wall_point.x() * 1e3 << ", " << w.wall_point.y() * 1e3 << ", "
-              << w.wall_point.z() * 1e3 << ") mm";
+    std::cout << "\n  load: contact on the inner wall, its force and point the guidewire's\n"
+              << "  guidewire: " << describe_guidewire_solve(*s.load.guidewire);
+  } else {
+    std::cout << "\n  load: " << to_string(s.load.kind) << ", " << s.load.magnitudes.size()
+              << " magnitude(s)";
   }
   std::cout << "\n  models:";
   for (const auto& m : s.models) std::cout << " " << m.name << " (" << to_string(m.kind) << ")";
@@ -39,7 +37,8 @@ void add_scene_command(CLI::App& app) {
   auto schema = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand(
       "scene",
-      "Validate scene files (TOML) and print what each would run. Unknown keys, wrong types and "
+      "Validate scene files (TOML) and print what each would run (nothing is solved or run: a "
+      "guidewire's solve, or its external program, is left to `run`). Unknown keys, wrong types and "
       "out-of-range values are reported with file, line and key. --schema prints every key "
       "(type, default, unit, range, meaning) as JSON Schema; docs/scene_reference.md is made "
       "from it.\n"

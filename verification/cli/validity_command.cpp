@@ -8,6 +8,7 @@
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/cli/jobs_option.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/studies/validity/validity.hpp"
 
 namespace vessel::cli {
@@ -105,6 +106,7 @@ void add_validity_command(CLI::App& app, const std::string& command_line) {
     vo.log = &std::cout;
     std::vector<Scene> scenes;
     for (const fs::path& p : o->scenes) scenes.push_back(read_scene(p));
+    for (Scene& s : scenes) solve_guidewire_load(s);
     const ValidityStudy study = run_validity_study(scenes, vo, o->jobs, command_line);
     print_validity_summary(study, std::cout);
     write_validity_json(study, o->output_dir / "validity.json");

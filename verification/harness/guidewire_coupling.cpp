@@ -4,6 +4,7 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <nlohmann/json.hpp>
 
 #include "msm/rods/rod_layout.hpp"
@@ -139,6 +140,10 @@ nlohmann::json reference_wire_json(const GuidewireRigid& r) {
 }  // namespace
 
 GuidewireOutcome couple_guidewire(const Scene& s, const std::vector<ModelOutcome>& outcomes) {
+  if (!s.load.wire) {
+    throw std::logic_error("couple_guidewire: the scene's guidewire is not solved yet "
+                           "(solve_guidewire_load)");
+  }
   GuidewireOutcome g;
   g.spec = *s.load.guidewire;
   g.patch_radius = s.load.contact.radius;

@@ -14,6 +14,7 @@
 #include "../../test_helpers.hpp"
 #include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
+#include "verification/guidewire_load.hpp"
 #include "verification/studies/recommend/wire_candidates.hpp"
 
 using namespace vessel;
@@ -25,6 +26,7 @@ const double kEI = 5.073e8 * std::numbers::pi * std::pow(0.356e-3, 4) / 64.0;
 
 Scene scene_with_budget(const std::string& file, double tolerance_mm) {
   Scene s = read_scene(std::string(VESSEL_SCENES_DIR) + "/" + file);
+  solve_guidewire_load(s);
   s.budget.stated = true;
   s.budget.quantity = BudgetQuantity::contact_point;
   s.budget.tolerance = tolerance_mm;
