@@ -1,6 +1,9 @@
 /// The serial displacement system on its unconstrained DoFs as Eigen matrices (stiffness,
 /// consistent mass, load), for the modal analysis, the Newmark transient and a simulator's
 /// prefactored linear FEM (free_displacement_system).
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+
 #include <stdexcept>
 
 #include "fem_reference/detail/serial_solver.hpp"
@@ -58,8 +61,15 @@ ElasticitySolver::Impl::FreeSystem ElasticitySolver::Impl::assemble_free_system(
   std::vector<Index> dofs(n);
   std::vector<unsigned> comp(n);
   for (unsigned i = 0; i < n; ++i) comp[i] = fe->system_to_component_index(i).first;
-  dl::SparseMatrix<double> kd(sparsity), md;
-  if (with_mass) md.reinit(sparsity);
+  dl::SparsityPattern own;  // the matrix-free solver builds no pattern of its own
+  if (sparsity.empty()) {
+    dl::DynamicSparsityPattern dsp(dof.n_dofs(), dof.n_dofs());
+    dl::DoFTools::make_sparsity_pattern(dof, dsp, constraints, false);
+    own.copy_from(dsp);
+  }
+  const dl::SparsityPattern& pattern = sparsity.empty() ? own : sparsity;
+  dl::SparseMatrix<double> kd(pattern), md;
+  if (with_mass) md.reinit(pattern);
   dl::Vector<double> fd(dof.n_dofs());
   for (const auto& cell : dof.active_cell_iterators()) {
     form->local_system(cell, values, k, f, nullptr);  // leaves values.cell on this cell
