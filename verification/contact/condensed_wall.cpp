@@ -1,5 +1,6 @@
 #include "verification/contact/condensed_wall.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 #include <string>
@@ -29,17 +30,25 @@ CondensedWall::CondensedWall(fem::FreeDisplacementSystem system, std::vector<int
   factor_ = std::make_unique<fem::CholmodFactor>(system_.K);
   const auto m = static_cast<Eigen::Index>(nodes_.size());
   compliance_.resize(m, m);
-  for (Eigen::Index j = 0; j < m; ++j) {
-    Eigen::VectorXd unit = Eigen::VectorXd::Zero(m);
-    unit[j] = 1.0;
-    const Eigen::VectorXd u = factor_->solve(load_vector(unit));
+  constexpr Eigen::Index kBlock = 32;  // columns per blocked solve: n × 32 doubles at a time
+  for (Eigen::Index first = 0; first < m; first += kBlock) {
+    const Eigen::Index cols = std::min(kBlock, m - first);
+    Eigen::MatrixXd B(system_.K.rows(), cols);
+    for (Eigen::Index j = 0; j < cols; ++j) {
+      Eigen::VectorXd unit = Eigen::VectorXd::Zero(m);
+      unit[first + j] = 1.0;
+      B.col(j) = load_vector(unit);
+    }
+    const Eigen::MatrixXd U = factor_->solve_block(B);
     for (Eigen::Index i = 0; i < m; ++i) {
       const auto& rows = system_.node_rows[static_cast<std::size_t>(nodes_[i])];
-      double along = 0.0;
-      for (int c = 0; c < 3; ++c) {
-        if (rows[c] >= 0) along += directions_[i][c] * u[rows[c]];
+      for (Eigen::Index j = 0; j < cols; ++j) {
+        double along = 0.0;
+        for (int c = 0; c < 3; ++c) {
+          if (rows[c] >= 0) along += directions_[i][c] * U(rows[c], j);
+        }
+        compliance_(i, first + j) = along;
       }
-      compliance_(i, j) = along;
     }
   }
   compliance_ = 0.5 * (compliance_ + compliance_.transpose()).eval();  // symmetric to round-off
