@@ -32,6 +32,7 @@ FLOORS = [
     "msm/rods",
     "msm/benchmarks",
     "fem_reference",
+    "verification/contact",
     "reports",
     "verification/scene",
     "verification/harness",
