@@ -247,7 +247,7 @@ TEST(LumenCli, YBifurcationListsItsEndsAndItsHoledTwinIsRefusedNamingEachHole) {
       {"outlet", vessel::Vec3(-L * std::sin(a), 0, L * std::cos(a)), spec.daughter_radius * 1e3},
       {"outlet", vessel::Vec3(L * std::sin(a), 0, L * std::cos(a)), spec.daughter_radius * 1e3}};
   expect_ends(printed_ends(clean.output), expected, clean.output);
-  // The same in --stats-json, unrounded; each end's normal along its tube's axis.
+  // The same in --stats-json, unrounded.
   const auto stats = nlohmann::json::parse(read_text(dir / "stats.json"));
   ASSERT_EQ(stats["lumen_ends"].size(), 3u) << stats.dump();
   for (const PrintedEnd& want : expected) {
@@ -260,8 +260,8 @@ TEST(LumenCli, YBifurcationListsItsEndsAndItsHoledTwinIsRefusedNamingEachHole) {
       EXPECT_EQ(e["group"].get<std::string>(), want.group);
       EXPECT_NEAR(e["radius_mm"].get<double>(), want.radius_mm, 1e-3);
       const auto n = e["normal"].get<std::vector<double>>();
-      EXPECT_NEAR(std::abs(vessel::Vec3(n[0], n[1], n[2]).dot(want.centre_mm.normalized())), 1.0,
-                  1e-6);
+      // Along the tube's axis, into the vessel: from the end towards the junction at the origin.
+      EXPECT_NEAR(vessel::Vec3(n[0], n[1], n[2]).dot(-want.centre_mm.normalized()), 1.0, 1e-6);
       // A polygon inscribed in the circle: its area just under πr².
       const double circle = M_PI * want.radius_mm * want.radius_mm;
       EXPECT_LT(e["area_mm2"].get<double>(), circle);
@@ -283,6 +283,20 @@ TEST(LumenCli, YBifurcationListsItsEndsAndItsHoledTwinIsRefusedNamingEachHole) {
   EXPECT_TRUE(contains(holed.output, "around (0, 3.25, 0) mm, radius 1.3 mm")) << holed.output;
   EXPECT_TRUE(contains(holed.output, "around (0, -3.25, 0) mm, radius 1.3 mm")) << holed.output;
   EXPECT_FALSE(contains(holed.output, "ends of the lumen")) << holed.output;
+  // `scene` lists the clean one's ends and refuses the holed one the same way.
+  for (const std::string name : {"y", "holed"}) {
+    write_text(dir / (name + ".toml"),
+               "name = \"" + name + "\"\n[vessel]\nlumen = \"" + name +
+                   ".stl\"\nwall_thickness = 0.4e-3\n[load]\ntype = \"contact\"\n"
+                   "magnitudes = [1e-4]\npoint = [3e-3, 0, -6e-3]\n[[models]]\nkind = \"fem\"\n");
+  }
+  const auto scene = vv("scene " + (dir / "y.toml").string());
+  EXPECT_EQ(scene.exit_code, 0) << scene.output;
+  expect_ends(printed_ends(scene.output), expected, scene.output);
+  const auto holed_scene = vv("scene " + (dir / "holed.toml").string());
+  EXPECT_EQ(holed_scene.exit_code, 1) << holed_scene.output;
+  EXPECT_TRUE(contains(holed_scene.output, "holed.stl: 2 holes where no end should be"))
+      << holed_scene.output;
 }
 
 namespace {
