@@ -342,28 +342,43 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
     ends.push_back(describe_end(lumen.nodes, loop, &lumen.triangles));
     largest = std::max(largest, ends.back().radius);
   }
+  // Every loop that is not an end is named (a segmentation often leaves more than one hole).
+  std::vector<std::string> holes;
+  bool in_wall = false;  // a loop that fails the steepness criterion alone
   for (const LumenEnd& e : ends) {
     const int edges = static_cast<int>(e.loop.size());
     if (edges < kMinEndEdges || e.planarity > kMaxEndPlanarity ||
         e.radius < kMinEndRadiusRatio * largest) {
-      throw InputError(
-          source + ": a hole where no end should be: an open loop of " + std::to_string(edges) +
-          " edges around " + mm(e.centre) + ", radius " + num(e.radius * 1e3) +
-          " mm, its nodes up to " + num(100.0 * e.planarity, 3) +
-          " % of its radius off its plane; expected every open loop to be an end (at least " +
-          std::to_string(kMinEndEdges) + " edges, within " + num(100.0 * kMaxEndPlanarity, 3) +
-          " % of one plane, radius at least " + num(100.0 * kMinEndRadiusRatio, 3) +
-          " % of the largest end's " + num(largest * 1e3) + " mm): fill the hole or cut the end flat");
-    }
-    if (e.steepness < kMinEndSteepness) {
+      holes.push_back("an open loop of " + std::to_string(edges) + " edges around " + mm(e.centre) +
+                      ", radius " + num(e.radius * 1e3) + " mm, its nodes up to " +
+                      num(100.0 * e.planarity, 3) +
+                      " % of its radius off its plane; expected every open "
+                      "loop to be an end (at least " +
+                      std::to_string(kMinEndEdges) + " edges, within " +
+                      num(100.0 * kMaxEndPlanarity, 3) + " % of one plane, radius at least " +
+                      num(100.0 * kMinEndRadiusRatio, 3) + " % of the largest end's " +
+                      num(largest * 1e3) + " mm): fill the hole or cut the end flat");
+    } else if (e.steepness < kMinEndSteepness) {
       const double angle = std::asin(std::clamp(e.steepness, 0.0, 1.0)) * 180.0 / std::numbers::pi;
-      throw InputError(
-          source + ": a hole where no end should be: the open loop around " + mm(e.centre) +
-          ", radius " + num(e.radius * 1e3) + " mm, lies in the vessel's wall (the surface meets "
-          "its plane at " + num(angle, 3) + "°, not across it; an end is a cut across the vessel, "
-          "which the wall leaves at more than 45°); expected every open loop to be an end of the "
-          "vessel: fill the hole in the surface, or, if it is an end, cut it square to the vessel");
+      holes.push_back("the open loop around " + mm(e.centre) + ", radius " + num(e.radius * 1e3) +
+                      " mm, lies in the vessel's wall (the surface meets its plane at " +
+                      num(angle, 3) + "°, not across it)");
+      in_wall = true;
     }
+  }
+  if (in_wall) {
+    holes.back() +=
+        "; an end is a cut across the vessel, which the wall leaves at more than 45°: "
+        "expected every open loop to be an end of the vessel: fill the hole in the "
+        "surface, or, if it is an end, cut it square to the vessel";
+  }
+  if (!holes.empty()) {
+    std::string message =
+        source + ": " +
+        (holes.size() == 1 ? std::string("a hole") : std::to_string(holes.size()) + " holes") +
+        " where no end should be: ";
+    for (std::size_t h = 0; h < holes.size(); ++h) message += (h ? "; " : "") + holes[h];
+    throw InputError(message);
   }
   if (ends.size() < 2) {
     throw InputError(source + ": the lumen has one open end (around " + mm(ends[0].centre) +

@@ -57,7 +57,8 @@ inline constexpr double kMinVesselSize = 1e-3;
 ///   touch;
 /// - inconsistently oriented: two triangles traversing a shared edge in the same direction;
 /// - closed: no open end (an inlet and at least one outlet are needed);
-/// - a hole: a boundary loop that fails the end criteria above, or fewer than two ends;
+/// - holes: every boundary loop that fails the end criteria above, each named (centre, radius);
+///   or fewer than two ends;
 /// - inside out: with every end closed by a fan, the enclosed volume is negative (the normals
 ///   point into the lumen; expected outward, into the wall);
 /// - self-intersecting: two triangles that share no vertex cross (an edge of one passes through

@@ -339,11 +339,12 @@ TEST(LumenMesh, YBifurcationWithHolesInItsJunctionIsRefusedNamingAHole) {
   EXPECT_EQ(holes, 2);
   EXPECT_EQ(ends, 3);
   const std::string message = refusal(lumen, "holed.stl");
-  // Either hole, whichever loop comes first.
-  EXPECT_NE(message.find("holed.stl: a hole where no end should be: the open loop around (0, "),
+  // Both holes named, each by its centre (0, ±√(R_j² − ρ²), 0) = (0, ±3.25, 0) mm and radius.
+  EXPECT_NE(message.find("holed.stl: 2 holes where no end should be: the open loop around (0, "),
             std::string::npos)
       << message;
-  EXPECT_NE(message.find("3.25, 0) mm, radius 1.3 mm"), std::string::npos) << message;
+  EXPECT_NE(message.find("(0, 3.25, 0) mm, radius 1.3 mm"), std::string::npos) << message;
+  EXPECT_NE(message.find("(0, -3.25, 0) mm, radius 1.3 mm"), std::string::npos) << message;
   EXPECT_NE(message.find("radius 1.3 mm, lies in the vessel's wall"), std::string::npos) << message;
   EXPECT_NE(message.find("fill the hole in the surface, or, if it is an end, cut it square"),
             std::string::npos)
