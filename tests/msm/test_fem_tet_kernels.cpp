@@ -1,7 +1,8 @@
 // The P1 tet kernels of msm/fem against independent truth: the linear tet stiffness against a
-// hand-derived single-tet stiffness and Kikuuwe et al.'s edge-pair formula at rest; every term's
-// energy, gradient and Hessian (and the rotation's derivative) against central finite differences;
-// the stable neo-Hookean Hessian at rest against the linear stiffness with Macklin & Müller's λ.
+// hand-derived single-tet stiffness, msm/stiffness's P1 matrix and Kikuuwe et al.'s edge-pair
+// formula at rest; every term's energy, gradient and Hessian (and the rotation's derivative)
+// against central finite differences; the stable neo-Hookean Hessian at rest against the linear
+// stiffness with Macklin & Müller's λ.
 #include <gtest/gtest.h>
 
 #include <iostream>
@@ -12,6 +13,7 @@
 #include "msm/fem/linear_tet.hpp"
 #include "msm/fem/polar_rotation.hpp"
 #include "msm/fem/stable_neo_hookean.hpp"
+#include "msm/stiffness/stiffness_rules.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;
@@ -72,6 +74,15 @@ TEST(LinearTet, StiffnessEqualsTheEdgePairFormulaAtRest) {
   const Mat12 K = linear_tet_stiffness(tet_rest_shape(kRest), kLame);
   const Mat12 Kp = edge_pair_hessian(kRest, kRest, edge_pair_coefficients(kRest, kLame), false);
   EXPECT_LT((K - Kp).norm(), 1e-10 * K.norm());
+}
+
+TEST(LinearTet, StiffnessEqualsTheStiffnessRulesP1Matrix) {
+  // msm/stiffness's P1 tet matrix (shape-function gradients, E and ν) is written independently.
+  const double l = kLame.lambda, m = kLame.mu;
+  const double E = m * (3 * l + 2 * m) / (l + m), nu = l / (2 * (l + m));
+  const Mat12 K = linear_tet_stiffness(tet_rest_shape(kRest), kLame);
+  const Eigen::MatrixXd Kr = fem_tet_stiffness(kRest, E, nu);
+  EXPECT_LT((K - Kr).norm(), 1e-10 * K.norm());
 }
 
 TEST(FemTetKernels, EachTermMatchesFiniteDifferences) {
