@@ -161,6 +161,22 @@ TEST(FemTetKernels, RotationDerivativeMatchesFiniteDifferences) {
   }
 }
 
+TEST(CorotationalTet, GradientIsMuellerGrossForce) {
+  // Müller & Gross 2004: f = R K₀ (Rᵀx − X), R the polar rotation of F (a stretched, turned tet).
+  const TetRestShape s = tet_rest_shape(kRest);
+  const Mat3 A = Eigen::AngleAxisd(1.3, Vec3(-1, 2, 0.5).normalized()).toRotationMatrix() *
+                 Eigen::Vector3d(1.1, 0.9, 1.2).asDiagonal();
+  const Eigen::VectorXd x = deformed(A, 0.05e-3, 11);
+  const Corners c{x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), x.segment<3>(9)};
+  const Mat3 R = rotated_svd(deformation_gradient(c, s)).rotation;
+  Vec12 unrotated, f;
+  for (int a = 0; a < 4; ++a) unrotated.segment<3>(3 * a) = R.transpose() * c[a] - kRest[a];
+  const Vec12 k0u = linear_tet_stiffness(s, kLame) * unrotated;
+  for (int a = 0; a < 4; ++a) f.segment<3>(3 * a) = R * k0u.segment<3>(3 * a);
+  const Vec12 g = corotational_tet_gradient(c, s, kLame);
+  EXPECT_LT((g - f).norm(), 1e-10 * f.norm());
+}
+
 TEST(CorotationalTet, WarpedStiffnessIsRotatedRestStiffnessAndConsistentAtRest) {
   const TetRestShape s = tet_rest_shape(kRest);
   const Mat12 K0 = linear_tet_stiffness(s, kLame);
