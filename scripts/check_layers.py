@@ -22,6 +22,7 @@ FLOORS = [
     "msm/stiffness",
     "msm/mass",
     "msm/terms",
+    "msm/fem",
     "msm/model",
     "msm/formats",
     "msm/pbd",
