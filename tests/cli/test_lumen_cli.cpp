@@ -27,15 +27,15 @@ bool contains(const std::string& s, const std::string& what) {
   return s.find(what) != std::string::npos;
 }
 
-
 }  // namespace
 
 TEST(LumenCli, BifurcationRunsEndToEndWithItsReport) {
   TempDir dir;
   // The example scene of the README, on a lumen made afresh by gmsh.
   vessel::test::write_bifurcation_stl(dir / "bifurcation_lumen.stl");
-  std::filesystem::copy_file(std::filesystem::path(VESSEL_EXAMPLES_DIR) / "bifurcation" / "bifurcation.toml",
-                             dir / "bifurcation.toml");
+  std::filesystem::copy_file(
+      std::filesystem::path(VESSEL_EXAMPLES_DIR) / "bifurcation" / "bifurcation.toml",
+      dir / "bifurcation.toml");
   const std::string out = (dir / "out").string();
   const auto mesh = vv("mesh --lumen " + (dir / "bifurcation_lumen.stl").string() +
                        " --wall-thickness 0.5e-3 --no-cache");
@@ -95,7 +95,8 @@ TEST(LumenCli, BifurcationRunsEndToEndWithItsReport) {
 
 TEST(LumenCli, FemOnAMeshFileAndOnALumenBalancesItsLoad) {
   TempDir dir;
-  write_stl(dir / "tube.stl", vessel::test::polygon_tube(3e-3, 20e-3, 16, 8), vessel::StlFormat::ascii);
+  write_stl(dir / "tube.stl", vessel::test::polygon_tube(3e-3, 20e-3, 16, 8),
+            vessel::StlFormat::ascii);
   vessel::VesselParams p;
   p.kind = vessel::VesselKind::lumen;
   p.file = dir / "tube.stl";
@@ -123,7 +124,8 @@ TEST(LumenCli, FemOnAMeshFileAndOnALumenBalancesItsLoad) {
     const auto applied = r.output.find("applied load");
     ASSERT_NE(applied, std::string::npos);
     double f[3];
-    std::sscanf(r.output.c_str() + r.output.find('(', applied), "(%lf, %lf, %lf)", &f[0], &f[1], &f[2]);
+    std::sscanf(r.output.c_str() + r.output.find('(', applied), "(%lf, %lf, %lf)", &f[0], &f[1],
+                &f[2]);
     // (printed to 6 digits per component)
     EXPECT_NEAR(std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]), 0.1, 1e-5) << r.output;
   }
@@ -137,7 +139,8 @@ TEST(LumenCli, RefusalsNameTheFile) {
   EXPECT_TRUE(contains(r.output, "mm.stl: the lumen's bounding box")) << r.output;
   EXPECT_TRUE(contains(r.output, "looks like millimetres; scale by 1e-3 or set units = \"mm\""))
       << r.output;
-  r = vv("mesh --lumen " + (dir / "mm.stl").string() + " --units mm --wall-thickness 1e-3 --no-cache");
+  r = vv("mesh --lumen " + (dir / "mm.stl").string() +
+         " --units mm --wall-thickness 1e-3 --no-cache");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   write_text(dir / "s.toml",
              "name = \"x\"\n[vessel]\nfile = \"none.msh\"\n[load]\ntype = \"pressure\"\n"
@@ -297,6 +300,44 @@ TEST(LumenCli, YBifurcationListsItsEndsAndItsHoledTwinIsRefusedNamingEachHole) {
   EXPECT_EQ(holed_scene.exit_code, 1) << holed_scene.output;
   EXPECT_TRUE(contains(holed_scene.output, "holed.stl: 2 holes where no end should be"))
       << holed_scene.output;
+
+  // Listed by hand (the scene's inlet_centre and outlet_centres, m): the holes, named as outlets,
+  // are accepted as ends, and a daughter listed as the inlet becomes it.
+  const std::string load =
+      "[load]\ntype = \"contact\"\nmagnitudes = [1e-4]\npoint = [3e-3, 0, -6e-3]\n"
+      "[[models]]\nkind = \"fem\"\n";
+  const auto m = [](const vessel::Vec3& x_mm) {
+    return "[" + std::to_string(x_mm.x() * 1e-3) + ", " + std::to_string(x_mm.y() * 1e-3) + ", " +
+           std::to_string(x_mm.z() * 1e-3) + "]";
+  };
+  write_text(dir / "listed.toml",
+             "name = \"listed\"\n[vessel]\nlumen = \"holed.stl\"\nwall_thickness = 0.4e-3\n"
+             "inlet_centre = " +
+                 m(expected[2].centre_mm) + "\noutlet_centres = [" + m(expected[0].centre_mm) +
+                 ", " + m(expected[1].centre_mm) + ", " + m(vessel::Vec3(0, cut, 0)) + ", " +
+                 m(vessel::Vec3(0, -cut, 0)) + "]\n" + load);
+  const auto listed = vv("scene " + (dir / "listed.toml").string());
+  EXPECT_EQ(listed.exit_code, 0) << listed.output;
+  EXPECT_TRUE(contains(listed.output, "ends of the lumen: 5\n")) << listed.output;
+  const auto ends = printed_ends(listed.output);
+  int inlets = 0;
+  for (const auto& e : ends) {
+    if (e.group != "inlet") continue;
+    ++inlets;
+    EXPECT_LT((e.centre_mm - expected[2].centre_mm).norm(), 0.01) << listed.output;
+  }
+  EXPECT_EQ(inlets, 1) << listed.output;
+  // One of the pair alone is refused, naming the key and what is missing.
+  write_text(dir / "half.toml",
+             "name = \"half\"\n[vessel]\nlumen = \"y.stl\"\nwall_thickness = 0.4e-3\n"
+             "outlet_centres = [" +
+                 m(expected[1].centre_mm) + "]\n" + load);
+  const auto half = vv("scene " + (dir / "half.toml").string());
+  EXPECT_EQ(half.exit_code, 1) << half.output;
+  EXPECT_TRUE(contains(half.output,
+                       "half.toml:5: key 'vessel.outlet_centres': found without "
+                       "inlet_centre"))
+      << half.output;
 }
 
 namespace {

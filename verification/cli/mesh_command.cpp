@@ -133,7 +133,7 @@ void run(MeshCommandOptions& o) {
   }
   nlohmann::json ends = nlohmann::json::array();
   if (generated && params.kind == VesselKind::lumen) {
-    const auto named = lumen_file_ends(params.file, params.file_scale);
+    const auto named = lumen_file_ends(params.file, params.file_scale, params.listed_ends);
     std::cout << "ends of the lumen: " << named.size() << "\n";
     for (const auto& [group, e] : named) {
       std::cout << "  " << std::left << std::setw(7) << group << std::right << format_end(e)

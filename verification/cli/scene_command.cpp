@@ -16,7 +16,7 @@ void print_scene(const Scene& s) {
   std::cout << "  vessel: " << describe(s.vessel) << "; reference level " << s.reference_level
             << "\n";
   if (s.vessel.kind == VesselKind::lumen) {
-    const auto ends = lumen_file_ends(s.vessel.file, s.vessel.file_scale);
+    const auto ends = lumen_file_ends(s.vessel.file, s.vessel.file_scale, s.vessel.listed_ends);
     std::cout << "  ends of the lumen: " << ends.size() << "\n";
     for (const auto& [group, e] : ends) {
       std::cout << "    " << group << ": " << format_end(e) << "\n";

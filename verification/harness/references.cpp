@@ -308,7 +308,7 @@ namespace {
 void describe_meshes(SceneReferences& r, std::ostream& log) {
   const Scene& s = r.scene;
   if (s.vessel.kind == VesselKind::lumen) {
-    r.lumen_ends = lumen_file_ends(s.vessel.file, s.vessel.file_scale);
+    r.lumen_ends = lumen_file_ends(s.vessel.file, s.vessel.file_scale, s.vessel.listed_ends);
     log << "  ends of the lumen: " << r.lumen_ends.size() << "\n";
     for (const auto& [group, end] : r.lumen_ends) {
       log << "    " << group << ": " << format_end(end) << "\n";
