@@ -212,6 +212,8 @@ struct FreeDisplacementSystem {
   Eigen::SparseMatrix<double> K;  ///< N/m, symmetric positive definite, both triangles stored
   Eigen::VectorXd f;              ///< N
   std::vector<int> free_index;    ///< per DoF (this solver's numbering) its row, −1 if constrained
+  /// Per TetMesh node, the rows of its x, y and z displacement (−1 where constrained).
+  std::vector<std::array<int, 3>> node_rows;
 };
 
 /// Solves a linear-elastic problem on one mesh and keeps the solution for point evaluation.

@@ -113,7 +113,15 @@ FreeDisplacementSystem ElasticitySolver::free_displacement_system() const {
         "(Taylor-Hood) system is indefinite");
   }
   Impl::FreeSystem sys = impl_->assemble_free_system(false);
-  return {std::move(sys.K), std::move(sys.f), std::move(sys.free_index)};
+  // Each node's rows through its vertex DoFs, shifted by one so that a node no cell uses (left at
+  // zero by nodal()) reads −1 like a constrained one (rows fit a double exactly).
+  const std::vector<Vec3> rows =
+      impl_->nodal([&](Index dof) { return static_cast<double>(sys.free_index[dof] + 1); });
+  std::vector<std::array<int, 3>> node_rows(rows.size());
+  for (std::size_t n = 0; n < rows.size(); ++n) {
+    for (int c = 0; c < 3; ++c) node_rows[n][c] = static_cast<int>(rows[n][c]) - 1;
+  }
+  return {std::move(sys.K), std::move(sys.f), std::move(sys.free_index), std::move(node_rows)};
 }
 
 }  // namespace vessel::fem

@@ -21,12 +21,12 @@
 #   default  the scenes' own levels, loads and sweeps (contact up to 1 mN, where the linear
 #            reference holds; seed 000's range is the validity study's, against the
 #            finite-strain reference, to 70 mN); the stability table at levels 0-1 with a
-#            2·10^5-step long run; level-0 recommendation candidates (~8 min from an empty
-#            cache on 2 cores, ~70 s once cached)
+#            2·10^5-step long run; level-0 recommendation candidates (times, from an
+#            empty cache and cached: docs/measurements/verify_times.md)
 #   --quick  models and the P2 reference on level 0 (the models' own mesh, so no estimate of
 #            the reference's uncertainty), smallest and largest load, the validity study at 0.1,
 #            1 and 10 mN, the quick stability study, recommendations against P2 on level 0
-#            (~100 s from an empty cache; ~25 s once cached)
+#            (docs/measurements/verify_times.md)
 #   --full   the default plus the stability table at level 2, the 10^6-step long run, the
 #            level-1 recommendation candidates and the validity study at the scenes' reference
 #            level on the dense ladder (not measured: P2 level 1 costs ~10 s per Newton

@@ -60,16 +60,54 @@ TEST(WireCandidates, ContinuumWiresAreTheShootingAndElasticaValues) {
   EXPECT_NE(why.find("clamped on the axis"), std::string::npos) << why;
 }
 
+TEST(WireCandidates, OnFixedTimingsTheRecommendedWireMeetsTheBudgetAndEveryFasterOneMissesIt) {
+  // The candidates' errors from their solves; their times per update fixed (N × a per-model
+  // cost, XPBD the cheapest), so which candidates are fast enough does not depend on the machine.
+  Scene s = scene_with_budget("guidewire_straight.toml", 1e-3);  // mm on the contact point
+  WireRecommendation w = recommend_wire(s, {"der", "corde", "xpbd"}, {8, 16, 32});
+  ASSERT_TRUE(w.reference.has_value()) << w.no_reference;
+  ASSERT_EQ(w.candidates.size(), 9u);
+  const double per_segment[3] = {1e-5, 2e-5, 1e-6};  // s: DER, CORDE, XPBD
+  const int segments[3] = {8, 16, 32};
+  for (std::size_t i = 0; i < 9; ++i) {
+    ASSERT_TRUE(w.candidates[i].ok) << w.candidates[i].failure;
+    w.candidates[i].update_seconds = segments[i % 3] * per_segment[i / 3];
+  }
+  // At N = 8 every model misses 1e-3 mm (its contact error is ~1.7e-3 mm; second order in N),
+  // at N = 16 every one meets it: XPBD at N = 16 is the cheapest meeting both.
+  const Selection sel = judge_wire(w.candidates, s.budget);
+  ASSERT_TRUE(sel.recommended.has_value());
+  const WireCandidate& best = w.candidates[*sel.recommended];
+  EXPECT_EQ(best.name, "wire/xpbd @ N16");
+  EXPECT_LE(best.error, s.budget.tolerance);
+  EXPECT_LE(best.update_seconds, s.budget.seconds_per_update());
+  std::size_t faster = 0;
+  for (std::size_t i = 0; i < 9; ++i) {
+    if (w.candidates[i].update_seconds >= best.update_seconds) continue;
+    ++faster;
+    EXPECT_GT(w.candidates[i].error, s.budget.tolerance) << w.candidates[i].name;
+    EXPECT_EQ(sel.verdicts[i], Verdict::too_inaccurate) << w.candidates[i].name;
+  }
+  EXPECT_EQ(faster, 1u);  // XPBD at N = 8: the choice was not simply the fastest
+
+  // A time budget only XPBD at N = 8 meets: nothing meets both, and nothing is recommended.
+  s.budget.time_budget_s = 1.2e-5;
+  const Selection none = judge_wire(w.candidates, s.budget);
+  EXPECT_FALSE(none.recommended.has_value());
+  ASSERT_TRUE(none.closest.has_value());
+}
+
 TEST(WireCandidates, ErrorsFallWithSegmentsAndTheCheapestPassingOneIsRecommended) {
   const Scene s = scene_with_budget("guidewire_straight.toml", 0.02);
   const WireRecommendation w = recommend_wire(s, {"der", "corde", "xpbd"}, {8, 16, 32});
   ASSERT_TRUE(w.reference.has_value()) << w.no_reference;
   ASSERT_EQ(w.candidates.size(), 9u);
   for (const WireCandidate& c : w.candidates) {
-    std::printf("WIRE-CANDIDATE %s: F %.6e N, force error %.4e mN, contact error %.4e mm, "
-                "update %.3e s, set-up %.3e s%s\n",
-                c.name.c_str(), c.force, c.force_error_mN, c.contact_error_mm, c.update_seconds,
-                c.setup_seconds, c.ok ? "" : (" FAILED: " + c.failure).c_str());
+    std::printf(
+        "WIRE-CANDIDATE %s: F %.6e N, force error %.4e mN, contact error %.4e mm, "
+        "update %.3e s, set-up %.3e s%s\n",
+        c.name.c_str(), c.force, c.force_error_mN, c.contact_error_mm, c.update_seconds,
+        c.setup_seconds, c.ok ? "" : (" FAILED: " + c.failure).c_str());
   }
   for (std::size_t m = 0; m < 3; ++m) {
     const WireCandidate& n8 = w.candidates[3 * m];
