@@ -35,7 +35,7 @@ enum class Formulation { automatic, displacement, mixed };
 /// direct: CHOLMOD (displacement) or UMFPACK (mixed); cg_amg: CG with AMG (displacement only);
 /// gmres_block: FGMRES with a block-triangular AMG / pressure-mass preconditioner (mixed only);
 /// matrix_free: CG on the matrix-free operator with a P2 → P1 p-multigrid and AMG on P1
-/// (displacement only; no P2 matrix is assembled, docs/measurements/matrix_free_solver.md).
+/// (displacement only; no P2 matrix is assembled).
 /// The values are part of the FEM solution cache's key: append, never renumber.
 enum class LinearSolver { automatic, direct, cg_amg, gmres_block, matrix_free };
 

@@ -68,7 +68,7 @@ class ElasticityOperator : public dl::Subscriptor {
 /// The constraints' pattern with zero inhomogeneities (what MatrixFree and the transfer need).
 dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<double>& constraints);
 
-/// Settings of the p-multigrid V-cycle (measured in docs/measurements/matrix_free_solver.md).
+/// Settings of the p-multigrid V-cycle.
 struct PMultigridSettings {
   unsigned chebyshev_degree = 4;      ///< matrix-vector products per smoothing step
   double smoothing_range = 20.0;      ///< Chebyshev smooths [λ_max / range, λ_max] of D⁻¹A
