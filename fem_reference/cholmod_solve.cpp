@@ -91,8 +91,8 @@ Eigen::VectorXd solve_spd_cholmod_keeping_factor(const Eigen::SparseMatrix<doubl
   std::shared_ptr<KeptFactor> entry;
   {
     const std::lock_guard lock(kept_mutex);
-    const auto it = std::find_if(kept.begin(), kept.end(),
-                                 [&](const auto& e) { return identical(e->K, A); });
+    const auto it =
+        std::find_if(kept.begin(), kept.end(), [&](const auto& e) { return identical(e->K, A); });
     if (it != kept.end()) {
       entry = *it;
       kept.splice(kept.begin(), kept, it);
@@ -123,6 +123,13 @@ Eigen::VectorXd CholmodFactor::solve(const Eigen::VectorXd& b) const {
   Eigen::VectorXd x = impl_->llt.solve(b);
   if (impl_->llt.info() != Eigen::Success) throw std::runtime_error("CHOLMOD solve failed");
   return x;
+}
+
+Eigen::MatrixXd CholmodFactor::solve_block(const Eigen::MatrixXd& B) const {
+  apply_solver_threads();
+  Eigen::MatrixXd X = impl_->llt.solve(B);
+  if (impl_->llt.info() != Eigen::Success) throw std::runtime_error("CHOLMOD solve failed");
+  return X;
 }
 
 struct CholmodSamePattern::Impl {

@@ -62,6 +62,8 @@ std::string to_string(LinearSolver s) {
       return "cg-amg";
     case LinearSolver::gmres_block:
       return "gmres-block";
+    case LinearSolver::matrix_free:
+      return "matrix-free";
   }
   return "?";
 }
@@ -98,17 +100,26 @@ void ElasticitySolver::Impl::setup_dofs() {
   for (const auto& cell : dof.active_cell_iterators()) cells[cell->active_cell_index()] = cell;
 
   constraints.clear();
-  detail::add_point_constraints(mesh, problem.point_constraints, dof, mesh_map.vertex_node,
-                                constraints);
-  detail::add_dirichlet_constraints(mesh, problem.dirichlet, *mapping, dof, constraints);
+  support_constraints(dof, constraints);
   constraints.close();
+  if (problem.options.solver != LinearSolver::matrix_free) ensure_matrix();
+  rhs.reinit(dof.n_dofs());
+  solution.reinit(dof.n_dofs());
+}
 
+void ElasticitySolver::Impl::support_constraints(const dl::DoFHandler<kDim>& dof_handler,
+                                                 dl::AffineConstraints<double>& c) const {
+  detail::add_point_constraints(mesh, problem.point_constraints, dof_handler,
+                                mesh_map.vertex_node, c);
+  detail::add_dirichlet_constraints(mesh, problem.dirichlet, *mapping, dof_handler, c);
+}
+
+void ElasticitySolver::Impl::ensure_matrix() {
+  if (!sparsity.empty()) return;
   dl::DynamicSparsityPattern dsp(dof.n_dofs(), dof.n_dofs());
   dl::DoFTools::make_sparsity_pattern(dof, dsp, constraints, false);
   sparsity.copy_from(dsp);
   matrix.reinit(sparsity);
-  rhs.reinit(dof.n_dofs());
-  solution.reinit(dof.n_dofs());
 }
 
 void ElasticitySolver::Impl::setup_curved_mapping() {
@@ -188,10 +199,18 @@ ElasticitySolver::~ElasticitySolver() = default;
 const ElasticityResult& ElasticitySolver::solve() {
   auto& im = *impl_;
   auto t0 = Clock::now();
-  im.assemble();
-  im.result.timings.assembly = seconds_since(t0);
-  t0 = Clock::now();
-  im.solve_linear(true, im.problem.options.keep_factor ? DirectReuse::factor : DirectReuse::nothing);
+  if (im.problem.options.solver == LinearSolver::matrix_free) {
+    im.assemble_load();
+    im.result.timings.assembly = seconds_since(t0);
+    t0 = Clock::now();
+    im.solve_displacement_matrix_free();
+  } else {
+    im.assemble();
+    im.result.timings.assembly = seconds_since(t0);
+    t0 = Clock::now();
+    im.solve_linear(true,
+                    im.problem.options.keep_factor ? DirectReuse::factor : DirectReuse::nothing);
+  }
   im.result.timings.solve = seconds_since(t0);
   t0 = Clock::now();
   im.postprocess();

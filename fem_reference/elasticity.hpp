@@ -33,8 +33,11 @@ struct Material {
 /// Displacement-only (P1 or P2) or mixed displacement–pressure (Taylor–Hood P2–P1).
 enum class Formulation { automatic, displacement, mixed };
 /// direct: CHOLMOD (displacement) or UMFPACK (mixed); cg_amg: CG with AMG (displacement only);
-/// gmres_block: FGMRES with a block-triangular AMG / pressure-mass preconditioner (mixed only).
-enum class LinearSolver { automatic, direct, cg_amg, gmres_block };
+/// gmres_block: FGMRES with a block-triangular AMG / pressure-mass preconditioner (mixed only);
+/// matrix_free: CG on the matrix-free operator with a P2 → P1 p-multigrid and AMG on P1
+/// (displacement only; no P2 matrix is assembled).
+/// The values are part of the FEM solution cache's key: append, never renumber.
+enum class LinearSolver { automatic, direct, cg_amg, gmres_block, matrix_free };
 
 /// A Dirichlet condition on the nodes of a boundary group (a dim-2 physical group).
 struct DirichletCondition {
@@ -209,6 +212,8 @@ struct FreeDisplacementSystem {
   Eigen::SparseMatrix<double> K;  ///< N/m, symmetric positive definite, both triangles stored
   Eigen::VectorXd f;              ///< N
   std::vector<int> free_index;    ///< per DoF (this solver's numbering) its row, −1 if constrained
+  /// Per TetMesh node, the rows of its x, y and z displacement (−1 where constrained).
+  std::vector<std::array<int, 3>> node_rows;
 };
 
 /// Solves a linear-elastic problem on one mesh and keeps the solution for point evaluation.
@@ -230,6 +235,12 @@ class ElasticitySolver {
   [[nodiscard]] FreeDisplacementSystem free_displacement_system() const;
 
   [[nodiscard]] const ElasticityResult& result() const;
+
+  /// A u by the matrix-free operator (N per DoF), for u (m) in this solver's DoF numbering: the
+  /// stiffness a(u, v) on the unconstrained DoFs, the identity on the constrained ones. The same
+  /// bilinear form free_displacement_system() assembles (compare them on its free rows).
+  /// Displacement formulation only (InputError for the mixed one); does not need solve().
+  [[nodiscard]] std::vector<double> matrix_free_product(const std::vector<double>& u) const;
 
   /// The solved DoF values (displacement, and pressure for the mixed formulation), in this
   /// solver's DoF numbering, which depends only on the mesh and the problem. Requires solve().

@@ -1,6 +1,9 @@
 /// The serial displacement system on its unconstrained DoFs as Eigen matrices (stiffness,
 /// consistent mass, load), for the modal analysis, the Newmark transient and a simulator's
 /// prefactored linear FEM (free_displacement_system).
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+
 #include <stdexcept>
 
 #include "fem_reference/detail/serial_solver.hpp"
@@ -58,8 +61,15 @@ ElasticitySolver::Impl::FreeSystem ElasticitySolver::Impl::assemble_free_system(
   std::vector<Index> dofs(n);
   std::vector<unsigned> comp(n);
   for (unsigned i = 0; i < n; ++i) comp[i] = fe->system_to_component_index(i).first;
-  dl::SparseMatrix<double> kd(sparsity), md;
-  if (with_mass) md.reinit(sparsity);
+  dl::SparsityPattern own;  // the matrix-free solver builds no pattern of its own
+  if (sparsity.empty()) {
+    dl::DynamicSparsityPattern dsp(dof.n_dofs(), dof.n_dofs());
+    dl::DoFTools::make_sparsity_pattern(dof, dsp, constraints, false);
+    own.copy_from(dsp);
+  }
+  const dl::SparsityPattern& pattern = sparsity.empty() ? own : sparsity;
+  dl::SparseMatrix<double> kd(pattern), md;
+  if (with_mass) md.reinit(pattern);
   dl::Vector<double> fd(dof.n_dofs());
   for (const auto& cell : dof.active_cell_iterators()) {
     form->local_system(cell, values, k, f, nullptr);  // leaves values.cell on this cell
@@ -103,7 +113,15 @@ FreeDisplacementSystem ElasticitySolver::free_displacement_system() const {
         "(Taylor-Hood) system is indefinite");
   }
   Impl::FreeSystem sys = impl_->assemble_free_system(false);
-  return {std::move(sys.K), std::move(sys.f), std::move(sys.free_index)};
+  // Each node's rows through its vertex DoFs, shifted by one so that a node no cell uses (left at
+  // zero by nodal()) reads −1 like a constrained one (rows fit a double exactly).
+  const std::vector<Vec3> rows =
+      impl_->nodal([&](Index dof) { return static_cast<double>(sys.free_index[dof] + 1); });
+  std::vector<std::array<int, 3>> node_rows(rows.size());
+  for (std::size_t n = 0; n < rows.size(); ++n) {
+    for (int c = 0; c < 3; ++c) node_rows[n][c] = static_cast<int>(rows[n][c]) - 1;
+  }
+  return {std::move(sys.K), std::move(sys.f), std::move(sys.free_index), std::move(node_rows)};
 }
 
 }  // namespace vessel::fem

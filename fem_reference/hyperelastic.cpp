@@ -106,6 +106,7 @@ struct HyperelasticSolver::Impl {
 
   Impl(const TetMesh& mesh, ElasticityProblem problem, HyperelasticOptions o)
       : linear(mesh, std::move(problem)), d(*linear.impl_), opt(o) {
+    d.ensure_matrix();
     material = NeoHookean::of(d.problem.material);
     mixed = d.mixed;
     inv_lambda = std::isinf(material.lambda) ? 0.0 : 1.0 / material.lambda;

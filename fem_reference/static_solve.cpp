@@ -19,6 +19,7 @@
 namespace vessel::fem {
 
 void ElasticitySolver::Impl::assemble() {
+  ensure_matrix();
   detail::CellValues values(*mapping, *fe, degree);
   const unsigned n = fe->n_dofs_per_cell();
   dl::FullMatrix<double> k(n, n);
@@ -33,7 +34,7 @@ void ElasticitySolver::Impl::assemble() {
   result.applied_load = applied;
 }
 
-namespace {
+namespace detail {
 
 /// The solver `automatic` picks, or InputError for a solver that does not fit the system.
 LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dofs) {
@@ -49,6 +50,11 @@ LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dof
         "(Taylor-Hood) system is indefinite: use gmres-block (block-preconditioned FGMRES) or "
         "direct");
   }
+  if (s == LinearSolver::matrix_free && mixed) {
+    throw InputError(
+        "solver matrix-free is for the displacement system (P1, P2); the mixed (Taylor-Hood) "
+        "system needs gmres-block or direct");
+  }
   if (s == LinearSolver::gmres_block && !mixed) {
     throw InputError(
         "solver gmres-block is for the mixed (Taylor-Hood) system; the displacement system is "
@@ -57,10 +63,10 @@ LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dof
   return s;
 }
 
-}  // namespace
+}  // namespace detail
 
 void ElasticitySolver::Impl::solve_linear(bool symmetric, DirectReuse reuse) {
-  LinearSolver s = chosen_solver(problem.options, mixed, dof.n_dofs());
+  LinearSolver s = detail::chosen_solver(problem.options, mixed, dof.n_dofs());
   if (!symmetric && !mixed && s == LinearSolver::cg_amg) {
     if (problem.options.solver == LinearSolver::cg_amg) {
       throw InputError(
@@ -68,6 +74,11 @@ void ElasticitySolver::Impl::solve_linear(bool symmetric, DirectReuse reuse) {
           "pressure is not symmetric: use direct (UMFPACK)");
     }
     s = LinearSolver::direct;
+  }
+  if (s == LinearSolver::matrix_free) {
+    throw InputError(
+        "solver matrix-free solves the linear reference only; the finite-strain tangent needs "
+        "direct or cg-amg");
   }
   result.solver = s;
   if (rhs.l2_norm() == 0.0) {

@@ -23,8 +23,8 @@ double cleaned(double v) { return std::round(v * 1e6) / 1e6 + 0.0; }
 std::string mm(const Vec3& p) {
   std::ostringstream s;
   s.precision(4);
-  s << "(" << cleaned(p.x() * 1e3) << ", " << cleaned(p.y() * 1e3) << ", "
-    << cleaned(p.z() * 1e3) << ") mm";
+  s << "(" << cleaned(p.x() * 1e3) << ", " << cleaned(p.y() * 1e3) << ", " << cleaned(p.z() * 1e3)
+    << ") mm";
   return s.str();
 }
 
@@ -68,8 +68,7 @@ bool segment_crosses(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b,
   return (s1 > eps && s2 > eps && s3 > eps) || (s1 < -eps && s2 < -eps && s3 < -eps);
 }
 
-bool triangles_cross(const std::vector<Vec3>& x, const Triangle& s, const Triangle& t,
-                     double eps) {
+bool triangles_cross(const std::vector<Vec3>& x, const Triangle& s, const Triangle& t, double eps) {
   for (int k = 0; k < 3; ++k) {
     if (segment_crosses(x[s[k]], x[s[(k + 1) % 3]], x[t[0]], x[t[1]], x[t[2]], eps)) return true;
     if (segment_crosses(x[t[k]], x[t[(k + 1) % 3]], x[s[0]], x[s[1]], x[s[2]], eps)) return true;
@@ -94,11 +93,11 @@ std::vector<Vec3> vertex_normals(const std::vector<Vec3>& x, const std::vector<T
 
 /// Dompierre et al. 1999 (Table 2): the prism's rotations/reflections bringing slot k to slot 0.
 constexpr std::array<std::array<int, 6>, 6> kPrismIndirection{{{0, 1, 2, 3, 4, 5},
-                                                                 {1, 2, 0, 4, 5, 3},
-                                                                 {2, 0, 1, 5, 3, 4},
-                                                                 {3, 5, 4, 0, 2, 1},
-                                                                 {4, 3, 5, 1, 0, 2},
-                                                                 {5, 4, 3, 2, 1, 0}}};
+                                                               {1, 2, 0, 4, 5, 3},
+                                                               {2, 0, 1, 5, 3, 4},
+                                                               {3, 5, 4, 0, 2, 1},
+                                                               {4, 3, 5, 1, 0, 2},
+                                                               {5, 4, 3, 2, 1, 0}}};
 
 /// The three tets of a prism (slots 0–2 bottom, 3–5 top, slot k+3 above slot k) as slots, chosen
 /// by the smallest global index so that neighbouring prisms split their shared quads alike; each
@@ -209,8 +208,8 @@ std::string format_end(const LumenEnd& e) {
   std::ostringstream s;
   s.precision(4);
   s << mm(e.centre) << ", radius " << e.radius * 1e3 << " mm, normal (" << cleaned(e.normal.x())
-    << ", " << cleaned(e.normal.y()) << ", " << cleaned(e.normal.z()) << "), area "
-    << e.area * 1e6 << " mm²";
+    << ", " << cleaned(e.normal.y()) << ", " << cleaned(e.normal.z()) << "), area " << e.area * 1e6
+    << " mm²";
   return s.str();
 }
 
@@ -248,7 +247,8 @@ std::vector<std::pair<int, int>> crossing_triangles(const std::vector<Vec3>& x,
     hi[t] = cell_of(b.max());
     for (int i = lo[t].x(); i <= hi[t].x(); ++i) {
       for (int j = lo[t].y(); j <= hi[t].y(); ++j) {
-        for (int k = lo[t].z(); k <= hi[t].z(); ++k) grid[key(i, j, k)].push_back(static_cast<int>(t));
+        for (int k = lo[t].z(); k <= hi[t].z(); ++k)
+          grid[key(i, j, k)].push_back(static_cast<int>(t));
       }
     }
   }
@@ -306,7 +306,8 @@ void check_lumen_edges(const TriangleSurface& lumen, const std::string& source) 
   for (const auto& [edge, uses] : edge_uses(lumen.triangles)) {
     if (uses.size() > 2) {
       std::string facets;
-      for (const auto& u : uses) facets += (facets.empty() ? "" : ", ") + std::to_string(u.triangle + 1);
+      for (const auto& u : uses)
+        facets += (facets.empty() ? "" : ", ") + std::to_string(u.triangle + 1);
       throw InputError(source + ": the surface is not manifold: the edge from " +
                        mm(lumen.nodes[edge.first]) + " to " + mm(lumen.nodes[edge.second]) +
                        " is shared by " + std::to_string(uses.size()) + " facets (" + facets +
@@ -324,7 +325,48 @@ void check_lumen_edges(const TriangleSurface& lumen, const std::string& source) 
 
 }  // namespace
 
-std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view source_view) {
+namespace {
+
+/// With ends listed: every loop is one of them and each listed centre is one loop's, else an
+/// InputError naming what is unmatched (the criteria of the unlisted case are not applied).
+void match_listed_ends(const std::vector<LumenEnd>& ends, const ListedEnds& listed,
+                       const std::string& source) {
+  std::vector<int> loops_of(listed.outlets.size() + 1, 0);
+  std::vector<std::string> problems;
+  for (const LumenEnd& e : ends) {
+    const int k = listed_end(e, listed);
+    if (k < 0) {
+      problems.push_back("the open loop around " + mm(e.centre) + ", radius " +
+                         num(e.radius * 1e3) + " mm, is none of the listed ends");
+    } else {
+      ++loops_of[static_cast<std::size_t>(k)];
+    }
+  }
+  for (std::size_t k = 0; k < loops_of.size(); ++k) {
+    if (loops_of[k] == 1) continue;
+    const Vec3& c = k == 0 ? listed.inlet : listed.outlets[k - 1];
+    const std::string name =
+        k == 0 ? "inlet_centre " : "outlet_centres[" + std::to_string(k - 1) + "] ";
+    problems.push_back(name + mm(c) +
+                       (loops_of[k] == 0
+                            ? " is the centre of no open loop"
+                            : " matches " + std::to_string(loops_of[k]) + " open loops"));
+  }
+  if (!problems.empty()) {
+    std::string message = source + ": the ends listed in the scene ([vessel] inlet_centre, " +
+                          "outlet_centres) do not match the lumen's open loops: ";
+    for (std::size_t p = 0; p < problems.size(); ++p) message += (p ? "; " : "") + problems[p];
+    throw InputError(message + "; expected each open loop's centre within " +
+                     num(100.0 * kListedEndTolerance, 3) +
+                     " % of its radius of exactly one listed centre (`vesselverify mesh --lumen` "
+                     "lists the loops it finds)");
+  }
+}
+
+}  // namespace
+
+std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view source_view,
+                                  const ListedEnds& listed) {
   const std::string source(source_view);
   if (lumen.triangles.empty()) throw InputError(source + ": the lumen surface has no triangles");
   check_lumen_size(lumen, source);
@@ -333,7 +375,8 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
   // Ends: every boundary loop must look like a cut end of the vessel.
   const std::vector<std::vector<int>> loops = boundary_loops(lumen, source);
   if (loops.empty()) {
-    throw InputError(source + ": the lumen surface is closed (no open end); expected it open "
+    throw InputError(source +
+                     ": the lumen surface is closed (no open end); expected it open "
                      "at its inlet and outlets (remove the caps, so each end is a loop of edges)");
   }
   std::vector<LumenEnd> ends;
@@ -342,28 +385,45 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
     ends.push_back(describe_end(lumen.nodes, loop, &lumen.triangles));
     largest = std::max(largest, ends.back().radius);
   }
-  for (const LumenEnd& e : ends) {
+  if (listed.given()) match_listed_ends(ends, listed, source);
+  // Every loop that is not an end is named (a segmentation often leaves more than one hole).
+  std::vector<std::string> holes;
+  bool in_wall = false;  // a loop that fails the steepness criterion alone
+  // Listed ends replace the criteria: then no loop is judged by them.
+  for (const LumenEnd& e : listed.given() ? std::vector<LumenEnd>{} : ends) {
     const int edges = static_cast<int>(e.loop.size());
     if (edges < kMinEndEdges || e.planarity > kMaxEndPlanarity ||
         e.radius < kMinEndRadiusRatio * largest) {
-      throw InputError(
-          source + ": a hole where no end should be: an open loop of " + std::to_string(edges) +
-          " edges around " + mm(e.centre) + ", radius " + num(e.radius * 1e3) +
-          " mm, its nodes up to " + num(100.0 * e.planarity, 3) +
-          " % of its radius off its plane; expected every open loop to be an end (at least " +
-          std::to_string(kMinEndEdges) + " edges, within " + num(100.0 * kMaxEndPlanarity, 3) +
-          " % of one plane, radius at least " + num(100.0 * kMinEndRadiusRatio, 3) +
-          " % of the largest end's " + num(largest * 1e3) + " mm): fill the hole or cut the end flat");
-    }
-    if (e.steepness < kMinEndSteepness) {
+      holes.push_back("an open loop of " + std::to_string(edges) + " edges around " + mm(e.centre) +
+                      ", radius " + num(e.radius * 1e3) + " mm, its nodes up to " +
+                      num(100.0 * e.planarity, 3) +
+                      " % of its radius off its plane; expected every open "
+                      "loop to be an end (at least " +
+                      std::to_string(kMinEndEdges) + " edges, within " +
+                      num(100.0 * kMaxEndPlanarity, 3) + " % of one plane, radius at least " +
+                      num(100.0 * kMinEndRadiusRatio, 3) + " % of the largest end's " +
+                      num(largest * 1e3) + " mm): fill the hole or cut the end flat");
+    } else if (e.steepness < kMinEndSteepness) {
       const double angle = std::asin(std::clamp(e.steepness, 0.0, 1.0)) * 180.0 / std::numbers::pi;
-      throw InputError(
-          source + ": a hole where no end should be: the open loop around " + mm(e.centre) +
-          ", radius " + num(e.radius * 1e3) + " mm, lies in the vessel's wall (the surface meets "
-          "its plane at " + num(angle, 3) + "°, not across it; an end is a cut across the vessel, "
-          "which the wall leaves at more than 45°); expected every open loop to be an end of the "
-          "vessel: fill the hole in the surface, or, if it is an end, cut it square to the vessel");
+      holes.push_back("the open loop around " + mm(e.centre) + ", radius " + num(e.radius * 1e3) +
+                      " mm, lies in the vessel's wall (the surface meets its plane at " +
+                      num(angle, 3) + "°, not across it)");
+      in_wall = true;
     }
+  }
+  if (in_wall) {
+    holes.back() +=
+        "; an end is a cut across the vessel, which the wall leaves at more than 45°: "
+        "expected every open loop to be an end of the vessel: fill the hole in the "
+        "surface, or, if it is an end, cut it square to the vessel";
+  }
+  if (!holes.empty()) {
+    std::string message =
+        source + ": " +
+        (holes.size() == 1 ? std::string("a hole") : std::to_string(holes.size()) + " holes") +
+        " where no end should be: ";
+    for (std::size_t h = 0; h < holes.size(); ++h) message += (h ? "; " : "") + holes[h];
+    throw InputError(message);
   }
   if (ends.size() < 2) {
     throw InputError(source + ": the lumen has one open end (around " + mm(ends[0].centre) +
@@ -383,8 +443,10 @@ std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view
     }
   }
   if (volume6 < 0.0) {
-    throw InputError(source + ": the lumen is inside out: its facet normals point into the lumen "
-                     "(the volume it encloses, ends closed, is " + num(volume6 / 6.0 * 1e9) +
+    throw InputError(source +
+                     ": the lumen is inside out: its facet normals point into the lumen "
+                     "(the volume it encloses, ends closed, is " +
+                     num(volume6 / 6.0 * 1e9) +
                      " mm³); expected them outward, away from the blood and into the wall: "
                      "reverse every facet's vertex order");
   }
@@ -428,7 +490,24 @@ TriangleSurface subdivide_surface(const TriangleSurface& surface, int times) {
   return s;
 }
 
-int inlet_end(const std::vector<LumenEnd>& ends) {
+int listed_end(const LumenEnd& end, const ListedEnds& listed) {
+  if (!listed.given()) return -1;
+  const double within = kListedEndTolerance * end.radius;
+  if ((listed.inlet - end.centre).norm() <= within) return 0;
+  for (std::size_t k = 0; k < listed.outlets.size(); ++k) {
+    if ((listed.outlets[k] - end.centre).norm() <= within) return static_cast<int>(k) + 1;
+  }
+  return -1;
+}
+
+int inlet_end(const std::vector<LumenEnd>& ends, const ListedEnds& listed) {
+  if (listed.given()) {
+    for (int e = 0; e < static_cast<int>(ends.size()); ++e) {
+      if (listed_end(ends[e], listed) == 0) return e;
+    }
+    throw std::logic_error(
+        "inlet_end: no loop matches the listed inlet (check_lumen refuses that)");
+  }
   int inlet = 0;
   for (int e = 1; e < static_cast<int>(ends.size()); ++e) {
     if (ends[e].area > kInletAreaTie * ends[inlet].area) inlet = e;
@@ -476,7 +555,7 @@ std::vector<std::vector<int>> lumen_neighbours(const TriangleSurface& lumen, int
 /// A wall extruded along given normals, and what its tets say about them.
 struct Extrusion {
   TetMesh mesh;
-  std::size_t inverted = 0;             ///< tets of (near) zero or negative volume
+  std::size_t inverted = 0;            ///< tets of (near) zero or negative volume
   Vec3 first_inverted = Vec3::Zero();  ///< the first one's centroid
   std::vector<char> near_flat;         ///< per lumen node: in a prism with a near-flat tet
 };
@@ -504,8 +583,8 @@ Extrusion extrude_along(const TriangleSurface& lumen, const std::vector<Vec3>& n
         const Vec3 &a = mesh.nodes[tet[0]], &b = mesh.nodes[tet[1]], &c = mesh.nodes[tet[2]],
                    &d = mesh.nodes[tet[3]];
         double longest = 0.0;
-        for (const auto& [p, q] : {std::pair{&a, &b}, {&a, &c}, {&a, &d}, {&b, &c},
-                                   {&b, &d}, {&c, &d}}) {
+        for (const auto& [p, q] :
+             {std::pair{&a, &b}, {&a, &c}, {&a, &d}, {&b, &c}, {&b, &d}, {&c, &d}}) {
           longest = std::max(longest, (*p - *q).norm());
         }
         const double v = signed_volume(a, b, c, d), l3 = longest * longest * longest;
@@ -557,7 +636,8 @@ void check_outer_wall(const TetMesh& mesh, const TriangleSurface& lumen, int lay
   const int n = static_cast<int>(lumen.nodes.size());
   const auto id = [n](int layer, int i) { return layer * n + i; };
   std::vector<Triangle> outer;
-  for (const Triangle& t : lumen.triangles) outer.push_back({id(layers, t[0]), id(layers, t[1]), id(layers, t[2])});
+  for (const Triangle& t : lumen.triangles)
+    outer.push_back({id(layers, t[0]), id(layers, t[1]), id(layers, t[2])});
   const auto crossing = crossing_triangles(mesh.nodes, outer, 1);
   if (!crossing.empty()) {
     Vec3 c = Vec3::Zero();
@@ -572,9 +652,9 @@ void check_outer_wall(const TetMesh& mesh, const TriangleSurface& lumen, int lay
 /// Boundary groups: lumen layer → inner wall, last layer → outer wall, else the end of its loop
 /// (the inlet or an outlet); every tet in the wall.
 void add_vessel_groups(TetMesh& mesh, const std::vector<LumenEnd>& ends,
-                       const std::vector<int>& end_of, int layers) {
+                       const std::vector<int>& end_of, int layers, const ListedEnds& listed) {
   const int n = static_cast<int>(end_of.size());
-  const int inlet = inlet_end(ends);
+  const int inlet = inlet_end(ends, listed);
   std::map<std::string_view, PhysicalGroup> groups;
   for (const auto& spec : kVesselGroups) {
     groups[spec.name] = PhysicalGroup{std::string(spec.name), spec.dim, spec.tag, {}};
@@ -606,7 +686,8 @@ void add_vessel_groups(TetMesh& mesh, const std::vector<LumenEnd>& ends,
 }  // namespace
 
 TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>& ends,
-                      double thickness, int layers, std::string_view source_view) {
+                      double thickness, int layers, std::string_view source_view,
+                      const ListedEnds& listed) {
   const std::string source(source_view);
   if (!(thickness > 0.0) || !std::isfinite(thickness)) {
     throw InputError(source + ": wall_thickness: expected a finite value > 0 m, got " +
@@ -637,7 +718,7 @@ TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>&
   }
   TetMesh mesh = std::move(x.mesh);
   check_outer_wall(mesh, lumen, layers, thickness, source);
-  add_vessel_groups(mesh, ends, end_of, layers);
+  add_vessel_groups(mesh, ends, end_of, layers, listed);
   sort_elements(mesh);
   orient_boundary_outward(mesh);
   require_vessel_groups(mesh, source);
@@ -645,11 +726,12 @@ TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>&
 }
 
 std::vector<std::pair<std::string, LumenEnd>> lumen_file_ends(const std::filesystem::path& file,
-                                                              double scale) {
+                                                              double scale,
+                                                              const ListedEnds& listed) {
   TriangleSurface lumen = read_stl(file);
   for (Vec3& x : lumen.nodes) x *= scale;
-  const std::vector<LumenEnd> ends = check_lumen(lumen, file.string());
-  const int inlet = inlet_end(ends);
+  const std::vector<LumenEnd> ends = check_lumen(lumen, file.string(), listed);
+  const int inlet = inlet_end(ends, listed);
   std::vector<std::pair<std::string, LumenEnd>> named;
   for (int e = 0; e < static_cast<int>(ends.size()); ++e) {
     named.emplace_back(std::string(e == inlet ? group_names::inlet : group_names::outlet), ends[e]);
@@ -670,11 +752,11 @@ TetMesh lumen_wall_mesh(const LumenWallParams& p) {
   }
   TriangleSurface lumen = read_stl(p.file);
   for (Vec3& x : lumen.nodes) x *= p.scale;
-  check_lumen(lumen, source);
+  check_lumen(lumen, source, p.listed);
   const TriangleSurface fine = subdivide_surface(lumen, p.level);
   std::vector<LumenEnd> ends;
   for (auto& loop : boundary_loops(fine, source)) ends.push_back(describe_end(fine.nodes, loop));
-  return extrude_lumen(fine, ends, p.thickness, lumen_wall_layers(p.level), source);
+  return extrude_lumen(fine, ends, p.thickness, lumen_wall_layers(p.level), source, p.listed);
 }
 
 }  // namespace vessel

@@ -11,6 +11,7 @@
 
 #include "meshes/stl_io.hpp"
 #include "meshes/tet_mesh.hpp"
+#include "meshes/vessel_geometry.hpp"
 
 namespace vessel {
 
@@ -57,13 +58,23 @@ inline constexpr double kMinVesselSize = 1e-3;
 ///   touch;
 /// - inconsistently oriented: two triangles traversing a shared edge in the same direction;
 /// - closed: no open end (an inlet and at least one outlet are needed);
-/// - a hole: a boundary loop that fails the end criteria above, or fewer than two ends;
+/// - holes: every boundary loop that fails the end criteria above, each named (centre, radius);
+///   or fewer than two ends;
 /// - inside out: with every end closed by a fan, the enclosed volume is negative (the normals
 ///   point into the lumen; expected outward, into the wall);
 /// - self-intersecting: two triangles that share no vertex cross (an edge of one passes through
 ///   the other), found through a uniform grid of their bounding boxes.
 /// Facets are named 1-based in file order (read_stl keeps it).
-std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view source);
+/// With `listed` given, the loops are the listed ends instead of what the end criteria say: every
+/// loop must match one listed centre (listed_end), every listed centre one loop, else InputError
+/// naming the loop or the listed centre.
+std::vector<LumenEnd> check_lumen(const TriangleSurface& lumen, std::string_view source,
+                                  const ListedEnds& listed = {});
+
+/// A listed centre matches a loop within kListedEndTolerance × the loop's radius of its centre.
+inline constexpr double kListedEndTolerance = 0.5;
+/// Which listed end the loop is: 0 the inlet, k ≥ 1 outlets[k − 1], −1 none (or no list).
+int listed_end(const LumenEnd& end, const ListedEnds& listed);
 
 /// The boundary loops of an edge-manifold, consistently oriented triangle surface, each in the
 /// direction its triangles traverse it; InputError naming `source` for a vertex on more than one
@@ -90,7 +101,8 @@ inline constexpr double kInletAreaTie = 1.01;
 /// The end that becomes the inlet: the largest area, where a later end must be more than 1 % larger
 /// than the one chosen so far to replace it (ends are listed by their smallest node index, so of
 /// two equal ends the one whose node comes first in the file is the inlet). All others: outlet.
-int inlet_end(const std::vector<LumenEnd>& ends);
+/// With `listed` given: the loop matching its inlet.
+int inlet_end(const std::vector<LumenEnd>& ends, const ListedEnds& listed = {});
 
 /// Splits every triangle into four at its edge midpoints, `times` times (each halves the edges).
 TriangleSurface subdivide_surface(const TriangleSurface& surface, int times);
@@ -113,7 +125,8 @@ inline constexpr int kMaxNormalSmoothingPasses = 100;
 /// inverts (the lumen curves more tightly than the wall is thick) or the outer wall crosses itself
 /// (two parts of the vessel closer than the thickness).
 TetMesh extrude_lumen(const TriangleSurface& lumen, const std::vector<LumenEnd>& ends,
-                      double thickness, int layers, std::string_view source);
+                      double thickness, int layers, std::string_view source,
+                      const ListedEnds& listed = {});
 
 /// Everything that determines the wall mesh of a lumen file.
 struct LumenWallParams {
@@ -121,12 +134,14 @@ struct LumenWallParams {
   double thickness = 0.0;  ///< m
   double scale = 1.0;      ///< file units → m (1e-3 for a file in millimetres)
   int level = 0;           ///< 0..kMaxMeshLevel: subdivided `level` times, 2·2^level layers
+  ListedEnds listed;       ///< the ends as the user lists them (none: by the end criteria)
 };
 
 /// The ends of the lumen file (read, scaled by `scale` to metres, checked by check_lumen), each
 /// with its group: inlet (inlet_end) or outlet. InputError as check_lumen.
 std::vector<std::pair<std::string, LumenEnd>> lumen_file_ends(const std::filesystem::path& file,
-                                                              double scale);
+                                                              double scale,
+                                                              const ListedEnds& listed = {});
 
 /// Layers through the wall at `level`: 2·2^level (the generated vessels' t/2 at level 0).
 int lumen_wall_layers(int level);

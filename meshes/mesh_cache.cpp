@@ -60,11 +60,21 @@ fs::path default_cache_dir() {
 
 std::string mesh_cache_key(const VesselParams& p) {
   if (p.kind == VesselKind::lumen) {
-    return "vesselverify-lumen-wall generator=" + std::to_string(kLumenGeneratorVersion) +
-           " file=" + file_hash(p.file) + " scale=" + exact(p.file_scale) +
-           " t=" + exact(p.wall_thickness) + " level=" + std::to_string(p.level);
+    std::string key =
+        "vesselverify-lumen-wall generator=" + std::to_string(kLumenGeneratorVersion) +
+        " file=" + file_hash(p.file) + " scale=" + exact(p.file_scale) +
+        " t=" + exact(p.wall_thickness) + " level=" + std::to_string(p.level);
+    if (p.listed_ends.given()) {  // they choose the inlet and which loops are ends
+      const auto point = [](const Vec3& c) {
+        return exact(c.x()) + "," + exact(c.y()) + "," + exact(c.z());
+      };
+      key += " inlet=" + point(p.listed_ends.inlet) + " outlets=";
+      for (const Vec3& c : p.listed_ends.outlets) key += point(c) + ";";
+    }
+    return key;
   }
-  if (p.kind == VesselKind::mesh_file) throw InputError(p.file.string() + ": a mesh file is not cached");
+  if (p.kind == VesselKind::mesh_file)
+    throw InputError(p.file.string() + ": a mesh file is not cached");
   std::string key = "vesselverify-mesh generator=" + std::to_string(kGeneratorVersion) +
                     " gmsh=" + gmsh_version() + " kind=" + to_string(p.kind) +
                     " style=" + to_string(p.style) + " level=" + std::to_string(p.level) +
@@ -89,7 +99,7 @@ TetMesh load_or_generate_vessel(const VesselParams& params, const fs::path& cach
   const auto generate = [&] {
     return as_stored(params.kind == VesselKind::lumen
                          ? lumen_wall_mesh({params.file, params.wall_thickness, params.file_scale,
-                                            params.level})
+                                            params.level, params.listed_ends})
                          : generate_vessel_mesh(params, options));
   };
   if (cache_dir.empty()) {

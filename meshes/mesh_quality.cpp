@@ -147,6 +147,8 @@ SliverReport find_slivers(const TetMesh& mesh) {
                                             mesh.nodes[t[3]]);
     const double lo = *std::min_element(angles.begin(), angles.end());
     const double hi = *std::max_element(angles.begin(), angles.end());
+    r.min_dihedral_deg = std::min(r.min_dihedral_deg, lo);
+    r.max_dihedral_deg = std::max(r.max_dihedral_deg, hi);
     if (lo >= kSliverMinDihedralDeg && hi <= kSliverMaxDihedralDeg) continue;
     ++r.count;
     if (lo < r.worst_min_dihedral_deg) {

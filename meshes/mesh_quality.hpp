@@ -51,9 +51,12 @@ std::string format_quality(const MeshQuality& q);
 inline constexpr double kSliverMinDihedralDeg = 2.0;
 inline constexpr double kSliverMaxDihedralDeg = 175.0;
 
-/// The slivers of a mesh: how many, and the worst (the tet with the smallest dihedral angle).
+/// The slivers of a mesh: how many, and the worst (the sliver with the smallest dihedral angle),
+/// beside the mesh's extreme dihedral angles over all tets.
 struct SliverReport {
   std::size_t count = 0;
+  double min_dihedral_deg = 180.0;     ///< smallest dihedral angle of any tet, degrees
+  double max_dihedral_deg = 0.0;       ///< largest dihedral angle of any tet, degrees
   Vec3 worst_centroid = Vec3::Zero();  ///< m
   double worst_min_dihedral_deg = 180.0;
   double worst_max_dihedral_deg = 0.0;  ///< the worst tet's largest angle

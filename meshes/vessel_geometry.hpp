@@ -4,6 +4,7 @@
 /// extruded from (meshes/lumen_mesh.hpp). Lengths in metres.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "meshes/tet_mesh.hpp"
 
@@ -17,6 +18,15 @@ enum class VesselKind { straight, arch, mesh_file, lumen };
 /// (transfinite, extruded) grid of circumferential × axial × radial layers doubled per level.
 enum class MeshStyle { unstructured, structured };
 
+/// A lumen's ends as the user lists them (the scene's [vessel] inlet_centre and outlet_centres),
+/// when check_lumen's criteria would refuse an end or take a hole for one, or pick another inlet:
+/// each open loop must then be one of these, matched by its centre (meshes/lumen_mesh.hpp).
+struct ListedEnds {
+  Vec3 inlet = Vec3::Zero();  ///< m
+  std::vector<Vec3> outlets;  ///< m; empty: no list (the ends are found by the criteria)
+  [[nodiscard]] bool given() const { return !outlets.empty(); }
+};
+
 struct VesselParams {
   VesselKind kind = VesselKind::straight;
   double inner_radius = 3e-3;    ///< a, m
@@ -29,6 +39,8 @@ struct VesselParams {
   std::filesystem::path file;
   /// lumen: the file's length unit in metres (1e-3 for an STL in millimetres).
   double file_scale = 1.0;
+  /// lumen: its ends listed by the user (none: found by check_lumen's criteria).
+  ListedEnds listed_ends;
 
   /// straight or arch: the vessel is given by the parameters above, not by a file.
   [[nodiscard]] bool parametric() const {

@@ -11,6 +11,7 @@
 
 #include "meshes/foundation/atomic_file.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "meshes/mesh_quality.hpp"
 #include "reports/best_model.hpp"
 #include "reports/guidewire_section.hpp"
 #include "reports/modal_section.hpp"
@@ -421,6 +422,45 @@ Table statistics_table(const SceneRows& s) {
   return t;
 }
 
+std::string point_mm(const std::vector<double>& p) {
+  return "(" + significant(p[0], 4) + ", " + significant(p[1], 4) + ", " + significant(p[2], 4) +
+         ") mm";
+}
+
+/// The lumen's ends and the meshes' dihedral angles; a warning where a mesh has slivers, whose
+/// error the models' errors there include.
+void mesh_paragraph(Document& doc, const SceneRows& s) {
+  std::string text;
+  if (!s.lumen_ends.empty()) {
+    text += "Ends of the lumen:";
+    for (const auto& e : s.lumen_ends) {
+      text += " " + e.group + " at " + point_mm(e.centre_mm) + ", radius " +
+              significant(e.radius_mm, 3) + " mm;";
+    }
+    text.back() = '.';
+  }
+  if (!s.mesh_quality.empty()) {
+    double lo = 180.0, hi = 0.0;
+    for (const auto& m : s.mesh_quality) {
+      lo = std::min(lo, m.min_dihedral_deg);
+      hi = std::max(hi, m.max_dihedral_deg);
+    }
+    text += (text.empty() ? "" : " ") + std::string("Dihedral angles of its meshes: ") +
+            significant(lo, 3) + "° to " + significant(hi, 4) + "°.";
+  }
+  for (const auto& m : s.mesh_quality) {
+    if (m.sliver_count == 0) continue;
+    text += " **The level-" + std::to_string(m.level) + " mesh has " +
+            std::to_string(m.sliver_count) + " sliver tets** (a dihedral angle below " +
+            significant(kSliverMinDihedralDeg) + "° or above " +
+            significant(kSliverMaxDihedralDeg) + "°), the worst at " +
+            point_mm(m.worst_centroid_mm) + " (" + significant(m.worst_min_dihedral_deg, 3) +
+            "° to " + significant(m.worst_max_dihedral_deg, 4) +
+            "°): the models' errors on this mesh include the mesh's.";
+  }
+  if (!text.empty()) doc.paragraph(text);
+}
+
 void scene_section(Document& doc, const SceneRows& s, SeriesStyles& styles) {
   doc.heading(2, "Scene `" + s.name + "`");
   doc.paragraph(s.description + (s.description.empty() ? "" : ". ") + s.vessel + ". Load: " +
@@ -429,6 +469,7 @@ void scene_section(Document& doc, const SceneRows& s, SeriesStyles& styles) {
                   for (const int v : s.model_levels) l += (l.empty() ? "" : ", ") + std::to_string(v);
                   return l;
                 }() + "; " + significant(s.seconds, 3) + " s for the whole scene.");
+  mesh_paragraph(doc, s);
   Table refs;
   refs.header = {"ν", "reference element", "level", "DoFs", "solve s", "max strain per unit load",
                  "GCI order: linear", "GCI order: finite strain"};

@@ -187,6 +187,37 @@ ResultsFile parse_results(const std::string& text, const std::filesystem::path& 
     if (const auto q = s.find("qoi_point_mm"); q != s.end() && q->is_array() && q->size() == 3) {
       sr.qoi_point_mm = q->get<std::vector<double>>();
     }
+    if (const auto m = s.find("mesh_quality"); m != s.end() && m->is_array()) {
+      for (std::size_t k = 0; k < m->size(); ++k) {
+        const json& q = (*m)[k];
+        const std::string at = where + ".mesh_quality[" + std::to_string(k) + "]";
+        MeshQualityRow row;
+        row.level = field<int>(q, "level", at);
+        row.min_dihedral_deg = field<double>(q, "min_dihedral_deg", at);
+        row.max_dihedral_deg = field<double>(q, "max_dihedral_deg", at);
+        row.sliver_count = field<std::size_t>(q, "sliver_count", at);
+        if (const auto w = q.find("worst_at"); w != q.end() && !w->is_null()) {
+          row.worst_centroid_mm = field<std::vector<double>>(*w, "centroid_mm", at + ".worst_at");
+          row.worst_min_dihedral_deg = field<double>(*w, "min_dihedral_deg", at + ".worst_at");
+          row.worst_max_dihedral_deg = field<double>(*w, "max_dihedral_deg", at + ".worst_at");
+          if (row.worst_centroid_mm.size() != 3) {
+            throw InputError(at + ".worst_at: centroid_mm needs 3 numbers");
+          }
+        }
+        sr.mesh_quality.push_back(row);
+      }
+    }
+    if (const auto e = s.find("lumen_ends"); e != s.end() && e->is_array()) {
+      for (std::size_t k = 0; k < e->size(); ++k) {
+        const std::string at = where + ".lumen_ends[" + std::to_string(k) + "]";
+        LumenEndRow row;
+        row.group = field<std::string>((*e)[k], "group", at);
+        row.centre_mm = field<std::vector<double>>((*e)[k], "centre_mm", at);
+        row.radius_mm = field<double>((*e)[k], "radius_mm", at);
+        if (row.centre_mm.size() != 3) throw InputError(at + ": centre_mm needs 3 numbers");
+        sr.lumen_ends.push_back(row);
+      }
+    }
     if (const auto c = s.find("contact_patch"); c != s.end() && !c->is_null()) {
       ContactPatchRow patch;
       patch.point_mm = field<std::vector<double>>(*c, "point_mm", where + ".contact_patch");

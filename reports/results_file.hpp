@@ -50,6 +50,22 @@ struct ContactPatchRow {
   std::vector<double> outward_normal;  ///< the wall's, unit
 };
 
+/// One mesh a scene ran on (results.json's mesh_quality): its dihedral extremes and slivers.
+struct MeshQualityRow {
+  int level = 0;
+  double min_dihedral_deg = 0.0, max_dihedral_deg = 0.0;
+  std::size_t sliver_count = 0;
+  std::vector<double> worst_centroid_mm;  ///< empty without slivers
+  double worst_min_dihedral_deg = 0.0, worst_max_dihedral_deg = 0.0;
+};
+
+/// One end of a lumen (results.json's lumen_ends), mm.
+struct LumenEndRow {
+  std::string group;
+  std::vector<double> centre_mm;
+  double radius_mm = 0.0;
+};
+
 /// A scene's [budget] as results.json states it.
 struct BudgetRow {
   std::string quantity;  ///< contact_point | patch | field | reaction
@@ -132,6 +148,8 @@ struct SceneRows {
   std::optional<std::vector<double>> qoi_point_mm;
   std::optional<ContactPatchRow> contact_patch;  ///< contact loads only
   std::optional<GuidewireRows> guidewire;         ///< guidewire loads only
+  std::vector<MeshQualityRow> mesh_quality;       ///< absent from older files: empty
+  std::vector<LumenEndRow> lumen_ends;            ///< vessels from lumen files only
   std::vector<ReferenceRow> references;
   std::vector<OutcomeRow> outcomes;
   /// Natural frequencies (absent from runs without [modes]): the reference per ν, the models.

@@ -18,6 +18,7 @@ packages=(
   libboost-dev                            # rod_theory: Boost.Math elliptic integrals, Odeint
   openmpi-bin                             # mpirun: fem --distributed, the reference job, their tests
   time                                    # /usr/bin/time: peak memory per rank (measure_cluster_scaling.py)
+  calculix-ccx                            # CalculiX: the reference side by side with a peer (calculix_side_by_side.py)
   munge slurmctld slurmd slurm-client     # a one-node Slurm cluster for the sbatch test (slurm_localhost.sh)
   python3-matplotlib python3-numpy        # reports (use /usr/bin/python3)
   libjs-three libjs-chart.js              # report.html: 3D views and plots, inlined when written

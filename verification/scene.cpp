@@ -52,6 +52,18 @@ VesselParams read_file_vessel(TableReader& r, const std::string& scene_file,
   // lumen's required one.
   p.wall_thickness = r.number_or("wall_thickness", 0.0);
   if (!file) p.file_scale = r.string_or("units") == "mm" ? 1e-3 : 1.0;
+  // A lumen's ends listed by hand: both keys or neither.
+  const toml::node* inlet = file ? nullptr : r.table().get("inlet_centre");
+  const toml::node* outlets = file ? nullptr : r.table().get("outlet_centres");
+  if ((inlet == nullptr) != (outlets == nullptr)) {
+    r.fail(inlet ? inlet : outlets, inlet ? "inlet_centre" : "outlet_centres",
+           std::string("found without ") + (inlet ? "outlet_centres" : "inlet_centre") +
+               "; expected both (the ends listed by hand) or neither (found by their shape)");
+  }
+  if (inlet) {
+    p.listed_ends.inlet = r.vector3(*inlet, "inlet_centre");
+    p.listed_ends.outlets = r.vectors3(*outlets, "outlet_centres");
+  }
   p.level = levels.front();
   if (!std::filesystem::exists(p.file)) r.fail(&node, key, "file " + p.file.string() + " not found");
   return p;

@@ -92,6 +92,14 @@ std::vector<SceneKey> top_and_vessel() {
           .required().in({"lumen"}),
       Row("vessel", "units", KeyType::string, "The STL's length unit").dflt("\"m\"")
           .one_of({"m", "mm"}).in({"lumen"}),
+      Row("vessel", "inlet_centre", KeyType::vector3,
+          "The inlet end's centre, when the ends are listed by hand (with outlet_centres): "
+          "every open loop of the lumen must then be a listed end")
+          .unit("m").note("the ends found by their shape; the largest is the inlet")
+          .in({"lumen"}),
+      Row("vessel", "outlet_centres", KeyType::vectors3,
+          "The outlet ends' centres, when the ends are listed by hand (with inlet_centre)")
+          .unit("m").note("the ends found by their shape").in({"lumen"}),
   };
   std::vector<SceneKey> out;
   for (auto& r : rows) out.push_back(std::move(r.k));
@@ -329,6 +337,7 @@ std::string SceneKey::expected() const {
       return what;
     case KeyType::boolean: return "true or false";
     case KeyType::vector3: return "[x, y, z]" + u;
+    case KeyType::vectors3: return "a non-empty array of [x, y, z]" + u;
     case KeyType::strings: return "a non-empty array of strings";
     case KeyType::table: return "a table";
     case KeyType::tables: return "an array of tables";

@@ -15,6 +15,7 @@ enum class KeyType {
   integer,  ///< an integer within [min, max]
   number,   ///< a finite number within the range (integers accepted)
   vector3,  ///< [x, y, z]
+  vectors3,  ///< a non-empty array of [x, y, z]
   strings,  ///< a non-empty array of non-empty strings
   table,    ///< a [section] table (the top level's sections)
   tables,   ///< an array of tables ([[section]])

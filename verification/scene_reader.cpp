@@ -68,7 +68,10 @@ std::string show(const toml::node& node) {
 
 TableReader::TableReader(const toml::table& table, std::string section, std::string prefix,
                          std::string file)
-    : table_(table), section_(std::move(section)), prefix_(std::move(prefix)), file_(std::move(file)) {
+    : table_(table),
+      section_(std::move(section)),
+      prefix_(std::move(prefix)),
+      file_(std::move(file)) {
   for (const auto& s : scene_sections()) {
     if (s.name == section_ && s.variants.empty()) enter("");
   }
@@ -253,6 +256,14 @@ Vec3 TableReader::vector3(const toml::node& n, const std::string& key) const {
     v[i] = *item.value<double>();
   }
   return v;
+}
+
+std::vector<Vec3> TableReader::vectors3(const toml::node& n, const std::string& key) const {
+  const auto* arr = n.as_array();
+  if (!arr || arr->empty()) fail_value(n, key, show(n));
+  std::vector<Vec3> out;
+  for (const auto& item : *arr) out.push_back(vector3(item, key));
+  return out;
 }
 
 TableReader TableReader::sub(const std::string& key) const {

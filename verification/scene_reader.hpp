@@ -60,6 +60,8 @@ class TableReader {
   /// A non-empty array of non-empty strings (KeyType::strings).
   std::vector<std::string> string_array(const std::string& key) const;
   Vec3 vector3(const toml::node& n, const std::string& key) const;
+  /// A non-empty array of [x, y, z] (KeyType::vectors3).
+  std::vector<Vec3> vectors3(const toml::node& n, const std::string& key) const;
 
   /// The sub-table `key` (an empty one when absent; missing if required).
   TableReader sub(const std::string& key) const;

@@ -28,7 +28,9 @@ Json value_schema(const SceneKey& k) {
       j["type"] = "string";
       if (!k.choices.empty()) j["enum"] = k.choices;
       break;
-    case KeyType::boolean: j["type"] = "boolean"; break;
+    case KeyType::boolean:
+      j["type"] = "boolean";
+      break;
     case KeyType::integer:
     case KeyType::number:
       j["type"] = k.type == KeyType::integer ? "integer" : "number";
@@ -38,12 +40,17 @@ Json value_schema(const SceneKey& k) {
     case KeyType::vector3:
       j = {{"type", "array"}, {"items", {{"type", "number"}}}, {"minItems", 3}, {"maxItems", 3}};
       break;
-    case KeyType::strings:
+    case KeyType::vectors3:
       j = {{"type", "array"},
-           {"items", {{"type", "string"}, {"minLength", 1}}},
+           {"items",
+            {{"type", "array"}, {"items", {{"type", "number"}}}, {"minItems", 3}, {"maxItems", 3}}},
            {"minItems", 1}};
       break;
-    case KeyType::table: return section_schema(section_named(k.name));
+    case KeyType::strings:
+      j = {{"type", "array"}, {"items", {{"type", "string"}, {"minLength", 1}}}, {"minItems", 1}};
+      break;
+    case KeyType::table:
+      return section_schema(section_named(k.name));
     case KeyType::tables:
       return {{"type", "array"}, {"items", section_schema(section_named(k.name))}, {"minItems", 1}};
   }
@@ -118,7 +125,8 @@ Json section_schema(const SceneSection& s) {
     then["properties"] = Json::object();
     add_keys(then, keys_of(s, variant));
     then["propertyNames"] = {{"enum", scene_key_names(s.name, variant)}};
-    clauses.push_back({{"if", variant_condition(s, variant)}, {"then", then}, {"x-variant", variant}});
+    clauses.push_back(
+        {{"if", variant_condition(s, variant)}, {"then", then}, {"x-variant", variant}});
   }
   j["allOf"] = clauses;
   return j;

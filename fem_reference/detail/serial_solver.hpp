@@ -33,6 +33,12 @@ namespace dl = dealii;
 /// Impl::same_pattern until release_same_pattern()).
 enum class DirectReuse { nothing, factor, analysis };
 using detail::kDim;
+
+namespace detail {
+/// The solver `automatic` picks (never matrix_free: no switch point measured), or InputError for a
+/// solver that does not fit the system.
+LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dofs);
+}  // namespace detail
 using Index = dealii::types::global_dof_index;
 
 struct ElasticitySolver::Impl {
@@ -80,6 +86,17 @@ struct ElasticitySolver::Impl {
   std::unique_ptr<CholmodSamePattern> same_pattern;
   void release_same_pattern() { same_pattern.reset(); }
   void solve_displacement_cg_amg();
+  /// matrix_free: CG on the matrix-free operator with the p-multigrid (detail/
+  /// matrix_free_elasticity), on rhs assembled without the matrix (assemble_load).
+  void solve_displacement_matrix_free();
+  /// rhs only (the matrix stays empty): the loads and −K u₀ of the prescribed values, cell by cell.
+  void assemble_load();
+  /// The sparsity pattern and matrix of the assembled path, built on first use (the matrix-free
+  /// path never builds them).
+  void ensure_matrix();
+  /// The problem's supports on a displacement DoFHandler of this mesh (P1 or P2).
+  void support_constraints(const dl::DoFHandler<kDim>& dof_handler,
+                           dl::AffineConstraints<double>& c) const;
   void postprocess();
   /// Per DoF: its component (0..2 displacement, 3 pressure).
   [[nodiscard]] std::vector<unsigned> dof_components() const;

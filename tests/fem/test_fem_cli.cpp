@@ -4,23 +4,23 @@
 
 #include <algorithm>
 #include <cmath>
-#include <string>
-#include <thread>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
 
 #include "../test_helpers.hpp"
 #include "meshes/vtu_io.hpp"
 
+using vessel::read_vtu;
+using vessel::Vec3;
+using vessel::VtuData;
+using vessel::VtuField;
 using vessel::test::CommandResult;
 using vessel::test::run_command;
 using vessel::test::TempDir;
 using vessel::test::vv;
-using vessel::Vec3;
-using vessel::VtuData;
-using vessel::VtuField;
-using vessel::read_vtu;
 
 namespace {
 
@@ -53,6 +53,32 @@ TEST(FemCli, PressureRunComparesWithLameAndBalancesReactions) {
   EXPECT_EQ(j["element"], "P2");
   EXPECT_LT(j["lame_relative_l2_error"].get<double>(), 0.02);  // level 0, P2: about 1 %
   EXPECT_GT(j["dofs"].get<int>(), 0);
+}
+
+TEST(FemCli, MatrixFreeSolverGivesTheDirectSolversAnswer) {
+  // The same P2 problem by CHOLMOD and by CG on the matrix-free operator (p-multigrid): strain
+  // energy and the contact point's displacement within the CG tolerance's reach.
+  TempDir dir;
+  const std::string run = "fem " + kTube +
+                          "--degree 2 --load contact --force 1e-4 "
+                          "--contact-point 0.003 0 0.001 --bc clamped --tolerance 1e-12 ";
+  const auto d = vv(run + "--solver direct --json " + (dir / "d.json").string());
+  const auto m = vv(run + "--solver matrix-free --json " + (dir / "m.json").string());
+  ASSERT_EQ(d.exit_code, 0) << d.output;
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  EXPECT_TRUE(contains(m.output, "matrix-free")) << m.output;
+  EXPECT_TRUE(contains(m.output, "CG iterations (p-multigrid P2->P1, ML on P1)")) << m.output;
+  const auto jd = nlohmann::json::parse(vessel::test::read_text(dir / "d.json"));
+  const auto jm = nlohmann::json::parse(vessel::test::read_text(dir / "m.json"));
+  EXPECT_EQ(jm["solver"], "matrix-free");
+  EXPECT_GT(jm["cg_iterations"].get<int>(), 0);
+  EXPECT_NEAR(jm["strain_energy_mJ"].get<double>() / jd["strain_energy_mJ"].get<double>(), 1.0,
+              1e-9);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(jm["contact"]["displacement_mm"][c].get<double>(),
+                jd["contact"]["displacement_mm"][c].get<double>(),
+                1e-9 * std::abs(jd["contact"]["displacement_mm"][0].get<double>()));
+  }
 }
 
 TEST(FemCli, ContactRunWritesVtuAndJson) {
@@ -122,9 +148,9 @@ TEST(FemCli, TransientPrintsTheHistoryAndWritesTheCsv) {
   const auto csv = dir / "h.csv";
   const std::string load = "--load contact --contact-point 0.003 0 0.001 ";
   // Mass damping 1e4 /s: the step response has settled after 300 steps (60 ms).
-  const auto r = vv("fem " + kTube + load +
-                    "--transient --dt 2e-4 --steps 300 --mass-damping 1e4 --history-csv " +
-                    csv.string());
+  const auto r =
+      vv("fem " + kTube + load +
+         "--transient --dt 2e-4 --steps 300 --mass-damping 1e4 --history-csv " + csv.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "Newmark")) << r.output;
   EXPECT_TRUE(contains(r.output, "ms/step")) << r.output;
@@ -229,8 +255,10 @@ TEST(FemCli, FiniteStrainWritesItsDisplacementFieldAsVtu) {
 
 TEST(FemCli, FiniteStrainJsonGivesTheLoadReachedAndTheContactDisplacement) {
   TempDir dir;
-  const auto r = vv("fem " + kTube + "--load contact --force 1e-4 --contact-point 0.003 0 0.001 "
-                    "--reference finite-strain --json " + (dir / "f.json").string());
+  const auto r = vv("fem " + kTube +
+                    "--load contact --force 1e-4 --contact-point 0.003 0 0.001 "
+                    "--reference finite-strain --json " +
+                    (dir / "f.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(vessel::test::read_text(dir / "f.json"));
   EXPECT_EQ(j["schema"], "vesselverify.fem_finite_strain");
@@ -287,7 +315,8 @@ TEST(FemCli, FiniteStrainUnderGravityPrintsTheQoiPointBesideTheLinearReference) 
 TEST(FemCli, FiniteStrainRefusesOptionsOfTheLinearReferenceOnly) {
   const auto r = vv("fem " + kTube + "--reference finite-strain --modes 3");
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_TRUE(contains(r.output, "--modes is available with the linear reference only")) << r.output;
+  EXPECT_TRUE(contains(r.output, "--modes is available with the linear reference only"))
+      << r.output;
   const auto d = vv("fem " + kTube + "--dead-pressure");
   EXPECT_EQ(d.exit_code, 1) << d.output;
   EXPECT_TRUE(contains(d.output, "--dead-pressure is for --reference finite-strain")) << d.output;

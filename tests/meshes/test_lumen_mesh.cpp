@@ -20,9 +20,10 @@ using test::TempDir;
 
 constexpr double kPi = std::numbers::pi;
 
-std::string refusal(const TriangleSurface& s, const std::string& source = "lumen.stl") {
+std::string refusal(const TriangleSurface& s, const std::string& source = "lumen.stl",
+                    const ListedEnds& listed = {}) {
   try {
-    check_lumen(s, source);
+    check_lumen(s, source, listed);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -89,8 +90,9 @@ TEST(LumenMesh, UnitsScaleAFileInMillimetres) {
     FAIL() << "a lumen in millimetres read as metres was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("mm.stl"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("looks like millimetres; scale by 1e-3 or set units = \"mm\""),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("looks like millimetres; scale by 1e-3 or set units = \"mm\""),
+        std::string::npos)
         << e.what();
   }
   const TetMesh m = lumen_wall_mesh({dir / "mm.stl", 1e-3, 1e-3, 0});
@@ -167,9 +169,9 @@ TEST(LumenMesh, RefusesASelfIntersectingSurface) {
 }
 
 TEST(LumenMesh, CrossingTrianglesFindsAPiercingPairOnly) {
-  const std::vector<Vec3> x{{0, 0, 0}, {1, 0, 0}, {0, 1, 0},          // in z = 0
-                            {0.2, 0.2, -1}, {0.2, 0.2, 1}, {3, 3, 1},  // pierces it
-                            {5, 5, -1}, {5, 5, 1}, {6, 5, 0}};         // far away
+  const std::vector<Vec3> x{{0, 0, 0},      {1, 0, 0},     {0, 1, 0},   // in z = 0
+                            {0.2, 0.2, -1}, {0.2, 0.2, 1}, {3, 3, 1},   // pierces it
+                            {5, 5, -1},     {5, 5, 1},     {6, 5, 0}};  // far away
   EXPECT_EQ(crossing_triangles(x, {{0, 1, 2}, {3, 4, 5}}).size(), 1u);
   EXPECT_TRUE(crossing_triangles(x, {{0, 1, 2}, {6, 7, 8}}).empty());
   EXPECT_TRUE(crossing_triangles(x, {{0, 1, 2}, {0, 4, 5}}).empty());  // shares a vertex
@@ -181,7 +183,8 @@ TEST(LumenMesh, RefusesAWallThickerThanTheLumenCurvatureAllows) {
   const TriangleSurface other = polygon_tube(3e-3, 20e-3, 16, 6);
   const int offset = static_cast<int>(s.nodes.size());
   for (const Vec3& x : other.nodes) s.nodes.push_back(x + Vec3(7e-3, 0.0, 0.0));
-  for (const Triangle& t : other.triangles) s.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  for (const Triangle& t : other.triangles)
+    s.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
   s.source_node.resize(s.nodes.size(), -1);
   const std::vector<LumenEnd> ends = check_lumen(s, "two.stl");
   EXPECT_EQ(ends.size(), 4u);
@@ -190,7 +193,8 @@ TEST(LumenMesh, RefusesAWallThickerThanTheLumenCurvatureAllows) {
     (void)extrude_lumen(s, ends, 1e-3, 2, "two.stl");
     FAIL() << "overlapping walls accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("two.stl: with wall_thickness = 1 mm the outer wall crosses itself"),
+    EXPECT_NE(std::string(e.what()).find(
+                  "two.stl: with wall_thickness = 1 mm the outer wall crosses itself"),
               std::string::npos)
         << e.what();
   }
@@ -222,9 +226,10 @@ TEST(LumenMesh, BifurcationFromGmshMeshesWithThreeEnds) {
   EXPECT_NEAR(inner, torus + 2 * kPi * spec.branch_radius * spec.branch_length, 0.1 * torus);
   // Inlet: a main-tube end (the two are equal; the larger-by-1 % rule keeps the first); outlet:
   // the other main end and the branch's end.
-  const double main_ring = kPi * ((spec.radius + t) * (spec.radius + t) - spec.radius * spec.radius);
-  const double branch_ring =
-      kPi * ((spec.branch_radius + t) * (spec.branch_radius + t) - spec.branch_radius * spec.branch_radius);
+  const double main_ring =
+      kPi * ((spec.radius + t) * (spec.radius + t) - spec.radius * spec.radius);
+  const double branch_ring = kPi * ((spec.branch_radius + t) * (spec.branch_radius + t) -
+                                    spec.branch_radius * spec.branch_radius);
   // Rings of N-gons cover (N/2)·sin(2π/N)/π of the circles' ring: 97 % for N = 16 (main tube),
   // 94 % for N = 10 (branch).
   EXPECT_NEAR(group_area_of(m, group_names::inlet), main_ring, 0.05 * main_ring);
@@ -277,7 +282,8 @@ TEST(LumenMesh, ProjectsAPointOntoTheChosenWall) {
   const TetMesh m = extrude_lumen(lumen, check_lumen(lumen, "tube"), t, 2, "tube");
   // From far outside along θ = 0 (a vertex line of the 16-gon), the nearest point of the outer
   // wall is the vertex line itself; from the axis side the inner wall's.
-  const Vec3 outer = nearest_point_on_group(m, group_names::outer_wall, Vec3(2 * (a + t), 0, L / 2), "t");
+  const Vec3 outer =
+      nearest_point_on_group(m, group_names::outer_wall, Vec3(2 * (a + t), 0, L / 2), "t");
   EXPECT_NEAR((outer - Vec3(a + t, 0, L / 2)).norm(), 0.0, 1e-12);
   // Towards the middle of a face: that face's chord midpoint, at radius a·cos(π/16).
   const Vec3 towards(std::cos(kPi / 16), std::sin(kPi / 16), 0.0);
@@ -287,7 +293,6 @@ TEST(LumenMesh, ProjectsAPointOntoTheChosenWall) {
   // The thickness estimate: radial offsets of t at the vertices, t + a(1 − cos π/16)·… ≥ t between.
   EXPECT_NEAR(estimate_wall_thickness(m, "t"), t, 0.02 * t);
 }
-
 
 TEST(LumenMesh, YBifurcationEndsAreItsThreeCutsWithTheirConstructedGeometry) {
   const test::YBifurcationSpec spec;
@@ -304,7 +309,8 @@ TEST(LumenMesh, YBifurcationEndsAreItsThreeCutsWithTheirConstructedGeometry) {
     for (const LumenEnd& e : ends) {
       if ((e.centre - centres[c]).norm() > 1e-6) continue;
       ++found;
-      // Nodes on the circle: the mean distance is the radius; a polygon's area is under the circle's.
+      // Nodes on the circle: the mean distance is the radius; a polygon's area is under the
+      // circle's.
       EXPECT_NEAR(e.radius, radii[c], 1e-6);
       EXPECT_NEAR(e.area, kPi * radii[c] * radii[c], 0.05 * kPi * radii[c] * radii[c]);
       EXPECT_NEAR(std::abs(e.normal.dot(centres[c].normalized())), 1.0, 1e-6);
@@ -339,11 +345,12 @@ TEST(LumenMesh, YBifurcationWithHolesInItsJunctionIsRefusedNamingAHole) {
   EXPECT_EQ(holes, 2);
   EXPECT_EQ(ends, 3);
   const std::string message = refusal(lumen, "holed.stl");
-  // Either hole, whichever loop comes first.
-  EXPECT_NE(message.find("holed.stl: a hole where no end should be: the open loop around (0, "),
+  // Both holes named, each by its centre (0, ±√(R_j² − ρ²), 0) = (0, ±3.25, 0) mm and radius.
+  EXPECT_NE(message.find("holed.stl: 2 holes where no end should be: the open loop around (0, "),
             std::string::npos)
       << message;
-  EXPECT_NE(message.find("3.25, 0) mm, radius 1.3 mm"), std::string::npos) << message;
+  EXPECT_NE(message.find("(0, 3.25, 0) mm, radius 1.3 mm"), std::string::npos) << message;
+  EXPECT_NE(message.find("(0, -3.25, 0) mm, radius 1.3 mm"), std::string::npos) << message;
   EXPECT_NE(message.find("radius 1.3 mm, lies in the vessel's wall"), std::string::npos) << message;
   EXPECT_NE(message.find("fill the hole in the surface, or, if it is an end, cut it square"),
             std::string::npos)
@@ -351,4 +358,62 @@ TEST(LumenMesh, YBifurcationWithHolesInItsJunctionIsRefusedNamingAHole) {
 }
 
 }  // namespace
+namespace {
+
+/// The Y's three true ends (the construction's), parent as the inlet.
+ListedEnds y_ends(const test::YBifurcationSpec& spec) {
+  const double L = spec.length, a = spec.half_angle;
+  return {Vec3(0, 0, -L),
+          {Vec3(-L * std::sin(a), 0, L * std::cos(a)), Vec3(L * std::sin(a), 0, L * std::cos(a))}};
+}
+
+/// The centroid of a surface group's triangles (unweighted).
+Vec3 group_centroid(const TetMesh& m, std::string_view name) {
+  Vec3 c = Vec3::Zero();
+  const auto tris = m.group_triangles(m.require_group(name, 2, "test"));
+  for (const Triangle& t : tris) c += (m.nodes[t[0]] + m.nodes[t[1]] + m.nodes[t[2]]) / 3.0;
+  return c / static_cast<double>(tris.size());
+}
+
+}  // namespace
+
+TEST(LumenMesh, ListedEndsChooseTheInletAndOverrideTheEndCriteria) {
+  test::YBifurcationSpec spec;
+  const ListedEnds truth = y_ends(spec);
+  // The clean Y with a daughter listed as the inlet: that cut becomes `inlet`, not the largest.
+  const TriangleSurface clean = test::y_bifurcation_lumen(spec);
+  ListedEnds daughter_in{truth.outlets[1], {truth.inlet, truth.outlets[0]}};
+  const std::vector<LumenEnd> ends = check_lumen(clean, "y.stl", daughter_in);
+  ASSERT_EQ(ends.size(), 3u);
+  EXPECT_LT((ends[inlet_end(ends, daughter_in)].centre - truth.outlets[1]).norm(), 1e-9);
+  EXPECT_LT((ends[inlet_end(ends)].centre - truth.inlet).norm(), 1e-9);  // by area: the parent
+  const TetMesh m = extrude_lumen(clean, ends, 0.4e-3, 2, "y.stl", daughter_in);
+  EXPECT_LT((group_centroid(m, "inlet") - truth.outlets[1]).norm(), 0.2 * spec.daughter_radius);
+
+  // The holed Y: its two holes, listed as outlets by a user who means them, are accepted as ends.
+  spec.holes = true;
+  const TriangleSurface holed = test::y_bifurcation_lumen(spec);
+  const double cut =
+      std::sqrt(spec.junction_radius * spec.junction_radius - spec.hole_radius * spec.hole_radius);
+  ListedEnds with_holes = truth;
+  with_holes.outlets.emplace_back(0, cut, 0);
+  with_holes.outlets.emplace_back(0, -cut, 0);
+  EXPECT_EQ(check_lumen(holed, "holed.stl", with_holes).size(), 5u);
+  // Listing only the true ends still refuses the holes, each named as no listed end.
+  const std::string unlisted = refusal(holed, "holed.stl", truth);
+  EXPECT_NE(unlisted.find("the open loop around (0, 3.25, 0) mm, radius 1.3 mm, is none of the "
+                          "listed ends"),
+            std::string::npos)
+      << unlisted;
+  EXPECT_NE(unlisted.find("(0, -3.25, 0) mm, radius 1.3 mm, is none"), std::string::npos)
+      << unlisted;
+  // A listed centre off every loop is named.
+  ListedEnds off = truth;
+  off.outlets.emplace_back(0.05, 0.05, 0.05);
+  const std::string missing = refusal(clean, "y.stl", off);
+  EXPECT_NE(missing.find("outlet_centres[2] (50, 50, 50) mm is the centre of no open loop"),
+            std::string::npos)
+      << missing;
+}
+
 }  // namespace vessel

@@ -72,6 +72,10 @@ TEST(MeshQuality, ASliverIsFoundWithItsAnglesAndPositionAndAGoodMeshIsNot) {
   SliverReport none = find_slivers(mesh);
   EXPECT_EQ(none.count, 0u);
   EXPECT_EQ(sliver_warning(none), "");
+  // The mesh's extremes: the corner tet's 90° (at the origin's edges) and acos(1/√3) = 54.74°
+  // (at its slanted face's edges); the regular tet's 70.53° lies between.
+  EXPECT_NEAR(none.min_dihedral_deg, std::acos(1.0 / std::sqrt(3.0)) * kDeg, 1e-9);
+  EXPECT_NEAR(none.max_dihedral_deg, 90.0, 1e-9);
   const double h = 0.01;
   const Vec3 o(10, 0, 0);
   const int base = static_cast<int>(mesh.nodes.size());
@@ -83,6 +87,8 @@ TEST(MeshQuality, ASliverIsFoundWithItsAnglesAndPositionAndAGoodMeshIsNot) {
   EXPECT_EQ(one.count, 1u);
   EXPECT_NEAR(one.worst_max_dihedral_deg, 180.0 - 2.0 * std::atan(h) * kDeg, 1e-9);
   EXPECT_LT(one.worst_min_dihedral_deg, kSliverMinDihedralDeg);
+  EXPECT_EQ(one.min_dihedral_deg, one.worst_min_dihedral_deg);
+  EXPECT_EQ(one.max_dihedral_deg, one.worst_max_dihedral_deg);
   EXPECT_NEAR((one.worst_centroid - (o + Vec3(0, 0, 0.5 * h))).norm(), 0.0, 1e-12);
   const std::string w = sliver_warning(one);
   EXPECT_NE(w.find("WARNING: 1 sliver tets"), std::string::npos) << w;

@@ -151,6 +151,7 @@ fem::ElasticityProblem command_problem(const FemCommandOptions& o, const Scene& 
   opt.solver = o.solver == "direct"        ? fem::LinearSolver::direct
                : o.solver == "cg-amg"      ? fem::LinearSolver::cg_amg
                : o.solver == "gmres-block" ? fem::LinearSolver::gmres_block
+               : o.solver == "matrix-free" ? fem::LinearSolver::matrix_free
                                            : fem::LinearSolver::automatic;
   opt.direct_max_dofs = o.direct_max_dofs;
   opt.direct_max_mixed_dofs = o.direct_max_mixed_dofs;
@@ -210,6 +211,9 @@ FemRunRecord run_record(const FemCommandOptions& o, const TetMesh& mesh, bool ca
 void print_solver(const fem::ElasticityResult& r) {
   std::cout << " " << fem::to_string(r.solver);
   if (r.solver == fem::LinearSolver::cg_amg) std::cout << ", " << r.iterations << " CG iterations";
+  if (r.solver == fem::LinearSolver::matrix_free) {
+    std::cout << ", " << r.iterations << " CG iterations (p-multigrid P2->P1, ML on P1)";
+  }
   if (r.solver == fem::LinearSolver::gmres_block) {
     std::cout << ", " << r.iterations << " FGMRES iterations (" << std::setprecision(3)
               << r.inner_iterations << " CG iterations per pressure-mass solve)"
@@ -635,8 +639,10 @@ void add_solver_options(CLI::App* cmd, FemCommandOptions& o) {
                   "else iterative), direct (CHOLMOD; UMFPACK for the mixed system), cg-amg (CG "
                   "with Trilinos ML AMG, displacement system), gmres-block (FGMRES with a "
                   "block-triangular preconditioner: AMG on the displacement block, scaled "
-                  "pressure mass for the Schur complement; mixed system)")
-      ->check(CLI::IsMember({"auto", "direct", "cg-amg", "gmres-block"}))
+                  "pressure mass for the Schur complement; mixed system), matrix-free (CG on "
+                  "the matrix-free operator with a P2->P1 p-multigrid and ML on P1; "
+                  "displacement system; never chosen by auto)")
+      ->check(CLI::IsMember({"auto", "direct", "cg-amg", "gmres-block", "matrix-free"}))
       ->capture_default_str();
   cmd->add_option("--direct-max-dofs", o.direct_max_dofs,
                   "auto: direct solver up to this many DoFs")

@@ -5,12 +5,14 @@
 
 #include "meshes/foundation/atomic_file.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "meshes/lumen_mesh.hpp"
 #include "meshes/mesh_quality.hpp"
 #include "meshes/msh_io.hpp"
 #include "meshes/stl_io.hpp"
 #include "meshes/vtu_io.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/cli/vessel_options.hpp"
+#include "verification/harness/results.hpp"
 
 namespace vessel::cli {
 
@@ -129,6 +131,16 @@ void run(MeshCommandOptions& o) {
     std::cout << "  structured grid " << c.circumferential << " circumferential × " << c.axial
               << " axial × " << c.radial << " radial divisions\n";
   }
+  nlohmann::json ends = nlohmann::json::array();
+  if (generated && params.kind == VesselKind::lumen) {
+    const auto named = lumen_file_ends(params.file, params.file_scale, params.listed_ends);
+    std::cout << "ends of the lumen: " << named.size() << "\n";
+    for (const auto& [group, e] : named) {
+      std::cout << "  " << std::left << std::setw(7) << group << std::right << format_end(e)
+                << "\n";
+      ends.push_back(lumen_end_json(group, e));
+    }
+  }
   // Closed forms exist for the parametric vessels only (not for a --lumen wall).
   nlohmann::json groups =
       report_groups(mesh, generated && params.parametric() ? &params : nullptr, std::cout);
@@ -147,6 +159,8 @@ void run(MeshCommandOptions& o) {
             << ")\n";
   const MeshQuality q = compute_quality(mesh);
   std::cout << "quality:\n" << format_quality(q);
+  const SliverReport slivers = find_slivers(mesh);
+  if (slivers.count > 0) std::cout << sliver_warning(slivers) << "\n";
 
   if (!o.output.empty()) {
     write_msh(o.output, mesh, o.msh_version == "2.2" ? MshVersion::v22 : MshVersion::v41);
@@ -174,6 +188,8 @@ void run(MeshCommandOptions& o) {
                        {"tet_volume_mm3", stats_to_json(q.volume, 1e9)},
                        {"inverted", q.inverted},
                        {"degenerate", q.degenerate}}}};
+    j["mesh_quality"] = mesh_quality_json(slivers);
+    if (!ends.empty()) j["lumen_ends"] = ends;
     if (generated) {
       j["meshing"] = {{"seconds", source.seconds}, {"cache_hit", source.cache_hit},
                       {"cached_file", source.path.string()}};

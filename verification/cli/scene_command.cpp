@@ -1,6 +1,7 @@
 /// `vesselverify scene`: validate scene files and print what they would run.
 #include <iostream>
 
+#include "meshes/lumen_mesh.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/guidewire_load.hpp"
 #include "verification/scene.hpp"
@@ -14,7 +15,15 @@ void print_scene(const Scene& s) {
   std::cout << s.source.string() << ": scene '" << s.name << "' is valid\n";
   if (!s.description.empty()) std::cout << "  " << s.description << "\n";
   std::cout << "  vessel: " << describe(s.vessel) << "; reference level " << s.reference_level
-            << "\n  material: E = " << s.youngs_modulus << " Pa, ν =";
+            << "\n";
+  if (s.vessel.kind == VesselKind::lumen) {
+    const auto ends = lumen_file_ends(s.vessel.file, s.vessel.file_scale, s.vessel.listed_ends);
+    std::cout << "  ends of the lumen: " << ends.size() << "\n";
+    for (const auto& [group, e] : ends) {
+      std::cout << "    " << group << ": " << format_end(e) << "\n";
+    }
+  }
+  std::cout << "  material: E = " << s.youngs_modulus << " Pa, ν =";
   for (double nu : s.poisson_ratios) std::cout << " " << nu;
   std::cout << ", ρ = " << s.density << " kg/m³\n  boundary:";
   for (const auto& [group, bc] : s.boundary) std::cout << " " << group << "=" << to_string(bc);

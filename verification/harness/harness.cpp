@@ -122,6 +122,8 @@ SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& pr
   SceneResult result;
   result.scene = s;
   result.qoi_point = qoi_point(s);
+  result.lumen_ends = r.lumen_ends;
+  result.mesh_slivers = r.mesh_slivers;
   if (s.load.kind == LoadKind::contact) {
     result.contact_normal = scene_contact_patch(s.load, r.fine_mesh, 1.0).outward_normal;
   }

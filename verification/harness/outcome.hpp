@@ -5,10 +5,13 @@
 /// the model runs; results.hpp writes them.
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "meshes/lumen_mesh.hpp"
+#include "meshes/mesh_quality.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "verification/harness/guidewire_outcome.hpp"
 #include "verification/scene.hpp"
@@ -189,6 +192,11 @@ struct SceneResult {
   std::vector<ModalOutcome> model_modes;
   /// A guidewire load: the wire and each model's coupled contact force (guidewire_coupling.hpp).
   std::optional<GuidewireOutcome> guidewire;
+  /// A vessel from a lumen file: its ends, each with its group (inlet or outlet).
+  std::vector<std::pair<std::string, LumenEnd>> lumen_ends;
+  /// Each mesh the scene ran on (models' levels and the reference's): its dihedral extremes and
+  /// slivers, by level. A model's error on a mesh with slivers includes the mesh's.
+  std::map<int, SliverReport> mesh_slivers;
   double seconds = 0.0;
 };
 

@@ -301,6 +301,33 @@ void add_reference_history(History& h, const ReferenceSolvers& ref, const Vec3& 
   }
 }
 
+namespace {
+
+/// Lists a lumen's ends in the log and finds each mesh's slivers, warning of them: a model's
+/// error on such a mesh includes the mesh's.
+void describe_meshes(SceneReferences& r, std::ostream& log) {
+  const Scene& s = r.scene;
+  if (s.vessel.kind == VesselKind::lumen) {
+    r.lumen_ends = lumen_file_ends(s.vessel.file, s.vessel.file_scale, s.vessel.listed_ends);
+    log << "  ends of the lumen: " << r.lumen_ends.size() << "\n";
+    for (const auto& [group, end] : r.lumen_ends) {
+      log << "    " << group << ": " << format_end(end) << "\n";
+    }
+  }
+  std::map<int, const TetMesh*> meshes{{s.reference_level, &r.fine_mesh}};
+  for (const auto& [level, mesh] : r.model_meshes) meshes[level] = &mesh;
+  if (r.coarse_mesh) meshes[s.reference_level - 1] = r.coarse_mesh.get();
+  if (r.coarsest_mesh) meshes[s.reference_level - 2] = r.coarsest_mesh.get();
+  for (const auto& [level, mesh] : r.other_meshes) meshes[level] = mesh.get();
+  for (const auto& [level, mesh] : meshes) {
+    const SliverReport& slivers = r.mesh_slivers[level] = find_slivers(*mesh);
+    if (slivers.count > 0)
+      log << "  mesh level " << level << ": " << sliver_warning(slivers) << "\n";
+  }
+}
+
+}  // namespace
+
 std::unique_ptr<SceneReferences> scene_meshes(const Scene& scene, const HarnessOptions& o,
                                               std::ostream& log) {
   auto r = std::make_unique<SceneReferences>();
@@ -329,6 +356,7 @@ std::unique_ptr<SceneReferences> scene_meshes(const Scene& scene, const HarnessO
   r->transient_level = transient_reference_level(s);
   r->transient_mesh = &mesh_at_level(*r, r->transient_level, o);
   r->at_nu.resize(s.poisson_ratios.size());
+  describe_meshes(*r, log);
   return r;
 }
 

@@ -105,6 +105,10 @@ struct SceneReferences {
     double seconds = 0.0;
   };
   std::vector<AtNu> at_nu;  ///< one per scene ν, in the scene's order
+  /// A vessel from a lumen file: its ends with their groups (lumen_file_ends).
+  std::vector<std::pair<std::string, LumenEnd>> lumen_ends;
+  /// The slivers of every mesh above, by level (find_slivers).
+  std::map<int, SliverReport> mesh_slivers;
 
   SceneReferences() = default;
   SceneReferences(const SceneReferences&) = delete;
@@ -112,7 +116,7 @@ struct SceneReferences {
 };
 
 /// The scene's meshes (generated or read from the mesh cache; gmsh is not thread-safe, so this
-/// runs on one thread).
+/// runs on one thread). Logs a lumen's ends and a warning for each mesh with slivers.
 std::unique_ptr<SceneReferences> scene_meshes(const Scene& scene, const HarnessOptions& o,
                                               std::ostream& log);
 

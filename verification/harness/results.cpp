@@ -193,6 +193,12 @@ nlohmann::json outcome_json(const ModelOutcome& o, const SceneResult& r,
 }
 
 nlohmann::json scene_json(const SceneResult& r, const std::filesystem::path& results_dir) {
+  nlohmann::json quality = nlohmann::json::array();
+  for (const auto& [level, slivers] : r.mesh_slivers) {
+    nlohmann::json q = mesh_quality_json(slivers);
+    q["level"] = level;
+    quality.push_back(q);
+  }
   nlohmann::json refs = nlohmann::json::array();
   for (const auto& ref : r.references) {
     refs.push_back({{"poisson_ratio", ref.poisson_ratio},
@@ -235,10 +241,38 @@ nlohmann::json scene_json(const SceneResult& r, const std::filesystem::path& res
       {"outcomes", outcomes},
       {"modes", modes}};
   if (r.guidewire) j["guidewire"] = guidewire_json(*r.guidewire);
+  if (!r.lumen_ends.empty()) {
+    j["lumen_ends"] = nlohmann::json::array();
+    for (const auto& [group, end] : r.lumen_ends)
+      j["lumen_ends"].push_back(lumen_end_json(group, end));
+  }
+  j["mesh_quality"] = quality;
   return j;
 }
 
 }  // namespace
+
+nlohmann::json lumen_end_json(const std::string& group, const LumenEnd& e) {
+  return {{"group", group},
+          {"centre_mm", {e.centre.x() * 1e3, e.centre.y() * 1e3, e.centre.z() * 1e3}},
+          {"radius_mm", e.radius * 1e3},
+          {"normal", {e.normal.x(), e.normal.y(), e.normal.z()}},
+          {"area_mm2", e.area * 1e6}};
+}
+
+nlohmann::json mesh_quality_json(const SliverReport& s) {
+  nlohmann::json worst = nullptr;
+  if (s.count > 0) {
+    worst = {{"centroid_mm",
+              {s.worst_centroid.x() * 1e3, s.worst_centroid.y() * 1e3, s.worst_centroid.z() * 1e3}},
+             {"min_dihedral_deg", s.worst_min_dihedral_deg},
+             {"max_dihedral_deg", s.worst_max_dihedral_deg}};
+  }
+  return {{"min_dihedral_deg", s.min_dihedral_deg},
+          {"max_dihedral_deg", s.max_dihedral_deg},
+          {"sliver_count", s.count},
+          {"worst_at", worst}};
+}
 
 void write_results_json(const std::filesystem::path& path, const std::vector<SceneResult>& results,
                         const std::string& command, double reference_kernel_seconds) {

@@ -3,6 +3,7 @@
 /// verification/results.schema.json), results.csv (one row per model, ν and magnitude) and
 /// summary.md; each written atomically.
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,13 @@ std::vector<SceneResult> run_and_write(const std::vector<Scene>& scenes,
 /// normalised timings) is written when positive.
 void write_results_json(const std::filesystem::path& path, const std::vector<SceneResult>& results,
                         const std::string& command, double reference_kernel_seconds = 0.0);
+/// One end of a lumen: {group, centre_mm, radius_mm, normal, area_mm2} (results.json's and
+/// `mesh --stats-json`'s lumen_ends).
+nlohmann::json lumen_end_json(const std::string& group, const LumenEnd& end);
+/// A mesh's {min_dihedral_deg, max_dihedral_deg, sliver_count, worst_at} (worst_at: the worst
+/// sliver's centroid_mm and its min/max dihedral angles, null without slivers).
+nlohmann::json mesh_quality_json(const SliverReport& slivers);
+
 void write_results_csv(const std::filesystem::path& path, const std::vector<SceneResult>& results);
 void write_summary_markdown(const std::filesystem::path& path,
                             const std::vector<SceneResult>& results, const std::string& command);

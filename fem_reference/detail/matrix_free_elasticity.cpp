@@ -1,0 +1,259 @@
+#include "fem_reference/detail/matrix_free_elasticity.hpp"
+
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_simplex_p.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/matrix_free/fe_evaluation.h>
+#include <deal.II/matrix_free/tools.h>
+
+#include <sstream>
+#include <stdexcept>
+
+#include "fem_reference/detail/amg.hpp"
+
+namespace vessel::fem::detail {
+
+namespace {
+
+using Evaluation = dl::FEEvaluation<kDim, -1, 0, kDim, double>;
+using Number = dl::VectorizedArray<double>;
+
+/// At each quadrature point σ = λ tr(ε) I + 2μ ε of the cell's ε(u), tested with ε(v): the
+/// displacement weak form of detail/weak_form (step-8's a(u, v)).
+void stress_divergence(Evaluation& phi, double lambda, double mu) {
+  phi.evaluate(dl::EvaluationFlags::gradients);
+  for (unsigned q = 0; q < phi.n_q_points; ++q) {
+    const dl::SymmetricTensor<2, kDim, Number> eps = phi.get_symmetric_gradient(q);
+    const Number lambda_trace = lambda * dl::trace(eps);
+    dl::SymmetricTensor<2, kDim, Number> sigma = (2.0 * mu) * eps;
+    for (unsigned d = 0; d < kDim; ++d) sigma[d][d] += lambda_trace;
+    phi.submit_symmetric_gradient(sigma, q);
+  }
+  phi.integrate(dl::EvaluationFlags::gradients);
+}
+
+void copy(const dl::Vector<double>& from, MfVector& to) {
+  for (unsigned i = 0; i < from.size(); ++i) to.local_element(i) = from[i];
+}
+
+void copy(const MfVector& from, dl::Vector<double>& to) {
+  for (unsigned i = 0; i < to.size(); ++i) to[i] = from.local_element(i);
+}
+
+}  // namespace
+
+dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<double>& constraints) {
+  dl::AffineConstraints<double> out;
+  out.copy_from(constraints);
+  for (const auto& line : constraints.get_lines()) out.set_inhomogeneity(line.index, 0.0);
+  return out;
+}
+
+ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
+                                       const dl::DoFHandler<kDim>& dof,
+                                       const dl::AffineConstraints<double>& constraints,
+                                       int degree, double lambda, double mu)
+    : constraints_(constraints), lambda_(lambda), mu_(mu) {
+  dl::MatrixFree<kDim, double>::AdditionalData data;
+  data.mapping_update_flags = dl::update_gradients | dl::update_JxW_values;
+  data.tasks_parallel_scheme = dl::MatrixFree<kDim, double>::AdditionalData::none;
+  mf_.reinit(mapping, dof, constraints, dl::QGaussSimplex<kDim>(static_cast<unsigned>(degree + 1)),
+             data);
+}
+
+void ElasticityOperator::vmult(MfVector& dst, const MfVector& src) const {
+  const std::function<void(const dl::MatrixFree<kDim, double>&, MfVector&, const MfVector&,
+                           const std::pair<unsigned, unsigned>&)>
+      cells = [this](const dl::MatrixFree<kDim, double>& mf, MfVector& out, const MfVector& in,
+                     const std::pair<unsigned, unsigned>& range) {
+        Evaluation phi(mf);
+        for (unsigned cell = range.first; cell < range.second; ++cell) {
+          phi.reinit(cell);
+          phi.read_dof_values(in);
+          stress_divergence(phi, lambda_, mu_);
+          phi.distribute_local_to_global(out);
+        }
+      };
+  mf_.cell_loop(cells, dst, src, true);
+  for (const unsigned i : mf_.get_constrained_dofs()) dst.local_element(i) = src.local_element(i);
+}
+
+MfVector ElasticityOperator::diagonal() const {
+  MfVector diag;
+  mf_.initialize_dof_vector(diag);
+  const std::function<void(Evaluation&)> kernel = [this](Evaluation& phi) {
+    stress_divergence(phi, lambda_, mu_);
+  };
+  dl::MatrixFreeTools::compute_diagonal(mf_, diag, kernel);
+  for (const unsigned i : mf_.get_constrained_dofs()) diag.local_element(i) = 1.0;
+  return diag;
+}
+
+void ElasticityOperator::compute_matrix(dl::TrilinosWrappers::SparseMatrix& matrix) const {
+  const auto& dof = mf_.get_dof_handler();
+  dl::DynamicSparsityPattern dsp(dof.n_dofs(), dof.n_dofs());
+  dl::DoFTools::make_sparsity_pattern(dof, dsp, constraints_, false);
+  matrix.reinit(dsp);
+  const std::function<void(Evaluation&)> kernel = [this](Evaluation& phi) {
+    stress_divergence(phi, lambda_, mu_);
+  };
+  dl::MatrixFreeTools::compute_matrix(mf_, constraints_, matrix, kernel);
+}
+
+void ElasticityOperator::zero_constrained(MfVector& v) const {
+  for (const unsigned i : mf_.get_constrained_dofs()) v.local_element(i) = 0.0;
+}
+
+/// One V-cycle: Chebyshev pre-smoothing on the fine level, the residual restricted to P1, one ML
+/// V-cycle there, prolongated and added, Chebyshev post-smoothing. Pre- and post-smoother are the
+/// same polynomial in A and the restriction is the prolongation's transpose, so the cycle is
+/// symmetric and CG may use it. For P1 (no lower degree on the mesh): ML alone.
+class MatrixFreeElasticitySolver::VCycle {
+ public:
+  VCycle(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
+         const ElasticityOperator& fine, const dl::AffineConstraints<double>& fine_constraints,
+         const ConstraintsFor& constraints_for, int degree, double lambda, double mu,
+         const Vec3& centre, const PMultigridSettings& settings)
+      : fine_(fine), coarse_dof_(dof.get_triangulation()) {
+    const ElasticityOperator* coarse = &fine;
+    if (degree > 1) {
+      coarse_dof_.distribute_dofs(dl::FESystem<kDim>(dl::FE_SimplexP<kDim>(1), kDim));
+      dl::AffineConstraints<double> c;
+      constraints_for(coarse_dof_, c);
+      c.close();
+      coarse_constraints_ = homogeneous_copy(c);
+      coarse_ = std::make_unique<ElasticityOperator>(mapping, coarse_dof_, coarse_constraints_, 1,
+                                                     lambda, mu);
+      coarse = coarse_.get();
+      transfer_.reinit_polynomial_transfer(dof, coarse_dof_, fine_constraints, coarse_constraints_);
+
+      inverse_diagonal_ = std::make_shared<dl::DiagonalMatrix<MfVector>>();
+      inverse_diagonal_->get_vector() = fine.diagonal();
+      for (auto& d : inverse_diagonal_->get_vector()) d = 1.0 / d;
+      Chebyshev::AdditionalData cheb;
+      cheb.degree = settings.chebyshev_degree;
+      cheb.smoothing_range = settings.smoothing_range;
+      cheb.eig_cg_n_iterations = 20;
+      cheb.preconditioner = inverse_diagonal_;
+      chebyshev_.initialize(fine, cheb);
+      fine.initialize_dof_vector(residual_);
+      fine.initialize_dof_vector(correction_);
+      coarse->initialize_dof_vector(coarse_residual_);
+      coarse->initialize_dof_vector(coarse_correction_);
+    }
+    coarse->compute_matrix(coarse_matrix_);
+    // The ML near-null space: the rigid-body modes at the P1 DoFs' support points.
+    const auto& level_dof = degree > 1 ? coarse_dof_ : dof;
+    DisplacementRows rows;
+    rows.support.resize(level_dof.n_dofs());
+    dl::DoFTools::map_dofs_to_support_points(mapping, level_dof, rows.support);
+    rows.component.resize(level_dof.n_dofs());
+    const auto& fe = level_dof.get_fe();
+    std::vector<dl::types::global_dof_index> idx(fe.n_dofs_per_cell());
+    for (const auto& cell : level_dof.active_cell_iterators()) {
+      cell->get_dof_indices(idx);
+      for (unsigned i = 0; i < idx.size(); ++i)
+        rows.component[idx[i]] = fe.system_to_component_index(i).first;
+    }
+    initialize_elasticity_amg(amg_, coarse_matrix_, rows, centre, false,
+                              settings.amg_rigid_body_modes, AmgProlongator::plain, mode_storage_);
+  }
+
+  void vmult(MfVector& dst, const MfVector& src) const {
+    if (!coarse_) {
+      amg_.vmult(dst, src);
+      fine_.zero_constrained(dst);
+      return;
+    }
+    chebyshev_.vmult(dst, src);  // pre-smoothing from zero
+    fine_.zero_constrained(dst);
+    fine_.vmult(residual_, dst);
+    residual_.sadd(-1.0, 1.0, src);
+    coarse_residual_ = 0.0;
+    transfer_.restrict_and_add(coarse_residual_, residual_);
+    coarse_->zero_constrained(coarse_residual_);
+    amg_.vmult(coarse_correction_, coarse_residual_);
+    coarse_->zero_constrained(coarse_correction_);
+    transfer_.prolongate_and_add(dst, coarse_correction_);
+    fine_.zero_constrained(dst);
+    fine_.vmult(residual_, dst);  // post-smoothing on the new residual
+    residual_.sadd(-1.0, 1.0, src);
+    chebyshev_.vmult(correction_, residual_);
+    dst += correction_;
+    fine_.zero_constrained(dst);
+  }
+
+  [[nodiscard]] std::size_t memory_consumption() const {
+    return (coarse_ ? coarse_->memory_consumption() : 0) + coarse_matrix_.memory_consumption() +
+           (inverse_diagonal_ ? inverse_diagonal_->memory_consumption() : 0) +
+           4 * residual_.memory_consumption();
+  }
+
+ private:
+  using Chebyshev = dl::PreconditionChebyshev<ElasticityOperator, MfVector,
+                                              dl::DiagonalMatrix<MfVector>>;
+  const ElasticityOperator& fine_;
+  dl::DoFHandler<kDim> coarse_dof_;
+  dl::AffineConstraints<double> coarse_constraints_;
+  std::unique_ptr<ElasticityOperator> coarse_;
+  dl::MGTwoLevelTransfer<kDim, MfVector> transfer_;
+  std::shared_ptr<dl::DiagonalMatrix<MfVector>> inverse_diagonal_;
+  Chebyshev chebyshev_;
+  dl::TrilinosWrappers::SparseMatrix coarse_matrix_;
+  dl::TrilinosWrappers::PreconditionAMG amg_;
+  std::vector<double> mode_storage_;  // must outlive amg_
+  mutable MfVector residual_, correction_, coarse_residual_, coarse_correction_;
+};
+
+MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(const dl::Mapping<kDim>& mapping,
+                                                       const dl::DoFHandler<kDim>& dof,
+                                                       const ConstraintsFor& constraints_for,
+                                                       int degree, double lambda, double mu,
+                                                       const Vec3& centre,
+                                                       const PMultigridSettings& settings) {
+  ensure_mpi_initialized();  // Trilinos and the distributed vectors need MPI
+  dl::AffineConstraints<double> c;
+  constraints_for(dof, c);
+  c.close();
+  fine_constraints_ = homogeneous_copy(c);
+  fine_ = std::make_unique<ElasticityOperator>(mapping, dof, fine_constraints_, degree, lambda, mu);
+  preconditioner_ = std::make_unique<VCycle>(mapping, dof, *fine_, fine_constraints_,
+                                             constraints_for, degree, lambda, mu, centre, settings);
+}
+
+MatrixFreeElasticitySolver::~MatrixFreeElasticitySolver() = default;
+
+MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::solve(
+    const dl::Vector<double>& b, dl::Vector<double>& u, double relative_tolerance,
+    unsigned max_iterations) const {
+  MfVector rhs, x;
+  fine_->initialize_dof_vector(rhs);
+  fine_->initialize_dof_vector(x);
+  copy(b, rhs);
+  copy(u, x);
+  fine_->zero_constrained(rhs);
+  fine_->zero_constrained(x);
+  dl::SolverControl control(max_iterations, relative_tolerance * rhs.l2_norm());
+  dl::SolverCG<MfVector> cg(control);
+  try {
+    cg.solve(*fine_, x, rhs, *preconditioner_);
+  } catch (const dl::SolverControl::NoConvergence& e) {
+    std::ostringstream m;
+    m << "matrix-free CG with p-multigrid did not converge in " << e.last_step
+      << " iterations (residual " << e.last_residual
+      << "); try --solver direct or more --max-iterations";
+    throw std::runtime_error(m.str());
+  }
+  copy(x, u);
+  return {control.last_step(), control.last_value()};
+}
+
+std::size_t MatrixFreeElasticitySolver::memory_consumption() const {
+  return fine_->memory_consumption() + preconditioner_->memory_consumption();
+}
+
+}  // namespace vessel::fem::detail

@@ -1,0 +1,121 @@
+#pragma once
+/// Private to fem_reference: the displacement stiffness of small-strain isotropic elasticity
+/// applied without a matrix (deal.II MatrixFree + FEEvaluation on FE_SimplexP P1/P2 tets), and the
+/// solver built on it: CG preconditioned by a two-level p-multigrid, P2 smoothed by Chebyshev on the
+/// operator's diagonal, the P1 level (same mesh) by one V-cycle of ML algebraic multigrid on the
+/// P1 matrix (computed cell by cell from the same kernel). What deal.II 9.4 supports on simplices:
+/// docs/measurements/dealii_simplex_support.md.
+#include <deal.II/base/subscriptor.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/mapping.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/diagonal_matrix.h>
+#include <deal.II/lac/la_parallel_vector.h>
+#include <deal.II/lac/precondition.h>
+#include <deal.II/lac/trilinos_precondition.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/matrix_free/matrix_free.h>
+#include <deal.II/multigrid/mg_transfer_global_coarsening.h>
+
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+#include "fem_reference/detail/common.hpp"
+
+namespace vessel::fem::detail {
+
+using MfVector = dl::LinearAlgebra::distributed::Vector<double>;
+
+/// A(u) = ∫ σ(u) : ε(v) dV with σ = λ tr(ε) I + 2μ ε (Pa, so A u is in N for u in m), evaluated
+/// cell by cell at QGaussSimplex(degree + 1) — the assembled path's quadrature, so both compute the
+/// same bilinear form to rounding. `constraints` must be homogeneous (their pattern only): A acts
+/// on the unconstrained DoFs and as the identity on the constrained ones.
+class ElasticityOperator : public dl::Subscriptor {
+ public:
+  ElasticityOperator(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
+                     const dl::AffineConstraints<double>& constraints, int degree, double lambda,
+                     double mu);
+
+  void vmult(MfVector& dst, const MfVector& src) const;
+  void Tvmult(MfVector& dst, const MfVector& src) const { vmult(dst, src); }
+  void initialize_dof_vector(MfVector& v) const { mf_.initialize_dof_vector(v); }
+  [[nodiscard]] dl::types::global_dof_index m() const { return mf_.get_dof_handler().n_dofs(); }
+  [[nodiscard]] dl::types::global_dof_index n() const { return m(); }
+  /// A's entry (i, i) (Chebyshev's interface; only the diagonal is available): diagonal()[i].
+  [[nodiscard]] double el(unsigned i, unsigned j) const {
+    if (i != j) throw std::logic_error("ElasticityOperator::el: only diagonal entries");
+    if (diagonal_.size() == 0) diagonal_ = diagonal();
+    return diagonal_.local_element(i);
+  }
+  /// diag(A) (1 on constrained DoFs), by MatrixFreeTools::compute_diagonal.
+  [[nodiscard]] MfVector diagonal() const;
+  /// The assembled A (the constrained rows and columns zero but for a positive diagonal), into
+  /// `matrix` on `dof`'s full sparsity pattern; MatrixFreeTools::compute_matrix.
+  void compute_matrix(dl::TrilinosWrappers::SparseMatrix& matrix) const;
+  /// Sets v to 0 on the constrained DoFs.
+  void zero_constrained(MfVector& v) const;
+  [[nodiscard]] std::size_t memory_consumption() const { return mf_.memory_consumption(); }
+
+ private:
+  dl::MatrixFree<kDim, double> mf_;
+  const dl::AffineConstraints<double>& constraints_;
+  double lambda_, mu_;
+  mutable MfVector diagonal_;  // el()'s, on first use
+};
+
+/// The constraints' pattern with zero inhomogeneities (what MatrixFree and the transfer need).
+dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<double>& constraints);
+
+/// Settings of the p-multigrid V-cycle.
+struct PMultigridSettings {
+  unsigned chebyshev_degree = 4;      ///< matrix-vector products per smoothing step
+  double smoothing_range = 20.0;      ///< Chebyshev smooths [λ_max / range, λ_max] of D⁻¹A
+  bool amg_rigid_body_modes = true;   ///< ML near-null space: all six rigid-body modes
+};
+
+/// The wall's displacement system, set up once, solved for many right-hand sides: the P2 (or P1)
+/// matrix-free operator on the fine DoFs, and below it (for P2) the P1 DoFs of the same mesh, the
+/// P2 → P1 transfer and ML on the assembled P1 matrix. Callers that solve the same wall under many
+/// loads (contact active sets, Newton steps with a fixed stiffness) construct it once and call
+/// solve() per load; set-up dominates when the loads are few.
+///
+/// The right-hand side is the assembled one on the unconstrained DoFs (N): loads, and −A u₀ of
+/// the prescribed values u₀; its constrained entries are ignored. solve() returns the solution
+/// with zeros on the constrained DoFs: the caller distributes the constraints' values.
+class MatrixFreeElasticitySolver {
+ public:
+  /// The supports as constraints on any displacement DoFHandler of the mesh (P1 or P2).
+  using ConstraintsFor =
+      std::function<void(const dl::DoFHandler<kDim>&, dl::AffineConstraints<double>&)>;
+  /// `dof` holds FESystem(FE_SimplexP(degree), 3) on a conforming tet mesh; `constraints_for`
+  /// builds the supports on it and on the P1 level (inhomogeneities are dropped here). `centre`
+  /// (m): the rotation centre of the AMG's rigid-body modes. `mapping` and `dof` must outlive this.
+  MatrixFreeElasticitySolver(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
+                             const ConstraintsFor& constraints_for, int degree, double lambda,
+                             double mu, const Vec3& centre, const PMultigridSettings& settings = {});
+  ~MatrixFreeElasticitySolver();
+
+  struct Outcome {
+    unsigned iterations = 0;
+    double residual = 0.0;  ///< final ‖r‖₂, N
+  };
+  /// Solves A u = b by preconditioned CG to ‖r‖ ≤ relative_tolerance·‖b‖ (runtime_error when
+  /// max_iterations pass first). `u` (m) is the initial guess on entry.
+  Outcome solve(const dl::Vector<double>& b, dl::Vector<double>& u, double relative_tolerance,
+                unsigned max_iterations) const;
+
+  [[nodiscard]] const ElasticityOperator& fine_operator() const { return *fine_; }
+  /// Bytes held: both operators' MatrixFree data, the P1 matrix and the diagonal (not ML's
+  /// hierarchy, which Trilinos does not report).
+  [[nodiscard]] std::size_t memory_consumption() const;
+
+ private:
+  class VCycle;
+  dl::AffineConstraints<double> fine_constraints_;
+  std::unique_ptr<ElasticityOperator> fine_;
+  std::unique_ptr<VCycle> preconditioner_;
+};
+
+}  // namespace vessel::fem::detail

@@ -1,0 +1,75 @@
+/// The serial matrix-free displacement solve: the load vector assembled cell by cell without the
+/// stiffness matrix, then CG on the matrix-free operator with the p-multigrid of
+/// detail/matrix_free_elasticity.
+#include <deal.II/lac/la_parallel_vector.h>
+
+#include "fem_reference/detail/matrix_free_elasticity.hpp"
+#include "fem_reference/detail/serial_solver.hpp"
+#include "meshes/foundation/errors.hpp"
+
+namespace vessel::fem {
+
+void ElasticitySolver::Impl::assemble_load() {
+  detail::CellValues values(*mapping, *fe, degree);
+  const unsigned n = fe->n_dofs_per_cell();
+  dl::FullMatrix<double> k(n, n);
+  dl::Vector<double> f(n);
+  std::vector<Index> dofs(n);
+  Vec3 applied = Vec3::Zero();
+  // Prescribed values u₀ ≠ 0 enter the free rows as −K_e u₀: those need the element matrix.
+  const bool lift = constraints.has_inhomogeneities();
+  for (const auto& cell : dof.active_cell_iterators()) {
+    cell->get_dof_indices(dofs);
+    if (lift) {
+      form->local_system(cell, values, k, f, &applied);
+      constraints.distribute_local_to_global(f, dofs, rhs, k);
+    } else {
+      form->local_load(cell, values, f, &applied, true);
+      constraints.distribute_local_to_global(f, dofs, rhs);
+    }
+  }
+  result.applied_load = applied;
+}
+
+void ElasticitySolver::Impl::solve_displacement_matrix_free() {
+  const auto& o = problem.options;
+  result.solver = detail::chosen_solver(o, mixed, dof.n_dofs());  // InputError for the mixed form
+  solution = 0.0;
+  for (const auto& line : constraints.get_lines()) rhs(line.index) = 0.0;
+  if (rhs.l2_norm() != 0.0) {
+    const detail::MatrixFreeElasticitySolver wall(
+        *mapping, dof,
+        [this](const dl::DoFHandler<kDim>& d, dl::AffineConstraints<double>& c) {
+          support_constraints(d, c);
+        },
+        degree, form->lambda(), form->mu(), detail::node_centroid(mesh));
+    result.iterations =
+        wall.solve(rhs, solution, o.cg_relative_tolerance, o.max_iterations).iterations;
+  }
+  constraints.distribute(solution);
+}
+
+std::vector<double> ElasticitySolver::matrix_free_product(const std::vector<double>& u) const {
+  const auto& im = *impl_;
+  if (im.mixed) {
+    throw InputError("matrix_free_product: the matrix-free operator is for the displacement "
+                     "formulation (P1, P2), not the mixed one");
+  }
+  if (u.size() != im.dof.n_dofs()) {
+    throw std::invalid_argument("matrix_free_product: " + std::to_string(u.size()) +
+                                " values for a solver with " + std::to_string(im.dof.n_dofs()) +
+                                " DoFs");
+  }
+  detail::ensure_mpi_initialized();
+  const auto homogeneous = detail::homogeneous_copy(im.constraints);
+  const detail::ElasticityOperator op(*im.mapping, im.dof, homogeneous, im.degree,
+                                      im.form->lambda(), im.form->mu());
+  detail::MfVector src, dst;
+  op.initialize_dof_vector(src);
+  op.initialize_dof_vector(dst);
+  for (std::size_t i = 0; i < u.size(); ++i) src.local_element(i) = u[i];
+  op.vmult(dst, src);
+  return {dst.begin(), dst.end()};
+}
+
+}  // namespace vessel::fem

@@ -1,0 +1,81 @@
+// The matrix-free displacement operator and its p-multigrid CG against the assembled system:
+// A u (MatrixFree, FEEvaluation) against K u (FEValues assembly, free_displacement_system) on the
+// free rows, and the matrix-free CG solution against CHOLMOD's.
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <iostream>
+#include <random>
+
+#include "fem_reference/elasticity.hpp"
+#include "fem_test_meshes.hpp"
+
+namespace vessel {
+namespace {
+
+using fem::ElasticityProblem;
+using fem::ElasticitySolver;
+using fem::LinearSolver;
+
+ElasticityProblem pressurised_tube(int degree, double nu) {
+  ElasticityProblem p;
+  p.options.degree = degree;
+  p.material.poisson_ratio = nu;
+  p.dirichlet = {fem::DirichletCondition::clamped("inlet"),
+                 fem::DirichletCondition::clamped("outlet")};
+  p.pressures = {{"inner_wall", 5.0}};
+  return p;
+}
+
+class MatrixFree : public ::testing::TestWithParam<int> {};
+
+TEST_P(MatrixFree, ProductEqualsAssembledMatrixOnFreeRows) {
+  const ElasticitySolver s(test::short_tube_mesh(0), pressurised_tube(GetParam(), 0.3));
+  const auto sys = s.free_displacement_system();
+  const std::size_t n = sys.free_index.size();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::vector<double> u(n, 0.0);  // zero on the constrained DoFs
+  Eigen::VectorXd u_free(sys.K.rows());
+  for (std::size_t i = 0; i < n; ++i) {
+    if (sys.free_index[i] < 0) continue;
+    u[i] = uniform(rng);
+    u_free[sys.free_index[i]] = u[i];
+  }
+  const auto au = s.matrix_free_product(u);
+  const Eigen::VectorXd ku = sys.K * u_free;
+  double diff = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (sys.free_index[i] >= 0) diff = std::max(diff, std::abs(au[i] - ku[sys.free_index[i]]));
+  }
+  EXPECT_LT(diff, 1e-12 * ku.lpNorm<Eigen::Infinity>()) << "P" << GetParam();
+}
+
+TEST_P(MatrixFree, CgWithPMultigridReachesCholmodSolution) {
+  for (const double nu : {0.0, 0.3, 0.45}) {
+    auto p = pressurised_tube(GetParam(), nu);
+    p.options.solver = LinearSolver::direct;
+    const auto direct = fem::solve_elasticity(test::short_tube_mesh(0), p);
+    p.options.solver = LinearSolver::matrix_free;
+    p.options.cg_relative_tolerance = 1e-10;
+    const auto mf = fem::solve_elasticity(test::short_tube_mesh(0), p);
+    EXPECT_EQ(mf.solver, LinearSolver::matrix_free);
+    EXPECT_GT(mf.iterations, 0u);
+    double scale = 0.0, diff = 0.0;
+    for (std::size_t k = 0; k < direct.nodal_displacement.size(); ++k) {
+      scale = std::max(scale, direct.nodal_displacement[k].norm());
+      diff = std::max(diff, (mf.nodal_displacement[k] - direct.nodal_displacement[k]).norm());
+    }
+    EXPECT_LT(diff, 1e-7 * scale) << "P" << GetParam() << " nu " << nu << ", "
+                                  << mf.iterations << " iterations";
+    EXPECT_NEAR(mf.strain_energy, direct.strain_energy, 1e-8 * direct.strain_energy);
+    std::cout << "P" << GetParam() << " nu " << nu << ": " << mf.iterations
+              << " CG iterations, max |u_mf - u_cholmod| / max |u| = " << diff / scale << "\n";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Degrees, MatrixFree, ::testing::Values(1, 2));
+
+}  // namespace
+}  // namespace vessel
