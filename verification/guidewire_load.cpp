@@ -152,7 +152,7 @@ struct GuidewireSolver::Impl {
   /// `rod` (DER, or CORDE with its constraints) against the lumen; `warm(x)` prepares the rod for
   /// a start x other than its rest state (DER: its reference frames).
   template <class Rod, class Warm>
-  GuidewireSolution solve_rod(const Rod& rod, const rods::EqualityConstraints* constraints,
+  GuidewireSolution solve_rod(const Rod& rod, const msm::EqualityConstraints* constraints,
                               Eigen::VectorXd x, const Vec3& origin, double L, double give,
                               Warm&& warm) {
     if (state.size() == x.size()) {

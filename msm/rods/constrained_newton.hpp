@@ -7,21 +7,10 @@
 #include <functional>
 #include <vector>
 
+#include "msm/form/equality_constraints.hpp"
 #include "msm/form/form.hpp"
 
 namespace vessel::msm::rods {
-
-/// Equality constraints c(x) = 0 on a Form's dofs.
-class EqualityConstraints {
- public:
-  virtual ~EqualityConstraints() = default;
-  [[nodiscard]] virtual int num_constraints() const = 0;
-  virtual void evaluate(const VectorXd& x, VectorXd& c) const = 0;
-  /// ∂c/∂x (rows: constraints).
-  virtual void jacobian(const VectorXd& x, SparseMatrix& J) const = 0;
-  /// Σ_k λ_k ∇²c_k(x).
-  virtual void weighted_hessian(const VectorXd& x, const VectorXd& lambda, SparseMatrix& H) const = 0;
-};
 
 struct ConstrainedProblem {
   const Form* form = nullptr;

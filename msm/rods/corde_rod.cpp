@@ -6,6 +6,7 @@
 
 #include "msm/rods/cosserat_terms.hpp"
 #include "msm/rods/element_assembly.hpp"
+#include "msm/form/form_sum.hpp"
 #include "msm/rods/rod_loads.hpp"
 #include "msm/rods/vec3.hpp"
 

@@ -1,27 +1,14 @@
 #pragma once
-/// Loads and helpers shared by the rod models: a sum of Forms, and a pure end moment about a
-/// fixed axis for a planar rod (a conservative load: potential −M ψ, ψ the rotation of the last
-/// edge about the axis from the clamp, summed over the vertices' signed turning angles so that it
-/// is continuous through any number of turns).
+/// Loads shared by the rod models: a pure end moment about a fixed axis for a planar rod (a
+/// conservative load: potential −M ψ, ψ the rotation of the last edge about the axis from the
+/// clamp, summed over the vertices' signed turning angles so that it is continuous through any
+/// number of turns).
 #include <vector>
 
 #include "msm/form/form.hpp"
 #include "msm/rods/rod_layout.hpp"
 
 namespace vessel::msm::rods {
-
-/// The sum of Forms on the same dofs (each term's pattern is x-independent, so is the sum's).
-class FormSum : public Form {
- public:
-  explicit FormSum(std::vector<const Form*> terms) : terms_(std::move(terms)) {}
-  [[nodiscard]] int num_dofs() const override { return terms_.front()->num_dofs(); }
-  [[nodiscard]] double energy(const VectorXd& x) const override;
-  void gradient(const VectorXd& x, VectorXd& g) const override;
-  void hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const override;
-
- private:
-  std::vector<const Form*> terms_;
-};
 
 /// −M·ψ over the nodes of a rod layout whose positions are the first 3·nodes dofs of x.
 class PlanarEndMoment : public Form {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "msm/form/form_sum.hpp"
 #include "msm/rods/rod_loads.hpp"
 
 namespace vessel::msm::rods {
