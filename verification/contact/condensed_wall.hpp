@@ -29,6 +29,9 @@ class CondensedWall {
   /// The wall's displacement at every mesh node (m; zero where held) under the forces λ (N, one
   /// per candidate, along its direction).
   [[nodiscard]] std::vector<Vec3> displacement(const Eigen::VectorXd& forces) const;
+  /// The candidates' mesh nodes and their unit directions, as given.
+  [[nodiscard]] const std::vector<int>& nodes() const { return nodes_; }
+  [[nodiscard]] const std::vector<Vec3>& directions() const { return directions_; }
   /// Seconds spent factorising K and solving for W's columns.
   [[nodiscard]] double setup_seconds() const { return setup_seconds_; }
 

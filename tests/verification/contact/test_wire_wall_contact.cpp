@@ -1,0 +1,272 @@
+// A rod inside a deformable tube, the wire's surface (a capsule of radius r_w) against the wall's
+// inner surface, the contact found by the solve (contact::solve_wire_wall_contact on a
+// contact::CondensedWall). Set-up of the straight-tube reference (guidewire_notes.md,
+// fem_reference/rod_theory/tube_contact.hpp): a 0.356 mm nitinol wire clamped on the axis of a
+// 3 mm tube, tilted by 0.3 rad towards the wall, its tip bearing on the wall at z_c = 20 mm.
+// Rows printed as "WIRE-WALL ...".
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "fem_reference/elasticity.hpp"
+#include "fem_reference/rod_theory/tube_contact.hpp"
+#include "meshes/gmsh_vessel.hpp"
+#include "meshes/surface_loads.hpp"
+#include "msm/rods/der_rod.hpp"
+#include "msm/rods/rigid_wall.hpp"
+#include "verification/contact/wire_wall_contact.hpp"
+
+using namespace vessel;
+
+namespace {
+
+const msm::rods::RodMaterial kNitinol{48e9, 48e9 / 2.66, 6450.0};
+constexpr double kA = 3e-3;         // lumen radius, m
+constexpr double kTheta = 0.3;      // clamp tilt, rad
+constexpr double kZc = 20e-3;       // the reference's contact distance, m
+constexpr double kWallE = 14.24e3;  // the scenes' wall modulus, Pa
+constexpr double kTubeLength = 30e-3;
+
+/// The structured straight tube (axis z, 0 ≤ z ≤ 30 mm, a = 3 mm, t = 1 mm), level 0.
+const TetMesh& tube_mesh() {
+  static const TetMesh mesh = [] {
+    VesselParams p;
+    p.length = kTubeLength;
+    p.style = MeshStyle::structured;
+    p.level = 0;
+    return generate_vessel_mesh(p);
+  }();
+  return mesh;
+}
+
+std::vector<int> inner_nodes(const TetMesh& mesh) {
+  return mesh.group_nodes(mesh.require_group("inner_wall", 2, "tube"));
+}
+
+/// The inner-wall node on the +x line (y = 0) nearest z = 25 mm: where the tip is aimed, so the
+/// tip's hemisphere meets the faceted wall at one of its nodes (which lie on the exact cylinder).
+int aim_node(const TetMesh& mesh) {
+  int best = -1;
+  for (const int n : inner_nodes(mesh)) {
+    const Vec3& x = mesh.nodes[n];
+    if (std::abs(x.y()) > 1e-9 || x.x() < 0) continue;
+    if (best < 0 || std::abs(x.z() - 25e-3) < std::abs(mesh.nodes[best].z() - 25e-3)) best = n;
+  }
+  return best;
+}
+
+fem::ElasticityProblem wall_problem(double young) {
+  fem::ElasticityProblem p;
+  p.material.youngs_modulus = young;
+  p.material.poisson_ratio = 0.45;
+  p.options.degree = 1;
+  p.dirichlet = {fem::DirichletCondition::clamped("inlet"),
+                 fem::DirichletCondition::clamped("outlet")};
+  return p;
+}
+
+/// Candidates: inner-wall nodes within `half_length` of z along the axis and `half_angle` of +x.
+std::vector<int> band(const TetMesh& mesh, double z, double half_length, double half_angle) {
+  std::vector<int> out;
+  for (const int n : inner_nodes(mesh)) {
+    const Vec3& x = mesh.nodes[n];
+    if (std::abs(x.z() - z) <= half_length && std::abs(std::atan2(x.y(), x.x())) <= half_angle)
+      out.push_back(n);
+  }
+  return out;
+}
+
+struct Wire {
+  msm::rods::RodLayout layout;
+  msm::rods::DerRod rod;
+  double EI = 0.0, radius = 0.0;
+  Wire(double diameter, double length, int segments, const Vec3& origin)
+      : layout([&] {
+          msm::rods::RodSpec s = msm::rods::uniform_rod(kNitinol, length, diameter, segments);
+          s.origin = origin;
+          s.direction = Vec3(std::sin(kTheta), 0.0, std::cos(kTheta));
+          return msm::rods::make_layout(s);
+        }()),
+        rod(layout),
+        EI(msm::rods::solid_section(kNitinol, diameter).EI),
+        radius(diameter / 2) {}
+  [[nodiscard]] contact::ContactWire contact() const {
+    contact::ContactWire w;
+    w.form = &rod;
+    w.fixed = rod.clamp_fixed();
+    w.first_node = layout.first_node;
+    w.last_node = layout.tip_node;
+    w.radius = radius;
+    return w;
+  }
+};
+
+/// The same wire against the exact rigid cylinder (msm/rods/rigid_wall): its contact force, N.
+struct RigidRun {
+  Eigen::VectorXd x;
+  double force = 0.0;
+};
+RigidRun rigid_run(Wire& w) {
+  const msm::rods::StraightTube tube(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(),
+                                     kA - w.radius);
+  Eigen::VectorXd x = w.rod.rest_state();
+  w.rod.update_reference(x);
+  msm::rods::ConstrainedOptions o;
+  o.force_scale = w.EI / (kZc * kZc);
+  const msm::rods::ContactSolution s = msm::rods::solve_wall_contact(
+      w.rod, nullptr, w.rod.clamp_fixed(), x, tube, 2, w.layout.tip_node, o);
+  RigidRun r{s.x, 0.0};
+  for (const double f : s.forces) r.force += f;
+  return r;
+}
+
+/// The candidate nearest the wire's tip pushed out by r_w (the rigid contact's wall point).
+int nearest_candidate(const TetMesh& mesh, const std::vector<int>& nodes, const Vec3& point) {
+  int best = 0;
+  for (int j = 1; j < static_cast<int>(nodes.size()); ++j) {
+    if ((mesh.nodes[nodes[j]] - point).norm() < (mesh.nodes[nodes[best]] - point).norm()) best = j;
+  }
+  return best;
+}
+
+/// The contact forces as nodal loads for a second FEM solve (deal.II's own assembly): each active
+/// candidate's λ n as a point at its node of an inner-wall triangle.
+std::vector<TractionPatch> nodal_loads(const TetMesh& mesh, const contact::CondensedWall& wall,
+                                       const contact::WireWallSolution& s) {
+  const PhysicalGroup& inner = mesh.require_group("inner_wall", 2, "tube");
+  std::vector<TractionPatch> loads;
+  for (const int j : s.active) {
+    const int node = wall.nodes()[static_cast<std::size_t>(j)];
+    for (const int t : inner.elements) {
+      const Triangle& tri = mesh.triangles[static_cast<std::size_t>(t)];
+      int corner = -1;
+      for (int k = 0; k < 3; ++k) {
+        if (tri[k] == node) corner = k;
+      }
+      if (corner < 0) continue;
+      TractionPatch p;
+      p.triangles = {t};
+      SurfacePoint q;
+      q.triangle = t;
+      q.barycentric[corner] = 1.0;
+      q.weight = 1.0;
+      p.points = {q};
+      p.traction = s.force[j] * wall.directions()[static_cast<std::size_t>(j)];
+      p.area = 1.0;
+      loads.push_back(p);
+      break;
+    }
+  }
+  return loads;
+}
+
+struct CoupledRun {
+  contact::WireWallSolution solution;
+  Vec3 clamp = Vec3::Zero();
+  double rigid_force = 0.0;
+  double setup_seconds = 0.0;
+};
+
+/// The wire (diameter d, N segments, the reference's length for z_c = 20 mm) in the tube of wall
+/// modulus E, candidates within 4 mm and 60° of the aimed node.
+CoupledRun coupled_run(double young, double diameter, int segments, double length_factor = 1.0) {
+  const TetMesh& mesh = tube_mesh();
+  const int aim = aim_node(mesh);
+  const Vec3 target = mesh.nodes[aim];
+  const double c = kA - diameter / 2;
+  const double length =
+      length_factor * rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
+  Wire w(diameter, length, segments, Vec3(0, 0, target.z() - kZc));
+  const RigidRun rigid = rigid_run(w);
+  const fem::ElasticitySolver solver(mesh, wall_problem(young));
+  const std::vector<int> nodes = band(mesh, target.z(), 4e-3, 1.05);
+  const contact::CondensedWall wall(solver.free_displacement_system(), nodes,
+                                    contact::into_wall_directions(mesh, nodes, "inner_wall"));
+  const Vec3 tip = rigid.x.segment<3>(3 * w.layout.tip_node);
+  const Vec3 radial = Vec3(tip.x(), tip.y(), 0).normalized();
+  const int first = nearest_candidate(mesh, nodes, tip + w.radius * radial);
+  contact::WireWallOptions o;
+  o.force_scale = w.EI / (kZc * kZc);
+  CoupledRun run;
+  run.solution = contact::solve_wire_wall_contact(w.contact(), wall, mesh, rigid.x, {first}, o);
+  run.clamp = contact::clamp_reaction(w.contact(), wall, mesh, run.solution);
+  run.rigid_force = rigid.force;
+  run.setup_seconds = wall.setup_seconds();
+  return run;
+}
+
+}  // namespace
+
+// The rigid limit: the scenes' wall made 10⁶ times stiffer. The force must be the rigid-wall
+// solve's of the same discrete wire (the wall's compliance ~0.5e-6 m/N moves it by ~1e-5) and so
+// the shooting reference's F z_c²/EI = 0.470968 within DER's error at N = 32 (4.3e-4, measured in
+// tests/rods/test_rigid_wall.cpp).
+TEST(WireWallContact, RigidLimitMatchesTheStraightTubeReference) {
+  const TetMesh& mesh = tube_mesh();
+  const double r_aim = std::hypot(mesh.nodes[aim_node(mesh)].x(), mesh.nodes[aim_node(mesh)].y());
+  ASSERT_NEAR(r_aim, kA, 1e-12);  // the aimed node is on the exact cylinder
+  const double d = 0.356e-3;
+  const CoupledRun run = coupled_run(kWallE * 1e6, d, 32);
+  double total = 0.0;
+  for (const int j : run.solution.active) total += run.solution.force[j];
+  const double EI = msm::rods::solid_section(kNitinol, d).EI;
+  const rod_theory::StraightTubeContact ref =
+      rod_theory::straight_tube_contact(kTheta, (kA - d / 2) / kZc);
+  const double scaled = total * kZc * kZc / EI;
+  std::printf(
+      "WIRE-WALL rigid limit N=32: F z^2/EI %.6f (ref %.6f, %+.2e; rigid-wall solve "
+      "%+.2e), %zu in contact, %d active-set changes, %d Newton, %.3f s (W %.3f s)\n",
+      scaled, ref.force, scaled / ref.force - 1, total / run.rigid_force - 1,
+      run.solution.active.size(), run.solution.active_set_changes, run.solution.newton_iterations,
+      run.solution.seconds, run.setup_seconds);
+  EXPECT_EQ(run.solution.active.size(), 1u);  // the tip's hemisphere on one node
+  EXPECT_LT(std::abs(total / run.rigid_force - 1), 1e-4);
+  EXPECT_LT(std::abs(scaled / ref.force - 1), 1.5 * 4.26e-4);
+}
+
+// Action and reaction on a compliant wall (the scenes' wall 100 times stiffer, 1.4 MPa, the wire
+// denting it by a few tenths of a mm): the wire's clamp reaction (from the rod's own forces at the
+// held nodes) plus the wall's support reactions (deal.II's, from a second FEM solve under the
+// contact forces as nodal loads) sum to zero; that FEM solve's displacement along each active
+// node's direction is the condensed wall's Wλ; Signorini's conditions hold on every candidate.
+TEST(WireWallContact, ActionEqualsReactionAndSignoriniHolds) {
+  const TetMesh& mesh = tube_mesh();
+  const double young = kWallE * 100;
+  const CoupledRun run = coupled_run(young, 0.356e-3, 32);
+  const contact::WireWallSolution& s = run.solution;
+  fem::ElasticityProblem p = wall_problem(young);
+  const fem::ElasticitySolver condensing(mesh, p);
+  const std::vector<int> nodes = band(mesh, mesh.nodes[aim_node(mesh)].z(), 4e-3, 1.05);
+  const contact::CondensedWall wall(condensing.free_displacement_system(), nodes,
+                                    contact::into_wall_directions(mesh, nodes, "inner_wall"));
+  p.patches = nodal_loads(mesh, wall, s);
+  ASSERT_EQ(p.patches.size(), s.active.size());
+  fem::ElasticitySolver solver(mesh, p);
+  const fem::ElasticityResult& r = solver.solve();
+  Vec3 supports = Vec3::Zero();
+  for (const fem::GroupReaction& g : r.reactions) supports += g.force;
+  const Vec3 on_wall = s.total_force_on_wall(wall);
+  const Vec3 sum = run.clamp + supports;
+  std::printf(
+      "WIRE-WALL action-reaction E=%.3g Pa: %zu in contact, force on wall (%.6e, %.6e, "
+      "%.6e) N, clamp + supports |%.3e| N (%.2e relative), %d active-set changes, %d "
+      "Newton, %.3f s\n",
+      young, s.active.size(), on_wall.x(), on_wall.y(), on_wall.z(), sum.norm(),
+      sum.norm() / on_wall.norm(), s.active_set_changes, s.newton_iterations, s.seconds);
+  EXPECT_LT(sum.norm(), 1e-9 * on_wall.norm());
+  const Eigen::VectorXd along = wall.compliance() * s.force;
+  double dent = 0.0;
+  for (const int j : s.active) {
+    const Vec3 u = r.nodal_displacement[static_cast<std::size_t>(wall.nodes()[j])];
+    EXPECT_NEAR(u.dot(wall.directions()[j]), along[j], 1e-9 * along.cwiseAbs().maxCoeff());
+    dent = std::max(dent, along[j]);
+  }
+  std::printf("WIRE-WALL action-reaction: largest dent %.4e m\n", dent);
+  for (int j = 0; j < s.force.size(); ++j) {
+    EXPECT_GE(s.force[j], 0.0);
+    EXPECT_GE(s.gap[j], -1e-13);
+    EXPECT_LE(s.force[j] * std::abs(s.gap[j]), 1e-13 * s.force.maxCoeff());
+  }
+}

@@ -1,0 +1,351 @@
+#include "verification/contact/wire_wall_contact.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "meshes/foundation/errors.hpp"
+
+namespace vessel::contact {
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+
+/// The centreline point nearest p: on segment (a, a+1) at parameter s ∈ [0, 1].
+struct Nearest {
+  int a = 0;
+  double s = 0.0;
+  bool interior = false;  ///< 0 < s < 1 (else c is a node: a hemisphere's centre)
+  Vector3d c, e;          ///< the point and the segment's vector
+};
+
+Nearest nearest_on_centreline(const VectorXd& x, int first, int last, const Vector3d& p) {
+  Nearest best;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  for (int i = first; i < last; ++i) {
+    const Vector3d xa = x.segment<3>(3 * i), e = x.segment<3>(3 * (i + 1)) - xa;
+    const double ee = e.squaredNorm();
+    const double t = std::clamp((p - xa).dot(e) / ee, 0.0, 1.0);
+    const Vector3d c = xa + t * e;
+    const double d2 = (p - c).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = {i, t, t > 0.0 && t < 1.0, c, e};
+    }
+  }
+  return best;
+}
+
+/// The coupled system's state on one active set: the wall's displacement along each candidate's
+/// direction, and per active candidate its nearest centreline point, normal ν and gap.
+struct ActiveGeometry {
+  VectorXd along;  ///< (Wλ)_j for every candidate, m
+  std::vector<Nearest> nearest;
+  std::vector<Vector3d> nu;
+  VectorXd gap;
+};
+
+class Coupled {
+ public:
+  Coupled(const ContactWire& wire, const CondensedWall& wall, const TetMesh& mesh)
+      : wire_(wire), W_(wall.compliance()), n_(wall.directions()) {
+    points_.reserve(wall.nodes().size());
+    for (const int node : wall.nodes()) points_.push_back(mesh.nodes[node]);
+  }
+
+  [[nodiscard]] int num_candidates() const { return static_cast<int>(points_.size()); }
+
+  /// P_j = X_j + (Wλ)_j n_j.
+  [[nodiscard]] Vector3d point(int j, const VectorXd& along) const {
+    return points_[j] + along[j] * n_[j];
+  }
+
+  [[nodiscard]] VectorXd wall_along(const std::vector<int>& active, const VectorXd& lambda) const {
+    VectorXd along = VectorXd::Zero(num_candidates());
+    for (std::size_t k = 0; k < active.size(); ++k) along += W_.col(active[k]) * lambda[k];
+    return along;
+  }
+
+  [[nodiscard]] double gap_of(int j, const VectorXd& x, const VectorXd& along) const {
+    const Vector3d p = point(j, along);
+    const Nearest c = nearest_on_centreline(x, wire_.first_node, wire_.last_node, p);
+    return (p - c.c).norm() - wire_.radius;
+  }
+
+  ActiveGeometry geometry(const std::vector<int>& active, const VectorXd& x,
+                          const VectorXd& lambda) const {
+    ActiveGeometry g;
+    g.along = wall_along(active, lambda);
+    g.gap.resize(static_cast<Eigen::Index>(active.size()));
+    for (std::size_t k = 0; k < active.size(); ++k) {
+      const Vector3d p = point(active[k], g.along);
+      g.nearest.push_back(nearest_on_centreline(x, wire_.first_node, wire_.last_node, p));
+      const Vector3d d = p - g.nearest.back().c;
+      g.nu.push_back(d / d.norm());
+      g.gap[static_cast<Eigen::Index>(k)] = d.norm() - wire_.radius;
+    }
+    return g;
+  }
+
+  /// Rod rows: ∇E + J_cᵀμ + Σ_k λ_k B_kᵀ n_k (held dofs included).
+  VectorXd rod_residual(const std::vector<int>& active, const VectorXd& x, const VectorXd& mu,
+                        const VectorXd& lambda, const ActiveGeometry& g) const {
+    VectorXd r;
+    wire_.form->gradient(x, r);
+    if (wire_.constraints && mu.size() > 0) {
+      msm::SparseMatrix J;
+      wire_.constraints->jacobian(x, J);
+      r += J.transpose() * mu;
+    }
+    for (std::size_t k = 0; k < active.size(); ++k) {
+      const Nearest& c = g.nearest[k];
+      const Vector3d f = lambda[static_cast<Eigen::Index>(k)] * n_[active[k]];
+      r.segment<3>(3 * c.a) += (1.0 - c.s) * f;
+      r.segment<3>(3 * (c.a + 1)) += c.s * f;
+    }
+    return r;
+  }
+
+  /// Newton on one active set; returns the iterations. Throws if it does not converge.
+  int newton(const std::vector<int>& active, VectorXd& x, VectorXd& mu, VectorXd& lambda,
+             const WireWallOptions& o, double& residual) const {
+    const int n = static_cast<int>(x.size());
+    const int mc = wire_.constraints ? wire_.constraints->num_constraints() : 0;
+    const int ma = static_cast<int>(active.size());
+    const int size = n + mc + ma;
+    const double extent = x.head(3 * (wire_.last_node + 1)).cwiseAbs().maxCoeff();
+    double last_step = std::numeric_limits<double>::infinity();
+    for (int it = 0; it <= o.max_newton; ++it) {
+      const ActiveGeometry g = geometry(active, x, lambda);
+      VectorXd R(size);
+      R.head(n) = rod_residual(active, x, mu, lambda, g);
+      for (int i = 0; i < n; ++i) {
+        if (wire_.fixed[i]) R[i] = 0.0;
+      }
+      VectorXd c;
+      if (mc > 0) {
+        wire_.constraints->evaluate(x, c);
+        R.segment(n, mc) = c;
+      }
+      R.tail(ma) = g.gap;
+      residual = R.head(n).norm();
+      const double cmax = mc > 0 ? c.cwiseAbs().maxCoeff() : 0.0;
+      const double gmax = ma > 0 ? g.gap.cwiseAbs().maxCoeff() : 0.0;
+      const bool feasible = cmax <= o.constraint_tolerance && gmax <= o.gap_tolerance;
+      // Converged, or at round-off: the last step moved no position by more than 1e-14 of the
+      // wire's extent (the stiff stretching term's cancellation floors ‖∇E‖ near 1e-10 N).
+      if (feasible && (residual <= o.tolerance * o.force_scale || last_step <= 1e-14 * extent)) {
+        return it;
+      }
+      if (it == o.max_newton || !R.allFinite()) {
+        std::ostringstream s;
+        s << "solve_wire_wall_contact: Newton did not converge in " << o.max_newton
+          << " iterations on an active set of " << ma << " candidates (rod residual " << residual
+          << " N, max |c| " << cmax << ", max |g| " << gmax << " m)";
+        throw std::runtime_error(s.str());
+      }
+      const MatrixXd A = jacobian(active, x, mu, lambda, g, n, mc);
+      const VectorXd step = A.partialPivLu().solve(-R);
+      last_step = step.head(3 * (wire_.last_node + 1)).cwiseAbs().maxCoeff();
+      x += step.head(n);
+      if (mc > 0) mu += step.segment(n, mc);
+      lambda += step.tail(ma);
+      if (wire_.project) wire_.project(x);
+    }
+    return o.max_newton;
+  }
+
+ private:
+  MatrixXd jacobian(const std::vector<int>& active, const VectorXd& x, const VectorXd& mu,
+                    const VectorXd& lambda, const ActiveGeometry& g, int n, int mc) const {
+    const int ma = static_cast<int>(active.size());
+    MatrixXd A = MatrixXd::Zero(n + mc + ma, n + mc + ma);
+    msm::SparseMatrix H;
+    wire_.form->hessian(x, H, false);
+    A.topLeftCorner(n, n) = MatrixXd(H);
+    if (mc > 0) {
+      msm::SparseMatrix J, Hc;
+      wire_.constraints->jacobian(x, J);
+      wire_.constraints->weighted_hessian(x, mu, Hc);
+      A.topLeftCorner(n, n) += MatrixXd(Hc);
+      const MatrixXd Jd(J);
+      A.block(0, n, n, mc) = Jd.transpose();
+      A.block(n, 0, mc, n) = Jd;
+    }
+    for (int k = 0; k < ma; ++k) {
+      const int j = active[k];
+      const Nearest& c = g.nearest[k];
+      const Vector3d& nk = n_[j];
+      const int ia = 3 * c.a, ib = 3 * (c.a + 1), col = n + mc + k;
+      // ∂(B_kᵀ n_k)/∂λ_k at fixed s, and the gap row −ν_kᵀ B_k, (ν_k·n_k) W_kl.
+      A.block<3, 1>(ia, col) += (1.0 - c.s) * nk;
+      A.block<3, 1>(ib, col) += c.s * nk;
+      A.block<1, 3>(col, ia) -= (1.0 - c.s) * g.nu[k].transpose();
+      A.block<1, 3>(col, ib) -= c.s * g.nu[k].transpose();
+      for (int l = 0; l < ma; ++l) A(col, n + mc + l) += g.nu[k].dot(nk) * W_(j, active[l]);
+      if (!c.interior) continue;
+      // The split's change: s = (P − x_a)·e/|e|², so ∂s/∂x_a = (2 s e − e − d)/|e|²,
+      // ∂s/∂x_b = (d − 2 s e)/|e|², ∂s/∂λ_l = (e·n_k/|e|²) W_kl; B_kᵀ n_k changes by (−n_k, n_k)
+      // ds. (The gap rows have no such term: ν_k ⟂ e at an interior nearest point.)
+      const double ee = c.e.squaredNorm(), lk = lambda[k];
+      const Vector3d d = point(j, g.along) - x.segment<3>(ia);
+      const Vector3d dsa = (2.0 * c.s * c.e - c.e - d) / ee, dsb = (d - 2.0 * c.s * c.e) / ee;
+      A.block<3, 3>(ia, ia) -= lk * nk * dsa.transpose();
+      A.block<3, 3>(ia, ib) -= lk * nk * dsb.transpose();
+      A.block<3, 3>(ib, ia) += lk * nk * dsa.transpose();
+      A.block<3, 3>(ib, ib) += lk * nk * dsb.transpose();
+      const double ds_dalong = c.e.dot(nk) / ee;
+      for (int l = 0; l < ma; ++l) {
+        const double ds = ds_dalong * W_(j, active[l]);
+        A.block<3, 1>(ia, n + mc + l) -= lk * ds * nk;
+        A.block<3, 1>(ib, n + mc + l) += lk * ds * nk;
+      }
+    }
+    for (int i = 0; i < n; ++i) {  // held dofs: Δ = 0
+      if (!wire_.fixed[i]) continue;
+      A.row(i).setZero();
+      A.col(i).setZero();
+      A(i, i) = 1.0;
+    }
+    return A;
+  }
+
+  const ContactWire& wire_;
+  const MatrixXd& W_;
+  const std::vector<Vec3>& n_;
+  std::vector<Vec3> points_;
+};
+
+void check(const ContactWire& wire, const Eigen::VectorXd& start) {
+  if (!wire.form) throw std::invalid_argument("solve_wire_wall_contact: the wire has no form");
+  if (!(wire.radius > 0.0)) {
+    throw std::invalid_argument("solve_wire_wall_contact: the wire's radius must be positive");
+  }
+  if (start.size() != wire.form->num_dofs() ||
+      static_cast<Eigen::Index>(wire.fixed.size()) != start.size() || wire.first_node < 0 ||
+      wire.last_node <= wire.first_node || 3 * (wire.last_node + 1) > start.size()) {
+    throw std::invalid_argument(
+        "solve_wire_wall_contact: start, fixed and the centreline's nodes must fit the form's "
+        "dofs");
+  }
+}
+
+}  // namespace
+
+Vec3 WireWallSolution::total_force_on_wall(const CondensedWall& wall) const {
+  Vec3 f = Vec3::Zero();
+  for (const int j : active) f += force[j] * wall.directions()[static_cast<std::size_t>(j)];
+  return f;
+}
+
+WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const CondensedWall& wall,
+                                         const TetMesh& mesh, const Eigen::VectorXd& start,
+                                         const std::vector<int>& initial_active,
+                                         const WireWallOptions& options) {
+  check(wire, start);
+  const auto t0 = std::chrono::steady_clock::now();
+  const Coupled coupled(wire, wall, mesh);
+  const int m = coupled.num_candidates();
+  std::vector<int> active = initial_active;
+  VectorXd x = start;
+  VectorXd mu = VectorXd::Zero(wire.constraints ? wire.constraints->num_constraints() : 0);
+  VectorXd lambda = VectorXd::Zero(static_cast<Eigen::Index>(active.size()));
+  WireWallSolution out;
+  for (int change = 0;; ++change) {
+    out.newton_iterations += coupled.newton(active, x, mu, lambda, options, out.residual);
+    // A candidate whose force would pull leaves; else the most penetrating one joins.
+    Eigen::Index worst = -1;
+    const double least = lambda.size() > 0 ? lambda.minCoeff(&worst) : 0.0;
+    int join = -1;
+    double deepest = -options.gap_tolerance;
+    if (least >= 0.0) {
+      const VectorXd along = coupled.wall_along(active, lambda);
+      for (int j = 0; j < m; ++j) {
+        if (std::find(active.begin(), active.end(), j) != active.end()) continue;
+        const double g = coupled.gap_of(j, x, along);
+        if (g < deepest) {
+          deepest = g;
+          join = j;
+        }
+      }
+      if (join < 0) break;
+    }
+    if (change == options.max_changes) {
+      throw std::runtime_error("solve_wire_wall_contact: the active set did not settle in " +
+                               std::to_string(options.max_changes) + " changes (" +
+                               std::to_string(active.size()) + " in contact)");
+    }
+    ++out.active_set_changes;
+    if (least < 0.0) {
+      active.erase(active.begin() + worst);
+      VectorXd kept(lambda.size() - 1);
+      kept << lambda.head(worst), lambda.tail(lambda.size() - worst - 1);
+      lambda = kept;
+    } else {
+      active.push_back(join);
+      lambda.conservativeResize(lambda.size() + 1);
+      lambda[lambda.size() - 1] = 0.0;
+    }
+  }
+  out.x = x;
+  out.rod_multipliers = mu;
+  out.active = active;
+  out.force = VectorXd::Zero(m);
+  for (std::size_t k = 0; k < active.size(); ++k)
+    out.force[active[k]] = lambda[static_cast<Eigen::Index>(k)];
+  const VectorXd along = coupled.wall_along(active, lambda);
+  out.gap.resize(m);
+  for (int j = 0; j < m; ++j) out.gap[j] = coupled.gap_of(j, x, along);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+Vec3 clamp_reaction(const ContactWire& wire, const CondensedWall& wall, const TetMesh& mesh,
+                    const WireWallSolution& solution) {
+  const Coupled coupled(wire, wall, mesh);
+  VectorXd lambda(static_cast<Eigen::Index>(solution.active.size()));
+  for (std::size_t k = 0; k < solution.active.size(); ++k) {
+    lambda[static_cast<Eigen::Index>(k)] = solution.force[solution.active[k]];
+  }
+  const ActiveGeometry g = coupled.geometry(solution.active, solution.x, lambda);
+  const VectorXd r =
+      coupled.rod_residual(solution.active, solution.x, solution.rod_multipliers, lambda, g);
+  Vec3 sum = Vec3::Zero();
+  const int nodes =
+      std::min<int>(static_cast<int>(r.size()) / 3, static_cast<int>(wire.fixed.size()) / 3);
+  for (int i = 0; i < nodes; ++i) {
+    if (wire.fixed[3 * i] || wire.fixed[3 * i + 1] || wire.fixed[3 * i + 2]) {
+      sum += r.segment<3>(3 * i);
+    }
+  }
+  return sum;
+}
+
+std::vector<Vec3> into_wall_directions(const TetMesh& mesh, const std::vector<int>& nodes,
+                                       const std::string& surface_group) {
+  const PhysicalGroup& group = mesh.require_group(surface_group, 2, "wall mesh");
+  std::vector<Vec3> sum(mesh.nodes.size(), Vec3::Zero());
+  for (const Triangle& t : mesh.group_triangles(group)) {
+    const Vec3 area2 =
+        (mesh.nodes[t[1]] - mesh.nodes[t[0]]).cross(mesh.nodes[t[2]] - mesh.nodes[t[0]]);
+    for (int k = 0; k < 3; ++k) sum[t[k]] += area2;
+  }
+  std::vector<Vec3> out;
+  for (const int node : nodes) {
+    if (node < 0 || static_cast<std::size_t>(node) >= sum.size() || sum[node].norm() == 0.0) {
+      throw InputError("contact candidate node " + std::to_string(node) +
+                       " is not a node of the group '" + surface_group + "'");
+    }
+    out.push_back(-sum[node].normalized());
+  }
+  return out;
+}
+
+}  // namespace vessel::contact

@@ -1,0 +1,91 @@
+#pragma once
+/// A rod (any msm::Form, with its own equality constraints or none) inside a linear elastic wall,
+/// the contact between the wire's surface and the wall's inner surface found by the solve.
+///
+/// The wire's surface is a capsule: the tube of radius r_w around its centreline polyline, closed
+/// by hemispheres at its ends (the rounded tip). The contact slaves are wall nodes (the
+/// CondensedWall's candidates), each with the unit direction n_j a contact force pushes it (out of
+/// the lumen). Node j's gap to the wire is its distance to the capsule,
+///   g_j = |P_j − c_j(x)| − r_w,   P_j = X_j + (Wλ)_j n_j,
+/// c_j the centreline point nearest P_j (on a segment, or an end node: the tip's hemisphere). The
+/// wall pushes the wire with −λ_j n_j at c_j (split between the segment's nodes as c_j is), and the
+/// wire pushes the wall with +λ_j n_j at node j, so the forces are equal and opposite by
+/// construction; the wall's displacement along n_j is (Wλ)_j. Frictionless and one-sided:
+/// g ≥ 0, λ ≥ 0, λ·g = 0 (to first order in the angle between n_j and the capsule's normal,
+/// which vanishes where the wall's surface and the wire's touch tangentially).
+///
+/// Solved by an active set on Newton's method for the coupled system (x, rod multipliers, λ_A):
+///   ∇E(x) − f + J_c(x)ᵀμ + Σ_{k∈A} λ_k B_k(x)ᵀ n_k = 0,   c(x) = 0,   g_A(x, λ_A) = 0,
+/// with held dofs fixed; the most penetrating node joins A, a node whose λ would pull leaves.
+#include <Eigen/Dense>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "meshes/tet_mesh.hpp"
+#include "msm/form/equality_constraints.hpp"
+#include "msm/form/form.hpp"
+#include "verification/contact/condensed_wall.hpp"
+
+namespace vessel::contact {
+
+/// The wire: its Form, constraints (or nullptr), held dofs and the centreline's material nodes
+/// first_node..last_node (positions are the first 3 × nodes dofs of x).
+struct ContactWire {
+  const msm::Form* form = nullptr;
+  const msm::EqualityConstraints* constraints = nullptr;
+  std::vector<char> fixed;
+  int first_node = 0;
+  int last_node = 0;
+  double radius = 0.0;  ///< r_w, m
+  /// Maps each Newton iterate back onto part of the constraints (CORDE's unit quaternions); may
+  /// be empty.
+  std::function<void(Eigen::VectorXd&)> project;
+};
+
+struct WireWallOptions {
+  double tolerance = 1e-10;      ///< on ‖rod residual‖ (free dofs) relative to force_scale
+  double force_scale = 1e-3;     ///< N
+  double gap_tolerance = 1e-13;  ///< m: |g| on the active set; −g beyond it penetrates
+  double constraint_tolerance = 1e-14;  ///< on max |c_k|
+  int max_newton = 60;
+  int max_changes = 200;  ///< active-set changes
+};
+
+struct WireWallSolution {
+  Eigen::VectorXd x;                ///< the wire's dofs
+  Eigen::VectorXd force;            ///< λ per candidate, N (zero off the active set)
+  Eigen::VectorXd gap;              ///< g per candidate at the solution, m
+  Eigen::VectorXd rod_multipliers;  ///< μ of the wire's own constraints
+  std::vector<int> active;          ///< candidates in contact
+  int active_set_changes = 0;
+  int newton_iterations = 0;  ///< summed over the active sets
+  double residual = 0.0;      ///< ‖rod residual‖ on free dofs at the end, N
+  double seconds = 0.0;
+  /// Σ_j λ_j n_j: the wire's total force on the wall, N.
+  [[nodiscard]] Vec3 total_force_on_wall(const CondensedWall& wall) const;
+};
+
+/// Equilibrium of the wire inside the wall from `start`, the active set started at
+/// `initial_active` (candidate indices; e.g. those nearest a rigid-wall solution's contacts).
+/// Throws std::runtime_error naming the active set's size and the residuals if Newton does not
+/// converge or the active set does not settle in options.max_changes; std::invalid_argument for a
+/// wire without a form, a non-positive radius or nodes outside x.
+WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const CondensedWall& wall,
+                                         const TetMesh& mesh, const Eigen::VectorXd& start,
+                                         const std::vector<int>& initial_active,
+                                         const WireWallOptions& options = {});
+
+/// The force the clamp exerts on the wire (N): on each held node's position the balance of the
+/// rod's internal force −∇E, the wall's −λ_k n_k share and the constraint force −J_cᵀμ, summed
+/// over the held nodes: R = Σ_held (∇E + Σ_k λ_k B_kᵀ n_k + J_cᵀμ).
+Vec3 clamp_reaction(const ContactWire& wire, const CondensedWall& wall, const TetMesh& mesh,
+                    const WireWallSolution& solution);
+
+/// Per candidate, the unit direction that points out of the lumen: the negated mean of the
+/// outward normals of `surface_group`'s triangles at the node, area-weighted. InputError unless
+/// every candidate is a node of the group's triangles.
+std::vector<Vec3> into_wall_directions(const TetMesh& mesh, const std::vector<int>& nodes,
+                                       const std::string& surface_group);
+
+}  // namespace vessel::contact
