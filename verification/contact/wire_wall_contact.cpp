@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "meshes/foundation/errors.hpp"
+#include "verification/contact/signorini.hpp"
 
 namespace vessel::contact {
 
@@ -113,56 +114,8 @@ class Coupled {
     return r;
   }
 
-  /// Newton on one active set; returns the iterations. Throws if it does not converge.
-  int newton(const std::vector<int>& active, VectorXd& x, VectorXd& mu, VectorXd& lambda,
-             const WireWallOptions& o, double& residual) const {
-    const int n = static_cast<int>(x.size());
-    const int mc = wire_.constraints ? wire_.constraints->num_constraints() : 0;
-    const int ma = static_cast<int>(active.size());
-    const int size = n + mc + ma;
-    const double extent = x.head(3 * (wire_.last_node + 1)).cwiseAbs().maxCoeff();
-    double last_step = std::numeric_limits<double>::infinity();
-    for (int it = 0; it <= o.max_newton; ++it) {
-      const ActiveGeometry g = geometry(active, x, lambda);
-      VectorXd R(size);
-      R.head(n) = rod_residual(active, x, mu, lambda, g);
-      for (int i = 0; i < n; ++i) {
-        if (wire_.fixed[i]) R[i] = 0.0;
-      }
-      VectorXd c;
-      if (mc > 0) {
-        wire_.constraints->evaluate(x, c);
-        R.segment(n, mc) = c;
-      }
-      R.tail(ma) = g.gap;
-      residual = R.head(n).norm();
-      const double cmax = mc > 0 ? c.cwiseAbs().maxCoeff() : 0.0;
-      const double gmax = ma > 0 ? g.gap.cwiseAbs().maxCoeff() : 0.0;
-      const bool feasible = cmax <= o.constraint_tolerance && gmax <= o.gap_tolerance;
-      // Converged, or at round-off: the last step moved no position by more than 1e-14 of the
-      // wire's extent (the stiff stretching term's cancellation floors ‖∇E‖ near 1e-10 N).
-      if (feasible && (residual <= o.tolerance * o.force_scale || last_step <= 1e-14 * extent)) {
-        return it;
-      }
-      if (it == o.max_newton || !R.allFinite()) {
-        std::ostringstream s;
-        s << "solve_wire_wall_contact: Newton did not converge in " << o.max_newton
-          << " iterations on an active set of " << ma << " candidates (rod residual " << residual
-          << " N, max |c| " << cmax << ", max |g| " << gmax << " m)";
-        throw std::runtime_error(s.str());
-      }
-      const MatrixXd A = jacobian(active, x, mu, lambda, g, n, mc);
-      const VectorXd step = A.partialPivLu().solve(-R);
-      last_step = step.head(3 * (wire_.last_node + 1)).cwiseAbs().maxCoeff();
-      x += step.head(n);
-      if (mc > 0) mu += step.segment(n, mc);
-      lambda += step.tail(ma);
-      if (wire_.project) wire_.project(x);
-    }
-    return o.max_newton;
-  }
-
- private:
+  /// ∂(rod rows, constraint rows, gap rows)/∂(x, μ, λ_A), held dofs' rows and columns the
+  /// identity's.
   MatrixXd jacobian(const std::vector<int>& active, const VectorXd& x, const VectorXd& mu,
                     const VectorXd& lambda, const ActiveGeometry& g, int n, int mc) const {
     const int ma = static_cast<int>(active.size());
@@ -217,6 +170,7 @@ class Coupled {
     return A;
   }
 
+ private:
   const ContactWire& wire_;
   const MatrixXd& W_;
   const std::vector<Vec3>& n_;
@@ -253,54 +207,88 @@ WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const Condense
   const auto t0 = std::chrono::steady_clock::now();
   const Coupled coupled(wire, wall, mesh);
   const int m = coupled.num_candidates();
-  std::vector<int> active = initial_active;
-  VectorXd x = start;
-  VectorXd mu = VectorXd::Zero(wire.constraints ? wire.constraints->num_constraints() : 0);
-  VectorXd lambda = VectorXd::Zero(static_cast<Eigen::Index>(active.size()));
+  const int n = static_cast<int>(start.size());
+  const int mc = wire.constraints ? wire.constraints->num_constraints() : 0;
+  const int r = n + mc;
+  std::vector<int> all(static_cast<std::size_t>(m));
+  for (int j = 0; j < m; ++j) all[static_cast<std::size_t>(j)] = j;
+  VectorXd x = start, mu = VectorXd::Zero(mc), lambda = VectorXd::Zero(m);
+  std::vector<char> active(static_cast<std::size_t>(m), 0);
+  for (const int j : initial_active) active[static_cast<std::size_t>(j)] = 1;
+  // The rod's rows are linearised about (x, λ) and condensed onto every candidate's gap:
+  //   K Δy + B̃ (λ' − λ) = −R,   g + G Δy + D (λ' − λ) = g' ≥ 0,  λ' ≥ 0,  λ'·g' = 0,
+  // y = (x, μ), so g' = q + M λ' with M = D − G K⁻¹B̃, a Signorini problem solved exactly
+  // (solve_signorini on M's symmetric part; the skew part, O(the angle between n_j and the
+  // capsule's normal), is evaluated at the current λ, so a fixed point is an exact solution).
   WireWallSolution out;
-  for (int change = 0;; ++change) {
-    out.newton_iterations += coupled.newton(active, x, mu, lambda, options, out.residual);
-    // A candidate whose force would pull leaves; else the most penetrating one joins.
-    Eigen::Index worst = -1;
-    const double least = lambda.size() > 0 ? lambda.minCoeff(&worst) : 0.0;
-    int join = -1;
-    double deepest = -options.gap_tolerance;
-    if (least >= 0.0) {
-      const VectorXd along = coupled.wall_along(active, lambda);
-      for (int j = 0; j < m; ++j) {
-        if (std::find(active.begin(), active.end(), j) != active.end()) continue;
-        const double g = coupled.gap_of(j, x, along);
-        if (g < deepest) {
-          deepest = g;
-          join = j;
-        }
-      }
-      if (join < 0) break;
+  const double extent = start.head(3 * (wire.last_node + 1)).cwiseAbs().maxCoeff();
+  double last_step = std::numeric_limits<double>::infinity();
+  bool settled = false;
+  for (int it = 0;; ++it) {
+    const ActiveGeometry g = coupled.geometry(all, x, lambda);
+    VectorXd R(r);
+    R.head(n) = coupled.rod_residual(all, x, mu, lambda, g);
+    for (int i = 0; i < n; ++i) {
+      if (wire.fixed[i]) R[i] = 0.0;
     }
-    if (change == options.max_changes) {
-      throw std::runtime_error("solve_wire_wall_contact: the active set did not settle in " +
-                               std::to_string(options.max_changes) + " changes (" +
-                               std::to_string(active.size()) + " in contact)");
+    double cmax = 0.0;
+    if (mc > 0) {
+      VectorXd c;
+      wire.constraints->evaluate(x, c);
+      R.tail(mc) = c;
+      cmax = c.cwiseAbs().maxCoeff();
     }
-    ++out.active_set_changes;
-    if (least < 0.0) {
-      active.erase(active.begin() + worst);
-      VectorXd kept(lambda.size() - 1);
-      kept << lambda.head(worst), lambda.tail(lambda.size() - worst - 1);
-      lambda = kept;
-    } else {
-      active.push_back(join);
-      lambda.conservativeResize(lambda.size() + 1);
-      lambda[lambda.size() - 1] = 0.0;
+    out.residual = R.head(n).norm();
+    double worst_gap = 0.0;  // penetration, or a pressed candidate's separation
+    for (int j = 0; j < m; ++j) {
+      worst_gap = std::max(worst_gap, lambda[j] > 0.0 ? std::abs(g.gap[j]) : -g.gap[j]);
     }
+    // Converged, or at round-off on a settled active set: the last step moved no position by
+    // more than 1e-14 of the wire's extent (the stiff stretching term's cancellation floors ‖∇E‖
+    // near 1e-10 N).
+    const bool feasible =
+        cmax <= options.constraint_tolerance && worst_gap <= options.gap_tolerance;
+    if (feasible && (out.residual <= options.tolerance * options.force_scale ||
+                     (settled && last_step <= 1e-14 * extent))) {
+      break;
+    }
+    if (it == options.max_newton || !R.allFinite()) {
+      std::ostringstream msg;
+      msg << "solve_wire_wall_contact: no equilibrium in " << options.max_newton << " iterations ("
+          << std::count(active.begin(), active.end(), 1) << " candidates in contact, rod residual "
+          << out.residual << " N, max |c| " << cmax << ", worst gap " << worst_gap << " m)";
+      throw std::runtime_error(msg.str());
+    }
+    const MatrixXd A = coupled.jacobian(all, x, mu, lambda, g, n, mc);
+    const Eigen::PartialPivLU<MatrixXd> K(A.topLeftCorner(r, r));
+    const MatrixXd X = K.solve(A.topRightCorner(r, m));
+    const VectorXd y = K.solve(R);
+    const MatrixXd M = A.bottomRightCorner(m, m) - A.bottomLeftCorner(m, r) * X;
+    const MatrixXd Msym = 0.5 * (M + M.transpose());
+    const VectorXd q = g.gap - A.bottomLeftCorner(m, r) * y - Msym * lambda;
+    const SignoriniSolution lcp = solve_signorini(Msym, q, 0.01 * options.gap_tolerance);
+    // Full steps first (quadratic once the active set holds); from the 8th on, half steps: the
+    // skew part evaluated at the last λ can make full steps cycle between active sets on a
+    // contact deep enough that n_j and the capsule's normal part by tens of degrees.
+    const double alpha = it < 8 ? 1.0 : 0.5;
+    const VectorXd step = -alpha * (y + X * (lcp.force - lambda));
+    last_step = step.head(3 * (wire.last_node + 1)).cwiseAbs().maxCoeff();
+    x += step.head(n);
+    if (mc > 0) mu += step.tail(mc);
+    lambda += alpha * (lcp.force - lambda);
+    if (wire.project) wire.project(x);
+    settled = std::equal(active.begin(), active.end(), lcp.active.begin());
+    if (!settled) ++out.active_set_changes;
+    active.assign(lcp.active.begin(), lcp.active.end());
+    ++out.newton_iterations;
   }
   out.x = x;
   out.rod_multipliers = mu;
-  out.active = active;
-  out.force = VectorXd::Zero(m);
-  for (std::size_t k = 0; k < active.size(); ++k)
-    out.force[active[k]] = lambda[static_cast<Eigen::Index>(k)];
-  const VectorXd along = coupled.wall_along(active, lambda);
+  out.force = lambda;
+  for (int j = 0; j < m; ++j) {
+    if (lambda[j] > 0.0) out.active.push_back(j);
+  }
+  const VectorXd along = coupled.wall_along(all, lambda);
   out.gap.resize(m);
   for (int j = 0; j < m; ++j) out.gap[j] = coupled.gap_of(j, x, along);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

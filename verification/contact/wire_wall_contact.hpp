@@ -14,9 +14,11 @@
 /// g ≥ 0, λ ≥ 0, λ·g = 0 (to first order in the angle between n_j and the capsule's normal,
 /// which vanishes where the wall's surface and the wire's touch tangentially).
 ///
-/// Solved by an active set on Newton's method for the coupled system (x, rod multipliers, λ_A):
-///   ∇E(x) − f + J_c(x)ᵀμ + Σ_{k∈A} λ_k B_k(x)ᵀ n_k = 0,   c(x) = 0,   g_A(x, λ_A) = 0,
-/// with held dofs fixed; the most penetrating node joins A, a node whose λ would pull leaves.
+/// Equilibrium: ∇E(x) + J_c(x)ᵀμ + Σ_k λ_k B_k(x)ᵀ n_k = 0 on the free dofs, c(x) = 0, and
+/// Signorini's conditions on every candidate. Solved by sequential linearisation: each step
+/// linearises the rod's rows and the gaps about (x, μ, λ), condenses the rod onto the
+/// candidates' gaps and solves that Signorini problem exactly (solve_signorini), so which
+/// candidates touch is decided over all of them at once at every step.
 #include <Eigen/Dense>
 #include <functional>
 #include <string>
@@ -48,8 +50,7 @@ struct WireWallOptions {
   double force_scale = 1e-3;     ///< N
   double gap_tolerance = 1e-13;  ///< m: |g| on the active set; −g beyond it penetrates
   double constraint_tolerance = 1e-14;  ///< on max |c_k|
-  int max_newton = 60;
-  int max_changes = 200;  ///< active-set changes
+  int max_newton = 200;                 ///< linearised steps (each a Signorini solve)
 };
 
 struct WireWallSolution {
@@ -67,9 +68,10 @@ struct WireWallSolution {
 };
 
 /// Equilibrium of the wire inside the wall from `start`, the active set started at
-/// `initial_active` (candidate indices; e.g. those nearest a rigid-wall solution's contacts).
-/// Throws std::runtime_error naming the active set's size and the residuals if Newton does not
-/// converge or the active set does not settle in options.max_changes; std::invalid_argument for a
+/// `initial_active` (candidate indices, e.g. those nearest a rigid-wall solution's contacts: only
+/// the first step's bookkeeping; the first Signorini solve chooses the contacts).
+/// Throws std::runtime_error naming the contact set's size and the residuals without convergence
+/// in options.max_newton steps; std::invalid_argument for a
 /// wire without a form, a non-positive radius or nodes outside x.
 WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const CondensedWall& wall,
                                          const TetMesh& mesh, const Eigen::VectorXd& start,

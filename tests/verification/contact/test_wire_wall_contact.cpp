@@ -6,6 +6,7 @@
 // Rows printed as "WIRE-WALL ...".
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -108,9 +109,9 @@ struct RigidRun {
   Eigen::VectorXd x;
   double force = 0.0;
 };
-RigidRun rigid_run(Wire& w) {
+RigidRun rigid_run(Wire& w, double wall_shift = 0.0) {
   const msm::rods::StraightTube tube(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(),
-                                     kA - w.radius);
+                                     kA + wall_shift - w.radius);
   Eigen::VectorXd x = w.rod.rest_state();
   w.rod.update_reference(x);
   msm::rods::ConstrainedOptions o;
@@ -166,22 +167,38 @@ struct CoupledRun {
   contact::WireWallSolution solution;
   Vec3 clamp = Vec3::Zero();
   double rigid_force = 0.0;
+  /// The wire's compliance at its rigid contact, m/N: −dc/dF with the rigid wall moved out by
+  /// ±1e-8 m (central difference on the same discrete wire).
+  double wire_compliance = 0.0;
+  /// The wall's compliance under the contact forces, m/N: λᵀWλ/F² (F = Σλ).
+  double wall_compliance = 0.0;
+  double total = 0.0;    ///< Σλ, N
+  Eigen::VectorXd dent;  ///< Wλ per candidate, m
   double setup_seconds = 0.0;
 };
 
 /// The wire (diameter d, N segments, the reference's length for z_c = 20 mm) in the tube of wall
 /// modulus E, candidates within 4 mm and 60° of the aimed node.
+CoupledRun coupled_run(const TetMesh& mesh, const Vec3& target, const std::vector<int>& nodes,
+                       double young, double diameter, int segments, double length_factor);
+
 CoupledRun coupled_run(double young, double diameter, int segments, double length_factor = 1.0) {
   const TetMesh& mesh = tube_mesh();
-  const int aim = aim_node(mesh);
-  const Vec3 target = mesh.nodes[aim];
+  const Vec3 target = mesh.nodes[aim_node(mesh)];
+  return coupled_run(mesh, target, band(mesh, target.z(), 4e-3, 1.05), young, diameter, segments,
+                     length_factor);
+}
+
+/// The wire aimed at `target` on the wall (its tip at z_c = 20 mm from the clamp), candidates
+/// `nodes`.
+CoupledRun coupled_run(const TetMesh& mesh, const Vec3& target, const std::vector<int>& nodes,
+                       double young, double diameter, int segments, double length_factor) {
   const double c = kA - diameter / 2;
   const double length =
       length_factor * rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
   Wire w(diameter, length, segments, Vec3(0, 0, target.z() - kZc));
   const RigidRun rigid = rigid_run(w);
   const fem::ElasticitySolver solver(mesh, wall_problem(young));
-  const std::vector<int> nodes = band(mesh, target.z(), 4e-3, 1.05);
   const contact::CondensedWall wall(solver.free_displacement_system(), nodes,
                                     contact::into_wall_directions(mesh, nodes, "inner_wall"));
   const Vec3 tip = rigid.x.segment<3>(3 * w.layout.tip_node);
@@ -194,6 +211,12 @@ CoupledRun coupled_run(double young, double diameter, int segments, double lengt
   run.clamp = contact::clamp_reaction(w.contact(), wall, mesh, run.solution);
   run.rigid_force = rigid.force;
   run.setup_seconds = wall.setup_seconds();
+  run.total = run.solution.force.sum();
+  run.wall_compliance =
+      run.solution.force.dot(wall.compliance() * run.solution.force) / (run.total * run.total);
+  run.dent = wall.compliance() * run.solution.force;
+  constexpr double kShift = 1e-8;
+  run.wire_compliance = 2 * kShift / (rigid_run(w, -kShift).force - rigid_run(w, kShift).force);
   return run;
 }
 
@@ -268,5 +291,97 @@ TEST(WireWallContact, ActionEqualsReactionAndSignoriniHolds) {
     EXPECT_GE(s.force[j], 0.0);
     EXPECT_GE(s.gap[j], -1e-13);
     EXPECT_LE(s.force[j] * std::abs(s.gap[j]), 1e-13 * s.force.maxCoeff());
+  }
+}
+
+// The series-spring law F = F_rigid·C_r/(C_r + C_v) (C_r the wire's compliance at the rigid
+// contact, C_v the wall's under the contact force): the first-order expansion of the coupled
+// equilibrium in C_v/C_r for a contact that stays at one point. So on a tip contact its error
+// must fall as (C_v/C_r)²: walls 1e4, 1e3 and 1e2 times the scenes' modulus.
+TEST(WireWallContact, SeriesSpringLawIsTheSmallComplianceLimit) {
+  double previous_error = 0.0, previous_ratio = 0.0;
+  for (const double factor : {1e4, 1e3, 1e2}) {
+    const CoupledRun run = coupled_run(kWallE * factor, 0.356e-3, 32);
+    const double ratio = run.wall_compliance / run.wire_compliance;
+    const double series = run.rigid_force / (1 + ratio);
+    const double error = run.total / series - 1;
+    std::printf(
+        "WIRE-WALL series spring E=%.3g Pa: F %.6e N, rigid %.6e, series %.6e (F/series-1 "
+        "%+.2e, F/rigid-1 %+.2e), C_v/C_r %.3e, %zu in contact\n",
+        kWallE * factor, run.total, run.rigid_force, series, error, run.total / run.rigid_force - 1,
+        ratio, run.solution.active.size());
+    ASSERT_EQ(run.solution.active.size(), 1u);
+    EXPECT_LT(std::abs(error), 0.1 * std::abs(run.total / run.rigid_force - 1));
+    if (previous_ratio > 0) {
+      const double order =
+          std::log(std::abs(error / previous_error)) / std::log(ratio / previous_ratio);
+      std::printf("WIRE-WALL series spring: order of its error in C_v/C_r %.2f\n", order);
+      EXPECT_GT(order, 1.8);
+    }
+    previous_error = error;
+    previous_ratio = ratio;
+  }
+}
+
+// A line of contact on a compliant wall (1.4 MPa) meshed finely where the wire bears (gmsh, 0.08 mm
+// within 1 mm of the aimed point, growing to the wall's 1 mm elsewhere): the tip's hemisphere and
+// the body behind it dent the wall by ~0.14 mm (0.8 r_w) over a zone of many nodes. Checks: the
+// zone lies inside the candidates (no contact at their edge), action = reaction against the FEM's
+// support reactions, Signorini on every candidate. The force is printed beside the rigid wall's and
+// the series-spring law's with the wall's compliance under the converged contact forces.
+TEST(WireWallContact, LineOfContactOnACompliantWall) {
+  VesselParams p;
+  p.length = kTubeLength;
+  const Vec3 target(kA, 0, 25e-3);
+  const auto t0 = std::chrono::steady_clock::now();
+  const TetMesh mesh = refined_patch_mesh(p, target, 0.08e-3, 1.0e-3);
+  const double mesh_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  constexpr double kBand = 1.6e-3;
+  std::vector<int> nodes;
+  for (const int n : inner_nodes(mesh)) {
+    if ((mesh.nodes[n] - target).norm() < kBand) nodes.push_back(n);
+  }
+  const double young = kWallE * 100;
+  const CoupledRun run = coupled_run(mesh, target, nodes, young, 0.356e-3, 32, 1.0);
+  const contact::WireWallSolution& s = run.solution;
+  double dent = 0, reach = 0, z_min = 1, z_max = 0;
+  for (const int j : s.active) {
+    const Vec3& x = mesh.nodes[nodes[j]];
+    dent = std::max(dent, run.dent[j]);
+    reach = std::max(reach, (x - target).norm());
+    z_min = std::min(z_min, x.z());
+    z_max = std::max(z_max, x.z());
+  }
+  const double ratio = run.wall_compliance / run.wire_compliance;
+  const double series = run.rigid_force / (1 + ratio);
+  std::printf(
+      "WIRE-WALL line contact E=%.3g Pa: mesh %zu nodes (%.1f s), %zu candidates (W %.1f "
+      "s), %zu in contact over z %.3f..%.3f mm (reach %.3f mm), largest dent %.3e m, F "
+      "%.6e N, rigid %.6e (%+.2e), series spring %.6e (F/series-1 %+.2e, C_v/C_r %.3e), "
+      "%d contact-set changes, %d steps, %.2f s\n",
+      young, mesh.nodes.size(), mesh_seconds, nodes.size(), run.setup_seconds, s.active.size(),
+      z_min * 1e3, z_max * 1e3, reach * 1e3, dent, run.total, run.rigid_force,
+      run.total / run.rigid_force - 1, series, run.total / series - 1, ratio, s.active_set_changes,
+      s.newton_iterations, s.seconds);
+  EXPECT_GE(s.active.size(), 10u);
+  EXPECT_LT(reach, kBand - 0.3e-3);  // well inside the candidates
+  // Action and reaction, against deal.II's reactions under the contact forces as nodal loads.
+  fem::ElasticityProblem problem = wall_problem(young);
+  const fem::ElasticitySolver condensing(mesh, problem);
+  const contact::CondensedWall wall(condensing.free_displacement_system(), nodes,
+                                    contact::into_wall_directions(mesh, nodes, "inner_wall"));
+  problem.patches = nodal_loads(mesh, wall, s);
+  fem::ElasticitySolver solver(mesh, problem);
+  Vec3 supports = Vec3::Zero();
+  for (const fem::GroupReaction& g : solver.solve().reactions) supports += g.force;
+  const Vec3 sum = run.clamp + supports;
+  std::printf("WIRE-WALL line contact: clamp + supports |%.3e| N (%.2e of the force)\n", sum.norm(),
+              sum.norm() / run.total);
+  EXPECT_LT(sum.norm(), 1e-9 * run.total);
+  for (int j = 0; j < s.force.size(); ++j) {
+    EXPECT_GE(s.force[j], 0.0);
+    EXPECT_GE(s.gap[j], -1e-12);
+    EXPECT_LE(s.force[j] * std::abs(s.gap[j]), 1e-12 * s.force.maxCoeff());
   }
 }
