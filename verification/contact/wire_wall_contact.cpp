@@ -184,7 +184,8 @@ void check(const ContactWire& wire, const Eigen::VectorXd& start) {
   }
   if (start.size() != wire.form->num_dofs() ||
       static_cast<Eigen::Index>(wire.fixed.size()) != start.size() || wire.first_node < 0 ||
-      wire.last_node <= wire.first_node || 3 * (wire.last_node + 1) > start.size()) {
+      wire.last_node <= wire.first_node || wire.last_node >= wire.num_nodes ||
+      3 * wire.num_nodes > start.size()) {
     throw std::invalid_argument(
         "solve_wire_wall_contact: start, fixed and the centreline's nodes must fit the form's "
         "dofs");
@@ -306,9 +307,7 @@ Vec3 clamp_reaction(const ContactWire& wire, const CondensedWall& wall, const Te
   const VectorXd r =
       coupled.rod_residual(solution.active, solution.x, solution.rod_multipliers, lambda, g);
   Vec3 sum = Vec3::Zero();
-  const int nodes =
-      std::min<int>(static_cast<int>(r.size()) / 3, static_cast<int>(wire.fixed.size()) / 3);
-  for (int i = 0; i < nodes; ++i) {
+  for (int i = 0; i < wire.num_nodes; ++i) {
     if (wire.fixed[3 * i] || wire.fixed[3 * i + 1] || wire.fixed[3 * i + 2]) {
       sum += r.segment<3>(3 * i);
     }

@@ -32,11 +32,13 @@
 namespace vessel::contact {
 
 /// The wire: its Form, constraints (or nullptr), held dofs and the centreline's material nodes
-/// first_node..last_node (positions are the first 3 × nodes dofs of x).
+/// first_node..last_node (positions are the first 3 × num_nodes dofs of x, ghost nodes included;
+/// the frames' dofs follow).
 struct ContactWire {
   const msm::Form* form = nullptr;
   const msm::EqualityConstraints* constraints = nullptr;
   std::vector<char> fixed;
+  int num_nodes = 0;
   int first_node = 0;
   int last_node = 0;
   double radius = 0.0;  ///< r_w, m
@@ -48,28 +50,28 @@ struct ContactWire {
 struct WireWallOptions {
   double tolerance = 1e-10;      ///< on ‖rod residual‖ (free dofs) relative to force_scale
   double force_scale = 1e-3;     ///< N
-  double gap_tolerance = 1e-13;  ///< m: |g| on the active set; −g beyond it penetrates
+  double gap_tolerance = 1e-13;  ///< m: |g| of a pressed candidate; −g beyond it penetrates
   double constraint_tolerance = 1e-14;  ///< on max |c_k|
   int max_newton = 200;                 ///< linearised steps (each a Signorini solve)
 };
 
 struct WireWallSolution {
   Eigen::VectorXd x;                ///< the wire's dofs
-  Eigen::VectorXd force;            ///< λ per candidate, N (zero off the active set)
+  Eigen::VectorXd force;            ///< λ per candidate, N (zero where not in contact)
   Eigen::VectorXd gap;              ///< g per candidate at the solution, m
   Eigen::VectorXd rod_multipliers;  ///< μ of the wire's own constraints
   std::vector<int> active;          ///< candidates in contact
-  int active_set_changes = 0;
-  int newton_iterations = 0;  ///< summed over the active sets
-  double residual = 0.0;      ///< ‖rod residual‖ on free dofs at the end, N
+  int active_set_changes = 0;       ///< steps whose contact set differed from the last step's
+  int newton_iterations = 0;        ///< linearised steps (each a Signorini solve)
+  double residual = 0.0;            ///< ‖rod residual‖ on free dofs at the end, N
   double seconds = 0.0;
   /// Σ_j λ_j n_j: the wire's total force on the wall, N.
   [[nodiscard]] Vec3 total_force_on_wall(const CondensedWall& wall) const;
 };
 
-/// Equilibrium of the wire inside the wall from `start`, the active set started at
-/// `initial_active` (candidate indices, e.g. those nearest a rigid-wall solution's contacts: only
-/// the first step's bookkeeping; the first Signorini solve chooses the contacts).
+/// Equilibrium of the wire inside the wall from `start` (e.g. a rigid-wall solution), its forces
+/// starting at zero. `initial_active` (candidate indices) only seeds the count of contact-set
+/// changes: the first step's Signorini solve chooses the contacts over all candidates.
 /// Throws std::runtime_error naming the contact set's size and the residuals without convergence
 /// in options.max_newton steps; std::invalid_argument for a
 /// wire without a form, a non-positive radius or nodes outside x.

@@ -13,8 +13,10 @@
 
 #include "fem_reference/elasticity.hpp"
 #include "fem_reference/rod_theory/tube_contact.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
+#include "msm/rods/corde_rod.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "msm/rods/rigid_wall.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
@@ -97,6 +99,7 @@ struct Wire {
     contact::ContactWire w;
     w.form = &rod;
     w.fixed = rod.clamp_fixed();
+    w.num_nodes = rod.num_nodes();
     w.first_node = layout.first_node;
     w.last_node = layout.tip_node;
     w.radius = radius;
@@ -384,4 +387,81 @@ TEST(WireWallContact, LineOfContactOnACompliantWall) {
     EXPECT_GE(s.gap[j], -1e-12);
     EXPECT_LE(s.force[j] * std::abs(s.gap[j]), 1e-12 * s.force.maxCoeff());
   }
+}
+
+// The same rigid limit with CORDE (its inextensibility and unit-quaternion constraints carried by
+// the coupled solve, its quaternions projected after each step): within CORDE's own error at
+// N = 32 against the rigid tube (6.56e-4, tests/rods/test_rigid_wall.cpp), and the clamp's
+// reaction (constraint forces included) against the wall's total force. Started from DER's
+// rigid-wall solution: its positions, each edge's frame turned from the rest tangent to the edge's.
+TEST(WireWallContact, RigidLimitWithCordeConstraints) {
+  const TetMesh& mesh = tube_mesh();
+  const Vec3 target = mesh.nodes[aim_node(mesh)];
+  const double d = 0.356e-3, c = kA - d / 2;
+  const rod_theory::StraightTubeContact ref = rod_theory::straight_tube_contact(kTheta, c / kZc);
+  Wire der(d, ref.length * kZc, 32, Vec3(0, 0, target.z() - kZc));
+  const RigidRun rigid = rigid_run(der);
+  const msm::rods::CordeRod corde(der.layout);
+  Eigen::VectorXd x = corde.rest_state();
+  const int nodes = corde.num_nodes();
+  x.head(3 * nodes) = rigid.x.head(3 * nodes);
+  for (int j = 0; j < der.layout.num_edges(); ++j) {
+    if (der.layout.ghost[static_cast<std::size_t>(j)]) continue;
+    const Vec3 t0 = (der.layout.rest[j + 1] - der.layout.rest[j]).normalized();
+    const Vec3 t = (x.segment<3>(3 * (j + 1)) - x.segment<3>(3 * j)).normalized();
+    const Eigen::Vector4d q0 = x.segment<4>(corde.quaternion_dof(j));
+    const Eigen::Quaterniond q =
+        Eigen::Quaterniond::FromTwoVectors(t0, t) * Eigen::Quaterniond(q0[0], q0[1], q0[2], q0[3]);
+    x.segment<4>(corde.quaternion_dof(j)) << q.w(), q.x(), q.y(), q.z();
+  }
+  const std::vector<int> cand = band(mesh, target.z(), 4e-3, 1.05);
+  const fem::ElasticitySolver solver(mesh, wall_problem(kWallE * 1e6));
+  const contact::CondensedWall wall(solver.free_displacement_system(), cand,
+                                    contact::into_wall_directions(mesh, cand, "inner_wall"));
+  contact::ContactWire w;
+  w.form = &corde;
+  w.constraints = &corde;
+  w.fixed = corde.clamp_fixed();
+  w.num_nodes = corde.num_nodes();
+  w.first_node = der.layout.first_node;
+  w.last_node = der.layout.tip_node;
+  w.radius = d / 2;
+  w.project = [&corde](Eigen::VectorXd& y) { corde.normalise_quaternions(y); };
+  contact::WireWallOptions o;
+  o.force_scale = der.EI / (kZc * kZc);
+  o.constraint_tolerance = 1e-13;
+  const contact::WireWallSolution s = contact::solve_wire_wall_contact(w, wall, mesh, x, {}, o);
+  const double total = s.force.sum();
+  const double scaled = total * kZc * kZc / der.EI;
+  const Vec3 sum = contact::clamp_reaction(w, wall, mesh, s) - s.total_force_on_wall(wall);
+  std::printf(
+      "WIRE-WALL rigid limit CORDE N=32: F z^2/EI %.6f (ref %.6f, %+.2e), %zu in contact, "
+      "%d steps, %.3f s; clamp reaction - force on wall |%.2e| N (%.1e relative)\n",
+      scaled, ref.force, scaled / ref.force - 1, s.active.size(), s.newton_iterations, s.seconds,
+      sum.norm(), sum.norm() / total);
+  EXPECT_EQ(s.active.size(), 1u);
+  EXPECT_LT(std::abs(scaled / ref.force - 1), 1.5 * 6.56e-4);
+  EXPECT_LT(sum.norm(), 1e-9 * total);
+}
+
+TEST(WireWallContact, RefusesAWireThatDoesNotFit) {
+  const TetMesh& mesh = tube_mesh();
+  const Vec3 target = mesh.nodes[aim_node(mesh)];
+  const std::vector<int> cand = band(mesh, target.z(), 2e-3, 0.5);
+  const fem::ElasticitySolver solver(mesh, wall_problem(kWallE));
+  const contact::CondensedWall wall(solver.free_displacement_system(), cand,
+                                    contact::into_wall_directions(mesh, cand, "inner_wall"));
+  const Wire w(0.356e-3, 20e-3, 8, Vec3(0, 0, 5e-3));
+  contact::ContactWire bad = w.contact();
+  bad.radius = 0.0;
+  EXPECT_THROW(contact::solve_wire_wall_contact(bad, wall, mesh, w.rod.rest_state(), {}),
+               std::invalid_argument);
+  bad = w.contact();
+  bad.last_node = bad.num_nodes;
+  EXPECT_THROW(contact::solve_wire_wall_contact(bad, wall, mesh, w.rod.rest_state(), {}),
+               std::invalid_argument);
+  // A candidate that is not a node of the inner wall has no direction.
+  EXPECT_THROW(
+      contact::into_wall_directions(mesh, {static_cast<int>(mesh.nodes.size())}, "inner_wall"),
+      InputError);
 }
