@@ -54,8 +54,12 @@ std::vector<BestModelRow> best_model_rows(const ResultsFile& results) {
         if (o.magnitude != load || o.poisson_ratio != nu || o.level != level || !o.ok) continue;
         if (is_p1(o) && !p1) p1 = &o;
         // The suite's own mass-spring models only: a model outside it (external, displacements)
-        // may be anything, so it is not named the best mass-spring model.
-        if (o.kind == "fem" || o.kind == "external" || o.kind == "displacements") continue;
+        // may be anything, so it is not named the best mass-spring model; nor are the P1 tet
+        // models (corotational_fem, xpbd_fem), which are FEM.
+        if (o.kind == "fem" || o.kind == "external" || o.kind == "displacements" ||
+            o.kind == "corotational_fem" || o.kind == "xpbd_fem") {
+          continue;
+        }
         if (is_edge_pair(o)) {
           if (better(o, edge_pair)) edge_pair = &o;
         } else if (better(o, best)) {

@@ -17,6 +17,12 @@ std::string model_refusal(const ModelSpec& spec, double youngs_modulus, double n
                : msm::homogenised_refusal(youngs_modulus, nu);
   }
   if (spec.edge_pairs) return msm::edge_pair_refusal(youngs_modulus, nu);
+  if (spec.kind == ModelKind::corotational_fem || spec.kind == ModelKind::xpbd_fem) {
+    if (!(nu >= 0.0 && nu < 0.5)) {
+      return to_string(spec.kind) + ": expected Poisson's ratio ν in [0, 0.5), got " +
+             std::to_string(nu) + " (P1 tets in displacement form: λ is infinite at ν = 0.5)";
+    }
+  }
   return {};
 }
 

@@ -13,7 +13,8 @@ namespace vessel {
 /// Why `spec` cannot run the material (E in Pa, ν), or "" if it can. Mass-spring models with a
 /// ν-limited term: the hybrid volume term (Golec et al. 2020), its homogenised rule (the range
 /// every mesh shares; a mesh's own floor below ν = 1/4 is found when the model is fitted, and the
-/// model then fails alone), the edge pairs (ν < 0.5). FEM models are checked by the FEM code
+/// model then fails alone), the edge pairs (ν < 0.5), the P1 tet models corotational_fem and
+/// xpbd_fem (ν in [0, 0.5)). FEM models are checked by the FEM code
 /// itself (P1 and P2 in displacement form cannot take ν = 0.5: recorded as failed).
 std::string model_refusal(const ModelSpec& spec, double youngs_modulus, double nu);
 

@@ -114,6 +114,20 @@ std::vector<ModelSpec> fem_models(TableReader& r, const ModelSpec& m) {
   return out;
 }
 
+/// A corotational_fem or xpbd_fem [[models]] table: the P1 tets of the vessel's mesh; xpbd_fem's
+/// step, sweeps, damping and steady-state test (TetFemSpec).
+std::vector<ModelSpec> tet_fem_model(TableReader& r, ModelSpec m) {
+  if (m.kind == ModelKind::xpbd_fem) {
+    TetFemSpec& t = m.tet_fem;
+    t.dt = r.number_or("dt", t.dt);
+    t.iterations = static_cast<int>(r.integer_or("iterations", t.iterations));
+    t.velocity_damping = r.number_or("velocity_damping", t.velocity_damping);
+    t.settle_tolerance = r.number_or("settle_tolerance", t.settle_tolerance);
+    t.max_steps = r.integer_or("max_steps", t.max_steps);
+  }
+  return {m};
+}
+
 /// Region of interest: a radius or an array of radii (a sweep), each > 0 m; contact loads only.
 /// {0} (the whole vessel) when absent.
 std::vector<double> roi_radii(TableReader& r, LoadKind load) {
@@ -317,14 +331,19 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
   const std::string kind = r.string_or("kind", "");
   if (kind.empty()) (void)r.require("kind");
   r.enter(kind);
-  m.kind = kind == "fem"             ? ModelKind::fem
-           : kind == "surface_msm"   ? ModelKind::surface_msm
-           : kind == "network"       ? ModelKind::network
-           : kind == "external"      ? ModelKind::external
-           : kind == "displacements" ? ModelKind::displacements
-                                     : ModelKind::volume_msm;
+  m.kind = kind == "fem"                ? ModelKind::fem
+           : kind == "surface_msm"      ? ModelKind::surface_msm
+           : kind == "network"          ? ModelKind::network
+           : kind == "external"         ? ModelKind::external
+           : kind == "displacements"    ? ModelKind::displacements
+           : kind == "corotational_fem" ? ModelKind::corotational_fem
+           : kind == "xpbd_fem"         ? ModelKind::xpbd_fem
+                                        : ModelKind::volume_msm;
   m.name = r.string_or("name", kind + "_" + std::to_string(index + 1));
   if (m.kind == ModelKind::fem) return fem_models(r, m);
+  if (m.kind == ModelKind::corotational_fem || m.kind == ModelKind::xpbd_fem) {
+    return tet_fem_model(r, m);
+  }
   if (m.kind == ModelKind::external || m.kind == ModelKind::displacements) {
     return outside_model(r, m);
   }
@@ -673,6 +692,8 @@ std::string to_string(ModelKind kind) {
     case ModelKind::network: return "network";
     case ModelKind::external: return "external";
     case ModelKind::displacements: return "displacements";
+    case ModelKind::corotational_fem: return "corotational_fem";
+    case ModelKind::xpbd_fem: return "xpbd_fem";
   }
   return "?";
 }

@@ -22,8 +22,18 @@ namespace vessel {
 enum class LoadKind { contact, pressure, gravity };
 /// network: a spring network read from a file (msm/formats/network_file.hpp), run by the suite's
 /// own solvers like the built-in mass-spring models; external and displacements: models outside
-/// the suite (ExternalSpec).
-enum class ModelKind { fem, surface_msm, volume_msm, network, external, displacements };
+/// the suite (ExternalSpec); corotational_fem and xpbd_fem: P1 tets on the vessel's mesh run by the
+/// msm solvers (TetFemSpec).
+enum class ModelKind {
+  fem,
+  surface_msm,
+  volume_msm,
+  network,
+  external,
+  displacements,
+  corotational_fem,
+  xpbd_fem
+};
 
 /// Which nodes a model outside the suite (kinds external and displacements) is given and answers
 /// at: every node of the vessel's tet mesh (cells: its tets), or the nodes of one wall surface
@@ -48,6 +58,18 @@ struct ExternalSpec {
   /// The folder the command runs in (the scene file's folder; relative paths in `command` resolve
   /// there).
   std::filesystem::path working_dir;
+};
+
+/// The P1 tet models the simulators run, on the vessel's own mesh (msm/fem): corotational_fem
+/// (Müller & Gross 2004) solved statically by Newton with its consistent tangent; xpbd_fem
+/// (Macklin & Müller 2021's stable neo-Hookean constraints) stepped by XPBD to its steady state.
+struct TetFemSpec {
+  double dt = 1e-4;              ///< xpbd_fem: time step, s
+  int iterations = 4;            ///< xpbd_fem: Gauss–Seidel sweeps per step
+  double velocity_damping = 0.02;  ///< xpbd_fem: fraction of the velocity removed per step
+  /// xpbd_fem: steady when no node moves farther than this in a step, m
+  double settle_tolerance = 1e-9;
+  long max_steps = 200'000;  ///< xpbd_fem: steps before the run is recorded as failed
 };
 
 /// One model to run against the reference. FEM models use `degree`; mass-spring models use the
@@ -90,6 +112,7 @@ struct ModelSpec {
   /// paths resolved against the scene file's folder. Its springs, masses and supports replace
   /// the stiffness, mass and topology keys.
   std::filesystem::path network_file;
+  TetFemSpec tet_fem;  ///< kinds corotational_fem and xpbd_fem
 };
 
 struct LoadSpec {

@@ -199,7 +199,8 @@ std::vector<SceneKey> models() {
   const std::vector<std::string> surfaces{"inner", "outer", "mid"};
   std::vector<Row> rows{
       Row("models", "kind", KeyType::string, "The model")
-          .one_of({"fem", "surface_msm", "volume_msm", "network", "external", "displacements"})
+          .one_of({"fem", "surface_msm", "volume_msm", "network", "external", "displacements",
+                   "corotational_fem", "xpbd_fem"})
           .required(),
       Row("models", "name", KeyType::string, "Unique within the scene; sweeps append the values")
           .note("kind_N, N the table's position"),
@@ -275,6 +276,21 @@ std::vector<SceneKey> models() {
           .positive().in(kOutsideKinds),
       Row("models", "steps", KeyType::integer, "A dynamic problem's steps from rest (with dt)")
           .range(1, kMaxSteps).in(kOutsideKinds),
+      Row("models", "dt", KeyType::number,
+          "XPBD time step; its carried multipliers' forces act explicitly, so it must resolve "
+          "the wall's shear waves")
+          .dflt("1e-4").unit("s").positive().in({"xpbd_fem"}),
+      Row("models", "iterations", KeyType::integer, "Gauss–Seidel sweeps over the tets per step")
+          .dflt("4").range(1, 1e6).in({"xpbd_fem"}),
+      Row("models", "velocity_damping", KeyType::number,
+          "Fraction of the velocity removed per step")
+          .dflt("0.02").range(0.0, 0.99).in({"xpbd_fem"}),
+      Row("models", "settle_tolerance", KeyType::number,
+          "Steady state: no node moves farther than this in a step")
+          .dflt("1e-9").unit("m").positive().in({"xpbd_fem"}),
+      Row("models", "max_steps", KeyType::integer,
+          "Steps to reach the steady state before the run is recorded as failed")
+          .dflt("200000").range(1, kMaxSteps).in({"xpbd_fem"}),
   };
   std::vector<SceneKey> out;
   for (auto& r : rows) out.push_back(std::move(r.k));
@@ -371,7 +387,10 @@ const std::vector<SceneSection>& scene_sections() {
        {"contact", "pressure", "gravity", "guidewire"}, ""},
       {"models",
        "One [[models]] table per model; array values of sweep keys stand for every combination",
-       "kind", {"fem", "surface_msm", "volume_msm", "network", "external", "displacements"}, ""},
+       "kind",
+       {"fem", "surface_msm", "volume_msm", "network", "external", "displacements",
+        "corotational_fem", "xpbd_fem"},
+       ""},
       {"tolerances", "", "", {}, ""},
       {"budget", "What a simulator needs; `vesselverify recommend` names the cheapest model meeting it",
        "", {}, ""},

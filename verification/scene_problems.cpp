@@ -256,4 +256,33 @@ msm::Problem msm_problem(const Scene& s, const msm::Form& form, const msm::Built
   return problem;
 }
 
+msm::Problem tet_mesh_problem(const Scene& s, const msm::TetTerm& term, const TetMesh& mesh,
+                              double magnitude) {
+  msm::Problem p;
+  p.form = &term;
+  const auto n = static_cast<Eigen::Index>(mesh.nodes.size());
+  p.rest.resize(3 * n);
+  p.external_force.resize(3 * n);
+  const std::vector<Vec3> loads = surface_nodal_loads(s, mesh, magnitude);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    p.rest.segment<3>(3 * i) = mesh.nodes[static_cast<std::size_t>(i)];
+    p.external_force.segment<3>(3 * i) = loads[static_cast<std::size_t>(i)];
+  }
+  p.mass = Eigen::VectorXd::Zero(3 * n);
+  for (std::size_t e = 0; e < mesh.tets.size(); ++e) {
+    for (const int v : mesh.tets[e]) {
+      p.mass.segment<3>(3 * v).array() += s.density * term.rest_shapes()[e].volume / 4.0;
+    }
+  }
+  Vec3 g = Vec3::Zero();
+  for (const auto& [load, m] : applied_loads(s, magnitude)) {
+    if (load->kind == LoadKind::gravity) g += m * kStandardGravity * load->gravity_direction;
+  }
+  for (Eigen::Index i = 0; i < 3 * n; i += 3) p.external_force.segment<3>(i) += p.mass[i] * g;
+  std::vector<int> source(mesh.nodes.size());
+  for (std::size_t i = 0; i < source.size(); ++i) source[i] = static_cast<int>(i);
+  p.fixed = held_dofs(mesh, mesh.nodes, source, scene_supports(s));
+  return p;
+}
+
 }  // namespace vessel

@@ -9,6 +9,7 @@
 
 #include "fem_reference/elasticity.hpp"
 #include "msm/model/build_network.hpp"
+#include "msm/fem/tet_term.hpp"
 #include "msm/form/form.hpp"
 #include "verification/scene.hpp"
 
@@ -79,5 +80,11 @@ std::vector<Vec3> surface_nodal_loads(const Scene& scene, const TetMesh& mesh, d
 /// held dofs.
 msm::Problem msm_problem(const Scene& scene, const msm::Form& form, const msm::BuiltNetwork& built,
                          const TetMesh& mesh, double magnitude);
+
+/// The problem of a P1 tet model on the scene's mesh itself (kinds corotational_fem and xpbd_fem):
+/// its nodes are the mesh's, with lumped masses ρV₀/4 per tet corner (kg), the surface loads'
+/// consistent nodal loads (N), gravity on those masses and the scene's supports as held dofs.
+msm::Problem tet_mesh_problem(const Scene& scene, const msm::TetTerm& term, const TetMesh& mesh,
+                              double magnitude);
 
 }  // namespace vessel

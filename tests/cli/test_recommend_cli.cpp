@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "../schema_check.hpp"
@@ -61,10 +62,19 @@ TEST(RecommendCli, NamesACandidateThatMeetsTheBudgetWithItsEvidence) {
   EXPECT_TRUE(problems.empty()) << vessel::test::joined(problems);
   EXPECT_EQ(j["budget"]["quantity"], "patch");
   EXPECT_DOUBLE_EQ(j["budget"]["seconds_per_update"].get<double>(), 10.0);
-  // FEM P1 + (2 kinds × 6 rules + the hybrid volume model under its two moduli rules + the
-  // edge-pair volume model + the discrete-shells surface model) × (static, linear, R = 4 mm),
-  // level 0.
-  ASSERT_EQ(j["candidates"].size(), 49u);
+  // FEM P1, corotational P1, XPBD FEM + (2 kinds × 6 rules + the hybrid volume model under its
+  // two moduli rules + the edge-pair volume model + the discrete-shells surface model) ×
+  // (static, linear, R = 4 mm), level 0.
+  ASSERT_EQ(j["candidates"].size(), 51u);
+  // At this small load corotational P1 is linear P1 to second order in the load: its patch error
+  // against the P2 reference is P1's within 1 %.
+  std::map<std::string, nlohmann::json> by_name;
+  for (const auto& c : j["candidates"]) by_name[c["name"]] = c;
+  const auto& p1 = by_name["fem_p1 @ L0"];
+  const auto& corotational = by_name["fem/corotational-p1/static @ L0"];
+  ASSERT_TRUE(corotational["ok"].get<bool>()) << corotational.dump();
+  EXPECT_NEAR(corotational["error"].get<double>(), p1["error"].get<double>(),
+              0.01 * p1["error"].get<double>());
   const double tol = 0.05, budget = 10.0;
   ASSERT_FALSE(j["recommended"].is_null()) << read_text(out / "recommend.md");
   const std::string best = j["recommended"];

@@ -44,6 +44,9 @@ ResultsFile synthetic() {
                 row("p2", "fem", "P2, direct (CHOLMOD)", 0.3, 0, L, 0.01, 2.0),
                 row("A", "volume_msm", "", 0.3, 0, L, 0.50, 0.02),
                 row("B", "surface_msm", "", 0.3, 0, L, 0.25, 0.08),
+                // the P1 tet models beat B but are FEM, not mass-spring models
+                row("R", "corotational_fem", "corotational P1", 0.3, 0, L, 0.10, 0.05),
+                row("X", "xpbd_fem", "XPBD stable neo-Hookean P1", 0.3, 0, L, 0.12, 0.05),
                 row("C", "volume_msm", "", 0.3, 0, L, 0.0, 0.001, false),
                 // the edge-pair model (P1 on the edges) beats B but is shown apart, not as best
                 row("E", "volume_msm",

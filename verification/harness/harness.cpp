@@ -167,6 +167,10 @@ SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& pr
                               progress.begin(fem_label);
                               run_fem_model(at_nu, spec, nu, mesh, a.ref, fine, o, base, part);
                               progress.end();
+                            } else if (spec.kind == ModelKind::corotational_fem ||
+                                       spec.kind == ModelKind::xpbd_fem) {
+                              run_tet_fem_model(at_nu, spec, nu, mesh, a.ref, fine, o, progress,
+                                                base, part);
                             } else {
                               run_msm_model(at_nu, spec, nu, mesh, a.ref, fine, o, progress, base,
                                             part);

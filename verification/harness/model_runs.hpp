@@ -25,6 +25,15 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
                    const HarnessOptions& o, Progress& progress, ModelOutcome base,
                    SceneResult& result);
 
+/// A P1 tet model on the scene's mesh (kinds corotational_fem and xpbd_fem; msm/fem) at every
+/// load: corotational P1 by static Newton with its consistent tangent, timed as warm-started
+/// updates of the load ramp; XPBD FEM stepped from rest to its steady state (its time per update
+/// is then the time per step × the steps an update period holds, as for the integrators).
+void run_tet_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
+                       const ReferenceSolvers& ref, const fem::ElasticityResult& fine,
+                       const HarnessOptions& o, Progress& progress, ModelOutcome base,
+                       SceneResult& result);
+
 /// A model outside the suite (kinds external and displacements; verification/harness/external_model.hpp)
 /// at every load: the case written to its exchange folder and its command run (external), or the
 /// answer read from the folder the export named (displacements); then compared as any model. A

@@ -3,6 +3,7 @@
 // the budget's load, and the generated candidate list.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -201,14 +202,16 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   m.stiffness = msm::StiffnessRule::seed001;
   s.models = {m};
   const std::vector<ModelSpec> c = candidate_models(s, {4e-3, 8e-3});
-  // FEM P1 + (2 kinds × every rule + the hybrid volume model under both rules for its moduli +
-  // the edge-pair volume model + the discrete-shells surface model) × (static, linear, 2 radii).
+  // FEM P1, corotational P1, XPBD FEM + (2 kinds × every rule + the hybrid volume model under both
+  // rules for its moduli + the edge-pair volume model + the discrete-shells surface model) ×
+  // (static, linear, 2 radii).
   const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 4;
-  ASSERT_EQ(c.size(), 1 + spring_models * 4);
+  ASSERT_EQ(c.size(), 3 + spring_models * 4);
   std::set<std::string> names, rules;
   for (const auto& x : c) {
     names.insert(x.name);
-    if (x.kind != ModelKind::fem) rules.insert(msm::to_string(x.stiffness));
+    if (x.kind == ModelKind::surface_msm || x.kind == ModelKind::volume_msm)
+      rules.insert(msm::to_string(x.stiffness));
   }
   EXPECT_EQ(names.size(), c.size());  // unique
   EXPECT_EQ(rules.size(), msm::kAllStiffnessRules.size());
@@ -217,6 +220,13 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   EXPECT_TRUE(names.count("volume/hybrid-volume-homogenised/static"));
   EXPECT_TRUE(names.count("surface/discrete-shells/static/R=8mm"));
   EXPECT_TRUE(names.count("volume/edge-pairs/linear"));
+  EXPECT_TRUE(names.count("fem/corotational-p1/static"));
+  EXPECT_EQ(std::count_if(c.begin(), c.end(),
+                          [](const ModelSpec& x) {
+                            return x.kind == ModelKind::xpbd_fem &&
+                                   x.name.starts_with("fem/xpbd-neo-hookean/dt=");
+                          }),
+            1);
   for (const auto& x : c) {
     EXPECT_EQ(x.edge_pairs, x.name.starts_with("volume/edge-pairs/")) << x.name;
     if (x.name.starts_with("surface/discrete-shells/")) {
@@ -230,7 +240,7 @@ TEST(Candidates, GeneratedFromTheLibrarysLists) {
   EXPECT_TRUE(names.count("surface/seed000/linear"));
   // Pressure: no regions of interest.
   s.load.kind = LoadKind::pressure;
-  EXPECT_EQ(candidate_models(s, {4e-3}).size(), 1 + spring_models * 2);
+  EXPECT_EQ(candidate_models(s, {4e-3}).size(), 3 + spring_models * 2);
 
   // Dynamic: every integrator at its family's time steps, over the scene's longest run.
   s.load.kind = LoadKind::contact;
@@ -278,7 +288,7 @@ TEST(Candidates, IncludeTheScenesCalibratedModels) {
   s.models = {m};
   const std::vector<ModelSpec> c = candidate_models(s, {4e-3});
   const std::size_t spring_models = 2 * msm::kAllStiffnessRules.size() + 4;  // as above
-  ASSERT_EQ(c.size(), 1 + spring_models * 3 + 2);
+  ASSERT_EQ(c.size(), 3 + spring_models * 3 + 2);
   int calibrated = 0;
   for (const auto& x : c) {
     if (x.calibration.empty()) continue;

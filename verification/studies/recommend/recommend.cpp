@@ -223,8 +223,8 @@ ModelSpec spring_model(ModelKind kind, const SpringChoice& choice) {
   return m;
 }
 
-/// Static scenes: FEM P1, every spring model under the static and linear solvers, and with
-/// contact loads the static solver on each region-of-interest radius.
+/// Static scenes: FEM P1, corotational P1 and XPBD FEM, every spring model under the static and
+/// linear solvers, and with contact loads the static solver on each region-of-interest radius.
 void add_static_candidates(const Scene& s, const std::vector<double>& roi_radii,
                            std::vector<ModelSpec>& out) {
   ModelSpec fem;
@@ -232,6 +232,17 @@ void add_static_candidates(const Scene& s, const std::vector<double>& roi_radii,
   fem.kind = ModelKind::fem;
   fem.degree = 1;
   out.push_back(fem);
+  // The P1 models simulators pick instead of springs (msm/fem), on P1's mesh: corotational P1 by
+  // static Newton, and XPBD FEM at its default step (its time per update: that step's cost × the
+  // steps an update period holds; its error: its steady state's).
+  ModelSpec corotational;
+  corotational.name = "fem/corotational-p1/static";
+  corotational.kind = ModelKind::corotational_fem;
+  out.push_back(corotational);
+  ModelSpec xpbd;
+  xpbd.kind = ModelKind::xpbd_fem;
+  xpbd.name = "fem/xpbd-neo-hookean/dt=" + significant(xpbd.tet_fem.dt);
+  out.push_back(xpbd);
   for (const auto& [kind, kind_name] : kKinds) {
     for (const SpringChoice& choice : spring_rules(kind)) {
       ModelSpec m = spring_model(kind, choice);
