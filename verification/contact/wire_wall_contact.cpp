@@ -296,6 +296,11 @@ WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const Condense
   return out;
 }
 
+double capsule_gap(const ContactWire& wire, const Eigen::VectorXd& x, const Vec3& point) {
+  const Nearest c = nearest_on_centreline(x, wire.first_node, wire.last_node, point);
+  return (point - c.c).norm() - wire.radius;
+}
+
 Vec3 clamp_reaction(const ContactWire& wire, const CondensedWall& wall, const TetMesh& mesh,
                     const WireWallSolution& solution) {
   const Coupled coupled(wire, wall, mesh);

@@ -80,6 +80,11 @@ WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const Condense
                                          const std::vector<int>& initial_active,
                                          const WireWallOptions& options = {});
 
+/// A point's gap to the wire's capsule at x: its distance to the centreline polyline
+/// first_node..last_node less r_w, m (negative inside the wire). For checking wall points that
+/// are not candidates (a band too narrow lets the wire pass through them unseen).
+double capsule_gap(const ContactWire& wire, const Eigen::VectorXd& x, const Vec3& point);
+
 /// The force the clamp exerts on the wire (N): on each held node's position the balance of the
 /// rod's internal force −∇E, the wall's −λ_k n_k share and the constraint force −J_cᵀμ, summed
 /// over the held nodes: R = Σ_held (∇E + Σ_k λ_k B_kᵀ n_k + J_cᵀμ).

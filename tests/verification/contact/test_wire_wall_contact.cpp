@@ -6,6 +6,7 @@
 // Rows printed as "WIRE-WALL ...".
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -168,6 +169,7 @@ std::vector<TractionPatch> nodal_loads(const TetMesh& mesh, const contact::Conde
 
 struct CoupledRun {
   contact::WireWallSolution solution;
+  contact::ContactWire wire;  ///< its centreline nodes and radius (no form: the rod is gone)
   Vec3 clamp = Vec3::Zero();
   double rigid_force = 0.0;
   /// The wire's compliance at its rigid contact, m/N: −dc/dF with the rigid wall moved out by
@@ -212,6 +214,8 @@ CoupledRun coupled_run(const TetMesh& mesh, const Vec3& target, const std::vecto
   CoupledRun run;
   run.solution = contact::solve_wire_wall_contact(w.contact(), wall, mesh, rigid.x, {first}, o);
   run.clamp = contact::clamp_reaction(w.contact(), wall, mesh, run.solution);
+  run.wire = w.contact();
+  run.wire.form = nullptr;
   run.rigid_force = rigid.force;
   run.setup_seconds = wall.setup_seconds();
   run.total = run.solution.force.sum();
@@ -382,6 +386,16 @@ TEST(WireWallContact, LineOfContactOnACompliantWall) {
   std::printf("WIRE-WALL line contact: clamp + supports |%.3e| N (%.2e of the force)\n", sum.norm(),
               sum.norm() / run.total);
   EXPECT_LT(sum.norm(), 1e-9 * run.total);
+  // No inner-wall node outside the candidates is inside the wire (the wall's whole displacement).
+  const std::vector<Vec3> u = wall.displacement(s.force);
+  double outside = std::numeric_limits<double>::infinity();
+  for (const int n : inner_nodes(mesh)) {
+    if (std::find(nodes.begin(), nodes.end(), n) != nodes.end()) continue;
+    outside =
+        std::min(outside, contact::capsule_gap(run.wire, run.solution.x, mesh.nodes[n] + u[n]));
+  }
+  std::printf("WIRE-WALL line contact: smallest gap of the non-candidates %.3e m\n", outside);
+  EXPECT_GT(outside, 0.0);
   for (int j = 0; j < s.force.size(); ++j) {
     EXPECT_GE(s.force[j], 0.0);
     EXPECT_GE(s.gap[j], -1e-12);
