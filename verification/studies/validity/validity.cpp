@@ -144,8 +144,8 @@ Continuation deserialise(std::string_view text, std::size_t mesh_nodes,
   return c;
 }
 
-/// The models the study runs: named ones, else (default) the seed models, else (full) every
-/// whole-vessel static or linear mass-spring model of the scene.
+/// The models the study runs: named ones, else (default) the seed models and corotational P1, else
+/// (full) every whole-vessel static or linear mass-spring model and corotational P1 of the scene.
 std::vector<const ModelSpec*> chosen_models(const Scene& s, const ValidityOptions& o) {
   auto eligible = [](const ModelSpec& m) {
     return ((m.kind == ModelKind::surface_msm || m.kind == ModelKind::volume_msm) &&
@@ -171,9 +171,9 @@ std::vector<const ModelSpec*> chosen_models(const Scene& s, const ValidityOption
     // The default runs the seed models and corotational P1, the model simulators pick instead.
     const bool seed = m.kind == ModelKind::corotational_fem ||
                       (!m.volume_term && !m.edge_pairs && m.bending == msm::Bending::none &&
-                      m.calibration.empty() &&
-                      (m.stiffness == msm::StiffnessRule::seed000 ||
-                       m.stiffness == msm::StiffnessRule::seed001));
+                       m.calibration.empty() &&
+                       (m.stiffness == msm::StiffnessRule::seed000 ||
+                        m.stiffness == msm::StiffnessRule::seed001));
     if (o.full || seed) out.push_back(&m);
   }
   return out;
