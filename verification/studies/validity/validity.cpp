@@ -13,8 +13,10 @@
 #include "meshes/foundation/content_hash.hpp"
 #include "meshes/self_contact.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "msm/fem/corotational_tet.hpp"
 #include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/updates.hpp"
+#include "msm/terms/edge_pair_term.hpp"
 #include "verification/harness/external_model.hpp"
 #include "verification/harness/metrics.hpp"
 #include "verification/harness/model_readout.hpp"
@@ -142,12 +144,13 @@ Continuation deserialise(std::string_view text, std::size_t mesh_nodes,
   return c;
 }
 
-/// The models the study runs: named ones, else (default) the seed models, else (full) every
-/// whole-vessel static or linear mass-spring model of the scene.
+/// The models the study runs: named ones, else (default) the seed models and corotational P1, else
+/// (full) every whole-vessel static or linear mass-spring model and corotational P1 of the scene.
 std::vector<const ModelSpec*> chosen_models(const Scene& s, const ValidityOptions& o) {
   auto eligible = [](const ModelSpec& m) {
-    return (m.kind == ModelKind::surface_msm || m.kind == ModelKind::volume_msm) &&
-           m.roi_radius <= 0.0 && msm::supports_updates(m.solver);
+    return ((m.kind == ModelKind::surface_msm || m.kind == ModelKind::volume_msm) &&
+            m.roi_radius <= 0.0 && msm::supports_updates(m.solver)) ||
+           m.kind == ModelKind::corotational_fem;
   };
   std::vector<const ModelSpec*> out;
   if (!o.models.empty()) {
@@ -156,7 +159,8 @@ std::vector<const ModelSpec*> chosen_models(const Scene& s, const ValidityOption
                                    [&](const ModelSpec& m) { return m.name == name; });
       if (it == s.models.end() || !eligible(*it)) {
         throw InputError("--models " + name + ": " + s.source.string() +
-                         " has no whole-vessel static mass-spring model of that name");
+                         " has no whole-vessel static mass-spring model or corotational_fem "
+                         "model of that name");
       }
       out.push_back(&*it);
     }
@@ -164,10 +168,12 @@ std::vector<const ModelSpec*> chosen_models(const Scene& s, const ValidityOption
   }
   for (const ModelSpec& m : s.models) {
     if (!eligible(m)) continue;
-    const bool seed = !m.volume_term && !m.edge_pairs && m.bending == msm::Bending::none &&
-                      m.calibration.empty() &&
-                      (m.stiffness == msm::StiffnessRule::seed000 ||
-                       m.stiffness == msm::StiffnessRule::seed001);
+    // The default runs the seed models and corotational P1, the model simulators pick instead.
+    const bool seed = m.kind == ModelKind::corotational_fem ||
+                      (!m.volume_term && !m.edge_pairs && m.bending == msm::Bending::none &&
+                       m.calibration.empty() &&
+                       (m.stiffness == msm::StiffnessRule::seed000 ||
+                        m.stiffness == msm::StiffnessRule::seed001));
     if (o.full || seed) out.push_back(&m);
   }
   return out;
@@ -270,13 +276,31 @@ ValidityScene scene_settings(const Scene& s, const ValidityOptions& o) {
   return out;
 }
 
-/// The mass-spring models the study judges, built on their level's mesh.
+/// The models the study judges, built on their level's mesh: mass-spring networks, and
+/// corotational P1 on the mesh's own nodes (tet models: an empty BuiltNetwork).
 struct StudyModels {
   std::vector<const ModelSpec*> specs;
   TetMesh mesh;
   std::vector<msm::BuiltNetwork> built;
-  std::vector<std::unique_ptr<msm::MassSpringModel>> forms;
+  std::vector<std::unique_ptr<msm::Form>> forms;
   std::vector<std::size_t> node_counts;
+
+  [[nodiscard]] bool on_mesh(std::size_t m) const {
+    return specs[m]->kind == ModelKind::corotational_fem;
+  }
+  [[nodiscard]] const std::vector<Vec3>& nodes(std::size_t m) const {
+    return on_mesh(m) ? mesh.nodes : built[m].network.nodes;
+  }
+  [[nodiscard]] VtuCells cells(std::size_t m) const {
+    return on_mesh(m) ? tet_cells(mesh.tets) : network_cells(built[m].network);
+  }
+  [[nodiscard]] msm::Problem problem(const Scene& s, std::size_t m, double load) const {
+    if (on_mesh(m)) {
+      return tet_mesh_problem(s, static_cast<const msm::TetTerm&>(*forms[m]), mesh, load);
+    }
+    return msm_problem(s, static_cast<const msm::MassSpringModel&>(*forms[m]), built[m], mesh,
+                       load);
+  }
 };
 
 StudyModels build_models(const Scene& s, const ValidityOptions& o, ValidityScene& out) {
@@ -286,13 +310,21 @@ StudyModels build_models(const Scene& s, const ValidityOptions& o, ValidityScene
   VesselParams vessel = s.vessel;
   vessel.level = out.model_level;
   for (const ModelSpec* spec : m.specs) {
-    m.built.push_back(scene_network(s, *spec, m.mesh, vessel, out.poisson_ratio));
-    m.forms.push_back(msm::make_model(m.built.back(), spec->damping));
-    m.node_counts.push_back(m.built.back().network.nodes.size());
-    out.models.push_back({spec->name,
-                          m.built.back().topology + ", " + msm::to_string(spec->stiffness) +
-                              " stiffness, " + msm::to_string(spec->solver),
-                          out.model_level, m.node_counts.back()});
+    std::string detail;
+    if (spec->kind == ModelKind::corotational_fem) {
+      m.built.emplace_back();
+      m.forms.push_back(std::make_unique<msm::CorotationalTetTerm>(
+          m.mesh.nodes, m.mesh.tets, msm::lame_parameters(s.youngs_modulus, out.poisson_ratio)));
+      m.node_counts.push_back(m.mesh.nodes.size());
+      detail = "corotational P1 (Müller & Gross 2004), static Newton, consistent tangent";
+    } else {
+      m.built.push_back(scene_network(s, *spec, m.mesh, vessel, out.poisson_ratio));
+      m.forms.push_back(msm::make_model(m.built.back(), spec->damping));
+      m.node_counts.push_back(m.built.back().network.nodes.size());
+      detail = m.built.back().topology + ", " + msm::to_string(spec->stiffness) + " stiffness, " +
+               msm::to_string(spec->solver);
+    }
+    out.models.push_back({spec->name, detail, out.model_level, m.node_counts.back()});
   }
   return m;
 }
@@ -317,9 +349,9 @@ Continuation finite_continuation(const Scene& s, const ValidityOptions& o, const
   ContentHash what;
   what.text("validity samples v2").real(qoi.x()).real(qoi.y()).real(qoi.z());
   what.real(kOutsideTolerance);
-  for (const auto& b : models.built) {
-    what.integer(static_cast<std::int64_t>(b.network.nodes.size()));
-    for (const Vec3& p : b.network.nodes) what.real(p.x()).real(p.y()).real(p.z());
+  for (std::size_t m = 0; m < models.specs.size(); ++m) {
+    what.integer(static_cast<std::int64_t>(models.nodes(m).size()));
+    for (const Vec3& p : models.nodes(m)) what.real(p.x()).real(p.y()).real(p.z());
   }
   auto compute = [&] {
     from_cache = false;
@@ -335,8 +367,8 @@ Continuation finite_continuation(const Scene& s, const ValidityOptions& o, const
           x.seconds = cp.seconds;
           x.qoi = at.displacement_at({qoi}, kOutsideTolerance)[0];
           x.mesh_nodes = cp.nodal_displacement;
-          for (const auto& b : models.built) {
-            x.model_nodes.push_back(at.displacement_at(b.network.nodes, kOutsideTolerance));
+          for (std::size_t m = 0; m < models.specs.size(); ++m) {
+            x.model_nodes.push_back(at.displacement_at(models.nodes(m), kOutsideTolerance));
           }
           std::ostringstream m;
           m << "  " << s.name << ": finite strain at " << cp.load_factor << " " << load_unit(s.load.kind) << ": "
@@ -381,12 +413,12 @@ ValidityModelError model_error(const Scene& s, const StudyModels& models, std::s
   ValidityModelError e;
   e.model = models.specs[m]->name;
   try {
-    const msm::Problem p = msm_problem(s, *models.forms[m], models.built[m], models.mesh, x.load);
+    const msm::Problem p = models.problem(s, m, x.load);
     if (!updater) updater = msm::prepare_updates(p, models.specs[m]->solver);
     const msm::UpdateResult u = updater->update(p.external_force);
     e.iterations = u.iterations;
     const Eigen::VectorXd& state = updater->state();
-    const auto& nodes = models.built[m].network.nodes;
+    const auto& nodes = models.nodes(m);
     std::vector<Vec3> um(nodes.size());
     for (std::size_t i = 0; i < nodes.size(); ++i) {
       um[i] = state.segment<3>(3 * static_cast<Eigen::Index>(i)) - nodes[i];
@@ -401,7 +433,7 @@ ValidityModelError model_error(const Scene& s, const StudyModels& models, std::s
     e.qoi_relative = uref.norm() > 0.0 ? (um[q] - uref).norm() / uref.norm() : 0.0;
     e.ok = true;
     if (!fields.empty()) {
-      write_fields_vtu(fields, nodes, network_cells(models.built[m].network), um, x.model_nodes[m]);
+      write_fields_vtu(fields, nodes, models.cells(m), um, x.model_nodes[m]);
       e.fields_file = fields;
     }
   } catch (const InputError&) {
