@@ -34,8 +34,8 @@ struct Material {
 enum class Formulation { automatic, displacement, mixed };
 /// direct: CHOLMOD (displacement) or UMFPACK (mixed); cg_amg: CG with AMG (displacement only);
 /// gmres_block: FGMRES with a block-triangular AMG / pressure-mass preconditioner (mixed only);
-/// matrix_free: CG on the matrix-free operator with a P2 → P1 p-multigrid and AMG on P1
-/// (displacement only; no P2 matrix is assembled).
+/// matrix_free: CG on the matrix-free operator with a P2 → P1 p-multigrid, CHOLMOD on P1 (AMG
+/// for P1 itself) (displacement only; no P2 matrix is assembled).
 /// The values are part of the FEM solution cache's key: append, never renumber.
 enum class LinearSolver { automatic, direct, cg_amg, gmres_block, matrix_free };
 

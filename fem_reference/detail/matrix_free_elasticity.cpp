@@ -10,10 +10,12 @@
 #include <deal.II/matrix_free/fe_evaluation.h>
 #include <deal.II/matrix_free/tools.h>
 
+#include <Eigen/SparseCore>
+#include <chrono>
 #include <sstream>
 #include <stdexcept>
 
-#include "fem_reference/detail/amg.hpp"
+#include "fem_reference/cholmod_solve.hpp"
 
 namespace vessel::fem::detail {
 
@@ -42,6 +44,21 @@ void copy(const dl::Vector<double>& from, MfVector& to) {
 
 void copy(const MfVector& from, dl::Vector<double>& to) {
   for (unsigned i = 0; i < to.size(); ++i) to[i] = from.local_element(i);
+}
+
+/// The serial Trilinos matrix as an Eigen one (both triangles), for CHOLMOD.
+Eigen::SparseMatrix<double> to_eigen(const dl::TrilinosWrappers::SparseMatrix& m) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(m.n_nonzero_elements());
+  for (const auto& e : m) {
+    if (e.value() != 0.0) {
+      entries.emplace_back(static_cast<int>(e.row()), static_cast<int>(e.column()), e.value());
+    }
+  }
+  Eigen::SparseMatrix<double> out(static_cast<Eigen::Index>(m.m()),
+                                  static_cast<Eigen::Index>(m.n()));
+  out.setFromTriplets(entries.begin(), entries.end());
+  return out;
 }
 
 }  // namespace
@@ -108,10 +125,11 @@ void ElasticityOperator::zero_constrained(MfVector& v) const {
   for (const unsigned i : mf_.get_constrained_dofs()) v.local_element(i) = 0.0;
 }
 
-/// One V-cycle: Chebyshev pre-smoothing on the fine level, the residual restricted to P1, one ML
-/// V-cycle there, prolongated and added, Chebyshev post-smoothing. Pre- and post-smoother are the
-/// same polynomial in A and the restriction is the prolongation's transpose, so the cycle is
-/// symmetric and CG may use it. For P1 (no lower degree on the mesh): ML alone.
+/// One V-cycle: Chebyshev pre-smoothing on the fine level, the residual restricted to P1, solved
+/// there (CHOLMOD or one ML V-cycle), prolongated and added, Chebyshev post-smoothing. Pre- and
+/// post-smoother are the same polynomial in A, the restriction is the prolongation's transpose
+/// and the coarse solve is symmetric, so the cycle is symmetric and CG may use it. For P1 (no
+/// lower degree on the mesh): ML alone.
 class MatrixFreeElasticitySolver::VCycle {
  public:
   VCycle(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
@@ -137,7 +155,7 @@ class MatrixFreeElasticitySolver::VCycle {
       Chebyshev::AdditionalData cheb;
       cheb.degree = settings.chebyshev_degree;
       cheb.smoothing_range = settings.smoothing_range;
-      cheb.eig_cg_n_iterations = 20;
+      cheb.eig_cg_n_iterations = settings.eigenvalue_cg_steps;
       cheb.preconditioner = inverse_diagonal_;
       chebyshev_.initialize(fine, cheb);
       fine.initialize_dof_vector(residual_);
@@ -145,7 +163,15 @@ class MatrixFreeElasticitySolver::VCycle {
       coarse->initialize_dof_vector(coarse_residual_);
       coarse->initialize_dof_vector(coarse_correction_);
     }
-    coarse->compute_matrix(coarse_matrix_);
+    coarse_matrix_ = std::make_unique<dl::TrilinosWrappers::SparseMatrix>();
+    coarse->compute_matrix(*coarse_matrix_);
+    // For P1 the "coarse" level is the fine one: a factor of it would make the matrix-free
+    // operator pointless, so P1 always takes ML.
+    if (settings.coarse == CoarseSolve::cholmod && degree > 1) {
+      cholmod_ = std::make_unique<CholmodFactor>(to_eigen(*coarse_matrix_));
+      coarse_matrix_.reset();
+      return;
+    }
     // The ML near-null space: the rigid-body modes at the P1 DoFs' support points.
     const auto& level_dof = degree > 1 ? coarse_dof_ : dof;
     DisplacementRows rows;
@@ -159,13 +185,14 @@ class MatrixFreeElasticitySolver::VCycle {
       for (unsigned i = 0; i < idx.size(); ++i)
         rows.component[idx[i]] = fe.system_to_component_index(i).first;
     }
-    initialize_elasticity_amg(amg_, coarse_matrix_, rows, centre, false,
-                              settings.amg_rigid_body_modes, AmgProlongator::plain, mode_storage_);
+    initialize_elasticity_amg(amg_, *coarse_matrix_, rows, centre, false,
+                              settings.amg_rigid_body_modes, settings.amg_prolongator,
+                              mode_storage_);
   }
 
   void vmult(MfVector& dst, const MfVector& src) const {
     if (!coarse_) {
-      amg_.vmult(dst, src);
+      coarse_solve(dst, src);
       fine_.zero_constrained(dst);
       return;
     }
@@ -176,7 +203,7 @@ class MatrixFreeElasticitySolver::VCycle {
     coarse_residual_ = 0.0;
     transfer_.restrict_and_add(coarse_residual_, residual_);
     coarse_->zero_constrained(coarse_residual_);
-    amg_.vmult(coarse_correction_, coarse_residual_);
+    coarse_solve(coarse_correction_, coarse_residual_);
     coarse_->zero_constrained(coarse_correction_);
     transfer_.prolongate_and_add(dst, coarse_correction_);
     fine_.zero_constrained(dst);
@@ -188,7 +215,8 @@ class MatrixFreeElasticitySolver::VCycle {
   }
 
   [[nodiscard]] std::size_t memory_consumption() const {
-    return (coarse_ ? coarse_->memory_consumption() : 0) + coarse_matrix_.memory_consumption() +
+    return (coarse_ ? coarse_->memory_consumption() : 0) +
+           (coarse_matrix_ ? coarse_matrix_->memory_consumption() : 0) +
            (inverse_diagonal_ ? inverse_diagonal_->memory_consumption() : 0) +
            4 * residual_.memory_consumption();
   }
@@ -196,6 +224,20 @@ class MatrixFreeElasticitySolver::VCycle {
  private:
   using Chebyshev = dl::PreconditionChebyshev<ElasticityOperator, MfVector,
                                               dl::DiagonalMatrix<MfVector>>;
+
+  /// x ≈ A₁⁻¹ b on the P1 level (on the fine level itself for P1).
+  void coarse_solve(MfVector& x, const MfVector& b) const {
+    if (!cholmod_) {
+      amg_.vmult(x, b);
+      return;
+    }
+    const unsigned n = b.locally_owned_size();
+    Eigen::VectorXd rhs(n);
+    for (unsigned i = 0; i < n; ++i) rhs[i] = b.local_element(i);
+    const Eigen::VectorXd y = cholmod_->solve(rhs);
+    for (unsigned i = 0; i < n; ++i) x.local_element(i) = y[i];
+  }
+
   const ElasticityOperator& fine_;
   dl::DoFHandler<kDim> coarse_dof_;
   dl::AffineConstraints<double> coarse_constraints_;
@@ -203,7 +245,8 @@ class MatrixFreeElasticitySolver::VCycle {
   dl::MGTwoLevelTransfer<kDim, MfVector> transfer_;
   std::shared_ptr<dl::DiagonalMatrix<MfVector>> inverse_diagonal_;
   Chebyshev chebyshev_;
-  dl::TrilinosWrappers::SparseMatrix coarse_matrix_;
+  std::unique_ptr<CholmodFactor> cholmod_;                             // CoarseSolve::cholmod
+  std::unique_ptr<dl::TrilinosWrappers::SparseMatrix> coarse_matrix_;  // ml_vcycle: ML's matrix
   dl::TrilinosWrappers::PreconditionAMG amg_;
   std::vector<double> mode_storage_;  // must outlive amg_
   mutable MfVector residual_, correction_, coarse_residual_, coarse_correction_;
@@ -215,6 +258,7 @@ MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(const dl::Mapping<kDim>& 
                                                        int degree, double lambda, double mu,
                                                        const Vec3& centre,
                                                        const PMultigridSettings& settings) {
+  const auto t0 = std::chrono::steady_clock::now();
   ensure_mpi_initialized();  // Trilinos and the distributed vectors need MPI
   dl::AffineConstraints<double> c;
   constraints_for(dof, c);
@@ -223,6 +267,8 @@ MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(const dl::Mapping<kDim>& 
   fine_ = std::make_unique<ElasticityOperator>(mapping, dof, fine_constraints_, degree, lambda, mu);
   preconditioner_ = std::make_unique<VCycle>(mapping, dof, *fine_, fine_constraints_,
                                              constraints_for, degree, lambda, mu, centre, settings);
+  setup_seconds_ =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 MatrixFreeElasticitySolver::~MatrixFreeElasticitySolver() = default;

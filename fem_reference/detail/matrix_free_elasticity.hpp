@@ -2,9 +2,9 @@
 /// Private to fem_reference: the displacement stiffness of small-strain isotropic elasticity
 /// applied without a matrix (deal.II MatrixFree + FEEvaluation on FE_SimplexP P1/P2 tets), and the
 /// solver built on it: CG preconditioned by a two-level p-multigrid, P2 smoothed by Chebyshev on the
-/// operator's diagonal, the P1 level (same mesh) by one V-cycle of ML algebraic multigrid on the
-/// P1 matrix (computed cell by cell from the same kernel). What deal.II 9.4 supports on simplices:
-/// docs/measurements/dealii_simplex_support.md.
+/// operator's diagonal, the P1 level (same mesh) solved on the P1 matrix (computed cell by cell
+/// from the same kernel) by a CHOLMOD factor or one ML V-cycle. What deal.II 9.4 supports on
+/// simplices: docs/measurements/dealii_simplex_support.md.
 #include <deal.II/base/subscriptor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/mapping.h>
@@ -22,6 +22,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "fem_reference/detail/amg.hpp"
 #include "fem_reference/detail/common.hpp"
 
 namespace vessel::fem::detail {
@@ -68,11 +69,20 @@ class ElasticityOperator : public dl::Subscriptor {
 /// The constraints' pattern with zero inhomogeneities (what MatrixFree and the transfer need).
 dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<double>& constraints);
 
+/// How the V-cycle solves on the P1 level. `cholmod`: exactly, by a CHOLMOD factor of the P1
+/// matrix, so the two-level iteration count depends on the smoother alone, not on the level.
+/// `ml_vcycle`: approximately, by one ML V-cycle (memory of the hierarchy only, but its error
+/// grows with the level and the outer iterations with it; docs/measurements/matrix_free_multigrid.md).
+enum class CoarseSolve { cholmod, ml_vcycle };
+
 /// Settings of the p-multigrid V-cycle.
 struct PMultigridSettings {
   unsigned chebyshev_degree = 4;      ///< matrix-vector products per smoothing step
   double smoothing_range = 20.0;      ///< Chebyshev smooths [λ_max / range, λ_max] of D⁻¹A
-  bool amg_rigid_body_modes = true;   ///< ML near-null space: all six rigid-body modes
+  unsigned eigenvalue_cg_steps = 20;  ///< CG steps of Chebyshev's λ_max(D⁻¹A) estimate
+  CoarseSolve coarse = CoarseSolve::cholmod;
+  bool amg_rigid_body_modes = true;   ///< ml_vcycle: ML near-null space, all six rigid-body modes
+  AmgProlongator amg_prolongator = AmgProlongator::plain;  ///< ml_vcycle
 };
 
 /// The wall's displacement system, set up once, solved for many right-hand sides: the P2 (or P1)
@@ -107,8 +117,10 @@ class MatrixFreeElasticitySolver {
                 unsigned max_iterations) const;
 
   [[nodiscard]] const ElasticityOperator& fine_operator() const { return *fine_; }
-  /// Bytes held: both operators' MatrixFree data, the P1 matrix and the diagonal (not ML's
-  /// hierarchy, which Trilinos does not report).
+  /// Wall-clock seconds the constructor took (operators, transfer, diagonal, coarse solver).
+  [[nodiscard]] double setup_seconds() const { return setup_seconds_; }
+  /// Bytes held: both operators' MatrixFree data, the diagonal and the vectors (not the CHOLMOD
+  /// factor or ML's hierarchy, which their libraries do not report).
   [[nodiscard]] std::size_t memory_consumption() const;
 
  private:
@@ -116,6 +128,7 @@ class MatrixFreeElasticitySolver {
   dl::AffineConstraints<double> fine_constraints_;
   std::unique_ptr<ElasticityOperator> fine_;
   std::unique_ptr<VCycle> preconditioner_;
+  double setup_seconds_ = 0.0;
 };
 
 }  // namespace vessel::fem::detail
