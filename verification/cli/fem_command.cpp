@@ -212,7 +212,8 @@ void print_solver(const fem::ElasticityResult& r) {
   std::cout << " " << fem::to_string(r.solver);
   if (r.solver == fem::LinearSolver::cg_amg) std::cout << ", " << r.iterations << " CG iterations";
   if (r.solver == fem::LinearSolver::matrix_free) {
-    std::cout << ", " << r.iterations << " CG iterations (p-multigrid P2->P1, ML on P1)";
+    std::cout << ", " << r.iterations << " CG iterations ("
+              << (r.element == "P1" ? "ML on P1" : "p-multigrid P2->P1, CHOLMOD on P1") << ")";
   }
   if (r.solver == fem::LinearSolver::gmres_block) {
     std::cout << ", " << r.iterations << " FGMRES iterations (" << std::setprecision(3)
@@ -640,7 +641,8 @@ void add_solver_options(CLI::App* cmd, FemCommandOptions& o) {
                   "with Trilinos ML AMG, displacement system), gmres-block (FGMRES with a "
                   "block-triangular preconditioner: AMG on the displacement block, scaled "
                   "pressure mass for the Schur complement; mixed system), matrix-free (CG on "
-                  "the matrix-free operator with a P2->P1 p-multigrid and ML on P1; "
+                  "the matrix-free operator: for P2 a P2->P1 p-multigrid with CHOLMOD on P1, for "
+                  "P1 ML; "
                   "displacement system; never chosen by auto)")
       ->check(CLI::IsMember({"auto", "direct", "cg-amg", "gmres-block", "matrix-free"}))
       ->capture_default_str();
