@@ -32,6 +32,8 @@ constexpr double kTheta = 0.3;      // clamp tilt, rad
 constexpr double kZc = 20e-3;       // the reference's contact distance, m
 constexpr double kWallE = 14.24e3;  // the scenes' wall modulus, Pa
 constexpr double kTubeLength = 30e-3;
+constexpr double kSoftFactor = 34.0;
+constexpr double kStageRatio = 1.2;  // the continuation test's wall: kSoftFactor × kWallE
 
 /// The structured straight tube (axis z, 0 ≤ z ≤ 30 mm, a = 3 mm, t = 1 mm), level 0.
 const TetMesh& tube_mesh() {
@@ -185,7 +187,8 @@ struct CoupledRun {
 /// The wire (diameter d, N segments, the reference's length for z_c = 20 mm) in the tube of wall
 /// modulus E, candidates within 4 mm and 60° of the aimed node.
 CoupledRun coupled_run(const TetMesh& mesh, const Vec3& target, const std::vector<int>& nodes,
-                       double young, double diameter, int segments, double length_factor);
+                       double young, double diameter, int segments, double length_factor,
+                       const std::vector<double>& compliance_scales = {});
 
 CoupledRun coupled_run(double young, double diameter, int segments, double length_factor = 1.0) {
   const TetMesh& mesh = tube_mesh();
@@ -195,9 +198,10 @@ CoupledRun coupled_run(double young, double diameter, int segments, double lengt
 }
 
 /// The wire aimed at `target` on the wall (its tip at z_c = 20 mm from the clamp), candidates
-/// `nodes`.
+/// `nodes`, the wall's compliance reached through `compliance_scales` (WireWallOptions).
 CoupledRun coupled_run(const TetMesh& mesh, const Vec3& target, const std::vector<int>& nodes,
-                       double young, double diameter, int segments, double length_factor) {
+                       double young, double diameter, int segments, double length_factor,
+                       const std::vector<double>& compliance_scales) {
   const double c = kA - diameter / 2;
   const double length =
       length_factor * rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
@@ -211,6 +215,7 @@ CoupledRun coupled_run(const TetMesh& mesh, const Vec3& target, const std::vecto
   const int first = nearest_candidate(mesh, nodes, tip + w.radius * radial);
   contact::WireWallOptions o;
   o.force_scale = w.EI / (kZc * kZc);
+  o.compliance_scales = compliance_scales;
   CoupledRun run;
   run.solution = contact::solve_wire_wall_contact(w.contact(), wall, mesh, rigid.x, {first}, o);
   run.clamp = contact::clamp_reaction(w.contact(), wall, mesh, run.solution);
@@ -401,6 +406,153 @@ TEST(WireWallContact, LineOfContactOnACompliantWall) {
     EXPECT_GE(s.gap[j], -1e-12);
     EXPECT_LE(s.force[j] * std::abs(s.gap[j]), 1e-12 * s.force.maxCoeff());
   }
+}
+
+/// Compliance scales from `first` rising by `ratio` to 1 (continuation stages).
+std::vector<double> geometric_scales(double first, double ratio) {
+  std::vector<double> out;
+  for (double s = first; s < 1.0; s *= ratio) out.push_back(s);
+  return out;
+}
+
+/// The largest principal strain magnitude over the mesh's tets (P1 gradient of u): the small
+/// strain's and the Green–Lagrange strain's, ½(H + Hᵀ) and ½(H + Hᵀ + HᵀH).
+struct WallStrain {
+  double small = 0.0, green = 0.0;
+};
+WallStrain largest_strain(const TetMesh& mesh, const std::vector<Vec3>& u) {
+  WallStrain out;
+  for (const Tet& t : mesh.tets) {
+    Eigen::Matrix3d dX, dU;
+    for (int k = 0; k < 3; ++k) {
+      dX.col(k) = mesh.nodes[t[k + 1]] - mesh.nodes[t[0]];
+      dU.col(k) = u[t[k + 1]] - u[t[0]];
+    }
+    const Eigen::Matrix3d H = dU * dX.inverse();
+    const Eigen::Matrix3d e = 0.5 * (H + H.transpose());
+    const Eigen::Matrix3d E = e + 0.5 * H.transpose() * H;
+    out.small = std::max(out.small, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(e)
+                                        .eigenvalues()
+                                        .cwiseAbs()
+                                        .maxCoeff());
+    out.green = std::max(out.green, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(E)
+                                        .eigenvalues()
+                                        .cwiseAbs()
+                                        .maxCoeff());
+  }
+  return out;
+}
+
+// Continuation on the wall's compliance: the line of contact's wall made softer, reached by
+// stages from the 100 × stiffer wall's equilibrium (each solved from the last). Signorini's
+// conditions, action = reaction against the wall's total force, no non-candidate inside the
+// wire; the dent against r_w and the wall's strains are printed (the linear wall is the model
+// here: whether it is valid at that dent is the neo-Hookean reference's question).
+TEST(WireWallContact, ContinuationReachesASofterWall) {
+  VesselParams p;
+  p.length = kTubeLength;
+  const Vec3 target(kA, 0, 25e-3);
+  const TetMesh mesh = refined_patch_mesh(p, target, 0.08e-3, 1.0e-3);
+  std::vector<int> nodes;
+  for (const int n : inner_nodes(mesh)) {
+    if ((mesh.nodes[n] - target).norm() < 1.6e-3) nodes.push_back(n);
+  }
+  const double young = kWallE * kSoftFactor;
+  const double c = kA - 0.356e-3 / 2;
+  const double length = rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
+  Wire w(0.356e-3, length, 32, Vec3(0, 0, target.z() - kZc));
+  const RigidRun rigid = rigid_run(w);
+  const fem::ElasticitySolver solver(mesh, wall_problem(young));
+  const Vec3 tip = rigid.x.segment<3>(3 * w.layout.tip_node);
+  const int first =
+      nearest_candidate(mesh, nodes, tip + w.radius * Vec3(tip.x(), tip.y(), 0).normalized());
+  contact::WireWallOptions o;
+  o.force_scale = w.EI / (kZc * kZc);
+  o.compliance_scales = geometric_scales(kSoftFactor / 100, kStageRatio);
+  const contact::GrownContact grown = contact::solve_wire_wall_contact_growing(
+      w.contact(), solver.free_displacement_system(), mesh, nodes, rigid.x, {first}, o);
+  const contact::WireWallSolution& s = grown.solution;
+  const Eigen::VectorXd dents = grown.wall->compliance() * s.force;
+  double dent = 0;
+  for (const int j : s.active) dent = std::max(dent, dents[j]);
+  const std::vector<Vec3> u = grown.wall->displacement(s.force);
+  const WallStrain strain = largest_strain(mesh, u);
+  const double total = s.force.sum();
+  std::printf(
+      "WIRE-WALL continuation E=%.4g Pa: %zu candidates grown to %zu in %d rounds, %zu in "
+      "contact, largest dent %.3e m (dent/r_w %.2f), largest strain %.3f (Green-Lagrange %.3f), "
+      "F %.6e N (rigid %.6e), %d contact-set changes, %d steps, %.2f s\n",
+      young, nodes.size(), grown.nodes.size(), grown.rounds, s.active.size(), dent,
+      dent / w.radius, strain.small, strain.green, total, rigid.force, s.active_set_changes,
+      s.newton_iterations, s.seconds);
+  const Vec3 clamp = contact::clamp_reaction(w.contact(), *grown.wall, mesh, s);
+  EXPECT_LT((clamp - s.total_force_on_wall(*grown.wall)).norm(), 1e-9 * total);
+  double outside = std::numeric_limits<double>::infinity();
+  for (const int n : inner_nodes(mesh)) {
+    if (std::find(grown.nodes.begin(), grown.nodes.end(), n) != grown.nodes.end()) continue;
+    outside = std::min(outside, contact::capsule_gap(w.contact(), s.x, mesh.nodes[n] + u[n]));
+  }
+  EXPECT_GT(outside, 0.0);
+  for (int j = 0; j < s.force.size(); ++j) {
+    EXPECT_GE(s.force[j], 0.0);
+    EXPECT_GE(s.gap[j], -1e-12);
+    EXPECT_LE(s.force[j] * std::abs(s.gap[j]), 1e-12 * s.force.maxCoeff());
+  }
+}
+
+// Band growth: the line of contact's candidates cut to the nodes within 0.3 mm of the aimed
+// point (the contact reaches ~1 mm), grown by solve_wire_wall_contact_growing until no pressed
+// candidate lies on the band's edge. The answer must be the wide band's (1.6 mm, which the
+// contact stays well inside): the same pressed nodes with the same forces.
+TEST(WireWallContact, GrownBandMatchesTheWideBand) {
+  VesselParams p;
+  p.length = kTubeLength;
+  const Vec3 target(kA, 0, 25e-3);
+  const TetMesh mesh = refined_patch_mesh(p, target, 0.08e-3, 1.0e-3);
+  auto within = [&](double radius) {
+    std::vector<int> out;
+    for (const int n : inner_nodes(mesh)) {
+      if ((mesh.nodes[n] - target).norm() < radius) out.push_back(n);
+    }
+    return out;
+  };
+  const std::vector<int> wide_nodes = within(1.6e-3), small_nodes = within(0.3e-3);
+  const double young = kWallE * 100;
+  const CoupledRun wide = coupled_run(mesh, target, wide_nodes, young, 0.356e-3, 32, 1.0);
+
+  const double c = kA - 0.356e-3 / 2;
+  const double length = rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
+  Wire w(0.356e-3, length, 32, Vec3(0, 0, target.z() - kZc));
+  const RigidRun rigid = rigid_run(w);
+  const fem::ElasticitySolver solver(mesh, wall_problem(young));
+  const Vec3 tip = rigid.x.segment<3>(3 * w.layout.tip_node);
+  const int first = nearest_candidate(mesh, small_nodes,
+                                      tip + w.radius * Vec3(tip.x(), tip.y(), 0).normalized());
+  contact::WireWallOptions o;
+  o.force_scale = w.EI / (kZc * kZc);
+  const contact::GrownContact grown = contact::solve_wire_wall_contact_growing(
+      w.contact(), solver.free_displacement_system(), mesh, small_nodes, rigid.x, {first}, o);
+  const contact::WireWallSolution& s = grown.solution;
+  std::printf(
+      "WIRE-WALL band growth: %zu candidates grown to %zu in %d rounds, %zu in contact (wide "
+      "band: %zu of %zu), F %.9e N (wide %.9e, %+.2e), %.2f s\n",
+      small_nodes.size(), grown.nodes.size(), grown.rounds, s.active.size(),
+      wide.solution.active.size(), wide_nodes.size(), s.force.sum(), wide.total,
+      s.force.sum() / wide.total - 1, s.seconds);
+  EXPECT_GE(grown.rounds, 1);
+  EXPECT_LT(grown.nodes.size(), wide_nodes.size());
+  std::vector<int> pressed, wide_pressed;
+  for (const int j : s.active) pressed.push_back(grown.nodes[j]);
+  for (const int j : wide.solution.active) wide_pressed.push_back(wide_nodes[j]);
+  std::sort(pressed.begin(), pressed.end());
+  std::sort(wide_pressed.begin(), wide_pressed.end());
+  ASSERT_EQ(pressed, wide_pressed);
+  for (const int j : s.active) {
+    const auto k = std::find(wide_nodes.begin(), wide_nodes.end(), grown.nodes[j]) -
+                   wide_nodes.begin();
+    EXPECT_NEAR(s.force[j], wide.solution.force[k], 1e-7 * wide.solution.force.maxCoeff());
+  }
+  EXPECT_NEAR(s.force.sum(), wide.total, 1e-8 * wide.total);
 }
 
 // The same rigid limit with CORDE (its inextensibility and unit-quaternion constraints carried by
