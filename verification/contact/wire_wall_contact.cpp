@@ -56,10 +56,8 @@ struct ActiveGeometry {
 
 class Coupled {
  public:
-  /// The wall's compliance scaled by `scale` (a continuation stage; 1 is the wall itself).
-  Coupled(const ContactWire& wire, const CondensedWall& wall, const TetMesh& mesh,
-          double scale = 1.0)
-      : wire_(wire), W_(scale * wall.compliance()), n_(wall.directions()) {
+  Coupled(const ContactWire& wire, const CondensedWall& wall, const TetMesh& mesh)
+      : wire_(wire), W_(wall.compliance()), n_(wall.directions()) {
     points_.reserve(wall.nodes().size());
     for (const int node : wall.nodes()) points_.push_back(mesh.nodes[node]);
   }
@@ -175,7 +173,7 @@ class Coupled {
 
  private:
   const ContactWire& wire_;
-  MatrixXd W_;
+  const MatrixXd& W_;
   const std::vector<Vec3>& n_;
   std::vector<Vec3> points_;
 };
@@ -205,16 +203,15 @@ Vec3 WireWallSolution::total_force_on_wall(const CondensedWall& wall) const {
 
 namespace {
 
-/// The coupled state carried from one continuation stage to the next.
+/// The coupled state a solve starts from and leaves at equilibrium.
 struct CoupledState {
   VectorXd x, mu, lambda;
   std::vector<char> active;
 };
 
-/// Sequential Signorini solves on one stage (the wall's compliance as `coupled` scales it) from
-/// `state`, which it leaves at that stage's equilibrium.
-void solve_stage(const Coupled& coupled, const ContactWire& wire, const WireWallOptions& options,
-                 double scale, CoupledState& state, WireWallSolution& out) {
+/// Sequential Signorini solves from `state`, which it leaves at equilibrium.
+void solve_sequence(const Coupled& coupled, const ContactWire& wire, const WireWallOptions& options,
+                    CoupledState& state, WireWallSolution& out) {
   const int m = coupled.num_candidates();
   const int n = static_cast<int>(state.x.size());
   const int mc = static_cast<int>(state.mu.size());
@@ -263,8 +260,7 @@ void solve_stage(const Coupled& coupled, const ContactWire& wire, const WireWall
     }
     if (it == options.max_newton || !R.allFinite()) {
       std::ostringstream msg;
-      msg << "solve_wire_wall_contact: no equilibrium in " << options.max_newton
-          << " iterations with the wall's compliance scaled by " << scale << " ("
+      msg << "solve_wire_wall_contact: no equilibrium in " << options.max_newton << " iterations ("
           << std::count(active.begin(), active.end(), 1) << " candidates in contact, rod residual "
           << out.residual << " N, max |c| " << cmax << ", worst gap " << worst_gap << " m)";
       throw std::runtime_error(msg.str());
@@ -304,27 +300,14 @@ void solve_stage(const Coupled& coupled, const ContactWire& wire, const WireWall
 
 namespace {
 
-/// Stages from `state` (options' compliance scales, then the wall itself).
-WireWallSolution solve_from(const ContactWire& wire, const CondensedWall& wall,
-                            const TetMesh& mesh, CoupledState state,
-                            const WireWallOptions& options) {
-  for (std::size_t k = 0; k < options.compliance_scales.size(); ++k) {
-    const double s = options.compliance_scales[k];
-    if (!(s > 0.0 && s <= 1.0) || (k > 0 && !(s > options.compliance_scales[k - 1]))) {
-      throw std::invalid_argument(
-          "solve_wire_wall_contact: compliance_scales must rise in (0, 1]");
-    }
-  }
+/// The equilibrium from `state`.
+WireWallSolution solve_from(const ContactWire& wire, const CondensedWall& wall, const TetMesh& mesh,
+                            CoupledState state, const WireWallOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const int m = static_cast<int>(wall.nodes().size());
   WireWallSolution out;
-  std::vector<double> scales = options.compliance_scales;
-  if (scales.empty() || scales.back() != 1.0) scales.push_back(1.0);
-  for (const double scale : scales) {
-    const Coupled coupled(wire, wall, mesh, scale);
-    solve_stage(coupled, wire, options, scale, state, out);
-  }
   const Coupled coupled(wire, wall, mesh);
+  solve_sequence(coupled, wire, options, state, out);
   out.x = state.x;
   out.rod_multipliers = state.mu;
   out.force = state.lambda;
@@ -355,13 +338,10 @@ WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const Condense
   return solve_from(wire, wall, mesh, std::move(state), options);
 }
 
-GrownContact solve_wire_wall_contact_growing(const ContactWire& wire,
-                                             const fem::FreeDisplacementSystem& system,
-                                             const TetMesh& mesh, std::vector<int> nodes,
-                                             const Eigen::VectorXd& start,
-                                             const std::vector<int>& initial_active,
-                                             const WireWallOptions& options,
-                                             const BandGrowth& growth) {
+GrownContact solve_wire_wall_contact_growing(
+    const ContactWire& wire, const fem::FreeDisplacementSystem& system, const TetMesh& mesh,
+    std::vector<int> nodes, const Eigen::VectorXd& start, const std::vector<int>& initial_active,
+    const WireWallOptions& options, const BandGrowth& growth) {
   check(wire, start);
   const std::vector<Triangle> triangles =
       mesh.group_triangles(mesh.require_group(growth.surface_group, 2, "wall mesh"));
@@ -374,8 +354,6 @@ GrownContact solve_wire_wall_contact_growing(const ContactWire& wire,
   };
   build();
   out.solution = solve_wire_wall_contact(wire, *out.wall, mesh, start, initial_active, options);
-  WireWallOptions again = options;
-  again.compliance_scales.clear();  // each re-solve starts at the last equilibrium
   for (;;) {
     std::vector<char> in(mesh.nodes.size(), 0), grow(mesh.nodes.size(), 0);
     for (const int node : nodes) in[static_cast<std::size_t>(node)] = 1;
@@ -404,10 +382,11 @@ GrownContact solve_wire_wall_contact_growing(const ContactWire& wire,
     }
     if (added.empty()) break;
     if (out.rounds == growth.max_rounds) {
-      throw std::runtime_error("solve_wire_wall_contact_growing: the contact still reaches the "
-                               "band's edge after " +
-                               std::to_string(growth.max_rounds) + " growths (" +
-                               std::to_string(nodes.size()) + " candidates)");
+      throw std::runtime_error(
+          "solve_wire_wall_contact_growing: the contact still reaches the "
+          "band's edge after " +
+          std::to_string(growth.max_rounds) + " growths (" + std::to_string(nodes.size()) +
+          " candidates)");
     }
     // Re-solve from the last equilibrium, the old candidates' forces carried, the new ones' zero.
     const int m_old = static_cast<int>(nodes.size());
@@ -418,7 +397,11 @@ GrownContact solve_wire_wall_contact_growing(const ContactWire& wire,
                        std::vector<char>(static_cast<std::size_t>(m), 0)};
     state.lambda.head(m_old) = out.solution.force;
     for (const int j : out.solution.active) state.active[static_cast<std::size_t>(j)] = 1;
-    out.solution = solve_from(wire, *out.wall, mesh, std::move(state), again);
+    const WireWallSolution last = std::move(out.solution);
+    out.solution = solve_from(wire, *out.wall, mesh, std::move(state), options);
+    out.solution.newton_iterations += last.newton_iterations;  // over every round
+    out.solution.active_set_changes += last.active_set_changes;
+    out.solution.seconds += last.seconds;
     ++out.rounds;
   }
   out.nodes = nodes;

@@ -53,10 +53,7 @@ struct WireWallOptions {
   double force_scale = 1e-3;     ///< N
   double gap_tolerance = 1e-13;  ///< m: |g| of a pressed candidate; −g beyond it penetrates
   double constraint_tolerance = 1e-14;  ///< on max |c_k|
-  int max_newton = 200;                 ///< linearised steps per stage (each a Signorini solve)
-  /// Continuation: the wall's compliance scaled by each in turn (rising in (0, 1]; 1 appended if
-  /// missing), each stage solved from the last's state. Empty: the wall itself at once.
-  std::vector<double> compliance_scales;
+  int max_newton = 200;                 ///< linearised steps (each a Signorini solve)
 };
 
 struct WireWallSolution {
@@ -95,23 +92,20 @@ struct BandGrowth {
 };
 
 struct GrownContact {
-  WireWallSolution solution;           ///< indices into `nodes`
-  std::vector<int> nodes;              ///< the final candidates' mesh nodes
+  WireWallSolution solution;  ///< indices into `nodes`; steps, changes, seconds over all rounds
+  std::vector<int> nodes;     ///< the final candidates' mesh nodes
   std::unique_ptr<CondensedWall> wall;  ///< condensed on `nodes`
-  int rounds = 0;                      ///< growths
+  int rounds = 0;                       ///< growths
 };
 
 /// solve_wire_wall_contact on candidates `nodes` (directions from into_wall_directions on
 /// growth.surface_group), the band grown as BandGrowth says until no pressed candidate lies on
 /// its edge and no other surface node comes within the margin. `system` as CondensedWall's.
 /// std::runtime_error after growth.max_rounds growths that still add nodes.
-GrownContact solve_wire_wall_contact_growing(const ContactWire& wire,
-                                             const fem::FreeDisplacementSystem& system,
-                                             const TetMesh& mesh, std::vector<int> nodes,
-                                             const Eigen::VectorXd& start,
-                                             const std::vector<int>& initial_active,
-                                             const WireWallOptions& options,
-                                             const BandGrowth& growth = {});
+GrownContact solve_wire_wall_contact_growing(
+    const ContactWire& wire, const fem::FreeDisplacementSystem& system, const TetMesh& mesh,
+    std::vector<int> nodes, const Eigen::VectorXd& start, const std::vector<int>& initial_active,
+    const WireWallOptions& options, const BandGrowth& growth = {});
 
 /// A point's gap to the wire's capsule at x: its distance to the centreline polyline
 /// first_node..last_node less r_w, m (negative inside the wire). For checking wall points that
