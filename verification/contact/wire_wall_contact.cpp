@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -200,29 +201,33 @@ Vec3 WireWallSolution::total_force_on_wall(const CondensedWall& wall) const {
   return f;
 }
 
-WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const CondensedWall& wall,
-                                         const TetMesh& mesh, const Eigen::VectorXd& start,
-                                         const std::vector<int>& initial_active,
-                                         const WireWallOptions& options) {
-  check(wire, start);
-  const auto t0 = std::chrono::steady_clock::now();
-  const Coupled coupled(wire, wall, mesh);
+namespace {
+
+/// The coupled state a solve starts from and leaves at equilibrium.
+struct CoupledState {
+  VectorXd x, mu, lambda;
+  std::vector<char> active;
+};
+
+/// Sequential Signorini solves from `state`, which it leaves at equilibrium.
+void solve_sequence(const Coupled& coupled, const ContactWire& wire, const WireWallOptions& options,
+                    CoupledState& state, WireWallSolution& out) {
   const int m = coupled.num_candidates();
-  const int n = static_cast<int>(start.size());
-  const int mc = wire.constraints ? wire.constraints->num_constraints() : 0;
+  const int n = static_cast<int>(state.x.size());
+  const int mc = static_cast<int>(state.mu.size());
   const int r = n + mc;
   std::vector<int> all(static_cast<std::size_t>(m));
   for (int j = 0; j < m; ++j) all[static_cast<std::size_t>(j)] = j;
-  VectorXd x = start, mu = VectorXd::Zero(mc), lambda = VectorXd::Zero(m);
-  std::vector<char> active(static_cast<std::size_t>(m), 0);
-  for (const int j : initial_active) active[static_cast<std::size_t>(j)] = 1;
+  VectorXd& x = state.x;
+  VectorXd& mu = state.mu;
+  VectorXd& lambda = state.lambda;
+  std::vector<char>& active = state.active;
   // The rod's rows are linearised about (x, λ) and condensed onto every candidate's gap:
   //   K Δy + B̃ (λ' − λ) = −R,   g + G Δy + D (λ' − λ) = g' ≥ 0,  λ' ≥ 0,  λ'·g' = 0,
   // y = (x, μ), so g' = q + M λ' with M = D − G K⁻¹B̃, a Signorini problem solved exactly
   // (solve_signorini on M's symmetric part; the skew part, O(the angle between n_j and the
   // capsule's normal), is evaluated at the current λ, so a fixed point is an exact solution).
-  WireWallSolution out;
-  const double extent = start.head(3 * (wire.last_node + 1)).cwiseAbs().maxCoeff();
+  const double extent = x.head(3 * (wire.last_node + 1)).cwiseAbs().maxCoeff();
   double last_step = std::numeric_limits<double>::infinity();
   bool settled = false;
   for (int it = 0;; ++it) {
@@ -251,7 +256,7 @@ WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const Condense
         cmax <= options.constraint_tolerance && worst_gap <= options.gap_tolerance;
     if (feasible && (out.residual <= options.tolerance * options.force_scale ||
                      (settled && last_step <= 1e-14 * extent))) {
-      break;
+      return;
     }
     if (it == options.max_newton || !R.allFinite()) {
       std::ostringstream msg;
@@ -277,22 +282,129 @@ WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const Condense
     x += step.head(n);
     if (mc > 0) mu += step.tail(mc);
     lambda += alpha * (lcp.force - lambda);
+    // A candidate the Signorini solve released decays by half per damped step and would stay
+    // "pressed" (λ > 0, its gap open) for ever: released once below 1e-9 of the largest force.
+    const double released = 1e-9 * lcp.force.maxCoeff();
+    for (int j = 0; j < m; ++j) {
+      if (lcp.force[j] == 0.0 && lambda[j] < released) lambda[j] = 0.0;
+    }
     if (wire.project) wire.project(x);
     settled = std::equal(active.begin(), active.end(), lcp.active.begin());
     if (!settled) ++out.active_set_changes;
     active.assign(lcp.active.begin(), lcp.active.end());
     ++out.newton_iterations;
   }
-  out.x = x;
-  out.rod_multipliers = mu;
-  out.force = lambda;
+}
+
+}  // namespace
+
+namespace {
+
+/// The equilibrium from `state`.
+WireWallSolution solve_from(const ContactWire& wire, const CondensedWall& wall, const TetMesh& mesh,
+                            CoupledState state, const WireWallOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int m = static_cast<int>(wall.nodes().size());
+  WireWallSolution out;
+  const Coupled coupled(wire, wall, mesh);
+  solve_sequence(coupled, wire, options, state, out);
+  out.x = state.x;
+  out.rod_multipliers = state.mu;
+  out.force = state.lambda;
   for (int j = 0; j < m; ++j) {
-    if (lambda[j] > 0.0) out.active.push_back(j);
+    if (state.lambda[j] > 0.0) out.active.push_back(j);
   }
-  const VectorXd along = coupled.wall_along(all, lambda);
+  std::vector<int> all(static_cast<std::size_t>(m));
+  for (int j = 0; j < m; ++j) all[static_cast<std::size_t>(j)] = j;
+  const VectorXd along = coupled.wall_along(all, state.lambda);
   out.gap.resize(m);
-  for (int j = 0; j < m; ++j) out.gap[j] = coupled.gap_of(j, x, along);
+  for (int j = 0; j < m; ++j) out.gap[j] = coupled.gap_of(j, state.x, along);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace
+
+WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const CondensedWall& wall,
+                                         const TetMesh& mesh, const Eigen::VectorXd& start,
+                                         const std::vector<int>& initial_active,
+                                         const WireWallOptions& options) {
+  check(wire, start);
+  const int m = static_cast<int>(wall.nodes().size());
+  const int mc = wire.constraints ? wire.constraints->num_constraints() : 0;
+  CoupledState state{start, VectorXd::Zero(mc), VectorXd::Zero(m),
+                     std::vector<char>(static_cast<std::size_t>(m), 0)};
+  for (const int j : initial_active) state.active[static_cast<std::size_t>(j)] = 1;
+  return solve_from(wire, wall, mesh, std::move(state), options);
+}
+
+GrownContact solve_wire_wall_contact_growing(
+    const ContactWire& wire, const fem::FreeDisplacementSystem& system, const TetMesh& mesh,
+    std::vector<int> nodes, const Eigen::VectorXd& start, const std::vector<int>& initial_active,
+    const WireWallOptions& options, const BandGrowth& growth) {
+  check(wire, start);
+  const std::vector<Triangle> triangles =
+      mesh.group_triangles(mesh.require_group(growth.surface_group, 2, "wall mesh"));
+  const std::vector<int> surface =
+      mesh.group_nodes(mesh.require_group(growth.surface_group, 2, "wall mesh"));
+  GrownContact out;
+  auto build = [&] {
+    out.wall = std::make_unique<CondensedWall>(
+        system, nodes, into_wall_directions(mesh, nodes, growth.surface_group));
+  };
+  build();
+  out.solution = solve_wire_wall_contact(wire, *out.wall, mesh, start, initial_active, options);
+  for (;;) {
+    std::vector<char> in(mesh.nodes.size(), 0), grow(mesh.nodes.size(), 0);
+    for (const int node : nodes) in[static_cast<std::size_t>(node)] = 1;
+    std::vector<char> pressed(mesh.nodes.size(), 0);
+    for (const int j : out.solution.active) pressed[static_cast<std::size_t>(nodes[j])] = 1;
+    // A pressed candidate on the band's edge: its surface neighbours outside the band join.
+    for (const Triangle& t : triangles) {
+      bool any = false;
+      for (int k = 0; k < 3; ++k) any = any || pressed[static_cast<std::size_t>(t[k])];
+      if (!any) continue;
+      for (int k = 0; k < 3; ++k) {
+        if (!in[static_cast<std::size_t>(t[k])]) grow[static_cast<std::size_t>(t[k])] = 1;
+      }
+    }
+    // A non-candidate that the displaced wall brings within `margin` of the wire's surface.
+    const std::vector<Vec3> u = out.wall->displacement(out.solution.force);
+    for (const int node : surface) {
+      if (in[static_cast<std::size_t>(node)]) continue;
+      if (capsule_gap(wire, out.solution.x, mesh.nodes[node] + u[node]) < growth.margin) {
+        grow[static_cast<std::size_t>(node)] = 1;
+      }
+    }
+    std::vector<int> added;
+    for (std::size_t node = 0; node < grow.size(); ++node) {
+      if (grow[node]) added.push_back(static_cast<int>(node));
+    }
+    if (added.empty()) break;
+    if (out.rounds == growth.max_rounds) {
+      throw std::runtime_error(
+          "solve_wire_wall_contact_growing: the contact still reaches the "
+          "band's edge after " +
+          std::to_string(growth.max_rounds) + " growths (" + std::to_string(nodes.size()) +
+          " candidates)");
+    }
+    // Re-solve from the last equilibrium, the old candidates' forces carried, the new ones' zero.
+    const int m_old = static_cast<int>(nodes.size());
+    nodes.insert(nodes.end(), added.begin(), added.end());
+    build();
+    const int m = static_cast<int>(nodes.size());
+    CoupledState state{out.solution.x, out.solution.rod_multipliers, VectorXd::Zero(m),
+                       std::vector<char>(static_cast<std::size_t>(m), 0)};
+    state.lambda.head(m_old) = out.solution.force;
+    for (const int j : out.solution.active) state.active[static_cast<std::size_t>(j)] = 1;
+    const WireWallSolution last = std::move(out.solution);
+    out.solution = solve_from(wire, *out.wall, mesh, std::move(state), options);
+    out.solution.newton_iterations += last.newton_iterations;  // over every round
+    out.solution.active_set_changes += last.active_set_changes;
+    out.solution.seconds += last.seconds;
+    ++out.rounds;
+  }
+  out.nodes = nodes;
   return out;
 }
 

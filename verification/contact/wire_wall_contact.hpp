@@ -21,6 +21,7 @@
 /// candidates touch is decided over all of them at once at every step.
 #include <Eigen/Dense>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,32 @@ WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const Condense
                                          const TetMesh& mesh, const Eigen::VectorXd& start,
                                          const std::vector<int>& initial_active,
                                          const WireWallOptions& options = {});
+
+/// Growing the candidates: after each solve, the surface group's nodes that share a triangle
+/// with a pressed candidate, and those the displaced wall brings within `margin` of the wire's
+/// surface, join; the wall is condensed again and the contact re-solved from the last
+/// equilibrium, until nothing joins.
+struct BandGrowth {
+  std::string surface_group = "inner_wall";
+  double margin = 0.0;  ///< m
+  int max_rounds = 8;
+};
+
+struct GrownContact {
+  WireWallSolution solution;  ///< indices into `nodes`; steps, changes, seconds over all rounds
+  std::vector<int> nodes;     ///< the final candidates' mesh nodes
+  std::unique_ptr<CondensedWall> wall;  ///< condensed on `nodes`
+  int rounds = 0;                       ///< growths
+};
+
+/// solve_wire_wall_contact on candidates `nodes` (directions from into_wall_directions on
+/// growth.surface_group), the band grown as BandGrowth says until no pressed candidate lies on
+/// its edge and no other surface node comes within the margin. `system` as CondensedWall's.
+/// std::runtime_error after growth.max_rounds growths that still add nodes.
+GrownContact solve_wire_wall_contact_growing(
+    const ContactWire& wire, const fem::FreeDisplacementSystem& system, const TetMesh& mesh,
+    std::vector<int> nodes, const Eigen::VectorXd& start, const std::vector<int>& initial_active,
+    const WireWallOptions& options, const BandGrowth& growth = {});
 
 /// A point's gap to the wire's capsule at x: its distance to the centreline polyline
 /// first_node..last_node less r_w, m (negative inside the wire). For checking wall points that
