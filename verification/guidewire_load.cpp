@@ -42,8 +42,8 @@ struct GuidewireSolver::Impl {
   double offset = 0.0;  ///< the centreline's allowed distance from the vessel's: a − r_wire
   Eigen::VectorXd state;  ///< the last solution's rod state (empty before the first solve)
   double state_length = 0.0;
-  std::filesystem::path case_dir;  ///< model = "external": its case folder (made on first use)
-  /// model = "xpbd": the last solve's rod and the lumen it is held in (step() advances them).
+  std::filesystem::path case_dir;  ///< model external: its case folder (made on first use)
+  /// model xpbd: the last solve's rod and the lumen it is held in (step() advances them).
   std::unique_ptr<rods::XpbdRod> xpbd;
   std::unique_ptr<rods::RigidLumen> xpbd_wall;
 
@@ -57,11 +57,14 @@ struct GuidewireSolver::Impl {
     rods::RodSpec rs = rods::uniform_rod(material, L, spec.diameter, spec.segments);
     rs.origin = spec.clamp_point;
     rs.direction = spec.clamp_direction;
-    if (spec.model == "external") return solve_external(L, give);
-    if (spec.model == "xpbd") return solve_xpbd(rods::make_layout(rs), rs.origin, L, give);
-    if (spec.model == "corde") {
-      const rods::CordeRod rod(rods::make_layout(rs));
-      return solve_rod(rod, &rod, rod.rest_state(), rs.origin, L, give, [](const auto&) {});
+    switch (spec.model) {
+      case WireModel::external: return solve_external(L, give);
+      case WireModel::xpbd: return solve_xpbd(rods::make_layout(rs), rs.origin, L, give);
+      case WireModel::corde: {
+        const rods::CordeRod rod(rods::make_layout(rs));
+        return solve_rod(rod, &rod, rod.rest_state(), rs.origin, L, give, [](const auto&) {});
+      }
+      case WireModel::der: break;
     }
     rods::DerRod rod(rods::make_layout(rs));
     return solve_rod(rod, nullptr, rod.rest_state(), rs.origin, L, give,
@@ -255,7 +258,7 @@ GuidewireSolution GuidewireSolver::solve_rigid() {
   const int n = std::max(2, static_cast<int>(std::ceil(m.spec.insertion / step)));
   GuidewireSolution s;
   // The user's program solves the whole insertion itself.
-  for (int k = m.spec.model == "external" ? n : 1; k <= n; ++k) {
+  for (int k = m.spec.model == WireModel::external ? n : 1; k <= n; ++k) {
     s = m.solve(m.spec.insertion * k / n, 0.0);
   }
   if (s.contact_nodes > 1) {
@@ -446,7 +449,7 @@ void solve_guidewire_load(Scene& scene) {
 
 std::string describe_guidewire_solve(const GuidewireSpec& spec) {
   std::ostringstream s;
-  if (spec.model == "external") {
+  if (spec.model == WireModel::external) {
     s << "external program `";
     for (std::size_t i = 0; i < spec.command.size(); ++i) s << (i ? " " : "") << spec.command[i];
     s << " <manifest>` (in " << (spec.working_dir.empty() ? "." : spec.working_dir.string())
@@ -454,7 +457,7 @@ std::string describe_guidewire_solve(const GuidewireSpec& spec) {
       << " s) would be run by `vesselverify run` (and the other commands that solve the "
          "scene); not run now";
   } else {
-    s << "the " << spec.model << " rod (" << spec.segments << " segments, EI = "
+    s << "the " << to_string(spec.model) << " rod (" << spec.segments << " segments, EI = "
       << rods::solid_section({spec.young, spec.shear, spec.density}, spec.diameter).EI
       << " N·m²) against the rigid lumen would be solved by `vesselverify run` (and the other "
          "commands that solve the scene); not solved now";

@@ -1,7 +1,7 @@
 #pragma once
 /// The guidewire as the vessel's load: a Discrete Elastic Rod (msm/rods/der_rod.hpp), seed 002's
-/// CORDE rod (msm/rods/corde_rod.hpp) with spec.model = "corde", the XPBD rod
-/// (msm/rods/xpbd_rod.hpp, its steady state) with "xpbd", or the user's program with "external";
+/// CORDE rod (msm/rods/corde_rod.hpp) with spec.model = WireModel::corde, the XPBD rod
+/// (msm/rods/xpbd_rod.hpp, its steady state) with xpbd, or the user's program with external;
 /// clamped at the inlet, inserted its length in steps, against the parametric vessel's lumen as a
 /// rigid, frictionless, one-sided wall (msm/rods/rigid_wall.hpp: the centreline keeps a − r_wire from the
 /// vessel's centreline). Its contact force and the wall point under its contact node become the
@@ -45,7 +45,7 @@ class GuidewireSolver {
   /// The wire inserted to `insertion` (m) against the rigid lumen from the last solution: one
   /// update of a simulator advancing the wire (solve_rigid first).
   GuidewireSolution solve_at_insertion(double insertion);
-  /// model = "xpbd": one XPBD step of length h (s) of the last solution's rod, the update a
+  /// model xpbd: one XPBD step of length h (s) of the last solution's rod, the update a
   /// simulator pays per frame (std::logic_error for another model or before a solve).
   GuidewireSolution step(double h);
   /// The wire's compliance at the contact, −dδ/dF by a central difference of solve_with_give

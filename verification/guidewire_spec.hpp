@@ -3,13 +3,56 @@
 /// the inlet and inserted a given length; solved against the rigid lumen, its contact force and
 /// point become the contact patch every model and the reference get (verification/guidewire_load
 /// .hpp). Plain data; SI units.
+#include <array>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
 
 namespace vessel {
+
+/// The wire's model: a rod of msm/rods, or the user's own program (verification/wire_exchange.hpp).
+enum class WireModel {
+  der,       ///< Discrete Elastic Rods (msm/rods/der_rod.hpp)
+  corde,     ///< seed 002's CORDE rod (msm/rods/corde_rod.hpp)
+  xpbd,      ///< the XPBD Cosserat rod's steady state (msm/rods/xpbd_rod.hpp)
+  external,  ///< the user's program through the wire exchange
+};
+
+/// Every model with its scene name (the `model` key's values), in the enum's order.
+inline constexpr std::array<std::pair<WireModel, std::string_view>, 4> kWireModelNames{{
+    {WireModel::der, "der"},
+    {WireModel::corde, "corde"},
+    {WireModel::xpbd, "xpbd"},
+    {WireModel::external, "external"},
+}};
+
+/// The rods msm/rods solves (every model but external).
+inline constexpr std::array<WireModel, 3> kRodModels{WireModel::der, WireModel::corde,
+                                                     WireModel::xpbd};
+
+/// The model's scene name ("der", ...).
+inline std::string to_string(WireModel m) {
+  return std::string(kWireModelNames[static_cast<std::size_t>(m)].second);
+}
+
+/// The model of a scene name; nullopt for any other string.
+inline std::optional<WireModel> parse_wire_model(std::string_view name) {
+  for (const auto& [m, n] : kWireModelNames) {
+    if (n == name) return m;
+  }
+  return std::nullopt;
+}
+
+/// The scene names, in order (the `model` key's allowed values).
+inline std::vector<std::string> wire_model_names() {
+  std::vector<std::string> names;
+  for (const auto& entry : kWireModelNames) names.emplace_back(entry.second);
+  return names;
+}
 
 enum class GuidewireCoupling {
   rigid,      ///< the wire's force against the rigid lumen loads every model
@@ -23,8 +66,8 @@ struct GuidewireSpec {
   double diameter = 0.0;  ///< m, solid circular section
   double insertion = 0.0;  ///< length of wire beyond the clamp, m
   int segments = 32;
-  std::string model = "der";  ///< der | corde | xpbd (msm/rods) | external (the user's program)
-  /// model = "external": the user's wire program (argv; the case's manifest path appended, run
+  WireModel model = WireModel::der;
+  /// model = external: the user's wire program (argv; the case's manifest path appended, run
   /// in working_dir, the scene file's folder) and its time limit (verification/wire_exchange.hpp).
   std::vector<std::string> command;
   std::filesystem::path working_dir;

@@ -402,9 +402,9 @@ GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
   w.diameter = r.number(r.require("diameter"), "diameter");
   w.insertion = r.number(r.require("insertion"), "insertion");
   w.segments = static_cast<int>(r.integer_or("segments", 32));
-  w.model = r.string_or("model");
+  w.model = *parse_wire_model(r.string_or("model"));  // one of the key's choices, checked
   const toml::node* command = r.get("command");
-  if (w.model == "external") {
+  if (w.model == WireModel::external) {
     if (!command) (void)r.require("command");
     w.command = r.string_array("command");
     w.timeout_s = r.number_or("timeout_s");
@@ -413,7 +413,7 @@ GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
     for (const char* key : {"command", "timeout_s"}) {
       if (const toml::node* n = r.get(key)) {
         if (std::string(key) == "timeout_s") (void)r.number(*n, key);  // its type first
-        r.fail(n, key, "found with model = \"" + w.model + "\"; expected model = \"external\"");
+        r.fail(n, key, "found with model = \"" + to_string(w.model) + "\"; expected model = \"external\"");
       }
     }
   }

@@ -7,6 +7,7 @@
 
 #include "meshes/vessel_geometry.hpp"
 #include "msm/solvers/solve.hpp"
+#include "verification/guidewire_spec.hpp"
 
 namespace vessel {
 
@@ -128,7 +129,7 @@ std::vector<Row> guidewire_rows() {
           "The rod model: der (Discrete Elastic Rods), corde (seed 002's CORDE rod) or xpbd "
           "(the XPBD Cosserat rod's steady state) of msm/rods, or external (your own program, "
           "`command`)")
-          .dflt("\"der\"").one_of({"der", "corde", "xpbd", "external"}).in(g),
+          .dflt("\"der\"").one_of(wire_model_names()).in(g),
       Row("load", "command", KeyType::strings,
           "model = \"external\": your wire program and its arguments (the case's manifest path "
           "is appended; it runs in the scene file's folder)").in(g),

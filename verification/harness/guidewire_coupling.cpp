@@ -158,7 +158,7 @@ GuidewireOutcome couple_guidewire(const Scene& s, const std::vector<ModelOutcome
 
 void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g) {
   const bool compliant = g.spec.coupling == GuidewireCoupling::compliant;
-  out << "Guidewire (" << g.spec.model << ", " << g.spec.segments << " segments, d = "
+  out << "Guidewire (" << to_string(g.spec.model) << ", " << g.spec.segments << " segments, d = "
       << g.spec.diameter * 1e3 << " mm, insertion " << g.spec.insertion * 1e3
       << " mm): against the rigid lumen, its force loads every model above"
       << (compliant ? "; coupled, each wall gives way by its compliance C (its indentation per "
@@ -241,7 +241,7 @@ nlohmann::json guidewire_json(const GuidewireOutcome& g) {
                     {"ok", r.ok},
                     {"failure", r.failure}});
   }
-  return {{"model", w.model},
+  return {{"model", to_string(w.model)},
           {"coupling", w.coupling == GuidewireCoupling::compliant ? "compliant" : "rigid"},
           {"young_pa", w.young},
           {"shear_pa", w.shear},

@@ -66,7 +66,7 @@ TEST(WireCandidates, OnFixedTimingsTheRecommendedWireMeetsTheBudgetAndEveryFaste
   // The candidates' errors from their solves; their times per update fixed (N × a per-model
   // cost, XPBD the cheapest), so which candidates are fast enough does not depend on the machine.
   Scene s = scene_with_budget("guidewire_straight.toml", 1e-3);  // mm on the contact point
-  WireRecommendation w = recommend_wire(s, {"der", "corde", "xpbd"}, {8, 16, 32});
+  WireRecommendation w = recommend_wire(s, {WireModel::der, WireModel::corde, WireModel::xpbd}, {8, 16, 32});
   ASSERT_TRUE(w.reference.has_value()) << w.no_reference;
   ASSERT_EQ(w.candidates.size(), 9u);
   const double per_segment[3] = {1e-5, 2e-5, 1e-6};  // s: DER, CORDE, XPBD
@@ -101,7 +101,7 @@ TEST(WireCandidates, OnFixedTimingsTheRecommendedWireMeetsTheBudgetAndEveryFaste
 
 TEST(WireCandidates, ErrorsFallWithSegmentsAndTheCheapestPassingOneIsRecommended) {
   const Scene s = scene_with_budget("guidewire_straight.toml", 0.02);
-  const WireRecommendation w = recommend_wire(s, {"der", "corde", "xpbd"}, {8, 16, 32});
+  const WireRecommendation w = recommend_wire(s, {WireModel::der, WireModel::corde, WireModel::xpbd}, {8, 16, 32});
   ASSERT_TRUE(w.reference.has_value()) << w.no_reference;
   ASSERT_EQ(w.candidates.size(), 9u);
   for (const WireCandidate& c : w.candidates) {

@@ -33,12 +33,12 @@ std::vector<Candidate> as_candidates(const std::vector<WireCandidate>& wires) {
 
 /// One candidate: the wire inserted (set-up), its error at the scene's insertion, then the timed
 /// updates (withdrawn by one update's travel each, from the last equilibrium).
-WireCandidate run_candidate(const Scene& scene, const WireReference& ref, const std::string& model,
+WireCandidate run_candidate(const Scene& scene, const WireReference& ref, WireModel model,
                             int segments) {
   WireCandidate c;
-  c.model = model;
+  c.model = to_string(model);
   c.segments = segments;
-  c.name = "wire/" + model + " @ N" + std::to_string(segments);
+  c.name = "wire/" + c.model + " @ N" + std::to_string(segments);
   GuidewireSpec spec = *scene.load.guidewire;
   spec.model = model;
   spec.segments = segments;
@@ -53,7 +53,7 @@ WireCandidate run_candidate(const Scene& scene, const WireReference& ref, const 
     c.error = std::string(budget_unit(scene.budget.quantity)) == "mN" ? c.force_error_mN
                                                                        : c.contact_error_mm;
     const double period = scene.budget.update_period();
-    const bool dynamic = model == "xpbd";
+    const bool dynamic = model == WireModel::xpbd;
     c.update = dynamic ? "one XPBD step of the update period"
                        : "a static re-solve after one update's travel at 10 mm/s";
     std::vector<double> times;
@@ -99,12 +99,12 @@ Selection judge_wire(const std::vector<WireCandidate>& candidates, const Budget&
                       budget_unit(budget.quantity));
 }
 
-WireRecommendation recommend_wire(const Scene& scene, const std::vector<std::string>& models,
+WireRecommendation recommend_wire(const Scene& scene, const std::vector<WireModel>& models,
                                   const std::vector<int>& segments) {
   WireRecommendation w;
   w.reference = continuum_wire(scene, w.no_reference);
   if (!w.reference) return w;
-  for (const std::string& m : models) {
+  for (const WireModel m : models) {
     for (const int n : segments) w.candidates.push_back(run_candidate(scene, *w.reference, m, n));
   }
   w.selection = judge_wire(w.candidates, scene.budget);

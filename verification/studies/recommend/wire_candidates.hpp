@@ -49,7 +49,8 @@ struct WireRecommendation {
 
 /// The wire's candidates of `scene` (a guidewire load and a stated budget): models × segments.
 WireRecommendation recommend_wire(const Scene& scene,
-                                  const std::vector<std::string>& models = {"der", "corde", "xpbd"},
+                                  const std::vector<WireModel>& models = {kRodModels.begin(),
+                                                                          kRodModels.end()},
                                   const std::vector<int>& segments = {8, 16, 32, 64});
 
 /// The same candidates judged against another budget (time per update, tolerance, unit).

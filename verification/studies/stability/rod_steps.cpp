@@ -12,6 +12,7 @@
 #include "msm/rods/xpbd_rod.hpp"
 #include "msm/solvers/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
+#include "verification/guidewire_spec.hpp"
 #include "verification/harness/timing.hpp"
 #include "verification/studies/stability/study_models.hpp"
 
@@ -27,9 +28,9 @@ constexpr double kBlowup = 1e3;  // as the vessel rows: energy beyond 1000× its
 /// as the explicit trials', would fall below Newton's tolerance at a 30 Hz step and move nothing).
 constexpr double kImplicitSpeed = 1e-3;
 
-RodStepRow base_row(const rods::RodLayout& layout, const char* model, const char* integrator) {
+RodStepRow base_row(const rods::RodLayout& layout, WireModel model, const char* integrator) {
   RodStepRow row;
-  row.model = model;
+  row.model = to_string(model);
   row.integrator = integrator;
   int material = 0;
   for (const char g : layout.ghost) material += g ? 0 : 1;
@@ -98,7 +99,7 @@ RodStepClosedForm rod_step_closed_form(const rods::SectionStiffness& s, double h
 RodStepRow der_explicit_row(const rods::RodLayout& layout, msm::Integrator integrator,
                             int steps) {
   Stopwatch clock;
-  RodStepRow row = base_row(layout, "der", msm::to_string(integrator).c_str());
+  RodStepRow row = base_row(layout, WireModel::der, msm::to_string(integrator).c_str());
   const rods::DerRod rod(layout);
   const msm::Problem p = der_problem(rod);
   const msm::Spectrum s = msm::analyse_spectrum(p, {.lowest = false});
@@ -119,7 +120,7 @@ RodStepRow der_explicit_row(const rods::RodLayout& layout, msm::Integrator integ
 
 RodStepRow der_implicit_row(const rods::RodLayout& layout, const std::vector<double>& dts,
                             int steps) {
-  RodStepRow row = base_row(layout, "der", "implicit-euler");
+  RodStepRow row = base_row(layout, WireModel::der, "implicit-euler");
   const rods::DerRod rod(layout);
   const msm::Problem p = der_problem(rod);
   run_ladder(row, dts, steps, [&](double dt) {
@@ -131,7 +132,7 @@ RodStepRow der_implicit_row(const rods::RodLayout& layout, const std::vector<dou
 
 RodStepRow corde_implicit_row(const rods::RodLayout& layout, const std::vector<double>& dts,
                               int steps) {
-  RodStepRow row = base_row(layout, "corde", "implicit-euler");
+  RodStepRow row = base_row(layout, WireModel::corde, "implicit-euler");
   const rods::CordeRod rod(layout);
   const std::vector<char> fixed = rod.clamp_fixed();
   const Eigen::VectorXd mass = rod.lumped_mass();
@@ -153,7 +154,7 @@ RodStepRow corde_implicit_row(const rods::RodLayout& layout, const std::vector<d
 }
 
 RodStepRow xpbd_row(const rods::RodLayout& layout, const std::vector<double>& dts, int steps) {
-  RodStepRow row = base_row(layout, "xpbd", "xpbd");
+  RodStepRow row = base_row(layout, WireModel::xpbd, "xpbd");
   run_ladder(row, dts, steps, [&](double dt) {
     rods::XpbdRod rod(layout);
     const rods::CordeRod& model = rod.energy_model();
