@@ -227,21 +227,11 @@ void run_msm_model(const Scene& s, const ModelSpec& spec, double nu, const TetMe
     ModelOutcome out = base;
     out.magnitude = mag;
     try {
-      if (finite_strain_judges(s, fine.max_abs_principal_strain, mag)) {
-        // The finite-strain displacement divided by the magnitude: finish_outcome scales the
-        // reference by it. No coarser finite-strain level: no Richardson uncertainty; the
-        // linear-validity flag does not apply (strain 0 passed).
-        out.reference = "finite-strain";
-        ReferenceAtPoints finite_here;
-        finite_here.u = scaled(
-            finite_reference(ref, mag).displacement_at(built.network.nodes, kOutsideTolerance),
-            1.0 / mag);
-        run_msm_load(s, spec, built, model, mesh, ref, finite_here, at, 0.0, result.qoi_point, o,
-                     out);
-      } else {
-        run_msm_load(s, spec, built, model, mesh, ref, ref_here, at,
-                     fine.max_abs_principal_strain, result.qoi_point, o, out);
-      }
+      const JudgingReference judge = judging_reference(ref, s, ref_here, built.network.nodes,
+                                                       fine.max_abs_principal_strain, mag);
+      if (judge.finite_strain) out.reference = "finite-strain";
+      run_msm_load(s, spec, built, model, mesh, ref, judge.at_points, at, judge.strain_unit,
+                   result.qoi_point, o, out);
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {

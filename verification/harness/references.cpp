@@ -12,6 +12,7 @@
 #include "reports/representative_load.hpp"
 #include "verification/harness/budget.hpp"
 #include "verification/harness/modal.hpp"
+#include "verification/harness/model_readout.hpp"
 #include "verification/harness/parallel.hpp"
 #include "verification/harness/timing.hpp"
 #include "verification/model_capabilities.hpp"
@@ -258,6 +259,20 @@ bool finite_strain_judges(const Scene& s, double linear_strain_unit, double magn
       return linear_strain_unit * magnitude > kLinearRegimeStrain;
   }
   return false;
+}
+
+JudgingReference judging_reference(const ReferenceSolvers& ref, const Scene& s,
+                                   const ReferenceAtPoints& linear_here,
+                                   const std::vector<Vec3>& points, double linear_strain_unit,
+                                   double magnitude) {
+  if (!finite_strain_judges(s, linear_strain_unit, magnitude)) {
+    return {linear_here, linear_strain_unit, false};
+  }
+  JudgingReference j;
+  j.at_points.u = scaled(finite_reference(ref, magnitude).displacement_at(points, kOutsideTolerance),
+                         1.0 / magnitude);
+  j.finite_strain = true;
+  return j;
 }
 
 const fem::HyperelasticSolver& finite_reference(const ReferenceSolvers& ref, double magnitude) {

@@ -66,6 +66,21 @@ ReferenceAtPoints reference_at(const ReferenceSolvers& ref, const std::vector<Ve
 /// (auto) where the linear reference's largest strain there exceeds the linear regime's 5 %.
 bool finite_strain_judges(const Scene& s, double linear_strain_unit, double magnitude);
 
+/// What judges a model at load `magnitude`: the linear reference at `points` (`linear_here`) with
+/// its largest strain per unit load, or, where finite_strain_judges says so, the finite-strain
+/// displacement divided by the magnitude (the models' outcomes scale the reference by it), with
+/// no Richardson uncertainty (no coarser finite-strain level) and strain 0 (the linear-validity
+/// flag does not apply).
+struct JudgingReference {
+  ReferenceAtPoints at_points;
+  double strain_unit = 0.0;
+  bool finite_strain = false;
+};
+JudgingReference judging_reference(const ReferenceSolvers& ref, const Scene& s,
+                                   const ReferenceAtPoints& linear_here,
+                                   const std::vector<Vec3>& points, double linear_strain_unit,
+                                   double magnitude);
+
 /// The finite-strain reference at `magnitude` (solved on first use). std::runtime_error naming
 /// the largest load reached when load stepping found no equilibrium at the magnitude.
 const fem::HyperelasticSolver& finite_reference(const ReferenceSolvers& ref, double magnitude);

@@ -179,18 +179,11 @@ void run_tet_fem_model(const Scene& s, const ModelSpec& spec, double nu, const T
     ModelOutcome out = base;
     out.magnitude = mag;
     try {
-      if (finite_strain_judges(s, fine.max_abs_principal_strain, mag)) {
-        // As for the mass-spring models (msm_model_run.cpp): the finite-strain reference divided
-        // by the magnitude, no Richardson uncertainty, no linear-validity flag.
-        out.reference = "finite-strain";
-        ReferenceAtPoints finite_here;
-        finite_here.u = scaled(
-            finite_reference(ref, mag).displacement_at(mesh.nodes, kOutsideTolerance), 1.0 / mag);
-        run_tet_fem_load(s, spec, *term, mesh, finite_here, at, 0.0, result.qoi_point, o, out);
-      } else {
-        run_tet_fem_load(s, spec, *term, mesh, ref_here, at, fine.max_abs_principal_strain,
-                         result.qoi_point, o, out);
-      }
+      const JudgingReference judge = judging_reference(ref, s, ref_here, mesh.nodes,
+                                                       fine.max_abs_principal_strain, mag);
+      if (judge.finite_strain) out.reference = "finite-strain";
+      run_tet_fem_load(s, spec, *term, mesh, judge.at_points, at, judge.strain_unit,
+                       result.qoi_point, o, out);
     } catch (const InputError&) {
       throw;
     } catch (const std::exception& e) {
