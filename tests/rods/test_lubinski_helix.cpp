@@ -7,13 +7,17 @@
 // "HELIX model N ..." for docs/rods.md.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <numbers>
+#include <string>
 #include <vector>
 
+#include "msm/rods/corde_rod.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "msm/rods/rigid_wall.hpp"
 
@@ -114,62 +118,83 @@ Guess helical_guess(double R, double k, double L, int N) {
 struct HelixRun {
   int segments = 0;
   double pitch = 0.0, force = 0.0, start_force = 0.0, force_per_length = 0.0, twist_moment = 0.0;
-  double radius_spread = 0.0;  ///< max − min radius of the middle third's nodes, m
   int middle_nodes = 0, middle_contacts = 0, contacts = 0, changes = 0;
   double min_gap = 0.0, seconds = 0.0;
 };
 
-/// DER with N segments, both ends clamped on the axis, from the helical guess.
-HelixRun der_helix(int N) {
-  const auto t0 = std::chrono::steady_clock::now();
-  RodSpec spec = uniform_rod(kNitinol, kLength, kWire, N);
-  spec.direction = Eigen::Vector3d::UnitZ();
-  spec.clamp_end = true;
-  DerRod rod(make_layout(spec));
-  const int tip = rod.layout().tip_node;
+enum class Model { der, corde };
+const char* name(Model m) { return m == Model::der ? "DER" : "CORDE"; }
+
+/// The guess's node positions in a state x (ghost nodes on the axis, a segment beyond the clamps)
+/// and the nodes it puts on the wall (the active set's start).
+std::vector<int> place_guess(const Guess& guess, int N, VectorXd& x) {
   const double l = kLength / N;
-  const Guess guess = helical_guess(kClearance, 2.0 * pi / kPitchGuess, kLength, N);
-  VectorXd x = rod.rest_state();
-  std::vector<int> initial;
+  std::vector<int> on_wall;
   for (int i = 0; i <= N; ++i) {
     x.segment<3>(3 * (i + 1)) = guess.nodes[i];
-    if (guess.on_wall[i] && i >= 1 && i + 1 <= N - 1) initial.push_back(i + 1);
+    if (guess.on_wall[i] && i >= 1 && i + 1 <= N - 1) on_wall.push_back(i + 1);
   }
   x.segment<3>(0) = Eigen::Vector3d(0.0, 0.0, -l);
-  x.segment<3>(3 * (tip + 1)) = Eigen::Vector3d(0.0, 0.0, guess.span + l);
-  rod.update_reference(x);
-  const StraightTube tube(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), kClearance);
-  const double EI = rod.layout().section[1].EI;
-  ConstrainedOptions options;
-  options.force_scale = EI * std::pow(2.0 * pi / kPitchGuess, 2);
-  const ContactSolution c = solve_wall_contact(rod, nullptr, rod.clamp_fixed(), x, tube, 2, tip - 1,
-                                               options, 4 * N, {}, initial);
+  x.segment<3>(3 * (N + 2)) = Eigen::Vector3d(0.0, 0.0, guess.span + l);
+  return on_wall;
+}
+
+/// CORDE's frames on the guess: d3 along each edge, d1 carried from the start clamp by parallel
+/// transport along the polygon, then turned about d3 by a share of the angle that closes on the
+/// end clamp's frame (growing linearly along the wire: a uniform twist, not a jump at the end).
+void corde_frames(const CordeRod& rod, VectorXd& x) {
+  const int edges = rod.layout().num_edges();
+  std::vector<Eigen::Vector3d> t(edges), d1(edges);
+  const Eigen::Quaterniond clamp = rod.clamp_frame();
+  t[0] = Eigen::Vector3d::UnitZ();
+  d1[0] = clamp * Eigen::Vector3d::UnitX();
+  for (int j = 1; j < edges; ++j) {
+    t[j] = (x.segment<3>(3 * (j + 1)) - x.segment<3>(3 * j)).normalized();
+    d1[j] = parallel_transport(d1[j - 1], t[j - 1], t[j]).normalized();
+  }
+  const Eigen::Vector3d end = clamp * Eigen::Vector3d::UnitX();
+  const double closing =
+      std::atan2(d1[edges - 1].cross(end).dot(t[edges - 1]), d1[edges - 1].dot(end));
+  Eigen::Quaterniond previous = clamp;
+  for (int j = 1; j < edges; ++j) {
+    Eigen::Quaterniond q = clamp;
+    if (j < edges - 1) {
+      const Eigen::Vector3d u = Eigen::AngleAxisd(closing * j / (edges - 1), t[j]) * d1[j];
+      Eigen::Matrix3d R;
+      R << u, t[j].cross(u), t[j];
+      q = Eigen::Quaterniond(R);
+    }
+    if (q.dot(previous) < 0.0) q.coeffs() *= -1.0;  // neighbours in one hemisphere
+    x.segment<4>(rod.quaternion_dof(j)) << q.w(), q.x(), q.y(), q.z();
+    previous = q;
+  }
+}
+
+/// The helix measured on a solution: the clamps' reactions (`reaction`: the force the held dofs
+/// need, ∇E + Jᵀλ there; no contact acts on them) and the middle third's pitch and contact force.
+HelixRun measure_helix(const ContactSolution& c, const VectorXd& reaction, double twist_moment,
+                       int N) {
+  const int tip = N + 1;
+  const double l = kLength / N;
   HelixRun run;
   run.segments = N;
   run.changes = c.active_set_changes;
   run.contacts = static_cast<int>(c.nodes.size());
   run.min_gap = c.min_gap;
-  // The clamps' reactions: the held dofs' energy gradient (no contact acts on them).
-  VectorXd g;
-  rod.gradient(c.x, g);
-  run.force = -(g[3 * tip + 2] + g[3 * (tip + 1) + 2]);
-  run.start_force = g[2] + g[3 * 1 + 2];
-  run.twist_moment = g[rod.twist_dof(rod.layout().num_edges() - 1)];
+  run.force = -(reaction[3 * tip + 2] + reaction[3 * (tip + 1) + 2]);
+  run.start_force = reaction[2] + reaction[3 * 1 + 2];
+  run.twist_moment = twist_moment;
   // The middle third: pitch from the centreline's angle about the axis against z (least
   // squares), contact force per arc length from the nodes' forces over their Voronoi lengths.
   const int first = 1 + (N + 2) / 3, last = 1 + (2 * N) / 3;
   std::vector<double> phi, z;
-  double rmin = 1e9, rmax = 0.0;
   for (int i = first; i <= last; ++i) {
     const Eigen::Vector3d p = c.x.segment<3>(3 * i);
     double a = std::atan2(p.y(), p.x());
     if (!phi.empty()) a += 2.0 * pi * std::round((phi.back() - a) / (2.0 * pi));
     phi.push_back(a);
     z.push_back(p.z());
-    rmin = std::min(rmin, std::hypot(p.x(), p.y()));
-    rmax = std::max(rmax, std::hypot(p.x(), p.y()));
   }
-  run.radius_spread = rmax - rmin;
   const double n = static_cast<double>(phi.size());
   double sz = 0, sp = 0, szz = 0, szp = 0;
   for (std::size_t i = 0; i < phi.size(); ++i) {
@@ -189,6 +214,57 @@ HelixRun der_helix(int N) {
     }
   }
   run.force_per_length = total / (n * l);
+  return run;
+}
+
+/// Model m with N segments, both ends clamped on the axis. DER starts from the helical guess;
+/// CORDE from DER's equilibrium (its positions and contacts, its frames from the polygon): from
+/// the guess its full Newton steps diverge (the alignment penalty is stiff; the multipliers start
+/// at zero), and its own equilibrium differs (inextensible: a 1 % shorter pitch).
+HelixRun helix(Model m, int N) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RodSpec spec = uniform_rod(kNitinol, kLength, kWire, N);
+  spec.direction = Eigen::Vector3d::UnitZ();
+  spec.clamp_end = true;
+  const RodLayout layout = make_layout(spec);
+  const Guess guess = helical_guess(kClearance, 2.0 * pi / kPitchGuess, kLength, N);
+  const StraightTube tube(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), kClearance);
+  ConstrainedOptions options;
+  options.force_scale = layout.section[1].EI * std::pow(2.0 * pi / kPitchGuess, 2);
+  const int tip = layout.tip_node, last_edge = layout.num_edges() - 1;
+  DerRod der(layout);
+  VectorXd y = der.rest_state();
+  const std::vector<int> on_wall = place_guess(guess, N, y);
+  der.update_reference(y);
+  const ContactSolution d = solve_wall_contact(der, nullptr, der.clamp_fixed(), y, tube, 2, tip - 1,
+                                               options, 4 * N, {}, on_wall);
+  HelixRun run;
+  if (m == Model::der) {
+    VectorXd g;
+    der.gradient(d.x, g);
+    // The twisting moment: the end clamp's reaction to a turn of its frame about the tangent.
+    run = measure_helix(d, g, g[der.twist_dof(last_edge)], N);
+  } else {
+    const CordeRod rod(layout);
+    VectorXd x = rod.rest_state();
+    x.head(3 * layout.num_nodes()) = d.x.head(3 * layout.num_nodes());
+    corde_frames(rod, x);
+    const ContactSolution c = solve_wall_contact(
+        rod, &rod, rod.clamp_fixed(), x, tube, 2, tip - 1, options, 4 * N,
+        [&rod](VectorXd& q) { rod.normalise_quaternions(q); }, d.nodes);
+    VectorXd g;
+    rod.gradient(c.x, g);
+    SparseMatrix J;
+    rod.jacobian(c.x, J);
+    g += J.transpose() * c.rod_multipliers;
+    // A turn ψ of the end clamp's frame about the axis moves its quaternion by ½(0, e_z)⊗q.
+    const int k = rod.quaternion_dof(last_edge);
+    const Eigen::Quaterniond q(c.x[k], c.x[k + 1], c.x[k + 2], c.x[k + 3]);
+    const Eigen::Quaterniond turn = Eigen::Quaterniond(0.0, 0.0, 0.0, 0.5) * q;
+    const double moment =
+        g[k] * turn.w() + g[k + 1] * turn.x() + g[k + 2] * turn.y() + g[k + 3] * turn.z();
+    run = measure_helix(c, g, moment, N);
+  }
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return run;
 }
@@ -213,11 +289,14 @@ TEST(LubinskiHelix, ExactHelixTendsToLubinskiAtSmallAngles) {
   }
 }
 
-TEST(LubinskiHelix, DerWireBuckledInARigidTube) {
+class LubinskiHelixModel : public ::testing::TestWithParam<Model> {};
+
+TEST_P(LubinskiHelixModel, WireBuckledInARigidTube) {
+  const Model m = GetParam();
   const double EI = solid_section(kNitinol, kWire).EI;
-  double previous_force = 0.0, previous_w = 0.0;
+  double previous_force = 0.0, previous_lubinski = 0.0;
   for (int N : {240, 480, 960}) {
-    const HelixRun r = der_helix(N);
+    const HelixRun r = helix(m, N);
     const double p = std::abs(r.pitch), k = 2.0 * pi / r.pitch;
     const double lub_force = r.force * p * p / (8.0 * pi * pi * EI) - 1.0;
     const double lub_w = r.force_per_length * 4.0 * EI / (kClearance * r.force * r.force) - 1.0;
@@ -225,10 +304,10 @@ TEST(LubinskiHelix, DerWireBuckledInARigidTube) {
     const double exact_force = r.force / exact.force - 1.0;
     const double exact_w = r.force_per_length / exact.force_per_length - 1.0;
     std::printf(
-        "HELIX DER N %d (%.1f per pitch) F %.6e N (start clamp %.6e) p %.6e m w %.6e N/m M3 %.3e "
+        "HELIX %s N %d (%.1f per pitch) F %.6e N (start clamp %.6e) p %.6e m w %.6e N/m M3 %.3e "
         "N·m | Lubinski F %+.3e w %+.3e | exact helix F %+.3e w %+.3e | middle contacts %d/%d, "
         "contacts %d, changes %d, min gap %.1e m, %.1f s, load %.2f\n",
-        N, N * p / kLength, r.force, r.start_force, p, r.force_per_length, r.twist_moment,
+        name(m), N, N * p / kLength, r.force, r.start_force, p, r.force_per_length, r.twist_moment,
         lub_force, lub_w, exact_force, exact_w, r.middle_contacts, r.middle_nodes, r.contacts,
         r.changes, r.min_gap, r.seconds, load_average());
     // Equal and opposite clamp reactions (the wall's forces are radial), to the Newton tolerance
@@ -238,17 +317,23 @@ TEST(LubinskiHelix, DerWireBuckledInARigidTube) {
     EXPECT_GE(r.min_gap, -1e-12) << N;
     EXPECT_LE(std::abs(lub_force), 0.02) << N;
     EXPECT_LE(std::abs(lub_w), 0.02) << N;
-    // The discretisation: against the exact helix, the force's error falls at second order
-    // (measured: 4.0 and 3.9 times per doubling) and w's stays below 1e-4 and falls.
+    // The discretisation: against the exact helix the force's error falls at second order
+    // (measured 3.6 to 4.0 times per doubling), and Lubinski's falls towards the helix angle's
+    // −1.2 (R k)² (−0.35 %); w's stays below 1e-4 (DER's falls, CORDE's levels at 3.8e-5).
     if (previous_force != 0.0) {
+      std::printf("HELIX %s N %d to %d: exact helix F error falls %.2f times, Lubinski's %.2f\n",
+                  name(m), N / 2, N, previous_force / exact_force, previous_lubinski / lub_force);
       EXPECT_GT(std::abs(previous_force / exact_force), 3.0) << N;
-      EXPECT_LT(std::abs(exact_w), std::abs(previous_w)) << N;
+      EXPECT_LT(std::abs(lub_force), std::abs(previous_lubinski)) << N;
     }
     EXPECT_LE(std::abs(exact_w), 1e-4) << N;
     previous_force = exact_force;
-    previous_w = exact_w;
+    previous_lubinski = lub_force;
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Models, LubinskiHelixModel, ::testing::Values(Model::der, Model::corde),
+                         [](const auto& info) { return std::string(name(info.param)); });
 
 }  // namespace
 }  // namespace vessel::msm::rods::test
