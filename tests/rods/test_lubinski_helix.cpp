@@ -120,6 +120,7 @@ struct HelixRun {
   double pitch = 0.0, force = 0.0, start_force = 0.0, force_per_length = 0.0, twist_moment = 0.0;
   int middle_nodes = 0, middle_contacts = 0, contacts = 0, changes = 0;
   double min_gap = 0.0, seconds = 0.0;
+  double shortening = 0.0;  ///< L less the clamps' distance, m
 };
 
 enum class Model { der, corde };
@@ -265,6 +266,7 @@ HelixRun helix(Model m, int N) {
         g[k] * turn.w() + g[k + 1] * turn.x() + g[k + 2] * turn.y() + g[k + 3] * turn.z();
     run = measure_helix(c, g, moment, N);
   }
+  run.shortening = kLength - guess.span;
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return run;
 }
@@ -306,10 +308,10 @@ TEST_P(LubinskiHelixModel, WireBuckledInARigidTube) {
     std::printf(
         "HELIX %s N %d (%.1f per pitch) F %.6e N (start clamp %.6e) p %.6e m w %.6e N/m M3 %.3e "
         "N·m | Lubinski F %+.3e w %+.3e | exact helix F %+.3e w %+.3e | middle contacts %d/%d, "
-        "contacts %d, changes %d, min gap %.1e m, %.1f s, load %.2f\n",
+        "contacts %d, changes %d, min gap %.1e m, end shortening %.4e m, %.1f s, load %.2f\n",
         name(m), N, N * p / kLength, r.force, r.start_force, p, r.force_per_length, r.twist_moment,
         lub_force, lub_w, exact_force, exact_w, r.middle_contacts, r.middle_nodes, r.contacts,
-        r.changes, r.min_gap, r.seconds, load_average());
+        r.changes, r.min_gap, r.shortening, r.seconds, load_average());
     // Equal and opposite clamp reactions (the wall's forces are radial), to the Newton tolerance
     // summed over the nodes; the middle third lies on the wall, node by node.
     EXPECT_NEAR(r.start_force / r.force, 1.0, 1e-8) << N;
