@@ -34,6 +34,7 @@ FLOORS = [
     "msm/benchmarks",
     "fem_reference",
     "verification/contact",
+    "verification/guidewire",
     "reports",
     "verification/scene",
     "verification/harness",

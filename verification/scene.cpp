@@ -1,18 +1,19 @@
 #include "verification/scene.hpp"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "meshes/foundation/errors.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
 #include "verification/model_capabilities.hpp"
-#include "verification/guidewire_load.hpp"
 #include "verification/scene_reader.hpp"
 
 namespace vessel {
@@ -389,7 +390,7 @@ std::vector<ModelSpec> read_model(TableReader r, std::size_t index, LoadKind loa
   return sweep(m, stiffness, mass, solvers, dts, radii);
 }
 
-/// The guidewire load's keys (verification/guidewire_spec.hpp), checked; its solve is
+/// The guidewire load's keys (verification/guidewire/guidewire_spec.hpp), checked; its solve is
 /// solve_guidewire_load's, on the run path.
 GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
   GuidewireSpec w;

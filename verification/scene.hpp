@@ -9,13 +9,13 @@
 #include <vector>
 
 #include "meshes/supports.hpp"
-#include "verification/guidewire_spec.hpp"
 #include "meshes/surface_loads.hpp"
 #include "meshes/vessel_geometry.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/solvers/solve.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
+#include "verification/guidewire/guidewire_spec.hpp"
 
 namespace vessel {
 
@@ -122,8 +122,8 @@ struct LoadSpec {
   Vec3 gravity_direction = Vec3(0.0, -1.0, 0.0);
   /// `type = "guidewire"`: the wire, a contact load on the inner wall whose one magnitude and
   /// point are those of `wire`, its solve against the rigid lumen. Parsing leaves `wire` empty
-  /// (and `magnitudes` with it); solve_guidewire_load (verification/guidewire_load.hpp) fills
-  /// both on the run path, where the references are computed.
+  /// (and `magnitudes` with it); solve_guidewire_load (verification/guidewire/guidewire_load.hpp)
+  /// fills both on the run path, where the references are computed.
   std::optional<GuidewireSpec> guidewire;
   std::optional<GuidewireSolution> wire;
 };

@@ -7,7 +7,7 @@
 
 #include "meshes/vessel_geometry.hpp"
 #include "msm/solvers/solve.hpp"
-#include "verification/guidewire_spec.hpp"
+#include "verification/guidewire/guidewire_spec.hpp"
 
 namespace vessel {
 
@@ -107,7 +107,7 @@ std::vector<SceneKey> top_and_vessel() {
   return out;
 }
 
-/// The guidewire load's keys (verification/guidewire_load.hpp).
+/// The guidewire load's keys (verification/guidewire/guidewire_load.hpp).
 std::vector<Row> guidewire_rows() {
   const std::vector<std::string> g{"guidewire"};
   return {

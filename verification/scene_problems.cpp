@@ -9,6 +9,7 @@
 #include "msm/formats/network_file.hpp"
 #include "msm/terms/spring_model.hpp"
 #include "verification/calibration_file.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
 
 namespace vessel {
 
@@ -28,8 +29,9 @@ namespace {
 /// problem built before that would put the load nowhere.
 void require_solved(const LoadSpec& load) {
   if (load.guidewire && !load.wire) {
-    throw std::logic_error("the scene's guidewire is not solved yet: call solve_guidewire_load "
-                           "(verification/guidewire_load.hpp) before building its problems");
+    throw std::logic_error(
+        "the scene's guidewire is not solved yet: call solve_guidewire_load "
+        "(verification/scene_problems.hpp) before building its problems");
   }
 }
 
@@ -283,6 +285,30 @@ msm::Problem tet_mesh_problem(const Scene& s, const msm::TetTerm& term, const Te
   for (std::size_t i = 0; i < source.size(); ++i) source[i] = static_cast<int>(i);
   p.fixed = held_dofs(mesh, mesh.nodes, source, scene_supports(s));
   return p;
+}
+
+void solve_guidewire_load(Scene& scene) {
+  LoadSpec& load = scene.load;
+  if (!load.guidewire || load.wire) return;
+  const std::string file = scene.source.string();
+  GuidewireSolution wire;
+  try {
+    GuidewireSolver solver(scene.vessel, *load.guidewire);
+    wire = solver.solve_rigid();
+  } catch (const InputError& e) {
+    throw InputError(file + ": " + e.what());
+  } catch (const std::runtime_error& e) {
+    throw InputError(file + ": load: the guidewire's solve failed: " + e.what());
+  }
+  if (wire.force <= 0.0) {
+    throw InputError(file + ": load.insertion: the wire of " +
+                     std::to_string(load.guidewire->insertion) +
+                     " m does not reach the wall; expected an insertion that makes it touch");
+  }
+  load.wire = wire;
+  load.magnitudes = {wire.force};
+  load.contact.point = wire.wall_point;
+  load.contact.direction = wire.normal;  // the wire's push, along the exact lumen's normal
 }
 
 }  // namespace vessel

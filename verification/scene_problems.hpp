@@ -15,6 +15,14 @@
 
 namespace vessel {
 
+/// Solves the scene's wire against the rigid lumen (a Newton solve, an XPBD run to rest or the
+/// user's program) and makes its load the contact patch of the wire's force at the wall point
+/// under its contact node (magnitudes = {F}). Does nothing for a scene without a guidewire or
+/// one already solved. InputError naming the scene file and `load.insertion` if the wire does
+/// not reach the wall, or touches it at more than one node; naming the file and `load` if the
+/// solve fails (the user's program among them).
+void solve_guidewire_load(Scene& scene);
+
 /// Where a contact pushes when no point is given: on the named wall (inner_wall or outer_wall,
 /// radius a or b) at mid-length on the θ = 0 side: (r, 0, L/2) on the tube, the outer bend's
 /// apex (0, R + r, 0) on the arch. InputError for a vessel from a file (its point must be given).

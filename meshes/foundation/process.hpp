@@ -1,7 +1,7 @@
 #pragma once
 /// Running another program: its own process group, a time-out, its output appended to a log. The
 /// suite runs a user's own simulator (verification/harness/external_model.hpp) and a user's own
-/// wire model (verification/wire_exchange.hpp) this way.
+/// wire model (verification/guidewire/wire_exchange.hpp) this way.
 #include <filesystem>
 #include <string>
 #include <utility>

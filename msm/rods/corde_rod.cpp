@@ -50,7 +50,7 @@ std::array<int, N> consecutive(int first) {
 }  // namespace
 
 CordeRod::CordeRod(RodLayout layout, double alignment, bool inextensible, DarbouxMeasure measure)
-    : layout_(std::move(layout)), inextensible_(inextensible), measure_(measure) {
+    : Rod(std::move(layout)), inextensible_(inextensible), measure_(measure) {
   // GJ = G·2I = G·A d²/8 → G·A = 8 GJ/d², the first material edge's d² = 16 I/A = 16 EI/EA.
   const SectionStiffness& s = layout_.section[1];
   const double d2 = 16.0 * s.EI / s.EA;
@@ -229,46 +229,6 @@ void CordeRod::weighted_hessian(const VectorXd& x, const VectorXd& lambda, Spars
       });
   H.resize(num_dofs(), num_dofs());
   H.setFromTriplets(t.begin(), t.end());
-}
-
-ConstrainedResult solve_corde_static(const CordeRod& rod, const CordeStaticLoad& load,
-                                     ConstrainedOptions options) {
-  std::vector<const Form*> terms{&rod};
-  if (load.extra != nullptr) terms.push_back(load.extra);
-  const FormSum form(terms);
-  ConstrainedProblem p;
-  p.form = &form;
-  p.constraints = &rod;
-  p.rest = rod.rest_state();
-  p.fixed = load.fixed.empty() ? rod.clamp_fixed() : load.fixed;
-  p.project = [&rod](VectorXd& x) { rod.normalise_quaternions(x); };
-  double ei = 0.0;
-  for (const auto& s : rod.layout().section) ei = std::max(ei, s.EI);
-  const double L = rod.layout().total_length();
-  options.force_scale = std::max(options.force_scale, ei / (L * L));
-  const VectorXd full = load.force.size() > 0 ? load.force : VectorXd::Zero(p.rest.size());
-  ConstrainedResult r;
-  r.x = load.start.size() > 0 ? load.start : p.rest;
-  // Load fractions in `steps` increments; an increment that does not converge is halved (at
-  // most 10 times) and retried from the last equilibrium.
-  double done = 0.0, increment = 1.0 / std::max(1, load.steps);
-  int iterations = 0, halvings = 0;
-  while (done < 1.0 - 1e-12) {
-    const double s = std::min(1.0, done + increment);
-    p.external_force = s * full;
-    if (load.scale_extra) load.scale_extra(s);
-    try {
-      ConstrainedResult next = solve_constrained(p, r.x, r.lambda, options);
-      iterations += next.iterations;
-      r = std::move(next);
-      done = s;
-    } catch (const std::runtime_error&) {
-      if (++halvings > 10) throw;
-      increment *= 0.5;
-    }
-  }
-  r.iterations = iterations;
-  return r;
 }
 
 ConstrainedResult corde_implicit_euler_step(const CordeRod& rod, const VectorXd& x,

@@ -14,9 +14,8 @@
 #include <functional>
 #include <vector>
 
-#include "msm/form/form.hpp"
 #include "msm/rods/constrained_newton.hpp"
-#include "msm/rods/rod_layout.hpp"
+#include "msm/rods/rod.hpp"
 
 namespace vessel::msm::rods {
 
@@ -28,7 +27,7 @@ namespace vessel::msm::rods {
 ///    paper's formula: name it so where it is used.
 enum class DarbouxMeasure { quaternion, rotation_vector };
 
-class CordeRod : public Form, public EqualityConstraints {
+class CordeRod : public Rod, public EqualityConstraints {
  public:
   /// `alignment`: κ, N. Default (≤ 0): the section's shear stiffness 0.9·G·A (Timoshenko's
   /// coefficient of a solid circle), which makes CORDE a shearable Cosserat rod.
@@ -47,43 +46,30 @@ class CordeRod : public Form, public EqualityConstraints {
   void jacobian(const VectorXd& x, SparseMatrix& J) const override;
   void weighted_hessian(const VectorXd& x, const VectorXd& lambda, SparseMatrix& H) const override;
 
-  [[nodiscard]] const RodLayout& layout() const { return layout_; }
-  [[nodiscard]] int num_nodes() const { return layout_.num_nodes(); }
   [[nodiscard]] double alignment() const { return kappa_; }
   [[nodiscard]] bool inextensible() const { return inextensible_; }
   [[nodiscard]] DarbouxMeasure darboux_measure() const { return measure_; }
   /// Index of edge j's quaternion (w, x, y, z) in x.
   [[nodiscard]] int quaternion_dof(int edge) const { return 3 * num_nodes() + 4 * edge; }
-  [[nodiscard]] VectorXd rest_state() const;
+  [[nodiscard]] VectorXd rest_state() const override;
   /// Scales every quaternion of x to unit length.
   void normalise_quaternions(VectorXd& x) const;
+  /// Rod's hooks: its constraints are itself; a state is projected by normalise_quaternions.
+  [[nodiscard]] const EqualityConstraints* constraints() const override { return this; }
+  void project(VectorXd& x) const override { normalise_quaternions(x); }
   /// The ghost nodes, the clamp nodes and the ghost edges' quaternions.
-  [[nodiscard]] std::vector<char> clamp_fixed() const;
+  [[nodiscard]] std::vector<char> clamp_fixed() const override;
   /// ρA per half segment on the nodes; 4ρI l on each quaternion component (rotary inertia).
-  [[nodiscard]] VectorXd lumped_mass() const;
+  [[nodiscard]] VectorXd lumped_mass() const override;
   /// The clamps' quaternion: d1 = the layout's normal, d3 = the rest tangent.
   [[nodiscard]] Eigen::Quaterniond clamp_frame() const { return frame0_; }
 
  private:
-  RodLayout layout_;
   double kappa_;
   bool inextensible_ = true;
   DarbouxMeasure measure_ = DarbouxMeasure::quaternion;
   Eigen::Quaterniond frame0_;
 };
-
-struct CordeStaticLoad {
-  VectorXd force;               ///< dead loads per dof, full value
-  const Form* extra = nullptr;  ///< a load Form on the same dofs (PlanarEndMoment)
-  std::function<void(double)> scale_extra;
-  std::vector<char> fixed;  ///< default: the clamps
-  VectorXd start;           ///< default: rest
-  int steps = 1;
-};
-
-/// Static equilibrium by KKT Newton (solve_constrained) in load steps.
-ConstrainedResult solve_corde_static(const CordeRod& rod, const CordeStaticLoad& load,
-                                     ConstrainedOptions options = {});
 
 /// One implicit Euler step (x, v) → (x₁, v₁): min ½|x₁ − x − h v|²_M/h² + E(x₁) − f·x₁ under
 /// the constraints, v₁ = (x₁ − x)/h.

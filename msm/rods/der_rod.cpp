@@ -57,7 +57,7 @@ Eigen::Vector3d parallel_transport(const Eigen::Vector3d& u, const Eigen::Vector
   return {r.x, r.y, r.z};
 }
 
-DerRod::DerRod(RodLayout layout) : layout_(std::move(layout)) {
+DerRod::DerRod(RodLayout layout) : Rod(std::move(layout)) {
   for (int j = 0; j < layout_.num_edges(); ++j) {
     ref_t_.push_back((layout_.rest[j + 1] - layout_.rest[j]).normalized());
     ref_u_.push_back(layout_.normal);

@@ -12,12 +12,11 @@
 /// Rest: straight and untwisted.
 #include <vector>
 
-#include "msm/form/form.hpp"
-#include "msm/rods/rod_layout.hpp"
+#include "msm/rods/rod.hpp"
 
 namespace vessel::msm::rods {
 
-class DerRod : public Form {
+class DerRod : public Rod {
  public:
   explicit DerRod(RodLayout layout);
 
@@ -26,23 +25,22 @@ class DerRod : public Form {
   void gradient(const VectorXd& x, VectorXd& g) const override;
   void hessian(const VectorXd& x, SparseMatrix& H, bool project_psd) const override;
 
-  [[nodiscard]] const RodLayout& layout() const { return layout_; }
-  [[nodiscard]] int num_nodes() const { return layout_.num_nodes(); }
   /// Index of edge j's twist angle in x.
   [[nodiscard]] int twist_dof(int edge) const { return 3 * num_nodes() + edge; }
   /// The rest state: rest positions, zero twist angles.
-  [[nodiscard]] VectorXd rest_state() const;
+  [[nodiscard]] VectorXd rest_state() const override;
   /// Held dofs of the clamps: the ghost nodes, the clamp nodes and the ghost edges' angles.
-  [[nodiscard]] std::vector<char> clamp_fixed() const;
+  [[nodiscard]] std::vector<char> clamp_fixed() const override;
   /// Lumped masses per dof: ρA per half segment at the nodes, ρJ l̄ on the twist angles.
-  [[nodiscard]] VectorXd lumped_mass() const;
+  [[nodiscard]] VectorXd lumped_mass() const override;
   /// Carries the reference frames to the edges of x by parallel transport (leaves the energy at
   /// x unchanged). Call between load steps or time steps so the frames never need a transport
   /// through a half turn.
   void update_reference(const VectorXd& x);
+  /// Rod's hook: update_reference.
+  void prepare(const VectorXd& x) override { update_reference(x); }
 
  private:
-  RodLayout layout_;
   std::vector<Eigen::Vector3d> ref_t_;  ///< tangent of each edge when its frame was stored
   std::vector<Eigen::Vector3d> ref_u_;  ///< reference director u_j ⟂ ref_t_j
 };

@@ -2,7 +2,10 @@
 // message and a non-zero exit with nothing half-written.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <iterator>
 #include <sstream>
@@ -211,4 +214,33 @@ TEST(Cli, SceneValidatesShippedScenesAndRefusesBadOnes) {
   const auto bad = vv("scene " + (dir / "bad.toml").string());
   EXPECT_EQ(bad.exit_code, 1) << bad.output;
   EXPECT_TRUE(contains(bad.output, "bad.toml:4: key 'vessel.radius': unknown key")) << bad.output;
+}
+
+TEST(Cli, RunPrintsTheGuidewiresSolvedForceAndWallPoint) {
+  // The shipped straight guidewire scene with one model and one wire: its log names the force the
+  // solved wire puts on the wall, which must be the continuum wire's against the rigid lumen,
+  // F = 0.470968·EI/z² at z = 20 mm (Kirchhoff shooting; within DER's error at N = 32, ~5e-4).
+  std::ifstream in(std::string(VESSEL_SCENES_DIR) + "/guidewire_straight.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text = text.substr(0, text.find("[[models]]"));
+  const auto sweep = text.find("stiffness_sweep");
+  text.erase(sweep, text.find('\n', sweep) - sweep);
+  text += "[[models]]\nname = \"fem_p1\"\nkind = \"fem\"\ndegree = 1\n";
+  TempDir dir;
+  write_text(dir / "wire.toml", text);
+  const auto r = vv("run --quick --cache-dir " + (dir / "cache").string() + " --output-dir " +
+                    (dir / "out").string() + " " + (dir / "wire.toml").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string marker = "guidewire_straight: the guidewire pushes the wall with ";
+  const auto at = r.output.find(marker);
+  ASSERT_NE(at, std::string::npos) << r.output;
+  double force_mN = 0.0, x = 0.0, y = 0.0, z = 0.0;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + at + marker.size(), "%lf mN at (%lf, %lf, %lf) mm",
+                        &force_mN, &x, &y, &z),
+            4)
+      << r.output.substr(at, 120);
+  const double closed_form_mN = 0.470968 * 4e-7 / (20e-3 * 20e-3) * 1e3;
+  EXPECT_NEAR(force_mN / closed_form_mN - 1.0, 0.0, 1e-3);
+  EXPECT_NEAR(std::hypot(x, y), 3.0, 1e-3);  // on the inner wall (radius 3 mm)
+  EXPECT_NEAR(z, 20.0, 0.05);
 }

@@ -1,5 +1,6 @@
 #include "msm/rods/corde_rod.hpp"
 #include "msm/rods/rod_loads.hpp"
+#include "msm/rods/rod_statics.hpp"
 #include "rod_cases.hpp"
 #include "rod_eigen.hpp"
 
@@ -19,9 +20,9 @@ class CordeAdapter : public RodAdapter {
   }
 
   Eigen::Vector2d tip(int segments, double fx, double fy, double moment, int steps) override {
-    const CordeRod rod = make(segments);
+    CordeRod rod = make(segments);
     PlanarEndMoment end_moment(rod.layout(), rod.num_dofs(), Eigen::Vector3d::UnitZ());
-    CordeStaticLoad load;
+    RodStaticLoad load;
     load.force = VectorXd::Zero(rod.num_dofs());
     const int tip = rod.layout().tip_node;
     load.force[3 * tip] = fx;
@@ -31,7 +32,7 @@ class CordeAdapter : public RodAdapter {
       load.scale_extra = [&](double s) { end_moment.set_moment(s * moment); };
     }
     load.steps = steps;
-    last_ = solve_corde_static(rod, load);
+    last_ = solve_rod_static(rod, load);
     return last_.x.segment<2>(3 * tip);
   }
 
@@ -65,7 +66,7 @@ class CordeAdapter : public RodAdapter {
     return kLength / make(1).alignment();
   }
 
-  ConstrainedResult last_;
+  RodStaticResult last_;
 
  private:
   double alignment_;

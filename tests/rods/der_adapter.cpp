@@ -27,9 +27,7 @@ class DerAdapter : public RodAdapter {
       load.scale_extra = [&](double s) { end_moment.set_moment(s * moment); };
     }
     load.steps = steps;
-    StaticOptions options;
-    options.tolerance = 1e-11;
-    const VectorXd x = solve_der_static(rod, load, options).x;
+    const VectorXd x = solve_rod_static(rod, load, 1e-11).x;
     return x.segment<2>(3 * tip);
   }
 

@@ -8,6 +8,7 @@
 
 #include "fem_reference/rod_theory/elastica.hpp"
 #include "msm/rods/corde_rod.hpp"
+#include "msm/rods/rod_statics.hpp"
 #include "rod_cases.hpp"
 
 namespace vessel::msm::rods::test {
@@ -17,17 +18,17 @@ CordeRod cantilever(int segments, double alignment = 0.0) {
   return CordeRod(make_layout(uniform_rod(test_material(), kLength, kDiameter, segments)), alignment);
 }
 
-ConstrainedResult tip_load(const CordeRod& rod, double alpha) {
-  CordeStaticLoad load;
+RodStaticResult tip_load(CordeRod rod, double alpha) {
+  RodStaticLoad load;
   load.force = VectorXd::Zero(rod.num_dofs());
   load.force[3 * rod.layout().tip_node + 1] = alpha * test_EI() / (kLength * kLength);
   load.steps = static_cast<int>(std::ceil(alpha));
-  return solve_corde_static(rod, load);
+  return solve_rod_static(rod, load);
 }
 
 TEST(Corde, InextensibilityResidualBelow1e10LSquared) {
   const CordeRod rod = cantilever(32);
-  const ConstrainedResult r = tip_load(rod, 3.0);
+  const RodStaticResult r = tip_load(rod, 3.0);
   VectorXd c;
   rod.evaluate(r.x, c);
   double stretch = 0.0;

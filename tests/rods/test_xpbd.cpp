@@ -17,6 +17,7 @@
 #include "msm/rods/block_tridiagonal_cholesky.hpp"
 #include "msm/rods/cosserat_terms.hpp"
 #include "msm/rods/element_assembly.hpp"
+#include "msm/rods/rod_statics.hpp"
 #include "msm/rods/xpbd_rod.hpp"
 #include "rod_cases.hpp"
 
@@ -35,11 +36,11 @@ VectorXd tip_force(int num_dofs, int tip, double alpha) {
 
 /// Newton (KKT, load steps) on XPBD's energy: CORDE's terms, unit quaternions, no inextensibility.
 Eigen::Vector3d newton_tip(int n, double alpha) {
-  const CordeRod energy(cantilever(n), 0.0, false);
-  CordeStaticLoad load;
+  CordeRod energy(cantilever(n), 0.0, false);
+  RodStaticLoad load;
   load.force = tip_force(energy.num_dofs(), energy.layout().tip_node, alpha);
   load.steps = static_cast<int>(std::ceil(alpha));
-  const ConstrainedResult r = solve_corde_static(energy, load);
+  const RodStaticResult r = solve_rod_static(energy, load);
   return r.x.segment<3>(3 * energy.layout().tip_node);
 }
 

@@ -15,9 +15,10 @@
 #include "../test_helpers.hpp"
 #include "fem_reference/rod_theory/tube_contact.hpp"
 #include "meshes/foundation/errors.hpp"
-#include "verification/guidewire_load.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
 #include "verification/harness/guidewire_coupling.hpp"
 #include "verification/scene.hpp"
+#include "verification/scene_problems.hpp"
 
 using namespace vessel;
 

@@ -7,7 +7,7 @@
 #include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "test_paths.hpp"
-#include "verification/guidewire_load.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_problems.hpp"

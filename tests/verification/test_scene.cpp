@@ -6,7 +6,7 @@
 
 #include "../test_helpers.hpp"
 #include "meshes/foundation/errors.hpp"
-#include "verification/guidewire_load.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_problems.hpp"
 

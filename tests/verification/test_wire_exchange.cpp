@@ -1,20 +1,20 @@
-// A user's own wire model through the exchange (verification/wire_exchange.hpp): the case's
-// manifest against $defs.wire_case of verification/exchange.schema.json, bad answers refused
+// A user's own wire model through the exchange (verification/guidewire/wire_exchange.hpp): the
+// case's manifest against $defs.wire_case of verification/exchange.schema.json, bad answers refused
 // naming the file, and the example program (examples/external/wire_model.py) run end to end by a
 // scene whose guidewire load has model = "external", against the continuum wire (Kirchhoff
 // shooting: F·z²/EI = 0.470968 at L/z = 1.012498) and against the suite's own DER.
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <numbers>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "../schema_check.hpp"
 #include "../test_helpers.hpp"
 #include "meshes/foundation/errors.hpp"
-#include "verification/guidewire_load.hpp"
+#include "verification/guidewire/wire_exchange.hpp"
 #include "verification/scene.hpp"
-#include "verification/wire_exchange.hpp"
+#include "verification/scene_problems.hpp"
 
 using namespace vessel;
 

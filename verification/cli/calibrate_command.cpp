@@ -9,7 +9,7 @@
 #include "reports/study_sections.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/guidewire_load.hpp"
+#include "verification/scene_problems.hpp"
 #include "verification/studies/calibrate/calibrate.hpp"
 
 namespace vessel::cli {

@@ -5,9 +5,9 @@
 
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/guidewire_load.hpp"
 #include "verification/harness/external_model.hpp"
 #include "verification/harness/harness.hpp"
+#include "verification/scene_problems.hpp"
 
 namespace vessel::cli {
 

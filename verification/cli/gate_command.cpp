@@ -11,11 +11,11 @@
 #include "meshes/foundation/errors.hpp"
 #include "reports/gate.hpp"
 #include "verification/cli/cache_options.hpp"
-#include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/guidewire_load.hpp"
+#include "verification/cli/jobs_option.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/harness/results.hpp"
+#include "verification/scene_problems.hpp"
 
 namespace vessel::cli {
 

@@ -4,9 +4,9 @@
 
 #include "reports/document.hpp"
 #include "verification/cli/cache_options.hpp"
-#include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/guidewire_load.hpp"
+#include "verification/cli/jobs_option.hpp"
+#include "verification/scene_problems.hpp"
 #include "verification/studies/recommend/recommend.hpp"
 
 namespace vessel::cli {

@@ -8,9 +8,9 @@
 #include "meshes/foundation/errors.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/guidewire_load.hpp"
 #include "verification/harness/distributed_references.hpp"
 #include "verification/harness/harness.hpp"
+#include "verification/scene_problems.hpp"
 
 namespace vessel::cli {
 

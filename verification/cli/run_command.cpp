@@ -4,12 +4,12 @@
 
 #include "meshes/foundation/errors.hpp"
 #include "verification/cli/cache_options.hpp"
-#include "verification/cli/jobs_option.hpp"
-#include "verification/guidewire_load.hpp"
 #include "verification/cli/commands.hpp"
+#include "verification/cli/jobs_option.hpp"
 #include "verification/harness/harness.hpp"
-#include "verification/harness/timed_updates.hpp"
 #include "verification/harness/results.hpp"
+#include "verification/harness/timed_updates.hpp"
+#include "verification/scene_problems.hpp"
 
 namespace vessel::cli {
 
@@ -57,7 +57,15 @@ void apply_sweeps(const RunOptions& o, Scene& s) {
 void run(const RunOptions& o) {
   std::vector<Scene> scenes;
   for (const auto& f : o.scenes) scenes.push_back(read_scene(f));  // validate all before running
-  for (Scene& s : scenes) solve_guidewire_load(s);  // a wire that cannot load its vessel stops here
+  for (Scene& s : scenes) {
+    solve_guidewire_load(s);  // a wire that cannot load its vessel stops here
+    if (s.load.wire) {
+      const GuidewireSolution& w = *s.load.wire;
+      std::cout << s.name << ": the guidewire pushes the wall with " << w.force * 1e3 << " mN at ("
+                << w.wall_point.x() * 1e3 << ", " << w.wall_point.y() * 1e3 << ", "
+                << w.wall_point.z() * 1e3 << ") mm\n";
+    }
+  }
   for (Scene& s : scenes) {
     if (o.quick) s = quick_variant(std::move(s));
     apply_sweeps(o, s);

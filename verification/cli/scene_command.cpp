@@ -3,7 +3,7 @@
 
 #include "meshes/lumen_mesh.hpp"
 #include "verification/cli/commands.hpp"
-#include "verification/guidewire_load.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
 #include "verification/scene.hpp"
 #include "verification/scene_keys.hpp"
 

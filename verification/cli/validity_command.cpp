@@ -8,7 +8,7 @@
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/cli/jobs_option.hpp"
-#include "verification/guidewire_load.hpp"
+#include "verification/scene_problems.hpp"
 #include "verification/studies/validity/validity.hpp"
 
 namespace vessel::cli {

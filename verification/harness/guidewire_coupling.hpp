@@ -9,7 +9,7 @@
 #include <ostream>
 #include <vector>
 
-#include "verification/harness/guidewire_outcome.hpp"
+#include "verification/guidewire/guidewire_outcome.hpp"
 #include "verification/harness/outcome.hpp"
 
 namespace vessel {

@@ -13,7 +13,7 @@
 #include "meshes/lumen_mesh.hpp"
 #include "meshes/mesh_quality.hpp"
 #include "meshes/tet_mesh.hpp"
-#include "verification/harness/guidewire_outcome.hpp"
+#include "verification/guidewire/guidewire_outcome.hpp"
 #include "verification/scene.hpp"
 
 namespace vessel {

@@ -14,7 +14,8 @@
 #include "../../test_helpers.hpp"
 #include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
-#include "verification/guidewire_load.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
+#include "verification/scene_problems.hpp"
 #include "verification/studies/recommend/wire_candidates.hpp"
 
 using namespace vessel;

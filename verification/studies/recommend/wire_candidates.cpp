@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "verification/guidewire_load.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
 #include "verification/harness/timing.hpp"
 
 namespace vessel {

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "verification/guidewire_load.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
 #include "verification/scene.hpp"
 #include "verification/studies/recommend/recommend.hpp"
 

@@ -12,7 +12,7 @@
 #include "msm/rods/xpbd_rod.hpp"
 #include "msm/solvers/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
-#include "verification/guidewire_spec.hpp"
+#include "verification/guidewire/guidewire_spec.hpp"
 #include "verification/harness/timing.hpp"
 #include "verification/studies/stability/study_models.hpp"
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
-#include "verification/guidewire_spec.hpp"
+#include "verification/guidewire/guidewire_spec.hpp"
 
 namespace vessel {
 

@@ -14,7 +14,7 @@
 
 namespace vessel {
 
-/// The wire's model: a rod of msm/rods, or the user's own program (verification/wire_exchange.hpp).
+/// The wire's model: a rod of msm/rods, or the user's own program (verification/guidewire/wire_exchange.hpp).
 enum class WireModel {
   der,       ///< Discrete Elastic Rods (msm/rods/der_rod.hpp)
   corde,     ///< seed 002's CORDE rod (msm/rods/corde_rod.hpp)
@@ -68,7 +68,7 @@ struct GuidewireSpec {
   int segments = 32;
   WireModel model = WireModel::der;
   /// model = external: the user's wire program (argv; the case's manifest path appended, run
-  /// in working_dir, the scene file's folder) and its time limit (verification/wire_exchange.hpp).
+  /// in working_dir, the scene file's folder) and its time limit (verification/guidewire/wire_exchange.hpp).
   std::vector<std::string> command;
   std::filesystem::path working_dir;
   double timeout_s = 120.0;

@@ -5,7 +5,7 @@
 /// clamped at the inlet, inserted its length in steps, against the parametric vessel's lumen as a
 /// rigid, frictionless, one-sided wall (msm/rods/rigid_wall.hpp: the centreline keeps a − r_wire from the
 /// vessel's centreline). Its contact force and the wall point under its contact node become the
-/// scene's contact patch load (`solve_guidewire_load`, on the run path; parsing a scene only
+/// scene's contact patch load (`solve_guidewire_load` in verification/scene_problems.hpp, on the run path; parsing a scene only
 /// checks the wire with `check_guidewire`).
 ///
 /// Compliant coupling (`GuidewireSolver::coupled_force`): a linear wall of compliance C (its
@@ -21,8 +21,7 @@
 #include <string>
 
 #include "meshes/vessel_geometry.hpp"
-#include "verification/guidewire_spec.hpp"
-#include "verification/scene.hpp"
+#include "verification/guidewire/guidewire_spec.hpp"
 
 namespace vessel {
 
@@ -91,14 +90,6 @@ void set_tilted_clamp(const VesselParams& vessel, double tilt, const Vec3& towar
 /// the GuidewireSolver's constructor too.
 void check_guidewire(const VesselParams& vessel, const GuidewireSpec& spec,
                      const std::string& key_prefix = "load.");
-
-/// Solves the scene's wire against the rigid lumen (a Newton solve, an XPBD run to rest or the
-/// user's program) and makes its load the contact patch of the wire's force at the wall point
-/// under its contact node (magnitudes = {F}). Does nothing for a scene without a guidewire or
-/// one already solved. InputError naming the scene file and `load.insertion` if the wire does
-/// not reach the wall, or touches it at more than one node; naming the file and `load` if the
-/// solve fails (the user's program among them).
-void solve_guidewire_load(Scene& scene);
 
 /// What solve_guidewire_load would run for `spec`, one line (for `vesselverify scene`, which
 /// runs nothing).

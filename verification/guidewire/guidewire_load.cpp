@@ -1,4 +1,4 @@
-#include "verification/guidewire_load.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
 
 #include <cmath>
 #include <cstdlib>
@@ -12,7 +12,7 @@
 #include "msm/rods/der_rod.hpp"
 #include "msm/rods/rigid_wall.hpp"
 #include "msm/rods/xpbd_rod.hpp"
-#include "verification/wire_exchange.hpp"
+#include "verification/guidewire/wire_exchange.hpp"
 
 namespace vessel {
 
@@ -61,17 +61,16 @@ struct GuidewireSolver::Impl {
       case WireModel::external: return solve_external(L, give);
       case WireModel::xpbd: return solve_xpbd(rods::make_layout(rs), rs.origin, L, give);
       case WireModel::corde: {
-        const rods::CordeRod rod(rods::make_layout(rs));
-        return solve_rod(rod, &rod, rod.rest_state(), rs.origin, L, give, [](const auto&) {});
+        rods::CordeRod rod(rods::make_layout(rs));
+        return solve_rod(rod, rs.origin, L, give);
       }
       case WireModel::der: break;
     }
     rods::DerRod rod(rods::make_layout(rs));
-    return solve_rod(rod, nullptr, rod.rest_state(), rs.origin, L, give,
-                     [&rod](const Eigen::VectorXd& x) { rod.update_reference(x); });
+    return solve_rod(rod, rs.origin, L, give);
   }
 
-  /// The user's program on the wire of length L (verification/wire_exchange.hpp), in a folder of
+  /// The user's program on the wire of length L (verification/guidewire/wire_exchange.hpp), in a folder of
   /// its own that the solver removes.
   GuidewireSolution solve_external(double L, double give) {
     if (case_dir.empty()) {
@@ -152,20 +151,19 @@ struct GuidewireSolver::Impl {
     if (!case_dir.empty()) std::filesystem::remove_all(case_dir, ec);
   }
 
-  /// `rod` (DER, or CORDE with its constraints) against the lumen; `warm(x)` prepares the rod for
-  /// a start x other than its rest state (DER: its reference frames).
-  template <class Rod, class Warm>
-  GuidewireSolution solve_rod(const Rod& rod, const msm::EqualityConstraints* constraints,
-                              Eigen::VectorXd x, const Vec3& origin, double L, double give,
-                              Warm&& warm) {
+  /// `rod` (DER, or CORDE with its constraints) against the lumen, from the last state (readied
+  /// by the rod's prepare hook) or its rest state.
+  GuidewireSolution solve_rod(rods::Rod& rod, const Vec3& origin, double L, double give) {
+    Eigen::VectorXd x = rod.rest_state();
     if (state.size() == x.size()) {
       x = scaled_state(origin, L, rod.num_nodes());
-      warm(x);
+      rod.prepare(x);
     }
     rods::ConstrainedOptions options;
     options.force_scale = EI / (L * L);
     const auto wall = lumen(give);
     const int tip = rod.layout().tip_node;
+    const msm::EqualityConstraints* constraints = rod.constraints();
     const rods::ContactSolution c =
         rods::solve_wall_contact(rod, constraints, rod.clamp_fixed(), x, *wall, 2, tip, options);
     state = c.x;
@@ -194,17 +192,16 @@ struct GuidewireSolver::Impl {
 
   /// The solution record of a rod's contact solution `c`, with `internal` its internal force
   /// (whose sum over the held nodes is the clamp's force on the wire).
-  template <class Rod>
-  GuidewireSolution solution_from(const Rod& rod, const rods::ContactSolution& c,
+  GuidewireSolution solution_from(const rods::Rod& rod, const rods::ContactSolution& c,
                                   const Eigen::VectorXd& internal, const rods::RigidLumen& wall) const {
     GuidewireSolution s;
     s.bending_stiffness = EI;
     s.contact_nodes = static_cast<int>(c.nodes.size());
     const int tip = rod.layout().tip_node;
-    for (int i = rod.layout().first_node; i <= tip; ++i) s.centreline.push_back(c.x.template segment<3>(3 * i));
+    for (int i = rod.layout().first_node; i <= tip; ++i) s.centreline.push_back(c.x.segment<3>(3 * i));
     if (!c.nodes.empty()) {
       const int k = c.nodes.front();
-      const Vec3 p = c.x.template segment<3>(3 * k);
+      const Vec3 p = c.x.segment<3>(3 * k);
       Vec3 grad;
       wall.gap(p, &grad, nullptr);
       s.force = c.forces.front();
@@ -214,7 +211,7 @@ struct GuidewireSolver::Impl {
     }
     const std::vector<char> fixed = rod.clamp_fixed();
     for (int i = 0; i < rod.num_nodes(); ++i) {
-      if (fixed[3 * i]) s.clamp_force += internal.template segment<3>(3 * i);
+      if (fixed[3 * i]) s.clamp_force += internal.segment<3>(3 * i);
     }
     return s;
   }
@@ -421,30 +418,6 @@ void set_tilted_clamp(const VesselParams& vessel, double tilt, const Vec3& towar
   }
   normal.normalize();
   spec.clamp_direction = std::cos(tilt) * tangent + std::sin(tilt) * normal;
-}
-
-void solve_guidewire_load(Scene& scene) {
-  LoadSpec& load = scene.load;
-  if (!load.guidewire || load.wire) return;
-  const std::string file = scene.source.string();
-  GuidewireSolution wire;
-  try {
-    GuidewireSolver solver(scene.vessel, *load.guidewire);
-    wire = solver.solve_rigid();
-  } catch (const InputError& e) {
-    throw InputError(file + ": " + e.what());
-  } catch (const std::runtime_error& e) {
-    throw InputError(file + ": load: the guidewire's solve failed: " + e.what());
-  }
-  if (wire.force <= 0.0) {
-    throw InputError(file + ": load.insertion: the wire of " +
-                     std::to_string(load.guidewire->insertion) +
-                     " m does not reach the wall; expected an insertion that makes it touch");
-  }
-  load.wire = wire;
-  load.magnitudes = {wire.force};
-  load.contact.point = wire.wall_point;
-  load.contact.direction = wire.normal;  // the wire's push, along the exact lumen's normal
 }
 
 std::string describe_guidewire_solve(const GuidewireSpec& spec) {

@@ -1,4 +1,4 @@
-#include "verification/wire_exchange.hpp"
+#include "verification/guidewire/wire_exchange.hpp"
 
 #include <cmath>
 #include <cstdlib>
