@@ -403,3 +403,38 @@ TEST(WireWallContact, RefusesAWireThatDoesNotFit) {
       contact::into_wall_directions(mesh, {static_cast<int>(mesh.nodes.size())}, "inner_wall"),
       InputError);
 }
+
+// The wall condensed on every component of its nodes (3 × 3 blocks) against the same wall
+// condensed on one direction per node: n_iᵀ W_ij n_j must be the one-direction compliance, and
+// the displacement fields under the same forces must match.
+TEST(WireWallContact, EveryComponentHoldsTheOneDirectionCompliance) {
+  const TetMesh& mesh = tube_mesh();
+  const std::vector<int> cand = band(mesh, mesh.nodes[aim_node(mesh)].z(), 2e-3, 0.5);
+  const std::vector<Vec3> n = contact::into_wall_directions(mesh, cand, "inner_wall");
+  const fem::ElasticitySolver solver(mesh, wall_problem(kWallE));
+  const contact::ComponentCandidates all = contact::every_component(cand);
+  const contact::CondensedWall full(solver.free_displacement_system(), all.nodes, all.directions);
+  const contact::CondensedWall along(solver.free_displacement_system(), cand, n);
+  const Eigen::Index m = static_cast<Eigen::Index>(cand.size());
+  ASSERT_EQ(full.compliance().rows(), 3 * m);
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    for (Eigen::Index j = 0; j < m; ++j) {
+      const double projected = n[i].dot(full.compliance().block<3, 3>(3 * i, 3 * j) * n[j]);
+      worst = std::max(worst, std::abs(projected - along.compliance()(i, j)));
+    }
+  }
+  std::printf("WIRE-WALL every component: %td nodes, |n W n - W_n| at most %.2e of max W_n\n", m,
+              worst / along.compliance().maxCoeff());
+  EXPECT_LT(worst, 1e-10 * along.compliance().maxCoeff());
+  Eigen::VectorXd lambda = Eigen::VectorXd::LinSpaced(m, 1e-3, 2e-3);
+  Eigen::VectorXd loads(3 * m);
+  for (Eigen::Index j = 0; j < m; ++j) loads.segment<3>(3 * j) = lambda[j] * n[j];
+  const std::vector<Vec3> a = full.displacement(loads), b = along.displacement(lambda);
+  double diff = 0.0, size = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    diff = std::max(diff, (a[k] - b[k]).norm());
+    size = std::max(size, b[k].norm());
+  }
+  EXPECT_LT(diff, 1e-10 * size);
+}
