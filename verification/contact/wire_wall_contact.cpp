@@ -54,7 +54,6 @@ struct Geometry {
   VectorXd u;  ///< u_j = Σ_l W_jl n_l λ_l, m (3 per contact node)
   std::vector<Nearest> nearest;
   std::vector<Vector3d> d, nu;
-  std::vector<double> side;
   VectorXd gap;
 };
 
@@ -85,18 +84,6 @@ class Coupled {
     return v;
   }
 
-  /// n_jᵀ W_jl n_l: the compliance along the force directions, m/N.
-  [[nodiscard]] MatrixXd along(const std::vector<Vec3>& n) const {
-    const int m = num_candidates();
-    MatrixXd Wn(m, m);
-    for (int j = 0; j < m; ++j) {
-      for (int l = 0; l < m; ++l) {
-        Wn(j, l) = n[j].dot(W_.block<3, 3>(3 * j, 3 * l) * n[l]);
-      }
-    }
-    return Wn;
-  }
-
   Geometry geometry(const VectorXd& x, const VectorXd& lambda, const std::vector<Vec3>& n,
                     const std::vector<Vec3>& last_nu) const {
     Geometry g;
@@ -107,9 +94,9 @@ class Coupled {
       const Vector3d p = points_[j] + g.u.segment<3>(3 * j);
       g.nearest.push_back(nearest_on_centreline(x, wire_.first_node, wire_.last_node, p));
       g.d.push_back(p - g.nearest.back().c);
-      g.side.push_back(g.d.back().dot(last_nu[j]) >= 0.0 ? 1.0 : -1.0);
-      g.nu.push_back(g.side.back() * g.d.back().normalized());
-      g.gap[j] = g.side.back() * g.d.back().norm() - wire_.radius;
+      const double side = g.d.back().dot(last_nu[j]) >= 0.0 ? 1.0 : -1.0;
+      g.nu.push_back(side * g.d.back().normalized());
+      g.gap[j] = side * g.d.back().norm() - wire_.radius;
     }
     return g;
   }
@@ -260,14 +247,15 @@ void solve_sequence(const Coupled& coupled, const ContactWire& wire, const WireW
   VectorXd& lambda = state.lambda;
   std::vector<Vec3>& dir = state.n;
   std::vector<char>& active = state.active;
-  const double compliance = options.penalty_stiffness > 0.0 ? 1.0 / options.penalty_stiffness : 0.0;
+  const double penalty_compliance =
+      options.penalty_stiffness > 0.0 ? 1.0 / options.penalty_stiffness : 0.0;
   // The rod's rows are linearised about (x, λ) and condensed onto every candidate's gap:
   //   K Δy + B̃ (λ' − λ) = −R,   g + G Δy + D (λ' − λ) = g' ≥ 0,  λ' ≥ 0,  λ'·g' = 0,
   // y = (x, μ), so g' = q + M λ' with M = D − G K⁻¹B̃, a Signorini problem solved exactly
   // (solve_signorini on M's symmetric part; the skew part, O(the angle between n_j and ν_j) and
   // the force's split along a segment, is evaluated at the current λ, so a fixed point is an
-  // exact solution). The penalty law
-  // λ = k max(0, −g) is the same problem on g + λ/k: M gains 1/k on its diagonal.
+  // exact solution). The penalty law λ = k max(0, −g) is the same problem on g + λ/k: M gains
+  // 1/k on its diagonal.
   const double extent = x.head(3 * (wire.last_node + 1)).cwiseAbs().maxCoeff();
   double last_step = std::numeric_limits<double>::infinity();
   bool settled = false;
@@ -287,7 +275,7 @@ void solve_sequence(const Coupled& coupled, const ContactWire& wire, const WireW
     }
     double worst_gap = 0.0;  // penetration, or a pressed candidate's separation
     for (int j = 0; j < m; ++j) {
-      const double gj = g.gap[j] + compliance * lambda[j];
+      const double gj = g.gap[j] + penalty_compliance * lambda[j];
       worst_gap = std::max(worst_gap, lambda[j] > 0.0 ? std::abs(gj) : -gj);
     }
     // Converged, or at round-off on a settled active set: the last step moved no position by
@@ -312,7 +300,7 @@ void solve_sequence(const Coupled& coupled, const ContactWire& wire, const WireW
     const MatrixXd M = L.A.bottomRightCorner(m, m) - L.A.bottomLeftCorner(m, r) * X;
     MatrixXd Msym = 0.5 * (M + M.transpose());
     const VectorXd q = g.gap - L.A.bottomLeftCorner(m, r) * y - Msym * lambda;
-    Msym.diagonal().array() += compliance;
+    Msym.diagonal().array() += penalty_compliance;
     const SignoriniSolution lcp = solve_signorini(Msym, q, 0.01 * options.gap_tolerance);
     // Full steps first (quadratic once the active set holds); from the 8th on, half steps, which
     // stop cycling between active sets. Either is cut so that no centreline node and no wall
