@@ -13,9 +13,9 @@
 /// side σ_j starts at +1 (every node outside the wire at the start) and is followed from step to
 /// step, σ_j = sign((P_j − c_j)·ν_j,last), so it turns −1 once the centreline has been carried past
 /// the node, which then counts as inside (an unsigned distance would find it outside, on the
-/// wire's far side). The wall pushes the wire with
-/// −λ_j n_j at c_j (split between the segment's nodes as c_j is), the wire pushes the wall with
-/// +λ_j n_j at node j, so the forces are equal and opposite by construction. Frictionless and
+/// wire's far side). The wall pushes the wire with −λ_j n_j at c_j (split between the segment's
+/// nodes as c_j is), the wire pushes the wall with +λ_j n_j at node j, so the forces are equal
+/// and opposite by construction. Frictionless and
 /// one-sided, g ≥ 0, λ ≥ 0, λ·g = 0, to first order in the angle between n_j and the capsule's
 /// normal ν_j = σ_j (P_j − c_j)/|P_j − c_j| (zero where the surfaces touch tangentially).
 ///
