@@ -80,4 +80,15 @@ std::vector<Vec3> CondensedWall::displacement(const Eigen::VectorXd& forces) con
   return out;
 }
 
+ComponentCandidates every_component(const std::vector<int>& nodes) {
+  ComponentCandidates out;
+  for (const int node : nodes) {
+    for (int c = 0; c < 3; ++c) {
+      out.nodes.push_back(node);
+      out.directions.push_back(Vec3::Unit(c));
+    }
+  }
+  return out;
+}
+
 }  // namespace vessel::contact

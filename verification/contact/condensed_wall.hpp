@@ -45,4 +45,13 @@ class CondensedWall {
   double setup_seconds_ = 0.0;
 };
 
+/// Every displacement component of `nodes` as a candidate: candidate 3k + c is nodes[k] along the
+/// unit axis e_c, so a CondensedWall on them holds the wall's full 3 × 3 compliance block per pair
+/// of nodes (W_(3i+a)(3j+b) = u_i,a under a unit force e_b at node j).
+struct ComponentCandidates {
+  std::vector<int> nodes;
+  std::vector<Vec3> directions;
+};
+ComponentCandidates every_component(const std::vector<int>& nodes);
+
 }  // namespace vessel::contact

@@ -3,22 +3,28 @@
 /// the contact between the wire's surface and the wall's inner surface found by the solve.
 ///
 /// The wire's surface is a capsule: the tube of radius r_w around its centreline polyline, closed
-/// by hemispheres at its ends (the rounded tip). The contact slaves are wall nodes (the
-/// CondensedWall's candidates), each with the unit direction n_j a contact force pushes it (out of
-/// the lumen). Node j's gap to the wire is its distance to the capsule,
-///   g_j = |P_j − c_j(x)| − r_w,   P_j = X_j + (Wλ)_j n_j,
-/// c_j the centreline point nearest P_j (on a segment, or an end node: the tip's hemisphere). The
-/// wall pushes the wire with −λ_j n_j at c_j (split between the segment's nodes as c_j is), and the
-/// wire pushes the wall with +λ_j n_j at node j, so the forces are equal and opposite by
-/// construction; the wall's displacement along n_j is (Wλ)_j. Frictionless and one-sided:
-/// g ≥ 0, λ ≥ 0, λ·g = 0 (to first order in the angle between n_j and the capsule's normal,
-/// which vanishes where the wall's surface and the wire's touch tangentially).
+/// by hemispheres at its ends (the rounded tip). The contact slaves are wall nodes, the wall
+/// condensed on all three displacement components of each (every_component), so a node's
+/// position is P_j = X_j + u_j with u_j = Σ_l W_jl n_l λ_l its whole displacement; n_j is the
+/// unit direction a contact force pushes node j (out of the lumen, fixed: the wall is linear).
+/// Node j's gap is its signed distance to the capsule,
+///   g_j = σ_j |P_j − c_j(x)| − r_w,
+/// c_j the centreline point nearest P_j (on a segment, or an end node: the tip's hemisphere); the
+/// side σ_j starts at +1 (every node outside the wire at the start) and is followed from step to
+/// step, σ_j = sign((P_j − c_j)·ν_j,last), so it turns −1 once the centreline has been carried past
+/// the node, which then counts as inside (an unsigned distance would find it outside, on the
+/// wire's far side). The wall pushes the wire with −λ_j n_j at c_j (split between the segment's
+/// nodes as c_j is), the wire pushes the wall with +λ_j n_j at node j, so the forces are equal
+/// and opposite by construction. Frictionless and
+/// one-sided, g ≥ 0, λ ≥ 0, λ·g = 0, to first order in the angle between n_j and the capsule's
+/// normal ν_j = σ_j (P_j − c_j)/|P_j − c_j| (zero where the surfaces touch tangentially).
 ///
 /// Equilibrium: ∇E(x) + J_c(x)ᵀμ + Σ_k λ_k B_k(x)ᵀ n_k = 0 on the free dofs, c(x) = 0, and
 /// Signorini's conditions on every candidate. Solved by sequential linearisation: each step
 /// linearises the rod's rows and the gaps about (x, μ, λ), condenses the rod onto the
 /// candidates' gaps and solves that Signorini problem exactly (solve_signorini), so which
-/// candidates touch is decided over all of them at once at every step.
+/// candidates touch is decided over all of them at once at every step; each step is cut so no
+/// centreline or wall node moves by more than max_move · r_w.
 #include <Eigen/Dense>
 #include <functional>
 #include <memory>
@@ -53,13 +59,20 @@ struct WireWallOptions {
   double force_scale = 1e-3;     ///< N
   double gap_tolerance = 1e-13;  ///< m: |g| of a pressed candidate; −g beyond it penetrates
   double constraint_tolerance = 1e-14;  ///< on max |c_k|
-  int max_newton = 200;                 ///< linearised steps (each a Signorini solve)
+  /// A step is cut so that no centreline node and no contact node moves by more than
+  /// max_move × r_w (the gaps are linearised about a surface of curvature 1/r_w).
+  double max_move = 0.5;
+  /// k (N/m): 0 for Signorini's conditions; above 0, the penalty law λ_j = k max(0, −g_j).
+  double penalty_stiffness = 0.0;
+  int max_newton = 200;  ///< linearised steps (each a Signorini solve)
 };
 
 struct WireWallSolution {
   Eigen::VectorXd x;                ///< the wire's dofs
-  Eigen::VectorXd force;            ///< λ per candidate, N (zero where not in contact)
-  Eigen::VectorXd gap;              ///< g per candidate at the solution, m
+  Eigen::VectorXd force;            ///< λ per contact node, N (zero where not in contact)
+  std::vector<Vec3> direction;      ///< n per contact node (the direction its force pushes it)
+  std::vector<Vec3> normal;         ///< ν per contact node: the capsule's normal towards it
+  Eigen::VectorXd gap;              ///< g per contact node at the solution, m
   Eigen::VectorXd rod_multipliers;  ///< μ of the wire's own constraints
   std::vector<int> active;          ///< candidates in contact
   int active_set_changes = 0;       ///< steps whose contact set differed from the last step's
@@ -67,17 +80,23 @@ struct WireWallSolution {
   double residual = 0.0;            ///< ‖rod residual‖ on free dofs at the end, N
   double seconds = 0.0;
   /// Σ_j λ_j n_j: the wire's total force on the wall, N.
-  [[nodiscard]] Vec3 total_force_on_wall(const CondensedWall& wall) const;
+  [[nodiscard]] Vec3 total_force_on_wall() const;
+  /// λ_j n_j stacked per component (3 per contact node, N): the CondensedWall's forces, so
+  /// wall.displacement(wall_loads()) is the wall's displacement field.
+  [[nodiscard]] Eigen::VectorXd wall_loads() const;
 };
 
 /// Equilibrium of the wire inside the wall from `start` (e.g. a rigid-wall solution), its forces
-/// starting at zero. `initial_active` (candidate indices) only seeds the count of contact-set
-/// changes: the first step's Signorini solve chooses the contacts over all candidates.
-/// Throws std::runtime_error naming the contact set's size and the residuals without convergence
-/// in options.max_newton steps; std::invalid_argument for a
-/// wire without a form, a non-positive radius or nodes outside x.
+/// starting at zero. `wall`: condensed on every_component of the contact nodes; `directions`:
+/// per contact node, n_j (into_wall_directions). `initial_active` (candidate indices) only seeds
+/// the count of contact-set changes: the first step's Signorini solve chooses the contacts over all
+/// candidates. Throws std::runtime_error naming the contact set's size and the residuals without
+/// convergence in options.max_newton steps; std::invalid_argument for a wire without a form, a
+/// non-positive radius, nodes outside x, a wall not condensed on every component or directions of
+/// the wrong count.
 WireWallSolution solve_wire_wall_contact(const ContactWire& wire, const CondensedWall& wall,
-                                         const TetMesh& mesh, const Eigen::VectorXd& start,
+                                         const std::vector<Vec3>& directions, const TetMesh& mesh,
+                                         const Eigen::VectorXd& start,
                                          const std::vector<int>& initial_active,
                                          const WireWallOptions& options = {});
 
@@ -94,14 +113,15 @@ struct BandGrowth {
 struct GrownContact {
   WireWallSolution solution;  ///< indices into `nodes`; steps, changes, seconds over all rounds
   std::vector<int> nodes;     ///< the final candidates' mesh nodes
-  std::unique_ptr<CondensedWall> wall;  ///< condensed on `nodes`
+  std::unique_ptr<CondensedWall> wall;  ///< condensed on every component of `nodes`
   int rounds = 0;                       ///< growths
 };
 
-/// solve_wire_wall_contact on candidates `nodes` (directions from into_wall_directions on
-/// growth.surface_group), the band grown as BandGrowth says until no pressed candidate lies on
-/// its edge and no other surface node comes within the margin. `system` as CondensedWall's.
-/// std::runtime_error after growth.max_rounds growths that still add nodes.
+/// solve_wire_wall_contact on candidates `nodes` (the wall condensed on every component,
+/// directions from into_wall_directions on growth.surface_group), the band grown as BandGrowth says
+/// until no pressed candidate lies on its edge and no other surface node comes within the margin.
+/// `system` as CondensedWall's. std::runtime_error after growth.max_rounds growths that still add
+/// nodes.
 GrownContact solve_wire_wall_contact_growing(
     const ContactWire& wire, const fem::FreeDisplacementSystem& system, const TetMesh& mesh,
     std::vector<int> nodes, const Eigen::VectorXd& start, const std::vector<int>& initial_active,

@@ -21,213 +21,11 @@
 #include "msm/rods/der_rod.hpp"
 #include "msm/rods/rigid_wall.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
+#include "wire_in_tube.hpp"
 
 using namespace vessel;
 
-namespace {
-
-const msm::rods::RodMaterial kNitinol{48e9, 48e9 / 2.66, 6450.0};
-constexpr double kA = 3e-3;         // lumen radius, m
-constexpr double kTheta = 0.3;      // clamp tilt, rad
-constexpr double kZc = 20e-3;       // the reference's contact distance, m
-constexpr double kWallE = 14.24e3;  // the scenes' wall modulus, Pa
-constexpr double kTubeLength = 30e-3;
-
-/// The structured straight tube (axis z, 0 ≤ z ≤ 30 mm, a = 3 mm, t = 1 mm), level 0.
-const TetMesh& tube_mesh() {
-  static const TetMesh mesh = [] {
-    VesselParams p;
-    p.length = kTubeLength;
-    p.style = MeshStyle::structured;
-    p.level = 0;
-    return generate_vessel_mesh(p);
-  }();
-  return mesh;
-}
-
-std::vector<int> inner_nodes(const TetMesh& mesh) {
-  return mesh.group_nodes(mesh.require_group("inner_wall", 2, "tube"));
-}
-
-/// The inner-wall node on the +x line (y = 0) nearest z = 25 mm: where the tip is aimed, so the
-/// tip's hemisphere meets the faceted wall at one of its nodes (which lie on the exact cylinder).
-int aim_node(const TetMesh& mesh) {
-  int best = -1;
-  for (const int n : inner_nodes(mesh)) {
-    const Vec3& x = mesh.nodes[n];
-    if (std::abs(x.y()) > 1e-9 || x.x() < 0) continue;
-    if (best < 0 || std::abs(x.z() - 25e-3) < std::abs(mesh.nodes[best].z() - 25e-3)) best = n;
-  }
-  return best;
-}
-
-fem::ElasticityProblem wall_problem(double young) {
-  fem::ElasticityProblem p;
-  p.material.youngs_modulus = young;
-  p.material.poisson_ratio = 0.45;
-  p.options.degree = 1;
-  p.dirichlet = {fem::DirichletCondition::clamped("inlet"),
-                 fem::DirichletCondition::clamped("outlet")};
-  return p;
-}
-
-/// Candidates: inner-wall nodes within `half_length` of z along the axis and `half_angle` of +x.
-std::vector<int> band(const TetMesh& mesh, double z, double half_length, double half_angle) {
-  std::vector<int> out;
-  for (const int n : inner_nodes(mesh)) {
-    const Vec3& x = mesh.nodes[n];
-    if (std::abs(x.z() - z) <= half_length && std::abs(std::atan2(x.y(), x.x())) <= half_angle)
-      out.push_back(n);
-  }
-  return out;
-}
-
-struct Wire {
-  msm::rods::RodLayout layout;
-  msm::rods::DerRod rod;
-  double EI = 0.0, radius = 0.0;
-  Wire(double diameter, double length, int segments, const Vec3& origin)
-      : layout([&] {
-          msm::rods::RodSpec s = msm::rods::uniform_rod(kNitinol, length, diameter, segments);
-          s.origin = origin;
-          s.direction = Vec3(std::sin(kTheta), 0.0, std::cos(kTheta));
-          return msm::rods::make_layout(s);
-        }()),
-        rod(layout),
-        EI(msm::rods::solid_section(kNitinol, diameter).EI),
-        radius(diameter / 2) {}
-  [[nodiscard]] contact::ContactWire contact() const {
-    contact::ContactWire w;
-    w.form = &rod;
-    w.fixed = rod.clamp_fixed();
-    w.num_nodes = rod.num_nodes();
-    w.first_node = layout.first_node;
-    w.last_node = layout.tip_node;
-    w.radius = radius;
-    return w;
-  }
-};
-
-/// The same wire against the exact rigid cylinder (msm/rods/rigid_wall): its contact force, N.
-struct RigidRun {
-  Eigen::VectorXd x;
-  double force = 0.0;
-};
-RigidRun rigid_run(Wire& w, double wall_shift = 0.0) {
-  const msm::rods::StraightTube tube(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(),
-                                     kA + wall_shift - w.radius);
-  Eigen::VectorXd x = w.rod.rest_state();
-  w.rod.update_reference(x);
-  msm::rods::ConstrainedOptions o;
-  o.force_scale = w.EI / (kZc * kZc);
-  const msm::rods::ContactSolution s = msm::rods::solve_wall_contact(
-      w.rod, nullptr, w.rod.clamp_fixed(), x, tube, 2, w.layout.tip_node, o);
-  RigidRun r{s.x, 0.0};
-  for (const double f : s.forces) r.force += f;
-  return r;
-}
-
-/// The candidate nearest the wire's tip pushed out by r_w (the rigid contact's wall point).
-int nearest_candidate(const TetMesh& mesh, const std::vector<int>& nodes, const Vec3& point) {
-  int best = 0;
-  for (int j = 1; j < static_cast<int>(nodes.size()); ++j) {
-    if ((mesh.nodes[nodes[j]] - point).norm() < (mesh.nodes[nodes[best]] - point).norm()) best = j;
-  }
-  return best;
-}
-
-/// The contact forces as nodal loads for a second FEM solve (deal.II's own assembly): each active
-/// candidate's λ n as a point at its node of an inner-wall triangle.
-std::vector<TractionPatch> nodal_loads(const TetMesh& mesh, const contact::CondensedWall& wall,
-                                       const contact::WireWallSolution& s) {
-  const PhysicalGroup& inner = mesh.require_group("inner_wall", 2, "tube");
-  std::vector<TractionPatch> loads;
-  for (const int j : s.active) {
-    const int node = wall.nodes()[static_cast<std::size_t>(j)];
-    for (const int t : inner.elements) {
-      const Triangle& tri = mesh.triangles[static_cast<std::size_t>(t)];
-      int corner = -1;
-      for (int k = 0; k < 3; ++k) {
-        if (tri[k] == node) corner = k;
-      }
-      if (corner < 0) continue;
-      TractionPatch p;
-      p.triangles = {t};
-      SurfacePoint q;
-      q.triangle = t;
-      q.barycentric[corner] = 1.0;
-      q.weight = 1.0;
-      p.points = {q};
-      p.traction = s.force[j] * wall.directions()[static_cast<std::size_t>(j)];
-      p.area = 1.0;
-      loads.push_back(p);
-      break;
-    }
-  }
-  return loads;
-}
-
-struct CoupledRun {
-  contact::WireWallSolution solution;
-  contact::ContactWire wire;  ///< its centreline nodes and radius (no form: the rod is gone)
-  Vec3 clamp = Vec3::Zero();
-  double rigid_force = 0.0;
-  /// The wire's compliance at its rigid contact, m/N: −dc/dF with the rigid wall moved out by
-  /// ±1e-8 m (central difference on the same discrete wire).
-  double wire_compliance = 0.0;
-  /// The wall's compliance under the contact forces, m/N: λᵀWλ/F² (F = Σλ).
-  double wall_compliance = 0.0;
-  double total = 0.0;    ///< Σλ, N
-  Eigen::VectorXd dent;  ///< Wλ per candidate, m
-  double setup_seconds = 0.0;
-};
-
-/// The wire (diameter d, N segments, the reference's length for z_c = 20 mm) in the tube of wall
-/// modulus E, candidates within 4 mm and 60° of the aimed node.
-CoupledRun coupled_run(const TetMesh& mesh, const Vec3& target, const std::vector<int>& nodes,
-                       double young, double diameter, int segments, double length_factor);
-
-CoupledRun coupled_run(double young, double diameter, int segments, double length_factor = 1.0) {
-  const TetMesh& mesh = tube_mesh();
-  const Vec3 target = mesh.nodes[aim_node(mesh)];
-  return coupled_run(mesh, target, band(mesh, target.z(), 4e-3, 1.05), young, diameter, segments,
-                     length_factor);
-}
-
-/// The wire aimed at `target` on the wall (its tip at z_c = 20 mm from the clamp), candidates
-/// `nodes`.
-CoupledRun coupled_run(const TetMesh& mesh, const Vec3& target, const std::vector<int>& nodes,
-                       double young, double diameter, int segments, double length_factor) {
-  const double c = kA - diameter / 2;
-  const double length =
-      length_factor * rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
-  Wire w(diameter, length, segments, Vec3(0, 0, target.z() - kZc));
-  const RigidRun rigid = rigid_run(w);
-  const fem::ElasticitySolver solver(mesh, wall_problem(young));
-  const contact::CondensedWall wall(solver.free_displacement_system(), nodes,
-                                    contact::into_wall_directions(mesh, nodes, "inner_wall"));
-  const Vec3 tip = rigid.x.segment<3>(3 * w.layout.tip_node);
-  const Vec3 radial = Vec3(tip.x(), tip.y(), 0).normalized();
-  const int first = nearest_candidate(mesh, nodes, tip + w.radius * radial);
-  contact::WireWallOptions o;
-  o.force_scale = w.EI / (kZc * kZc);
-  CoupledRun run;
-  run.solution = contact::solve_wire_wall_contact(w.contact(), wall, mesh, rigid.x, {first}, o);
-  run.clamp = contact::clamp_reaction(w.contact(), wall, mesh, run.solution);
-  run.wire = w.contact();
-  run.wire.form = nullptr;
-  run.rigid_force = rigid.force;
-  run.setup_seconds = wall.setup_seconds();
-  run.total = run.solution.force.sum();
-  run.wall_compliance =
-      run.solution.force.dot(wall.compliance() * run.solution.force) / (run.total * run.total);
-  run.dent = wall.compliance() * run.solution.force;
-  constexpr double kShift = 1e-8;
-  run.wire_compliance = 2 * kShift / (rigid_run(w, -kShift).force - rigid_run(w, kShift).force);
-  return run;
-}
-
-}  // namespace
+using namespace vessel::wire_in_tube;
 
 // The rigid limit: the scenes' wall made 10⁶ times stiffer. The force must be the rigid-wall
 // solve's of the same discrete wire (the wall's compliance ~0.5e-6 m/N moves it by ~1e-5) and so
@@ -269,15 +67,16 @@ TEST(WireWallContact, ActionEqualsReactionAndSignoriniHolds) {
   fem::ElasticityProblem p = wall_problem(young);
   const fem::ElasticitySolver condensing(mesh, p);
   const std::vector<int> nodes = band(mesh, mesh.nodes[aim_node(mesh)].z(), 4e-3, 1.05);
-  const contact::CondensedWall wall(condensing.free_displacement_system(), nodes,
-                                    contact::into_wall_directions(mesh, nodes, "inner_wall"));
+  const contact::ComponentCandidates all = contact::every_component(nodes);
+  const contact::CondensedWall wall(condensing.free_displacement_system(), all.nodes,
+                                    all.directions);
   p.patches = nodal_loads(mesh, wall, s);
   ASSERT_EQ(p.patches.size(), s.active.size());
   fem::ElasticitySolver solver(mesh, p);
   const fem::ElasticityResult& r = solver.solve();
   Vec3 supports = Vec3::Zero();
   for (const fem::GroupReaction& g : r.reactions) supports += g.force;
-  const Vec3 on_wall = s.total_force_on_wall(wall);
+  const Vec3 on_wall = s.total_force_on_wall();
   const Vec3 sum = run.clamp + supports;
   std::printf(
       "WIRE-WALL action-reaction E=%.3g Pa: %zu in contact, force on wall (%.6e, %.6e, "
@@ -286,12 +85,12 @@ TEST(WireWallContact, ActionEqualsReactionAndSignoriniHolds) {
       young, s.active.size(), on_wall.x(), on_wall.y(), on_wall.z(), sum.norm(),
       sum.norm() / on_wall.norm(), s.active_set_changes, s.newton_iterations, s.seconds);
   EXPECT_LT(sum.norm(), 1e-9 * on_wall.norm());
-  const Eigen::VectorXd along = wall.compliance() * s.force;
+  const Eigen::VectorXd condensed = wall.compliance() * s.wall_loads();
   double dent = 0.0;
   for (const int j : s.active) {
-    const Vec3 u = r.nodal_displacement[static_cast<std::size_t>(wall.nodes()[j])];
-    EXPECT_NEAR(u.dot(wall.directions()[j]), along[j], 1e-9 * along.cwiseAbs().maxCoeff());
-    dent = std::max(dent, along[j]);
+    const Vec3 u = r.nodal_displacement[static_cast<std::size_t>(wall.nodes()[3 * j])];
+    EXPECT_LT((u - condensed.segment<3>(3 * j)).norm(), 1e-9 * condensed.cwiseAbs().maxCoeff());
+    dent = std::max(dent, u.norm());
   }
   std::printf("WIRE-WALL action-reaction: largest dent %.4e m\n", dent);
   for (int j = 0; j < s.force.size(); ++j) {
@@ -376,8 +175,9 @@ TEST(WireWallContact, LineOfContactOnACompliantWall) {
   // Action and reaction, against deal.II's reactions under the contact forces as nodal loads.
   fem::ElasticityProblem problem = wall_problem(young);
   const fem::ElasticitySolver condensing(mesh, problem);
-  const contact::CondensedWall wall(condensing.free_displacement_system(), nodes,
-                                    contact::into_wall_directions(mesh, nodes, "inner_wall"));
+  const contact::ComponentCandidates all = contact::every_component(nodes);
+  const contact::CondensedWall wall(condensing.free_displacement_system(), all.nodes,
+                                    all.directions);
   problem.patches = nodal_loads(mesh, wall, s);
   fem::ElasticitySolver solver(mesh, problem);
   Vec3 supports = Vec3::Zero();
@@ -387,7 +187,7 @@ TEST(WireWallContact, LineOfContactOnACompliantWall) {
               sum.norm() / run.total);
   EXPECT_LT(sum.norm(), 1e-9 * run.total);
   // No inner-wall node outside the candidates is inside the wire (the wall's whole displacement).
-  const std::vector<Vec3> u = wall.displacement(s.force);
+  const std::vector<Vec3> u = wall.displacement(s.wall_loads());
   double outside = std::numeric_limits<double>::infinity();
   for (const int n : inner_nodes(mesh)) {
     if (std::find(nodes.begin(), nodes.end(), n) != nodes.end()) continue;
@@ -401,32 +201,6 @@ TEST(WireWallContact, LineOfContactOnACompliantWall) {
     EXPECT_GE(s.gap[j], -1e-12);
     EXPECT_LE(s.force[j] * std::abs(s.gap[j]), 1e-12 * s.force.maxCoeff());
   }
-}
-
-/// The largest principal strain magnitude over the mesh's tets (P1 gradient of u): the small
-/// strain's and the Green–Lagrange strain's, ½(H + Hᵀ) and ½(H + Hᵀ + HᵀH).
-struct WallStrain {
-  double small = 0.0, green = 0.0;
-};
-WallStrain largest_strain(const TetMesh& mesh, const std::vector<Vec3>& u) {
-  WallStrain out;
-  for (const Tet& t : mesh.tets) {
-    Eigen::Matrix3d dX, dU;
-    for (int k = 0; k < 3; ++k) {
-      dX.col(k) = mesh.nodes[t[k + 1]] - mesh.nodes[t[0]];
-      dU.col(k) = u[t[k + 1]] - u[t[0]];
-    }
-    const Eigen::Matrix3d H = dU * dX.inverse();
-    const Eigen::Matrix3d e = 0.5 * (H + H.transpose());
-    const Eigen::Matrix3d E = e + 0.5 * H.transpose() * H;
-    out.small = std::max(
-        out.small,
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(e).eigenvalues().cwiseAbs().maxCoeff());
-    out.green = std::max(
-        out.green,
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(E).eigenvalues().cwiseAbs().maxCoeff());
-  }
-  return out;
 }
 
 // The line of contact on a wall of 30 × 14.24 kPa, where the dent is twice r_w, solved directly
@@ -457,10 +231,10 @@ TEST(WireWallContact, LineOfContactOnASofterWall) {
   const contact::GrownContact grown = contact::solve_wire_wall_contact_growing(
       w.contact(), solver.free_displacement_system(), mesh, nodes, rigid.x, {first}, o);
   const contact::WireWallSolution& s = grown.solution;
-  const Eigen::VectorXd dents = grown.wall->compliance() * s.force;
+  const std::vector<Vec3> u = grown.wall->displacement(s.wall_loads());
   double dent = 0;
-  for (const int j : s.active) dent = std::max(dent, dents[j]);
-  const std::vector<Vec3> u = grown.wall->displacement(s.force);
+  for (const int j : s.active)
+    dent = std::max(dent, u[static_cast<std::size_t>(grown.nodes[j])].norm());
   const WallStrain strain = largest_strain(mesh, u);
   const double total = s.force.sum();
   std::printf(
@@ -471,7 +245,7 @@ TEST(WireWallContact, LineOfContactOnASofterWall) {
       strain.small, strain.green, total, rigid.force, s.active_set_changes, s.newton_iterations,
       s.seconds);
   const Vec3 clamp = contact::clamp_reaction(w.contact(), *grown.wall, mesh, s);
-  EXPECT_LT((clamp - s.total_force_on_wall(*grown.wall)).norm(), 1e-9 * total);
+  EXPECT_LT((clamp - s.total_force_on_wall()).norm(), 1e-9 * total);
   double outside = std::numeric_limits<double>::infinity();
   for (const int n : inner_nodes(mesh)) {
     if (std::find(grown.nodes.begin(), grown.nodes.end(), n) != grown.nodes.end()) continue;
@@ -567,8 +341,8 @@ TEST(WireWallContact, RigidLimitWithCordeConstraints) {
   }
   const std::vector<int> cand = band(mesh, target.z(), 4e-3, 1.05);
   const fem::ElasticitySolver solver(mesh, wall_problem(kWallE * 1e6));
-  const contact::CondensedWall wall(solver.free_displacement_system(), cand,
-                                    contact::into_wall_directions(mesh, cand, "inner_wall"));
+  const contact::ComponentCandidates all = contact::every_component(cand);
+  const contact::CondensedWall wall(solver.free_displacement_system(), all.nodes, all.directions);
   contact::ContactWire w;
   w.form = &corde;
   w.constraints = &corde;
@@ -581,10 +355,11 @@ TEST(WireWallContact, RigidLimitWithCordeConstraints) {
   contact::WireWallOptions o;
   o.force_scale = der.EI / (kZc * kZc);
   o.constraint_tolerance = 1e-13;
-  const contact::WireWallSolution s = contact::solve_wire_wall_contact(w, wall, mesh, x, {}, o);
+  const contact::WireWallSolution s = contact::solve_wire_wall_contact(
+      w, wall, contact::into_wall_directions(mesh, cand, "inner_wall"), mesh, x, {}, o);
   const double total = s.force.sum();
   const double scaled = total * kZc * kZc / der.EI;
-  const Vec3 sum = contact::clamp_reaction(w, wall, mesh, s) - s.total_force_on_wall(wall);
+  const Vec3 sum = contact::clamp_reaction(w, wall, mesh, s) - s.total_force_on_wall();
   std::printf(
       "WIRE-WALL rigid limit CORDE N=32: F z^2/EI %.6f (ref %.6f, %+.2e), %zu in contact, "
       "%d steps, %.3f s; clamp reaction - force on wall |%.2e| N (%.1e relative)\n",
@@ -600,19 +375,66 @@ TEST(WireWallContact, RefusesAWireThatDoesNotFit) {
   const Vec3 target = mesh.nodes[aim_node(mesh)];
   const std::vector<int> cand = band(mesh, target.z(), 2e-3, 0.5);
   const fem::ElasticitySolver solver(mesh, wall_problem(kWallE));
-  const contact::CondensedWall wall(solver.free_displacement_system(), cand,
-                                    contact::into_wall_directions(mesh, cand, "inner_wall"));
+  const contact::ComponentCandidates all = contact::every_component(cand);
+  const contact::CondensedWall wall(solver.free_displacement_system(), all.nodes, all.directions);
+  const std::vector<Vec3> directions = contact::into_wall_directions(mesh, cand, "inner_wall");
   const Wire w(0.356e-3, 20e-3, 8, Vec3(0, 0, 5e-3));
+  // A wall condensed on one direction per node (no whole displacement), and a direction short.
+  const contact::CondensedWall along_one(solver.free_displacement_system(), cand, directions);
+  EXPECT_THROW(contact::solve_wire_wall_contact(w.contact(), along_one, directions, mesh,
+                                                w.rod.rest_state(), {}),
+               std::invalid_argument);
+  const std::vector<Vec3> short_by_one(directions.begin() + 1, directions.end());
+  EXPECT_THROW(contact::solve_wire_wall_contact(w.contact(), wall, short_by_one, mesh,
+                                                w.rod.rest_state(), {}),
+               std::invalid_argument);
   contact::ContactWire bad = w.contact();
   bad.radius = 0.0;
-  EXPECT_THROW(contact::solve_wire_wall_contact(bad, wall, mesh, w.rod.rest_state(), {}),
-               std::invalid_argument);
+  EXPECT_THROW(
+      contact::solve_wire_wall_contact(bad, wall, directions, mesh, w.rod.rest_state(), {}),
+      std::invalid_argument);
   bad = w.contact();
   bad.last_node = bad.num_nodes;
-  EXPECT_THROW(contact::solve_wire_wall_contact(bad, wall, mesh, w.rod.rest_state(), {}),
-               std::invalid_argument);
+  EXPECT_THROW(
+      contact::solve_wire_wall_contact(bad, wall, directions, mesh, w.rod.rest_state(), {}),
+      std::invalid_argument);
   // A candidate that is not a node of the inner wall has no direction.
   EXPECT_THROW(
       contact::into_wall_directions(mesh, {static_cast<int>(mesh.nodes.size())}, "inner_wall"),
       InputError);
+}
+
+// The wall condensed on every component of its nodes (3 × 3 blocks) against the same wall
+// condensed on one direction per node: n_iᵀ W_ij n_j must be the one-direction compliance, and
+// the displacement fields under the same forces must match.
+TEST(WireWallContact, EveryComponentHoldsTheOneDirectionCompliance) {
+  const TetMesh& mesh = tube_mesh();
+  const std::vector<int> cand = band(mesh, mesh.nodes[aim_node(mesh)].z(), 2e-3, 0.5);
+  const std::vector<Vec3> n = contact::into_wall_directions(mesh, cand, "inner_wall");
+  const fem::ElasticitySolver solver(mesh, wall_problem(kWallE));
+  const contact::ComponentCandidates all = contact::every_component(cand);
+  const contact::CondensedWall full(solver.free_displacement_system(), all.nodes, all.directions);
+  const contact::CondensedWall along(solver.free_displacement_system(), cand, n);
+  const Eigen::Index m = static_cast<Eigen::Index>(cand.size());
+  ASSERT_EQ(full.compliance().rows(), 3 * m);
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    for (Eigen::Index j = 0; j < m; ++j) {
+      const double projected = n[i].dot(full.compliance().block<3, 3>(3 * i, 3 * j) * n[j]);
+      worst = std::max(worst, std::abs(projected - along.compliance()(i, j)));
+    }
+  }
+  std::printf("WIRE-WALL every component: %td nodes, |n W n - W_n| at most %.2e of max W_n\n", m,
+              worst / along.compliance().maxCoeff());
+  EXPECT_LT(worst, 1e-10 * along.compliance().maxCoeff());
+  Eigen::VectorXd lambda = Eigen::VectorXd::LinSpaced(m, 1e-3, 2e-3);
+  Eigen::VectorXd loads(3 * m);
+  for (Eigen::Index j = 0; j < m; ++j) loads.segment<3>(3 * j) = lambda[j] * n[j];
+  const std::vector<Vec3> a = full.displacement(loads), b = along.displacement(lambda);
+  double diff = 0.0, size = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    diff = std::max(diff, (a[k] - b[k]).norm());
+    size = std::max(size, b[k].norm());
+  }
+  EXPECT_LT(diff, 1e-10 * size);
 }
