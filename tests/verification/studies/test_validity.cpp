@@ -430,4 +430,17 @@ kind = "xpbd_fem"
   }
   EXPECT_LT(v.rows.front().models[3].qoi_relative, 1e-3);
   EXPECT_LT(v.rows.back().models[3].relative_l2, 0.5 * v.rows.back().models[1].relative_l2);
+
+  // validity.json carries the timings (what scripts/measure_fem_models_vs_springs.py reads).
+  ValidityStudy study;
+  study.scenes = {v};
+  const auto dir = temp_dir("validity_timing");
+  write_validity_json(study, dir / "validity.json");
+  std::ifstream in(dir / "validity.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const nlohmann::json& xj = j["scenes"][0]["rows"][2]["models"][3];
+  EXPECT_EQ(xj["model"], "xpbd");
+  EXPECT_EQ(xj["timing"]["steps"].get<long>(), v.rows[2].models[3].timing->steps);
+  EXPECT_EQ(xj["timing"]["update_seconds_1khz"].get<double>(),
+            v.rows[2].models[3].timing->update_seconds_1khz);
 }
