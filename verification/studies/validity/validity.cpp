@@ -381,7 +381,7 @@ Continuation finite_continuation(const Scene& s, const ValidityOptions& o, const
   fo.min_step = (o.full ? 1e-4 : 2e-2) * ladder.back();
   fo.checkpoints = ladder;
   ContentHash what;
-  what.text("validity samples v2").real(qoi.x()).real(qoi.y()).real(qoi.z());
+  what.text("validity samples v3").real(qoi.x()).real(qoi.y()).real(qoi.z());
   what.real(kOutsideTolerance);
   for (std::size_t m = 0; m < models.specs.size(); ++m) {
     what.integer(static_cast<std::int64_t>(models.nodes(m).size()));
@@ -391,27 +391,41 @@ Continuation finite_continuation(const Scene& s, const ValidityOptions& o, const
     from_cache = false;
     Continuation c;
     fem::HyperelasticSolver fs(ref_mesh, problem, fo);
-    const fem::HyperelasticResult& r =
-        fs.solve([&](const fem::HyperelasticSolver& at, const fem::Checkpoint& cp) {
-          Sample x;
-          x.load = cp.load_factor;
-          x.load_steps = cp.load_steps;
-          x.rejected_steps = cp.rejected_steps;
-          x.newton_iterations = cp.newton_iterations;
-          x.seconds = cp.seconds;
-          x.qoi = at.displacement_at({qoi}, kOutsideTolerance)[0];
-          x.mesh_nodes = cp.nodal_displacement;
-          for (std::size_t m = 0; m < models.specs.size(); ++m) {
-            x.model_nodes.push_back(at.displacement_at(models.nodes(m), kOutsideTolerance));
-          }
-          std::ostringstream m;
-          m << "  " << s.name << ": finite strain at " << cp.load_factor << " " << load_unit(s.load.kind) << ": "
-            << cp.load_steps << " steps, " << cp.newton_iterations << " Newton iterations, "
-            << std::setprecision(3) << cp.seconds << " s";
-          log_line(o, m.str());
-          c.samples.push_back(std::move(x));
-          return std::string();
-        });
+    const auto take = [&](const fem::HyperelasticSolver& at, const fem::Checkpoint& cp) {
+      Sample x;
+      x.load = cp.load_factor;
+      x.load_steps = cp.load_steps;
+      x.rejected_steps = cp.rejected_steps;
+      x.newton_iterations = cp.newton_iterations;
+      x.seconds = cp.seconds;
+      x.qoi = at.displacement_at({qoi}, kOutsideTolerance)[0];
+      x.mesh_nodes = cp.nodal_displacement;
+      for (std::size_t m = 0; m < models.specs.size(); ++m) {
+        x.model_nodes.push_back(at.displacement_at(models.nodes(m), kOutsideTolerance));
+      }
+      std::ostringstream m;
+      m << "  " << s.name << ": finite strain at " << cp.load_factor << " " << load_unit(s.load.kind) << ": "
+        << cp.load_steps << " steps, " << cp.newton_iterations << " Newton iterations, "
+        << std::setprecision(3) << cp.seconds << " s";
+      log_line(o, m.str());
+      c.samples.push_back(std::move(x));
+      return std::string();
+    };
+    const fem::HyperelasticResult& r = fs.solve(take);
+    // A continuation that ends at the top of the ladder by an increment that lands there within
+    // round-off (not one cut to end on it) reports no checkpoint there: its final state is that
+    // load's, sampled here.
+    if (r.completed &&
+        (c.samples.empty() || c.samples.back().load < ladder.back() * (1.0 - 1e-12))) {
+      fem::Checkpoint top;
+      top.load_factor = ladder.back();
+      top.load_steps = static_cast<int>(r.steps.size());
+      top.rejected_steps = r.rejected_steps;
+      top.newton_iterations = r.newton_iterations;
+      top.seconds = r.timings.assembly + r.timings.solve;
+      top.nodal_displacement = r.nodal_displacement;
+      take(fs, top);
+    }
     c.element = r.element;
     c.dofs = r.n_dofs;
     c.completed = r.completed;
