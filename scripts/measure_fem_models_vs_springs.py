@@ -87,8 +87,7 @@ def study(vv, scene, loads, tmp, env):
     with open(os.path.join(out_dir, "validity.json")) as f:
         v = json.load(f)["scenes"][0]
     shown = " ".join(["vesselverify"] + [os.path.basename(c) if c == path else c
-                                        for c in cmd[1:]
-                                        if not c.startswith(tmp) or c == path])
+                                        for c in cmd[1:-2]])
     return dict(scene=scene, kinds=dict(kinds), order=[n for n, _ in kinds], v=v,
                 load_before=before, load_after=after, command=shown)
 
@@ -115,7 +114,8 @@ def front(points):
 def scene_section(r):
     v, kinds = r["v"], r["kinds"]
     lines = [f"## {r['scene']}\n",
-             f"`{r['command']}` (plus `--output-dir DIR`); load average (1, 5, 15 min) "
+             f"`{r['command']}` (plus `--output-dir DIR`), the scene being "
+             f"verification/scenes/{r['scene']}.toml with the two P1 tet models added; load average (1, 5, 15 min) "
              f"{r['load_before']} before, {r['load_after']} after.\n",
              f"Finite-strain reference: {v['element']} on level {v['reference_level']} "
              f"({v['dofs']} DoFs); models on level {v['model_level']}; contact point "
