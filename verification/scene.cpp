@@ -123,7 +123,7 @@ std::vector<ModelSpec> tet_fem_model(TableReader& r, ModelSpec m) {
     t.dt = r.number_or("dt", t.dt);
     t.iterations = static_cast<int>(r.integer_or("iterations", t.iterations));
     t.velocity_damping = r.number_or("velocity_damping", t.velocity_damping);
-    t.settle_tolerance = r.number_or("settle_tolerance", t.settle_tolerance);
+    t.settle_relative_change = r.number_or("settle_relative_change", t.settle_relative_change);
     t.max_steps = r.integer_or("max_steps", t.max_steps);
   }
   return {m};

@@ -67,8 +67,9 @@ struct TetFemSpec {
   double dt = 1e-4;              ///< xpbd_fem: time step, s
   int iterations = 4;            ///< xpbd_fem: Gauss–Seidel sweeps per step
   double velocity_damping = 0.02;  ///< xpbd_fem: fraction of the velocity removed per step
-  /// xpbd_fem: steady when no node moves farther than this in a step, m
-  double settle_tolerance = 1e-9;
+  /// xpbd_fem: steady when no node moves farther in a step than this fraction of the largest node
+  /// displacement from rest (msm::XpbdFem::relax)
+  double settle_relative_change = 1e-6;
   long max_steps = 200'000;  ///< xpbd_fem: steps before the run is recorded as failed
 };
 

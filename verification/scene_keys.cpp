@@ -286,9 +286,11 @@ std::vector<SceneKey> models() {
       Row("models", "velocity_damping", KeyType::number,
           "Fraction of the velocity removed per step")
           .dflt("0.02").range(0.0, 0.99).in({"xpbd_fem"}),
-      Row("models", "settle_tolerance", KeyType::number,
-          "Steady state: no node moves farther than this in a step")
-          .dflt("1e-9").unit("m").positive().in({"xpbd_fem"}),
+      Row("models", "settle_relative_change", KeyType::number,
+          "Steady state: no node moves farther in a step than this fraction of the largest node "
+          "displacement from rest (a bound on the last step, not on the distance to the steady "
+          "state)")
+          .dflt("1e-6").range(1e-15, 0.1).in({"xpbd_fem"}),
       Row("models", "max_steps", KeyType::integer,
           "Steps to reach the steady state before the run is recorded as failed")
           .dflt("200000").range(1, kMaxSteps).in({"xpbd_fem"}),

@@ -6,7 +6,10 @@
 
 #include "meshes/foundation/errors.hpp"
 #include "meshes/mesh_cache.hpp"
+#include "msm/fem/corotational_tet.hpp"
+#include "msm/fem/stable_neo_hookean.hpp"
 #include "msm/formats/network_file.hpp"
+#include "msm/terms/edge_pair_term.hpp"
 #include "msm/terms/spring_model.hpp"
 #include "verification/calibration_file.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
@@ -309,6 +312,20 @@ void solve_guidewire_load(Scene& scene) {
   load.magnitudes = {wire.force};
   load.contact.point = wire.wall_point;
   load.contact.direction = wire.normal;  // the wire's push, along the exact lumen's normal
+}
+
+std::unique_ptr<msm::TetTerm> tet_fem_term(const ModelSpec& spec, const TetMesh& mesh, double E,
+                                           double nu) {
+  const msm::LameParameters linear = msm::lame_parameters(E, nu);
+  if (spec.kind == ModelKind::corotational_fem) {
+    return std::make_unique<msm::CorotationalTetTerm>(mesh.nodes, mesh.tets, linear,
+                                                      msm::CorotationalStiffness::consistent);
+  }
+  if (spec.kind == ModelKind::xpbd_fem) {
+    const msm::LameParameters snh{msm::snh_lambda_for_linear(linear), linear.mu};
+    return std::make_unique<msm::StableNeoHookeanTerm>(mesh.nodes, mesh.tets, snh);
+  }
+  throw InputError("model " + spec.name + ": not a P1 tet model (corotational_fem or xpbd_fem)");
 }
 
 }  // namespace vessel

@@ -5,6 +5,7 @@
 /// springs get the same loads (the contact patch and pressure triangles of meshes/surface_loads)
 /// and the same supports (meshes/supports). SI units.
 #include <filesystem>
+#include <memory>
 #include <string>
 
 #include "fem_reference/elasticity.hpp"
@@ -94,5 +95,13 @@ msm::Problem msm_problem(const Scene& scene, const msm::Form& form, const msm::B
 /// consistent nodal loads (N), gravity on those masses and the scene's supports as held dofs.
 msm::Problem tet_mesh_problem(const Scene& scene, const msm::TetTerm& term, const TetMesh& mesh,
                               double magnitude);
+
+/// The energy of a P1 tet model (kinds corotational_fem and xpbd_fem) on `mesh` with Young's
+/// modulus E (Pa) and Poisson's ratio ν: corotational P1 with its consistent tangent (static
+/// Newton's), or the stable neo-Hookean energy XPBD FEM's constraints carry, with the λ whose
+/// small-strain limit is the material's (msm/fem/stable_neo_hookean.hpp). InputError for another
+/// kind.
+std::unique_ptr<msm::TetTerm> tet_fem_term(const ModelSpec& spec, const TetMesh& mesh, double E,
+                                           double nu);
 
 }  // namespace vessel

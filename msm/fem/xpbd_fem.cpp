@@ -1,5 +1,6 @@
 #include "msm/fem/xpbd_fem.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -19,6 +20,7 @@ XpbdFem::XpbdFem(const std::vector<Vec3>& nodes, std::vector<Tet> tets, LamePara
   }
   x_.resize(3 * n);
   for (int i = 0; i < n; ++i) x_.segment<3>(3 * i) = nodes[i];
+  rest_ = x_;
   v_.setZero(3 * n);
   inverse_mass_.setZero(3 * n);
   for (int i = 0; i < n; ++i) {
@@ -111,15 +113,16 @@ void XpbdFem::step(double h, const VectorXd& force) {
   }
 }
 
-int XpbdFem::relax(double h, const VectorXd& force, double tolerance, int max_steps) {
+int XpbdFem::relax(double h, const VectorXd& force, double relative_change, int max_steps) {
   for (int s = 1; s <= max_steps; ++s) {
     const VectorXd before = x_;
     step(h, force);
-    double largest = 0.0;
+    double moved = 0.0, displaced = 0.0;
     for (Eigen::Index i = 0; i < x_.size(); i += 3) {
-      largest = std::max(largest, (x_.segment<3>(i) - before.segment<3>(i)).norm());
+      moved = std::max(moved, (x_.segment<3>(i) - before.segment<3>(i)).norm());
+      displaced = std::max(displaced, (x_.segment<3>(i) - rest_.segment<3>(i)).norm());
     }
-    if (largest <= tolerance) return s;
+    if (moved <= relative_change * displaced || moved == 0.0) return s;
   }
   return max_steps;
 }

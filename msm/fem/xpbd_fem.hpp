@@ -43,9 +43,12 @@ class XpbdFem {
   /// One step of length h (s) under the dead loads `force` (N, per dof). DivergenceError on a
   /// non-finite position.
   void step(double h, const VectorXd& force);
-  /// Steps until the largest node displacement in a step is ≤ tolerance (m), or max_steps; returns
-  /// the steps taken.
-  int relax(double h, const VectorXd& force, double tolerance, int max_steps);
+  /// Steps until the largest node movement in a step is at most `relative_change` × the largest
+  /// node displacement from rest (so the test means the same at 1 µN and at 100 mN), or
+  /// max_steps; returns the steps taken. The test bounds the last step's movement, not the
+  /// distance to the steady state: that is about the movement × 1/(1 − ρ), ρ the per-step decay
+  /// of the slowest mode.
+  int relax(double h, const VectorXd& force, double relative_change, int max_steps);
 
   [[nodiscard]] const VectorXd& state() const { return x_; }
   /// The energy the constraints carry, as a Form (for a Newton solve of the same energy).
@@ -57,7 +60,7 @@ class XpbdFem {
 
   StableNeoHookeanTerm energy_;
   XpbdFemOptions options_;
-  VectorXd x_, v_, inverse_mass_;
+  VectorXd rest_, x_, v_, inverse_mass_;
   std::vector<std::array<double, 2>> compliance_;    ///< per tet: α_D, α_H (1/(Pa·m³))
   std::vector<std::array<double, 2>> lambda_;        ///< the step's multipliers (scaled by h²)
   std::vector<std::array<double, 2>> force_lambda_;  ///< carried multipliers as forces (λ/h²)

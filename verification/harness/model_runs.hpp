@@ -34,6 +34,9 @@ void run_tet_fem_model(const Scene& s, const ModelSpec& spec, double nu, const T
                        const HarnessOptions& o, Progress& progress, ModelOutcome base,
                        SceneResult& result);
 
+/// What a P1 tet model (kinds corotational_fem and xpbd_fem) is, for the results' detail column.
+std::string tet_fem_detail(const ModelSpec& spec);
+
 /// A model outside the suite (kinds external and displacements; verification/harness/external_model.hpp)
 /// at every load: the case written to its exchange folder and its command run (external), or the
 /// answer read from the folder the export named (displacements); then compared as any model. A

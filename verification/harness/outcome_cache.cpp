@@ -351,7 +351,8 @@ std::string model_run_key(const Scene& s, const ModelSpec& m, double nu, int lev
   h.integer(static_cast<int>(m.mass));
   hash_solver(h, m.solver);
   const TetFemSpec& t = m.tet_fem;
-  h.real(t.dt).integer(t.iterations).real(t.velocity_damping).real(t.settle_tolerance);
+  h.real(t.dt).integer(t.iterations).real(t.velocity_damping);
+  h.text("settle relative").real(t.settle_relative_change);
   h.integer(t.max_steps);
   h.real(m.damping).real(m.roi_radius).integer(m.calibration_transfer);
   h.text(m.calibration.string()).text(m.calibration.empty() ? "" : file_contents(m.calibration));

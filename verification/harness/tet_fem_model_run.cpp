@@ -7,9 +7,6 @@
 #include <string>
 
 #include "meshes/foundation/errors.hpp"
-#include "msm/fem/corotational_tet.hpp"
-#include "msm/fem/stable_neo_hookean.hpp"
-#include "msm/fem/xpbd_fem.hpp"
 #include "msm/terms/edge_pair_term.hpp"
 #include "verification/harness/memory.hpp"
 #include "verification/harness/modal.hpp"
@@ -40,45 +37,19 @@ double max_principal_stretch_strain(const msm::TetTerm& term, const TetMesh& mes
   return largest;
 }
 
-/// The model's energy as a Form: corotational P1 with its consistent tangent (Newton's), or the
-/// stable neo-Hookean energy XPBD FEM's constraints carry, with the λ whose small-strain limit is
-/// the material's (msm/fem/stable_neo_hookean.hpp).
-std::unique_ptr<msm::TetTerm> tet_fem_term(const ModelSpec& spec, const TetMesh& mesh, double E,
-                                           double nu) {
-  const msm::LameParameters linear = msm::lame_parameters(E, nu);
-  if (spec.kind == ModelKind::corotational_fem) {
-    return std::make_unique<msm::CorotationalTetTerm>(mesh.nodes, mesh.tets, linear,
-                                                      msm::CorotationalStiffness::consistent);
-  }
-  const msm::LameParameters snh{msm::snh_lambda_for_linear(linear), linear.mu};
-  return std::make_unique<msm::StableNeoHookeanTerm>(mesh.nodes, mesh.tets, snh);
-}
-
 /// XPBD FEM stepped from rest to its steady state, `repeats` times afresh: set-up (the solver's
 /// construction) and the whole run's time (median), and the steps it took. runtime_error if the
 /// run is not steady after spec.tet_fem.max_steps steps.
-Eigen::VectorXd timed_xpbd(const msm::Problem& p, const msm::TetTerm& term, const TetMesh& mesh,
-                           const ModelSpec& spec, int repeats, ModelOutcome& out, long& steps) {
-  const TetFemSpec& t = spec.tet_fem;
-  msm::XpbdFemOptions xo;
-  xo.iterations = t.iterations;
-  xo.damping = t.velocity_damping;
+Eigen::VectorXd timed_xpbd(const msm::Problem& p, const msm::TetTerm& term, const ModelSpec& spec,
+                           int repeats, ModelOutcome& out, long& steps) {
   std::vector<double> setups, runs;
   Eigen::VectorXd x;
   for (int k = 0; k < std::max(1, repeats); ++k) {
-    Stopwatch setup;
-    msm::XpbdFem xpbd(mesh.nodes, mesh.tets, term.lame(), p.mass, p.fixed, xo);
-    setups.push_back(setup.seconds());
-    Stopwatch run;
-    steps = xpbd.relax(t.dt, p.external_force, t.settle_tolerance, static_cast<int>(t.max_steps));
-    runs.push_back(run.seconds());
-    if (steps >= t.max_steps) {
-      std::ostringstream why;
-      why << "xpbd_fem: not steady after max_steps = " << t.max_steps << " steps of dt = " << t.dt
-          << " s (a node still moves farther in a step than settle_tolerance = "
-          << t.settle_tolerance << " m)";
-      throw std::runtime_error(why.str());
-    }
+    XpbdFemUpdater xpbd(p, term, spec.tet_fem);
+    setups.push_back(xpbd.setup_seconds());
+    const msm::UpdateResult r = xpbd.update(p.external_force);
+    runs.push_back(r.seconds);
+    steps = r.iterations;
     x = xpbd.state();
   }
   out.setup_seconds += median(setups);
@@ -109,7 +80,7 @@ void run_tet_fem_load(const Scene& s, const ModelSpec& spec, const msm::TetTerm&
     out.factorisations_per_update = seq.factorisations_per_update;
     x = std::move(seq.x);
   } else {
-    x = timed_xpbd(p, term, mesh, spec, o.repeats, out, steps);
+    x = timed_xpbd(p, term, spec, o.repeats, out, steps);
     dt = spec.tet_fem.dt;
     out.detail += ", steady after " + std::to_string(steps) + " steps";
   }
@@ -125,6 +96,8 @@ void run_tet_fem_load(const Scene& s, const ModelSpec& spec, const msm::TetTerm&
   }
 }
 
+}  // namespace
+
 std::string tet_fem_detail(const ModelSpec& spec) {
   if (spec.kind == ModelKind::corotational_fem) {
     return "corotational P1 (Müller & Gross 2004), static Newton, consistent tangent";
@@ -135,8 +108,6 @@ std::string tet_fem_detail(const ModelSpec& spec) {
     << " sweeps/step, to steady state";
   return d.str();
 }
-
-}  // namespace
 
 void run_tet_fem_model(const Scene& s, const ModelSpec& spec, double nu, const TetMesh& mesh,
                        const ReferenceSolvers& ref, const fem::ElasticityResult& fine,

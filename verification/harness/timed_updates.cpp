@@ -1,6 +1,8 @@
 #include "verification/harness/timed_updates.hpp"
 
 #include <memory>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -60,6 +62,45 @@ FemUpdates timed_fem_updates(const fem::ElasticitySolver& solver, int updates, i
   const double assembly_seconds = assembly.seconds();
   const UpdateSequence seq = timed_updates(p, msm::parse_solver("linear"), updates, repeats);
   return {assembly_seconds + seq.setup_seconds, seq.update_seconds};
+}
+
+XpbdFemUpdater::XpbdFemUpdater(const msm::Problem& problem, const msm::TetTerm& energy,
+                               const TetFemSpec& spec)
+    : spec_(spec) {
+  const Stopwatch setup;
+  std::vector<Vec3> nodes(static_cast<std::size_t>(problem.rest.size() / 3));
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    nodes[i] = problem.rest.segment<3>(3 * static_cast<Eigen::Index>(i));
+  }
+  msm::XpbdFemOptions xo;
+  xo.iterations = spec.iterations;
+  xo.damping = spec.velocity_damping;
+  xpbd_ = std::make_unique<msm::XpbdFem>(nodes, energy.elements(), energy.lame(), problem.mass,
+                                         problem.fixed, xo);
+  x_ = xpbd_->state();
+  setup_seconds_ = setup.seconds();
+}
+
+msm::UpdateResult XpbdFemUpdater::update(const Eigen::VectorXd& external_force) {
+  if (external_force.size() != x_.size()) {
+    throw InputError("XPBD FEM update: expected " + std::to_string(x_.size()) +
+                     " load entries, got " + std::to_string(external_force.size()));
+  }
+  const Stopwatch run;
+  const int steps = xpbd_->relax(spec_.dt, external_force, spec_.settle_relative_change,
+                                 static_cast<int>(spec_.max_steps));
+  msm::UpdateResult r;
+  r.seconds = run.seconds();
+  r.iterations = steps;
+  x_ = xpbd_->state();
+  if (steps >= spec_.max_steps) {
+    std::ostringstream why;
+    why << "xpbd_fem: not steady after max_steps = " << spec_.max_steps << " steps of dt = "
+        << spec_.dt << " s (a node still moves farther in a step than settle_relative_change = "
+        << spec_.settle_relative_change << " of the largest displacement)";
+    throw std::runtime_error(why.str());
+  }
+  return r;
 }
 
 }  // namespace vessel

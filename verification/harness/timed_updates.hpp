@@ -2,9 +2,14 @@
 /// Static and linear models timed as a simulator runs them (msm/solvers/updates.hpp): prepared
 /// once, then warm-started updates of a load ramp; linear FEM by the same procedure.
 #include <Eigen/Core>
+#include <memory>
 
+#include "msm/fem/tet_term.hpp"
+#include "msm/fem/xpbd_fem.hpp"
 #include "msm/form/form.hpp"
 #include "msm/solvers/solve.hpp"
+#include "msm/solvers/updates.hpp"
+#include "verification/scene.hpp"
 
 namespace vessel::fem {
 class ElasticitySolver;
@@ -37,5 +42,23 @@ struct FemUpdates {
   double update_seconds = 0.0;  ///< median update, s
 };
 FemUpdates timed_fem_updates(const fem::ElasticitySolver& solver, int updates, int repeats);
+
+/// XPBD FEM (msm/fem/xpbd_fem.hpp) run as a simulator runs it: prepared once (the constraints'
+/// compliances and the rest shape's multipliers; setup_seconds), then each update steps from the
+/// state it holds under the new load until steady (spec.settle_relative_change,
+/// XpbdFem::relax), its UpdateResult::iterations the steps taken. `energy`: the stable
+/// neo-Hookean term of the problem's mesh (tet_fem_term), whose tets and Lamé parameters the
+/// constraints carry. An update not steady after spec.max_steps steps throws
+/// std::runtime_error naming the keys.
+class XpbdFemUpdater final : public msm::Updater {
+ public:
+  XpbdFemUpdater(const msm::Problem& problem, const msm::TetTerm& energy, const TetFemSpec& spec);
+  msm::UpdateResult update(const Eigen::VectorXd& external_force) override;
+  [[nodiscard]] int factorisations() const override { return 0; }
+
+ private:
+  TetFemSpec spec_;
+  std::unique_ptr<msm::XpbdFem> xpbd_;
+};
 
 }  // namespace vessel

@@ -376,3 +376,71 @@ kind = "corotational_fem"
   EXPECT_LT(v.rows.front().models[1].qoi_relative, 1e-3);
   EXPECT_LT(v.rows.back().models[1].qoi_relative, v.rows.back().qoi_difference);
 }
+
+// Linear P1, corotational P1 and XPBD FEM on the reference's own mesh and element (P1, level 0),
+// judged against the finite-strain reference and timed. Linear P1's row is the linear
+// reference's own difference from the finite-strain one (the same element on the same mesh,
+// reached through the study's reference solve on one path and the model row on the other). XPBD
+// FEM's steady state is its stable neo-Hookean energy's equilibrium, whose small-strain limit is
+// the material's: at 1 µN it is the reference to first order, and at 4 mN, where the wall turns,
+// it is nearer the finite-strain reference than linear P1. Its time per update is its per-step
+// cost × the steps a period holds: ⌈1 ms / 0.1 ms⌉ = 10 at 1 kHz, ⌈33.3 ms / 0.1 ms⌉ = 334 at 30 Hz.
+TEST(ValidityStudy, LinearCorotationalAndXpbdP1AreJudgedAndTimed) {
+  const Scene s = parse_scene(std::string(kScene) + R"(
+[[models]]
+name = "p1"
+kind = "fem"
+degree = 1
+[[models]]
+name = "corotational"
+kind = "corotational_fem"
+[[models]]
+name = "xpbd"
+kind = "xpbd_fem"
+)",
+                              "validity_test.toml");
+  ValidityOptions o = small_options();
+  o.ladder = {1e-6, 1e-3, 4e-3};
+  o.time_updates = true;
+  const ValidityScene v = run_validity_scene(s, o);
+  ASSERT_TRUE(v.completed) << v.stop_reason;
+  ASSERT_EQ(v.rows.size(), 3u);
+  ASSERT_EQ(v.models.size(), 4u);  // the seed model, linear, corotational and XPBD P1
+  for (const ValidityRow& r : v.rows) {
+    ASSERT_EQ(r.models.size(), 4u);
+    for (const ValidityModelError& e : r.models) {
+      ASSERT_TRUE(e.ok) << e.model << ": " << e.failure;
+      ASSERT_TRUE(e.timing.has_value()) << e.model;
+      EXPECT_GT(e.timing->update_seconds, 0.0) << e.model;
+      std::cout << "  " << r.magnitude << " N: " << e.model << " rel. L2 " << e.relative_l2
+                << ", QoI " << e.qoi_relative << ", update " << e.timing->update_seconds
+                << " s (" << e.timing->steps << " steps)\n";
+    }
+    const ValidityModelError& p1 = r.models[1];
+    EXPECT_EQ(p1.model, "p1");
+    EXPECT_NEAR(p1.relative_l2, r.l2_difference, 1e-9 + 1e-6 * r.l2_difference);
+    const ValidityModelError& spring = r.models[0];
+    EXPECT_EQ(spring.timing->steps, 0);
+    EXPECT_EQ(spring.timing->update_seconds_30hz, spring.timing->update_seconds);
+    const ValidityTiming& xt = *r.models[3].timing;
+    EXPECT_EQ(r.models[3].model, "xpbd");
+    EXPECT_GT(xt.steps, 0);
+    EXPECT_DOUBLE_EQ(xt.update_seconds_1khz, xt.update_seconds / xt.steps * 10.0);
+    EXPECT_DOUBLE_EQ(xt.update_seconds_30hz, xt.update_seconds / xt.steps * 334.0);
+  }
+  EXPECT_LT(v.rows.front().models[3].qoi_relative, 1e-3);
+  EXPECT_LT(v.rows.back().models[3].relative_l2, 0.5 * v.rows.back().models[1].relative_l2);
+
+  // validity.json carries the timings (what scripts/measure_fem_models_vs_springs.py reads).
+  ValidityStudy study;
+  study.scenes = {v};
+  const auto dir = temp_dir("validity_timing");
+  write_validity_json(study, dir / "validity.json");
+  std::ifstream in(dir / "validity.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const nlohmann::json& xj = j["scenes"][0]["rows"][2]["models"][3];
+  EXPECT_EQ(xj["model"], "xpbd");
+  EXPECT_EQ(xj["timing"]["steps"].get<long>(), v.rows[2].models[3].timing->steps);
+  EXPECT_EQ(xj["timing"]["update_seconds_1khz"].get<double>(),
+            v.rows[2].models[3].timing->update_seconds_1khz);
+}

@@ -13,13 +13,17 @@
 #include "meshes/foundation/content_hash.hpp"
 #include "meshes/self_contact.hpp"
 #include "meshes/foundation/errors.hpp"
-#include "msm/fem/corotational_tet.hpp"
 #include "msm/model/mass_spring_model.hpp"
 #include "msm/solvers/updates.hpp"
 #include "msm/terms/edge_pair_term.hpp"
+#include "verification/harness/budget.hpp"
 #include "verification/harness/external_model.hpp"
 #include "verification/harness/metrics.hpp"
 #include "verification/harness/model_readout.hpp"
+#include "verification/harness/model_runs.hpp"
+#include "verification/harness/options.hpp"
+#include "verification/harness/timed_updates.hpp"
+#include "verification/harness/timing.hpp"
 #include "verification/harness/parallel.hpp"
 #include "verification/scene_problems.hpp"
 
@@ -144,13 +148,21 @@ Continuation deserialise(std::string_view text, std::size_t mesh_nodes,
   return c;
 }
 
-/// The models the study runs: named ones, else (default) the seed models and corotational P1, else
-/// (full) every whole-vessel static or linear mass-spring model and corotational P1 of the scene.
+/// Whether the study judges a model of this kind on the mesh's own nodes: linear P1 FEM,
+/// corotational P1, XPBD FEM.
+bool on_mesh_kind(const ModelSpec& m) {
+  return (m.kind == ModelKind::fem && m.degree == 1) || m.kind == ModelKind::corotational_fem ||
+         m.kind == ModelKind::xpbd_fem;
+}
+
+/// The models the study runs: named ones, else (default) the seed models and the P1 tet models
+/// (linear, corotational, XPBD), else (full) every whole-vessel static or linear mass-spring model
+/// and the P1 tet models of the scene.
 std::vector<const ModelSpec*> chosen_models(const Scene& s, const ValidityOptions& o) {
   auto eligible = [](const ModelSpec& m) {
     return ((m.kind == ModelKind::surface_msm || m.kind == ModelKind::volume_msm) &&
             m.roi_radius <= 0.0 && msm::supports_updates(m.solver)) ||
-           m.kind == ModelKind::corotational_fem;
+           on_mesh_kind(m);
   };
   std::vector<const ModelSpec*> out;
   if (!o.models.empty()) {
@@ -159,8 +171,8 @@ std::vector<const ModelSpec*> chosen_models(const Scene& s, const ValidityOption
                                    [&](const ModelSpec& m) { return m.name == name; });
       if (it == s.models.end() || !eligible(*it)) {
         throw InputError("--models " + name + ": " + s.source.string() +
-                         " has no whole-vessel static mass-spring model or corotational_fem "
-                         "model of that name");
+                         " has no whole-vessel static mass-spring model, P1 fem, corotational_fem "
+                         "or xpbd_fem model of that name");
       }
       out.push_back(&*it);
     }
@@ -168,8 +180,9 @@ std::vector<const ModelSpec*> chosen_models(const Scene& s, const ValidityOption
   }
   for (const ModelSpec& m : s.models) {
     if (!eligible(m)) continue;
-    // The default runs the seed models and corotational P1, the model simulators pick instead.
-    const bool seed = m.kind == ModelKind::corotational_fem ||
+    // The default runs the seed models, linear P1 (what the errors are read against) and the P1
+    // models simulators pick instead of springs.
+    const bool seed = on_mesh_kind(m) ||
                       (!m.volume_term && !m.edge_pairs && m.bending == msm::Bending::none &&
                        m.calibration.empty() &&
                        (m.stiffness == msm::StiffnessRule::seed000 ||
@@ -276,18 +289,20 @@ ValidityScene scene_settings(const Scene& s, const ValidityOptions& o) {
   return out;
 }
 
-/// The models the study judges, built on their level's mesh: mass-spring networks, and
-/// corotational P1 on the mesh's own nodes (tet models: an empty BuiltNetwork).
+/// The models the study judges, built on their level's mesh: mass-spring networks, and the P1
+/// tet models on the mesh's own nodes (those: an empty BuiltNetwork; linear P1 also no Form, its
+/// answer the unit load's displacement scaled).
 struct StudyModels {
   std::vector<const ModelSpec*> specs;
   TetMesh mesh;
   std::vector<msm::BuiltNetwork> built;
   std::vector<std::unique_ptr<msm::Form>> forms;
   std::vector<std::size_t> node_counts;
+  std::vector<std::vector<Vec3>> unit_displacement;  ///< linear P1 at unit load, m per unit
+  std::vector<std::optional<FemUpdates>> fem_timing;  ///< linear P1, when the study times updates
 
-  [[nodiscard]] bool on_mesh(std::size_t m) const {
-    return specs[m]->kind == ModelKind::corotational_fem;
-  }
+  [[nodiscard]] bool on_mesh(std::size_t m) const { return on_mesh_kind(*specs[m]); }
+  [[nodiscard]] bool linear_fem(std::size_t m) const { return specs[m]->kind == ModelKind::fem; }
   [[nodiscard]] const std::vector<Vec3>& nodes(std::size_t m) const {
     return on_mesh(m) ? mesh.nodes : built[m].network.nodes;
   }
@@ -311,12 +326,31 @@ StudyModels build_models(const Scene& s, const ValidityOptions& o, ValidityScene
   vessel.level = out.model_level;
   for (const ModelSpec* spec : m.specs) {
     std::string detail;
-    if (spec->kind == ModelKind::corotational_fem) {
+    m.unit_displacement.emplace_back();
+    m.fem_timing.emplace_back();
+    if (spec->kind == ModelKind::fem) {
+      // Linear P1 in the displacement formulation, as the harness runs it (fem_model_run.cpp).
       m.built.emplace_back();
-      m.forms.push_back(std::make_unique<msm::CorotationalTetTerm>(
-          m.mesh.nodes, m.mesh.tets, msm::lame_parameters(s.youngs_modulus, out.poisson_ratio)));
+      m.forms.emplace_back();
+      fem::ElasticityProblem problem = fem_problem(s, m.mesh, out.poisson_ratio, 1);
+      problem.options.formulation = fem::Formulation::displacement;
+      const Stopwatch construction;
+      fem::ElasticitySolver solver(m.mesh, problem);
+      const double construction_seconds = construction.seconds();
+      const fem::ElasticityResult& r = fem::solve_with(o.cache, solver, m.mesh, problem);
+      m.unit_displacement.back() = r.nodal_displacement;
+      if (o.time_updates) {
+        FemUpdates t = timed_fem_updates(solver, kRampUpdates, 1);
+        t.setup_seconds += construction_seconds;
+        m.fem_timing.back() = t;
+      }
       m.node_counts.push_back(m.mesh.nodes.size());
-      detail = "corotational P1 (Müller & Gross 2004), static Newton, consistent tangent";
+      detail = "linear P1 FEM (displacement formulation), the unit load's answer scaled";
+    } else if (on_mesh_kind(*spec)) {
+      m.built.emplace_back();
+      m.forms.push_back(tet_fem_term(*spec, m.mesh, s.youngs_modulus, out.poisson_ratio));
+      m.node_counts.push_back(m.mesh.nodes.size());
+      detail = tet_fem_detail(*spec);
     } else {
       m.built.push_back(scene_network(s, *spec, m.mesh, vessel, out.poisson_ratio));
       m.forms.push_back(msm::make_model(m.built.back(), spec->damping));
@@ -347,7 +381,7 @@ Continuation finite_continuation(const Scene& s, const ValidityOptions& o, const
   fo.min_step = (o.full ? 1e-4 : 2e-2) * ladder.back();
   fo.checkpoints = ladder;
   ContentHash what;
-  what.text("validity samples v2").real(qoi.x()).real(qoi.y()).real(qoi.z());
+  what.text("validity samples v3").real(qoi.x()).real(qoi.y()).real(qoi.z());
   what.real(kOutsideTolerance);
   for (std::size_t m = 0; m < models.specs.size(); ++m) {
     what.integer(static_cast<std::int64_t>(models.nodes(m).size()));
@@ -357,27 +391,41 @@ Continuation finite_continuation(const Scene& s, const ValidityOptions& o, const
     from_cache = false;
     Continuation c;
     fem::HyperelasticSolver fs(ref_mesh, problem, fo);
-    const fem::HyperelasticResult& r =
-        fs.solve([&](const fem::HyperelasticSolver& at, const fem::Checkpoint& cp) {
-          Sample x;
-          x.load = cp.load_factor;
-          x.load_steps = cp.load_steps;
-          x.rejected_steps = cp.rejected_steps;
-          x.newton_iterations = cp.newton_iterations;
-          x.seconds = cp.seconds;
-          x.qoi = at.displacement_at({qoi}, kOutsideTolerance)[0];
-          x.mesh_nodes = cp.nodal_displacement;
-          for (std::size_t m = 0; m < models.specs.size(); ++m) {
-            x.model_nodes.push_back(at.displacement_at(models.nodes(m), kOutsideTolerance));
-          }
-          std::ostringstream m;
-          m << "  " << s.name << ": finite strain at " << cp.load_factor << " " << load_unit(s.load.kind) << ": "
-            << cp.load_steps << " steps, " << cp.newton_iterations << " Newton iterations, "
-            << std::setprecision(3) << cp.seconds << " s";
-          log_line(o, m.str());
-          c.samples.push_back(std::move(x));
-          return std::string();
-        });
+    const auto take = [&](const fem::HyperelasticSolver& at, const fem::Checkpoint& cp) {
+      Sample x;
+      x.load = cp.load_factor;
+      x.load_steps = cp.load_steps;
+      x.rejected_steps = cp.rejected_steps;
+      x.newton_iterations = cp.newton_iterations;
+      x.seconds = cp.seconds;
+      x.qoi = at.displacement_at({qoi}, kOutsideTolerance)[0];
+      x.mesh_nodes = cp.nodal_displacement;
+      for (std::size_t m = 0; m < models.specs.size(); ++m) {
+        x.model_nodes.push_back(at.displacement_at(models.nodes(m), kOutsideTolerance));
+      }
+      std::ostringstream m;
+      m << "  " << s.name << ": finite strain at " << cp.load_factor << " " << load_unit(s.load.kind) << ": "
+        << cp.load_steps << " steps, " << cp.newton_iterations << " Newton iterations, "
+        << std::setprecision(3) << cp.seconds << " s";
+      log_line(o, m.str());
+      c.samples.push_back(std::move(x));
+      return std::string();
+    };
+    const fem::HyperelasticResult& r = fs.solve(take);
+    // A continuation that ends at the top of the ladder by an increment that lands there within
+    // round-off (not one cut to end on it) reports no checkpoint there: its final state is that
+    // load's, sampled here.
+    if (r.completed &&
+        (c.samples.empty() || c.samples.back().load < ladder.back() * (1.0 - 1e-12))) {
+      fem::Checkpoint top;
+      top.load_factor = ladder.back();
+      top.load_steps = static_cast<int>(r.steps.size());
+      top.rejected_steps = r.rejected_steps;
+      top.newton_iterations = r.newton_iterations;
+      top.seconds = r.timings.assembly + r.timings.solve;
+      top.nodal_displacement = r.nodal_displacement;
+      take(fs, top);
+    }
     c.element = r.element;
     c.dofs = r.n_dofs;
     c.completed = r.completed;
@@ -403,25 +451,77 @@ Continuation finite_continuation(const Scene& s, const ValidityOptions& o, const
   return deserialise(payload, ref_mesh.nodes.size(), models.node_counts);
 }
 
-/// Model m's errors against the finite-strain sample x, updated from its previous state along
-/// the ladder (a continuation too); a failure is recorded and restarts it from rest.
-/// Model m's errors against the finite-strain reference at sample x; with `fields` non-empty,
-/// its fields written there.
+/// The updater of model m on problem p: XPBD FEM stepped to its steady state, static Newton for
+/// corotational P1, the model's own solver for a spring network.
+std::unique_ptr<msm::Updater> model_updater(const StudyModels& models, std::size_t m,
+                                            const msm::Problem& p) {
+  const ModelSpec& spec = *models.specs[m];
+  if (spec.kind == ModelKind::xpbd_fem) {
+    return std::make_unique<XpbdFemUpdater>(p, static_cast<const msm::TetTerm&>(*models.forms[m]),
+                                            spec.tet_fem);
+  }
+  if (spec.kind == ModelKind::corotational_fem) {
+    return msm::prepare_updates(p, msm::parse_solver("static"));
+  }
+  return msm::prepare_updates(p, spec.solver);
+}
+
+/// Model m timed at `load` as `vesselverify run` times it (set-up apart): linear P1 and the static
+/// models over a ramp of kRampUpdates warm-started updates to the load (timed_updates), XPBD FEM
+/// from rest to its steady state; with the time per update at 30 Hz and 1 kHz (time_per_update:
+/// XPBD FEM pays its per-step cost × the steps one period holds).
+ValidityTiming timed_update(const Scene& s, const StudyModels& models, std::size_t m, double load) {
+  ValidityTiming t;
+  const ModelSpec& spec = *models.specs[m];
+  if (models.linear_fem(m)) {
+    t.setup_seconds = models.fem_timing[m]->setup_seconds;
+    t.update_seconds = models.fem_timing[m]->update_seconds;
+  } else if (spec.kind == ModelKind::xpbd_fem) {
+    const msm::Problem p = models.problem(s, m, load);
+    XpbdFemUpdater up(p, static_cast<const msm::TetTerm&>(*models.forms[m]), spec.tet_fem);
+    const msm::UpdateResult r = up.update(p.external_force);
+    t.setup_seconds = up.setup_seconds();
+    t.update_seconds = r.seconds;
+    t.steps = r.iterations;
+    t.dt = spec.tet_fem.dt;
+  } else {
+    const msm::Problem p = models.problem(s, m, load);
+    const msm::SolverSpec solver = spec.kind == ModelKind::corotational_fem
+                                       ? msm::parse_solver("static")
+                                       : spec.solver;
+    const UpdateSequence seq = timed_updates(p, solver, kRampUpdates, 1);
+    t.setup_seconds = seq.setup_seconds;
+    t.update_seconds = seq.update_seconds;
+  }
+  t.update_seconds_30hz = time_per_update(t.update_seconds, t.steps, t.dt, 1.0 / 30.0).first;
+  t.update_seconds_1khz = time_per_update(t.update_seconds, t.steps, t.dt, 1e-3).first;
+  return t;
+}
+
+/// Model m's errors against the finite-strain reference at sample x, updated from its previous
+/// state along the ladder (a continuation too; a failure is recorded and restarts it from rest);
+/// linear P1's answer is its unit-load answer scaled. With `fields` non-empty, its fields written
+/// there; with `timed`, its update timed afresh (timed_update).
 ValidityModelError model_error(const Scene& s, const StudyModels& models, std::size_t m,
                                const Sample& x, std::unique_ptr<msm::Updater>& updater,
-                               const std::filesystem::path& fields) {
+                               const std::filesystem::path& fields, bool timed) {
   ValidityModelError e;
   e.model = models.specs[m]->name;
   try {
-    const msm::Problem p = models.problem(s, m, x.load);
-    if (!updater) updater = msm::prepare_updates(p, models.specs[m]->solver);
-    const msm::UpdateResult u = updater->update(p.external_force);
-    e.iterations = u.iterations;
-    const Eigen::VectorXd& state = updater->state();
     const auto& nodes = models.nodes(m);
     std::vector<Vec3> um(nodes.size());
-    for (std::size_t i = 0; i < nodes.size(); ++i) {
-      um[i] = state.segment<3>(3 * static_cast<Eigen::Index>(i)) - nodes[i];
+    if (models.linear_fem(m)) {
+      um = scaled(models.unit_displacement[m], x.load);
+      e.iterations = 1;
+    } else {
+      const msm::Problem p = models.problem(s, m, x.load);
+      if (!updater) updater = model_updater(models, m, p);
+      const msm::UpdateResult u = updater->update(p.external_force);
+      e.iterations = u.iterations;
+      const Eigen::VectorXd& state = updater->state();
+      for (std::size_t i = 0; i < nodes.size(); ++i) {
+        um[i] = state.segment<3>(3 * static_cast<Eigen::Index>(i)) - nodes[i];
+      }
     }
     const ErrorStatistics st = compare_displacements(um, x.model_nodes[m]);
     e.relative_l2 = st.relative_l2;
@@ -431,6 +531,7 @@ ValidityModelError model_error(const Scene& s, const StudyModels& models, std::s
     e.qoi_error_mm = (um[q] - uref).norm() * 1e3;
     e.qoi_model_mm = um[q].norm() * 1e3;
     e.qoi_relative = uref.norm() > 0.0 ? (um[q] - uref).norm() / uref.norm() : 0.0;
+    if (timed) e.timing = timed_update(s, models, m, x.load);
     e.ok = true;
     if (!fields.empty()) {
       write_fields_vtu(fields, nodes, models.cells(m), um, x.model_nodes[m]);
@@ -509,7 +610,7 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
         name << file_stem(models.specs[m]->name) << "_load" << x.load << ".vtu";
         fields = o.fields_dir / file_stem(s.name) / name.str();
       }
-      row.models.push_back(model_error(s, models, m, x, updaters[m], fields));
+      row.models.push_back(model_error(s, models, m, x, updaters[m], fields, o.time_updates));
     }
     out.rows.push_back(std::move(row));
   }
@@ -532,7 +633,7 @@ ValidityScene run_validity_scene(const Scene& s, const ValidityOptions& o) {
 
 std::vector<ValidityScene> run_validity(const std::vector<Scene>& scenes,
                                         const ValidityOptions& o, int jobs) {
-  if (o.mesh_cache_dir.empty()) jobs = 1;
+  if (o.mesh_cache_dir.empty() || o.time_updates) jobs = 1;  // timings: one scene at a time
   if (jobs > 1) {
     for (const Scene& s : scenes) {
       (void)scene_mesh(s, reference_level_of(s, o), o.mesh_cache_dir);
@@ -580,6 +681,15 @@ json model_error_json(const ValidityModelError& e, const std::filesystem::path& 
             {"qoi_relative", e.qoi_relative},
             {"qoi_model_mm", e.qoi_model_mm},
             {"iterations", e.iterations}});
+  if (e.timing) {
+    const ValidityTiming& t = *e.timing;
+    m["timing"] = {{"setup_seconds", t.setup_seconds},
+                   {"update_seconds", t.update_seconds},
+                   {"steps", t.steps},
+                   {"dt", t.dt},
+                   {"update_seconds_30hz", t.update_seconds_30hz},
+                   {"update_seconds_1khz", t.update_seconds_1khz}};
+  }
   if (!e.fields_file.empty()) {
     m["fields"] = std::filesystem::absolute(e.fields_file)
                       .lexically_relative(std::filesystem::absolute(json_dir))

@@ -1,7 +1,8 @@
 #pragma once
-/// `vesselverify validity` (issue 17 item 3): the measured limit of the linear reference's
-/// validity and the mass-spring models judged against the finite-strain reference over a load
-/// ladder (for contact, seed 000's force range up to 140 mN). Per scene: the linear reference
+/// `vesselverify validity`: the measured limit of the linear reference's validity, and the
+/// mass-spring models and linear, corotational and XPBD P1 FEM judged against the finite-strain
+/// reference over a load ladder, optionally with each model's time per update. For contact the
+/// ladder spans seed 000's force range up to 140 mN. Per scene: the linear reference
 /// (unit load, scaled) and one finite-strain continuation (fem::HyperelasticSolver with the
 /// ladder as checkpoints, kept in the FEM solution cache) on the same mesh and elements; at each
 /// load of the ladder the two references' relative difference at the QoI and over the mesh's
@@ -42,6 +43,19 @@ struct ThresholdCrossing {
 ThresholdCrossing threshold_crossing(const std::vector<double>& loads,
                                      const std::vector<double>& differences, double threshold);
 
+/// A model's update timed as `vesselverify run` times it (set-up apart), s.
+struct ValidityTiming {
+  double setup_seconds = 0.0;  ///< assembly, factorisation (XPBD FEM: its constraints)
+  /// Linear P1 and the static models: the median update of a ramp of kRampUpdates warm-started
+  /// updates to the load (timed_updates); XPBD FEM: its run from rest to steady state.
+  double update_seconds = 0.0;
+  long steps = 0;   ///< XPBD FEM: that run's steps; 0 otherwise
+  double dt = 0.0;  ///< XPBD FEM: its step, s; 0 otherwise
+  /// What a simulator pays per update at 30 Hz and at 1 kHz (harness/budget.hpp time_per_update:
+  /// XPBD FEM's per-step cost × the steps one period holds; the others update_seconds).
+  double update_seconds_30hz = 0.0, update_seconds_1khz = 0.0;
+};
+
 /// One model's errors against the finite-strain reference at one load.
 struct ValidityModelError {
   std::string model;
@@ -52,7 +66,8 @@ struct ValidityModelError {
   double qoi_error_mm = 0.0;     ///< |u_model − u_ref| at its QoI node
   double qoi_relative = 0.0;     ///< that over |u_ref| there
   double qoi_model_mm = 0.0;     ///< |u_model| at its QoI node
-  int iterations = 0;            ///< Newton iterations of its update
+  int iterations = 0;  ///< Newton iterations of its update (XPBD FEM: steps; linear P1: 1)
+  std::optional<ValidityTiming> timing;  ///< when ValidityOptions::time_updates
   /// The VTU of its fields against the finite-strain reference (written at the largest load
   /// reached when ValidityOptions::fields_dir is set); empty otherwise.
   std::filesystem::path fields_file;
@@ -124,6 +139,8 @@ struct ValidityOptions {
   /// `vesselverify run` writes them (harness/model_readout.hpp write_fields_vtu), under
   /// <fields_dir>/<scene>/; "" none.
   std::filesystem::path fields_dir;
+  /// Each model's update also timed afresh at each load (ValidityTiming), scenes one at a time.
+  bool time_updates = false;
   fem::SolutionCache* cache = nullptr;   ///< the finite-strain continuation and linear solve
   fem::HyperelasticOptions finite;       ///< Newton settings (target and checkpoints: the study's)
   std::ostream* log = nullptr;
@@ -136,11 +153,11 @@ std::vector<double> default_ladder(const Scene& scene, bool full, bool quick = f
 
 /// The study on one scene at its first Poisson's ratio. InputError for a scene it cannot run
 /// (a dynamic or modal-only scene, a model named that is not a whole-vessel static mass-spring
-/// model).
+/// model, linear P1 FEM, corotational P1 or XPBD FEM).
 ValidityScene run_validity_scene(const Scene& scene, const ValidityOptions& options);
 
-/// run_validity_scene for each scene, `jobs` scenes at a time (untimed work: the study reports
-/// no model timings). With jobs > 1 the meshes are made first, one at a time (gmsh is not
+/// run_validity_scene for each scene, `jobs` scenes at a time (one at a time when it times the
+/// models' updates). With jobs > 1 the meshes are made first, one at a time (gmsh is not
 /// thread-safe), and the threads read them from the mesh cache; without a mesh cache, one at a
 /// time. In the scenes' order.
 std::vector<ValidityScene> run_validity(const std::vector<Scene>& scenes,
