@@ -474,10 +474,11 @@ struct HyperelasticSolver::Impl {
     result.self_contact = false;
     result.stop_reason.clear();
     while (s < target * (1.0 - 1e-14)) {
-      // A step ends at the next checkpoint when it would pass it; ds itself (the increment the
-      // adaptation has learnt) is kept for the steps after it.
+      // A step ends at the next checkpoint when it would pass it, or reach it within round-off
+      // (steps of 0.1 sum to 0.9999999999999999, not 1); ds itself (the increment the adaptation
+      // has learnt) is kept for the steps after it.
       const double stop = next < opt.checkpoints.size() ? opt.checkpoints[next] : target;
-      const bool to_stop = ds >= stop - s;
+      const bool to_stop = ds >= (stop - s) - 1e-12 * stop;
       const double step = to_stop ? stop - s : ds;
       const dl::Vector<double> u_start = u;
       StepOutcome o = newton_step(s, s + step);

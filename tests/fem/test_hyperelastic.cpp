@@ -272,6 +272,21 @@ TEST(HyperelasticContinuation, CheckpointsMatchTheClosedFormAtEachLoad) {
   }
 }
 
+TEST(HyperelasticContinuation, AStepThatReachesACheckpointWithinRoundOffEndsOnIt) {
+  // Ten steps of 0.1 sum to 0.9999999999999999: the last must still end on the checkpoint at 1
+  // (and record it), not stop a round-off short of the target with no checkpoint there.
+  const TetMesh mesh = test::cube_mesh(1, 1e-3);
+  HyperelasticOptions o;
+  o.initial_step = o.max_step = 0.1;
+  o.checkpoints = {1.0};
+  HyperelasticSolver s(mesh, cube_problem(0.3, 1, Formulation::displacement, -2000.0), o);
+  const auto& r = s.solve([](const HyperelasticSolver&, const Checkpoint&) { return std::string(); });
+  ASSERT_TRUE(r.completed) << r.stop_reason;
+  ASSERT_EQ(r.checkpoints.size(), 1u);
+  EXPECT_EQ(r.checkpoints[0].load_factor, 1.0);
+  EXPECT_EQ(r.load_factor, 1.0);
+}
+
 TEST(HyperelasticContinuation, AnObserverStopsTheContinuationWithItsReason) {
   const TetMesh mesh = test::cube_mesh(1, 1e-3);
   HyperelasticOptions o;

@@ -412,20 +412,6 @@ Continuation finite_continuation(const Scene& s, const ValidityOptions& o, const
       return std::string();
     };
     const fem::HyperelasticResult& r = fs.solve(take);
-    // A continuation that ends at the top of the ladder by an increment that lands there within
-    // round-off (not one cut to end on it) reports no checkpoint there: its final state is that
-    // load's, sampled here.
-    if (r.completed &&
-        (c.samples.empty() || c.samples.back().load < ladder.back() * (1.0 - 1e-12))) {
-      fem::Checkpoint top;
-      top.load_factor = ladder.back();
-      top.load_steps = static_cast<int>(r.steps.size());
-      top.rejected_steps = r.rejected_steps;
-      top.newton_iterations = r.newton_iterations;
-      top.seconds = r.timings.assembly + r.timings.solve;
-      top.nodal_displacement = r.nodal_displacement;
-      take(fs, top);
-    }
     c.element = r.element;
     c.dofs = r.n_dofs;
     c.completed = r.completed;
