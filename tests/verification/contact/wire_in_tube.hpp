@@ -79,15 +79,16 @@ struct Wire {
   msm::rods::RodLayout layout;
   msm::rods::DerRod rod;
   double EI = 0.0, radius = 0.0;
-  Wire(double diameter, double length, int segments, const Vec3& origin)
+  Wire(double diameter, double length, int segments, const Vec3& origin,
+       const msm::rods::RodMaterial& material = kNitinol)
       : layout([&] {
-          msm::rods::RodSpec s = msm::rods::uniform_rod(kNitinol, length, diameter, segments);
+          msm::rods::RodSpec s = msm::rods::uniform_rod(material, length, diameter, segments);
           s.origin = origin;
           s.direction = Vec3(std::sin(kTheta), 0.0, std::cos(kTheta));
           return msm::rods::make_layout(s);
         }()),
         rod(layout),
-        EI(msm::rods::solid_section(kNitinol, diameter).EI),
+        EI(msm::rods::solid_section(material, diameter).EI),
         radius(diameter / 2) {}
   [[nodiscard]] contact::ContactWire contact() const {
     contact::ContactWire w;
