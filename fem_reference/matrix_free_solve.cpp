@@ -45,6 +45,7 @@ void ElasticitySolver::Impl::solve_displacement_matrix_free() {
         degree, form->lambda(), form->mu(), detail::node_centroid(mesh));
     result.iterations =
         wall.solve(rhs, solution, o.cg_relative_tolerance, o.max_iterations).iterations;
+    result.matrix_free = wall.profile();
   }
   constraints.distribute(solution);
 }
