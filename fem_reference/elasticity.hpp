@@ -262,6 +262,10 @@ class ElasticitySolver {
   /// bilinear form free_displacement_system() assembles (compare them on its free rows).
   /// Displacement formulation only (InputError for the mixed one); does not need solve().
   [[nodiscard]] std::vector<double> matrix_free_product(const std::vector<double>& u) const;
+  /// diag(A) of the matrix-free operator (N/m per DoF; 1 on the constrained DoFs), as the
+  /// multigrid's Chebyshev smoother gets it (MatrixFreeTools::compute_diagonal). Displacement
+  /// formulation only.
+  [[nodiscard]] std::vector<double> matrix_free_diagonal() const;
 
   /// The solved DoF values (displacement, and pressure for the mixed formulation), in this
   /// solver's DoF numbering, which depends only on the mesh and the problem. Requires solve().

@@ -31,8 +31,9 @@ namespace vessel::fem::detail {
 using MfVector = dl::LinearAlgebra::distributed::Vector<double>;
 
 /// A(u) = ∫ σ(u) : ε(v) dV with σ = λ tr(ε) I + 2μ ε (Pa, so A u is in N for u in m), evaluated
-/// cell by cell at QGaussSimplex(degree + 1) — the assembled path's quadrature, so both compute the
-/// same bilinear form to rounding. `constraints` must be homogeneous (their pattern only): A acts
+/// cell by cell at QGaussSimplex(degree) on straight-sided tets (exact there) and at the assembled
+/// path's QGaussSimplex(degree + 1) on curved ones, so both compute the same bilinear form to
+/// rounding. `constraints` must be homogeneous (their pattern only): A acts
 /// on the unconstrained DoFs and as the identity on the constrained ones.
 class ElasticityOperator : public dl::Subscriptor {
  public:
