@@ -154,14 +154,14 @@ struct PhaseTimings {
 /// Where the matrix-free solve (LinearSolver::matrix_free) spent its wall-clock seconds: the
 /// set-up's parts, then the CG's. Zero for the other solvers.
 struct MatrixFreeProfile {
-  double fine_operator = 0.0;   ///< MatrixFree::reinit on the fine DoFs (mapping data, indices)
-  double coarse_level = 0.0;    ///< P1 DoFHandler, its constraints and MatrixFree::reinit
-  double transfer = 0.0;        ///< the P2 → P1 transfer's set-up
-  double diagonal = 0.0;        ///< diag(A) for Chebyshev
+  double fine_operator = 0.0;  ///< MatrixFree::reinit on the fine DoFs (mapping data, indices)
+  double coarse_level = 0.0;   ///< P1 DoFHandler, its constraints and MatrixFree::reinit
+  double transfer = 0.0;       ///< the P2 → P1 transfer's set-up
+  double diagonal = 0.0;       ///< diag(A) for Chebyshev
   double eigenvalue_estimate = 0.0;  ///< Chebyshev's λ_max(D⁻¹A) by CG steps
-  double coarse_matrix = 0.0;   ///< the P1 matrix (MatrixFreeTools::compute_matrix)
-  double coarse_factor = 0.0;   ///< CHOLMOD's analysis and factorisation of it (or ML's set-up)
-  double cg = 0.0;              ///< the CG iterations, all of them
+  double coarse_matrix = 0.0;        ///< the P1 matrix (MatrixFreeTools::compute_matrix)
+  double coarse_factor = 0.0;  ///< CHOLMOD's analysis and factorisation of it (or ML's set-up)
+  double cg = 0.0;             ///< the CG iterations, all of them
   unsigned operator_applications = 0;  ///< fine A·v in the CG (smoother, residuals, CG's own)
   double operator_seconds = 0.0;       ///< of cg: in those applications
   unsigned coarse_solves = 0;          ///< P1 solves (one per V-cycle)

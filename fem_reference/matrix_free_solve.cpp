@@ -55,7 +55,8 @@ void ElasticitySolver::Impl::solve_displacement_matrix_free() {
 namespace {
 void require_displacement(bool mixed, const char* what) {
   if (mixed) {
-    throw InputError(std::string(what) + ": the matrix-free operator is for the displacement "
+    throw InputError(std::string(what) +
+                     ": the matrix-free operator is for the displacement "
                      "formulation (P1, P2), not the mixed one");
   }
 }

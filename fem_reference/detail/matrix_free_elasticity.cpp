@@ -322,9 +322,9 @@ MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(const dl::Mapping<kDim>& 
   fine_ = std::make_unique<ElasticityOperator>(mapping, dof, fine_constraints_, degree, lambda, mu);
   profile_.fine_operator = seconds_since(t_fine);
   profile_.quadrature_points = fine_->quadrature_points();
-  preconditioner_ = std::make_unique<VCycle>(mapping, dof, *fine_, fine_constraints_,
-                                             constraints_for, degree, lambda, mu, centre, settings,
-                                             profile_);
+  preconditioner_ =
+      std::make_unique<VCycle>(mapping, dof, *fine_, fine_constraints_, constraints_for, degree,
+                               lambda, mu, centre, settings, profile_);
   setup_seconds_ =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
