@@ -151,6 +151,26 @@ struct PhaseTimings {
   double postprocess = 0.0;  ///< nodal values, energy, strains, reactions
 };
 
+/// Where the matrix-free solve (LinearSolver::matrix_free) spent its wall-clock seconds: the
+/// set-up's parts, then the CG's. Zero for the other solvers.
+struct MatrixFreeProfile {
+  double fine_operator = 0.0;  ///< MatrixFree::reinit on the fine DoFs (mapping data, indices)
+  double coarse_level = 0.0;   ///< P1 DoFHandler, its constraints and MatrixFree::reinit
+  double transfer = 0.0;       ///< the P2 → P1 transfer's set-up
+  double diagonal = 0.0;       ///< diag(A) for Chebyshev
+  double eigenvalue_estimate = 0.0;  ///< Chebyshev's λ_max(D⁻¹A) by CG steps
+  double coarse_matrix = 0.0;        ///< the P1 matrix (MatrixFreeTools::compute_matrix)
+  double coarse_factor = 0.0;  ///< CHOLMOD's analysis and factorisation of it (or ML's set-up)
+  double cg = 0.0;             ///< the CG iterations, all of them
+  unsigned operator_applications = 0;  ///< fine A·v in the CG (smoother, residuals, CG's own)
+  double operator_seconds = 0.0;       ///< of cg: in those applications
+  unsigned coarse_solves = 0;          ///< P1 solves (one per V-cycle)
+  double coarse_solve_seconds = 0.0;   ///< of cg: in those
+  double transfer_seconds = 0.0;       ///< of cg: restriction and prolongation
+  unsigned chebyshev_degree = 0;       ///< matrix-vector products per smoothing step
+  unsigned quadrature_points = 0;      ///< per cell, of the fine operator
+};
+
 struct ElasticityResult {
   std::string element;  ///< "P1", "P2" or "P2-P1 (Taylor-Hood)"
   bool curved = false;  ///< quadratic geometry on the curved surfaces
@@ -170,6 +190,7 @@ struct ElasticityResult {
   std::vector<std::array<double, 6>> tet_strain;
   std::vector<std::array<double, 6>> tet_stress;
   PhaseTimings timings;
+  MatrixFreeProfile matrix_free;  ///< solver matrix_free only
 };
 
 /// Natural frequencies and mode shapes: K x = ω² M x with the consistent mass matrix, on the
@@ -241,6 +262,10 @@ class ElasticitySolver {
   /// bilinear form free_displacement_system() assembles (compare them on its free rows).
   /// Displacement formulation only (InputError for the mixed one); does not need solve().
   [[nodiscard]] std::vector<double> matrix_free_product(const std::vector<double>& u) const;
+  /// diag(A) of the matrix-free operator (N/m per DoF; 1 on the constrained DoFs), as the
+  /// multigrid's Chebyshev smoother gets it (MatrixFreeTools::compute_diagonal). Displacement
+  /// formulation only.
+  [[nodiscard]] std::vector<double> matrix_free_diagonal() const;
 
   /// The solved DoF values (displacement, and pressure for the mixed formulation), in this
   /// solver's DoF numbering, which depends only on the mesh and the problem. Requires solve().

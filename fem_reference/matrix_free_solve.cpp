@@ -3,6 +3,8 @@
 /// detail/matrix_free_elasticity.
 #include <deal.II/lac/la_parallel_vector.h>
 
+#include <string>
+
 #include "fem_reference/detail/matrix_free_elasticity.hpp"
 #include "fem_reference/detail/serial_solver.hpp"
 #include "meshes/foundation/errors.hpp"
@@ -45,16 +47,35 @@ void ElasticitySolver::Impl::solve_displacement_matrix_free() {
         degree, form->lambda(), form->mu(), detail::node_centroid(mesh));
     result.iterations =
         wall.solve(rhs, solution, o.cg_relative_tolerance, o.max_iterations).iterations;
+    result.matrix_free = wall.profile();
   }
   constraints.distribute(solution);
 }
 
-std::vector<double> ElasticitySolver::matrix_free_product(const std::vector<double>& u) const {
-  const auto& im = *impl_;
-  if (im.mixed) {
-    throw InputError("matrix_free_product: the matrix-free operator is for the displacement "
+namespace {
+void require_displacement(bool mixed, const char* what) {
+  if (mixed) {
+    throw InputError(std::string(what) +
+                     ": the matrix-free operator is for the displacement "
                      "formulation (P1, P2), not the mixed one");
   }
+}
+}  // namespace
+
+std::vector<double> ElasticitySolver::matrix_free_diagonal() const {
+  const auto& im = *impl_;
+  require_displacement(im.mixed, "matrix_free_diagonal");
+  detail::ensure_mpi_initialized();
+  const auto homogeneous = detail::homogeneous_copy(im.constraints);
+  const detail::ElasticityOperator op(*im.mapping, im.dof, homogeneous, im.degree,
+                                      im.form->lambda(), im.form->mu());
+  const auto d = op.diagonal();
+  return {d.begin(), d.end()};
+}
+
+std::vector<double> ElasticitySolver::matrix_free_product(const std::vector<double>& u) const {
+  const auto& im = *impl_;
+  require_displacement(im.mixed, "matrix_free_product");
   if (u.size() != im.dof.n_dofs()) {
     throw std::invalid_argument("matrix_free_product: " + std::to_string(u.size()) +
                                 " values for a solver with " + std::to_string(im.dof.n_dofs()) +

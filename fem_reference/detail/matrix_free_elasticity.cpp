@@ -4,6 +4,7 @@
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/mapping_fe.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
@@ -37,6 +38,8 @@ void stress_divergence(Evaluation& phi, double lambda, double mu) {
   }
   phi.integrate(dl::EvaluationFlags::gradients);
 }
+
+using Clock = std::chrono::steady_clock;
 
 void copy(const dl::Vector<double>& from, MfVector& to) {
   for (unsigned i = 0; i < from.size(); ++i) to.local_element(i) = from[i];
@@ -78,11 +81,19 @@ ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
   dl::MatrixFree<kDim, double>::AdditionalData data;
   data.mapping_update_flags = dl::update_gradients | dl::update_JxW_values;
   data.tasks_parallel_scheme = dl::MatrixFree<kDim, double>::AdditionalData::none;
-  mf_.reinit(mapping, dof, constraints, dl::QGaussSimplex<kDim>(static_cast<unsigned>(degree + 1)),
-             data);
+  // On straight-sided tets (a degree-1 MappingFE) ε(u):Cε(v) is a polynomial of degree
+  // 2(degree − 1), which QGaussSimplex(degree) integrates exactly (degree 2·degree − 1): the same
+  // bilinear form as the assembled path's QGaussSimplex(degree + 1), at 6 instead of 14 points
+  // per P2 cell (1 instead of 6 for P1). Curved cells keep degree + 1, as the assembly does.
+  const auto* fe_mapping = dynamic_cast<const dl::MappingFE<kDim>*>(&mapping);
+  const bool affine = fe_mapping != nullptr && fe_mapping->get_degree() == 1;
+  const dl::QGaussSimplex<kDim> quadrature(static_cast<unsigned>(affine ? degree : degree + 1));
+  n_quadrature_points_ = quadrature.size();
+  mf_.reinit(mapping, dof, constraints, quadrature, data);
 }
 
 void ElasticityOperator::vmult(MfVector& dst, const MfVector& src) const {
+  const auto t0 = Clock::now();
   const std::function<void(const dl::MatrixFree<kDim, double>&, MfVector&, const MfVector&,
                            const std::pair<unsigned, unsigned>&)>
       cells = [this](const dl::MatrixFree<kDim, double>& mf, MfVector& out, const MfVector& in,
@@ -97,6 +108,8 @@ void ElasticityOperator::vmult(MfVector& dst, const MfVector& src) const {
       };
   mf_.cell_loop(cells, dst, src, true);
   for (const unsigned i : mf_.get_constrained_dofs()) dst.local_element(i) = src.local_element(i);
+  ++applications_;
+  seconds_ += seconds_since(t0);
 }
 
 MfVector ElasticityOperator::diagonal() const {
@@ -135,9 +148,16 @@ class MatrixFreeElasticitySolver::VCycle {
   VCycle(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
          const ElasticityOperator& fine, const dl::AffineConstraints<double>& fine_constraints,
          const ConstraintsFor& constraints_for, int degree, double lambda, double mu,
-         const Vec3& centre, const PMultigridSettings& settings)
+         const Vec3& centre, const PMultigridSettings& settings, MatrixFreeProfile& profile)
       : fine_(fine), coarse_dof_(dof.get_triangulation()) {
     const ElasticityOperator* coarse = &fine;
+    auto t0 = Clock::now();
+    // The seconds since the last lap, for the profile.
+    const auto lap = [&t0] {
+      const double s = seconds_since(t0);
+      t0 = Clock::now();
+      return s;
+    };
     if (degree > 1) {
       coarse_dof_.distribute_dofs(dl::FESystem<kDim>(dl::FE_SimplexP<kDim>(1), kDim));
       dl::AffineConstraints<double> c;
@@ -147,11 +167,14 @@ class MatrixFreeElasticitySolver::VCycle {
       coarse_ = std::make_unique<ElasticityOperator>(mapping, coarse_dof_, coarse_constraints_, 1,
                                                      lambda, mu);
       coarse = coarse_.get();
+      profile.coarse_level = lap();
       transfer_.reinit_polynomial_transfer(dof, coarse_dof_, fine_constraints, coarse_constraints_);
+      profile.transfer = lap();
 
       inverse_diagonal_ = std::make_shared<dl::DiagonalMatrix<MfVector>>();
       inverse_diagonal_->get_vector() = fine.diagonal();
       for (auto& d : inverse_diagonal_->get_vector()) d = 1.0 / d;
+      profile.diagonal = lap();
       Chebyshev::AdditionalData cheb;
       cheb.degree = settings.chebyshev_degree;
       cheb.smoothing_range = settings.smoothing_range;
@@ -162,14 +185,23 @@ class MatrixFreeElasticitySolver::VCycle {
       fine.initialize_dof_vector(correction_);
       coarse->initialize_dof_vector(coarse_residual_);
       coarse->initialize_dof_vector(coarse_correction_);
+      const unsigned applications_before = fine.applications();
+      const double seconds_before = fine.seconds();
+      chebyshev_.estimate_eigenvalues(residual_);  // here rather than in the first V-cycle
+      profile.eigenvalue_estimate = lap();
+      eigenvalue_applications_ = fine.applications() - applications_before;
+      eigenvalue_seconds_ = fine.seconds() - seconds_before;
+      profile.chebyshev_degree = settings.chebyshev_degree;
     }
     coarse_matrix_ = std::make_unique<dl::TrilinosWrappers::SparseMatrix>();
     coarse->compute_matrix(*coarse_matrix_);
+    profile.coarse_matrix = lap();
     // For P1 the "coarse" level is the fine one: a factor of it would make the matrix-free
     // operator pointless, so P1 always takes ML.
     if (settings.coarse == CoarseSolve::cholmod && degree > 1) {
       cholmod_ = std::make_unique<CholmodFactor>(to_eigen(*coarse_matrix_));
       coarse_matrix_.reset();
+      profile.coarse_factor = lap();
       return;
     }
     // The ML near-null space: the rigid-body modes at the P1 DoFs' support points.
@@ -188,6 +220,7 @@ class MatrixFreeElasticitySolver::VCycle {
     initialize_elasticity_amg(amg_, *coarse_matrix_, rows, centre, false,
                               settings.amg_rigid_body_modes, settings.amg_prolongator,
                               mode_storage_);
+    profile.coarse_factor = lap();
   }
 
   void vmult(MfVector& dst, const MfVector& src) const {
@@ -200,12 +233,16 @@ class MatrixFreeElasticitySolver::VCycle {
     fine_.zero_constrained(dst);
     fine_.vmult(residual_, dst);
     residual_.sadd(-1.0, 1.0, src);
+    auto t0 = Clock::now();
     coarse_residual_ = 0.0;
     transfer_.restrict_and_add(coarse_residual_, residual_);
     coarse_->zero_constrained(coarse_residual_);
+    transfer_seconds_ += seconds_since(t0);
     coarse_solve(coarse_correction_, coarse_residual_);
     coarse_->zero_constrained(coarse_correction_);
+    t0 = Clock::now();
     transfer_.prolongate_and_add(dst, coarse_correction_);
+    transfer_seconds_ += seconds_since(t0);
     fine_.zero_constrained(dst);
     fine_.vmult(residual_, dst);  // post-smoothing on the new residual
     residual_.sadd(-1.0, 1.0, src);
@@ -221,21 +258,34 @@ class MatrixFreeElasticitySolver::VCycle {
            4 * residual_.memory_consumption();
   }
 
+  /// The CG-time parts of `profile`: coarse solves and transfers so far.
+  void add_solve_profile(MatrixFreeProfile& profile) const {
+    profile.coarse_solves = coarse_solves_;
+    profile.coarse_solve_seconds = coarse_solve_seconds_;
+    profile.transfer_seconds = transfer_seconds_;
+  }
+  /// Fine-operator applications of the set-up's eigenvalue estimate (not the CG's), and seconds.
+  [[nodiscard]] unsigned eigenvalue_applications() const { return eigenvalue_applications_; }
+  [[nodiscard]] double eigenvalue_seconds() const { return eigenvalue_seconds_; }
+
  private:
   using Chebyshev = dl::PreconditionChebyshev<ElasticityOperator, MfVector,
                                               dl::DiagonalMatrix<MfVector>>;
 
   /// x ≈ A₁⁻¹ b on the P1 level (on the fine level itself for P1).
   void coarse_solve(MfVector& x, const MfVector& b) const {
+    const auto t0 = Clock::now();
+    ++coarse_solves_;
     if (!cholmod_) {
       amg_.vmult(x, b);
-      return;
+    } else {
+      const unsigned n = b.locally_owned_size();
+      Eigen::VectorXd rhs(n);
+      for (unsigned i = 0; i < n; ++i) rhs[i] = b.local_element(i);
+      const Eigen::VectorXd y = cholmod_->solve(rhs);
+      for (unsigned i = 0; i < n; ++i) x.local_element(i) = y[i];
     }
-    const unsigned n = b.locally_owned_size();
-    Eigen::VectorXd rhs(n);
-    for (unsigned i = 0; i < n; ++i) rhs[i] = b.local_element(i);
-    const Eigen::VectorXd y = cholmod_->solve(rhs);
-    for (unsigned i = 0; i < n; ++i) x.local_element(i) = y[i];
+    coarse_solve_seconds_ += seconds_since(t0);
   }
 
   const ElasticityOperator& fine_;
@@ -250,6 +300,10 @@ class MatrixFreeElasticitySolver::VCycle {
   dl::TrilinosWrappers::PreconditionAMG amg_;
   std::vector<double> mode_storage_;  // must outlive amg_
   mutable MfVector residual_, correction_, coarse_residual_, coarse_correction_;
+  unsigned eigenvalue_applications_ = 0;
+  double eigenvalue_seconds_ = 0.0;
+  mutable unsigned coarse_solves_ = 0;
+  mutable double coarse_solve_seconds_ = 0.0, transfer_seconds_ = 0.0;
 };
 
 MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(const dl::Mapping<kDim>& mapping,
@@ -264,9 +318,13 @@ MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(const dl::Mapping<kDim>& 
   constraints_for(dof, c);
   c.close();
   fine_constraints_ = homogeneous_copy(c);
+  const auto t_fine = Clock::now();
   fine_ = std::make_unique<ElasticityOperator>(mapping, dof, fine_constraints_, degree, lambda, mu);
-  preconditioner_ = std::make_unique<VCycle>(mapping, dof, *fine_, fine_constraints_,
-                                             constraints_for, degree, lambda, mu, centre, settings);
+  profile_.fine_operator = seconds_since(t_fine);
+  profile_.quadrature_points = fine_->quadrature_points();
+  preconditioner_ =
+      std::make_unique<VCycle>(mapping, dof, *fine_, fine_constraints_, constraints_for, degree,
+                               lambda, mu, centre, settings, profile_);
   setup_seconds_ =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -285,6 +343,7 @@ MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::solve(
   fine_->zero_constrained(x);
   dl::SolverControl control(max_iterations, relative_tolerance * rhs.l2_norm());
   dl::SolverCG<MfVector> cg(control);
+  const auto t0 = Clock::now();
   try {
     cg.solve(*fine_, x, rhs, *preconditioner_);
   } catch (const dl::SolverControl::NoConvergence& e) {
@@ -294,8 +353,17 @@ MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::solve(
       << "); try --solver direct or more --max-iterations";
     throw std::runtime_error(m.str());
   }
+  profile_.cg += seconds_since(t0);
   copy(x, u);
   return {control.last_step(), control.last_value()};
+}
+
+MatrixFreeProfile MatrixFreeElasticitySolver::profile() const {
+  MatrixFreeProfile p = profile_;
+  p.operator_applications = fine_->applications() - preconditioner_->eigenvalue_applications();
+  p.operator_seconds = fine_->seconds() - preconditioner_->eigenvalue_seconds();
+  preconditioner_->add_solve_profile(p);
+  return p;
 }
 
 std::size_t MatrixFreeElasticitySolver::memory_consumption() const {

@@ -24,14 +24,16 @@
 
 #include "fem_reference/detail/amg.hpp"
 #include "fem_reference/detail/common.hpp"
+#include "fem_reference/elasticity.hpp"
 
 namespace vessel::fem::detail {
 
 using MfVector = dl::LinearAlgebra::distributed::Vector<double>;
 
 /// A(u) = ∫ σ(u) : ε(v) dV with σ = λ tr(ε) I + 2μ ε (Pa, so A u is in N for u in m), evaluated
-/// cell by cell at QGaussSimplex(degree + 1) — the assembled path's quadrature, so both compute the
-/// same bilinear form to rounding. `constraints` must be homogeneous (their pattern only): A acts
+/// cell by cell at QGaussSimplex(degree) on straight-sided tets (exact there) and at the assembled
+/// path's QGaussSimplex(degree + 1) on curved ones, so both compute the same bilinear form to
+/// rounding. `constraints` must be homogeneous (their pattern only): A acts
 /// on the unconstrained DoFs and as the identity on the constrained ones.
 class ElasticityOperator : public dl::Subscriptor {
  public:
@@ -39,6 +41,7 @@ class ElasticityOperator : public dl::Subscriptor {
                      const dl::AffineConstraints<double>& constraints, int degree, double lambda,
                      double mu);
 
+  /// dst = A src; counted in applications() and seconds().
   void vmult(MfVector& dst, const MfVector& src) const;
   void Tvmult(MfVector& dst, const MfVector& src) const { vmult(dst, src); }
   void initialize_dof_vector(MfVector& v) const { mf_.initialize_dof_vector(v); }
@@ -58,12 +61,19 @@ class ElasticityOperator : public dl::Subscriptor {
   /// Sets v to 0 on the constrained DoFs.
   void zero_constrained(MfVector& v) const;
   [[nodiscard]] std::size_t memory_consumption() const { return mf_.memory_consumption(); }
+  /// vmult calls so far, and their wall-clock seconds.
+  [[nodiscard]] unsigned applications() const { return applications_; }
+  [[nodiscard]] double seconds() const { return seconds_; }
+  [[nodiscard]] unsigned quadrature_points() const { return n_quadrature_points_; }
 
  private:
   dl::MatrixFree<kDim, double> mf_;
   const dl::AffineConstraints<double>& constraints_;
   double lambda_, mu_;
   mutable MfVector diagonal_;  // el()'s, on first use
+  unsigned n_quadrature_points_ = 0;
+  mutable unsigned applications_ = 0;
+  mutable double seconds_ = 0.0;
 };
 
 /// The constraints' pattern with zero inhomogeneities (what MatrixFree and the transfer need).
@@ -119,6 +129,8 @@ class MatrixFreeElasticitySolver {
   [[nodiscard]] const ElasticityOperator& fine_operator() const { return *fine_; }
   /// Wall-clock seconds the constructor took (operators, transfer, diagonal, coarse solver).
   [[nodiscard]] double setup_seconds() const { return setup_seconds_; }
+  /// The set-up's parts and, after solve(), the CG's (summed over the solves so far).
+  [[nodiscard]] MatrixFreeProfile profile() const;
   /// Bytes held: both operators' MatrixFree data, the diagonal and the vectors (not the CHOLMOD
   /// factor or ML's hierarchy, which their libraries do not report).
   [[nodiscard]] std::size_t memory_consumption() const;
@@ -129,6 +141,7 @@ class MatrixFreeElasticitySolver {
   std::unique_ptr<ElasticityOperator> fine_;
   std::unique_ptr<VCycle> preconditioner_;
   double setup_seconds_ = 0.0;
+  mutable MatrixFreeProfile profile_;
 };
 
 }  // namespace vessel::fem::detail

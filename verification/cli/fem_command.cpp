@@ -208,6 +208,22 @@ FemRunRecord run_record(const FemCommandOptions& o, const TetMesh& mesh, bool ca
   return run;
 }
 
+/// Where the matrix-free solve's time went: the set-up's parts, then the CG's.
+void print_matrix_free_profile(const fem::MatrixFreeProfile& p) {
+  const double per_application =
+      p.operator_applications ? p.operator_seconds / p.operator_applications : 0.0;
+  std::cout << std::fixed << std::setprecision(3) << "matrix-free set-up (s): fine operator "
+            << p.fine_operator << ", P1 level " << p.coarse_level << ", transfer " << p.transfer
+            << ", diagonal " << p.diagonal << ", eigenvalue estimate " << p.eigenvalue_estimate
+            << ", P1 matrix " << p.coarse_matrix << ", P1 factor " << p.coarse_factor << "\n"
+            << "matrix-free CG (s): " << p.cg << " in all; " << p.operator_applications
+            << " operator applications " << p.operator_seconds << " (" << per_application * 1e3
+            << " ms each, " << p.quadrature_points << " quadrature points per cell), "
+            << p.coarse_solves << " P1 solves " << p.coarse_solve_seconds << ", transfers "
+            << p.transfer_seconds << "; Chebyshev degree " << p.chebyshev_degree
+            << std::defaultfloat << "\n";
+}
+
 void print_solver(const fem::ElasticityResult& r) {
   std::cout << " " << fem::to_string(r.solver);
   if (r.solver == fem::LinearSolver::cg_amg) std::cout << ", " << r.iterations << " CG iterations";
@@ -221,6 +237,7 @@ void print_solver(const fem::ElasticityResult& r) {
               << std::setprecision(6);
   }
   std::cout << "\n";
+  if (r.solver == fem::LinearSolver::matrix_free) print_matrix_free_profile(r.matrix_free);
 }
 
 /// The reference's own uncertainty at the contact point (or the inner wall's default point): the
