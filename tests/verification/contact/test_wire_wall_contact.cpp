@@ -136,18 +136,13 @@ TEST(WireWallContact, SeriesSpringLawIsTheSmallComplianceLimit) {
 // support reactions, Signorini on every candidate. The force is printed beside the rigid wall's and
 // the series-spring law's with the wall's compliance under the converged contact forces.
 TEST(WireWallContact, LineOfContactOnACompliantWall) {
-  VesselParams p;
-  p.length = kTubeLength;
-  const Vec3 target(kA, 0, 25e-3);
+  const Vec3& target = kAimPoint;
   const auto t0 = std::chrono::steady_clock::now();
-  const TetMesh mesh = refined_patch_mesh(p, target, 0.08e-3, 1.0e-3);
+  const TetMesh mesh = line_of_contact_mesh();
   const double mesh_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   constexpr double kBand = 1.6e-3;
-  std::vector<int> nodes;
-  for (const int n : inner_nodes(mesh)) {
-    if ((mesh.nodes[n] - target).norm() < kBand) nodes.push_back(n);
-  }
+  const std::vector<int> nodes = nodes_within(mesh, target, kBand);
   const double young = kWallE * 100;
   const CoupledRun run = coupled_run(mesh, target, nodes, young, 0.356e-3, 32, 1.0);
   const contact::WireWallSolution& s = run.solution;
@@ -209,14 +204,9 @@ TEST(WireWallContact, LineOfContactOnACompliantWall) {
 // strains are printed (the linear wall is the model here: whether it is valid at that dent is
 // the neo-Hookean reference's question).
 TEST(WireWallContact, LineOfContactOnASofterWall) {
-  VesselParams p;
-  p.length = kTubeLength;
-  const Vec3 target(kA, 0, 25e-3);
-  const TetMesh mesh = refined_patch_mesh(p, target, 0.08e-3, 1.0e-3);
-  std::vector<int> nodes;
-  for (const int n : inner_nodes(mesh)) {
-    if ((mesh.nodes[n] - target).norm() < 1.6e-3) nodes.push_back(n);
-  }
+  const Vec3& target = kAimPoint;
+  const TetMesh mesh = line_of_contact_mesh();
+  const std::vector<int> nodes = nodes_within(mesh, target, 1.6e-3);
   const double young = kWallE * 30;
   const double c = kA - 0.356e-3 / 2;
   const double length = rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
@@ -264,17 +254,9 @@ TEST(WireWallContact, LineOfContactOnASofterWall) {
 // candidate lies on the band's edge. The answer must be the wide band's (1.6 mm, which the
 // contact stays well inside): the same pressed nodes with the same forces.
 TEST(WireWallContact, GrownBandMatchesTheWideBand) {
-  VesselParams p;
-  p.length = kTubeLength;
-  const Vec3 target(kA, 0, 25e-3);
-  const TetMesh mesh = refined_patch_mesh(p, target, 0.08e-3, 1.0e-3);
-  auto within = [&](double radius) {
-    std::vector<int> out;
-    for (const int n : inner_nodes(mesh)) {
-      if ((mesh.nodes[n] - target).norm() < radius) out.push_back(n);
-    }
-    return out;
-  };
+  const Vec3& target = kAimPoint;
+  const TetMesh mesh = line_of_contact_mesh();
+  auto within = [&](double radius) { return nodes_within(mesh, target, radius); };
   const std::vector<int> wide_nodes = within(1.6e-3), small_nodes = within(0.3e-3);
   const double young = kWallE * 100;
   const CoupledRun wide = coupled_run(mesh, target, wide_nodes, young, 0.356e-3, 32, 1.0);

@@ -50,14 +50,9 @@ Extrapolated richardson(const std::vector<double>& f) {
 }  // namespace
 
 TEST(WireWallContactSlow, PenaltyExtrapolatedToInfiniteStiffnessMatchesSignorini) {
-  VesselParams p;
-  p.length = kTubeLength;
-  const Vec3 target(kA, 0, 25e-3);
-  const TetMesh mesh = refined_patch_mesh(p, target, 0.08e-3, 1.0e-3);
-  std::vector<int> nodes;
-  for (const int n : inner_nodes(mesh)) {
-    if ((mesh.nodes[n] - target).norm() < 1.6e-3) nodes.push_back(n);
-  }
+  const Vec3& target = kAimPoint;
+  const TetMesh mesh = line_of_contact_mesh();
+  const std::vector<int> nodes = nodes_within(mesh, target, 1.6e-3);
   const double young = kWallE * 30;
   const double c = kA - 0.356e-3 / 2;
   const double length = rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
@@ -130,14 +125,9 @@ TEST(WireWallContactSlow, PenaltyExtrapolatedToInfiniteStiffnessMatchesSignorini
 // same candidates extrapolated to k → ∞ agreeing with Signorini's force.
 TEST(WireWallContactSlow, ScenesWireOnTheScenesWall) {
   const auto t0 = std::chrono::steady_clock::now();
-  VesselParams p;
-  p.length = kTubeLength;
-  const Vec3 target(kA, 0, 25e-3);
-  const TetMesh mesh = refined_patch_mesh(p, target, 0.08e-3, 1.0e-3);
-  std::vector<int> nodes;
-  for (const int n : inner_nodes(mesh)) {
-    if ((mesh.nodes[n] - target).norm() < 1.6e-3) nodes.push_back(n);
-  }
+  const Vec3& target = kAimPoint;
+  const TetMesh mesh = line_of_contact_mesh();
+  const std::vector<int> nodes = nodes_within(mesh, target, 1.6e-3);
   const double d = 0.356e-3, c = kA - d / 2, EI = 4e-7;
   // Nitinol's E scaled so that E·I = 4e-7 N·m² (E ≈ 5.073e8 Pa), its E/G kept.
   const double scale = EI / msm::rods::solid_section(kNitinol, d).EI;

@@ -64,6 +64,25 @@ inline fem::ElasticityProblem wall_problem(double young) {
   return p;
 }
 
+/// Where the tilted wire's tip is aimed on the line-of-contact set-up: the +x inner wall at z = 25 mm.
+inline const Vec3 kAimPoint(kA, 0, 25e-3);
+
+/// The line-of-contact tube: 30 mm, gmsh's mesh refined to 0.08 mm within 1 mm of kAimPoint.
+inline TetMesh line_of_contact_mesh() {
+  VesselParams p;
+  p.length = kTubeLength;
+  return refined_patch_mesh(p, kAimPoint, 0.08e-3, 1.0e-3);
+}
+
+/// Candidates: the inner-wall nodes within `radius` (m) of `point`.
+inline std::vector<int> nodes_within(const TetMesh& mesh, const Vec3& point, double radius) {
+  std::vector<int> out;
+  for (const int n : inner_nodes(mesh)) {
+    if ((mesh.nodes[n] - point).norm() < radius) out.push_back(n);
+  }
+  return out;
+}
+
 /// Candidates: inner-wall nodes within `half_length` of z along the axis and `half_angle` of +x.
 inline std::vector<int> band(const TetMesh& mesh, double z, double half_length, double half_angle) {
   std::vector<int> out;
