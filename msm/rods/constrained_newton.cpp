@@ -10,6 +10,10 @@ namespace vessel::msm::rods {
 
 namespace {
 
+int num_constraints(const ConstrainedProblem& p) {
+  return p.constraints ? p.constraints->num_constraints() : 0;
+}
+
 struct KktResidual {
   VectorXd gradient;  ///< ∇L on free dofs (zero on held ones)
   VectorXd c;
@@ -22,24 +26,28 @@ KktResidual residual(const ConstrainedProblem& p, const VectorXd& x, const Vecto
   if (p.inertia_mass.size() > 0) {
     r.gradient += p.inertia_mass.cwiseProduct(x - p.inertia_target) / (p.time_step * p.time_step);
   }
-  SparseMatrix J;
-  p.constraints->jacobian(x, J);
-  r.gradient += J.transpose() * lambda;
+  if (p.constraints) {
+    SparseMatrix J;
+    p.constraints->jacobian(x, J);
+    r.gradient += J.transpose() * lambda;
+    p.constraints->evaluate(x, r.c);
+  }
   for (int i = 0; i < r.gradient.size(); ++i) {
     if (p.fixed[i]) r.gradient[i] = 0.0;
   }
-  p.constraints->evaluate(x, r.c);
   return r;
 }
 
 SparseMatrix kkt_matrix(const ConstrainedProblem& p, const VectorXd& x, const VectorXd& lambda) {
   const int n = static_cast<int>(x.size());
-  const int m = p.constraints->num_constraints();
-  SparseMatrix H, Hc, J;
+  const int m = num_constraints(p);
+  SparseMatrix H, Hc, J(m, n);
   p.form->hessian(x, H, false);
-  p.constraints->weighted_hessian(x, lambda, Hc);
-  p.constraints->jacobian(x, J);
-  H += Hc;
+  if (p.constraints) {
+    p.constraints->weighted_hessian(x, lambda, Hc);
+    p.constraints->jacobian(x, J);
+    H += Hc;
+  }
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(H.nonZeros() + 2 * J.nonZeros() + n);
   for (int k = 0; k < H.outerSize(); ++k) {
@@ -72,7 +80,7 @@ ConstrainedResult solve_constrained(const ConstrainedProblem& problem, const Vec
                                     const VectorXd& lambda_start,
                                     const ConstrainedOptions& options) {
   const int n = static_cast<int>(start.size());
-  const int m = problem.constraints->num_constraints();
+  const int m = num_constraints(problem);
   VectorXd x = start;
   VectorXd lambda = lambda_start.size() == m ? lambda_start : VectorXd::Zero(m);
   const double fs = std::max(options.force_scale, problem.external_force.norm());

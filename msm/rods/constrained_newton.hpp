@@ -3,7 +3,8 @@
 /// (Lagrange multipliers), held dofs at their start values. The matrix
 ///   [ ∇²E + Σ λ_k ∇²c_k   Jᵀ ] [Δx]     [∇E − f + Jᵀλ]
 ///   [ J                    0 ] [Δλ] = − [c           ]
-/// is factorised by sparse LU (it is indefinite). Used by the rods with hard constraints (CORDE).
+/// is factorised by sparse LU (it is indefinite). Used by the rods' statics with hard constraints
+/// (CORDE) and by every rod's implicit Euler step (rod_dynamics.hpp).
 #include <functional>
 #include <vector>
 
@@ -14,7 +15,7 @@ namespace vessel::msm::rods {
 
 struct ConstrainedProblem {
   const Form* form = nullptr;
-  const EqualityConstraints* constraints = nullptr;
+  const EqualityConstraints* constraints = nullptr;  ///< none: plain Newton with full steps
   VectorXd rest;            ///< x0 of the load's potential
   VectorXd external_force;  ///< dead loads per dof
   std::vector<char> fixed;  ///< held dofs

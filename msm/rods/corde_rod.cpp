@@ -231,27 +231,4 @@ void CordeRod::weighted_hessian(const VectorXd& x, const VectorXd& lambda, Spars
   H.setFromTriplets(t.begin(), t.end());
 }
 
-ConstrainedResult corde_implicit_euler_step(const CordeRod& rod, const VectorXd& x,
-                                            const VectorXd& v, const VectorXd& force, double dt,
-                                            const std::vector<char>& fixed, VectorXd& v_next) {
-  ConstrainedProblem p;
-  p.form = &rod;
-  p.constraints = &rod;
-  p.rest = x;
-  p.external_force = force;
-  p.fixed = fixed;
-  p.inertia_mass = rod.lumped_mass();
-  p.inertia_target = x + dt * v;
-  p.time_step = dt;
-  p.project = [&rod](VectorXd& y) { rod.normalise_quaternions(y); };
-  ConstrainedOptions options;
-  double ei = 0.0;
-  for (const auto& s : rod.layout().section) ei = std::max(ei, s.EI);
-  options.force_scale = ei / std::pow(rod.layout().total_length(), 2);
-  VectorXd start = x;
-  const ConstrainedResult r = solve_constrained(p, start, VectorXd(), options);
-  v_next = (r.x - x) / dt;
-  return r;
-}
-
 }  // namespace vessel::msm::rods

@@ -71,10 +71,4 @@ class CordeRod : public Rod, public EqualityConstraints {
   Eigen::Quaterniond frame0_;
 };
 
-/// One implicit Euler step (x, v) → (x₁, v₁): min ½|x₁ − x − h v|²_M/h² + E(x₁) − f·x₁ under
-/// the constraints, v₁ = (x₁ − x)/h.
-ConstrainedResult corde_implicit_euler_step(const CordeRod& rod, const VectorXd& x,
-                                            const VectorXd& v, const VectorXd& force, double dt,
-                                            const std::vector<char>& fixed, VectorXd& v_next);
-
 }  // namespace vessel::msm::rods

@@ -3,6 +3,7 @@
 /// step it, so those are written once for DER and CORDE (and the XPBD rod's energy, a CordeRod):
 /// the layout, the rest state, the clamps' held dofs, the lumped masses, the energy (a Form), the
 /// model's own equality constraints and the two hooks a state change needs.
+#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -37,5 +38,14 @@ class Rod : public Form {
  protected:
   RodLayout layout_;
 };
+
+/// EI/L² of the rod's stiffest section (N): the force scale of a rod under a moment alone, the
+/// scale its solvers' residuals are measured against when no nodal load sets one.
+inline double bending_force_scale(const Rod& rod) {
+  double ei = 0.0;
+  for (const auto& section : rod.layout().section) ei = std::max(ei, section.EI);
+  const double L = rod.layout().total_length();
+  return ei / (L * L);
+}
 
 }  // namespace vessel::msm::rods

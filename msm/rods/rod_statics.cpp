@@ -8,17 +8,6 @@
 #include "msm/solvers/static_solver.hpp"
 
 namespace vessel::msm::rods {
-namespace {
-
-/// EI/L² of the rod's stiffest section (N): the force scale of a rod under a moment alone.
-double bending_force_scale(const Rod& rod) {
-  double ei = 0.0;
-  for (const auto& section : rod.layout().section) ei = std::max(ei, section.EI);
-  const double L = rod.layout().total_length();
-  return ei / (L * L);
-}
-
-}  // namespace
 
 RodStaticResult solve_rod_static(Rod& rod, const RodStaticLoad& load, double tolerance) {
   std::vector<const Form*> terms{&rod};

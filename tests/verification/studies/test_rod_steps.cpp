@@ -10,6 +10,7 @@
 
 #include "../../schema_check.hpp"
 #include "../../test_helpers.hpp"
+#include "msm/rods/corde_rod.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "msm/rods/rod_layout.hpp"
 #include "msm/stability/stability_search.hpp"
@@ -91,8 +92,11 @@ TEST(RodSteps, ImplicitIntegratorsAndXpbdStayBoundedFarBeyondTheExplicitStep) {
   p.fixed = rod.clamp_fixed();
   EXPECT_FALSE(msm::is_stable(p, msm::Integrator::symplectic_euler, 1e-6, 200,
                               msm::random_velocity(p, 1e-3, 1)));
-  for (const RodStepRow& r : {der_implicit_row(layout, dts, 50), corde_implicit_row(layout, dts, 50),
-                              xpbd_row(layout, dts, 50)}) {
+  rods::DerRod der(layout);
+  rods::CordeRod corde(layout);
+  for (const RodStepRow& r :
+       {implicit_row(der, WireModel::der, dts, 50), implicit_row(corde, WireModel::corde, dts, 50),
+        xpbd_row(layout, dts, 50)}) {
     ASSERT_EQ(r.bounded.size(), dts.size());
     for (std::size_t k = 0; k < dts.size(); ++k) {
       EXPECT_TRUE(r.bounded[k]) << r.model << " " << r.integrator << " at " << dts[k] << " s: "

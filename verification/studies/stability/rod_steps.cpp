@@ -6,9 +6,11 @@
 #include <limits>
 #include <random>
 #include <sstream>
+#include <utility>
 
 #include "msm/rods/corde_rod.hpp"
 #include "msm/rods/der_rod.hpp"
+#include "msm/rods/rod_dynamics.hpp"
 #include "msm/rods/xpbd_rod.hpp"
 #include "msm/solvers/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
@@ -118,33 +120,21 @@ RodStepRow der_explicit_row(const rods::RodLayout& layout, msm::Integrator integ
   return row;
 }
 
-RodStepRow der_implicit_row(const rods::RodLayout& layout, const std::vector<double>& dts,
-                            int steps) {
-  RodStepRow row = base_row(layout, WireModel::der, "implicit-euler");
-  const rods::DerRod rod(layout);
-  const msm::Problem p = der_problem(rod);
-  run_ladder(row, dts, steps, [&](double dt) {
-    const Eigen::VectorXd v0 = msm::random_velocity(p, kImplicitSpeed, 12345);
-    return msm::is_stable(p, msm::Integrator::implicit_euler, dt, steps, v0, kBlowup);
-  });
-  return row;
-}
-
-RodStepRow corde_implicit_row(const rods::RodLayout& layout, const std::vector<double>& dts,
-                              int steps) {
-  RodStepRow row = base_row(layout, WireModel::corde, "implicit-euler");
-  const rods::CordeRod rod(layout);
+RodStepRow implicit_row(rods::Rod& rod, WireModel model, const std::vector<double>& dts,
+                        int steps) {
+  RodStepRow row = base_row(rod.layout(), model, "implicit-euler");
   const std::vector<char> fixed = rod.clamp_fixed();
   const Eigen::VectorXd mass = rod.lumped_mass();
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(rod.num_dofs());
   run_ladder(row, dts, steps, [&](double dt) {
-    Eigen::VectorXd x = rod.rest_state(), v_next;
+    Eigen::VectorXd x = rod.rest_state();
     Eigen::VectorXd v = position_velocity(rod.num_nodes(), rod.num_dofs(), fixed, kImplicitSpeed);
+    rod.prepare(x);
     const auto energy = [&] { return rod.energy(x) + 0.5 * v.dot(mass.cwiseProduct(v)); };
     const double start = energy();
     for (int k = 0; k < steps; ++k) {
-      x = rods::corde_implicit_euler_step(rod, x, v, zero, dt, fixed, v_next).x;
-      v = v_next;
+      rods::RodStep next = rods::rod_implicit_euler_step(rod, x, v, Eigen::VectorXd(), dt, fixed);
+      x = std::move(next.x);
+      v = std::move(next.v);
       const double e = energy();
       if (!std::isfinite(e) || e > start * (1.0 + kBlowup)) return false;
     }
@@ -204,8 +194,10 @@ std::vector<RodStepRow> rod_critical_steps(const RodWire& w, int steps, std::ost
     for (const msm::Integrator i : {msm::Integrator::symplectic_euler, msm::Integrator::verlet}) {
       rows.push_back(der_explicit_row(layout, i, steps));
     }
-    rows.push_back(der_implicit_row(layout, dts, implicit_steps));
-    rows.push_back(corde_implicit_row(layout, dts, implicit_steps));
+    rods::DerRod der(layout);
+    rows.push_back(implicit_row(der, WireModel::der, dts, implicit_steps));
+    rods::CordeRod corde(layout);
+    rows.push_back(implicit_row(corde, WireModel::corde, dts, implicit_steps));
     rows.push_back(xpbd_row(layout, dts, implicit_steps));
     for (std::size_t k = rows.size() - 5; k < rows.size(); ++k) {
       const RodStepRow& r = rows[k];

@@ -12,14 +12,16 @@
 ///            (2 − 2cos kh)² = 16 at kh = π: ω_max = (4/h²)·√(EI/(ρA)), dt = h²/(2√(EI/(ρA)))
 ///            (the Euler–Bernoulli dispersion ω = k²√(EI/ρA) with k → 2 sin(kh/2)/h).
 /// dt = 2/ω_max for symplectic Euler and Verlet; the smallest of the three binds (axial for a
-/// slender wire: bending's dt is axial's times 2h/d). The implicit integrators (DER by linearised
-/// implicit Euler, CORDE by its KKT implicit Euler step, the XPBD rod) are run at steps up to
+/// slender wire: bending's dt is axial's times 2h/d). The implicit integrators (DER and CORDE by
+/// rod_implicit_euler_step, each step converged; the XPBD rod) are run at steps up to
 /// 1/30 s instead: stable at every step tried is what they claim.
 #include <ostream>
 #include <vector>
 
+#include "msm/rods/rod.hpp"
 #include "msm/rods/rod_layout.hpp"
 #include "msm/solvers/integrators.hpp"
+#include "verification/guidewire/guidewire_spec.hpp"
 #include "verification/studies/stability/stability.hpp"
 
 namespace vessel::stability_study {
@@ -38,11 +40,10 @@ RodStepRow der_explicit_row(const msm::rods::RodLayout& layout, msm::Integrator 
                             int steps);
 
 /// The implicit rows at each step of `dts` (s), `steps` steps per trial from a small random
-/// velocity (XPBD: from a tip load held 5 steps, then released): bounded or not.
-RodStepRow der_implicit_row(const msm::rods::RodLayout& layout, const std::vector<double>& dts,
-                            int steps);
-RodStepRow corde_implicit_row(const msm::rods::RodLayout& layout, const std::vector<double>& dts,
-                              int steps);
+/// velocity (XPBD: from a tip load held 5 steps, then released): bounded or not. implicit_row
+/// steps any rod model by rod_implicit_euler_step (`model` names the row).
+RodStepRow implicit_row(msm::rods::Rod& rod, WireModel model, const std::vector<double>& dts,
+                        int steps);
 RodStepRow xpbd_row(const msm::rods::RodLayout& layout, const std::vector<double>& dts, int steps);
 
 /// Every row for the wire at each segment count: DER symplectic Euler and Verlet (found step),
