@@ -41,14 +41,18 @@ void print_run(const contact::ContactModelsRun& run) {
               << fmt("%.3f", ref.centroid.z() * 1e3) << " mm, " << ref.candidates
               << " candidates.\n";
   }
+  constexpr int kColumns = 14;
   std::cout << "\n| model | wall | F (mN) | error (mN) | error (%) | pressed | centroid z (mm) "
-               "| zone axial × circ. (mm) | dent (mm) | tip error (mm) | set-up (s) | solve (s) "
-               "| steps |\n"
-            << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+               "| zone axial × circ. (mm) | dent (mm) | tip error (mm) | own imbalance "
+               "| set-up (s) | solve (s) | steps |\n|";
+  for (int c = 0; c < kColumns; ++c) std::cout << " --- |";
+  std::cout << "\n";
   const auto row = [&](const contact::ModelContact& m) {
     std::cout << "| " << m.name << " | ";
     if (!m.failure.empty()) {
-      std::cout << m.linearisation << " | failed: " << m.failure << " | | | | | | | | | | |\n";
+      std::cout << m.linearisation << " | failed: " << m.failure << " |";
+      for (int c = 3; c < kColumns; ++c) std::cout << " |";
+      std::cout << "\n";
       return;
     }
     const bool judged = ref.failure.empty();
@@ -59,8 +63,8 @@ void print_run(const contact::ContactModelsRun& run) {
               << fmt("%.3f", m.axial_extent * 1e3) << " × "
               << fmt("%.3f", m.circumferential_extent * 1e3) << " | " << fmt("%.4f", m.dent * 1e3)
               << " | " << (judged ? fmt("%.4f", (m.tip - ref.tip).norm() * 1e3) : "n/a") << " | "
-              << fmt("%.1f", m.setup_seconds) << " | " << fmt("%.1f", m.solve_seconds) << " | "
-              << m.steps << " |\n";
+              << fmt("%.1e", m.own_imbalance) << " | " << fmt("%.1f", m.setup_seconds) << " | "
+              << fmt("%.1f", m.solve_seconds) << " | " << m.steps << " |\n";
   };
   row(ref);
   for (const contact::ModelContact& m : run.models) row(m);

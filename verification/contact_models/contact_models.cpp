@@ -130,6 +130,12 @@ ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidCo
     t_lo = std::min(t_lo, theta);
     t_hi = std::max(t_hi, theta);
   }
+  std::vector<Vec3> loads(p.mesh->nodes.size(), Vec3::Zero());
+  for (std::size_t j = 0; j < grown.nodes.size(); ++j) {
+    loads[static_cast<std::size_t>(grown.nodes[j])] +=
+        s.force[static_cast<Eigen::Index>(j)] * s.direction[j];
+  }
+  out.own_imbalance = own_imbalance(wall, u, loads);
   if (out.force > 0.0) {
     out.centroid /= out.force;
     out.axial_extent = z_hi - z_lo;

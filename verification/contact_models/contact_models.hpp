@@ -42,7 +42,10 @@ struct ModelContact {
   double circumferential_extent = 0.0;  ///< their span around it, as arc length at the lumen, m
   double dent = 0.0;                    ///< the largest displacement of a pressed node, m
   Vec3 tip = Vec3::Zero();              ///< the wire's tip, m
-  int steps = 0;                        ///< linearised steps over every round
+  /// own_imbalance at the dent: the share of the contact load the model's own (nonlinear) energy
+  /// does not balance there (0 for deal.II's FEM).
+  double own_imbalance = 0.0;
+  int steps = 0;               ///< linearised steps over every round
   double setup_seconds = 0.0;  ///< the model's stiffness and its condensation (every round), s
   double solve_seconds = 0.0;  ///< the contact solves, s
 };

@@ -1,6 +1,7 @@
 #include "verification/contact_models/model_walls.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 
@@ -89,11 +90,12 @@ ModelWall model_wall(const Scene& scene, const ModelSpec& spec, const TetMesh& m
     }
     case ModelKind::corotational_fem:
     case ModelKind::xpbd_fem: {
-      const std::unique_ptr<msm::TetTerm> term = tet_fem_term(spec, mesh, scene.youngs_modulus, nu);
+      std::shared_ptr<const msm::TetTerm> term = tet_fem_term(spec, mesh, scene.youngs_modulus, nu);
       const msm::Problem p = tet_mesh_problem(scene, *term, mesh, 0.0);
       std::vector<int> identity(mesh.nodes.size());
       for (std::size_t i = 0; i < identity.size(); ++i) identity[i] = static_cast<int>(i);
       out.system = form_wall_system(*term, p.rest, p.fixed, identity, mesh.nodes.size());
+      out.energy = {term, term.get(), p.rest, p.fixed, identity};
       out.detail = spec.kind == ModelKind::corotational_fem
                        ? "corotational P1 (Müller & Gross 2004), its tangent at rest"
                        : "XPBD FEM's stable neo-Hookean P1 energy (Macklin & Müller 2021), its "
@@ -110,11 +112,18 @@ ModelWall model_wall(const Scene& scene, const ModelSpec& spec, const TetMesh& m
                          ": surface = \"outer\" has no node on the inner wall the wire "
                          "touches; expected surface \"inner\" or \"mid\" for the contact");
       }
-      const msm::BuiltNetwork built = scene_network(scene, spec, mesh, vessel, nu);
-      const auto model = msm::make_model(built, 0.0);
-      const msm::Problem p = msm_problem(scene, *model, built, mesh, 0.0);
-      out.system =
-          form_wall_system(*model, p.rest, p.fixed, built.network.source_node, mesh.nodes.size());
+      struct Owned {
+        msm::BuiltNetwork built;
+        std::unique_ptr<msm::MassSpringModel> model;
+      };
+      auto owned = std::make_shared<Owned>();
+      owned->built = scene_network(scene, spec, mesh, vessel, nu);
+      owned->model = msm::make_model(owned->built, 0.0);
+      const msm::BuiltNetwork& built = owned->built;
+      const msm::Problem p = msm_problem(scene, *owned->model, built, mesh, 0.0);
+      out.system = form_wall_system(*owned->model, p.rest, p.fixed, built.network.source_node,
+                                    mesh.nodes.size());
+      out.energy = {owned, owned->model.get(), p.rest, p.fixed, built.network.source_node};
       out.detail = built.topology;
       // Springs are nonlinear in x through their lengths, the edge pairs (StVK) quartic in x.
       out.linearisation = WallLinearisation::small_dent;
@@ -127,6 +136,28 @@ ModelWall model_wall(const Scene& scene, const ModelSpec& spec, const TetMesh& m
   }
   out.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
+}
+
+double own_imbalance(const ModelWall& wall, const std::vector<Vec3>& u,
+                     const std::vector<Vec3>& loads) {
+  const WallEnergy& e = wall.energy;
+  if (e.form == nullptr) return 0.0;
+  Eigen::VectorXd x = e.rest, f = Eigen::VectorXd::Zero(e.rest.size());
+  for (std::size_t i = 0; i < e.mesh_node.size(); ++i) {
+    const int m = e.mesh_node[i];
+    if (m < 0) continue;
+    x.segment<3>(3 * static_cast<Eigen::Index>(i)) += u[static_cast<std::size_t>(m)];
+    f.segment<3>(3 * static_cast<Eigen::Index>(i)) = loads[static_cast<std::size_t>(m)];
+  }
+  Eigen::VectorXd g;
+  e.form->gradient(x, g);
+  double r2 = 0.0, f2 = 0.0;
+  for (Eigen::Index d = 0; d < g.size(); ++d) {
+    if (e.fixed[static_cast<std::size_t>(d)]) continue;
+    r2 += (g[d] - f[d]) * (g[d] - f[d]);
+    f2 += f[d] * f[d];
+  }
+  return f2 > 0.0 ? std::sqrt(r2 / f2) : 0.0;
 }
 
 }  // namespace vessel::contact

@@ -17,6 +17,7 @@
 /// tube is the contact of the mid-surface with the wire's radius grown by t/2. The thickness enters
 /// the stiffness (springs ∝ E·t, hinges ∝ E·t³) and this offset. Outer-wall surface models have no
 /// node on the inner wall: InputError.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -44,13 +45,31 @@ enum class WallLinearisation {
 };
 std::string to_string(WallLinearisation l);  ///< "own (linear)" | "small-dent"
 
+/// A msm model's energy as the wall carries it, to measure how far a linearised dent is from the
+/// model's own equilibrium.
+struct WallEnergy {
+  std::shared_ptr<const void> owner;  ///< keeps the model (and its network) alive
+  const msm::Form* form = nullptr;    ///< nullptr: deal.II's FEM (linear)
+  Eigen::VectorXd rest;               ///< m
+  std::vector<char> fixed;
+  std::vector<int> mesh_node;  ///< per Form node its tet-mesh node (−1: none)
+};
+
 struct ModelWall {
   std::string name;
   std::string detail;  ///< what the model is (kind, rules)
   fem::FreeDisplacementSystem system;
   WallLinearisation linearisation = WallLinearisation::exact;
+  WallEnergy energy;
   double setup_seconds = 0.0;  ///< building the model and its stiffness, s
 };
+
+/// The model's own force imbalance at a dent of its linearised wall: ‖∇E(X + u) − f‖ over its free
+/// dofs relative to ‖f‖, u (m) and f (N) per tet-mesh node (each Form node takes its mesh node's).
+/// 0 for deal.II's FEM (linear: the linearised dent is its equilibrium); for the nonlinear models
+/// the part of the contact load their own energy does not balance at that dent.
+double own_imbalance(const ModelWall& wall, const std::vector<Vec3>& u,
+                     const std::vector<Vec3>& loads);
 
 /// The wall of `spec` (kinds fem, volume_msm, surface_msm with surface inner or mid,
 /// corotational_fem, xpbd_fem) on `mesh`, the scene's material at ν and its supports held.

@@ -113,6 +113,21 @@ TEST(ContactModels, MsmP1EqualsDealIiP1InTheContact) {
   ASSERT_EQ(msm_p1.K.rows(), deal.K.rows());  // the same dofs held
 
   const Pressed ref = press(deal);
+  // msm's linear P1 is its own linearisation: its energy balances the contact loads at the dent
+  // (own_imbalance maps the wall's displacement and loads onto the Form's nodes).
+  {
+    const Pressed p = press(msm_p1);
+    contact::ModelWall wall;
+    wall.energy = {nullptr, &linear, rest, held, identity};
+    std::vector<Vec3> loads(mesh.nodes.size(), Vec3::Zero());
+    for (std::size_t j = 0; j < p.nodes.size(); ++j) {
+      loads[static_cast<std::size_t>(p.nodes[j])] =
+          p.solution.force[static_cast<Eigen::Index>(j)] * p.solution.direction[j];
+    }
+    const double imbalance = contact::own_imbalance(wall, p.u, loads);
+    std::printf("CONTACT-MODELS msm linear P1's own imbalance at its dent: %.2e\n", imbalance);
+    EXPECT_LT(imbalance, 1e-8);
+  }
   for (const fem::FreeDisplacementSystem* sys : {&msm_p1, &corotational.system}) {
     const Pressed p = press(*sys);
     const double w_diff = (p.wall->compliance() - ref.wall->compliance()).cwiseAbs().maxCoeff();
