@@ -22,6 +22,16 @@ struct ContactModelsCli {
   contact::ContactModelsOptions options;
 };
 
+/// `text` fit for a Markdown table's cell (its bars escaped).
+std::string cell(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '|') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
 std::string fmt(const char* format, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, v);
@@ -34,7 +44,7 @@ void print_run(const contact::ContactModelsRun& run) {
             << "Rigid lumen: " << fmt("%.4f", run.rigid_force * 1e3) << " mN. Reference ("
             << ref.name << ", " << ref.detail << "): ";
   if (!ref.failure.empty()) {
-    std::cout << "FAILED: " << ref.failure << "\n";
+    std::cout << "FAILED: " << cell(ref.failure) << "\n";
   } else {
     std::cout << fmt("%.4f", ref.force * 1e3) << " mN, " << ref.pressed << " pressed, dent "
               << fmt("%.4f", ref.dent * 1e3) << " mm, centroid z "
@@ -50,7 +60,7 @@ void print_run(const contact::ContactModelsRun& run) {
   const auto row = [&](const contact::ModelContact& m) {
     std::cout << "| " << m.name << " | ";
     if (!m.failure.empty()) {
-      std::cout << m.linearisation << " | failed: " << m.failure << " |";
+      std::cout << m.linearisation << " | failed: " << cell(m.failure) << " |";
       for (int c = 3; c < kColumns; ++c) std::cout << " |";
       std::cout << "\n";
       return;
@@ -98,6 +108,10 @@ void add_contact_models_command(CLI::App& app) {
   cmd->add_option("--band-radius", o->options.band_radius,
                   "First contact candidates: inner-wall nodes this near the rigid contact, m "
                   "(grown while the contact reaches the band's edge)")
+      ->capture_default_str();
+  cmd->add_option("--max-move", o->options.max_move,
+                  "Each contact step moves no wire or wall node by more than this times the "
+                  "wire's radius")
       ->capture_default_str();
   cmd->add_option("--reference-degree", o->options.reference_degree,
                   "Degree of the reference FEM wall (deal.II)")

@@ -103,6 +103,7 @@ ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidCo
   WireWallOptions o;
   o.force_scale = EI / (w.length * w.length);
   o.max_newton = options.max_newton;
+  o.max_move = options.max_move;
   const auto t0 = std::chrono::steady_clock::now();
   const GrownContact grown = solve_wire_wall_contact_growing(w.contact(), wall.system, *p.mesh,
                                                              p.nodes, rigid.x, {p.first}, o);

@@ -24,6 +24,7 @@ struct ContactModelsOptions {
   double band_radius = 0.5e-3;  ///< m: the first candidates, inner-wall nodes this near it
   int reference_degree = 2;     ///< the reference wall: FEM of this degree (deal.II)
   int max_newton = 400;         ///< per contact solve (each growth round)
+  double max_move = 0.5;        ///< WireWallOptions::max_move
 };
 
 /// One wall's contact with the wire.
