@@ -37,6 +37,7 @@ FLOORS = [
     "verification/guidewire",
     "reports",
     "verification/scene",
+    "verification/contact_models",
     "verification/harness",
     "verification/studies",
     "verification/cli",

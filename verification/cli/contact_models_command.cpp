@@ -1,0 +1,147 @@
+/// `vesselverify contact-models`: every vessel model's wall in the same wire–wall contact as the
+/// FEM reference's (verification/contact_models/contact_models.hpp), one Markdown table per EI.
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "meshes/foundation/errors.hpp"
+#include "verification/cli/commands.hpp"
+#include "verification/contact_models/contact_models.hpp"
+
+namespace vessel::cli {
+
+namespace {
+
+struct ContactModelsCli {
+  std::string scene;
+  std::vector<double> ei;
+  bool scene_models_only = false;
+  std::vector<std::string> only;
+  contact::ContactModelsOptions options;
+};
+
+/// `text` fit for a Markdown table's cell (its bars escaped).
+std::string cell(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '|') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+std::string fmt(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+void print_run(const contact::ContactModelsRun& run) {
+  const contact::ModelContact& ref = run.reference;
+  std::cout << "\n### EI = " << fmt("%.3g", run.bending_stiffness) << " N·m²\n\n"
+            << "Rigid lumen: " << fmt("%.4f", run.rigid_force * 1e3) << " mN. Reference ("
+            << ref.name << ", " << ref.detail << "): ";
+  if (!ref.failure.empty()) {
+    std::cout << "FAILED: " << cell(ref.failure) << "\n";
+  } else {
+    std::cout << fmt("%.4f", ref.force * 1e3) << " mN, " << ref.pressed << " pressed, dent "
+              << fmt("%.4f", ref.dent * 1e3) << " mm, centroid z "
+              << fmt("%.3f", ref.centroid.z() * 1e3) << " mm, " << ref.candidates
+              << " candidates.\n";
+  }
+  constexpr int kColumns = 14;
+  std::cout << "\n| model | wall | F (mN) | error (mN) | error (%) | pressed | centroid z (mm) "
+               "| zone axial × circ. (mm) | dent (mm) | tip error (mm) | own imbalance "
+               "| set-up (s) | solve (s) | steps |\n|";
+  for (int c = 0; c < kColumns; ++c) std::cout << " --- |";
+  std::cout << "\n";
+  const auto row = [&](const contact::ModelContact& m) {
+    std::cout << "| " << m.name << " | ";
+    if (!m.failure.empty()) {
+      std::cout << m.linearisation << " | failed: " << cell(m.failure) << " |";
+      for (int c = 3; c < kColumns; ++c) std::cout << " |";
+      std::cout << "\n";
+      return;
+    }
+    const bool judged = ref.failure.empty();
+    std::cout << m.linearisation << " | " << fmt("%.4f", m.force * 1e3) << " | "
+              << (judged ? fmt("%+.4f", (m.force - ref.force) * 1e3) : "n/a") << " | "
+              << (judged ? fmt("%+.2f", 100 * (m.force / ref.force - 1)) : "n/a") << " | "
+              << m.pressed << " | " << fmt("%.3f", m.centroid.z() * 1e3) << " | "
+              << fmt("%.3f", m.axial_extent * 1e3) << " × "
+              << fmt("%.3f", m.circumferential_extent * 1e3) << " | " << fmt("%.4f", m.dent * 1e3)
+              << " | " << (judged ? fmt("%.4f", (m.tip - ref.tip).norm() * 1e3) : "n/a") << " | "
+              << fmt("%.1e", m.own_imbalance) << " | " << fmt("%.1f", m.setup_seconds) << " | "
+              << fmt("%.1f", m.solve_seconds) << " | " << m.steps << " |\n";
+  };
+  row(ref);
+  for (const contact::ModelContact& m : run.models) row(m);
+}
+
+}  // namespace
+
+void add_contact_models_command(CLI::App& app) {
+  auto o = std::make_shared<ContactModelsCli>();
+  CLI::App* cmd = app.add_subcommand(
+      "contact-models",
+      "Every vessel model in the same wire-wall contact: the guidewire scene's wire (DER) "
+      "against each model's wall linearised at rest (its stiffness, the scene's supports held), "
+      "the contact between the wire's surface and the inner wall found by the solve (Signorini), "
+      "on one mesh refined around the rigid wire's contact; each model's contact force against "
+      "the FEM reference's on the same mesh. Prints a Markdown table per EI (forces in mN, "
+      "lengths in mm).\n"
+      "Example:\n  vesselverify contact-models verification/scenes/guidewire_straight.toml "
+      "--ei 4e-7");
+  cmd->add_option("scene", o->scene, "A guidewire scene on a straight tube")->required();
+  cmd->add_option("--ei", o->ei,
+                  "Bending stiffness of the wire, N*m^2 (repeatable; default: the scene wire's)");
+  cmd->add_flag("--scene-models-only", o->scene_models_only,
+                "Only the scene's own models (default: also one of each model kind it lacks)");
+  cmd->add_option("--model", o->only, "Only this model (repeatable; by name)");
+  cmd->add_option("--fine-size", o->options.fine_size, "Element size near the rigid contact, m")
+      ->capture_default_str();
+  cmd->add_option("--fine-radius", o->options.fine_radius,
+                  "Radius of the refined patch around the rigid contact, m")
+      ->capture_default_str();
+  cmd->add_option("--band-radius", o->options.band_radius,
+                  "First contact candidates: inner-wall nodes this near the rigid contact, m "
+                  "(grown while the contact reaches the band's edge)")
+      ->capture_default_str();
+  cmd->add_option("--max-move", o->options.max_move,
+                  "Each contact step moves no wire or wall node by more than this times the "
+                  "wire's radius")
+      ->capture_default_str();
+  cmd->add_option("--reference-degree", o->options.reference_degree,
+                  "Degree of the reference FEM wall (deal.II)")
+      ->check(CLI::IsMember({1, 2}))
+      ->capture_default_str();
+  cmd->callback([o] {
+    const Scene scene = read_scene(o->scene);
+    std::vector<ModelSpec> models =
+        o->scene_models_only ? scene.models : contact::contact_model_kinds(scene);
+    if (!o->only.empty()) {
+      std::vector<ModelSpec> chosen;
+      for (const std::string& name : o->only) {
+        const auto it = std::find_if(models.begin(), models.end(),
+                                     [&](const ModelSpec& m) { return m.name == name; });
+        if (it == models.end()) {
+          throw InputError("--model " + name + ": no such model among the " +
+                           std::to_string(models.size()) + " of " + o->scene);
+        }
+        chosen.push_back(*it);
+      }
+      models = chosen;
+    }
+    o->options.bending_stiffness = o->ei;
+    const contact::ContactModels result = contact::solve_contact_models(scene, models, o->options);
+    std::cout << "Scene " << scene.name << ": nu = " << result.nu << ", mesh " << result.mesh_nodes
+              << " nodes, " << result.mesh_tets << " tets (refined to "
+              << o->options.fine_size * 1e3 << " mm within " << o->options.fine_radius * 1e3
+              << " mm of the rigid contact).\n";
+    for (const contact::ContactModelsRun& run : result.runs) print_run(run);
+  });
+}
+
+}  // namespace vessel::cli

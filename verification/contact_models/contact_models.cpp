@@ -1,0 +1,318 @@
+#include "verification/contact_models/contact_models.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <numbers>
+
+#include "meshes/foundation/errors.hpp"
+#include "meshes/gmsh_vessel.hpp"
+#include "msm/rods/der_rod.hpp"
+#include "msm/rods/rigid_wall.hpp"
+#include "verification/contact/wire_wall_contact.hpp"
+
+namespace vessel::contact {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The scene's wire as a DER rod at bending stiffness EI (E and G scaled, the section kept),
+/// clamped where the scene clamps it.
+struct SceneWire {
+  msm::rods::RodLayout layout;
+  msm::rods::DerRod rod;
+  double radius = 0.0;
+  double length = 0.0;
+  SceneWire(const GuidewireSpec& spec, double EI)
+      : layout([&] {
+          const msm::rods::RodMaterial own{spec.young, spec.shear, spec.density};
+          const double scale = EI / msm::rods::solid_section(own, spec.diameter).EI;
+          const msm::rods::RodMaterial m{spec.young * scale, spec.shear * scale, spec.density};
+          msm::rods::RodSpec s =
+              msm::rods::uniform_rod(m, spec.insertion, spec.diameter, spec.segments);
+          s.origin = spec.clamp_point;
+          s.direction = spec.clamp_direction;
+          return msm::rods::make_layout(s);
+        }()),
+        rod(layout),
+        radius(spec.diameter / 2),
+        length(spec.insertion) {}
+  [[nodiscard]] ContactWire contact() const {
+    ContactWire w;
+    w.form = &rod;
+    w.fixed = rod.clamp_fixed();
+    w.num_nodes = rod.num_nodes();
+    w.first_node = layout.first_node;
+    w.last_node = layout.tip_node;
+    w.radius = radius;
+    return w;
+  }
+};
+
+/// The wire against the straight tube's rigid lumen (its centreline kept a − r_w off the axis).
+struct RigidContact {
+  Eigen::VectorXd x;
+  double force = 0.0;
+  Vec3 wall_point = Vec3::Zero();
+};
+
+RigidContact rigid_contact(SceneWire& w, const VesselParams& vessel, double EI) {
+  const msm::rods::StraightTube tube(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(),
+                                     vessel.inner_radius - w.radius);
+  Eigen::VectorXd x = w.rod.rest_state();
+  w.rod.update_reference(x);
+  msm::rods::ConstrainedOptions o;
+  o.force_scale = EI / (w.length * w.length);
+  const msm::rods::ContactSolution s = msm::rods::solve_wall_contact(
+      w.rod, nullptr, w.rod.clamp_fixed(), x, tube, 2, w.layout.tip_node, o);
+  RigidContact out{s.x, 0.0, Vec3::Zero()};
+  double largest = -1.0;
+  for (std::size_t k = 0; k < s.nodes.size(); ++k) {
+    out.force += s.forces[k];
+    if (s.forces[k] > largest) {
+      largest = s.forces[k];
+      const Vec3 c = s.x.segment<3>(3 * s.nodes[k]);
+      out.wall_point = c + w.radius * Vec3(c.x(), c.y(), 0.0).normalized();
+    }
+  }
+  if (largest <= 0.0) {
+    throw std::runtime_error("the wire does not touch the rigid lumen: no contact to solve");
+  }
+  return out;
+}
+
+/// The contact problem's fixed parts, shared by every wall at one EI.
+struct Problem {
+  const TetMesh* mesh = nullptr;
+  std::vector<int> nodes;  ///< the first candidates
+  int first = 0;           ///< the candidate nearest the rigid wall point
+  double lumen_radius = 0.0;
+};
+
+ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidContact& rigid,
+                        const Problem& p, double EI, const ContactModelsOptions& options) {
+  ModelContact out;
+  out.name = wall.name;
+  out.detail = wall.detail;
+  out.linearisation = to_string(wall.linearisation);
+  WireWallOptions o;
+  o.force_scale = EI / (w.length * w.length);
+  o.max_newton = options.max_newton;
+  o.max_move = options.max_move;
+  const auto t0 = std::chrono::steady_clock::now();
+  const GrownContact grown = solve_wire_wall_contact_growing(w.contact(), wall.system, *p.mesh,
+                                                             p.nodes, rigid.x, {p.first}, o);
+  const WireWallSolution& s = grown.solution;
+  out.solve_seconds = s.seconds;
+  out.setup_seconds = wall.setup_seconds + seconds_since(t0) - s.seconds;
+  out.force = s.force.sum();
+  out.force_on_wall = s.total_force_on_wall();
+  out.pressed = static_cast<int>(s.active.size());
+  out.candidates = static_cast<int>(grown.nodes.size());
+  out.rounds = grown.rounds;
+  out.steps = s.newton_iterations;
+  out.tip = s.x.segment<3>(3 * w.layout.tip_node);
+  const std::vector<Vec3> u = grown.wall->displacement(s.wall_loads());
+  double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
+  double t_lo = z_lo, t_hi = z_hi;
+  for (const int j : s.active) {
+    const auto node = static_cast<std::size_t>(grown.nodes[static_cast<std::size_t>(j)]);
+    const Vec3& X = p.mesh->nodes[node];
+    out.centroid += s.force[j] * X;
+    out.dent = std::max(out.dent, u[node].norm());
+    z_lo = std::min(z_lo, X.z());
+    z_hi = std::max(z_hi, X.z());
+    const double theta = std::atan2(X.y(), X.x());
+    t_lo = std::min(t_lo, theta);
+    t_hi = std::max(t_hi, theta);
+  }
+  std::vector<Vec3> loads(p.mesh->nodes.size(), Vec3::Zero());
+  for (std::size_t j = 0; j < grown.nodes.size(); ++j) {
+    loads[static_cast<std::size_t>(grown.nodes[j])] +=
+        s.force[static_cast<Eigen::Index>(j)] * s.direction[j];
+  }
+  out.own_imbalance = own_imbalance(wall, u, loads);
+  if (out.force > 0.0) {
+    out.centroid /= out.force;
+    out.axial_extent = z_hi - z_lo;
+    out.circumferential_extent = p.lumen_radius * (t_hi - t_lo);
+  }
+  return out;
+}
+
+ModelContact failed(const ModelSpec& spec, const std::string& why) {
+  ModelContact out;
+  out.name = spec.name;
+  out.failure = why;
+  return out;
+}
+
+ModelSpec spec_of(std::string name, ModelKind kind) {
+  ModelSpec s;
+  s.name = std::move(name);
+  s.kind = kind;
+  return s;
+}
+
+}  // namespace
+
+std::vector<ModelSpec> contact_model_kinds(const Scene& scene) {
+  std::vector<ModelSpec> out;
+  for (const ModelSpec& m : scene.models) {
+    const bool no_wall = m.kind == ModelKind::network || m.kind == ModelKind::external ||
+                         m.kind == ModelKind::displacements ||
+                         (m.kind == ModelKind::surface_msm && m.surface == msm::WallSurface::outer);
+    if (!no_wall) out.push_back(m);
+  }
+  std::vector<ModelSpec> extra;
+  ModelSpec p1 = spec_of("fem_p1", ModelKind::fem);
+  p1.degree = 1;
+  extra.push_back(p1);
+  ModelSpec mollemans = spec_of("volume_mollemans", ModelKind::volume_msm);
+  mollemans.stiffness = msm::StiffnessRule::seed001;
+  extra.push_back(mollemans);
+  ModelSpec van_gelder = spec_of("volume_van_gelder", ModelKind::volume_msm);
+  van_gelder.stiffness = msm::StiffnessRule::van_gelder;
+  extra.push_back(van_gelder);
+  ModelSpec hybrid = spec_of("volume_hybrid", ModelKind::volume_msm);
+  hybrid.stiffness = msm::StiffnessRule::van_gelder;
+  hybrid.volume_term = true;
+  extra.push_back(hybrid);
+  ModelSpec pairs = spec_of("volume_edge_pairs", ModelKind::volume_msm);
+  pairs.edge_pairs = true;
+  extra.push_back(pairs);
+  extra.push_back(spec_of("corotational_fem", ModelKind::corotational_fem));
+  extra.push_back(spec_of("xpbd_fem", ModelKind::xpbd_fem));
+  ModelSpec mid = spec_of("surface_seed000", ModelKind::surface_msm);
+  mid.surface = msm::WallSurface::mid;
+  extra.push_back(mid);
+  ModelSpec inner = spec_of("surface_seed000_inner", ModelKind::surface_msm);
+  inner.surface = msm::WallSurface::inner;
+  extra.push_back(inner);
+  ModelSpec shells = spec_of("surface_shells", ModelKind::surface_msm);
+  shells.surface = msm::WallSurface::mid;
+  shells.stiffness = msm::StiffnessRule::van_gelder;
+  shells.bending = msm::Bending::discrete_shells;
+  extra.push_back(shells);
+  // One of each: a scene model of the same name or the same kind and rules stands for it.
+  const auto same = [](const ModelSpec& a, const ModelSpec& b) {
+    return a.kind == b.kind && a.degree == b.degree && a.surface == b.surface &&
+           a.stiffness == b.stiffness && a.volume_term == b.volume_term &&
+           a.edge_pairs == b.edge_pairs && a.bending == b.bending && a.calibration.empty() &&
+           b.calibration.empty();
+  };
+  for (const ModelSpec& e : extra) {
+    const bool present = std::any_of(out.begin(), out.end(), [&](const ModelSpec& m) {
+      return m.name == e.name || same(m, e) ||
+             (m.kind == e.kind && (m.kind == ModelKind::corotational_fem ||
+                                   m.kind == ModelKind::xpbd_fem || m.edge_pairs));
+    });
+    if (!present) out.push_back(e);
+  }
+  return out;
+}
+
+ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSpec>& models,
+                                   const ContactModelsOptions& options) {
+  const std::string file = scene.source.string();
+  if (!scene.load.guidewire) {
+    throw InputError(file +
+                     ": load: expected type = \"guidewire\" (the wire the walls are "
+                     "pressed by)");
+  }
+  if (scene.vessel.kind != VesselKind::straight) {
+    throw InputError(file +
+                     ": vessel.kind: the contact models' mesh is refined around the "
+                     "contact on a straight tube; expected kind = \"straight\"");
+  }
+  const GuidewireSpec& spec = *scene.load.guidewire;
+  ContactModels out;
+  out.nu = scene.poisson_ratios.front();
+  std::vector<double> EIs = options.bending_stiffness;
+  if (EIs.empty()) {
+    EIs = {msm::rods::solid_section({spec.young, spec.shear, spec.density}, spec.diameter).EI};
+  }
+  // The rigid contact's place does not depend on EI (the wire's shape against a rigid wall is
+  // EI's alone): one mesh for every run.
+  std::vector<std::unique_ptr<SceneWire>> wires;
+  std::vector<RigidContact> rigid;
+  for (const double EI : EIs) {
+    wires.push_back(std::make_unique<SceneWire>(spec, EI));
+    rigid.push_back(rigid_contact(*wires.back(), scene.vessel, EI));
+  }
+  VesselParams vessel = scene.vessel;
+  vessel.style = MeshStyle::unstructured;
+  const TetMesh mesh =
+      refined_patch_mesh(vessel, rigid.front().wall_point, options.fine_size, options.fine_radius);
+  out.mesh_nodes = mesh.nodes.size();
+  out.mesh_tets = mesh.tets.size();
+  Problem p;
+  p.mesh = &mesh;
+  p.lumen_radius = vessel.inner_radius;
+  const PhysicalGroup& inner = mesh.require_group("inner_wall", 2, "contact mesh");
+  for (const int n : mesh.group_nodes(inner)) {
+    if ((mesh.nodes[n] - rigid.front().wall_point).norm() < options.band_radius) {
+      p.nodes.push_back(n);
+    }
+  }
+  if (p.nodes.empty()) {
+    throw std::runtime_error("no inner-wall node within the band radius of the rigid contact");
+  }
+  for (std::size_t j = 1; j < p.nodes.size(); ++j) {
+    const Vec3& w = rigid.front().wall_point;
+    if ((mesh.nodes[p.nodes[j]] - w).norm() <
+        (mesh.nodes[p.nodes[static_cast<std::size_t>(p.first)]] - w).norm()) {
+      p.first = static_cast<int>(j);
+    }
+  }
+  for (std::size_t e = 0; e < EIs.size(); ++e) {
+    ContactModelsRun run;
+    run.bending_stiffness = EIs[e];
+    run.rigid_force = rigid[e].force;
+    run.rigid_wall_point = rigid[e].wall_point;
+    out.runs.push_back(run);
+  }
+  // Every wall once, solved at each EI: the reference first, then the models.
+  ModelSpec reference;
+  reference.name = "reference_fem_p" + std::to_string(options.reference_degree);
+  reference.kind = ModelKind::fem;
+  reference.degree = options.reference_degree;
+  std::vector<const ModelSpec*> walls{&reference};
+  for (const ModelSpec& m : models) walls.push_back(&m);
+  for (std::size_t k = 0; k < walls.size(); ++k) {
+    std::optional<ModelWall> wall;
+    std::string why;
+    try {
+      wall.emplace(model_wall(scene, *walls[k], mesh, vessel, out.nu));
+    } catch (const std::exception& ex) {
+      why = ex.what();
+    }
+    for (std::size_t e = 0; e < EIs.size(); ++e) {
+      ModelContact c;
+      if (!wall) {
+        c = failed(*walls[k], why);
+      } else {
+        try {
+          c = solve_wall(*wall, *wires[e], rigid[e], p, EIs[e], options);
+        } catch (const std::exception& ex) {
+          c = failed(*walls[k], ex.what());
+          c.detail = wall->detail;
+          c.linearisation = to_string(wall->linearisation);
+        }
+      }
+      if (k == 0) {
+        out.runs[e].reference = c;  // a failed reference leaves the run's errors undefined
+      } else {
+        out.runs[e].models.push_back(c);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace vessel::contact

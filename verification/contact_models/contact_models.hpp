@@ -1,0 +1,83 @@
+#pragma once
+/// Every vessel model in the same wire–wall contact problem: a straight-tube guidewire scene's wire
+/// (Discrete Elastic Rods at the scene's segments, clamped as the scene clamps it, at a chosen EI)
+/// against each model's wall (model_walls.hpp), the contact between the wire's capsule and the
+/// inner wall found by solve_wire_wall_contact_growing, on one tet mesh refined around the rigid
+/// wire's contact: every model and the reference (FEM P2 on the same mesh) are solved on the same
+/// mesh, the same candidates' growth and the same contact law, so their contact forces compare.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "meshes/tet_mesh.hpp"
+#include "verification/contact_models/model_walls.hpp"
+#include "verification/scene.hpp"
+
+namespace vessel::contact {
+
+struct ContactModelsOptions {
+  /// EI (N·m²) of each run: the scene wire's E (and G) scaled, its section kept. Empty: the
+  /// scene's own wire.
+  std::vector<double> bending_stiffness;
+  double fine_size = 0.08e-3;   ///< m: the mesh's element size near the rigid contact
+  double fine_radius = 1.0e-3;  ///< m: the refined patch's radius around the rigid contact
+  double band_radius = 0.5e-3;  ///< m: the first candidates, inner-wall nodes this near it
+  int reference_degree = 2;     ///< the reference wall: FEM of this degree (deal.II)
+  int max_newton = 400;         ///< per contact solve (each growth round)
+  double max_move = 0.5;        ///< WireWallOptions::max_move
+};
+
+/// One wall's contact with the wire.
+struct ModelContact {
+  std::string name;
+  std::string detail;
+  std::string linearisation;          ///< to_string(WallLinearisation)
+  std::string failure;                ///< empty when solved
+  double force = 0.0;                 ///< Σλ over the pressed nodes, N
+  Vec3 force_on_wall = Vec3::Zero();  ///< Σλn, N
+  int pressed = 0;
+  int candidates = 0;            ///< after growth
+  int rounds = 0;                ///< growths
+  Vec3 centroid = Vec3::Zero();  ///< force-weighted mean rest position of the pressed nodes, m
+  double axial_extent = 0.0;     ///< span of the pressed nodes along the tube's axis (z), m
+  double circumferential_extent = 0.0;  ///< their span around it, as arc length at the lumen, m
+  double dent = 0.0;                    ///< the largest displacement of a pressed node, m
+  Vec3 tip = Vec3::Zero();              ///< the wire's tip, m
+  /// own_imbalance at the dent: the share of the contact load the model's own (nonlinear) energy
+  /// does not balance there (0 for deal.II's FEM).
+  double own_imbalance = 0.0;
+  int steps = 0;               ///< linearised steps over every round
+  double setup_seconds = 0.0;  ///< the model's stiffness and its condensation (every round), s
+  double solve_seconds = 0.0;  ///< the contact solves, s
+};
+
+/// All walls at one EI.
+struct ContactModelsRun {
+  double bending_stiffness = 0.0;        ///< N·m²
+  double rigid_force = 0.0;              ///< the same wire against the rigid lumen, N
+  Vec3 rigid_wall_point = Vec3::Zero();  ///< where it touches (tip + r_w along the radius), m
+  ModelContact reference;                ///< FEM P(reference_degree)
+  std::vector<ModelContact> models;
+};
+
+struct ContactModels {
+  std::size_t mesh_nodes = 0, mesh_tets = 0;
+  double nu = 0.0;
+  std::vector<ContactModelsRun> runs;  ///< one per EI
+};
+
+/// The scene's models and the model kinds the suite runs that the scene lacks, one each: the
+/// spring networks (seed001, van-gelder), the hybrid volume model, the edge pairs, corotational P1,
+/// XPBD FEM, the surface models (seed 000 on the mid-surface and on the inner wall, Discrete Shells
+/// on the mid-surface) and FEM P1. Kinds with no wall in the contact (network, external,
+/// displacements; surface models on the outer wall) are left out.
+std::vector<ModelSpec> contact_model_kinds(const Scene& scene);
+
+/// The scene's wire (a guidewire load in a straight tube) against every wall of `models` and the
+/// reference's, at each EI, at the scene's first ν. InputError naming the scene's file for a scene
+/// without a guidewire or a vessel that is not a straight tube. A model whose contact solve fails
+/// is recorded with its reason (ModelContact::failure) and the others go on.
+ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSpec>& models,
+                                   const ContactModelsOptions& options);
+
+}  // namespace vessel::contact
