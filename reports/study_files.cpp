@@ -93,6 +93,27 @@ RodStepEntry read_rod_step(const json& j, const std::string& where) {
   return e;
 }
 
+TetStepEntry read_tet_step(const json& j, const std::string& where) {
+  TetStepEntry e;
+  e.model = field<std::string>(j, "model", where);
+  e.integrator = field<std::string>(j, "integrator", where);
+  e.failure = field<std::string>(j, "failure", where);
+  e.level = field<int>(j, "level", where);
+  e.nodes = field<int>(j, "nodes", where);
+  e.nu = field<double>(j, "nu", where);
+  e.load = field<double>(j, "load", where);
+  e.predicted_dt = optional_field<double>(j, "predicted_dt", where);
+  e.power_dt = optional_field<double>(j, "power_dt", where);
+  e.found_dt = optional_field<double>(j, "found_dt", where);
+  e.unstable_dt = optional_field<double>(j, "unstable_dt", where);
+  e.steps_tried = field<std::vector<double>>(j, "steps_tried", where);
+  e.bounded = field<std::vector<bool>>(j, "bounded", where);
+  if (e.bounded.size() != e.steps_tried.size()) {
+    throw InputError(where + ": 'bounded' and 'steps_tried' differ in length");
+  }
+  return e;
+}
+
 WireCandidateEntry read_wire_candidate(const json& j, const std::string& where) {
   WireCandidateEntry e;
   e.name = field<std::string>(j, "name", where);
@@ -300,18 +321,20 @@ StabilityFile parse_stability(const std::string& text, const std::filesystem::pa
   if (const auto rod = j.find("rod_critical_steps"); rod != j.end() && !rod->is_null()) {
     const std::string where = file + ": rod_critical_steps";
     const json w = field<json>(*rod, "wire", where);
-    s.rod_wire = RodWireEntry{field<double>(w, "length", where + ".wire"),
-                              field<double>(w, "diameter", where + ".wire"),
-                              field<double>(w, "young", where + ".wire"),
-                              field<double>(w, "shear", where + ".wire"),
-                              field<double>(w, "density", where + ".wire")};
+    s.rod_wire = RodWireEntry{
+        field<double>(w, "length", where + ".wire"), field<double>(w, "diameter", where + ".wire"),
+        field<double>(w, "young", where + ".wire"), field<double>(w, "shear", where + ".wire"),
+        field<double>(w, "density", where + ".wire")};
     s.rod_steps = read_array(*rod, "rows", where, read_rod_step);
+  }
+  if (j.contains("tet_critical_steps")) {
+    s.tet_steps = read_array(j, "tet_critical_steps", file, read_tet_step);
   }
   if (const auto t = j.find("timing_provenance"); t != j.end() && t->is_object()) {
     const std::string where = file + ": timing_provenance";
-    s.timing_provenance = timing_provenance_line(
-        field<std::size_t>(*t, "items", where),
-        field<std::vector<std::string>>(*t, "cached_measured_at", where));
+    s.timing_provenance =
+        timing_provenance_line(field<std::size_t>(*t, "items", where),
+                               field<std::vector<std::string>>(*t, "cached_measured_at", where));
   }
   return s;
 }

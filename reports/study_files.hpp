@@ -41,6 +41,17 @@ struct RodStepEntry {
   std::vector<bool> bounded;
 };
 
+/// One row of corotational P1's and XPBD FEM's critical steps (s): the estimate 2/ω_max (Lanczos,
+/// power iteration) and the found step, or the implicit rows' steps tried under a load.
+struct TetStepEntry {
+  std::string model, integrator, failure;
+  int level = 0, nodes = 0;
+  double nu = 0.0, load = 0.0;
+  std::optional<double> predicted_dt, power_dt, found_dt, unstable_dt;
+  std::vector<double> steps_tried;
+  std::vector<bool> bounded;
+};
+
 /// The wire the rod rows are for (SI).
 struct RodWireEntry {
   double length = 0.0, diameter = 0.0, young = 0.0, shear = 0.0, density = 0.0;
@@ -70,7 +81,8 @@ struct StabilityFile {
   std::vector<HardCaseEntry> hard_cases;
   std::optional<RodWireEntry> rod_wire;  ///< absent in files without the rod's rows
   std::vector<RodStepEntry> rod_steps;
-  int hard_cases_at_a_time = 1;  ///< how many hard cases ran at once (1 in older files)
+  std::vector<TetStepEntry> tet_steps;  ///< empty in files without them
+  int hard_cases_at_a_time = 1;         ///< how many hard cases ran at once (1 in older files)
   /// Which rows' and hard cases' timings came from the model outcome cache
   /// (timing_provenance_line); empty in a file without that record.
   std::string timing_provenance;
@@ -132,7 +144,7 @@ struct RecommendFile {
   std::filesystem::path results;
   /// The cheapest whole-vessel candidate meeting the budget (absent in older files, or none).
   std::optional<std::string> whole_vessel;
-  bool whole_vessel_reported = false;  ///< the file has "whole_vessel" (null: none meets it)
+  bool whole_vessel_reported = false;       ///< the file has "whole_vessel" (null: none meets it)
   double reference_contact_point_mm = 0.0;  ///< the reference's largest QoI displacement
   std::vector<CandidateEntry> candidates;
   std::optional<WireEntry> wire;  ///< guidewire scenes only

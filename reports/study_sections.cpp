@@ -22,17 +22,27 @@ std::string hz(double rate) { return significant(rate, 6) + " Hz"; }
 
 Table critical_step_table(const StabilityFile& s) {
   Table t;
-  t.header = {"model", "integrator", "ζ", "level", "nodes", "ω_max (rad/s)", "Gershgorin bound",
-              "predicted (µs)", "guaranteed (µs)", "found stable (µs)", "found / predicted",
+  t.header = {"model",
+              "integrator",
+              "ζ",
+              "level",
+              "nodes",
+              "ω_max (rad/s)",
+              "Gershgorin bound",
+              "predicted (µs)",
+              "guaranteed (µs)",
+              "found stable (µs)",
+              "found / predicted",
               "found / guaranteed"};
   for (const auto& r : s.critical_steps) {
     const bool proven = r.guaranteed_dt.has_value();
-    t.rows.push_back({r.model, r.integrator, significant(r.zeta, 4), std::to_string(r.level),
-                      std::to_string(r.nodes), significant(r.omega_max, 5), significant(r.omega_gershgorin, 5),
-                      significant(r.predicted_dt * 1e6, 5), proven ? significant(*r.guaranteed_dt * 1e6, 5) : "–",
-                      significant(r.found_dt * 1e6, 5), significant(r.found_dt / r.predicted_dt, 4),
-                      proven && *r.guaranteed_dt > 0 ? significant(r.found_dt / *r.guaranteed_dt, 4)
-                                                     : "–"});
+    t.rows.push_back(
+        {r.model, r.integrator, significant(r.zeta, 4), std::to_string(r.level),
+         std::to_string(r.nodes), significant(r.omega_max, 5), significant(r.omega_gershgorin, 5),
+         significant(r.predicted_dt * 1e6, 5),
+         proven ? significant(*r.guaranteed_dt * 1e6, 5) : "–", significant(r.found_dt * 1e6, 5),
+         significant(r.found_dt / r.predicted_dt, 4),
+         proven && *r.guaranteed_dt > 0 ? significant(r.found_dt / *r.guaranteed_dt, 4) : "–"});
   }
   return t;
 }
@@ -46,8 +56,8 @@ Table refinement_table(const StabilityFile& s) {
       if (!levels.empty()) levels += ',';
       levels += std::to_string(l);
     }
-    t.rows.push_back({f.model, f.integrator, significant(f.zeta, 4), levels, significant(f.found_exponent, 3),
-                      significant(f.predicted_exponent, 3)});
+    t.rows.push_back({f.model, f.integrator, significant(f.zeta, 4), levels,
+                      significant(f.found_exponent, 3), significant(f.predicted_exponent, 3)});
   }
   return t;
 }
@@ -88,34 +98,93 @@ void rod_steps(Document& doc, const StabilityFile& s) {
       "30 Hz frame instead (from a 1 mm/s random velocity; XPBD from a released tip load): "
       "bounded means the energy stayed within 1000× its start. Steps in µs.");
   Table t;
-  t.header = {"model", "integrator", "N", "h (mm)", "axial h/c", "twist", "bending",
-              "closed form", "2/ω_max (Lanczos)", "found stable", "found / closed form"};
+  t.header = {"model",        "integrator",         "N",
+              "h (mm)",       "axial h/c",          "twist",
+              "bending",      "closed form",        "2/ω_max (Lanczos)",
+              "found stable", "found / closed form"};
   for (const RodStepEntry& r : s.rod_steps) {
     const bool explicit_row = r.found_dt.has_value();
-    t.rows.push_back(
-        {r.model, r.integrator, std::to_string(r.segments), significant(r.h * 1e3, 4),
-         significant(r.axial_dt * 1e6, 4), significant(r.twist_dt * 1e6, 4),
-         significant(r.bending_dt * 1e6, 4), significant(r.closed_form_dt * 1e6, 4),
-         r.predicted_dt ? significant(*r.predicted_dt * 1e6, 4) : "–",
-         explicit_row ? significant(*r.found_dt * 1e6, 4) : rod_ladder_text(r),
-         explicit_row ? significant(*r.found_dt / r.closed_form_dt, 4) : "–"});
+    t.rows.push_back({r.model, r.integrator, std::to_string(r.segments), significant(r.h * 1e3, 4),
+                      significant(r.axial_dt * 1e6, 4), significant(r.twist_dt * 1e6, 4),
+                      significant(r.bending_dt * 1e6, 4), significant(r.closed_form_dt * 1e6, 4),
+                      r.predicted_dt ? significant(*r.predicted_dt * 1e6, 4) : "–",
+                      explicit_row ? significant(*r.found_dt * 1e6, 4) : rod_ladder_text(r),
+                      explicit_row ? significant(*r.found_dt / r.closed_form_dt, 4) : "–"});
   }
   doc.table(t);
   doc.paragraph(
       "What each integrator needs: symplectic Euler and Verlet the closed-form step or less, about "
-      "h/c (" + significant(1e-3 / std::sqrt(w.young / w.density) * 1e6, 3) +
+      "h/c (" +
+      significant(1e-3 / std::sqrt(w.young / w.density) * 1e6, 3) +
       " µs per mm of segment for this wire), i.e. thousands of steps per 1 ms haptic frame; "
       "explicit Euler no stable step at all without damping; implicit Euler (DER, CORDE) "
       "and XPBD any step tried, at the price of numerical damping (implicit Euler) or of "
       "stiffness lost with few sweeps per step (XPBD, measured in tests/rods/test_xpbd.cpp).");
 }
 
+/// An implicit P1 row's ladder: bounded everywhere, or the first step that was not.
+std::string tet_ladder_text(const TetStepEntry& r) {
+  for (std::size_t k = 0; k < r.steps_tried.size(); ++k) {
+    if (!r.bounded[k]) return "unbounded at " + significant(r.steps_tried[k] * 1e3, 4) + " ms";
+  }
+  return "bounded at every step tried, " + significant(r.steps_tried.front() * 1e3, 3) + " to " +
+         significant(r.steps_tried.back() * 1e3, 3) + " ms";
+}
+
+void tet_steps(Document& doc, const StabilityFile& s) {
+  if (s.tet_steps.empty()) return;
+  doc.heading(3, "Corotational P1 and XPBD FEM");
+  doc.paragraph(
+      "The P1 tet models simulators run instead of springs, on the same tube (ν = " +
+      significant(s.tet_steps.front().nu, 3) +
+      ", the contact scenes'; the springs' rows above are at ν = 1/4, their Cauchy value). "
+      "Corotational P1 (Müller & Gross 2004) by symplectic Euler and Verlet: found by bisection as "
+      "for the springs, against 2/ω_max of M⁻¹K at rest (its Hessian there is linear P1's "
+      "stiffness) by Lanczos and, independently, by power iteration. By implicit Euler, with the "
+      "warped stiffness R K₀ Rᵀ re-assembled each step (SOFA's TetrahedronFEMForceField) and with "
+      "K₀ factorised once (what a simulator pays for speed): both are unconditionally stable at "
+      "rest, so they ran from rest under a step contact load at steps up to a 30 Hz frame; where "
+      "one diverged, its largest bounded step under that load was bisected (no closed form "
+      "predicts it: the rest stiffness lacks the turned wall's rotation, integrated explicitly). "
+      "XPBD FEM (Macklin & Müller 2021, multipliers carried, its scene defaults: 4 sweeps, 2 % "
+      "velocity damping a step): its constraint solve is implicit, but the multipliers it carries "
+      "act as an explicit force whose stiffness at rest is linear P1's shear stiffness (λ = "
+      "−2μ/3, no bulk stiffness), so its critical step is predicted as 2/ω_max of that stiffness; "
+      "below it the steady state is the energy's equilibrium whatever the sweep count, above it "
+      "the run diverges. Steps in ms.");
+  Table t;
+  t.header = {"model",
+              "integrator",
+              "level",
+              "nodes",
+              "load (mN)",
+              "2/ω_max Lanczos",
+              "2/ω_max power iteration",
+              "found stable",
+              "found / predicted"};
+  const auto ms = [](const std::optional<double>& v) {
+    return v ? significant(*v * 1e3, 4) : std::string("–");
+  };
+  for (const TetStepEntry& r : s.tet_steps) {
+    std::string found = ms(r.found_dt);
+    if (!r.steps_tried.empty()) {
+      found = r.found_dt ? found + " (" + tet_ladder_text(r) + ")" : tet_ladder_text(r);
+    }
+    t.rows.push_back(
+        {r.model, r.integrator, std::to_string(r.level), std::to_string(r.nodes),
+         significant(r.load * 1e3, 3), ms(r.predicted_dt), ms(r.power_dt), found,
+         r.found_dt && r.predicted_dt ? significant(*r.found_dt / *r.predicted_dt, 4) : "–"});
+  }
+  doc.table(t);
+}
+
 void hard_cases(Document& doc, const StabilityFile& s) {
   if (s.hard_cases.empty()) return;
   doc.heading(3, "Hard cases");
-  std::string about = "Each case lists what every model did: finished (returned a result), "
-                      "converged (static or linear solve), bounded (dynamic run), and what it "
-                      "reported. Displacements in mm, loads in mN.";
+  std::string about =
+      "Each case lists what every model did: finished (returned a result), "
+      "converged (static or linear solve), bounded (dynamic run), and what it "
+      "reported. Displacements in mm, loads in mN.";
   if (s.hard_cases_at_a_time > 1) {
     about += " The cases ran " + std::to_string(s.hard_cases_at_a_time) +
              " at a time, so the time after each case's set-up is its wall time on a shared "
@@ -142,13 +211,15 @@ void stability_section(Document& doc, const StabilityFile& s) {
   doc.paragraph(
       "How large a time step each explicit integrator of the mass-spring models takes before it "
       "blows up — predicted from the largest eigenvalue of M⁻¹K at rest (Lanczos) and found by "
-      "running (bisection on dt, " + std::to_string(s.steps_per_trial) +
+      "running (bisection on dt, " +
+      std::to_string(s.steps_per_trial) +
       " steps per trial from a small random velocity, unstable when the energy exceeds 1000× its "
       "start or turns non-finite) — and what every model does on hard cases. Produced by `" +
-      s.command + "`" + (s.quick ? " (quick mode)" : "") + " in " + significant(s.total_seconds, 3) +
-      " s (`" + s.path.filename().string() + "`).");
+      s.command + "`" + (s.quick ? " (quick mode)" : "") + " in " +
+      significant(s.total_seconds, 3) + " s (`" + s.path.filename().string() + "`).");
   if (!s.timing_provenance.empty()) {
-    doc.paragraph("Timings (per level and model's rows, per hard case): " + s.timing_provenance + ".");
+    doc.paragraph("Timings (per level and model's rows, per hard case): " + s.timing_provenance +
+                  ".");
   }
   doc.heading(3, "Predicted vs found stable step");
   doc.paragraph(
@@ -167,14 +238,17 @@ void stability_section(Document& doc, const StabilityFile& s) {
       "(`msm/solvers/critical_step.hpp`; none is proven for damped Verlet). Use it, not the "
       "prediction, as a safe damped step. Steps in µs.");
   doc.table(critical_step_table(s));
-  doc.paragraph("Explicit Euler without damping is not in the table: it is unstable at every step "
-                "(|1 + ihω| > 1; the energy grows by a factor 1 + h²ω² per step in each mode), "
-                "asserted by the test suite.");
+  doc.paragraph(
+      "Explicit Euler without damping is not in the table: it is unstable at every step "
+      "(|1 + ihω| > 1; the energy grows by a factor 1 + h²ω² per step in each mode), "
+      "asserted by the test suite.");
   doc.heading(3, "Step against refinement");
-  doc.paragraph("Least-squares exponent p of dt ∝ h^p over the levels (h the nominal element "
-                "size, halved per level; p = 1 expected for springs whose k scales like E·h and "
-                "masses like ρh³).");
+  doc.paragraph(
+      "Least-squares exponent p of dt ∝ h^p over the levels (h the nominal element "
+      "size, halved per level; p = 1 expected for springs whose k scales like E·h and "
+      "masses like ρh³).");
   doc.table(refinement_table(s));
+  tet_steps(doc, s);
   rod_steps(doc, s);
   hard_cases(doc, s);
 }
@@ -190,13 +264,14 @@ std::string load_text(const RecommendFile& r, double magnitude) {
 std::string budget_text(const RecommendFile& r) {
   std::string t = "the " + r.quantity;
   if (r.radius_mm) t += " (within " + significant(*r.radius_mm, 3) + " mm)";
-  t += " error ≤ " + significant(r.tolerance, 3) + " " + r.unit + ", and ≤ " + ms(r.seconds_per_update) +
-       " of computation per update";
+  t += " error ≤ " + significant(r.tolerance, 3) + " " + r.unit + ", and ≤ " +
+       ms(r.seconds_per_update) + " of computation per update";
   if (r.rate_hz) t += " (" + hz(*r.rate_hz) + ")";
   for (const auto& l : r.loads) {
-    t += "; at ν = " + significant(l.poisson_ratio, 6) + " the load is " + load_text(r, l.magnitude) +
-         " (reference " + (l.reference_element.empty() ? "" : l.reference_element + ", ") +
-         "level " + std::to_string(r.reference_level) + ")";
+    t += "; at ν = " + significant(l.poisson_ratio, 6) + " the load is " +
+         load_text(r, l.magnitude) + " (reference " +
+         (l.reference_element.empty() ? "" : l.reference_element + ", ") + "level " +
+         std::to_string(r.reference_level) + ")";
   }
   return t;
 }
@@ -229,9 +304,9 @@ void answer(Document& doc, const RecommendFile& r) {
   }
   const CandidateEntry* whole = candidate_named(r, r.whole_vessel);
   if (whole && r.whole_vessel != r.recommended) {
-    doc.paragraph("Whole vessel (no region of interest): `" + whole->name + "` (" +
-                  whole->detail + ") meets the budget too: error " + error_text(*whole, r.unit) +
-                  ", " + ms(whole->update_seconds.value_or(0.0)) + " per update, " +
+    doc.paragraph("Whole vessel (no region of interest): `" + whole->name + "` (" + whole->detail +
+                  ") meets the budget too: error " + error_text(*whole, r.unit) + ", " +
+                  ms(whole->update_seconds.value_or(0.0)) + " per update, " +
                   std::to_string(whole->unknowns) + " unknowns.");
   } else if (!whole && r.whole_vessel_reported) {
     doc.paragraph("No whole-vessel candidate (without a region of interest) meets the budget.");
@@ -240,11 +315,13 @@ void answer(Document& doc, const RecommendFile& r) {
   // not move at all: the answer then says nothing about accuracy.
   if (r.quantity != "reaction" && r.reference_contact_point_mm > 0.0 &&
       r.tolerance >= r.reference_contact_point_mm) {
-    doc.paragraph("⚠ **The tolerance does not discriminate**: at this load the reference's "
-                  "contact point moves " + significant(r.reference_contact_point_mm, 3) +
-                  " mm, no more than the " + significant(r.tolerance, 3) +
-                  " mm tolerance, so a model that does not move at all would meet it. State a "
-                  "tighter tolerance or a larger load (`magnitude`) for an answer about accuracy.");
+    doc.paragraph(
+        "⚠ **The tolerance does not discriminate**: at this load the reference's "
+        "contact point moves " +
+        significant(r.reference_contact_point_mm, 3) + " mm, no more than the " +
+        significant(r.tolerance, 3) +
+        " mm tolerance, so a model that does not move at all would meet it. State a "
+        "tighter tolerance or a larger load (`magnitude`) for an answer about accuracy.");
   }
 }
 
@@ -266,8 +343,14 @@ std::vector<const CandidateEntry*> evidence_order(const RecommendFile& r) {
 
 Table evidence_table(const RecommendFile& r) {
   Table t;
-  t.header = {"candidate", "unknowns", "error (" + r.unit + ")", "time per update (ms)",
-              "set-up (ms)", "Pareto", "verdict", "why"};
+  t.header = {"candidate",
+              "unknowns",
+              "error (" + r.unit + ")",
+              "time per update (ms)",
+              "set-up (ms)",
+              "Pareto",
+              "verdict",
+              "why"};
   for (const CandidateEntry* c : evidence_order(r)) {
     t.rows.push_back({"`" + c->name + "`", std::to_string(c->unknowns),
                       c->ok && c->error ? significant(*c->error, 3) : "–",
@@ -290,17 +373,23 @@ void wire_candidates(Document& doc, const RecommendFile& r) {
   doc.paragraph(
       "The wire against the rigid lumen, each rod model of msm/rods (Discrete Elastic Rods, "
       "seed 002's CORDE, the XPBD rod's steady state) at a few segment counts, against the "
-      "continuum wire (" + w.reference + ", F = " +
-      significant(w.reference_force_N * 1e3, 4) + " mN), judged on the " +
-      (r.unit == "mN" ? "contact force's error" : "contact point's error") + " and its time per "
+      "continuum wire (" +
+      w.reference + ", F = " + significant(w.reference_force_N * 1e3, 4) + " mN), judged on the " +
+      (r.unit == "mN" ? "contact force's error" : "contact point's error") +
+      " and its time per "
       "update, set-up apart (median of 10): for DER and CORDE the wire moved by one update's "
       "travel at 10 mm/s and solved again from its last equilibrium, for XPBD one step of the "
       "update period (its error is its steady state's, reached once the wire is at rest). "
       "**Recommended: " +
       (w.recommended ? "`" + *w.recommended + "`" : std::string("none")) + "**.");
   Table t;
-  t.header = {"candidate", "force error (mN)", "contact point error (mm)", "time per update (ms)",
-              "set-up (ms)", "verdict", "why"};
+  t.header = {"candidate",
+              "force error (mN)",
+              "contact point error (mm)",
+              "time per update (ms)",
+              "set-up (ms)",
+              "verdict",
+              "why"};
   for (const WireCandidateEntry& c : w.candidates) {
     if (!c.ok) {
       t.rows.push_back({"`" + c.name + "`", "–", "–", "–", "–", c.verdict, c.failure});
@@ -327,7 +416,8 @@ void recommendation_section(Document& doc, const RecommendFile& r) {
   }
   doc.paragraph("Budget: " + budget_text(r) + ". " + std::to_string(r.candidates.size()) +
                 " candidates (generated from the mass-spring library's stiffness rules and "
-                "solvers, surface and volume, mesh levels" + levels +
+                "solvers, surface and volume, mesh levels" +
+                levels +
                 ", regions of interest; FEM P1 for comparison) were run against the FEM "
                 "reference by");
   doc.code(r.command);
@@ -337,7 +427,8 @@ void recommendation_section(Document& doc, const RecommendFile& r) {
                 "against the P2 reference at each model node; region-of-interest models (R) hold "
                 "every node farther than R from the contact and are compared on the whole vessel. "
                 "★ marks the Pareto front (no other candidate is both faster and more accurate). "
-                "From `" + r.path.filename().string() + "`.");
+                "From `" +
+                r.path.filename().string() + "`.");
   doc.table(evidence_table(r));
   if (!r.timing_provenance.empty()) doc.paragraph("Timings: " + r.timing_provenance + ".");
   wire_candidates(doc, r);
@@ -366,12 +457,15 @@ void validity_scene(Document& doc, const ValiditySceneEntry& v) {
                   " (" + std::to_string(v.dofs) + " DoFs); models on level " +
                   std::to_string(v.model_level) + ". Finite-strain continuation: ";
   if (v.completed) {
-    p += "equilibrium at every load of the ladder, up to " + load_text(v.largest_load, v.load_unit) + ". ";
+    p += "equilibrium at every load of the ladder, up to " +
+         load_text(v.largest_load, v.load_unit) + ". ";
   } else if (v.self_contact) {
     p += "**stopped where the wall would touch itself: the largest load reached without the wall "
-         "passing through itself is " + load_text(v.largest_load, v.load_unit) +
+         "passing through itself is " +
+         load_text(v.largest_load, v.load_unit) +
          "**; beyond it the vessel has no equilibrium this reference can represent (it models no "
-         "self-contact). Details: " + v.stop_reason + ". The rows end at the last ladder load reached. ";
+         "self-contact). Details: " +
+         v.stop_reason + ". The rows end at the last ladder load reached. ";
   } else {
     p += "**stopped: the largest load reached is " + load_text(v.largest_load, v.load_unit) +
          "** (" + v.stop_reason + "); the rows end at the last ladder load reached. ";
@@ -384,7 +478,8 @@ void validity_scene(Document& doc, const ValiditySceneEntry& v) {
        ".";
   doc.paragraph(p);
   Table limits;
-  limits.header = {"references part by", "at the QoI (contact point)", "over the mesh (relative L2)"};
+  limits.header = {"references part by", "at the QoI (contact point)",
+                   "over the mesh (relative L2)"};
   for (std::size_t k = 0; k < v.qoi_limits.size() && k < v.l2_limits.size(); ++k) {
     limits.rows.push_back({percent(v.qoi_limits[k].threshold),
                            crossing_text(v.qoi_limits[k], v.load_unit),
@@ -392,8 +487,8 @@ void validity_scene(Document& doc, const ValiditySceneEntry& v) {
   }
   doc.table(limits);
   Table rows;
-  rows.header = {"load", "u finite strain (mm)", "u linear (mm)", "QoI difference",
-                 "L2 difference", "linear strain", "lumen gap (mm)", "Newton its (cum.)"};
+  rows.header = {"load",          "u finite strain (mm)", "u linear (mm)",  "QoI difference",
+                 "L2 difference", "linear strain",        "lumen gap (mm)", "Newton its (cum.)"};
   for (const std::string& m : v.models) rows.header.push_back(m + ": rel. L2 / QoI error (mm)");
   for (const ValidityRowEntry& r : v.rows) {
     std::vector<std::string> row = {load_text(r.magnitude, v.load_unit),
@@ -454,8 +549,18 @@ std::string case_load(const CalibrationCaseEntry& c) {
 
 Table calibration_case_table(const CalibrateFile& c, bool training) {
   Table t;
-  t.header = {"scene", "level", "case", "holds out", "load", "P1", "base", "calibrated",
-              "calibrated / P1", "base s/update", "calibrated s/update", "P1 solve s",
+  t.header = {"scene",
+              "level",
+              "case",
+              "holds out",
+              "load",
+              "P1",
+              "base",
+              "calibrated",
+              "calibrated / P1",
+              "base s/update",
+              "calibrated s/update",
+              "P1 solve s",
               "reference max strain"};
   const auto or_dash = [](const std::optional<double>& x, auto&& show) {
     return x ? show(*x) : std::string("—");
@@ -467,8 +572,7 @@ Table calibration_case_table(const CalibrateFile& c, bool training) {
         {e.scene, std::to_string(e.level), e.name, e.holds_out, case_load(e),
          fixed3(e.p1_relative_l2), or_dash(e.base_relative_l2, fixed3),
          or_dash(e.calibrated_relative_l2, fixed3),
-         or_dash(e.calibrated_relative_l2,
-                 [&](double x) { return fixed3(x / e.p1_relative_l2); }),
+         or_dash(e.calibrated_relative_l2, [&](double x) { return fixed3(x / e.p1_relative_l2); }),
          or_dash(e.base_update_seconds, s3), or_dash(e.calibrated_update_seconds, s3),
          s3(e.p1_solve_seconds), significant(100.0 * e.max_strain_reference, 2) + " %"});
   }
@@ -481,13 +585,12 @@ void calibration_section(Document& doc, const CalibrateFile& c) {
   doc.heading(1, "Calibration of " + c.model + " (" + c.scene + ", " + c.granularity + ")");
   doc.code(c.command);
   doc.paragraph("Model: " + c.model_detail + ", ν = " + significant(c.poisson_ratio, 6) + ", " +
-                c.vessel + " (mesh " + c.mesh_hash + ", " + std::to_string(c.nodes) +
-                " nodes, " + std::to_string(c.springs) + " springs). Fit: " + c.method + ". " +
-                std::to_string(c.parameter_count) + " parameters, " +
-                std::to_string(c.iterations) + " iterations (" + c.stop_reason + "), " +
-                fixed3(c.fit_seconds) + " s; objective " + significant(c.objective_before, 6) +
-                " → " + significant(c.objective_after, 6) + ". Written to `" +
-                c.calibration_file + "`.");
+                c.vessel + " (mesh " + c.mesh_hash + ", " + std::to_string(c.nodes) + " nodes, " +
+                std::to_string(c.springs) + " springs). Fit: " + c.method + ". " +
+                std::to_string(c.parameter_count) + " parameters, " + std::to_string(c.iterations) +
+                " iterations (" + c.stop_reason + "), " + fixed3(c.fit_seconds) + " s; objective " +
+                significant(c.objective_before, 6) + " → " + significant(c.objective_after, 6) +
+                ". Written to `" + c.calibration_file + "`.");
   if (!c.parameters.empty()) {
     Table t;
     t.header = {"parameter", "factor"};
@@ -498,9 +601,10 @@ void calibration_section(Document& doc, const CalibrateFile& c) {
                   " factors (kappa included): min " + fixed3(c.factor_min) + ", median " +
                   fixed3(c.factor_median) + ", max " + fixed3(c.factor_max) + ".");
   }
-  doc.paragraph("Relative L2 errors against the P2 reference at the model's nodes (P1 at its "
-                "mesh's nodes), each model solved as the scene solves it; *s/update*: the median "
-                "time per update of a warm-started load ramp (set-up apart).");
+  doc.paragraph(
+      "Relative L2 errors against the P2 reference at the model's nodes (P1 at its "
+      "mesh's nodes), each model solved as the scene solves it; *s/update*: the median "
+      "time per update of a warm-started load ramp (set-up apart).");
   doc.heading(2, "Training loads");
   doc.table(calibration_case_table(c, true));
   doc.heading(2, "Held-out loads");

@@ -64,6 +64,17 @@ double XpbdFem::evaluate(std::size_t k, int c, Vec12& grad) const {
   return F.determinant() - (1.0 + energy_.lame().mu / energy_.lame().lambda);
 }
 
+void XpbdFem::set_velocity(const VectorXd& v) {
+  if (v.size() != x_.size()) {
+    throw InputError("XPBD FEM: expected " + std::to_string(x_.size()) + " velocities, got " +
+                     std::to_string(v.size()));
+  }
+  v_ = v;
+  for (Eigen::Index i = 0; i < v_.size(); ++i) {
+    if (inverse_mass_[i] == 0.0) v_[i] = 0.0;
+  }
+}
+
 void XpbdFem::step(double h, const VectorXd& force) {
   ++steps_taken_;
   const double h2 = h * h;

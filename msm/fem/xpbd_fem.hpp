@@ -51,6 +51,10 @@ class XpbdFem {
   int relax(double h, const VectorXd& force, double relative_change, int max_steps);
 
   [[nodiscard]] const VectorXd& state() const { return x_; }
+  /// The velocity the next step starts from, m/s (per dof).
+  [[nodiscard]] const VectorXd& velocity() const { return v_; }
+  /// Sets it (zero on held nodes); InputError for a wrong size.
+  void set_velocity(const VectorXd& v);
   /// The energy the constraints carry, as a Form (for a Newton solve of the same energy).
   [[nodiscard]] const StableNeoHookeanTerm& energy_model() const { return energy_; }
 

@@ -1,8 +1,8 @@
 #include "msm/solvers/critical_step.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <Spectra/SymEigsSolver.h>
 
+#include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -78,7 +78,8 @@ struct InverseProd {
 };
 
 /// The free-dof block of a full symmetric matrix, scaled S·B·S by `scale` (per free dof).
-SparseMatrix free_block(const SparseMatrix& B, const std::vector<int>& index, const VectorXd& scale) {
+SparseMatrix free_block(const SparseMatrix& B, const std::vector<int>& index,
+                        const VectorXd& scale) {
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(static_cast<std::size_t>(B.nonZeros()));
   for (int k = 0; k < B.outerSize(); ++k) {
@@ -114,8 +115,10 @@ std::pair<double, VectorXd> largest(Op op, int n, const SpectrumOptions& o, int&
   eigs.init();
   eigs.compute(Spectra::SortRule::LargestAlge, o.max_iterations, o.tolerance);
   if (eigs.info() != Spectra::CompInfo::Successful) {
-    throw std::runtime_error("Lanczos (Spectra) did not converge on the largest eigenvalue of "
-                             "M^-1 K in " + std::to_string(o.max_iterations) + " restarts");
+    throw std::runtime_error(
+        "Lanczos (Spectra) did not converge on the largest eigenvalue of "
+        "M^-1 K in " +
+        std::to_string(o.max_iterations) + " restarts");
   }
   iters = static_cast<int>(eigs.num_iterations());
   return {eigs.eigenvalues()[0], eigs.eigenvectors().col(0)};
@@ -156,6 +159,30 @@ double critical_step_mode(Integrator integrator, double omega, double gamma) {
       return kInf;
   }
   return 0.0;
+}
+
+double power_iteration_omega_max(const Problem& p, double tolerance, int max_iterations) {
+  const int n = p.num_dofs();
+  VectorXd scale = VectorXd::Zero(n);  // M^{-1/2} on the free dofs, 0 on the fixed ones
+  for (int i = 0; i < n; ++i) scale[i] = p.fixed[i] ? 0.0 : 1.0 / std::sqrt(p.mass[i]);
+  SparseMatrix K;
+  p.form->hessian(p.rest, K, false);
+  VectorXd y(n);
+  for (int i = 0; i < n; ++i) y[i] = scale[i] > 0 ? std::sin(0.7 * i + 0.3) + 1.5 : 0.0;
+  if (y.norm() == 0.0) return 0.0;
+  y.normalize();
+  double rayleigh = 0.0;
+  for (int k = 0; k < max_iterations; ++k) {
+    const VectorXd w = scale.cwiseProduct(K * scale.cwiseProduct(y));
+    const double next = y.dot(w);  // ‖y‖ = 1
+    const double norm = w.norm();
+    if (norm == 0.0) return 0.0;
+    y = w / norm;
+    const bool settled = std::abs(next - rayleigh) <= tolerance * std::abs(next);
+    rayleigh = next;
+    if (settled) break;
+  }
+  return std::sqrt(std::max(rayleigh, 0.0));
 }
 
 Spectrum analyse_spectrum(const Problem& p, const SpectrumOptions& o) {

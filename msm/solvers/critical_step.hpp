@@ -22,17 +22,17 @@ double critical_step_mode(Integrator integrator, double omega, double gamma);
 /// The lowest and highest modes of the linearised model at rest.
 struct Spectrum {
   int free_dofs = 0;
-  double omega_max = 0.0;     ///< rad/s, Lanczos (Spectra) on M^{-1/2} K M^{-1/2}
-  double gamma_max = 0.0;     ///< damping rate φᵀCφ/φᵀMφ of the top mode, 1/s
-  double omega_min = 0.0;     ///< rad/s (0 when K has a null space: a mechanism)
-  double gamma_min = 0.0;     ///< damping rate of the lowest mode, 1/s
-  bool has_lowest = false;    ///< omega_min/gamma_min computed
+  double omega_max = 0.0;   ///< rad/s, Lanczos (Spectra) on M^{-1/2} K M^{-1/2}
+  double gamma_max = 0.0;   ///< damping rate φᵀCφ/φᵀMφ of the top mode, 1/s
+  double omega_min = 0.0;   ///< rad/s (0 when K has a null space: a mechanism)
+  double gamma_min = 0.0;   ///< damping rate of the lowest mode, 1/s
+  bool has_lowest = false;  ///< omega_min/gamma_min computed
   /// Bounds of the damping rate γ(x) = x*Cx / x*Mx over every (complex) vector of the free
   /// dofs, 1/s: the extreme eigenvalues of M⁻¹C. Exact (min/max of C_ii/m_i) when C is diagonal,
   /// as for point damping; Gershgorin bounds of M^{-1/2} C M^{-1/2} (γ_lo ≥ 0) otherwise.
   double gamma_lo = 0.0;
   double gamma_hi = 0.0;
-  double gershgorin = 0.0;    ///< max_frequency_bound(): an upper bound of omega_max, rad/s
+  double gershgorin = 0.0;  ///< max_frequency_bound(): an upper bound of omega_max, rad/s
   int lanczos_iterations = 0;
   double seconds = 0.0;
 };
@@ -48,6 +48,14 @@ struct SpectrumOptions {
 /// Spectrum of M⁻¹K at rest with the fixed dofs removed (K the exact Hessian at rest, C the
 /// damping Jacobian, M the lumped masses). Throws std::runtime_error if Lanczos does not converge.
 Spectrum analyse_spectrum(const Problem& problem, const SpectrumOptions& options = {});
+
+/// ω_max (rad/s) of M⁻¹K at rest (K the exact Hessian, fixed dofs removed) by power iteration on
+/// M^{-1/2} K M^{-1/2} from a fixed pseudo-random start, until the Rayleigh quotient changes by
+/// less than `tolerance` (relative) in an iteration or after `max_iterations`: a check of the
+/// Lanczos ω_max by another method (its Rayleigh quotient never exceeds the top eigenvalue, so
+/// it can only under-estimate ω_max, and 2/ω over-estimate the critical step).
+double power_iteration_omega_max(const Problem& problem, double tolerance = 1e-9,
+                                 int max_iterations = 20000);
 
 /// Predicted critical step (s) of an integrator for that spectrum: the most restrictive of the
 /// highest and (when computed) lowest mode. 0 / +infinity as in critical_step_mode. With damping

@@ -35,27 +35,20 @@ bool is_stable(const Problem& p, Integrator integrator, double dt, int steps, co
   }
 }
 
-StabilitySearchResult find_stable_step(const Problem& p, double guess,
-                                       const StabilitySearchOptions& o) {
+StabilitySearchResult bisect_stable_step(double guess, double tolerance, int max_trials,
+                                         const std::function<bool(double)>& run) {
   if (!(guess > 0) || !std::isfinite(guess)) {
-    throw std::invalid_argument("find_stable_step: the initial guess must be a finite step > 0");
+    throw std::invalid_argument("stability search: the initial guess must be a finite step > 0");
   }
   const auto t0 = std::chrono::steady_clock::now();
   StabilitySearchResult r;
-  // Velocity amplitude: displacements of ~1e-9 of the model's size over one period at the guess.
-  double extent = 0.0;
-  for (int i = 0; i < p.num_dofs(); ++i) extent = std::max(extent, std::abs(p.rest[i]));
-  const VectorXd v0 = random_velocity(p, 1e-9 * std::max(extent, 1e-3) / guess, o.seed);
   auto trial = [&](double dt) {
-    if (r.trials >= o.max_trials) {
-      throw std::runtime_error("stability search: no bracket after " +
-                               std::to_string(o.max_trials) + " trials (last dt " +
-                               std::to_string(dt) + " s)");
+    if (r.trials >= max_trials) {
+      throw std::runtime_error("stability search: no bracket after " + std::to_string(max_trials) +
+                               " trials (last dt " + std::to_string(dt) + " s)");
     }
     ++r.trials;
-    const bool ok = is_stable(p, o.integrator, dt, o.steps, v0, o.blowup_factor, &r.steps_run);
-    if (o.on_trial) o.on_trial(dt, ok);
-    return ok;
+    return run(dt);
   };
   double lo = 0.0, hi = 0.0;
   if (trial(guess / 1.02)) {
@@ -75,13 +68,32 @@ StabilitySearchResult find_stable_step(const Problem& p, double guess,
     }
     lo = dt;
   }
-  while (hi - lo > o.tolerance * lo) {
+  while (hi - lo > tolerance * lo) {
     const double mid = 0.5 * (lo + hi);
     (trial(mid) ? lo : hi) = mid;
   }
   r.stable_dt = lo;
   r.unstable_dt = hi;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+StabilitySearchResult find_stable_step(const Problem& p, double guess,
+                                       const StabilitySearchOptions& o) {
+  if (!(guess > 0) || !std::isfinite(guess)) {
+    throw std::invalid_argument("find_stable_step: the initial guess must be a finite step > 0");
+  }
+  // Velocity amplitude: displacements of ~1e-9 of the model's size over one period at the guess.
+  double extent = 0.0;
+  for (int i = 0; i < p.num_dofs(); ++i) extent = std::max(extent, std::abs(p.rest[i]));
+  const VectorXd v0 = random_velocity(p, 1e-9 * std::max(extent, 1e-3) / guess, o.seed);
+  long long steps_run = 0;
+  StabilitySearchResult r = bisect_stable_step(guess, o.tolerance, o.max_trials, [&](double dt) {
+    const bool ok = is_stable(p, o.integrator, dt, o.steps, v0, o.blowup_factor, &steps_run);
+    if (o.on_trial) o.on_trial(dt, ok);
+    return ok;
+  });
+  r.steps_run = steps_run;
   return r;
 }
 

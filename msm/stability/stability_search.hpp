@@ -25,7 +25,7 @@ struct StabilitySearchResult {
   double stable_dt = 0.0;    ///< largest step that stayed bounded, s
   double unstable_dt = 0.0;  ///< smallest step that diverged, s
   int trials = 0;
-  long long steps_run = 0;   ///< over all trials
+  long long steps_run = 0;  ///< over all trials
   double seconds = 0.0;
 };
 
@@ -37,6 +37,13 @@ VectorXd random_velocity(const Problem& problem, double speed, std::uint32_t see
 /// true if no DivergenceError was raised.
 bool is_stable(const Problem& problem, Integrator integrator, double dt, int steps,
                const VectorXd& v0, double blowup_factor = 1e3, long long* steps_run = nullptr);
+
+/// The bracketing and bisection of find_stable_step on any stability trial: `trial(dt)` true when
+/// a run at dt stayed bounded. Brackets from `guess` (s, > 0) by factors of 1.02 then 1.25, then
+/// bisects until (unstable − stable)/stable ≤ tolerance. Throws std::runtime_error if no bracket
+/// is found in max_trials.
+StabilitySearchResult bisect_stable_step(double guess, double tolerance, int max_trials,
+                                         const std::function<bool(double)>& trial);
 
 /// Bisection for the largest stable step, starting from `guess` (s, > 0, e.g. the predicted
 /// critical step): brackets by factors of 1.02 then 1.25, then bisects to `tolerance`. The

@@ -183,3 +183,181 @@ TEST(FemTube, CorotationalSolversReachTheNewtonEquilibrium) {
     }
   }
 }
+
+// Corotational P1 dynamically: implicit Euler (Baraff & Witkin's one linear solve per step) with
+// the warped stiffness R K₀ Rᵀ re-assembled each step (SOFA's TetrahedronFEMForceField), and with
+// the rest stiffness K₀ factorised once (the force stays corotational; what K₀ lacks of the
+// rotation is integrated explicitly).
+
+namespace {
+
+struct ImplicitVariant {
+  const char* name;
+  ImplicitMatrix matrix;
+};
+constexpr ImplicitVariant kImplicitVariants[] = {
+    {"warped stiffness re-assembled", ImplicitMatrix::current_state},
+    {"rest stiffness prefactored", ImplicitMatrix::rest_prefactored}};
+
+DynamicOptions implicit_euler(ImplicitMatrix matrix, double dt, int steps) {
+  DynamicOptions d;
+  d.integrator = Integrator::implicit_euler;
+  d.implicit_matrix = matrix;
+  d.dt = dt;
+  d.steps = steps;
+  return d;
+}
+
+/// The positions after every step of an implicit Euler run of `p` from rest.
+std::vector<Eigen::VectorXd> trajectory(const Problem& p, DynamicOptions d,
+                                        const Eigen::VectorXd& x0 = {},
+                                        const Eigen::VectorXd& v0 = {}) {
+  std::vector<Eigen::VectorXd> xs;
+  d.on_step = [&](int, const Eigen::VectorXd& x, const Eigen::VectorXd&) { xs.push_back(x); };
+  integrate(p, d, x0, v0);
+  return xs;
+}
+
+double largest_node_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const Eigen::VectorXd d = a - b;
+  return d.reshaped(3, d.size() / 3).colwise().norm().maxCoeff();
+}
+
+}  // namespace
+
+TEST(FemTube, CorotationalImplicitEulerOscillationEqualsLinearP1sToSecondOrderInTheAmplitude) {
+  // A step load on the free end from rest: the tube swings about its deflected shape (its lowest
+  // period is ~10 ms, 50 steps of 0.2 ms; implicit Euler damps it by ~1 % a step). Linear P1's
+  // implicit Euler is exact backward Euler on a linear system; corotational P1's force and
+  // stiffness differ from linear P1's by O(u²) and O(u), so the trajectories part by O(P²):
+  // doubling the load multiplies the largest difference over the run by 4.
+  const TetMesh mesh = fem_tube();
+  const LinearTetTerm linear(mesh.nodes, mesh.tets, kLame);
+  const CorotationalTetTerm warped(mesh.nodes, mesh.tets, kLame, CorotationalStiffness::warped);
+  constexpr double kDt = 2e-4;  // s
+  constexpr int kSteps = 150;
+  for (const ImplicitVariant& variant : kImplicitVariants) {
+    double previous = 0.0;
+    for (double load : {1e-4, 2e-4, 4e-4, 8e-4}) {  // N
+      Problem pl = fem_tube_problem(mesh, linear), pc = fem_tube_problem(mesh, warped);
+      load_free_end(mesh, pl, load);
+      load_free_end(mesh, pc, load);
+      const auto xl = trajectory(pl, implicit_euler(ImplicitMatrix::current_state, kDt, kSteps));
+      const auto xc = trajectory(pc, implicit_euler(variant.matrix, kDt, kSteps));
+      ASSERT_EQ(xl.size(), xc.size());
+      double diff = 0.0, swing = 0.0, lowest_after_peak = 1e300, peak = 0.0;
+      for (std::size_t k = 0; k < xl.size(); ++k) {
+        diff = std::max(diff, largest_node_distance(xc[k], xl[k]));
+        const double u = largest_node_distance(xl[k], pl.rest);
+        swing = std::max(swing, u);
+        if (u >= peak) {
+          peak = u;
+          lowest_after_peak = u;
+        }
+        lowest_after_peak = std::min(lowest_after_peak, u);
+      }
+      std::cout << "[ dynamics ] " << variant.name << ", P = " << load
+                << " N: largest linear displacement " << swing << " m, largest difference " << diff
+                << " m (relative " << diff / swing << ")";
+      if (previous > 0.0) std::cout << ", ratio to the previous load's " << diff / previous;
+      std::cout << "\n";
+      // It oscillates: after its first peak the linear tip swings back by more than a tenth of it.
+      EXPECT_LT(lowest_after_peak, 0.9 * peak) << variant.name;
+      EXPECT_LT(diff / swing, 0.05) << variant.name << ", " << load;
+      if (previous > 0.0) {
+        EXPECT_NEAR(diff / previous, 4.0, 0.2) << variant.name << ", " << load;
+      }
+      previous = diff;
+    }
+  }
+}
+
+TEST(FemTube, CorotationalImplicitEulerKeepsARigidlyTurnedTubeWhereItIs) {
+  // The tube turned by 120° about a generic axis and shifted, its clamp turned with it: no force
+  // there, so both implicit Euler variants leave it where it is over 2000 steps; given a small
+  // velocity it returns there (implicit Euler damps the motion out). Linear P1,
+  // strained by the turn, moves away: the check can fail.
+  const TetMesh mesh = fem_tube();
+  const CorotationalTetTerm warped(mesh.nodes, mesh.tets, kLame, CorotationalStiffness::warped);
+  const LinearTetTerm linear(mesh.nodes, mesh.tets, kLame);
+  const Mat3 Q = Eigen::AngleAxisd(2.0 * std::numbers::pi / 3.0, Vec3(0.2, 0.9, -0.4).normalized())
+                     .toRotationMatrix();
+  const Eigen::VectorXd turned = moved(mesh, Q, Vec3(4e-3, -1e-3, 2e-3));
+  constexpr double kSize = 6e-3;  // m, the tube's length
+  {
+    Problem p = fem_tube_problem(mesh, warped);
+    p.rest = turned;  // the clamp holds its turned position
+    Eigen::VectorXd g;
+    warped.gradient(turned, g);
+    Eigen::VectorXd g1;
+    warped.gradient(moved(mesh, Eigen::Vector3d(1.01, 1.0, 1.0).asDiagonal(), Vec3::Zero()), g1);
+    std::cout << "[ turned ] ‖∇E‖ turned / ‖∇E‖ at 1 % stretch: " << g.norm() / g1.norm() << "\n";
+    EXPECT_LT(g.norm() / g1.norm(), 1e-10);
+    for (const ImplicitVariant& variant : kImplicitVariants) {
+      const DynamicResult still = integrate(p, implicit_euler(variant.matrix, 1e-3, 2000));
+      const double drift = largest_node_distance(still.x, turned);
+      // A small velocity (1 cm/s), then 1000 steps of 1 ms: back where it was.
+      Eigen::VectorXd v0 = Eigen::VectorXd::Zero(p.num_dofs());
+      for (Eigen::Index i = 0; i < v0.size(); ++i) {
+        v0[i] = p.fixed[i] ? 0.0 : 1e-2 * std::sin(0.37 * static_cast<double>(i));
+      }
+      double excursion = 0.0;
+      DynamicOptions d = implicit_euler(variant.matrix, 1e-3, 1000);
+      d.on_step = [&](int, const Eigen::VectorXd& x, const Eigen::VectorXd&) {
+        excursion = std::max(excursion, largest_node_distance(x, turned));
+      };
+      const DynamicResult back = integrate(p, d, turned, v0);
+      const double returned = largest_node_distance(back.x, turned);
+      std::cout << "[ turned ] " << variant.name << ": drift over 2000 steps " << drift / kSize
+                << " × length; after a kick (largest excursion " << excursion << " m) it ends "
+                << returned << " m from the turned shape\n";
+      EXPECT_LT(drift / kSize, 1e-12) << variant.name;
+      EXPECT_GT(excursion, 1e-6) << variant.name;
+      EXPECT_LT(returned, 1e-6 * excursion) << variant.name;
+    }
+  }
+  Problem pl = fem_tube_problem(mesh, linear);
+  pl.rest = turned;
+  const DynamicResult lin = integrate(pl, implicit_euler(ImplicitMatrix::current_state, 1e-3, 200));
+  std::cout << "[ turned ] linear P1 moves " << largest_node_distance(lin.x, turned) << " m\n";
+  EXPECT_GT(largest_node_distance(lin.x, turned), 1e-2 * kSize);
+}
+
+TEST(FemTube, CorotationalImplicitEulerLosesEnergyAtEveryStepWithoutLoad) {
+  // Released from the static shape under an end load (15 mN: the end turned, tip deflection ~40 %
+  // of the length; 1 mN for the prefactored rest stiffness, which diverges from the larger turn),
+  // no load: backward Euler dissipates, so the total energy ½vᵀMv + E(x) falls at every step.
+  const TetMesh mesh = fem_tube();
+  const CorotationalTetTerm consistent(mesh.nodes, mesh.tets, kLame);
+  const CorotationalTetTerm warped(mesh.nodes, mesh.tets, kLame, CorotationalStiffness::warped);
+  for (const ImplicitVariant& variant : kImplicitVariants) {
+    const bool rest = variant.matrix == ImplicitMatrix::rest_prefactored;
+    Problem p = fem_tube_problem(mesh, consistent);
+    load_free_end(mesh, p, rest ? 1e-3 : 1.5e-2);
+    StaticOptions so;
+    so.tolerance = 1e-12;
+    const StaticResult bent = solve_static(p, so);
+    ASSERT_TRUE(bent.converged);
+    p.form = &warped;
+    p.external_force.setZero();
+    std::vector<double> energy{total_energy(p, bent.x, Eigen::VectorXd::Zero(p.num_dofs()))};
+    DynamicOptions d = implicit_euler(variant.matrix, 5e-4, 300);
+    d.on_step = [&](int, const Eigen::VectorXd& x, const Eigen::VectorXd& v) {
+      energy.push_back(total_energy(p, x, v));
+    };
+    integrate(p, d, bent.x);
+    int rises = 0;
+    double largest_rise = 0.0;
+    for (std::size_t k = 1; k < energy.size(); ++k) {
+      if (energy[k] > energy[k - 1]) {
+        ++rises;
+        largest_rise = std::max(largest_rise, (energy[k] - energy[k - 1]) / energy.front());
+      }
+    }
+    std::cout << "[ energy ] " << variant.name << ": " << energy.front() << " J → " << energy.back()
+              << " J over " << energy.size() - 1 << " steps, " << rises << " rises (largest "
+              << largest_rise << " of the start)\n";
+    EXPECT_EQ(rises, 0) << variant.name;
+    EXPECT_LT(energy.back(), 0.5 * energy.front()) << variant.name;
+  }
+}

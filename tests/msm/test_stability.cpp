@@ -9,10 +9,10 @@
 #include <random>
 
 #include "msm/mass/mass_rules.hpp"
-#include "msm/terms/spring_model.hpp"
 #include "msm/solvers/critical_step.hpp"
 #include "msm/stability/stability_search.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
+#include "msm/terms/spring_model.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;
@@ -54,8 +54,10 @@ double spectral_radius(const Oscillator& o, Integrator integrator, double h, dou
   for (int col = 0; col < 2; ++col) {
     Eigen::VectorXd x0 = o.problem.rest, v0 = Eigen::VectorXd::Zero(6);
     const double amp = 1e-9;
-    if (col == 0) x0[3] += amp;
-    else v0[3] = amp * omega;
+    if (col == 0)
+      x0[3] += amp;
+    else
+      v0[3] = amp * omega;
     DynamicOptions d;
     d.integrator = integrator;
     d.dt = h;
@@ -78,14 +80,14 @@ TetMesh box_mesh(double jitter = 0.15) {
   auto id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) mesh.nodes.emplace_back(h * (i + u(rng)), h * (j + u(rng)),
-                                                            h * (k + u(rng)));
+      for (int i = 0; i <= nx; ++i)
+        mesh.nodes.emplace_back(h * (i + u(rng)), h * (j + u(rng)), h * (k + u(rng)));
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
-        const int v[8] = {id(i, j, k),         id(i + 1, j, k),         id(i + 1, j + 1, k),
-                          id(i, j + 1, k),     id(i, j, k + 1),         id(i + 1, j, k + 1),
-                          id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)};
+        const int v[8] = {
+            id(i, j, k),     id(i + 1, j, k),     id(i + 1, j + 1, k),     id(i, j + 1, k),
+            id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)};
         // Kuhn: the six tets around the diagonal v0–v6.
         const int paths[6][2] = {{1, 2}, {1, 5}, {3, 2}, {3, 7}, {4, 5}, {4, 7}};
         for (const auto& p : paths) {
@@ -156,8 +158,8 @@ TEST(CriticalStep, ClosedFormsMatchTheSpectralRadiusOfEachIntegratorsOneStepMap)
   for (double zeta : {0.0, 0.05, 0.3, 0.9, 1.5, 4.0}) {
     const double gamma = 2 * zeta * omega;
     const Oscillator o = make_oscillator(k, m, gamma * m);
-    for (Integrator in : {Integrator::explicit_euler, Integrator::symplectic_euler,
-                          Integrator::verlet}) {
+    for (Integrator in :
+         {Integrator::explicit_euler, Integrator::symplectic_euler, Integrator::verlet}) {
       const double hc = critical_step_mode(in, omega, gamma);
       SCOPED_TRACE(to_string(in) + " zeta " + std::to_string(zeta));
       if (in == Integrator::explicit_euler && zeta == 0.0) {
@@ -249,8 +251,8 @@ TEST(CriticalStep, ConditionallyStableIntegratorsAreStableAt09AndUnstableAt11OfT
     const BoxModel b = make_box_model(MassRule::uniform, c);
     const Spectrum s = analyse_spectrum(b.problem);
     EXPECT_NEAR(s.gamma_max, c / b.problem.mass[0], 1e-9 * s.gamma_max);
-    for (Integrator in : {Integrator::explicit_euler, Integrator::symplectic_euler,
-                          Integrator::verlet}) {
+    for (Integrator in :
+         {Integrator::explicit_euler, Integrator::symplectic_euler, Integrator::verlet}) {
       const double hc = predicted_critical_step(in, s);
       EXPECT_TRUE(runs_bounded(b.problem, in, 0.9 * hc, 3000)) << to_string(in);
       EXPECT_FALSE(runs_bounded(b.problem, in, 1.1 * hc, 3000)) << to_string(in);
@@ -292,8 +294,8 @@ TEST(CriticalStep, ImplicitEulerStaysBoundedAt100TimesTheCriticalStep) {
   const BoxModel b = make_box_model(MassRule::consistent);
   const Spectrum s = analyse_spectrum(b.problem, {.lowest = false});
   double ratio = 0.0;
-  ASSERT_TRUE(runs_bounded(b.problem, Integrator::implicit_euler, 100 * 2.0 / s.omega_max, 200,
-                           &ratio));
+  ASSERT_TRUE(
+      runs_bounded(b.problem, Integrator::implicit_euler, 100 * 2.0 / s.omega_max, 200, &ratio));
   EXPECT_LE(ratio, 1.0 + 1e-9);  // backward Euler dissipates: never above the initial energy
 }
 
@@ -347,7 +349,8 @@ TEST(CriticalStep, GuaranteedDampedStepIsStableWithNonUniformMasses) {
   }
   // No bound is proven for damped Verlet.
   const BoxModel damped = make_box_model(MassRule::consistent, 2.0 * 0.3 * s0.omega_max * m_mean);
-  EXPECT_TRUE(std::isnan(guaranteed_critical_step(Integrator::verlet, analyse_spectrum(damped.problem))));
+  EXPECT_TRUE(
+      std::isnan(guaranteed_critical_step(Integrator::verlet, analyse_spectrum(damped.problem))));
 }
 
 TEST(StabilitySearch, BisectionFindsTheUndampedSymplecticEulerLimit) {
@@ -363,4 +366,41 @@ TEST(StabilitySearch, BisectionFindsTheUndampedSymplecticEulerLimit) {
   EXPECT_LT(r.stable_dt, r.unstable_dt);
   EXPECT_LE(r.unstable_dt - r.stable_dt, 2e-3 * r.stable_dt * 1.0000001);
   EXPECT_NEAR(r.stable_dt / predicted, 1.0, 0.01);
+}
+
+TEST(CriticalStep, PowerIterationAgreesWithADenseEigensolver) {
+  // The same box and dense M^{-1/2} K M^{-1/2} as the Lanczos test: power iteration's ω_max is a
+  // second, independent estimate of 2/ω_max (its Rayleigh quotient cannot exceed the top one).
+  const BoxModel b = make_box_model(MassRule::consistent, 0.0);
+  const Problem& p = b.problem;
+  SparseMatrix K;
+  p.form->hessian(p.rest, K, false);
+  std::vector<int> free;
+  for (int i = 0; i < p.num_dofs(); ++i) {
+    if (!p.fixed[i]) free.push_back(i);
+  }
+  const int n = static_cast<int>(free.size());
+  const Eigen::MatrixXd Kd(K);
+  Eigen::MatrixXd A(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      A(i, j) = Kd(free[i], free[j]) / std::sqrt(p.mass[free[i]] * p.mass[free[j]]);
+  const double dense_max =
+      std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(A).eigenvalues()[n - 1]);
+  const double power = power_iteration_omega_max(p, 1e-13, 200000);
+  std::cout << "[ power iteration ] ω_max " << power << " rad/s, dense " << dense_max << "\n";
+  EXPECT_LE(power, dense_max * (1.0 + 1e-12));
+  EXPECT_NEAR(power, dense_max, 1e-4 * dense_max);
+}
+
+TEST(StabilitySearch, GenericBisectionBracketsAndNarrowsAKnownThreshold) {
+  // A trial stable below 3.7e-4 s: bracketed from guesses above and below, narrowed to 0.5 %.
+  for (const double guess : {1e-5, 3.7e-4, 1e-2}) {
+    const StabilitySearchResult r =
+        bisect_stable_step(guess, 5e-3, 60, [](double dt) { return dt <= 3.7e-4; });
+    EXPECT_LE(r.stable_dt, 3.7e-4) << guess;
+    EXPECT_GT(r.unstable_dt, 3.7e-4) << guess;
+    EXPECT_LE(r.unstable_dt - r.stable_dt, 5e-3 * r.stable_dt * 1.0000001) << guess;
+  }
+  EXPECT_THROW(bisect_stable_step(1e-3, 5e-3, 10, [](double) { return true; }), std::runtime_error);
 }

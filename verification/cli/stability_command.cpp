@@ -7,8 +7,8 @@
 #include "meshes/foundation/errors.hpp"
 #include "meshes/mesh_cache.hpp"
 #include "verification/cli/cache_options.hpp"
-#include "verification/cli/jobs_option.hpp"
 #include "verification/cli/commands.hpp"
+#include "verification/cli/jobs_option.hpp"
 #include "verification/studies/stability/stability.hpp"
 
 namespace vessel::cli {
@@ -28,6 +28,8 @@ struct StabilityCli {
   int max_level = -1;
   bool no_hard_cases = false;
   bool no_rod_steps = false;
+  bool no_tet_steps = false;
+  int tet_max_level = 0;
   std::vector<std::string> only_cases;
   int jobs = 1;
 };
@@ -91,6 +93,13 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
   cmd->add_flag("--no-rod-steps", o->no_rod_steps,
                 "Leave out the guidewire's critical steps (a metal wire at 50 and 200 segments: "
                 "about a minute)");
+  cmd->add_flag("--no-tet-steps", o->no_tet_steps,
+                "Leave out corotational P1's and XPBD FEM's critical steps (explicit, implicit "
+                "Euler under a 70 mN load, XPBD)");
+  cmd->add_option("--tet-max-level", o->tet_max_level,
+                  "Highest mesh level of corotational P1's and XPBD FEM's rows (at most "
+                  "--max-level)")
+      ->capture_default_str();
   cmd->add_option("--hard-case", o->only_cases,
                   "Run only this hard case (repeatable): poisson, youngs_modulus, sliver, "
                   "refined_patch, inverting_load, long_run, tight_bend, zero_length");
@@ -113,6 +122,11 @@ void add_stability_command(CLI::App& app, const std::string& command_line) {
     so.max_level = o->max_level;
     so.hard_cases = !o->no_hard_cases;
     so.rod_steps = !o->no_rod_steps;
+    so.tet_steps = !o->no_tet_steps;
+    if (o->tet_max_level < 0) {
+      throw InputError("--tet-max-level: expected ≥ 0, got " + std::to_string(o->tet_max_level));
+    }
+    so.tet_max_level = o->tet_max_level;
     so.only_cases = o->only_cases;
     so.jobs = o->jobs;
     OutcomeCache outcomes(o->no_cache ? fs::path() : outcome_cache_dir(o->cache_dir), o->retime,

@@ -9,9 +9,9 @@
 
 #include "../../schema_check.hpp"
 #include "../../test_helpers.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
-#include "meshes/foundation/errors.hpp"
 #include "verification/harness/outcome_cache.hpp"
 #include "verification/studies/stability/stability.hpp"
 
@@ -42,9 +42,25 @@ StabilityReport sample_report() {
   r.rows[1].level = 1;
   r.fits.push_back({"volume / seed001", "verlet", 0.0, {0, 1}, 1.0, 1.0});
   HardCase hc{"x", "A case", "setup", {}, 1.0};
-  hc.outcomes.push_back({"FEM | P1", true, true, std::nullopt, "fine | ok", {{"u_contact_mm", 0.1}}});
+  hc.outcomes.push_back(
+      {"FEM | P1", true, true, std::nullopt, "fine | ok", {{"u_contact_mm", 0.1}}});
   hc.outcomes.push_back({"msm", false, std::nullopt, false, "stopped", {{"nan", NAN}}});
   r.hard_cases.push_back(hc);
+  TetStepRow explicit_row;
+  explicit_row.model = "corotational-p1";
+  explicit_row.integrator = "symplectic-euler";
+  explicit_row.predicted_dt = 2e-5;
+  explicit_row.power_dt = 2.01e-5;
+  explicit_row.found_dt = 1.99e-5;
+  explicit_row.unstable_dt = 2.0e-5;
+  TetStepRow ladder = explicit_row;
+  ladder.integrator = "implicit-euler";
+  ladder.load = 0.07;
+  ladder.predicted_dt = ladder.power_dt = ladder.found_dt = ladder.unstable_dt = NAN;
+  ladder.steps_tried = {1e-4, 1e-3};
+  ladder.bounded = {true, false};
+  ladder.failure = "dt 0.001 s: diverged";
+  r.tet_rows = {explicit_row, ladder};
   return r;
 }
 }  // namespace
@@ -75,6 +91,11 @@ TEST(Stability, JsonHasEveryFieldItsSchemaRequires) {
   EXPECT_TRUE(j["hard_cases"][0]["outcomes"][1]["converged"].is_null());
   EXPECT_TRUE(j["hard_cases"][0]["outcomes"][1]["values"]["nan"].is_null());  // NaN → null
   EXPECT_NEAR(j["critical_steps"][0]["found_over_predicted"].get<double>(), 0.995, 1e-12);
+  for (const auto& key : props["tet_critical_steps"]["items"]["required"]) {
+    EXPECT_TRUE(j["tet_critical_steps"][1].contains(key)) << key;
+  }
+  EXPECT_TRUE(j["tet_critical_steps"][1]["found_dt"].is_null());  // NaN → null
+  EXPECT_NEAR(j["tet_critical_steps"][0]["found_over_predicted"].get<double>(), 0.995, 1e-12);
 }
 
 TEST(Stability, MarkdownIsOneSelfContainedSectionWithTheCommandAndEscapedCells) {
@@ -84,6 +105,14 @@ TEST(Stability, MarkdownIsOneSelfContainedSectionWithTheCommandAndEscapedCells) 
   EXPECT_NE(md.find("`vesselverify stability --quick`"), std::string::npos);
   EXPECT_NE(md.find("fine \\| ok"), std::string::npos);
   EXPECT_NE(md.find("| volume / seed001 | verlet | 0 | 0,1 | 1 | 1 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| corotational-p1 | symplectic-euler | 0 | 0 | 0 | 0.02 | 0.0201 | 0.0199 | "
+                    "0.995 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(
+      md.find("| corotational-p1 | implicit-euler | 0 | 0 | 70 | – | – | unbounded at 1 ms |"),
+      std::string::npos)
+      << md;
 }
 
 TEST(Stability, WritesBothFilesAtomicallyAndRefusesAnUnwritableDirectory) {
@@ -103,6 +132,7 @@ TEST(Stability, TheStepTableIsTheSameComputedOneRowAtATimeOrInParallel) {
   o.cache_dir = cache.path();
   o.hard_cases = false;
   o.rod_steps = false;  // the vessel table only (test_rod_steps.cpp has the rod's)
+  o.tet_steps = false;  // and the springs' (test_tet_steps.cpp has the P1 models')
   o.max_level = 0;
   o.trial_steps = 50;
   o.jobs = 1;
@@ -133,6 +163,7 @@ TEST(Stability, HardCasesSideBySideGiveWhatTheyGiveOneAtATime) {
   o.long_run_steps = 500;
   o.only_cases = {"zero_length", "long_run", "inverting_load", "tight_bend"};
   o.rod_steps = false;
+  o.tet_steps = false;
   o.jobs = 1;
   const StabilityReport one = run_stability(o);
   o.jobs = 2;
@@ -174,6 +205,7 @@ TEST(Stability, ASecondRunReadsTheRowsFromTheOutcomeCacheWithTheirTimings) {
   o.cache_dir = cache.path();
   o.hard_cases = false;
   o.rod_steps = false;  // the vessel table only (test_rod_steps.cpp has the rod's)
+  o.tet_steps = false;
   o.max_level = 0;
   o.trial_steps = 50;
   o.outcome_cache = &outcomes;

@@ -10,9 +10,10 @@
 #include "meshes/vessel_geometry.hpp"
 #include "verification/harness/outcome_cache.hpp"
 #include "verification/harness/parallel.hpp"
+#include "verification/harness/timing.hpp"
 #include "verification/studies/stability/rod_steps.hpp"
 #include "verification/studies/stability/study_models.hpp"
-#include "verification/harness/timing.hpp"
+#include "verification/studies/stability/tet_steps.hpp"
 
 namespace vessel {
 
@@ -137,11 +138,14 @@ HardCase run_or_recall_case(const HardCaseEntry& c, std::size_t i, std::size_t k
 /// then run alone.
 void run_hard_cases(const StabilityOptions& o, const Stopwatch& clock, std::ostream& log,
                     StabilityReport& rep, std::vector<TimingProvenance>& provenance) {
-  const HardCaseEntry all_cases[] = {
-      {"ν → 0.5", case_poisson, false},          {"E sweep", case_youngs_modulus, false},
-      {"sliver tets", case_sliver, false},       {"refined contact patch", case_refined_patch, false},
-      {"inverting load", case_inverting_load, false}, {"long run", case_long_run, true},
-      {"tight bend", case_tight_bend, false},    {"zero-length springs", case_zero_length, false}};
+  const HardCaseEntry all_cases[] = {{"ν → 0.5", case_poisson, false},
+                                     {"E sweep", case_youngs_modulus, false},
+                                     {"sliver tets", case_sliver, false},
+                                     {"refined contact patch", case_refined_patch, false},
+                                     {"inverting load", case_inverting_load, false},
+                                     {"long run", case_long_run, true},
+                                     {"tight bend", case_tight_bend, false},
+                                     {"zero-length springs", case_zero_length, false}};
   static_assert(std::size(all_cases) == kHardCaseIds.size());
   std::vector<std::size_t> cases;
   for (std::size_t i = 0; i < kHardCaseIds.size(); ++i) {
@@ -168,11 +172,12 @@ void run_hard_cases(const StabilityOptions& o, const Stopwatch& clock, std::ostr
   parallel_solves(side_by_side.size(), o.jobs, [&](std::size_t t) {
     const std::size_t k = side_by_side[t];
     std::ostringstream case_log;
-    done[k] = run_or_recall_case(all_cases[cases[k]], cases[k], k + 1, o, case_log,
-                                 done_provenance[k]);
+    done[k] =
+        run_or_recall_case(all_cases[cases[k]], cases[k], k + 1, o, case_log, done_provenance[k]);
     const std::lock_guard lock(log_mutex);
     log << header(k) << ", done in " << fmt(done[k].seconds, 3) << " s (" << fmt(clock.seconds(), 3)
-        << " s so far)\n" << case_log.str() << std::flush;
+        << " s so far)\n"
+        << case_log.str() << std::flush;
   });
   for (const std::size_t k : alone) {
     log << header(k) << ", alone (" << fmt(clock.seconds(), 3) << " s so far)" << std::endl;
@@ -215,6 +220,12 @@ StabilityReport run_stability(const StabilityOptions& o) {
         << std::endl;
     rep.rod_wire = o.rod_wire;
     rep.rod_rows = rod_critical_steps(o.rod_wire, rep.trial_steps, log);
+  }
+  if (o.tet_steps) {
+    const int tet_level = std::min(max_level, o.tet_max_level);
+    log << "[stability] corotational P1's and XPBD FEM's critical steps, levels 0.." << tet_level
+        << std::endl;
+    rep.tet_rows = tet_critical_steps(o, tet_level, rep.trial_steps, log, provenance);
   }
   if (o.hard_cases) run_hard_cases(o, clock, log, rep, provenance);
   rep.timed_items = provenance.size();

@@ -24,11 +24,11 @@ class OutcomeCache;  // verification/harness/outcome_cache.hpp
 
 /// The guidewire of the rod rows: a metal wire (nitinol-like), clamped at one end.
 struct RodWire {
-  double length = 0.1;           ///< m
-  double diameter = 0.356e-3;    ///< m (0.014")
-  double young = 60e9;           ///< E, Pa
-  double shear = 60e9 / 2.66;    ///< G = E/(2(1 + ν)), ν = 0.33, Pa
-  double density = 6450.0;       ///< kg/m³
+  double length = 0.1;         ///< m
+  double diameter = 0.356e-3;  ///< m (0.014")
+  double young = 60e9;         ///< E, Pa
+  double shear = 60e9 / 2.66;  ///< G = E/(2(1 + ν)), ν = 0.33, Pa
+  double density = 6450.0;     ///< kg/m³
   std::vector<int> segments{50, 200};
 };
 
@@ -44,6 +44,10 @@ struct StabilityOptions {
   int max_level = -1;
   bool hard_cases = true;  ///< false: only the critical-step table
   bool rod_steps = true;   ///< the guidewire's critical steps (rod_steps.hpp)
+  /// Corotational P1's and XPBD FEM's critical steps (tet_steps.hpp), at levels
+  /// 0..min(max level, tet_max_level).
+  bool tet_steps = true;
+  int tet_max_level = 0;
   RodWire rod_wire;
   /// Rows of the critical-step table, and hard cases without a measured time, computed at a time
   /// (each on its own thread); the timed hard case (the long run) runs alone after them.
@@ -59,14 +63,14 @@ struct StabilityOptions {
 
 /// The hard cases' ids, in the order they run.
 inline constexpr std::array<std::string_view, 8> kHardCaseIds{
-    "poisson", "youngs_modulus", "sliver", "refined_patch", "inverting_load", "long_run",
-    "tight_bend", "zero_length"};
+    "poisson",        "youngs_modulus", "sliver",     "refined_patch",
+    "inverting_load", "long_run",       "tight_bend", "zero_length"};
 
 /// One row of the critical-step table.
 struct CriticalStepRow {
-  std::string model;       ///< e.g. "volume / seed001"
-  std::string integrator;  ///< explicit-euler | symplectic-euler | verlet
-  double zeta = 0.0;       ///< target damping ratio of the top mode (c = 2ζω_max·mean mass)
+  std::string model;           ///< e.g. "volume / seed001"
+  std::string integrator;      ///< explicit-euler | symplectic-euler | verlet
+  double zeta = 0.0;           ///< target damping ratio of the top mode (c = 2ζω_max·mean mass)
   double point_damping = 0.0;  ///< c, N·s/m per node (seed 000 eq. 3.3)
   int level = 0;
   int nodes = 0;
@@ -75,7 +79,7 @@ struct CriticalStepRow {
   double omega_max = 0.0;  ///< rad/s (Lanczos)
   double omega_gershgorin = 0.0;
   double omega_min = 0.0;
-  double gamma_max = 0.0;  ///< damping rate of the top mode, 1/s
+  double gamma_max = 0.0;     ///< damping rate of the top mode, 1/s
   double predicted_dt = 0.0;  ///< modal estimate (exact undamped; may over-predict when damped)
   /// Proven stable step (msm::guaranteed_critical_step), s; NaN where none is proven.
   double guaranteed_dt = 0.0;
@@ -101,7 +105,7 @@ struct RodStepRow {
   std::string model;       ///< der | corde | xpbd
   std::string integrator;  ///< symplectic-euler | verlet | implicit-euler | xpbd
   int segments = 0;
-  double h = 0.0;          ///< segment length, m
+  double h = 0.0;  ///< segment length, m
   /// Closed forms of the straight discrete rod, s (the smallest: closed_form_dt).
   double axial_dt = 0.0, twist_dt = 0.0, bending_dt = 0.0, closed_form_dt = 0.0;
   /// Explicit rows: 2/ω_max (Lanczos on the rod at rest), the bisection's stable and unstable
@@ -116,13 +120,40 @@ struct RodStepRow {
   double seconds = 0.0;
 };
 
+/// One row of the P1 tet models' critical-step table
+/// (verification/studies/stability/tet_steps.hpp).
+struct TetStepRow {
+  std::string model;  ///< corotational-p1 | xpbd-fem
+  std::string
+      integrator;  ///< symplectic-euler | verlet | implicit-euler | implicit-euler-rest | xpbd
+  int level = 0;
+  int nodes = 0;
+  int tets = 0;
+  double nu = 0.0;    ///< Poisson's ratio
+  double load = 0.0;  ///< N: the trials' contact load (0: from rest with a small random velocity)
+  /// The independent estimate, 2/ω_max with ω_max of M⁻¹K (K: corotational P1's Hessian at rest;
+  /// XPBD: the shear stiffness its carried multipliers integrate explicitly) by Lanczos and by
+  /// power iteration, rad/s and s; NaN on the implicit rows.
+  double omega_lanczos = 0.0, omega_power = 0.0, predicted_dt = 0.0, power_dt = 0.0;
+  /// Largest step found bounded and smallest found unbounded by bisection, s; NaN where no
+  /// bisection ran (bounded at every step of the ladder).
+  double found_dt = 0.0, unstable_dt = 0.0;
+  /// Implicit rows: the ladder's steps (s), whether each stayed bounded, and why one did not.
+  std::vector<double> steps_tried;
+  std::vector<bool> bounded;
+  std::string failure;
+  int steps_per_trial = 0;
+  int trials = 0;
+  double seconds = 0.0;
+};
+
 /// What one model did on a hard case.
 struct HardCaseOutcome {
   std::string model;
-  bool finished = false;           ///< returned a result (no exception)
-  std::optional<bool> converged;   ///< solver converged (static / linear solve), if applicable
-  std::optional<bool> bounded;     ///< energy stayed bounded (dynamic runs), if applicable
-  std::string reported;            ///< what it reported (numbers in mm, mN, s), or its error
+  bool finished = false;          ///< returned a result (no exception)
+  std::optional<bool> converged;  ///< solver converged (static / linear solve), if applicable
+  std::optional<bool> bounded;    ///< energy stayed bounded (dynamic runs), if applicable
+  std::string reported;           ///< what it reported (numbers in mm, mN, s), or its error
   std::map<std::string, double> values;  ///< the main figures, SI unless the key says mm
 };
 
@@ -143,6 +174,8 @@ struct StabilityReport {
   std::vector<HardCase> hard_cases;
   RodWire rod_wire;
   std::vector<RodStepRow> rod_rows;  ///< empty when the options leave the rod out
+  /// Corotational P1 and XPBD FEM (tet_steps.hpp); empty when the options leave them out.
+  std::vector<TetStepRow> tet_rows;
   /// Hard cases run side by side (their seconds are wall times on a shared machine); the long run
   /// ran alone.
   int hard_cases_at_a_time = 1;
