@@ -5,8 +5,8 @@ against the finite-strain reference at 1, 10 and 70 mN and timed per update.
 All models on the scene's level-0 mesh; writes docs/measurements/fem_models_vs_springs.md.
 
 Each scene (verification/scenes/contact_straight.toml, contact_arch.toml) is copied to a
-temporary folder with two models added (kind corotational_fem, and kind xpbd_fem at its defaults)
-and its calibration paths made absolute, then run by
+temporary folder with a corotational_fem and an xpbd_fem model added at their defaults where it
+has none of the kind, and its calibration paths made absolute, then run by
 
     vesselverify validity SCENE --ladder 0.001,0.01,0.07 --models ... --time-updates --fields none
 
@@ -29,17 +29,11 @@ import tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENES_DIR = os.path.join(ROOT, "verification", "scenes")
-COROTATIONAL = "fem/corotational-p1"
-XPBD = "fem/xpbd-neo-hookean"
-ADDED_MODELS = f'''
-[[models]]
-name = "{COROTATIONAL}"
-kind = "corotational_fem"
-
-[[models]]
-name = "{XPBD}"
-kind = "xpbd_fem"
-'''
+# Added to a scene that lacks a model of the kind (at the kind's defaults).
+ADDED_MODELS = {
+    "corotational_fem": ("fem/corotational-p1", "corotational P1"),
+    "xpbd_fem": ("fem/xpbd-neo-hookean", "XPBD FEM"),
+}
 RATES = [(30.0, "update_seconds_30hz"), (1000.0, "update_seconds_1khz")]
 
 
@@ -49,7 +43,8 @@ def load_average():
 
 
 def models_of(scene_text):
-    """The scene's models the study judges: linear P1, the whole-vessel static spring models."""
+    """The scene's models the study judges: linear P1, the whole-vessel static spring models,
+    corotational P1 and XPBD FEM."""
     scene = tomllib.loads(scene_text)
     out = []
     for m in scene.get("models", []):
@@ -60,6 +55,8 @@ def models_of(scene_text):
                 and "roi_radius" not in m:
             # The edge pairs are P1's StVK tetrahedron written on the edges, not a spring network.
             out.append((m["name"], "edge pairs" if m.get("edge_pairs") else "springs"))
+        elif kind in ADDED_MODELS:
+            out.append((m["name"], ADDED_MODELS[kind][1]))
     return out
 
 
@@ -70,8 +67,11 @@ def study(vv, scene, loads, tmp, env):
     text = re.sub(r'^(calibration\s*=\s*")([^"/][^"]*)"',
                   lambda m: m.group(1) + os.path.join(SCENES_DIR, m.group(2)) + '"', text,
                   flags=re.M)
-    text += ADDED_MODELS
-    kinds = models_of(text) + [(COROTATIONAL, "corotational P1"), (XPBD, "XPBD FEM")]
+    present = {m.get("kind") for m in tomllib.loads(text).get("models", [])}
+    for kind, (name, label) in ADDED_MODELS.items():
+        if kind not in present:
+            text += f'\n[[models]]\nname = "{name}"\nkind = "{kind}"\n'
+    kinds = models_of(text)
     path = os.path.join(tmp, scene + ".toml")
     with open(path, "w") as f:
         f.write(text)
@@ -169,7 +169,7 @@ def verdict(scene, load_mn, by, kinds, order):
     best = min(springs, key=lambda n: by[n]["qoi_error_mm"])
     best_err = by[best]["qoi_error_mm"]
     parts = []
-    for fem in (COROTATIONAL, XPBD):
+    for fem in (n for n in order if kinds[n] in ("corotational P1", "XPBD FEM")):
         e = by[fem]
         if not e["ok"]:
             parts.append(f"{kinds[fem]} gave no answer ({e['failure']})")
