@@ -34,8 +34,8 @@ struct Material {
 enum class Formulation { automatic, displacement, mixed };
 /// direct: CHOLMOD (displacement) or UMFPACK (mixed); cg_amg: CG with AMG (displacement only);
 /// gmres_block: FGMRES with a block-triangular AMG / pressure-mass preconditioner (mixed only);
-/// matrix_free: CG on the matrix-free operator with a P2 → P1 p-multigrid, CHOLMOD on P1 (AMG
-/// for P1 itself) (displacement only; no P2 matrix is assembled).
+/// matrix_free: CG on the matrix-free operator with a P2 → P1 p-multigrid, ML-CG on P1 (AMG for
+/// P1 itself) (displacement only; no P2 matrix is assembled).
 /// The values are part of the FEM solution cache's key: append, never renumber.
 enum class LinearSolver { automatic, direct, cg_amg, gmres_block, matrix_free };
 
@@ -108,6 +108,11 @@ struct SolverOptions {
   /// CG-AMG: give ML all six rigid-body modes (translations and rotations) as near-null space;
   /// false: only the three translations (deal.II's AdditionalData::constant_modes).
   bool amg_rigid_body_modes = true;
+  /// matrix_free, P2: the P1 level of the p-multigrid solved exactly by a CHOLMOD factor at or
+  /// below this many P1 DoFs, above by CG with ML to a relative residual of 1e-2 (measured in
+  /// docs/measurements/matrix_free_multigrid.md). Changes the answer only within the CG
+  /// tolerance, so it is not part of the solution cache's key.
+  std::size_t matrix_free_direct_coarse_max_dofs = 0;
   double cg_relative_tolerance = 1e-10;  ///< ‖r‖ ≤ tol·‖b‖ for CG and FGMRES
   /// gmres_block: Krylov basis size before FGMRES restarts (memory: 2 × this many vectors).
   unsigned gmres_restart = 100;
@@ -161,6 +166,8 @@ struct MatrixFreeProfile {
   double eigenvalue_estimate = 0.0;  ///< Chebyshev's λ_max(D⁻¹A) by CG steps
   double coarse_matrix = 0.0;        ///< the P1 matrix (MatrixFreeTools::compute_matrix)
   double coarse_factor = 0.0;  ///< CHOLMOD's analysis and factorisation of it (or ML's set-up)
+  std::string coarse_method;   ///< how the P1 level is solved: "CHOLMOD", "ML-CG", "one ML V-cycle"
+  unsigned coarse_iterations = 0;  ///< ML-CG: inner CG iterations, all P1 solves together
   double cg = 0.0;             ///< the CG iterations, all of them
   unsigned operator_applications = 0;  ///< fine A·v in the CG (smoother, residuals, CG's own)
   double operator_seconds = 0.0;       ///< of cg: in those applications

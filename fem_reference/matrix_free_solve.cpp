@@ -39,12 +39,14 @@ void ElasticitySolver::Impl::solve_displacement_matrix_free() {
   solution = 0.0;
   for (const auto& line : constraints.get_lines()) rhs(line.index) = 0.0;
   if (rhs.l2_norm() != 0.0) {
+    detail::PMultigridSettings settings;
+    settings.direct_coarse_max_dofs = o.matrix_free_direct_coarse_max_dofs;
     const detail::MatrixFreeElasticitySolver wall(
         *mapping, dof,
         [this](const dl::DoFHandler<kDim>& d, dl::AffineConstraints<double>& c) {
           support_constraints(d, c);
         },
-        degree, form->lambda(), form->mu(), detail::node_centroid(mesh));
+        degree, form->lambda(), form->mu(), detail::node_centroid(mesh), settings);
     result.iterations =
         wall.solve(rhs, solution, o.cg_relative_tolerance, o.max_iterations).iterations;
     result.matrix_free = wall.profile();

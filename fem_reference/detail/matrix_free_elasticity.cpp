@@ -4,6 +4,7 @@
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_fe.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/solver_cg.h>
@@ -75,9 +76,9 @@ dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<doubl
 
 ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
                                        const dl::DoFHandler<kDim>& dof,
-                                       const dl::AffineConstraints<double>& constraints,
-                                       int degree, double lambda, double mu)
-    : constraints_(constraints), lambda_(lambda), mu_(mu) {
+                                       const dl::AffineConstraints<double>& constraints, int degree,
+                                       double lambda, double mu)
+    : mapping_(mapping), constraints_(constraints), lambda_(lambda), mu_(mu) {
   dl::MatrixFree<kDim, double>::AdditionalData data;
   data.mapping_update_flags = dl::update_gradients | dl::update_JxW_values;
   data.tasks_parallel_scheme = dl::MatrixFree<kDim, double>::AdditionalData::none;
@@ -88,6 +89,7 @@ ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
   const auto* fe_mapping = dynamic_cast<const dl::MappingFE<kDim>*>(&mapping);
   const bool affine = fe_mapping != nullptr && fe_mapping->get_degree() == 1;
   const dl::QGaussSimplex<kDim> quadrature(static_cast<unsigned>(affine ? degree : degree + 1));
+  quadrature_ = quadrature;
   n_quadrature_points_ = quadrature.size();
   mf_.reinit(mapping, dof, constraints, quadrature, data);
 }
@@ -113,6 +115,34 @@ void ElasticityOperator::vmult(MfVector& dst, const MfVector& src) const {
 }
 
 MfVector ElasticityOperator::diagonal() const {
+  for (const auto& line : constraints_.get_lines()) {
+    if (!line.entries.empty()) return diagonal_by_kernel();
+  }
+  MfVector diag;
+  mf_.initialize_dof_vector(diag);
+  const auto& dof = mf_.get_dof_handler();
+  const auto& fe = dof.get_fe();  // FESystem(FE_SimplexP(degree), 3): one base element
+  dl::FEValues<kDim> values(mapping_, fe.base_element(0), quadrature_,
+                            dl::update_gradients | dl::update_JxW_values);
+  std::vector<dl::types::global_dof_index> idx(fe.n_dofs_per_cell());
+  for (const auto& cell : dof.active_cell_iterators()) {
+    values.reinit(static_cast<dl::Triangulation<kDim>::cell_iterator>(cell));
+    cell->get_dof_indices(idx);
+    for (unsigned i = 0; i < idx.size(); ++i) {
+      const auto [c, k] = fe.system_to_component_index(i);
+      double a = 0.0;
+      for (unsigned q = 0; q < values.n_quadrature_points; ++q) {
+        const dl::Tensor<1, kDim> g = values.shape_grad(k, q);
+        a += values.JxW(q) * ((lambda_ + mu_) * g[c] * g[c] + mu_ * (g * g));
+      }
+      diag(idx[i]) += a;
+    }
+  }
+  for (const unsigned i : mf_.get_constrained_dofs()) diag.local_element(i) = 1.0;
+  return diag;
+}
+
+MfVector ElasticityOperator::diagonal_by_kernel() const {
   MfVector diag;
   mf_.initialize_dof_vector(diag);
   const std::function<void(Evaluation&)> kernel = [this](Evaluation& phi) {
@@ -139,10 +169,11 @@ void ElasticityOperator::zero_constrained(MfVector& v) const {
 }
 
 /// One V-cycle: Chebyshev pre-smoothing on the fine level, the residual restricted to P1, solved
-/// there (CHOLMOD or one ML V-cycle), prolongated and added, Chebyshev post-smoothing. Pre- and
-/// post-smoother are the same polynomial in A, the restriction is the prolongation's transpose
-/// and the coarse solve is symmetric, so the cycle is symmetric and CG may use it. For P1 (no
-/// lower degree on the mesh): ML alone.
+/// there (ML-CG, CHOLMOD or one ML V-cycle), prolongated and added, Chebyshev post-smoothing.
+/// Pre- and post-smoother are the same polynomial in A, the restriction is the prolongation's
+/// transpose and the CHOLMOD or V-cycle coarse solve is symmetric, so the cycle is symmetric and
+/// CG may use it; ML-CG's coarse solve depends on its right-hand side, hence the flexible CG. For
+/// P1 (no lower degree on the mesh): one ML V-cycle alone.
 class MatrixFreeElasticitySolver::VCycle {
  public:
   VCycle(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
@@ -197,8 +228,17 @@ class MatrixFreeElasticitySolver::VCycle {
     coarse->compute_matrix(*coarse_matrix_);
     profile.coarse_matrix = lap();
     // For P1 the "coarse" level is the fine one: a factor of it would make the matrix-free
-    // operator pointless, so P1 always takes ML.
-    if (settings.coarse == CoarseSolve::cholmod && degree > 1) {
+    // operator pointless, so P1 always takes one ML V-cycle.
+    method_ = degree == 1 ? CoarseSolve::ml_vcycle : settings.coarse;
+    if (method_ == CoarseSolve::automatic) {
+      method_ = coarse->m() <= settings.direct_coarse_max_dofs ? CoarseSolve::cholmod
+                                                               : CoarseSolve::ml_cg;
+    }
+    coarse_tolerance_ = settings.coarse_tolerance;
+    profile.coarse_method = method_ == CoarseSolve::cholmod     ? "CHOLMOD"
+                            : method_ == CoarseSolve::ml_vcycle ? "one ML V-cycle"
+                                                                : "ML-CG";
+    if (method_ == CoarseSolve::cholmod) {
       cholmod_ = std::make_unique<CholmodFactor>(to_eigen(*coarse_matrix_));
       coarse_matrix_.reset();
       profile.coarse_factor = lap();
@@ -258,9 +298,13 @@ class MatrixFreeElasticitySolver::VCycle {
            4 * residual_.memory_consumption();
   }
 
+  /// Whether the cycle is a fixed linear map (false for ml_cg: the outer CG must be flexible).
+  [[nodiscard]] bool linear() const { return method_ != CoarseSolve::ml_cg; }
+
   /// The CG-time parts of `profile`: coarse solves and transfers so far.
   void add_solve_profile(MatrixFreeProfile& profile) const {
     profile.coarse_solves = coarse_solves_;
+    profile.coarse_iterations = coarse_iterations_;
     profile.coarse_solve_seconds = coarse_solve_seconds_;
     profile.transfer_seconds = transfer_seconds_;
   }
@@ -269,15 +313,26 @@ class MatrixFreeElasticitySolver::VCycle {
   [[nodiscard]] double eigenvalue_seconds() const { return eigenvalue_seconds_; }
 
  private:
-  using Chebyshev = dl::PreconditionChebyshev<ElasticityOperator, MfVector,
-                                              dl::DiagonalMatrix<MfVector>>;
+  using Chebyshev =
+      dl::PreconditionChebyshev<ElasticityOperator, MfVector, dl::DiagonalMatrix<MfVector>>;
 
   /// x ≈ A₁⁻¹ b on the P1 level (on the fine level itself for P1).
   void coarse_solve(MfVector& x, const MfVector& b) const {
     const auto t0 = Clock::now();
     ++coarse_solves_;
-    if (!cholmod_) {
+    if (method_ == CoarseSolve::ml_vcycle) {
       amg_.vmult(x, b);
+    } else if (method_ == CoarseSolve::ml_cg) {
+      // From x = 0 to ‖b − A₁x‖ ≤ coarse_tolerance·‖b‖; the cap only guards against stagnation,
+      // as any iterate is a usable coarse correction.
+      dl::ReductionControl control(200, 0.0, coarse_tolerance_, false, false);
+      dl::SolverCG<MfVector> cg(control);
+      x = 0.0;
+      try {
+        cg.solve(*coarse_matrix_, x, b, amg_);
+      } catch (const dl::SolverControl::NoConvergence&) {
+      }
+      coarse_iterations_ += control.last_step();
     } else {
       const unsigned n = b.locally_owned_size();
       Eigen::VectorXd rhs(n);
@@ -296,13 +351,15 @@ class MatrixFreeElasticitySolver::VCycle {
   std::shared_ptr<dl::DiagonalMatrix<MfVector>> inverse_diagonal_;
   Chebyshev chebyshev_;
   std::unique_ptr<CholmodFactor> cholmod_;                             // CoarseSolve::cholmod
-  std::unique_ptr<dl::TrilinosWrappers::SparseMatrix> coarse_matrix_;  // ml_vcycle: ML's matrix
+  std::unique_ptr<dl::TrilinosWrappers::SparseMatrix> coarse_matrix_;  // ML's matrix
   dl::TrilinosWrappers::PreconditionAMG amg_;
   std::vector<double> mode_storage_;  // must outlive amg_
   mutable MfVector residual_, correction_, coarse_residual_, coarse_correction_;
   unsigned eigenvalue_applications_ = 0;
   double eigenvalue_seconds_ = 0.0;
-  mutable unsigned coarse_solves_ = 0;
+  CoarseSolve method_ = CoarseSolve::cholmod;
+  double coarse_tolerance_ = 0.0;
+  mutable unsigned coarse_solves_ = 0, coarse_iterations_ = 0;
   mutable double coarse_solve_seconds_ = 0.0, transfer_seconds_ = 0.0;
 };
 
@@ -325,8 +382,7 @@ MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(const dl::Mapping<kDim>& 
   preconditioner_ =
       std::make_unique<VCycle>(mapping, dof, *fine_, fine_constraints_, constraints_for, degree,
                                lambda, mu, centre, settings, profile_);
-  setup_seconds_ =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  setup_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 MatrixFreeElasticitySolver::~MatrixFreeElasticitySolver() = default;
@@ -342,10 +398,13 @@ MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::solve(
   fine_->zero_constrained(rhs);
   fine_->zero_constrained(x);
   dl::SolverControl control(max_iterations, relative_tolerance * rhs.l2_norm());
-  dl::SolverCG<MfVector> cg(control);
   const auto t0 = Clock::now();
   try {
-    cg.solve(*fine_, x, rhs, *preconditioner_);
+    if (preconditioner_->linear()) {
+      dl::SolverCG<MfVector>(control).solve(*fine_, x, rhs, *preconditioner_);
+    } else {
+      dl::SolverFlexibleCG<MfVector>(control).solve(*fine_, x, rhs, *preconditioner_);
+    }
   } catch (const dl::SolverControl::NoConvergence& e) {
     std::ostringstream m;
     m << "matrix-free CG with p-multigrid did not converge in " << e.last_step

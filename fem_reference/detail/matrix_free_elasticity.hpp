@@ -1,9 +1,9 @@
 #pragma once
 /// Private to fem_reference: the displacement stiffness of small-strain isotropic elasticity
 /// applied without a matrix (deal.II MatrixFree + FEEvaluation on FE_SimplexP P1/P2 tets), and the
-/// solver built on it: CG preconditioned by a two-level p-multigrid, P2 smoothed by Chebyshev on the
-/// operator's diagonal, the P1 level (same mesh) solved on the P1 matrix (computed cell by cell
-/// from the same kernel) by a CHOLMOD factor or one ML V-cycle. What deal.II 9.4 supports on
+/// solver built on it: CG preconditioned by a two-level p-multigrid, P2 smoothed by Chebyshev on
+/// the operator's diagonal, the P1 level (same mesh) solved on the P1 matrix (computed cell by cell
+/// from the same kernel) by ML-CG, a CHOLMOD factor or one ML V-cycle. What deal.II 9.4 supports on
 /// simplices: docs/measurements/dealii_simplex_support.md.
 #include <deal.II/base/subscriptor.h>
 #include <deal.II/dofs/dof_handler.h>
@@ -53,7 +53,10 @@ class ElasticityOperator : public dl::Subscriptor {
     if (diagonal_.size() == 0) diagonal_ = diagonal();
     return diagonal_.local_element(i);
   }
-  /// diag(A) (1 on constrained DoFs), by MatrixFreeTools::compute_diagonal.
+  /// diag(A) (1 on constrained DoFs). With Dirichlet constraints only, per DoF (component c of
+  /// shape N) A_ii = Σ_cells Σ_q w_q ((λ + μ)(∂_c N)² + μ |∇N|²) by FEValues of the scalar
+  /// element: one pass over the cells instead of MatrixFreeTools::compute_diagonal's one kernel
+  /// evaluation per cell DoF (30 for P2); with other constraints compute_diagonal.
   [[nodiscard]] MfVector diagonal() const;
   /// The assembled A (the constrained rows and columns zero but for a positive diagonal), into
   /// `matrix` on `dof`'s full sparsity pattern; MatrixFreeTools::compute_matrix.
@@ -67,7 +70,12 @@ class ElasticityOperator : public dl::Subscriptor {
   [[nodiscard]] unsigned quadrature_points() const { return n_quadrature_points_; }
 
  private:
+  /// diag(A) by MatrixFreeTools::compute_diagonal (any constraints).
+  [[nodiscard]] MfVector diagonal_by_kernel() const;
+
   dl::MatrixFree<kDim, double> mf_;
+  const dl::Mapping<kDim>& mapping_;
+  dl::Quadrature<kDim> quadrature_;
   const dl::AffineConstraints<double>& constraints_;
   double lambda_, mu_;
   mutable MfVector diagonal_;  // el()'s, on first use
@@ -82,24 +90,30 @@ dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<doubl
 /// How the V-cycle solves on the P1 level. `cholmod`: exactly, by a CHOLMOD factor of the P1
 /// matrix, so the two-level iteration count depends on the smoother alone, not on the level.
 /// `ml_vcycle`: approximately, by one ML V-cycle (memory of the hierarchy only, but its error
-/// grows with the level and the outer iterations with it; docs/measurements/matrix_free_multigrid.md).
-enum class CoarseSolve { cholmod, ml_vcycle };
+/// grows with the level and the outer iterations with it). `ml_cg`: CG preconditioned by ML to
+/// a relative residual of PMultigridSettings::coarse_tolerance: an inexact but level-independent
+/// coarse solve; the outer CG is then the flexible one (the preconditioner is not a fixed linear
+/// map). `automatic`: cholmod up to direct_coarse_max_dofs P1 DoFs, else ml_cg
+/// (docs/measurements/matrix_free_multigrid.md).
+enum class CoarseSolve { automatic, cholmod, ml_vcycle, ml_cg };
 
 /// Settings of the p-multigrid V-cycle.
 struct PMultigridSettings {
   unsigned chebyshev_degree = 4;      ///< matrix-vector products per smoothing step
   double smoothing_range = 20.0;      ///< Chebyshev smooths [λ_max / range, λ_max] of D⁻¹A
   unsigned eigenvalue_cg_steps = 20;  ///< CG steps of Chebyshev's λ_max(D⁻¹A) estimate
-  CoarseSolve coarse = CoarseSolve::cholmod;
-  bool amg_rigid_body_modes = true;   ///< ml_vcycle: ML near-null space, all six rigid-body modes
+  CoarseSolve coarse = CoarseSolve::automatic;
+  std::size_t direct_coarse_max_dofs = 0;  ///< automatic: CHOLMOD on P1 up to this many P1 DoFs
+  double coarse_tolerance = 1e-2;    ///< ml_cg: ‖r₁‖ ≤ this·‖b₁‖ on the P1 level
+  bool amg_rigid_body_modes = true;  ///< ml_vcycle: ML near-null space, all six rigid-body modes
   AmgProlongator amg_prolongator = AmgProlongator::plain;  ///< ml_vcycle
 };
 
 /// The wall's displacement system, set up once, solved for many right-hand sides: the P2 (or P1)
 /// matrix-free operator on the fine DoFs, and below it (for P2) the P1 DoFs of the same mesh, the
-/// P2 → P1 transfer and ML on the assembled P1 matrix. Callers that solve the same wall under many
-/// loads (contact active sets, Newton steps with a fixed stiffness) construct it once and call
-/// solve() per load; set-up dominates when the loads are few.
+/// P2 → P1 transfer and ML (or CHOLMOD) on the assembled P1 matrix. Callers that solve the same
+/// wall under many loads (contact active sets, Newton steps with a fixed stiffness) construct it
+/// once and call solve() per load; set-up dominates when the loads are few.
 ///
 /// The right-hand side is the assembled one on the unconstrained DoFs (N): loads, and −A u₀ of
 /// the prescribed values u₀; its constrained entries are ignored. solve() returns the solution
@@ -114,7 +128,8 @@ class MatrixFreeElasticitySolver {
   /// (m): the rotation centre of the AMG's rigid-body modes. `mapping` and `dof` must outlive this.
   MatrixFreeElasticitySolver(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
                              const ConstraintsFor& constraints_for, int degree, double lambda,
-                             double mu, const Vec3& centre, const PMultigridSettings& settings = {});
+                             double mu, const Vec3& centre,
+                             const PMultigridSettings& settings = {});
   ~MatrixFreeElasticitySolver();
 
   struct Outcome {

@@ -215,13 +215,14 @@ void print_matrix_free_profile(const fem::MatrixFreeProfile& p) {
   std::cout << std::fixed << std::setprecision(3) << "matrix-free set-up (s): fine operator "
             << p.fine_operator << ", P1 level " << p.coarse_level << ", transfer " << p.transfer
             << ", diagonal " << p.diagonal << ", eigenvalue estimate " << p.eigenvalue_estimate
-            << ", P1 matrix " << p.coarse_matrix << ", P1 factor " << p.coarse_factor << "\n"
+            << ", P1 matrix " << p.coarse_matrix << ", P1 solver (" << p.coarse_method << ") "
+            << p.coarse_factor << "\n"
             << "matrix-free CG (s): " << p.cg << " in all; " << p.operator_applications
             << " operator applications " << p.operator_seconds << " (" << per_application * 1e3
             << " ms each, " << p.quadrature_points << " quadrature points per cell), "
-            << p.coarse_solves << " P1 solves " << p.coarse_solve_seconds << ", transfers "
-            << p.transfer_seconds << "; Chebyshev degree " << p.chebyshev_degree
-            << std::defaultfloat << "\n";
+            << p.coarse_solves << " P1 solves " << p.coarse_solve_seconds << " ("
+            << p.coarse_iterations << " inner CG iterations), transfers " << p.transfer_seconds
+            << "; Chebyshev degree " << p.chebyshev_degree << std::defaultfloat << "\n";
 }
 
 void print_solver(const fem::ElasticityResult& r) {
@@ -229,7 +230,10 @@ void print_solver(const fem::ElasticityResult& r) {
   if (r.solver == fem::LinearSolver::cg_amg) std::cout << ", " << r.iterations << " CG iterations";
   if (r.solver == fem::LinearSolver::matrix_free) {
     std::cout << ", " << r.iterations << " CG iterations ("
-              << (r.element == "P1" ? "ML on P1" : "p-multigrid P2->P1, CHOLMOD on P1") << ")";
+              << (r.element == "P1"
+                      ? "ML on P1"
+                      : "p-multigrid P2->P1, " + r.matrix_free.coarse_method + " on P1")
+              << ")";
   }
   if (r.solver == fem::LinearSolver::gmres_block) {
     std::cout << ", " << r.iterations << " FGMRES iterations (" << std::setprecision(3)
@@ -658,7 +662,7 @@ void add_solver_options(CLI::App* cmd, FemCommandOptions& o) {
                   "with Trilinos ML AMG, displacement system), gmres-block (FGMRES with a "
                   "block-triangular preconditioner: AMG on the displacement block, scaled "
                   "pressure mass for the Schur complement; mixed system), matrix-free (CG on "
-                  "the matrix-free operator: for P2 a P2->P1 p-multigrid with CHOLMOD on P1, for "
+                  "the matrix-free operator: for P2 a P2->P1 p-multigrid with ML-CG on P1, for "
                   "P1 ML; "
                   "displacement system; never chosen by auto)")
       ->check(CLI::IsMember({"auto", "direct", "cg-amg", "gmres-block", "matrix-free"}))
