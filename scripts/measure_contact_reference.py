@@ -7,11 +7,18 @@ guidewire_straight.toml and guidewire_arch.toml side by side, and
 writes the page with the machine and the load average before and after each run: figures from a
 loaded machine are upper bounds on time.
 
+With --outputs DIR the runs are not made here: each scene's output is read from DIR/SCENE.md (the
+command's stdout) and DIR/SCENE.meta (its command line, "load before L start T" and "exit C load
+after L end T" lines), as written by a run by hand; a stiffness of the scene's sweep missing from
+an output is listed as not measured.
+
 Usage: /usr/bin/python3 scripts/measure_contact_reference.py [--program build/verification/vesselverify]
-       [--scenes guidewire_straight,guidewire_arch] [--out PAGE] [-- extra vesselverify contact flags]"""
+       [--scenes guidewire_straight,guidewire_arch] [--out PAGE] [--outputs DIR]
+       [-- extra vesselverify contact flags]"""
 import argparse
 import datetime
 import os
+import re
 import subprocess
 import sys
 import time
@@ -52,10 +59,15 @@ def main():
     ap.add_argument("--program", default=os.path.join(ROOT, "build/verification/vesselverify"))
     ap.add_argument("--scenes", default="guidewire_straight,guidewire_arch")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs/measurements/contact_reference.md"))
+    ap.add_argument("--outputs", help="read the runs' outputs from this folder instead of running")
     ap.add_argument("extra", nargs="*", help="further `vesselverify contact` flags (after --)")
     args = ap.parse_args()
     if not os.path.exists(args.program):
         sys.exit(f"measure_contact_reference.py: no program at {args.program} (build vesselverify)")
+    if args.outputs:
+        sections = [saved_section(args.outputs, scene) for scene in args.scenes.split(",")]
+        write_page(args, sections)
+        return
     runs = []
     for scene in args.scenes.split(","):
         path = os.path.join("verification/scenes", scene + ".toml")
@@ -74,6 +86,47 @@ def main():
         sections.append(f"## {scene}\n\n`{shown}`: {seconds:.0f} s (the scenes side by side), load "
                         f"average {before} before, {load_average()} after.\n\n" +
                         stdout.replace("### ", "#### "))
+    write_page(args, sections)
+
+
+def saved_section(folder, scene):
+    """A scene's section from a run made by hand (its stdout and its .meta lines)."""
+    with open(os.path.join(folder, scene + ".md")) as f:
+        stdout = f.read()
+    meta = {}
+    with open(os.path.join(folder, scene + ".meta")) as f:
+        text = f.read()
+    for key, pattern in (("before", r"load before (\S+)"), ("start", r"start (\S+)"),
+                         ("after", r"load after (\S+)"), ("end", r"end (\S+)"),
+                         ("command", r"^command (.+)$")):
+        m = re.search(pattern, text, re.M)
+        if m:
+            meta[key] = m.group(1)
+    head = f"## {scene}\n\n`{meta.get('command', 'vesselverify contact')}`"
+    if "end" in meta:
+        head += (f": {float(meta['end']) - float(meta['start']):.0f} s (the scenes side by side), "
+                 f"load average {meta['before']} before, {meta['after']} after.")
+    else:
+        head += (f": stopped before it finished (started with the load average at "
+                 f"{meta.get('before', '?')}); the stiffnesses it did not reach are not measured.")
+    sweep = []
+    with open(os.path.join(ROOT, "verification/scenes", scene + ".toml")) as f:
+        for line in f:
+            if line.startswith("stiffness_sweep"):
+                sweep = [float(v) for v in line.split("[")[1].split("]")[0].split(",")]
+    missing = [ei for ei in sweep if f"EI = {ei:g} N" not in stdout]
+    tail = "".join(f"\n#### {scene}, EI = {ei:g} N·m²\n\nNot measured (the run was stopped before "
+                   "it reached this stiffness).\n" for ei in missing)
+    log = os.path.join(folder, scene + ".log")
+    if "end" not in meta and os.path.exists(log):
+        with open(log) as f:
+            progress = f.read().strip()
+        tail += ("\nThe stopped run's progress lines (stderr), one per solve; the first solve of "
+                 "each stiffness is the scout:\n\n```\n" + progress + "\n```\n")
+    return head + "\n\n" + stdout.replace("### ", "#### ") + tail
+
+
+def write_page(args, sections):
     lines = [
         "# The guidewire scenes' contact reference",
         "",
