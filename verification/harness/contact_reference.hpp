@@ -55,7 +55,7 @@ struct ContactLevel {
   double strain = 0.0;  ///< largest principal small strain over the wall (P1 gradient of the
                         ///< vertex displacements)
   bool zone_inside_patch = true;  ///< every pressed node within the refined ball
-  int steps = 0;                  ///< linearised steps over all growth rounds
+  int steps = 0;                  ///< linearised steps over all growth rounds (0 if not converged)
   double seconds = 0.0;           ///< meshing, condensing and solving this level
 };
 
