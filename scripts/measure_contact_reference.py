@@ -97,28 +97,33 @@ def saved_section(folder, scene):
     with open(os.path.join(folder, scene + ".meta")) as f:
         text = f.read()
     for key, pattern in (("before", r"load before (\S+)"), ("start", r"start (\S+)"),
-                         ("after", r"load after (\S+)"), ("end", r"end (\S+)"),
+                         ("after", r"load after (\S+)"), ("end", r"end (\S+)"), ("exit", r"exit (\S+)"),
                          ("command", r"^command (.+)$")):
         m = re.search(pattern, text, re.M)
         if m:
             meta[key] = m.group(1)
     head = f"## {scene}\n\n`{meta.get('command', 'vesselverify contact')}`"
-    if "end" in meta:
+    finished = meta.get("exit") == "0"
+    if finished:
         head += (f": {float(meta['end']) - float(meta['start']):.0f} s (the scenes side by side), "
                  f"load average {meta['before']} before, {meta['after']} after.")
     else:
-        head += (f": stopped before it finished (started with the load average at "
-                 f"{meta.get('before', '?')}); the stiffnesses it did not reach are not measured.")
+        ran = (f" after {float(meta['end']) - float(meta['start']):.0f} s" if "end" in meta
+               else "")
+        head += (f": stopped before it finished{ran} (the scenes side by side, load average "
+                 f"{meta.get('before', '?')} at the start); the stiffnesses it did not reach are "
+                 "not measured.")
     sweep = []
     with open(os.path.join(ROOT, "verification/scenes", scene + ".toml")) as f:
         for line in f:
             if line.startswith("stiffness_sweep"):
                 sweep = [float(v) for v in line.split("[")[1].split("]")[0].split(",")]
     missing = [ei for ei in sweep if f"EI = {ei:g} N" not in stdout]
-    tail = "".join(f"\n#### {scene}, EI = {ei:g} N·m²\n\nNot measured (the run was stopped before "
-                   "it reached this stiffness).\n" for ei in missing)
+    tail = "".join(f"\n#### {scene}, EI = {ei:g} N·m²\n\nNot finished (the run was stopped at or "
+                   "before this stiffness; its progress, if any, is in the lines below).\n"
+                   for ei in missing)
     log = os.path.join(folder, scene + ".log")
-    if "end" not in meta and os.path.exists(log):
+    if not finished and os.path.exists(log):
         with open(log) as f:
             progress = f.read().strip()
         tail += ("\nThe stopped run's progress lines (stderr), one per solve; the first solve of "
