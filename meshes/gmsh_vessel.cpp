@@ -277,15 +277,11 @@ TetMesh generate_vessel_mesh(const VesselParams& params, const MeshingOptions& o
   return mesh;
 }
 
-TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
-                           double radius) {
-  validate(params);
-  if (params.kind != VesselKind::straight) {
-    throw InputError("refined_patch_mesh: expected a straight vessel");
-  }
+namespace {
+
+/// The straight tube by OpenCASCADE (a cylinder cut from a cylinder), its groups added.
+void build_occ_tube(const VesselParams& params) {
   const double a = params.inner_radius, b = params.outer_radius(), L = params.length;
-  const double h = unstructured_mesh_size(params);
-  GmshSession session(MeshingOptions{});
   const int outer = gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, L, b);
   const int inner = gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, L, a);
   gmsh::vectorpair out;
@@ -317,12 +313,37 @@ TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double
     gmsh::model::addPhysicalGroup(spec.dim, tags, spec.tag);
     gmsh::model::setPhysicalName(spec.dim, spec.tag, std::string(spec.name));
   }
+}
+
+}  // namespace
+
+TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
+                           double radius) {
+  validate(params);
+  if (!params.parametric()) {
+    throw InputError("refined_patch_mesh: expected a straight vessel or an arch");
+  }
+  if (!(fine > 0.0) || !(radius >= 0.0)) {
+    throw InputError(
+        "refined_patch_mesh: expected a positive fine size and a non-negative radius");
+  }
+  const double h = unstructured_mesh_size(params);
+  GmshSession session(MeshingOptions{});
+  if (params.kind == VesselKind::straight) {
+    build_occ_tube(params);
+  } else {
+    // The arch by the built-in kernel's revolution, unstructured.
+    VesselParams p = params;
+    p.style = MeshStyle::unstructured;
+    add_physical_groups(build_geometry(p));
+  }
   // Size field: `fine` within `radius` of the point, growing linearly to h over 2 mm.
   const int f = gmsh::model::mesh::field::add("MathEval");
   std::ostringstream expr;
-  expr << std::setprecision(17) << "Min(" << h << ", " << fine << " + Max(0, Sqrt((x-"
-       << point.x() << ")^2+(y-" << point.y() << ")^2+(z-" << point.z() << ")^2) - " << radius
-       << ") * " << (h - fine) / 2e-3 << ")";
+  // Each coordinate in parentheses: "y--1e-05" (a negative one) does not parse.
+  expr << std::setprecision(17) << "Min(" << h << ", " << fine << " + Max(0, Sqrt((x-("
+       << point.x() << "))^2+(y-(" << point.y() << "))^2+(z-(" << point.z() << "))^2) - "
+       << radius << ") * " << (h - fine) / 2e-3 << ")";
   gmsh::model::mesh::field::setString(f, "F", expr.str());
   gmsh::model::mesh::field::setAsBackgroundMesh(f);
   gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);

@@ -16,13 +16,14 @@ struct MeshingOptions {
 /// InputError for invalid params (see validate) and std::runtime_error if gmsh fails.
 TetMesh generate_vessel_mesh(const VesselParams& params, const MeshingOptions& options = {});
 
-/// A straight tube meshed with gmsh's OpenCASCADE kernel (a cylinder cut from a cylinder), the
-/// element size graded from `fine` (m) within `radius` (m) of `point` up to the vessel's nominal
-/// size (unstructured_mesh_size, its level) over a 2 mm transition: a finely refined contact
-/// patch, as the stability study's hard case uses. Groups as in kVesselGroups (faces classified by
-/// their bounding boxes: OCC renumbers them), tets positively oriented, boundary outward. Throws
-/// InputError for invalid params or a vessel that is not straight; std::runtime_error if gmsh
-/// fails.
+/// A parametric vessel with its element size graded from `fine` (m) within `radius` (m) of `point`
+/// up to the vessel's nominal size (unstructured_mesh_size, its level) over a 2 mm transition: a
+/// finely refined contact patch, as the stability study's hard case and the contact reference
+/// use. The straight tube is meshed with gmsh's OpenCASCADE kernel (a cylinder cut from a
+/// cylinder; faces classified by their bounding boxes: OCC renumbers them), the arch with the
+/// built-in kernel's revolution (as generate_vessel_mesh, unstructured). Groups as in
+/// kVesselGroups, tets positively oriented, boundary outward. Throws InputError for invalid params,
+/// a vessel from a file or a non-positive fine size; std::runtime_error if gmsh fails.
 TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
                            double radius);
 

@@ -131,14 +131,19 @@ void add_fem_supports(const Scene& s, fem::ElasticityProblem& prob) {
 
 }  // namespace
 
-fem::ElasticityProblem fem_problem(const Scene& s, const TetMesh& mesh, double nu, int degree,
-                                   double magnitude) {
+fem::ElasticityProblem wall_problem(const Scene& s, double nu, int degree) {
   fem::ElasticityProblem prob;
   prob.material.youngs_modulus = s.youngs_modulus;
   prob.material.poisson_ratio = nu;
   prob.material.density = s.density;
   prob.options.degree = degree;
   add_fem_supports(s, prob);
+  return prob;
+}
+
+fem::ElasticityProblem fem_problem(const Scene& s, const TetMesh& mesh, double nu, int degree,
+                                   double magnitude) {
+  fem::ElasticityProblem prob = wall_problem(s, nu, degree);
   for (const auto& [load, m] : applied_loads(s, magnitude)) {
     switch (load->kind) {
       case LoadKind::contact:

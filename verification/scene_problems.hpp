@@ -61,6 +61,10 @@ TractionPatch scene_contact_patch(const LoadSpec& load, const TetMesh& mesh, dou
 fem::ElasticityProblem fem_problem(const Scene& scene, const TetMesh& mesh, double nu, int degree,
                                    double magnitude = 1.0);
 
+/// The scene's wall alone: its material at ν, its supports, elements of `degree`, no load (the
+/// contact reference puts the wire's forces on it). InputError as fem_problem's.
+fem::ElasticityProblem wall_problem(const Scene& scene, double nu, int degree);
+
 /// The network options of a mass-spring model of the scene at ν.
 msm::NetworkOptions network_options(const Scene& scene, const ModelSpec& model, double nu);
 

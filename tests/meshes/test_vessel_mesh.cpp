@@ -240,6 +240,35 @@ TEST(RefinedPatchMesh, IsFineAtThePointCoarseElsewhereAndHasTheTubesVolume) {
   }
   EXPECT_LT(near_max, 2.5 * fine);
   EXPECT_GT(far_min, 0.3e-3);
-  EXPECT_THROW((void)refined_patch_mesh(VesselParams{.kind = VesselKind::arch}, point, fine, 1e-3),
-               InputError);
+  EXPECT_THROW(
+      (void)refined_patch_mesh(VesselParams{.kind = VesselKind::mesh_file}, point, fine, 1e-3),
+      InputError);
+  EXPECT_THROW((void)refined_patch_mesh(params, point, 0.0, 1e-3), InputError);
+}
+
+// The arch's graded mesh: its closed-form volume (Pappus) and fine edges at the apex only.
+TEST(RefinedPatchMesh, ArchIsFineAtTheApexAndHasTheArchsVolume) {
+  const VesselParams params{.kind = VesselKind::arch};
+  // Slightly off the apex on the negative side of x and z: the size field takes negative
+  // coordinates.
+  const Vec3 apex(-1e-5, params.bend_radius + params.inner_radius, -1e-5);
+  const double fine = 0.2e-3;
+  const TetMesh mesh = refined_patch_mesh(params, apex, fine, 0.5e-3);
+  EXPECT_NO_THROW(require_vessel_groups(mesh, "refined arch"));
+  const MeshQuality q = compute_quality(mesh);
+  EXPECT_EQ(q.inverted, 0u);
+  const double exact = analytic_wall_volume(params);
+  EXPECT_NEAR(q.total_volume, exact, 0.02 * exact);
+  double near_max = 0.0, far_min = 1.0;
+  for (const Tet& t : mesh.tets) {
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        const Vec3 a = mesh.nodes[t[i]], b = mesh.nodes[t[j]];
+        const double len = (a - b).norm();
+        if ((0.5 * (a + b) - apex).norm() < 0.3e-3) near_max = std::max(near_max, len);
+        if ((0.5 * (a + b) - apex).norm() > 8e-3) far_min = std::min(far_min, len);
+      }
+  }
+  EXPECT_LT(near_max, 2.5 * fine);
+  EXPECT_GT(far_min, 0.3e-3);
 }

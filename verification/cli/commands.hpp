@@ -30,6 +30,8 @@ void add_stability_command(CLI::App& app, const std::string& command_line);
 void add_calibrate_command(CLI::App& app, const std::string& command_line);
 /// `vesselverify validity` (verification/cli/validity_command.cpp).
 void add_validity_command(CLI::App& app, const std::string& command_line);
+/// `vesselverify contact`: a guidewire scene's contact reference (contact_command.cpp).
+void add_contact_command(CLI::App& app);
 /// `vesselverify contact-models`: every model's wall in the wire-wall contact
 /// (contact_models_command.cpp).
 void add_contact_models_command(CLI::App& app);

@@ -54,9 +54,7 @@ struct GuidewireSolver::Impl {
   /// The wire of length L against the lumen grown by `give`, from the last state (scaled about
   /// the clamp to L) or straight.
   GuidewireSolution solve(double L, double give) {
-    rods::RodSpec rs = rods::uniform_rod(material, L, spec.diameter, spec.segments);
-    rs.origin = spec.clamp_point;
-    rs.direction = spec.clamp_direction;
+    const rods::RodSpec rs = guidewire_rod_spec(spec, L);
     switch (spec.model) {
       case WireModel::external: return solve_external(L, give);
       case WireModel::xpbd: return solve_xpbd(rods::make_layout(rs), rs.origin, L, give);
@@ -217,6 +215,26 @@ struct GuidewireSolver::Impl {
   }
 };
 
+rods::RodSpec guidewire_rod_spec(const GuidewireSpec& spec, double length) {
+  rods::RodSpec rs = rods::uniform_rod({spec.young, spec.shear, spec.density}, length,
+                                       spec.diameter, spec.segments);
+  rs.origin = spec.clamp_point;
+  rs.direction = spec.clamp_direction;
+  return rs;
+}
+
+GuidewireSpec with_stiffness(GuidewireSpec spec, double EI) {
+  if (!(EI > 0.0) || !std::isfinite(EI)) {
+    throw InputError("the wire's bending stiffness EI: found " + std::to_string(EI) +
+                     " N·m², expected a positive finite value");
+  }
+  const double I = M_PI * std::pow(spec.diameter, 4) / 64.0;
+  const double scale = EI / (spec.young * I);
+  spec.young *= scale;
+  spec.shear *= scale;
+  return spec;
+}
+
 GuidewireSolver::GuidewireSolver(const VesselParams& vessel, const GuidewireSpec& spec,
                                  const std::string& key_prefix)
     : impl_(std::make_unique<Impl>()) {
@@ -268,6 +286,8 @@ GuidewireSolution GuidewireSolver::solve_rigid() {
   compliance_ = 0.0;
   return s;
 }
+
+const Eigen::VectorXd& GuidewireSolver::rod_state() const { return impl_->state; }
 
 GuidewireSolution GuidewireSolver::solve_with_give(double give) {
   Impl& m = *impl_;

@@ -21,6 +21,7 @@
 #include <string>
 
 #include "meshes/vessel_geometry.hpp"
+#include "msm/rods/rod_layout.hpp"
 #include "verification/guidewire/guidewire_spec.hpp"
 
 namespace vessel {
@@ -55,6 +56,9 @@ class GuidewireSolver {
   double coupled_force(double wall_compliance);
   [[nodiscard]] const GuidewireSolution& last() const { return last_; }
   [[nodiscard]] const GuidewireSolution& rigid() const { return rigid_; }
+  /// The last solve's whole rod state (positions, ghost nodes and frames' dofs, as the rod of
+  /// guidewire_rod_spec at the solved length numbers them); empty for the external model.
+  [[nodiscard]] const Eigen::VectorXd& rod_state() const;
 
  private:
   struct Impl;
@@ -62,6 +66,14 @@ class GuidewireSolver {
   GuidewireSolution rigid_, last_;
   double compliance_ = 0.0;  ///< 0: not computed since the last solve_rigid
 };
+
+/// The rod of the spec at `length` (m): uniform, clamped at the spec's clamp point along its
+/// clamp direction (the rod every GuidewireSolver solve builds).
+msm::rods::RodSpec guidewire_rod_spec(const GuidewireSpec& spec, double length);
+
+/// The spec with E (and G in proportion) scaled so its solid section has bending stiffness EI
+/// (N·m²). InputError unless EI is positive and finite.
+GuidewireSpec with_stiffness(GuidewireSpec spec, double EI);
 
 /// The continuum wire (fem_reference/rod_theory) against the rigid lumen: its contact force and
 /// the centreline's contact point.

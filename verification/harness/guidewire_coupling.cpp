@@ -14,15 +14,6 @@ namespace vessel {
 
 namespace {
 
-/// The spec with E (and G in proportion) scaled to bending stiffness EI.
-GuidewireSpec with_stiffness(GuidewireSpec spec, double EI) {
-  const double I = M_PI * std::pow(spec.diameter, 4) / 64.0;
-  const double scale = EI / (spec.young * I);
-  spec.young *= scale;
-  spec.shear *= scale;
-  return spec;
-}
-
 /// The relative L2 error of r·u against u_ref, from e = |u − u_ref|/|u_ref| and
 /// a = |u|/|u_ref| (the same nodes): |r u − u_ref|²/|u_ref|² = r²a² − r(a² + 1 − e²) + 1, the
 /// inner product ⟨u, u_ref⟩/|u_ref|² = (a² + 1 − e²)/2 read off |u − u_ref|².

@@ -1,0 +1,74 @@
+/// `vesselverify contact`: the contact reference of a guidewire scene (the wire's surface against
+/// the wall's, found by the solve) at one or more wire stiffnesses, the wall refined level by
+/// level around the contact zone, with the force's Richardson extrapolate and GCI.
+#include <filesystem>
+#include <iostream>
+
+#include "verification/cli/commands.hpp"
+#include "verification/harness/contact_reference.hpp"
+#include "verification/scene.hpp"
+
+namespace vessel::cli {
+
+namespace {
+
+struct ContactCli {
+  std::filesystem::path scene;
+  std::vector<double> ei;
+  ContactReferenceOptions options;
+};
+
+}  // namespace
+
+void add_contact_command(CLI::App& app) {
+  auto o = std::make_shared<ContactCli>();
+  CLI::App* cmd = app.add_subcommand(
+      "contact",
+      "The contact reference of a guidewire scene: its wire (DER) and its wall (linear FEM) "
+      "solved together, the contact between the wire's surface and the wall's found by the "
+      "solve (Signorini's conditions), the wall refined level by level around the contact zone. "
+      "Per level: the total contact force, the zone's centroid and extent, the dent, the largest "
+      "strain, steps and time; then the force's Richardson extrapolate, observed order and GCI, "
+      "and whether the answer is a reference (converged, strain within the linear wall's "
+      "validity).\n"
+      "Example:\n"
+      "  vesselverify contact verification/scenes/guidewire_straight.toml --ei 4e-7");
+  cmd->add_option("scene", o->scene, "A scene file with a guidewire load")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--ei", o->ei,
+                  "Wire bending stiffnesses EI, N·m², comma separated (default: the scene's "
+                  "stiffness_sweep, or its wire's own EI)")
+      ->delimiter(',');
+  cmd->add_option("--levels", o->options.levels, "Refinement levels")
+      ->check(CLI::Range(1, 6))
+      ->capture_default_str();
+  cmd->add_option("--coarsest-size", o->options.coarsest_size,
+                  "Element size around the contact zone at level 0, m")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--ratio", o->options.ratio, "Element size ratio between levels (> 1)")
+      ->check(CLI::Range(1.01, 4.0))
+      ->capture_default_str();
+  cmd->add_option("--degree", o->options.degree, "The wall's element degree")
+      ->check(CLI::IsMember({1, 2}))
+      ->capture_default_str();
+  cmd->add_option("--strain-limit", o->options.strain_limit,
+                  "The linear wall's validity: largest strain at most this")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--max-steps", o->options.max_steps, "Linearised contact steps per solve")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->callback([o] {
+    o->options.log = &std::cerr;  // progress; the table goes to stdout
+    const Scene scene = read_scene(o->scene);
+    const std::vector<double> ei = o->ei.empty() ? contact_reference_stiffnesses(scene) : o->ei;
+    for (const double EI : ei) {
+      print_contact_reference(solve_contact_reference(scene, EI, o->options), std::cout);
+      std::cout << "\n" << std::flush;
+    }
+  });
+}
+
+}  // namespace vessel::cli

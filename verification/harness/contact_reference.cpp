@@ -1,0 +1,331 @@
+#include "verification/harness/contact_reference.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "fem_reference/elasticity.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "meshes/gmsh_vessel.hpp"
+#include "msm/rods/der_rod.hpp"
+#include "verification/contact/wire_wall_contact.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
+#include "verification/scene_problems.hpp"
+
+namespace vessel {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// The largest principal small strain magnitude over the tets, from the P1 gradient of the
+/// vertex displacements u (m).
+double largest_strain(const TetMesh& mesh, const std::vector<Vec3>& u) {
+  double out = 0.0;
+  for (const Tet& t : mesh.tets) {
+    Eigen::Matrix3d dX, dU;
+    for (int k = 0; k < 3; ++k) {
+      dX.col(k) = mesh.nodes[t[k + 1]] - mesh.nodes[t[0]];
+      dU.col(k) = u[t[k + 1]] - u[t[0]];
+    }
+    const Eigen::Matrix3d H = dU * dX.inverse();
+    const Eigen::Matrix3d e = 0.5 * (H + H.transpose());
+    out = std::max(
+        out, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(e).eigenvalues().cwiseAbs().maxCoeff());
+  }
+  return out;
+}
+
+/// The wire: DER at the scene's segments, at the rigid-wall state.
+struct ReferenceWire {
+  msm::rods::DerRod rod;
+  Eigen::VectorXd rigid_state;
+  double radius = 0.0;
+  explicit ReferenceWire(const GuidewireSpec& spec, const Eigen::VectorXd& state)
+      : rod(msm::rods::make_layout(guidewire_rod_spec(spec, spec.insertion))),
+        rigid_state(state),
+        radius(0.5 * spec.diameter) {
+    rod.prepare(rigid_state);
+  }
+  [[nodiscard]] contact::ContactWire contact() const {
+    contact::ContactWire w;
+    w.form = &rod;
+    w.fixed = rod.clamp_fixed();
+    w.num_nodes = rod.num_nodes();
+    w.first_node = rod.layout().first_node;
+    w.last_node = rod.layout().tip_node;
+    w.radius = radius;
+    return w;
+  }
+};
+
+/// Inner-wall nodes within `radius` of `centre` and within `band` of the wire's surface at x.
+std::vector<int> candidates(const TetMesh& mesh, const contact::ContactWire& wire,
+                            const Eigen::VectorXd& x, const Vec3& centre, double radius,
+                            double band) {
+  std::vector<int> out;
+  const PhysicalGroup& inner = mesh.require_group("inner_wall", 2, "vessel");
+  for (const int n : mesh.group_nodes(inner)) {
+    const Vec3& p = mesh.nodes[static_cast<std::size_t>(n)];
+    if ((p - centre).norm() <= radius && contact::capsule_gap(wire, x, p) <= band) out.push_back(n);
+  }
+  return out;
+}
+
+/// One contact solve on a mesh refined to `fine` within `radius` of `centre`.
+ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double nu, double fine,
+                         const Vec3& centre, double radius, const Vec3& wall_point,
+                         double force_scale, const ContactReferenceOptions& o) {
+  const auto t0 = Clock::now();
+  ContactLevel out;
+  out.fine_size = fine;
+  const TetMesh mesh = refined_patch_mesh(scene.vessel, centre, fine, radius);
+  out.mesh_nodes = static_cast<int>(mesh.nodes.size());
+  const contact::ContactWire cw = wire.contact();
+  const std::vector<int> nodes = candidates(mesh, cw, wire.rigid_state, centre, radius, o.band);
+  out.candidates = static_cast<int>(nodes.size());
+  if (nodes.empty()) {
+    out.failure = "no inner-wall node within the band of the wire's surface";
+    out.seconds = seconds_since(t0);
+    return out;
+  }
+  int first = 0;
+  for (int j = 1; j < static_cast<int>(nodes.size()); ++j) {
+    if ((mesh.nodes[nodes[j]] - wall_point).norm() < (mesh.nodes[nodes[first]] - wall_point).norm())
+      first = j;
+  }
+  if (o.log) {
+    *o.log << "contact: fine " << fine * 1e3 << " mm within " << radius * 1e3 << " mm, "
+           << mesh.nodes.size() << " nodes, " << nodes.size() << " candidates" << std::endl;
+  }
+  const fem::ElasticitySolver solver(mesh, wall_problem(scene, nu, o.degree));
+  contact::WireWallOptions wo;
+  wo.force_scale = force_scale;
+  wo.max_newton = o.max_steps;
+  contact::BandGrowth growth;
+  growth.margin = 0.25 * wire.radius;
+  try {
+    const contact::GrownContact grown = contact::solve_wire_wall_contact_growing(
+        cw, solver.free_displacement_system(), mesh, nodes, wire.rigid_state, {first}, wo, growth);
+    const contact::WireWallSolution& s = grown.solution;
+    out.converged = true;
+    out.candidates = static_cast<int>(grown.nodes.size());
+    out.steps = s.newton_iterations;
+    out.pressed = static_cast<int>(s.active.size());
+    out.force = s.total_force_on_wall().norm();
+    const std::vector<Vec3> u = grown.wall->displacement(s.wall_loads());
+    double weight = 0.0;
+    for (const int j : s.active) {
+      const auto n = static_cast<std::size_t>(grown.nodes[static_cast<std::size_t>(j)]);
+      out.centroid += s.force[j] * mesh.nodes[n];
+      weight += s.force[j];
+      out.dent = std::max(out.dent, u[n].norm());
+      out.zone_inside_patch = out.zone_inside_patch && (mesh.nodes[n] - centre).norm() <= radius;
+      for (const int k : s.active) {
+        const auto m = static_cast<std::size_t>(grown.nodes[static_cast<std::size_t>(k)]);
+        const double d = (mesh.nodes[n] - mesh.nodes[m]).norm();
+        if (d >= out.extent) {
+          out.extent = d;
+          out.middle = 0.5 * (mesh.nodes[n] + mesh.nodes[m]);
+        }
+      }
+    }
+    if (weight > 0.0) out.centroid /= weight;
+    for (const int j : s.active) {
+      const auto n = static_cast<std::size_t>(grown.nodes[static_cast<std::size_t>(j)]);
+      out.reach = std::max(out.reach, (mesh.nodes[n] - out.middle).norm());
+    }
+    out.strain = largest_strain(mesh, u);
+  } catch (const std::runtime_error& e) {
+    out.failure = e.what();
+  }
+  out.seconds = seconds_since(t0);
+  if (o.log) {
+    *o.log << "contact:   "
+           << (out.converged ? "F " + std::to_string(out.force * 1e3) + " mN, " +
+                                   std::to_string(out.pressed) + " pressed"
+                             : "not converged: " + out.failure)
+           << ", " << out.candidates << " candidates, " << out.steps << " steps, " << out.seconds
+           << " s" << std::endl;
+  }
+  return out;
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+void require_guidewire(const Scene& scene) {
+  if (!scene.load.guidewire) {
+    throw InputError(scene.source.string() +
+                     ": load: expected a guidewire load (type = \"guidewire\"); the contact "
+                     "reference solves a wire against the wall");
+  }
+}
+
+}  // namespace
+
+std::vector<double> contact_reference_stiffnesses(const Scene& scene) {
+  require_guidewire(scene);
+  const GuidewireSpec& g = *scene.load.guidewire;
+  if (!g.stiffness_sweep.empty()) return g.stiffness_sweep;
+  return {msm::rods::solid_section({g.young, g.shear, g.density}, g.diameter).EI};
+}
+
+ContactReference solve_contact_reference(const Scene& scene, double EI,
+                                         const ContactReferenceOptions& o) {
+  const std::string file = scene.source.string();
+  require_guidewire(scene);
+  if (o.levels < 1 || !(o.coarsest_size > 0.0) || !(o.ratio > 1.0) ||
+      (o.degree != 1 && o.degree != 2) || !(o.margin >= 0.0) || !(o.band > 0.0) ||
+      !(o.strain_limit > 0.0) || o.max_steps < 1) {
+    throw InputError(
+        "contact reference options: expected levels ≥ 1, a positive coarsest size, "
+        "ratio > 1, degree 1 or 2, margin ≥ 0, band > 0, strain limit > 0, steps ≥ 1");
+  }
+  GuidewireSpec spec;
+  try {
+    spec = with_stiffness(*scene.load.guidewire, EI);
+  } catch (const InputError& e) {
+    throw InputError(file + ": " + e.what());
+  }
+  spec.model = WireModel::der;  // the reference's wire: DER (verified against the elastica)
+  ContactReference r;
+  r.scene = scene.name;
+  r.bending_stiffness = EI;
+  r.wall_modulus = scene.youngs_modulus;
+  r.poisson_ratio = scene.poisson_ratios.front();
+  r.strain_limit = o.strain_limit;
+
+  GuidewireSolver rigid_solver(scene.vessel, spec);
+  GuidewireSolution rigid;
+  try {
+    rigid = rigid_solver.solve_rigid();
+  } catch (const InputError& e) {
+    throw InputError(file + ": " + e.what());
+  }
+  if (rigid.force <= 0.0) {
+    throw InputError(file +
+                     ": load.insertion: the wire does not reach the wall; expected an "
+                     "insertion that makes it touch");
+  }
+  r.rigid_force = rigid.force;
+  r.rigid_wall_point = rigid.wall_point;
+  std::string why;
+  if (const auto c = continuum_wire(scene.vessel, spec, why)) r.continuum_rigid_force = c->force;
+  const ReferenceWire wire(spec, rigid_solver.rod_state());
+
+  // The scout: the coarsest level refined at the rigid wall point finds the zone.
+  const double scout_radius = 1.0e-3;
+  r.scout = solve_level(scene, wire, r.poisson_ratio, o.coarsest_size, rigid.wall_point,
+                        scout_radius, rigid.wall_point, rigid.force, o);
+  r.patch_centre = rigid.wall_point;
+  r.patch_radius = scout_radius;
+  if (r.scout.converged && r.scout.pressed > 0) {
+    r.patch_centre = r.scout.middle;
+    r.patch_radius = r.scout.reach + o.margin;
+  }
+  for (int l = 0; l < o.levels; ++l) {
+    const double fine = o.coarsest_size / std::pow(o.ratio, l);
+    ContactLevel level = solve_level(scene, wire, r.poisson_ratio, fine, r.patch_centre,
+                                     r.patch_radius, rigid.wall_point, rigid.force, o);
+    level.level = l;
+    r.levels.push_back(level);
+  }
+
+  const ContactLevel& finest = r.levels.back();
+  bool all_converged = true;
+  for (const ContactLevel& l : r.levels) all_converged = all_converged && l.converged;
+  if (!all_converged) {
+    std::string reason;
+    for (const ContactLevel& l : r.levels) {
+      if (!l.converged) {
+        reason = "level " + std::to_string(l.level) + ": " + l.failure;
+        break;
+      }
+    }
+    r.verdict = "did not converge (" + reason + ")";
+    return r;
+  }
+  if (r.levels.size() >= 2) {
+    const std::size_t n = r.levels.size();
+    std::optional<std::vector<double>> three;
+    if (n >= 3)
+      three =
+          std::vector<double>{r.levels[n - 3].force, r.levels[n - 2].force, r.levels[n - 1].force};
+    // Assumed first order where three levels do not give one: a contact zone's edge cuts
+    // elements, which limits the force's convergence.
+    r.order = fem::gci_order(three, 1.0, o.ratio);
+    r.estimate = fem::richardson(r.levels[n - 2].force, finest.force, r.order->order, o.ratio,
+                                 r.order->safety_factor);
+  }
+  double strain = 0.0;
+  bool inside = true;
+  for (const ContactLevel& l : r.levels) {
+    strain = std::max(strain, l.strain);
+    inside = inside && l.zone_inside_patch;
+  }
+  if (strain > o.strain_limit) {
+    r.verdict = "beyond the linear wall's validity (largest strain " + fixed(strain, 3) + " > " +
+                fixed(o.strain_limit, 3) + ")";
+  } else if (!inside) {
+    r.verdict = "not a reference: the contact zone leaves the refined patch";
+  } else {
+    r.verdict = "reference";
+  }
+  return r;
+}
+
+void print_contact_reference(const ContactReference& r, std::ostream& out) {
+  out << "### " << r.scene << ", EI = " << r.bending_stiffness << " N·m²\n\n"
+      << "Wall E = " << r.wall_modulus << " Pa, ν = " << r.poisson_ratio
+      << "; rigid wall: " << fixed(r.rigid_force * 1e3, 4) << " mN (discrete wire)";
+  if (r.continuum_rigid_force)
+    out << ", " << fixed(*r.continuum_rigid_force * 1e3, 4) << " mN (continuum)";
+  out << "; refined within " << fixed(r.patch_radius * 1e3, 3) << " mm of ("
+      << fixed(r.patch_centre.x() * 1e3, 3) << ", " << fixed(r.patch_centre.y() * 1e3, 3) << ", "
+      << fixed(r.patch_centre.z() * 1e3, 3) << ") mm (the zone of a scout solve at "
+      << fixed(r.scout.fine_size * 1e3, 3) << " mm within 1 mm of the rigid wall point: "
+      << (r.scout.converged
+              ? std::to_string(r.scout.pressed) + " pressed, " + fixed(r.scout.seconds, 1) + " s"
+              : std::string("did not converge"))
+      << ").\n\n"
+      << "| level | fine mm | nodes | candidates | pressed | F mN | zone centroid mm | extent mm | "
+         "dent mm | largest strain | steps | s |\n"
+      << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const ContactLevel& l : r.levels) {
+    out << "| " << l.level << " | " << fixed(l.fine_size * 1e3, 3) << " | " << l.mesh_nodes << " | "
+        << l.candidates << " | ";
+    if (!l.converged) {
+      // The step count is in the failure's message (the solve throws without it).
+      out << "— | did not converge | — | — | — | — | — | " << fixed(l.seconds, 1) << " |\n";
+      continue;
+    }
+    out << l.pressed << " | " << fixed(l.force * 1e3, 5) << " | (" << fixed(l.centroid.x() * 1e3, 2)
+        << ", " << fixed(l.centroid.y() * 1e3, 2) << ", " << fixed(l.centroid.z() * 1e3, 2)
+        << ") | " << fixed(l.extent * 1e3, 3) << (l.zone_inside_patch ? "" : " (leaves the patch)")
+        << " | " << fixed(l.dent * 1e3, 3) << " | " << fixed(l.strain, 3) << " | " << l.steps
+        << " | " << fixed(l.seconds, 1) << " |\n";
+  }
+  for (const ContactLevel& l : r.levels) {
+    if (!l.converged) out << "\nLevel " << l.level << " did not converge: " << l.failure << "\n";
+  }
+  if (r.estimate && r.order) {
+    out << "\nRichardson: F = " << fixed(r.estimate->extrapolated * 1e3, 5) << " mN ("
+        << r.order->note << ", safety factor " << r.order->safety_factor << "), GCI of the finest "
+        << fixed(100.0 * r.estimate->gci_fine, 2) << " %.\n";
+  }
+  out << "\nVerdict: " << r.verdict << ".\n";
+}
+
+}  // namespace vessel

@@ -1,0 +1,100 @@
+#pragma once
+/// The contact reference of a guidewire scene: the scene's wire (DER, the scene's segments) and its
+/// wall (linear FEM, the scene's material and supports) solved together, the contact between the
+/// wire's surface and the wall's found by the solve (verification/contact/wire_wall_contact.hpp),
+/// on the wall meshed at several refinement levels around the contact zone, with the contact
+/// force's Richardson extrapolate and grid convergence index (fem_reference/convergence.hpp).
+///
+/// The zone is found in two passes: the rigid-wall solve gives the wall point under the wire's
+/// contact node; a scout solve on the coarsest level's mesh refined there gives the pressed zone;
+/// every level is then meshed with refined_patch_mesh around the zone's middle (fine size
+/// coarsest_size / ratio^level within the zone's reach from its middle plus a margin, graded to
+/// the scene's nominal size over 2 mm). Candidates: the inner-wall nodes within `band` of the
+/// rigid-wall wire's surface inside the refined ball, grown by solve_wire_wall_contact_growing.
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "fem_reference/convergence.hpp"
+#include "meshes/tet_mesh.hpp"
+#include "verification/scene.hpp"
+
+namespace vessel {
+
+struct ContactReferenceOptions {
+  int levels = 3;  ///< refinement levels (three give an observed order)
+  /// m: the fine size around the zone at level 0 (at 0.16 mm, near the wire's radius 0.178 mm,
+  /// the capsule passes between the nodes of the shipped scenes' wall)
+  double coarsest_size = 0.08e-3;
+  double ratio = 1.4142135623730951;  ///< fine size ratio between levels (> 1): √2
+  /// The wall's elements, P1 or P2 (P2 at 0.08 mm takes 2–3 minutes a level on this machine)
+  int degree = 1;
+  double margin = 0.3e-3;       ///< m: the refined ball's radius beyond the zone's half extent
+  double band = 0.5e-3;         ///< m: candidates within this of the rigid-wall wire's surface
+  double strain_limit = 0.1;    ///< the linear wall's validity: largest strain at most this
+  int max_steps = 300;          ///< linearised contact steps per solve
+  std::ostream* log = nullptr;  ///< one line per solve (mesh, candidates, result), if set
+};
+
+/// One level's contact solve.
+struct ContactLevel {
+  int level = 0;
+  double fine_size = 0.0;  ///< m
+  int mesh_nodes = 0;
+  int candidates = 0;  ///< after growth
+  bool converged = false;
+  std::string failure;           ///< why not, when not converged
+  int pressed = 0;               ///< wall nodes in contact
+  double force = 0.0;            ///< |Σ λ_j n_j|, the wire's total force on the wall, N
+  Vec3 centroid = Vec3::Zero();  ///< force-weighted mean of the pressed nodes' rest positions, m
+  double extent = 0.0;           ///< largest distance between two pressed nodes, m
+  Vec3 middle = Vec3::Zero();    ///< midpoint of the two pressed nodes farthest apart, m
+  double reach = 0.0;            ///< largest distance of a pressed node from `middle`, m
+  double dent = 0.0;             ///< largest displacement of a pressed node, m
+  double strain = 0.0;  ///< largest principal small strain over the wall (P1 gradient of the
+                        ///< vertex displacements)
+  bool zone_inside_patch = true;  ///< every pressed node within the refined ball
+  int steps = 0;                  ///< linearised steps over all growth rounds (0 if not converged)
+  double seconds = 0.0;           ///< meshing, condensing and solving this level
+};
+
+struct ContactReference {
+  std::string scene;
+  double bending_stiffness = 0.0;  ///< EI, N·m²
+  double wall_modulus = 0.0;       ///< Pa
+  double poisson_ratio = 0.0;
+  double rigid_force = 0.0;                     ///< the same discrete wire on the rigid lumen, N
+  std::optional<double> continuum_rigid_force;  ///< the continuum wire's (closed form), N
+  Vec3 rigid_wall_point = Vec3::Zero();         ///< m
+  Vec3 patch_centre = Vec3::Zero();             ///< m: where every level is refined
+  double patch_radius = 0.0;                    ///< m
+  double strain_limit = 0.0;
+  ContactLevel scout;  ///< the coarsest size at the rigid wall point: where the zone is
+  std::vector<ContactLevel> levels;
+  /// From the three finest levels when all converged: Roache's order and GCI on the force.
+  std::optional<fem::GciOrder> order;
+  std::optional<fem::RichardsonEstimate> estimate;
+  /// "reference", "beyond the linear wall's validity (largest strain ...)" or "did not
+  /// converge: ...": what the finest level's force may be used as.
+  std::string verdict;
+  [[nodiscard]] bool is_reference() const { return verdict == "reference"; }
+};
+
+/// The contact reference of `scene`'s guidewire at bending stiffness EI (N·m²; E and G scaled,
+/// with_stiffness), against the scene's wall at its first Poisson's ratio. InputError naming the
+/// scene's file for a scene without a guidewire load, a vessel from a file, EI ≤ 0 or not finite,
+/// or options out of range. A level whose solve does not converge is reported, not thrown.
+ContactReference solve_contact_reference(const Scene& scene, double EI,
+                                         const ContactReferenceOptions& options = {});
+
+/// The stiffnesses a scene's contact reference is solved at: its wire's stiffness_sweep, or its
+/// wire's own EI (N·m²). InputError naming the scene's file without a guidewire load.
+std::vector<double> contact_reference_stiffnesses(const Scene& scene);
+
+/// The reference as Markdown: a line with the scene, EI, the wall, the rigid-wall forces and the
+/// refined patch; a table of the levels (mm, mN, seconds); the extrapolate, order and GCI; the
+/// verdict.
+void print_contact_reference(const ContactReference& reference, std::ostream& out);
+
+}  // namespace vessel
