@@ -1,5 +1,6 @@
 #include "verification/contact/condensed_wall.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
@@ -87,6 +88,25 @@ ComponentCandidates every_component(const std::vector<int>& nodes) {
       out.nodes.push_back(node);
       out.directions.push_back(Vec3::Unit(c));
     }
+  }
+  return out;
+}
+
+WallStrain largest_strain(const TetMesh& mesh, const std::vector<Vec3>& u) {
+  const auto largest_magnitude = [](const Eigen::Matrix3d& m) {
+    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m).eigenvalues().cwiseAbs().maxCoeff();
+  };
+  WallStrain out;
+  for (const Tet& t : mesh.tets) {
+    Eigen::Matrix3d dX, dU;
+    for (int k = 0; k < 3; ++k) {
+      dX.col(k) = mesh.nodes[t[k + 1]] - mesh.nodes[t[0]];
+      dU.col(k) = u[t[k + 1]] - u[t[0]];
+    }
+    const Eigen::Matrix3d H = dU * dX.inverse();
+    const Eigen::Matrix3d e = 0.5 * (H + H.transpose());
+    out.small = std::max(out.small, largest_magnitude(e));
+    out.green = std::max(out.green, largest_magnitude(e + 0.5 * H.transpose() * H));
   }
   return out;
 }

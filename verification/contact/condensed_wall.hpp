@@ -54,4 +54,13 @@ struct ComponentCandidates {
 };
 ComponentCandidates every_component(const std::vector<int>& nodes);
 
+/// The largest principal strain magnitudes over a wall's tets under the vertex displacements u
+/// (m), from each tet's P1 gradient H = ∇u: the small strain ½(H + Hᵀ) and Green–Lagrange's
+/// ½(H + Hᵀ + HᵀH). How far a linear wall's answer is beyond its small-strain range.
+struct WallStrain {
+  double small = 0.0;
+  double green = 0.0;
+};
+WallStrain largest_strain(const TetMesh& mesh, const std::vector<Vec3>& u);
+
 }  // namespace vessel::contact

@@ -14,6 +14,19 @@
 
 namespace vessel::contact {
 
+ContactWire contact_wire(const msm::rods::Rod& rod, double radius) {
+  ContactWire w;
+  w.form = &rod;
+  w.constraints = rod.constraints();
+  w.fixed = rod.clamp_fixed();
+  w.num_nodes = rod.num_nodes();
+  w.first_node = rod.layout().first_node;
+  w.last_node = rod.layout().tip_node;
+  w.radius = radius;
+  w.project = [&rod](Eigen::VectorXd& x) { rod.project(x); };
+  return w;
+}
+
 namespace {
 
 using Eigen::MatrixXd;

@@ -34,6 +34,7 @@
 #include "meshes/tet_mesh.hpp"
 #include "msm/form/equality_constraints.hpp"
 #include "msm/form/form.hpp"
+#include "msm/rods/rod.hpp"
 #include "verification/contact/condensed_wall.hpp"
 
 namespace vessel::contact {
@@ -53,6 +54,11 @@ struct ContactWire {
   /// be empty.
   std::function<void(Eigen::VectorXd&)> project;
 };
+
+/// A rod model as the contact's wire: its energy, its own constraints and projection, its clamps,
+/// its centreline's material nodes, and the radius r_w (m) of its surface. The rod must outlive
+/// the result.
+ContactWire contact_wire(const msm::rods::Rod& rod, double radius);
 
 struct WireWallOptions {
   double tolerance = 1e-10;      ///< on ‖rod residual‖ (free dofs) relative to force_scale

@@ -42,16 +42,7 @@ struct SceneWire {
         rod(layout),
         radius(spec.diameter / 2),
         length(spec.insertion) {}
-  [[nodiscard]] ContactWire contact() const {
-    ContactWire w;
-    w.form = &rod;
-    w.fixed = rod.clamp_fixed();
-    w.num_nodes = rod.num_nodes();
-    w.first_node = layout.first_node;
-    w.last_node = layout.tip_node;
-    w.radius = radius;
-    return w;
-  }
+  [[nodiscard]] ContactWire contact() const { return contact_wire(rod, radius); }
 };
 
 /// The wire against the straight tube's rigid lumen (its centreline kept a − r_w off the axis).

@@ -24,24 +24,6 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-/// The largest principal small strain magnitude over the tets, from the P1 gradient of the
-/// vertex displacements u (m).
-double largest_strain(const TetMesh& mesh, const std::vector<Vec3>& u) {
-  double out = 0.0;
-  for (const Tet& t : mesh.tets) {
-    Eigen::Matrix3d dX, dU;
-    for (int k = 0; k < 3; ++k) {
-      dX.col(k) = mesh.nodes[t[k + 1]] - mesh.nodes[t[0]];
-      dU.col(k) = u[t[k + 1]] - u[t[0]];
-    }
-    const Eigen::Matrix3d H = dU * dX.inverse();
-    const Eigen::Matrix3d e = 0.5 * (H + H.transpose());
-    out = std::max(
-        out, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(e).eigenvalues().cwiseAbs().maxCoeff());
-  }
-  return out;
-}
-
 /// The wire: DER at the scene's segments, at the rigid-wall state.
 struct ReferenceWire {
   msm::rods::DerRod rod;
@@ -53,16 +35,7 @@ struct ReferenceWire {
         radius(0.5 * spec.diameter) {
     rod.prepare(rigid_state);
   }
-  [[nodiscard]] contact::ContactWire contact() const {
-    contact::ContactWire w;
-    w.form = &rod;
-    w.fixed = rod.clamp_fixed();
-    w.num_nodes = rod.num_nodes();
-    w.first_node = rod.layout().first_node;
-    w.last_node = rod.layout().tip_node;
-    w.radius = radius;
-    return w;
-  }
+  [[nodiscard]] contact::ContactWire contact() const { return contact::contact_wire(rod, radius); }
 };
 
 /// Inner-wall nodes within `radius` of `centre` and within `band` of the wire's surface at x.
@@ -141,7 +114,7 @@ ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double n
       const auto n = static_cast<std::size_t>(grown.nodes[static_cast<std::size_t>(j)]);
       out.reach = std::max(out.reach, (mesh.nodes[n] - out.middle).norm());
     }
-    out.strain = largest_strain(mesh, u);
+    out.strain = contact::largest_strain(mesh, u).small;
   } catch (const std::runtime_error& e) {
     out.failure = e.what();
   }

@@ -325,15 +325,7 @@ TEST(WireWallContact, RigidLimitWithCordeConstraints) {
   const fem::ElasticitySolver solver(mesh, wall_problem(kWallE * 1e6));
   const contact::ComponentCandidates all = contact::every_component(cand);
   const contact::CondensedWall wall(solver.free_displacement_system(), all.nodes, all.directions);
-  contact::ContactWire w;
-  w.form = &corde;
-  w.constraints = &corde;
-  w.fixed = corde.clamp_fixed();
-  w.num_nodes = corde.num_nodes();
-  w.first_node = der.layout.first_node;
-  w.last_node = der.layout.tip_node;
-  w.radius = d / 2;
-  w.project = [&corde](Eigen::VectorXd& y) { corde.normalise_quaternions(y); };
+  const contact::ContactWire w = contact::contact_wire(corde, d / 2);
   contact::WireWallOptions o;
   o.force_scale = der.EI / (kZc * kZc);
   o.constraint_tolerance = 1e-13;

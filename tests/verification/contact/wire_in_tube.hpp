@@ -109,16 +109,7 @@ struct Wire {
         rod(layout),
         EI(msm::rods::solid_section(material, diameter).EI),
         radius(diameter / 2) {}
-  [[nodiscard]] contact::ContactWire contact() const {
-    contact::ContactWire w;
-    w.form = &rod;
-    w.fixed = rod.clamp_fixed();
-    w.num_nodes = rod.num_nodes();
-    w.first_node = layout.first_node;
-    w.last_node = layout.tip_node;
-    w.radius = radius;
-    return w;
-  }
+  [[nodiscard]] contact::ContactWire contact() const { return contact::contact_wire(rod, radius); }
 };
 
 /// The same wire against the exact rigid cylinder (msm/rods/rigid_wall): its contact force, N.
@@ -249,30 +240,7 @@ inline CoupledRun coupled_run(const TetMesh& mesh, const Vec3& target,
   return run;
 }
 
-/// The largest principal strain magnitude over the mesh's tets (P1 gradient of u): the small
-/// strain's and the Green–Lagrange strain's, ½(H + Hᵀ) and ½(H + Hᵀ + HᵀH).
-struct WallStrain {
-  double small = 0.0, green = 0.0;
-};
-inline WallStrain largest_strain(const TetMesh& mesh, const std::vector<Vec3>& u) {
-  WallStrain out;
-  for (const Tet& t : mesh.tets) {
-    Eigen::Matrix3d dX, dU;
-    for (int k = 0; k < 3; ++k) {
-      dX.col(k) = mesh.nodes[t[k + 1]] - mesh.nodes[t[0]];
-      dU.col(k) = u[t[k + 1]] - u[t[0]];
-    }
-    const Eigen::Matrix3d H = dU * dX.inverse();
-    const Eigen::Matrix3d e = 0.5 * (H + H.transpose());
-    const Eigen::Matrix3d E = e + 0.5 * H.transpose() * H;
-    out.small = std::max(
-        out.small,
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(e).eigenvalues().cwiseAbs().maxCoeff());
-    out.green = std::max(
-        out.green,
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(E).eigenvalues().cwiseAbs().maxCoeff());
-  }
-  return out;
-}
+using contact::largest_strain;
+using contact::WallStrain;
 
 }  // namespace vessel::wire_in_tube
