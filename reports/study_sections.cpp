@@ -93,9 +93,10 @@ void rod_steps(Document& doc, const StabilityFile& s) {
       "Euler and Verlet are stable to 2/ω_max; the smallest of the three binds (for a slender wire "
       "the axial one: bending's dt is the axial one times 2h/d). Found: bisection on the "
       "integrator running the Discrete Elastic Rod (msm/rods/der_rod.hpp), as for the vessels. "
-      "The implicit integrators — DER by implicit Euler (linearised per step, CHOLMOD), seed "
-      "002's CORDE by its KKT implicit Euler step, the XPBD rod — ran at steps from 1 µs to a "
-      "30 Hz frame instead (from a 1 mm/s random velocity; XPBD from a released tip load): "
+      "The implicit integrators — DER and seed 002's CORDE by the same implicit Euler (each "
+      "step Newton on the rod's KKT system to convergence), the XPBD rod — ran at steps from "
+      "1 µs to a 30 Hz frame instead (from a 1 mm/s random velocity; XPBD from a released tip "
+      "load): "
       "bounded means the energy stayed within 1000× its start. Steps in µs.");
   Table t;
   t.header = {"model",        "integrator",         "N",
