@@ -270,9 +270,12 @@ class ElasticitySolver {
   /// Displacement formulation only (InputError for the mixed one); does not need solve().
   [[nodiscard]] std::vector<double> matrix_free_product(const std::vector<double>& u) const;
   /// diag(A) of the matrix-free operator (N/m per DoF; 1 on the constrained DoFs), as the
-  /// multigrid's Chebyshev smoother gets it (MatrixFreeTools::compute_diagonal). Displacement
-  /// formulation only.
+  /// multigrid's Chebyshev smoother gets it. Displacement formulation only.
   [[nodiscard]] std::vector<double> matrix_free_diagonal() const;
+  /// A u (N per DoF) by the sparse matrix MatrixFreeTools::compute_matrix builds from the
+  /// matrix-free operator's cell kernel, as the multigrid's P1 level gets it; u (m) zero on the
+  /// constrained DoFs. Displacement formulation only.
+  [[nodiscard]] std::vector<double> matrix_free_matrix_product(const std::vector<double>& u) const;
 
   /// The solved DoF values (displacement, and pressure for the mixed formulation), in this
   /// solver's DoF numbering, which depends only on the mesh and the problem. Requires solve().

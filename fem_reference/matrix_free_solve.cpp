@@ -75,11 +75,15 @@ std::vector<double> ElasticitySolver::matrix_free_diagonal() const {
   return {d.begin(), d.end()};
 }
 
-std::vector<double> ElasticitySolver::matrix_free_product(const std::vector<double>& u) const {
-  const auto& im = *impl_;
-  require_displacement(im.mixed, "matrix_free_product");
+namespace {
+/// A u by the matrix-free operator itself or (`by_matrix`) by the matrix built from its kernel;
+/// `Impl` is ElasticitySolver's (private, so deduced).
+template <typename Impl>
+std::vector<double> operator_product(const Impl& im, const std::vector<double>& u, bool by_matrix,
+                                     const char* what) {
+  require_displacement(im.mixed, what);
   if (u.size() != im.dof.n_dofs()) {
-    throw std::invalid_argument("matrix_free_product: " + std::to_string(u.size()) +
+    throw std::invalid_argument(std::string(what) + ": " + std::to_string(u.size()) +
                                 " values for a solver with " + std::to_string(im.dof.n_dofs()) +
                                 " DoFs");
   }
@@ -91,8 +95,24 @@ std::vector<double> ElasticitySolver::matrix_free_product(const std::vector<doub
   op.initialize_dof_vector(src);
   op.initialize_dof_vector(dst);
   for (std::size_t i = 0; i < u.size(); ++i) src.local_element(i) = u[i];
-  op.vmult(dst, src);
+  if (by_matrix) {
+    dl::TrilinosWrappers::SparseMatrix matrix;
+    op.compute_matrix(matrix);
+    matrix.vmult(dst, src);
+  } else {
+    op.vmult(dst, src);
+  }
   return {dst.begin(), dst.end()};
+}
+}  // namespace
+
+std::vector<double> ElasticitySolver::matrix_free_product(const std::vector<double>& u) const {
+  return operator_product(*impl_, u, false, "matrix_free_product");
+}
+
+std::vector<double> ElasticitySolver::matrix_free_matrix_product(
+    const std::vector<double>& u) const {
+  return operator_product(*impl_, u, true, "matrix_free_matrix_product");
 }
 
 }  // namespace vessel::fem

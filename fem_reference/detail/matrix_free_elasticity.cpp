@@ -13,6 +13,8 @@
 #include <deal.II/matrix_free/tools.h>
 
 #include <Eigen/SparseCore>
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <sstream>
 #include <stdexcept>
@@ -40,6 +42,53 @@ void stress_divergence(Evaluation& phi, double lambda, double mu) {
   phi.integrate(dl::EvaluationFlags::gradients);
 }
 
+/// The same a(u, v) on a straight-sided tet from the cell's dof values alone, in place: J⁻ᵀ and
+/// |det J| are constant on the cell, so phi needs MatrixFree's geometry at one point only, and ∇u
+/// is taken at a rule's Q points x_q (reference weights `weights`, summing to 1/6) from
+/// `ref_grad`, the scalar element's N shape gradients there, [(q·N + i)·3 + e] = ∂N_i/∂ξ_e(x_q).
+/// Dof values are component-major: phi.begin_dof_values()[c·N + i] (FESystem(FE_SimplexP, 3)).
+template <unsigned N, unsigned Q>
+void stress_divergence_straight(Evaluation& phi, const double* ref_grad, const double* weights,
+                                double lambda, double mu) {
+  Number* dofs = phi.begin_dof_values();
+  // inverse_jacobian(0)[d][e] = ∂ξ_e/∂x_d; JxW(0) = |det J|·(the one-point rule's weight 1/6).
+  const dl::Tensor<2, kDim, Number> inv_jt = phi.inverse_jacobian(0);
+  const Number det = 6.0 * phi.JxW(0);
+  std::array<Number, kDim * N> out{};
+  for (unsigned q = 0; q < Q; ++q) {
+    const double* g = ref_grad + q * N * kDim;
+    Number ref[kDim][kDim] = {};  // ∂u_c/∂ξ_e
+    for (unsigned c = 0; c < kDim; ++c) {
+      for (unsigned i = 0; i < N; ++i) {
+        for (unsigned e = 0; e < kDim; ++e) ref[c][e] += dofs[c * N + i] * g[i * kDim + e];
+      }
+    }
+    Number grad[kDim][kDim];  // ∂u_c/∂x_d
+    for (unsigned c = 0; c < kDim; ++c) {
+      for (unsigned d = 0; d < kDim; ++d) {
+        grad[c][d] = inv_jt[d][0] * ref[c][0] + inv_jt[d][1] * ref[c][1] + inv_jt[d][2] * ref[c][2];
+      }
+    }
+    const Number w = det * weights[q];
+    const Number lambda_trace = (lambda * w) * (grad[0][0] + grad[1][1] + grad[2][2]);
+    Number sigma[kDim][kDim];  // w·σ, symmetric
+    for (unsigned c = 0; c < kDim; ++c) {
+      for (unsigned d = 0; d < kDim; ++d) sigma[c][d] = (mu * w) * (grad[c][d] + grad[d][c]);
+      sigma[c][c] += lambda_trace;
+    }
+    for (unsigned c = 0; c < kDim; ++c) {
+      Number s[kDim];  // Σ_d wσ_cd ∂ξ_e/∂x_d
+      for (unsigned e = 0; e < kDim; ++e) {
+        s[e] = sigma[c][0] * inv_jt[0][e] + sigma[c][1] * inv_jt[1][e] + sigma[c][2] * inv_jt[2][e];
+      }
+      for (unsigned i = 0; i < N; ++i) {
+        out[c * N + i] += s[0] * g[i * kDim] + s[1] * g[i * kDim + 1] + s[2] * g[i * kDim + 2];
+      }
+    }
+  }
+  std::copy(out.begin(), out.end(), dofs);
+}
+
 using Clock = std::chrono::steady_clock;
 
 void copy(const dl::Vector<double>& from, MfVector& to) {
@@ -65,6 +114,15 @@ Eigen::SparseMatrix<double> to_eigen(const dl::TrilinosWrappers::SparseMatrix& m
   return out;
 }
 
+/// The fewest-point rule of deal.II 9.4 exact for polynomials of degree 2(degree − 1) on a tet:
+/// the centroid for P1; for P2 Witherden–Vincent's 4-point rule of degree 2 (QGaussSimplex(2)
+/// has 6 points, degree 3); above, QGaussSimplex(degree) (degree 2·degree − 1).
+dl::Quadrature<kDim> exact_on_straight_tets(int degree) {
+  if (degree == 1) return dl::QGaussSimplex<kDim>(1);
+  if (degree == 2) return dl::QWitherdenVincentSimplex<kDim>(1, false);
+  return dl::QGaussSimplex<kDim>(static_cast<unsigned>(degree));
+}
+
 }  // namespace
 
 dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<double>& constraints) {
@@ -83,15 +141,43 @@ ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
   data.mapping_update_flags = dl::update_gradients | dl::update_JxW_values;
   data.tasks_parallel_scheme = dl::MatrixFree<kDim, double>::AdditionalData::none;
   // On straight-sided tets (a degree-1 MappingFE) ε(u):Cε(v) is a polynomial of degree
-  // 2(degree − 1), which QGaussSimplex(degree) integrates exactly (degree 2·degree − 1): the same
-  // bilinear form as the assembled path's QGaussSimplex(degree + 1), at 6 instead of 14 points
-  // per P2 cell (1 instead of 6 for P1). Curved cells keep degree + 1, as the assembly does.
+  // 2(degree − 1): the smallest rule exact for it gives the same bilinear form as the assembled
+  // path's QGaussSimplex(degree + 1) (14 points per P2 cell). deal.II 9.4's MatrixFree takes only
+  // QGaussSimplex and odd Witherden–Vincent rules on tets (get_unique_face_quadratures), not the
+  // 4-point one, so for P1 and P2 the kernel is our own (stress_divergence_straight) on
+  // MatrixFree's one-point geometry. Curved cells keep degree + 1, as the assembly does.
   const auto* fe_mapping = dynamic_cast<const dl::MappingFE<kDim>*>(&mapping);
   const bool affine = fe_mapping != nullptr && fe_mapping->get_degree() == 1;
-  const dl::QGaussSimplex<kDim> quadrature(static_cast<unsigned>(affine ? degree : degree + 1));
-  quadrature_ = quadrature;
-  n_quadrature_points_ = quadrature.size();
-  mf_.reinit(mapping, dof, constraints, quadrature, data);
+  straight_ = affine && degree <= 2;
+  quadrature_ = affine ? exact_on_straight_tets(degree) : dl::QGaussSimplex<kDim>(degree + 1);
+  n_quadrature_points_ = quadrature_.size();
+  if (straight_) {
+    const dl::FE_SimplexP<kDim> scalar(static_cast<unsigned>(degree));
+    n_shapes_ = scalar.n_dofs_per_cell();
+    for (unsigned q = 0; q < quadrature_.size(); ++q) {
+      for (unsigned i = 0; i < n_shapes_; ++i) {
+        const dl::Tensor<1, kDim> g = scalar.shape_grad(i, quadrature_.point(q));
+        for (unsigned e = 0; e < kDim; ++e) ref_grad_.push_back(g[e]);
+      }
+    }
+    mf_.reinit(mapping, dof, constraints, dl::QGaussSimplex<kDim>(1), data);
+    return;
+  }
+  mf_.reinit(mapping, dof, constraints, quadrature_, data);
+}
+
+template <typename Evaluation>
+void ElasticityOperator::apply_cell(Evaluation& phi) const {
+  if (!straight_) {
+    stress_divergence(phi, lambda_, mu_);
+    return;
+  }
+  const double* w = quadrature_.get_weights().data();
+  if (n_shapes_ == 4) {
+    stress_divergence_straight<4, 1>(phi, ref_grad_.data(), w, lambda_, mu_);
+  } else {
+    stress_divergence_straight<10, 4>(phi, ref_grad_.data(), w, lambda_, mu_);
+  }
 }
 
 void ElasticityOperator::vmult(MfVector& dst, const MfVector& src) const {
@@ -104,7 +190,7 @@ void ElasticityOperator::vmult(MfVector& dst, const MfVector& src) const {
         for (unsigned cell = range.first; cell < range.second; ++cell) {
           phi.reinit(cell);
           phi.read_dof_values(in);
-          stress_divergence(phi, lambda_, mu_);
+          apply_cell(phi);
           phi.distribute_local_to_global(out);
         }
       };
@@ -145,9 +231,7 @@ MfVector ElasticityOperator::diagonal() const {
 MfVector ElasticityOperator::diagonal_by_kernel() const {
   MfVector diag;
   mf_.initialize_dof_vector(diag);
-  const std::function<void(Evaluation&)> kernel = [this](Evaluation& phi) {
-    stress_divergence(phi, lambda_, mu_);
-  };
+  const std::function<void(Evaluation&)> kernel = [this](Evaluation& phi) { apply_cell(phi); };
   dl::MatrixFreeTools::compute_diagonal(mf_, diag, kernel);
   for (const unsigned i : mf_.get_constrained_dofs()) diag.local_element(i) = 1.0;
   return diag;
@@ -158,9 +242,7 @@ void ElasticityOperator::compute_matrix(dl::TrilinosWrappers::SparseMatrix& matr
   dl::DynamicSparsityPattern dsp(dof.n_dofs(), dof.n_dofs());
   dl::DoFTools::make_sparsity_pattern(dof, dsp, constraints_, false);
   matrix.reinit(dsp);
-  const std::function<void(Evaluation&)> kernel = [this](Evaluation& phi) {
-    stress_divergence(phi, lambda_, mu_);
-  };
+  const std::function<void(Evaluation&)> kernel = [this](Evaluation& phi) { apply_cell(phi); };
   dl::MatrixFreeTools::compute_matrix(mf_, constraints_, matrix, kernel);
 }
 

@@ -31,10 +31,11 @@ namespace vessel::fem::detail {
 using MfVector = dl::LinearAlgebra::distributed::Vector<double>;
 
 /// A(u) = ∫ σ(u) : ε(v) dV with σ = λ tr(ε) I + 2μ ε (Pa, so A u is in N for u in m), evaluated
-/// cell by cell at QGaussSimplex(degree) on straight-sided tets (exact there) and at the assembled
-/// path's QGaussSimplex(degree + 1) on curved ones, so both compute the same bilinear form to
-/// rounding. `constraints` must be homogeneous (their pattern only): A acts
-/// on the unconstrained DoFs and as the identity on the constrained ones.
+/// cell by cell on straight-sided tets at the fewest-point rule exact for the integrand's degree
+/// 2(degree − 1) (P2: 4 points) and on curved ones at the assembled path's
+/// QGaussSimplex(degree + 1), so both compute the same bilinear form to rounding. `constraints`
+/// must be homogeneous (their pattern only): A acts on the unconstrained DoFs and as the identity
+/// on the constrained ones.
 class ElasticityOperator : public dl::Subscriptor {
  public:
   ElasticityOperator(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
@@ -72,10 +73,16 @@ class ElasticityOperator : public dl::Subscriptor {
  private:
   /// diag(A) by MatrixFreeTools::compute_diagonal (any constraints).
   [[nodiscard]] MfVector diagonal_by_kernel() const;
+  /// One cell's A_e u_e in place on phi's dof values (an FEEvaluation; defined in the .cpp).
+  template <typename Evaluation>
+  void apply_cell(Evaluation& phi) const;
 
   dl::MatrixFree<kDim, double> mf_;
   const dl::Mapping<kDim>& mapping_;
-  dl::Quadrature<kDim> quadrature_;
+  dl::Quadrature<kDim> quadrature_;  // the integrand's rule (MatrixFree's one point if straight_)
+  bool straight_ = false;            // P1/P2 on straight-sided tets: stress_divergence_straight
+  unsigned n_shapes_ = 0;            // straight_: the scalar element's shape functions
+  std::vector<double> ref_grad_;     // straight_: their reference gradients at quadrature_
   const dl::AffineConstraints<double>& constraints_;
   double lambda_, mu_;
   mutable MfVector diagonal_;  // el()'s, on first use
