@@ -109,7 +109,7 @@ struct SolverOptions {
   /// false: only the three translations (deal.II's AdditionalData::constant_modes).
   bool amg_rigid_body_modes = true;
   /// matrix_free, P2: the P1 level of the p-multigrid solved exactly by a CHOLMOD factor at or
-  /// below this many P1 DoFs, above by CG with ML to a relative residual of 1e-2 (measured in
+  /// below this many P1 DoFs, above by CG with ML to a relative residual of 0.1 (measured in
   /// docs/measurements/matrix_free_multigrid.md). Changes the answer only within the CG
   /// tolerance, so it is not part of the solution cache's key.
   std::size_t matrix_free_direct_coarse_max_dofs = 0;

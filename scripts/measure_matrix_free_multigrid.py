@@ -90,7 +90,7 @@ def main():
             "preconditioned by one two-level V-cycle: Chebyshev (degree 4, range 20) on the "
             "operator's diagonal at P2, the P1 level of the same mesh solved by CG preconditioned "
             "by ML (plain aggregation, the six rigid-body modes as near-null space) to a relative "
-            "residual of 1e-2, the outer CG then the flexible variant. The P2 "
+            "residual of 0.1, the outer CG then the flexible variant. The P2 "
             "operator integrates at Witherden–Vincent's 4-point rule of degree 2 (exact on these "
             "straight-sided tets) in the project's own cell kernel on MatrixFree's one-point "
             "geometry, serially and without SIMD (Debian's deal.II is built with "

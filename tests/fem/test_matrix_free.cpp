@@ -138,7 +138,7 @@ TEST_P(MatrixFree, DiagonalEqualsAssembledMatrixDiagonal) {
 INSTANTIATE_TEST_SUITE_P(Degrees, MatrixFree, ::testing::Values(1, 2));
 
 // The two-level P2 -> P1 cycle with the P1 level solved to a fixed relative residual (ML-CG to
-// 1e-2) is an h-independent preconditioner: refining the mesh must not raise the outer CG
+// 0.1) is an h-independent preconditioner: refining the mesh must not raise the outer CG
 // iterations by more than 1.3x. With one ML V-cycle on P1 instead, the iterations grew 1.67x from
 // structured level 0 to 1.
 TEST(MatrixFreeMultigrid, P2IterationsStayWithinThirtyPercentFromLevelZeroToOne) {
