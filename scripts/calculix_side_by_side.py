@@ -10,7 +10,7 @@ difference relative to the largest displacement), and reports wall time and peak
 (/usr/bin/time) of each whole run, mesh reading and set-up included. Both solve on every core.
 
 Usage: /usr/bin/python3 scripts/calculix_side_by_side.py [--levels 0,1] [--nu 0.3]
-           [--pressure 10] [--repeats 2] [--vesselverify build/verification/vesselverify]
+           [--pressure 10] [--repeats 2] [--solver direct] [--vesselverify build/verification/vesselverify]
            [--out table.md] [--keep DIR]
 Exit status 1 if a field differs by more than --tolerance (default 1e-6: CalculiX prints
 seven significant digits)."""
@@ -147,6 +147,8 @@ def main():
     ap.add_argument("--E", type=float, default=14.24e3)
     ap.add_argument("--pressure", type=float, default=10.0)
     ap.add_argument("--repeats", type=int, default=2)
+    ap.add_argument("--solver", default="direct", choices=["direct", "cg-amg", "matrix-free"],
+                    help="vesselverify fem --solver")
     ap.add_argument("--tolerance", type=float, default=1e-6)
     ap.add_argument("--vesselverify", default=os.path.join(ROOT, "build", "verification",
                                                            "vesselverify"))
@@ -175,7 +177,7 @@ def main():
             vtu = os.path.join(work, f"vv_L{level}.vtu")
             vv_cmd = [args.vesselverify, "fem", "--input", msh, "--degree", "2", "--bc", "clamped",
                       "--load", "pressure", "--pressure", repr(args.pressure), "--E", repr(args.E),
-                      "--nu", repr(args.nu), "--solver", "direct", "--vtu", vtu]
+                      "--nu", repr(args.nu), "--solver", args.solver, "--vtu", vtu]
             vv_runs, ccx_runs = [], []
             load_before = load_average()
             for _ in range(args.repeats):  # alternately, so both see the same machine
