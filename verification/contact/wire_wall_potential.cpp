@@ -18,7 +18,7 @@ namespace vessel::contact {
 using Eigen::VectorXd;
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
-std::vector<Vec3> WallEnergy::nodal(const VectorXd& u) const {
+std::vector<Vec3> WallPotential::nodal(const VectorXd& u) const {
   const auto& rows = node_rows();
   std::vector<Vec3> out(rows.size(), Vec3::Zero());
   for (std::size_t n = 0; n < rows.size(); ++n) {
@@ -74,6 +74,66 @@ Vec3 NeoHookeanWall::support_reaction(const VectorXd& u) const {
   return r;
 }
 
+FormWall::FormWall(const msm::Form& form, VectorXd rest, std::vector<int> free_index,
+                   std::vector<std::array<int, 3>> node_rows)
+    : form_(form),
+      rest_(std::move(rest)),
+      free_index_(std::move(free_index)),
+      node_rows_(std::move(node_rows)) {
+  for (const int r : free_index_) n_ = std::max(n_, r + 1);
+  rest_energy_ = form_.energy(rest_);
+}
+
+VectorXd FormWall::positions(const VectorXd& u) const {
+  VectorXd x = rest_;
+  for (std::size_t d = 0; d < free_index_.size(); ++d) {
+    if (free_index_[d] >= 0) x[static_cast<Eigen::Index>(d)] += u[free_index_[d]];
+  }
+  return x;
+}
+
+double FormWall::evaluate(const VectorXd& u, VectorXd* gradient,
+                          Eigen::SparseMatrix<double>* hessian) const {
+  const VectorXd x = positions(u);
+  if (gradient) {
+    VectorXd g;
+    form_.gradient(x, g);
+    gradient->setZero(n_);
+    for (std::size_t d = 0; d < free_index_.size(); ++d) {
+      if (free_index_[d] >= 0) (*gradient)[free_index_[d]] = g[static_cast<Eigen::Index>(d)];
+    }
+  }
+  if (hessian) {
+    Eigen::SparseMatrix<double> H;
+    form_.hessian(x, H, false);
+    Triplets t;
+    t.reserve(static_cast<std::size_t>(H.nonZeros()));
+    for (Eigen::Index c = 0; c < H.outerSize(); ++c) {
+      const int fc = free_index_[static_cast<std::size_t>(c)];
+      if (fc < 0) continue;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(H, c); it; ++it) {
+        const int fr = free_index_[static_cast<std::size_t>(it.row())];
+        if (fr >= 0) t.emplace_back(fr, fc, it.value());
+      }
+    }
+    hessian->resize(n_, n_);
+    hessian->setFromTriplets(t.begin(), t.end());
+  }
+  return form_.energy(x) - rest_energy_;
+}
+
+double FormWall::largest_strain(const TetMesh& mesh, const VectorXd& u) const {
+  TetMesh carried = mesh;
+  carried.tets.clear();
+  for (const Tet& t : mesh.tets) {
+    bool all = true;
+    for (const int n : t) all = all && node_rows_[static_cast<std::size_t>(n)][0] >= 0;
+    if (all) carried.tets.push_back(t);
+  }
+  if (carried.tets.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return contact::largest_strain(carried, nodal(u)).small;
+}
+
 Vec3 PotentialContactSolution::total_force_on_wall() const {
   Vec3 f = Vec3::Zero();
   for (std::size_t j = 0; j < force.size(); ++j) f += force[j] * direction[j];
@@ -107,7 +167,7 @@ struct Linearisation {
 /// The coupled problem Π(z) and the bookkeeping between z, the rod's dofs and the wall's rows.
 class Coupled {
  public:
-  Coupled(msm::rods::Rod& rod, double radius, const WallEnergy& wall, const TetMesh& mesh,
+  Coupled(msm::rods::Rod& rod, double radius, const WallPotential& wall, const TetMesh& mesh,
           const std::vector<int>& candidates, const VectorXd& start, double k)
       : rod_(rod), r_(radius), wall_(wall), k_(k), x0_(start) {
     fixed_ = rod.clamp_fixed();
@@ -366,7 +426,7 @@ class Coupled {
 
   msm::rods::Rod& rod_;
   double r_;
-  const WallEnergy& wall_;
+  const WallPotential& wall_;
   double k_;
   VectorXd x0_;
   std::vector<char> fixed_;
@@ -381,7 +441,7 @@ class Coupled {
 
 /// k from the wall's stiffness at rest: penalty_factor × its largest diagonal entry on the
 /// candidates' rows.
-double default_penalty(const WallEnergy& wall, const std::vector<int>& candidates, double factor) {
+double default_penalty(const WallPotential& wall, const std::vector<int>& candidates, double factor) {
   Eigen::SparseMatrix<double> h;
   VectorXd g;
   (void)wall.evaluate(VectorXd::Zero(wall.num_dofs()), &g, &h);
@@ -525,7 +585,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
 }  // namespace
 
 PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double radius,
-                                                   const WallEnergy& wall, const TetMesh& mesh,
+                                                   const WallPotential& wall, const TetMesh& mesh,
                                                    const std::vector<int>& candidates,
                                                    const VectorXd& start,
                                                    const PotentialContactOptions& options) {

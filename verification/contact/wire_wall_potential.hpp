@@ -27,14 +27,15 @@
 #include "fem_reference/elasticity.hpp"
 #include "fem_reference/hyperelastic.hpp"
 #include "meshes/tet_mesh.hpp"
+#include "msm/form/form.hpp"
 #include "msm/rods/rod.hpp"
 
 namespace vessel::contact {
 
 /// A wall as the energy of its free displacement rows (m).
-class WallEnergy {
+class WallPotential {
  public:
-  virtual ~WallEnergy() = default;
+  virtual ~WallPotential() = default;
   [[nodiscard]] virtual int num_dofs() const = 0;
   /// Per mesh node, the rows of its x, y, z displacement (−1 where held).
   [[nodiscard]] virtual const std::vector<std::array<int, 3>>& node_rows() const = 0;
@@ -51,7 +52,7 @@ class WallEnergy {
 };
 
 /// The linear wall: ½uᵀKu − fᵀu of the FEM's free displacement system.
-class LinearWall final : public WallEnergy {
+class LinearWall final : public WallPotential {
  public:
   explicit LinearWall(fem::FreeDisplacementSystem system) : s_(std::move(system)) {}
   [[nodiscard]] int num_dofs() const override { return static_cast<int>(s_.f.size()); }
@@ -68,7 +69,7 @@ class LinearWall final : public WallEnergy {
 
 /// The finite-strain wall: the FEM reference's compressible neo-Hookean strain energy
 /// (fem::HyperelasticSolver::free_state, displacement formulation, P1 or P2).
-class NeoHookeanWall final : public WallEnergy {
+class NeoHookeanWall final : public WallPotential {
  public:
   NeoHookeanWall(const TetMesh& mesh, fem::ElasticityProblem problem);
   [[nodiscard]] int num_dofs() const override { return n_; }
@@ -87,6 +88,33 @@ class NeoHookeanWall final : public WallEnergy {
   std::unique_ptr<fem::HyperelasticSolver> solver_;
   fem::FreeDisplacementSystem dofs_;
   int n_ = 0;
+};
+
+/// A msm model's own energy as the wall: E(X + u) − E(X) over its free dofs with its exact
+/// gradient and Hessian, so the contact solve finds the model's own (nonlinear) equilibrium.
+/// `free_index` and `node_rows` as form_wall_system (contact_models/model_walls.hpp) gives them.
+/// The form must outlive the wall.
+class FormWall final : public WallPotential {
+ public:
+  FormWall(const msm::Form& form, Eigen::VectorXd rest, std::vector<int> free_index,
+           std::vector<std::array<int, 3>> node_rows);
+  [[nodiscard]] int num_dofs() const override { return n_; }
+  [[nodiscard]] const std::vector<std::array<int, 3>>& node_rows() const override {
+    return node_rows_;
+  }
+  double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
+                  Eigen::SparseMatrix<double>* hessian) const override;
+  /// The P1 small strain of the tets whose four nodes the model carries (NaN if none).
+  [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
+
+ private:
+  [[nodiscard]] Eigen::VectorXd positions(const Eigen::VectorXd& u) const;
+  const msm::Form& form_;
+  Eigen::VectorXd rest_;
+  std::vector<int> free_index_;
+  std::vector<std::array<int, 3>> node_rows_;
+  int n_ = 0;
+  double rest_energy_ = 0.0;
 };
 
 struct PotentialContactOptions {
@@ -136,7 +164,7 @@ struct PotentialContactSolution {
 /// and the penetration without convergence; InputError for a rod with constraints, r_w ≤ 0, a
 /// start of the wrong size or a candidate not in the mesh.
 PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double radius,
-                                                   const WallEnergy& wall, const TetMesh& mesh,
+                                                   const WallPotential& wall, const TetMesh& mesh,
                                                    const std::vector<int>& candidates,
                                                    const Eigen::VectorXd& start,
                                                    const PotentialContactOptions& options = {});

@@ -135,7 +135,7 @@ struct PotentialRun {
   Vec3 clamp = Vec3::Zero();
 };
 
-PotentialRun potential_run(const TetMesh& mesh, const Vec3& target, const contact::WallEnergy& wall,
+PotentialRun potential_run(const TetMesh& mesh, const Vec3& target, const contact::WallPotential& wall,
                            const std::vector<int>& candidates,
                            contact::PotentialContactOptions o = {}) {
   const double d = 0.356e-3;
@@ -177,9 +177,9 @@ TEST(WireWallPotentialSlow, RigidLimitApproachesTheRigidWallSolve) {
   const contact::LinearWall linear_wall(linear.free_displacement_system());
   const contact::NeoHookeanWall neo_wall(mesh, problem);
   std::vector<double> forces;
-  for (const contact::WallEnergy* wall :
-       {static_cast<const contact::WallEnergy*>(&linear_wall),
-        static_cast<const contact::WallEnergy*>(&neo_wall)}) {
+  for (const contact::WallPotential* wall :
+       {static_cast<const contact::WallPotential*>(&linear_wall),
+        static_cast<const contact::WallPotential*>(&neo_wall)}) {
     const PotentialRun run = potential_run(mesh, kAimPoint, *wall, nodes);
     const contact::PotentialContactSolution& s = run.solution;
     const double F = s.total_force_on_wall().norm();
