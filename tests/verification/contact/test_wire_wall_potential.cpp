@@ -14,6 +14,7 @@
 #include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/rod_theory/tube_contact.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "msm/fem/linear_tet.hpp"
 #include "verification/contact/point_segment_distance.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
 #include "wire_in_tube.hpp"
@@ -241,4 +242,40 @@ TEST(WireWallPotentialSlow, TwoFormulationsAndActionReactionOnAFiniteStrainWall)
       estimate / F);
   EXPECT_NEAR(order, 1.0, 0.1);
   EXPECT_LT(std::abs(extrapolated - F), std::max(estimate, 1e-5 * F));
+}
+
+// A model's own energy as the wall (FormWall): msm's linear P1 tetrahedron (LinearTetTerm, its own
+// assembly) in the potential solve gives deal.II's linear P1 wall's contact (LinearWall) on the
+// same mesh and supports, 100 times the scenes' wall: the same pressed nodes and force to 1e-8.
+TEST(WireWallPotentialSlow, ModelEnergyWallEqualsTheFemWall) {
+  const TetMesh mesh = line_of_contact_mesh();
+  const std::vector<int> nodes = nodes_within(mesh, kAimPoint, 1.6e-3);
+  const fem::ElasticityProblem problem = wall_problem(kWallE * 100);
+  const fem::ElasticitySolver linear(mesh, problem);
+  const contact::LinearWall fem_wall(linear.free_displacement_system());
+  const msm::LinearTetTerm term(mesh.nodes, mesh.tets,
+                                msm::lame_parameters(kWallE * 100, problem.material.poisson_ratio));
+  std::vector<char> held(mesh.nodes.size(), 0);
+  for (const char* group : {"inlet", "outlet"}) {
+    for (const int n : mesh.group_nodes(mesh.require_group(group, 2, "tube"))) held[n] = 1;
+  }
+  std::vector<int> free_index(3 * mesh.nodes.size(), -1);
+  std::vector<std::array<int, 3>> rows(mesh.nodes.size(), {-1, -1, -1});
+  int next = 0;
+  Eigen::VectorXd rest(3 * mesh.nodes.size());
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+    rest.segment<3>(3 * static_cast<Eigen::Index>(n)) = mesh.nodes[n];
+    if (held[n]) continue;
+    for (int c = 0; c < 3; ++c) rows[n][c] = free_index[3 * n + c] = next++;
+  }
+  const contact::FormWall model_wall(term, rest, free_index, rows);
+  const PotentialRun a = potential_run(mesh, kAimPoint, fem_wall, nodes);
+  const PotentialRun b = potential_run(mesh, kAimPoint, model_wall, nodes);
+  const double Fa = a.solution.total_force_on_wall().norm();
+  const double Fb = b.solution.total_force_on_wall().norm();
+  std::printf("WIRE-WALL-POTENTIAL 100x: deal.II P1 %.10e N (%zu pressed), msm P1 %.10e N (%zu "
+              "pressed), %+.1e\n",
+              Fa, a.solution.pressed.size(), Fb, b.solution.pressed.size(), Fb / Fa - 1);
+  EXPECT_EQ(a.solution.pressed, b.solution.pressed);
+  EXPECT_NEAR(Fa, Fb, 1e-8 * Fa);
 }
