@@ -30,9 +30,11 @@ void cell_mass(const dl::FEValues<kDim>& fev, const std::vector<unsigned>& compo
   }
 }
 
-/// The rows and columns of `a` at free DoFs (free_index ≥ 0), renumbered by free_index.
-Eigen::SparseMatrix<double> free_block(const dl::SparseMatrix<double>& a,
-                                       const std::vector<int>& free_index, int n_free) {
+}  // namespace
+
+Eigen::SparseMatrix<double> ElasticitySolver::Impl::free_block(const dl::SparseMatrix<double>& a,
+                                                               const std::vector<int>& free_index,
+                                                               int n_free) {
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(a.n_nonzero_elements());
   for (Index row = 0; row < a.m(); ++row) {
@@ -47,8 +49,6 @@ Eigen::SparseMatrix<double> free_block(const dl::SparseMatrix<double>& a,
   e.setFromTriplets(t.begin(), t.end());
   return e;
 }
-
-}  // namespace
 
 ElasticitySolver::Impl::FreeSystem ElasticitySolver::Impl::assemble_free_system(
     bool with_mass) const {
@@ -113,15 +113,21 @@ FreeDisplacementSystem ElasticitySolver::free_displacement_system() const {
         "(Taylor-Hood) system is indefinite");
   }
   Impl::FreeSystem sys = impl_->assemble_free_system(false);
+  std::vector<std::array<int, 3>> rows = impl_->node_rows(sys.free_index);
+  return {std::move(sys.K), std::move(sys.f), std::move(sys.free_index), std::move(rows)};
+}
+
+std::vector<std::array<int, 3>> ElasticitySolver::Impl::node_rows(
+    const std::vector<int>& free_index) const {
   // Each node's rows through its vertex DoFs, shifted by one so that a node no cell uses (left at
   // zero by nodal()) reads −1 like a constrained one (rows fit a double exactly).
   const std::vector<Vec3> rows =
-      impl_->nodal([&](Index dof) { return static_cast<double>(sys.free_index[dof] + 1); });
-  std::vector<std::array<int, 3>> node_rows(rows.size());
+      nodal([&](Index i) { return static_cast<double>(free_index[i] + 1); });
+  std::vector<std::array<int, 3>> out(rows.size());
   for (std::size_t n = 0; n < rows.size(); ++n) {
-    for (int c = 0; c < 3; ++c) node_rows[n][c] = static_cast<int>(rows[n][c]) - 1;
+    for (int c = 0; c < 3; ++c) out[n][c] = static_cast<int>(rows[n][c]) - 1;
   }
-  return {std::move(sys.K), std::move(sys.f), std::move(sys.free_index), std::move(node_rows)};
+  return out;
 }
 
 }  // namespace vessel::fem

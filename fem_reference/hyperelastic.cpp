@@ -99,6 +99,8 @@ struct HyperelasticSolver::Impl {
   std::vector<unsigned> component;  // per DoF: 0..2 displacement, 3 pressure
   std::vector<Index> constrained;   // constrained DoFs
   std::vector<double> prescribed;   // their values at load factor 1
+  std::vector<int> free_index;      // per DoF its row among the unconstrained ones, −1 if constrained
+  int n_free = 0;
   dl::Vector<double> pressure_volume;  // per pressure DoF: ∫ψ dV (scale of its residual)
   dl::Vector<double> u, internal;
   HyperelasticResult result;
@@ -112,10 +114,13 @@ struct HyperelasticSolver::Impl {
     inv_lambda = std::isinf(material.lambda) ? 0.0 : 1.0 / material.lambda;
     symmetric = !(opt.follower_pressure && !d.problem.pressures.empty());
     component = d.dof_components();
+    free_index.assign(d.dof.n_dofs(), -1);
     for (Index i = 0; i < d.dof.n_dofs(); ++i) {
       if (d.constraints.is_constrained(i)) {
         constrained.push_back(i);
         prescribed.push_back(d.constraints.get_inhomogeneity(i));
+      } else {
+        free_index[i] = n_free++;
       }
     }
     u.reinit(d.dof.n_dofs());
@@ -192,7 +197,8 @@ struct HyperelasticSolver::Impl {
             (mixed ? -p * ln_j - 0.5 * p * p * inv_lambda : 0.5 * material.lambda * ln_j * ln_j);
         stats.energy += psi * jxw;
         const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
-        const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Mat3>(E).eigenvalues();
+        const Eigen::Vector3d ev =
+            Eigen::SelfAdjointEigenSolver<Mat3>().computeDirect(E, Eigen::EigenvaluesOnly).eigenvalues();
         stats.max_abs_strain = std::max(stats.max_abs_strain, ev.cwiseAbs().maxCoeff());
         // R_p = ∫ (−ln J − p/λ) ψ: stationarity of ∫ −p ln J − p²/(2λ) in p (p = −λ ln J).
         const double r_p = -ln_j - p * inv_lambda;
@@ -606,6 +612,66 @@ std::vector<Vec3> HyperelasticSolver::displacement_at(const std::vector<Vec3>& p
 double HyperelasticSolver::relative_l2_error(const std::function<Vec3(const Vec3&)>& exact) const {
   if (!impl_->solved) throw std::logic_error("relative_l2_error called before solve()");
   return impl_->linear.relative_l2_error(exact);
+}
+
+FreeDisplacementSystem HyperelasticSolver::free_dofs() const {
+  if (impl_->mixed) {
+    throw InputError("the free DoFs' state is for the displacement formulation, not the mixed one");
+  }
+  FreeDisplacementSystem out;
+  out.free_index = impl_->free_index;
+  out.node_rows = impl_->d.node_rows(out.free_index);
+  return out;
+}
+
+FreeHyperelasticState HyperelasticSolver::free_state(const Eigen::VectorXd& u_free,
+                                                     bool with_tangent) const {
+  auto& im = *impl_;
+  if (im.mixed) {
+    throw InputError("the free DoFs' state is for the displacement formulation, not the mixed one");
+  }
+  if (u_free.size() != im.n_free) {
+    throw std::invalid_argument("free_state: wrong number of free DoF values");
+  }
+  dl::Vector<double> w(im.d.dof.n_dofs());
+  for (Index i = 0; i < w.size(); ++i) {
+    if (im.free_index[i] >= 0) w(i) = u_free[im.free_index[i]];
+  }
+  FreeHyperelasticState out;
+  out.gradient = Eigen::VectorXd::Zero(im.n_free);
+  if (with_tangent) im.d.matrix = 0.0;  // scratch: the assembled path's matrix
+  std::vector<Index> cols;
+  std::vector<double> vals;
+  // Load factor 0: the strain energy alone (loads and prescribed values are not applied).
+  const PassStats st = im.pass(
+      w, 0.0, with_tangent,
+      [&](const std::vector<Index>& dofs, const dl::FullMatrix<double>& k, const auto&,
+          const dl::Vector<double>& r_int) {
+        for (unsigned i = 0; i < dofs.size(); ++i) {
+          const int fi = im.free_index[dofs[i]];
+          if (fi < 0) continue;
+          out.gradient[fi] += r_int(i);
+          if (!with_tangent) continue;
+          cols.clear();
+          vals.clear();
+          for (unsigned j = 0; j < dofs.size(); ++j) {
+            if (im.free_index[dofs[j]] < 0) continue;
+            cols.push_back(dofs[j]);
+            vals.push_back(k(i, j));
+          }
+          im.d.matrix.add(dofs[i], static_cast<unsigned>(cols.size()), cols.data(), vals.data());
+        }
+      });
+  out.admissible = st.valid;
+  out.min_jacobian = st.min_jacobian;
+  if (!st.valid) {
+    out.energy = std::numeric_limits<double>::infinity();
+    return out;
+  }
+  out.energy = st.energy;
+  out.max_abs_principal_strain = st.max_abs_strain;
+  if (with_tangent) out.tangent = ElasticitySolver::Impl::free_block(im.d.matrix, im.free_index, im.n_free);
+  return out;
 }
 
 std::size_t HyperelasticSolver::n_dofs() const { return impl_->d.dof.n_dofs(); }

@@ -6,6 +6,7 @@
 /// line search, adaptive load stepping. Plain data only (no deal.II). SI units. The formulas are
 /// derived in docs/physics/finite_strain.md.
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <functional>
 #include <memory>
 #include <string>
@@ -111,6 +112,17 @@ struct HyperelasticResult {
   PhaseTimings timings;       ///< assembly and solve summed over all Newton iterations
 };
 
+/// The wall's strain energy and its derivatives on the unconstrained DoFs at a displacement, for
+/// a problem solved outside the solver (a wire pressed into the wall: verification/contact/).
+struct FreeHyperelasticState {
+  bool admissible = true;  ///< false when an element is inverted (J ≤ 0): energy +∞
+  double energy = 0.0;     ///< ∫Ψ dV, J
+  Eigen::VectorXd gradient;             ///< ∂/∂u of the energy on the free DoFs (internal forces), N
+  Eigen::SparseMatrix<double> tangent;  ///< its Hessian on the free DoFs, N/m (when asked)
+  double max_abs_principal_strain = 0.0;  ///< Green–Lagrange, at quadrature points
+  double min_jacobian = 1.0;
+};
+
 /// Solves a hyperelastic problem on one mesh (the ElasticityProblem's supports, loads, elements
 /// and solver options; its Material's E, ν give μ, λ).
 class HyperelasticSolver {
@@ -138,6 +150,17 @@ class HyperelasticSolver {
                                                   double outside_tolerance = 1e-9) const;
   /// ‖u_h − u‖_L2 / ‖u‖_L2, as ElasticitySolver::relative_l2_error.
   [[nodiscard]] double relative_l2_error(const std::function<Vec3(const Vec3&)>& exact) const;
+
+  /// The unconstrained DoFs' layout as ElasticitySolver::free_displacement_system gives it
+  /// (free_index, node_rows; K and f left empty). InputError for the mixed formulation, loads, or
+  /// supports that prescribe a non-zero displacement: free_state() is the energy of a wall held
+  /// at zero and loaded only from outside.
+  [[nodiscard]] FreeDisplacementSystem free_dofs() const;
+  /// The strain energy, its gradient and (with_tangent) its Hessian at the displacement u_free
+  /// (m, one value per free row; the constrained DoFs at zero). An inverted element gives
+  /// admissible = false. Requires what free_dofs() requires.
+  [[nodiscard]] FreeHyperelasticState free_state(const Eigen::VectorXd& u_free,
+                                                 bool with_tangent) const;
 
   [[nodiscard]] std::size_t n_dofs() const;
   /// Per DoF: its component (0–2 displacement, 3 the mixed form's pressure).

@@ -132,6 +132,13 @@ struct ElasticitySolver::Impl {
     Eigen::VectorXd f;
   };
   [[nodiscard]] FreeSystem assemble_free_system(bool with_mass) const;
+  /// Per TetMesh node, the rows of its x, y and z displacement (−1 where constrained) under
+  /// `free_index` (FreeDisplacementSystem::node_rows).
+  [[nodiscard]] std::vector<std::array<int, 3>> node_rows(const std::vector<int>& free_index) const;
+  /// The rows and columns of `a` at free DoFs (free_index ≥ 0), renumbered by free_index.
+  [[nodiscard]] static Eigen::SparseMatrix<double> free_block(const dl::SparseMatrix<double>& a,
+                                                              const std::vector<int>& free_index,
+                                                              int n_free);
   /// Per TetMesh node, the vertex DoFs' values value(dof).
   template <class ValueOfDof>
   [[nodiscard]] std::vector<Vec3> nodal(const ValueOfDof& value) const;

@@ -45,6 +45,9 @@ TEST(ContactReference, RefusesASceneWithoutAGuidewireAndABadStiffness) {
   ContactReferenceOptions bad;
   bad.ratio = 1.0;
   expect_input_error([&] { (void)solve_contact_reference(wire, 4e-7, bad); }, {"ratio > 1"});
+  expect_input_error([] { (void)parse_contact_wall("hyperelastic"); },
+                     {"linear", "neo-hookean", "hyperelastic"});
+  EXPECT_EQ(parse_contact_wall("neo-hookean"), ContactWall::neo_hookean);
   // The stiffnesses default to the scene's sweep.
   EXPECT_EQ(contact_reference_stiffnesses(wire), (std::vector<double>{4e-7, 4e-6, 4e-5}));
 }
@@ -84,6 +87,30 @@ TEST(ContactReferenceSlow, StraightSceneFloppyWireConverges) {
   EXPECT_LT(r.estimate->gci_fine, 0.02);
   EXPECT_LT(r.estimate->extrapolated, r.rigid_force);
   EXPECT_NE(r.verdict.find("beyond the linear wall's validity"), std::string::npos) << r.verdict;
+}
+
+// The same wire on the finite-strain (neo-Hookean) wall, two levels (0.1, 0.08 mm): each converges
+// to a line of contact below both rigid-lumen forces, the levels agree within 0.5 %, and the
+// verdict does not depend on a strain limit (the wall is valid at finite strain).
+TEST(ContactReferenceSlow, StraightSceneFloppyWireOnTheNeoHookeanWall) {
+  const Scene scene = shipped("guidewire_straight.toml");
+  ContactReferenceOptions o;
+  o.wall = ContactWall::neo_hookean;
+  o.levels = 2;
+  o.coarsest_size = 0.1e-3;
+  o.ratio = 1.25;
+  const ContactReference r = solve_contact_reference(scene, 4e-7, o);
+  print_contact_reference(r, std::cout);
+  ASSERT_EQ(r.levels.size(), 2u);
+  for (const ContactLevel& l : r.levels) {
+    ASSERT_TRUE(l.converged) << l.failure;
+    EXPECT_LT(l.force, r.rigid_force);
+    EXPECT_LT(l.force, *r.continuum_rigid_force);
+    EXPECT_GT(l.pressed, 1);
+    EXPECT_GT(l.strain, o.strain_limit);  // beyond the linear wall's range, within this one's
+  }
+  EXPECT_NEAR(r.levels[0].force, r.levels[1].force, 5e-3 * r.levels[1].force);
+  EXPECT_EQ(r.verdict, "reference");
 }
 
 }  // namespace

@@ -15,6 +15,7 @@ namespace {
 struct ContactCli {
   std::filesystem::path scene;
   std::vector<double> ei;
+  std::string wall = "linear";
   ContactReferenceOptions options;
 };
 
@@ -24,15 +25,17 @@ void add_contact_command(CLI::App& app) {
   auto o = std::make_shared<ContactCli>();
   CLI::App* cmd = app.add_subcommand(
       "contact",
-      "The contact reference of a guidewire scene: its wire (DER) and its wall (linear FEM) "
-      "solved together, the contact between the wire's surface and the wall's found by the "
-      "solve (Signorini's conditions), the wall refined level by level around the contact zone. "
+      "The contact reference of a guidewire scene: its wire (DER) and its wall (linear or "
+      "finite-strain neo-Hookean FEM) solved together, the contact between the wire's surface "
+      "and the wall's found by the solve (Signorini's conditions), the wall refined level by "
+      "level around the contact zone. "
       "Per level: the total contact force, the zone's centroid and extent, the dent, the largest "
       "strain, steps and time; then the force's Richardson extrapolate, observed order and GCI, "
-      "and whether the answer is a reference (converged, strain within the linear wall's "
-      "validity).\n"
+      "and whether the answer is a reference (converged, the zone inside the refined patch, and "
+      "for the linear wall the strain within its validity).\n"
       "Example:\n"
-      "  vesselverify contact verification/scenes/guidewire_straight.toml --ei 4e-7");
+      "  vesselverify contact verification/scenes/guidewire_straight.toml --ei 4e-7 "
+      "--wall neo-hookean");
   cmd->add_option("scene", o->scene, "A scene file with a guidewire load")
       ->required()
       ->check(CLI::ExistingFile);
@@ -40,6 +43,11 @@ void add_contact_command(CLI::App& app) {
                   "Wire bending stiffnesses EI, N·m², comma separated (default: the scene's "
                   "stiffness_sweep, or its wire's own EI)")
       ->delimiter(',');
+  cmd->add_option("--wall", o->wall,
+                  "The wall: linear (condensed, active set) or neo-hookean (finite strain, the "
+                  "wire and the wall as one potential)")
+      ->check(CLI::IsMember({"linear", "neo-hookean"}))
+      ->capture_default_str();
   cmd->add_option("--levels", o->options.levels, "Refinement levels")
       ->check(CLI::Range(1, 6))
       ->capture_default_str();
@@ -62,6 +70,7 @@ void add_contact_command(CLI::App& app) {
       ->capture_default_str();
   cmd->callback([o] {
     o->options.log = &std::cerr;  // progress; the table goes to stdout
+    o->options.wall = parse_contact_wall(o->wall);
     const Scene scene = read_scene(o->scene);
     const std::vector<double> ei = o->ei.empty() ? contact_reference_stiffnesses(scene) : o->ei;
     for (const double EI : ei) {

@@ -117,6 +117,10 @@ void add_contact_models_command(CLI::App& app) {
                   "Degree of the reference FEM wall (deal.II)")
       ->check(CLI::IsMember({1, 2}))
       ->capture_default_str();
+  cmd->add_flag("--own-equilibrium", o->options.own_equilibrium,
+                "Each model at its own nonlinear equilibrium (its own energy) and the reference at "
+                "finite strain (neo-Hookean FEM), the wire and each wall solved as one potential; "
+                "default: every wall linearised at rest");
   cmd->callback([o] {
     const Scene scene = read_scene(o->scene);
     std::vector<ModelSpec> models =

@@ -12,6 +12,8 @@
 #include "msm/rods/der_rod.hpp"
 #include "msm/rods/rigid_wall.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
+#include "verification/contact/wire_wall_potential.hpp"
+#include "verification/scene_problems.hpp"
 
 namespace vessel::contact {
 
@@ -85,6 +87,32 @@ struct Problem {
   double lumen_radius = 0.0;
 };
 
+/// The pressed zone: its centroid, its spans along and around the axis, the dent.
+void describe_zone(const TetMesh& mesh, double lumen_radius, const std::vector<int>& pressed,
+                   const std::vector<double>& force, const std::vector<Vec3>& u,
+                   ModelContact& out) {
+  double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
+  double t_lo = z_lo, t_hi = z_hi, total = 0.0;
+  out.pressed = static_cast<int>(pressed.size());
+  for (std::size_t j = 0; j < pressed.size(); ++j) {
+    const auto node = static_cast<std::size_t>(pressed[j]);
+    const Vec3& X = mesh.nodes[node];
+    out.centroid += force[j] * X;
+    total += force[j];
+    out.dent = std::max(out.dent, u[node].norm());
+    z_lo = std::min(z_lo, X.z());
+    z_hi = std::max(z_hi, X.z());
+    const double theta = std::atan2(X.y(), X.x());
+    t_lo = std::min(t_lo, theta);
+    t_hi = std::max(t_hi, theta);
+  }
+  if (total > 0.0) {
+    out.centroid /= total;
+    out.axial_extent = z_hi - z_lo;
+    out.circumferential_extent = lumen_radius * (t_hi - t_lo);
+  }
+}
+
 ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidContact& rigid,
                         const Problem& p, double EI, const ContactModelsOptions& options) {
   ModelContact out;
@@ -103,36 +131,65 @@ ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidCo
   out.setup_seconds = wall.setup_seconds + seconds_since(t0) - s.seconds;
   out.force = s.force.sum();
   out.force_on_wall = s.total_force_on_wall();
-  out.pressed = static_cast<int>(s.active.size());
   out.candidates = static_cast<int>(grown.nodes.size());
   out.rounds = grown.rounds;
   out.steps = s.newton_iterations;
   out.tip = s.x.segment<3>(3 * w.layout.tip_node);
   const std::vector<Vec3> u = grown.wall->displacement(s.wall_loads());
-  double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
-  double t_lo = z_lo, t_hi = z_hi;
+  std::vector<int> pressed;
+  std::vector<double> force;
   for (const int j : s.active) {
-    const auto node = static_cast<std::size_t>(grown.nodes[static_cast<std::size_t>(j)]);
-    const Vec3& X = p.mesh->nodes[node];
-    out.centroid += s.force[j] * X;
-    out.dent = std::max(out.dent, u[node].norm());
-    z_lo = std::min(z_lo, X.z());
-    z_hi = std::max(z_hi, X.z());
-    const double theta = std::atan2(X.y(), X.x());
-    t_lo = std::min(t_lo, theta);
-    t_hi = std::max(t_hi, theta);
+    pressed.push_back(grown.nodes[static_cast<std::size_t>(j)]);
+    force.push_back(s.force[j]);
   }
+  describe_zone(*p.mesh, p.lumen_radius, pressed, force, u, out);
   std::vector<Vec3> loads(p.mesh->nodes.size(), Vec3::Zero());
   for (std::size_t j = 0; j < grown.nodes.size(); ++j) {
     loads[static_cast<std::size_t>(grown.nodes[j])] +=
         s.force[static_cast<Eigen::Index>(j)] * s.direction[j];
   }
   out.own_imbalance = own_imbalance(wall, u, loads);
-  if (out.force > 0.0) {
-    out.centroid /= out.force;
-    out.axial_extent = z_hi - z_lo;
-    out.circumferential_extent = p.lumen_radius * (t_hi - t_lo);
+  return out;
+}
+
+/// The wall at its own equilibrium with the wire as one potential: a msm model's own energy
+/// (FormWall), deal.II's FEM as the neo-Hookean wall (the reference) or the linear one (a linear
+/// FEM model).
+ModelContact solve_wall_own(const Scene& scene, const ModelSpec& spec, const ModelWall& wall,
+                            SceneWire& w, const RigidContact& rigid, const Problem& p, double EI,
+                            double nu, bool reference, const ContactModelsOptions& options) {
+  ModelContact out;
+  out.name = wall.name;
+  out.detail = wall.detail;
+  out.linearisation = "own equilibrium";
+  const auto t0 = std::chrono::steady_clock::now();
+  std::unique_ptr<WallPotential> potential;
+  if (wall.energy.form) {
+    potential = std::make_unique<FormWall>(*wall.energy.form, wall.energy.rest,
+                                           wall.system.free_index, wall.system.node_rows);
+  } else if (reference) {
+    potential = std::make_unique<NeoHookeanWall>(*p.mesh, wall_problem(scene, nu, spec.degree));
+    out.detail += ", compressible neo-Hookean";
+  } else {
+    potential = std::make_unique<LinearWall>(wall.system);
   }
+  const std::vector<int> candidates =
+      p.mesh->group_nodes(p.mesh->require_group("inner_wall", 2, "contact mesh"));
+  PotentialContactOptions o;
+  o.force_scale = EI / (w.length * w.length);
+  o.max_newton = options.max_newton;
+  o.max_move = options.max_move;
+  msm::rods::DerRod rod = w.rod;
+  const PotentialContactSolution s =
+      solve_wire_wall_potential(rod, w.radius, *potential, *p.mesh, candidates, rigid.x, o);
+  out.solve_seconds = s.seconds;
+  out.setup_seconds = wall.setup_seconds + seconds_since(t0) - s.seconds;
+  for (const double f : s.force) out.force += f;
+  out.force_on_wall = s.total_force_on_wall();
+  out.candidates = static_cast<int>(candidates.size());
+  out.steps = s.newton_iterations;
+  out.tip = s.x.segment<3>(3 * w.layout.tip_node);
+  describe_zone(*p.mesh, p.lumen_radius, s.pressed, s.force, potential->nodal(s.u), out);
   return out;
 }
 
@@ -289,7 +346,10 @@ ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSp
         c = failed(*walls[k], why);
       } else {
         try {
-          c = solve_wall(*wall, *wires[e], rigid[e], p, EIs[e], options);
+          c = options.own_equilibrium
+                  ? solve_wall_own(scene, *walls[k], *wall, *wires[e], rigid[e], p, EIs[e],
+                                   out.nu, k == 0, options)
+                  : solve_wall(*wall, *wires[e], rigid[e], p, EIs[e], options);
         } catch (const std::exception& ex) {
           c = failed(*walls[k], ex.what());
           c.detail = wall->detail;

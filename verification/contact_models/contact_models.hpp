@@ -25,13 +25,18 @@ struct ContactModelsOptions {
   int reference_degree = 2;     ///< the reference wall: FEM of this degree (deal.II)
   int max_newton = 400;         ///< per contact solve (each growth round)
   double max_move = 0.5;        ///< WireWallOptions::max_move
+  /// false: every wall linearised at rest, the contact by the active set on the condensed wall
+  /// (wire_wall_contact.hpp). true: every model at its own equilibrium (its own nonlinear energy,
+  /// FormWall) and the reference at finite strain (the neo-Hookean FEM), each with the wire as one
+  /// potential (wire_wall_potential.hpp); every inner-wall node a candidate.
+  bool own_equilibrium = false;
 };
 
 /// One wall's contact with the wire.
 struct ModelContact {
   std::string name;
   std::string detail;
-  std::string linearisation;          ///< to_string(WallLinearisation)
+  std::string linearisation;  ///< to_string(WallLinearisation), or "own equilibrium"
   std::string failure;                ///< empty when solved
   double force = 0.0;                 ///< Σλ over the pressed nodes, N
   Vec3 force_on_wall = Vec3::Zero();  ///< Σλn, N

@@ -11,6 +11,7 @@
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
+#include "verification/contact/wire_wall_potential.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
 #include "verification/scene_problems.hpp"
 
@@ -51,6 +52,92 @@ std::vector<int> candidates(const TetMesh& mesh, const contact::ContactWire& wir
   return out;
 }
 
+/// The zone of a solved contact: the pressed nodes (mesh indices) with their forces, the wall's
+/// displacement at every mesh node.
+void describe_zone(const TetMesh& mesh, const std::vector<int>& pressed,
+                   const std::vector<double>& force, const std::vector<Vec3>& u, const Vec3& centre,
+                   double radius, ContactLevel& out) {
+  double weight = 0.0;
+  out.pressed = static_cast<int>(pressed.size());
+  for (std::size_t j = 0; j < pressed.size(); ++j) {
+    const auto n = static_cast<std::size_t>(pressed[j]);
+    out.centroid += force[j] * mesh.nodes[n];
+    weight += force[j];
+    out.dent = std::max(out.dent, u[n].norm());
+    out.zone_inside_patch = out.zone_inside_patch && (mesh.nodes[n] - centre).norm() <= radius;
+    for (const int k : pressed) {
+      const auto m = static_cast<std::size_t>(k);
+      const double d = (mesh.nodes[n] - mesh.nodes[m]).norm();
+      if (d >= out.extent) {
+        out.extent = d;
+        out.middle = 0.5 * (mesh.nodes[n] + mesh.nodes[m]);
+      }
+    }
+  }
+  if (weight > 0.0) out.centroid /= weight;
+  for (const int j : pressed) {
+    out.reach = std::max(out.reach, (mesh.nodes[static_cast<std::size_t>(j)] - out.middle).norm());
+  }
+}
+
+/// The linear wall: condensed on the candidates, Signorini's conditions by an active set
+/// (solve_wire_wall_contact_growing).
+void solve_linear_wall(const Scene& scene, const ReferenceWire& wire, double nu,
+                       const TetMesh& mesh, const std::vector<int>& nodes, const Vec3& wall_point,
+                       const Vec3& centre, double radius, double force_scale,
+                       const ContactReferenceOptions& o, ContactLevel& out) {
+  int first = 0;
+  for (int j = 1; j < static_cast<int>(nodes.size()); ++j) {
+    if ((mesh.nodes[nodes[j]] - wall_point).norm() < (mesh.nodes[nodes[first]] - wall_point).norm())
+      first = j;
+  }
+  const fem::ElasticitySolver solver(mesh, wall_problem(scene, nu, o.degree));
+  contact::WireWallOptions wo;
+  wo.force_scale = force_scale;
+  wo.max_newton = o.max_steps;
+  contact::BandGrowth growth;
+  growth.margin = 0.25 * wire.radius;
+  const contact::GrownContact grown = contact::solve_wire_wall_contact_growing(
+      wire.contact(), solver.free_displacement_system(), mesh, nodes, wire.rigid_state, {first},
+      wo, growth);
+  const contact::WireWallSolution& s = grown.solution;
+  out.converged = true;
+  out.candidates = static_cast<int>(grown.nodes.size());
+  out.steps = s.newton_iterations;
+  out.force = s.total_force_on_wall().norm();
+  const std::vector<Vec3> u = grown.wall->displacement(s.wall_loads());
+  std::vector<int> pressed;
+  std::vector<double> force;
+  for (const int j : s.active) {
+    pressed.push_back(grown.nodes[static_cast<std::size_t>(j)]);
+    force.push_back(s.force[j]);
+  }
+  describe_zone(mesh, pressed, force, u, centre, radius, out);
+  out.strain = contact::largest_strain(mesh, u).small;
+}
+
+/// The finite-strain wall: the wire and the neo-Hookean wall as one potential
+/// (solve_wire_wall_potential), every inner-wall node a candidate.
+void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, double nu,
+                            const TetMesh& mesh, const Vec3& centre, double radius,
+                            double force_scale, const ContactReferenceOptions& o,
+                            ContactLevel& out) {
+  const contact::NeoHookeanWall wall(mesh, wall_problem(scene, nu, o.degree));
+  const std::vector<int> nodes = mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
+  msm::rods::DerRod rod = wire.rod;
+  contact::PotentialContactOptions po;
+  po.force_scale = force_scale;
+  po.max_newton = o.max_steps;
+  const contact::PotentialContactSolution s = contact::solve_wire_wall_potential(
+      rod, wire.radius, wall, mesh, nodes, wire.rigid_state, po);
+  out.converged = true;
+  out.candidates = static_cast<int>(nodes.size());
+  out.steps = s.newton_iterations;
+  out.force = s.total_force_on_wall().norm();
+  describe_zone(mesh, s.pressed, s.force, wall.nodal(s.u), centre, radius, out);
+  out.strain = wall.largest_strain(mesh, s.u);
+}
+
 /// One contact solve on a mesh refined to `fine` within `radius` of `centre`.
 ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double nu, double fine,
                          const Vec3& centre, double radius, const Vec3& wall_point,
@@ -68,54 +155,20 @@ ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double n
     out.seconds = seconds_since(t0);
     return out;
   }
-  int first = 0;
-  for (int j = 1; j < static_cast<int>(nodes.size()); ++j) {
-    if ((mesh.nodes[nodes[j]] - wall_point).norm() < (mesh.nodes[nodes[first]] - wall_point).norm())
-      first = j;
-  }
   if (o.log) {
     *o.log << "contact: fine " << fine * 1e3 << " mm within " << radius * 1e3 << " mm, "
-           << mesh.nodes.size() << " nodes, " << nodes.size() << " candidates" << std::endl;
+           << mesh.nodes.size() << " nodes, " << nodes.size() << " candidates, "
+           << to_string(o.wall) << " wall" << std::endl;
   }
-  const fem::ElasticitySolver solver(mesh, wall_problem(scene, nu, o.degree));
-  contact::WireWallOptions wo;
-  wo.force_scale = force_scale;
-  wo.max_newton = o.max_steps;
-  contact::BandGrowth growth;
-  growth.margin = 0.25 * wire.radius;
   try {
-    const contact::GrownContact grown = contact::solve_wire_wall_contact_growing(
-        cw, solver.free_displacement_system(), mesh, nodes, wire.rigid_state, {first}, wo, growth);
-    const contact::WireWallSolution& s = grown.solution;
-    out.converged = true;
-    out.candidates = static_cast<int>(grown.nodes.size());
-    out.steps = s.newton_iterations;
-    out.pressed = static_cast<int>(s.active.size());
-    out.force = s.total_force_on_wall().norm();
-    const std::vector<Vec3> u = grown.wall->displacement(s.wall_loads());
-    double weight = 0.0;
-    for (const int j : s.active) {
-      const auto n = static_cast<std::size_t>(grown.nodes[static_cast<std::size_t>(j)]);
-      out.centroid += s.force[j] * mesh.nodes[n];
-      weight += s.force[j];
-      out.dent = std::max(out.dent, u[n].norm());
-      out.zone_inside_patch = out.zone_inside_patch && (mesh.nodes[n] - centre).norm() <= radius;
-      for (const int k : s.active) {
-        const auto m = static_cast<std::size_t>(grown.nodes[static_cast<std::size_t>(k)]);
-        const double d = (mesh.nodes[n] - mesh.nodes[m]).norm();
-        if (d >= out.extent) {
-          out.extent = d;
-          out.middle = 0.5 * (mesh.nodes[n] + mesh.nodes[m]);
-        }
-      }
+    if (o.wall == ContactWall::linear) {
+      solve_linear_wall(scene, wire, nu, mesh, nodes, wall_point, centre, radius, force_scale, o,
+                        out);
+    } else {
+      solve_neo_hookean_wall(scene, wire, nu, mesh, centre, radius, force_scale, o, out);
     }
-    if (weight > 0.0) out.centroid /= weight;
-    for (const int j : s.active) {
-      const auto n = static_cast<std::size_t>(grown.nodes[static_cast<std::size_t>(j)]);
-      out.reach = std::max(out.reach, (mesh.nodes[n] - out.middle).norm());
-    }
-    out.strain = contact::largest_strain(mesh, u).small;
   } catch (const std::runtime_error& e) {
+    out.converged = false;
     out.failure = e.what();
   }
   out.seconds = seconds_since(t0);
@@ -148,6 +201,16 @@ void require_guidewire(const Scene& scene) {
 
 }  // namespace
 
+std::string to_string(ContactWall wall) {
+  return wall == ContactWall::linear ? "linear" : "neo-Hookean";
+}
+
+ContactWall parse_contact_wall(const std::string& name) {
+  if (name == "linear") return ContactWall::linear;
+  if (name == "neo-hookean") return ContactWall::neo_hookean;
+  throw InputError("wall: expected \"linear\" or \"neo-hookean\", got \"" + name + "\"");
+}
+
 std::vector<double> contact_reference_stiffnesses(const Scene& scene) {
   require_guidewire(scene);
   const GuidewireSpec& g = *scene.load.guidewire;
@@ -179,6 +242,7 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
   r.wall_modulus = scene.youngs_modulus;
   r.poisson_ratio = scene.poisson_ratios.front();
   r.strain_limit = o.strain_limit;
+  r.wall = o.wall;
 
   GuidewireSolver rigid_solver(scene.vessel, spec);
   GuidewireSolution rigid;
@@ -248,7 +312,7 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
     strain = std::max(strain, l.strain);
     inside = inside && l.zone_inside_patch;
   }
-  if (strain > o.strain_limit) {
+  if (o.wall == ContactWall::linear && strain > o.strain_limit) {
     r.verdict = "beyond the linear wall's validity (largest strain " + fixed(strain, 3) + " > " +
                 fixed(o.strain_limit, 3) + ")";
   } else if (!inside) {
@@ -261,7 +325,7 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
 
 void print_contact_reference(const ContactReference& r, std::ostream& out) {
   out << "### " << r.scene << ", EI = " << r.bending_stiffness << " N·m²\n\n"
-      << "Wall E = " << r.wall_modulus << " Pa, ν = " << r.poisson_ratio
+      << to_string(r.wall) << " wall, E = " << r.wall_modulus << " Pa, ν = " << r.poisson_ratio
       << "; rigid wall: " << fixed(r.rigid_force * 1e3, 4) << " mN (discrete wire)";
   if (r.continuum_rigid_force)
     out << ", " << fixed(*r.continuum_rigid_force * 1e3, 4) << " mN (continuum)";

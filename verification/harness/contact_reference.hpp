@@ -22,7 +22,17 @@
 
 namespace vessel {
 
+/// The wall of the contact reference: linear elasticity (condensed on the candidates, Signorini's
+/// conditions by an active set: verification/contact/wire_wall_contact.hpp) or the finite-strain
+/// compressible neo-Hookean wall (the wire and the wall as one potential:
+/// verification/contact/wire_wall_potential.hpp).
+enum class ContactWall { linear, neo_hookean };
+std::string to_string(ContactWall wall);
+/// "linear" or "neo-hookean"; InputError naming both otherwise.
+ContactWall parse_contact_wall(const std::string& name);
+
 struct ContactReferenceOptions {
+  ContactWall wall = ContactWall::linear;
   int levels = 3;  ///< refinement levels (three give an observed order)
   /// m: the fine size around the zone at level 0 (at 0.16 mm, near the wire's radius 0.178 mm,
   /// the capsule passes between the nodes of the shipped scenes' wall)
@@ -32,7 +42,8 @@ struct ContactReferenceOptions {
   int degree = 1;
   double margin = 0.3e-3;       ///< m: the refined ball's radius beyond the zone's half extent
   double band = 0.5e-3;         ///< m: candidates within this of the rigid-wall wire's surface
-  double strain_limit = 0.1;    ///< the linear wall's validity: largest strain at most this
+  /// the linear wall's validity: largest strain at most this (the neo-Hookean wall has no limit)
+  double strain_limit = 0.1;
   int max_steps = 300;          ///< linearised contact steps per solve
   std::ostream* log = nullptr;  ///< one line per solve (mesh, candidates, result), if set
 };
@@ -52,8 +63,9 @@ struct ContactLevel {
   Vec3 middle = Vec3::Zero();    ///< midpoint of the two pressed nodes farthest apart, m
   double reach = 0.0;            ///< largest distance of a pressed node from `middle`, m
   double dent = 0.0;             ///< largest displacement of a pressed node, m
-  double strain = 0.0;  ///< largest principal small strain over the wall (P1 gradient of the
-                        ///< vertex displacements)
+  /// largest principal strain over the wall: small strain from the P1 gradient of the vertex
+  /// displacements (linear wall), Green–Lagrange at the quadrature points (neo-Hookean wall)
+  double strain = 0.0;
   bool zone_inside_patch = true;  ///< every pressed node within the refined ball
   int steps = 0;                  ///< linearised steps over all growth rounds (0 if not converged)
   double seconds = 0.0;           ///< meshing, condensing and solving this level
@@ -70,6 +82,7 @@ struct ContactReference {
   Vec3 patch_centre = Vec3::Zero();             ///< m: where every level is refined
   double patch_radius = 0.0;                    ///< m
   double strain_limit = 0.0;
+  ContactWall wall = ContactWall::linear;
   ContactLevel scout;  ///< the coarsest size at the rigid wall point: where the zone is
   std::vector<ContactLevel> levels;
   /// From the three finest levels when all converged: Roache's order and GCI on the force.

@@ -1,0 +1,281 @@
+// The wire and the wall as one potential (contact::solve_wire_wall_potential): the gap's exact
+// derivatives against finite differences, the finite-strain wall's energy against its linear
+// limit and finite differences, the rigid limit against the shooting reference, two contact
+// formulations (augmented Lagrangian, penalty extrapolated to infinite stiffness) against each
+// other, action and reaction through the wall's own support reactions. Rows "WIRE-WALL-POTENTIAL".
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <random>
+
+#include "fem_reference/hyperelastic.hpp"
+#include "fem_reference/rod_theory/tube_contact.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "msm/fem/linear_tet.hpp"
+#include "verification/contact/point_segment_distance.hpp"
+#include "verification/contact/wire_wall_potential.hpp"
+#include "wire_in_tube.hpp"
+
+using namespace vessel;
+using namespace vessel::wire_in_tube;
+using Eigen::VectorXd;
+
+namespace {
+
+using Vec9 = Eigen::Matrix<double, 9, 1>;
+
+Vec9 stack(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  Vec9 q;
+  q << p, a, b;
+  return q;
+}
+
+contact::PointSegmentDistance at(const Vec9& q, bool hessian) {
+  return contact::point_segment_distance(q.head<3>(), q.segment<3>(3), q.tail<3>(), hessian);
+}
+
+}  // namespace
+
+// d and its derivatives against central differences, inside the segment and beyond either end.
+TEST(PointSegmentDistance, DerivativesMatchFiniteDifferences) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Eigen::Vector3d a(0.1, -0.2, 0.05), b(1.1, 0.3, -0.2);
+  // Points whose nearest point is inside, before a and beyond b.
+  for (const double along : {0.4, -0.5, 1.6}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      const Eigen::Vector3d off(u(rng), u(rng), u(rng));
+      const Eigen::Vector3d p = a + along * (b - a) + 0.5 * off;
+      const Vec9 q = stack(p, a + 0.01 * off, b - 0.02 * off);
+      const auto d = at(q, true);
+      constexpr double h = 1e-6;
+      double g_err = 0.0, h_err = 0.0;
+      for (int k = 0; k < 9; ++k) {
+        Vec9 qp = q, qm = q;
+        qp[k] += h;
+        qm[k] -= h;
+        const auto dp = at(qp, true), dm = at(qm, true);
+        g_err = std::max(g_err, std::abs((dp.distance - dm.distance) / (2 * h) - d.gradient[k]));
+        h_err = std::max(h_err,
+                         ((dp.gradient - dm.gradient) / (2 * h) - d.hessian.col(k)).cwiseAbs().maxCoeff());
+      }
+      EXPECT_LT(g_err, 1e-8) << "along " << along;
+      EXPECT_LT(h_err, 1e-6 * std::max(1.0, d.hessian.cwiseAbs().maxCoeff())) << "along " << along;
+      EXPECT_LT((d.hessian - d.hessian.transpose()).cwiseAbs().maxCoeff(), 1e-12);
+      // Translating everything leaves d unchanged: the gradient's three blocks sum to zero (the
+      // contact forces on the wall and the wire are equal and opposite).
+      EXPECT_LT((d.gradient.head<3>() + d.gradient.segment<3>(3) + d.gradient.tail<3>()).norm(),
+                1e-14);
+    }
+  }
+  EXPECT_THROW((void)contact::point_segment_distance(a, a, a, false), std::invalid_argument);
+}
+
+// The finite-strain wall's energy, gradient and tangent (fem::HyperelasticSolver::free_state): at
+// rest its tangent is the linear wall's stiffness (the same mesh and supports, deal.II's linear
+// assembly) to round-off; away from rest its gradient and tangent are the central differences of
+// its energy and gradient.
+TEST(NeoHookeanWall, StateMatchesLinearLimitAndFiniteDifferences) {
+  const TetMesh& mesh = tube_mesh();
+  const fem::ElasticityProblem problem = wall_problem(kWallE);
+  const contact::NeoHookeanWall wall(mesh, problem);
+  const fem::ElasticitySolver linear(mesh, problem);
+  const fem::FreeDisplacementSystem sys = linear.free_displacement_system();
+  ASSERT_EQ(wall.num_dofs(), sys.K.rows());
+  VectorXd g;
+  Eigen::SparseMatrix<double> H;
+  const double e0 = wall.evaluate(VectorXd::Zero(wall.num_dofs()), &g, &H);
+  EXPECT_NEAR(e0, 0.0, 1e-30);
+  EXPECT_LT(g.norm(), 1e-12);
+  const Eigen::SparseMatrix<double> diff = H - sys.K;
+  const double kmax = Eigen::MatrixXd(sys.K.diagonal()).cwiseAbs().maxCoeff();
+  double worst = 0.0;
+  for (int c = 0; c < diff.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(diff, c); it; ++it)
+      worst = std::max(worst, std::abs(it.value()));
+  std::printf("WIRE-WALL-POTENTIAL neo-Hookean tangent at rest - linear K: %.2e of max K_ii\n",
+              worst / kmax);
+  EXPECT_LT(worst, 1e-10 * kmax);
+  // A displacement of strain ~0.05: a smooth field over the tube.
+  VectorXd u(wall.num_dofs());
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+    const Vec3& x = mesh.nodes[n];
+    const Vec3 v(0.05 * std::sin(200 * x.z()) * 1e-3, 0.03e-3 * std::cos(300 * x.x()),
+                 0.02 * x.y());
+    for (int c = 0; c < 3; ++c) {
+      if (wall.node_rows()[n][c] >= 0) u[wall.node_rows()[n][c]] = v[c];
+    }
+  }
+  VectorXd gu;
+  Eigen::SparseMatrix<double> Hu;
+  (void)wall.evaluate(u, &gu, &Hu);
+  const VectorXd dir = VectorXd::Random(wall.num_dofs()) * 1e-6;
+  constexpr double h = 1e-3;
+  VectorXd gp, gm;
+  const double ep = wall.evaluate(u + h * dir, &gp, nullptr);
+  const double em = wall.evaluate(u - h * dir, &gm, nullptr);
+  const double slope = (ep - em) / (2 * h);
+  std::printf("WIRE-WALL-POTENTIAL neo-Hookean gradient: directional %.9e vs FD %.9e\n",
+              gu.dot(dir), slope);
+  EXPECT_NEAR(gu.dot(dir), slope, 1e-6 * std::abs(slope));
+  const VectorXd hd = Hu * dir, fd = (gp - gm) / (2 * h);
+  EXPECT_LT((hd - fd).norm(), 1e-6 * hd.norm());
+}
+
+namespace {
+
+/// The straight-tube wire (DER, N = 32) aimed at the structured tube's node, against `wall`:
+/// its rigid-wall state and the potential's solution.
+struct PotentialRun {
+  contact::PotentialContactSolution solution;
+  double rigid_force = 0.0;
+  double EI = 0.0;
+  Vec3 clamp = Vec3::Zero();
+};
+
+PotentialRun potential_run(const TetMesh& mesh, const Vec3& target, const contact::WallPotential& wall,
+                           const std::vector<int>& candidates,
+                           contact::PotentialContactOptions o = {}) {
+  const double d = 0.356e-3;
+  const double c = kA - d / 2;
+  const double length = rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
+  Wire w(d, length, 32, Vec3(0, 0, target.z() - kZc));
+  const RigidRun rigid = rigid_run(w);
+  o.force_scale = w.EI / (kZc * kZc);
+  PotentialRun run;
+  run.solution = contact::solve_wire_wall_potential(w.rod, w.radius, wall, mesh, candidates,
+                                                    rigid.x, o);
+  run.rigid_force = rigid.force;
+  run.EI = w.EI;
+  run.clamp = contact::potential_clamp_reaction(w.rod, run.solution);
+  return run;
+}
+
+[[maybe_unused]] double sum(const std::vector<double>& v) {
+  double s = 0.0;
+  for (const double x : v) s += x;
+  return s;
+}
+
+}  // namespace
+
+// The rigid limit, both walls: the scenes' wall made 10⁶ times stiffer, on the line-of-contact
+// mesh (0.08 mm within 1 mm of the aimed point; on a coarser wall the tip's hemisphere, resting on
+// one node, slides off it and through the gap between nodes). The force must be the rigid-wall
+// solve's of the same discrete wire (which is the shooting reference's F z_c²/EI = 0.470968
+// within DER's error at N = 32, 4.26e-4) up to the tip's sinking between the wall's nodes: a
+// sphere of radius r_w resting on nodes a distance s apart sinks by about s²/(8 r_w) below the
+// cylinder through them, 4.5 µm at s = 0.08 mm, which moves this force by about 0.5 %. The
+// linear and the neo-Hookean walls (two assemblies) give the same force at this strain.
+TEST(WireWallPotentialSlow, RigidLimitApproachesTheRigidWallSolve) {
+  const TetMesh mesh = line_of_contact_mesh();
+  const std::vector<int> nodes = nodes_within(mesh, kAimPoint, 1.6e-3);
+  const fem::ElasticityProblem problem = wall_problem(kWallE * 1e6);
+  const fem::ElasticitySolver linear(mesh, problem);
+  const contact::LinearWall linear_wall(linear.free_displacement_system());
+  const contact::NeoHookeanWall neo_wall(mesh, problem);
+  std::vector<double> forces;
+  for (const contact::WallPotential* wall :
+       {static_cast<const contact::WallPotential*>(&linear_wall),
+        static_cast<const contact::WallPotential*>(&neo_wall)}) {
+    const PotentialRun run = potential_run(mesh, kAimPoint, *wall, nodes);
+    const contact::PotentialContactSolution& s = run.solution;
+    const double F = s.total_force_on_wall().norm();
+    std::printf(
+        "WIRE-WALL-POTENTIAL rigid limit (%s): F %.6e N, F z^2/EI %.6f (rigid-wall solve "
+        "%+.2e), %zu pressed, %d rounds, %d Newton, penetration %.1e m, %.2f s\n",
+        wall == &linear_wall ? "linear" : "neo-Hookean", F, F * kZc * kZc / run.EI,
+        F / run.rigid_force - 1, s.pressed.size(), s.rounds, s.newton_iterations,
+        s.max_penetration, s.seconds);
+    EXPECT_GE(s.pressed.size(), 1u);
+    EXPECT_LT(F / run.rigid_force - 1, 0.0);  // the tip sinks between nodes: less bending
+    EXPECT_GT(F / run.rigid_force - 1, -0.006);
+    // The wire's clamp balances the force on the wall (the contact's share at the wire is
+    // equal and opposite by construction; this checks the wire's own equilibrium).
+    EXPECT_LT((run.clamp - s.total_force_on_wall()).norm(), 1e-6 * F);
+    forces.push_back(F);
+  }
+  EXPECT_NEAR(forces[0], forces[1], 1e-6 * forces[0]);
+}
+
+// A wall 30 times the scenes' (the dent twice r_w, strains beyond 0.4), neo-Hookean: the wire's
+// clamp and the wall's supports (their reactions from the wall's own internal forces at the held
+// DoFs) balance to 1e-9 of the force; the augmented Lagrangian's force equals the penalty law's
+// extrapolated to infinite stiffness (k, 2k, 4k; Richardson in 1/k, first order) within the
+// extrapolation's own error estimate and 1e-5 relative.
+TEST(WireWallPotentialSlow, TwoFormulationsAndActionReactionOnAFiniteStrainWall) {
+  const TetMesh mesh = line_of_contact_mesh();
+  const std::vector<int> nodes = nodes_within(mesh, kAimPoint, 1.6e-3);
+  const contact::NeoHookeanWall wall(mesh, wall_problem(kWallE * 30));
+  const PotentialRun run = potential_run(mesh, kAimPoint, wall, nodes);
+  const contact::PotentialContactSolution& s = run.solution;
+  const double F = s.total_force_on_wall().norm();
+  const Vec3 supports = wall.support_reaction(s.u);
+  const double strain = wall.largest_strain(mesh, s.u);
+  std::printf(
+      "WIRE-WALL-POTENTIAL 30x neo-Hookean: F %.8e N (rigid %+.2e), %zu pressed, strain %.3f, "
+      "clamp + supports |%.2e| N (%.1e of F), %d rounds, %d Newton, %.1f s\n",
+      F, F / run.rigid_force - 1, s.pressed.size(), strain, (run.clamp + supports).norm(),
+      (run.clamp + supports).norm() / F, s.rounds, s.newton_iterations, s.seconds);
+  EXPECT_GT(s.pressed.size(), 10u);
+  EXPECT_GT(strain, 0.1);
+  EXPECT_LT((run.clamp + supports).norm(), 1e-9 * F);
+  std::vector<double> penalty;
+  for (const double factor : {1.0, 2.0, 4.0}) {
+    contact::PotentialContactOptions o;
+    o.augmented_lagrangian = false;
+    o.penalty_stiffness = factor * s.penalty_stiffness;
+    const PotentialRun p = potential_run(mesh, kAimPoint, wall, nodes, o);
+    penalty.push_back(p.solution.total_force_on_wall().norm());
+  }
+  // F(k) = F∞ + c/k: two finest give F∞ = 2 F(4k) − F(2k); the observed order from all three.
+  const double order = std::log((penalty[1] - penalty[0]) / (penalty[2] - penalty[1])) / std::log(2.0);
+  const double extrapolated = 2 * penalty[2] - penalty[1];
+  const double estimate = std::abs(penalty[2] - penalty[1]);
+  std::printf(
+      "WIRE-WALL-POTENTIAL penalty k x1,2,4: %.8e %.8e %.8e N (order in 1/k %.2f), extrapolated "
+      "%.8e, augmented Lagrangian %.8e (%+.1e, estimate %.1e)\n",
+      penalty[0], penalty[1], penalty[2], order, extrapolated, F, extrapolated / F - 1,
+      estimate / F);
+  EXPECT_NEAR(order, 1.0, 0.1);
+  EXPECT_LT(std::abs(extrapolated - F), std::max(estimate, 1e-5 * F));
+}
+
+// A model's own energy as the wall (FormWall): msm's linear P1 tetrahedron (LinearTetTerm, its own
+// assembly) in the potential solve gives deal.II's linear P1 wall's contact (LinearWall) on the
+// same mesh and supports, 100 times the scenes' wall: the same pressed nodes and force to 1e-8.
+TEST(WireWallPotentialSlow, ModelEnergyWallEqualsTheFemWall) {
+  const TetMesh mesh = line_of_contact_mesh();
+  const std::vector<int> nodes = nodes_within(mesh, kAimPoint, 1.6e-3);
+  const fem::ElasticityProblem problem = wall_problem(kWallE * 100);
+  const fem::ElasticitySolver linear(mesh, problem);
+  const contact::LinearWall fem_wall(linear.free_displacement_system());
+  const msm::LinearTetTerm term(mesh.nodes, mesh.tets,
+                                msm::lame_parameters(kWallE * 100, problem.material.poisson_ratio));
+  std::vector<char> held(mesh.nodes.size(), 0);
+  for (const char* group : {"inlet", "outlet"}) {
+    for (const int n : mesh.group_nodes(mesh.require_group(group, 2, "tube"))) held[n] = 1;
+  }
+  std::vector<int> free_index(3 * mesh.nodes.size(), -1);
+  std::vector<std::array<int, 3>> rows(mesh.nodes.size(), {-1, -1, -1});
+  int next = 0;
+  Eigen::VectorXd rest(3 * mesh.nodes.size());
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+    rest.segment<3>(3 * static_cast<Eigen::Index>(n)) = mesh.nodes[n];
+    if (held[n]) continue;
+    for (int c = 0; c < 3; ++c) rows[n][c] = free_index[3 * n + c] = next++;
+  }
+  const contact::FormWall model_wall(term, rest, free_index, rows);
+  const PotentialRun a = potential_run(mesh, kAimPoint, fem_wall, nodes);
+  const PotentialRun b = potential_run(mesh, kAimPoint, model_wall, nodes);
+  const double Fa = a.solution.total_force_on_wall().norm();
+  const double Fb = b.solution.total_force_on_wall().norm();
+  std::printf("WIRE-WALL-POTENTIAL 100x: deal.II P1 %.10e N (%zu pressed), msm P1 %.10e N (%zu "
+              "pressed), %+.1e\n",
+              Fa, a.solution.pressed.size(), Fb, b.solution.pressed.size(), Fb / Fa - 1);
+  EXPECT_EQ(a.solution.pressed, b.solution.pressed);
+  EXPECT_NEAR(Fa, Fb, 1e-8 * Fa);
+}

@@ -1,0 +1,668 @@
+#include "verification/contact/wire_wall_potential.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "meshes/foundation/errors.hpp"
+#include "msm/linalg/linear_solver.hpp"
+#include "verification/contact/condensed_wall.hpp"
+#include "verification/contact/point_segment_distance.hpp"
+
+namespace vessel::contact {
+
+using Eigen::VectorXd;
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+std::vector<Vec3> WallPotential::nodal(const VectorXd& u) const {
+  const auto& rows = node_rows();
+  std::vector<Vec3> out(rows.size(), Vec3::Zero());
+  for (std::size_t n = 0; n < rows.size(); ++n) {
+    for (int c = 0; c < 3; ++c) {
+      if (rows[n][c] >= 0) out[n][c] = u[rows[n][c]];
+    }
+  }
+  return out;
+}
+
+double LinearWall::evaluate(const VectorXd& u, VectorXd* gradient,
+                            Eigen::SparseMatrix<double>* hessian) const {
+  const VectorXd Ku = s_.K * u;
+  if (gradient) *gradient = Ku - s_.f;
+  if (hessian) *hessian = s_.K;
+  return 0.5 * u.dot(Ku) - s_.f.dot(u);
+}
+
+double LinearWall::largest_strain(const TetMesh& mesh, const VectorXd& u) const {
+  return contact::largest_strain(mesh, nodal(u)).small;
+}
+
+NeoHookeanWall::NeoHookeanWall(const TetMesh& mesh, fem::ElasticityProblem problem)
+    : solver_(std::make_unique<fem::HyperelasticSolver>(mesh, std::move(problem))),
+      dofs_(solver_->free_dofs()) {
+  n_ = static_cast<int>(std::count_if(dofs_.free_index.begin(), dofs_.free_index.end(),
+                                      [](int r) { return r >= 0; }));
+}
+
+double NeoHookeanWall::evaluate(const VectorXd& u, VectorXd* gradient,
+                                Eigen::SparseMatrix<double>* hessian) const {
+  fem::FreeHyperelasticState s = solver_->free_state(u, hessian != nullptr);
+  if (gradient) *gradient = std::move(s.gradient);
+  if (hessian) *hessian = std::move(s.tangent);
+  return s.admissible ? s.energy : std::numeric_limits<double>::infinity();
+}
+
+double NeoHookeanWall::largest_strain(const TetMesh& /*mesh*/, const VectorXd& u) const {
+  return solver_->free_state(u, false).max_abs_principal_strain;
+}
+
+Vec3 NeoHookeanWall::support_reaction(const VectorXd& u) const {
+  std::vector<double> w(dofs_.free_index.size(), 0.0);
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    if (dofs_.free_index[i] >= 0) w[i] = u[dofs_.free_index[i]];
+  }
+  const std::vector<double> f = solver_->residual(w, 0.0);
+  const std::vector<unsigned> component = solver_->dof_components();
+  Vec3 r = Vec3::Zero();
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (dofs_.free_index[i] < 0 && component[i] < 3) r[component[i]] += f[i];
+  }
+  return r;
+}
+
+FormWall::FormWall(const msm::Form& form, VectorXd rest, std::vector<int> free_index,
+                   std::vector<std::array<int, 3>> node_rows)
+    : form_(form),
+      rest_(std::move(rest)),
+      free_index_(std::move(free_index)),
+      node_rows_(std::move(node_rows)) {
+  for (const int r : free_index_) n_ = std::max(n_, r + 1);
+  rest_energy_ = form_.energy(rest_);
+}
+
+VectorXd FormWall::positions(const VectorXd& u) const {
+  VectorXd x = rest_;
+  for (std::size_t d = 0; d < free_index_.size(); ++d) {
+    if (free_index_[d] >= 0) x[static_cast<Eigen::Index>(d)] += u[free_index_[d]];
+  }
+  return x;
+}
+
+double FormWall::evaluate(const VectorXd& u, VectorXd* gradient,
+                          Eigen::SparseMatrix<double>* hessian) const {
+  const VectorXd x = positions(u);
+  if (gradient) {
+    VectorXd g;
+    form_.gradient(x, g);
+    gradient->setZero(n_);
+    for (std::size_t d = 0; d < free_index_.size(); ++d) {
+      if (free_index_[d] >= 0) (*gradient)[free_index_[d]] = g[static_cast<Eigen::Index>(d)];
+    }
+  }
+  if (hessian) {
+    Eigen::SparseMatrix<double> H;
+    form_.hessian(x, H, false);
+    Triplets t;
+    t.reserve(static_cast<std::size_t>(H.nonZeros()));
+    for (Eigen::Index c = 0; c < H.outerSize(); ++c) {
+      const int fc = free_index_[static_cast<std::size_t>(c)];
+      if (fc < 0) continue;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(H, c); it; ++it) {
+        const int fr = free_index_[static_cast<std::size_t>(it.row())];
+        if (fr >= 0) t.emplace_back(fr, fc, it.value());
+      }
+    }
+    hessian->resize(n_, n_);
+    hessian->setFromTriplets(t.begin(), t.end());
+  }
+  return form_.energy(x) - rest_energy_;
+}
+
+double FormWall::largest_strain(const TetMesh& mesh, const VectorXd& u) const {
+  TetMesh carried = mesh;
+  carried.tets.clear();
+  for (const Tet& t : mesh.tets) {
+    bool all = true;
+    for (const int n : t) all = all && node_rows_[static_cast<std::size_t>(n)][0] >= 0;
+    if (all) carried.tets.push_back(t);
+  }
+  if (carried.tets.empty()) return std::numeric_limits<double>::quiet_NaN();
+  return contact::largest_strain(carried, nodal(u)).small;
+}
+
+Vec3 PotentialContactSolution::total_force_on_wall() const {
+  Vec3 f = Vec3::Zero();
+  for (std::size_t j = 0; j < force.size(); ++j) f += force[j] * direction[j];
+  return f;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Mat9 = Eigen::Matrix<double, 9, 9>;
+
+/// The rows (in the coupled unknown z = (the rod's free dofs, the wall's rows)) of one contact
+/// pair's nine coordinates (the wall node's, the segment's two ends'); −1 where held.
+using PairRows = std::array<int, 9>;
+
+/// One candidate's contact with the nearest segment of the centreline.
+struct Pair {
+  int candidate = 0;
+  int segment = 0;  ///< its first node
+  PointSegmentDistance d;
+};
+
+/// The pieces of one Newton model (Coupled::evaluate).
+struct Linearisation {
+  Triplets base;
+  std::vector<PairRows> rows;
+  std::vector<Eigen::Matrix<double, 9, 1>> gap_gradient;
+  std::vector<double> c;
+};
+
+/// The coupled problem Π(z) and the bookkeeping between z, the rod's dofs and the wall's rows.
+class Coupled {
+ public:
+  Coupled(msm::rods::Rod& rod, double radius, const WallPotential& wall, const TetMesh& mesh,
+          const std::vector<int>& candidates, const VectorXd& start, double k)
+      : rod_(rod), r_(radius), wall_(wall), k_(k), x0_(start) {
+    fixed_ = rod.clamp_fixed();
+    rod_row_.assign(fixed_.size(), -1);
+    for (std::size_t i = 0; i < fixed_.size(); ++i) {
+      if (!fixed_[i]) rod_row_[i] = n_rod_++;
+    }
+    first_ = rod.layout().first_node;
+    last_ = rod.layout().tip_node;
+    for (const int c : candidates) {
+      if (c < 0 || c >= static_cast<int>(mesh.nodes.size())) {
+        throw InputError("the contact candidate " + std::to_string(c) + " is not a mesh node");
+      }
+      rest_.push_back(mesh.nodes[static_cast<std::size_t>(c)]);
+      rows_.push_back(wall.node_rows()[static_cast<std::size_t>(c)]);
+    }
+    nodes_ = candidates;
+    multiplier_.assign(candidates.size(), 0.0);
+  }
+
+  [[nodiscard]] int size() const { return n_rod_ + wall_.num_dofs(); }
+  [[nodiscard]] double radius() const { return r_; }
+  [[nodiscard]] double stiffness() const { return k_; }
+
+  [[nodiscard]] VectorXd rod_dofs(const VectorXd& z) const {
+    VectorXd x = x0_;
+    for (std::size_t i = 0; i < rod_row_.size(); ++i) {
+      if (rod_row_[i] >= 0) x[static_cast<Eigen::Index>(i)] = z[rod_row_[i]];
+    }
+    return x;
+  }
+  [[nodiscard]] VectorXd wall_rows(const VectorXd& z) const {
+    return z.tail(wall_.num_dofs());
+  }
+  [[nodiscard]] VectorXd pack(const VectorXd& x, const VectorXd& u) const {
+    VectorXd z(size());
+    for (std::size_t i = 0; i < rod_row_.size(); ++i) {
+      if (rod_row_[i] >= 0) z[rod_row_[i]] = x[static_cast<Eigen::Index>(i)];
+    }
+    z.tail(wall_.num_dofs()) = u;
+    return z;
+  }
+
+  /// Candidate j's position at wall displacement u.
+  [[nodiscard]] Eigen::Vector3d position(int j, const VectorXd& u) const {
+    Eigen::Vector3d p = rest_[static_cast<std::size_t>(j)];
+    for (int c = 0; c < 3; ++c) {
+      const int row = rows_[static_cast<std::size_t>(j)][c];
+      if (row >= 0) p[c] += u[row];
+    }
+    return p;
+  }
+
+  /// Every candidate's nearest segment and distance (with derivatives where it is in contact).
+  /// Every candidate within `band` of pressing (λ̂ − k(g − band) > 0) with its nearest segment
+  /// and distance (and the distance's Hessian when asked).
+  [[nodiscard]] std::vector<Pair> pairs(const VectorXd& x, const VectorXd& u, bool with_hessian,
+                                        double band = 0.0) const {
+    // A cheap cull: the wire's bounding box grown by the radius and the multipliers' reach.
+    Eigen::Vector3d lo = x.segment<3>(3 * first_), hi = lo;
+    for (int i = first_; i <= last_; ++i) {
+      lo = lo.cwiseMin(x.segment<3>(3 * i));
+      hi = hi.cwiseMax(x.segment<3>(3 * i));
+    }
+    const double reach =
+        r_ + band + (*std::max_element(multiplier_.begin(), multiplier_.end())) / k_;
+    std::vector<Pair> out;
+    for (int j = 0; j < static_cast<int>(rest_.size()); ++j) {
+      const Eigen::Vector3d p = position(j, u);
+      if ((p.array() < lo.array() - reach).any() || (p.array() > hi.array() + reach).any()) continue;
+      double best = std::numeric_limits<double>::infinity();
+      int seg = first_;
+      for (int i = first_; i < last_; ++i) {
+        const Eigen::Vector3d a = x.segment<3>(3 * i), e = x.segment<3>(3 * (i + 1)) - a;
+        const double t = std::clamp((p - a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+        const double d2 = (p - a - t * e).squaredNorm();
+        if (d2 < best) {
+          best = d2;
+          seg = i;
+        }
+      }
+      const double g = std::sqrt(best) - r_;
+      if (force_at(j, g - band) <= 0.0) continue;
+      out.push_back({j, seg,
+                     point_segment_distance(p, x.segment<3>(3 * seg), x.segment<3>(3 * seg + 3),
+                                            with_hessian)});
+    }
+    return out;
+  }
+
+  /// λ = max(0, λ̂ − k g).
+  [[nodiscard]] double force_at(int j, double gap) const {
+    return std::max(0.0, multiplier_[static_cast<std::size_t>(j)] - k_ * gap);
+  }
+  /// ψ(g) + λ̂²/(2k) = λ²/(2k): shifted by a constant so that it vanishes where the candidate
+  /// is open (ψ' = −λ unchanged) and Π stays continuous as candidates open and close.
+  [[nodiscard]] double contact_energy(int j, double gap) const {
+    const double l = force_at(j, gap);
+    return l * l / (2.0 * k_);
+  }
+
+  [[nodiscard]] PairRows pair_rows(const Pair& p) const {
+    PairRows rows{};
+    for (int c = 0; c < 3; ++c) {
+      const int wr = rows_[static_cast<std::size_t>(p.candidate)][c];
+      rows[c] = wr >= 0 ? n_rod_ + wr : -1;
+      rows[3 + c] = rod_row_[static_cast<std::size_t>(3 * p.segment + c)];
+      rows[6 + c] = rod_row_[static_cast<std::size_t>(3 * (p.segment + 1) + c)];
+    }
+    return rows;
+  }
+
+  /// Π at z (+∞ where the wall is inadmissible).
+  [[nodiscard]] double potential(const VectorXd& z) const {
+    const VectorXd x = rod_dofs(z), u = wall_rows(z);
+    const double w = wall_.evaluate(u, nullptr, nullptr);
+    if (!std::isfinite(w)) return w;
+    double pi = rod_.energy(x) + w;
+    for (const Pair& p : pairs(x, u, false)) pi += contact_energy(p.candidate, p.d.distance - r_);
+    return pi;
+  }
+
+  /// ∇Π at z and, with `lin`, the Newton model's pieces: the rod's and the wall's Hessians and
+  /// each pressed pair's curvature −λ∇²d (with `project`, the rod's element blocks and those
+  /// 9 × 9 blocks projected onto the PSD cone), and every pair within `band` of pressing with its
+  /// gap's gradient and c = λ̂/k − g (pressed while c − ∇g·dz > 0 in the model).
+  double evaluate(const VectorXd& z, VectorXd& gradient, Linearisation* lin, bool project,
+                  double band = 0.0) const {
+    const VectorXd x = rod_dofs(z), u = wall_rows(z);
+    VectorXd gw;
+    Eigen::SparseMatrix<double> hw;
+    const double w = wall_.evaluate(u, &gw, lin ? &hw : nullptr);
+    VectorXd gr;
+    rod_.gradient(x, gr);
+    gradient.setZero(size());
+    for (std::size_t i = 0; i < rod_row_.size(); ++i) {
+      if (rod_row_[i] >= 0) gradient[rod_row_[i]] = gr[static_cast<Eigen::Index>(i)];
+    }
+    gradient.tail(wall_.num_dofs()) = gw;
+    if (lin) {
+      *lin = {};
+      Triplets& t = lin->base;
+      Eigen::SparseMatrix<double> hr;
+      rod_.hessian(x, hr, project);
+      t.reserve(static_cast<std::size_t>(hr.nonZeros() + hw.nonZeros()));
+      for (int c = 0; c < hr.outerSize(); ++c) {
+        for (Eigen::SparseMatrix<double>::InnerIterator it(hr, c); it; ++it) {
+          const int a = rod_row_[static_cast<std::size_t>(it.row())];
+          const int b = rod_row_[static_cast<std::size_t>(it.col())];
+          if (a >= 0 && b >= 0) t.emplace_back(a, b, it.value());
+        }
+      }
+      for (int c = 0; c < hw.outerSize(); ++c) {
+        for (Eigen::SparseMatrix<double>::InnerIterator it(hw, c); it; ++it) {
+          t.emplace_back(n_rod_ + it.row(), n_rod_ + it.col(), it.value());
+        }
+      }
+    }
+    double pi = rod_.energy(x) + w;
+    for (const Pair& p : pairs(x, u, lin != nullptr, lin ? band : 0.0)) {
+      const double g = p.d.distance - r_;
+      const double lambda = force_at(p.candidate, g);
+      const PairRows rows = pair_rows(p);
+      if (lin) {
+        lin->rows.push_back(rows);
+        lin->gap_gradient.push_back(p.d.gradient);
+        lin->c.push_back(multiplier_[static_cast<std::size_t>(p.candidate)] / k_ - g);
+      }
+      if (lambda <= 0.0) continue;
+      pi += contact_energy(p.candidate, g);
+      // ψ'(g) = −λ, ψ''(g) = k while λ > 0 (k∇d∇dᵀ is the model's, added per pair by the step).
+      for (int a = 0; a < 9; ++a) {
+        if (rows[a] >= 0) gradient[rows[a]] -= lambda * p.d.gradient[a];
+      }
+      if (!lin) continue;
+      Mat9 h = -lambda * p.d.hessian;
+      if (project) h = projected(h);
+      add_block(lin->base, rows, h);
+    }
+    return pi;
+  }
+
+  static void add_block(Triplets& t, const PairRows& rows, const Mat9& h) {
+    for (int a = 0; a < 9; ++a) {
+      for (int b = 0; b < 9; ++b) {
+        if (rows[a] >= 0 && rows[b] >= 0) t.emplace_back(rows[a], rows[b], h(a, b));
+      }
+    }
+  }
+
+  /// The contact forces at z: pressed candidates, λ and unit directions.
+  void forces(const VectorXd& z, PotentialContactSolution& out) const {
+    const VectorXd x = rod_dofs(z), u = wall_rows(z);
+    out.pressed.clear();
+    out.force.clear();
+    out.direction.clear();
+    out.segment.clear();
+    out.parameter.clear();
+    out.max_penetration = 0.0;
+    for (const Pair& p : pairs(x, u, false)) {
+      const double g = p.d.distance - r_;
+      out.max_penetration = std::max(out.max_penetration, -g);
+      out.pressed.push_back(nodes_[static_cast<std::size_t>(p.candidate)]);
+      out.force.push_back(force_at(p.candidate, g));
+      out.direction.push_back(p.d.gradient.head<3>());
+      out.segment.push_back(p.segment);
+      out.parameter.push_back(p.d.t);
+    }
+  }
+
+  /// λ̂ ← λ at z (the augmented Lagrangian's first-order update); returns max |λ − λ̂|/k over
+  /// the candidates (m): |g| where pressed, λ̂/k where a candidate opened.
+  double update_multipliers(const VectorXd& z) {
+    const VectorXd x = rod_dofs(z), u = wall_rows(z);
+    std::vector<double> next(multiplier_.size(), 0.0);
+    for (const Pair& p : pairs(x, u, false)) {
+      next[static_cast<std::size_t>(p.candidate)] = force_at(p.candidate, p.d.distance - r_);
+    }
+    double change = 0.0;
+    for (std::size_t j = 0; j < next.size(); ++j) {
+      change = std::max(change, std::abs(next[j] - multiplier_[j]) / k_);
+    }
+    multiplier_ = std::move(next);
+    return change;
+  }
+
+  /// Largest move of a centreline node or a candidate under the step dz.
+  [[nodiscard]] double largest_move(const VectorXd& dz) const {
+    double m = 0.0;
+    for (int i = first_; i <= last_; ++i) {
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      for (int c = 0; c < 3; ++c) {
+        const int row = rod_row_[static_cast<std::size_t>(3 * i + c)];
+        if (row >= 0) v[c] = dz[row];
+      }
+      m = std::max(m, v.norm());
+    }
+    for (const auto& rows : rows_) {
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      for (int c = 0; c < 3; ++c) {
+        if (rows[c] >= 0) v[c] = dz[n_rod_ + rows[c]];
+      }
+      m = std::max(m, v.norm());
+    }
+    return m;
+  }
+
+  void prepare(const VectorXd& z) { rod_.prepare(rod_dofs(z)); }
+
+ private:
+  static Mat9 projected(const Mat9& h) {
+    const Eigen::SelfAdjointEigenSolver<Mat9> es(h);
+    const Eigen::Matrix<double, 9, 1> ev = es.eigenvalues().cwiseMax(0.0);
+    return es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+  }
+
+  msm::rods::Rod& rod_;
+  double r_;
+  const WallPotential& wall_;
+  double k_;
+  VectorXd x0_;
+  std::vector<char> fixed_;
+  std::vector<int> rod_row_;
+  int n_rod_ = 0;
+  int first_ = 0, last_ = 0;
+  std::vector<int> nodes_;
+  std::vector<Eigen::Vector3d> rest_;
+  std::vector<std::array<int, 3>> rows_;
+  std::vector<double> multiplier_;
+};
+
+/// k from the wall's stiffness at rest: penalty_factor × its largest diagonal entry on the
+/// candidates' rows.
+double default_penalty(const WallPotential& wall, const std::vector<int>& candidates, double factor) {
+  Eigen::SparseMatrix<double> h;
+  VectorXd g;
+  (void)wall.evaluate(VectorXd::Zero(wall.num_dofs()), &g, &h);
+  const VectorXd diag = h.diagonal();
+  double largest = 0.0;
+  for (const int c : candidates) {
+    for (const int row : wall.node_rows()[static_cast<std::size_t>(c)]) {
+      if (row >= 0) largest = std::max(largest, diag[row]);
+    }
+  }
+  return factor * largest;
+}
+
+/// The Newton step: the minimiser of the model ½dzᵀH dz + ∇Πᵀdz in which every pair near
+/// contact keeps its piecewise penalty of the linearised gap, k/2 max(0, c − ∇g·dz)², found by
+/// an active-set iteration (each pass one factorisation): a wire about to touch is stopped by the
+/// wall within the step instead of passing it in the model. false if H cannot be factorised.
+bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gradient,
+                 VectorXd& dz) {
+  const double k = p.stiffness();
+  const std::size_t m = lin.c.size();
+  // ∇Π without the pressed pairs' −λ∇g: the model adds each pair's own term.
+  VectorXd g0 = gradient;
+  for (std::size_t j = 0; j < m; ++j) {
+    if (lin.c[j] <= 0.0) continue;
+    for (int a = 0; a < 9; ++a) {
+      if (lin.rows[j][a] >= 0) g0[lin.rows[j][a]] += k * lin.c[j] * lin.gap_gradient[j][a];
+    }
+  }
+  std::vector<char> active(m), next(m);
+  for (std::size_t j = 0; j < m; ++j) active[j] = lin.c[j] > 0.0;
+  Eigen::SparseMatrix<double> base(p.size(), p.size());
+  base.setFromTriplets(lin.base.begin(), lin.base.end());
+  // Every near pair's block is in the pattern (zero while the pair is open in the model), so all
+  // passes share one symbolic analysis.
+  msm::CholmodSolver solver;
+  for (int pass = 0; pass < 20; ++pass) {
+    Triplets t;
+    t.reserve(81 * m);
+    VectorXd rhs = -g0;
+    for (std::size_t j = 0; j < m; ++j) {
+      const auto& a = lin.gap_gradient[j];
+      Coupled::add_block(t, lin.rows[j], (active[j] ? k : 0.0) * a * a.transpose());
+      if (!active[j]) continue;
+      for (int i = 0; i < 9; ++i) {
+        if (lin.rows[j][i] >= 0) rhs[lin.rows[j][i]] += k * lin.c[j] * a[i];
+      }
+    }
+    Eigen::SparseMatrix<double> near(p.size(), p.size());
+    near.setFromTriplets(t.begin(), t.end());
+    const Eigen::SparseMatrix<double> H = base + near;
+    try {
+      solver.factorize(H);
+    } catch (const std::runtime_error&) {
+      return false;
+    }
+    dz = solver.solve(rhs);
+    for (std::size_t j = 0; j < m; ++j) {
+      double slope = 0.0;
+      for (int i = 0; i < 9; ++i) {
+        if (lin.rows[j][i] >= 0) slope += lin.gap_gradient[j][i] * dz[lin.rows[j][i]];
+      }
+      next[j] = lin.c[j] - slope > 0.0;
+    }
+    if (next == active) break;
+    active = next;
+  }
+  return true;
+}
+
+struct NewtonOutcome {
+  bool converged = false;
+  int iterations = 0;
+  double residual = 0.0;
+  std::string reason;
+};
+
+/// Newton's method on Π from z (left at the last accepted iterate).
+NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o) {
+  NewtonOutcome out;
+  VectorXd g, dz, trial;
+  Linearisation lin;
+  const double target = o.tolerance * o.force_scale;
+  const double band = o.max_move * p.radius();
+  for (int it = 0; it <= o.max_newton; ++it) {
+    const double pi = p.evaluate(z, g, &lin, false, band);
+    out.residual = g.norm();
+    out.iterations = it;
+    if (out.residual <= target) {
+      out.converged = true;
+      return out;
+    }
+    if (it == o.max_newton) break;
+    bool descent = newton_step(p, lin, g, dz) && g.dot(dz) < 0.0;
+    if (!descent) {
+      (void)p.evaluate(z, g, &lin, true, band);
+      descent = newton_step(p, lin, g, dz) && g.dot(dz) < 0.0;
+    }
+    if (!descent) dz = -g * (p.radius() / std::max(g.norm(), 1e-300));  // steepest descent
+    const double move = p.largest_move(dz);
+    double alpha = std::min(1.0, o.max_move * p.radius() / std::max(move, 1e-300));
+    const double slope = g.dot(dz);
+    // Armijo's condition on Π first. Near the solution the decrease a step makes can fall below
+    // the energy's round-off (a neo-Hookean Ψ at small strain is a difference of O(ε) terms, its
+    // value O(ε²)); if no step passes, a step is accepted when it lowers ‖∇Π‖ instead.
+    const double alpha0 = alpha;
+    bool accepted = false;
+    VectorXd g_trial;
+    for (int ls = 0; ls < 12 && !accepted; ++ls, alpha *= 0.5) {
+      trial = z + alpha * dz;
+      const double next = p.potential(trial);
+      accepted = std::isfinite(next) && next <= pi + 1e-4 * alpha * slope;
+    }
+    if (!accepted) {
+      alpha = alpha0;
+      for (int ls = 0; ls < 30 && !accepted; ++ls, alpha *= 0.5) {
+        trial = z + alpha * dz;
+        accepted = std::isfinite(p.evaluate(trial, g_trial, nullptr, false)) &&
+                   g_trial.norm() < (1.0 - 1e-4 * alpha) * out.residual;
+      }
+    }
+    alpha *= 2.0;  // the loops halve once past the accepted step
+    if (!accepted) {
+      out.converged = out.residual <= 1e3 * target;  // at the round-off floor of ‖∇Π‖
+      if (!out.converged) out.reason = "the line search found no decrease of the potential";
+      return out;
+    }
+    z = trial;
+    p.prepare(z);
+    // A stiff wall's forces (K u with K up to ~1e6 N/m) floor ‖∇Π‖ above the target by round-off:
+    // a step that moves nothing by 1e-12 r_w ends the iteration there.
+    if (alpha * move <= 1e-12 * p.radius() && out.residual <= 1e3 * target) {
+      out.converged = true;
+      return out;
+    }
+  }
+  out.reason = "Newton did not converge in " + std::to_string(o.max_newton) + " steps";
+  return out;
+}
+
+}  // namespace
+
+PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double radius,
+                                                   const WallPotential& wall, const TetMesh& mesh,
+                                                   const std::vector<int>& candidates,
+                                                   const VectorXd& start,
+                                                   const PotentialContactOptions& options) {
+  const auto t0 = Clock::now();
+  if (rod.constraints() != nullptr) {
+    throw InputError(
+        "the wire-wall potential takes a rod without equality constraints (DER), not CORDE");
+  }
+  if (!(radius > 0.0)) throw InputError("the wire's radius must be positive");
+  if (start.size() != rod.num_dofs()) throw InputError("the wire's start has the wrong size");
+  const double k = options.penalty_stiffness > 0.0
+                       ? options.penalty_stiffness
+                       : default_penalty(wall, candidates, options.penalty_factor);
+  Coupled problem(rod, radius, wall, mesh, candidates, start, k);
+  rod.prepare(start);
+  VectorXd z = problem.pack(start, VectorXd::Zero(wall.num_dofs()));
+  PotentialContactSolution out;
+  out.penalty_stiffness = k;
+  const int rounds = options.augmented_lagrangian ? options.max_rounds : 1;
+  for (int round = 1; round <= rounds; ++round) {
+    const NewtonOutcome n = minimise(problem, z, options);
+    out.newton_iterations += n.iterations;
+    out.rounds = round;
+    out.residual = n.residual;
+    problem.forces(z, out);
+    if (options.log) {
+      *options.log << "potential contact: round " << round << ", " << n.iterations
+                   << " Newton steps, residual " << n.residual << " N, " << out.pressed.size()
+                   << " pressed, force " << out.total_force_on_wall().norm() * 1e3
+                   << " mN, penetration " << out.max_penetration << " m" << std::endl;
+    }
+    if (!n.converged) {
+      std::ostringstream m;
+      m << "the wire-wall potential did not converge in round " << round << ": " << n.reason
+        << " (residual " << n.residual << " N, " << out.pressed.size() << " pressed, penetration "
+        << out.max_penetration << " m)";
+      throw std::runtime_error(m.str());
+    }
+    if (out.pressed.empty()) {
+      throw std::runtime_error(
+          "no wall node bears on the wire: it passed between the wall's nodes (refine the wall "
+          "where the wire bears)");
+    }
+    if (!options.augmented_lagrangian) break;
+    const double change = problem.update_multipliers(z);
+    if (change <= options.gap_tolerance) break;
+    if (round == rounds) {
+      std::ostringstream m;
+      m << "the wire-wall potential's multipliers did not converge in " << rounds
+        << " rounds (their last change " << change << " m over k, penetration "
+        << out.max_penetration << " m)";
+      throw std::runtime_error(m.str());
+    }
+  }
+  out.x = problem.rod_dofs(z);
+  out.u = problem.wall_rows(z);
+  out.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return out;
+}
+
+Vec3 potential_clamp_reaction(const msm::rods::Rod& rod, const PotentialContactSolution& s) {
+  VectorXd g;
+  rod.gradient(s.x, g);
+  // The contact's share of ∇Π on the wire: −λ ∂d/∂(a, b) = λ (1 − t) n at a, λ t n at b.
+  for (std::size_t j = 0; j < s.pressed.size(); ++j) {
+    const int a = s.segment[j];
+    g.segment<3>(3 * a) += s.force[j] * (1.0 - s.parameter[j]) * s.direction[j];
+    g.segment<3>(3 * a + 3) += s.force[j] * s.parameter[j] * s.direction[j];
+  }
+  const std::vector<char> fixed = rod.clamp_fixed();
+  Vec3 r = Vec3::Zero();
+  for (int n = 0; n < rod.num_nodes(); ++n) {
+    for (int c = 0; c < 3; ++c) {
+      if (fixed[static_cast<std::size_t>(3 * n + c)]) r[c] += g[3 * n + c];
+    }
+  }
+  return r;
+}
+
+}  // namespace vessel::contact

@@ -1,0 +1,176 @@
+#pragma once
+/// The wire and the wall as one potential: a rod (DER) and a wall (linear, or the finite-strain
+/// neo-Hookean FEM wall) pressed together, frictionless, the contact found by minimising
+///   Π(x, u) = E_rod(x) + W_wall(u) + Σ_j ψ(g_j),  g_j = d(P_j, centreline(x)) − r_w,
+/// over the wire's free dofs x and the wall's free displacements u. P_j = X_j + u_j is wall node
+/// j's position, d its distance to the nearest segment of the wire's centreline (a hemisphere
+/// at the ends: the wire's surface is a capsule of radius r_w). The contact law is the augmented
+/// Lagrangian of Signorini's conditions (g ≥ 0, λ ≥ 0, λg = 0):
+///   ψ(g) = (max(0, λ̂ − k g)² − λ̂²)/(2k),  λ = −ψ'(g) = max(0, λ̂ − k g),
+/// Newton's method on Π for fixed multiplier estimates λ̂ (the exact Hessian of the gap,
+/// point_segment_distance.hpp), then λ̂ ← λ, until no node penetrates by more than the gap
+/// tolerance (Nocedal & Wright, Numerical Optimization, 2nd ed., Framework 17.3; with λ̂ = 0 the
+/// penalty law λ = k max(0, −g)). The forces act along the capsule's normal at every iterate,
+/// exactly frictionless, equal and opposite by construction (d is invariant under translation).
+///
+/// The wall re-linearises at every Newton step, so dents of many wire radii, strains of order
+/// one and a zone that slides are one solve; each step is cut so no centreline or wall node moves
+/// by more than max_move · r_w (a longer step can carry a node across the wire), and accepted by
+/// Armijo's condition on Π (an inverted wall element makes Π infinite).
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <array>
+#include <memory>
+#include <ostream>
+#include <vector>
+
+#include "fem_reference/elasticity.hpp"
+#include "fem_reference/hyperelastic.hpp"
+#include "meshes/tet_mesh.hpp"
+#include "msm/form/form.hpp"
+#include "msm/rods/rod.hpp"
+
+namespace vessel::contact {
+
+/// A wall as the energy of its free displacement rows (m).
+class WallPotential {
+ public:
+  virtual ~WallPotential() = default;
+  [[nodiscard]] virtual int num_dofs() const = 0;
+  /// Per mesh node, the rows of its x, y, z displacement (−1 where held).
+  [[nodiscard]] virtual const std::vector<std::array<int, 3>>& node_rows() const = 0;
+  /// The energy at u (J; +∞ where an element is inverted), its gradient (N) and Hessian (N/m)
+  /// when asked.
+  virtual double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
+                          Eigen::SparseMatrix<double>* hessian) const = 0;
+  /// The largest principal strain at u: small strain for a linear wall, Green–Lagrange for a
+  /// finite-strain one.
+  [[nodiscard]] virtual double largest_strain(const TetMesh& mesh,
+                                              const Eigen::VectorXd& u) const = 0;
+  /// Per mesh node its displacement (m) at u.
+  [[nodiscard]] std::vector<Vec3> nodal(const Eigen::VectorXd& u) const;
+};
+
+/// The linear wall: ½uᵀKu − fᵀu of the FEM's free displacement system.
+class LinearWall final : public WallPotential {
+ public:
+  explicit LinearWall(fem::FreeDisplacementSystem system) : s_(std::move(system)) {}
+  [[nodiscard]] int num_dofs() const override { return static_cast<int>(s_.f.size()); }
+  [[nodiscard]] const std::vector<std::array<int, 3>>& node_rows() const override {
+    return s_.node_rows;
+  }
+  double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
+                  Eigen::SparseMatrix<double>* hessian) const override;
+  [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
+
+ private:
+  fem::FreeDisplacementSystem s_;
+};
+
+/// The finite-strain wall: the FEM reference's compressible neo-Hookean strain energy
+/// (fem::HyperelasticSolver::free_state, displacement formulation, P1 or P2).
+class NeoHookeanWall final : public WallPotential {
+ public:
+  NeoHookeanWall(const TetMesh& mesh, fem::ElasticityProblem problem);
+  [[nodiscard]] int num_dofs() const override { return n_; }
+  [[nodiscard]] const std::vector<std::array<int, 3>>& node_rows() const override {
+    return dofs_.node_rows;
+  }
+  double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
+                  Eigen::SparseMatrix<double>* hessian) const override;
+  [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
+  /// The supports' total reaction at u (N): the internal forces on the held DoFs, summed per
+  /// component.
+  [[nodiscard]] Vec3 support_reaction(const Eigen::VectorXd& u) const;
+  [[nodiscard]] const fem::FreeDisplacementSystem& dofs() const { return dofs_; }
+
+ private:
+  std::unique_ptr<fem::HyperelasticSolver> solver_;
+  fem::FreeDisplacementSystem dofs_;
+  int n_ = 0;
+};
+
+/// A msm model's own energy as the wall: E(X + u) − E(X) over its free dofs with its exact
+/// gradient and Hessian, so the contact solve finds the model's own (nonlinear) equilibrium.
+/// `free_index` and `node_rows` as form_wall_system (contact_models/model_walls.hpp) gives them.
+/// The form must outlive the wall.
+class FormWall final : public WallPotential {
+ public:
+  FormWall(const msm::Form& form, Eigen::VectorXd rest, std::vector<int> free_index,
+           std::vector<std::array<int, 3>> node_rows);
+  [[nodiscard]] int num_dofs() const override { return n_; }
+  [[nodiscard]] const std::vector<std::array<int, 3>>& node_rows() const override {
+    return node_rows_;
+  }
+  double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
+                  Eigen::SparseMatrix<double>* hessian) const override;
+  /// The P1 small strain of the tets whose four nodes the model carries (NaN if none).
+  [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
+
+ private:
+  [[nodiscard]] Eigen::VectorXd positions(const Eigen::VectorXd& u) const;
+  const msm::Form& form_;
+  Eigen::VectorXd rest_;
+  std::vector<int> free_index_;
+  std::vector<std::array<int, 3>> node_rows_;
+  int n_ = 0;
+  double rest_energy_ = 0.0;
+};
+
+struct PotentialContactOptions {
+  /// k (N/m). 0: penalty_factor × the wall's largest diagonal stiffness at rest on the
+  /// candidates' rows.
+  double penalty_stiffness = 0.0;
+  double penalty_factor = 100.0;
+  /// true: augmented-Lagrangian rounds to Signorini's conditions; false: the penalty law at k.
+  bool augmented_lagrangian = true;
+  /// m: the augmented Lagrangian stops when no force changes by more than k × this in a round
+  /// (then no pressed node is open or penetrating by more than this)
+  double gap_tolerance = 1e-9;
+  double tolerance = 1e-9;      ///< on ‖∇Π‖ over the free dofs, relative to force_scale
+  double force_scale = 1e-3;    ///< N
+  double max_move = 0.5;        ///< × r_w: the largest node move of one Newton step
+  int max_newton = 300;         ///< Newton steps per round
+  int max_rounds = 40;          ///< augmented-Lagrangian rounds
+  std::ostream* log = nullptr;  ///< one line per round, if set
+};
+
+struct PotentialContactSolution {
+  Eigen::VectorXd x;  ///< the wire's dofs
+  Eigen::VectorXd u;  ///< the wall's free displacement rows, m
+  /// The pressed wall nodes (mesh indices), their forces λ (N) and the unit directions the wire
+  /// pushes them (from the nearest centreline point to the node).
+  std::vector<int> pressed;
+  std::vector<double> force;
+  std::vector<Vec3> direction;
+  /// Per pressed node, the nearest centreline segment's first node and the nearest point's
+  /// parameter on it (where the wall's force on the wire acts).
+  std::vector<int> segment;
+  std::vector<double> parameter;
+  double max_penetration = 0.0;  ///< m, over every candidate
+  double penalty_stiffness = 0.0;  ///< the k used, N/m
+  int newton_iterations = 0;       ///< over all rounds
+  int rounds = 0;                  ///< augmented-Lagrangian rounds (1 for the penalty law)
+  double residual = 0.0;           ///< ‖∇Π‖ on the free dofs at the end, N
+  double seconds = 0.0;
+  /// Σ λ_j n_j: the wire's total force on the wall, N.
+  [[nodiscard]] Vec3 total_force_on_wall() const;
+};
+
+/// Minimises Π from the wire at `start` (e.g. its rigid-lumen state) and the wall at rest. The
+/// contact candidates are `candidates` (mesh nodes; e.g. the whole inner wall): each one's gap
+/// to the capsule enters Π. `rod`: without equality constraints (DER); its clamps are held; it
+/// is left prepared at the solution. Throws std::runtime_error naming the round, the residual
+/// and the penetration without convergence; InputError for a rod with constraints, r_w ≤ 0, a
+/// start of the wrong size or a candidate not in the mesh.
+PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double radius,
+                                                   const WallPotential& wall, const TetMesh& mesh,
+                                                   const std::vector<int>& candidates,
+                                                   const Eigen::VectorXd& start,
+                                                   const PotentialContactOptions& options = {});
+
+/// The force the clamp exerts on the wire at a solution (N): the rod's internal force and its
+/// contact share summed over the held nodes' positions.
+Vec3 potential_clamp_reaction(const msm::rods::Rod& rod, const PotentialContactSolution& solution);
+
+}  // namespace vessel::contact
