@@ -249,6 +249,10 @@ class Coupled {
           seg = i;
         }
       }
+      if (!(best > 0.0)) {
+        throw std::runtime_error(
+            "a wall node lies on the wire's centreline: the wire passed through the wall");
+      }
       const double g = std::sqrt(best) - r_;
       if (force_at(j, g - band) <= 0.0) continue;
       out.push_back({j, seg,
