@@ -6,9 +6,10 @@
 /// j's position, d its distance to the nearest segment of the wire's centreline (a hemisphere
 /// at the ends: the wire's surface is a capsule of radius r_w). The contact law is the augmented
 /// Lagrangian of Signorini's conditions (g ≥ 0, λ ≥ 0, λg = 0):
-///   ψ(g) = (max(0, λ̂ − k g)² − λ̂²)/(2k),  λ = −ψ'(g) = max(0, λ̂ − k g),
+///   ψ(g) = max(0, λ̂ − k g)²/(2k),  λ = −ψ'(g) = max(0, λ̂ − k g)
+/// (the augmented Lagrangian's term shifted by λ̂²/(2k) so it vanishes where a node is open);
 /// Newton's method on Π for fixed multiplier estimates λ̂ (the exact Hessian of the gap,
-/// point_segment_distance.hpp), then λ̂ ← λ, until no node penetrates by more than the gap
+/// point_segment_distance.hpp), then λ̂ ← λ, until no force changes by more than k × the gap
 /// tolerance (Nocedal & Wright, Numerical Optimization, 2nd ed., Framework 17.3; with λ̂ = 0 the
 /// penalty law λ = k max(0, −g)). The forces act along the capsule's normal at every iterate,
 /// exactly frictionless, equal and opposite by construction (d is invariant under translation).
