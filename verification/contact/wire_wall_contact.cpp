@@ -484,6 +484,15 @@ GrownContact solve_wire_wall_contact_growing(
   return out;
 }
 
+void GrownContact::pressed(std::vector<int>& mesh_nodes, std::vector<double>& forces) const {
+  mesh_nodes.clear();
+  forces.clear();
+  for (const int j : solution.active) {
+    mesh_nodes.push_back(nodes[static_cast<std::size_t>(j)]);
+    forces.push_back(solution.force[j]);
+  }
+}
+
 double capsule_gap(const ContactWire& wire, const Eigen::VectorXd& x, const Vec3& point) {
   const Nearest c = nearest_on_centreline(x, wire.first_node, wire.last_node, point);
   return (point - c.c).norm() - wire.radius;

@@ -121,6 +121,8 @@ struct GrownContact {
   std::vector<int> nodes;     ///< the final candidates' mesh nodes
   std::unique_ptr<CondensedWall> wall;  ///< condensed on every component of `nodes`
   int rounds = 0;                       ///< growths
+  /// The pressed candidates as mesh nodes, with their forces λ (N), in the active set's order.
+  void pressed(std::vector<int>& mesh_nodes, std::vector<double>& forces) const;
 };
 
 /// solve_wire_wall_contact on candidates `nodes` (the wall condensed on every component,

@@ -138,10 +138,7 @@ ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidCo
   const std::vector<Vec3> u = grown.wall->displacement(s.wall_loads());
   std::vector<int> pressed;
   std::vector<double> force;
-  for (const int j : s.active) {
-    pressed.push_back(grown.nodes[static_cast<std::size_t>(j)]);
-    force.push_back(s.force[j]);
-  }
+  grown.pressed(pressed, force);
   describe_zone(*p.mesh, p.lumen_radius, pressed, force, u, out);
   std::vector<Vec3> loads(p.mesh->nodes.size(), Vec3::Zero());
   for (std::size_t j = 0; j < grown.nodes.size(); ++j) {

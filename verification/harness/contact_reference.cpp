@@ -108,10 +108,7 @@ void solve_linear_wall(const Scene& scene, const ReferenceWire& wire, double nu,
   const std::vector<Vec3> u = grown.wall->displacement(s.wall_loads());
   std::vector<int> pressed;
   std::vector<double> force;
-  for (const int j : s.active) {
-    pressed.push_back(grown.nodes[static_cast<std::size_t>(j)]);
-    force.push_back(s.force[j]);
-  }
+  grown.pressed(pressed, force);
   describe_zone(mesh, pressed, force, u, centre, radius, out);
   out.strain = contact::largest_strain(mesh, u).small;
 }
