@@ -209,7 +209,8 @@ def main():
     lines = [f"Structured straight tube, P2 (C3D10), clamped ends, {args.pressure:g} Pa inside, "
              f"E {args.E:g} Pa, ν {args.nu:g}; {os.cpu_count()} cores, the fastest of "
              f"{args.repeats} alternate runs each (whole program: mesh reading, set-up, solve, "
-             "output). `/usr/bin/python3 scripts/calculix_side_by_side.py`.", "",
+             f"output); vesselverify's solver: {args.solver}. `/usr/bin/python3 "
+             f"scripts/calculix_side_by_side.py --levels {args.levels} --solver {args.solver}`.", "",
              "| level | DoFs | vesselverify s | MB | CalculiX 2.20 s | MB | CalculiX / vesselverify "
              "| max\\|Δu\\| / max\\|u\\| | load before / after |",
              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
