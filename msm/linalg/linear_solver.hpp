@@ -64,6 +64,8 @@ class CholmodSolver {
   [[nodiscard]] int symbolic_analyses() const { return analyses_; }
   [[nodiscard]] int numeric_factorisations() const { return factorisations_; }
   [[nodiscard]] double last_regularisation() const { return mu_; }
+  /// The factorised matrix's dimension (−1 before the first factorisation).
+  [[nodiscard]] Eigen::Index rows() const { return pattern_rows_; }
   /// Wall-clock seconds spent in numeric factorisations (and symbolic analyses) so far.
   [[nodiscard]] double factorisation_seconds() const { return seconds_; }
 
