@@ -10,6 +10,7 @@
 
 #include "meshes/foundation/errors.hpp"
 #include "msm/linalg/linear_solver.hpp"
+#include "msm/linalg/low_rank_update.hpp"
 #include "verification/contact/condensed_wall.hpp"
 #include "verification/contact/point_segment_distance.hpp"
 
@@ -199,9 +200,7 @@ class Coupled {
     }
     return x;
   }
-  [[nodiscard]] VectorXd wall_rows(const VectorXd& z) const {
-    return z.tail(wall_.num_dofs());
-  }
+  [[nodiscard]] VectorXd wall_rows(const VectorXd& z) const { return z.tail(wall_.num_dofs()); }
   [[nodiscard]] VectorXd pack(const VectorXd& x, const VectorXd& u) const {
     VectorXd z(size());
     for (std::size_t i = 0; i < rod_row_.size(); ++i) {
@@ -237,7 +236,8 @@ class Coupled {
     std::vector<Pair> out;
     for (int j = 0; j < static_cast<int>(rest_.size()); ++j) {
       const Eigen::Vector3d p = position(j, u);
-      if ((p.array() < lo.array() - reach).any() || (p.array() > hi.array() + reach).any()) continue;
+      if ((p.array() < lo.array() - reach).any() || (p.array() > hi.array() + reach).any())
+        continue;
       double best = std::numeric_limits<double>::infinity();
       int seg = first_;
       for (int i = first_; i < last_; ++i) {
@@ -445,7 +445,8 @@ class Coupled {
 
 /// k from the wall's stiffness at rest: penalty_factor × its largest diagonal entry on the
 /// candidates' rows.
-double default_penalty(const WallPotential& wall, const std::vector<int>& candidates, double factor) {
+double default_penalty(const WallPotential& wall, const std::vector<int>& candidates,
+                       double factor) {
   Eigen::SparseMatrix<double> h;
   VectorXd g;
   (void)wall.evaluate(VectorXd::Zero(wall.num_dofs()), &g, &h);
@@ -459,12 +460,114 @@ double default_penalty(const WallPotential& wall, const std::vector<int>& candid
   return factor * largest;
 }
 
+/// The Newton model's matrix H(A) = B + Σ_{j∈A} k a_j a_jᵀ for the active sets A of one step's
+/// passes: H(A₀) factorised once, a later set's pairs that differ from A₀ applied as rank-one
+/// terms (+k entering, −k leaving; msm::LowRankUpdatedSolve), so a pass costs solves with the
+/// factor, not a factorisation. Past kMaxChanged such pairs H(A) is factorised afresh.
+class ModelMatrix {
+ public:
+  static constexpr std::size_t kMaxChanged = 64;
+
+  ModelMatrix(const Coupled& p, const Linearisation& lin, int& factorisations)
+      : p_(p), lin_(lin), factorisations_(factorisations), base_(p.size(), p.size()) {
+    base_.setFromTriplets(lin.base.begin(), lin.base.end());
+  }
+
+  /// dz = H(active)⁻¹ rhs; false if H cannot be factorised.
+  bool solve(const std::vector<char>& active, const VectorXd& rhs, VectorXd& dz) {
+    std::vector<int> ids;
+    std::vector<msm::SparseColumn> columns;
+    std::vector<double> weights;
+    for (std::size_t j = 0; j < active.size() && update_; ++j) {
+      if (active[j] == factored_[j]) continue;
+      ids.push_back(static_cast<int>(j));
+      columns.push_back(column(j));
+      weights.push_back(active[j] ? p_.stiffness() : -p_.stiffness());
+    }
+    if (!update_ || ids.size() > kMaxChanged) {
+      if (!factorize(active)) return false;
+      ids.clear();
+      columns.clear();
+      weights.clear();
+    }
+    try {
+      dz = update_->solve(rhs, ids, columns, weights);
+      // Woodbury's capacitance (±1/k + aᵀH₀⁻¹a, near-cancelling for a stiff k) costs digits:
+      // two steps of iterative refinement on H(A)'s own product restore the direct solve's.
+      for (int refinement = 0; refinement < 2 && !ids.empty(); ++refinement) {
+        dz += update_->solve(rhs - product(active, dz), ids, columns, weights);
+      }
+    } catch (const std::runtime_error&) {  // the updated matrix is singular: factorise it
+      if (ids.empty() || !factorize(active)) return false;
+      dz = update_->solve(rhs, {}, {}, {});
+    }
+    return true;
+  }
+
+ private:
+  bool factorize(const std::vector<char>& active) {
+    Triplets t;
+    t.reserve(81 * active.size());
+    for (std::size_t j = 0; j < active.size(); ++j) {
+      // Every near pair's block is in the pattern (zero while open), so a refactorisation of the
+      // same step reuses the symbolic analysis.
+      const auto& a = lin_.gap_gradient[j];
+      Coupled::add_block(t, lin_.rows[j], (active[j] ? p_.stiffness() : 0.0) * a * a.transpose());
+    }
+    Eigen::SparseMatrix<double> near(p_.size(), p_.size());
+    near.setFromTriplets(t.begin(), t.end());
+    ++factorisations_;
+    update_.reset();
+    try {
+      solver_.factorize(base_ + near);
+    } catch (const std::runtime_error&) {
+      return false;
+    }
+    factored_ = active;
+    update_ = std::make_unique<msm::LowRankUpdatedSolve>(solver_);
+    return true;
+  }
+
+  /// H(active) v.
+  [[nodiscard]] VectorXd product(const std::vector<char>& active, const VectorXd& v) const {
+    VectorXd out = base_ * v;  // both triangles stored
+    for (std::size_t j = 0; j < active.size(); ++j) {
+      if (!active[j]) continue;
+      const msm::SparseColumn u = column(j);
+      double s = 0.0;
+      for (std::size_t i = 0; i < u.rows.size(); ++i) s += u.values[i] * v[u.rows[i]];
+      for (std::size_t i = 0; i < u.rows.size(); ++i)
+        out[u.rows[i]] += p_.stiffness() * s * u.values[i];
+    }
+    return out;
+  }
+
+  /// Pair j's gap gradient a_j on its free rows.
+  [[nodiscard]] msm::SparseColumn column(std::size_t j) const {
+    msm::SparseColumn u;
+    for (int i = 0; i < 9; ++i) {
+      if (lin_.rows[j][i] < 0) continue;
+      u.rows.push_back(lin_.rows[j][i]);
+      u.values.push_back(lin_.gap_gradient[j][i]);
+    }
+    return u;
+  }
+
+  const Coupled& p_;
+  const Linearisation& lin_;
+  int& factorisations_;
+  Eigen::SparseMatrix<double> base_;
+  msm::CholmodSolver solver_;
+  std::vector<char> factored_;
+  std::unique_ptr<msm::LowRankUpdatedSolve> update_;
+};
+
 /// The Newton step: the minimiser of the model ½dzᵀH dz + ∇Πᵀdz in which every pair near
 /// contact keeps its piecewise penalty of the linearised gap, k/2 max(0, c − ∇g·dz)², found by
-/// an active-set iteration (each pass one factorisation): a wire about to touch is stopped by the
-/// wall within the step instead of passing it in the model. false if H cannot be factorised.
-bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gradient,
-                 VectorXd& dz) {
+/// an active-set iteration (ModelMatrix): a wire about to touch is stopped by the wall within the
+/// step instead of passing it in the model. false if H cannot be factorised.
+bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gradient, VectorXd& dz,
+                 int& factorisations) {
   const double k = p.stiffness();
   const std::size_t m = lin.c.size();
   // ∇Π without the pressed pairs' −λ∇g: the model adds each pair's own term.
@@ -477,32 +580,16 @@ bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gra
   }
   std::vector<char> active(m), next(m);
   for (std::size_t j = 0; j < m; ++j) active[j] = lin.c[j] > 0.0;
-  Eigen::SparseMatrix<double> base(p.size(), p.size());
-  base.setFromTriplets(lin.base.begin(), lin.base.end());
-  // Every near pair's block is in the pattern (zero while the pair is open in the model), so all
-  // passes share one symbolic analysis.
-  msm::CholmodSolver solver;
+  ModelMatrix H(p, lin, factorisations);
   for (int pass = 0; pass < 20; ++pass) {
-    Triplets t;
-    t.reserve(81 * m);
     VectorXd rhs = -g0;
     for (std::size_t j = 0; j < m; ++j) {
-      const auto& a = lin.gap_gradient[j];
-      Coupled::add_block(t, lin.rows[j], (active[j] ? k : 0.0) * a * a.transpose());
       if (!active[j]) continue;
       for (int i = 0; i < 9; ++i) {
-        if (lin.rows[j][i] >= 0) rhs[lin.rows[j][i]] += k * lin.c[j] * a[i];
+        if (lin.rows[j][i] >= 0) rhs[lin.rows[j][i]] += k * lin.c[j] * lin.gap_gradient[j][i];
       }
     }
-    Eigen::SparseMatrix<double> near(p.size(), p.size());
-    near.setFromTriplets(t.begin(), t.end());
-    const Eigen::SparseMatrix<double> H = base + near;
-    try {
-      solver.factorize(H);
-    } catch (const std::runtime_error&) {
-      return false;
-    }
-    dz = solver.solve(rhs);
+    if (!H.solve(active, rhs, dz)) return false;
     for (std::size_t j = 0; j < m; ++j) {
       double slope = 0.0;
       for (int i = 0; i < 9; ++i) {
@@ -519,6 +606,7 @@ bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gra
 struct NewtonOutcome {
   bool converged = false;
   int iterations = 0;
+  int factorisations = 0;
   double residual = 0.0;
   std::string reason;
 };
@@ -539,10 +627,10 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
       return out;
     }
     if (it == o.max_newton) break;
-    bool descent = newton_step(p, lin, g, dz) && g.dot(dz) < 0.0;
+    bool descent = newton_step(p, lin, g, dz, out.factorisations) && g.dot(dz) < 0.0;
     if (!descent) {
       (void)p.evaluate(z, g, &lin, true, band);
-      descent = newton_step(p, lin, g, dz) && g.dot(dz) < 0.0;
+      descent = newton_step(p, lin, g, dz, out.factorisations) && g.dot(dz) < 0.0;
     }
     if (!descent) dz = -g * (p.radius() / std::max(g.norm(), 1e-300));  // steepest descent
     const double move = p.largest_move(dz);
@@ -612,14 +700,16 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
   for (int round = 1; round <= rounds; ++round) {
     const NewtonOutcome n = minimise(problem, z, options);
     out.newton_iterations += n.iterations;
+    out.factorisations += n.factorisations;
     out.rounds = round;
     out.residual = n.residual;
     problem.forces(z, out);
     if (options.log) {
       *options.log << "potential contact: round " << round << ", " << n.iterations
-                   << " Newton steps, residual " << n.residual << " N, " << out.pressed.size()
-                   << " pressed, force " << out.total_force_on_wall().norm() * 1e3
-                   << " mN, penetration " << out.max_penetration << " m" << std::endl;
+                   << " Newton steps, " << n.factorisations << " factorisations, residual "
+                   << n.residual << " N, " << out.pressed.size() << " pressed, force "
+                   << out.total_force_on_wall().norm() * 1e3 << " mN, penetration "
+                   << out.max_penetration << " m" << std::endl;
     }
     if (!n.converged) {
       std::ostringstream m;

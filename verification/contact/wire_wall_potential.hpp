@@ -151,6 +151,7 @@ struct PotentialContactSolution {
   double max_penetration = 0.0;  ///< m, over every candidate
   double penalty_stiffness = 0.0;  ///< the k used, N/m
   int newton_iterations = 0;       ///< over all rounds
+  int factorisations = 0;          ///< of the coupled Newton matrix, over all rounds
   int rounds = 0;                  ///< augmented-Lagrangian rounds (1 for the penalty law)
   double residual = 0.0;           ///< ‖∇Π‖ on the free dofs at the end, N
   double seconds = 0.0;

@@ -124,7 +124,11 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
   msm::rods::DerRod rod = wire.rod;
   contact::PotentialContactOptions po;
   po.force_scale = force_scale;
+  // ‖∇Π‖ to 1e-8 of the rigid-wall force: the force to ~1e-8 of itself, short of the
+  // neo-Hookean energy's round-off floor where the line search stalls.
+  po.tolerance = 1e-8;
   po.max_newton = o.max_steps;
+  po.log = o.log;
   const contact::PotentialContactSolution s = contact::solve_wire_wall_potential(
       rod, wire.radius, wall, mesh, nodes, wire.rigid_state, po);
   out.converged = true;
