@@ -3,6 +3,7 @@
 /// detail/matrix_free_elasticity.
 #include <deal.II/lac/la_parallel_vector.h>
 
+#include <algorithm>
 #include <string>
 
 #include "fem_reference/detail/matrix_free_elasticity.hpp"
@@ -94,7 +95,7 @@ std::vector<double> operator_product(const Impl& im, const std::vector<double>& 
   detail::MfVector src, dst;
   op.initialize_dof_vector(src);
   op.initialize_dof_vector(dst);
-  for (std::size_t i = 0; i < u.size(); ++i) src.local_element(i) = u[i];
+  std::copy(u.begin(), u.end(), src.begin());
   if (by_matrix) {
     dl::TrilinosWrappers::SparseMatrix matrix;
     op.compute_matrix(matrix);

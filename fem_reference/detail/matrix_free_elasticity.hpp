@@ -30,6 +30,11 @@ namespace vessel::fem::detail {
 
 using MfVector = dl::LinearAlgebra::distributed::Vector<double>;
 
+/// The straight-tet cell kernel on a batch of cells (the .cpp's straight_batch).
+using StraightTetKernel = void (*)(const double* in, double* out, const double* geometry,
+                                   const double* ref_grad, const double* weights, double lambda,
+                                   double mu);
+
 /// A(u) = ∫ σ(u) : ε(v) dV with σ = λ tr(ε) I + 2μ ε (Pa, so A u is in N for u in m), evaluated
 /// cell by cell on straight-sided tets at the fewest-point rule exact for the integrand's degree
 /// 2(degree − 1) (P2: 4 points) and on curved ones at the assembled path's
@@ -64,7 +69,10 @@ class ElasticityOperator : public dl::Subscriptor {
   void compute_matrix(dl::TrilinosWrappers::SparseMatrix& matrix) const;
   /// Sets v to 0 on the constrained DoFs.
   void zero_constrained(MfVector& v) const;
-  [[nodiscard]] std::size_t memory_consumption() const { return mf_.memory_consumption(); }
+  [[nodiscard]] std::size_t memory_consumption() const {
+    return mf_.memory_consumption() + batch_dofs_.capacity() * sizeof(unsigned) +
+           batch_geometry_.capacity() * sizeof(double);
+  }
   /// vmult calls so far, and their wall-clock seconds.
   [[nodiscard]] unsigned applications() const { return applications_; }
   [[nodiscard]] double seconds() const { return seconds_; }
@@ -76,13 +84,32 @@ class ElasticityOperator : public dl::Subscriptor {
   /// One cell's A_e u_e in place on phi's dof values (an FEEvaluation; defined in the .cpp).
   template <typename Evaluation>
   void apply_cell(Evaluation& phi) const;
+  /// dst = A src by MatrixFree's cell loop, one FEEvaluation cell at a time (apply_cell).
+  void cell_loop(MfVector& dst, const MfVector& src) const;
+  /// straight_ on a serial mesh with constraints that only fix values: batch_dofs_ and
+  /// batch_geometry_ from MatrixFree's cells, in its order (otherwise left empty).
+  void build_batches();
+  /// Whether build_batches applies: a serial mesh, constraints without entries.
+  [[nodiscard]] bool batchable() const;
+  /// phi's J⁻ᵀ and |det J| into one lane of a batch's geometry.
+  template <typename Evaluation>
+  static void store_geometry(const Evaluation& phi, double* lane);
+  /// dst = A src (free rows; constrained rows zero) by kernel_ on the batches.
+  void apply_batches(MfVector& dst, const MfVector& src) const;
 
   dl::MatrixFree<kDim, double> mf_;
   const dl::Mapping<kDim>& mapping_;
   dl::Quadrature<kDim> quadrature_;  // the integrand's rule (MatrixFree's one point if straight_)
-  bool straight_ = false;            // P1/P2 on straight-sided tets: stress_divergence_straight
+  bool straight_ = false;            // P1/P2 on straight-sided tets: straight_batch
   unsigned n_shapes_ = 0;            // straight_: the scalar element's shape functions
   std::vector<double> ref_grad_;     // straight_: their reference gradients at quadrature_
+  StraightTetKernel kernel_ = nullptr;  // straight_: for this CPU (AVX2 + FMA where it has them)
+  static constexpr unsigned kNoDof = ~0u;
+  // straight_ and batchable: each batch's cells' DoF indices [(b·3N + k)·lanes + l] (cell l of
+  // batch b, component-major local DoF k; kNoDof where constrained or padding) and their
+  // geometry [(b·10 + j)·lanes + l] (J⁻ᵀ row-major, then |det J|).
+  std::vector<unsigned> batch_dofs_;
+  std::vector<double> batch_geometry_;
   const dl::AffineConstraints<double>& constraints_;
   double lambda_, mu_;
   mutable MfVector diagonal_;  // el()'s, on first use
