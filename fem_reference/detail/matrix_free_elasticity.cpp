@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <sstream>
 #include <stdexcept>
@@ -46,49 +47,53 @@ void stress_divergence(Evaluation& phi, double lambda, double mu) {
 
 /// Cells per batch of the straight-tet kernel: one AVX2 register of doubles per quantity.
 constexpr unsigned kLanes = 4;
-/// kLanes doubles as one GCC vector: arithmetic on it is lane-wise (a scalar operand is broadcast)
-/// and compiles to AVX2 in the avx2 variant of the kernel, to SSE2 pairs otherwise.
-using Lanes = double __attribute__((vector_size(kLanes * sizeof(double))));
 /// Doubles per cell of a batch's geometry: J⁻ᵀ (∂ξ_e/∂x_d at [3d + e]) and |det J|.
 constexpr unsigned kGeometry = kDim * kDim + 1;
+/// Two and four doubles as one GCC vector: arithmetic on them is lane-wise (a scalar operand is
+/// broadcast); an SSE2 and an AVX2 register.
+using Lanes2 = double __attribute__((vector_size(2 * sizeof(double))));
+using Lanes4 = double __attribute__((vector_size(4 * sizeof(double))));
 
-/// The displacement a(u, v) on kLanes straight-sided tets at once (struct of arrays: entry
-/// [k·kLanes + l] belongs to cell l): out = A_e u_e for each cell, u_e from `in`, both
-/// component-major (k = c·N + i for component c of the scalar element's shape i), `geometry`
-/// [j·kLanes + l] as kGeometry describes. J⁻ᵀ and |det J| are constant on a straight-sided tet,
-/// so ∇u is taken at a rule's Q points x_q (reference weights `weights`, summing to 1/6) from
-/// `ref_grad`, the N shape gradients there, [(q·N + i)·3 + e] = ∂N_i/∂ξ_e(x_q); the stress is
-/// σ = λ tr(ε) I + 2μ ε (step-8's a(u, v)).
-template <unsigned N, unsigned Q>
-[[gnu::always_inline]] inline void straight_batch(const double* in, double* out,
+/// The displacement a(u, v) on V's lanes, as many of a batch's kLanes straight-sided tets at
+/// once (struct of arrays: entry [k·kLanes + l] belongs to cell l; the pointers start at V's
+/// first):
+/// out = A_e u_e for each cell, u_e from `in`, both component-major (k = c·N + i for component
+/// c of the scalar element's shape i), `geometry` [j·kLanes + l] as kGeometry describes. J⁻ᵀ and
+/// |det J| are constant on a straight-sided tet, so ∇u is taken at a rule's Q points x_q
+/// (reference weights `weights`, summing to 1/6) from `ref_grad`, the N shape gradients there,
+/// [(q·N + i)·3 + e] = ∂N_i/∂ξ_e(x_q); the stress is σ = λ tr(ε) I + 2μ ε (step-8's a(u, v)).
+template <typename V, unsigned N, unsigned Q>
+[[gnu::always_inline]] inline void straight_lanes(const double* in, double* out,
                                                   const double* geometry, const double* ref_grad,
                                                   const double* weights, double lambda, double mu) {
-  Lanes u[kDim * N], a[kDim * N] = {}, inv_jt[kDim][kDim], det;
-  std::memcpy(u, in, sizeof u);
-  std::memcpy(inv_jt, geometry, sizeof inv_jt);
-  std::memcpy(&det, geometry + kDim * kDim * kLanes, sizeof det);
+  V u[kDim * N], a[kDim * N] = {}, inv_jt[kDim][kDim], det;
+  for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(&u[k], in + k * kLanes, sizeof(V));
+  for (unsigned j = 0; j < kDim * kDim; ++j) {
+    std::memcpy(&inv_jt[j / kDim][j % kDim], geometry + j * kLanes, sizeof(V));
+  }
+  std::memcpy(&det, geometry + kDim * kDim * kLanes, sizeof(V));
   for (unsigned q = 0; q < Q; ++q) {
     const double* g = ref_grad + q * N * kDim;
-    Lanes ref[kDim][kDim] = {};  // ∂u_c/∂ξ_e
+    V ref[kDim][kDim] = {};  // ∂u_c/∂ξ_e
     for (unsigned c = 0; c < kDim; ++c) {
       for (unsigned i = 0; i < N; ++i) {
         for (unsigned e = 0; e < kDim; ++e) ref[c][e] += u[c * N + i] * g[i * kDim + e];
       }
     }
-    Lanes grad[kDim][kDim];  // ∂u_c/∂x_d
+    V grad[kDim][kDim];  // ∂u_c/∂x_d
     for (unsigned c = 0; c < kDim; ++c) {
       for (unsigned d = 0; d < kDim; ++d) {
         grad[c][d] = inv_jt[d][0] * ref[c][0] + inv_jt[d][1] * ref[c][1] + inv_jt[d][2] * ref[c][2];
       }
     }
-    const Lanes w = det * weights[q];
-    const Lanes lambda_trace = (lambda * w) * (grad[0][0] + grad[1][1] + grad[2][2]);
-    const Lanes mu_w = mu * w;
+    const V w = det * weights[q];
+    const V lambda_trace = (lambda * w) * (grad[0][0] + grad[1][1] + grad[2][2]);
+    const V mu_w = mu * w;
     for (unsigned c = 0; c < kDim; ++c) {
-      Lanes sigma[kDim];  // row c of w·σ
+      V sigma[kDim];  // row c of w·σ
       for (unsigned d = 0; d < kDim; ++d) sigma[d] = mu_w * (grad[c][d] + grad[d][c]);
       sigma[c] += lambda_trace;
-      Lanes s[kDim];  // Σ_d wσ_cd ∂ξ_e/∂x_d
+      V s[kDim];  // Σ_d wσ_cd ∂ξ_e/∂x_d
       for (unsigned e = 0; e < kDim; ++e) {
         s[e] = sigma[0] * inv_jt[0][e] + sigma[1] * inv_jt[1][e] + sigma[2] * inv_jt[2][e];
       }
@@ -97,30 +102,34 @@ template <unsigned N, unsigned Q>
       }
     }
   }
-  std::memcpy(out, a, sizeof a);
+  for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(out + k * kLanes, &a[k], sizeof(V));
 }
 
+/// straight_lanes on a whole batch: two halves of SSE2 width (any x86-64) ...
 template <unsigned N, unsigned Q>
-void straight_batch_generic(const double* in, double* out, const double* geometry,
-                            const double* ref_grad, const double* weights, double lambda,
-                            double mu) {
-  straight_batch<N, Q>(in, out, geometry, ref_grad, weights, lambda, mu);
+void straight_batch_sse2(const double* in, double* out, const double* geometry,
+                         const double* ref_grad, const double* weights, double lambda, double mu) {
+  for (unsigned first = 0; first < kLanes; first += 2) {
+    straight_lanes<Lanes2, N, Q>(in + first, out + first, geometry + first, ref_grad, weights,
+                                 lambda, mu);
+  }
 }
-// The same, compiled for AVX2 + FMA; chosen at run time only on a CPU that has both, so the
-// project keeps building for any x86-64.
+/// ... or at once in AVX2 registers, chosen at run time only on a CPU that has AVX2, so the
+/// project keeps building and running on any x86-64.
 template <unsigned N, unsigned Q>
-[[gnu::target("avx2,fma")]] void straight_batch_avx2(const double* in, double* out,
-                                                     const double* geometry, const double* ref_grad,
-                                                     const double* weights, double lambda,
-                                                     double mu) {
-  straight_batch<N, Q>(in, out, geometry, ref_grad, weights, lambda, mu);
+[[gnu::target("avx2")]] void straight_batch_avx2(const double* in, double* out,
+                                                 const double* geometry, const double* ref_grad,
+                                                 const double* weights, double lambda, double mu) {
+  straight_lanes<Lanes4, N, Q>(in, out, geometry, ref_grad, weights, lambda, mu);
 }
-
-/// The batch kernel for the scalar element's `n_shapes` (4: P1, 10: P2) on this CPU.
+/// The batch kernel for the scalar element's `n_shapes` (4: P1, 10: P2) on this CPU: AVX2 where
+/// it has it, unless the environment sets VESSELVERIFY_MATRIX_FREE_SSE2 (the tests, to check the
+/// SSE2 variant too; measurements).
 StraightTetKernel straight_batch_kernel(unsigned n_shapes) {
-  const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  if (n_shapes == 4) return avx2 ? straight_batch_avx2<4, 1> : straight_batch_generic<4, 1>;
-  return avx2 ? straight_batch_avx2<10, 4> : straight_batch_generic<10, 4>;
+  const bool avx2 =
+      __builtin_cpu_supports("avx2") && std::getenv("VESSELVERIFY_MATRIX_FREE_SSE2") == nullptr;
+  if (n_shapes == 4) return avx2 ? straight_batch_avx2<4, 1> : straight_batch_sse2<4, 1>;
+  return avx2 ? straight_batch_avx2<10, 4> : straight_batch_sse2<10, 4>;
 }
 
 using Clock = std::chrono::steady_clock;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cstdlib>
 #include <iostream>
 #include <random>
 #include <utility>
@@ -64,6 +65,17 @@ TEST_P(MatrixFree, ProductEqualsAssembledMatrixOnFreeRows) {
       relative_product_difference(s, 7, [&](const auto& u) { return s.matrix_free_product(u); }),
       1e-12)
       << "P" << GetParam();
+}
+
+// The same with the kernel's SSE2 variant, which runs on CPUs without AVX2 (this one would
+// otherwise pick AVX2).
+TEST_P(MatrixFree, Sse2KernelProductEqualsAssembledMatrixOnFreeRows) {
+  const ElasticitySolver s(test::short_tube_mesh(0), pressurised_tube(GetParam(), 0.3));
+  ::setenv("VESSELVERIFY_MATRIX_FREE_SSE2", "1", 1);
+  const double difference =
+      relative_product_difference(s, 9, [&](const auto& u) { return s.matrix_free_product(u); });
+  ::unsetenv("VESSELVERIFY_MATRIX_FREE_SSE2");
+  EXPECT_LT(difference, 1e-12) << "P" << GetParam();
 }
 
 // The sparse matrix MatrixFreeTools::compute_matrix builds from the same cell kernel (the P1
