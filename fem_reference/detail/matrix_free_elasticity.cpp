@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -175,6 +176,68 @@ dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<doubl
   return out;
 }
 
+bool plain_indexable(const dl::DoFHandler<kDim>& dof,
+                     const dl::AffineConstraints<double>& constraints) {
+  if (dynamic_cast<const dl::parallel::TriangulationBase<kDim>*>(&dof.get_triangulation()) !=
+      nullptr) {
+    return false;
+  }
+  const auto& lines = constraints.get_lines();
+  return std::all_of(lines.begin(), lines.end(), [](const auto& l) { return l.entries.empty(); });
+}
+
+P1ToP2Embedding::P1ToP2Embedding(const dl::DoFHandler<kDim>& p2, const dl::DoFHandler<kDim>& p1,
+                                 const dl::AffineConstraints<double>& p2_constraints,
+                                 const dl::AffineConstraints<double>& p1_constraints)
+    : from_(p2.n_dofs(), {kNone, kNone}) {
+  const auto& fe2 = p2.get_fe();
+  const auto& fe1 = p1.get_fe();
+  // Each P2 node is a vertex of the reference tet or the midpoint of two: which P1 shapes.
+  const auto& nodes = fe2.base_element(0).get_unit_support_points();
+  const auto& vertices = fe1.base_element(0).get_unit_support_points();
+  std::vector<std::array<unsigned, 2>> parents(nodes.size());
+  for (unsigned i = 0; i < nodes.size(); ++i) {
+    for (unsigned a = 0; a < vertices.size(); ++a) {
+      for (unsigned b = a; b < vertices.size(); ++b) {
+        if ((0.5 * (vertices[a] + vertices[b]) - nodes[i]).norm() < 1e-12) parents[i] = {a, b};
+      }
+    }
+  }
+  std::vector<dl::types::global_dof_index> fine(fe2.n_dofs_per_cell()),
+      coarse(fe1.n_dofs_per_cell());
+  auto cell1 = p1.begin_active();
+  for (const auto& cell2 : p2.active_cell_iterators()) {
+    cell2->get_dof_indices(fine);
+    cell1->get_dof_indices(coarse);
+    ++cell1;
+    for (unsigned k = 0; k < fine.size(); ++k) {
+      if (p2_constraints.is_constrained(fine[k])) continue;
+      const auto [c, i] = fe2.system_to_component_index(k);
+      for (unsigned j = 0; j < 2; ++j) {  // both, as another cell may order the edge otherwise
+        const auto parent = coarse[fe1.component_to_system_index(c, parents[i][j])];
+        from_[fine[k]][j] =
+            p1_constraints.is_constrained(parent) ? kNone : static_cast<unsigned>(parent);
+      }
+    }
+  }
+}
+
+void P1ToP2Embedding::prolongate_and_add(MfVector& p2, const MfVector& p1) const {
+  for (unsigned k = 0; k < from_.size(); ++k) {
+    for (const unsigned parent : from_[k]) {
+      if (parent != kNone) p2.local_element(k) += 0.5 * p1.local_element(parent);
+    }
+  }
+}
+
+void P1ToP2Embedding::restrict_and_add(MfVector& p1, const MfVector& p2) const {
+  for (unsigned k = 0; k < from_.size(); ++k) {
+    for (const unsigned parent : from_[k]) {
+      if (parent != kNone) p1.local_element(parent) += 0.5 * p2.local_element(k);
+    }
+  }
+}
+
 ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
                                        const dl::DoFHandler<kDim>& dof,
                                        const dl::AffineConstraints<double>& constraints, int degree,
@@ -211,19 +274,8 @@ ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
   mf_.reinit(mapping, dof, constraints, quadrature_, data);
 }
 
-bool ElasticityOperator::batchable() const {
-  // The batches read and write the vectors by plain DoF index and drop the constrained DoFs:
-  // that needs serial vectors and constraints that only fix values (no entries).
-  if (dynamic_cast<const dl::parallel::TriangulationBase<kDim>*>(
-          &mf_.get_dof_handler().get_triangulation()) != nullptr) {
-    return false;
-  }
-  const auto& lines = constraints_.get_lines();
-  return std::all_of(lines.begin(), lines.end(), [](const auto& l) { return l.entries.empty(); });
-}
-
 void ElasticityOperator::build_batches() {
-  if (!batchable()) return;
+  if (!plain_indexable(mf_.get_dof_handler(), constraints_)) return;
   const auto& fe = mf_.get_dof_handler().get_fe();
   const unsigned per_cell = kDim * n_shapes_;
   std::vector<unsigned> system_index(per_cell);  // component-major k = c·N + i → cell DoF
@@ -406,7 +458,13 @@ class MatrixFreeElasticitySolver::VCycle {
                                                      lambda, mu);
       coarse = coarse_.get();
       profile.coarse_level = lap();
-      transfer_.reinit_polynomial_transfer(dof, coarse_dof_, fine_constraints, coarse_constraints_);
+      if (false && plain_indexable(dof, fine_constraints) &&
+          plain_indexable(coarse_dof_, coarse_constraints_)) {
+        embedding_.emplace(dof, coarse_dof_, fine_constraints, coarse_constraints_);
+      } else {
+        transfer_.reinit_polynomial_transfer(dof, coarse_dof_, fine_constraints,
+                                             coarse_constraints_);
+      }
       profile.transfer = lap();
 
       inverse_diagonal_ = std::make_shared<dl::DiagonalMatrix<MfVector>>();
@@ -482,13 +540,21 @@ class MatrixFreeElasticitySolver::VCycle {
     residual_.sadd(-1.0, 1.0, src);
     auto t0 = Clock::now();
     coarse_residual_ = 0.0;
-    transfer_.restrict_and_add(coarse_residual_, residual_);
+    if (embedding_) {
+      embedding_->restrict_and_add(coarse_residual_, residual_);
+    } else {
+      transfer_.restrict_and_add(coarse_residual_, residual_);
+    }
     coarse_->zero_constrained(coarse_residual_);
     transfer_seconds_ += seconds_since(t0);
     coarse_solve(coarse_correction_, coarse_residual_);
     coarse_->zero_constrained(coarse_correction_);
     t0 = Clock::now();
-    transfer_.prolongate_and_add(dst, coarse_correction_);
+    if (embedding_) {
+      embedding_->prolongate_and_add(dst, coarse_correction_);
+    } else {
+      transfer_.prolongate_and_add(dst, coarse_correction_);
+    }
     transfer_seconds_ += seconds_since(t0);
     fine_.zero_constrained(dst);
     fine_.vmult(residual_, dst);  // post-smoothing on the new residual
@@ -554,7 +620,8 @@ class MatrixFreeElasticitySolver::VCycle {
   dl::DoFHandler<kDim> coarse_dof_;
   dl::AffineConstraints<double> coarse_constraints_;
   std::unique_ptr<ElasticityOperator> coarse_;
-  dl::MGTwoLevelTransfer<kDim, MfVector> transfer_;
+  std::optional<P1ToP2Embedding> embedding_;         // both levels plain_indexable
+  dl::MGTwoLevelTransfer<kDim, MfVector> transfer_;  // otherwise
   std::shared_ptr<dl::DiagonalMatrix<MfVector>> inverse_diagonal_;
   Chebyshev chebyshev_;
   std::unique_ptr<CholmodFactor> cholmod_;                             // CoarseSolve::cholmod

@@ -17,6 +17,7 @@
 #include <deal.II/matrix_free/matrix_free.h>
 #include <deal.II/multigrid/mg_transfer_global_coarsening.h>
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <stdexcept>
@@ -89,8 +90,6 @@ class ElasticityOperator : public dl::Subscriptor {
   /// straight_ on a serial mesh with constraints that only fix values: batch_dofs_ and
   /// batch_geometry_ from MatrixFree's cells, in its order (otherwise left empty).
   void build_batches();
-  /// Whether build_batches applies: a serial mesh, constraints without entries.
-  [[nodiscard]] bool batchable() const;
   /// phi's J⁻ᵀ and |det J| into one lane of a batch's geometry.
   template <typename Evaluation>
   static void store_geometry(const Evaluation& phi, double* lane);
@@ -116,6 +115,34 @@ class ElasticityOperator : public dl::Subscriptor {
   unsigned n_quadrature_points_ = 0;
   mutable unsigned applications_ = 0;
   mutable double seconds_ = 0.0;
+};
+
+/// Whether vectors on `dof` can be read and written by plain DoF index with the constrained DoFs
+/// dropped: a serial mesh and constraints that only fix values (no entries).
+bool plain_indexable(const dl::DoFHandler<kDim>& dof,
+                     const dl::AffineConstraints<double>& constraints);
+
+/// The P1 → P2 prolongation on one mesh as nodal interpolation (exact, as P1 ⊂ P2): a P2 vertex
+/// DoF takes its P1 DoF's value, an edge-midpoint DoF the mean of its edge's two; the restriction
+/// is the transpose. The operator MGTwoLevelTransfer::reinit_polynomial_transfer builds for this
+/// pair, as two index reads per P2 DoF. Both levels plain_indexable: constrained DoFs are read
+/// and written as zero.
+class P1ToP2Embedding {
+ public:
+  /// `p2`, `p1`: FESystem(FE_SimplexP(2 resp. 1), 3) on the same triangulation.
+  P1ToP2Embedding(const dl::DoFHandler<kDim>& p2, const dl::DoFHandler<kDim>& p1,
+                  const dl::AffineConstraints<double>& p2_constraints,
+                  const dl::AffineConstraints<double>& p1_constraints);
+  /// p2 += P p1.
+  void prolongate_and_add(MfVector& p2, const MfVector& p1) const;
+  /// p1 += Pᵀ p2.
+  void restrict_and_add(MfVector& p1, const MfVector& p2) const;
+
+ private:
+  static constexpr unsigned kNone = ~0u;
+  // Per P2 DoF the two P1 DoFs it averages (the same one twice at a vertex); kNone where either
+  // level constrains the DoF.
+  std::vector<std::array<unsigned, 2>> from_;
 };
 
 /// The constraints' pattern with zero inhomogeneities (what MatrixFree and the transfer need).

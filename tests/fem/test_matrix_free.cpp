@@ -92,7 +92,7 @@ TEST_P(MatrixFree, KernelMatrixEqualsAssembledMatrixOnFreeRows) {
 // outer CG flexible) and a CHOLMOD factor (a limit above the P1 DoF count). P1 takes one ML
 // V-cycle.
 TEST_P(MatrixFree, CgWithPMultigridReachesCholmodSolution) {
-  for (const auto [nu, coarse_max_dofs] :
+  for (const auto& [nu, coarse_max_dofs] :
        {std::pair{0.0, std::size_t{0}}, {0.3, 0}, {0.45, 0}, {0.3, 1000000}, {0.45, 1000000}}) {
     auto p = pressurised_tube(GetParam(), nu);
     p.options.solver = LinearSolver::direct;
@@ -145,6 +145,15 @@ TEST_P(MatrixFree, DiagonalEqualsAssembledMatrixDiagonal) {
     diff = std::max(diff, row >= 0 ? std::abs(d[i] - k_diag[row]) : std::abs(d[i] - 1.0));
   }
   EXPECT_LT(diff, 1e-12 * k_diag.lpNorm<Eigen::Infinity>()) << "P" << GetParam();
+}
+
+// The multigrid's own P1 -> P2 prolongation (nodal interpolation, two index reads per P2 DoF)
+// and its transpose against deal.II's MGTwoLevelTransfer for the same pair of spaces.
+TEST(MatrixFreeTransfer, P1ToP2EmbeddingEqualsDealiiPolynomialTransfer) {
+  const ElasticitySolver s(test::short_tube_mesh(0), pressurised_tube(2, 0.3));
+  const auto [prolongation, restriction] = s.matrix_free_transfer_difference(3);
+  EXPECT_LT(prolongation, 1e-14);
+  EXPECT_LT(restriction, 1e-14);
 }
 
 INSTANTIATE_TEST_SUITE_P(Degrees, MatrixFree, ::testing::Values(1, 2));
