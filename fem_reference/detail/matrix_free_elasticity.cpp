@@ -458,7 +458,7 @@ class MatrixFreeElasticitySolver::VCycle {
                                                      lambda, mu);
       coarse = coarse_.get();
       profile.coarse_level = lap();
-      if (false && plain_indexable(dof, fine_constraints) &&
+      if (plain_indexable(dof, fine_constraints) &&
           plain_indexable(coarse_dof_, coarse_constraints_)) {
         embedding_.emplace(dof, coarse_dof_, fine_constraints, coarse_constraints_);
       } else {
