@@ -88,8 +88,8 @@ struct SolverOptions {
   Formulation formulation = Formulation::automatic;
   /// automatic: mixed Taylor–Hood when ν ≥ this (and always at ν = 0.5). Below 0.49 P2
   /// displacement elements do not lock appreciably, while the saddle-point system costs minutes
-  /// and gigabytes at reference levels (docs/measurements/fem_measurements.md). The one default the
-  /// harness, the scenes and the `fem` command (--mixed-threshold) use.
+  /// and gigabytes at reference levels (docs/measurements/fem_measurements.md). The one default the harness,
+  /// the scenes and the `fem` command (--mixed-threshold) use.
   double mixed_threshold = 0.49;
   LinearSolver solver = LinearSolver::automatic;
   /// automatic: direct at or below this many DoFs (CHOLMOD for the displacement system, UMFPACK
@@ -102,9 +102,8 @@ struct SolverOptions {
   /// about 6 GB at this limit, so two references solved side by side fit a 24 GB machine.
   std::size_t direct_max_dofs = 400000;
   /// automatic, mixed system: UMFPACK at or below this many DoFs, else gmres_block. Measured
-  /// (docs/measurements/fem_measurements.md): level 0 (34–47k DoFs) UMFPACK 4–11 s vs FGMRES 8–21
-  /// s; level 1 (214k / 241k) UMFPACK 102 s, 4.6 GB / 426 s, 13.4 GB vs FGMRES 51 s / 216 s at ~2
-  /// GB (contact).
+  /// (docs/measurements/fem_measurements.md): level 0 (34–47k DoFs) UMFPACK 4–11 s vs FGMRES 8–21 s; level 1
+  /// (214k / 241k) UMFPACK 102 s, 4.6 GB / 426 s, 13.4 GB vs FGMRES 51 s / 216 s at ~2 GB (contact).
   std::size_t direct_max_mixed_dofs = 100000;
   /// CG-AMG: give ML all six rigid-body modes (translations and rotations) as near-null space;
   /// false: only the three translations (deal.II's AdditionalData::constant_modes).
@@ -168,8 +167,8 @@ struct MatrixFreeProfile {
   double coarse_matrix = 0.0;        ///< the P1 matrix (MatrixFreeTools::compute_matrix)
   double coarse_factor = 0.0;  ///< CHOLMOD's analysis and factorisation of it (or ML's set-up)
   std::string coarse_method;   ///< how the P1 level is solved: "CHOLMOD", "ML-CG", "one ML V-cycle"
-  unsigned coarse_iterations = 0;      ///< ML-CG: inner CG iterations, all P1 solves together
-  double cg = 0.0;                     ///< the CG iterations, all of them
+  unsigned coarse_iterations = 0;  ///< ML-CG: inner CG iterations, all P1 solves together
+  double cg = 0.0;             ///< the CG iterations, all of them
   unsigned operator_applications = 0;  ///< fine A·v in the CG (smoother, residuals, CG's own)
   double operator_seconds = 0.0;       ///< of cg: in those applications
   unsigned coarse_solves = 0;          ///< P1 solves (one per V-cycle)
@@ -184,7 +183,7 @@ struct ElasticityResult {
   bool curved = false;  ///< quadratic geometry on the curved surfaces
   Formulation formulation = Formulation::displacement;  ///< the one used
   LinearSolver solver = LinearSolver::direct;           ///< the one used
-  unsigned iterations = 0;                              ///< CG or FGMRES iterations (0 for direct)
+  unsigned iterations = 0;  ///< CG or FGMRES iterations (0 for direct)
   double inner_iterations = 0.0;  ///< gmres_block: mean CG iterations per pressure-mass solve
   std::size_t n_dofs = 0;
   std::size_t n_pressure_dofs = 0;       ///< mixed only: how many of n_dofs are pressure's
@@ -215,11 +214,10 @@ struct ModalResult {
 /// problem's loads (and any prescribed Dirichlet values) applied at t = 0 to a body at rest,
 /// M ü + C u̇ + K u = f with the consistent mass matrix and C = α M.
 struct TransientOptions {
-  double dt = 1e-4;           ///< s (> 0, else InputError)
-  int steps = 100;            ///< (> 0)
-  double mass_damping = 0.0;  ///< α (1/s): C = α M
-  std::vector<Vec3>
-      probe_points;  ///< where the history is recorded (evaluated like displacement_at)
+  double dt = 1e-4;                 ///< s (> 0, else InputError)
+  int steps = 100;                  ///< (> 0)
+  double mass_damping = 0.0;        ///< α (1/s): C = α M
+  std::vector<Vec3> probe_points;   ///< where the history is recorded (evaluated like displacement_at)
   double outside_tolerance = 1e-9;  ///< as displacement_at
 };
 
@@ -241,7 +239,7 @@ struct TransientResult {
 struct FreeDisplacementSystem {
   Eigen::SparseMatrix<double> K;  ///< N/m, symmetric positive definite, both triangles stored
   Eigen::VectorXd f;              ///< N
-  std::vector<int> free_index;  ///< per DoF (this solver's numbering) its row, −1 if constrained
+  std::vector<int> free_index;    ///< per DoF (this solver's numbering) its row, −1 if constrained
   /// Per TetMesh node, the rows of its x, y and z displacement (−1 where constrained).
   std::vector<std::array<int, 3>> node_rows;
 };
@@ -295,8 +293,8 @@ class ElasticitySolver {
   /// The FE displacement (m) at arbitrary points inside the mesh (within a relative tolerance of
   /// 1e-9 of the element size). Throws InputError naming the first point outside. Requires solve().
   /// `outside_tolerance` (barycentric, dimensionless) also accepts points that far outside the
-  /// nearest tet, evaluated by extending its polynomial: a node on an exact curved wall lies
-  /// outside the straight-sided tets by up to the chord's sagitta (a few % of a tet's height).
+  /// nearest tet, evaluated by extending its polynomial: a node on an exact curved wall lies outside
+  /// the straight-sided tets by up to the chord's sagitta (a few % of a tet's height).
   [[nodiscard]] std::vector<Vec3> displacement_at(const std::vector<Vec3>& points,
                                                   double outside_tolerance = 1e-9) const;
 
