@@ -276,6 +276,11 @@ class ElasticitySolver {
   /// matrix-free operator's cell kernel, as the multigrid's P1 level gets it; u (m) zero on the
   /// constrained DoFs. Displacement formulation only.
   [[nodiscard]] std::vector<double> matrix_free_matrix_product(const std::vector<double>& u) const;
+  /// The P2 multigrid's P1 → P2 prolongation P (detail::P1ToP2Embedding) against deal.II's
+  /// MGTwoLevelTransfer::reinit_polynomial_transfer on this solver's P2 DoFs: max |P x − P' x|
+  /// and max |Pᵀ y − P'ᵀ y| for random x, y (zero on the constrained DoFs), each relative to the
+  /// largest entry of P' x resp. P'ᵀ y. P2 displacement formulation only.
+  [[nodiscard]] std::array<double, 2> matrix_free_transfer_difference(unsigned seed) const;
 
   /// The solved DoF values (displacement, and pressure for the mixed formulation), in this
   /// solver's DoF numbering, which depends only on the mesh and the problem. Requires solve().

@@ -1,6 +1,7 @@
 #include "fem_reference/detail/matrix_free_elasticity.hpp"
 
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/fe_system.h>
@@ -16,6 +17,9 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -42,51 +46,91 @@ void stress_divergence(Evaluation& phi, double lambda, double mu) {
   phi.integrate(dl::EvaluationFlags::gradients);
 }
 
-/// The same a(u, v) on a straight-sided tet from the cell's dof values alone, in place: J⁻ᵀ and
-/// |det J| are constant on the cell, so phi needs MatrixFree's geometry at one point only, and ∇u
-/// is taken at a rule's Q points x_q (reference weights `weights`, summing to 1/6) from
-/// `ref_grad`, the scalar element's N shape gradients there, [(q·N + i)·3 + e] = ∂N_i/∂ξ_e(x_q).
-/// Dof values are component-major: phi.begin_dof_values()[c·N + i] (FESystem(FE_SimplexP, 3)).
-template <unsigned N, unsigned Q>
-void stress_divergence_straight(Evaluation& phi, const double* ref_grad, const double* weights,
-                                double lambda, double mu) {
-  Number* dofs = phi.begin_dof_values();
-  // inverse_jacobian(0)[d][e] = ∂ξ_e/∂x_d; JxW(0) = |det J|·(the one-point rule's weight 1/6).
-  const dl::Tensor<2, kDim, Number> inv_jt = phi.inverse_jacobian(0);
-  const Number det = 6.0 * phi.JxW(0);
-  std::array<Number, kDim * N> out{};
+/// Cells per batch of the straight-tet kernel: one AVX2 register of doubles per quantity.
+constexpr unsigned kLanes = 4;
+/// Doubles per cell of a batch's geometry: J⁻ᵀ (∂ξ_e/∂x_d at [3d + e]) and |det J|.
+constexpr unsigned kGeometry = kDim * kDim + 1;
+/// Two and four doubles as one GCC vector: arithmetic on them is lane-wise (a scalar operand is
+/// broadcast); an SSE2 and an AVX2 register.
+using Lanes2 = double __attribute__((vector_size(2 * sizeof(double))));
+using Lanes4 = double __attribute__((vector_size(4 * sizeof(double))));
+
+/// The displacement a(u, v) on V's lanes, as many of a batch's kLanes straight-sided tets at
+/// once (struct of arrays: entry [k·kLanes + l] belongs to cell l; the pointers start at V's
+/// first):
+/// out = A_e u_e for each cell, u_e from `in`, both component-major (k = c·N + i for component
+/// c of the scalar element's shape i), `geometry` [j·kLanes + l] as kGeometry describes. J⁻ᵀ and
+/// |det J| are constant on a straight-sided tet, so ∇u is taken at a rule's Q points x_q
+/// (reference weights `weights`, summing to 1/6) from `ref_grad`, the N shape gradients there,
+/// [(q·N + i)·3 + e] = ∂N_i/∂ξ_e(x_q); the stress is σ = λ tr(ε) I + 2μ ε (step-8's a(u, v)).
+template <typename V, unsigned N, unsigned Q>
+[[gnu::always_inline]] inline void straight_lanes(const double* in, double* out,
+                                                  const double* geometry, const double* ref_grad,
+                                                  const double* weights, double lambda, double mu) {
+  V u[kDim * N], a[kDim * N] = {}, inv_jt[kDim][kDim], det;
+  for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(&u[k], in + k * kLanes, sizeof(V));
+  for (unsigned j = 0; j < kDim * kDim; ++j) {
+    std::memcpy(&inv_jt[j / kDim][j % kDim], geometry + j * kLanes, sizeof(V));
+  }
+  std::memcpy(&det, geometry + kDim * kDim * kLanes, sizeof(V));
   for (unsigned q = 0; q < Q; ++q) {
     const double* g = ref_grad + q * N * kDim;
-    Number ref[kDim][kDim] = {};  // ∂u_c/∂ξ_e
+    V ref[kDim][kDim] = {};  // ∂u_c/∂ξ_e
     for (unsigned c = 0; c < kDim; ++c) {
       for (unsigned i = 0; i < N; ++i) {
-        for (unsigned e = 0; e < kDim; ++e) ref[c][e] += dofs[c * N + i] * g[i * kDim + e];
+        for (unsigned e = 0; e < kDim; ++e) ref[c][e] += u[c * N + i] * g[i * kDim + e];
       }
     }
-    Number grad[kDim][kDim];  // ∂u_c/∂x_d
+    V grad[kDim][kDim];  // ∂u_c/∂x_d
     for (unsigned c = 0; c < kDim; ++c) {
       for (unsigned d = 0; d < kDim; ++d) {
         grad[c][d] = inv_jt[d][0] * ref[c][0] + inv_jt[d][1] * ref[c][1] + inv_jt[d][2] * ref[c][2];
       }
     }
-    const Number w = det * weights[q];
-    const Number lambda_trace = (lambda * w) * (grad[0][0] + grad[1][1] + grad[2][2]);
-    Number sigma[kDim][kDim];  // w·σ, symmetric
+    const V w = det * weights[q];
+    const V lambda_trace = (lambda * w) * (grad[0][0] + grad[1][1] + grad[2][2]);
+    const V mu_w = mu * w;
     for (unsigned c = 0; c < kDim; ++c) {
-      for (unsigned d = 0; d < kDim; ++d) sigma[c][d] = (mu * w) * (grad[c][d] + grad[d][c]);
-      sigma[c][c] += lambda_trace;
-    }
-    for (unsigned c = 0; c < kDim; ++c) {
-      Number s[kDim];  // Σ_d wσ_cd ∂ξ_e/∂x_d
+      V sigma[kDim];  // row c of w·σ
+      for (unsigned d = 0; d < kDim; ++d) sigma[d] = mu_w * (grad[c][d] + grad[d][c]);
+      sigma[c] += lambda_trace;
+      V s[kDim];  // Σ_d wσ_cd ∂ξ_e/∂x_d
       for (unsigned e = 0; e < kDim; ++e) {
-        s[e] = sigma[c][0] * inv_jt[0][e] + sigma[c][1] * inv_jt[1][e] + sigma[c][2] * inv_jt[2][e];
+        s[e] = sigma[0] * inv_jt[0][e] + sigma[1] * inv_jt[1][e] + sigma[2] * inv_jt[2][e];
       }
       for (unsigned i = 0; i < N; ++i) {
-        out[c * N + i] += s[0] * g[i * kDim] + s[1] * g[i * kDim + 1] + s[2] * g[i * kDim + 2];
+        a[c * N + i] += s[0] * g[i * kDim] + s[1] * g[i * kDim + 1] + s[2] * g[i * kDim + 2];
       }
     }
   }
-  std::copy(out.begin(), out.end(), dofs);
+  for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(out + k * kLanes, &a[k], sizeof(V));
+}
+
+/// straight_lanes on a whole batch: two halves of SSE2 width (any x86-64) ...
+template <unsigned N, unsigned Q>
+void straight_batch_sse2(const double* in, double* out, const double* geometry,
+                         const double* ref_grad, const double* weights, double lambda, double mu) {
+  for (unsigned first = 0; first < kLanes; first += 2) {
+    straight_lanes<Lanes2, N, Q>(in + first, out + first, geometry + first, ref_grad, weights,
+                                 lambda, mu);
+  }
+}
+/// ... or at once in AVX2 registers, chosen at run time only on a CPU that has AVX2, so the
+/// project keeps building and running on any x86-64.
+template <unsigned N, unsigned Q>
+[[gnu::target("avx2")]] void straight_batch_avx2(const double* in, double* out,
+                                                 const double* geometry, const double* ref_grad,
+                                                 const double* weights, double lambda, double mu) {
+  straight_lanes<Lanes4, N, Q>(in, out, geometry, ref_grad, weights, lambda, mu);
+}
+/// The batch kernel for the scalar element's `n_shapes` (4: P1, 10: P2) on this CPU: AVX2 where
+/// it has it, unless the environment sets VESSELVERIFY_MATRIX_FREE_SSE2 (the tests, to check the
+/// SSE2 variant too; measurements).
+StraightTetKernel straight_batch_kernel(unsigned n_shapes) {
+  const bool avx2 =
+      __builtin_cpu_supports("avx2") && std::getenv("VESSELVERIFY_MATRIX_FREE_SSE2") == nullptr;
+  if (n_shapes == 4) return avx2 ? straight_batch_avx2<4, 1> : straight_batch_sse2<4, 1>;
+  return avx2 ? straight_batch_avx2<10, 4> : straight_batch_sse2<10, 4>;
 }
 
 using Clock = std::chrono::steady_clock;
@@ -132,6 +176,68 @@ dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<doubl
   return out;
 }
 
+bool plain_indexable(const dl::DoFHandler<kDim>& dof,
+                     const dl::AffineConstraints<double>& constraints) {
+  if (dynamic_cast<const dl::parallel::TriangulationBase<kDim>*>(&dof.get_triangulation()) !=
+      nullptr) {
+    return false;
+  }
+  const auto& lines = constraints.get_lines();
+  return std::all_of(lines.begin(), lines.end(), [](const auto& l) { return l.entries.empty(); });
+}
+
+P1ToP2Embedding::P1ToP2Embedding(const dl::DoFHandler<kDim>& p2, const dl::DoFHandler<kDim>& p1,
+                                 const dl::AffineConstraints<double>& p2_constraints,
+                                 const dl::AffineConstraints<double>& p1_constraints)
+    : from_(p2.n_dofs(), {kNone, kNone}) {
+  const auto& fe2 = p2.get_fe();
+  const auto& fe1 = p1.get_fe();
+  // Each P2 node is a vertex of the reference tet or the midpoint of two: which P1 shapes.
+  const auto& nodes = fe2.base_element(0).get_unit_support_points();
+  const auto& vertices = fe1.base_element(0).get_unit_support_points();
+  std::vector<std::array<unsigned, 2>> parents(nodes.size());
+  for (unsigned i = 0; i < nodes.size(); ++i) {
+    for (unsigned a = 0; a < vertices.size(); ++a) {
+      for (unsigned b = a; b < vertices.size(); ++b) {
+        if ((0.5 * (vertices[a] + vertices[b]) - nodes[i]).norm() < 1e-12) parents[i] = {a, b};
+      }
+    }
+  }
+  std::vector<dl::types::global_dof_index> fine(fe2.n_dofs_per_cell()),
+      coarse(fe1.n_dofs_per_cell());
+  auto cell1 = p1.begin_active();
+  for (const auto& cell2 : p2.active_cell_iterators()) {
+    cell2->get_dof_indices(fine);
+    cell1->get_dof_indices(coarse);
+    ++cell1;
+    for (unsigned k = 0; k < fine.size(); ++k) {
+      if (p2_constraints.is_constrained(fine[k])) continue;
+      const auto [c, i] = fe2.system_to_component_index(k);
+      for (unsigned j = 0; j < 2; ++j) {  // both, as another cell may order the edge otherwise
+        const auto parent = coarse[fe1.component_to_system_index(c, parents[i][j])];
+        from_[fine[k]][j] =
+            p1_constraints.is_constrained(parent) ? kNone : static_cast<unsigned>(parent);
+      }
+    }
+  }
+}
+
+void P1ToP2Embedding::prolongate_and_add(MfVector& p2, const MfVector& p1) const {
+  for (unsigned k = 0; k < from_.size(); ++k) {
+    for (const unsigned parent : from_[k]) {
+      if (parent != kNone) p2.local_element(k) += 0.5 * p1.local_element(parent);
+    }
+  }
+}
+
+void P1ToP2Embedding::restrict_and_add(MfVector& p1, const MfVector& p2) const {
+  for (unsigned k = 0; k < from_.size(); ++k) {
+    for (const unsigned parent : from_[k]) {
+      if (parent != kNone) p1.local_element(parent) += 0.5 * p2.local_element(k);
+    }
+  }
+}
+
 ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
                                        const dl::DoFHandler<kDim>& dof,
                                        const dl::AffineConstraints<double>& constraints, int degree,
@@ -144,8 +250,8 @@ ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
   // 2(degree − 1): the smallest rule exact for it gives the same bilinear form as the assembled
   // path's QGaussSimplex(degree + 1) (14 points per P2 cell). deal.II 9.4's MatrixFree takes only
   // QGaussSimplex and odd Witherden–Vincent rules on tets (get_unique_face_quadratures), not the
-  // 4-point one, so for P1 and P2 the kernel is our own (stress_divergence_straight) on
-  // MatrixFree's one-point geometry. Curved cells keep degree + 1, as the assembly does.
+  // 4-point one, so for P1 and P2 the kernel is our own (straight_batch) on MatrixFree's
+  // one-point geometry. Curved cells keep degree + 1, as the assembly does.
   const auto* fe_mapping = dynamic_cast<const dl::MappingFE<kDim>*>(&mapping);
   const bool affine = fe_mapping != nullptr && fe_mapping->get_degree() == 1;
   straight_ = affine && degree <= 2;
@@ -160,10 +266,70 @@ ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
         for (unsigned e = 0; e < kDim; ++e) ref_grad_.push_back(g[e]);
       }
     }
+    kernel_ = straight_batch_kernel(n_shapes_);
     mf_.reinit(mapping, dof, constraints, dl::QGaussSimplex<kDim>(1), data);
+    build_batches();
     return;
   }
   mf_.reinit(mapping, dof, constraints, quadrature_, data);
+}
+
+void ElasticityOperator::build_batches() {
+  if (!plain_indexable(mf_.get_dof_handler(), constraints_)) return;
+  const auto& fe = mf_.get_dof_handler().get_fe();
+  const unsigned per_cell = kDim * n_shapes_;
+  std::vector<unsigned> system_index(per_cell);  // component-major k = c·N + i → cell DoF
+  for (unsigned c = 0; c < kDim; ++c) {
+    for (unsigned i = 0; i < n_shapes_; ++i) {
+      system_index[c * n_shapes_ + i] = fe.component_to_system_index(c, i);
+    }
+  }
+  const unsigned n_cells = mf_.n_cell_batches();  // one cell each: no SIMD in this deal.II
+  const unsigned n_batches = (n_cells + kLanes - 1) / kLanes;
+  batch_dofs_.assign(std::size_t{n_batches} * per_cell * kLanes, kNoDof);
+  batch_geometry_.assign(std::size_t{n_batches} * kGeometry * kLanes, 0.0);
+  Evaluation phi(mf_);
+  std::vector<dl::types::global_dof_index> idx(per_cell);
+  for (unsigned cell = 0; cell < n_cells; ++cell) {
+    const unsigned b = cell / kLanes, l = cell % kLanes;
+    mf_.get_cell_iterator(cell, 0)->get_dof_indices(idx);
+    unsigned* dofs = batch_dofs_.data() + std::size_t{b} * per_cell * kLanes;
+    for (unsigned k = 0; k < per_cell; ++k) {
+      const auto i = idx[system_index[k]];
+      if (!constraints_.is_constrained(i)) dofs[k * kLanes + l] = static_cast<unsigned>(i);
+    }
+    phi.reinit(cell);
+    store_geometry(phi, batch_geometry_.data() + std::size_t{b} * kGeometry * kLanes + l);
+  }
+}
+
+template <typename Evaluation>
+void ElasticityOperator::store_geometry(const Evaluation& phi, double* lane) {
+  // inverse_jacobian(0)[d][e] = ∂ξ_e/∂x_d; JxW(0) = |det J|·(the one-point rule's weight 1/6).
+  const auto inv_jt = phi.inverse_jacobian(0);
+  for (unsigned d = 0; d < kDim; ++d) {
+    for (unsigned e = 0; e < kDim; ++e) lane[(d * kDim + e) * kLanes] = inv_jt[d][e][0];
+  }
+  lane[kDim * kDim * kLanes] = 6.0 * phi.JxW(0)[0];
+}
+
+void ElasticityOperator::apply_batches(MfVector& dst, const MfVector& src) const {
+  const unsigned per_batch = kDim * n_shapes_ * kLanes;
+  const double* w = quadrature_.get_weights().data();
+  std::array<double, kDim * 10 * kLanes> in{}, out{};
+  dst = 0.0;
+  const std::size_t n_batches = batch_geometry_.size() / (kGeometry * kLanes);
+  for (std::size_t b = 0; b < n_batches; ++b) {
+    const unsigned* idx = batch_dofs_.data() + b * per_batch;
+    for (unsigned j = 0; j < per_batch; ++j) {
+      in[j] = idx[j] == kNoDof ? 0.0 : src.local_element(idx[j]);
+    }
+    kernel_(in.data(), out.data(), batch_geometry_.data() + b * kGeometry * kLanes,
+            ref_grad_.data(), w, lambda_, mu_);
+    for (unsigned j = 0; j < per_batch; ++j) {
+      if (idx[j] != kNoDof) dst.local_element(idx[j]) += out[j];
+    }
+  }
 }
 
 template <typename Evaluation>
@@ -172,16 +338,30 @@ void ElasticityOperator::apply_cell(Evaluation& phi) const {
     stress_divergence(phi, lambda_, mu_);
     return;
   }
-  const double* w = quadrature_.get_weights().data();
-  if (n_shapes_ == 4) {
-    stress_divergence_straight<4, 1>(phi, ref_grad_.data(), w, lambda_, mu_);
-  } else {
-    stress_divergence_straight<10, 4>(phi, ref_grad_.data(), w, lambda_, mu_);
-  }
+  // The batch kernel on one cell: lane 0, the other lanes zero (|det J| = 0 gives them nothing).
+  std::array<double, kDim * 10 * kLanes> in{}, out{};
+  std::array<double, kGeometry * kLanes> geometry{};
+  const unsigned per_cell = kDim * n_shapes_;
+  for (unsigned k = 0; k < per_cell; ++k) in[k * kLanes] = phi.begin_dof_values()[k][0];
+  store_geometry(phi, geometry.data());
+  kernel_(in.data(), out.data(), geometry.data(), ref_grad_.data(),
+          quadrature_.get_weights().data(), lambda_, mu_);
+  for (unsigned k = 0; k < per_cell; ++k) phi.begin_dof_values()[k] = out[k * kLanes];
 }
 
 void ElasticityOperator::vmult(MfVector& dst, const MfVector& src) const {
   const auto t0 = Clock::now();
+  if (!batch_dofs_.empty()) {
+    apply_batches(dst, src);
+  } else {
+    cell_loop(dst, src);
+  }
+  for (const unsigned i : mf_.get_constrained_dofs()) dst.local_element(i) = src.local_element(i);
+  ++applications_;
+  seconds_ += seconds_since(t0);
+}
+
+void ElasticityOperator::cell_loop(MfVector& dst, const MfVector& src) const {
   const std::function<void(const dl::MatrixFree<kDim, double>&, MfVector&, const MfVector&,
                            const std::pair<unsigned, unsigned>&)>
       cells = [this](const dl::MatrixFree<kDim, double>& mf, MfVector& out, const MfVector& in,
@@ -195,9 +375,6 @@ void ElasticityOperator::vmult(MfVector& dst, const MfVector& src) const {
         }
       };
   mf_.cell_loop(cells, dst, src, true);
-  for (const unsigned i : mf_.get_constrained_dofs()) dst.local_element(i) = src.local_element(i);
-  ++applications_;
-  seconds_ += seconds_since(t0);
 }
 
 MfVector ElasticityOperator::diagonal() const {
@@ -281,7 +458,13 @@ class MatrixFreeElasticitySolver::VCycle {
                                                      lambda, mu);
       coarse = coarse_.get();
       profile.coarse_level = lap();
-      transfer_.reinit_polynomial_transfer(dof, coarse_dof_, fine_constraints, coarse_constraints_);
+      if (plain_indexable(dof, fine_constraints) &&
+          plain_indexable(coarse_dof_, coarse_constraints_)) {
+        embedding_.emplace(dof, coarse_dof_, fine_constraints, coarse_constraints_);
+      } else {
+        transfer_.reinit_polynomial_transfer(dof, coarse_dof_, fine_constraints,
+                                             coarse_constraints_);
+      }
       profile.transfer = lap();
 
       inverse_diagonal_ = std::make_shared<dl::DiagonalMatrix<MfVector>>();
@@ -357,13 +540,21 @@ class MatrixFreeElasticitySolver::VCycle {
     residual_.sadd(-1.0, 1.0, src);
     auto t0 = Clock::now();
     coarse_residual_ = 0.0;
-    transfer_.restrict_and_add(coarse_residual_, residual_);
+    if (embedding_) {
+      embedding_->restrict_and_add(coarse_residual_, residual_);
+    } else {
+      transfer_.restrict_and_add(coarse_residual_, residual_);
+    }
     coarse_->zero_constrained(coarse_residual_);
     transfer_seconds_ += seconds_since(t0);
     coarse_solve(coarse_correction_, coarse_residual_);
     coarse_->zero_constrained(coarse_correction_);
     t0 = Clock::now();
-    transfer_.prolongate_and_add(dst, coarse_correction_);
+    if (embedding_) {
+      embedding_->prolongate_and_add(dst, coarse_correction_);
+    } else {
+      transfer_.prolongate_and_add(dst, coarse_correction_);
+    }
     transfer_seconds_ += seconds_since(t0);
     fine_.zero_constrained(dst);
     fine_.vmult(residual_, dst);  // post-smoothing on the new residual
@@ -429,7 +620,8 @@ class MatrixFreeElasticitySolver::VCycle {
   dl::DoFHandler<kDim> coarse_dof_;
   dl::AffineConstraints<double> coarse_constraints_;
   std::unique_ptr<ElasticityOperator> coarse_;
-  dl::MGTwoLevelTransfer<kDim, MfVector> transfer_;
+  std::optional<P1ToP2Embedding> embedding_;         // both levels plain_indexable
+  dl::MGTwoLevelTransfer<kDim, MfVector> transfer_;  // otherwise
   std::shared_ptr<dl::DiagonalMatrix<MfVector>> inverse_diagonal_;
   Chebyshev chebyshev_;
   std::unique_ptr<CholmodFactor> cholmod_;                             // CoarseSolve::cholmod

@@ -17,6 +17,7 @@
 #include <deal.II/matrix_free/matrix_free.h>
 #include <deal.II/multigrid/mg_transfer_global_coarsening.h>
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <stdexcept>
@@ -29,6 +30,11 @@
 namespace vessel::fem::detail {
 
 using MfVector = dl::LinearAlgebra::distributed::Vector<double>;
+
+/// The straight-tet cell kernel on a batch of cells (the .cpp's straight_batch).
+using StraightTetKernel = void (*)(const double* in, double* out, const double* geometry,
+                                   const double* ref_grad, const double* weights, double lambda,
+                                   double mu);
 
 /// A(u) = ∫ σ(u) : ε(v) dV with σ = λ tr(ε) I + 2μ ε (Pa, so A u is in N for u in m), evaluated
 /// cell by cell on straight-sided tets at the fewest-point rule exact for the integrand's degree
@@ -64,7 +70,10 @@ class ElasticityOperator : public dl::Subscriptor {
   void compute_matrix(dl::TrilinosWrappers::SparseMatrix& matrix) const;
   /// Sets v to 0 on the constrained DoFs.
   void zero_constrained(MfVector& v) const;
-  [[nodiscard]] std::size_t memory_consumption() const { return mf_.memory_consumption(); }
+  [[nodiscard]] std::size_t memory_consumption() const {
+    return mf_.memory_consumption() + batch_dofs_.capacity() * sizeof(unsigned) +
+           batch_geometry_.capacity() * sizeof(double);
+  }
   /// vmult calls so far, and their wall-clock seconds.
   [[nodiscard]] unsigned applications() const { return applications_; }
   [[nodiscard]] double seconds() const { return seconds_; }
@@ -76,19 +85,64 @@ class ElasticityOperator : public dl::Subscriptor {
   /// One cell's A_e u_e in place on phi's dof values (an FEEvaluation; defined in the .cpp).
   template <typename Evaluation>
   void apply_cell(Evaluation& phi) const;
+  /// dst = A src by MatrixFree's cell loop, one FEEvaluation cell at a time (apply_cell).
+  void cell_loop(MfVector& dst, const MfVector& src) const;
+  /// straight_ on a serial mesh with constraints that only fix values: batch_dofs_ and
+  /// batch_geometry_ from MatrixFree's cells, in its order (otherwise left empty).
+  void build_batches();
+  /// phi's J⁻ᵀ and |det J| into one lane of a batch's geometry.
+  template <typename Evaluation>
+  static void store_geometry(const Evaluation& phi, double* lane);
+  /// dst = A src (free rows; constrained rows zero) by kernel_ on the batches.
+  void apply_batches(MfVector& dst, const MfVector& src) const;
 
   dl::MatrixFree<kDim, double> mf_;
   const dl::Mapping<kDim>& mapping_;
   dl::Quadrature<kDim> quadrature_;  // the integrand's rule (MatrixFree's one point if straight_)
-  bool straight_ = false;            // P1/P2 on straight-sided tets: stress_divergence_straight
+  bool straight_ = false;            // P1/P2 on straight-sided tets: straight_batch
   unsigned n_shapes_ = 0;            // straight_: the scalar element's shape functions
   std::vector<double> ref_grad_;     // straight_: their reference gradients at quadrature_
+  StraightTetKernel kernel_ = nullptr;  // straight_: for this CPU (AVX2 + FMA where it has them)
+  static constexpr unsigned kNoDof = ~0u;
+  // straight_ and batchable: each batch's cells' DoF indices [(b·3N + k)·lanes + l] (cell l of
+  // batch b, component-major local DoF k; kNoDof where constrained or padding) and their
+  // geometry [(b·10 + j)·lanes + l] (J⁻ᵀ row-major, then |det J|).
+  std::vector<unsigned> batch_dofs_;
+  std::vector<double> batch_geometry_;
   const dl::AffineConstraints<double>& constraints_;
   double lambda_, mu_;
   mutable MfVector diagonal_;  // el()'s, on first use
   unsigned n_quadrature_points_ = 0;
   mutable unsigned applications_ = 0;
   mutable double seconds_ = 0.0;
+};
+
+/// Whether vectors on `dof` can be read and written by plain DoF index with the constrained DoFs
+/// dropped: a serial mesh and constraints that only fix values (no entries).
+bool plain_indexable(const dl::DoFHandler<kDim>& dof,
+                     const dl::AffineConstraints<double>& constraints);
+
+/// The P1 → P2 prolongation on one mesh as nodal interpolation (exact, as P1 ⊂ P2): a P2 vertex
+/// DoF takes its P1 DoF's value, an edge-midpoint DoF the mean of its edge's two; the restriction
+/// is the transpose. The operator MGTwoLevelTransfer::reinit_polynomial_transfer builds for this
+/// pair, as two index reads per P2 DoF. Both levels plain_indexable: constrained DoFs are read
+/// and written as zero.
+class P1ToP2Embedding {
+ public:
+  /// `p2`, `p1`: FESystem(FE_SimplexP(2 resp. 1), 3) on the same triangulation.
+  P1ToP2Embedding(const dl::DoFHandler<kDim>& p2, const dl::DoFHandler<kDim>& p1,
+                  const dl::AffineConstraints<double>& p2_constraints,
+                  const dl::AffineConstraints<double>& p1_constraints);
+  /// p2 += P p1.
+  void prolongate_and_add(MfVector& p2, const MfVector& p1) const;
+  /// p1 += Pᵀ p2.
+  void restrict_and_add(MfVector& p1, const MfVector& p2) const;
+
+ private:
+  static constexpr unsigned kNone = ~0u;
+  // Per P2 DoF the two P1 DoFs it averages (the same one twice at a vertex); kNone where either
+  // level constrains the DoF.
+  std::vector<std::array<unsigned, 2>> from_;
 };
 
 /// The constraints' pattern with zero inhomogeneities (what MatrixFree and the transfer need).

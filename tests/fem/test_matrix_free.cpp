@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cstdlib>
 #include <iostream>
 #include <random>
 #include <utility>
@@ -66,6 +67,17 @@ TEST_P(MatrixFree, ProductEqualsAssembledMatrixOnFreeRows) {
       << "P" << GetParam();
 }
 
+// The same with the kernel's SSE2 variant, which runs on CPUs without AVX2 (this one would
+// otherwise pick AVX2).
+TEST_P(MatrixFree, Sse2KernelProductEqualsAssembledMatrixOnFreeRows) {
+  const ElasticitySolver s(test::short_tube_mesh(0), pressurised_tube(GetParam(), 0.3));
+  ::setenv("VESSELVERIFY_MATRIX_FREE_SSE2", "1", 1);
+  const double difference =
+      relative_product_difference(s, 9, [&](const auto& u) { return s.matrix_free_product(u); });
+  ::unsetenv("VESSELVERIFY_MATRIX_FREE_SSE2");
+  EXPECT_LT(difference, 1e-12) << "P" << GetParam();
+}
+
 // The sparse matrix MatrixFreeTools::compute_matrix builds from the same cell kernel (the P1
 // level's matrix for ML and CHOLMOD) against the assembled one.
 TEST_P(MatrixFree, KernelMatrixEqualsAssembledMatrixOnFreeRows) {
@@ -80,7 +92,7 @@ TEST_P(MatrixFree, KernelMatrixEqualsAssembledMatrixOnFreeRows) {
 // outer CG flexible) and a CHOLMOD factor (a limit above the P1 DoF count). P1 takes one ML
 // V-cycle.
 TEST_P(MatrixFree, CgWithPMultigridReachesCholmodSolution) {
-  for (const auto [nu, coarse_max_dofs] :
+  for (const auto& [nu, coarse_max_dofs] :
        {std::pair{0.0, std::size_t{0}}, {0.3, 0}, {0.45, 0}, {0.3, 1000000}, {0.45, 1000000}}) {
     auto p = pressurised_tube(GetParam(), nu);
     p.options.solver = LinearSolver::direct;
@@ -133,6 +145,15 @@ TEST_P(MatrixFree, DiagonalEqualsAssembledMatrixDiagonal) {
     diff = std::max(diff, row >= 0 ? std::abs(d[i] - k_diag[row]) : std::abs(d[i] - 1.0));
   }
   EXPECT_LT(diff, 1e-12 * k_diag.lpNorm<Eigen::Infinity>()) << "P" << GetParam();
+}
+
+// The multigrid's own P1 -> P2 prolongation (nodal interpolation, two index reads per P2 DoF)
+// and its transpose against deal.II's MGTwoLevelTransfer for the same pair of spaces.
+TEST(MatrixFreeTransfer, P1ToP2EmbeddingEqualsDealiiPolynomialTransfer) {
+  const ElasticitySolver s(test::short_tube_mesh(0), pressurised_tube(2, 0.3));
+  const auto [prolongation, restriction] = s.matrix_free_transfer_difference(3);
+  EXPECT_LT(prolongation, 1e-14);
+  EXPECT_LT(restriction, 1e-14);
 }
 
 INSTANTIATE_TEST_SUITE_P(Degrees, MatrixFree, ::testing::Values(1, 2));

@@ -225,6 +225,15 @@ void print_matrix_free_profile(const fem::MatrixFreeProfile& p) {
             << "; Chebyshev degree " << p.chebyshev_degree << std::defaultfloat << "\n";
 }
 
+/// Why this solver ran: --solver asked for it, or auto's DoF limit picked it.
+std::string solver_reason(const FemCommandOptions& o, const fem::ElasticityResult& r) {
+  if (o.solver != "auto") return "requested by --solver " + o.solver;
+  const bool mixed = r.n_pressure_dofs > 0;
+  const std::size_t limit = mixed ? o.direct_max_mixed_dofs : o.direct_max_dofs;
+  return "auto: " + std::to_string(r.n_dofs) + " DoFs " + (r.n_dofs <= limit ? "<=" : ">") +
+         (mixed ? " --direct-max-mixed-dofs " : " --direct-max-dofs ") + std::to_string(limit);
+}
+
 void print_solver(const fem::ElasticityResult& r) {
   std::cout << " " << fem::to_string(r.solver);
   if (r.solver == fem::LinearSolver::cg_amg) std::cout << ", " << r.iterations << " CG iterations";
@@ -399,6 +408,8 @@ void run_serial(const FemCommandOptions& o, const Scene& s, const TetMesh& mesh,
   std::cout << "\nsolving on " << solver_threads() << " thread(s) ..." << std::flush;
   run.result = solver.solve();
   print_solver(run.result);
+  std::cout << "solver " << fem::to_string(run.result.solver) << ": "
+            << solver_reason(o, run.result) << "\n";
   if (run.contact) run.contact->displacement = solver.displacement_at({run.contact->point})[0];
   const bool lame_setup = run.ends == "roller" && o.loads == std::vector<std::string>{"pressure"};
   if (lame_setup) {  // plane strain is exact with roller ends: Lamé's closed form applies
