@@ -460,6 +460,22 @@ double default_penalty(const WallPotential& wall, const std::vector<int>& candid
   return factor * largest;
 }
 
+/// a_jᵀ v over pair j's free rows (a_j its gap gradient).
+double pair_dot(const Linearisation& lin, std::size_t j, const VectorXd& v) {
+  double s = 0.0;
+  for (int i = 0; i < 9; ++i) {
+    if (lin.rows[j][i] >= 0) s += lin.gap_gradient[j][i] * v[lin.rows[j][i]];
+  }
+  return s;
+}
+
+/// v += s a_j over pair j's free rows.
+void add_pair(const Linearisation& lin, std::size_t j, double s, VectorXd& v) {
+  for (int i = 0; i < 9; ++i) {
+    if (lin.rows[j][i] >= 0) v[lin.rows[j][i]] += s * lin.gap_gradient[j][i];
+  }
+}
+
 /// The Newton model's matrix H(A) = B + Σ_{j∈A} k a_j a_jᵀ for the active sets A of one step's
 /// passes: H(A₀) factorised once, a later set's pairs that differ from A₀ applied as rank-one
 /// terms (+k entering, −k leaving; msm::LowRankUpdatedSolve), so a pass costs solves with the
@@ -532,12 +548,7 @@ class ModelMatrix {
   [[nodiscard]] VectorXd product(const std::vector<char>& active, const VectorXd& v) const {
     VectorXd out = base_ * v;  // both triangles stored
     for (std::size_t j = 0; j < active.size(); ++j) {
-      if (!active[j]) continue;
-      const msm::SparseColumn u = column(j);
-      double s = 0.0;
-      for (std::size_t i = 0; i < u.rows.size(); ++i) s += u.values[i] * v[u.rows[i]];
-      for (std::size_t i = 0; i < u.rows.size(); ++i)
-        out[u.rows[i]] += p_.stiffness() * s * u.values[i];
+      if (active[j]) add_pair(lin_, j, p_.stiffness() * pair_dot(lin_, j, v), out);
     }
     return out;
   }
@@ -573,10 +584,7 @@ bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gra
   // ∇Π without the pressed pairs' −λ∇g: the model adds each pair's own term.
   VectorXd g0 = gradient;
   for (std::size_t j = 0; j < m; ++j) {
-    if (lin.c[j] <= 0.0) continue;
-    for (int a = 0; a < 9; ++a) {
-      if (lin.rows[j][a] >= 0) g0[lin.rows[j][a]] += k * lin.c[j] * lin.gap_gradient[j][a];
-    }
+    if (lin.c[j] > 0.0) add_pair(lin, j, k * lin.c[j], g0);
   }
   std::vector<char> active(m), next(m);
   for (std::size_t j = 0; j < m; ++j) active[j] = lin.c[j] > 0.0;
@@ -584,19 +592,10 @@ bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gra
   for (int pass = 0; pass < 20; ++pass) {
     VectorXd rhs = -g0;
     for (std::size_t j = 0; j < m; ++j) {
-      if (!active[j]) continue;
-      for (int i = 0; i < 9; ++i) {
-        if (lin.rows[j][i] >= 0) rhs[lin.rows[j][i]] += k * lin.c[j] * lin.gap_gradient[j][i];
-      }
+      if (active[j]) add_pair(lin, j, k * lin.c[j], rhs);
     }
     if (!H.solve(active, rhs, dz)) return false;
-    for (std::size_t j = 0; j < m; ++j) {
-      double slope = 0.0;
-      for (int i = 0; i < 9; ++i) {
-        if (lin.rows[j][i] >= 0) slope += lin.gap_gradient[j][i] * dz[lin.rows[j][i]];
-      }
-      next[j] = lin.c[j] - slope > 0.0;
-    }
+    for (std::size_t j = 0; j < m; ++j) next[j] = lin.c[j] - pair_dot(lin, j, dz) > 0.0;
     if (next == active) break;
     active = next;
   }
