@@ -45,6 +45,10 @@ TEST(ContactReference, RefusesASceneWithoutAGuidewireAndABadStiffness) {
   ContactReferenceOptions bad;
   bad.ratio = 1.0;
   expect_input_error([&] { (void)solve_contact_reference(wire, 4e-7, bad); }, {"ratio > 1"});
+  ContactReferenceOptions bad_rungs;
+  bad_rungs.continuation_ratio = 1.0;
+  expect_input_error([&] { (void)solve_contact_reference(wire, 4e-7, bad_rungs); },
+                     {"continuation ratio > 1"});
   expect_input_error([] { (void)parse_contact_wall("hyperelastic"); },
                      {"linear", "neo-hookean", "hyperelastic"});
   EXPECT_EQ(parse_contact_wall("neo-hookean"), ContactWall::neo_hookean);

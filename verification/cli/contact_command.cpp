@@ -68,6 +68,15 @@ void add_contact_command(CLI::App& app) {
   cmd->add_option("--max-steps", o->options.max_steps, "Linearised contact steps per solve")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
+  cmd->add_option("--continuation-from", o->options.continuation_from,
+                  "Neo-Hookean wall: a stiffer wire is reached by raising EI from this, N·m², "
+                  "each rung solved from the last one's equilibrium")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--continuation-ratio", o->options.continuation_ratio,
+                  "Neo-Hookean wall: the EI ratio between the continuation's rungs (> 1)")
+      ->check(CLI::Range(1.01, 1e6))
+      ->capture_default_str();
   cmd->callback([o] {
     o->options.log = &std::cerr;  // progress; the table goes to stdout
     o->options.wall = parse_contact_wall(o->wall);

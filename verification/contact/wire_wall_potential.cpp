@@ -679,7 +679,8 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
                                                    const WallPotential& wall, const TetMesh& mesh,
                                                    const std::vector<int>& candidates,
                                                    const VectorXd& start,
-                                                   const PotentialContactOptions& options) {
+                                                   const PotentialContactOptions& options,
+                                                   const VectorXd& wall_start) {
   const auto t0 = Clock::now();
   if (rod.constraints() != nullptr) {
     throw InputError(
@@ -687,12 +688,17 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
   }
   if (!(radius > 0.0)) throw InputError("the wire's radius must be positive");
   if (start.size() != rod.num_dofs()) throw InputError("the wire's start has the wrong size");
+  if (wall_start.size() != 0 && wall_start.size() != wall.num_dofs()) {
+    throw InputError("the wall's start has " + std::to_string(wall_start.size()) +
+                     " rows; expected " + std::to_string(wall.num_dofs()) + " (or none: at rest)");
+  }
   const double k = options.penalty_stiffness > 0.0
                        ? options.penalty_stiffness
                        : default_penalty(wall, candidates, options.penalty_factor);
   Coupled problem(rod, radius, wall, mesh, candidates, start, k);
   rod.prepare(start);
-  VectorXd z = problem.pack(start, VectorXd::Zero(wall.num_dofs()));
+  VectorXd z =
+      problem.pack(start, wall_start.size() != 0 ? wall_start : VectorXd::Zero(wall.num_dofs()));
   PotentialContactSolution out;
   out.penalty_stiffness = k;
   const int rounds = options.augmented_lagrangian ? options.max_rounds : 1;

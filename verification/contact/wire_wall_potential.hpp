@@ -159,17 +159,19 @@ struct PotentialContactSolution {
   [[nodiscard]] Vec3 total_force_on_wall() const;
 };
 
-/// Minimises Π from the wire at `start` (e.g. its rigid-lumen state) and the wall at rest. The
-/// contact candidates are `candidates` (mesh nodes; e.g. the whole inner wall): each one's gap
-/// to the capsule enters Π. `rod`: without equality constraints (DER); its clamps are held; it
-/// is left prepared at the solution. Throws std::runtime_error naming the round, the residual
-/// and the penetration without convergence; InputError for a rod with constraints, r_w ≤ 0, a
-/// start of the wrong size or a candidate not in the mesh.
+/// Minimises Π from the wire at `start` (e.g. its rigid-lumen state) and the wall at
+/// `wall_start` (its free rows, m; empty: at rest), e.g. the equilibrium of a softer wire on the
+/// same wall. The contact candidates are `candidates` (mesh nodes; e.g. the whole inner wall):
+/// each one's gap to the capsule enters Π. `rod`: without equality constraints (DER); its clamps
+/// are held; it is left prepared at the solution. Throws std::runtime_error naming the round, the
+/// residual and the penetration without convergence; InputError for a rod with constraints,
+/// r_w ≤ 0, a start of the wrong size or a candidate not in the mesh.
 PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double radius,
                                                    const WallPotential& wall, const TetMesh& mesh,
                                                    const std::vector<int>& candidates,
                                                    const Eigen::VectorXd& start,
-                                                   const PotentialContactOptions& options = {});
+                                                   const PotentialContactOptions& options = {},
+                                                   const Eigen::VectorXd& wall_start = {});
 
 /// The force the clamp exerts on the wire at a solution (N): the rod's internal force and its
 /// contact share summed over the held nodes' positions.

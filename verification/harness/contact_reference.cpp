@@ -27,14 +27,23 @@ double seconds_since(Clock::time_point t0) {
 
 /// The wire: DER at the scene's segments, at the rigid-wall state.
 struct ReferenceWire {
+  GuidewireSpec spec;
   msm::rods::DerRod rod;
   Eigen::VectorXd rigid_state;
   double radius = 0.0;
-  explicit ReferenceWire(const GuidewireSpec& spec, const Eigen::VectorXd& state)
-      : rod(msm::rods::make_layout(guidewire_rod_spec(spec, spec.insertion))),
+  double bending_stiffness = 0.0;  ///< EI, N·m²
+  explicit ReferenceWire(const GuidewireSpec& s, const Eigen::VectorXd& state)
+      : spec(s),
+        rod(msm::rods::make_layout(guidewire_rod_spec(s, s.insertion))),
         rigid_state(state),
-        radius(0.5 * spec.diameter) {
+        radius(0.5 * s.diameter),
+        bending_stiffness(msm::rods::solid_section({s.young, s.shear, s.density}, s.diameter).EI) {
     rod.prepare(rigid_state);
+  }
+  /// The same wire with its E and G scaled to bending stiffness EI (N·m²). Its rigid-lumen shape
+  /// is the same at every EI: the rod's whole energy scales with E, the lumen is geometric.
+  [[nodiscard]] ReferenceWire with_bending_stiffness(double EI) const {
+    return ReferenceWire(with_stiffness(spec, EI), rigid_state);
   }
   [[nodiscard]] contact::ContactWire contact() const { return contact::contact_wire(rod, radius); }
 };
@@ -113,27 +122,69 @@ void solve_linear_wall(const Scene& scene, const ReferenceWire& wire, double nu,
   out.strain = contact::largest_strain(mesh, u).small;
 }
 
+/// The bending stiffnesses of the continuation towards `target` (N·m², ascending, ending at
+/// target): from `first` in steps of `ratio`, or the target alone when it is not above `first`.
+std::vector<double> continuation_rungs(double first, double ratio, double target) {
+  std::vector<double> rungs;
+  if (target > first) {
+    const int n = static_cast<int>(std::ceil(std::log(target / first) / std::log(ratio) - 1e-9));
+    for (int k = n; k >= 1; --k) rungs.push_back(target / std::pow(ratio, k));
+  }
+  rungs.push_back(target);
+  return rungs;
+}
+
 /// The finite-strain wall: the wire and the neo-Hookean wall as one potential
-/// (solve_wire_wall_potential), every inner-wall node a candidate.
+/// (solve_wire_wall_potential), every inner-wall node a candidate. A stiff wire dents the wall
+/// by millimetres, and Newton's method from the rigid-lumen state (the wall at rest) does not
+/// reach that equilibrium; so the wire's stiffness is raised in rungs (continuation_rungs), each
+/// solved from the last rung's equilibrium (the wire's rigid-lumen shape holds at every EI). A
+/// rung that fails is split at its geometric mean with the last converged one, up to 3 times.
 void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, double nu,
                             const TetMesh& mesh, const Vec3& centre, double radius,
                             double force_scale, const ContactReferenceOptions& o,
                             ContactLevel& out) {
   const contact::NeoHookeanWall wall(mesh, wall_problem(scene, nu, o.degree));
   const std::vector<int> nodes = mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
-  msm::rods::DerRod rod = wire.rod;
+  const double target = wire.bending_stiffness;
   contact::PotentialContactOptions po;
-  po.force_scale = force_scale;
   // ‖∇Π‖ to 1e-8 of the rigid-wall force: the force to ~1e-8 of itself, short of the
   // neo-Hookean energy's round-off floor where the line search stalls.
   po.tolerance = 1e-8;
   po.max_newton = o.max_steps;
   po.log = o.log;
-  const contact::PotentialContactSolution s = contact::solve_wire_wall_potential(
-      rod, wire.radius, wall, mesh, nodes, wire.rigid_state, po);
+  std::vector<double> rungs =
+      continuation_rungs(o.continuation_from, o.continuation_ratio, target);
+  Eigen::VectorXd x = wire.rigid_state, u;
+  double done = 0.0;  // the EI of the equilibrium in hand (0: the rigid-lumen state, wall at rest)
+  int splits = 0;
+  contact::PotentialContactSolution s;
+  for (std::size_t k = 0; k < rungs.size();) {
+    ReferenceWire rung = wire.with_bending_stiffness(rungs[k]);
+    po.force_scale = force_scale * rungs[k] / target;
+    try {
+      s = contact::solve_wire_wall_potential(rung.rod, wire.radius, wall, mesh, nodes, x, po, u);
+    } catch (const std::runtime_error& e) {
+      if (splits == 3 || done == 0.0) throw;
+      ++splits;
+      if (o.log) *o.log << "contact:   EI " << rungs[k] << " N·m² failed; split" << std::endl;
+      rungs.insert(rungs.begin() + static_cast<std::ptrdiff_t>(k), std::sqrt(done * rungs[k]));
+      continue;
+    }
+    out.steps += s.newton_iterations;
+    ++out.rungs;
+    if (o.log && rungs.size() > 1) {
+      *o.log << "contact:   EI " << rungs[k] << " N·m²: F " << s.total_force_on_wall().norm() * 1e3
+             << " mN, " << s.pressed.size() << " pressed, " << s.newton_iterations << " steps"
+             << std::endl;
+    }
+    x = s.x;
+    u = s.u;
+    done = rungs[k];
+    ++k;
+  }
   out.converged = true;
   out.candidates = static_cast<int>(nodes.size());
-  out.steps = s.newton_iterations;
   out.force = s.total_force_on_wall().norm();
   describe_zone(mesh, s.pressed, s.force, wall.nodal(s.u), centre, radius, out);
   out.strain = wall.largest_strain(mesh, s.u);
@@ -225,10 +276,12 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
   require_guidewire(scene);
   if (o.levels < 1 || !(o.coarsest_size > 0.0) || !(o.ratio > 1.0) ||
       (o.degree != 1 && o.degree != 2) || !(o.margin >= 0.0) || !(o.band > 0.0) ||
-      !(o.strain_limit > 0.0) || o.max_steps < 1) {
+      !(o.strain_limit > 0.0) || o.max_steps < 1 || !(o.continuation_from > 0.0) ||
+      !(o.continuation_ratio > 1.0)) {
     throw InputError(
         "contact reference options: expected levels ≥ 1, a positive coarsest size, "
-        "ratio > 1, degree 1 or 2, margin ≥ 0, band > 0, strain limit > 0, steps ≥ 1");
+        "ratio > 1, degree 1 or 2, margin ≥ 0, band > 0, strain limit > 0, steps ≥ 1, a "
+        "positive continuation start and a continuation ratio > 1");
   }
   GuidewireSpec spec;
   try {
@@ -353,6 +406,7 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
         << ", " << fixed(l.centroid.y() * 1e3, 2) << ", " << fixed(l.centroid.z() * 1e3, 2)
         << ") | " << fixed(l.extent * 1e3, 3) << (l.zone_inside_patch ? "" : " (leaves the patch)")
         << " | " << fixed(l.dent * 1e3, 3) << " | " << fixed(l.strain, 3) << " | " << l.steps
+        << (l.rungs > 1 ? " in " + std::to_string(l.rungs) + " EI rungs" : std::string())
         << " | " << fixed(l.seconds, 1) << " |\n";
   }
   for (const ContactLevel& l : r.levels) {

@@ -45,6 +45,11 @@ struct ContactReferenceOptions {
   /// the linear wall's validity: largest strain at most this (the neo-Hookean wall has no limit)
   double strain_limit = 0.1;
   int max_steps = 300;          ///< linearised contact steps per solve
+  /// The neo-Hookean wall: a stiffer wire is reached by raising EI from this (N·m²) in steps of
+  /// continuation_ratio, each solved from the last one's equilibrium (4e-7: the floppy wire of
+  /// the shipped scenes, which Newton reaches from the rigid-lumen state on their 14.24 kPa wall)
+  double continuation_from = 4e-7;
+  double continuation_ratio = 10.0;
   std::ostream* log = nullptr;  ///< one line per solve (mesh, candidates, result), if set
 };
 
@@ -67,7 +72,8 @@ struct ContactLevel {
   /// displacements (linear wall), Green–Lagrange at the quadrature points (neo-Hookean wall)
   double strain = 0.0;
   bool zone_inside_patch = true;  ///< every pressed node within the refined ball
-  int steps = 0;                  ///< linearised steps over all growth rounds (0 if not converged)
+  int steps = 0;  ///< linearised steps over all growth rounds or rungs (0 if not converged)
+  int rungs = 0;  ///< the neo-Hookean wall's stiffness continuation: solves to reach the EI
   double seconds = 0.0;           ///< meshing, condensing and solving this level
 };
 

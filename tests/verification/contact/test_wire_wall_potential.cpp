@@ -279,3 +279,45 @@ TEST(WireWallPotentialSlow, ModelEnergyWallEqualsTheFemWall) {
   EXPECT_EQ(a.solution.pressed, b.solution.pressed);
   EXPECT_NEAR(Fa, Fb, 1e-8 * Fa);
 }
+
+// The wall's start (a stiffness continuation's rung): the wire at a tenth of its EI solved first,
+// then the wire at its EI from that equilibrium (the softer wire's centreline, the wall's dented
+// displacement) reaches the equilibrium the solve from the rigid-lumen state with the wall at rest
+// reaches (the same minimiser of Π: the same pressed nodes, the force to 1e-7). The rigid-lumen
+// shape a continuation starts every rung from does not depend on EI (the rod's energy scales
+// with E): the softer wire's rigid-wall solve gives the same centreline to 1e-9 of the radius.
+TEST(WireWallPotentialSlow, ContinuationFromASofterWireReachesTheDirectSolve) {
+  const TetMesh mesh = line_of_contact_mesh();
+  const std::vector<int> nodes = nodes_within(mesh, kAimPoint, 1.6e-3);
+  const contact::NeoHookeanWall wall(mesh, wall_problem(kWallE * 30));
+  const PotentialRun direct = potential_run(mesh, kAimPoint, wall, nodes);
+
+  const double d = 0.356e-3, c = kA - d / 2;
+  const double length = rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
+  const Vec3 origin(0, 0, kAimPoint.z() - kZc);
+  msm::rods::RodMaterial soft = kNitinol;
+  soft.young /= 10;
+  soft.shear /= 10;
+  Wire w_soft(d, length, 32, origin, soft), w(d, length, 32, origin);
+  const RigidRun rigid_soft = rigid_run(w_soft), rigid = rigid_run(w);
+  EXPECT_LT((rigid_soft.x - rigid.x).cwiseAbs().maxCoeff(), 1e-9 * w.radius);
+  contact::PotentialContactOptions o;
+  o.force_scale = w_soft.EI / (kZc * kZc);
+  const contact::PotentialContactSolution s_soft = contact::solve_wire_wall_potential(
+      w_soft.rod, w_soft.radius, wall, mesh, nodes, rigid_soft.x, o);
+  o.force_scale = w.EI / (kZc * kZc);
+  const contact::PotentialContactSolution s = contact::solve_wire_wall_potential(
+      w.rod, w.radius, wall, mesh, nodes, s_soft.x, o, s_soft.u);
+  const double F = s.total_force_on_wall().norm();
+  const double F_direct = direct.solution.total_force_on_wall().norm();
+  std::printf(
+      "WIRE-WALL-POTENTIAL continuation: EI/10 %.8e N (%d Newton), then EI %.8e N (%d Newton) "
+      "against the direct %.8e N (%d Newton), %+.1e\n",
+      s_soft.total_force_on_wall().norm(), s_soft.newton_iterations, F, s.newton_iterations,
+      F_direct, direct.solution.newton_iterations, F / F_direct - 1);
+  EXPECT_EQ(s.pressed, direct.solution.pressed);
+  EXPECT_NEAR(F, F_direct, 1e-7 * F_direct);
+  EXPECT_THROW((void)contact::solve_wire_wall_potential(w.rod, w.radius, wall, mesh, nodes,
+                                                        s_soft.x, o, VectorXd::Zero(5)),
+               InputError);
+}
