@@ -626,6 +626,10 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
       return out;
     }
     if (it == o.max_newton) break;
+    if (o.log && it > 0 && it % 25 == 0) {
+      *o.log << "potential contact:   step " << it << ", residual " << out.residual << " N, "
+             << out.factorisations << " factorisations" << std::endl;
+    }
     bool descent = newton_step(p, lin, g, dz, out.factorisations) && g.dot(dz) < 0.0;
     if (!descent) {
       (void)p.evaluate(z, g, &lin, true, band);

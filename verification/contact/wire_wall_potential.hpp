@@ -133,7 +133,7 @@ struct PotentialContactOptions {
   double max_move = 0.5;        ///< × r_w: the largest node move of one Newton step
   int max_newton = 300;         ///< Newton steps per round
   int max_rounds = 40;          ///< augmented-Lagrangian rounds
-  std::ostream* log = nullptr;  ///< one line per round, if set
+  std::ostream* log = nullptr;  ///< one line per round and per 25 Newton steps, if set
 };
 
 struct PotentialContactSolution {
