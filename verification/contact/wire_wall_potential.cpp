@@ -617,6 +617,10 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
   Linearisation lin;
   const double target = o.tolerance * o.force_scale;
   const double band = o.max_move * p.radius();
+  struct {
+    int projected = 0, steepest = 0, capped = 0;
+    double move = 0.0;  // r_w
+  } recent;  // for the progress line
   for (int it = 0; it <= o.max_newton; ++it) {
     const double pi = p.evaluate(z, g, &lin, false, band);
     out.residual = g.norm();
@@ -628,14 +632,22 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     if (it == o.max_newton) break;
     if (o.log && it > 0 && it % 25 == 0) {
       *o.log << "potential contact:   step " << it << ", residual " << out.residual << " N, "
-             << out.factorisations << " factorisations" << std::endl;
+             << out.factorisations << " factorisations; the last 25 steps: " << recent.projected
+             << " on the PSD-projected Hessian, " << recent.steepest << " steepest descent, "
+             << recent.capped << " capped at the largest move, mean move "
+             << recent.move / 25.0 << " r_w" << std::endl;
+      recent = {};
     }
     bool descent = newton_step(p, lin, g, dz, out.factorisations) && g.dot(dz) < 0.0;
     if (!descent) {
+      ++recent.projected;
       (void)p.evaluate(z, g, &lin, true, band);
       descent = newton_step(p, lin, g, dz, out.factorisations) && g.dot(dz) < 0.0;
     }
-    if (!descent) dz = -g * (p.radius() / std::max(g.norm(), 1e-300));  // steepest descent
+    if (!descent) {
+      ++recent.steepest;
+      dz = -g * (p.radius() / std::max(g.norm(), 1e-300));
+    }
     const double move = p.largest_move(dz);
     double alpha = std::min(1.0, o.max_move * p.radius() / std::max(move, 1e-300));
     const double slope = g.dot(dz);
@@ -666,6 +678,8 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     }
     z = trial;
     p.prepare(z);
+    recent.capped += alpha0 < 1.0 && alpha == alpha0;
+    recent.move += alpha * move / p.radius();
     // A stiff wall's forces (K u with K up to ~1e6 N/m) floor ‖∇Π‖ above the target by round-off:
     // a step that moves nothing by 1e-12 r_w ends the iteration there.
     if (alpha * move <= 1e-12 * p.radius() && out.residual <= 1e3 * target) {

@@ -167,7 +167,10 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
     } catch (const std::runtime_error& e) {
       if (splits == 3 || done == 0.0) throw;
       ++splits;
-      if (o.log) *o.log << "contact:   EI " << rungs[k] << " N·m² failed; split" << std::endl;
+      if (o.log) {
+        *o.log << "contact:   EI " << rungs[k] << " N·m² failed (" << e.what()
+               << "); the rung split at " << std::sqrt(done * rungs[k]) << " N·m²" << std::endl;
+      }
       rungs.insert(rungs.begin() + static_cast<std::ptrdiff_t>(k), std::sqrt(done * rungs[k]));
       continue;
     }
