@@ -624,8 +624,27 @@ FreeDisplacementSystem HyperelasticSolver::free_dofs() const {
   return out;
 }
 
+namespace {
+
+/// k with its negative eigenvalues set to zero (k symmetric).
+void project_onto_psd_cone(dl::FullMatrix<double>& k) {
+  const auto n = static_cast<Eigen::Index>(k.m());
+  Eigen::MatrixXd a(n, n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j) a(i, j) = k(i, j);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(a);
+  if (es.eigenvalues().minCoeff() >= 0.0) return;
+  a = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() *
+      es.eigenvectors().transpose();
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j) k(i, j) = a(i, j);
+}
+
+}  // namespace
+
 FreeHyperelasticState HyperelasticSolver::free_state(const Eigen::VectorXd& u_free,
-                                                     bool with_tangent) const {
+                                                     bool with_tangent,
+                                                     bool project_tangent) const {
   auto& im = *impl_;
   if (im.mixed) {
     throw InputError("the free DoFs' state is for the displacement formulation, not the mixed one");
@@ -642,11 +661,17 @@ FreeHyperelasticState HyperelasticSolver::free_state(const Eigen::VectorXd& u_fr
   if (with_tangent) im.d.matrix = 0.0;  // scratch: the assembled path's matrix
   std::vector<Index> cols;
   std::vector<double> vals;
+  dl::FullMatrix<double> projected;
   // Load factor 0: the strain energy alone (loads and prescribed values are not applied).
   const PassStats st = im.pass(
       w, 0.0, with_tangent,
-      [&](const std::vector<Index>& dofs, const dl::FullMatrix<double>& k, const auto&,
+      [&](const std::vector<Index>& dofs, const dl::FullMatrix<double>& exact, const auto&,
           const dl::Vector<double>& r_int) {
+        if (with_tangent && project_tangent) {
+          projected = exact;
+          project_onto_psd_cone(projected);
+        }
+        const dl::FullMatrix<double>& k = with_tangent && project_tangent ? projected : exact;
         for (unsigned i = 0; i < dofs.size(); ++i) {
           const int fi = im.free_index[dofs[i]];
           if (fi < 0) continue;

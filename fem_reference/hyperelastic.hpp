@@ -158,9 +158,13 @@ class HyperelasticSolver {
   [[nodiscard]] FreeDisplacementSystem free_dofs() const;
   /// The strain energy, its gradient and (with_tangent) its Hessian at the displacement u_free
   /// (m, one value per free row; the constrained DoFs at zero). An inverted element gives
-  /// admissible = false. Requires what free_dofs() requires.
-  [[nodiscard]] FreeHyperelasticState free_state(const Eigen::VectorXd& u_free,
-                                                 bool with_tangent) const;
+  /// admissible = false. Requires what free_dofs() requires. With project_tangent each cell's
+  /// tangent is projected onto the positive semidefinite cone before assembly (its negative
+  /// eigenvalues set to zero), so the Hessian is positive semidefinite where a compressed or
+  /// buckling wall's exact one is not: the projected Newton of minimisers (Teran et al. 2005,
+  /// "Robust quasistatic finite elements and flesh simulation").
+  [[nodiscard]] FreeHyperelasticState free_state(const Eigen::VectorXd& u_free, bool with_tangent,
+                                                 bool project_tangent = false) const;
 
   [[nodiscard]] std::size_t n_dofs() const;
   /// Per DoF: its component (0–2 displacement, 3 the mixed form's pressure).

@@ -31,7 +31,7 @@ std::vector<Vec3> WallPotential::nodal(const VectorXd& u) const {
 }
 
 double LinearWall::evaluate(const VectorXd& u, VectorXd* gradient,
-                            Eigen::SparseMatrix<double>* hessian) const {
+                            Eigen::SparseMatrix<double>* hessian, bool /*project_psd*/) const {
   const VectorXd Ku = s_.K * u;
   if (gradient) *gradient = Ku - s_.f;
   if (hessian) *hessian = s_.K;
@@ -50,8 +50,8 @@ NeoHookeanWall::NeoHookeanWall(const TetMesh& mesh, fem::ElasticityProblem probl
 }
 
 double NeoHookeanWall::evaluate(const VectorXd& u, VectorXd* gradient,
-                                Eigen::SparseMatrix<double>* hessian) const {
-  fem::FreeHyperelasticState s = solver_->free_state(u, hessian != nullptr);
+                                Eigen::SparseMatrix<double>* hessian, bool project_psd) const {
+  fem::FreeHyperelasticState s = solver_->free_state(u, hessian != nullptr, project_psd);
   if (gradient) *gradient = std::move(s.gradient);
   if (hessian) *hessian = std::move(s.tangent);
   return s.admissible ? s.energy : std::numeric_limits<double>::infinity();
@@ -94,7 +94,7 @@ VectorXd FormWall::positions(const VectorXd& u) const {
 }
 
 double FormWall::evaluate(const VectorXd& u, VectorXd* gradient,
-                          Eigen::SparseMatrix<double>* hessian) const {
+                          Eigen::SparseMatrix<double>* hessian, bool project_psd) const {
   const VectorXd x = positions(u);
   if (gradient) {
     VectorXd g;
@@ -106,7 +106,7 @@ double FormWall::evaluate(const VectorXd& u, VectorXd* gradient,
   }
   if (hessian) {
     Eigen::SparseMatrix<double> H;
-    form_.hessian(x, H, false);
+    form_.hessian(x, H, project_psd);
     Triplets t;
     t.reserve(static_cast<std::size_t>(H.nonZeros()));
     for (Eigen::Index c = 0; c < H.outerSize(); ++c) {
@@ -295,15 +295,15 @@ class Coupled {
   }
 
   /// ∇Π at z and, with `lin`, the Newton model's pieces: the rod's and the wall's Hessians and
-  /// each pressed pair's curvature −λ∇²d (with `project`, the rod's element blocks and those
-  /// 9 × 9 blocks projected onto the PSD cone), and every pair within `band` of pressing with its
+  /// each pressed pair's curvature −λ∇²d (with `project`, the rod's and the wall's element
+  /// blocks and those 9 × 9 blocks projected onto the PSD cone), and every pair within `band` of pressing with its
   /// gap's gradient and c = λ̂/k − g (pressed while c − ∇g·dz > 0 in the model).
   double evaluate(const VectorXd& z, VectorXd& gradient, Linearisation* lin, bool project,
                   double band = 0.0) const {
     const VectorXd x = rod_dofs(z), u = wall_rows(z);
     VectorXd gw;
     Eigen::SparseMatrix<double> hw;
-    const double w = wall_.evaluate(u, &gw, lin ? &hw : nullptr);
+    const double w = wall_.evaluate(u, &gw, lin ? &hw : nullptr, project);
     VectorXd gr;
     rod_.gradient(x, gr);
     gradient.setZero(size());

@@ -41,9 +41,10 @@ class WallPotential {
   /// Per mesh node, the rows of its x, y, z displacement (−1 where held).
   [[nodiscard]] virtual const std::vector<std::array<int, 3>>& node_rows() const = 0;
   /// The energy at u (J; +∞ where an element is inverted), its gradient (N) and Hessian (N/m)
-  /// when asked.
+  /// when asked; with project_psd the Hessian's element blocks projected onto the positive
+  /// semidefinite cone (a linear wall's already are).
   virtual double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
-                          Eigen::SparseMatrix<double>* hessian) const = 0;
+                          Eigen::SparseMatrix<double>* hessian, bool project_psd = false) const = 0;
   /// The largest principal strain at u: small strain for a linear wall, Green–Lagrange for a
   /// finite-strain one.
   [[nodiscard]] virtual double largest_strain(const TetMesh& mesh,
@@ -61,7 +62,7 @@ class LinearWall final : public WallPotential {
     return s_.node_rows;
   }
   double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
-                  Eigen::SparseMatrix<double>* hessian) const override;
+                  Eigen::SparseMatrix<double>* hessian, bool project_psd = false) const override;
   [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
 
  private:
@@ -78,7 +79,7 @@ class NeoHookeanWall final : public WallPotential {
     return dofs_.node_rows;
   }
   double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
-                  Eigen::SparseMatrix<double>* hessian) const override;
+                  Eigen::SparseMatrix<double>* hessian, bool project_psd = false) const override;
   [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
   /// The supports' total reaction at u (N): the internal forces on the held DoFs, summed per
   /// component.
@@ -104,7 +105,7 @@ class FormWall final : public WallPotential {
     return node_rows_;
   }
   double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
-                  Eigen::SparseMatrix<double>* hessian) const override;
+                  Eigen::SparseMatrix<double>* hessian, bool project_psd = false) const override;
   /// The P1 small strain of the tets whose four nodes the model carries (NaN if none).
   [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
 
