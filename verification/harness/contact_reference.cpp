@@ -10,6 +10,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/rods/der_rod.hpp"
+#include "verification/contact/wall_crossing.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
@@ -59,6 +60,27 @@ std::vector<int> candidates(const TetMesh& mesh, const contact::ContactWire& wir
     if ((p - centre).norm() <= radius && contact::capsule_gap(wire, x, p) <= band) out.push_back(n);
   }
   return out;
+}
+
+/// Throws std::runtime_error when the solved wire's centreline (rod dofs x) crosses the inner
+/// wall displaced by u (per mesh node): the capsule passed between the wall's nodes, which the
+/// nodes' gaps cannot see (verification/contact/wall_crossing.hpp).
+void require_wire_inside_lumen(const TetMesh& mesh, const msm::rods::Rod& rod,
+                               const Eigen::VectorXd& x, const std::vector<Vec3>& u) {
+  std::vector<Vec3> centreline;
+  for (int i = rod.layout().first_node; i <= rod.layout().tip_node; ++i) {
+    centreline.emplace_back(x.segment<3>(3 * i));
+  }
+  const std::vector<Triangle> wall =
+      mesh.group_triangles(mesh.require_group("inner_wall", 2, "vessel"));
+  if (const auto c = contact::first_wall_crossing(mesh, wall, u, centreline)) {
+    std::ostringstream m;
+    m.precision(3);
+    m << "the wire's centreline crosses the wall at (" << c->point.x() * 1e3 << ", "
+      << c->point.y() * 1e3 << ", " << c->point.z() * 1e3 << ") mm (segment " << c->segment
+      << "): it passed between the wall's nodes, whose spacing there exceeds the wire's diameter";
+    throw std::runtime_error(m.str());
+  }
 }
 
 /// The zone of a solved contact: the pressed nodes (mesh indices) with their forces, the wall's
@@ -115,6 +137,7 @@ void solve_linear_wall(const Scene& scene, const ReferenceWire& wire, double nu,
   out.steps = s.newton_iterations;
   out.force = s.total_force_on_wall().norm();
   const std::vector<Vec3> u = grown.wall->displacement(s.wall_loads());
+  require_wire_inside_lumen(mesh, wire.rod, s.x, u);
   std::vector<int> pressed;
   std::vector<double> force;
   grown.pressed(pressed, force);
@@ -186,10 +209,12 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
     done = rungs[k];
     ++k;
   }
+  const std::vector<Vec3> displacement = wall.nodal(s.u);
+  require_wire_inside_lumen(mesh, wire.rod, s.x, displacement);
   out.converged = true;
   out.candidates = static_cast<int>(nodes.size());
   out.force = s.total_force_on_wall().norm();
-  describe_zone(mesh, s.pressed, s.force, wall.nodal(s.u), centre, radius, out);
+  describe_zone(mesh, s.pressed, s.force, displacement, centre, radius, out);
   out.strain = wall.largest_strain(mesh, s.u);
 }
 

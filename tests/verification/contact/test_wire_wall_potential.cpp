@@ -17,6 +17,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "msm/fem/linear_tet.hpp"
 #include "verification/contact/point_segment_distance.hpp"
+#include "verification/contact/wall_crossing.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
 #include "wire_in_tube.hpp"
 
@@ -73,6 +74,41 @@ TEST(PointSegmentDistance, DerivativesMatchFiniteDifferences) {
     }
   }
   EXPECT_THROW((void)contact::point_segment_distance(a, a, a, false), std::invalid_argument);
+}
+
+// Möller–Trumbore by hand: the triangle (0,0,0), (1,0,0), (0,1,0) in z = 0.
+TEST(WallCrossing, SegmentTriangleByHand) {
+  const Vec3 p(0, 0, 0), q(1, 0, 0), r(0, 1, 0);
+  const auto through = contact::segment_triangle_crossing(Vec3(0.2, 0.3, -1), Vec3(0.2, 0.3, 3), p, q, r);
+  ASSERT_TRUE(through);
+  EXPECT_NEAR(*through, 0.25, 1e-15);
+  // Beyond the hypotenuse (u + v > 1), beside an edge (v < 0), short of the plane, in the plane.
+  EXPECT_FALSE(contact::segment_triangle_crossing(Vec3(0.6, 0.6, -1), Vec3(0.6, 0.6, 1), p, q, r));
+  EXPECT_FALSE(contact::segment_triangle_crossing(Vec3(0.5, -0.1, -1), Vec3(0.5, -0.1, 1), p, q, r));
+  EXPECT_FALSE(contact::segment_triangle_crossing(Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, -0.1), p, q, r));
+  EXPECT_FALSE(contact::segment_triangle_crossing(Vec3(-1, 0.2, 0), Vec3(2, 0.2, 0), p, q, r));
+}
+
+// On the tube (inner radius kA): a centreline inside the lumen crosses nothing; one carried
+// radially out to 1.2 kA crosses the inner wall where it leaves (at radius kA, between nodes);
+// the same wall displaced outward by 0.3 kA holds it again.
+TEST(WallCrossing, CentrelineThroughTheTubeWall) {
+  const TetMesh& mesh = tube_mesh();
+  const std::vector<Triangle> inner = mesh.group_triangles(mesh.require_group("inner_wall", 2, "tube"));
+  const std::vector<Vec3> rest(mesh.nodes.size(), Vec3::Zero());
+  const double zm = 0.5 * kTubeLength;
+  std::vector<Vec3> wire;
+  for (int i = 0; i <= 10; ++i) wire.emplace_back(0.09 * kA * i, 0.013 * kA * i, zm);
+  EXPECT_FALSE(contact::first_wall_crossing(mesh, inner, rest, wire));
+  for (Vec3& x : wire) x *= 1.2 / 0.9;
+  const auto c = contact::first_wall_crossing(mesh, inner, rest, wire);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR(std::hypot(c->point.x(), c->point.y()), kA, 0.02 * kA);  // chords of the circle
+  std::vector<Vec3> out(mesh.nodes.size());
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+    out[n] = 0.3 * Vec3(mesh.nodes[n].x(), mesh.nodes[n].y(), 0.0);
+  }
+  EXPECT_FALSE(contact::first_wall_crossing(mesh, inner, out, wire));
 }
 
 // The finite-strain wall's energy, gradient and tangent (fem::HyperelasticSolver::free_state): at

@@ -1,0 +1,34 @@
+#pragma once
+/// Whether the wire's centreline crosses the wall's inner surface. The contact's slaves are the
+/// wall's nodes, so a wall whose node spacing exceeds the wire's diameter where it bears lets the
+/// capsule pass between nodes: every node's gap stays non-negative while the centreline is
+/// through the wall, and the solve "converges" on a wire outside the lumen. A centreline segment
+/// that intersects a (deformed) inner-wall triangle is that failure, seen directly.
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "meshes/tet_mesh.hpp"
+
+namespace vessel::contact {
+
+/// Where segment [a, b] meets triangle (p, q, r), by Möller and Trumbore's test ("Fast,
+/// minimum storage ray-triangle intersection", J. Graphics Tools 2, 1997): the segment's
+/// parameter s ∈ [0, 1] of the crossing, or nullopt (also for a segment in the triangle's plane).
+std::optional<double> segment_triangle_crossing(const Vec3& a, const Vec3& b, const Vec3& p,
+                                                const Vec3& q, const Vec3& r);
+
+struct WallCrossing {
+  int segment = 0;       ///< the centreline segment's first node
+  int triangle = 0;      ///< index into the triangles given
+  Vec3 point = Vec3::Zero();  ///< where it crosses, m
+};
+
+/// The first centreline segment (nodes `centreline`, in order) crossing one of `triangles` of
+/// `mesh` displaced by `displacement` (per mesh node, m), or nullopt.
+std::optional<WallCrossing> first_wall_crossing(const TetMesh& mesh,
+                                                const std::vector<Triangle>& triangles,
+                                                const std::vector<Vec3>& displacement,
+                                                const std::vector<Vec3>& centreline);
+
+}  // namespace vessel::contact
