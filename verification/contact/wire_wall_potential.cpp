@@ -296,8 +296,9 @@ class Coupled {
 
   /// ∇Π at z and, with `lin`, the Newton model's pieces: the rod's and the wall's Hessians and
   /// each pressed pair's curvature −λ∇²d (with `project`, the rod's and the wall's element
-  /// blocks and those 9 × 9 blocks projected onto the PSD cone), and every pair within `band` of pressing with its
-  /// gap's gradient and c = λ̂/k − g (pressed while c − ∇g·dz > 0 in the model).
+  /// blocks and those 9 × 9 blocks projected onto the PSD cone), and every pair within `band`
+  /// of pressing with its gap's gradient and c = λ̂/k − g (pressed while c − ∇g·dz > 0 in the
+  /// model).
   double evaluate(const VectorXd& z, VectorXd& gradient, Linearisation* lin, bool project,
                   double band = 0.0) const {
     const VectorXd x = rod_dofs(z), u = wall_rows(z);
@@ -610,6 +611,22 @@ struct NewtonOutcome {
   std::string reason;
 };
 
+/// What the last Newton steps needed, for a progress line on long solves.
+struct RecentSteps {
+  static constexpr int kEvery = 25;
+  int projected = 0;  ///< steps on the PSD-projected model (the exact one not factorisable)
+  int steepest = 0;   ///< steps that fell back to steepest descent
+  int capped = 0;     ///< steps cut to the largest move
+  double move = 0.0;  ///< the steps' node moves summed, r_w
+  void report(std::ostream& log, int step, const NewtonOutcome& out) {
+    log << "potential contact:   step " << step << ", residual " << out.residual << " N, "
+        << out.factorisations << " factorisations; the last " << kEvery << " steps: " << projected
+        << " on the PSD-projected Hessian, " << steepest << " steepest descent, " << capped
+        << " capped at the largest move, mean move " << move / kEvery << " r_w" << std::endl;
+    *this = {};
+  }
+};
+
 /// Newton's method on Π from z (left at the last accepted iterate).
 NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o) {
   NewtonOutcome out;
@@ -617,10 +634,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
   Linearisation lin;
   const double target = o.tolerance * o.force_scale;
   const double band = o.max_move * p.radius();
-  struct {
-    int projected = 0, steepest = 0, capped = 0;
-    double move = 0.0;  // r_w
-  } recent;  // for the progress line
+  RecentSteps recent;
   for (int it = 0; it <= o.max_newton; ++it) {
     const double pi = p.evaluate(z, g, &lin, false, band);
     out.residual = g.norm();
@@ -630,14 +644,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
       return out;
     }
     if (it == o.max_newton) break;
-    if (o.log && it > 0 && it % 25 == 0) {
-      *o.log << "potential contact:   step " << it << ", residual " << out.residual << " N, "
-             << out.factorisations << " factorisations; the last 25 steps: " << recent.projected
-             << " on the PSD-projected Hessian, " << recent.steepest << " steepest descent, "
-             << recent.capped << " capped at the largest move, mean move "
-             << recent.move / 25.0 << " r_w" << std::endl;
-      recent = {};
-    }
+    if (o.log && it > 0 && it % RecentSteps::kEvery == 0) recent.report(*o.log, it, out);
     bool descent = newton_step(p, lin, g, dz, out.factorisations) && g.dot(dz) < 0.0;
     if (!descent) {
       ++recent.projected;
