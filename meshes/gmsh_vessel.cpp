@@ -2,6 +2,7 @@
 
 #include <gmsh.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <map>
@@ -319,13 +320,21 @@ void build_occ_tube(const VesselParams& params) {
 
 TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
                            double radius) {
+  return refined_balls_mesh(params, {RefinedBall{point, radius}}, fine);
+}
+
+TetMesh refined_balls_mesh(const VesselParams& params, const std::vector<RefinedBall>& balls,
+                           double fine) {
   validate(params);
   if (!params.parametric()) {
     throw InputError("refined_patch_mesh: expected a straight vessel or an arch");
   }
-  if (!(fine > 0.0) || !(radius >= 0.0)) {
+  const bool radii_ok = std::all_of(balls.begin(), balls.end(),
+                                    [](const RefinedBall& b) { return b.radius >= 0.0; });
+  if (!(fine > 0.0) || balls.empty() || !radii_ok) {
     throw InputError(
-        "refined_patch_mesh: expected a positive fine size and a non-negative radius");
+        "refined_patch_mesh: expected a positive fine size and at least one ball, each with a "
+        "non-negative radius");
   }
   const double h = unstructured_mesh_size(params);
   GmshSession session(MeshingOptions{});
@@ -337,13 +346,17 @@ TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double
     p.style = MeshStyle::unstructured;
     add_physical_groups(build_geometry(p));
   }
-  // Size field: `fine` within `radius` of the point, growing linearly to h over 2 mm.
+  // Size field: `fine` within each ball, growing linearly to h over 2 mm; the smallest wins.
   const int f = gmsh::model::mesh::field::add("MathEval");
   std::ostringstream expr;
-  // Each coordinate in parentheses: "y--1e-05" (a negative one) does not parse.
-  expr << std::setprecision(17) << "Min(" << h << ", " << fine << " + Max(0, Sqrt((x-("
-       << point.x() << "))^2+(y-(" << point.y() << "))^2+(z-(" << point.z() << "))^2) - "
-       << radius << ") * " << (h - fine) / 2e-3 << ")";
+  expr << std::setprecision(17);
+  for (const RefinedBall& b : balls) {
+    // Each coordinate in parentheses: "y--1e-05" (a negative one) does not parse.
+    expr << "Min(" << fine << " + Max(0, Sqrt((x-(" << b.centre.x() << "))^2+(y-("
+         << b.centre.y() << "))^2+(z-(" << b.centre.z() << "))^2) - " << b.radius << ") * "
+         << (h - fine) / 2e-3 << ", ";
+  }
+  expr << h << std::string(balls.size(), ')');
   gmsh::model::mesh::field::setString(f, "F", expr.str());
   gmsh::model::mesh::field::setAsBackgroundMesh(f);
   gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);

@@ -27,6 +27,18 @@ TetMesh generate_vessel_mesh(const VesselParams& params, const MeshingOptions& o
 TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double fine,
                            double radius);
 
+/// A ball the mesh is refined in (m).
+struct RefinedBall {
+  Vec3 centre = Vec3::Zero();
+  double radius = 0.0;
+};
+
+/// As refined_patch_mesh, refined to `fine` within every ball (each graded to the nominal size
+/// over 2 mm; the smallest size wins): a contact that bears in several places, or along a wire.
+/// InputError also for no ball or a negative radius.
+TetMesh refined_balls_mesh(const VesselParams& params, const std::vector<RefinedBall>& balls,
+                           double fine);
+
 /// The gmsh API version string ("4.8.0"), part of the mesh cache key.
 std::string gmsh_version();
 

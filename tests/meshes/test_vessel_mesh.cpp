@@ -246,6 +246,35 @@ TEST(RefinedPatchMesh, IsFineAtThePointCoarseElsewhereAndHasTheTubesVolume) {
   EXPECT_THROW((void)refined_patch_mesh(params, point, 0.0, 1e-3), InputError);
 }
 
+// Two refined balls, on opposite sides of the tube: fine edges at both, coarse between and far.
+TEST(RefinedPatchMesh, EveryBallIsRefined) {
+  VesselParams params;
+  const Vec3 a(params.inner_radius, 0.0, 0.3 * params.length);
+  const Vec3 b(-params.inner_radius, 0.0, 0.7 * params.length);
+  const double fine = 0.15e-3;
+  const TetMesh mesh = refined_balls_mesh(params, {{a, 0.5e-3}, {b, 0.5e-3}}, fine);
+  EXPECT_EQ(compute_quality(mesh).inverted, 0u);
+  double near_a = 0.0, near_b = 0.0, far_min = 1.0;
+  for (const Tet& t : mesh.tets) {
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        const Vec3 p = mesh.nodes[t[i]], q = mesh.nodes[t[j]];
+        const Vec3 mid = 0.5 * (p + q);
+        const double len = (p - q).norm();
+        if ((mid - a).norm() < 0.3e-3) near_a = std::max(near_a, len);
+        if ((mid - b).norm() < 0.3e-3) near_b = std::max(near_b, len);
+        if ((mid - a).norm() > 8e-3 && (mid - b).norm() > 8e-3) far_min = std::min(far_min, len);
+      }
+  }
+  EXPECT_GT(near_a, 0.0);
+  EXPECT_GT(near_b, 0.0);
+  EXPECT_LT(near_a, 2.5 * fine);
+  EXPECT_LT(near_b, 2.5 * fine);
+  EXPECT_GT(far_min, 0.3e-3);
+  EXPECT_THROW((void)refined_balls_mesh(params, {}, fine), InputError);
+  EXPECT_THROW((void)refined_balls_mesh(params, {{a, -1e-3}}, fine), InputError);
+}
+
 // The arch's graded mesh: its closed-form volume (Pappus) and fine edges at the apex only.
 TEST(RefinedPatchMesh, ArchIsFineAtTheApexAndHasTheArchsVolume) {
   const VesselParams params{.kind = VesselKind::arch};

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <sstream>
 
@@ -62,8 +63,20 @@ std::vector<int> candidates(const TetMesh& mesh, const contact::ContactWire& wir
   return out;
 }
 
-/// Throws std::runtime_error when the solved wire's centreline (rod dofs x) crosses the inner
-/// wall displaced by u (per mesh node): the capsule passed between the wall's nodes, which the
+/// A solved wire that passed between the wall's nodes, with where to refine the wall next.
+struct WallCrossed : std::runtime_error {
+  using std::runtime_error::runtime_error;
+  std::vector<Vec3> near_wall;  ///< its centreline nodes within kNearWall of the inner wall, m
+};
+
+/// m: a crossed wire's centreline nodes this near the (undeformed) inner wall are where a
+/// scout refines next.
+constexpr double kNearWall = 1.5e-3;
+/// m: the radius refined around each of them.
+constexpr double kAlongWireRadius = 0.5e-3;
+
+/// Throws WallCrossed when the solved wire's centreline (rod dofs x) crosses the inner wall
+/// displaced by u (per mesh node): the capsule passed between the wall's nodes, which the
 /// nodes' gaps cannot see (verification/contact/wall_crossing.hpp).
 void require_wire_inside_lumen(const TetMesh& mesh, const msm::rods::Rod& rod,
                                const Eigen::VectorXd& x, const std::vector<Vec3>& u) {
@@ -71,23 +84,35 @@ void require_wire_inside_lumen(const TetMesh& mesh, const msm::rods::Rod& rod,
   for (int i = rod.layout().first_node; i <= rod.layout().tip_node; ++i) {
     centreline.emplace_back(x.segment<3>(3 * i));
   }
-  const std::vector<Triangle> wall =
-      mesh.group_triangles(mesh.require_group("inner_wall", 2, "vessel"));
-  if (const auto c = contact::first_wall_crossing(mesh, wall, u, centreline)) {
-    std::ostringstream m;
-    m.precision(3);
-    m << "the wire's centreline crosses the wall at (" << c->point.x() * 1e3 << ", "
-      << c->point.y() * 1e3 << ", " << c->point.z() * 1e3 << ") mm (segment " << c->segment
-      << "): it passed between the wall's nodes, whose spacing there exceeds the wire's diameter";
-    throw std::runtime_error(m.str());
+  const PhysicalGroup& inner = mesh.require_group("inner_wall", 2, "vessel");
+  const auto c = contact::first_wall_crossing(mesh, mesh.group_triangles(inner), u, centreline);
+  if (!c) return;
+  std::ostringstream m;
+  m.precision(3);
+  m << "the wire's centreline crosses the wall at (" << c->point.x() * 1e3 << ", "
+    << c->point.y() * 1e3 << ", " << c->point.z() * 1e3 << ") mm (segment " << c->segment
+    << "): it passed between the wall's nodes, whose spacing there exceeds the wire's diameter";
+  WallCrossed crossed(m.str());
+  const std::vector<int> wall_nodes = mesh.group_nodes(inner);
+  for (const Vec3& p : centreline) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const int n : wall_nodes)
+      nearest = std::min(nearest, (mesh.nodes[static_cast<std::size_t>(n)] - p).norm());
+    if (nearest <= kNearWall) crossed.near_wall.push_back(p);
   }
+  throw crossed;
+}
+
+bool inside_any(const std::vector<RefinedBall>& balls, const Vec3& p) {
+  return std::any_of(balls.begin(), balls.end(),
+                     [&](const RefinedBall& b) { return (p - b.centre).norm() <= b.radius; });
 }
 
 /// The zone of a solved contact: the pressed nodes (mesh indices) with their forces, the wall's
 /// displacement at every mesh node.
 void describe_zone(const TetMesh& mesh, const std::vector<int>& pressed,
-                   const std::vector<double>& force, const std::vector<Vec3>& u, const Vec3& centre,
-                   double radius, ContactLevel& out) {
+                   const std::vector<double>& force, const std::vector<Vec3>& u,
+                   const std::vector<RefinedBall>& balls, ContactLevel& out) {
   double weight = 0.0;
   out.pressed = static_cast<int>(pressed.size());
   for (std::size_t j = 0; j < pressed.size(); ++j) {
@@ -95,7 +120,7 @@ void describe_zone(const TetMesh& mesh, const std::vector<int>& pressed,
     out.centroid += force[j] * mesh.nodes[n];
     weight += force[j];
     out.dent = std::max(out.dent, u[n].norm());
-    out.zone_inside_patch = out.zone_inside_patch && (mesh.nodes[n] - centre).norm() <= radius;
+    out.zone_inside_patch = out.zone_inside_patch && inside_any(balls, mesh.nodes[n]);
     for (const int k : pressed) {
       const auto m = static_cast<std::size_t>(k);
       const double d = (mesh.nodes[n] - mesh.nodes[m]).norm();
@@ -115,7 +140,7 @@ void describe_zone(const TetMesh& mesh, const std::vector<int>& pressed,
 /// (solve_wire_wall_contact_growing).
 void solve_linear_wall(const Scene& scene, const ReferenceWire& wire, double nu,
                        const TetMesh& mesh, const std::vector<int>& nodes, const Vec3& wall_point,
-                       const Vec3& centre, double radius, double force_scale,
+                       const std::vector<RefinedBall>& balls, double force_scale,
                        const ContactReferenceOptions& o, ContactLevel& out) {
   int first = 0;
   for (int j = 1; j < static_cast<int>(nodes.size()); ++j) {
@@ -141,7 +166,7 @@ void solve_linear_wall(const Scene& scene, const ReferenceWire& wire, double nu,
   std::vector<int> pressed;
   std::vector<double> force;
   grown.pressed(pressed, force);
-  describe_zone(mesh, pressed, force, u, centre, radius, out);
+  describe_zone(mesh, pressed, force, u, balls, out);
   out.strain = contact::largest_strain(mesh, u).small;
 }
 
@@ -164,7 +189,7 @@ std::vector<double> continuation_rungs(double first, double ratio, double target
 /// solved from the last rung's equilibrium (the wire's rigid-lumen shape holds at every EI). A
 /// rung that fails is split at its geometric mean with the last converged one, up to 3 times.
 void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, double nu,
-                            const TetMesh& mesh, const Vec3& centre, double radius,
+                            const TetMesh& mesh, const std::vector<RefinedBall>& balls,
                             double force_scale, const ContactReferenceOptions& o,
                             ContactLevel& out) {
   const contact::NeoHookeanWall wall(mesh, wall_problem(scene, nu, o.degree));
@@ -214,18 +239,23 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
   out.converged = true;
   out.candidates = static_cast<int>(nodes.size());
   out.force = s.total_force_on_wall().norm();
-  describe_zone(mesh, s.pressed, s.force, displacement, centre, radius, out);
+  describe_zone(mesh, s.pressed, s.force, displacement, balls, out);
   out.strain = wall.largest_strain(mesh, s.u);
 }
 
-/// One contact solve on a mesh refined to `fine` within `radius` of `centre`.
+/// One contact solve on a mesh refined to `fine` within the balls (the first: the zone; its
+/// candidates for the linear wall). A wire that crossed the wall leaves its centreline nodes near
+/// the wall in `near_wall`.
 ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double nu, double fine,
-                         const Vec3& centre, double radius, const Vec3& wall_point,
-                         double force_scale, const ContactReferenceOptions& o) {
+                         const std::vector<RefinedBall>& balls, const Vec3& wall_point,
+                         double force_scale, const ContactReferenceOptions& o,
+                         std::vector<Vec3>* near_wall = nullptr) {
   const auto t0 = Clock::now();
   ContactLevel out;
   out.fine_size = fine;
-  const TetMesh mesh = refined_patch_mesh(scene.vessel, centre, fine, radius);
+  const Vec3& centre = balls.front().centre;
+  const double radius = balls.front().radius;
+  const TetMesh mesh = refined_balls_mesh(scene.vessel, balls, fine);
   out.mesh_nodes = static_cast<int>(mesh.nodes.size());
   const contact::ContactWire cw = wire.contact();
   const std::vector<int> nodes = candidates(mesh, cw, wire.rigid_state, centre, radius, o.band);
@@ -236,17 +266,22 @@ ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double n
     return out;
   }
   if (o.log) {
-    *o.log << "contact: fine " << fine * 1e3 << " mm within " << radius * 1e3 << " mm, "
+    *o.log << "contact: fine " << fine * 1e3 << " mm within " << radius * 1e3 << " mm"
+           << (balls.size() > 1 ? " and " + std::to_string(balls.size() - 1) + " balls more" : "")
+           << ", "
            << mesh.nodes.size() << " nodes, " << nodes.size() << " candidates, "
            << to_string(o.wall) << " wall" << std::endl;
   }
   try {
     if (o.wall == ContactWall::linear) {
-      solve_linear_wall(scene, wire, nu, mesh, nodes, wall_point, centre, radius, force_scale, o,
-                        out);
+      solve_linear_wall(scene, wire, nu, mesh, nodes, wall_point, balls, force_scale, o, out);
     } else {
-      solve_neo_hookean_wall(scene, wire, nu, mesh, centre, radius, force_scale, o, out);
+      solve_neo_hookean_wall(scene, wire, nu, mesh, balls, force_scale, o, out);
     }
+  } catch (const WallCrossed& e) {
+    out.converged = false;
+    out.failure = e.what();
+    if (near_wall) *near_wall = e.near_wall;
   } catch (const std::runtime_error& e) {
     out.converged = false;
     out.failure = e.what();
@@ -344,20 +379,31 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
   if (const auto c = continuum_wire(scene.vessel, spec, why)) r.continuum_rigid_force = c->force;
   const ReferenceWire wire(spec, rigid_solver.rod_state());
 
-  // The scout: the coarsest level refined at the rigid wall point finds the zone.
+  // The scout: the coarsest level refined at the rigid wall point finds the zone. A wire that
+  // passed between the wall's nodes elsewhere (a stiff wire's body, straightened as the wall
+  // gives) is scouted once more with the wall also refined around its centreline nodes near the
+  // wall, which every level then keeps.
   const double scout_radius = 1.0e-3;
-  r.scout = solve_level(scene, wire, r.poisson_ratio, o.coarsest_size, rigid.wall_point,
-                        scout_radius, rigid.wall_point, rigid.force, o);
+  std::vector<RefinedBall> balls{{rigid.wall_point, scout_radius}};
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    std::vector<Vec3> near_wall;
+    r.scout = solve_level(scene, wire, r.poisson_ratio, o.coarsest_size, balls, rigid.wall_point,
+                          rigid.force, o, &near_wall);
+    if (r.scout.converged || near_wall.empty() || attempt == 1) break;
+    for (const Vec3& p : near_wall) balls.push_back({p, kAlongWireRadius});
+  }
+  r.refined_along_wire = static_cast<int>(balls.size()) - 1;
   r.patch_centre = rigid.wall_point;
   r.patch_radius = scout_radius;
   if (r.scout.converged && r.scout.pressed > 0) {
     r.patch_centre = r.scout.middle;
     r.patch_radius = r.scout.reach + o.margin;
   }
+  balls.front() = {r.patch_centre, r.patch_radius};
   for (int l = 0; l < o.levels; ++l) {
     const double fine = o.coarsest_size / std::pow(o.ratio, l);
-    ContactLevel level = solve_level(scene, wire, r.poisson_ratio, fine, r.patch_centre,
-                                     r.patch_radius, rigid.wall_point, rigid.force, o);
+    ContactLevel level = solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point,
+                                     rigid.force, o);
     level.level = l;
     r.levels.push_back(level);
   }
@@ -413,7 +459,13 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
     out << ", " << fixed(*r.continuum_rigid_force * 1e3, 4) << " mN (continuum)";
   out << "; refined within " << fixed(r.patch_radius * 1e3, 3) << " mm of ("
       << fixed(r.patch_centre.x() * 1e3, 3) << ", " << fixed(r.patch_centre.y() * 1e3, 3) << ", "
-      << fixed(r.patch_centre.z() * 1e3, 3) << ") mm (the zone of a scout solve at "
+      << fixed(r.patch_centre.z() * 1e3, 3) << ") mm"
+      << (r.refined_along_wire > 0
+              ? " and within " + fixed(kAlongWireRadius * 1e3, 1) + " mm of " +
+                    std::to_string(r.refined_along_wire) +
+                    " centreline nodes of a scout wire that crossed the wall"
+              : std::string())
+      << " (the zone of a scout solve at "
       << fixed(r.scout.fine_size * 1e3, 3) << " mm within 1 mm of the rigid wall point: "
       << (r.scout.converged
               ? std::to_string(r.scout.pressed) + " pressed, " + fixed(r.scout.seconds, 1) + " s"

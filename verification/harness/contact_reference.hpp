@@ -89,6 +89,8 @@ struct ContactReference {
   Vec3 rigid_wall_point = Vec3::Zero();         ///< m
   Vec3 patch_centre = Vec3::Zero();             ///< m: where every level is refined
   double patch_radius = 0.0;                    ///< m
+  /// Balls refined along a scout wire that passed between the wall's nodes (0: none)
+  int refined_along_wire = 0;
   double strain_limit = 0.0;
   ContactWall wall = ContactWall::linear;
   ContactLevel scout;  ///< the coarsest size at the rigid wall point: where the zone is
