@@ -48,8 +48,8 @@ struct ContactReferenceOptions {
   /// The neo-Hookean wall: a stiffer wire is reached by raising EI from this (N·m²) in steps of
   /// continuation_ratio, each solved from the last one's equilibrium (4e-7: the floppy wire of
   /// the shipped scenes, which Newton reaches from the rigid-lumen state on their 14.24 kPa wall;
-  /// √10: on the straight scene 4e-6 → 1.26e-5 converges in 41 steps where 4e-6 → 4e-5 did not
-  /// in 300)
+  /// √10: on the straight scene 4e-6 → 1.26e-5 converges in 41 steps; 4e-6 → 4e-5 did not in
+  /// 300, measured with the wall's tangent left unprojected)
   double continuation_from = 4e-7;
   double continuation_ratio = 3.1622776601683795;
   std::ostream* log = nullptr;  ///< one line per solve (mesh, candidates, result), if set
