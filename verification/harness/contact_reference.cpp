@@ -314,6 +314,78 @@ void require_guidewire(const Scene& scene) {
   }
 }
 
+/// The scout: the coarsest level refined at the rigid wall point finds the zone (r.scout,
+/// r.patch_centre, r.patch_radius, r.refined_along_wire). A wire that passed between the wall's
+/// nodes elsewhere (a stiff wire's body, straightened as the wall gives) is scouted once more
+/// with the wall also refined around its centreline nodes near the wall. Returns the balls every
+/// level is refined in: the zone's first, then those along the wire.
+std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
+                               const Vec3& wall_point, double force_scale,
+                               const ContactReferenceOptions& o, ContactReference& r) {
+  const double scout_radius = 1.0e-3;
+  std::vector<RefinedBall> balls{{wall_point, scout_radius}};
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    std::vector<Vec3> near_wall;
+    r.scout = solve_level(scene, wire, r.poisson_ratio, o.coarsest_size, balls, wall_point,
+                          force_scale, o, &near_wall);
+    if (r.scout.converged || near_wall.empty() || attempt == 1) break;
+    for (const Vec3& p : near_wall) balls.push_back({p, kAlongWireRadius});
+  }
+  r.refined_along_wire = static_cast<int>(balls.size()) - 1;
+  r.patch_centre = wall_point;
+  r.patch_radius = scout_radius;
+  if (r.scout.converged && r.scout.pressed > 0) {
+    r.patch_centre = r.scout.middle;
+    r.patch_radius = r.scout.reach + o.margin;
+  }
+  balls.front() = {r.patch_centre, r.patch_radius};
+  return balls;
+}
+
+/// The levels' order, Richardson estimate and GCI on the force, and the verdict.
+void judge(const ContactReferenceOptions& o, ContactReference& r) {
+  const ContactLevel& finest = r.levels.back();
+  bool all_converged = true;
+  for (const ContactLevel& l : r.levels) all_converged = all_converged && l.converged;
+  if (!all_converged) {
+    std::string reason;
+    for (const ContactLevel& l : r.levels) {
+      if (!l.converged) {
+        reason = "level " + std::to_string(l.level) + ": " + l.failure;
+        break;
+      }
+    }
+    r.verdict = "did not converge (" + reason + ")";
+    return;
+  }
+  if (r.levels.size() >= 2) {
+    const std::size_t n = r.levels.size();
+    std::optional<std::vector<double>> three;
+    if (n >= 3)
+      three =
+          std::vector<double>{r.levels[n - 3].force, r.levels[n - 2].force, r.levels[n - 1].force};
+    // Assumed first order where three levels do not give one: a contact zone's edge cuts
+    // elements, which limits the force's convergence.
+    r.order = fem::gci_order(three, 1.0, o.ratio);
+    r.estimate = fem::richardson(r.levels[n - 2].force, finest.force, r.order->order, o.ratio,
+                                 r.order->safety_factor);
+  }
+  double strain = 0.0;
+  bool inside = true;
+  for (const ContactLevel& l : r.levels) {
+    strain = std::max(strain, l.strain);
+    inside = inside && l.zone_inside_patch;
+  }
+  if (o.wall == ContactWall::linear && strain > o.strain_limit) {
+    r.verdict = "beyond the linear wall's validity (largest strain " + fixed(strain, 3) + " > " +
+                fixed(o.strain_limit, 3) + ")";
+  } else if (!inside) {
+    r.verdict = "not a reference: the contact zone leaves the refined patch";
+  } else {
+    r.verdict = "reference";
+  }
+}
+
 }  // namespace
 
 std::string to_string(ContactWall wall) {
@@ -379,27 +451,8 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
   if (const auto c = continuum_wire(scene.vessel, spec, why)) r.continuum_rigid_force = c->force;
   const ReferenceWire wire(spec, rigid_solver.rod_state());
 
-  // The scout: the coarsest level refined at the rigid wall point finds the zone. A wire that
-  // passed between the wall's nodes elsewhere (a stiff wire's body, straightened as the wall
-  // gives) is scouted once more with the wall also refined around its centreline nodes near the
-  // wall, which every level then keeps.
-  const double scout_radius = 1.0e-3;
-  std::vector<RefinedBall> balls{{rigid.wall_point, scout_radius}};
-  for (int attempt = 0; attempt < 2; ++attempt) {
-    std::vector<Vec3> near_wall;
-    r.scout = solve_level(scene, wire, r.poisson_ratio, o.coarsest_size, balls, rigid.wall_point,
-                          rigid.force, o, &near_wall);
-    if (r.scout.converged || near_wall.empty() || attempt == 1) break;
-    for (const Vec3& p : near_wall) balls.push_back({p, kAlongWireRadius});
-  }
-  r.refined_along_wire = static_cast<int>(balls.size()) - 1;
-  r.patch_centre = rigid.wall_point;
-  r.patch_radius = scout_radius;
-  if (r.scout.converged && r.scout.pressed > 0) {
-    r.patch_centre = r.scout.middle;
-    r.patch_radius = r.scout.reach + o.margin;
-  }
-  balls.front() = {r.patch_centre, r.patch_radius};
+  std::vector<RefinedBall> balls =
+      scout(scene, wire, rigid.wall_point, rigid.force, o, r);
   for (int l = 0; l < o.levels; ++l) {
     const double fine = o.coarsest_size / std::pow(o.ratio, l);
     ContactLevel level = solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point,
@@ -408,46 +461,7 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
     r.levels.push_back(level);
   }
 
-  const ContactLevel& finest = r.levels.back();
-  bool all_converged = true;
-  for (const ContactLevel& l : r.levels) all_converged = all_converged && l.converged;
-  if (!all_converged) {
-    std::string reason;
-    for (const ContactLevel& l : r.levels) {
-      if (!l.converged) {
-        reason = "level " + std::to_string(l.level) + ": " + l.failure;
-        break;
-      }
-    }
-    r.verdict = "did not converge (" + reason + ")";
-    return r;
-  }
-  if (r.levels.size() >= 2) {
-    const std::size_t n = r.levels.size();
-    std::optional<std::vector<double>> three;
-    if (n >= 3)
-      three =
-          std::vector<double>{r.levels[n - 3].force, r.levels[n - 2].force, r.levels[n - 1].force};
-    // Assumed first order where three levels do not give one: a contact zone's edge cuts
-    // elements, which limits the force's convergence.
-    r.order = fem::gci_order(three, 1.0, o.ratio);
-    r.estimate = fem::richardson(r.levels[n - 2].force, finest.force, r.order->order, o.ratio,
-                                 r.order->safety_factor);
-  }
-  double strain = 0.0;
-  bool inside = true;
-  for (const ContactLevel& l : r.levels) {
-    strain = std::max(strain, l.strain);
-    inside = inside && l.zone_inside_patch;
-  }
-  if (o.wall == ContactWall::linear && strain > o.strain_limit) {
-    r.verdict = "beyond the linear wall's validity (largest strain " + fixed(strain, 3) + " > " +
-                fixed(o.strain_limit, 3) + ")";
-  } else if (!inside) {
-    r.verdict = "not a reference: the contact zone leaves the refined patch";
-  } else {
-    r.verdict = "reference";
-  }
+  judge(o, r);
   return r;
 }
 
