@@ -156,7 +156,8 @@ VesselEntities build_geometry(const VesselParams& p) {
   const bool structured = p.style == MeshStyle::structured;
   const StructuredCounts counts = structured_counts(p);
   if (structured) {
-    for (int arc : section.arcs) geo::mesh::setTransfiniteCurve(arc, counts.circumferential / 4 + 1);
+    for (int arc : section.arcs)
+      geo::mesh::setTransfiniteCurve(arc, counts.circumferential / 4 + 1);
     for (int line : section.radials) geo::mesh::setTransfiniteCurve(line, counts.radial + 1);
     for (int patch : section.patches) geo::mesh::setTransfiniteSurface(patch);
   }
@@ -297,10 +298,14 @@ void build_occ_tube(const VesselParams& params) {
   for (const auto& [dim, tag] : faces) {
     double x0, y0, z0, x1, y1, z1;
     gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
-    if (z1 < tol) inlet.push_back(tag);
-    else if (z0 > L - tol) outlet.push_back(tag);
-    else if (x1 < a + tol) inner_wall.push_back(tag);
-    else outer_wall.push_back(tag);
+    if (z1 < tol)
+      inlet.push_back(tag);
+    else if (z0 > L - tol)
+      outlet.push_back(tag);
+    else if (x1 < a + tol)
+      inner_wall.push_back(tag);
+    else
+      outer_wall.push_back(tag);
   }
   gmsh::vectorpair vols;
   gmsh::model::getEntities(vols, 3);
@@ -329,8 +334,8 @@ TetMesh refined_balls_mesh(const VesselParams& params, const std::vector<Refined
   if (!params.parametric()) {
     throw InputError("refined_patch_mesh: expected a straight vessel or an arch");
   }
-  const bool radii_ok = std::all_of(balls.begin(), balls.end(),
-                                    [](const RefinedBall& b) { return b.radius >= 0.0; });
+  const bool radii_ok =
+      std::all_of(balls.begin(), balls.end(), [](const RefinedBall& b) { return b.radius >= 0.0; });
   if (!(fine > 0.0) || balls.empty() || !radii_ok) {
     throw InputError(
         "refined_patch_mesh: expected a positive fine size and at least one ball, each with a "
@@ -352,9 +357,9 @@ TetMesh refined_balls_mesh(const VesselParams& params, const std::vector<Refined
   expr << std::setprecision(17);
   for (const RefinedBall& b : balls) {
     // Each coordinate in parentheses: "y--1e-05" (a negative one) does not parse.
-    expr << "Min(" << fine << " + Max(0, Sqrt((x-(" << b.centre.x() << "))^2+(y-("
-         << b.centre.y() << "))^2+(z-(" << b.centre.z() << "))^2) - " << b.radius << ") * "
-         << (h - fine) / 2e-3 << ", ";
+    expr << "Min(" << fine << " + Max(0, Sqrt((x-(" << b.centre.x() << "))^2+(y-(" << b.centre.y()
+         << "))^2+(z-(" << b.centre.z() << "))^2) - " << b.radius << ") * " << (h - fine) / 2e-3
+         << ", ";
   }
   expr << h << std::string(balls.size(), ')');
   gmsh::model::mesh::field::setString(f, "F", expr.str());

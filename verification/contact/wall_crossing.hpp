@@ -19,8 +19,8 @@ std::optional<double> segment_triangle_crossing(const Vec3& a, const Vec3& b, co
                                                 const Vec3& q, const Vec3& r);
 
 struct WallCrossing {
-  int segment = 0;       ///< the centreline segment's first node
-  int triangle = 0;      ///< index into the triangles given
+  int segment = 0;            ///< the centreline segment's first node
+  int triangle = 0;           ///< index into the triangles given
   Vec3 point = Vec3::Zero();  ///< where it crosses, m
 };
 

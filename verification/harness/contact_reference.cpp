@@ -3,8 +3,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "fem_reference/elasticity.hpp"
@@ -153,9 +153,9 @@ void solve_linear_wall(const Scene& scene, const ReferenceWire& wire, double nu,
   wo.max_newton = o.max_steps;
   contact::BandGrowth growth;
   growth.margin = 0.25 * wire.radius;
-  const contact::GrownContact grown = contact::solve_wire_wall_contact_growing(
-      wire.contact(), solver.free_displacement_system(), mesh, nodes, wire.rigid_state, {first},
-      wo, growth);
+  const contact::GrownContact grown =
+      contact::solve_wire_wall_contact_growing(wire.contact(), solver.free_displacement_system(),
+                                               mesh, nodes, wire.rigid_state, {first}, wo, growth);
   const contact::WireWallSolution& s = grown.solution;
   out.converged = true;
   out.candidates = static_cast<int>(grown.nodes.size());
@@ -201,8 +201,7 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
   po.tolerance = 1e-8;
   po.max_newton = o.max_steps;
   po.log = o.log;
-  std::vector<double> rungs =
-      continuation_rungs(o.continuation_from, o.continuation_ratio, target);
+  std::vector<double> rungs = continuation_rungs(o.continuation_from, o.continuation_ratio, target);
   Eigen::VectorXd x = wire.rigid_state, u;
   double done = 0.0;  // the EI of the equilibrium in hand (0: the rigid-lumen state, wall at rest)
   int splits = 0;
@@ -268,8 +267,7 @@ ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double n
   if (o.log) {
     *o.log << "contact: fine " << fine * 1e3 << " mm within " << radius * 1e3 << " mm"
            << (balls.size() > 1 ? " and " + std::to_string(balls.size() - 1) + " balls more" : "")
-           << ", "
-           << mesh.nodes.size() << " nodes, " << nodes.size() << " candidates, "
+           << ", " << mesh.nodes.size() << " nodes, " << nodes.size() << " candidates, "
            << to_string(o.wall) << " wall" << std::endl;
   }
   try {
@@ -451,12 +449,11 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
   if (const auto c = continuum_wire(scene.vessel, spec, why)) r.continuum_rigid_force = c->force;
   const ReferenceWire wire(spec, rigid_solver.rod_state());
 
-  std::vector<RefinedBall> balls =
-      scout(scene, wire, rigid.wall_point, rigid.force, o, r);
+  std::vector<RefinedBall> balls = scout(scene, wire, rigid.wall_point, rigid.force, o, r);
   for (int l = 0; l < o.levels; ++l) {
     const double fine = o.coarsest_size / std::pow(o.ratio, l);
-    ContactLevel level = solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point,
-                                     rigid.force, o);
+    ContactLevel level =
+        solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point, rigid.force, o);
     level.level = l;
     r.levels.push_back(level);
   }
@@ -474,13 +471,12 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
   out << "; refined within " << fixed(r.patch_radius * 1e3, 3) << " mm of ("
       << fixed(r.patch_centre.x() * 1e3, 3) << ", " << fixed(r.patch_centre.y() * 1e3, 3) << ", "
       << fixed(r.patch_centre.z() * 1e3, 3) << ") mm"
-      << (r.refined_along_wire > 0
-              ? " and within " + fixed(kAlongWireRadius * 1e3, 1) + " mm of " +
-                    std::to_string(r.refined_along_wire) +
-                    " centreline nodes of a scout wire that crossed the wall"
-              : std::string())
-      << " (the zone of a scout solve at "
-      << fixed(r.scout.fine_size * 1e3, 3) << " mm within 1 mm of the rigid wall point: "
+      << (r.refined_along_wire > 0 ? " and within " + fixed(kAlongWireRadius * 1e3, 1) + " mm of " +
+                                         std::to_string(r.refined_along_wire) +
+                                         " centreline nodes of a scout wire that crossed the wall"
+                                   : std::string())
+      << " (the zone of a scout solve at " << fixed(r.scout.fine_size * 1e3, 3)
+      << " mm within 1 mm of the rigid wall point: "
       << (r.scout.converged
               ? std::to_string(r.scout.pressed) + " pressed, " + fixed(r.scout.seconds, 1) + " s"
               : std::string("did not converge"))
@@ -500,8 +496,8 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
         << ", " << fixed(l.centroid.y() * 1e3, 2) << ", " << fixed(l.centroid.z() * 1e3, 2)
         << ") | " << fixed(l.extent * 1e3, 3) << (l.zone_inside_patch ? "" : " (leaves the patch)")
         << " | " << fixed(l.dent * 1e3, 3) << " | " << fixed(l.strain, 3) << " | " << l.steps
-        << (l.rungs > 1 ? " in " + std::to_string(l.rungs) + " EI rungs" : std::string())
-        << " | " << fixed(l.seconds, 1) << " |\n";
+        << (l.rungs > 1 ? " in " + std::to_string(l.rungs) + " EI rungs" : std::string()) << " | "
+        << fixed(l.seconds, 1) << " |\n";
   }
   for (const ContactLevel& l : r.levels) {
     if (!l.converged) out << "\nLevel " << l.level << " did not converge: " << l.failure << "\n";

@@ -40,11 +40,11 @@ struct ContactReferenceOptions {
   double ratio = 1.4142135623730951;  ///< fine size ratio between levels (> 1): √2
   /// The wall's elements, P1 or P2 (P2 at 0.08 mm takes 2–3 minutes a level on this machine)
   int degree = 1;
-  double margin = 0.3e-3;       ///< m: the refined ball's radius beyond the zone's half extent
-  double band = 0.5e-3;         ///< m: candidates within this of the rigid-wall wire's surface
+  double margin = 0.3e-3;  ///< m: the refined ball's radius beyond the zone's half extent
+  double band = 0.5e-3;    ///< m: candidates within this of the rigid-wall wire's surface
   /// the linear wall's validity: largest strain at most this (the neo-Hookean wall has no limit)
   double strain_limit = 0.1;
-  int max_steps = 300;          ///< linearised contact steps per solve
+  int max_steps = 300;  ///< linearised contact steps per solve
   /// The neo-Hookean wall: a stiffer wire is reached by raising EI from this (N·m²) in steps of
   /// continuation_ratio, each solved from the last one's equilibrium (4e-7: the floppy wire of
   /// the shipped scenes, which Newton reaches from the rigid-lumen state on their 14.24 kPa wall;
@@ -74,9 +74,9 @@ struct ContactLevel {
   /// displacements (linear wall), Green–Lagrange at the quadrature points (neo-Hookean wall)
   double strain = 0.0;
   bool zone_inside_patch = true;  ///< every pressed node within the refined ball
-  int steps = 0;  ///< linearised steps over all growth rounds or rungs (0 if not converged)
-  int rungs = 0;  ///< the neo-Hookean wall's stiffness continuation: solves to reach the EI
-  double seconds = 0.0;           ///< meshing, condensing and solving this level
+  int steps = 0;         ///< linearised steps over all growth rounds or rungs (0 if not converged)
+  int rungs = 0;         ///< the neo-Hookean wall's stiffness continuation: solves to reach the EI
+  double seconds = 0.0;  ///< meshing, condensing and solving this level
 };
 
 struct ContactReference {
