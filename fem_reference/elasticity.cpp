@@ -102,7 +102,10 @@ void ElasticitySolver::Impl::setup_dofs() {
   constraints.clear();
   support_constraints(dof, constraints);
   constraints.close();
-  if (problem.options.solver != LinearSolver::matrix_free) ensure_matrix();
+  linear_choice = detail::chosen_solver(
+      problem.options,
+      {mixed, dof.n_dofs(), degree, degree == 2 && !problem.curved_surfaces.empty(), true});
+  if (linear_choice.solver != LinearSolver::matrix_free) ensure_matrix();
   rhs.reinit(dof.n_dofs());
   solution.reinit(dof.n_dofs());
 }
@@ -199,7 +202,7 @@ ElasticitySolver::~ElasticitySolver() = default;
 const ElasticityResult& ElasticitySolver::solve() {
   auto& im = *impl_;
   auto t0 = Clock::now();
-  if (im.problem.options.solver == LinearSolver::matrix_free) {
+  if (im.linear_choice.solver == LinearSolver::matrix_free) {
     im.assemble_load();
     im.result.timings.assembly = seconds_since(t0);
     t0 = Clock::now();

@@ -105,6 +105,12 @@ struct SolverOptions {
   /// (docs/measurements/fem_measurements.md): level 0 (34–47k DoFs) UMFPACK 4–11 s vs FGMRES 8–21 s; level 1
   /// (214k / 241k) UMFPACK 102 s, 4.6 GB / 426 s, 13.4 GB vs FGMRES 51 s / 216 s at ~2 GB (contact).
   std::size_t direct_max_mixed_dofs = 100000;
+  /// automatic, the linear reference's P2 displacement system on straight-sided tets solved once
+  /// (not keep_factor): the matrix-free p-multigrid CG from this many DoFs, where it overtook
+  /// CHOLMOD on this machine (docs/measurements/solver_switch.md,
+  /// scripts/measure_solver_switch.py); 0: never. It changes the answer within
+  /// cg_relative_tolerance, so it is in the solution cache's key where it can apply.
+  std::size_t matrix_free_min_dofs = 14000;
   /// CG-AMG: give ML all six rigid-body modes (translations and rotations) as near-null space;
   /// false: only the three translations (deal.II's AdditionalData::constant_modes).
   bool amg_rigid_body_modes = true;
@@ -122,6 +128,12 @@ struct SolverOptions {
   /// factorise once). Changes no result, so it is not part of the solution cache's key. Off by
   /// default: a timed FEM model must pay for its factorisation each time.
   bool keep_factor = false;
+};
+
+/// The solver a system gets and why (the request, or `automatic`'s rule and its numbers).
+struct SolverChoice {
+  LinearSolver solver = LinearSolver::direct;
+  std::string reason;
 };
 
 struct ElasticityProblem {
@@ -183,6 +195,7 @@ struct ElasticityResult {
   bool curved = false;  ///< quadratic geometry on the curved surfaces
   Formulation formulation = Formulation::displacement;  ///< the one used
   LinearSolver solver = LinearSolver::direct;           ///< the one used
+  std::string solver_reason;  ///< why: requested, or automatic's rule (SolverChoice)
   unsigned iterations = 0;  ///< CG or FGMRES iterations (0 for direct)
   double inner_iterations = 0.0;  ///< gmres_block: mean CG iterations per pressure-mass solve
   std::size_t n_dofs = 0;

@@ -40,7 +40,8 @@ void ElasticitySolver::Impl::assemble_load() {
 
 void ElasticitySolver::Impl::solve_displacement_matrix_free() {
   const auto& o = problem.options;
-  result.solver = detail::chosen_solver(o, mixed, dof.n_dofs());  // InputError for the mixed form
+  result.solver = linear_choice.solver;
+  result.solver_reason = linear_choice.reason;
   solution = 0.0;
   for (const auto& line : constraints.get_lines()) rhs(line.index) = 0.0;
   if (rhs.l2_norm() != 0.0) {

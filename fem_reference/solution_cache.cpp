@@ -71,6 +71,10 @@ void hash_options(KeyHash& h, const SolverOptions& o) {
   h.integer(static_cast<int>(o.solver)).integer(static_cast<std::int64_t>(o.direct_max_dofs));
   h.integer(static_cast<std::int64_t>(o.direct_max_mixed_dofs)).integer(o.amg_rigid_body_modes);
   h.real(o.cg_relative_tolerance).integer(o.gmres_restart).integer(o.max_iterations);
+  // automatic may pick the matrix-free CG (an answer within its tolerance) only for P2
+  if (o.solver == LinearSolver::automatic && o.degree == 2 && !o.keep_factor) {
+    h.integer(static_cast<std::int64_t>(o.matrix_free_min_dofs));
+  }
 }
 
 // Binary (de)serialisation of a result and its DoF values, native byte order: the cache is a
@@ -159,6 +163,7 @@ std::string serialise(const ElasticityResult& r, const std::vector<double>& dofs
   w.pod(r.curved);
   w.pod(r.formulation);
   w.pod(r.solver);
+  w.text(r.solver_reason);
   w.pod(r.iterations);
   w.pod(r.inner_iterations);
   w.pod(static_cast<std::uint64_t>(r.n_dofs));
@@ -187,6 +192,7 @@ std::pair<ElasticityResult, std::vector<double>> deserialise(std::string_view by
   r.curved = in.pod<bool>();
   r.formulation = in.pod<Formulation>();
   r.solver = in.pod<LinearSolver>();
+  r.solver_reason = in.text();
   r.iterations = in.pod<unsigned>();
   r.inner_iterations = in.pod<double>();
   r.n_dofs = in.pod<std::uint64_t>();

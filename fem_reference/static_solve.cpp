@@ -36,14 +36,36 @@ void ElasticitySolver::Impl::assemble() {
 
 namespace detail {
 
-/// The solver `automatic` picks, or InputError for a solver that does not fit the system.
-LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dofs) {
-  LinearSolver s = o.solver;
-  if (s == LinearSolver::automatic) {
-    const std::size_t limit = mixed ? o.direct_max_mixed_dofs : o.direct_max_dofs;
-    s = n_dofs <= limit ? LinearSolver::direct
-                        : (mixed ? LinearSolver::gmres_block : LinearSolver::cg_amg);
+namespace {
+
+/// `automatic`'s rule: the matrix-free p-multigrid for the linear reference's one P2 solve on
+/// straight-sided tets from matrix_free_min_dofs; otherwise a direct solve up to the direct limit
+/// and an iterative one beyond.
+SolverChoice automatic_solver(const SolverOptions& o, const SystemShape& shape) {
+  const std::string dofs = std::to_string(shape.n_dofs) + " DoFs";
+  if (!shape.mixed && shape.linear_static && shape.degree == 2 && !shape.curved && !o.keep_factor &&
+      o.matrix_free_min_dofs > 0 && shape.n_dofs >= o.matrix_free_min_dofs) {
+    return {LinearSolver::matrix_free, "auto: " + dofs + " >= matrix-free-min-dofs " +
+                                           std::to_string(o.matrix_free_min_dofs) +
+                                           " (P2 on straight-sided tets, one solve)"};
   }
+  const std::size_t limit = shape.mixed ? o.direct_max_mixed_dofs : o.direct_max_dofs;
+  const std::string limit_name = shape.mixed ? "direct-max-mixed-dofs " : "direct-max-dofs ";
+  if (shape.n_dofs <= limit) {
+    return {LinearSolver::direct, "auto: " + dofs + " <= " + limit_name + std::to_string(limit)};
+  }
+  return {shape.mixed ? LinearSolver::gmres_block : LinearSolver::cg_amg,
+          "auto: " + dofs + " > " + limit_name + std::to_string(limit)};
+}
+
+}  // namespace
+
+SolverChoice chosen_solver(const SolverOptions& o, const SystemShape& shape) {
+  const bool mixed = shape.mixed;
+  const SolverChoice choice = o.solver == LinearSolver::automatic
+                                  ? automatic_solver(o, shape)
+                                  : SolverChoice{o.solver, "requested"};
+  const LinearSolver s = choice.solver;
   if (s == LinearSolver::cg_amg && mixed) {
     throw InputError(
         "solver cg-amg is for the symmetric positive definite displacement system; the mixed "
@@ -60,13 +82,15 @@ LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dof
         "solver gmres-block is for the mixed (Taylor-Hood) system; the displacement system is "
         "symmetric positive definite: use cg-amg or direct");
   }
-  return s;
+  return choice;
 }
 
 }  // namespace detail
 
 void ElasticitySolver::Impl::solve_linear(bool symmetric, DirectReuse reuse) {
-  LinearSolver s = detail::chosen_solver(problem.options, mixed, dof.n_dofs());
+  const SolverChoice choice =
+      detail::chosen_solver(problem.options, {mixed, dof.n_dofs(), degree, false, false});
+  LinearSolver s = choice.solver;
   if (!symmetric && !mixed && s == LinearSolver::cg_amg) {
     if (problem.options.solver == LinearSolver::cg_amg) {
       throw InputError(
@@ -81,6 +105,8 @@ void ElasticitySolver::Impl::solve_linear(bool symmetric, DirectReuse reuse) {
         "direct or cg-amg");
   }
   result.solver = s;
+  result.solver_reason =
+      s == choice.solver ? choice.reason : choice.reason + "; direct: the matrix is not symmetric";
   if (rhs.l2_norm() == 0.0) {
     solution = 0.0;  // no load and homogeneous constraints: u = 0
   } else if (s == LinearSolver::direct && !mixed && symmetric) {

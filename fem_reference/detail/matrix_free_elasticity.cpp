@@ -524,7 +524,7 @@ class MatrixFreeElasticitySolver::VCycle {
     }
     initialize_elasticity_amg(amg_, *coarse_matrix_, rows, centre, false,
                               settings.amg_rigid_body_modes, settings.amg_prolongator,
-                              mode_storage_);
+                              mode_storage_, settings.amg_aggregation_threshold);
     profile.coarse_factor = lap();
   }
 

@@ -35,9 +35,19 @@ enum class DirectReuse { nothing, factor, analysis };
 using detail::kDim;
 
 namespace detail {
-/// The solver `automatic` picks (never matrix_free: no switch point measured), or InputError for a
-/// solver that does not fit the system.
-LinearSolver chosen_solver(const SolverOptions& o, bool mixed, std::size_t n_dofs);
+/// What chosen_solver needs to know of the system.
+struct SystemShape {
+  bool mixed = false;
+  std::size_t n_dofs = 0;
+  int degree = 1;
+  /// P2 geometry on a curved surface (the matrix-free kernel is for straight tets)
+  bool curved = false;
+  /// the linear reference's one solve (ElasticitySolver::solve), not a Newton tangent
+  bool linear_static = false;
+};
+/// The solver `automatic` picks for `shape` and why, or InputError for a solver that does not fit
+/// the system.
+SolverChoice chosen_solver(const SolverOptions& o, const SystemShape& shape);
 }  // namespace detail
 using Index = dealii::types::global_dof_index;
 
@@ -46,6 +56,8 @@ struct ElasticitySolver::Impl {
   ElasticityProblem problem;
   bool mixed = false;
   int degree = 1;
+  /// The linear reference's solver (solve()), chosen once the DoFs are distributed.
+  SolverChoice linear_choice;
 
   dl::Triangulation<kDim> tria;
   detail::MeshCorrespondence mesh_map;

@@ -184,5 +184,43 @@ TEST(MatrixFreeMultigrid, P2IterationsStayWithinThirtyPercentFromLevelZeroToOne)
       << "CG iterations " << iterations[0] << " at level 0, " << iterations[1] << " at level 1";
 }
 
+// automatic's rule: the matrix-free CG for the linear reference's one P2 solve on straight tets
+// from matrix_free_min_dofs; CHOLMOD below it, for P1, with keep_factor and on curved walls.
+TEST(SolverChoice, AutomaticTakesMatrixFreeForOneStraightP2SolveFromItsLimit) {
+  const TetMesh& mesh = test::short_tube_mesh(0);
+  auto p = pressurised_tube(2, 0.3);
+  p.options.solver = LinearSolver::direct;
+  const auto direct = fem::solve_elasticity(mesh, p);
+  ASSERT_GT(direct.n_dofs, 100u);
+  p.options.solver = LinearSolver::automatic;
+  p.options.matrix_free_min_dofs = direct.n_dofs;
+  const auto at_limit = fem::solve_elasticity(mesh, p);
+  EXPECT_EQ(at_limit.solver, LinearSolver::matrix_free) << at_limit.solver_reason;
+  EXPECT_NE(at_limit.solver_reason.find("matrix-free-min-dofs"), std::string::npos)
+      << at_limit.solver_reason;
+  EXPECT_NEAR(at_limit.strain_energy, direct.strain_energy, 1e-8 * direct.strain_energy);
+
+  auto expect_direct = [&](const fem::ElasticityProblem& q, const char* why) {
+    const auto r = fem::solve_elasticity(mesh, q);
+    EXPECT_EQ(r.solver, LinearSolver::direct) << why << ": " << r.solver_reason;
+    EXPECT_NE(r.solver_reason.find("direct-max-dofs"), std::string::npos) << r.solver_reason;
+  };
+  auto below = p;
+  below.options.matrix_free_min_dofs = direct.n_dofs + 1;
+  expect_direct(below, "one DoF below the limit");
+  auto kept = p;
+  kept.options.keep_factor = true;
+  expect_direct(kept, "keep_factor");
+  auto never = p;
+  never.options.matrix_free_min_dofs = 0;
+  expect_direct(never, "limit 0");
+  auto curved = p;
+  curved.curved_surfaces = fem::tube_curved_walls(3e-3, 4e-3);  // short_tube's a and b
+  expect_direct(curved, "curved walls");
+  auto linear = pressurised_tube(1, 0.3);
+  linear.options.matrix_free_min_dofs = 1;
+  expect_direct(linear, "P1");
+}
+
 }  // namespace
 }  // namespace vessel

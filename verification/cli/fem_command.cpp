@@ -47,6 +47,7 @@ struct FemCommandOptions {
   std::string solver = "auto";
   std::size_t direct_max_dofs = fem::SolverOptions{}.direct_max_dofs;
   std::size_t direct_max_mixed_dofs = fem::SolverOptions{}.direct_max_mixed_dofs;
+  std::size_t matrix_free_min_dofs = fem::SolverOptions{}.matrix_free_min_dofs;
   double tolerance = fem::SolverOptions{}.cg_relative_tolerance;
   unsigned max_iterations = fem::SolverOptions{}.max_iterations;
   unsigned gmres_restart = fem::SolverOptions{}.gmres_restart;
@@ -155,6 +156,7 @@ fem::ElasticityProblem command_problem(const FemCommandOptions& o, const Scene& 
                                            : fem::LinearSolver::automatic;
   opt.direct_max_dofs = o.direct_max_dofs;
   opt.direct_max_mixed_dofs = o.direct_max_mixed_dofs;
+  opt.matrix_free_min_dofs = o.matrix_free_min_dofs;
   opt.cg_relative_tolerance = o.tolerance;
   opt.max_iterations = o.max_iterations;
   opt.gmres_restart = o.gmres_restart;
@@ -223,15 +225,6 @@ void print_matrix_free_profile(const fem::MatrixFreeProfile& p) {
             << p.coarse_solves << " P1 solves " << p.coarse_solve_seconds << " ("
             << p.coarse_iterations << " inner CG iterations), transfers " << p.transfer_seconds
             << "; Chebyshev degree " << p.chebyshev_degree << std::defaultfloat << "\n";
-}
-
-/// Why this solver ran: --solver asked for it, or auto's DoF limit picked it.
-std::string solver_reason(const FemCommandOptions& o, const fem::ElasticityResult& r) {
-  if (o.solver != "auto") return "requested by --solver " + o.solver;
-  const bool mixed = r.n_pressure_dofs > 0;
-  const std::size_t limit = mixed ? o.direct_max_mixed_dofs : o.direct_max_dofs;
-  return "auto: " + std::to_string(r.n_dofs) + " DoFs " + (r.n_dofs <= limit ? "<=" : ">") +
-         (mixed ? " --direct-max-mixed-dofs " : " --direct-max-dofs ") + std::to_string(limit);
 }
 
 void print_solver(const fem::ElasticityResult& r) {
@@ -409,7 +402,8 @@ void run_serial(const FemCommandOptions& o, const Scene& s, const TetMesh& mesh,
   run.result = solver.solve();
   print_solver(run.result);
   std::cout << "solver " << fem::to_string(run.result.solver) << ": "
-            << solver_reason(o, run.result) << "\n";
+            << (o.solver == "auto" ? run.result.solver_reason : "requested by --solver " + o.solver)
+            << "\n";
   if (run.contact) run.contact->displacement = solver.displacement_at({run.contact->point})[0];
   const bool lame_setup = run.ends == "roller" && o.loads == std::vector<std::string>{"pressure"};
   if (lame_setup) {  // plane strain is exact with roller ends: Lamé's closed form applies
@@ -668,18 +662,23 @@ void add_solver_options(CLI::App* cmd, FemCommandOptions& o) {
       ->check(CLI::IsMember({"auto", "roller", "clamped", "clamped-inlet"}))
       ->capture_default_str();
   cmd->add_option("--solver", o.solver,
-                  "Linear solver: auto (direct up to --direct-max-dofs / --direct-max-mixed-dofs, "
-                  "else iterative), direct (CHOLMOD; UMFPACK for the mixed system), cg-amg (CG "
+                  "Linear solver: auto (matrix-free for one P2 solve on straight-sided tets from "
+                  "--matrix-free-min-dofs; else direct up to --direct-max-dofs / "
+                  "--direct-max-mixed-dofs, else iterative), direct (CHOLMOD; UMFPACK for the "
+                  "mixed system), cg-amg (CG "
                   "with Trilinos ML AMG, displacement system), gmres-block (FGMRES with a "
                   "block-triangular preconditioner: AMG on the displacement block, scaled "
                   "pressure mass for the Schur complement; mixed system), matrix-free (CG on "
                   "the matrix-free operator: for P2 a P2->P1 p-multigrid with ML-CG on P1, for "
-                  "P1 ML; "
-                  "displacement system; never chosen by auto)")
+                  "P1 ML; displacement system)")
       ->check(CLI::IsMember({"auto", "direct", "cg-amg", "gmres-block", "matrix-free"}))
       ->capture_default_str();
   cmd->add_option("--direct-max-dofs", o.direct_max_dofs,
                   "auto: direct solver up to this many DoFs")
+      ->capture_default_str();
+  cmd->add_option("--matrix-free-min-dofs", o.matrix_free_min_dofs,
+                  "auto: the matrix-free P2 solve from this many DoFs (straight-sided tets, one "
+                  "solve; 0: never)")
       ->capture_default_str();
   cmd->add_option("--direct-max-mixed-dofs", o.direct_max_mixed_dofs,
                   "auto: direct solver (UMFPACK) for the mixed system up to this many DoFs")
