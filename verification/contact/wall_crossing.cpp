@@ -1,6 +1,7 @@
 #include "verification/contact/wall_crossing.hpp"
 
 #include <cmath>
+#include <sstream>
 
 namespace vessel::contact {
 
@@ -45,6 +46,20 @@ std::optional<WallCrossing> first_wall_crossing(const TetMesh& mesh,
     }
   }
   return std::nullopt;
+}
+
+std::optional<std::string> describe_wall_crossing(const TetMesh& mesh,
+                                                  const std::vector<Vec3>& displacement,
+                                                  const std::vector<Vec3>& centreline) {
+  const PhysicalGroup& inner = mesh.require_group("inner_wall", 2, "vessel");
+  const auto c = first_wall_crossing(mesh, mesh.group_triangles(inner), displacement, centreline);
+  if (!c) return std::nullopt;
+  std::ostringstream m;
+  m.precision(3);
+  m << "the wire's centreline crosses the wall at (" << c->point.x() * 1e3 << ", "
+    << c->point.y() * 1e3 << ", " << c->point.z() * 1e3 << ") mm (segment " << c->segment
+    << "): it passed between the wall's nodes, whose spacing there exceeds the wire's diameter";
+  return m.str();
 }
 
 }  // namespace vessel::contact

@@ -6,6 +6,7 @@
 /// that intersects a (deformed) inner-wall triangle is that failure, seen directly.
 #include <Eigen/Core>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
@@ -30,5 +31,12 @@ std::optional<WallCrossing> first_wall_crossing(const TetMesh& mesh,
                                                 const std::vector<Triangle>& triangles,
                                                 const std::vector<Vec3>& displacement,
                                                 const std::vector<Vec3>& centreline);
+
+/// Where `centreline` crosses `mesh`'s inner wall (group "inner_wall") displaced by
+/// `displacement`, as a sentence for a failed solve ("the wire's centreline crosses the wall at
+/// (x, y, z) mm (segment k): ..."), or nullopt when it stays inside the lumen.
+std::optional<std::string> describe_wall_crossing(const TetMesh& mesh,
+                                                  const std::vector<Vec3>& displacement,
+                                                  const std::vector<Vec3>& centreline);
 
 }  // namespace vessel::contact

@@ -770,7 +770,8 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
   return out;
 }
 
-Vec3 potential_clamp_reaction(const msm::rods::Rod& rod, const PotentialContactSolution& s) {
+std::vector<std::pair<int, Vec3>> potential_clamp_forces(const msm::rods::Rod& rod,
+                                                        const PotentialContactSolution& s) {
   VectorXd g;
   rod.gradient(s.x, g);
   // The contact's share of ∇Π on the wire: −λ ∂d/∂(a, b) = λ (1 − t) n at a, λ t n at b.
@@ -780,12 +781,23 @@ Vec3 potential_clamp_reaction(const msm::rods::Rod& rod, const PotentialContactS
     g.segment<3>(3 * a + 3) += s.force[j] * s.parameter[j] * s.direction[j];
   }
   const std::vector<char> fixed = rod.clamp_fixed();
-  Vec3 r = Vec3::Zero();
+  std::vector<std::pair<int, Vec3>> out;
   for (int n = 0; n < rod.num_nodes(); ++n) {
+    Vec3 f = Vec3::Zero();
+    bool held = false;
     for (int c = 0; c < 3; ++c) {
-      if (fixed[static_cast<std::size_t>(3 * n + c)]) r[c] += g[3 * n + c];
+      if (!fixed[static_cast<std::size_t>(3 * n + c)]) continue;
+      f[c] = g[3 * n + c];
+      held = true;
     }
+    if (held) out.emplace_back(n, f);
   }
+  return out;
+}
+
+Vec3 potential_clamp_reaction(const msm::rods::Rod& rod, const PotentialContactSolution& s) {
+  Vec3 r = Vec3::Zero();
+  for (const auto& [node, f] : potential_clamp_forces(rod, s)) r += f;
   return r;
 }
 

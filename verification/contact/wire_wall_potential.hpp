@@ -23,6 +23,7 @@
 #include <array>
 #include <memory>
 #include <ostream>
+#include <utility>
 #include <vector>
 
 #include "fem_reference/elasticity.hpp"
@@ -174,8 +175,12 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
                                                    const PotentialContactOptions& options = {},
                                                    const Eigen::VectorXd& wall_start = {});
 
-/// The force the clamp exerts on the wire at a solution (N): the rod's internal force and its
-/// contact share summed over the held nodes' positions.
+/// The forces the clamp exerts on the wire at a solution, per node with a held position
+/// component (N): the rod's internal force and its contact share there.
+std::vector<std::pair<int, Vec3>> potential_clamp_forces(const msm::rods::Rod& rod,
+                                                        const PotentialContactSolution& solution);
+
+/// The force the clamp exerts on the wire at a solution (N): potential_clamp_forces summed.
 Vec3 potential_clamp_reaction(const msm::rods::Rod& rod, const PotentialContactSolution& solution);
 
 }  // namespace vessel::contact

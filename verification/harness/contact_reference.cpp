@@ -84,16 +84,11 @@ void require_wire_inside_lumen(const TetMesh& mesh, const msm::rods::Rod& rod,
   for (int i = rod.layout().first_node; i <= rod.layout().tip_node; ++i) {
     centreline.emplace_back(x.segment<3>(3 * i));
   }
-  const PhysicalGroup& inner = mesh.require_group("inner_wall", 2, "vessel");
-  const auto c = contact::first_wall_crossing(mesh, mesh.group_triangles(inner), u, centreline);
-  if (!c) return;
-  std::ostringstream m;
-  m.precision(3);
-  m << "the wire's centreline crosses the wall at (" << c->point.x() * 1e3 << ", "
-    << c->point.y() * 1e3 << ", " << c->point.z() * 1e3 << ") mm (segment " << c->segment
-    << "): it passed between the wall's nodes, whose spacing there exceeds the wire's diameter";
-  WallCrossed crossed(m.str());
-  const std::vector<int> wall_nodes = mesh.group_nodes(inner);
+  const auto failure = contact::describe_wall_crossing(mesh, u, centreline);
+  if (!failure) return;
+  WallCrossed crossed(*failure);
+  const std::vector<int> wall_nodes =
+      mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
   for (const Vec3& p : centreline) {
     double nearest = std::numeric_limits<double>::infinity();
     for (const int n : wall_nodes)

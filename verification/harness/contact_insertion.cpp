@@ -1,0 +1,330 @@
+#include "verification/harness/contact_insertion.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include "fem_reference/elasticity.hpp"
+#include "meshes/foundation/errors.hpp"
+#include "meshes/gmsh_vessel.hpp"
+#include "msm/rods/der_rod.hpp"
+#include "verification/contact/wall_crossing.hpp"
+#include "verification/contact/wire_wall_potential.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
+#include "verification/scene_problems.hpp"
+
+namespace vessel {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// Pressed nodes closer than this to another of a zone belong to it.
+constexpr double kZoneGap = 1.0e-3;
+
+/// The pressed nodes grouped into zones (single linkage at kZoneGap), each with its force,
+/// centroid and extent.
+std::vector<ContactZone> contact_zones(const TetMesh& mesh,
+                                       const contact::PotentialContactSolution& s) {
+  const std::size_t n = s.pressed.size();
+  std::vector<int> zone(n, -1);
+  int zones = 0;
+  for (std::size_t seed = 0; seed < n; ++seed) {
+    if (zone[seed] >= 0) continue;
+    zone[seed] = zones;
+    std::vector<std::size_t> stack{seed};
+    while (!stack.empty()) {
+      const std::size_t a = stack.back();
+      stack.pop_back();
+      for (std::size_t b = 0; b < n; ++b) {
+        const Vec3& pa = mesh.nodes[static_cast<std::size_t>(s.pressed[a])];
+        const Vec3& pb = mesh.nodes[static_cast<std::size_t>(s.pressed[b])];
+        if (zone[b] < 0 && (pa - pb).norm() < kZoneGap) {
+          zone[b] = zones;
+          stack.push_back(b);
+        }
+      }
+    }
+    ++zones;
+  }
+  std::vector<ContactZone> out(static_cast<std::size_t>(zones));
+  std::vector<Vec3> total(out.size(), Vec3::Zero());
+  std::vector<double> weight(out.size(), 0.0);
+  for (std::size_t j = 0; j < n; ++j) {
+    const auto z = static_cast<std::size_t>(zone[j]);
+    const Vec3& p = mesh.nodes[static_cast<std::size_t>(s.pressed[j])];
+    total[z] += s.force[j] * s.direction[j];
+    out[z].centroid += s.force[j] * p;
+    weight[z] += s.force[j];
+    ++out[z].nodes;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (zone[k] == zone[j]) {
+        const Vec3& q = mesh.nodes[static_cast<std::size_t>(s.pressed[k])];
+        out[z].extent = std::max(out[z].extent, (p - q).norm());
+      }
+    }
+  }
+  for (std::size_t z = 0; z < out.size(); ++z) {
+    out[z].force = total[z].norm();
+    if (weight[z] > 0.0) out[z].centroid /= weight[z];
+  }
+  return out;
+}
+
+/// The rod's dofs x with its node positions scaled about `origin` by `factor` (its frames' angles
+/// unchanged): the last step's shape at the next step's length.
+Eigen::VectorXd scaled_about(const Eigen::VectorXd& x, int nodes, const Vec3& origin,
+                             double factor) {
+  Eigen::VectorXd out = x;
+  for (int i = 0; i < nodes; ++i) {
+    out.segment<3>(3 * i) = origin + factor * (x.segment<3>(3 * i) - origin);
+  }
+  return out;
+}
+
+std::unique_ptr<contact::WallPotential> make_wall(const Scene& scene, const TetMesh& mesh,
+                                                  const ContactInsertionOptions& o) {
+  const fem::ElasticityProblem problem =
+      wall_problem(scene, scene.poisson_ratios.front(), o.degree);
+  if (o.wall == ContactWall::neo_hookean) {
+    return std::make_unique<contact::NeoHookeanWall>(mesh, problem);
+  }
+  const fem::ElasticitySolver solver(mesh, problem);
+  return std::make_unique<contact::LinearWall>(solver.free_displacement_system());
+}
+
+/// A failed insertion step is retried after one halfway, this many times deep: a long step scales
+/// the last shape so far that its tip starts beyond the wall.
+constexpr int kMaxSplits = 3;
+
+/// The equilibrium in hand along the insertion: the wire's dofs x at length x_length and the
+/// wall's free rows u.
+struct InsertionPath {
+  const GuidewireSpec& spec;
+  double EI;
+  const contact::WallPotential& wall;
+  const TetMesh& mesh;
+  const std::vector<int>& candidates;
+  contact::PotentialContactOptions options;
+  Eigen::VectorXd x, u;
+  double x_length = 0.0;
+  int newton_steps = 0;                    ///< since the caller last reset it
+  std::unique_ptr<msm::rods::DerRod> rod;  ///< at x_length, prepared at x
+  contact::PotentialContactSolution solution;
+
+  /// Solves at length L from the equilibrium in hand (its shape scaled about the clamp to L);
+  /// a failure (Newton, or a centreline through the wall) is retried via L's midpoint with the
+  /// last length, up to kMaxSplits deep. Throws std::runtime_error beyond that.
+  void advance_to(double L, int depth) {
+    auto next =
+        std::make_unique<msm::rods::DerRod>(msm::rods::make_layout(guidewire_rod_spec(spec, L)));
+    options.force_scale = EI / (L * L);
+    try {
+      const Eigen::VectorXd from =
+          scaled_about(x, next->num_nodes(), spec.clamp_point, L / x_length);
+      contact::PotentialContactSolution s = contact::solve_wire_wall_potential(
+          *next, 0.5 * spec.diameter, wall, mesh, candidates, from, options, u);
+      newton_steps += s.newton_iterations;
+      std::vector<Vec3> centreline;
+      for (int i = next->layout().first_node; i <= next->layout().tip_node; ++i) {
+        centreline.emplace_back(s.x.segment<3>(3 * i));
+      }
+      if (const auto crossing =
+              contact::describe_wall_crossing(mesh, wall.nodal(s.u), centreline)) {
+        throw std::runtime_error(*crossing);
+      }
+      x = s.x;
+      u = s.u;
+      x_length = L;
+      rod = std::move(next);
+      solution = std::move(s);
+    } catch (const std::runtime_error&) {
+      if (depth == kMaxSplits || L == x_length) throw;
+      advance_to(0.5 * (x_length + L), depth + 1);
+      advance_to(L, depth + 1);
+    }
+  }
+
+  /// The step's record at the equilibrium in hand.
+  void describe(InsertionStep& step) const {
+    const contact::PotentialContactSolution& s = solution;
+    const std::vector<Vec3> displacement = wall.nodal(s.u);
+    step.converged = true;
+    step.force = s.total_force_on_wall().norm();
+    step.pressed = static_cast<int>(s.pressed.size());
+    step.zones = contact_zones(mesh, s);
+    for (const int n : s.pressed) {
+      step.dent = std::max(step.dent, displacement[static_cast<std::size_t>(n)].norm());
+    }
+    Vec3 reaction = Vec3::Zero(), moment = Vec3::Zero();
+    for (const auto& [node, f] : contact::potential_clamp_forces(*rod, s)) {
+      reaction += f;
+      moment += (Vec3(s.x.segment<3>(3 * node)) - spec.clamp_point).cross(f);
+    }
+    step.clamp_axial = reaction.dot(spec.clamp_direction.normalized());
+    step.clamp_moment = moment.norm();
+    step.push = step.clamp_axial - step.clamp_moment * step.clamp_moment / (2.0 * EI);
+    step.energy = rod->energy(s.x) + wall.evaluate(s.u, nullptr, nullptr);
+    step.tip = s.x.segment<3>(3 * rod->layout().tip_node);
+  }
+};
+
+void require_options(const std::string& file, const ContactInsertionOptions& o) {
+  if (o.steps < 1 || !(o.first >= 0.0) || !(o.last >= 0.0) || !(o.fine_size > 0.0) ||
+      !(o.refine_radius > 0.0) || (o.degree != 1 && o.degree != 2) || o.max_steps < 1) {
+    throw InputError(file +
+                     ": insertion options: expected steps ≥ 1, first and last ≥ 0 (0: the "
+                     "defaults), a positive fine size and refined radius, degree 1 or 2 and "
+                     "Newton steps ≥ 1");
+  }
+}
+
+}  // namespace
+
+ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
+                                         const ContactInsertionOptions& o) {
+  const std::string file = scene.source.string();
+  if (!scene.load.guidewire) {
+    throw InputError(file +
+                     ": load: expected a guidewire load (type = \"guidewire\"); the "
+                     "insertion pushes a wire into the vessel");
+  }
+  require_options(file, o);
+  GuidewireSpec spec;
+  try {
+    spec = with_stiffness(*scene.load.guidewire, EI);
+  } catch (const InputError& e) {
+    throw InputError(file + ": " + e.what());
+  }
+  spec.model = WireModel::der;
+  const double last = o.last > 0.0 ? o.last : spec.insertion;
+  const double first = o.first > 0.0 ? o.first : 0.8 * last;
+  if (!(first < last)) {
+    throw InputError(file + ": insertion: the first length (" + std::to_string(first * 1e3) +
+                     " mm) must be shorter than the last (" + std::to_string(last * 1e3) + " mm)");
+  }
+  spec.insertion = last;
+  ContactInsertion out;
+  out.scene = scene.name;
+  out.bending_stiffness = EI;
+  out.wall = o.wall;
+
+  // The rigid lumen's wall points over the insertion, every quarter of the refined radius (so
+  // the mesh does not depend on the steps): where the wall is refined.
+  const auto t_mesh = Clock::now();
+  GuidewireSolver rigid_solver(scene.vessel, spec);
+  try {
+    (void)rigid_solver.solve_rigid();
+  } catch (const InputError& e) {
+    throw InputError(file + ": " + e.what());
+  }
+  const int samples = static_cast<int>(std::ceil((last - first) / (0.25 * o.refine_radius)));
+  std::vector<RefinedBall> balls;
+  Eigen::VectorXd start;
+  for (int k = 0; k <= samples; ++k) {
+    const GuidewireSolution s =
+        rigid_solver.solve_at_insertion(first + (last - first) * k / samples);
+    if (start.size() == 0) start = rigid_solver.rod_state();
+    if (s.force <= 0.0) continue;
+    bool covered = false;
+    for (const RefinedBall& b : balls)
+      covered = covered || (b.centre - s.wall_point).norm() < 0.25 * b.radius;
+    if (!covered) balls.push_back({s.wall_point, o.refine_radius});
+  }
+  if (balls.empty()) {
+    throw InputError(file + ": insertion: the wire touches the rigid lumen at no length from " +
+                     std::to_string(first * 1e3) + " to " + std::to_string(last * 1e3) + " mm");
+  }
+  const TetMesh mesh = refined_balls_mesh(scene.vessel, balls, o.fine_size);
+  const std::unique_ptr<contact::WallPotential> wall = make_wall(scene, mesh, o);
+  const std::vector<int> candidates =
+      mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
+  out.mesh_nodes = static_cast<int>(mesh.nodes.size());
+  out.refined_balls = static_cast<int>(balls.size());
+  out.mesh_seconds = seconds_since(t_mesh);
+  if (o.log) {
+    *o.log << "insertion: " << scene.name << ", EI " << EI << " N·m², " << to_string(o.wall)
+           << " wall, " << mesh.nodes.size() << " nodes (" << o.fine_size * 1e3 << " mm within "
+           << o.refine_radius * 1e3 << " mm of " << balls.size() << " rigid-lumen wall points), "
+           << out.mesh_seconds << " s" << std::endl;
+  }
+
+  std::vector<double> lengths;
+  for (int k = 0; k <= o.steps; ++k) lengths.push_back(first + (last - first) * k / o.steps);
+  InsertionPath path{spec, EI, *wall, mesh, candidates, {}, start, {}, first, 0, nullptr, {}};
+  path.options.tolerance = 1e-8;
+  path.options.max_newton = o.max_steps;
+  for (const double L : lengths) {
+    const auto t0 = Clock::now();
+    InsertionStep step;
+    step.insertion = L;
+    path.newton_steps = 0;
+    try {
+      path.advance_to(L, 0);
+      path.describe(step);
+    } catch (const std::runtime_error& e) {
+      step.failure = e.what();
+    }
+    step.newton_steps = path.newton_steps;
+    step.seconds = seconds_since(t0);
+    if (o.log) {
+      *o.log << "insertion: L " << L * 1e3 << " mm: "
+             << (step.converged ? "F " + std::to_string(step.force * 1e3) + " mN, " +
+                                      std::to_string(step.zones.size()) + " zone(s), push " +
+                                      std::to_string(step.push * 1e3) + " mN"
+                                : "not converged: " + step.failure)
+             << ", " << step.newton_steps << " Newton steps, " << step.seconds << " s" << std::endl;
+    }
+    out.steps.push_back(step);
+  }
+
+  // dΠ/dL from the neighbours' energies.
+  const std::size_t n = out.steps.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 == n ? k : k + 1;
+    const InsertionStep &sa = out.steps[a], &sb = out.steps[b];
+    out.steps[k].push_by_energy = sa.converged && sb.converged
+                                      ? (sb.energy - sa.energy) / (sb.insertion - sa.insertion)
+                                      : std::numeric_limits<double>::quiet_NaN();
+  }
+  return out;
+}
+
+void print_contact_insertion(const ContactInsertion& r, std::ostream& out) {
+  out << "### " << r.scene << ", EI = " << r.bending_stiffness << " N·m², insertion\n\n"
+      << to_string(r.wall) << " wall, " << r.mesh_nodes << " nodes, refined at " << r.refined_balls
+      << " rigid-lumen wall point(s); set-up " << std::fixed << std::setprecision(1)
+      << r.mesh_seconds << " s\n\n"
+      << "| insertion (mm) | force (mN) | pressed | zones (centroid z mm: mN) | dent (mm) | "
+         "clamp axial R·t (mN) | push R·t − M²/2EI (mN) | push dΠ/dL (mN) | tip (mm) | "
+         "Newton steps | s |\n"
+      << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const InsertionStep& s : r.steps) {
+    out << std::setprecision(3) << "| " << s.insertion * 1e3 << " | ";
+    if (!s.converged) {
+      out << "not converged: " << s.failure << " | | | | | | | | | " << std::setprecision(1)
+          << s.seconds << " |\n";
+      continue;
+    }
+    out << std::setprecision(5) << s.force * 1e3 << " | " << s.pressed << " | ";
+    for (std::size_t z = 0; z < s.zones.size(); ++z) {
+      out << (z ? "; " : "") << std::setprecision(2) << s.zones[z].centroid.z() * 1e3 << ": "
+          << std::setprecision(4) << s.zones[z].force * 1e3;
+    }
+    out << " | " << std::setprecision(3) << s.dent * 1e3 << " | " << std::setprecision(5)
+        << s.clamp_axial * 1e3 << " | " << s.push * 1e3 << " | " << s.push_by_energy * 1e3 << " | ("
+        << std::setprecision(2) << s.tip.x() * 1e3 << ", " << s.tip.y() * 1e3 << ", "
+        << s.tip.z() * 1e3 << ") | " << s.newton_steps << " | " << std::setprecision(1) << s.seconds
+        << " |\n";
+  }
+  out << std::defaultfloat;
+}
+
+}  // namespace vessel

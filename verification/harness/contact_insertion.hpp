@@ -1,0 +1,93 @@
+#pragma once
+/// The wire pushed into the vessel in steps, quasi-statically, against a deformable wall: at each
+/// insertion length the wire and the wall are solved together as one potential
+/// (verification/contact/wire_wall_potential.hpp), each step from the last step's equilibrium
+/// (the wire's shape scaled about the clamp to the new length, the wall's displacement kept), so
+/// contacts appear, slide and separate as the solve finds them.
+///
+/// The wall is meshed once, refined to `fine_size` within `refine_radius` of every point where
+/// the same wire touches the rigid lumen over the insertion (sampled every quarter of that radius,
+/// so the mesh follows the range, not the steps); a wire whose centreline crosses the wall (it
+/// bears outside the refined balls) is a failed step.
+///
+/// Per step the hub's two forces: the clamp's axial force R·t (what a clamp holding the wire
+/// bears) and the push P that advances it. A wire leaving a frictionless sleeve is drawn out of
+/// it by M²/(2EI) (M its bending moment at the sleeve's exit: Bigoni et al., "Eshelby-like forces
+/// acting on elastic structures", J. Mech. Phys. Solids 2015), so P = R·t − M²/(2EI), and by
+/// virtual work P = dΠ/dL with Π the equilibrium's stored energy (wire and wall); both are
+/// reported, the second by central differences between steps.
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "meshes/tet_mesh.hpp"
+#include "verification/harness/contact_reference.hpp"
+#include "verification/scene.hpp"
+
+namespace vessel {
+
+struct ContactInsertionOptions {
+  ContactWall wall = ContactWall::neo_hookean;
+  double first = 0.0;  ///< m: the first insertion length (0: 80 % of the scene's insertion)
+  double last = 0.0;   ///< m: the last (0: the scene's insertion)
+  int steps = 8;       ///< steps from first to last (steps + 1 solves)
+  /// m: the wall's size where the wire may bear (below the wire's diameter, so the capsule
+  /// cannot pass between the nodes)
+  double fine_size = 0.1e-3;
+  double refine_radius = 1.0e-3;  ///< m: the refined ball around each rigid-lumen wall point
+  int degree = 1;                 ///< the wall's elements
+  int max_steps = 300;            ///< Newton steps per insertion step
+  std::ostream* log = nullptr;    ///< one line per step, if set
+};
+
+/// One pressed region: pressed nodes closer than 1 mm to each other.
+struct ContactZone {
+  double force = 0.0;            ///< |Σ λ_j n_j| over its nodes, N
+  Vec3 centroid = Vec3::Zero();  ///< force-weighted mean of its nodes' rest positions, m
+  double extent = 0.0;           ///< largest distance between two of its nodes, m
+  int nodes = 0;
+};
+
+struct InsertionStep {
+  double insertion = 0.0;  ///< m: the wire's length beyond the clamp
+  bool converged = false;
+  std::string failure;
+  double force = 0.0;  ///< |Σ λ_j n_j| over every pressed node, N
+  int pressed = 0;
+  std::vector<ContactZone> zones;
+  double clamp_axial = 0.0;   ///< R·t: the clamp's force on the wire along the clamp direction, N
+  double clamp_moment = 0.0;  ///< |M|: the clamp's moment on the wire about the clamp point, N·m
+  double push = 0.0;          ///< R·t − M²/(2EI), N
+  /// dΠ/dL by central differences of the neighbouring steps' energies (one-sided at the ends;
+  /// NaN when a neighbour failed), N
+  double push_by_energy = 0.0;
+  double energy = 0.0;      ///< the wire's and the wall's stored energy at equilibrium, J
+  Vec3 tip = Vec3::Zero();  ///< m
+  double dent = 0.0;        ///< largest wall displacement of a pressed node, m
+  int newton_steps = 0;
+  double seconds = 0.0;
+};
+
+struct ContactInsertion {
+  std::string scene;
+  double bending_stiffness = 0.0;  ///< EI, N·m²
+  ContactWall wall = ContactWall::neo_hookean;
+  int mesh_nodes = 0;
+  int refined_balls = 0;
+  double mesh_seconds = 0.0;  ///< meshing and the wall's set-up
+  std::vector<InsertionStep> steps;
+};
+
+/// The insertion of `scene`'s guidewire at bending stiffness EI (N·m²) against the scene's wall
+/// at its first Poisson's ratio. InputError naming the scene's file for a scene without a
+/// guidewire load, a vessel from a file, EI ≤ 0, options out of range or a first insertion
+/// beyond the last. A step that does not converge is reported, and the next starts from the last
+/// converged one.
+ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
+                                         const ContactInsertionOptions& options = {});
+
+/// The insertion as Markdown: one line with the scene, EI, the wall and its mesh; a table per
+/// step (mm, mN).
+void print_contact_insertion(const ContactInsertion& insertion, std::ostream& out);
+
+}  // namespace vessel
