@@ -485,9 +485,16 @@ class ModelMatrix {
  public:
   static constexpr std::size_t kMaxChanged = 64;
 
-  ModelMatrix(const Coupled& p, const Linearisation& lin, int& factorisations)
+  /// `shift` μ ≥ 0: Levenberg–Marquardt's damping, B + μ diag(|B|) in place of B.
+  ModelMatrix(const Coupled& p, const Linearisation& lin, int& factorisations, double shift)
       : p_(p), lin_(lin), factorisations_(factorisations), base_(p.size(), p.size()) {
     base_.setFromTriplets(lin.base.begin(), lin.base.end());
+    if (shift > 0.0) {
+      for (int i = 0; i < base_.rows(); ++i) {
+        double& d = base_.coeffRef(i, i);
+        d += shift * std::abs(d);
+      }
+    }
   }
 
   /// dz = H(active)⁻¹ rhs; false if H cannot be factorised.
@@ -579,7 +586,7 @@ class ModelMatrix {
 /// an active-set iteration (ModelMatrix): a wire about to touch is stopped by the wall within the
 /// step instead of passing it in the model. false if H cannot be factorised.
 bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gradient, VectorXd& dz,
-                 int& factorisations) {
+                 int& factorisations, double shift) {
   const double k = p.stiffness();
   const std::size_t m = lin.c.size();
   // ∇Π without the pressed pairs' −λ∇g: the model adds each pair's own term.
@@ -589,7 +596,7 @@ bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gra
   }
   std::vector<char> active(m), next(m);
   for (std::size_t j = 0; j < m; ++j) active[j] = lin.c[j] > 0.0;
-  ModelMatrix H(p, lin, factorisations);
+  ModelMatrix H(p, lin, factorisations, shift);
   for (int pass = 0; pass < 20; ++pass) {
     VectorXd rhs = -g0;
     for (std::size_t j = 0; j < m; ++j) {
@@ -618,11 +625,13 @@ struct RecentSteps {
   int steepest = 0;   ///< steps that fell back to steepest descent
   int capped = 0;     ///< steps cut to the largest move
   double move = 0.0;  ///< the steps' node moves summed, r_w
-  void report(std::ostream& log, int step, const NewtonOutcome& out) {
+  void report(std::ostream& log, int step, const NewtonOutcome& out, double shift) {
     log << "potential contact:   step " << step << ", residual " << out.residual << " N, "
         << out.factorisations << " factorisations; the last " << kEvery << " steps: " << projected
         << " on the PSD-projected Hessian, " << steepest << " steepest descent, " << capped
-        << " capped at the largest move, mean move " << move / kEvery << " r_w" << std::endl;
+        << " capped at the largest move, mean move " << move / kEvery << " r_w"
+        << (shift > 0.0 ? ", Levenberg–Marquardt μ " + std::to_string(shift) : std::string())
+        << std::endl;
     *this = {};
   }
 };
@@ -635,6 +644,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
   const double target = o.tolerance * o.force_scale;
   const double band = o.max_move * p.radius();
   RecentSteps recent;
+  double shift = 0.0;  // Levenberg–Marquardt's μ (damped_newton)
   for (int it = 0; it <= o.max_newton; ++it) {
     const double pi = p.evaluate(z, g, &lin, false, band);
     out.residual = g.norm();
@@ -644,12 +654,12 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
       return out;
     }
     if (it == o.max_newton) break;
-    if (o.log && it > 0 && it % RecentSteps::kEvery == 0) recent.report(*o.log, it, out);
-    bool descent = newton_step(p, lin, g, dz, out.factorisations) && g.dot(dz) < 0.0;
+    if (o.log && it > 0 && it % RecentSteps::kEvery == 0) recent.report(*o.log, it, out, shift);
+    bool descent = newton_step(p, lin, g, dz, out.factorisations, shift) && g.dot(dz) < 0.0;
     if (!descent) {
       ++recent.projected;
       (void)p.evaluate(z, g, &lin, true, band);
-      descent = newton_step(p, lin, g, dz, out.factorisations) && g.dot(dz) < 0.0;
+      descent = newton_step(p, lin, g, dz, out.factorisations, shift) && g.dot(dz) < 0.0;
     }
     if (!descent) {
       ++recent.steepest;
@@ -682,6 +692,11 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
       out.converged = out.residual <= 1e3 * target;  // at the round-off floor of ‖∇Π‖
       if (!out.converged) out.reason = "the line search found no decrease of the potential";
       return out;
+    }
+    if (o.damped_newton) {
+      // Levenberg–Marquardt's update of μ (Nocedal & Wright §10.3): a step the line search had to
+      // cut was longer than the model can be trusted for; a full one says it can be trusted more.
+      shift = alpha < alpha0 ? std::max(10.0 * shift, 1e-4) : (shift < 1e-7 ? 0.0 : 0.1 * shift);
     }
     z = trial;
     p.prepare(z);

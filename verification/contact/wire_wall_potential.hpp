@@ -134,6 +134,9 @@ struct PotentialContactOptions {
   double force_scale = 1e-3;    ///< N
   double max_move = 0.5;        ///< × r_w: the largest node move of one Newton step
   int max_newton = 300;         ///< Newton steps per round
+  /// Levenberg–Marquardt: the Newton model's matrix B + μ diag(|B|), μ raised tenfold (from 1e-4)
+  /// after a step the line search cut and lowered tenfold after a full one.
+  bool damped_newton = false;
   int max_rounds = 40;          ///< augmented-Lagrangian rounds
   std::ostream* log = nullptr;  ///< one line per round and per 25 Newton steps, if set
 };

@@ -289,7 +289,8 @@ TEST(WireWallPotentialSlow, RigidLimitApproachesTheRigidWallSolve) {
 // clamp and the wall's supports (their reactions from the wall's own internal forces at the held
 // DoFs) balance to 1e-9 of the force; the augmented Lagrangian's force equals the penalty law's
 // extrapolated to infinite stiffness (k, 2k, 4k; Richardson in 1/k, first order) within the
-// extrapolation's own error estimate and 1e-5 relative.
+// extrapolation's own error estimate and 1e-5 relative; Levenberg–Marquardt's damped Newton steps
+// end at the same pressed nodes and force (1e-8).
 TEST(WireWallPotentialSlow, TwoFormulationsAndActionReactionOnAFiniteStrainWall) {
   const TetMesh mesh = line_of_contact_mesh();
   const std::vector<int> nodes = nodes_within(mesh, kAimPoint, 1.6e-3);
@@ -307,6 +308,15 @@ TEST(WireWallPotentialSlow, TwoFormulationsAndActionReactionOnAFiniteStrainWall)
   EXPECT_GT(s.pressed.size(), 10u);
   EXPECT_GT(strain, 0.1);
   EXPECT_LT((run.clamp + supports).norm(), 1e-9 * F);
+  // Levenberg–Marquardt's damped Newton steps end at the same minimiser.
+  contact::PotentialContactOptions damped;
+  damped.damped_newton = true;
+  const PotentialRun d = potential_run(mesh, kAimPoint, wall, nodes, damped);
+  std::printf("WIRE-WALL-POTENTIAL damped Newton: F %.8e N, %zu pressed, %d Newton (undamped %d)\n",
+              d.solution.total_force_on_wall().norm(), d.solution.pressed.size(),
+              d.solution.newton_iterations, s.newton_iterations);
+  EXPECT_EQ(d.solution.pressed, s.pressed);
+  EXPECT_NEAR(d.solution.total_force_on_wall().norm(), F, 1e-8 * F);
   std::vector<double> penalty;
   for (const double factor : {1.0, 2.0, 4.0}) {
     contact::PotentialContactOptions o;
