@@ -176,6 +176,48 @@ struct InsertionPath {
   }
 };
 
+/// The points where the wire touches the rigid lumen from `first` to `last` (m), every quarter of
+/// `radius` (so they follow the range, not the steps), as balls of `radius` (one within a quarter
+/// radius of another is left out); `start` gets the rigid-lumen state at `first`. `rigid` has
+/// solved the last length.
+std::vector<RefinedBall> rigid_lumen_balls(GuidewireSolver& rigid, double first, double last,
+                                           double radius, Eigen::VectorXd& start) {
+  const int samples = static_cast<int>(std::ceil((last - first) / (0.25 * radius)));
+  std::vector<RefinedBall> balls;
+  for (int k = 0; k <= samples; ++k) {
+    const GuidewireSolution s = rigid.solve_at_insertion(first + (last - first) * k / samples);
+    if (k == 0) start = rigid.rod_state();
+    if (s.force <= 0.0) continue;
+    bool covered = false;
+    for (const RefinedBall& b : balls)
+      covered = covered || (b.centre - s.wall_point).norm() < 0.25 * b.radius;
+    if (!covered) balls.push_back({s.wall_point, radius});
+  }
+  return balls;
+}
+
+/// Each step's dΠ/dL from its neighbours' energies (one-sided at the ends; NaN next to a failed
+/// step).
+void set_push_by_energy(std::vector<InsertionStep>& steps) {
+  const std::size_t n = steps.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 == n ? k : k + 1;
+    const InsertionStep &sa = steps[a], &sb = steps[b];
+    steps[k].push_by_energy = sa.converged && sb.converged && b > a
+                                  ? (sb.energy - sa.energy) / (sb.insertion - sa.insertion)
+                                  : std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+void log_step(std::ostream& log, const InsertionStep& step) {
+  log << "insertion: L " << step.insertion * 1e3 << " mm: "
+      << (step.converged ? "F " + std::to_string(step.force * 1e3) + " mN, " +
+                               std::to_string(step.zones.size()) + " zone(s), push " +
+                               std::to_string(step.push * 1e3) + " mN"
+                         : "not converged: " + step.failure)
+      << ", " << step.newton_steps << " Newton steps, " << step.seconds << " s" << std::endl;
+}
+
 void require_options(const std::string& file, const ContactInsertionOptions& o) {
   if (o.steps < 1 || !(o.first >= 0.0) || !(o.last >= 0.0) || !(o.fine_size > 0.0) ||
       !(o.refine_radius > 0.0) || (o.degree != 1 && o.degree != 2) || o.max_steps < 1) {
@@ -186,10 +228,11 @@ void require_options(const std::string& file, const ContactInsertionOptions& o) 
   }
 }
 
-}  // namespace
-
-ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
-                                         const ContactInsertionOptions& o) {
+/// The scene's wire at EI (DER) inserted to `last`, and the range [first, last] (m) from the
+/// options; InputError naming the file for a scene without a guidewire, bad options or an empty
+/// range.
+GuidewireSpec insertion_spec(const Scene& scene, double EI, const ContactInsertionOptions& o,
+                             double& first, double& last) {
   const std::string file = scene.source.string();
   if (!scene.load.guidewire) {
     throw InputError(file +
@@ -204,20 +247,28 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
     throw InputError(file + ": " + e.what());
   }
   spec.model = WireModel::der;
-  const double last = o.last > 0.0 ? o.last : spec.insertion;
-  const double first = o.first > 0.0 ? o.first : 0.8 * last;
+  last = o.last > 0.0 ? o.last : spec.insertion;
+  first = o.first > 0.0 ? o.first : 0.8 * last;
   if (!(first < last)) {
     throw InputError(file + ": insertion: the first length (" + std::to_string(first * 1e3) +
                      " mm) must be shorter than the last (" + std::to_string(last * 1e3) + " mm)");
   }
   spec.insertion = last;
+  return spec;
+}
+
+}  // namespace
+
+ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
+                                         const ContactInsertionOptions& o) {
+  const std::string file = scene.source.string();
+  double first = 0.0, last = 0.0;
+  const GuidewireSpec spec = insertion_spec(scene, EI, o, first, last);
   ContactInsertion out;
   out.scene = scene.name;
   out.bending_stiffness = EI;
   out.wall = o.wall;
 
-  // The rigid lumen's wall points over the insertion, every quarter of the refined radius (so
-  // the mesh does not depend on the steps): where the wall is refined.
   const auto t_mesh = Clock::now();
   GuidewireSolver rigid_solver(scene.vessel, spec);
   try {
@@ -225,19 +276,9 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
   } catch (const InputError& e) {
     throw InputError(file + ": " + e.what());
   }
-  const int samples = static_cast<int>(std::ceil((last - first) / (0.25 * o.refine_radius)));
-  std::vector<RefinedBall> balls;
   Eigen::VectorXd start;
-  for (int k = 0; k <= samples; ++k) {
-    const GuidewireSolution s =
-        rigid_solver.solve_at_insertion(first + (last - first) * k / samples);
-    if (start.size() == 0) start = rigid_solver.rod_state();
-    if (s.force <= 0.0) continue;
-    bool covered = false;
-    for (const RefinedBall& b : balls)
-      covered = covered || (b.centre - s.wall_point).norm() < 0.25 * b.radius;
-    if (!covered) balls.push_back({s.wall_point, o.refine_radius});
-  }
+  const std::vector<RefinedBall> balls =
+      rigid_lumen_balls(rigid_solver, first, last, o.refine_radius, start);
   if (balls.empty()) {
     throw InputError(file + ": insertion: the wire touches the rigid lumen at no length from " +
                      std::to_string(first * 1e3) + " to " + std::to_string(last * 1e3) + " mm");
@@ -274,26 +315,11 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
     }
     step.newton_steps = path.newton_steps;
     step.seconds = seconds_since(t0);
-    if (o.log) {
-      *o.log << "insertion: L " << L * 1e3 << " mm: "
-             << (step.converged ? "F " + std::to_string(step.force * 1e3) + " mN, " +
-                                      std::to_string(step.zones.size()) + " zone(s), push " +
-                                      std::to_string(step.push * 1e3) + " mN"
-                                : "not converged: " + step.failure)
-             << ", " << step.newton_steps << " Newton steps, " << step.seconds << " s" << std::endl;
-    }
+    if (o.log) log_step(*o.log, step);
     out.steps.push_back(step);
   }
 
-  // dΠ/dL from the neighbours' energies.
-  const std::size_t n = out.steps.size();
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 == n ? k : k + 1;
-    const InsertionStep &sa = out.steps[a], &sb = out.steps[b];
-    out.steps[k].push_by_energy = sa.converged && sb.converged
-                                      ? (sb.energy - sa.energy) / (sb.insertion - sa.insertion)
-                                      : std::numeric_limits<double>::quiet_NaN();
-  }
+  set_push_by_energy(out.steps);
   return out;
 }
 
