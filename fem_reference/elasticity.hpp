@@ -108,8 +108,9 @@ struct SolverOptions {
   /// automatic, the linear reference's P2 displacement system on straight-sided tets solved once
   /// (not keep_factor): the matrix-free p-multigrid CG from this many DoFs, where it overtook
   /// CHOLMOD on this machine (docs/measurements/solver_switch.md,
-  /// scripts/measure_solver_switch.py); 0: never. It changes the answer within
-  /// cg_relative_tolerance, so it is in the solution cache's key where it can apply.
+  /// scripts/measure_solver_switch.py); 0: never. It changes the answer only within
+  /// cg_relative_tolerance, so it is not part of the solution cache's key (a reference the
+  /// distributed job stored serves the serial run).
   std::size_t matrix_free_min_dofs = 14000;
   /// CG-AMG: give ML all six rigid-body modes (translations and rotations) as near-null space;
   /// false: only the three translations (deal.II's AdditionalData::constant_modes).

@@ -71,10 +71,6 @@ void hash_options(KeyHash& h, const SolverOptions& o) {
   h.integer(static_cast<int>(o.solver)).integer(static_cast<std::int64_t>(o.direct_max_dofs));
   h.integer(static_cast<std::int64_t>(o.direct_max_mixed_dofs)).integer(o.amg_rigid_body_modes);
   h.real(o.cg_relative_tolerance).integer(o.gmres_restart).integer(o.max_iterations);
-  // automatic may pick the matrix-free CG (an answer within its tolerance) only for P2
-  if (o.solver == LinearSolver::automatic && o.degree == 2 && !o.keep_factor) {
-    h.integer(static_cast<std::int64_t>(o.matrix_free_min_dofs));
-  }
 }
 
 // Binary (de)serialisation of a result and its DoF values, native byte order: the cache is a
