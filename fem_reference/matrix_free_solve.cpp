@@ -13,6 +13,7 @@
 #include "fem_reference/detail/matrix_free_elasticity.hpp"
 #include "fem_reference/detail/serial_solver.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 
 namespace vessel::fem {
 
@@ -96,7 +97,7 @@ std::vector<double> operator_product(const Impl& im, const std::vector<double>& 
   detail::ensure_mpi_initialized();
   const auto homogeneous = detail::homogeneous_copy(im.constraints);
   const detail::ElasticityOperator op(*im.mapping, im.dof, homogeneous, im.degree,
-                                      im.form->lambda(), im.form->mu());
+                                      im.form->lambda(), im.form->mu(), solver_threads());
   detail::MfVector src, dst;
   op.initialize_dof_vector(src);
   op.initialize_dof_vector(dst);

@@ -22,8 +22,11 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <thread>
 
 #include "fem_reference/cholmod_solve.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 
 namespace vessel::fem::detail {
 
@@ -46,14 +49,16 @@ void stress_divergence(Evaluation& phi, double lambda, double mu) {
   phi.integrate(dl::EvaluationFlags::gradients);
 }
 
-/// Cells per batch of the straight-tet kernel: one AVX2 register of doubles per quantity.
-constexpr unsigned kLanes = 4;
+/// Cells per batch of the straight-tet kernel: one AVX-512 register of doubles per quantity
+/// (two AVX2, four SSE2 registers).
+constexpr unsigned kLanes = 8;
 /// Doubles per cell of a batch's geometry: J⁻ᵀ (∂ξ_e/∂x_d at [3d + e]) and |det J|.
 constexpr unsigned kGeometry = kDim * kDim + 1;
-/// Two and four doubles as one GCC vector: arithmetic on them is lane-wise (a scalar operand is
-/// broadcast); an SSE2 and an AVX2 register.
+/// Two, four and eight doubles as one GCC vector: arithmetic on them is lane-wise (a scalar
+/// operand is broadcast); an SSE2, an AVX2 and an AVX-512 register.
 using Lanes2 = double __attribute__((vector_size(2 * sizeof(double))));
 using Lanes4 = double __attribute__((vector_size(4 * sizeof(double))));
+using Lanes8 = double __attribute__((vector_size(8 * sizeof(double))));
 
 /// The displacement a(u, v) on V's lanes, as many of a batch's kLanes straight-sided tets at
 /// once (struct of arrays: entry [k·kLanes + l] belongs to cell l; the pointers start at V's
@@ -106,31 +111,55 @@ template <typename V, unsigned N, unsigned Q>
   for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(out + k * kLanes, &a[k], sizeof(V));
 }
 
-/// straight_lanes on a whole batch: two halves of SSE2 width (any x86-64) ...
+/// straight_lanes on a whole batch, `Width` cells at a time: SSE2 (any x86-64), AVX2 + FMA or
+/// AVX-512 + FMA, each compiled for its instruction set and chosen at run time (straight_kernel),
+/// so the project builds and runs on any x86-64.
+template <typename V, unsigned Width, unsigned N, unsigned Q>
+[[gnu::always_inline]] inline void straight_batch(const double* in, double* out,
+                                                  const double* geometry, const double* ref_grad,
+                                                  const double* weights, double lambda, double mu) {
+  for (unsigned first = 0; first < kLanes; first += Width) {
+    straight_lanes<V, N, Q>(in + first, out + first, geometry + first, ref_grad, weights, lambda,
+                            mu);
+  }
+}
 template <unsigned N, unsigned Q>
 void straight_batch_sse2(const double* in, double* out, const double* geometry,
                          const double* ref_grad, const double* weights, double lambda, double mu) {
-  for (unsigned first = 0; first < kLanes; first += 2) {
-    straight_lanes<Lanes2, N, Q>(in + first, out + first, geometry + first, ref_grad, weights,
-                                 lambda, mu);
-  }
+  straight_batch<Lanes2, 2, N, Q>(in, out, geometry, ref_grad, weights, lambda, mu);
 }
-/// ... or at once in AVX2 registers, chosen at run time only on a CPU that has AVX2, so the
-/// project keeps building and running on any x86-64.
 template <unsigned N, unsigned Q>
-[[gnu::target("avx2")]] void straight_batch_avx2(const double* in, double* out,
-                                                 const double* geometry, const double* ref_grad,
-                                                 const double* weights, double lambda, double mu) {
-  straight_lanes<Lanes4, N, Q>(in, out, geometry, ref_grad, weights, lambda, mu);
+[[gnu::target("avx2,fma")]] void straight_batch_avx2(const double* in, double* out,
+                                                     const double* geometry, const double* ref_grad,
+                                                     const double* weights, double lambda,
+                                                     double mu) {
+  straight_batch<Lanes4, 4, N, Q>(in, out, geometry, ref_grad, weights, lambda, mu);
 }
-/// The batch kernel for the scalar element's `n_shapes` (4: P1, 10: P2) on this CPU: AVX2 where
-/// it has it, unless the environment sets VESSELVERIFY_MATRIX_FREE_SSE2 (the tests, to check the
-/// SSE2 variant too; measurements).
-StraightTetKernel straight_batch_kernel(unsigned n_shapes) {
-  const bool avx2 =
-      __builtin_cpu_supports("avx2") && std::getenv("VESSELVERIFY_MATRIX_FREE_SSE2") == nullptr;
-  if (n_shapes == 4) return avx2 ? straight_batch_avx2<4, 1> : straight_batch_sse2<4, 1>;
-  return avx2 ? straight_batch_avx2<10, 4> : straight_batch_sse2<10, 4>;
+template <unsigned N, unsigned Q>
+[[gnu::target("avx512f,fma")]] void straight_batch_avx512(const double* in, double* out,
+                                                          const double* geometry,
+                                                          const double* ref_grad,
+                                                          const double* weights, double lambda,
+                                                          double mu) {
+  straight_batch<Lanes8, 8, N, Q>(in, out, geometry, ref_grad, weights, lambda, mu);
+}
+
+template <unsigned N, unsigned Q>
+StraightTetKernel straight_batch_for(StraightTetIsa isa) {
+  switch (isa) {
+    case StraightTetIsa::avx512:
+      return straight_batch_avx512<N, Q>;
+    case StraightTetIsa::avx2:
+      return straight_batch_avx2<N, Q>;
+    case StraightTetIsa::sse2:
+      break;
+  }
+  return straight_batch_sse2<N, Q>;
+}
+
+/// The batch kernel for the scalar element's `n_shapes` (4: P1, 10: P2) on `isa`.
+StraightTetKernel straight_batch_kernel(unsigned n_shapes, StraightTetIsa isa) {
+  return n_shapes == 4 ? straight_batch_for<4, 1>(isa) : straight_batch_for<10, 4>(isa);
 }
 
 using Clock = std::chrono::steady_clock;
@@ -168,6 +197,50 @@ dl::Quadrature<kDim> exact_on_straight_tets(int degree) {
 }
 
 }  // namespace
+
+const char* to_string(StraightTetIsa isa) {
+  switch (isa) {
+    case StraightTetIsa::avx512:
+      return "avx512";
+    case StraightTetIsa::avx2:
+      return "avx2";
+    case StraightTetIsa::sse2:
+      break;
+  }
+  return "sse2";
+}
+
+bool cpu_supports(StraightTetIsa isa) {
+  switch (isa) {
+    case StraightTetIsa::avx512:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("fma");
+    case StraightTetIsa::avx2:
+      return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    case StraightTetIsa::sse2:
+      break;
+  }
+  return true;
+}
+
+StraightTetIsa straight_tet_isa() {
+  constexpr auto kVariable = "VESSELVERIFY_MATRIX_FREE_ISA";
+  const char* asked = std::getenv(kVariable);
+  if (asked == nullptr) {
+    for (const auto isa : {StraightTetIsa::avx512, StraightTetIsa::avx2}) {
+      if (cpu_supports(isa)) return isa;
+    }
+    return StraightTetIsa::sse2;
+  }
+  for (const auto isa : {StraightTetIsa::sse2, StraightTetIsa::avx2, StraightTetIsa::avx512}) {
+    if (std::string(asked) != to_string(isa)) continue;
+    if (!cpu_supports(isa)) {
+      throw std::runtime_error(std::string(kVariable) + "=" + asked + ": this CPU lacks it");
+    }
+    return isa;
+  }
+  throw std::runtime_error(std::string(kVariable) + "=" + asked +
+                           ": expected sse2, avx2 or avx512");
+}
 
 dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<double>& constraints) {
   dl::AffineConstraints<double> out;
@@ -241,7 +314,7 @@ void P1ToP2Embedding::restrict_and_add(MfVector& p1, const MfVector& p2) const {
 ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
                                        const dl::DoFHandler<kDim>& dof,
                                        const dl::AffineConstraints<double>& constraints, int degree,
-                                       double lambda, double mu)
+                                       double lambda, double mu, unsigned threads)
     : mapping_(mapping), constraints_(constraints), lambda_(lambda), mu_(mu) {
   dl::MatrixFree<kDim, double>::AdditionalData data;
   data.mapping_update_flags = dl::update_gradients | dl::update_JxW_values;
@@ -266,9 +339,11 @@ ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
         for (unsigned e = 0; e < kDim; ++e) ref_grad_.push_back(g[e]);
       }
     }
-    kernel_ = straight_batch_kernel(n_shapes_);
+    isa_ = straight_tet_isa();
+    kernel_ = straight_batch_kernel(n_shapes_, isa_);
     mf_.reinit(mapping, dof, constraints, dl::QGaussSimplex<kDim>(1), data);
     build_batches();
+    partition_batches(threads);
     return;
   }
   mf_.reinit(mapping, dof, constraints, quadrature_, data);
@@ -313,21 +388,66 @@ void ElasticityOperator::store_geometry(const Evaluation& phi, double* lane) {
   lane[kDim * kDim * kLanes] = 6.0 * phi.JxW(0)[0];
 }
 
-void ElasticityOperator::apply_batches(MfVector& dst, const MfVector& src) const {
+void ElasticityOperator::partition_batches(unsigned threads) {
+  const std::size_t n_batches = batch_geometry_.size() / (kGeometry * kLanes);
+  if (n_batches == 0) return;
+  const unsigned per_batch = kDim * n_shapes_ * kLanes;
+  // A part of fewer batches costs more to start on a thread than it saves.
+  constexpr std::size_t kMinBatchesPerPart = 32;
+  const std::size_t n_parts =
+      std::clamp<std::size_t>(threads, 1, std::max<std::size_t>(1, n_batches / kMinBatchesPerPart));
+  parts_.resize(n_parts);
+  for (std::size_t p = 0; p < n_parts; ++p) {
+    Part& part = parts_[p];
+    part.first = n_batches * p / n_parts;
+    part.end = n_batches * (p + 1) / n_parts;
+    if (p == 0) continue;  // part 0 writes dst itself
+    const auto begin = batch_dofs_.begin() + static_cast<std::ptrdiff_t>(part.first * per_batch);
+    const auto end = batch_dofs_.begin() + static_cast<std::ptrdiff_t>(part.end * per_batch);
+    part.first_dof = kNoDof;
+    for (auto it = begin; it != end; ++it) {
+      if (*it == kNoDof) continue;
+      part.first_dof = std::min(part.first_dof, *it);
+      part.end_dof = std::max(part.end_dof, *it + 1);
+    }
+    if (part.first_dof == kNoDof) part.first_dof = part.end_dof = 0;
+    part.sum.resize(part.end_dof - part.first_dof);
+  }
+}
+
+void ElasticityOperator::apply_batch_range(std::size_t first, std::size_t end, const MfVector& src,
+                                           double* out, unsigned offset) const {
   const unsigned per_batch = kDim * n_shapes_ * kLanes;
   const double* w = quadrature_.get_weights().data();
-  std::array<double, kDim * 10 * kLanes> in{}, out{};
-  dst = 0.0;
-  const std::size_t n_batches = batch_geometry_.size() / (kGeometry * kLanes);
-  for (std::size_t b = 0; b < n_batches; ++b) {
+  std::array<double, kDim * 10 * kLanes> in{}, a{};
+  for (std::size_t b = first; b < end; ++b) {
     const unsigned* idx = batch_dofs_.data() + b * per_batch;
     for (unsigned j = 0; j < per_batch; ++j) {
       in[j] = idx[j] == kNoDof ? 0.0 : src.local_element(idx[j]);
     }
-    kernel_(in.data(), out.data(), batch_geometry_.data() + b * kGeometry * kLanes,
-            ref_grad_.data(), w, lambda_, mu_);
+    kernel_(in.data(), a.data(), batch_geometry_.data() + b * kGeometry * kLanes, ref_grad_.data(),
+            w, lambda_, mu_);
     for (unsigned j = 0; j < per_batch; ++j) {
-      if (idx[j] != kNoDof) dst.local_element(idx[j]) += out[j];
+      if (idx[j] != kNoDof) out[idx[j] - offset] += a[j];
+    }
+  }
+}
+
+void ElasticityOperator::apply_batches(MfVector& dst, const MfVector& src) const {
+  dst = 0.0;
+  std::vector<std::thread> others;
+  for (std::size_t p = 1; p < parts_.size(); ++p) {
+    others.emplace_back([this, &src, &part = parts_[p]] {
+      std::fill(part.sum.begin(), part.sum.end(), 0.0);
+      apply_batch_range(part.first, part.end, src, part.sum.data(), part.first_dof);
+    });
+  }
+  apply_batch_range(parts_[0].first, parts_[0].end, src, dst.begin(), 0);
+  for (std::thread& t : others) t.join();
+  for (std::size_t p = 1; p < parts_.size(); ++p) {
+    const Part& part = parts_[p];
+    for (unsigned i = part.first_dof; i < part.end_dof; ++i) {
+      dst.local_element(i) += part.sum[i - part.first_dof];
     }
   }
 }
@@ -455,7 +575,7 @@ class MatrixFreeElasticitySolver::VCycle {
       c.close();
       coarse_constraints_ = homogeneous_copy(c);
       coarse_ = std::make_unique<ElasticityOperator>(mapping, coarse_dof_, coarse_constraints_, 1,
-                                                     lambda, mu);
+                                                     lambda, mu, solver_threads());
       coarse = coarse_.get();
       profile.coarse_level = lap();
       if (plain_indexable(dof, fine_constraints) &&
@@ -650,7 +770,8 @@ MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(const dl::Mapping<kDim>& 
   c.close();
   fine_constraints_ = homogeneous_copy(c);
   const auto t_fine = Clock::now();
-  fine_ = std::make_unique<ElasticityOperator>(mapping, dof, fine_constraints_, degree, lambda, mu);
+  fine_ = std::make_unique<ElasticityOperator>(mapping, dof, fine_constraints_, degree, lambda, mu,
+                                               solver_threads());
   profile_.fine_operator = seconds_since(t_fine);
   profile_.quadrature_points = fine_->quadrature_points();
   preconditioner_ =

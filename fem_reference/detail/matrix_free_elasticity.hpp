@@ -17,6 +17,7 @@
 #include <deal.II/matrix_free/matrix_free.h>
 #include <deal.II/multigrid/mg_transfer_global_coarsening.h>
 
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <memory>
@@ -37,6 +38,18 @@ using StraightTetKernel = void (*)(const double* in, double* out, const double* 
                                    const double* ref_grad, const double* weights, double lambda,
                                    double mu);
 
+/// The instruction set the straight-tet kernel runs in: a batch of 8 cells as four SSE2, two
+/// AVX2 (+ FMA) or one AVX-512 (+ FMA) register per quantity.
+enum class StraightTetIsa { sse2, avx2, avx512 };
+[[nodiscard]] const char* to_string(StraightTetIsa isa);
+/// Whether this CPU has `isa` (and FMA for avx2, avx512).
+[[nodiscard]] bool cpu_supports(StraightTetIsa isa);
+/// The widest instruction set this CPU has, or the one the environment's
+/// VESSELVERIFY_MATRIX_FREE_ISA names (sse2, avx2, avx512: the tests check every variant and
+/// measurements compare them); std::runtime_error naming the variable for another value or one
+/// this CPU lacks.
+[[nodiscard]] StraightTetIsa straight_tet_isa();
+
 /// A(u) = ∫ σ(u) : ε(v) dV with σ = λ tr(ε) I + 2μ ε (Pa, so A u is in N for u in m), evaluated
 /// cell by cell on straight-sided tets at the fewest-point rule exact for the integrand's degree
 /// 2(degree − 1) (P2: 4 points) and on curved ones at the assembled path's
@@ -45,9 +58,11 @@ using StraightTetKernel = void (*)(const double* in, double* out, const double* 
 /// on the constrained ones.
 class ElasticityOperator : public dl::Subscriptor {
  public:
+  /// `threads`: the batched kernel's cells are cut into that many contiguous parts, one per
+  /// thread (fewer on a small mesh); the other paths are serial.
   ElasticityOperator(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
                      const dl::AffineConstraints<double>& constraints, int degree, double lambda,
-                     double mu);
+                     double mu, unsigned threads = 1);
 
   /// dst = A src; counted in applications() and seconds().
   void vmult(MfVector& dst, const MfVector& src) const;
@@ -72,13 +87,21 @@ class ElasticityOperator : public dl::Subscriptor {
   /// Sets v to 0 on the constrained DoFs.
   void zero_constrained(MfVector& v) const;
   [[nodiscard]] std::size_t memory_consumption() const {
+    std::size_t sums = 0;
+    for (const Part& p : parts_) sums += p.sum.capacity() * sizeof(double);
     return mf_.memory_consumption() + batch_dofs_.capacity() * sizeof(unsigned) +
-           batch_geometry_.capacity() * sizeof(double);
+           batch_geometry_.capacity() * sizeof(double) + sums;
   }
   /// vmult calls so far, and their wall-clock seconds.
   [[nodiscard]] unsigned applications() const { return applications_; }
   [[nodiscard]] double seconds() const { return seconds_; }
   [[nodiscard]] unsigned quadrature_points() const { return n_quadrature_points_; }
+  /// The straight-tet kernel's instruction set (meaningful where it runs: P1, P2 on straight
+  /// tets) and the threads its application runs on.
+  [[nodiscard]] StraightTetIsa isa() const { return isa_; }
+  [[nodiscard]] unsigned threads() const {
+    return std::max(1U, static_cast<unsigned>(parts_.size()));
+  }
 
  private:
   /// diag(A) by MatrixFreeTools::compute_diagonal (any constraints).
@@ -94,8 +117,14 @@ class ElasticityOperator : public dl::Subscriptor {
   /// phi's J⁻ᵀ and |det J| into one lane of a batch's geometry.
   template <typename Evaluation>
   static void store_geometry(const Evaluation& phi, double* lane);
-  /// dst = A src (free rows; constrained rows zero) by kernel_ on the batches.
+  /// The batches cut into `threads` contiguous parts and the DoF range each writes.
+  void partition_batches(unsigned threads);
+  /// dst = A src (free rows; constrained rows zero) by kernel_ on the batches, one thread per
+  /// part.
   void apply_batches(MfVector& dst, const MfVector& src) const;
+  /// out[i − offset] += (A src)_i of the batches [first, end).
+  void apply_batch_range(std::size_t first, std::size_t end, const MfVector& src, double* out,
+                         unsigned offset) const;
 
   dl::MatrixFree<kDim, double> mf_;
   const dl::Mapping<kDim>& mapping_;
@@ -103,7 +132,16 @@ class ElasticityOperator : public dl::Subscriptor {
   bool straight_ = false;            // P1/P2 on straight-sided tets: straight_batch
   unsigned n_shapes_ = 0;            // straight_: the scalar element's shape functions
   std::vector<double> ref_grad_;     // straight_: their reference gradients at quadrature_
-  StraightTetKernel kernel_ = nullptr;  // straight_: for this CPU (AVX2 + FMA where it has them)
+  StraightTetKernel kernel_ = nullptr;  // straight_: for isa_
+  StraightTetIsa isa_ = StraightTetIsa::sse2;
+  /// A thread's share of the batches and the DoFs they write, [first_dof, end_dof): part 0 adds
+  /// into dst, every other into its own `sum` (as parts share DoFs), added to dst after.
+  struct Part {
+    std::size_t first = 0, end = 0;
+    unsigned first_dof = 0, end_dof = 0;
+    mutable std::vector<double> sum;
+  };
+  std::vector<Part> parts_;
   static constexpr unsigned kNoDof = ~0u;
   // straight_ and batchable: each batch's cells' DoF indices [(b·3N + k)·lanes + l] (cell l of
   // batch b, component-major local DoF k; kNoDof where constrained or padding) and their

@@ -8,10 +8,13 @@
 #include <cstdlib>
 #include <iostream>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "fem_reference/elasticity.hpp"
 #include "fem_test_meshes.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 
 namespace vessel {
 namespace {
@@ -67,15 +70,55 @@ TEST_P(MatrixFree, ProductEqualsAssembledMatrixOnFreeRows) {
       << "P" << GetParam();
 }
 
-// The same with the kernel's SSE2 variant, which runs on CPUs without AVX2 (this one would
-// otherwise pick AVX2).
-TEST_P(MatrixFree, Sse2KernelProductEqualsAssembledMatrixOnFreeRows) {
+// The same with each of the kernel's instruction sets (a batch of 8 cells in four SSE2, two AVX2
+// or one AVX-512 register per quantity; the operator takes the widest this CPU has).
+TEST_P(MatrixFree, EveryKernelVariantsProductEqualsAssembledMatrixOnFreeRows) {
   const ElasticitySolver s(test::short_tube_mesh(0), pressurised_tube(GetParam(), 0.3));
-  ::setenv("VESSELVERIFY_MATRIX_FREE_SSE2", "1", 1);
-  const double difference =
-      relative_product_difference(s, 9, [&](const auto& u) { return s.matrix_free_product(u); });
-  ::unsetenv("VESSELVERIFY_MATRIX_FREE_SSE2");
-  EXPECT_LT(difference, 1e-12) << "P" << GetParam();
+  for (const char* isa : {"sse2", "avx2", "avx512"}) {
+    ::setenv("VESSELVERIFY_MATRIX_FREE_ISA", isa, 1);
+    try {
+      const double difference = relative_product_difference(
+          s, 9, [&](const auto& u) { return s.matrix_free_product(u); });
+      EXPECT_LT(difference, 1e-12) << "P" << GetParam() << " " << isa;
+    } catch (const std::runtime_error& e) {  // this CPU lacks the instruction set
+      EXPECT_NE(std::string(e.what()).find("this CPU lacks it"), std::string::npos) << e.what();
+      std::cout << "P" << GetParam() << ": " << e.what() << "\n";
+    }
+    ::unsetenv("VESSELVERIFY_MATRIX_FREE_ISA");
+  }
+}
+
+TEST(MatrixFreeKernel, AnUnknownInstructionSetIsRefusedByName) {
+  const ElasticitySolver s(test::short_tube_mesh(0), pressurised_tube(2, 0.3));
+  ::setenv("VESSELVERIFY_MATRIX_FREE_ISA", "neon", 1);
+  const std::vector<double> u(s.free_displacement_system().free_index.size(), 0.0);
+  try {
+    (void)s.matrix_free_product(u);
+    ADD_FAILURE() << "VESSELVERIFY_MATRIX_FREE_ISA=neon was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("VESSELVERIFY_MATRIX_FREE_ISA=neon: expected sse2, avx2"),
+              std::string::npos)
+        << e.what();
+  }
+  ::unsetenv("VESSELVERIFY_MATRIX_FREE_ISA");
+}
+
+// The batches cut into one part per thread, the parts' shared DoFs summed after: the same product
+// on two and three threads.
+TEST_P(MatrixFree, ThreadedProductEqualsAssembledMatrixOnFreeRows) {
+  // A part has at least 32 batches of 8 cells (ElasticityOperator::partition_batches): this mesh
+  // is cut into as many parts as threads.
+  ASSERT_GE(test::short_tube_mesh(1).tets.size(), 3U * 32U * 8U);
+  const ElasticitySolver s(test::short_tube_mesh(1), pressurised_tube(GetParam(), 0.3));
+  const int saved = solver_threads();
+  for (const int threads : {2, 3}) {
+    set_solver_threads(threads);
+    EXPECT_LT(
+        relative_product_difference(s, 13, [&](const auto& u) { return s.matrix_free_product(u); }),
+        1e-12)
+        << "P" << GetParam() << " on " << threads << " threads";
+  }
+  set_solver_threads(saved);
 }
 
 // The sparse matrix MatrixFreeTools::compute_matrix builds from the same cell kernel (the P1

@@ -51,6 +51,7 @@ struct FemCommandOptions {
   double tolerance = fem::SolverOptions{}.cg_relative_tolerance;
   unsigned max_iterations = fem::SolverOptions{}.max_iterations;
   unsigned gmres_restart = fem::SolverOptions{}.gmres_restart;
+  int threads = default_jobs();
   int modes = 0;
   bool curved = false;
   bool distributed = false;
@@ -395,9 +396,9 @@ void run_serial(const FemCommandOptions& o, const Scene& s, const TetMesh& mesh,
   std::cout << "element " << pre.element << (pre.curved ? " on curved walls" : "") << ": "
             << pre.n_dofs << " DoFs";
   if (pre.n_pressure_dofs) std::cout << " (" << pre.n_pressure_dofs << " pressure)";
-  // One problem: its direct solvers' BLAS (CHOLMOD, UMFPACK) get every core, as the harness
-  // gives a reference solved alone.
-  set_solver_threads(default_jobs());
+  // One problem: its direct solvers' BLAS (CHOLMOD, UMFPACK) and the matrix-free operator get
+  // every core by default, as the harness gives a reference solved alone.
+  set_solver_threads(o.threads);
   std::cout << "\nsolving on " << solver_threads() << " thread(s) ..." << std::flush;
   run.result = solver.solve();
   print_solver(run.result);
@@ -690,6 +691,11 @@ void add_solver_options(CLI::App* cmd, FemCommandOptions& o) {
   cmd->add_option("--gmres-restart", o.gmres_restart,
                   "gmres-block: Krylov basis size before FGMRES restarts (2 vectors each)")
       ->check(CLI::Range(2u, 2000u))
+      ->capture_default_str();
+  cmd->add_option("--threads", o.threads,
+                  "Threads of the serial solve (CHOLMOD's BLAS, the matrix-free operator's "
+                  "cells; default: the core count)")
+      ->check(CLI::PositiveNumber)
       ->capture_default_str();
 }
 
