@@ -319,9 +319,8 @@ VectorT Distributed::residual(StrainSummary& strain) const {
   VectorT r(owned_, comm_);
   for (const auto& cell : dof_.active_cell_iterators()) {
     if (!cell->is_locally_owned()) continue;
-    values.cell.reinit(cell);
+    element_residual(*form_, cell, values, ghosted_, dofs, r_local);  // values.cell on cell
     add_cell_strain(*form_, values.cell, ghosted_, strain);
-    element_residual(*form_, cell, values, ghosted_, dofs, r_local);
     r.add(dofs, r_local);
   }
   r.compress(dl::VectorOperation::add);

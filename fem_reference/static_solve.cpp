@@ -252,13 +252,12 @@ void ElasticitySolver::Impl::postprocess() {
   dl::Vector<double> r_local, residual(dof.n_dofs());
   std::vector<Index> dofs;
   for (const auto& cell : dof.active_cell_iterators()) {
-    values.cell.reinit(cell);
+    detail::element_residual(*form, cell, values, solution, dofs, r_local);  // values.cell on cell
+    for (unsigned i = 0; i < dofs.size(); ++i) residual(dofs[i]) += r_local(i);
     detail::add_cell_strain(*form, values.cell, solution, strain);
     const auto idx = cell->active_cell_index();
     centroid_strain_stress(*form, centre, cell, solution, result.tet_strain[idx],
                            result.tet_stress[idx]);
-    detail::element_residual(*form, cell, values, solution, dofs, r_local);
-    for (unsigned i = 0; i < dofs.size(); ++i) residual(dofs[i]) += r_local(i);
   }
   result.strain_energy = strain.energy;
   result.max_principal_strain = strain.max_principal;

@@ -38,15 +38,11 @@ void element_residual(const WeakForm& form, const CellIterator& cell, CellValues
                       const VectorType& u, std::vector<dl::types::global_dof_index>& dofs,
                       dl::Vector<double>& residual) {
   const unsigned n = cell->get_fe().n_dofs_per_cell();
-  dl::FullMatrix<double> k(n, n);
-  dl::Vector<double> f(n), u_local(n);
-  form.local_system(cell, values, k, f, nullptr);
+  dl::Vector<double> u_local(n);
   dofs.resize(n);
   cell->get_dof_indices(dofs);
   for (unsigned i = 0; i < n; ++i) u_local(i) = u(dofs[i]);
-  residual.reinit(n);
-  k.vmult(residual, u_local);
-  residual -= f;
+  form.local_residual(cell, values, u_local, residual);
 }
 
 template <class VectorType>

@@ -28,7 +28,7 @@ void add_cell_strain(const WeakForm& form, const dl::FEValues<kDim>& fev, const 
                      StrainSummary& summary);
 
 /// The element residual K_e u_e − f_e of the unconstrained system on `cell` (its DoFs in `dofs`):
-/// at constrained DoFs, summed over cells, the supports' reactions.
+/// at constrained DoFs, summed over cells, the supports' reactions. values.cell is left on `cell`.
 template <class VectorType>
 void element_residual(const WeakForm& form, const CellIterator& cell, CellValues& values,
                       const VectorType& u, std::vector<dl::types::global_dof_index>& dofs,

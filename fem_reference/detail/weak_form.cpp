@@ -117,6 +117,45 @@ void WeakForm::add_stiffness(const dl::FEValues<kDim>& fev, dl::FullMatrix<doubl
     for (unsigned j = i + 1; j < n; ++j) k(i, j) = k(j, i);
 }
 
+void WeakForm::local_residual(const CellIterator& cell, CellValues& values,
+                              const dl::Vector<double>& u, dl::Vector<double>& r) const {
+  dl::Vector<double> f(u.size());
+  local_load(cell, values, f, nullptr, true);
+  r.reinit(u.size());
+  add_stiffness_times(values.cell, u, r);
+  r -= f;
+}
+
+void WeakForm::add_stiffness_times(const dl::FEValues<kDim>& fev, const dl::Vector<double>& u,
+                                   dl::Vector<double>& r) const {
+  const dl::FEValuesExtractors::Vector disp(0);
+  const dl::FEValuesExtractors::Scalar pres(kDim);
+  const unsigned n = fev.dofs_per_cell;
+  std::vector<dl::SymmetricTensor<2, kDim>> eps(n);
+  std::vector<double> div(n), psi(n);
+  const double inv_lambda = mixed_ ? (std::isinf(lambda_) ? 0.0 : 1.0 / lambda_) : 0.0;
+  for (unsigned q = 0; q < fev.n_quadrature_points; ++q) {
+    const double jxw = fev.JxW(q);
+    dl::SymmetricTensor<2, kDim> eps_u;  // ε(u_h), div u_h and p_h at the point
+    double div_u = 0.0, p_u = 0.0;
+    for (unsigned j = 0; j < n; ++j) {
+      eps[j] = fev[disp].symmetric_gradient(j, q);
+      div[j] = fev[disp].divergence(j, q);
+      psi[j] = mixed_ ? fev[pres].value(j, q) : 0.0;
+      eps_u += u(j) * eps[j];
+      div_u += u(j) * div[j];
+      p_u += u(j) * psi[j];
+    }
+    for (unsigned i = 0; i < n; ++i) {
+      // Σ_j k_ij u_j with add_stiffness's k_ij.
+      const double a = mixed_ ? 2.0 * mu_ * (eps[i] * eps_u) - psi[i] * div_u - div[i] * p_u -
+                                    inv_lambda * psi[i] * p_u
+                              : lambda_ * div[i] * div_u + 2.0 * mu_ * (eps[i] * eps_u);
+      r(i) += a * jxw;
+    }
+  }
+}
+
 void WeakForm::add_body_force(const dl::FEValues<kDim>& fev, dl::Vector<double>& f,
                               Vec3* applied) const {
   const dl::FEValuesExtractors::Vector disp(0);
