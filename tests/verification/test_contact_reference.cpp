@@ -141,6 +141,41 @@ TEST(ContactInsertion, RefusesASceneWithoutAGuidewireAndAnEmptyRange) {
                      {"guidewire_straight.toml", "EI"});
 }
 
+// The figure's curves: each force of each converged step in mN at its length in mm, a failed
+// step left out of every curve (a hand-made insertion: the mapping, not a solve).
+TEST(ContactInsertion, PlotCarriesEachConvergedStepsForcesInMillinewtons) {
+  ContactInsertion r;
+  r.bending_stiffness = 4e-7;
+  const auto step = [](double length, bool converged, double f, double rt, double p, double dp) {
+    InsertionStep s;
+    s.insertion = length;
+    s.converged = converged;
+    s.force = f;
+    s.clamp_axial = rt;
+    s.push = p;
+    s.push_by_energy = dp;
+    return s;
+  };
+  r.steps = {step(19.25e-3, true, 4.6e-4, 1.4e-4, 4.9e-5, 4.3e-5),
+             step(19.5e-3, false, 0.0, 0.0, 0.0, 0.0),
+             step(19.75e-3, true, 4.5e-4, 1.3e-4, 4.1e-5, 3.8e-5)};
+  const auto plot = insertion_plot({r});
+  ASSERT_EQ(plot.series.size(), 4U);
+  const std::vector<std::vector<double>> expected{
+      {0.46, 0.45}, {0.14, 0.13}, {0.049, 0.041}, {0.043, 0.038}};
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_NE(plot.series[k].label.find("EI 4e-07"), std::string::npos) << plot.series[k].label;
+    ASSERT_EQ(plot.series[k].x.size(), 2U) << plot.series[k].label;
+    EXPECT_DOUBLE_EQ(plot.series[k].x[0], 19.25);
+    EXPECT_DOUBLE_EQ(plot.series[k].x[1], 19.75);
+    for (std::size_t i = 0; i < 2; ++i) {
+      EXPECT_NEAR(plot.series[k].y[i], expected[k][i], 1e-12) << plot.series[k].label;
+    }
+  }
+  EXPECT_TRUE(plot.series[3].dashed);
+  EXPECT_NE(reports::render_svg(plot).find("<svg"), std::string::npos);
+}
+
 // guidewire_straight's floppy wire (EI 4e-7 N·m²) on its neo-Hookean wall, pushed from 19.25 to
 // 20.25 mm in four steps of 0.25 mm.
 TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes) {

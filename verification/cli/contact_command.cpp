@@ -5,7 +5,10 @@
 /// deformable wall (verification/harness/contact_insertion.hpp).
 #include <filesystem>
 #include <iostream>
+#include <vector>
 
+#include "meshes/foundation/atomic_file.hpp"
+#include "reports/svg_plot.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/harness/contact_insertion.hpp"
 #include "verification/harness/contact_reference.hpp"
@@ -27,6 +30,7 @@ struct InsertionCli {
   std::vector<double> ei;
   std::string wall = "neo-hookean";
   ContactInsertionOptions options;
+  std::filesystem::path svg;  // empty: no figure
 };
 
 /// The options a guidewire scene's contact commands share: the scene, the stiffnesses and the wall.
@@ -146,13 +150,23 @@ void add_insertion_command(CLI::App& app) {
   cmd->add_option("--max-steps", o->options.max_steps, "Newton steps per insertion step")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
+  cmd->add_option("--svg", o->svg,
+                  "Also write the forces against the insertion length as an SVG figure here")
+      ->capture_default_str();
   cmd->callback([o] {
     o->options.log = &std::cerr;  // progress; the table goes to stdout
     o->options.wall = parse_contact_wall(o->wall);
     const Scene scene = read_scene(o->scene);
+    std::vector<ContactInsertion> insertions;
     for (const double EI : stiffnesses(scene, o->ei)) {
-      print_contact_insertion(solve_contact_insertion(scene, EI, o->options), std::cout);
+      insertions.push_back(solve_contact_insertion(scene, EI, o->options));
+      print_contact_insertion(insertions.back(), std::cout);
       std::cout << "\n" << std::flush;
+    }
+    if (!o->svg.empty()) {
+      write_file_atomically(
+          o->svg, [&](std::ostream& f) { f << reports::render_svg(insertion_plot(insertions)); });
+      std::cout << "figure: " << o->svg.string() << "\n";
     }
   });
 }

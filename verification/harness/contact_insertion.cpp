@@ -353,4 +353,32 @@ void print_contact_insertion(const ContactInsertion& r, std::ostream& out) {
   out << std::defaultfloat;
 }
 
+reports::Plot insertion_plot(const std::vector<ContactInsertion>& insertions) {
+  reports::Plot plot;
+  plot.title = "The insertion: forces against the insertion length";
+  plot.x.label = "insertion length (mm)";
+  plot.y.label = "force (mN)";
+  for (const ContactInsertion& r : insertions) {
+    std::ostringstream ei;
+    ei << " (EI " << r.bending_stiffness << " N·m²)";
+    const auto series = [&](const std::string& name, double InsertionStep::*value, bool dashed) {
+      reports::Series s;
+      s.label = name + ei.str();
+      s.lines = true;
+      s.dashed = dashed;
+      for (const InsertionStep& step : r.steps) {
+        if (!step.converged) continue;
+        s.x.push_back(step.insertion * 1e3);
+        s.y.push_back(step.*value * 1e3);
+      }
+      plot.series.push_back(std::move(s));
+    };
+    series("contact force", &InsertionStep::force, false);
+    series("clamp axial R·t", &InsertionStep::clamp_axial, false);
+    series("push R·t − M²/2EI", &InsertionStep::push, false);
+    series("push dΠ/dL", &InsertionStep::push_by_energy, true);
+  }
+  return plot;
+}
+
 }  // namespace vessel

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
+#include "reports/svg_plot.hpp"
 #include "verification/harness/contact_reference.hpp"
 #include "verification/scene.hpp"
 
@@ -89,5 +90,10 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
 /// The insertion as Markdown: one line with the scene, EI, the wall and its mesh; a table per
 /// step (mm, mN).
 void print_contact_insertion(const ContactInsertion& insertion, std::ostream& out);
+
+/// The insertions' curves against the insertion length (mm, mN), per insertion: the total
+/// contact force, the clamp's axial force R·t, the push R·t − M²/2EI and the push dΠ/dL (dashed;
+/// its undefined ends left out). Converged steps only.
+reports::Plot insertion_plot(const std::vector<ContactInsertion>& insertions);
 
 }  // namespace vessel
