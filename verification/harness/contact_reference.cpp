@@ -306,26 +306,34 @@ void require_guidewire(const Scene& scene) {
   if (!scene.load.guidewire) {
     throw InputError(scene.source.string() +
                      ": load: expected a guidewire load (type = \"guidewire\"); the contact "
-                     "reference solves a wire against the wall");
+                     "commands (contact, insertion) solve the scene's wire against its wall");
   }
 }
 
+/// Scout solves at most this many times: each wire that passed between the wall's nodes adds
+/// the balls along its centreline near the wall that the wall lacks (a stiff wire's body
+/// straightens as the wall gives, and refined in one place it bears and crosses further along).
+constexpr int kScoutSolves = 4;
+
 /// The scout: the coarsest level refined at the rigid wall point finds the zone (r.scout,
 /// r.patch_centre, r.patch_radius, r.refined_along_wire). A wire that passed between the wall's
-/// nodes elsewhere (a stiff wire's body, straightened as the wall gives) is scouted once more
-/// with the wall also refined around its centreline nodes near the wall. Returns the balls every
-/// level is refined in: the zone's first, then those along the wire.
+/// nodes elsewhere (a stiff wire's body, straightened as the wall gives) is scouted again with
+/// the wall also refined around its centreline nodes near the wall, up to kScoutSolves solves in
+/// all. Returns the balls every level is refined in: the zone's first, then those along the wire.
 std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
                                const Vec3& wall_point, double force_scale,
                                const ContactReferenceOptions& o, ContactReference& r) {
   const double scout_radius = 1.0e-3;
   std::vector<RefinedBall> balls{{wall_point, scout_radius}};
-  for (int attempt = 0; attempt < 2; ++attempt) {
+  for (int solve = 1; solve <= kScoutSolves; ++solve) {
     std::vector<Vec3> near_wall;
     r.scout = solve_level(scene, wire, r.poisson_ratio, o.coarsest_size, balls, wall_point,
                           force_scale, o, &near_wall);
-    if (r.scout.converged || near_wall.empty() || attempt == 1) break;
-    for (const Vec3& p : near_wall) balls.push_back({p, kAlongWireRadius});
+    const std::size_t before = balls.size();
+    for (const Vec3& p : near_wall) {
+      if (!inside_any(balls, p)) balls.push_back({p, kAlongWireRadius});
+    }
+    if (r.scout.converged || balls.size() == before || solve == kScoutSolves) break;
   }
   r.refined_along_wire = static_cast<int>(balls.size()) - 1;
   r.patch_centre = wall_point;
@@ -471,7 +479,7 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
       << fixed(r.patch_centre.z() * 1e3, 3) << ") mm"
       << (r.refined_along_wire > 0 ? " and within " + fixed(kAlongWireRadius * 1e3, 1) + " mm of " +
                                          std::to_string(r.refined_along_wire) +
-                                         " centreline nodes of a scout wire that crossed the wall"
+                                         " centreline nodes of scout wires that crossed the wall"
                                    : std::string())
       << " (the zone of a scout solve at " << fixed(r.scout.fine_size * 1e3, 3)
       << " mm within 1 mm of the rigid wall point: "
