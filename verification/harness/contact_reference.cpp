@@ -66,11 +66,14 @@ std::vector<int> candidates(const TetMesh& mesh, const contact::ContactWire& wir
 /// A solved wire that passed between the wall's nodes, with where to refine the wall next.
 struct WallCrossed : std::runtime_error {
   using std::runtime_error::runtime_error;
-  std::vector<Vec3> near_wall;  ///< its centreline nodes within kNearWall of the inner wall, m
+  /// For each of its centreline nodes within kNearWall of the (undeformed) inner wall, the
+  /// nearest inner-wall node's rest position, m: where the wall bears the wire. (The centreline
+  /// itself lies beyond the dented wall, up to ~0.7 mm off the nodes it presses.)
+  std::vector<Vec3> near_wall;
 };
 
-/// m: a crossed wire's centreline nodes this near the (undeformed) inner wall are where a
-/// scout refines next.
+/// m: the inner wall nearest a crossed wire's centreline nodes this near it is where a scout
+/// refines next.
 constexpr double kNearWall = 1.5e-3;
 /// m: the radius refined around each of them.
 constexpr double kAlongWireRadius = 0.5e-3;
@@ -91,9 +94,15 @@ void require_wire_inside_lumen(const TetMesh& mesh, const msm::rods::Rod& rod,
       mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
   for (const Vec3& p : centreline) {
     double nearest = std::numeric_limits<double>::infinity();
-    for (const int n : wall_nodes)
-      nearest = std::min(nearest, (mesh.nodes[static_cast<std::size_t>(n)] - p).norm());
-    if (nearest <= kNearWall) crossed.near_wall.push_back(p);
+    Vec3 at = p;
+    for (const int n : wall_nodes) {
+      const Vec3& node = mesh.nodes[static_cast<std::size_t>(n)];
+      if ((node - p).norm() < nearest) {
+        nearest = (node - p).norm();
+        at = node;
+      }
+    }
+    if (nearest <= kNearWall) crossed.near_wall.push_back(at);
   }
   throw crossed;
 }
@@ -311,15 +320,16 @@ void require_guidewire(const Scene& scene) {
 }
 
 /// Scout solves at most this many times: each wire that passed between the wall's nodes adds
-/// the balls along its centreline near the wall that the wall lacks (a stiff wire's body
+/// the balls on the inner wall along its centreline that the wall lacks (a stiff wire's body
 /// straightens as the wall gives, and refined in one place it bears and crosses further along).
 constexpr int kScoutSolves = 4;
 
 /// The scout: the coarsest level refined at the rigid wall point finds the zone (r.scout,
 /// r.patch_centre, r.patch_radius, r.refined_along_wire). A wire that passed between the wall's
 /// nodes elsewhere (a stiff wire's body, straightened as the wall gives) is scouted again with
-/// the wall also refined around its centreline nodes near the wall, up to kScoutSolves solves in
-/// all. Returns the balls every level is refined in: the zone's first, then those along the wire.
+/// the wall also refined around the inner-wall nodes nearest its centreline nodes near the wall,
+/// up to kScoutSolves solves in all. Returns the balls every level is refined in: the zone's first,
+/// then those along the wire.
 std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
                                const Vec3& wall_point, double force_scale,
                                const ContactReferenceOptions& o, ContactReference& r) {
