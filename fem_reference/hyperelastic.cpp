@@ -238,7 +238,7 @@ struct HyperelasticSolver::Impl {
                          const std::vector<Eigen::Vector3d>& g,
                          std::vector<Eigen::Matrix<double, 9, 1>>& h,
                          dl::FullMatrix<double>& k) const {
-    const unsigned n = comp.size();
+    const auto n = static_cast<unsigned>(comp.size());
     const Mat3 f_inv_t = F.inverse().transpose();
     const Mat9 A = mixed ? NeoHookean::tangent_at_pressure(F, p, material.mu) : material.tangent(F);
     for (unsigned j = 0; j < n; ++j) {

@@ -13,7 +13,8 @@
 namespace vessel::fem::detail {
 
 /// Trilinos (Epetra/ML) is built with MPI: it needs MPI initialised even on one process. The
-/// program may not have done so (a serial run): initialise once and finalise at exit.
+/// program may not have done so (a serial run): initialise once and finalise at exit. Safe to
+/// call from several threads at once.
 void ensure_mpi_initialized();
 
 /// The displacement DoFs a preconditioner works on, in the matrix's (local) row order: each row's

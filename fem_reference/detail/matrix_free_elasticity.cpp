@@ -112,7 +112,7 @@ template <typename V, unsigned N, unsigned Q>
 }
 
 /// straight_lanes on a whole batch, `Width` cells at a time: SSE2 (any x86-64), AVX2 + FMA or
-/// AVX-512 + FMA, each compiled for its instruction set and chosen at run time (straight_kernel),
+/// AVX-512 + FMA, each compiled for its instruction set and chosen at run time (straight_tet_isa),
 /// so the project builds and runs on any x86-64.
 template <typename V, unsigned Width, unsigned N, unsigned Q>
 [[gnu::always_inline]] inline void straight_batch(const double* in, double* out,

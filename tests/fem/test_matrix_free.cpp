@@ -7,9 +7,11 @@
 #include <algorithm>
 #include <cstdlib>
 #include <iostream>
+#include <latch>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "fem_reference/elasticity.hpp"
@@ -197,6 +199,27 @@ TEST(MatrixFreeTransfer, P1ToP2EmbeddingEqualsDealiiPolynomialTransfer) {
   const auto [prolongation, restriction] = s.matrix_free_transfer_difference(3);
   EXPECT_LT(prolongation, 1e-14);
   EXPECT_LT(restriction, 1e-14);
+}
+
+// The harness solves references on several threads; in a process whose MPI is not yet
+// initialised, the first solves started at once must initialise it once (Open MPI aborts the
+// process on a second MPI_Init_thread). Each thread waits for the others before it solves.
+TEST(MatrixFreeThreads, FirstSolvesStartedTogetherInitialiseMpiOnce) {
+  const TetMesh& mesh = test::short_tube_mesh(0);
+  constexpr int kThreads = 4;
+  std::latch start(kThreads);
+  std::vector<double> energy(kThreads, 0.0);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&, t] {
+      auto p = pressurised_tube(2, 0.3);
+      p.options.solver = LinearSolver::matrix_free;
+      start.arrive_and_wait();
+      energy[static_cast<std::size_t>(t)] = fem::solve_elasticity(mesh, p).strain_energy;
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  for (int t = 1; t < kThreads; ++t) EXPECT_NEAR(energy[t], energy[0], 1e-9 * energy[0]);
 }
 
 INSTANTIATE_TEST_SUITE_P(Degrees, MatrixFree, ::testing::Values(1, 2));
