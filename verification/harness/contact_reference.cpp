@@ -489,7 +489,7 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
       << fixed(r.patch_centre.z() * 1e3, 3) << ") mm"
       << (r.refined_along_wire > 0 ? " and within " + fixed(kAlongWireRadius * 1e3, 1) + " mm of " +
                                          std::to_string(r.refined_along_wire) +
-                                         " centreline nodes of scout wires that crossed the wall"
+                                         " inner-wall nodes under scout wires that crossed the wall"
                                    : std::string())
       << " (the zone of a scout solve at " << fixed(r.scout.fine_size * 1e3, 3)
       << " mm within 1 mm of the rigid wall point: "
