@@ -83,34 +83,35 @@ void WeakForm::local_load(const CellIterator& cell, CellValues& values, dl::Vect
   }
 }
 
-void WeakForm::add_stiffness(const dl::FEValues<kDim>& fev, dl::FullMatrix<double>& k) const {
+void WeakForm::point_shapes(const dl::FEValues<kDim>& fev, unsigned q,
+                            std::vector<PointShape>& out) const {
   const dl::FEValuesExtractors::Vector disp(0);
   const dl::FEValuesExtractors::Scalar pres(kDim);
+  out.resize(fev.dofs_per_cell);
+  for (unsigned i = 0; i < fev.dofs_per_cell; ++i) {
+    out[i] = {fev[disp].symmetric_gradient(i, q), fev[disp].divergence(i, q),
+              mixed_ ? fev[pres].value(i, q) : 0.0};
+  }
+}
+
+double WeakForm::bilinear(const PointShape& a, const PointShape& b) const {
+  if (mixed_) {
+    // a(u,v) = ∫ 2μ ε(u):ε(v) − p div v;  −∫ q div u − ∫ p q / λ  (p = −λ div u; step-22
+    // pattern, symmetric; λ = ∞ at ν = 0.5 leaves the saddle-point Stokes system).
+    const double inv_lambda = std::isinf(lambda_) ? 0.0 : 1.0 / lambda_;
+    return 2.0 * mu_ * (a.eps * b.eps) - a.psi * b.div - a.div * b.psi - inv_lambda * a.psi * b.psi;
+  }
+  // a(u,v) = ∫ λ div u div v + 2μ ε(u):ε(v)  (step-8)
+  return lambda_ * a.div * b.div + 2.0 * mu_ * (a.eps * b.eps);
+}
+
+void WeakForm::add_stiffness(const dl::FEValues<kDim>& fev, dl::FullMatrix<double>& k) const {
   const unsigned n = fev.dofs_per_cell;
-  std::vector<dl::SymmetricTensor<2, kDim>> eps(n);
-  std::vector<double> div(n), psi(n);
-  const double inv_lambda = mixed_ ? (std::isinf(lambda_) ? 0.0 : 1.0 / lambda_) : 0.0;
+  std::vector<PointShape> shape;
   for (unsigned q = 0; q < fev.n_quadrature_points; ++q) {
-    const double jxw = fev.JxW(q);
+    point_shapes(fev, q, shape);
     for (unsigned i = 0; i < n; ++i) {
-      eps[i] = fev[disp].symmetric_gradient(i, q);
-      div[i] = fev[disp].divergence(i, q);
-      psi[i] = mixed_ ? fev[pres].value(i, q) : 0.0;
-    }
-    for (unsigned i = 0; i < n; ++i) {
-      for (unsigned j = 0; j <= i; ++j) {
-        double kij;
-        if (mixed_) {
-          // a(u,v) = ∫ 2μ ε(u):ε(v) − p div v;  −∫ q div u − ∫ p q / λ  (p = −λ div u; step-22
-          // pattern, symmetric; λ = ∞ at ν = 0.5 leaves the saddle-point Stokes system).
-          kij = 2.0 * mu_ * (eps[i] * eps[j]) - psi[i] * div[j] - div[i] * psi[j] -
-                inv_lambda * psi[i] * psi[j];
-        } else {
-          // a(u,v) = ∫ λ div u div v + 2μ ε(u):ε(v)  (step-8)
-          kij = lambda_ * div[i] * div[j] + 2.0 * mu_ * (eps[i] * eps[j]);
-        }
-        k(i, j) += kij * jxw;
-      }
+      for (unsigned j = 0; j <= i; ++j) k(i, j) += bilinear(shape[i], shape[j]) * fev.JxW(q);
     }
   }
   for (unsigned i = 0; i < n; ++i)
@@ -128,31 +129,16 @@ void WeakForm::local_residual(const CellIterator& cell, CellValues& values,
 
 void WeakForm::add_stiffness_times(const dl::FEValues<kDim>& fev, const dl::Vector<double>& u,
                                    dl::Vector<double>& r) const {
-  const dl::FEValuesExtractors::Vector disp(0);
-  const dl::FEValuesExtractors::Scalar pres(kDim);
-  const unsigned n = fev.dofs_per_cell;
-  std::vector<dl::SymmetricTensor<2, kDim>> eps(n);
-  std::vector<double> div(n), psi(n);
-  const double inv_lambda = mixed_ ? (std::isinf(lambda_) ? 0.0 : 1.0 / lambda_) : 0.0;
+  std::vector<PointShape> shape;
   for (unsigned q = 0; q < fev.n_quadrature_points; ++q) {
-    const double jxw = fev.JxW(q);
-    dl::SymmetricTensor<2, kDim> eps_u;  // ε(u_h), div u_h and p_h at the point
-    double div_u = 0.0, p_u = 0.0;
-    for (unsigned j = 0; j < n; ++j) {
-      eps[j] = fev[disp].symmetric_gradient(j, q);
-      div[j] = fev[disp].divergence(j, q);
-      psi[j] = mixed_ ? fev[pres].value(j, q) : 0.0;
-      eps_u += u(j) * eps[j];
-      div_u += u(j) * div[j];
-      p_u += u(j) * psi[j];
+    point_shapes(fev, q, shape);
+    PointShape u_h{};  // ε(u_h), div u_h and p_h at the point: a(·, ·) is linear in each
+    for (unsigned j = 0; j < shape.size(); ++j) {
+      u_h.eps += u(j) * shape[j].eps;
+      u_h.div += u(j) * shape[j].div;
+      u_h.psi += u(j) * shape[j].psi;
     }
-    for (unsigned i = 0; i < n; ++i) {
-      // Σ_j k_ij u_j with add_stiffness's k_ij.
-      const double a = mixed_ ? 2.0 * mu_ * (eps[i] * eps_u) - psi[i] * div_u - div[i] * p_u -
-                                    inv_lambda * psi[i] * p_u
-                              : lambda_ * div[i] * div_u + 2.0 * mu_ * (eps[i] * eps_u);
-      r(i) += a * jxw;
-    }
+    for (unsigned i = 0; i < shape.size(); ++i) r(i) += bilinear(shape[i], u_h) * fev.JxW(q);
   }
 }
 

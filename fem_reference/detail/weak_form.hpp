@@ -4,6 +4,7 @@
 /// body force, pressure on faces and contact-patch tractions at their quadrature points. The one
 /// definition the serial and the distributed solver both assemble from, so both solve the same
 /// discrete system.
+#include <deal.II/base/symmetric_tensor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe.h>
 #include <deal.II/fe/fe_values.h>
@@ -73,6 +74,15 @@ class WeakForm {
     Vec3 force;
   };
 
+  /// A shape function's (or a field's) ε, div and pressure value at one quadrature point.
+  struct PointShape {
+    dl::SymmetricTensor<2, kDim> eps;
+    double div = 0.0, psi = 0.0;
+  };
+  /// Every shape function's PointShape at quadrature point q.
+  void point_shapes(const dl::FEValues<kDim>& fev, unsigned q, std::vector<PointShape>& out) const;
+  /// The integrand of a(u, v) at a point (displacement or mixed form; the formula's one place).
+  [[nodiscard]] double bilinear(const PointShape& a, const PointShape& b) const;
   /// a(u, v) at the cell's quadrature points (values.cell reinit'ed on the cell).
   void add_stiffness(const dl::FEValues<kDim>& fev, dl::FullMatrix<double>& k) const;
   /// r_i += a(u_h, φ_i) at the cell's quadrature points, u_h = Σ_j u_j φ_j: k u (add_stiffness's
