@@ -14,6 +14,7 @@
 #include <limits>
 #include <sstream>
 
+#include "fem_reference/detail/matrix_free_elasticity.hpp"
 #include "fem_reference/detail/serial_solver.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "meshes/self_contact.hpp"
@@ -77,6 +78,10 @@ Mat3 to_mat3(const dl::Tensor<2, kDim>& t) {
   return m;
 }
 
+/// Which share of the tangent a pass over the cells computes: none, the follower pressure's
+/// faces only (what the matrix-free Newton system adds to its operator), or all of it.
+enum class Tangent { none, faces, all };
+
 /// What one pass over the cells found, besides the local systems it handed on.
 struct PassStats {
   bool valid = true;  ///< J > 0 at every quadrature point
@@ -96,6 +101,8 @@ struct HyperelasticSolver::Impl {
   double inv_lambda = 0.0;
   bool mixed = false;
   bool symmetric = true;            // false with follower pressure (its tangent is not symmetric)
+  /// The Newton systems by the matrix-free p-multigrid on the tangent (solver matrix-free).
+  bool matrix_free = false;
   std::vector<unsigned> component;  // per DoF: 0..2 displacement, 3 pressure
   std::vector<Index> constrained;   // constrained DoFs
   std::vector<double> prescribed;   // their values at load factor 1
@@ -108,9 +115,12 @@ struct HyperelasticSolver::Impl {
 
   Impl(const TetMesh& mesh, ElasticityProblem problem, HyperelasticOptions o)
       : linear(mesh, std::move(problem)), d(*linear.impl_), opt(o) {
-    d.ensure_matrix();
     material = NeoHookean::of(d.problem.material);
     mixed = d.mixed;
+    // Only where requested: a Newton iterate's tangent can be indefinite (a compressed or
+    // buckling wall), where CG fails and the step is halved; the direct path falls back to LU.
+    matrix_free = d.problem.options.solver == LinearSolver::matrix_free;
+    if (!matrix_free) d.ensure_matrix();
     inv_lambda = std::isinf(material.lambda) ? 0.0 : 1.0 / material.lambda;
     symmetric = !(opt.follower_pressure && !d.problem.pressures.empty());
     component = d.dof_components();
@@ -145,10 +155,15 @@ struct HyperelasticSolver::Impl {
   }
 
   /// One pass over the cells at DoF values `w` and load factor s: per cell, the residual
-  /// r = f_int − f_follower − s f_dead and (with_matrix) its tangent k = ∂r/∂u, handed to
-  /// sink(dofs, k, r, r_int) with r_int = f_int alone.
+  /// r = f_int − f_follower − s f_dead and the share `tangent` of its tangent k = ∂r/∂u, handed
+  /// to sink(dofs, k, r, r_int) with r_int = f_int alone.
   template <class Sink>
   PassStats pass(const dl::Vector<double>& w, double s, bool with_matrix, Sink&& sink) const {
+    return pass(w, s, with_matrix ? Tangent::all : Tangent::none, sink);
+  }
+  template <class Sink>
+  PassStats pass(const dl::Vector<double>& w, double s, Tangent tangent, Sink&& sink) const {
+    const bool with_matrix = tangent == Tangent::all;
     const unsigned n = d.fe->n_dofs_per_cell();
     detail::CellValues values(*d.mapping, *d.fe, d.degree);
     dl::FEFaceValues<kDim> face(*d.mapping, *d.fe, detail::face_quadrature(d.degree),
@@ -220,8 +235,8 @@ struct HyperelasticSolver::Impl {
         for (unsigned fi = 0; fi < 4; ++fi) {
           double pressure = 0.0;
           if (faces[fi] < 0 || !d.form->pressure_on(faces[fi], pressure)) continue;
-          add_follower_pressure(face, cell, fi, s * pressure, w, comp, face_grad, with_matrix, k, r,
-                                stats);
+          add_follower_pressure(face, cell, fi, s * pressure, w, comp, face_grad,
+                                tangent != Tangent::none, k, r, stats);
           if (!stats.valid) return stats;
         }
       }
@@ -333,7 +348,14 @@ struct HyperelasticSolver::Impl {
                }
                for (unsigned i = 0; i < dofs.size(); ++i) internal(dofs[i]) += r_int(i);
              });
-    norms = {};
+    norms = residual_norms();
+    result.timings.assembly += seconds_since(t0);
+    return stats;
+  }
+
+  /// The norms of d.rhs = −R against the internal forces `internal`.
+  [[nodiscard]] Norms residual_norms() const {
+    Norms norms;
     double f2 = 0.0, s2 = 0.0, p_max = 0.0;
     for (Index i = 0; i < d.dof.n_dofs(); ++i) {
       if (component[i] < 3) {
@@ -346,8 +368,131 @@ struct HyperelasticSolver::Impl {
     norms.force = std::sqrt(f2);
     norms.force_scale = std::sqrt(s2);
     norms.pressure = p_max;
+    return norms;
+  }
+
+  using AddedMatrix = detail::MatrixFreeElasticitySolver::AddedMatrix;
+
+  /// The matrix-free Newton system's right-hand side d.rhs = −R on the free DoFs and, with
+  /// follower pressure, its faces' share of the tangent into `follower` (free rows and columns;
+  /// empty otherwise). `lift`: the prescribed increment (d.constraints' inhomogeneities) enters
+  /// the free rows as −K u₀ (the tangent predictor), which takes every cell's tangent.
+  PassStats assemble_matrix_free(const dl::Vector<double>& w, double s, bool lift, Norms& norms,
+                                 AddedMatrix& follower) {
+    const auto t0 = Clock::now();
+    d.rhs = 0.0;
+    internal = 0.0;
+    const bool faces = !symmetric;
+    std::vector<Eigen::Triplet<double>> entries;
+    const auto add_faces = [&](const std::vector<Index>& dofs, const dl::FullMatrix<double>& k) {
+      for (unsigned i = 0; i < dofs.size(); ++i) {
+        if (free_index[dofs[i]] < 0) continue;
+        for (unsigned j = 0; j < dofs.size(); ++j) {
+          if (free_index[dofs[j]] >= 0 && k(i, j) != 0.0) {
+            entries.emplace_back(static_cast<int>(dofs[i]), static_cast<int>(dofs[j]), k(i, j));
+          }
+        }
+      }
+    };
+    dl::Vector<double> minus_r;
+    PassStats stats = pass(w, s,
+                           lift    ? Tangent::all
+                           : faces ? Tangent::faces
+                                   : Tangent::none,
+                           [&](const std::vector<Index>& dofs, const dl::FullMatrix<double>& k,
+                               const dl::Vector<double>& r, const dl::Vector<double>& r_int) {
+                             minus_r = r;
+                             minus_r *= -1.0;
+                             if (lift) {
+                               d.constraints.distribute_local_to_global(minus_r, dofs, d.rhs, k);
+                             } else {
+                               d.constraints.distribute_local_to_global(minus_r, dofs, d.rhs);
+                               if (faces) add_faces(dofs, k);
+                             }
+                             for (unsigned i = 0; i < dofs.size(); ++i)
+                               internal(dofs[i]) += r_int(i);
+                           });
+    if (stats.valid && faces && lift) {
+      stats = pass(w, s, Tangent::faces,
+                   [&](const std::vector<Index>& dofs, const dl::FullMatrix<double>& k, const auto&,
+                       const auto&) { add_faces(dofs, k); });
+    }
+    const auto n = static_cast<Eigen::Index>(d.dof.n_dofs());
+    follower.resize(faces ? n : 0, faces ? n : 0);
+    follower.setFromTriplets(entries.begin(), entries.end());
+    norms = residual_norms();
     result.timings.assembly += seconds_since(t0);
     return stats;
+  }
+
+  /// The neo-Hookean tangent's coefficients (F⁻¹, μ − λ ln J) at the residual's quadrature
+  /// points at DoF values w (no element inverted: the pass at w checked it).
+  [[nodiscard]] detail::NeoHookeanTangentState tangent_state(const dl::Vector<double>& w) const {
+    detail::NeoHookeanTangentState state;
+    state.quadrature = detail::cell_quadrature(d.degree);
+    const unsigned nq = state.n_q();
+    constexpr unsigned kPer = detail::NeoHookeanTangentState::kPerPoint;
+    dl::FEValues<kDim> values(*d.mapping, *d.fe, state.quadrature, dl::update_gradients);
+    const dl::FEValuesExtractors::Vector disp(0);
+    std::vector<dl::Tensor<2, kDim>> grad_u(nq);
+    state.values.resize(std::size_t{d.dof.get_triangulation().n_active_cells()} * nq * kPer);
+    for (const auto& cell : d.dof.active_cell_iterators()) {
+      values.reinit(cell);
+      values[disp].get_function_gradients(w, grad_u);
+      for (unsigned q = 0; q < nq; ++q) {
+        const Mat3 F = Mat3::Identity() + to_mat3(grad_u[q]);
+        const Mat3 g = F.inverse();
+        double* v = state.values.data() + (std::size_t{cell->active_cell_index()} * nq + q) * kPer;
+        for (unsigned i = 0; i < kDim; ++i)
+          for (unsigned j = 0; j < kDim; ++j) v[kDim * i + j] = g(i, j);
+        v[kDim * kDim] = material.mu - material.lambda * std::log(F.determinant());
+      }
+    }
+    return state;
+  }
+
+  /// The Newton system d.rhs (from assemble_matrix_free) by CG (FGMRES with follower pressure)
+  /// on the matrix-free tangent at u with the p-multigrid; d.solution with the constraints'
+  /// values (the prescribed increment) distributed.
+  void solve_tangent_matrix_free(const AddedMatrix& follower) {
+    const auto& o = d.problem.options;
+    const detail::NeoHookeanTangentState state = tangent_state(u);
+    detail::PMultigridSettings settings;
+    settings.direct_coarse_max_dofs = o.matrix_free_direct_coarse_max_dofs;
+    const detail::MatrixFreeElasticitySolver tangent(
+        *d.mapping, d.dof,
+        [this](const dl::DoFHandler<kDim>& dof, dl::AffineConstraints<double>& c) {
+          d.support_constraints(dof, c);
+        },
+        d.degree, material.lambda, material.mu, detail::node_centroid(d.mesh), settings, &state);
+    d.solution = 0.0;
+    const auto outcome = tangent.solve(d.rhs, d.solution, o.cg_relative_tolerance, o.max_iterations,
+                                       symmetric ? nullptr : &follower);
+    d.constraints.distribute(d.solution);
+    d.result.iterations = outcome.iterations;
+    d.result.solver = LinearSolver::matrix_free;
+    add_profile(result.matrix_free, tangent.profile());
+  }
+
+  /// total += one, part by part (the method and per-system counts: one's).
+  static void add_profile(MatrixFreeProfile& total, const MatrixFreeProfile& one) {
+    for (const auto member :
+         {&MatrixFreeProfile::fine_operator, &MatrixFreeProfile::coarse_level,
+          &MatrixFreeProfile::transfer, &MatrixFreeProfile::diagonal,
+          &MatrixFreeProfile::eigenvalue_estimate, &MatrixFreeProfile::coarse_matrix,
+          &MatrixFreeProfile::coarse_factor, &MatrixFreeProfile::cg,
+          &MatrixFreeProfile::operator_seconds, &MatrixFreeProfile::coarse_solve_seconds,
+          &MatrixFreeProfile::transfer_seconds}) {
+      total.*member += one.*member;
+    }
+    for (const auto member :
+         {&MatrixFreeProfile::coarse_iterations, &MatrixFreeProfile::operator_applications,
+          &MatrixFreeProfile::coarse_solves}) {
+      total.*member += one.*member;
+    }
+    total.coarse_method = one.coarse_method;
+    total.chebyshev_degree = one.chebyshev_degree;
+    total.quadrature_points = one.quadrature_points;
   }
 
   void set_prescribed_increment(double ds) {
@@ -373,7 +518,9 @@ struct HyperelasticSolver::Impl {
       // later updates leave them where they are.
       const bool predictor = it == 0 && moves_supports;
       set_prescribed_increment(predictor ? s1 - s0 : 0.0);
-      const PassStats st = assemble(u, s1, true, norms);
+      AddedMatrix follower;
+      const PassStats st = matrix_free ? assemble_matrix_free(u, s1, predictor, norms, follower)
+                                       : assemble(u, s1, true, norms);
       if (!st.valid) {
         out.reason = "an element inverted (J <= 0)";
         return out;
@@ -389,11 +536,15 @@ struct HyperelasticSolver::Impl {
       const auto t0 = Clock::now();
       try {
         try {
-          d.solve_linear(symmetric, DirectReuse::analysis);
+          if (matrix_free) {
+            solve_tangent_matrix_free(follower);
+          } else {
+            d.solve_linear(symmetric, DirectReuse::analysis);
+          }
         } catch (const std::exception&) {
           // Away from equilibrium (a Newton iterate after a large increment) the symmetric
           // tangent can be indefinite, which CHOLMOD refuses: LU (UMFPACK) solves it.
-          if (!symmetric || d.mixed) throw;
+          if (!symmetric || d.mixed || matrix_free) throw;
           d.solve_linear(false);
         }
       } catch (const std::exception& e) {
@@ -405,6 +556,7 @@ struct HyperelasticSolver::Impl {
       result.timings.solve += seconds_since(t0);
       result.linear_iterations += d.result.iterations;
       result.solver = d.result.solver;
+      result.solver_reason = matrix_free ? d.linear_choice.reason : d.result.solver_reason;
       ++result.newton_iterations;
       out.iterations = it + 1;
       if (predictor) {
@@ -658,7 +810,10 @@ FreeHyperelasticState HyperelasticSolver::free_state(const Eigen::VectorXd& u_fr
   }
   FreeHyperelasticState out;
   out.gradient = Eigen::VectorXd::Zero(im.n_free);
-  if (with_tangent) im.d.matrix = 0.0;  // scratch: the assembled path's matrix
+  if (with_tangent) {
+    im.d.ensure_matrix();
+    im.d.matrix = 0.0;  // scratch: the assembled path's matrix
+  }
   std::vector<Index> cols;
   std::vector<double> vals;
   dl::FullMatrix<double> projected;
@@ -732,6 +887,51 @@ std::vector<std::vector<double>> HyperelasticSolver::tangent_columns(const std::
                                });
   if (!st.valid) throw std::invalid_argument("tangent: an element is inverted (J <= 0)");
   return cols;
+}
+
+namespace {
+/// The matrix-free tangent of `im` (HyperelasticSolver's, private: deduced) at u, on f(op).
+template <typename Impl, typename Use>
+std::vector<double> with_tangent_operator(const Impl& im, const std::vector<double>& u,
+                                          const char* what, const Use& f) {
+  if (im.mixed) {
+    throw InputError(
+        "the matrix-free tangent is for the displacement formulation, not the mixed one");
+  }
+  if (u.size() != im.d.dof.n_dofs()) {
+    throw std::invalid_argument(std::string(what) + ": wrong number of DoF values");
+  }
+  detail::ensure_mpi_initialized();
+  const dl::Vector<double> w(u.begin(), u.end());
+  const detail::NeoHookeanTangentState state = im.tangent_state(w);
+  const auto homogeneous = detail::homogeneous_copy(im.d.constraints);
+  const detail::ElasticityOperator op(*im.d.mapping, im.d.dof, homogeneous, im.d.degree,
+                                      im.material.lambda, im.material.mu, 1, &state);
+  const detail::MfVector out = f(op);
+  return {out.begin(), out.end()};
+}
+}  // namespace
+
+std::vector<double> HyperelasticSolver::matrix_free_tangent_diagonal(
+    const std::vector<double>& u) const {
+  return with_tangent_operator(*impl_, u, "matrix_free_tangent_diagonal",
+                               [](const detail::ElasticityOperator& op) { return op.diagonal(); });
+}
+
+std::vector<double> HyperelasticSolver::matrix_free_tangent_product(
+    const std::vector<double>& u, const std::vector<double>& v) const {
+  if (v.size() != n_dofs()) {
+    throw std::invalid_argument("matrix_free_tangent_product: wrong number of DoF values");
+  }
+  return with_tangent_operator(*impl_, u, "matrix_free_tangent_product",
+                               [&](const detail::ElasticityOperator& op) {
+                                 detail::MfVector src, dst;
+                                 op.initialize_dof_vector(src);
+                                 op.initialize_dof_vector(dst);
+                                 std::copy(v.begin(), v.end(), src.begin());
+                                 op.vmult(dst, src);
+                                 return dst;
+                               });
 }
 
 }  // namespace vessel::fem

@@ -92,6 +92,7 @@ struct HyperelasticResult {
   std::string element;  ///< "P1", "P2" or "P2-P1 (Taylor-Hood)"
   Formulation formulation = Formulation::displacement;
   LinearSolver solver = LinearSolver::direct;  ///< the one used for the Newton systems
+  std::string solver_reason;  ///< why: requested, or automatic's rule (SolverChoice)
   std::size_t n_dofs = 0;
   /// The largest load factor at which equilibrium was found, and whether it is the target.
   double load_factor = 0.0;
@@ -103,6 +104,9 @@ struct HyperelasticResult {
   int rejected_steps = 0;          ///< increments halved after a Newton failure
   int newton_iterations = 0;       ///< total, accepted and rejected steps
   unsigned linear_iterations = 0;  ///< total CG / FGMRES iterations (0 for direct)
+  /// solver matrix_free: the p-multigrid's set-up and Krylov parts summed over the Newton systems
+  /// (coarse_method and the counts of the last).
+  MatrixFreeProfile matrix_free;
   std::vector<Vec3> nodal_displacement;  ///< at load_factor, at every TetMesh node, m
   std::vector<Checkpoint> checkpoints;   ///< those reached, in order
   double strain_energy = 0.0;            ///< ∫Ψ dV, J
@@ -175,6 +179,14 @@ class HyperelasticSolver {
   [[nodiscard]] std::vector<double> residual(const std::vector<double>& u, double s) const;
   [[nodiscard]] std::vector<std::vector<double>> tangent_columns(const std::vector<double>& u,
                                                                  double s) const;
+  /// The tangent at DoF values u applied to v by the matrix-free operator the solver matrix-free
+  /// uses (displacement form; the follower pressure's faces left out): v's constrained entries
+  /// read as zero, those rows returned as v's. For tests against tangent_columns.
+  [[nodiscard]] std::vector<double> matrix_free_tangent_product(const std::vector<double>& u,
+                                                                const std::vector<double>& v) const;
+  /// The diagonal of that operator at u (the Chebyshev smoother's; 1 on constrained DoFs).
+  [[nodiscard]] std::vector<double> matrix_free_tangent_diagonal(
+      const std::vector<double>& u) const;
 
  private:
   struct Impl;

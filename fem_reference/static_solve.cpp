@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <sstream>
+#include <stdexcept>
 
 #include "fem_reference/cholmod_solve.hpp"
 #include "fem_reference/detail/constraints.hpp"
@@ -38,16 +39,16 @@ namespace detail {
 
 namespace {
 
-/// `automatic`'s rule: the matrix-free p-multigrid for the linear reference's one P2 solve on
-/// straight-sided tets from matrix_free_min_dofs; otherwise a direct solve up to the direct limit
-/// and an iterative one beyond.
+/// `automatic`'s rule: the matrix-free p-multigrid for the linear reference's P2 solve on
+/// straight-sided tets from matrix_free_min_dofs; otherwise a direct solve up to the direct
+/// limit and an iterative one beyond.
 SolverChoice automatic_solver(const SolverOptions& o, const SystemShape& shape) {
   const std::string dofs = std::to_string(shape.n_dofs) + " DoFs";
   if (!shape.mixed && shape.linear_static && shape.degree == 2 && !shape.curved && !o.keep_factor &&
       o.matrix_free_min_dofs > 0 && shape.n_dofs >= o.matrix_free_min_dofs) {
     return {LinearSolver::matrix_free, "auto: " + dofs + " >= matrix-free-min-dofs " +
                                            std::to_string(o.matrix_free_min_dofs) +
-                                           " (P2 on straight-sided tets, one solve)"};
+                                           " (P2 on straight-sided tets, no kept factor)"};
   }
   const std::size_t limit = shape.mixed ? o.direct_max_mixed_dofs : o.direct_max_dofs;
   const std::string limit_name = shape.mixed ? "direct-max-mixed-dofs " : "direct-max-dofs ";
@@ -100,9 +101,8 @@ void ElasticitySolver::Impl::solve_linear(bool symmetric, DirectReuse reuse) {
     s = LinearSolver::direct;
   }
   if (s == LinearSolver::matrix_free) {
-    throw InputError(
-        "solver matrix-free solves the linear reference only; the finite-strain tangent needs "
-        "direct or cg-amg");
+    // The linear reference's solve() and the finite-strain Newton take it before this.
+    throw std::logic_error("solve_linear: the matrix-free solver is not an assembled one");
   }
   result.solver = s;
   result.solver_reason =

@@ -10,6 +10,7 @@
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/solver_gmres.h>
 #include <deal.II/matrix_free/fe_evaluation.h>
 #include <deal.II/matrix_free/tools.h>
 
@@ -155,6 +156,112 @@ StraightTetKernel straight_batch_for(StraightTetIsa isa) {
       break;
   }
   return straight_batch_sse2<N, Q>;
+}
+
+/// The neo-Hookean tangent on V's lanes of a batch of straight-sided tets, as straight_lanes
+/// with the stress replaced by dP = μ H + (μ − λ ln J)(F⁻¹ H F⁻¹)ᵀ + λ tr(F⁻¹ H) F⁻ᵀ of
+/// H = ∇δu, at the state's n_q points (`state` as TangentTetKernel describes, from V's first lane).
+template <typename V, unsigned N>
+[[gnu::always_inline]] inline void tangent_lanes(const double* in, double* out,
+                                                 const double* geometry, const double* state,
+                                                 const double* ref_grad, const double* weights,
+                                                 unsigned n_q, double lambda, double mu) {
+  constexpr unsigned kPer = NeoHookeanTangentState::kPerPoint;
+  V u[kDim * N], a[kDim * N] = {}, inv_jt[kDim][kDim], det;
+  for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(&u[k], in + k * kLanes, sizeof(V));
+  for (unsigned j = 0; j < kDim * kDim; ++j) {
+    std::memcpy(&inv_jt[j / kDim][j % kDim], geometry + j * kLanes, sizeof(V));
+  }
+  std::memcpy(&det, geometry + kDim * kDim * kLanes, sizeof(V));
+  for (unsigned q = 0; q < n_q; ++q) {
+    const double* g = ref_grad + q * N * kDim;
+    V ref[kDim][kDim] = {};  // ∂δu_c/∂ξ_e
+    for (unsigned c = 0; c < kDim; ++c) {
+      for (unsigned i = 0; i < N; ++i) {
+        for (unsigned e = 0; e < kDim; ++e) ref[c][e] += u[c * N + i] * g[i * kDim + e];
+      }
+    }
+    V h[kDim][kDim];  // H = ∂δu_c/∂X_d
+    for (unsigned c = 0; c < kDim; ++c) {
+      for (unsigned d = 0; d < kDim; ++d) {
+        h[c][d] = inv_jt[d][0] * ref[c][0] + inv_jt[d][1] * ref[c][1] + inv_jt[d][2] * ref[c][2];
+      }
+    }
+    const double* st = state + q * kPer * kLanes;
+    V f_inv[kDim][kDim], coefficient;  // F⁻¹ and μ − λ ln J
+    for (unsigned j = 0; j < kDim * kDim; ++j) {
+      std::memcpy(&f_inv[j / kDim][j % kDim], st + j * kLanes, sizeof(V));
+    }
+    std::memcpy(&coefficient, st + kDim * kDim * kLanes, sizeof(V));
+    V gh[kDim][kDim];  // F⁻¹ H
+    for (unsigned i = 0; i < kDim; ++i) {
+      for (unsigned j = 0; j < kDim; ++j) {
+        gh[i][j] = f_inv[i][0] * h[0][j] + f_inv[i][1] * h[1][j] + f_inv[i][2] * h[2][j];
+      }
+    }
+    const V w = det * weights[q];
+    const V mu_w = mu * w, c_w = coefficient * w;
+    const V lambda_trace = (lambda * w) * (gh[0][0] + gh[1][1] + gh[2][2]);
+    for (unsigned c = 0; c < kDim; ++c) {
+      V p[kDim];  // row c of w·dP
+      for (unsigned d = 0; d < kDim; ++d) {
+        // (F⁻¹ H F⁻¹)_dc
+        const V ghg = gh[d][0] * f_inv[0][c] + gh[d][1] * f_inv[1][c] + gh[d][2] * f_inv[2][c];
+        p[d] = mu_w * h[c][d] + c_w * ghg + lambda_trace * f_inv[d][c];
+      }
+      V s[kDim];  // Σ_d w dP_cd ∂ξ_e/∂x_d
+      for (unsigned e = 0; e < kDim; ++e) {
+        s[e] = p[0] * inv_jt[0][e] + p[1] * inv_jt[1][e] + p[2] * inv_jt[2][e];
+      }
+      for (unsigned i = 0; i < N; ++i) {
+        a[c * N + i] += s[0] * g[i * kDim] + s[1] * g[i * kDim + 1] + s[2] * g[i * kDim + 2];
+      }
+    }
+  }
+  for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(out + k * kLanes, &a[k], sizeof(V));
+}
+
+template <typename V, unsigned Width, unsigned N>
+[[gnu::always_inline]] inline void tangent_batch(const double* in, double* out,
+                                                 const double* geometry, const double* state,
+                                                 const double* ref_grad, const double* weights,
+                                                 unsigned n_q, double lambda, double mu) {
+  for (unsigned first = 0; first < kLanes; first += Width) {
+    tangent_lanes<V, N>(in + first, out + first, geometry + first, state + first, ref_grad, weights,
+                        n_q, lambda, mu);
+  }
+}
+template <unsigned N>
+void tangent_batch_sse2(const double* in, double* out, const double* geometry, const double* state,
+                        const double* ref_grad, const double* weights, unsigned n_q, double lambda,
+                        double mu) {
+  tangent_batch<Lanes2, 2, N>(in, out, geometry, state, ref_grad, weights, n_q, lambda, mu);
+}
+template <unsigned N>
+[[gnu::target("avx2,fma")]] void tangent_batch_avx2(const double* in, double* out,
+                                                    const double* geometry, const double* state,
+                                                    const double* ref_grad, const double* weights,
+                                                    unsigned n_q, double lambda, double mu) {
+  tangent_batch<Lanes4, 4, N>(in, out, geometry, state, ref_grad, weights, n_q, lambda, mu);
+}
+template <unsigned N>
+[[gnu::target("avx512f,fma")]] void tangent_batch_avx512(
+    const double* in, double* out, const double* geometry, const double* state,
+    const double* ref_grad, const double* weights, unsigned n_q, double lambda, double mu) {
+  tangent_batch<Lanes8, 8, N>(in, out, geometry, state, ref_grad, weights, n_q, lambda, mu);
+}
+
+template <unsigned N>
+TangentTetKernel tangent_batch_for(StraightTetIsa isa) {
+  switch (isa) {
+    case StraightTetIsa::avx512:
+      return tangent_batch_avx512<N>;
+    case StraightTetIsa::avx2:
+      return tangent_batch_avx2<N>;
+    case StraightTetIsa::sse2:
+      break;
+  }
+  return tangent_batch_sse2<N>;
 }
 
 /// The batch kernel for the scalar element's `n_shapes` (4: P1, 10: P2) on `isa`.
@@ -314,8 +421,9 @@ void P1ToP2Embedding::restrict_and_add(MfVector& p1, const MfVector& p2) const {
 ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
                                        const dl::DoFHandler<kDim>& dof,
                                        const dl::AffineConstraints<double>& constraints, int degree,
-                                       double lambda, double mu, unsigned threads)
-    : mapping_(mapping), constraints_(constraints), lambda_(lambda), mu_(mu) {
+                                       double lambda, double mu, unsigned threads,
+                                       const NeoHookeanTangentState* tangent)
+    : mapping_(mapping), constraints_(constraints), lambda_(lambda), mu_(mu), tangent_(tangent) {
   dl::MatrixFree<kDim, double>::AdditionalData data;
   data.mapping_update_flags = dl::update_gradients | dl::update_JxW_values;
   data.tasks_parallel_scheme = dl::MatrixFree<kDim, double>::AdditionalData::none;
@@ -324,11 +432,15 @@ ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
   // path's QGaussSimplex(degree + 1) (14 points per P2 cell). deal.II 9.4's MatrixFree takes only
   // QGaussSimplex and odd Witherden–Vincent rules on tets (get_unique_face_quadratures), not the
   // 4-point one, so for P1 and P2 the kernel is our own (straight_batch) on MatrixFree's
-  // one-point geometry. Curved cells keep degree + 1, as the assembly does.
+  // one-point geometry. Curved cells keep degree + 1, as the assembly does. The finite-strain
+  // tangent is not polynomial: it takes the residual's own rule (tangent_'s), so that it is the
+  // residual's exact derivative.
   const auto* fe_mapping = dynamic_cast<const dl::MappingFE<kDim>*>(&mapping);
   const bool affine = fe_mapping != nullptr && fe_mapping->get_degree() == 1;
   straight_ = affine && degree <= 2;
-  quadrature_ = affine ? exact_on_straight_tets(degree) : dl::QGaussSimplex<kDim>(degree + 1);
+  quadrature_ = tangent_ != nullptr ? tangent_->quadrature
+                : affine            ? exact_on_straight_tets(degree)
+                                    : dl::QGaussSimplex<kDim>(degree + 1);
   n_quadrature_points_ = quadrature_.size();
   if (straight_) {
     const dl::FE_SimplexP<kDim> scalar(static_cast<unsigned>(degree));
@@ -340,13 +452,33 @@ ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
       }
     }
     isa_ = straight_tet_isa();
-    kernel_ = straight_batch_kernel(n_shapes_, isa_);
+    if (tangent_ != nullptr) {
+      tangent_kernel_ = n_shapes_ == 4 ? tangent_batch_for<4>(isa_) : tangent_batch_for<10>(isa_);
+    } else {
+      kernel_ = straight_batch_kernel(n_shapes_, isa_);
+    }
     mf_.reinit(mapping, dof, constraints, dl::QGaussSimplex<kDim>(1), data);
     build_batches();
     partition_batches(threads);
     return;
   }
   mf_.reinit(mapping, dof, constraints, quadrature_, data);
+  if (tangent_ != nullptr) {
+    const unsigned width = dl::VectorizedArray<double>::size();
+    lane_cells_.assign(mf_.n_cell_batches() * width, kNoDof);
+    for (unsigned b = 0; b < mf_.n_cell_batches(); ++b) {
+      for (unsigned l = 0; l < mf_.n_active_entries_per_cell_batch(b); ++l) {
+        lane_cells_[b * width + l] = mf_.get_cell_iterator(b, l)->active_cell_index();
+      }
+    }
+  }
+}
+
+void ElasticityOperator::store_state(unsigned cell, double* lane) const {
+  constexpr unsigned kPer = NeoHookeanTangentState::kPerPoint;
+  const unsigned n_q = tangent_->n_q();
+  const double* v = tangent_->values.data() + std::size_t{cell} * n_q * kPer;
+  for (unsigned k = 0; k < n_q * kPer; ++k) lane[k * kLanes] = v[k];
 }
 
 void ElasticityOperator::build_batches() {
@@ -375,6 +507,14 @@ void ElasticityOperator::build_batches() {
     }
     phi.reinit(cell);
     store_geometry(phi, batch_geometry_.data() + std::size_t{b} * kGeometry * kLanes + l);
+  }
+  if (tangent_ == nullptr) return;
+  const std::size_t per_batch =
+      std::size_t{tangent_->n_q()} * NeoHookeanTangentState::kPerPoint * kLanes;
+  batch_state_.assign(n_batches * per_batch, 0.0);
+  for (unsigned cell = 0; cell < n_cells; ++cell) {
+    store_state(mf_.get_cell_iterator(cell, 0)->active_cell_index(),
+                batch_state_.data() + cell / kLanes * per_batch + cell % kLanes);
   }
 }
 
@@ -425,8 +565,15 @@ void ElasticityOperator::apply_batch_range(std::size_t first, std::size_t end, c
     for (unsigned j = 0; j < per_batch; ++j) {
       in[j] = idx[j] == kNoDof ? 0.0 : src.local_element(idx[j]);
     }
-    kernel_(in.data(), a.data(), batch_geometry_.data() + b * kGeometry * kLanes, ref_grad_.data(),
-            w, lambda_, mu_);
+    const double* geometry = batch_geometry_.data() + b * kGeometry * kLanes;
+    if (tangent_kernel_ != nullptr) {
+      const std::size_t per_state =
+          std::size_t{n_quadrature_points_} * NeoHookeanTangentState::kPerPoint * kLanes;
+      tangent_kernel_(in.data(), a.data(), geometry, batch_state_.data() + b * per_state,
+                      ref_grad_.data(), w, n_quadrature_points_, lambda_, mu_);
+    } else {
+      kernel_(in.data(), a.data(), geometry, ref_grad_.data(), w, lambda_, mu_);
+    }
     for (unsigned j = 0; j < per_batch; ++j) {
       if (idx[j] != kNoDof) out[idx[j] - offset] += a[j];
     }
@@ -453,7 +600,43 @@ void ElasticityOperator::apply_batches(MfVector& dst, const MfVector& src) const
 }
 
 template <typename Evaluation>
+void ElasticityOperator::apply_tangent(Evaluation& phi) const {
+  constexpr unsigned kPer = NeoHookeanTangentState::kPerPoint;
+  const unsigned width = Number::size();
+  const unsigned* lanes = lane_cells_.data() + phi.get_current_cell_index() * width;
+  const unsigned n_q = tangent_->n_q();
+  phi.evaluate(dl::EvaluationFlags::gradients);
+  for (unsigned q = 0; q < phi.n_q_points; ++q) {
+    dl::Tensor<2, kDim, Number> g;  // F⁻¹ (the identity on an empty lane)
+    Number c = 0.0;                 // μ − λ ln J
+    for (unsigned l = 0; l < width; ++l) {
+      if (lanes[l] == kNoDof) {
+        for (unsigned i = 0; i < kDim; ++i) g[i][i][l] = 1.0;
+        continue;
+      }
+      const double* v = tangent_->values.data() + (std::size_t{lanes[l]} * n_q + q) * kPer;
+      for (unsigned i = 0; i < kDim; ++i) {
+        for (unsigned j = 0; j < kDim; ++j) g[i][j][l] = v[kDim * i + j];
+      }
+      c[l] = v[kDim * kDim];
+    }
+    const dl::Tensor<2, kDim, Number> h = phi.get_gradient(q);  // ∂δu_a/∂X_J
+    const dl::Tensor<2, kDim, Number> gh = g * h;
+    const Number trace_gh = dl::trace(gh);
+    // dP = μ H + (μ − λ ln J)(F⁻¹ H F⁻¹)ᵀ + λ tr(F⁻¹H) F⁻ᵀ
+    const dl::Tensor<2, kDim, Number> dp =
+        mu_ * h + c * dl::transpose(gh * g) + (lambda_ * trace_gh) * dl::transpose(g);
+    phi.submit_gradient(dp, q);
+  }
+  phi.integrate(dl::EvaluationFlags::gradients);
+}
+
+template <typename Evaluation>
 void ElasticityOperator::apply_cell(Evaluation& phi) const {
+  if (tangent_ != nullptr && !straight_) {
+    apply_tangent(phi);
+    return;
+  }
   if (!straight_) {
     stress_divergence(phi, lambda_, mu_);
     return;
@@ -464,8 +647,18 @@ void ElasticityOperator::apply_cell(Evaluation& phi) const {
   const unsigned per_cell = kDim * n_shapes_;
   for (unsigned k = 0; k < per_cell; ++k) in[k * kLanes] = phi.begin_dof_values()[k][0];
   store_geometry(phi, geometry.data());
-  kernel_(in.data(), out.data(), geometry.data(), ref_grad_.data(),
-          quadrature_.get_weights().data(), lambda_, mu_);
+  if (tangent_kernel_ != nullptr) {
+    thread_local std::vector<double> state;
+    state.assign(std::size_t{n_quadrature_points_} * NeoHookeanTangentState::kPerPoint * kLanes,
+                 0.0);
+    store_state(mf_.get_cell_iterator(phi.get_current_cell_index(), 0)->active_cell_index(),
+                state.data());
+    tangent_kernel_(in.data(), out.data(), geometry.data(), state.data(), ref_grad_.data(),
+                    quadrature_.get_weights().data(), n_quadrature_points_, lambda_, mu_);
+  } else {
+    kernel_(in.data(), out.data(), geometry.data(), ref_grad_.data(),
+            quadrature_.get_weights().data(), lambda_, mu_);
+  }
   for (unsigned k = 0; k < per_cell; ++k) phi.begin_dof_values()[k] = out[k * kLanes];
 }
 
@@ -501,6 +694,7 @@ MfVector ElasticityOperator::diagonal() const {
   for (const auto& line : constraints_.get_lines()) {
     if (!line.entries.empty()) return diagonal_by_kernel();
   }
+  if (tangent_ != nullptr) return tangent_diagonal();
   MfVector diag;
   mf_.initialize_dof_vector(diag);
   const auto& dof = mf_.get_dof_handler();
@@ -517,6 +711,37 @@ MfVector ElasticityOperator::diagonal() const {
       for (unsigned q = 0; q < values.n_quadrature_points; ++q) {
         const dl::Tensor<1, kDim> g = values.shape_grad(k, q);
         a += values.JxW(q) * ((lambda_ + mu_) * g[c] * g[c] + mu_ * (g * g));
+      }
+      diag(idx[i]) += a;
+    }
+  }
+  for (const unsigned i : mf_.get_constrained_dofs()) diag.local_element(i) = 1.0;
+  return diag;
+}
+
+MfVector ElasticityOperator::tangent_diagonal() const {
+  constexpr unsigned kPer = NeoHookeanTangentState::kPerPoint;
+  MfVector diag;
+  mf_.initialize_dof_vector(diag);
+  const auto& dof = mf_.get_dof_handler();
+  const auto& fe = dof.get_fe();
+  dl::FEValues<kDim> values(mapping_, fe.base_element(0), quadrature_,
+                            dl::update_gradients | dl::update_JxW_values);
+  const unsigned n_q = quadrature_.size();
+  std::vector<dl::types::global_dof_index> idx(fe.n_dofs_per_cell());
+  for (const auto& cell : dof.active_cell_iterators()) {
+    values.reinit(static_cast<dl::Triangulation<kDim>::cell_iterator>(cell));
+    cell->get_dof_indices(idx);
+    const double* state =
+        tangent_->values.data() + std::size_t{cell->active_cell_index()} * n_q * kPer;
+    for (unsigned i = 0; i < idx.size(); ++i) {
+      const auto [c, k] = fe.system_to_component_index(i);
+      double a = 0.0;
+      for (unsigned q = 0; q < n_q; ++q) {
+        const double* v = state + q * kPer;  // F⁻¹ row-major, then μ − λ ln J
+        const dl::Tensor<1, kDim> g = values.shape_grad(k, q);
+        const double f_inv_t_g = v[c] * g[0] + v[kDim + c] * g[1] + v[2 * kDim + c] * g[2];
+        a += values.JxW(q) * (mu_ * (g * g) + (v[kDim * kDim] + lambda_) * f_inv_t_g * f_inv_t_g);
       }
       diag(idx[i]) += a;
     }
@@ -558,7 +783,8 @@ class MatrixFreeElasticitySolver::VCycle {
   VCycle(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
          const ElasticityOperator& fine, const dl::AffineConstraints<double>& fine_constraints,
          const ConstraintsFor& constraints_for, int degree, double lambda, double mu,
-         const Vec3& centre, const PMultigridSettings& settings, MatrixFreeProfile& profile)
+         const Vec3& centre, const PMultigridSettings& settings, MatrixFreeProfile& profile,
+         const NeoHookeanTangentState* tangent)
       : fine_(fine), coarse_dof_(dof.get_triangulation()) {
     const ElasticityOperator* coarse = &fine;
     auto t0 = Clock::now();
@@ -575,7 +801,7 @@ class MatrixFreeElasticitySolver::VCycle {
       c.close();
       coarse_constraints_ = homogeneous_copy(c);
       coarse_ = std::make_unique<ElasticityOperator>(mapping, coarse_dof_, coarse_constraints_, 1,
-                                                     lambda, mu, solver_threads());
+                                                     lambda, mu, solver_threads(), tangent);
       coarse = coarse_.get();
       profile.coarse_level = lap();
       if (plain_indexable(dof, fine_constraints) &&
@@ -757,12 +983,28 @@ class MatrixFreeElasticitySolver::VCycle {
   mutable double coarse_solve_seconds_ = 0.0, transfer_seconds_ = 0.0;
 };
 
-MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(const dl::Mapping<kDim>& mapping,
-                                                       const dl::DoFHandler<kDim>& dof,
-                                                       const ConstraintsFor& constraints_for,
-                                                       int degree, double lambda, double mu,
-                                                       const Vec3& centre,
-                                                       const PMultigridSettings& settings) {
+namespace {
+/// A + S: the matrix-free operator and a sparse matrix on the same (serial) DoF numbering.
+struct WithAddedMatrix {
+  const ElasticityOperator& a;
+  const MatrixFreeElasticitySolver::AddedMatrix& s;
+  void vmult(MfVector& dst, const MfVector& src) const {
+    a.vmult(dst, src);
+    for (Eigen::Index row = 0; row < s.outerSize(); ++row) {
+      double sum = 0.0;
+      for (MatrixFreeElasticitySolver::AddedMatrix::InnerIterator it(s, row); it; ++it) {
+        sum += it.value() * src.local_element(static_cast<unsigned>(it.col()));
+      }
+      dst.local_element(static_cast<unsigned>(row)) += sum;
+    }
+  }
+};
+}  // namespace
+
+MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(
+    const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
+    const ConstraintsFor& constraints_for, int degree, double lambda, double mu, const Vec3& centre,
+    const PMultigridSettings& settings, const NeoHookeanTangentState* tangent) {
   const auto t0 = std::chrono::steady_clock::now();
   ensure_mpi_initialized();  // Trilinos and the distributed vectors need MPI
   dl::AffineConstraints<double> c;
@@ -771,12 +1013,12 @@ MatrixFreeElasticitySolver::MatrixFreeElasticitySolver(const dl::Mapping<kDim>& 
   fine_constraints_ = homogeneous_copy(c);
   const auto t_fine = Clock::now();
   fine_ = std::make_unique<ElasticityOperator>(mapping, dof, fine_constraints_, degree, lambda, mu,
-                                               solver_threads());
+                                               solver_threads(), tangent);
   profile_.fine_operator = seconds_since(t_fine);
   profile_.quadrature_points = fine_->quadrature_points();
   preconditioner_ =
       std::make_unique<VCycle>(mapping, dof, *fine_, fine_constraints_, constraints_for, degree,
-                               lambda, mu, centre, settings, profile_);
+                               lambda, mu, centre, settings, profile_, tangent);
   setup_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -784,7 +1026,7 @@ MatrixFreeElasticitySolver::~MatrixFreeElasticitySolver() = default;
 
 MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::solve(
     const dl::Vector<double>& b, dl::Vector<double>& u, double relative_tolerance,
-    unsigned max_iterations) const {
+    unsigned max_iterations, const AddedMatrix* added) const {
   MfVector rhs, x;
   fine_->initialize_dof_vector(rhs);
   fine_->initialize_dof_vector(x);
@@ -795,16 +1037,19 @@ MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::solve(
   dl::SolverControl control(max_iterations, relative_tolerance * rhs.l2_norm());
   const auto t0 = Clock::now();
   try {
-    if (preconditioner_->linear()) {
+    if (added != nullptr) {
+      dl::SolverFGMRES<MfVector>(control).solve(WithAddedMatrix{*fine_, *added}, x, rhs,
+                                                *preconditioner_);
+    } else if (preconditioner_->linear()) {
       dl::SolverCG<MfVector>(control).solve(*fine_, x, rhs, *preconditioner_);
     } else {
       dl::SolverFlexibleCG<MfVector>(control).solve(*fine_, x, rhs, *preconditioner_);
     }
   } catch (const dl::SolverControl::NoConvergence& e) {
     std::ostringstream m;
-    m << "matrix-free CG with p-multigrid did not converge in " << e.last_step
-      << " iterations (residual " << e.last_residual
-      << "); try --solver direct or more --max-iterations";
+    m << "matrix-free " << (added != nullptr ? "FGMRES" : "CG")
+      << " with p-multigrid did not converge in " << e.last_step << " iterations (residual "
+      << e.last_residual << "); try --solver direct or more --max-iterations";
     throw std::runtime_error(m.str());
   }
   profile_.cg += seconds_since(t0);

@@ -17,6 +17,7 @@
 #include <deal.II/matrix_free/matrix_free.h>
 #include <deal.II/multigrid/mg_transfer_global_coarsening.h>
 
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <array>
 #include <functional>
@@ -38,6 +39,13 @@ using StraightTetKernel = void (*)(const double* in, double* out, const double* 
                                    const double* ref_grad, const double* weights, double lambda,
                                    double mu);
 
+/// The neo-Hookean tangent's straight-tet kernel on a batch (the .cpp's tangent_batch): as
+/// StraightTetKernel, with the batch's NeoHookeanTangentState values at its n_q points
+/// [(q·kPerPoint + j)·lanes + l].
+using TangentTetKernel = void (*)(const double* in, double* out, const double* geometry,
+                                  const double* state, const double* ref_grad,
+                                  const double* weights, unsigned n_q, double lambda, double mu);
+
 /// The instruction set the straight-tet kernel runs in: a batch of 8 cells as four SSE2, two
 /// AVX2 (+ FMA) or one AVX-512 (+ FMA) register per quantity.
 enum class StraightTetIsa { sse2, avx2, avx512 };
@@ -50,6 +58,19 @@ enum class StraightTetIsa { sse2, avx2, avx512 };
 /// this CPU lacks.
 [[nodiscard]] StraightTetIsa straight_tet_isa();
 
+/// The compressible neo-Hookean tangent's coefficients at a displacement (the finite-strain
+/// reference's displacement form, Ψ = μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)²): at quadrature point q
+/// of the cell with active index c, F⁻¹ row-major at values[(c·n_q + q)·kPerPoint + 3i + j] and
+/// μ − λ ln J at [... + 9]. The tangent's action on H = ∇δu is then
+/// dP = μ H + (μ − λ ln J) (F⁻¹ H F⁻¹)ᵀ + λ tr(F⁻¹ H) F⁻ᵀ (NeoHookean::tangent contracted with H);
+/// at u = 0 it is σ(ε(δu)) of linear elasticity.
+struct NeoHookeanTangentState {
+  static constexpr unsigned kPerPoint = kDim * kDim + 1;
+  dl::Quadrature<kDim> quadrature;  ///< the residual's cell rule (the assembled path's)
+  std::vector<double> values;
+  [[nodiscard]] unsigned n_q() const { return quadrature.size(); }
+};
+
 /// A(u) = ∫ σ(u) : ε(v) dV with σ = λ tr(ε) I + 2μ ε (Pa, so A u is in N for u in m), evaluated
 /// cell by cell on straight-sided tets at the fewest-point rule exact for the integrand's degree
 /// 2(degree − 1) (P2: 4 points) and on curved ones at the assembled path's
@@ -60,9 +81,12 @@ class ElasticityOperator : public dl::Subscriptor {
  public:
   /// `threads`: the batched kernel's cells are cut into that many contiguous parts, one per
   /// thread (fewer on a small mesh); the other paths are serial.
+  /// `tangent` (kept by reference): the operator is instead the neo-Hookean tangent
+  /// ∫ dP(∇δu) : ∇v dV at that state, on the state's quadrature, cell by cell (serial).
   ElasticityOperator(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
                      const dl::AffineConstraints<double>& constraints, int degree, double lambda,
-                     double mu, unsigned threads = 1);
+                     double mu, unsigned threads = 1,
+                     const NeoHookeanTangentState* tangent = nullptr);
 
   /// dst = A src; counted in applications() and seconds().
   void vmult(MfVector& dst, const MfVector& src) const;
@@ -90,7 +114,7 @@ class ElasticityOperator : public dl::Subscriptor {
     std::size_t sums = 0;
     for (const Part& p : parts_) sums += p.sum.capacity() * sizeof(double);
     return mf_.memory_consumption() + batch_dofs_.capacity() * sizeof(unsigned) +
-           batch_geometry_.capacity() * sizeof(double) + sums;
+           (batch_geometry_.capacity() + batch_state_.capacity()) * sizeof(double) + sums;
   }
   /// vmult calls so far, and their wall-clock seconds.
   [[nodiscard]] unsigned applications() const { return applications_; }
@@ -114,6 +138,14 @@ class ElasticityOperator : public dl::Subscriptor {
   /// straight_ on a serial mesh with constraints that only fix values: batch_dofs_ and
   /// batch_geometry_ from MatrixFree's cells, in its order (otherwise left empty).
   void build_batches();
+  /// The neo-Hookean tangent on phi's cell batch: dP(∇δu) tested with ∇v at tangent_'s points.
+  template <typename Evaluation>
+  void apply_tangent(Evaluation& phi) const;
+  /// tangent_'s values of `cell` (an active index) into one lane of a batch's state.
+  void store_state(unsigned cell, double* lane) const;
+  /// diag(A) of the tangent: per DoF (component c of shape N, g = ∇N) at each point
+  /// μ|g|² + (μ − λ ln J + λ)((F⁻ᵀ g)_c)², by FEValues of the scalar element.
+  [[nodiscard]] MfVector tangent_diagonal() const;
   /// phi's J⁻ᵀ and |det J| into one lane of a batch's geometry.
   template <typename Evaluation>
   static void store_geometry(const Evaluation& phi, double* lane);
@@ -133,6 +165,7 @@ class ElasticityOperator : public dl::Subscriptor {
   unsigned n_shapes_ = 0;            // straight_: the scalar element's shape functions
   std::vector<double> ref_grad_;     // straight_: their reference gradients at quadrature_
   StraightTetKernel kernel_ = nullptr;  // straight_: for isa_
+  TangentTetKernel tangent_kernel_ = nullptr;  // straight_ and tangent_: for isa_
   StraightTetIsa isa_ = StraightTetIsa::sse2;
   /// A thread's share of the batches and the DoFs they write, [first_dof, end_dof): part 0 adds
   /// into dst, every other into its own `sum` (as parts share DoFs), added to dst after.
@@ -148,8 +181,14 @@ class ElasticityOperator : public dl::Subscriptor {
   // geometry [(b·10 + j)·lanes + l] (J⁻ᵀ row-major, then |det J|).
   std::vector<unsigned> batch_dofs_;
   std::vector<double> batch_geometry_;
+  /// straight_, tangent_ and batchable: the batches' tangent_ values
+  /// [((b·n_q + q)·kPerPoint + j)·lanes + l].
+  std::vector<double> batch_state_;
   const dl::AffineConstraints<double>& constraints_;
   double lambda_, mu_;
+  const NeoHookeanTangentState* tangent_ = nullptr;
+  /// tangent_: per cell batch and lane, the cell's active index (kNoDof for an empty lane).
+  std::vector<unsigned> lane_cells_;
   mutable MfVector diagonal_;  // el()'s, on first use
   unsigned n_quadrature_points_ = 0;
   mutable unsigned applications_ = 0;
@@ -238,9 +277,13 @@ class MatrixFreeElasticitySolver {
   /// (m): the rotation centre of the AMG's rigid-body modes. `mapping` and `dof` must outlive this.
   MatrixFreeElasticitySolver(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
                              const ConstraintsFor& constraints_for, int degree, double lambda,
-                             double mu, const Vec3& centre,
-                             const PMultigridSettings& settings = {});
+                             double mu, const Vec3& centre, const PMultigridSettings& settings = {},
+                             const NeoHookeanTangentState* tangent = nullptr);
   ~MatrixFreeElasticitySolver();
+
+  /// A matrix added to the operator, on the full DoF numbering, zero on constrained rows and
+  /// columns: the follower pressure's (unsymmetric) share of the finite-strain tangent.
+  using AddedMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 
   struct Outcome {
     unsigned iterations = 0;
@@ -248,8 +291,9 @@ class MatrixFreeElasticitySolver {
   };
   /// Solves A u = b by preconditioned CG to ‖r‖ ≤ relative_tolerance·‖b‖ (runtime_error when
   /// max_iterations pass first). `u` (m) is the initial guess on entry.
+  /// With `added` = S: (A + S) u = b by FGMRES, preconditioned by the same V-cycle on A.
   Outcome solve(const dl::Vector<double>& b, dl::Vector<double>& u, double relative_tolerance,
-                unsigned max_iterations) const;
+                unsigned max_iterations, const AddedMatrix* added = nullptr) const;
 
   [[nodiscard]] const ElasticityOperator& fine_operator() const { return *fine_; }
   /// Wall-clock seconds the constructor took (operators, transfer, diagonal, coarse solver).

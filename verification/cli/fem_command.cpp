@@ -511,6 +511,12 @@ void run_finite_strain(const FemCommandOptions& o, const Scene& scene,
   if (r.linear_iterations > 0) std::cout << ", " << r.linear_iterations << " Krylov iterations";
   std::cout << "\n  load steps " << r.steps.size() << " accepted, " << r.rejected_steps
             << " rejected; Newton iterations " << r.newton_iterations << "\n";
+  std::cout << "  solver " << fem::to_string(r.solver) << ": "
+            << (o.solver == "auto" ? r.solver_reason : "requested by --solver " + o.solver) << "\n";
+  if (r.solver == fem::LinearSolver::matrix_free) {
+    std::cout << "  the Newton systems' p-multigrid, summed over them:\n";
+    print_matrix_free_profile(r.matrix_free);
+  }
   if (r.completed) {
     std::cout << "  load factor reached 1 (the full load)\n";
   } else {
@@ -535,7 +541,8 @@ void run_finite_strain(const FemCommandOptions& o, const Scene& scene,
   std::cout << std::fixed << std::setprecision(3) << "timings (s): mesh " << run.mesh_seconds
             << ", setup " << r.timings.setup << ", assembly " << r.timings.assembly << ", solve "
             << r.timings.solve << ", postprocess " << r.timings.postprocess << std::defaultfloat
-            << "\n";  if (!o.vtu.empty()) {  // the displacement at the load factor reached, as the linear --vtu
+            << "\n";
+  if (!o.vtu.empty()) {  // the displacement at the load factor reached, as the linear --vtu
     VtuField disp{"displacement", 3, {}};
     for (const Vec3& u : r.nodal_displacement) disp.values.insert(disp.values.end(), {u.x(), u.y(), u.z()});
     write_vtu(o.vtu, mesh, {disp});
@@ -671,7 +678,9 @@ void add_solver_options(CLI::App* cmd, FemCommandOptions& o) {
                   "block-triangular preconditioner: AMG on the displacement block, scaled "
                   "pressure mass for the Schur complement; mixed system), matrix-free (CG on "
                   "the matrix-free operator: for P2 a P2->P1 p-multigrid with ML-CG on P1, for "
-                  "P1 ML; displacement system)")
+                  "P1 ML; displacement system; with --reference finite-strain the Newton "
+                  "systems on the matrix-free neo-Hookean tangent, FGMRES with follower "
+                  "pressure; auto never takes it there)")
       ->check(CLI::IsMember({"auto", "direct", "cg-amg", "gmres-block", "matrix-free"}))
       ->capture_default_str();
   cmd->add_option("--direct-max-dofs", o.direct_max_dofs,
