@@ -481,16 +481,21 @@ void ElasticityOperator::store_state(unsigned cell, double* lane) const {
   for (unsigned k = 0; k < n_q * kPer; ++k) lane[k * kLanes] = v[k];
 }
 
-void ElasticityOperator::build_batches() {
-  if (!plain_indexable(mf_.get_dof_handler(), constraints_)) return;
+std::vector<unsigned> ElasticityOperator::component_major_system_index() const {
   const auto& fe = mf_.get_dof_handler().get_fe();
-  const unsigned per_cell = kDim * n_shapes_;
-  std::vector<unsigned> system_index(per_cell);  // component-major k = c·N + i → cell DoF
+  std::vector<unsigned> system_index(kDim * n_shapes_);
   for (unsigned c = 0; c < kDim; ++c) {
     for (unsigned i = 0; i < n_shapes_; ++i) {
       system_index[c * n_shapes_ + i] = fe.component_to_system_index(c, i);
     }
   }
+  return system_index;
+}
+
+void ElasticityOperator::build_batches() {
+  if (!plain_indexable(mf_.get_dof_handler(), constraints_)) return;
+  const unsigned per_cell = kDim * n_shapes_;
+  const std::vector<unsigned> system_index = component_major_system_index();
   const unsigned n_cells = mf_.n_cell_batches();  // one cell each: no SIMD in this deal.II
   const unsigned n_batches = (n_cells + kLanes - 1) / kLanes;
   batch_dofs_.assign(std::size_t{n_batches} * per_cell * kLanes, kNoDof);
@@ -555,6 +560,19 @@ void ElasticityOperator::partition_batches(unsigned threads) {
   }
 }
 
+void ElasticityOperator::apply_kernel(std::size_t b, const double* in, double* out,
+                                      const double* weights) const {
+  const double* geometry = batch_geometry_.data() + b * kGeometry * kLanes;
+  if (tangent_kernel_ != nullptr) {
+    const std::size_t per_state =
+        std::size_t{n_quadrature_points_} * NeoHookeanTangentState::kPerPoint * kLanes;
+    tangent_kernel_(in, out, geometry, batch_state_.data() + b * per_state, ref_grad_.data(),
+                    weights, n_quadrature_points_, lambda_, mu_);
+  } else {
+    kernel_(in, out, geometry, ref_grad_.data(), weights, lambda_, mu_);
+  }
+}
+
 void ElasticityOperator::apply_batch_range(std::size_t first, std::size_t end, const MfVector& src,
                                            double* out, unsigned offset) const {
   const unsigned per_batch = kDim * n_shapes_ * kLanes;
@@ -565,15 +583,7 @@ void ElasticityOperator::apply_batch_range(std::size_t first, std::size_t end, c
     for (unsigned j = 0; j < per_batch; ++j) {
       in[j] = idx[j] == kNoDof ? 0.0 : src.local_element(idx[j]);
     }
-    const double* geometry = batch_geometry_.data() + b * kGeometry * kLanes;
-    if (tangent_kernel_ != nullptr) {
-      const std::size_t per_state =
-          std::size_t{n_quadrature_points_} * NeoHookeanTangentState::kPerPoint * kLanes;
-      tangent_kernel_(in.data(), a.data(), geometry, batch_state_.data() + b * per_state,
-                      ref_grad_.data(), w, n_quadrature_points_, lambda_, mu_);
-    } else {
-      kernel_(in.data(), a.data(), geometry, ref_grad_.data(), w, lambda_, mu_);
-    }
+    apply_kernel(b, in.data(), a.data(), w);
     for (unsigned j = 0; j < per_batch; ++j) {
       if (idx[j] != kNoDof) out[idx[j] - offset] += a[j];
     }
@@ -764,8 +774,36 @@ void ElasticityOperator::compute_matrix(dl::TrilinosWrappers::SparseMatrix& matr
   dl::DynamicSparsityPattern dsp(dof.n_dofs(), dof.n_dofs());
   dl::DoFTools::make_sparsity_pattern(dof, dsp, constraints_, false);
   matrix.reinit(dsp);
-  const std::function<void(Evaluation&)> kernel = [this](Evaluation& phi) { apply_cell(phi); };
-  dl::MatrixFreeTools::compute_matrix(mf_, constraints_, matrix, kernel);
+  if (batch_dofs_.empty()) {
+    const std::function<void(Evaluation&)> kernel = [this](Evaluation& phi) { apply_cell(phi); };
+    dl::MatrixFreeTools::compute_matrix(mf_, constraints_, matrix, kernel);
+    return;
+  }
+  // The batches' element matrices, a column per kernel call for all kLanes cells at once: the
+  // kernel on the k-th unit vector gives column k of each cell's matrix.
+  const unsigned per_cell = kDim * n_shapes_;
+  const std::vector<unsigned> system_index = component_major_system_index();
+  const unsigned n_cells = mf_.n_cell_batches();  // one cell each: no SIMD in this deal.II
+  const std::size_t n_batches = batch_geometry_.size() / (kGeometry * kLanes);
+  std::array<double, kDim * 10 * kLanes> in{}, out{};
+  std::vector<dl::FullMatrix<double>> cell_matrix(kLanes, dl::FullMatrix<double>(per_cell));
+  std::vector<dl::types::global_dof_index> idx(per_cell), local(per_cell);
+  for (std::size_t b = 0; b < n_batches; ++b) {
+    for (unsigned k = 0; k < per_cell; ++k) {
+      std::fill(in.begin(), in.end(), 0.0);
+      std::fill(in.begin() + k * kLanes, in.begin() + (k + 1) * kLanes, 1.0);
+      apply_kernel(b, in.data(), out.data(), quadrature_.get_weights().data());
+      for (unsigned l = 0; l < kLanes; ++l) {
+        for (unsigned j = 0; j < per_cell; ++j) cell_matrix[l](j, k) = out[j * kLanes + l];
+      }
+    }
+    for (unsigned l = 0; l < kLanes && b * kLanes + l < n_cells; ++l) {
+      mf_.get_cell_iterator(static_cast<unsigned>(b * kLanes + l), 0)->get_dof_indices(idx);
+      for (unsigned k = 0; k < per_cell; ++k) local[k] = idx[system_index[k]];
+      constraints_.distribute_local_to_global(cell_matrix[l], local, matrix);
+    }
+  }
+  matrix.compress(dl::VectorOperation::add);
 }
 
 void ElasticityOperator::zero_constrained(MfVector& v) const {

@@ -106,7 +106,8 @@ class ElasticityOperator : public dl::Subscriptor {
   /// evaluation per cell DoF (30 for P2); with other constraints compute_diagonal.
   [[nodiscard]] MfVector diagonal() const;
   /// The assembled A (the constrained rows and columns zero but for a positive diagonal), into
-  /// `matrix` on `dof`'s full sparsity pattern; MatrixFreeTools::compute_matrix.
+  /// `matrix` on `dof`'s full sparsity pattern: from the batched kernel, kLanes cells per call,
+  /// where it runs; otherwise MatrixFreeTools::compute_matrix.
   void compute_matrix(dl::TrilinosWrappers::SparseMatrix& matrix) const;
   /// Sets v to 0 on the constrained DoFs.
   void zero_constrained(MfVector& v) const;
@@ -149,6 +150,10 @@ class ElasticityOperator : public dl::Subscriptor {
   /// phi's J⁻ᵀ and |det J| into one lane of a batch's geometry.
   template <typename Evaluation>
   static void store_geometry(const Evaluation& phi, double* lane);
+  /// Per component-major local DoF k = c·N + i (the batches' order), the cell's DoF index.
+  [[nodiscard]] std::vector<unsigned> component_major_system_index() const;
+  /// out = the batch b's cells' A_e in (kernel_ or tangent_kernel_), the batches' layout.
+  void apply_kernel(std::size_t b, const double* in, double* out, const double* weights) const;
   /// The batches cut into `threads` contiguous parts and the DoF range each writes.
   void partition_batches(unsigned threads);
   /// dst = A src (free rows; constrained rows zero) by kernel_ on the batches, one thread per
