@@ -513,13 +513,17 @@ void ElasticityOperator::build_batches() {
     phi.reinit(cell);
     store_geometry(phi, batch_geometry_.data() + std::size_t{b} * kGeometry * kLanes + l);
   }
-  if (tangent_ == nullptr) return;
-  const std::size_t per_batch =
-      std::size_t{tangent_->n_q()} * NeoHookeanTangentState::kPerPoint * kLanes;
-  batch_state_.assign(n_batches * per_batch, 0.0);
-  for (unsigned cell = 0; cell < n_cells; ++cell) {
-    store_state(mf_.get_cell_iterator(cell, 0)->active_cell_index(),
-                batch_state_.data() + cell / kLanes * per_batch + cell % kLanes);
+}
+
+std::size_t ElasticityOperator::state_per_batch() const {
+  return std::size_t{n_quadrature_points_} * NeoHookeanTangentState::kPerPoint * kLanes;
+}
+
+void ElasticityOperator::store_batch_state(std::size_t b, double* state) const {
+  const unsigned n_cells = mf_.n_cell_batches();  // one cell each
+  for (unsigned l = 0; l < kLanes && b * kLanes + l < n_cells; ++l) {
+    const auto cell = static_cast<unsigned>(b * kLanes + l);
+    store_state(mf_.get_cell_iterator(cell, 0)->active_cell_index(), state + l);
   }
 }
 
@@ -561,13 +565,12 @@ void ElasticityOperator::partition_batches(unsigned threads) {
 }
 
 void ElasticityOperator::apply_kernel(std::size_t b, const double* in, double* out,
-                                      const double* weights) const {
+                                      const double* weights, const double* state) const {
   const double* geometry = batch_geometry_.data() + b * kGeometry * kLanes;
   if (tangent_kernel_ != nullptr) {
-    const std::size_t per_state =
-        std::size_t{n_quadrature_points_} * NeoHookeanTangentState::kPerPoint * kLanes;
-    tangent_kernel_(in, out, geometry, batch_state_.data() + b * per_state, ref_grad_.data(),
-                    weights, n_quadrature_points_, lambda_, mu_);
+    if (state == nullptr) state = batch_state_.data() + b * state_per_batch();
+    tangent_kernel_(in, out, geometry, state, ref_grad_.data(), weights, n_quadrature_points_,
+                    lambda_, mu_);
   } else {
     kernel_(in, out, geometry, ref_grad_.data(), weights, lambda_, mu_);
   }
@@ -591,6 +594,13 @@ void ElasticityOperator::apply_batch_range(std::size_t first, std::size_t end, c
 }
 
 void ElasticityOperator::apply_batches(MfVector& dst, const MfVector& src) const {
+  if (tangent_kernel_ != nullptr && batch_state_.empty()) {
+    const std::size_t n_batches = batch_geometry_.size() / (kGeometry * kLanes);
+    batch_state_.assign(n_batches * state_per_batch(), 0.0);
+    for (std::size_t b = 0; b < n_batches; ++b) {
+      store_batch_state(b, batch_state_.data() + b * state_per_batch());
+    }
+  }
   dst = 0.0;
   std::vector<std::thread> others;
   for (std::size_t p = 1; p < parts_.size(); ++p) {
@@ -788,11 +798,16 @@ void ElasticityOperator::compute_matrix(dl::TrilinosWrappers::SparseMatrix& matr
   std::array<double, kDim * 10 * kLanes> in{}, out{};
   std::vector<dl::FullMatrix<double>> cell_matrix(kLanes, dl::FullMatrix<double>(per_cell));
   std::vector<dl::types::global_dof_index> idx(per_cell), local(per_cell);
+  // The tangent's values per batch as they are needed: the P1 level never applies its operator,
+  // so it never holds them all.
+  std::vector<double> state(tangent_kernel_ != nullptr ? state_per_batch() : 0);
   for (std::size_t b = 0; b < n_batches; ++b) {
+    if (!state.empty()) store_batch_state(b, state.data());
     for (unsigned k = 0; k < per_cell; ++k) {
       std::fill(in.begin(), in.end(), 0.0);
       std::fill(in.begin() + k * kLanes, in.begin() + (k + 1) * kLanes, 1.0);
-      apply_kernel(b, in.data(), out.data(), quadrature_.get_weights().data());
+      apply_kernel(b, in.data(), out.data(), quadrature_.get_weights().data(),
+                   state.empty() ? nullptr : state.data());
       for (unsigned l = 0; l < kLanes; ++l) {
         for (unsigned j = 0; j < per_cell; ++j) cell_matrix[l](j, k) = out[j * kLanes + l];
       }

@@ -152,8 +152,13 @@ class ElasticityOperator : public dl::Subscriptor {
   static void store_geometry(const Evaluation& phi, double* lane);
   /// Per component-major local DoF k = c·N + i (the batches' order), the cell's DoF index.
   [[nodiscard]] std::vector<unsigned> component_major_system_index() const;
-  /// out = the batch b's cells' A_e in (kernel_ or tangent_kernel_), the batches' layout.
-  void apply_kernel(std::size_t b, const double* in, double* out, const double* weights) const;
+  /// out = the batch b's cells' A_e in (kernel_ or tangent_kernel_ on `state`, by default the
+  /// batch's in batch_state_), the batches' layout.
+  void apply_kernel(std::size_t b, const double* in, double* out, const double* weights,
+                    const double* state = nullptr) const;
+  /// Doubles of one batch's tangent values, and batch b's lanes' values into `state`.
+  [[nodiscard]] std::size_t state_per_batch() const;
+  void store_batch_state(std::size_t b, double* state) const;
   /// The batches cut into `threads` contiguous parts and the DoF range each writes.
   void partition_batches(unsigned threads);
   /// dst = A src (free rows; constrained rows zero) by kernel_ on the batches, one thread per
@@ -187,8 +192,8 @@ class ElasticityOperator : public dl::Subscriptor {
   std::vector<unsigned> batch_dofs_;
   std::vector<double> batch_geometry_;
   /// straight_, tangent_ and batchable: the batches' tangent_ values
-  /// [((b·n_q + q)·kPerPoint + j)·lanes + l].
-  std::vector<double> batch_state_;
+  /// [((b·n_q + q)·kPerPoint + j)·lanes + l], gathered at the first application.
+  mutable std::vector<double> batch_state_;
   const dl::AffineConstraints<double>& constraints_;
   double lambda_, mu_;
   const NeoHookeanTangentState* tangent_ = nullptr;
