@@ -1,14 +1,19 @@
 /// The serial solver's mixed (Taylor–Hood) system by FGMRES with the block-triangular
-/// preconditioner of detail/block_preconditioner.hpp: AMG on the displacement block, a scaled
-/// pressure mass matrix for the Schur complement.
+/// preconditioner of detail/block_preconditioner.hpp: on the displacement block the matrix-free
+/// p-multigrid's V-cycle (straight-sided tets) or AMG (curved walls), a scaled pressure mass
+/// matrix for the Schur complement.
+#include <deal.II/fe/fe_simplex_p.h>
+#include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/solver_gmres.h>
 
 #include <cmath>
+#include <memory>
 #include <sstream>
 
 #include "fem_reference/detail/block_preconditioner.hpp"
+#include "fem_reference/detail/matrix_free_elasticity.hpp"
 #include "fem_reference/detail/serial_solver.hpp"
 
 namespace vessel::fem {
@@ -40,6 +45,29 @@ BlockSplit split_blocks(const std::vector<unsigned>& component) {
     }
   }
   return s;
+}
+
+/// Per displacement DoF of the mixed system (u_dofs' order), its DoF in `p2`: the P2 vector
+/// element alone on the same triangulation.
+std::vector<Index> displacement_in_p2(const dl::DoFHandler<kDim>& mixed,
+                                      const dl::DoFHandler<kDim>& p2, const BlockSplit& blocks) {
+  const auto& fe = mixed.get_fe();
+  const auto& fe2 = p2.get_fe();
+  std::vector<Index> out(blocks.u_dofs.size()), dofs(fe.n_dofs_per_cell()),
+      dofs2(fe2.n_dofs_per_cell());
+  for (const auto& cell : mixed.active_cell_iterators()) {
+    const dl::DoFHandler<kDim>::active_cell_iterator cell2(&p2.get_triangulation(), cell->level(),
+                                                           cell->index(), &p2);
+    cell->get_dof_indices(dofs);
+    cell2->get_dof_indices(dofs2);
+    for (unsigned i = 0; i < dofs.size(); ++i) {
+      const auto [base, shape] = fe.system_to_base_index(i);
+      if (base.first != 0) continue;  // the pressure
+      out[static_cast<std::size_t>(blocks.u_local[dofs[i]])] =
+          dofs2[fe2.component_to_system_index(base.second, shape)];
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -91,18 +119,55 @@ void ElasticitySolver::Impl::solve_mixed_iterative() {
   const Index n = dof.n_dofs();
   const BlockSplit blocks = split_blocks(dof_components());
 
-  // Displacement block A = ∫ 2μ ε:ε (with the constrained rows' diagonal) and its AMG.
+  // Displacement block A = ∫ 2μ ε:ε (with the constrained rows' diagonal).
   dl::SparsityPattern a_pattern;
   dl::SparseMatrix<double> a_block;
   detail::extract_block(matrix, blocks.u_dofs, blocks.u_local, a_pattern, a_block);
   detail::ensure_mpi_initialized();  // before any Trilinos object is made
+  // Â⁻¹: on straight-sided tets one V-cycle of the matrix-free p-multigrid on the same form
+  // (the displacement operator with λ = 0) on the P2 element alone, its constrained rows by
+  // A's diagonal; on curved walls (where its kernel does not run) one smoothed-aggregation AMG
+  // V-cycle on A.
   dl::TrilinosWrappers::SparseMatrix a_trilinos;
-  a_trilinos.reinit(a_block);
   dl::TrilinosWrappers::PreconditionAMG amg;
   std::vector<double> modes_storage;
-  detail::initialize_elasticity_amg(amg, a_trilinos, displacement_rows(blocks.u_dofs),
-                                    detail::node_centroid(mesh), true, o.amg_rigid_body_modes,
-                                    detail::AmgProlongator::smoothed, modes_storage);
+  dl::DoFHandler<kDim> p2(tria);
+  std::unique_ptr<detail::MatrixFreeElasticitySolver> multigrid;
+  std::vector<Index> to_p2;
+  std::vector<double> constrained_diagonal;  // per displacement DoF: A_ii if constrained, else 0
+  detail::BlockTriangularPreconditioner::DisplacementInverse a_inverse;
+  if (problem.curved_surfaces.empty()) {
+    p2.distribute_dofs(dl::FESystem<kDim>(dl::FE_SimplexP<kDim>(2), kDim));
+    to_p2 = displacement_in_p2(dof, p2, blocks);
+    constrained_diagonal.assign(blocks.u_dofs.size(), 0.0);
+    for (Index i = 0; i < blocks.u_dofs.size(); ++i) {
+      if (constraints.is_constrained(blocks.u_dofs[i])) {
+        constrained_diagonal[i] = a_block.diag_element(i);
+      }
+    }
+    detail::PMultigridSettings settings;
+    settings.direct_coarse_max_dofs = o.matrix_free_direct_coarse_max_dofs;
+    multigrid = std::make_unique<detail::MatrixFreeElasticitySolver>(
+        *mapping, p2,
+        [this](const dl::DoFHandler<kDim>& d, dl::AffineConstraints<double>& c) {
+          support_constraints(d, c);
+        },
+        2, 0.0, form->mu(), detail::node_centroid(mesh), settings);
+    a_inverse = [&, r2 = dl::Vector<double>(p2.n_dofs()), x2 = dl::Vector<double>(p2.n_dofs())](
+                    dl::Vector<double>& x, const dl::Vector<double>& r) mutable {
+      for (Index i = 0; i < to_p2.size(); ++i) r2(to_p2[i]) = r(i);
+      multigrid->precondition(x2, r2);
+      for (Index i = 0; i < to_p2.size(); ++i) {
+        x(i) = constrained_diagonal[i] != 0.0 ? r(i) / constrained_diagonal[i] : x2(to_p2[i]);
+      }
+    };
+  } else {
+    a_trilinos.reinit(a_block);
+    detail::initialize_elasticity_amg(amg, a_trilinos, displacement_rows(blocks.u_dofs),
+                                      detail::node_centroid(mesh), true, o.amg_rigid_body_modes,
+                                      detail::AmgProlongator::smoothed, modes_storage);
+    a_inverse = [&amg](dl::Vector<double>& x, const dl::Vector<double>& r) { amg.vmult(x, r); };
+  }
 
   dl::SparsityPattern p_pattern;
   dl::SparseMatrix<double> schur;
@@ -118,8 +183,8 @@ void ElasticitySolver::Impl::solve_mixed_iterative() {
   a_block.clear();
 
   const detail::ScaledMixedOperator op(matrix, blocks.is_pressure, omega);
-  const detail::BlockTriangularPreconditioner prec(op, amg, schur, blocks.u_dofs, blocks.p_dofs,
-                                                   omega);
+  const detail::BlockTriangularPreconditioner prec(op, a_inverse, schur, blocks.u_dofs,
+                                                   blocks.p_dofs, omega);
   dl::Vector<double> b = rhs;
   op.scale(b);
   dl::Vector<double> y(n);

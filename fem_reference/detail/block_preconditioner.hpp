@@ -8,6 +8,7 @@
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/vector.h>
 
+#include <functional>
 #include <vector>
 
 #include "fem_reference/detail/common.hpp"
@@ -47,17 +48,25 @@ class ScaledMixedOperator {
 };
 
 /// Block upper-triangular preconditioner P = [Â  ωBᵀ; 0  −ω²Ŝ] for the scaled Taylor–Hood
-/// system [A  ωBᵀ; ωB  −ω²C] (step-22 / step-56 pattern): Â⁻¹ one AMG V-cycle on the
-/// displacement block, Ŝ⁻¹ a Jacobi-CG solve with Ŝ = (1/(2μ) + 1/λ) M_p. Inexact inner solves
-/// make P vary between applications: used with FGMRES.
+/// system [A  ωBᵀ; ωB  −ω²C] (step-22 / step-56 pattern): Â⁻¹ one V-cycle on the displacement
+/// block (the matrix-free p-multigrid's or AMG's), Ŝ⁻¹ a Jacobi-CG solve with
+/// Ŝ = (1/(2μ) + 1/λ) M_p. Inexact inner solves make P vary between applications: used with
+/// FGMRES.
 class BlockTriangularPreconditioner {
  public:
-  BlockTriangularPreconditioner(const ScaledMixedOperator& op,
-                                const dl::TrilinosWrappers::PreconditionAMG& amg,
+  /// x = Â⁻¹ r on the displacement block's numbering (u_dofs' order).
+  using DisplacementInverse =
+      std::function<void(dl::Vector<double>& x, const dl::Vector<double>& r)>;
+  BlockTriangularPreconditioner(const ScaledMixedOperator& op, DisplacementInverse a_inverse,
                                 const dl::SparseMatrix<double>& schur,
-                                const std::vector<Index>& u_dofs,
-                                const std::vector<Index>& p_dofs, double omega)
-      : op_(op), amg_(amg), schur_(schur), u_dofs_(u_dofs), p_dofs_(p_dofs), omega_(omega) {
+                                const std::vector<Index>& u_dofs, const std::vector<Index>& p_dofs,
+                                double omega)
+      : op_(op),
+        a_inverse_(std::move(a_inverse)),
+        schur_(schur),
+        u_dofs_(u_dofs),
+        p_dofs_(p_dofs),
+        omega_(omega) {
     jacobi_.initialize(schur_);
     ru_.reinit(static_cast<Index>(u_dofs.size()));
     xu_.reinit(static_cast<Index>(u_dofs.size()));
@@ -81,7 +90,7 @@ class BlockTriangularPreconditioner {
     product_.reinit(src.size());
     op_.vmult(product_, full_);
     for (Index i = 0; i < u_dofs_.size(); ++i) ru_(i) = src(u_dofs_[i]) - product_(u_dofs_[i]);
-    amg_.vmult(xu_, ru_);
+    a_inverse_(xu_, ru_);
     for (Index i = 0; i < u_dofs_.size(); ++i) dst(u_dofs_[i]) = xu_(i);
     for (Index i = 0; i < p_dofs_.size(); ++i) dst(p_dofs_[i]) = xp_(i);
     ++applications_;
@@ -93,7 +102,7 @@ class BlockTriangularPreconditioner {
 
  private:
   const ScaledMixedOperator& op_;
-  const dl::TrilinosWrappers::PreconditionAMG& amg_;
+  DisplacementInverse a_inverse_;
   const dl::SparseMatrix<double>& schur_;
   const std::vector<Index>& u_dofs_;
   const std::vector<Index>& p_dofs_;

@@ -1110,6 +1110,17 @@ MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::solve(
   return {control.last_step(), control.last_value()};
 }
 
+void MatrixFreeElasticitySolver::precondition(dl::Vector<double>& x,
+                                              const dl::Vector<double>& r) const {
+  MfVector rhs, y;
+  fine_->initialize_dof_vector(rhs);
+  fine_->initialize_dof_vector(y);
+  copy(r, rhs);
+  fine_->zero_constrained(rhs);
+  preconditioner_->vmult(y, rhs);
+  copy(y, x);
+}
+
 MatrixFreeProfile MatrixFreeElasticitySolver::profile() const {
   MatrixFreeProfile p = profile_;
   p.operator_applications = fine_->applications() - preconditioner_->eigenvalue_applications();

@@ -305,6 +305,10 @@ class MatrixFreeElasticitySolver {
   Outcome solve(const dl::Vector<double>& b, dl::Vector<double>& u, double relative_tolerance,
                 unsigned max_iterations, const AddedMatrix* added = nullptr) const;
 
+  /// x = one V-cycle of the preconditioner applied to r (zero on the constrained DoFs): an
+  /// approximate A⁻¹ for a block preconditioner (the Taylor–Hood system's displacement block).
+  void precondition(dl::Vector<double>& x, const dl::Vector<double>& r) const;
+
   [[nodiscard]] const ElasticityOperator& fine_operator() const { return *fine_; }
   /// Wall-clock seconds the constructor took (operators, transfer, diagonal, coarse solver).
   [[nodiscard]] double setup_seconds() const { return setup_seconds_; }
