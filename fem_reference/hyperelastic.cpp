@@ -117,6 +117,7 @@ struct HyperelasticSolver::Impl {
       : linear(mesh, std::move(problem)), d(*linear.impl_), opt(o) {
     material = NeoHookean::of(d.problem.material);
     mixed = d.mixed;
+    d.tangent_systems = true;
     // Only where requested: a Newton iterate's tangent can be indefinite (a compressed or
     // buckling wall), where CG fails and the step is halved; the direct path falls back to LU.
     matrix_free = d.problem.options.solver == LinearSolver::matrix_free;

@@ -126,8 +126,8 @@ void ElasticitySolver::Impl::solve_mixed_iterative() {
   detail::ensure_mpi_initialized();  // before any Trilinos object is made
   // Â⁻¹: on straight-sided tets one V-cycle of the matrix-free p-multigrid on the same form
   // (the displacement operator with λ = 0) on the P2 element alone, its constrained rows by
-  // A's diagonal; on curved walls (where its kernel does not run) one smoothed-aggregation AMG
-  // V-cycle on A.
+  // A's diagonal; on curved walls (where its kernel does not run) and for a finite-strain
+  // tangent (whose block is not that form) one smoothed-aggregation AMG V-cycle on A.
   dl::TrilinosWrappers::SparseMatrix a_trilinos;
   dl::TrilinosWrappers::PreconditionAMG amg;
   std::vector<double> modes_storage;
@@ -136,7 +136,7 @@ void ElasticitySolver::Impl::solve_mixed_iterative() {
   std::vector<Index> to_p2;
   std::vector<double> constrained_diagonal;  // per displacement DoF: A_ii if constrained, else 0
   detail::BlockTriangularPreconditioner::DisplacementInverse a_inverse;
-  if (problem.curved_surfaces.empty()) {
+  if (problem.curved_surfaces.empty() && !tangent_systems) {
     p2.distribute_dofs(dl::FESystem<kDim>(dl::FE_SimplexP<kDim>(2), kDim));
     to_p2 = displacement_in_p2(dof, p2, blocks);
     constrained_diagonal.assign(blocks.u_dofs.size(), 0.0);

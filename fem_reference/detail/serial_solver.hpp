@@ -78,6 +78,9 @@ struct ElasticitySolver::Impl {
   std::unique_ptr<detail::TetLocator> locator;
   ElasticityResult result;
   bool solved = false;
+  /// The matrix holds a finite-strain tangent (HyperelasticSolver), whose displacement block is
+  /// not the linear 2μ ε:ε: the mixed block preconditioner then takes AMG on the block itself.
+  bool tangent_systems = false;
 
   Impl(const TetMesh& m, ElasticityProblem p) : mesh(m), problem(std::move(p)) {}
 
