@@ -70,6 +70,68 @@ std::vector<Index> displacement_in_p2(const dl::DoFHandler<kDim>& mixed,
   return out;
 }
 
+/// Â⁻¹ of the block preconditioner and what it holds. On straight-sided tets one V-cycle of the
+/// matrix-free p-multigrid on the same form (the displacement operator with λ = 0) on the P2
+/// element alone, its constrained rows by A's diagonal; on curved walls (where its kernel does
+/// not run) and for a finite-strain tangent (whose block is not that form) one
+/// smoothed-aggregation AMG V-cycle on A itself.
+struct DisplacementBlockInverse {
+  detail::BlockTriangularPreconditioner::DisplacementInverse apply;
+  dl::TrilinosWrappers::SparseMatrix a_trilinos;
+  std::vector<double> modes_storage;  // must outlive amg (declared after: destroyed first)
+  dl::TrilinosWrappers::PreconditionAMG amg;
+  std::unique_ptr<dl::DoFHandler<kDim>> p2;
+  std::unique_ptr<detail::MatrixFreeElasticitySolver> multigrid;
+  std::vector<Index> to_p2;                  // per displacement DoF its P2 DoF
+  std::vector<double> constrained_diagonal;  // per displacement DoF: A_ii if constrained, else 0
+};
+
+/// Fills `out` (which `apply` refers to: it must stay where it is) for ElasticitySolver's `im`
+/// (private: deduced) and the displacement block `a` of its mixed matrix.
+template <typename Impl>
+void make_displacement_block_inverse(const Impl& im, const BlockSplit& blocks,
+                                     const dl::SparseMatrix<double>& a,
+                                     DisplacementBlockInverse& out) {
+  const auto& o = im.problem.options;
+  if (!im.problem.curved_surfaces.empty() || im.tangent_systems) {
+    out.a_trilinos.reinit(a);
+    detail::initialize_elasticity_amg(out.amg, out.a_trilinos, im.displacement_rows(blocks.u_dofs),
+                                      detail::node_centroid(im.mesh), true, o.amg_rigid_body_modes,
+                                      detail::AmgProlongator::smoothed, out.modes_storage);
+    out.apply = [&amg = out.amg](dl::Vector<double>& x, const dl::Vector<double>& r) {
+      amg.vmult(x, r);
+    };
+    return;
+  }
+  out.p2 = std::make_unique<dl::DoFHandler<kDim>>(im.tria);
+  out.p2->distribute_dofs(dl::FESystem<kDim>(dl::FE_SimplexP<kDim>(2), kDim));
+  out.to_p2 = displacement_in_p2(im.dof, *out.p2, blocks);
+  out.constrained_diagonal.assign(blocks.u_dofs.size(), 0.0);
+  for (Index i = 0; i < blocks.u_dofs.size(); ++i) {
+    if (im.constraints.is_constrained(blocks.u_dofs[i])) {
+      out.constrained_diagonal[i] = a.diag_element(i);
+    }
+  }
+  detail::PMultigridSettings settings;
+  settings.direct_coarse_max_dofs = o.matrix_free_direct_coarse_max_dofs;
+  out.multigrid = std::make_unique<detail::MatrixFreeElasticitySolver>(
+      *im.mapping, *out.p2,
+      [&im](const dl::DoFHandler<kDim>& d, dl::AffineConstraints<double>& c) {
+        im.support_constraints(d, c);
+      },
+      2, 0.0, im.form->mu(), detail::node_centroid(im.mesh), settings);
+  const auto n2 = out.p2->n_dofs();
+  out.apply = [&out, r2 = dl::Vector<double>(n2), x2 = dl::Vector<double>(n2)](
+                  dl::Vector<double>& x, const dl::Vector<double>& r) mutable {
+    for (Index i = 0; i < out.to_p2.size(); ++i) r2(out.to_p2[i]) = r(i);
+    out.multigrid->precondition(x2, r2);
+    for (Index i = 0; i < out.to_p2.size(); ++i) {
+      const double d = out.constrained_diagonal[i];
+      x(i) = d != 0.0 ? r(i) / d : x2(out.to_p2[i]);
+    }
+  };
+}
+
 }  // namespace
 
 /// Ŝ = (1/(2μ) + 1/λ) M_p on the pressure DoFs. Schur complement S = C + B A⁻¹ Bᵀ of
@@ -124,50 +186,8 @@ void ElasticitySolver::Impl::solve_mixed_iterative() {
   dl::SparseMatrix<double> a_block;
   detail::extract_block(matrix, blocks.u_dofs, blocks.u_local, a_pattern, a_block);
   detail::ensure_mpi_initialized();  // before any Trilinos object is made
-  // Â⁻¹: on straight-sided tets one V-cycle of the matrix-free p-multigrid on the same form
-  // (the displacement operator with λ = 0) on the P2 element alone, its constrained rows by
-  // A's diagonal; on curved walls (where its kernel does not run) and for a finite-strain
-  // tangent (whose block is not that form) one smoothed-aggregation AMG V-cycle on A.
-  dl::TrilinosWrappers::SparseMatrix a_trilinos;
-  dl::TrilinosWrappers::PreconditionAMG amg;
-  std::vector<double> modes_storage;
-  dl::DoFHandler<kDim> p2(tria);
-  std::unique_ptr<detail::MatrixFreeElasticitySolver> multigrid;
-  std::vector<Index> to_p2;
-  std::vector<double> constrained_diagonal;  // per displacement DoF: A_ii if constrained, else 0
-  detail::BlockTriangularPreconditioner::DisplacementInverse a_inverse;
-  if (problem.curved_surfaces.empty() && !tangent_systems) {
-    p2.distribute_dofs(dl::FESystem<kDim>(dl::FE_SimplexP<kDim>(2), kDim));
-    to_p2 = displacement_in_p2(dof, p2, blocks);
-    constrained_diagonal.assign(blocks.u_dofs.size(), 0.0);
-    for (Index i = 0; i < blocks.u_dofs.size(); ++i) {
-      if (constraints.is_constrained(blocks.u_dofs[i])) {
-        constrained_diagonal[i] = a_block.diag_element(i);
-      }
-    }
-    detail::PMultigridSettings settings;
-    settings.direct_coarse_max_dofs = o.matrix_free_direct_coarse_max_dofs;
-    multigrid = std::make_unique<detail::MatrixFreeElasticitySolver>(
-        *mapping, p2,
-        [this](const dl::DoFHandler<kDim>& d, dl::AffineConstraints<double>& c) {
-          support_constraints(d, c);
-        },
-        2, 0.0, form->mu(), detail::node_centroid(mesh), settings);
-    a_inverse = [&, r2 = dl::Vector<double>(p2.n_dofs()), x2 = dl::Vector<double>(p2.n_dofs())](
-                    dl::Vector<double>& x, const dl::Vector<double>& r) mutable {
-      for (Index i = 0; i < to_p2.size(); ++i) r2(to_p2[i]) = r(i);
-      multigrid->precondition(x2, r2);
-      for (Index i = 0; i < to_p2.size(); ++i) {
-        x(i) = constrained_diagonal[i] != 0.0 ? r(i) / constrained_diagonal[i] : x2(to_p2[i]);
-      }
-    };
-  } else {
-    a_trilinos.reinit(a_block);
-    detail::initialize_elasticity_amg(amg, a_trilinos, displacement_rows(blocks.u_dofs),
-                                      detail::node_centroid(mesh), true, o.amg_rigid_body_modes,
-                                      detail::AmgProlongator::smoothed, modes_storage);
-    a_inverse = [&amg](dl::Vector<double>& x, const dl::Vector<double>& r) { amg.vmult(x, r); };
-  }
+  DisplacementBlockInverse a_inverse;
+  make_displacement_block_inverse(*this, blocks, a_block, a_inverse);
 
   dl::SparsityPattern p_pattern;
   dl::SparseMatrix<double> schur;
@@ -183,7 +203,7 @@ void ElasticitySolver::Impl::solve_mixed_iterative() {
   a_block.clear();
 
   const detail::ScaledMixedOperator op(matrix, blocks.is_pressure, omega);
-  const detail::BlockTriangularPreconditioner prec(op, a_inverse, schur, blocks.u_dofs,
+  const detail::BlockTriangularPreconditioner prec(op, a_inverse.apply, schur, blocks.u_dofs,
                                                    blocks.p_dofs, omega);
   dl::Vector<double> b = rhs;
   op.scale(b);
