@@ -1,10 +1,11 @@
 #pragma once
-/// Private to fem_reference: the displacement stiffness of small-strain isotropic elasticity
-/// applied without a matrix (deal.II MatrixFree + FEEvaluation on FE_SimplexP P1/P2 tets), and the
-/// solver built on it: CG preconditioned by a two-level p-multigrid, P2 smoothed by Chebyshev on
-/// the operator's diagonal, the P1 level (same mesh) solved on the P1 matrix (computed cell by cell
-/// from the same kernel) by ML-CG, a CHOLMOD factor or one ML V-cycle. What deal.II 9.4 supports on
-/// simplices: docs/measurements/dealii_simplex_support.md.
+/// Private to fem_reference: the displacement stiffness of small-strain isotropic elasticity, or
+/// the compressible neo-Hookean tangent at a displacement, applied without a matrix (deal.II
+/// MatrixFree + FEEvaluation on FE_SimplexP P1/P2 tets, the project's own batched kernel on
+/// straight-sided ones), and the solver built on it: CG preconditioned by a two-level p-multigrid,
+/// P2 smoothed by Chebyshev on the operator's diagonal, the P1 level (same mesh) solved on the P1
+/// matrix (computed cell by cell from the same kernel) by ML-CG, a CHOLMOD factor or one ML
+/// V-cycle. What deal.II 9.4 supports on simplices: docs/measurements/dealii_simplex_support.md.
 #include <deal.II/base/subscriptor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/mapping.h>
@@ -82,7 +83,8 @@ class ElasticityOperator : public dl::Subscriptor {
   /// `threads`: the batched kernel's cells are cut into that many contiguous parts, one per
   /// thread (fewer on a small mesh); the other paths are serial.
   /// `tangent` (kept by reference): the operator is instead the neo-Hookean tangent
-  /// ∫ dP(∇δu) : ∇v dV at that state, on the state's quadrature, cell by cell (serial).
+  /// ∫ dP(∇δu) : ∇v dV at that state, on the state's quadrature (the batched kernel on
+  /// straight-sided tets, on `threads`; FEEvaluation, serial, on curved ones).
   ElasticityOperator(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& dof,
                      const dl::AffineConstraints<double>& constraints, int degree, double lambda,
                      double mu, unsigned threads = 1,
@@ -197,7 +199,8 @@ class ElasticityOperator : public dl::Subscriptor {
   const dl::AffineConstraints<double>& constraints_;
   double lambda_, mu_;
   const NeoHookeanTangentState* tangent_ = nullptr;
-  /// tangent_: per cell batch and lane, the cell's active index (kNoDof for an empty lane).
+  /// tangent_ on curved cells (FEEvaluation): per cell batch and lane, the cell's active index
+  /// (kNoDof for an empty lane).
   std::vector<unsigned> lane_cells_;
   mutable MfVector diagonal_;  // el()'s, on first use
   unsigned n_quadrature_points_ = 0;
@@ -272,7 +275,8 @@ struct PMultigridSettings {
 /// matrix-free operator on the fine DoFs, and below it (for P2) the P1 DoFs of the same mesh, the
 /// P2 → P1 transfer and ML (or CHOLMOD) on the assembled P1 matrix. Callers that solve the same
 /// wall under many loads (contact active sets, Newton steps with a fixed stiffness) construct it
-/// once and call solve() per load; set-up dominates when the loads are few.
+/// once and call solve() per load; set-up dominates when the loads are few. Given a
+/// NeoHookeanTangentState, both levels are that tangent (a finite-strain Newton system).
 ///
 /// The right-hand side is the assembled one on the unconstrained DoFs (N): loads, and −A u₀ of
 /// the prescribed values u₀; its constrained entries are ignored. solve() returns the solution
