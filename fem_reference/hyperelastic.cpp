@@ -508,6 +508,22 @@ struct HyperelasticSolver::Impl {
     std::string reason;
   };
 
+  /// The assembled Newton system into d.solution: matrix-free, or directly. Away from
+  /// equilibrium (a Newton iterate after a large increment) the symmetric tangent can be
+  /// indefinite, which CHOLMOD refuses: LU (UMFPACK) solves it.
+  void solve_newton_system(const AddedMatrix& follower) {
+    if (matrix_free) {
+      solve_tangent_matrix_free(follower);
+      return;
+    }
+    try {
+      d.solve_linear(symmetric, DirectReuse::analysis);
+    } catch (const std::exception&) {
+      if (!symmetric || d.mixed) throw;
+      d.solve_linear(false);
+    }
+  }
+
   /// Newton from the equilibrium u at s0 to s1; u is left at the new equilibrium on success.
   StepOutcome newton_step(double s0, double s1) {
     StepOutcome out;
@@ -536,18 +552,7 @@ struct HyperelasticSolver::Impl {
       if (it == opt.max_newton_iterations) break;
       const auto t0 = Clock::now();
       try {
-        try {
-          if (matrix_free) {
-            solve_tangent_matrix_free(follower);
-          } else {
-            d.solve_linear(symmetric, DirectReuse::analysis);
-          }
-        } catch (const std::exception&) {
-          // Away from equilibrium (a Newton iterate after a large increment) the symmetric
-          // tangent can be indefinite, which CHOLMOD refuses: LU (UMFPACK) solves it.
-          if (!symmetric || d.mixed || matrix_free) throw;
-          d.solve_linear(false);
-        }
+        solve_newton_system(follower);
       } catch (const std::exception& e) {
         result.timings.solve += seconds_since(t0);
         out.reason = std::string("the linear solve failed: ") + e.what();

@@ -61,25 +61,27 @@ using Lanes2 = double __attribute__((vector_size(2 * sizeof(double))));
 using Lanes4 = double __attribute__((vector_size(4 * sizeof(double))));
 using Lanes8 = double __attribute__((vector_size(8 * sizeof(double))));
 
-/// The displacement a(u, v) on V's lanes, as many of a batch's kLanes straight-sided tets at
-/// once (struct of arrays: entry [k·kLanes + l] belongs to cell l; the pointers start at V's
-/// first):
-/// out = A_e u_e for each cell, u_e from `in`, both component-major (k = c·N + i for component
-/// c of the scalar element's shape i), `geometry` [j·kLanes + l] as kGeometry describes. J⁻ᵀ and
-/// |det J| are constant on a straight-sided tet, so ∇u is taken at a rule's Q points x_q
+/// The cell loop the straight-tet kernels share, on V's lanes of a batch's kLanes straight-sided
+/// tets (struct of arrays: entry [k·kLanes + l] belongs to cell l; the pointers start at V's
+/// first): u_e from `in` and out = A_e u_e, both component-major (k = c·N + i for component c of
+/// the scalar element's shape i), `geometry` [j·kLanes + l] as kGeometry describes. J⁻ᵀ and
+/// |det J| are constant on a straight-sided tet, so ∇u is taken at a rule's n_q points x_q
 /// (reference weights `weights`, summing to 1/6) from `ref_grad`, the N shape gradients there,
-/// [(q·N + i)·3 + e] = ∂N_i/∂ξ_e(x_q); the stress is σ = λ tr(ε) I + 2μ ε (step-8's a(u, v)).
-template <typename V, unsigned N, unsigned Q>
-[[gnu::always_inline]] inline void straight_lanes(const double* in, double* out,
-                                                  const double* geometry, const double* ref_grad,
-                                                  const double* weights, double lambda, double mu) {
+/// [(q·N + i)·3 + e] = ∂N_i/∂ξ_e(x_q). At each point stress(q, ∇u, w, p) gives p = w·P(∇u)
+/// (p[c][d], ∇u[c][d] = ∂u_c/∂x_d), and out_ci += Σ_d p[c][d] ∂N_i/∂x_d.
+template <typename V, unsigned N, typename Stress>
+[[gnu::always_inline]] inline void tested_stress_lanes(const double* in, double* out,
+                                                       const double* geometry,
+                                                       const double* ref_grad,
+                                                       const double* weights, unsigned n_q,
+                                                       const Stress& stress) {
   V u[kDim * N], a[kDim * N] = {}, inv_jt[kDim][kDim], det;
   for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(&u[k], in + k * kLanes, sizeof(V));
   for (unsigned j = 0; j < kDim * kDim; ++j) {
     std::memcpy(&inv_jt[j / kDim][j % kDim], geometry + j * kLanes, sizeof(V));
   }
   std::memcpy(&det, geometry + kDim * kDim * kLanes, sizeof(V));
-  for (unsigned q = 0; q < Q; ++q) {
+  for (unsigned q = 0; q < n_q; ++q) {
     const double* g = ref_grad + q * N * kDim;
     V ref[kDim][kDim] = {};  // ∂u_c/∂ξ_e
     for (unsigned c = 0; c < kDim; ++c) {
@@ -93,16 +95,12 @@ template <typename V, unsigned N, unsigned Q>
         grad[c][d] = inv_jt[d][0] * ref[c][0] + inv_jt[d][1] * ref[c][1] + inv_jt[d][2] * ref[c][2];
       }
     }
-    const V w = det * weights[q];
-    const V lambda_trace = (lambda * w) * (grad[0][0] + grad[1][1] + grad[2][2]);
-    const V mu_w = mu * w;
+    V p[kDim][kDim];
+    stress(q, grad, det * weights[q], p);
     for (unsigned c = 0; c < kDim; ++c) {
-      V sigma[kDim];  // row c of w·σ
-      for (unsigned d = 0; d < kDim; ++d) sigma[d] = mu_w * (grad[c][d] + grad[d][c]);
-      sigma[c] += lambda_trace;
-      V s[kDim];  // Σ_d wσ_cd ∂ξ_e/∂x_d
+      V s[kDim];  // Σ_d p_cd ∂ξ_e/∂x_d
       for (unsigned e = 0; e < kDim; ++e) {
-        s[e] = sigma[0] * inv_jt[0][e] + sigma[1] * inv_jt[1][e] + sigma[2] * inv_jt[2][e];
+        s[e] = p[c][0] * inv_jt[0][e] + p[c][1] * inv_jt[1][e] + p[c][2] * inv_jt[2][e];
       }
       for (unsigned i = 0; i < N; ++i) {
         a[c * N + i] += s[0] * g[i * kDim] + s[1] * g[i * kDim + 1] + s[2] * g[i * kDim + 2];
@@ -110,6 +108,25 @@ template <typename V, unsigned N, unsigned Q>
     }
   }
   for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(out + k * kLanes, &a[k], sizeof(V));
+}
+
+/// The displacement a(u, v) on V's lanes (tested_stress_lanes at a rule's Q points): the stress
+/// is σ = λ tr(ε) I + 2μ ε (step-8's a(u, v)).
+template <typename V, unsigned N, unsigned Q>
+[[gnu::always_inline]] inline void straight_lanes(const double* in, double* out,
+                                                  const double* geometry, const double* ref_grad,
+                                                  const double* weights, double lambda, double mu) {
+  tested_stress_lanes<V, N>(
+      in, out, geometry, ref_grad, weights, Q,
+      [ lambda, mu ](unsigned, const V(&grad)[kDim][kDim], V w, V(&p)[kDim][kDim])
+          __attribute__((always_inline)) {
+            const V lambda_trace = (lambda * w) * (grad[0][0] + grad[1][1] + grad[2][2]);
+            const V mu_w = mu * w;
+            for (unsigned c = 0; c < kDim; ++c) {
+              for (unsigned d = 0; d < kDim; ++d) p[c][d] = mu_w * (grad[c][d] + grad[d][c]);
+              p[c][c] += lambda_trace;
+            }
+          });
 }
 
 /// straight_lanes on a whole batch, `Width` cells at a time: SSE2 (any x86-64), AVX2 + FMA or
@@ -158,67 +175,40 @@ StraightTetKernel straight_batch_for(StraightTetIsa isa) {
   return straight_batch_sse2<N, Q>;
 }
 
-/// The neo-Hookean tangent on V's lanes of a batch of straight-sided tets, as straight_lanes
-/// with the stress replaced by dP = μ H + (μ − λ ln J)(F⁻¹ H F⁻¹)ᵀ + λ tr(F⁻¹ H) F⁻ᵀ of
-/// H = ∇δu, at the state's n_q points (`state` as TangentTetKernel describes, from V's first lane).
+/// The neo-Hookean tangent on V's lanes (tested_stress_lanes at the state's n_q points): the
+/// stress is dP = μ H + (μ − λ ln J)(F⁻¹ H F⁻¹)ᵀ + λ tr(F⁻¹ H) F⁻ᵀ of H = ∇δu (`state` as
+/// TangentTetKernel describes, from V's first lane).
 template <typename V, unsigned N>
 [[gnu::always_inline]] inline void tangent_lanes(const double* in, double* out,
                                                  const double* geometry, const double* state,
                                                  const double* ref_grad, const double* weights,
                                                  unsigned n_q, double lambda, double mu) {
-  constexpr unsigned kPer = NeoHookeanTangentState::kPerPoint;
-  V u[kDim * N], a[kDim * N] = {}, inv_jt[kDim][kDim], det;
-  for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(&u[k], in + k * kLanes, sizeof(V));
-  for (unsigned j = 0; j < kDim * kDim; ++j) {
-    std::memcpy(&inv_jt[j / kDim][j % kDim], geometry + j * kLanes, sizeof(V));
-  }
-  std::memcpy(&det, geometry + kDim * kDim * kLanes, sizeof(V));
-  for (unsigned q = 0; q < n_q; ++q) {
-    const double* g = ref_grad + q * N * kDim;
-    V ref[kDim][kDim] = {};  // ∂δu_c/∂ξ_e
-    for (unsigned c = 0; c < kDim; ++c) {
-      for (unsigned i = 0; i < N; ++i) {
-        for (unsigned e = 0; e < kDim; ++e) ref[c][e] += u[c * N + i] * g[i * kDim + e];
-      }
-    }
-    V h[kDim][kDim];  // H = ∂δu_c/∂X_d
-    for (unsigned c = 0; c < kDim; ++c) {
-      for (unsigned d = 0; d < kDim; ++d) {
-        h[c][d] = inv_jt[d][0] * ref[c][0] + inv_jt[d][1] * ref[c][1] + inv_jt[d][2] * ref[c][2];
-      }
-    }
-    const double* st = state + q * kPer * kLanes;
-    V f_inv[kDim][kDim], coefficient;  // F⁻¹ and μ − λ ln J
-    for (unsigned j = 0; j < kDim * kDim; ++j) {
-      std::memcpy(&f_inv[j / kDim][j % kDim], st + j * kLanes, sizeof(V));
-    }
-    std::memcpy(&coefficient, st + kDim * kDim * kLanes, sizeof(V));
-    V gh[kDim][kDim];  // F⁻¹ H
-    for (unsigned i = 0; i < kDim; ++i) {
-      for (unsigned j = 0; j < kDim; ++j) {
-        gh[i][j] = f_inv[i][0] * h[0][j] + f_inv[i][1] * h[1][j] + f_inv[i][2] * h[2][j];
-      }
-    }
-    const V w = det * weights[q];
-    const V mu_w = mu * w, c_w = coefficient * w;
-    const V lambda_trace = (lambda * w) * (gh[0][0] + gh[1][1] + gh[2][2]);
-    for (unsigned c = 0; c < kDim; ++c) {
-      V p[kDim];  // row c of w·dP
-      for (unsigned d = 0; d < kDim; ++d) {
-        // (F⁻¹ H F⁻¹)_dc
-        const V ghg = gh[d][0] * f_inv[0][c] + gh[d][1] * f_inv[1][c] + gh[d][2] * f_inv[2][c];
-        p[d] = mu_w * h[c][d] + c_w * ghg + lambda_trace * f_inv[d][c];
-      }
-      V s[kDim];  // Σ_d w dP_cd ∂ξ_e/∂x_d
-      for (unsigned e = 0; e < kDim; ++e) {
-        s[e] = p[0] * inv_jt[0][e] + p[1] * inv_jt[1][e] + p[2] * inv_jt[2][e];
-      }
-      for (unsigned i = 0; i < N; ++i) {
-        a[c * N + i] += s[0] * g[i * kDim] + s[1] * g[i * kDim + 1] + s[2] * g[i * kDim + 2];
-      }
-    }
-  }
-  for (unsigned k = 0; k < kDim * N; ++k) std::memcpy(out + k * kLanes, &a[k], sizeof(V));
+  tested_stress_lanes<V, N>(
+      in, out, geometry, ref_grad, weights, n_q,
+      [ state, lambda, mu ](unsigned q, const V(&h)[kDim][kDim], V w,
+                            V(&p)[kDim][kDim]) __attribute__((always_inline)) {
+        const double* st = state + q * NeoHookeanTangentState::kPerPoint * kLanes;
+        V f_inv[kDim][kDim], coefficient;  // F⁻¹ and μ − λ ln J
+        for (unsigned j = 0; j < kDim * kDim; ++j) {
+          std::memcpy(&f_inv[j / kDim][j % kDim], st + j * kLanes, sizeof(V));
+        }
+        std::memcpy(&coefficient, st + kDim * kDim * kLanes, sizeof(V));
+        V gh[kDim][kDim];  // F⁻¹ H
+        for (unsigned i = 0; i < kDim; ++i) {
+          for (unsigned j = 0; j < kDim; ++j) {
+            gh[i][j] = f_inv[i][0] * h[0][j] + f_inv[i][1] * h[1][j] + f_inv[i][2] * h[2][j];
+          }
+        }
+        const V mu_w = mu * w, c_w = coefficient * w;
+        const V lambda_trace = (lambda * w) * (gh[0][0] + gh[1][1] + gh[2][2]);
+        for (unsigned c = 0; c < kDim; ++c) {
+          for (unsigned d = 0; d < kDim; ++d) {
+            // (F⁻¹ H F⁻¹)_dc
+            const V ghg = gh[d][0] * f_inv[0][c] + gh[d][1] * f_inv[1][c] + gh[d][2] * f_inv[2][c];
+            p[c][d] = mu_w * h[c][d] + c_w * ghg + lambda_trace * f_inv[d][c];
+          }
+        }
+      });
 }
 
 template <typename V, unsigned Width, unsigned N>
