@@ -44,8 +44,10 @@
 #include "fem_reference/detail/byte_buffer.hpp"
 #include "fem_reference/detail/constraints.hpp"
 #include "fem_reference/detail/distributed_solver.hpp"
+#include "fem_reference/detail/matrix_free_elasticity.hpp"
 #include "fem_reference/detail/memory_probe.hpp"
 #include "fem_reference/detail/postprocess.hpp"
+#include "fem_reference/detail/serial_solver.hpp"
 #include "fem_reference/detail/validation.hpp"
 #include "fem_reference/detail/weak_form.hpp"
 #include "meshes/foundation/errors.hpp"
@@ -138,9 +140,12 @@ void validate_distributable(const ElasticityProblem& p) {
     msg << "the distributed (MPI) solver has straight-sided (affine) tets only; curved surfaces "
            "(--curved) need the serial solver";
   } else if (p.options.solver == LinearSolver::direct) {
-    msg << "the distributed (MPI) solver is iterative (CG with algebraic multigrid, FGMRES with "
-           "the block preconditioner for the mixed system); solver 'direct' is serial only: use "
-           "auto, cg-amg or gmres-block";
+    msg << "the distributed (MPI) solver is iterative (CG with algebraic multigrid or the "
+           "matrix-free p-multigrid, FGMRES with the block preconditioner for the mixed system); "
+           "solver 'direct' is serial only: use auto, cg-amg, matrix-free or gmres-block";
+  } else if (p.options.solver == LinearSolver::matrix_free && detail::uses_mixed_formulation(p)) {
+    msg << "solver matrix-free is for the displacement system (P1, P2); the mixed (Taylor-Hood) "
+           "system needs gmres-block";
   }
   if (!msg.str().empty()) throw InputError(msg.str());
 }
@@ -148,6 +153,18 @@ void validate_distributable(const ElasticityProblem& p) {
 }  // namespace
 
 namespace detail {
+
+SolverChoice distributed_displacement_solver(const SolverOptions& o, std::size_t n_dofs,
+                                             int degree) {
+  // The serial rule where it picks the matrix-free solve; CG-AMG where it would factorise.
+  const SolverChoice serial = chosen_solver(o, {false, n_dofs, degree, false, true});
+  if (serial.solver == LinearSolver::matrix_free || serial.solver == LinearSolver::cg_amg) {
+    return serial;
+  }
+  return {LinearSolver::cg_amg, serial.reason +
+                                    "; the distributed solver has no direct "
+                                    "solve: CG with AMG"};
+}
 
 using CellIt = CellIterator;
 
@@ -214,13 +231,15 @@ void Distributed::release_system() {
   release_free_memory();
 }
 
-void Distributed::setup_constraints() {
-  constraints_.clear();
-  constraints_.reinit(relevant_);
-  add_point_constraints(mesh_, problem_.point_constraints, dof_, mesh_map_.vertex_node,
-                        constraints_);
-  add_dirichlet_constraints(mesh_, problem_.dirichlet, mapping_, dof_, constraints_);
-  constraints_.close();
+void Distributed::support_constraints(const dl::DoFHandler<kDim>& dof,
+                                      dl::AffineConstraints<double>& constraints) const {
+  dl::IndexSet relevant;
+  dl::DoFTools::extract_locally_relevant_dofs(dof, relevant);
+  constraints.clear();
+  constraints.reinit(relevant);
+  add_point_constraints(mesh_, problem_.point_constraints, dof, mesh_map_.vertex_node, constraints);
+  add_dirichlet_constraints(mesh_, problem_.dirichlet, mapping_, dof, constraints);
+  constraints.close();
 }
 
 void Distributed::setup_dofs() {
@@ -233,16 +252,22 @@ void Distributed::setup_dofs() {
   }
   owned_ = dof_.locally_owned_dofs();
   dl::DoFTools::extract_locally_relevant_dofs(dof_, relevant_);
-  setup_constraints();
+  support_constraints(dof_, constraints_);
+  rhs_.reinit(owned_, comm_);
+  solution_.reinit(owned_, comm_);
+  ghosted_.reinit(owned_, relevant_, comm_);
+  const SolverChoice choice =
+      distributed_displacement_solver(problem_.options, dof_.n_dofs(), degree_);
+  out_.fem.solver = choice.solver;
+  out_.fem.solver_reason = choice.reason;
+  matrix_free_ = choice.solver == LinearSolver::matrix_free;
+  if (matrix_free_) return;  // no matrix
 
   // step-40's distributed sparsity pattern.
   dl::DynamicSparsityPattern dsp(relevant_);
   dl::DoFTools::make_sparsity_pattern(dof_, dsp, constraints_, false);
   dl::SparsityTools::distribute_sparsity_pattern(dsp, owned_, comm_, relevant_);
   matrix_.reinit(owned_, owned_, dsp, comm_);
-  rhs_.reinit(owned_, comm_);
-  solution_.reinit(owned_, comm_);
-  ghosted_.reinit(owned_, relevant_, comm_);
 }
 
 void Distributed::assemble() {
@@ -250,30 +275,13 @@ void Distributed::assemble() {
     assemble_mixed();
     return;
   }
-  assemble_into(matrix_, rhs_);
-}
-
-DisplacementRows Distributed::owned_rows(const dl::IndexSet& rows_set) const {
-  // The locally owned rows in the row map's order (the owned DoFs' order within the IndexSet).
-  const std::size_t n_local = rows_set.n_elements();
-  std::map<dl::types::global_dof_index, dl::Point<kDim>> x;
-  dl::DoFTools::map_dofs_to_support_points(mapping_, dof_, x);
-  DisplacementRows rows;
-  rows.support.resize(n_local);
-  rows.component.assign(n_local, 0);
-  std::vector<dl::types::global_dof_index> dofs(fe_->n_dofs_per_cell());
-  for (const auto& cell : dof_.active_cell_iterators()) {
-    if (!cell->is_locally_owned()) continue;
-    cell->get_dof_indices(dofs);
-    for (unsigned i = 0; i < dofs.size(); ++i) {
-      if (rows_set.is_element(dofs[i]))
-        rows.component[rows_set.index_within_set(dofs[i])] =
-            fe_->system_to_component_index(i).first;
-    }
+  if (matrix_free_) {
+    const Vec3 applied = assemble_load_vector(*form_, mapping_, dof_, degree_, constraints_, rhs_);
+    rhs_.compress(dl::VectorOperation::add);
+    out_.fem.applied_load = sum_over_ranks(applied);
+    return;
   }
-  for (std::size_t l = 0; l < n_local; ++l)
-    rows.support[l] = x.at(rows_set.nth_index_in_set(static_cast<dl::IndexSet::size_type>(l)));
-  return rows;
+  assemble_into(matrix_, rhs_);
 }
 
 void Distributed::solve_linear() {
@@ -281,16 +289,20 @@ void Distributed::solve_linear() {
     solve_mixed();
     return;
   }
+  if (matrix_free_) {
+    solve_matrix_free();
+    return;
+  }
   const auto& o = problem_.options;
-  out_.fem.solver = LinearSolver::cg_amg;
   const double rhs_norm = rhs_.l2_norm();
   solution_ = 0.0;
   if (rhs_norm > 0.0) {
     // Rotations about the mesh's node centroid, the same point on every rank.
     dl::TrilinosWrappers::PreconditionAMG amg;
     std::vector<double> modes_storage;  // must outlive amg
-    initialize_elasticity_amg(amg, matrix_, owned_rows(owned_), part_.centroid, degree_ > 1,
-                              o.amg_rigid_body_modes, AmgProlongator::plain, modes_storage);
+    initialize_elasticity_amg(amg, matrix_, displacement_rows(mapping_, dof_, owned_),
+                              part_.centroid, degree_ > 1, o.amg_rigid_body_modes,
+                              AmgProlongator::plain, modes_storage);
     release_free_memory();  // ML's set-up temporaries
     report_memory(static_cast<int>(rank_), "AMG hierarchy built");
     dl::SolverControl control(o.max_iterations, o.cg_relative_tolerance * rhs_norm);
@@ -305,6 +317,31 @@ void Distributed::solve_linear() {
       throw std::runtime_error(m.str());
     }
     out_.fem.iterations = control.last_step();
+  }
+  constraints_.distribute(solution_);
+  ghosted_ = solution_;
+}
+
+void Distributed::solve_matrix_free() {
+  const auto& o = problem_.options;
+  solution_ = 0.0;
+  if (rhs_.l2_norm() > 0.0) {
+    PMultigridSettings settings;  // ML-CG on P1: CHOLMOD is serial
+    const MatrixFreeElasticitySolver wall(
+        mapping_, dof_,
+        [this](const dl::DoFHandler<kDim>& d, dl::AffineConstraints<double>& c) {
+          support_constraints(d, c);
+        },
+        degree_, form_->lambda(), form_->mu(), part_.centroid, settings);
+    report_memory(static_cast<int>(rank_), "matrix-free operator and p-multigrid set up");
+    MfVector b, u;
+    wall.initialize_dof_vector(b);
+    wall.initialize_dof_vector(u);
+    for (const auto i : owned_) b[i] = rhs_[i];
+    out_.fem.iterations = wall.solve(b, u, o.cg_relative_tolerance, o.max_iterations).iterations;
+    out_.fem.matrix_free = wall.profile();
+    for (const auto i : owned_) solution_[i] = u[i];
+    solution_.compress(dl::VectorOperation::insert);
   }
   constraints_.distribute(solution_);
   ghosted_ = solution_;

@@ -1,9 +1,10 @@
 #pragma once
 /// The FEM reference in parallel with MPI, P1, P2 and Taylor–Hood on deal.II's fully distributed
-/// triangulation with Trilinos matrices and vectors. The displacement formulation by CG with ML
-/// AMG (all six rigid-body modes as near-null space), the mixed one (ν up to 0.5) by FGMRES with
-/// the block-triangular AMG / pressure-mass preconditioner. Plain data only: deal.II and mpi.h stay
-/// inside fem_reference's .cpp files and detail/ headers. SI units throughout.
+/// triangulation with Trilinos matrices and vectors. The displacement formulation by the
+/// matrix-free p-multigrid CG (where the serial `automatic` rule takes it, or on request) or by
+/// CG with ML AMG (all six rigid-body modes as near-null space), the mixed one (ν up to 0.5) by
+/// FGMRES with the block-triangular AMG / pressure-mass preconditioner. Plain data only: deal.II
+/// and mpi.h stay inside fem_reference's .cpp files and detail/ headers. SI units throughout.
 ///
 /// Every function here is collective over MPI_COMM_WORLD (or over the single calling rank with
 /// DistributedOptions::self_only). Only rank 0 needs the whole mesh: it partitions it and sends
@@ -70,9 +71,10 @@ struct DistributedOptions {
 struct DistributedResult {
   /// Same meaning as the serial result's fields, with these differences: nodal_displacement (every
   /// TetMesh node, m) is filled on rank 0 only (gathered there; empty on other ranks);
-  /// tet_strain and tet_stress are empty (not gathered); solver is cg_amg (displacement) or
-  /// gmres_block (mixed); timings are the slowest rank's per phase; applied_load, reactions, strain_energy and the principal
-  /// strains are global (reduced over the ranks) on every rank.
+  /// tet_strain and tet_stress are empty (not gathered); solver is matrix_free or cg_amg
+  /// (displacement) or gmres_block (mixed), with solver_reason; timings are the slowest rank's
+  /// per phase, matrix_free (the profile) this rank's; applied_load, reactions,
+  /// strain_energy and the principal strains are global (reduced over the ranks) on every rank.
   ElasticityResult fem;
   int n_ranks = 1;
   std::vector<std::size_t> cells_per_rank;  ///< locally owned tets of each rank (every rank)
@@ -99,17 +101,17 @@ struct DistributedResult {
 /// loads and supports on them. The other ranks may pass an empty mesh and a default problem,
 /// except for the functions, which cannot be sent: if rank 0's problem has a DirichletCondition
 /// value or a body_force, every rank's problem must have it at the same place (std::logic_error
-/// on every rank otherwise). CG with Trilinos ML AMG to
-/// options.cg_relative_tolerance (the mixed system: FGMRES to the same relative residual of the
-/// scaled system, as the serial gmres_block). Supports P1 and P2 displacement elements and the
-/// Taylor–Hood element (chosen as the serial solver chooses: options.formulation and
-/// mixed_threshold), clamped and roller Dirichlet groups, point constraints, pressures, traction
-/// patches, gravity and body forces. InputError (the same on every rank) for invalid parameters, a
-/// missing group, a point constraint off the nodes, an evaluation point off the mesh, and what is
-/// not distributed: curved surfaces and the direct solver. With the environment variable
-/// VESSELVERIFY_MEMORY set, each rank prints its resident and peak memory after each phase to
-/// stderr.
-/// std::runtime_error if the Krylov solver does not converge.
+/// on every rank otherwise). The displacement system: the matrix-free p-multigrid CG where the
+/// serial `automatic` rule picks it (P2 from matrix_free_min_dofs DoFs) or options.solver asks
+/// for it, else CG with Trilinos ML AMG, to options.cg_relative_tolerance (the mixed system: FGMRES
+/// to the same relative residual of the scaled system, as the serial gmres_block). Supports P1 and
+/// P2 displacement elements and the Taylor–Hood element (chosen as the serial solver chooses:
+/// options.formulation and mixed_threshold), clamped and roller Dirichlet groups, point
+/// constraints, pressures, traction patches, gravity and body forces. InputError (the same on every
+/// rank) for invalid parameters, a missing group, a point constraint off the nodes, an evaluation
+/// point off the mesh, and what is not distributed: curved surfaces and the direct solver. With the
+/// environment variable VESSELVERIFY_MEMORY set, each rank prints its resident and peak memory
+/// after each phase to stderr. std::runtime_error if the Krylov solver does not converge.
 DistributedResult solve_elasticity_distributed(const TetMesh& mesh,
                                                const ElasticityProblem& problem,
                                                const DistributedOptions& options = {});

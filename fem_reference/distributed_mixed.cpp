@@ -89,7 +89,7 @@ void Distributed::setup_mixed_system() {
   owned_blocks_ = {owned_.get_view(0, n_u), owned_.get_view(n_u, n_u + n_p)};
   relevant_blocks_ = {relevant_.get_view(0, n_u), relevant_.get_view(n_u, n_u + n_p)};
   out_.fem.n_pressure_dofs = n_p;
-  setup_constraints();
+  support_constraints(dof_, constraints_);
 
   dl::BlockDynamicSparsityPattern dsp(relevant_blocks_);
   dl::DoFTools::make_sparsity_pattern(dof_, dsp, constraints_, false);
@@ -149,6 +149,7 @@ void Distributed::assemble_schur_approximation() {
 void Distributed::solve_mixed() {
   const auto& o = problem_.options;
   out_.fem.solver = LinearSolver::gmres_block;
+  out_.fem.solver_reason = "the mixed (Taylor-Hood) system: FGMRES with the block preconditioner";
   auto& a = block_matrix_.block(0, 0);
   auto& s = schur_.block(1, 1);
   // ω² = mean diag(A) / mean diag(Ŝ): balances the blocks (as the serial solver).
@@ -161,8 +162,9 @@ void Distributed::solve_mixed() {
 
   dl::TrilinosWrappers::PreconditionAMG amg;
   std::vector<double> modes_storage;  // must outlive amg
-  initialize_elasticity_amg(amg, a, owned_rows(owned_blocks_[0]), part_.centroid, true,
-                            o.amg_rigid_body_modes, AmgProlongator::smoothed, modes_storage);
+  initialize_elasticity_amg(amg, a, displacement_rows(mapping_, dof_, owned_blocks_[0]),
+                            part_.centroid, true, o.amg_rigid_body_modes, AmgProlongator::smoothed,
+                            modes_storage);
   release_free_memory();  // ML's set-up temporaries
   report_memory(static_cast<int>(rank_), "AMG hierarchy built");
   const BlockPreconditioner prec(block_matrix_.block(0, 1), amg, s, omega, owned_blocks_[0],

@@ -18,25 +18,8 @@
 namespace vessel::fem {
 
 void ElasticitySolver::Impl::assemble_load() {
-  detail::CellValues values(*mapping, *fe, degree);
-  const unsigned n = fe->n_dofs_per_cell();
-  dl::FullMatrix<double> k(n, n);
-  dl::Vector<double> f(n);
-  std::vector<Index> dofs(n);
-  Vec3 applied = Vec3::Zero();
-  // Prescribed values u₀ ≠ 0 enter the free rows as −K_e u₀: those need the element matrix.
-  const bool lift = constraints.has_inhomogeneities();
-  for (const auto& cell : dof.active_cell_iterators()) {
-    cell->get_dof_indices(dofs);
-    if (lift) {
-      form->local_system(cell, values, k, f, &applied);
-      constraints.distribute_local_to_global(f, dofs, rhs, k);
-    } else {
-      form->local_load(cell, values, f, &applied, true);
-      constraints.distribute_local_to_global(f, dofs, rhs);
-    }
-  }
-  result.applied_load = applied;
+  result.applied_load =
+      detail::assemble_load_vector(*form, *mapping, dof, degree, constraints, rhs);
 }
 
 void ElasticitySolver::Impl::solve_displacement_matrix_free() {
@@ -153,7 +136,9 @@ std::array<double, 2> ElasticitySolver::matrix_free_transfer_difference(unsigned
   im.support_constraints(p1, c);
   c.close();
   const auto coarse_constraints = detail::homogeneous_copy(c);
-  const detail::P1ToP2Embedding embedding(im.dof, p1, fine_constraints, coarse_constraints);
+  const dl::Utilities::MPI::Partitioner p2_layout(im.dof.n_dofs()), p1_layout(p1.n_dofs());
+  const detail::P1ToP2Embedding embedding(im.dof, p1, fine_constraints, coarse_constraints,
+                                          p2_layout, p1_layout);
   dl::MGTwoLevelTransfer<kDim, detail::MfVector> dealii;
   dealii.reinit_polynomial_transfer(im.dof, p1, fine_constraints, coarse_constraints);
   detail::MfVector x(p1.n_dofs()), y(im.dof.n_dofs());

@@ -2,6 +2,9 @@
 /// Private to fem_reference: Trilinos ML algebraic multigrid for the elasticity matrix, with the
 /// rigid-body modes as near-null space; shared by the serial CG / block preconditioner and the
 /// distributed CG.
+#include <deal.II/base/index_set.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/mapping.h>
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 
@@ -24,6 +27,11 @@ struct DisplacementRows {
   std::vector<unsigned> component;
 };
 
+/// The rows of `dof` (a displacement FESystem) in `rows` that this rank's cells hold, in the
+/// IndexSet's order (a matrix's row map: `rows` = its locally owned DoFs).
+DisplacementRows displacement_rows(const dl::Mapping<kDim>& mapping,
+                                   const dl::DoFHandler<kDim>& dof, const dl::IndexSet& rows);
+
 /// How ML builds the prolongators from the aggregates. `plain`: the tentative prolongator itself
 /// (unsmoothed aggregation): sparse coarse operators and a small set-up, for the displacement
 /// system's CG. `smoothed`: one damped Jacobi step on it (Vaněk, Mandel & Brezina 1996), a
@@ -37,13 +45,15 @@ enum class AmgProlongator { smoothed, plain };
 /// filled first and the modes added as pre-computed vectors; `storage` holds them and must outlive
 /// `amg`); without, only the three translations. `aggregation_threshold`: ML drops connections
 /// weaker than this fraction of the diagonal when aggregating (none: the prolongator's own
-/// default, default_aggregation_threshold).
+/// default, default_aggregation_threshold). `aggregate_across_ranks`: ML's MIS aggregation, whose
+/// aggregates may span the ranks, instead of each rank aggregating its own rows (Uncoupled).
 void initialize_elasticity_amg(dl::TrilinosWrappers::PreconditionAMG& amg,
                                const dl::TrilinosWrappers::SparseMatrix& matrix,
                                const DisplacementRows& rows, const Vec3& centre, bool higher_order,
                                bool rigid_body_modes, AmgProlongator prolongator,
                                std::vector<double>& storage,
-                               std::optional<double> aggregation_threshold = std::nullopt);
+                               std::optional<double> aggregation_threshold = std::nullopt,
+                               bool aggregate_across_ranks = false);
 
 /// The aggregation threshold that gave the fewest CG iterations with `prolongator` on the P2
 /// displacement system (plain 0.1, smoothed 0.02).

@@ -33,6 +33,11 @@ namespace vessel::fem::detail {
 using VectorT = dl::TrilinosWrappers::MPI::Vector;
 using BlockVectorT = dl::TrilinosWrappers::MPI::BlockVector;
 
+/// The displacement system's solver on several ranks: matrix-free where the serial `automatic`
+/// rule (or the request) takes it, CG with AMG otherwise (there is no distributed direct solve).
+SolverChoice distributed_displacement_solver(const SolverOptions& o, std::size_t n_dofs,
+                                             int degree);
+
 class Distributed {
  public:
   /// `mesh` and `problem`: the whole mesh and the problem on rank 0 (validated); other ranks'
@@ -49,7 +54,10 @@ class Distributed {
   /// Frees what the solve needed and the post-processing does not (the matrices).
   void release_system();
   void setup_dofs();
-  void setup_constraints();
+  /// The supports (Dirichlet groups and point constraints) on `dof` (this rank's relevant DoFs),
+  /// closed: the solution's DoFHandler or the p-multigrid's P1 level.
+  void support_constraints(const dl::DoFHandler<kDim>& dof,
+                           dl::AffineConstraints<double>& constraints) const;
   void assemble();
   /// The locally owned cells' weak form into `matrix` and `rhs` (plain or block, Trilinos),
   /// compressed; the applied load summed over the ranks into out_.
@@ -72,8 +80,9 @@ class Distributed {
     out_.fem.applied_load = sum_over_ranks(applied);
   }
   void solve_linear();
-  /// The locally owned rows of `rows` (a set of displacement DoFs) in the row map's order.
-  [[nodiscard]] DisplacementRows owned_rows(const dl::IndexSet& rows) const;
+  /// CG on the matrix-free operator with the p-multigrid (the serial solver's, on this rank's
+  /// cells): rhs_ → solution_.
+  void solve_matrix_free();
   void postprocess();
   [[nodiscard]] VectorT residual(StrainSummary& strain) const;
   [[nodiscard]] double max_over_ranks(double v) const;
@@ -107,6 +116,7 @@ class Distributed {
   MPI_Comm comm_;
   unsigned rank_, n_ranks_;
   bool mixed_ = false;
+  bool matrix_free_ = false;  // the displacement system without its matrix
   int degree_ = 1;
 
   dl::FE_SimplexP<kDim> linear_;

@@ -11,6 +11,7 @@
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/solver_gmres.h>
+#include <deal.II/lac/sparsity_tools.h>
 #include <deal.II/matrix_free/fe_evaluation.h>
 #include <deal.II/matrix_free/tools.h>
 
@@ -346,20 +347,17 @@ dl::AffineConstraints<double> homogeneous_copy(const dl::AffineConstraints<doubl
   return out;
 }
 
-bool plain_indexable(const dl::DoFHandler<kDim>& dof,
-                     const dl::AffineConstraints<double>& constraints) {
-  if (dynamic_cast<const dl::parallel::TriangulationBase<kDim>*>(&dof.get_triangulation()) !=
-      nullptr) {
-    return false;
-  }
+bool fixes_values_only(const dl::AffineConstraints<double>& constraints) {
   const auto& lines = constraints.get_lines();
   return std::all_of(lines.begin(), lines.end(), [](const auto& l) { return l.entries.empty(); });
 }
 
 P1ToP2Embedding::P1ToP2Embedding(const dl::DoFHandler<kDim>& p2, const dl::DoFHandler<kDim>& p1,
                                  const dl::AffineConstraints<double>& p2_constraints,
-                                 const dl::AffineConstraints<double>& p1_constraints)
-    : from_(p2.n_dofs(), {kNone, kNone}) {
+                                 const dl::AffineConstraints<double>& p1_constraints,
+                                 const dl::Utilities::MPI::Partitioner& p2_part,
+                                 const dl::Utilities::MPI::Partitioner& p1_part)
+    : from_(p2_part.locally_owned_size(), {kNone, kNone}) {
   const auto& fe2 = p2.get_fe();
   const auto& fe1 = p1.get_fe();
   // Each P2 node is a vertex of the reference tet or the midpoint of two: which P1 shapes.
@@ -377,35 +375,41 @@ P1ToP2Embedding::P1ToP2Embedding(const dl::DoFHandler<kDim>& p2, const dl::DoFHa
       coarse(fe1.n_dofs_per_cell());
   auto cell1 = p1.begin_active();
   for (const auto& cell2 : p2.active_cell_iterators()) {
+    const auto this_cell1 = cell1++;
+    if (!cell2->is_locally_owned()) continue;
     cell2->get_dof_indices(fine);
-    cell1->get_dof_indices(coarse);
-    ++cell1;
+    this_cell1->get_dof_indices(coarse);
     for (unsigned k = 0; k < fine.size(); ++k) {
-      if (p2_constraints.is_constrained(fine[k])) continue;
+      if (!p2_part.in_local_range(fine[k]) || p2_constraints.is_constrained(fine[k])) continue;
       const auto [c, i] = fe2.system_to_component_index(k);
+      auto& from = from_[p2_part.global_to_local(fine[k])];
       for (unsigned j = 0; j < 2; ++j) {  // both, as another cell may order the edge otherwise
         const auto parent = coarse[fe1.component_to_system_index(c, parents[i][j])];
-        from_[fine[k]][j] =
-            p1_constraints.is_constrained(parent) ? kNone : static_cast<unsigned>(parent);
+        from[j] = p1_constraints.is_constrained(parent) ? kNone : p1_part.global_to_local(parent);
       }
     }
   }
 }
 
 void P1ToP2Embedding::prolongate_and_add(MfVector& p2, const MfVector& p1) const {
+  const bool had_ghosts = p1.has_ghost_elements();
+  if (!had_ghosts) p1.update_ghost_values();
   for (unsigned k = 0; k < from_.size(); ++k) {
     for (const unsigned parent : from_[k]) {
       if (parent != kNone) p2.local_element(k) += 0.5 * p1.local_element(parent);
     }
   }
+  if (!had_ghosts) p1.zero_out_ghost_values();
 }
 
 void P1ToP2Embedding::restrict_and_add(MfVector& p1, const MfVector& p2) const {
+  p1.zero_out_ghost_values();
   for (unsigned k = 0; k < from_.size(); ++k) {
     for (const unsigned parent : from_[k]) {
       if (parent != kNone) p1.local_element(parent) += 0.5 * p2.local_element(k);
     }
   }
+  p1.compress(dl::VectorOperation::add);
 }
 
 ElasticityOperator::ElasticityOperator(const dl::Mapping<kDim>& mapping,
@@ -483,7 +487,8 @@ std::vector<unsigned> ElasticityOperator::component_major_system_index() const {
 }
 
 void ElasticityOperator::build_batches() {
-  if (!plain_indexable(mf_.get_dof_handler(), constraints_)) return;
+  if (!fixes_values_only(constraints_)) return;
+  const auto& layout = partitioner();
   const unsigned per_cell = kDim * n_shapes_;
   const std::vector<unsigned> system_index = component_major_system_index();
   const unsigned n_cells = mf_.n_cell_batches();  // one cell each: no SIMD in this deal.II
@@ -498,7 +503,7 @@ void ElasticityOperator::build_batches() {
     unsigned* dofs = batch_dofs_.data() + std::size_t{b} * per_cell * kLanes;
     for (unsigned k = 0; k < per_cell; ++k) {
       const auto i = idx[system_index[k]];
-      if (!constraints_.is_constrained(i)) dofs[k * kLanes + l] = static_cast<unsigned>(i);
+      if (!constraints_.is_constrained(i)) dofs[k * kLanes + l] = layout.global_to_local(i);
     }
     phi.reinit(cell);
     store_geometry(phi, batch_geometry_.data() + std::size_t{b} * kGeometry * kLanes + l);
@@ -675,7 +680,12 @@ void ElasticityOperator::apply_cell(Evaluation& phi) const {
 void ElasticityOperator::vmult(MfVector& dst, const MfVector& src) const {
   const auto t0 = Clock::now();
   if (!batch_dofs_.empty()) {
+    // The batches read src's ghosts and add into dst's, which their owners then sum.
+    const bool had_ghosts = src.has_ghost_elements();
+    if (!had_ghosts) src.update_ghost_values();
     apply_batches(dst, src);
+    dst.compress(dl::VectorOperation::add);
+    if (!had_ghosts) src.zero_out_ghost_values();
   } else {
     cell_loop(dst, src);
   }
@@ -713,6 +723,7 @@ MfVector ElasticityOperator::diagonal() const {
                             dl::update_gradients | dl::update_JxW_values);
   std::vector<dl::types::global_dof_index> idx(fe.n_dofs_per_cell());
   for (const auto& cell : dof.active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue;
     values.reinit(static_cast<dl::Triangulation<kDim>::cell_iterator>(cell));
     cell->get_dof_indices(idx);
     for (unsigned i = 0; i < idx.size(); ++i) {
@@ -725,6 +736,7 @@ MfVector ElasticityOperator::diagonal() const {
       diag(idx[i]) += a;
     }
   }
+  diag.compress(dl::VectorOperation::add);
   for (const unsigned i : mf_.get_constrained_dofs()) diag.local_element(i) = 1.0;
   return diag;
 }
@@ -740,6 +752,7 @@ MfVector ElasticityOperator::tangent_diagonal() const {
   const unsigned n_q = quadrature_.size();
   std::vector<dl::types::global_dof_index> idx(fe.n_dofs_per_cell());
   for (const auto& cell : dof.active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue;
     values.reinit(static_cast<dl::Triangulation<kDim>::cell_iterator>(cell));
     cell->get_dof_indices(idx);
     const double* state =
@@ -756,6 +769,7 @@ MfVector ElasticityOperator::tangent_diagonal() const {
       diag(idx[i]) += a;
     }
   }
+  diag.compress(dl::VectorOperation::add);
   for (const unsigned i : mf_.get_constrained_dofs()) diag.local_element(i) = 1.0;
   return diag;
 }
@@ -771,9 +785,22 @@ MfVector ElasticityOperator::diagonal_by_kernel() const {
 
 void ElasticityOperator::compute_matrix(dl::TrilinosWrappers::SparseMatrix& matrix) const {
   const auto& dof = mf_.get_dof_handler();
-  dl::DynamicSparsityPattern dsp(dof.n_dofs(), dof.n_dofs());
-  dl::DoFTools::make_sparsity_pattern(dof, dsp, constraints_, false);
-  matrix.reinit(dsp);
+  if (const auto* parallel =
+          dynamic_cast<const dl::parallel::TriangulationBase<kDim>*>(&dof.get_triangulation())) {
+    // step-40's distributed pattern: each rank's cells' rows, sent to their owners.
+    const dl::IndexSet& owned = dof.locally_owned_dofs();
+    dl::IndexSet relevant;
+    dl::DoFTools::extract_locally_relevant_dofs(dof, relevant);
+    dl::DynamicSparsityPattern dsp(relevant);
+    dl::DoFTools::make_sparsity_pattern(dof, dsp, constraints_, false);
+    dl::SparsityTools::distribute_sparsity_pattern(dsp, owned, parallel->get_communicator(),
+                                                   relevant);
+    matrix.reinit(owned, owned, dsp, parallel->get_communicator());
+  } else {
+    dl::DynamicSparsityPattern dsp(dof.n_dofs(), dof.n_dofs());
+    dl::DoFTools::make_sparsity_pattern(dof, dsp, constraints_, false);
+    matrix.reinit(dsp);
+  }
   if (batch_dofs_.empty()) {
     const std::function<void(Evaluation&)> kernel = [this](Evaluation& phi) { apply_cell(phi); };
     dl::MatrixFreeTools::compute_matrix(mf_, constraints_, matrix, kernel);
@@ -847,9 +874,9 @@ class MatrixFreeElasticitySolver::VCycle {
                                                      lambda, mu, solver_threads(), tangent);
       coarse = coarse_.get();
       profile.coarse_level = lap();
-      if (plain_indexable(dof, fine_constraints) &&
-          plain_indexable(coarse_dof_, coarse_constraints_)) {
-        embedding_.emplace(dof, coarse_dof_, fine_constraints, coarse_constraints_);
+      if (fixes_values_only(fine_constraints) && fixes_values_only(coarse_constraints_)) {
+        embedding_.emplace(dof, coarse_dof_, fine_constraints, coarse_constraints_,
+                           fine.partitioner(), coarse_->partitioner());
       } else {
         transfer_.reinit_polynomial_transfer(dof, coarse_dof_, fine_constraints,
                                              coarse_constraints_);
@@ -884,9 +911,15 @@ class MatrixFreeElasticitySolver::VCycle {
     // For P1 the "coarse" level is the fine one: a factor of it would make the matrix-free
     // operator pointless, so P1 always takes one ML V-cycle.
     method_ = degree == 1 ? CoarseSolve::ml_vcycle : settings.coarse;
+    const bool distributed =
+        dl::Utilities::MPI::n_mpi_processes(coarse->partitioner().get_mpi_communicator()) > 1;
     if (method_ == CoarseSolve::automatic) {
-      method_ = coarse->m() <= settings.direct_coarse_max_dofs ? CoarseSolve::cholmod
-                                                               : CoarseSolve::ml_cg;
+      method_ = coarse->m() <= settings.direct_coarse_max_dofs && !distributed
+                    ? CoarseSolve::cholmod
+                    : CoarseSolve::ml_cg;
+    }
+    if (method_ == CoarseSolve::cholmod && distributed) {
+      throw std::invalid_argument("p-multigrid: the CHOLMOD coarse solve is serial only");
     }
     coarse_tolerance_ = settings.coarse_tolerance;
     profile.coarse_method = method_ == CoarseSolve::cholmod     ? "CHOLMOD"
@@ -900,20 +933,11 @@ class MatrixFreeElasticitySolver::VCycle {
     }
     // The ML near-null space: the rigid-body modes at the P1 DoFs' support points.
     const auto& level_dof = degree > 1 ? coarse_dof_ : dof;
-    DisplacementRows rows;
-    rows.support.resize(level_dof.n_dofs());
-    dl::DoFTools::map_dofs_to_support_points(mapping, level_dof, rows.support);
-    rows.component.resize(level_dof.n_dofs());
-    const auto& fe = level_dof.get_fe();
-    std::vector<dl::types::global_dof_index> idx(fe.n_dofs_per_cell());
-    for (const auto& cell : level_dof.active_cell_iterators()) {
-      cell->get_dof_indices(idx);
-      for (unsigned i = 0; i < idx.size(); ++i)
-        rows.component[idx[i]] = fe.system_to_component_index(i).first;
-    }
+    const DisplacementRows rows =
+        displacement_rows(mapping, level_dof, level_dof.locally_owned_dofs());
     initialize_elasticity_amg(amg_, *coarse_matrix_, rows, centre, false,
                               settings.amg_rigid_body_modes, settings.amg_prolongator,
-                              mode_storage_, settings.amg_aggregation_threshold);
+                              mode_storage_, settings.amg_aggregation_threshold, distributed);
     profile.coarse_factor = lap();
   }
 
@@ -1075,6 +1099,20 @@ MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::solve(
   fine_->initialize_dof_vector(x);
   copy(b, rhs);
   copy(u, x);
+  const Outcome outcome = krylov(rhs, x, relative_tolerance, max_iterations, added);
+  copy(x, u);
+  return outcome;
+}
+
+MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::solve(
+    const MfVector& b, MfVector& u, double relative_tolerance, unsigned max_iterations) const {
+  MfVector rhs = b;
+  return krylov(rhs, u, relative_tolerance, max_iterations, nullptr);
+}
+
+MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::krylov(
+    MfVector& rhs, MfVector& x, double relative_tolerance, unsigned max_iterations,
+    const AddedMatrix* added) const {
   fine_->zero_constrained(rhs);
   fine_->zero_constrained(x);
   dl::SolverControl control(max_iterations, relative_tolerance * rhs.l2_norm());
@@ -1096,7 +1134,6 @@ MatrixFreeElasticitySolver::Outcome MatrixFreeElasticitySolver::solve(
     throw std::runtime_error(m.str());
   }
   profile_.cg += seconds_since(t0);
-  copy(x, u);
   return {control.last_step(), control.last_value()};
 }
 

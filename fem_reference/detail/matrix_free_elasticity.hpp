@@ -5,7 +5,9 @@
 /// straight-sided ones), and the solver built on it: CG preconditioned by a two-level p-multigrid,
 /// P2 smoothed by Chebyshev on the operator's diagonal, the P1 level (same mesh) solved on the P1
 /// matrix (computed cell by cell from the same kernel) by ML-CG, a CHOLMOD factor or one ML
-/// V-cycle. What deal.II 9.4 supports on simplices: docs/measurements/dealii_simplex_support.md.
+/// V-cycle. Serial or on a parallel::fullydistributed triangulation (each rank its own cells;
+/// vectors in MatrixFree's local numbering, owned DoFs then ghosts). What deal.II 9.4 supports on
+/// simplices: docs/measurements/dealii_simplex_support.md.
 #include <deal.II/base/subscriptor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/mapping.h>
@@ -90,10 +92,15 @@ class ElasticityOperator : public dl::Subscriptor {
                      double mu, unsigned threads = 1,
                      const NeoHookeanTangentState* tangent = nullptr);
 
-  /// dst = A src; counted in applications() and seconds().
+  /// dst = A src; counted in applications() and seconds(). On several ranks src's ghosts are
+  /// updated here (and left as they were found).
   void vmult(MfVector& dst, const MfVector& src) const;
   void Tvmult(MfVector& dst, const MfVector& src) const { vmult(dst, src); }
   void initialize_dof_vector(MfVector& v) const { mf_.initialize_dof_vector(v); }
+  /// The DoFs this rank holds in a vector: its owned ones, then the ghosts its cells touch.
+  [[nodiscard]] const dl::Utilities::MPI::Partitioner& partitioner() const {
+    return *mf_.get_vector_partitioner();
+  }
   [[nodiscard]] dl::types::global_dof_index m() const { return mf_.get_dof_handler().n_dofs(); }
   [[nodiscard]] dl::types::global_dof_index n() const { return m(); }
   /// A's entry (i, i) (Chebyshev's interface; only the diagonal is available): diagonal()[i].
@@ -138,7 +145,7 @@ class ElasticityOperator : public dl::Subscriptor {
   void apply_cell(Evaluation& phi) const;
   /// dst = A src by MatrixFree's cell loop, one FEEvaluation cell at a time (apply_cell).
   void cell_loop(MfVector& dst, const MfVector& src) const;
-  /// straight_ on a serial mesh with constraints that only fix values: batch_dofs_ and
+  /// straight_ with constraints that only fix values: batch_dofs_ (local indices) and
   /// batch_geometry_ from MatrixFree's cells, in its order (otherwise left empty).
   void build_batches();
   /// The neo-Hookean tangent on phi's cell batch: dP(∇δu) tested with ∇v at tangent_'s points.
@@ -188,8 +195,9 @@ class ElasticityOperator : public dl::Subscriptor {
   };
   std::vector<Part> parts_;
   static constexpr unsigned kNoDof = ~0u;
-  // straight_ and batchable: each batch's cells' DoF indices [(b·3N + k)·lanes + l] (cell l of
-  // batch b, component-major local DoF k; kNoDof where constrained or padding) and their
+  // straight_ and batchable: each batch's cells' DoF indices in the vectors' local numbering
+  // [(b·3N + k)·lanes + l] (cell l of batch b, component-major local DoF k; kNoDof where
+  // constrained or padding) and their
   // geometry [(b·10 + j)·lanes + l] (J⁻ᵀ row-major, then |det J|).
   std::vector<unsigned> batch_dofs_;
   std::vector<double> batch_geometry_;
@@ -208,31 +216,34 @@ class ElasticityOperator : public dl::Subscriptor {
   mutable double seconds_ = 0.0;
 };
 
-/// Whether vectors on `dof` can be read and written by plain DoF index with the constrained DoFs
-/// dropped: a serial mesh and constraints that only fix values (no entries).
-bool plain_indexable(const dl::DoFHandler<kDim>& dof,
-                     const dl::AffineConstraints<double>& constraints);
+/// Whether `constraints` only fix values (no entries tie a DoF to others): then a cell's
+/// constrained DoFs can be dropped from its vector entries.
+bool fixes_values_only(const dl::AffineConstraints<double>& constraints);
 
 /// The P1 → P2 prolongation on one mesh as nodal interpolation (exact, as P1 ⊂ P2): a P2 vertex
 /// DoF takes its P1 DoF's value, an edge-midpoint DoF the mean of its edge's two; the restriction
 /// is the transpose. The operator MGTwoLevelTransfer::reinit_polynomial_transfer builds for this
-/// pair, as two index reads per P2 DoF. Both levels plain_indexable: constrained DoFs are read
-/// and written as zero.
+/// pair, as two index reads per P2 DoF. Both levels' constraints fixes_values_only: constrained
+/// DoFs are read and written as zero. On several ranks each rank maps its owned P2 DoFs (whose
+/// P1 parents are on its own cells: owned or ghosts of `p1_part`).
 class P1ToP2Embedding {
  public:
-  /// `p2`, `p1`: FESystem(FE_SimplexP(2 resp. 1), 3) on the same triangulation.
+  /// `p2`, `p1`: FESystem(FE_SimplexP(2 resp. 1), 3) on the same triangulation; `p2_part`,
+  /// `p1_part`: the vectors' layouts (the levels' ElasticityOperator::partitioner()).
   P1ToP2Embedding(const dl::DoFHandler<kDim>& p2, const dl::DoFHandler<kDim>& p1,
                   const dl::AffineConstraints<double>& p2_constraints,
-                  const dl::AffineConstraints<double>& p1_constraints);
-  /// p2 += P p1.
+                  const dl::AffineConstraints<double>& p1_constraints,
+                  const dl::Utilities::MPI::Partitioner& p2_part,
+                  const dl::Utilities::MPI::Partitioner& p1_part);
+  /// p2 += P p1 (p1's ghosts updated here).
   void prolongate_and_add(MfVector& p2, const MfVector& p1) const;
-  /// p1 += Pᵀ p2.
+  /// p1 += Pᵀ p2 (p1's ghost contributions sent to their owners).
   void restrict_and_add(MfVector& p1, const MfVector& p2) const;
 
  private:
   static constexpr unsigned kNone = ~0u;
-  // Per P2 DoF the two P1 DoFs it averages (the same one twice at a vertex); kNone where either
-  // level constrains the DoF.
+  // Per owned P2 DoF (local index) the two P1 DoFs it averages, local indices (the same one twice
+  // at a vertex); kNone where either level constrains the DoF.
   std::vector<std::array<unsigned, 2>> from_;
 };
 
@@ -308,6 +319,11 @@ class MatrixFreeElasticitySolver {
   /// With `added` = S: (A + S) u = b by FGMRES, preconditioned by the same V-cycle on A.
   Outcome solve(const dl::Vector<double>& b, dl::Vector<double>& u, double relative_tolerance,
                 unsigned max_iterations, const AddedMatrix* added = nullptr) const;
+  /// The same on vectors of initialize_dof_vector's layout (any number of ranks; no `added`).
+  Outcome solve(const MfVector& b, MfVector& u, double relative_tolerance,
+                unsigned max_iterations) const;
+  /// `v` in the fine operator's layout (owned DoFs and ghosts), zero.
+  void initialize_dof_vector(MfVector& v) const { fine_->initialize_dof_vector(v); }
 
   /// x = one V-cycle of the preconditioner applied to r (zero on the constrained DoFs): an
   /// approximate A⁻¹ for a block preconditioner (the Taylor–Hood system's displacement block).
@@ -324,6 +340,10 @@ class MatrixFreeElasticitySolver {
 
  private:
   class VCycle;
+  /// CG (FGMRES with `added`) on rhs with the initial guess and result x, both in the fine
+  /// operator's layout (rhs's constrained entries zeroed here).
+  Outcome krylov(MfVector& rhs, MfVector& x, double relative_tolerance, unsigned max_iterations,
+                 const AddedMatrix* added) const;
   dl::AffineConstraints<double> fine_constraints_;
   std::unique_ptr<ElasticityOperator> fine_;
   std::unique_ptr<VCycle> preconditioner_;

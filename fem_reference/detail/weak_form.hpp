@@ -9,6 +9,7 @@
 #include <deal.II/fe/fe.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping.h>
+#include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/full_matrix.h>
 
 #include <memory>
@@ -105,5 +106,34 @@ class WeakForm {
   std::vector<std::pair<int, double>> pressure_tags_;   ///< (group tag, p) per pressure load
   std::vector<std::vector<PointLoad>> triangle_points_;  ///< per TetMesh triangle
 };
+
+/// The load vector of this rank's cells (every cell on a serial mesh) into `rhs`, without the
+/// stiffness matrix but for the cells whose prescribed values u₀ ≠ 0 enter the free rows as
+/// −K_e u₀; returns those cells' applied load (N). Call rhs.compress(add) after, on several ranks.
+template <class Vector>
+Vec3 assemble_load_vector(const WeakForm& form, const dl::Mapping<kDim>& mapping,
+                          const dl::DoFHandler<kDim>& dof, int degree,
+                          const dl::AffineConstraints<double>& constraints, Vector& rhs) {
+  const auto& fe = dof.get_fe();
+  CellValues values(mapping, fe, degree);
+  const unsigned n = fe.n_dofs_per_cell();
+  dl::FullMatrix<double> k(n, n);
+  dl::Vector<double> f(n);
+  std::vector<dl::types::global_dof_index> dofs(n);
+  Vec3 applied = Vec3::Zero();
+  const bool lift = constraints.has_inhomogeneities();
+  for (const auto& cell : dof.active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue;
+    cell->get_dof_indices(dofs);
+    if (lift) {
+      form.local_system(cell, values, k, f, &applied);
+      constraints.distribute_local_to_global(f, dofs, rhs, k);
+    } else {
+      form.local_load(cell, values, f, &applied, true);
+      constraints.distribute_local_to_global(f, dofs, rhs);
+    }
+  }
+  return applied;
+}
 
 }  // namespace vessel::fem::detail

@@ -136,11 +136,17 @@ void check_points_and_serial_dofs(const DistributedResult& d, const ElasticitySo
 
 /// The distributed solve over every rank and over rank 0 alone, checked against CHOLMOD (serial
 /// ElasticitySolver, direct) on rank 0: nodal displacement, contact-point displacement, applied
-/// load, reactions and strain energy.
-void check_against_serial(Load load, int degree, double nu = 0.3) {
+/// load, reactions and strain energy. `solver`: the distributed solve's (the displacement
+/// system's CG-AMG by default, or the matrix-free p-multigrid).
+void check_against_serial(Load load, int degree, double nu = 0.3,
+                          LinearSolver solver = LinearSolver::automatic) {
   const TetMesh& mesh = tube();
-  const ElasticityProblem problem = make_problem(load, degree, nu);
+  ElasticityProblem problem = make_problem(load, degree, nu);
+  problem.options.solver = solver;
   const bool mixed = nu >= problem.options.mixed_threshold;
+  const LinearSolver expected = mixed                                 ? LinearSolver::gmres_block
+                                : solver == LinearSolver::matrix_free ? solver
+                                                                      : LinearSolver::cg_amg;
   DistributedOptions opt;
   const Vec3 point(3.2e-3, 0.1e-3, 0.5 * kLength);  // inside the wall, off the nodes
   opt.evaluation_points = {point};
@@ -187,7 +193,7 @@ void check_against_serial(Load load, int degree, double nu = 0.3) {
     EXPECT_EQ(r.n_dofs, s.n_dofs);
     EXPECT_EQ(r.element, element);
     EXPECT_EQ(r.n_pressure_dofs, s.n_pressure_dofs);
-    EXPECT_EQ(r.solver, mixed ? LinearSolver::gmres_block : LinearSolver::cg_amg);
+    EXPECT_EQ(r.solver, expected);
     EXPECT_GT(r.iterations, 0u);
     ASSERT_EQ(r.nodal_displacement.size(), mesh.nodes.size());
     const double diff = max_relative_difference(r.nodal_displacement, s.nodal_displacement);
@@ -250,6 +256,21 @@ TEST(DistributedElasticity, P2PressureRollersAndPinsMatchCholmod) {
 }
 TEST(DistributedElasticity, P2PressureAndGravityClampedInletMatchCholmod) {
   check_against_serial(Load::pressure_gravity, 2);
+}
+
+// The matrix-free p-multigrid on each rank's cells (the batched kernel reading ghosts, the P1
+// level's distributed matrix and ML, the P2 -> P1 embedding across ranks) against CHOLMOD.
+TEST(DistributedElasticity, MatrixFreeP2ContactMatchesCholmodOnOneAndAllRanks) {
+  check_against_serial(Load::contact, 2, 0.3, LinearSolver::matrix_free);
+}
+TEST(DistributedElasticity, MatrixFreeP2PressureRollersAndPinsMatchCholmod) {
+  check_against_serial(Load::pressure_rollers, 2, 0.3, LinearSolver::matrix_free);
+}
+TEST(DistributedElasticity, MatrixFreeP2PressureAndGravityAtNu045MatchCholmod) {
+  check_against_serial(Load::pressure_gravity, 2, 0.45, LinearSolver::matrix_free);
+}
+TEST(DistributedElasticity, MatrixFreeP1ContactMatchesCholmodOnOneAndAllRanks) {
+  check_against_serial(Load::contact, 1, 0.3, LinearSolver::matrix_free);
 }
 
 TEST(DistributedElasticity, OtherRanksGetOnlyTheirPartAndEvaluateTheirPointsAsTheSerialSolver) {
@@ -358,6 +379,10 @@ TEST(DistributedElasticity, RefusesWhatIsNotDistributedWithClearMessages) {
   p = make_problem(Load::contact, 1);
   p.options.solver = LinearSolver::direct;
   EXPECT_NE(input_error(p).find("solver 'direct' is serial only"), std::string::npos);
+  p.options.solver = LinearSolver::matrix_free;
+  p.material.poisson_ratio = 0.5;
+  p.options.formulation = Formulation::automatic;
+  EXPECT_NE(input_error(p).find("matrix-free is for the displacement system"), std::string::npos);
   p = make_problem(Load::contact, 1);
   p.material.youngs_modulus = -1.0;
   EXPECT_NE(input_error(p).find("Young's modulus"), std::string::npos);

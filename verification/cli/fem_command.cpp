@@ -438,9 +438,10 @@ void run_distributed(const TetMesh& mesh,
                                       d.local_tets_per_rank, peak_mb};
   if (run.contact) run.contact->displacement = d.point_displacement.at(0);
   std::cout << " " << d.n_ranks << " MPI rank(s)\n";
-  std::cout << "element " << run.result.element << ": " << run.result.n_dofs << " DoFs; "
-            << fem::to_string(run.result.solver) << ", " << run.result.iterations
-            << " iterations\n  per rank: tets owned";
+  std::cout << "element " << run.result.element << ": " << run.result.n_dofs << " DoFs;";
+  print_solver(run.result);
+  std::cout << "solver " << fem::to_string(run.result.solver) << ": " << run.result.solver_reason
+            << "\n  per rank: tets owned";
   for (auto c : d.cells_per_rank) std::cout << " " << c;
   std::cout << ", held (with ghosts)";
   for (auto c : d.local_tets_per_rank) std::cout << " " << c;
@@ -728,8 +729,10 @@ void add_study_options(CLI::App* cmd, FemCommandOptions& o) {
   cmd->add_flag(
       "--distributed", o.distributed,
       "Solve in parallel over the MPI ranks (run under 'mpirun -np N'): fully distributed "
-      "mesh; P1/P2 by Trilinos CG with ML AMG, Taylor-Hood (nu >= --mixed-threshold) by FGMRES "
-      "with the block preconditioner; no --curved, --modes or --transient. Rank 0 prints and "
+      "mesh; P1/P2 by the matrix-free p-multigrid CG where auto takes it (or --solver "
+      "matrix-free), else Trilinos CG with ML AMG; Taylor-Hood (nu >= --mixed-threshold) by "
+      "FGMRES with the block preconditioner; no --curved, --modes or --transient. Rank 0 prints "
+      "and "
       "writes the files; --vtu gets the nodal displacement only");
   cmd->add_flag("--transient", o.transient,
                 "Also run the step response: the loads applied at t = 0 to the body at rest, "
