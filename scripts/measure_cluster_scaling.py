@@ -6,11 +6,14 @@ each run (the figures mean little on a busy machine: rerun it on an idle one).
 
 Usage: /usr/bin/python3 scripts/measure_cluster_scaling.py [--program build/verification/vesselverify]
            [--levels 1] [--ranks 1,2] [--cases p2,th] [--no-serial] [--length 0.04] [--out table.md]
-           [--log-dir DIR]
-Cases: p2 = P2 at nu = 0.45; th = Taylor-Hood at nu = 0.5 (serial: UMFPACK and FGMRES). --length
-gives a longer tube (metres; `fem`'s default 0.04), labelled in the case column. Needs
-mpirun and /usr/bin/time (scripts/install_deps.sh)."""
+           [--distributed-solvers cg-amg,matrix-free] [--repeat 1] [--log-dir DIR]
+Cases: p2 = P2 at nu = 0.45 (distributed: AMG-CG and the matrix-free p-multigrid CG); th =
+Taylor-Hood at nu = 0.5 (serial: UMFPACK and FGMRES; distributed: FGMRES). --length gives a
+longer tube (metres; `fem`'s default 0.04), labelled in the case column. --repeat runs the
+distributed ones that many times, the rank counts alternating (one row each: the spread is the
+machine's noise). Needs mpirun and /usr/bin/time (scripts/install_deps.sh)."""
 import argparse
+import glob
 import json
 import os
 import re
@@ -23,6 +26,7 @@ MPIRUN = ["mpirun", "--allow-run-as-root", "--oversubscribe", "--mca", "mpi_yiel
 CASES = {"p2": ["--degree", "2", "--nu", "0.45"], "th": ["--nu", "0.5"]}
 SERIAL = {"p2": [("CHOLMOD", "direct"), ("AMG-CG", "cg-amg")],
           "th": [("UMFPACK", "direct"), ("FGMRES", "gmres-block")]}
+DISTRIBUTED = {"p2": ["cg-amg", "matrix-free"], "th": ["gmres-block"]}
 
 
 def load_average():
@@ -30,17 +34,22 @@ def load_average():
         return f.read().split()[0]
 
 
-def run(command, json_path, log):
-    """Runs `command` (each process under /usr/bin/time); returns (json, "peak MiB of each rank",
-    the ranks' peaks together in bytes)."""
+def run(command, json_path, peak_base, log):
+    """Runs `command` (each process under /usr/bin/time, writing its peak to peak_base.RANK);
+    returns (json, "peak MiB of each rank", the ranks' peaks together in bytes)."""
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    for old in glob.glob(peak_base + ".*"):
+        os.remove(old)
     p = subprocess.run(command, capture_output=True, text=True, env=env)
     if log:
         with open(log, "w") as f:
             f.write(" ".join(command) + "\n" + p.stdout + p.stderr)
     if p.returncode != 0:
         sys.exit(f"failed ({p.returncode}): {' '.join(command)}\n{p.stdout}\n{p.stderr}")
-    peaks = [int(k) for k in re.findall(r"peak_kb (\d+)", p.stderr)]
+    peaks = []
+    for name in glob.glob(peak_base + ".*"):
+        with open(name) as f:
+            peaks += [int(k) for k in re.findall(r"peak_kb (\d+)", f.read())]
     with open(json_path) as f:
         return (json.load(f), "/".join(f"{k / 1024.0:.0f}" for k in sorted(peaks, reverse=True)),
                 1024 * sum(peaks))
@@ -55,10 +64,16 @@ def main():
     ap.add_argument("--no-serial", action="store_true", help="the distributed runs only")
     ap.add_argument("--length", default="", help="tube length in metres (default: fem's)")
     ap.add_argument("--out", default="")
+    ap.add_argument("--distributed-solvers", default="",
+                    help="the distributed runs' --solver values (default: the case's, above)")
+    ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--log-dir", default="", help="keep each run's command, stdout and stderr here "
                     "(with VESSELVERIFY_MEMORY=1 in the environment: each rank's memory by phase)")
     a = ap.parse_args()
-    timed = ["/usr/bin/time", "-f", "peak_kb %M", a.program]
+    # Each rank's /usr/bin/time to its own file: on a shared stderr the ranks' lines interleave.
+    peak_base = os.path.join(tempfile.gettempdir(), f"cluster_scaling_peak_{os.getpid()}")
+    timed = ["sh", "-c", '/usr/bin/time -f "peak_kb %M" -o "$0.${OMPI_COMM_WORLD_RANK:-0}" "$@"',
+             peak_base, a.program]
     rows = ["| case | level | solver | ranks | DoFs | iterations | setup s | assembly s | solve s | "
             "peak MiB per rank | kB per DoF (all ranks) | load avg before/after |",
             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
@@ -73,13 +88,17 @@ def main():
                     label = f"{case} ({a.length} m)"
                 runs = [] if a.no_serial else [(name, 1, timed + base + ["--solver", s])
                                                for name, s in SERIAL[case]]
+                solvers = (a.distributed_solvers.split(",") if a.distributed_solvers
+                           else DISTRIBUTED[case])
                 runs += [("distributed", int(n), MPIRUN + ["-np", n] + timed + base +
-                          ["--distributed"]) for n in a.ranks.split(",")]
-                for name, n, command in runs:
+                          ["--distributed", "--solver", s])
+                         for s in solvers for _ in range(a.repeat) for n in a.ranks.split(",")]
+                for k, (name, n, command) in enumerate(runs):
                     before = load_average()
-                    log = (os.path.join(a.log_dir, f"{case}-l{level}-{name.lower()}-np{n}.log")
+                    log = (os.path.join(a.log_dir,
+                                        f"{case}-l{level}-{k:02d}-{name.lower()}-np{n}.log")
                            if a.log_dir else "")
-                    j, peak, total = run(command, out, log)
+                    j, peak, total = run(command, out, peak_base, log)
                     t = j["timings_s"]
                     rows.append(f"| {label} | {level} | {name} ({j['solver']}) | {n} | {j['dofs']} | "
                                 f"{j['cg_iterations']} | {t['setup']:.2f} | {t['assembly']:.2f} | "
