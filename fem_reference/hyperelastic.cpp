@@ -101,8 +101,13 @@ struct HyperelasticSolver::Impl {
   double inv_lambda = 0.0;
   bool mixed = false;
   bool symmetric = true;            // false with follower pressure (its tangent is not symmetric)
-  /// The Newton systems by the matrix-free p-multigrid on the tangent (solver matrix-free).
+  /// The Newton systems by the matrix-free p-multigrid on the tangent (solver matrix-free, or
+  /// automatic where the linear reference's rule takes it).
   bool matrix_free = false;
+  /// matrix_free by `automatic`: a Krylov failure (an indefinite tangent) moves the solve to the
+  /// assembled tangent instead of failing the Newton step.
+  bool assembled_fallback = false;
+  std::string solver_reason;        // why the Newton systems are solved as they are
   std::vector<unsigned> component;  // per DoF: 0..2 displacement, 3 pressure
   std::vector<Index> constrained;   // constrained DoFs
   std::vector<double> prescribed;   // their values at load factor 1
@@ -118,9 +123,23 @@ struct HyperelasticSolver::Impl {
     material = NeoHookean::of(d.problem.material);
     mixed = d.mixed;
     d.tangent_systems = true;
-    // Only where requested: a Newton iterate's tangent can be indefinite (a compressed or
-    // buckling wall), where CG fails and the step is halved; the direct path falls back to LU.
-    matrix_free = d.problem.options.solver == LinearSolver::matrix_free;
+    // Where requested, or where `automatic` takes it for the linear reference (P2 on
+    // straight-sided tets from matrix_free_min_dofs: finite strain at P2 level 1 17x faster
+    // than UMFPACK in 1/18 of its memory, docs/measurements/finite_strain_solvers.md). A Newton
+    // iterate's tangent can be indefinite (a compressed or buckling wall), where CG fails: a
+    // requested matrix-free solve then halves the step; an automatic one moves to the
+    // assembled tangent (LU where CHOLMOD refuses it) for the rest of the solve.
+    const bool requested = d.problem.options.solver == LinearSolver::matrix_free;
+    assembled_fallback = d.problem.options.solver == LinearSolver::automatic && !d.mixed &&
+                         d.linear_choice.solver == LinearSolver::matrix_free;
+    matrix_free = requested || assembled_fallback;
+    if (assembled_fallback) {
+      solver_reason = d.linear_choice.reason +
+                      "; the Newton systems on the matrix-free tangent, the assembled one if its "
+                      "Krylov solve fails";
+    } else if (requested) {
+      solver_reason = d.linear_choice.reason;
+    }
     if (!matrix_free) d.ensure_matrix();
     inv_lambda = std::isinf(material.lambda) ? 0.0 : 1.0 / material.lambda;
     symmetric = !(opt.follower_pressure && !d.problem.pressures.empty());
@@ -508,13 +527,25 @@ struct HyperelasticSolver::Impl {
     std::string reason;
   };
 
-  /// The assembled Newton system into d.solution: matrix-free, or directly. Away from
+  /// The assembled Newton system at (u, s) into d.solution: matrix-free, or directly. Away from
   /// equilibrium (a Newton iterate after a large increment) the symmetric tangent can be
   /// indefinite, which CHOLMOD refuses: LU (UMFPACK) solves it.
-  void solve_newton_system(const AddedMatrix& follower) {
+  void solve_newton_system(const AddedMatrix& follower, double s) {
     if (matrix_free) {
-      solve_tangent_matrix_free(follower);
-      return;
+      try {
+        solve_tangent_matrix_free(follower);
+        return;
+      } catch (const std::runtime_error& e) {
+        if (!assembled_fallback) throw;
+        // This system and the rest of the solve on the assembled tangent (the same system:
+        // the prescribed increment is in the constraints already).
+        matrix_free = false;
+        solver_reason +=
+            std::string("; it failed (") + e.what() + "): the assembled tangent from then on";
+        d.ensure_matrix();
+        Norms norms;
+        assemble(u, s, true, norms);
+      }
     }
     try {
       d.solve_linear(symmetric, DirectReuse::analysis);
@@ -552,7 +583,7 @@ struct HyperelasticSolver::Impl {
       if (it == opt.max_newton_iterations) break;
       const auto t0 = Clock::now();
       try {
-        solve_newton_system(follower);
+        solve_newton_system(follower, s1);
       } catch (const std::exception& e) {
         result.timings.solve += seconds_since(t0);
         out.reason = std::string("the linear solve failed: ") + e.what();
@@ -562,7 +593,7 @@ struct HyperelasticSolver::Impl {
       result.timings.solve += seconds_since(t0);
       result.linear_iterations += d.result.iterations;
       result.solver = d.result.solver;
-      result.solver_reason = matrix_free ? d.linear_choice.reason : d.result.solver_reason;
+      result.solver_reason = solver_reason.empty() ? d.result.solver_reason : solver_reason;
       ++result.newton_iterations;
       out.iterations = it + 1;
       if (predictor) {

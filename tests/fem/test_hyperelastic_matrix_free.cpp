@@ -205,3 +205,53 @@ TEST(HyperelasticMatrixFree, NewtonReachesTheDirectSolversEquilibriumOnATube) {
     EXPECT_NEAR(rm.strain_energy, rd.strain_energy, 1e-8 * rd.strain_energy);
   }
 }
+
+TEST(HyperelasticMatrixFree, AutomaticTakesItAndMovesToTheAssembledTangentWhenItsKrylovSolveFails) {
+  // The tube above (follower pressure: FGMRES) under `automatic` with the matrix-free switch at
+  // one DoF, so the linear reference's rule takes the matrix-free solve here. With the Krylov
+  // solver allowed 3 iterations the first Newton system fails: the solve must move to the
+  // assembled tangent (UMFPACK, which max_iterations does not bound) and reach the direct
+  // solver's equilibrium; with the default cap it stays matrix-free.
+  const auto problem = [](LinearSolver solver, unsigned max_iterations) {
+    ElasticityProblem p;
+    p.material.poisson_ratio = 0.45;
+    p.options.degree = 2;
+    p.options.solver = solver;
+    p.options.matrix_free_min_dofs = 1;
+    p.options.max_iterations = max_iterations;
+    p.dirichlet = {
+        DirichletCondition::clamped("inlet"),
+        DirichletCondition::clamped("outlet", [](const Vec3&) { return Vec3(0.0, 0.0, 0.3e-3); })};
+    p.pressures = {{"inner_wall", 1000.0}};
+    return p;
+  };
+  HyperelasticOptions o;
+  o.follower_pressure = true;
+  HyperelasticSolver direct(test::short_tube_mesh(0), problem(LinearSolver::direct, 5000), o);
+  const auto& rd = direct.solve();
+  ASSERT_TRUE(rd.completed) << rd.stop_reason;
+  double scale = 0.0;
+  for (const auto& x : rd.nodal_displacement) scale = std::max(scale, x.norm());
+  for (const unsigned cap : {5000U, 3U}) {
+    SCOPED_TRACE("max_iterations " + std::to_string(cap));
+    HyperelasticSolver automatic(test::short_tube_mesh(0), problem(LinearSolver::automatic, cap),
+                                 o);
+    const auto& ra = automatic.solve();
+    ASSERT_TRUE(ra.completed) << ra.stop_reason;
+    std::cout << "  automatic, Krylov cap " << cap << ": " << to_string(ra.solver) << " ("
+              << ra.solver_reason << ")\n";
+    EXPECT_EQ(ra.solver_reason.rfind("auto:", 0), 0U) << ra.solver_reason;
+    if (cap == 3U) {
+      EXPECT_EQ(ra.solver, LinearSolver::direct);
+      EXPECT_NE(ra.solver_reason.find("the assembled tangent from then on"), std::string::npos);
+      EXPECT_EQ(ra.newton_iterations, rd.newton_iterations);
+    } else {
+      EXPECT_EQ(ra.solver, LinearSolver::matrix_free);
+    }
+    double diff = 0.0;
+    for (std::size_t i = 0; i < rd.nodal_displacement.size(); ++i) {
+      diff = std::max(diff, (ra.nodal_displacement[i] - rd.nodal_displacement[i]).norm());
+    }
+    EXPECT_LT(diff / scale, 1e-8);
+  }
+}
