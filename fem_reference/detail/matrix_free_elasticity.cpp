@@ -905,40 +905,8 @@ class MatrixFreeElasticitySolver::VCycle {
       eigenvalue_seconds_ = fine.seconds() - seconds_before;
       profile.chebyshev_degree = settings.chebyshev_degree;
     }
-    coarse_matrix_ = std::make_unique<dl::TrilinosWrappers::SparseMatrix>();
-    coarse->compute_matrix(*coarse_matrix_);
-    profile.coarse_matrix = lap();
-    // For P1 the "coarse" level is the fine one: a factor of it would make the matrix-free
-    // operator pointless, so P1 always takes one ML V-cycle.
-    method_ = degree == 1 ? CoarseSolve::ml_vcycle : settings.coarse;
-    const bool distributed =
-        dl::Utilities::MPI::n_mpi_processes(coarse->partitioner().get_mpi_communicator()) > 1;
-    if (method_ == CoarseSolve::automatic) {
-      method_ = coarse->m() <= settings.direct_coarse_max_dofs && !distributed
-                    ? CoarseSolve::cholmod
-                    : CoarseSolve::ml_cg;
-    }
-    if (method_ == CoarseSolve::cholmod && distributed) {
-      throw std::invalid_argument("p-multigrid: the CHOLMOD coarse solve is serial only");
-    }
-    coarse_tolerance_ = settings.coarse_tolerance;
-    profile.coarse_method = method_ == CoarseSolve::cholmod     ? "CHOLMOD"
-                            : method_ == CoarseSolve::ml_vcycle ? "one ML V-cycle"
-                                                                : "ML-CG";
-    if (method_ == CoarseSolve::cholmod) {
-      cholmod_ = std::make_unique<CholmodFactor>(to_eigen(*coarse_matrix_));
-      coarse_matrix_.reset();
-      profile.coarse_factor = lap();
-      return;
-    }
-    // The ML near-null space: the rigid-body modes at the P1 DoFs' support points.
-    const auto& level_dof = degree > 1 ? coarse_dof_ : dof;
-    const DisplacementRows rows =
-        displacement_rows(mapping, level_dof, level_dof.locally_owned_dofs());
-    initialize_elasticity_amg(amg_, *coarse_matrix_, rows, centre, false,
-                              settings.amg_rigid_body_modes, settings.amg_prolongator,
-                              mode_storage_, settings.amg_aggregation_threshold, distributed);
-    profile.coarse_factor = lap();
+    set_up_coarse_solve(mapping, degree > 1 ? coarse_dof_ : dof, *coarse, degree, centre, settings,
+                        profile);
   }
 
   void vmult(MfVector& dst, const MfVector& src) const {
@@ -1001,6 +969,46 @@ class MatrixFreeElasticitySolver::VCycle {
  private:
   using Chebyshev =
       dl::PreconditionChebyshev<ElasticityOperator, MfVector, dl::DiagonalMatrix<MfVector>>;
+
+  /// The P1 level's matrix (the fine one for P1) and its solver as `settings` say: a CHOLMOD
+  /// factor (serial only) or ML with the rigid-body modes at `level_dof`'s support points.
+  void set_up_coarse_solve(const dl::Mapping<kDim>& mapping, const dl::DoFHandler<kDim>& level_dof,
+                           const ElasticityOperator& coarse, int degree, const Vec3& centre,
+                           const PMultigridSettings& settings, MatrixFreeProfile& profile) {
+    auto t0 = Clock::now();
+    coarse_matrix_ = std::make_unique<dl::TrilinosWrappers::SparseMatrix>();
+    coarse.compute_matrix(*coarse_matrix_);
+    profile.coarse_matrix = seconds_since(t0);
+    t0 = Clock::now();
+    // For P1 the "coarse" level is the fine one: a factor of it would make the matrix-free
+    // operator pointless, so P1 always takes one ML V-cycle.
+    method_ = degree == 1 ? CoarseSolve::ml_vcycle : settings.coarse;
+    const bool distributed =
+        dl::Utilities::MPI::n_mpi_processes(coarse.partitioner().get_mpi_communicator()) > 1;
+    if (method_ == CoarseSolve::automatic) {
+      method_ = coarse.m() <= settings.direct_coarse_max_dofs && !distributed ? CoarseSolve::cholmod
+                                                                              : CoarseSolve::ml_cg;
+    }
+    if (method_ == CoarseSolve::cholmod && distributed) {
+      throw std::invalid_argument("p-multigrid: the CHOLMOD coarse solve is serial only");
+    }
+    coarse_tolerance_ = settings.coarse_tolerance;
+    profile.coarse_method = method_ == CoarseSolve::cholmod     ? "CHOLMOD"
+                            : method_ == CoarseSolve::ml_vcycle ? "one ML V-cycle"
+                                                                : "ML-CG";
+    if (method_ == CoarseSolve::cholmod) {
+      cholmod_ = std::make_unique<CholmodFactor>(to_eigen(*coarse_matrix_));
+      coarse_matrix_.reset();
+    } else {
+      // The ML near-null space: the rigid-body modes at the P1 DoFs' support points.
+      const DisplacementRows rows =
+          displacement_rows(mapping, level_dof, level_dof.locally_owned_dofs());
+      initialize_elasticity_amg(amg_, *coarse_matrix_, rows, centre, false,
+                                settings.amg_rigid_body_modes, settings.amg_prolongator,
+                                mode_storage_, settings.amg_aggregation_threshold, distributed);
+    }
+    profile.coarse_factor = seconds_since(t0);
+  }
 
   /// x ≈ A₁⁻¹ b on the P1 level (on the fine level itself for P1).
   void coarse_solve(MfVector& x, const MfVector& b) const {
