@@ -123,26 +123,29 @@ struct HyperelasticSolver::Impl {
     material = NeoHookean::of(d.problem.material);
     mixed = d.mixed;
     d.tangent_systems = true;
-    // Where requested, or where `automatic` takes it for the linear reference (P2 on
-    // straight-sided tets from matrix_free_min_dofs: finite strain at P2 level 1 17x faster
-    // than UMFPACK in 1/18 of its memory, docs/measurements/finite_strain_solvers.md). A Newton
-    // iterate's tangent can be indefinite (a compressed or buckling wall), where CG fails: a
-    // requested matrix-free solve then halves the step; an automatic one moves to the
-    // assembled tangent (LU where CHOLMOD refuses it) for the rest of the solve.
+    inv_lambda = std::isinf(material.lambda) ? 0.0 : 1.0 / material.lambda;
+    symmetric = !(opt.follower_pressure && !d.problem.pressures.empty());
+    // Where requested, or under `automatic` for the unsymmetric tangent (follower pressure:
+    // UMFPACK otherwise) where `automatic` takes the linear reference's matrix-free solve (P2 on
+    // straight-sided tets from matrix_free_min_dofs): 2x faster than UMFPACK at P2 level 0, 17x
+    // at level 1 in 1/18 of its memory (docs/measurements/finite_strain_solvers.md). The
+    // symmetric tangent keeps CHOLMOD, whose symbolic analysis is reused over the Newton
+    // systems: on the main job's contact references (P2 level 0, 40 Newton systems) the
+    // matrix-free solves took twice as long. A Newton iterate's tangent can be indefinite (a
+    // compressed or buckling wall), where the Krylov solve fails: a requested matrix-free solve
+    // then halves the step; an automatic one moves to the assembled tangent for the rest.
     const bool requested = d.problem.options.solver == LinearSolver::matrix_free;
     assembled_fallback = d.problem.options.solver == LinearSolver::automatic && !d.mixed &&
-                         d.linear_choice.solver == LinearSolver::matrix_free;
+                         !symmetric && d.linear_choice.solver == LinearSolver::matrix_free;
     matrix_free = requested || assembled_fallback;
     if (assembled_fallback) {
       solver_reason = d.linear_choice.reason +
-                      "; the Newton systems on the matrix-free tangent, the assembled one if its "
-                      "Krylov solve fails";
+                      "; follower pressure: the Newton systems on the matrix-free tangent, the "
+                      "assembled one if its Krylov solve fails";
     } else if (requested) {
       solver_reason = d.linear_choice.reason;
     }
     if (!matrix_free) d.ensure_matrix();
-    inv_lambda = std::isinf(material.lambda) ? 0.0 : 1.0 / material.lambda;
-    symmetric = !(opt.follower_pressure && !d.problem.pressures.empty());
     component = d.dof_components();
     free_index.assign(d.dof.n_dofs(), -1);
     for (Index i = 0; i < d.dof.n_dofs(); ++i) {

@@ -206,12 +206,14 @@ TEST(HyperelasticMatrixFree, NewtonReachesTheDirectSolversEquilibriumOnATube) {
   }
 }
 
-TEST(HyperelasticMatrixFree, AutomaticTakesItAndMovesToTheAssembledTangentWhenItsKrylovSolveFails) {
+TEST(HyperelasticMatrixFree,
+     AutomaticTakesItForFollowerPressureAndMovesToTheAssembledTangentWhenItsKrylovSolveFails) {
   // The tube above (follower pressure: FGMRES) under `automatic` with the matrix-free switch at
   // one DoF, so the linear reference's rule takes the matrix-free solve here. With the Krylov
   // solver allowed 3 iterations the first Newton system fails: the solve must move to the
   // assembled tangent (UMFPACK, which max_iterations does not bound) and reach the direct
-  // solver's equilibrium; with the default cap it stays matrix-free.
+  // solver's equilibrium; with the default cap it stays matrix-free. The symmetric tangent (a
+  // dead pressure) keeps the assembled path (CHOLMOD).
   const auto problem = [](LinearSolver solver, unsigned max_iterations) {
     ElasticityProblem p;
     p.material.poisson_ratio = 0.45;
@@ -254,4 +256,11 @@ TEST(HyperelasticMatrixFree, AutomaticTakesItAndMovesToTheAssembledTangentWhenIt
     }
     EXPECT_LT(diff / scale, 1e-8);
   }
+  HyperelasticOptions dead_load;
+  dead_load.follower_pressure = false;
+  HyperelasticSolver dead(test::short_tube_mesh(0), problem(LinearSolver::automatic, 5000),
+                          dead_load);
+  const auto& rs = dead.solve();
+  ASSERT_TRUE(rs.completed) << rs.stop_reason;
+  EXPECT_EQ(rs.solver, LinearSolver::direct) << rs.solver_reason;
 }

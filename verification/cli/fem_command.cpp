@@ -681,8 +681,8 @@ void add_solver_options(CLI::App* cmd, FemCommandOptions& o) {
                   "the matrix-free operator: for P2 a P2->P1 p-multigrid with ML-CG on P1, for "
                   "P1 ML; displacement system; with --reference finite-strain the Newton "
                   "systems on the matrix-free neo-Hookean tangent, FGMRES with follower "
-                  "pressure; auto takes it where it takes the linear solve, the assembled "
-                  "tangent if a Krylov solve fails)")
+                  "pressure; auto takes it there with follower pressure where it takes the "
+                  "linear solve, the assembled tangent if a Krylov solve fails)")
       ->check(CLI::IsMember({"auto", "direct", "cg-amg", "gmres-block", "matrix-free"}))
       ->capture_default_str();
   cmd->add_option("--direct-max-dofs", o.direct_max_dofs,
