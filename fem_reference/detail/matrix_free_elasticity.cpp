@@ -1041,7 +1041,7 @@ class MatrixFreeElasticitySolver::VCycle {
   dl::DoFHandler<kDim> coarse_dof_;
   dl::AffineConstraints<double> coarse_constraints_;
   std::unique_ptr<ElasticityOperator> coarse_;
-  std::optional<P1ToP2Embedding> embedding_;         // both levels plain_indexable
+  std::optional<P1ToP2Embedding> embedding_;         // both levels fixes_values_only
   dl::MGTwoLevelTransfer<kDim, MfVector> transfer_;  // otherwise
   std::shared_ptr<dl::DiagonalMatrix<MfVector>> inverse_diagonal_;
   Chebyshev chebyshev_;
