@@ -25,7 +25,6 @@ constexpr double kXpbdRelaxStep = 1e-3;
 constexpr double kXpbdRelaxDamping = 0.3;
 constexpr int kXpbdMaxRelaxSteps = 20000;  // ≤ 900 taken on the guidewire scenes
 
-/// The parametric vessel's lumen for a centreline kept within `offset` (m) of the vessel's.
 std::unique_ptr<rods::RigidLumen> rigid_lumen(const VesselParams& vessel, double offset) {
   if (vessel.kind == VesselKind::straight) {
     return std::make_unique<rods::StraightTube>(Vec3::Zero(), Vec3::UnitZ(), offset);

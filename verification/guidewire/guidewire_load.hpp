@@ -21,6 +21,7 @@
 #include <string>
 
 #include "meshes/vessel_geometry.hpp"
+#include "msm/rods/rigid_wall.hpp"
 #include "msm/rods/rod_layout.hpp"
 #include "verification/guidewire/guidewire_spec.hpp"
 
@@ -102,6 +103,10 @@ void set_tilted_clamp(const VesselParams& vessel, double tilt, const Vec3& towar
 /// the GuidewireSolver's constructor too.
 void check_guidewire(const VesselParams& vessel, const GuidewireSpec& spec,
                      const std::string& key_prefix = "load.");
+
+/// The parametric vessel's lumen for a centreline kept within `offset` (m) of the vessel's (the
+/// inner wall itself at offset = inner radius): its gap is + inside, − beyond, ∇g of unit length.
+std::unique_ptr<msm::rods::RigidLumen> rigid_lumen(const VesselParams& vessel, double offset);
 
 /// What solve_guidewire_load would run for `spec`, one line (for `vesselverify scene`, which
 /// runs nothing).

@@ -112,6 +112,40 @@ bool inside_any(const std::vector<RefinedBall>& balls, const Vec3& p) {
                      [&](const RefinedBall& b) { return (p - b.centre).norm() <= b.radius; });
 }
 
+/// The inner wall a wire may bear on, as points a kAlongWireRadius ball apart: under the two
+/// shapes that bracket a wire's on a deformable wall, its rigid-lumen shape (the wall infinitely
+/// stiff) and the straight wire along the clamp (the wire infinitely stiff), wherever they come
+/// within kNearWall of the wall or beyond it; each point the radial projection onto the lumen's
+/// wall of a point sampled along a shape. A stiff wire straightens as the soft wall gives and
+/// bears along its body: refined only where one solve crossed, the next crosses further along.
+std::vector<Vec3> bearing_band(const Scene& scene, const ReferenceWire& wire) {
+  const auto lumen = rigid_lumen(scene.vessel, scene.vessel.inner_radius);
+  std::vector<Vec3> shape;  // the two shapes, sampled a half ball apart
+  const double spacing = 0.5 * kAlongWireRadius;
+  auto sample = [&](const Vec3& a, const Vec3& b) {
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing)));
+    for (int k = 0; k < n; ++k) shape.push_back(a + (b - a) * (static_cast<double>(k) / n));
+  };
+  const msm::rods::RodLayout& layout = wire.rod.layout();
+  for (int i = layout.first_node; i < layout.tip_node; ++i) {
+    sample(wire.rigid_state.segment<3>(3 * i), wire.rigid_state.segment<3>(3 * i + 3));
+  }
+  const Vec3 clamp = wire.spec.clamp_point, t = wire.spec.clamp_direction.normalized();
+  sample(clamp, clamp + wire.spec.insertion * t);
+  std::vector<Vec3> band;
+  for (const Vec3& p : shape) {
+    Vec3 gradient;
+    const double g = lumen->gap(p, &gradient, nullptr);
+    if (g > kNearWall) continue;
+    const Vec3 on_wall = p + g * gradient;  // g = a − distance from the axis, |∇g| = 1
+    const bool near = std::any_of(band.begin(), band.end(), [&](const Vec3& q) {
+      return (q - on_wall).norm() < 0.5 * kAlongWireRadius;
+    });
+    if (!near) band.push_back(on_wall);
+  }
+  return band;
+}
+
 /// The zone of a solved contact: the pressed nodes (mesh indices) with their forces, the wall's
 /// displacement at every mesh node.
 void describe_zone(const TetMesh& mesh, const std::vector<int>& pressed,
@@ -327,9 +361,9 @@ constexpr int kScoutSolves = 4;
 /// The scout: the coarsest level refined at the rigid wall point finds the zone (r.scout,
 /// r.patch_centre, r.patch_radius, r.refined_along_wire). A wire that passed between the wall's
 /// nodes elsewhere (a stiff wire's body, straightened as the wall gives) is scouted again with
-/// the wall also refined around the inner-wall nodes nearest its centreline nodes near the wall,
-/// up to kScoutSolves solves in all. Returns the balls every level is refined in: the zone's first,
-/// then those along the wire.
+/// the wall also refined along the band it may bear on (bearing_band) and around the inner-wall
+/// nodes nearest its centreline nodes near the wall, up to kScoutSolves solves in all. Returns the
+/// balls every level is refined in: the zone's first, then those along the wire.
 std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
                                const Vec3& wall_point, double force_scale,
                                const ContactReferenceOptions& o, ContactReference& r) {
@@ -340,6 +374,10 @@ std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
     r.scout = solve_level(scene, wire, r.poisson_ratio, o.coarsest_size, balls, wall_point,
                           force_scale, o, &near_wall);
     const std::size_t before = balls.size();
+    if (!near_wall.empty() && solve == 1) {
+      const std::vector<Vec3> band = bearing_band(scene, wire);
+      near_wall.insert(near_wall.end(), band.begin(), band.end());
+    }
     for (const Vec3& p : near_wall) {
       if (!inside_any(balls, p)) balls.push_back({p, kAlongWireRadius});
     }
@@ -489,7 +527,8 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
       << fixed(r.patch_centre.z() * 1e3, 3) << ") mm"
       << (r.refined_along_wire > 0 ? " and within " + fixed(kAlongWireRadius * 1e3, 1) + " mm of " +
                                          std::to_string(r.refined_along_wire) +
-                                         " inner-wall nodes under scout wires that crossed the wall"
+                                         " inner-wall points along the band the wire may bear "
+                                         "on, after a scout wire crossed the wall"
                                    : std::string())
       << " (the zone of a scout solve at " << fixed(r.scout.fine_size * 1e3, 3)
       << " mm within 1 mm of the rigid wall point: "
