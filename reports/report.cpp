@@ -14,6 +14,7 @@
 #include "meshes/mesh_quality.hpp"
 #include "reports/best_model.hpp"
 #include "reports/guidewire_section.hpp"
+#include "reports/insertion_section.hpp"
 #include "reports/modal_section.hpp"
 #include "reports/representative_load.hpp"
 #include "reports/scene_card.hpp"
@@ -560,9 +561,9 @@ double representative_load(const SceneRows& s) {
 }
 
 Document build_report(const ResultsFile& r, const std::optional<StabilityFile>& stability,
-                      const std::string& command,
-                      const std::vector<RecommendFile>& recommendations,
-                      const std::optional<ValidityFile>& validity) {
+                      const std::string& command, const std::vector<RecommendFile>& recommendations,
+                      const std::optional<ValidityFile>& validity,
+                      const std::optional<InsertionFile>& insertion) {
   Document doc;
   doc.heading(1, "vesselverify report");
   doc.paragraph("How wrong, and how fast, is each mass-spring vessel model against linear-elastic "
@@ -600,6 +601,7 @@ Document build_report(const ResultsFile& r, const std::optional<StabilityFile>& 
   best_model_section(doc, r);
   SeriesStyles styles(r);
   for (const auto& s : r.scenes) scene_section(doc, s, styles);
+  if (insertion) insertion_section(doc, *insertion);
   for (const auto& recommendation : recommendations) recommendation_section(doc, recommendation);
   if (validity) validity_section(doc, *validity);
   if (stability) {
@@ -637,7 +639,10 @@ void write_report(const ReportOptions& o) {
   }
   std::optional<ValidityFile> validity;
   if (!o.validity.empty()) validity = read_validity(o.validity);
-  const Document doc = build_report(results, stability, o.command, recommendations, validity);
+  std::optional<InsertionFile> insertion;
+  if (!o.insertion.empty()) insertion = read_insertion(o.insertion);
+  const Document doc =
+      build_report(results, stability, o.command, recommendations, validity, insertion);
   std::error_code ec;
   std::filesystem::create_directories(o.output_dir / "figures", ec);
   if (ec) {

@@ -23,16 +23,19 @@ struct ReportOptions {
   /// results.json its run wrote beside it, when there, names the load unit and the reference.
   std::vector<std::filesystem::path> recommend;
   std::filesystem::path validity;  ///< validity.json of `vesselverify validity` (optional)
+  std::filesystem::path insertion;   ///< of `vesselverify insertion --json` (optional)
   std::filesystem::path output_dir;  ///< report.md, report.html, figures/
   std::string command;               ///< the command line that makes the report
 };
 
-/// The report's content: the summary and every scene of `results`, a section per
-/// recommendation, then the stability section (absent: a note says it was not run).
+/// The report's content: the summary and every scene of `results`, the guidewire's insertion, a
+/// section per recommendation, the validity study, then the stability section (absent: a note
+/// says it was not run).
 Document build_report(const ResultsFile& results, const std::optional<StabilityFile>& stability,
                       const std::string& command,
                       const std::vector<RecommendFile>& recommendations = {},
-                      const std::optional<ValidityFile>& validity = std::nullopt);
+                      const std::optional<ValidityFile>& validity = std::nullopt,
+                      const std::optional<InsertionFile>& insertion = std::nullopt);
 
 /// Fills in what recommend.json leaves to its run's results.json: the scene's load unit and the
 /// reference element at each Poisson's ratio (matched by scene name and ν).

@@ -285,6 +285,51 @@ ValiditySceneEntry read_validity_scene(const json& j, const std::string& where) 
   return e;
 }
 
+std::array<double, 3> read_vector(const json& j, const char* key, const std::string& where) {
+  const auto v = field<std::vector<double>>(j, key, where);
+  if (v.size() != 3) throw InputError(where + ": " + key + " needs 3 numbers");
+  return {v[0], v[1], v[2]};
+}
+
+InsertionZoneEntry read_insertion_zone(const json& j, const std::string& where) {
+  InsertionZoneEntry z;
+  z.force = field<double>(j, "force_N", where);
+  z.centroid = read_vector(j, "centroid_m", where);
+  z.extent = field<double>(j, "extent_m", where);
+  z.nodes = field<int>(j, "nodes", where);
+  return z;
+}
+
+InsertionStepEntry read_insertion_step(const json& j, const std::string& where) {
+  InsertionStepEntry s;
+  s.insertion = field<double>(j, "insertion_m", where);
+  s.converged = field<bool>(j, "converged", where);
+  s.failure = field<std::string>(j, "failure", where);
+  s.force = field<double>(j, "force_N", where);
+  s.pressed = field<int>(j, "pressed", where);
+  s.zones = read_array(j, "zones", where, read_insertion_zone);
+  s.clamp_axial = field<double>(j, "clamp_axial_N", where);
+  s.push = field<double>(j, "push_N", where);
+  s.push_by_energy = optional_field<double>(j, "push_by_energy_N", where);
+  s.tip = read_vector(j, "tip_m", where);
+  s.dent = field<double>(j, "dent_m", where);
+  s.newton_steps = field<int>(j, "newton_steps", where);
+  s.seconds = field<double>(j, "seconds", where);
+  return s;
+}
+
+InsertionEntry read_insertion_entry(const json& j, const std::string& where) {
+  InsertionEntry e;
+  e.scene = field<std::string>(j, "scene", where);
+  e.wall = field<std::string>(j, "wall", where);
+  e.bending_stiffness = field<double>(j, "bending_stiffness_Nm2", where);
+  e.mesh_nodes = field<int>(j, "mesh_nodes", where);
+  e.refined_balls = field<int>(j, "refined_balls", where);
+  e.mesh_seconds = field<double>(j, "mesh_seconds", where);
+  e.steps = read_array(j, "steps", where, read_insertion_step);
+  return e;
+}
+
 }  // namespace
 
 ValidityFile parse_validity(const std::string& text, const std::filesystem::path& source) {
@@ -423,5 +468,21 @@ CalibrateFile read_calibrate(const std::filesystem::path& path) {
 }
 
 std::string validity_view_slot(const std::string& scene) { return "view:validity-" + scene; }
+
+InsertionFile parse_insertion(const std::string& text, const std::filesystem::path& source) {
+  const std::string file = source.string();
+  const json j = json_fields::parse_versioned(text, file, "vesselverify.insertion", 1,
+                                              "insertion file", "vesselverify insertion --json");
+  InsertionFile f;
+  f.path = source;
+  f.command = field<std::string>(j, "command", file);
+  f.total_seconds = field<double>(j, "total_seconds", file);
+  f.insertions = read_array(j, "insertions", file, read_insertion_entry);
+  return f;
+}
+
+InsertionFile read_insertion(const std::filesystem::path& path) {
+  return parse_insertion(json_fields::read_text(path, "insertion file"), path);
+}
 
 }  // namespace vessel::reports

@@ -4,6 +4,7 @@
 /// validity.json of `vesselverify validity` and the calibration study of `vesselverify calibrate`
 /// (each "vesselverify.<study>", version 1, with its JSON Schema in its study's folder,
 /// verification/studies/<study>/<study>.schema.json). Only what the report shows is read.
+#include <array>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -245,6 +246,47 @@ struct CalibrateFile {
   std::vector<CalibrationCaseEntry> cases;
 };
 
+/// The insertion of `vesselverify insertion --json` (schema "vesselverify.insertion", version 1;
+/// verification/harness/contact_insertion.schema.json): per wire stiffness, each step's contact
+/// forces and zones and the hub's forces, SI units.
+struct InsertionZoneEntry {
+  double force = 0.0;                ///< N
+  std::array<double, 3> centroid{};  ///< m
+  double extent = 0.0;               ///< m
+  int nodes = 0;
+};
+
+struct InsertionStepEntry {
+  double insertion = 0.0;  ///< m
+  bool converged = false;
+  std::string failure;
+  double force = 0.0;  ///< N
+  int pressed = 0;
+  std::vector<InsertionZoneEntry> zones;
+  double clamp_axial = 0.0;              ///< R·t, N
+  double push = 0.0;                     ///< R·t − M²/(2EI), N
+  std::optional<double> push_by_energy;  ///< dΠ/dL, N (none next to a failed step)
+  std::array<double, 3> tip{};           ///< m
+  double dent = 0.0;                     ///< m
+  int newton_steps = 0;
+  double seconds = 0.0;
+};
+
+struct InsertionEntry {
+  std::string scene, wall;
+  double bending_stiffness = 0.0;  ///< EI, N·m²
+  int mesh_nodes = 0, refined_balls = 0;
+  double mesh_seconds = 0.0;
+  std::vector<InsertionStepEntry> steps;
+};
+
+struct InsertionFile {
+  std::filesystem::path path;
+  std::string command;
+  double total_seconds = 0.0;
+  std::vector<InsertionEntry> insertions;
+};
+
 /// Reads and checks a stability file; InputError naming the file and what is wrong (missing file,
 /// not JSON, another schema or version, a missing field).
 StabilityFile read_stability(const std::filesystem::path& path);
@@ -261,5 +303,9 @@ ValidityFile parse_validity(const std::string& text, const std::filesystem::path
 /// Reads and checks a calibration study; InputError as read_stability.
 CalibrateFile read_calibrate(const std::filesystem::path& path);
 CalibrateFile parse_calibrate(const std::string& text, const std::filesystem::path& source);
+
+/// Reads and checks an insertion file; InputError as read_stability.
+InsertionFile read_insertion(const std::filesystem::path& path);
+InsertionFile parse_insertion(const std::string& text, const std::filesystem::path& source);
 
 }  // namespace vessel::reports

@@ -13,9 +13,11 @@
 #      stability.json, stability.md;
 #   5. `vesselverify recommend` on the two contact scenes at 30 Hz (visual) and 1 kHz (haptic):
 #      the cheapest model meeting each scene's [budget] → recommend/<scene>/<rate>hz/;
-#   6. `vesselverify report` → report.md, report.html (self-contained) and figures/, with the
-#      stability, recommendation and validity sections drawn from stability.json, each
-#      recommend.json and validity.json.
+#   6. `vesselverify insertion` (not in --quick): the straight scene's floppy guidewire pushed in
+#      against the finite-strain wall in steps → insertion.json, insertion.md;
+#   7. `vesselverify report` → report.md, report.html (self-contained) and figures/, with the
+#      stability, recommendation, validity and insertion sections drawn from stability.json, each
+#      recommend.json, validity.json and insertion.json.
 #
 # Usage: scripts/verify.sh [--quick | --full] [--retime] [output-dir]   (default: results/)
 #   default  the scenes' own levels, loads and sweeps (contact up to 1 mN, where the linear
@@ -105,9 +107,19 @@ for scene in contact_straight contact_arch; do
   "$vv" recommend "${candidates[@]}" "${reference[@]}" "${retime[@]}" --rate 30,1000 --output-dir "$dir" "$scenes/$scene.toml"
   recommendations+=(--recommend "$dir/30hz/recommend.json" --recommend "$dir/1000hz/recommend.json")
 done
+insertion=()
+if [ ${#mode[@]} -eq 0 ]; then
+  phase "insertion: the floppy wire pushed into the straight tube"
+  # guidewire_straight's wire (EI 4e-7 N·m²) on its neo-Hookean wall, pushed its last 0.5 mm in
+  # two steps (a longer insertion, or the stiffer wires: `vesselverify insertion`, minutes a
+  # millimetre); not in --quick.
+  "$vv" insertion "$scenes/guidewire_straight.toml" --ei 4e-7 --from 19.75e-3 --to 20.25e-3 \
+    --steps 2 --json "$out/insertion.json" > "$out/insertion.md"
+  insertion=(--insertion "$out/insertion.json")
+fi
 phase "report"
 "$vv" report "$out/results.json" --stability "$out/stability.json" "${recommendations[@]}" \
-  --validity "$out/validity.json" --output-dir "$out"
+  --validity "$out/validity.json" "${insertion[@]}" --output-dir "$out"
 # The guidewire scenes' figures: the wire's shape and each model's coupled force over the EI sweep.
 /usr/bin/python3 "$root/scripts/guidewire_figures.py" "$out/results.json" "$out/figures"
 phase "done"

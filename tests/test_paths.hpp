@@ -31,6 +31,8 @@ std::string test_cache_dir();       ///< the build tree's cache for the tests (n
   (::vessel::test::paths::source_dir() + "/verification/studies/stability/stability.schema.json")
 #define VESSEL_VALIDITY_SCHEMA \
   (::vessel::test::paths::source_dir() + "/verification/studies/validity/validity.schema.json")
+#define VESSEL_INSERTION_SCHEMA \
+  (::vessel::test::paths::source_dir() + "/verification/harness/contact_insertion.schema.json")
 #define VESSEL_SCREENSHOT_SCRIPT (::vessel::test::paths::source_dir() + "/scripts/report_screenshots.sh")
 #define COMPARE_RESULTS (::vessel::test::paths::source_dir() + "/scripts/compare_results.py")
 #define VESSEL_TEST_FIXTURES (::vessel::test::paths::tests_dir() + "/fixtures")

@@ -9,8 +9,13 @@
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <nlohmann/json.hpp>
 
 #include "meshes/foundation/errors.hpp"
+#include "reports/insertion_section.hpp"
+#include "reports/study_files.hpp"
+#include "schema_check.hpp"
+#include "test_helpers.hpp"
 #include "test_paths.hpp"
 #include "verification/harness/contact_insertion.hpp"
 #include "verification/harness/contact_reference.hpp"
@@ -141,11 +146,18 @@ TEST(ContactInsertion, RefusesASceneWithoutAGuidewireAndAnEmptyRange) {
                      {"guidewire_straight.toml", "EI"});
 }
 
-// The figure's curves: each force of each converged step in mN at its length in mm, a failed
-// step left out of every curve (a hand-made insertion: the mapping, not a solve).
-TEST(ContactInsertion, PlotCarriesEachConvergedStepsForcesInMillinewtons) {
+// The insertion's document (a hand-made insertion: the mapping, not a solve): it conforms to its
+// schema; read back, the figure's curves carry each force of each converged step in mN at its
+// length in mm, a failed step left out of every curve and dΠ/dL's undefined end left out of its
+// own; the table gives each step's numbers in mm and mN and the failure's reason; a document
+// without a step's force is refused naming it.
+TEST(ContactInsertion,
+     DocumentConformsToItsSchemaAndTheReportDrawsItsStepsInMillimetresAndMillinewtons) {
   ContactInsertion r;
+  r.scene = "hand";
   r.bending_stiffness = 4e-7;
+  r.mesh_nodes = 5546;
+  r.refined_balls = 3;
   const auto step = [](double length, bool converged, double f, double rt, double p, double dp) {
     InsertionStep s;
     s.insertion = length;
@@ -154,26 +166,54 @@ TEST(ContactInsertion, PlotCarriesEachConvergedStepsForcesInMillinewtons) {
     s.clamp_axial = rt;
     s.push = p;
     s.push_by_energy = dp;
+    s.tip = Vec3(2.5e-3, 0.0, 19.5e-3);
+    if (converged) s.zones.push_back({f, Vec3(3e-3, 0.0, 19.75e-3), 1e-3, 28});
     return s;
   };
-  r.steps = {step(19.25e-3, true, 4.6e-4, 1.4e-4, 4.9e-5, 4.3e-5),
-             step(19.5e-3, false, 0.0, 0.0, 0.0, 0.0),
-             step(19.75e-3, true, 4.5e-4, 1.3e-4, 4.1e-5, 3.8e-5)};
-  const auto plot = insertion_plot({r});
+  r.steps = {
+      step(19.25e-3, true, 4.6e-4, 1.4e-4, 4.9e-5, 4.3e-5),
+      step(19.5e-3, false, 0.0, 0.0, 0.0, 0.0),
+      step(19.75e-3, true, 4.5e-4, 1.3e-4, 4.1e-5, std::numeric_limits<double>::quiet_NaN())};
+  r.steps[1].failure = "the line search found no decrease";
+  const std::string text = contact_insertion_json({r}, "vesselverify insertion hand", 12.0);
+  const auto j = nlohmann::json::parse(text);
+  const auto problems =
+      test::schema_problems(j, nlohmann::json::parse(test::read_text(VESSEL_INSERTION_SCHEMA)));
+  EXPECT_TRUE(problems.empty()) << test::joined(problems);
+  EXPECT_TRUE(j["insertions"][0]["steps"][2]["push_by_energy_N"].is_null());
+
+  const reports::InsertionFile file = reports::parse_insertion(text, "ins.json");
+  const reports::Plot plot = reports::insertion_plot(file);
   ASSERT_EQ(plot.series.size(), 4U);
   const std::vector<std::vector<double>> expected{
-      {0.46, 0.45}, {0.14, 0.13}, {0.049, 0.041}, {0.043, 0.038}};
+      {0.46, 0.45}, {0.14, 0.13}, {0.049, 0.041}, {0.043}};
   for (std::size_t k = 0; k < 4; ++k) {
     EXPECT_NE(plot.series[k].label.find("EI 4e-07"), std::string::npos) << plot.series[k].label;
-    ASSERT_EQ(plot.series[k].x.size(), 2U) << plot.series[k].label;
-    EXPECT_DOUBLE_EQ(plot.series[k].x[0], 19.25);
-    EXPECT_DOUBLE_EQ(plot.series[k].x[1], 19.75);
-    for (std::size_t i = 0; i < 2; ++i) {
+    ASSERT_EQ(plot.series[k].x.size(), expected[k].size()) << plot.series[k].label;
+    for (std::size_t i = 0; i < expected[k].size(); ++i) {
+      EXPECT_DOUBLE_EQ(plot.series[k].x[i], i == 0 ? 19.25 : 19.75);
       EXPECT_NEAR(plot.series[k].y[i], expected[k][i], 1e-12) << plot.series[k].label;
     }
   }
   EXPECT_TRUE(plot.series[3].dashed);
   EXPECT_NE(reports::render_svg(plot).find("<svg"), std::string::npos);
+
+  const std::string md = reports::insertion_markdown(file);
+  EXPECT_NE(
+      md.find("| 19.250 | 0.46000 | 0 | 19.75: 0.4600 | 0.000 | 0.14000 | 0.04900 | 0.04300 | "
+              "(2.50, 0.00, 19.50) |"),
+      std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| 19.500 | not converged: the line search found no decrease |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| 0.04100 | — |"), std::string::npos) << md;
+  EXPECT_NE(md.find("`vesselverify insertion hand` in 12 s"), std::string::npos) << md;
+
+  auto broken = j;
+  broken["insertions"][0]["steps"][0].erase("force_N");
+  expect_input_error([&] { (void)reports::parse_insertion(broken.dump(), "bad.json"); },
+                     {"bad.json: insertions[0].steps[0]", "missing field 'force_N'"});
 }
 
 // guidewire_straight's floppy wire (EI 4e-7 N·m²) on its neo-Hookean wall, pushed from 19.25 to
@@ -187,7 +227,8 @@ TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes
   o.steps = 4;
   o.log = &std::cerr;
   const ContactInsertion r = solve_contact_insertion(scene, EI, o);
-  print_contact_insertion(r, std::cout);
+  std::cout << reports::insertion_markdown(
+      reports::parse_insertion(contact_insertion_json({r}, "test", 0.0), "insertion"));
   ASSERT_EQ(r.steps.size(), 5u);
   for (const InsertionStep& s : r.steps) {
     ASSERT_TRUE(s.converged) << s.insertion << ": " << s.failure;

@@ -33,8 +33,8 @@ void add_validity_command(CLI::App& app, const std::string& command_line);
 /// `vesselverify contact`: a guidewire scene's contact reference (contact_command.cpp).
 void add_contact_command(CLI::App& app);
 /// `vesselverify insertion`: a guidewire pushed into the vessel in steps against the deformable
-/// wall (contact_command.cpp).
-void add_insertion_command(CLI::App& app);
+/// wall (contact_command.cpp); `command_line` is recorded in its JSON document.
+void add_insertion_command(CLI::App& app, const std::string& command_line);
 /// `vesselverify contact-models`: every model's wall in the wire-wall contact
 /// (contact_models_command.cpp).
 void add_contact_models_command(CLI::App& app);

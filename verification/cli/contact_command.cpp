@@ -3,11 +3,14 @@
 /// level around the contact zone, with the force's Richardson extrapolate and GCI; and
 /// `vesselverify insertion`: the scene's wire pushed into the vessel in steps against the
 /// deformable wall (verification/harness/contact_insertion.hpp).
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <vector>
 
 #include "meshes/foundation/atomic_file.hpp"
+#include "reports/insertion_section.hpp"
+#include "reports/study_files.hpp"
 #include "reports/svg_plot.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/harness/contact_insertion.hpp"
@@ -30,7 +33,8 @@ struct InsertionCli {
   std::vector<double> ei;
   std::string wall = "neo-hookean";
   ContactInsertionOptions options;
-  std::filesystem::path svg;  // empty: no figure
+  std::filesystem::path svg;   // empty: no figure
+  std::filesystem::path json;  // empty: no document
 };
 
 /// The options a guidewire scene's contact commands share: the scene, the stiffnesses and the wall.
@@ -113,7 +117,7 @@ void add_contact_command(CLI::App& app) {
   });
 }
 
-void add_insertion_command(CLI::App& app) {
+void add_insertion_command(CLI::App& app, const std::string& command_line) {
   auto o = std::make_shared<InsertionCli>();
   CLI::App* cmd = app.add_subcommand(
       "insertion",
@@ -151,21 +155,34 @@ void add_insertion_command(CLI::App& app) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--svg", o->svg,
-                  "Also write the forces against the insertion length as an SVG figure here")
-      ->capture_default_str();
-  cmd->callback([o] {
-    o->options.log = &std::cerr;  // progress; the table goes to stdout
+                  "Also write the forces against the insertion length as an SVG figure here");
+  cmd->add_option("--json", o->json,
+                  "Also write the insertion as a JSON document here (schema "
+                  "verification/harness/contact_insertion.schema.json), which `vesselverify "
+                  "report --insertion` draws as a section");
+  cmd->callback([o, command_line] {
+    o->options.log = &std::cerr;  // progress; the tables go to stdout
     o->options.wall = parse_contact_wall(o->wall);
     const Scene scene = read_scene(o->scene);
+    const auto t0 = std::chrono::steady_clock::now();
     std::vector<ContactInsertion> insertions;
     for (const double EI : stiffnesses(scene, o->ei)) {
       insertions.push_back(solve_contact_insertion(scene, EI, o->options));
-      print_contact_insertion(insertions.back(), std::cout);
-      std::cout << "\n" << std::flush;
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // The tables, the figure and the document all from the document, as the report reads it.
+    const std::string json = contact_insertion_json(insertions, command_line, seconds);
+    const reports::InsertionFile file = reports::parse_insertion(json, "insertion");
+    std::cout << reports::insertion_markdown(file) << std::flush;
+    if (!o->json.empty()) {
+      write_file_atomically(o->json, [&](std::ostream& f) { f << json; });
+      std::cout << "document: " << o->json.string() << "\n";
     }
     if (!o->svg.empty()) {
-      write_file_atomically(
-          o->svg, [&](std::ostream& f) { f << reports::render_svg(insertion_plot(insertions)); });
+      write_file_atomically(o->svg, [&](std::ostream& f) {
+        f << reports::render_svg(reports::insertion_plot(file));
+      });
       std::cout << "figure: " << o->svg.string() << "\n";
     }
   });

@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
   vessel::cli::add_calibrate_command(app, command_line);
   vessel::cli::add_validity_command(app, command_line);
   vessel::cli::add_contact_command(app);
-  vessel::cli::add_insertion_command(app);
+  vessel::cli::add_insertion_command(app, command_line);
   vessel::cli::add_export_command(app);
   vessel::cli::add_contact_models_command(app);
   try {

@@ -40,6 +40,10 @@ void add_report_command(CLI::App& app, const std::string& command_line) {
                   "validity.json written by `vesselverify validity`: the linear reference's "
                   "limit and the models against the finite-strain reference, drawn as a section")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--insertion", o->insertion,
+                  "the JSON of `vesselverify insertion --json`: the guidewire pushed in, its "
+                  "forces per step as tables and curves, drawn as a section")
+      ->check(CLI::ExistingFile);
   cmd->add_option("-o,--output-dir", o->output_dir,
                   "Where report.md, report.html and figures/ go (default: beside the results)");
   cmd->callback([o] {

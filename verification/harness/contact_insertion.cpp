@@ -2,10 +2,9 @@
 
 #include <chrono>
 #include <cmath>
-#include <iomanip>
 #include <limits>
 #include <memory>
-#include <sstream>
+#include <nlohmann/json.hpp>
 
 #include "fem_reference/elasticity.hpp"
 #include "meshes/foundation/errors.hpp"
@@ -323,62 +322,52 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
   return out;
 }
 
-void print_contact_insertion(const ContactInsertion& r, std::ostream& out) {
-  out << "### " << r.scene << ", EI = " << r.bending_stiffness << " N·m², insertion\n\n"
-      << to_string(r.wall) << " wall, " << r.mesh_nodes << " nodes, refined at " << r.refined_balls
-      << " rigid-lumen wall point(s); set-up " << std::fixed << std::setprecision(1)
-      << r.mesh_seconds << " s\n\n"
-      << "| insertion (mm) | force (mN) | pressed | zones (centroid z mm: mN) | dent (mm) | "
-         "clamp axial R·t (mN) | push R·t − M²/2EI (mN) | push dΠ/dL (mN) | tip (mm) | "
-         "Newton steps | s |\n"
-      << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
-  for (const InsertionStep& s : r.steps) {
-    out << std::setprecision(3) << "| " << s.insertion * 1e3 << " | ";
-    if (!s.converged) {
-      out << "not converged: " << s.failure << " | | | | | | | | | " << std::setprecision(1)
-          << s.seconds << " |\n";
-      continue;
-    }
-    out << std::setprecision(5) << s.force * 1e3 << " | " << s.pressed << " | ";
-    for (std::size_t z = 0; z < s.zones.size(); ++z) {
-      out << (z ? "; " : "") << std::setprecision(2) << s.zones[z].centroid.z() * 1e3 << ": "
-          << std::setprecision(4) << s.zones[z].force * 1e3;
-    }
-    out << " | " << std::setprecision(3) << s.dent * 1e3 << " | " << std::setprecision(5)
-        << s.clamp_axial * 1e3 << " | " << s.push * 1e3 << " | " << s.push_by_energy * 1e3 << " | ("
-        << std::setprecision(2) << s.tip.x() * 1e3 << ", " << s.tip.y() * 1e3 << ", "
-        << s.tip.z() * 1e3 << ") | " << s.newton_steps << " | " << std::setprecision(1) << s.seconds
-        << " |\n";
-  }
-  out << std::defaultfloat;
-}
-
-reports::Plot insertion_plot(const std::vector<ContactInsertion>& insertions) {
-  reports::Plot plot;
-  plot.title = "The insertion: forces against the insertion length";
-  plot.x.label = "insertion length (mm)";
-  plot.y.label = "force (mN)";
+std::string contact_insertion_json(const std::vector<ContactInsertion>& insertions,
+                                   const std::string& command, double total_seconds) {
+  using nlohmann::json;
+  const auto vec = [](const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); };
+  json all = json::array();
   for (const ContactInsertion& r : insertions) {
-    std::ostringstream ei;
-    ei << " (EI " << r.bending_stiffness << " N·m²)";
-    const auto series = [&](const std::string& name, double InsertionStep::*value, bool dashed) {
-      reports::Series s;
-      s.label = name + ei.str();
-      s.lines = true;
-      s.dashed = dashed;
-      for (const InsertionStep& step : r.steps) {
-        if (!step.converged) continue;
-        s.x.push_back(step.insertion * 1e3);
-        s.y.push_back(step.*value * 1e3);
+    json steps = json::array();
+    for (const InsertionStep& s : r.steps) {
+      json zones = json::array();
+      for (const ContactZone& z : s.zones) {
+        zones.push_back({{"force_N", z.force},
+                         {"centroid_m", vec(z.centroid)},
+                         {"extent_m", z.extent},
+                         {"nodes", z.nodes}});
       }
-      plot.series.push_back(std::move(s));
-    };
-    series("contact force", &InsertionStep::force, false);
-    series("clamp axial R·t", &InsertionStep::clamp_axial, false);
-    series("push R·t − M²/2EI", &InsertionStep::push, false);
-    series("push dΠ/dL", &InsertionStep::push_by_energy, true);
+      steps.push_back({{"insertion_m", s.insertion},
+                       {"converged", s.converged},
+                       {"failure", s.failure},
+                       {"force_N", s.force},
+                       {"pressed", s.pressed},
+                       {"zones", zones},
+                       {"clamp_axial_N", s.clamp_axial},
+                       {"clamp_moment_Nm", s.clamp_moment},
+                       {"push_N", s.push},
+                       {"push_by_energy_N",
+                        std::isfinite(s.push_by_energy) ? json(s.push_by_energy) : json(nullptr)},
+                       {"energy_J", s.energy},
+                       {"tip_m", vec(s.tip)},
+                       {"dent_m", s.dent},
+                       {"newton_steps", s.newton_steps},
+                       {"seconds", s.seconds}});
+    }
+    all.push_back({{"scene", r.scene},
+                   {"bending_stiffness_Nm2", r.bending_stiffness},
+                   {"wall", to_string(r.wall)},
+                   {"mesh_nodes", r.mesh_nodes},
+                   {"refined_balls", r.refined_balls},
+                   {"mesh_seconds", r.mesh_seconds},
+                   {"steps", steps}});
   }
-  return plot;
+  const json j{{"schema", "vesselverify.insertion"},
+               {"schema_version", 1},
+               {"command", command},
+               {"total_seconds", total_seconds},
+               {"insertions", all}};
+  return j.dump(2) + "\n";
 }
 
 }  // namespace vessel

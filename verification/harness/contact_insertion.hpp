@@ -21,7 +21,6 @@
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
-#include "reports/svg_plot.hpp"
 #include "verification/harness/contact_reference.hpp"
 #include "verification/scene.hpp"
 
@@ -87,13 +86,10 @@ struct ContactInsertion {
 ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
                                          const ContactInsertionOptions& options = {});
 
-/// The insertion as Markdown: one line with the scene, EI, the wall and its mesh; a table per
-/// step (mm, mN).
-void print_contact_insertion(const ContactInsertion& insertion, std::ostream& out);
-
-/// The insertions' curves against the insertion length (mm, mN), per insertion: the total
-/// contact force, the clamp's axial force R·t, the push R·t − M²/2EI and the push dΠ/dL (dashed;
-/// its undefined ends left out). Converged steps only.
-reports::Plot insertion_plot(const std::vector<ContactInsertion>& insertions);
+/// The insertions as the JSON document `vesselverify insertion --json` writes (schema
+/// "vesselverify.insertion", version 1: verification/harness/contact_insertion.schema.json), SI
+/// units; the report reads it back (reports/study_files.hpp) for its tables and curves.
+std::string contact_insertion_json(const std::vector<ContactInsertion>& insertions,
+                                   const std::string& command, double total_seconds);
 
 }  // namespace vessel
