@@ -1,6 +1,7 @@
 #include "reports/svg_plot.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -75,7 +76,8 @@ std::pair<double, double> range(const Plot& plot, bool x_axis) {
   return {lo - pad, hi + pad};
 }
 
-/// Coordinates are written with the stream's fixed-point format set by render_svg.
+/// Coordinates are written with the stream's fixed-point format set by render_svg; `shape`'s
+/// order is palette_marker's.
 void marker(std::ostream& out, int shape, double x, double y, double r, const std::string& colour) {
   switch (shape % 4) {
     case 0:
@@ -98,6 +100,13 @@ void marker(std::ostream& out, int shape, double x, double y, double r, const st
 }
 
 }  // namespace
+
+std::string palette_colour(std::size_t index) { return kPalette[index % kPalette.size()]; }
+
+std::string palette_marker(std::size_t index) {
+  static const std::array<const char*, 4> kShapes{"circle", "rect", "triangle", "rectRot"};
+  return kShapes[index % kShapes.size()];
+}
 
 std::string escape_xml(const std::string& text) {
   std::string out;
@@ -223,7 +232,7 @@ std::string render_svg(const Plot& plot, int width, int height) {
   // Series.
   for (std::size_t k = 0; k < plot.series.size(); ++k) {
     const Series& s = plot.series[k];
-    const std::string colour = s.colour.empty() ? kPalette[k % kPalette.size()] : s.colour;
+    const std::string colour = s.colour.empty() ? palette_colour(k) : s.colour;
     std::vector<std::pair<double, double>> pts;
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
       if (drawable(s.x[i], plot.x.scale) && drawable(s.y[i], plot.y.scale)) {

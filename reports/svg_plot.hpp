@@ -25,7 +25,7 @@ struct Series {
   /// Colour as "#rrggbb"; empty: the palette colour of the series' index.
   std::string colour;
   /// Marker shape in report.html's plots (circle, triangle, rect, rectRot, star, crossRot, cross,
-  /// rectRounded); the SVG draws circles.
+  /// rectRounded) for a series with its own colour; the SVG draws palette_marker's shapes.
   std::string marker = "circle";
   /// Optional, one per point: what hovering the point names (model, ν, level, load), and the
   /// 3D view it opens when clicked ("<scene>|<model>|<level>").
@@ -38,6 +38,13 @@ struct Plot {
   Axis y;
   std::vector<Series> series;
 };
+
+/// The colour a series without its own is drawn with, by its index in the plot (the SVG and
+/// report.html's plots agree): the Okabe–Ito palette, then greys.
+std::string palette_colour(std::size_t index);
+/// The marker shape the SVG draws series `index` with, by its name in report.html's plots
+/// (circle, rect, triangle, rectRot in turn).
+std::string palette_marker(std::size_t index);
 
 /// The plot as an <svg> element `width` × `height` pixels (plus the legend's rows). Points that a
 /// log axis cannot show (≤ 0) or that are not finite are left out, and the count left out is

@@ -88,16 +88,26 @@ json wire_json(const std::optional<WireView>& w) {
 
 json plot_json(const Plot& p) {
   json series = json::array();
-  for (const Series& s : p.series) {
+  for (std::size_t k = 0; k < p.series.size(); ++k) {
+    const Series& s = p.series[k];
+    // A series without its own colour: the SVG's palette colour and shape for its index.
+    const bool styled = !s.colour.empty();
     json x = json::array(), y = json::array();
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
       x.push_back(std::isfinite(s.x[i]) ? json(s.x[i]) : json(nullptr));
       y.push_back(std::isfinite(s.y[i]) ? json(s.y[i]) : json(nullptr));
     }
-    series.push_back({{"label", s.label}, {"colour", s.colour}, {"marker", s.marker},
-                      {"lines", s.lines}, {"markers", s.markers}, {"dashed", s.dashed},
-                      {"emphasis", s.emphasis}, {"x", x}, {"y", y},
-                      {"labels", s.point_labels}, {"views", s.point_views}});
+    series.push_back({{"label", s.label},
+                      {"colour", styled ? s.colour : palette_colour(k)},
+                      {"marker", styled ? s.marker : palette_marker(k)},
+                      {"lines", s.lines},
+                      {"markers", s.markers},
+                      {"dashed", s.dashed},
+                      {"emphasis", s.emphasis},
+                      {"x", x},
+                      {"y", y},
+                      {"labels", s.point_labels},
+                      {"views", s.point_views}});
   }
   return {{"title", p.title},
           {"x", {{"label", p.x.label}, {"log", p.x.scale == Scale::log}}},

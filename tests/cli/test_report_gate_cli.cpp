@@ -118,6 +118,46 @@ TEST(ReportCli, DrawsTheStudiesFromTheirJsonFiles) {
   EXPECT_TRUE(contains(read_text(dir / "report.md"), "| `volume/lloyd/static @ L0` | 600 | 0.0421 |"));
 }
 
+// The insertion's document (hand-written: one converged step of 0.45 mN at 20 mm, one failed)
+// drawn as its section, and a document without its steps refused naming the file.
+TEST(ReportCli, DrawsTheInsertionFromItsJsonFile) {
+  TempDir dir;
+  write_text(dir / "insertion.json", R"({"schema": "vesselverify.insertion", "schema_version": 1,
+    "command": "vesselverify insertion s.toml", "total_seconds": 30.0,
+    "insertions": [{"scene": "guidewire_straight", "bending_stiffness_Nm2": 4e-7,
+      "wall": "neo-Hookean", "mesh_nodes": 5546, "refined_balls": 2, "mesh_seconds": 1.0,
+      "steps": [{"insertion_m": 0.02, "converged": true, "failure": "", "force_N": 4.5e-4,
+                 "pressed": 18, "zones": [{"force_N": 4.5e-4, "centroid_m": [0.003, 0, 0.0195],
+                 "extent_m": 0.001, "nodes": 18}], "clamp_axial_N": 1.4e-4,
+                 "clamp_moment_Nm": 1e-6, "push_N": 4.5e-5, "push_by_energy_N": null,
+                 "energy_J": 1e-8, "tip_m": [0.00307, 0, 0.01972], "dent_m": 2.48e-4,
+                 "newton_steps": 19, "seconds": 18.9},
+                {"insertion_m": 0.0205, "converged": false, "failure": "Newton did not converge",
+                 "force_N": 0, "pressed": 0, "zones": [], "clamp_axial_N": 0,
+                 "clamp_moment_Nm": 0, "push_N": 0, "push_by_energy_N": null, "energy_J": 0,
+                 "tip_m": [0, 0, 0], "dent_m": 0, "newton_steps": 300, "seconds": 99.0}]}]})");
+  auto r = vv("report " + kBaseline + " --insertion " + (dir / "insertion.json").string() + " -o " +
+              dir.path().string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string md = read_text(dir / "report.md");
+  EXPECT_TRUE(contains(md, "## The guidewire pushed in")) << md;
+  EXPECT_TRUE(contains(md, "### guidewire_straight, EI 4e-07 N·m²")) << md;
+  EXPECT_TRUE(contains(md,
+                       "| 20.000 | 0.45000 | 18 | 19.50: 0.4500 | 0.248 | 0.14000 | 0.04500 | — | "
+                       "(3.07, 0.00, 19.72) | 19 | 18.9 |"))
+      << md;
+  EXPECT_TRUE(contains(md, "| 20.500 | not converged: Newton did not converge |")) << md;
+  EXPECT_TRUE(std::filesystem::exists(dir / "figures" / "insertion.svg"));
+
+  write_text(dir / "broken.json", R"({"schema": "vesselverify.insertion", "schema_version": 1,
+    "command": "c", "total_seconds": 1.0})");
+  r = vv("report " + kBaseline + " --insertion " + (dir / "broken.json").string() + " -o " +
+         (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "broken.json: missing field 'insertions'")) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "report.md"));
+}
+
 TEST(ReportCli, AStudyFileOfAnotherKindIsAClearErrorNamingIt) {
   TempDir dir;
   auto r = vv("report " + kBaseline + " --stability " + kBaseline + " -o " + dir.path().string());

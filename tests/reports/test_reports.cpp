@@ -3,9 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "../test_helpers.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "reports/document.hpp"
 #include "reports/gate.hpp"
@@ -13,9 +14,7 @@
 #include "reports/representative_load.hpp"
 #include "reports/study_files.hpp"
 #include "reports/svg_plot.hpp"
-#include "../test_helpers.hpp"
-
-#include <filesystem>
+#include "reports/web_page.hpp"
 
 using namespace vessel;
 using namespace vessel::reports;
@@ -173,6 +172,32 @@ TEST(SvgPlot, RendersSeriesEscapesTextAndCountsPointsALogAxisCannotShow) {
   Plot empty;
   empty.title = "nothing";
   EXPECT_NE(render_svg(empty).find("no data to plot"), std::string::npos);
+}
+
+// A series without its own colour is drawn alike in the SVG and in report.html's interactive plot:
+// the palette's colour and marker shape for its index (report.html drew such series grey).
+TEST(Document, AnUnstyledSeriesHasTheSameColourAndShapeInTheSvgAndTheInteractivePlot) {
+  Plot plot;
+  plot.title = "two curves";
+  for (const char* name : {"first", "second"}) {
+    Series s;
+    s.label = name;
+    s.x = {1.0, 2.0};
+    s.y = {1.0, 3.0};
+    plot.series.push_back(s);
+  }
+  Document doc;
+  doc.figure("two.svg", plot, "two curves");
+  const std::string svg = render_svg(plot);
+  const std::string html = interactive_html(doc, {}, {}, WebLibraries{}, "t");
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_NE(svg.find("\"" + palette_colour(k) + "\""), std::string::npos) << svg;
+    EXPECT_NE(html.find("\"colour\":\"" + palette_colour(k) + "\""), std::string::npos) << html;
+    EXPECT_NE(html.find("\"marker\":\"" + palette_marker(k) + "\""), std::string::npos) << html;
+  }
+  EXPECT_EQ(palette_colour(0), "#0072B2");
+  EXPECT_EQ(palette_marker(1), "rect");
+  EXPECT_NE(svg.find("<rect x="), std::string::npos);  // the second series' square markers
 }
 
 TEST(Document, BlocksRenderAsMarkdownAndHtml) {
