@@ -674,9 +674,11 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     const double alpha0 = alpha;
     bool accepted = false;
     VectorXd g_trial;
+    int inverted = 0;  // trials whose wall had an inverted element (Π = +∞), for the message
     for (int ls = 0; ls < 12 && !accepted; ++ls, alpha *= 0.5) {
       trial = z + alpha * dz;
       const double next = p.potential(trial);
+      inverted += !std::isfinite(next);
       accepted = std::isfinite(next) && next <= pi + 1e-4 * alpha * slope;
     }
     if (!accepted) {
@@ -690,7 +692,10 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     alpha *= 2.0;  // the loops halve once past the accepted step
     if (!accepted) {
       out.converged = out.residual <= 1e3 * target;  // at the round-off floor of ‖∇Π‖
-      if (!out.converged) out.reason = "the line search found no decrease of the potential";
+      if (!out.converged) {
+        out.reason = "the line search found no decrease of the potential (" +
+                     std::to_string(inverted) + " of its 12 trial steps inverted a wall element)";
+      }
       return out;
     }
     if (o.damped_newton) {
