@@ -79,7 +79,10 @@ void insertion_text(Document& doc, const InsertionFile& f) {
     doc.heading(3, e.scene + ", " + stiffness_label(e.bending_stiffness));
     doc.paragraph(e.wall + " wall, " + std::to_string(e.mesh_nodes) + " nodes, refined at " +
                   std::to_string(e.refined_balls) + " rigid-lumen wall point(s); set-up " +
-                  fixed(e.mesh_seconds, 1) + " s.");
+                  fixed(e.mesh_seconds, 1) + " s" +
+                  (e.cached_from.empty() ? std::string(".")
+                                         : "; read from the cache, computed " + e.cached_from +
+                                               " (the times are that run's)."));
     doc.table(insertion_table(e));
   }
 }

@@ -326,6 +326,7 @@ InsertionEntry read_insertion_entry(const json& j, const std::string& where) {
   e.mesh_nodes = field<int>(j, "mesh_nodes", where);
   e.refined_balls = field<int>(j, "refined_balls", where);
   e.mesh_seconds = field<double>(j, "mesh_seconds", where);
+  e.cached_from = field_or<std::string>(j, "cached_from", "", where);
   e.steps = read_array(j, "steps", where, read_insertion_step);
   return e;
 }

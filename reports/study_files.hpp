@@ -277,6 +277,7 @@ struct InsertionEntry {
   double bending_stiffness = 0.0;  ///< EI, N·m²
   int mesh_nodes = 0, refined_balls = 0;
   double mesh_seconds = 0.0;
+  std::string cached_from;  ///< when it was computed, if read from the cache (else empty)
   std::vector<InsertionStepEntry> steps;
 };
 

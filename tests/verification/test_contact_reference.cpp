@@ -10,6 +10,7 @@
 #include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "meshes/foundation/errors.hpp"
 #include "reports/insertion_section.hpp"
@@ -19,11 +20,23 @@
 #include "test_paths.hpp"
 #include "verification/harness/contact_insertion.hpp"
 #include "verification/harness/contact_reference.hpp"
+#include "verification/harness/outcome_cache.hpp"
 
 namespace vessel {
 namespace {
 
 Scene shipped(const std::string& name) { return read_scene(VESSEL_SCENES_DIR + "/" + name); }
+
+/// The insertion document of one insertion, as contact_insertion_document writes it.
+std::string document_of(const ContactInsertion& r, const std::string& command, double seconds) {
+  const nlohmann::json j{
+      {"schema", "vesselverify.insertion"},
+      {"schema_version", 1},
+      {"command", command},
+      {"total_seconds", seconds},
+      {"insertions", nlohmann::json::array({nlohmann::json::parse(contact_insertion_entry(r))})}};
+  return j.dump();
+}
 
 // Expects `f` to throw InputError whose message contains every one of `parts`.
 template <class F>
@@ -175,7 +188,7 @@ TEST(ContactInsertion,
       step(19.5e-3, false, 0.0, 0.0, 0.0, 0.0),
       step(19.75e-3, true, 4.5e-4, 1.3e-4, 4.1e-5, std::numeric_limits<double>::quiet_NaN())};
   r.steps[1].failure = "the line search found no decrease";
-  const std::string text = contact_insertion_json({r}, "vesselverify insertion hand", 12.0);
+  const std::string text = document_of(r, "vesselverify insertion hand", 12.0);
   const auto j = nlohmann::json::parse(text);
   const auto problems =
       test::schema_problems(j, nlohmann::json::parse(test::read_text(VESSEL_INSERTION_SCHEMA)));
@@ -228,7 +241,7 @@ TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes
   o.log = &std::cerr;
   const ContactInsertion r = solve_contact_insertion(scene, EI, o);
   std::cout << reports::insertion_markdown(
-      reports::parse_insertion(contact_insertion_json({r}, "test", 0.0), "insertion"));
+      reports::parse_insertion(document_of(r, "test", 0.0), "insertion"));
   ASSERT_EQ(r.steps.size(), 5u);
   for (const InsertionStep& s : r.steps) {
     ASSERT_TRUE(s.converged) << s.insertion << ": " << s.failure;
@@ -255,14 +268,32 @@ TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes
   EXPECT_NEAR(work, stored, 0.08 * std::abs(stored)) << "push's work " << work << " J";
   // Without the sleeve's M²/2EI the clamp's axial force alone is several times the push.
   EXPECT_GT(r.steps[2].clamp_axial, 2.0 * r.steps[2].push_by_energy);
-  // The same range in one step (the same mesh: it follows the range, not the steps).
+  // The same range in one step (the same mesh: it follows the range, not the steps), as the
+  // command's document with an outcome cache: solved once, then read back with the same numbers
+  // and the date it was computed.
   ContactInsertionOptions one = o;
   one.steps = 1;
-  const ContactInsertion direct = solve_contact_insertion(scene, EI, one);
+  test::TempDir dir;
+  std::ostringstream cache_log;
+  OutcomeCache cache(dir.path(), false, &cache_log);
+  const auto document = [&] {
+    return reports::parse_insertion(contact_insertion_document(scene, {EI}, one, "test", &cache),
+                                    "insertion");
+  };
+  const reports::InsertionFile solved = document(), again = document();
+  ASSERT_EQ(solved.insertions.size(), 1u);
+  const reports::InsertionEntry& direct = solved.insertions[0];
+  EXPECT_TRUE(direct.cached_from.empty());
   ASSERT_EQ(direct.mesh_nodes, r.mesh_nodes);
   ASSERT_TRUE(direct.steps.back().converged) << direct.steps.back().failure;
   EXPECT_NEAR(direct.steps.back().force, r.steps.back().force, 1e-3 * r.steps.back().force);
-  EXPECT_LT((direct.steps.back().tip - r.steps.back().tip).norm(), 1e-3 * 0.178e-3);
+  const Vec3 tip(direct.steps.back().tip[0], direct.steps.back().tip[1],
+                 direct.steps.back().tip[2]);
+  EXPECT_LT((tip - r.steps.back().tip).norm(), 1e-3 * 0.178e-3);
+  ASSERT_EQ(again.insertions.size(), 1u);
+  EXPECT_FALSE(again.insertions[0].cached_from.empty());
+  EXPECT_EQ(again.insertions[0].steps.back().force, direct.steps.back().force);
+  EXPECT_EQ(cache.statistics().hits, 1);
 }
 
 }  // namespace

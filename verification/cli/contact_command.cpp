@@ -3,7 +3,6 @@
 /// level around the contact zone, with the force's Richardson extrapolate and GCI; and
 /// `vesselverify insertion`: the scene's wire pushed into the vessel in steps against the
 /// deformable wall (verification/harness/contact_insertion.hpp).
-#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <vector>
@@ -12,6 +11,7 @@
 #include "reports/insertion_section.hpp"
 #include "reports/study_files.hpp"
 #include "reports/svg_plot.hpp"
+#include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/harness/contact_insertion.hpp"
 #include "verification/harness/contact_reference.hpp"
@@ -35,6 +35,7 @@ struct InsertionCli {
   ContactInsertionOptions options;
   std::filesystem::path svg;   // empty: no figure
   std::filesystem::path json;  // empty: no document
+  CacheOptions cache;
 };
 
 /// The options a guidewire scene's contact commands share: the scene, the stiffnesses and the wall.
@@ -160,19 +161,18 @@ void add_insertion_command(CLI::App& app, const std::string& command_line) {
                   "Also write the insertion as a JSON document here (schema "
                   "verification/harness/contact_insertion.schema.json), which `vesselverify "
                   "report --insertion` draws as a section");
+  add_cache_options(*cmd, o->cache);
+  cmd->add_flag("--retime", o->cache.retime,
+                "Solve every insertion again (and replace its entry in the outcome cache) instead "
+                "of reading the one a run of the same executable on this machine stored");
   cmd->callback([o, command_line] {
     o->options.log = &std::cerr;  // progress; the tables go to stdout
     o->options.wall = parse_contact_wall(o->wall);
     const Scene scene = read_scene(o->scene);
-    const auto t0 = std::chrono::steady_clock::now();
-    std::vector<ContactInsertion> insertions;
-    for (const double EI : stiffnesses(scene, o->ei)) {
-      insertions.push_back(solve_contact_insertion(scene, EI, o->options));
-    }
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    // The tables, the figure and the document all from the document, as the report reads it.
-    const std::string json = contact_insertion_json(insertions, command_line, seconds);
+    const auto cache = o->cache.outcome_cache(std::cerr);
+    const std::string json = contact_insertion_document(scene, stiffnesses(scene, o->ei),
+                                                        o->options, command_line, cache.get());
+    // The tables and the figure from the document, as the report reads it.
     const reports::InsertionFile file = reports::parse_insertion(json, "insertion");
     std::cout << reports::insertion_markdown(file) << std::flush;
     if (!o->json.empty()) {

@@ -2,9 +2,12 @@
 
 #include <chrono>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "fem_reference/elasticity.hpp"
 #include "meshes/foundation/errors.hpp"
@@ -13,6 +16,7 @@
 #include "verification/contact/wall_crossing.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
+#include "verification/harness/outcome_cache.hpp"
 #include "verification/scene_problems.hpp"
 
 namespace vessel {
@@ -322,50 +326,86 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
   return out;
 }
 
-std::string contact_insertion_json(const std::vector<ContactInsertion>& insertions,
-                                   const std::string& command, double total_seconds) {
+std::string contact_insertion_entry(const ContactInsertion& r) {
   using nlohmann::json;
   const auto vec = [](const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); };
-  json all = json::array();
-  for (const ContactInsertion& r : insertions) {
-    json steps = json::array();
-    for (const InsertionStep& s : r.steps) {
-      json zones = json::array();
-      for (const ContactZone& z : s.zones) {
-        zones.push_back({{"force_N", z.force},
-                         {"centroid_m", vec(z.centroid)},
-                         {"extent_m", z.extent},
-                         {"nodes", z.nodes}});
-      }
-      steps.push_back({{"insertion_m", s.insertion},
-                       {"converged", s.converged},
-                       {"failure", s.failure},
-                       {"force_N", s.force},
-                       {"pressed", s.pressed},
-                       {"zones", zones},
-                       {"clamp_axial_N", s.clamp_axial},
-                       {"clamp_moment_Nm", s.clamp_moment},
-                       {"push_N", s.push},
-                       {"push_by_energy_N",
-                        std::isfinite(s.push_by_energy) ? json(s.push_by_energy) : json(nullptr)},
-                       {"energy_J", s.energy},
-                       {"tip_m", vec(s.tip)},
-                       {"dent_m", s.dent},
-                       {"newton_steps", s.newton_steps},
-                       {"seconds", s.seconds}});
+  json steps = json::array();
+  for (const InsertionStep& s : r.steps) {
+    json zones = json::array();
+    for (const ContactZone& z : s.zones) {
+      zones.push_back({{"force_N", z.force},
+                       {"centroid_m", vec(z.centroid)},
+                       {"extent_m", z.extent},
+                       {"nodes", z.nodes}});
     }
-    all.push_back({{"scene", r.scene},
+    steps.push_back({{"insertion_m", s.insertion},
+                     {"converged", s.converged},
+                     {"failure", s.failure},
+                     {"force_N", s.force},
+                     {"pressed", s.pressed},
+                     {"zones", zones},
+                     {"clamp_axial_N", s.clamp_axial},
+                     {"clamp_moment_Nm", s.clamp_moment},
+                     {"push_N", s.push},
+                     {"push_by_energy_N",
+                      std::isfinite(s.push_by_energy) ? json(s.push_by_energy) : json(nullptr)},
+                     {"energy_J", s.energy},
+                     {"tip_m", vec(s.tip)},
+                     {"dent_m", s.dent},
+                     {"newton_steps", s.newton_steps},
+                     {"seconds", s.seconds}});
+  }
+  const json entry{{"scene", r.scene},
                    {"bending_stiffness_Nm2", r.bending_stiffness},
                    {"wall", to_string(r.wall)},
                    {"mesh_nodes", r.mesh_nodes},
                    {"refined_balls", r.refined_balls},
                    {"mesh_seconds", r.mesh_seconds},
-                   {"steps", steps}});
+                   {"steps", steps}};
+  return entry.dump();
+}
+
+std::string contact_insertion_document(const Scene& scene, const std::vector<double>& stiffnesses,
+                                       const ContactInsertionOptions& o, const std::string& command,
+                                       OutcomeCache* cache) {
+  using nlohmann::json;
+  const auto t0 = Clock::now();
+  // Everything an insertion depends on besides the code and the machine (OutcomeCache adds
+  // those): the scene file's text, EI and the options, doubles in hexadecimal (exact).
+  std::string scene_text;
+  if (cache && cache->enabled()) {
+    std::ifstream in(scene.source);
+    scene_text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const auto hex = [](double v) {
+    std::ostringstream s;
+    s << std::hexfloat << v;
+    return s.str();
+  };
+  json all = json::array();
+  for (const double EI : stiffnesses) {
+    const auto solve = [&] {
+      return contact_insertion_entry(solve_contact_insertion(scene, EI, o));
+    };
+    json entry;
+    if (cache && cache->enabled()) {
+      const std::string key = "contact insertion v1|" + scene_text + "|EI " + hex(EI) + "|wall " +
+                              to_string(o.wall) + "|" + hex(o.first) + " " + hex(o.last) + " " +
+                              std::to_string(o.steps) + " " + hex(o.fine_size) + " " +
+                              hex(o.refine_radius) + " " + std::to_string(o.degree) + " " +
+                              std::to_string(o.max_steps);
+      TimingProvenance provenance;
+      entry = json::parse(cache->get(key, solve, provenance));
+      if (provenance.cached) entry["cached_from"] = provenance.measured_at;
+    } else {
+      entry = json::parse(solve());
+    }
+    all.push_back(entry);
   }
   const json j{{"schema", "vesselverify.insertion"},
                {"schema_version", 1},
                {"command", command},
-               {"total_seconds", total_seconds},
+               {"total_seconds", seconds_since(t0)},
                {"insertions", all}};
   return j.dump(2) + "\n";
 }

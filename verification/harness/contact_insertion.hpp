@@ -86,10 +86,20 @@ struct ContactInsertion {
 ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
                                          const ContactInsertionOptions& options = {});
 
-/// The insertions as the JSON document `vesselverify insertion --json` writes (schema
-/// "vesselverify.insertion", version 1: verification/harness/contact_insertion.schema.json), SI
-/// units; the report reads it back (reports/study_files.hpp) for its tables and curves.
-std::string contact_insertion_json(const std::vector<ContactInsertion>& insertions,
-                                   const std::string& command, double total_seconds);
+class OutcomeCache;  // verification/harness/outcome_cache.hpp
+
+/// The insertions of `scene`'s wire at each bending stiffness in `stiffnesses` (N·m²) as the JSON
+/// document `vesselverify insertion --json` writes (schema "vesselverify.insertion", version 1:
+/// verification/harness/contact_insertion.schema.json; SI units), which the report reads back
+/// (reports/study_files.hpp) for its tables and curves. With a `cache`, each insertion is kept
+/// under the scene file's text, its EI and the options (and the code and machine, as every
+/// outcome): a repeated insertion is read back, its time the original solve's, and the document
+/// says when that was. InputError as solve_contact_insertion.
+std::string contact_insertion_document(const Scene& scene, const std::vector<double>& stiffnesses,
+                                       const ContactInsertionOptions& options,
+                                       const std::string& command, OutcomeCache* cache = nullptr);
+
+/// One insertion as the document's entry (a JSON object), as contact_insertion_document writes it.
+std::string contact_insertion_entry(const ContactInsertion& insertion);
 
 }  // namespace vessel
