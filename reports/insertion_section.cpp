@@ -67,7 +67,9 @@ void insertion_text(Document& doc, const InsertionFile& f) {
       "deformable wall: at each insertion length the wire and the wall are solved together as "
       "one potential from the last step's equilibrium, so contacts appear, slide and separate as "
       "the solve finds them (the wall meshed once, refined where the wire touches the rigid "
-      "lumen over the range). *force* is the wire's net force on the wall, |Σ λ_j n_j|; a zone "
+      "lumen over the range). Each wall on the same mesh: the reference (deal.II's FEM) or a "
+      "vessel model's own (its own energy, so its own equilibrium). *force* is the wire's net "
+      "force on the wall, |Σ λ_j n_j|; a zone "
       "is a group of pressed wall nodes closer than 1 mm to each other (its force-weighted "
       "centroid along the axis and its force); *dent* the largest displacement of a pressed "
       "node. The hub: the clamp's axial force R·t, and the push that advances the wire, "
@@ -76,8 +78,8 @@ void insertion_text(Document& doc, const InsertionFile& f) {
       "by central differences of the neighbouring steps. Made by `" +
       f.command + "` in " + significant(f.total_seconds, 3) + " s.");
   for (const InsertionEntry& e : f.insertions) {
-    doc.heading(3, e.scene + ", " + stiffness_label(e.bending_stiffness));
-    doc.paragraph(e.wall + " wall, " + std::to_string(e.mesh_nodes) + " nodes, refined at " +
+    doc.heading(3, e.scene + ", " + e.model + ", " + stiffness_label(e.bending_stiffness));
+    doc.paragraph(e.model_detail + "; " + std::to_string(e.mesh_nodes) + " nodes, refined at " +
                   std::to_string(e.refined_balls) + " rigid-lumen wall point(s); set-up " +
                   fixed(e.mesh_seconds, 1) + " s" +
                   (e.cached_from.empty() ? std::string(".")
@@ -95,7 +97,7 @@ Plot insertion_plot(const InsertionFile& f) {
   plot.x.label = "insertion length (mm)";
   plot.y.label = "force (mN)";
   for (const InsertionEntry& e : f.insertions) {
-    const std::string ei = " (" + stiffness_label(e.bending_stiffness) + ")";
+    const std::string ei = " (" + e.model + ", " + stiffness_label(e.bending_stiffness) + ")";
     const auto series = [&](const std::string& name, auto value, bool dashed) {
       Series s;
       s.label = name + ei;

@@ -322,6 +322,8 @@ InsertionEntry read_insertion_entry(const json& j, const std::string& where) {
   InsertionEntry e;
   e.scene = field<std::string>(j, "scene", where);
   e.wall = field<std::string>(j, "wall", where);
+  e.model = field<std::string>(j, "model", where);
+  e.model_detail = field<std::string>(j, "model_detail", where);
   e.bending_stiffness = field<double>(j, "bending_stiffness_Nm2", where);
   e.mesh_nodes = field<int>(j, "mesh_nodes", where);
   e.refined_balls = field<int>(j, "refined_balls", where);

@@ -274,6 +274,7 @@ struct InsertionStepEntry {
 
 struct InsertionEntry {
   std::string scene, wall;
+  std::string model, model_detail;  ///< "reference" (deal.II's FEM) or one of the scene's models
   double bending_stiffness = 0.0;  ///< EI, N·m²
   int mesh_nodes = 0, refined_balls = 0;
   double mesh_seconds = 0.0;

@@ -124,7 +124,8 @@ TEST(ReportCli, DrawsTheInsertionFromItsJsonFile) {
   TempDir dir;
   write_text(dir / "insertion.json", R"({"schema": "vesselverify.insertion", "schema_version": 1,
     "command": "vesselverify insertion s.toml", "total_seconds": 30.0,
-    "insertions": [{"scene": "guidewire_straight", "bending_stiffness_Nm2": 4e-7,
+    "insertions": [{"scene": "guidewire_straight", "model": "reference",
+      "model_detail": "FEM P1 (deal.II), neo-Hookean", "bending_stiffness_Nm2": 4e-7,
       "wall": "neo-Hookean", "mesh_nodes": 5546, "refined_balls": 2, "mesh_seconds": 1.0,
       "steps": [{"insertion_m": 0.02, "converged": true, "failure": "", "force_N": 4.5e-4,
                  "pressed": 18, "zones": [{"force_N": 4.5e-4, "centroid_m": [0.003, 0, 0.0195],
@@ -141,7 +142,8 @@ TEST(ReportCli, DrawsTheInsertionFromItsJsonFile) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string md = read_text(dir / "report.md");
   EXPECT_TRUE(contains(md, "## The guidewire pushed in")) << md;
-  EXPECT_TRUE(contains(md, "### guidewire_straight, EI 4e-07 N·m²")) << md;
+  EXPECT_TRUE(contains(md, "### guidewire_straight, reference, EI 4e-07 N·m²")) << md;
+  EXPECT_TRUE(contains(md, "FEM P1 (deal.II), neo-Hookean; 5546 nodes")) << md;
   EXPECT_TRUE(contains(md,
                        "| 20.000 | 0.45000 | 18 | 19.50: 0.4500 | 0.248 | 0.14000 | 0.04500 | — | "
                        "(3.07, 0.00, 19.72) | 19 | 18.9 |"))

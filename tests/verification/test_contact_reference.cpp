@@ -141,7 +141,7 @@ TEST(ContactReferenceSlow, StraightSceneFloppyWireOnTheNeoHookeanWall) {
 // named; on the straight scene the push computed from the clamp's force and moment (R·t − M²/2EI,
 // the Eshelby-like force of a rod leaving a sleeve) equals the derivative of the stored energy
 // along the insertion (virtual work), and four steps end where one does.
-TEST(ContactInsertion, RefusesASceneWithoutAGuidewireAndAnEmptyRange) {
+TEST(ContactInsertion, RefusesASceneWithoutAGuidewireAnEmptyRangeAndAModelItDoesNotHave) {
   const Scene patch = shipped("contact_straight.toml");
   expect_input_error([&] { (void)solve_contact_insertion(patch, 4e-7); },
                      {"contact_straight.toml", "guidewire"});
@@ -157,6 +157,11 @@ TEST(ContactInsertion, RefusesASceneWithoutAGuidewireAndAnEmptyRange) {
                      {"guidewire_straight.toml", "steps ≥ 1"});
   expect_input_error([&] { (void)solve_contact_insertion(wire, 0.0); },
                      {"guidewire_straight.toml", "EI"});
+  ContactInsertionOptions unknown;
+  unknown.model = "no_such_model";
+  expect_input_error(
+      [&] { (void)solve_contact_insertion(wire, 4e-7, unknown); },
+      {"guidewire_straight.toml", "no model \"no_such_model\"", "fem_p1", "volume_hybrid"});
 }
 
 // The insertion's document (a hand-made insertion: the mapping, not a solve): it conforms to its
@@ -168,6 +173,7 @@ TEST(ContactInsertion,
      DocumentConformsToItsSchemaAndTheReportDrawsItsStepsInMillimetresAndMillinewtons) {
   ContactInsertion r;
   r.scene = "hand";
+  r.model_detail = "FEM P1 (deal.II), neo-Hookean";
   r.bending_stiffness = 4e-7;
   r.mesh_nodes = 5546;
   r.refined_balls = 3;

@@ -36,6 +36,7 @@ struct InsertionCli {
   std::filesystem::path svg;   // empty: no figure
   std::filesystem::path json;  // empty: no document
   CacheOptions cache;
+  std::vector<std::string> models{"reference"};
 };
 
 /// The options a guidewire scene's contact commands share: the scene, the stiffnesses and the wall.
@@ -130,7 +131,9 @@ void add_insertion_command(CLI::App& app, const std::string& command_line) {
       "from the steps' energies) and the tip.\n"
       "Example:\n"
       "  vesselverify insertion verification/scenes/guidewire_straight.toml --ei 4e-7 "
-      "--steps 8");
+      "--steps 8\n"
+      "  vesselverify insertion verification/scenes/guidewire_straight.toml --ei 4e-7 "
+      "--models reference,volume_hybrid --json insertion.json");
   add_scene_stiffness_wall(cmd, o->scene, o->ei, o->wall);
   cmd->add_option("--from", o->options.first, "The first insertion length, m (0: 80 % of the last)")
       ->check(CLI::NonNegativeNumber)
@@ -161,6 +164,12 @@ void add_insertion_command(CLI::App& app, const std::string& command_line) {
                   "Also write the insertion as a JSON document here (schema "
                   "verification/harness/contact_insertion.schema.json), which `vesselverify "
                   "report --insertion` draws as a section");
+  cmd->add_option("--models", o->models,
+                  "The walls pushed against, comma separated: reference (deal.II's FEM, as --wall "
+                  "says) and any of the scene's models by name (its own wall on the same mesh, "
+                  "at its own equilibrium)")
+      ->delimiter(',')
+      ->capture_default_str();
   add_cache_options(*cmd, o->cache);
   cmd->add_flag("--retime", o->cache.retime,
                 "Solve every insertion again (and replace its entry in the outcome cache) instead "
@@ -170,8 +179,10 @@ void add_insertion_command(CLI::App& app, const std::string& command_line) {
     o->options.wall = parse_contact_wall(o->wall);
     const Scene scene = read_scene(o->scene);
     const auto cache = o->cache.outcome_cache(std::cerr);
-    const std::string json = contact_insertion_document(scene, stiffnesses(scene, o->ei),
-                                                        o->options, command_line, cache.get());
+    std::vector<std::string> walls;  // "" is the reference
+    for (const std::string& m : o->models) walls.push_back(m == "reference" ? "" : m);
+    const std::string json = contact_insertion_document(
+        scene, stiffnesses(scene, o->ei), o->options, command_line, cache.get(), walls);
     // The tables and the figure from the document, as the report reads it.
     const reports::InsertionFile file = reports::parse_insertion(json, "insertion");
     std::cout << reports::insertion_markdown(file) << std::flush;

@@ -1,5 +1,6 @@
 #include "verification/harness/contact_insertion.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -7,6 +8,7 @@
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "fem_reference/elasticity.hpp"
@@ -15,6 +17,7 @@
 #include "msm/rods/der_rod.hpp"
 #include "verification/contact/wall_crossing.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
+#include "verification/contact_models/model_walls.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
 #include "verification/harness/outcome_cache.hpp"
 #include "verification/scene_problems.hpp"
@@ -92,15 +95,52 @@ Eigen::VectorXd scaled_about(const Eigen::VectorXd& x, int nodes, const Vec3& or
   return out;
 }
 
-std::unique_ptr<contact::WallPotential> make_wall(const Scene& scene, const TetMesh& mesh,
-                                                  const ContactInsertionOptions& o) {
-  const fem::ElasticityProblem problem =
-      wall_problem(scene, scene.poisson_ratios.front(), o.degree);
-  if (o.wall == ContactWall::neo_hookean) {
-    return std::make_unique<contact::NeoHookeanWall>(mesh, problem);
+/// The insertion's wall: deal.II's FEM (the reference) or one of the scene's models on the mesh,
+/// with what keeps the model alive.
+struct InsertionWall {
+  std::unique_ptr<contact::WallPotential> potential;
+  std::optional<contact::ModelWall> model;  ///< owns the form a FormWall refers to
+  std::string detail;
+};
+
+InsertionWall make_wall(const Scene& scene, const TetMesh& mesh, const ContactInsertionOptions& o) {
+  const double nu = scene.poisson_ratios.front();
+  InsertionWall w;
+  if (o.model.empty()) {
+    const fem::ElasticityProblem problem = wall_problem(scene, nu, o.degree);
+    w.detail = "FEM P" + std::to_string(o.degree) + " (deal.II), " + to_string(o.wall);
+    if (o.wall == ContactWall::neo_hookean) {
+      w.potential = std::make_unique<contact::NeoHookeanWall>(mesh, problem);
+    } else {
+      const fem::ElasticitySolver solver(mesh, problem);
+      w.potential = std::make_unique<contact::LinearWall>(solver.free_displacement_system());
+    }
+    return w;
   }
-  const fem::ElasticitySolver solver(mesh, problem);
-  return std::make_unique<contact::LinearWall>(solver.free_displacement_system());
+  const auto spec = std::find_if(scene.models.begin(), scene.models.end(),
+                                 [&](const ModelSpec& m) { return m.name == o.model; });
+  if (spec == scene.models.end()) {
+    std::string names;
+    for (const ModelSpec& m : scene.models) names += (names.empty() ? "" : ", ") + m.name;
+    throw InputError(scene.source.string() + ": insertion: no model \"" + o.model +
+                     "\" in the scene; expected one of " + names);
+  }
+  VesselParams vessel = scene.vessel;
+  vessel.style = MeshStyle::unstructured;  // the insertion's mesh is gmsh's
+  try {
+    w.model.emplace(contact::model_wall(scene, *spec, mesh, vessel, nu));
+  } catch (const InputError& e) {
+    throw InputError(scene.source.string() + ": insertion: model " + o.model + ": " + e.what());
+  }
+  const contact::ModelWall& m = *w.model;
+  w.detail = m.detail;
+  if (m.energy.form) {  // a mass-spring or tet model's own energy: its own equilibrium
+    w.potential = std::make_unique<contact::FormWall>(*m.energy.form, m.energy.rest,
+                                                      m.system.free_index, m.system.node_rows);
+  } else {  // deal.II's FEM as a model: linear
+    w.potential = std::make_unique<contact::LinearWall>(m.system);
+  }
+  return w;
 }
 
 /// A failed insertion step is retried after one halfway, this many times deep: a long step scales
@@ -287,17 +327,20 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
                      std::to_string(first * 1e3) + " to " + std::to_string(last * 1e3) + " mm");
   }
   const TetMesh mesh = refined_balls_mesh(scene.vessel, balls, o.fine_size);
-  const std::unique_ptr<contact::WallPotential> wall = make_wall(scene, mesh, o);
+  const InsertionWall made = make_wall(scene, mesh, o);
+  const contact::WallPotential* wall = made.potential.get();
+  if (!o.model.empty()) out.model = o.model;
+  out.model_detail = made.detail;
   const std::vector<int> candidates =
       mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
   out.mesh_nodes = static_cast<int>(mesh.nodes.size());
   out.refined_balls = static_cast<int>(balls.size());
   out.mesh_seconds = seconds_since(t_mesh);
   if (o.log) {
-    *o.log << "insertion: " << scene.name << ", EI " << EI << " N·m², " << to_string(o.wall)
-           << " wall, " << mesh.nodes.size() << " nodes (" << o.fine_size * 1e3 << " mm within "
-           << o.refine_radius * 1e3 << " mm of " << balls.size() << " rigid-lumen wall points), "
-           << out.mesh_seconds << " s" << std::endl;
+    *o.log << "insertion: " << scene.name << ", EI " << EI << " N·m², " << out.model << " ("
+           << made.detail << "), " << mesh.nodes.size() << " nodes (" << o.fine_size * 1e3
+           << " mm within " << o.refine_radius * 1e3 << " mm of " << balls.size()
+           << " rigid-lumen wall points), " << out.mesh_seconds << " s" << std::endl;
   }
 
   std::vector<double> lengths;
@@ -356,6 +399,8 @@ std::string contact_insertion_entry(const ContactInsertion& r) {
                      {"seconds", s.seconds}});
   }
   const json entry{{"scene", r.scene},
+                   {"model", r.model},
+                   {"model_detail", r.model_detail},
                    {"bending_stiffness_Nm2", r.bending_stiffness},
                    {"wall", to_string(r.wall)},
                    {"mesh_nodes", r.mesh_nodes},
@@ -366,8 +411,9 @@ std::string contact_insertion_entry(const ContactInsertion& r) {
 }
 
 std::string contact_insertion_document(const Scene& scene, const std::vector<double>& stiffnesses,
-                                       const ContactInsertionOptions& o, const std::string& command,
-                                       OutcomeCache* cache) {
+                                       const ContactInsertionOptions& options,
+                                       const std::string& command, OutcomeCache* cache,
+                                       const std::vector<std::string>& models) {
   using nlohmann::json;
   const auto t0 = Clock::now();
   // Everything an insertion depends on besides the code and the machine (OutcomeCache adds
@@ -383,24 +429,28 @@ std::string contact_insertion_document(const Scene& scene, const std::vector<dou
     return s.str();
   };
   json all = json::array();
-  for (const double EI : stiffnesses) {
-    const auto solve = [&] {
-      return contact_insertion_entry(solve_contact_insertion(scene, EI, o));
-    };
-    json entry;
-    if (cache && cache->enabled()) {
-      const std::string key = "contact insertion v1|" + scene_text + "|EI " + hex(EI) + "|wall " +
-                              to_string(o.wall) + "|" + hex(o.first) + " " + hex(o.last) + " " +
-                              std::to_string(o.steps) + " " + hex(o.fine_size) + " " +
-                              hex(o.refine_radius) + " " + std::to_string(o.degree) + " " +
-                              std::to_string(o.max_steps);
-      TimingProvenance provenance;
-      entry = json::parse(cache->get(key, solve, provenance));
-      if (provenance.cached) entry["cached_from"] = provenance.measured_at;
-    } else {
-      entry = json::parse(solve());
+  for (const std::string& model : models) {
+    ContactInsertionOptions o = options;
+    o.model = model;
+    for (const double EI : stiffnesses) {
+      const auto solve = [&] {
+        return contact_insertion_entry(solve_contact_insertion(scene, EI, o));
+      };
+      json entry;
+      if (cache && cache->enabled()) {
+        const std::string key = "contact insertion v1|" + scene_text + "|EI " + hex(EI) + "|wall " +
+                                to_string(o.wall) + "|" + hex(o.first) + " " + hex(o.last) + " " +
+                                std::to_string(o.steps) + " " + hex(o.fine_size) + " " +
+                                hex(o.refine_radius) + " " + std::to_string(o.degree) + " " +
+                                std::to_string(o.max_steps) + "|model " + o.model;
+        TimingProvenance provenance;
+        entry = json::parse(cache->get(key, solve, provenance));
+        if (provenance.cached) entry["cached_from"] = provenance.measured_at;
+      } else {
+        entry = json::parse(solve());
+      }
+      all.push_back(entry);
     }
-    all.push_back(entry);
   }
   const json j{{"schema", "vesselverify.insertion"},
                {"schema_version", 1},

@@ -37,6 +37,11 @@ struct ContactInsertionOptions {
   double refine_radius = 1.0e-3;  ///< m: the refined ball around each rigid-lumen wall point
   int degree = 1;                 ///< the wall's elements
   int max_steps = 300;            ///< Newton steps per insertion step
+  /// The wall: empty for the reference (deal.II's FEM as `wall` says), else the name of one of
+  /// the scene's models, its own wall on the same mesh (a mass-spring or tet model's own energy,
+  /// so its own nonlinear equilibrium; a linear FEM model's linear wall; contact_models/
+  /// model_walls.hpp says how a surface model's thickness enters)
+  std::string model;
   std::ostream* log = nullptr;    ///< one line per step, if set
 };
 
@@ -70,6 +75,8 @@ struct InsertionStep {
 
 struct ContactInsertion {
   std::string scene;
+  std::string model = "reference";  ///< the wall's model ("reference": the FEM wall)
+  std::string model_detail;         ///< what that wall is
   double bending_stiffness = 0.0;  ///< EI, N·m²
   ContactWall wall = ContactWall::neo_hookean;
   int mesh_nodes = 0;
@@ -79,16 +86,17 @@ struct ContactInsertion {
 };
 
 /// The insertion of `scene`'s guidewire at bending stiffness EI (N·m²) against the scene's wall
-/// at its first Poisson's ratio. InputError naming the scene's file for a scene without a
-/// guidewire load, a vessel from a file, EI ≤ 0, options out of range or a first insertion
-/// beyond the last. A step that does not converge is reported, and the next starts from the last
-/// converged one.
+/// (or options.model's) at its first Poisson's ratio. InputError naming the scene's file for a
+/// scene without a guidewire load, a vessel from a file, EI ≤ 0, options out of range, a first
+/// insertion beyond the last, or a model the scene does not have or the contact cannot carry. A
+/// step that does not converge is reported, and the next starts from the last converged one.
 ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
                                          const ContactInsertionOptions& options = {});
 
 class OutcomeCache;  // verification/harness/outcome_cache.hpp
 
-/// The insertions of `scene`'s wire at each bending stiffness in `stiffnesses` (N·m²) as the JSON
+/// The insertions of `scene`'s wire at each bending stiffness in `stiffnesses` (N·m²), against each
+/// wall of `models` (options.model's meaning: "" the reference, else a model's name), as the JSON
 /// document `vesselverify insertion --json` writes (schema "vesselverify.insertion", version 1:
 /// verification/harness/contact_insertion.schema.json; SI units), which the report reads back
 /// (reports/study_files.hpp) for its tables and curves. With a `cache`, each insertion is kept
@@ -97,7 +105,8 @@ class OutcomeCache;  // verification/harness/outcome_cache.hpp
 /// says when that was. InputError as solve_contact_insertion.
 std::string contact_insertion_document(const Scene& scene, const std::vector<double>& stiffnesses,
                                        const ContactInsertionOptions& options,
-                                       const std::string& command, OutcomeCache* cache = nullptr);
+                                       const std::string& command, OutcomeCache* cache = nullptr,
+                                       const std::vector<std::string>& models = {""});
 
 /// One insertion as the document's entry (a JSON object), as contact_insertion_document writes it.
 std::string contact_insertion_entry(const ContactInsertion& insertion);
