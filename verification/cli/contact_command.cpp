@@ -61,6 +61,31 @@ std::vector<double> stiffnesses(const Scene& scene, const std::vector<double>& e
   return ei.empty() ? contact_reference_stiffnesses(scene) : ei;
 }
 
+/// Solves (or reads from the cache) the insertions asked for, prints their tables and writes the
+/// document and the figure asked for.
+void run_insertion(InsertionCli& o, const std::string& command_line) {
+  o.options.log = &std::cerr;  // progress; the tables go to stdout
+  o.options.wall = parse_contact_wall(o.wall);
+  const Scene scene = read_scene(o.scene);
+  const auto cache = o.cache.outcome_cache(std::cerr);
+  std::vector<std::string> walls;  // "" is the reference
+  for (const std::string& m : o.models) walls.push_back(m == "reference" ? "" : m);
+  const std::string json = contact_insertion_document(scene, stiffnesses(scene, o.ei), o.options,
+                                                      command_line, cache.get(), walls);
+  // The tables and the figure from the document, as the report reads it.
+  const reports::InsertionFile file = reports::parse_insertion(json, "insertion");
+  std::cout << reports::insertion_markdown(file) << std::flush;
+  if (!o.json.empty()) {
+    write_file_atomically(o.json, [&](std::ostream& f) { f << json; });
+    std::cout << "document: " << o.json.string() << "\n";
+  }
+  if (!o.svg.empty()) {
+    write_file_atomically(
+        o.svg, [&](std::ostream& f) { f << reports::render_svg(reports::insertion_plot(file)); });
+    std::cout << "figure: " << o.svg.string() << "\n";
+  }
+}
+
 }  // namespace
 
 void add_contact_command(CLI::App& app) {
@@ -174,29 +199,7 @@ void add_insertion_command(CLI::App& app, const std::string& command_line) {
   cmd->add_flag("--retime", o->cache.retime,
                 "Solve every insertion again (and replace its entry in the outcome cache) instead "
                 "of reading the one a run of the same executable on this machine stored");
-  cmd->callback([o, command_line] {
-    o->options.log = &std::cerr;  // progress; the tables go to stdout
-    o->options.wall = parse_contact_wall(o->wall);
-    const Scene scene = read_scene(o->scene);
-    const auto cache = o->cache.outcome_cache(std::cerr);
-    std::vector<std::string> walls;  // "" is the reference
-    for (const std::string& m : o->models) walls.push_back(m == "reference" ? "" : m);
-    const std::string json = contact_insertion_document(
-        scene, stiffnesses(scene, o->ei), o->options, command_line, cache.get(), walls);
-    // The tables and the figure from the document, as the report reads it.
-    const reports::InsertionFile file = reports::parse_insertion(json, "insertion");
-    std::cout << reports::insertion_markdown(file) << std::flush;
-    if (!o->json.empty()) {
-      write_file_atomically(o->json, [&](std::ostream& f) { f << json; });
-      std::cout << "document: " << o->json.string() << "\n";
-    }
-    if (!o->svg.empty()) {
-      write_file_atomically(o->svg, [&](std::ostream& f) {
-        f << reports::render_svg(reports::insertion_plot(file));
-      });
-      std::cout << "figure: " << o->svg.string() << "\n";
-    }
-  });
+  cmd->callback([o, command_line] { run_insertion(*o, command_line); });
 }
 
 }  // namespace vessel::cli
