@@ -38,8 +38,7 @@ Table insertion_table(const InsertionEntry& e) {
       std::vector<std::string> row(t.header.size());
       row[0] = fixed(s.insertion * 1e3, 3);
       row[1] = "not converged: " + s.failure;
-      row[9] = std::to_string(s.newton_steps);
-      row[10] = fixed(s.seconds, 1);
+      row[10] = fixed(s.seconds, 1);  // Newton steps: the failed solve's are in its message
       t.rows.push_back(row);
       continue;
     }
@@ -128,7 +127,7 @@ Plot insertion_plot(const InsertionFile& f) {
 void insertion_section(Document& doc, const InsertionFile& f) {
   insertion_text(doc, f);
   doc.figure("insertion.svg", insertion_plot(f),
-             "The contact force and the hub's forces against the insertion length, per wire "
+             "The contact force and the hub's forces against the insertion length, per wall and wire "
              "stiffness (converged steps).");
 }
 
