@@ -7,7 +7,8 @@ VESSELVERIFY_CACHE_DIR pointed at a new empty folder (meshes, FEM references and
 all computed), and again with the cache that run filled. The time is verify.sh's own ("finished
 in N s": from the first mesh to the report, the build excluded). It writes
 docs/measurements/verify_times.md with the machine (CPU, cores, memory) and the load average
-before and after each run: figures from a loaded machine are upper bounds.
+before and after each run: figures from a loaded machine are upper bounds. The rows of a mode not
+asked for are kept from the page as it was.
 
 Usage: /usr/bin/python3 scripts/measure_verify_times.py [--modes default,quick] [--out PAGE]"""
 import argparse
@@ -54,6 +55,16 @@ def run_verify(mode, cache, out):
     return int(m.group(1)), before, load_average()
 
 
+def kept_rows(page, measured_modes):
+    """The page's rows of the modes not measured this time (so `--modes default` keeps --quick's)."""
+    if not os.path.exists(page):
+        return []
+    labels = {"default": "| default |", "quick": "| `--quick` |"}
+    keep = [labels[m] for m in MODES if m not in measured_modes]
+    with open(page) as f:
+        return [line.rstrip("\n") for line in f if any(line.startswith(k) for k in keep)]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--modes", default="default,quick", help="comma-separated: default, quick")
@@ -85,8 +96,9 @@ def main():
              "average is the machine's before and after the run: on a loaded machine the times are "
              "upper bounds.", "",
              "| mode | cache | seconds | load before / after |", "| --- | --- | --- | --- |"]
-    lines += [f"| {'`--quick`' if r[0] == 'quick' else 'default'} | {r[1]} | {r[2]} | {r[3]} / {r[4]} |"
-              for r in rows]
+    measured = [f"| {'`--quick`' if r[0] == 'quick' else 'default'} | {r[1]} | {r[2]} | {r[3]} / {r[4]} |"
+                for r in rows]
+    lines += measured + kept_rows(args.out, modes)
     with open(args.out, "w") as f:
         f.write("\n".join(lines) + "\n")
     print(f"wrote {args.out}")
