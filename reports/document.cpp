@@ -13,6 +13,12 @@ std::string significant(double v, int digits) {
   return s.str();
 }
 
+std::string decimals(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
 namespace {
 
 std::string cell_md(const std::string& s) {

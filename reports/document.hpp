@@ -13,6 +13,8 @@ namespace vessel::reports {
 /// `v` with `digits` significant digits (shortest form: 0.0131, 1.5e-05), as report tables show
 /// numbers.
 std::string significant(double v, int digits = 3);
+/// `v` with `digits` digits after the point (0.441, 19.750), for columns read down a table.
+std::string decimals(double v, int digits);
 
 struct Table {
   std::vector<std::string> header;

@@ -1,18 +1,11 @@
 #include "reports/insertion_section.hpp"
 
-#include <iomanip>
 #include <optional>
 #include <sstream>
 
 namespace vessel::reports {
 
 namespace {
-
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
-}
 
 std::string stiffness_label(double EI) {
   std::ostringstream s;
@@ -36,24 +29,24 @@ Table insertion_table(const InsertionEntry& e) {
   for (const InsertionStepEntry& s : e.steps) {
     if (!s.converged) {
       std::vector<std::string> row(t.header.size());
-      row[0] = fixed(s.insertion * 1e3, 3);
+      row[0] = decimals(s.insertion * 1e3, 3);
       row[1] = "not converged: " + s.failure;
-      row[10] = fixed(s.seconds, 1);  // Newton steps: the failed solve's are in its message
+      row[10] = decimals(s.seconds, 1);  // Newton steps: the failed solve's are in its message
       t.rows.push_back(row);
       continue;
     }
     std::string zones;
     for (const InsertionZoneEntry& z : s.zones) {
-      zones += (zones.empty() ? "" : "; ") + fixed(z.centroid[2] * 1e3, 2) + ": " +
-               fixed(z.force * 1e3, 4);
+      zones += (zones.empty() ? "" : "; ") + decimals(z.centroid[2] * 1e3, 2) + ": " +
+               decimals(z.force * 1e3, 4);
     }
-    t.rows.push_back({fixed(s.insertion * 1e3, 3), fixed(s.force * 1e3, 5),
-                      std::to_string(s.pressed), zones, fixed(s.dent * 1e3, 3),
-                      fixed(s.clamp_axial * 1e3, 5), fixed(s.push * 1e3, 5),
-                      s.push_by_energy ? fixed(*s.push_by_energy * 1e3, 5) : "—",
-                      "(" + fixed(s.tip[0] * 1e3, 2) + ", " + fixed(s.tip[1] * 1e3, 2) + ", " +
-                          fixed(s.tip[2] * 1e3, 2) + ")",
-                      std::to_string(s.newton_steps), fixed(s.seconds, 1)});
+    t.rows.push_back({decimals(s.insertion * 1e3, 3), decimals(s.force * 1e3, 5),
+                      std::to_string(s.pressed), zones, decimals(s.dent * 1e3, 3),
+                      decimals(s.clamp_axial * 1e3, 5), decimals(s.push * 1e3, 5),
+                      s.push_by_energy ? decimals(*s.push_by_energy * 1e3, 5) : "—",
+                      "(" + decimals(s.tip[0] * 1e3, 2) + ", " + decimals(s.tip[1] * 1e3, 2) + ", " +
+                          decimals(s.tip[2] * 1e3, 2) + ")",
+                      std::to_string(s.newton_steps), decimals(s.seconds, 1)});
   }
   return t;
 }
@@ -80,7 +73,7 @@ void insertion_text(Document& doc, const InsertionFile& f) {
     doc.heading(3, e.scene + ", " + e.model + ", " + stiffness_label(e.bending_stiffness));
     doc.paragraph(e.model_detail + "; " + std::to_string(e.mesh_nodes) + " nodes, refined at " +
                   std::to_string(e.refined_balls) + " rigid-lumen wall point(s); set-up " +
-                  fixed(e.mesh_seconds, 1) + " s" +
+                  decimals(e.mesh_seconds, 1) + " s" +
                   (e.cached_from.empty() ? std::string(".")
                                          : "; read from the cache, computed " + e.cached_from +
                                                " (the times are that run's)."));

@@ -538,11 +538,7 @@ void validity_section(Document& doc, const ValidityFile& v) {
 
 namespace {
 
-std::string fixed3(double v) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(3) << v;
-  return s.str();
-}
+std::string fixed3(double v) { return decimals(v, 3); }
 
 std::string case_load(const CalibrationCaseEntry& c) {
   return significant(c.magnitude, 6) + " " + c.load_unit;
@@ -571,9 +567,9 @@ Table calibration_case_table(const CalibrateFile& c, bool training) {
     if (e.training != training) continue;
     t.rows.push_back(
         {e.scene, std::to_string(e.level), e.name, e.holds_out, case_load(e),
-         fixed3(e.p1_relative_l2), or_dash(e.base_relative_l2, fixed3),
+         decimals(e.p1_relative_l2, 3), or_dash(e.base_relative_l2, fixed3),
          or_dash(e.calibrated_relative_l2, fixed3),
-         or_dash(e.calibrated_relative_l2, [&](double x) { return fixed3(x / e.p1_relative_l2); }),
+         or_dash(e.calibrated_relative_l2, [&](double x) { return decimals(x / e.p1_relative_l2, 3); }),
          or_dash(e.base_update_seconds, s3), or_dash(e.calibrated_update_seconds, s3),
          s3(e.p1_solve_seconds), significant(100.0 * e.max_strain_reference, 2) + " %"});
   }
@@ -589,18 +585,18 @@ void calibration_section(Document& doc, const CalibrateFile& c) {
                 c.vessel + " (mesh " + c.mesh_hash + ", " + std::to_string(c.nodes) + " nodes, " +
                 std::to_string(c.springs) + " springs). Fit: " + c.method + ". " +
                 std::to_string(c.parameter_count) + " parameters, " + std::to_string(c.iterations) +
-                " iterations (" + c.stop_reason + "), " + fixed3(c.fit_seconds) + " s; objective " +
+                " iterations (" + c.stop_reason + "), " + decimals(c.fit_seconds, 3) + " s; objective " +
                 significant(c.objective_before, 6) + " → " + significant(c.objective_after, 6) +
                 ". Written to `" + c.calibration_file + "`.");
   if (!c.parameters.empty()) {
     Table t;
     t.header = {"parameter", "factor"};
-    for (const auto& p : c.parameters) t.rows.push_back({p.name, fixed3(p.factor)});
+    for (const auto& p : c.parameters) t.rows.push_back({p.name, decimals(p.factor, 3)});
     doc.table(t);
   } else {
     doc.paragraph(std::string(c.granularity == "per_spring" ? "Per-spring" : "Per-section-spring") +
-                  " factors (kappa included): min " + fixed3(c.factor_min) + ", median " +
-                  fixed3(c.factor_median) + ", max " + fixed3(c.factor_max) + ".");
+                  " factors (kappa included): min " + decimals(c.factor_min, 3) + ", median " +
+                  decimals(c.factor_median, 3) + ", max " + decimals(c.factor_max, 3) + ".");
   }
   doc.paragraph(
       "Relative L2 errors against the P2 reference at the model's nodes (P1 at its "

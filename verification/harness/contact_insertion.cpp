@@ -3,15 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 
 #include "fem_reference/elasticity.hpp"
+#include "meshes/foundation/content_hash.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/rods/der_rod.hpp"
@@ -300,6 +298,16 @@ GuidewireSpec insertion_spec(const Scene& scene, double EI, const ContactInserti
   return spec;
 }
 
+/// The outcome cache's key of one insertion: everything it depends on besides the code and the
+/// machine (OutcomeCache adds those): the scene file's bytes, EI, the wall, the options, the model.
+std::string insertion_key(const Scene& scene, double EI, const ContactInsertionOptions& o) {
+  ContentHash h;
+  h.text(file_contents(scene.source)).real(EI).integer(static_cast<int>(o.wall));
+  h.real(o.first).real(o.last).integer(o.steps).real(o.fine_size).real(o.refine_radius);
+  h.integer(o.degree).integer(o.max_steps).text(o.model);
+  return "contact-insertion " + h.hex();
+}
+
 }  // namespace
 
 ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
@@ -416,18 +424,6 @@ std::string contact_insertion_document(const Scene& scene, const std::vector<dou
                                        const std::vector<std::string>& models) {
   using nlohmann::json;
   const auto t0 = Clock::now();
-  // Everything an insertion depends on besides the code and the machine (OutcomeCache adds
-  // those): the scene file's text, EI and the options, doubles in hexadecimal (exact).
-  std::string scene_text;
-  if (cache && cache->enabled()) {
-    std::ifstream in(scene.source);
-    scene_text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  const auto hex = [](double v) {
-    std::ostringstream s;
-    s << std::hexfloat << v;
-    return s.str();
-  };
   json all = json::array();
   for (const std::string& model : models) {
     ContactInsertionOptions o = options;
@@ -438,11 +434,7 @@ std::string contact_insertion_document(const Scene& scene, const std::vector<dou
       };
       json entry;
       if (cache && cache->enabled()) {
-        const std::string key = "contact insertion v1|" + scene_text + "|EI " + hex(EI) + "|wall " +
-                                to_string(o.wall) + "|" + hex(o.first) + " " + hex(o.last) + " " +
-                                std::to_string(o.steps) + " " + hex(o.fine_size) + " " +
-                                hex(o.refine_radius) + " " + std::to_string(o.degree) + " " +
-                                std::to_string(o.max_steps) + "|model " + o.model;
+        const std::string key = insertion_key(scene, EI, o);
         TimingProvenance provenance;
         entry = json::parse(cache->get(key, solve, provenance));
         if (provenance.cached) entry["cached_from"] = provenance.measured_at;

@@ -25,12 +25,6 @@ std::string to_bytes(const Json& j) {
 }
 Json from_bytes(std::string_view b) { return Json::from_cbor(b.begin(), b.end()); }
 
-std::string file_contents(const std::filesystem::path& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return "(unreadable)";
-  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-}
-
 Json error_json(const ErrorStatistics& e) {
   return {e.max_mm, e.mean_mm, e.stddev_mm, e.rms_mm, e.relative_l2, e.points,
           e.model_l2_over_reference};
@@ -313,6 +307,12 @@ ModelRun deserialise_model_run(std::string_view bytes) {
     run.field_files.emplace_back(f.at(0).get<std::string>(), std::string(b.begin(), b.end()));
   }
   return run;
+}
+
+std::string file_contents(const std::filesystem::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return "(unreadable)";
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
 }
 
 std::string mesh_key(const TetMesh& mesh) {

@@ -75,6 +75,9 @@ struct ModelRun {
 std::string serialise(const ModelRun& run);
 ModelRun deserialise_model_run(std::string_view bytes);  ///< throws std::exception if unreadable
 
+/// A file's bytes, for keys ("(unreadable)" if it cannot be opened).
+std::string file_contents(const std::filesystem::path& path);
+
 /// A hash of a mesh's nodes (exact), tets, triangles and groups, for keys.
 std::string mesh_key(const TetMesh& mesh);
 
