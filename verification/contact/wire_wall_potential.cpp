@@ -13,6 +13,7 @@
 #include "msm/linalg/low_rank_update.hpp"
 #include "verification/contact/condensed_wall.hpp"
 #include "verification/contact/point_segment_distance.hpp"
+#include "verification/contact/point_triangle_distance.hpp"
 
 namespace vessel::contact {
 
@@ -144,26 +145,57 @@ Vec3 PotentialContactSolution::total_force_on_wall() const {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using Mat9 = Eigen::Matrix<double, 9, 9>;
+using Mat12 = Eigen::Matrix<double, 12, 12>;
+using Vec12 = Eigen::Matrix<double, 12, 1>;
 
 /// The rows (in the coupled unknown z = (the rod's free dofs, the wall's rows)) of one contact
-/// pair's nine coordinates (the wall node's, the segment's two ends'); −1 where held.
-using PairRows = std::array<int, 9>;
+/// pair's twelve coordinates (its four points'); −1 where held or unused.
+using PairRows = std::array<int, 12>;
 
-/// One candidate's contact with the nearest segment of the centreline.
+/// One point of a contact pair: a wall candidate or a centreline node (−1: unused).
+struct PairPoint {
+  bool wall = false;
+  int index = -1;
+};
+
+/// One contact pair and its gap's distance term d (g = d − r_w): a candidate against the nearest
+/// segment of the centreline (points: the candidate, the segment's two ends), or the wire's tip
+/// against a face of the wall (points: the tip, the face's three candidates).
 struct Pair {
-  int candidate = 0;
-  int segment = 0;  ///< its first node
-  PointSegmentDistance d;
+  int multiplier = 0;  ///< its λ̂'s index: the candidate's, or past them the face's
+  std::array<PairPoint, 4> points;
+  double distance = 0.0;
+  Vec12 gradient = Vec12::Zero();  ///< ∂d/∂(the points' coordinates)
+  Mat12 hessian = Mat12::Zero();   ///< when asked
 };
 
 /// The pieces of one Newton model (Coupled::evaluate).
 struct Linearisation {
   Triplets base;
   std::vector<PairRows> rows;
-  std::vector<Eigen::Matrix<double, 9, 1>> gap_gradient;
+  std::vector<Vec12> gap_gradient;
   std::vector<double> c;
 };
+
+/// The inner wall's triangles whose three nodes are all candidates, as candidate indices (none
+/// for a mesh without the group).
+std::vector<std::array<int, 3>> candidate_faces(const TetMesh& mesh,
+                                                const std::vector<int>& candidates) {
+  std::vector<std::array<int, 3>> faces;
+  const PhysicalGroup* inner = mesh.find_group(group_names::inner_wall, 2);
+  if (inner == nullptr) return faces;
+  std::vector<int> index(mesh.nodes.size(), -1);
+  for (std::size_t j = 0; j < candidates.size(); ++j) {
+    index[static_cast<std::size_t>(candidates[j])] = static_cast<int>(j);
+  }
+  for (const Triangle& t : mesh.group_triangles(*inner)) {
+    const std::array<int, 3> f{index[static_cast<std::size_t>(t[0])],
+                               index[static_cast<std::size_t>(t[1])],
+                               index[static_cast<std::size_t>(t[2])]};
+    if (f[0] >= 0 && f[1] >= 0 && f[2] >= 0) faces.push_back(f);
+  }
+  return faces;
+}
 
 /// The coupled problem Π(z) and the bookkeeping between z, the rod's dofs and the wall's rows.
 class Coupled {
@@ -186,7 +218,8 @@ class Coupled {
       rows_.push_back(wall.node_rows()[static_cast<std::size_t>(c)]);
     }
     nodes_ = candidates;
-    multiplier_.assign(candidates.size(), 0.0);
+    faces_ = candidate_faces(mesh, candidates);
+    multiplier_.assign(candidates.size() + faces_.size(), 0.0);
   }
 
   [[nodiscard]] int size() const { return n_rod_ + wall_.num_dofs(); }
@@ -220,9 +253,8 @@ class Coupled {
     return p;
   }
 
-  /// Every candidate's nearest segment and distance (with derivatives where it is in contact).
-  /// Every candidate within `band` of pressing (λ̂ − k(g − band) > 0) with its nearest segment
-  /// and distance (and the distance's Hessian when asked).
+  /// Every pair within `band` of pressing (λ̂ − k(g − band) > 0): each candidate with its nearest
+  /// segment, and the tip with each face of the wall (with the distance's Hessian when asked).
   [[nodiscard]] std::vector<Pair> pairs(const VectorXd& x, const VectorXd& u, bool with_hessian,
                                         double band = 0.0) const {
     // A cheap cull: the wire's bounding box grown by the radius and the multipliers' reach.
@@ -255,11 +287,37 @@ class Coupled {
       }
       const double g = std::sqrt(best) - r_;
       if (force_at(j, g - band) <= 0.0) continue;
-      out.push_back({j, seg,
-                     point_segment_distance(p, x.segment<3>(3 * seg), x.segment<3>(3 * seg + 3),
-                                            with_hessian)});
+      const PointSegmentDistance d =
+          point_segment_distance(p, x.segment<3>(3 * seg), x.segment<3>(3 * seg + 3), with_hessian);
+      Pair pair{j, {{{true, j}, {false, seg}, {false, seg + 1}, {}}}, d.distance};
+      pair.gradient.head<9>() = d.gradient;
+      if (with_hessian) pair.hessian.topLeftCorner<9, 9>() = d.hessian;
+      out.push_back(pair);
     }
+    tip_pairs(x.segment<3>(3 * last_), u, with_hessian, reach, band, out);
     return out;
+  }
+
+  /// The tip's hemisphere against each face of the wall within `reach` of its centre, appended
+  /// to `out` where within `band` of pressing.
+  void tip_pairs(const Eigen::Vector3d& tip, const VectorXd& u, bool with_hessian, double reach,
+                 double band, std::vector<Pair>& out) const {
+    const auto offset = static_cast<int>(rest_.size());
+    for (int f = 0; f < static_cast<int>(faces_.size()); ++f) {
+      const auto& face = faces_[static_cast<std::size_t>(f)];
+      const Eigen::Vector3d a = position(face[0], u), b = position(face[1], u),
+                            c = position(face[2], u);
+      const Eigen::Vector3d centre = (a + b + c) / 3.0;
+      const double size = std::max({(a - centre).norm(), (b - centre).norm(), (c - centre).norm()});
+      if ((tip - centre).norm() > size + reach) continue;
+      const PointTriangleDistance d = point_triangle_distance(tip, a, b, c, with_hessian);
+      if (force_at(offset + f, d.distance - r_ - band) <= 0.0) continue;
+      out.push_back({offset + f,
+                     {{{false, last_}, {true, face[0]}, {true, face[1]}, {true, face[2]}}},
+                     d.distance,
+                     d.gradient,
+                     d.hessian});
+    }
   }
 
   /// λ = max(0, λ̂ − k g).
@@ -274,12 +332,17 @@ class Coupled {
   }
 
   [[nodiscard]] PairRows pair_rows(const Pair& p) const {
-    PairRows rows{};
-    for (int c = 0; c < 3; ++c) {
-      const int wr = rows_[static_cast<std::size_t>(p.candidate)][c];
-      rows[c] = wr >= 0 ? n_rod_ + wr : -1;
-      rows[3 + c] = rod_row_[static_cast<std::size_t>(3 * p.segment + c)];
-      rows[6 + c] = rod_row_[static_cast<std::size_t>(3 * (p.segment + 1) + c)];
+    PairRows rows;
+    rows.fill(-1);
+    for (int k = 0; k < 4; ++k) {
+      const PairPoint& point = p.points[static_cast<std::size_t>(k)];
+      if (point.index < 0) continue;
+      for (int c = 0; c < 3; ++c) {
+        const auto i = static_cast<std::size_t>(point.index);
+        const int wr = point.wall ? rows_[i][c] : -1;
+        rows[3 * k + c] = point.wall ? (wr >= 0 ? n_rod_ + wr : -1)
+                                     : rod_row_[3 * i + static_cast<std::size_t>(c)];
+      }
     }
     return rows;
   }
@@ -290,7 +353,7 @@ class Coupled {
     const double w = wall_.evaluate(u, nullptr, nullptr);
     if (!std::isfinite(w)) return w;
     double pi = rod_.energy(x) + w;
-    for (const Pair& p : pairs(x, u, false)) pi += contact_energy(p.candidate, p.d.distance - r_);
+    for (const Pair& p : pairs(x, u, false)) pi += contact_energy(p.multiplier, p.distance - r_);
     return pi;
   }
 
@@ -333,53 +396,63 @@ class Coupled {
     }
     double pi = rod_.energy(x) + w;
     for (const Pair& p : pairs(x, u, lin != nullptr, lin ? band : 0.0)) {
-      const double g = p.d.distance - r_;
-      const double lambda = force_at(p.candidate, g);
+      const double g = p.distance - r_;
+      const double lambda = force_at(p.multiplier, g);
       const PairRows rows = pair_rows(p);
       if (lin) {
         lin->rows.push_back(rows);
-        lin->gap_gradient.push_back(p.d.gradient);
-        lin->c.push_back(multiplier_[static_cast<std::size_t>(p.candidate)] / k_ - g);
+        lin->gap_gradient.push_back(p.gradient);
+        lin->c.push_back(multiplier_[static_cast<std::size_t>(p.multiplier)] / k_ - g);
       }
       if (lambda <= 0.0) continue;
-      pi += contact_energy(p.candidate, g);
+      pi += contact_energy(p.multiplier, g);
       // ψ'(g) = −λ, ψ''(g) = k while λ > 0 (k∇d∇dᵀ is the model's, added per pair by the step).
-      for (int a = 0; a < 9; ++a) {
-        if (rows[a] >= 0) gradient[rows[a]] -= lambda * p.d.gradient[a];
+      for (int a = 0; a < 12; ++a) {
+        if (rows[a] >= 0) gradient[rows[a]] -= lambda * p.gradient[a];
       }
       if (!lin) continue;
-      Mat9 h = -lambda * p.d.hessian;
+      Mat12 h = -lambda * p.hessian;
       if (project) h = projected(h);
       add_block(lin->base, rows, h);
     }
     return pi;
   }
 
-  static void add_block(Triplets& t, const PairRows& rows, const Mat9& h) {
-    for (int a = 0; a < 9; ++a) {
-      for (int b = 0; b < 9; ++b) {
+  static void add_block(Triplets& t, const PairRows& rows, const Mat12& h) {
+    for (int a = 0; a < 12; ++a) {
+      for (int b = 0; b < 12; ++b) {
         if (rows[a] >= 0 && rows[b] >= 0) t.emplace_back(rows[a], rows[b], h(a, b));
       }
     }
   }
 
-  /// The contact forces at z: pressed candidates, λ and unit directions.
+  /// The contact forces at z: on each pressed candidate (its pairs' shares summed) and on each
+  /// centreline node. A point's share of a pair's force is λ ∂d/∂(its position): −ψ'(g)∇g.
   void forces(const VectorXd& z, PotentialContactSolution& out) const {
     const VectorXd x = rod_dofs(z), u = wall_rows(z);
+    std::vector<Vec3> on_wall(rest_.size(), Vec3::Zero());
+    out.force_on_wire.assign(x.size() / 3, Vec3::Zero());
+    out.max_penetration = 0.0;
+    for (const Pair& p : pairs(x, u, false)) {
+      const double g = p.distance - r_;
+      out.max_penetration = std::max(out.max_penetration, -g);
+      const double lambda = force_at(p.multiplier, g);
+      for (int k = 0; k < 4; ++k) {
+        const PairPoint& point = p.points[static_cast<std::size_t>(k)];
+        if (point.index < 0) continue;
+        const Vec3 f = lambda * p.gradient.segment<3>(3 * k);
+        (point.wall ? on_wall : out.force_on_wire)[static_cast<std::size_t>(point.index)] += f;
+      }
+    }
     out.pressed.clear();
     out.force.clear();
     out.direction.clear();
-    out.segment.clear();
-    out.parameter.clear();
-    out.max_penetration = 0.0;
-    for (const Pair& p : pairs(x, u, false)) {
-      const double g = p.d.distance - r_;
-      out.max_penetration = std::max(out.max_penetration, -g);
-      out.pressed.push_back(nodes_[static_cast<std::size_t>(p.candidate)]);
-      out.force.push_back(force_at(p.candidate, g));
-      out.direction.push_back(p.d.gradient.head<3>());
-      out.segment.push_back(p.segment);
-      out.parameter.push_back(p.d.t);
+    for (std::size_t j = 0; j < on_wall.size(); ++j) {
+      const double f = on_wall[j].norm();
+      if (!(f > 0.0)) continue;
+      out.pressed.push_back(nodes_[j]);
+      out.force.push_back(f);
+      out.direction.push_back(on_wall[j] / f);
     }
   }
 
@@ -389,7 +462,7 @@ class Coupled {
     const VectorXd x = rod_dofs(z), u = wall_rows(z);
     std::vector<double> next(multiplier_.size(), 0.0);
     for (const Pair& p : pairs(x, u, false)) {
-      next[static_cast<std::size_t>(p.candidate)] = force_at(p.candidate, p.d.distance - r_);
+      next[static_cast<std::size_t>(p.multiplier)] = force_at(p.multiplier, p.distance - r_);
     }
     double change = 0.0;
     for (std::size_t j = 0; j < next.size(); ++j) {
@@ -423,9 +496,9 @@ class Coupled {
   void prepare(const VectorXd& z) { rod_.prepare(rod_dofs(z)); }
 
  private:
-  static Mat9 projected(const Mat9& h) {
-    const Eigen::SelfAdjointEigenSolver<Mat9> es(h);
-    const Eigen::Matrix<double, 9, 1> ev = es.eigenvalues().cwiseMax(0.0);
+  static Mat12 projected(const Mat12& h) {
+    const Eigen::SelfAdjointEigenSolver<Mat12> es(h);
+    const Vec12 ev = es.eigenvalues().cwiseMax(0.0);
     return es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
   }
 
@@ -441,6 +514,7 @@ class Coupled {
   std::vector<int> nodes_;
   std::vector<Eigen::Vector3d> rest_;
   std::vector<std::array<int, 3>> rows_;
+  std::vector<std::array<int, 3>> faces_;  ///< the wall's faces, as candidate indices
   std::vector<double> multiplier_;
 };
 
@@ -464,7 +538,7 @@ double default_penalty(const WallPotential& wall, const std::vector<int>& candid
 /// a_jᵀ v over pair j's free rows (a_j its gap gradient).
 double pair_dot(const Linearisation& lin, std::size_t j, const VectorXd& v) {
   double s = 0.0;
-  for (int i = 0; i < 9; ++i) {
+  for (int i = 0; i < 12; ++i) {
     if (lin.rows[j][i] >= 0) s += lin.gap_gradient[j][i] * v[lin.rows[j][i]];
   }
   return s;
@@ -472,7 +546,7 @@ double pair_dot(const Linearisation& lin, std::size_t j, const VectorXd& v) {
 
 /// v += s a_j over pair j's free rows.
 void add_pair(const Linearisation& lin, std::size_t j, double s, VectorXd& v) {
-  for (int i = 0; i < 9; ++i) {
+  for (int i = 0; i < 12; ++i) {
     if (lin.rows[j][i] >= 0) v[lin.rows[j][i]] += s * lin.gap_gradient[j][i];
   }
 }
@@ -564,7 +638,7 @@ class ModelMatrix {
   /// Pair j's gap gradient a_j on its free rows.
   [[nodiscard]] msm::SparseColumn column(std::size_t j) const {
     msm::SparseColumn u;
-    for (int i = 0; i < 9; ++i) {
+    for (int i = 0; i < 12; ++i) {
       if (lin_.rows[j][i] < 0) continue;
       u.rows.push_back(lin_.rows[j][i]);
       u.values.push_back(lin_.gap_gradient[j][i]);
@@ -794,11 +868,9 @@ std::vector<std::pair<int, Vec3>> potential_clamp_forces(const msm::rods::Rod& r
                                                         const PotentialContactSolution& s) {
   VectorXd g;
   rod.gradient(s.x, g);
-  // The contact's share of ∇Π on the wire: −λ ∂d/∂(a, b) = λ (1 − t) n at a, λ t n at b.
-  for (std::size_t j = 0; j < s.pressed.size(); ++j) {
-    const int a = s.segment[j];
-    g.segment<3>(3 * a) += s.force[j] * (1.0 - s.parameter[j]) * s.direction[j];
-    g.segment<3>(3 * a + 3) += s.force[j] * s.parameter[j] * s.direction[j];
+  // The contact's share of ∇Π on the wire: −(the wall's contact force on each node).
+  for (std::size_t n = 0; n < s.force_on_wire.size(); ++n) {
+    g.segment<3>(3 * static_cast<Eigen::Index>(n)) -= s.force_on_wire[n];
   }
   const std::vector<char> fixed = rod.clamp_fixed();
   std::vector<std::pair<int, Vec3>> out;

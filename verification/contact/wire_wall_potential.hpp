@@ -4,7 +4,10 @@
 ///   Π(x, u) = E_rod(x) + W_wall(u) + Σ_j ψ(g_j),  g_j = d(P_j, centreline(x)) − r_w,
 /// over the wire's free dofs x and the wall's free displacements u. P_j = X_j + u_j is wall node
 /// j's position, d its distance to the nearest segment of the wire's centreline (a hemisphere
-/// at the ends: the wire's surface is a capsule of radius r_w). The contact law is the augmented
+/// at the ends: the wire's surface is a capsule of radius r_w); and as many pairs of the wire's
+/// tip against each face of the inner wall (its three nodes candidates), d the distance of the
+/// tip's centre to the face, so a wall that wraps round the tip between its nodes still meets its
+/// hemisphere (point_triangle_distance.hpp). The contact law is the augmented
 /// Lagrangian of Signorini's conditions (g ≥ 0, λ ≥ 0, λg = 0):
 ///   ψ(g) = max(0, λ̂ − k g)²/(2k),  λ = −ψ'(g) = max(0, λ̂ − k g)
 /// (the augmented Lagrangian's term shifted by λ̂²/(2k) so it vanishes where a node is open);
@@ -144,15 +147,14 @@ struct PotentialContactOptions {
 struct PotentialContactSolution {
   Eigen::VectorXd x;  ///< the wire's dofs
   Eigen::VectorXd u;  ///< the wall's free displacement rows, m
-  /// The pressed wall nodes (mesh indices), their forces λ (N) and the unit directions the wire
-  /// pushes them (from the nearest centreline point to the node).
+  /// The pressed wall nodes (mesh indices, ascending), the magnitude of the wire's force on each
+  /// (N) and its unit direction: its own contact with the capsule plus its shares of the tip's
+  /// contacts with its faces.
   std::vector<int> pressed;
   std::vector<double> force;
   std::vector<Vec3> direction;
-  /// Per pressed node, the nearest centreline segment's first node and the nearest point's
-  /// parameter on it (where the wall's force on the wire acts).
-  std::vector<int> segment;
-  std::vector<double> parameter;
+  /// Per centreline node, the wall's contact force on it (N).
+  std::vector<Vec3> force_on_wire;
   double max_penetration = 0.0;  ///< m, over every candidate
   double penalty_stiffness = 0.0;  ///< the k used, N/m
   int newton_iterations = 0;       ///< over all rounds
