@@ -1,6 +1,9 @@
 #include "reports/insertion_section.hpp"
 
+#include <Eigen/Geometry>
+#include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 
 namespace vessel::reports {
@@ -81,7 +84,135 @@ void insertion_text(Document& doc, const InsertionFile& f) {
   }
 }
 
+std::string view_scene(const std::string& scene) { return "insertion-" + scene; }
+
+/// The reference's entry with a view at the same EI and insertion length as `e`'s view, if any.
+const InsertionEntry* reference_at(const InsertionFile& f, const InsertionEntry& e) {
+  const double L = e.steps[static_cast<std::size_t>(e.view->step)].insertion;
+  for (const InsertionEntry& r : f.insertions) {
+    if (r.model == "reference" && r.scene == e.scene && r.view &&
+        r.bending_stiffness == e.bending_stiffness &&
+        r.steps[static_cast<std::size_t>(r.view->step)].insertion == L) {
+      return &r;
+    }
+  }
+  return nullptr;
+}
+
+/// The force-weighted mean direction of the pressed nodes' displacements (the dent's, out of the
+/// lumen: the camera looks from there, onto the wall's outside), or none without a force.
+std::optional<std::vector<double>> dent_direction(const InsertionViewEntry& v) {
+  Vec3 d = Vec3::Zero();
+  for (std::size_t k = 0; k < v.force.size(); ++k) {
+    d += v.force[k] *
+         Vec3(v.displacement[3 * k], v.displacement[3 * k + 1], v.displacement[3 * k + 2]);
+  }
+  if (!(d.norm() > 0.0)) return std::nullopt;
+  d.normalize();
+  return std::vector<double>{d.x(), d.y(), d.z()};
+}
+
+/// The force-weighted centroid of the view's contact forces on the deformed wall (mm; a red
+/// sphere marks it), or none without a force.
+std::optional<std::vector<double>> contact_centroid_mm(const InsertionViewEntry& v) {
+  double total = 0.0;
+  std::vector<double> c(3, 0.0);
+  for (std::size_t k = 0; k < v.force.size(); ++k) {
+    total += v.force[k];
+    for (std::size_t i = 0; i < 3; ++i) {
+      c[i] += v.force[k] * (v.rest[3 * k + i] + v.displacement[3 * k + i]) * 1e3;
+    }
+  }
+  if (!(total > 0.0)) return std::nullopt;
+  for (double& x : c) x /= total;
+  return c;
+}
+
+WallView insertion_wall(const InsertionFile& f, const InsertionEntry& e) {
+  const InsertionViewEntry& v = *e.view;
+  WallView w;
+  w.model = e.model + ", " + stiffness_label(e.bending_stiffness) + ", " +
+            decimals(e.steps[static_cast<std::size_t>(v.step)].insertion * 1e3, 3) + " mm";
+  w.kind = e.model == "reference" ? "fem" : "model";
+  w.level = -1;
+  std::map<int, std::size_t> reference_node;  // mesh index → position in the reference's view
+  const InsertionEntry* r = reference_at(f, e);
+  if (r) {
+    for (std::size_t k = 0; k < r->view->nodes.size(); ++k) reference_node[r->view->nodes[k]] = k;
+  }
+  std::vector<double> force_mN;
+  for (std::size_t k = 0; k < v.nodes.size(); ++k) {
+    const auto at = reference_node.find(v.nodes[k]);
+    for (std::size_t c = 0; c < 3; ++c) {
+      w.rest_mm.push_back(static_cast<float>(v.rest[3 * k + c] * 1e3));
+      w.u_model_mm.push_back(static_cast<float>(v.displacement[3 * k + c] * 1e3));
+      w.u_reference_mm.push_back(
+          at == reference_node.end()
+              ? 0.0F
+              : static_cast<float>(r->view->displacement[3 * at->second + c] * 1e3));
+    }
+    force_mN.push_back(v.force[k] * 1e3);
+  }
+  w.indices.assign(v.triangles.begin(), v.triangles.end());
+  set_colour(w, force_mN);
+  return w;
+}
+
 }  // namespace
+
+std::vector<SceneViews> insertion_views(const InsertionFile& f) {
+  std::vector<SceneViews> out;
+  std::set<std::string> done;
+  for (const InsertionEntry& first : f.insertions) {
+    if (!first.view || !done.insert(first.scene).second) continue;
+    SceneViews s;
+    s.scene = view_scene(first.scene);
+    s.tolerance_mm.reset();
+    s.colour_name = "contact force";
+    s.colour_unit = "mN";
+    s.true_scale = true;
+    s.load_text = "the last converged step";
+    const InsertionEntry* drawn = nullptr;  // whose wire is drawn: the reference's, else the first
+    for (const InsertionEntry& e : f.insertions) {
+      if (e.scene != first.scene || !e.view) continue;
+      s.views.push_back(insertion_wall(f, e));
+      if (!drawn || (e.model == "reference" && drawn->model != "reference")) drawn = &e;
+    }
+    s.qoi_mm = contact_centroid_mm(*drawn->view);
+    s.view_from = dent_direction(*drawn->view);
+    const InsertionStepEntry& step = drawn->steps[static_cast<std::size_t>(drawn->view->step)];
+    if (!step.centreline.empty()) {
+      WireView wire;
+      wire.radius_mm = drawn->wire_radius * 1e3;
+      // Its nodes within 2 mm of the drawn wall's box (the camera frames the wall, not the wire).
+      Eigen::AlignedBox3d box;
+      const std::vector<double>& rest = drawn->view->rest;
+      for (std::size_t k = 0; k + 2 < rest.size(); k += 3)
+        box.extend(Vec3(rest[k], rest[k + 1], rest[k + 2]));
+      box.min().array() -= 2e-3;
+      box.max().array() += 2e-3;
+      for (std::size_t k = 0; k + 2 < step.centreline.size(); k += 3) {
+        const Vec3 p(step.centreline[k], step.centreline[k + 1], step.centreline[k + 2]);
+        if (box.contains(p)) wire.rigid_mm.push_back({p.x() * 1e3, p.y() * 1e3, p.z() * 1e3});
+      }
+      s.wire = wire;
+    }
+    s.caption =
+        "Each wall within 2 mm of where the wire bears at the last converged step of "
+        "its insertion, "
+        "at true scale, coloured by the wire's contact force on each node (mN, viridis, "
+        "one scale for every wall). Grey ghost: the reference's wall at the same step "
+        "(at rest where the file has none). Red sphere: the force-weighted centroid of "
+        "the contact on the wire's wall. Orange tube: the wire on " +
+        drawn->model + "'s wall (" + stiffness_label(drawn->bending_stiffness) +
+        "; its part near the drawn wall, in place and half transparent). The camera starts "
+        "outside the lumen, looking onto the dent. Drag to turn, wheel to zoom; both panes share "
+        "the "
+        "camera; hover a node for its force and both displacements.";
+    out.push_back(std::move(s));
+  }
+  return out;
+}
 
 Plot insertion_plot(const InsertionFile& f) {
   Plot plot;
@@ -122,6 +253,10 @@ void insertion_section(Document& doc, const InsertionFile& f) {
   doc.figure("insertion.svg", insertion_plot(f),
              "The contact force and the hub's forces against the insertion length, per wall and wire "
              "stiffness (converged steps).");
+  std::set<std::string> viewed;
+  for (const InsertionEntry& e : f.insertions) {
+    if (e.view && viewed.insert(e.scene).second) doc.slot("view:" + view_scene(e.scene));
+  }
 }
 
 std::string insertion_markdown(const InsertionFile& f) {

@@ -669,6 +669,9 @@ void write_report(const ReportOptions& o) {
     }
     views.push_back(validity_scene_views(s, o.validity.parent_path(), tolerance_mm));
   }
+  if (insertion) {
+    for (SceneViews& v : insertion_views(*insertion)) views.push_back(std::move(v));
+  }
   const WebLibraries libraries = load_web_libraries(default_javascript_dir());
   write_file_atomically(o.output_dir / "report.html", [&](std::ostream& out) {
     out << interactive_html(doc, scene_cards(results), views, libraries, "vesselverify report");

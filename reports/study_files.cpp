@@ -313,9 +313,35 @@ InsertionStepEntry read_insertion_step(const json& j, const std::string& where) 
   s.push_by_energy = optional_field<double>(j, "push_by_energy_N", where);
   s.tip = read_vector(j, "tip_m", where);
   s.dent = field<double>(j, "dent_m", where);
+  s.centreline = field_or<std::vector<double>>(j, "centreline_m", {}, where);
+  if (s.centreline.size() % 3 != 0)
+    throw InputError(where + ": centreline_m needs 3 numbers a point");
   s.newton_steps = field<int>(j, "newton_steps", where);
   s.seconds = field<double>(j, "seconds", where);
   return s;
+}
+
+/// The view, its arrays' sizes checked against each other and the entry's `steps`.
+InsertionViewEntry read_insertion_view(const json& j, const std::string& where, std::size_t steps) {
+  InsertionViewEntry v;
+  v.step = field<int>(j, "step", where);
+  v.nodes = field<std::vector<int>>(j, "nodes", where);
+  v.rest = field<std::vector<double>>(j, "rest_m", where);
+  v.displacement = field<std::vector<double>>(j, "displacement_m", where);
+  v.force = field<std::vector<double>>(j, "force_N", where);
+  v.triangles = field<std::vector<int>>(j, "triangles", where);
+  const std::size_t n = v.nodes.size();
+  const bool indices_fit = std::all_of(v.triangles.begin(), v.triangles.end(), [&](int i) {
+    return i >= 0 && static_cast<std::size_t>(i) < n;
+  });
+  if (v.step < 0 || static_cast<std::size_t>(v.step) >= steps || v.rest.size() != 3 * n ||
+      v.displacement.size() != 3 * n || v.force.size() != n || v.triangles.size() % 3 != 0 ||
+      !indices_fit) {
+    throw InputError(where +
+                     ": expected a step among the steps, 3 numbers a node in rest_m and "
+                     "displacement_m, one in force_N, and triangles of 3 indices into nodes");
+  }
+  return v;
 }
 
 InsertionEntry read_insertion_entry(const json& j, const std::string& where) {
@@ -329,7 +355,11 @@ InsertionEntry read_insertion_entry(const json& j, const std::string& where) {
   e.refined_balls = field<int>(j, "refined_balls", where);
   e.mesh_seconds = field<double>(j, "mesh_seconds", where);
   e.cached_from = field_or<std::string>(j, "cached_from", "", where);
+  e.wire_radius = field_or<double>(j, "wire_radius_m", 0.0, where);
   e.steps = read_array(j, "steps", where, read_insertion_step);
+  if (const auto v = j.find("view"); v != j.end()) {
+    e.view = read_insertion_view(*v, where + ".view", e.steps.size());
+  }
   return e;
 }
 

@@ -268,8 +268,18 @@ struct InsertionStepEntry {
   std::optional<double> push_by_energy;  ///< dΠ/dL, N (none next to a failed step)
   std::array<double, 3> tip{};           ///< m
   double dent = 0.0;                     ///< m
+  std::vector<double> centreline;        ///< the wire's nodes, x, y, z each, m (may be empty)
   int newton_steps = 0;
   double seconds = 0.0;
+};
+
+/// The inner wall near the wire at one step (the insertion's view).
+struct InsertionViewEntry {
+  int step = 0;                            ///< index into the entry's steps
+  std::vector<int> nodes;                  ///< mesh indices
+  std::vector<double> rest, displacement;  ///< x, y, z per node, m
+  std::vector<double> force;               ///< N per node
+  std::vector<int> triangles;              ///< three indices into nodes each
 };
 
 struct InsertionEntry {
@@ -279,7 +289,9 @@ struct InsertionEntry {
   int mesh_nodes = 0, refined_balls = 0;
   double mesh_seconds = 0.0;
   std::string cached_from;  ///< when it was computed, if read from the cache (else empty)
+  double wire_radius = 0.0;  ///< m (0: not given)
   std::vector<InsertionStepEntry> steps;
+  std::optional<InsertionViewEntry> view;
 };
 
 struct InsertionFile {

@@ -92,17 +92,27 @@ WallView wall_view(const VtuData& vtu, const std::string& source) {
     c = static_cast<std::uint32_t>(drawn[c]);
   }
   v.indices = std::move(cells);
-  for (const std::size_t i : kept) v.max_error_mm = std::max(v.max_error_mm, err.values[i]);
-  v.error_step_mm = v.max_error_mm > 0.0 ? v.max_error_mm / 65535.0 : 1.0;
+  std::vector<double> error;
   for (const std::size_t i : kept) {
+    error.push_back(err.values[i]);
     for (int c = 0; c < 3; ++c) {
       v.rest_mm.push_back(static_cast<float>(vtu.points[i][c] * 1e3));
       v.u_model_mm.push_back(static_cast<float>(um.values[3 * i + c] * 1e3));
       v.u_reference_mm.push_back(static_cast<float>(ur.values[3 * i + c] * 1e3));
     }
-    v.error_code.push_back(static_cast<std::uint16_t>(std::lround(err.values[i] / v.error_step_mm)));
   }
+  set_colour(v, error);
   return v;
+}
+
+void set_colour(WallView& v, const std::vector<double>& values) {
+  v.colour_max = 0.0;
+  for (const double x : values) v.colour_max = std::max(v.colour_max, x);
+  v.colour_step = v.colour_max > 0.0 ? v.colour_max / 65535.0 : 1.0;
+  v.colour_code.clear();
+  for (const double x : values) {
+    v.colour_code.push_back(static_cast<std::uint16_t>(std::lround(x / v.colour_step)));
+  }
 }
 
 std::string base64_encode(const void* data, std::size_t bytes) {

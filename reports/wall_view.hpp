@@ -16,7 +16,7 @@ namespace vessel::reports {
 
 struct WallView {
   std::string model, kind;  ///< kind: the outcome's (fem, volume_msm, surface_msm, ...)
-  int level = 0;
+  int level = 0;            ///< the model's mesh level (−1: a wall that is not one level's)
   double poisson_ratio = 0.0, magnitude = 0.0;
   bool lines = false;  ///< springs as line segments (a network without faces); else triangles
   bool network_faces = false;  ///< the triangles are a surface network's own (their edges: springs)
@@ -24,12 +24,16 @@ struct WallView {
   std::vector<float> u_model_mm;      ///< the model's displacement per drawn node, mm
   std::vector<float> u_reference_mm;  ///< the reference's displacement at the same nodes, mm
   std::vector<std::uint32_t> indices;  ///< 3 per triangle or 2 per line, into the drawn nodes
-  /// |error| per drawn node quantised: error ≈ error_code · error_step_mm (rounded to nearest,
-  /// so within half a step of the VTU's value).
-  std::vector<std::uint16_t> error_code;
-  double error_step_mm = 0.0;
-  double max_error_mm = 0.0;  ///< the largest |error| over the drawn nodes
+  /// The coloured quantity per drawn node (|error| in mm for a model's wall; the scene's views
+  /// name it and its unit, SceneViews) quantised: value ≈ colour_code · colour_step (rounded to
+  /// nearest, so within half a step of the value).
+  std::vector<std::uint16_t> colour_code;
+  double colour_step = 0.0;
+  double colour_max = 0.0;  ///< the largest value over the drawn nodes
 };
+
+/// Sets v's colour_code, colour_step and colour_max from one value per drawn node.
+void set_colour(WallView& v, const std::vector<double>& values);
 
 /// The drawn part of a VTU as above. InputError naming `source` when a field is missing or the
 /// cells are of a type the view cannot draw.

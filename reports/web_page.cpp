@@ -61,20 +61,20 @@ json patch_json(const std::optional<ContactPatchRow>& patch) {
 json view_json(const WallView& v) {
   return {{"model", v.model},
           {"kind", v.kind},
-          {"level", v.level},
+          {"level", v.level >= 0 ? json(v.level) : json(nullptr)},
           {"lines", v.lines},
           {"springs", v.network_faces},
           {"nodes", v.rest_mm.size() / 3},
           {"rest", b64(v.rest_mm)},
           {"um", b64(v.u_model_mm)},
           {"ur", b64(v.u_reference_mm)},
-          {"idx", v.rest_mm.size() / 3 <= 65536 ? b64(std::vector<std::uint16_t>(
-                                                       v.indices.begin(), v.indices.end()))
-                                                 : b64(v.indices)},
+          {"idx", v.rest_mm.size() / 3 <= 65536
+                      ? b64(std::vector<std::uint16_t>(v.indices.begin(), v.indices.end()))
+                      : b64(v.indices)},
           {"idx_bytes", v.rest_mm.size() / 3 <= 65536 ? 2 : 4},
-          {"err", b64(v.error_code)},
-          {"step", v.error_step_mm},
-          {"max", v.max_error_mm}};
+          {"err", b64(v.colour_code)},
+          {"step", v.colour_step},
+          {"max", v.colour_max}};
 }
 
 /// The wire the view draws (null without one).
@@ -194,17 +194,22 @@ std::string view_html(const SceneViews& v, std::size_t index) {
                  : "")
       << "</div>\n<div class=\"vv-panes\"><div class=\"vv-pane\" data-pane=\"0\"></div>"
       << "<div class=\"vv-pane\" data-pane=\"1\"></div></div>\n<div class=\"vv-colourbar\"></div>\n"
-      << "<p class=\"vv-view-caption\">Each model's wall at " << escape_xml(v.load_text)
-      << ", deformed by its own displacement and coloured by |model − reference| at its nodes "
-         "(viridis, one scale for every model of the scene, logarithmic when their errors span "
-         "more than a decade; the tick marks the tolerance, "
-      << significant(v.tolerance_mm) << " mm). " << escape_xml(v.reference_note)
-      << "Grey ghost: the reference's deformed wall. Red sphere: the QoI point"
-      << (v.contact_patch ? "; red disc: the contact patch the force is spread over (both"
-                          : " (")
-      << " at rest, drawn through the wall). Drag to turn, wheel to zoom; both panes share "
-         "the camera; hover a node for its error and both displacements."
-      << wire_caption(v) << "</p>\n";
+      << "<p class=\"vv-view-caption\">";
+  if (!v.caption.empty()) {
+    out << escape_xml(v.caption);
+  } else {
+    out << "Each model's wall at " << escape_xml(v.load_text)
+        << ", deformed by its own displacement and coloured by |model − reference| at its nodes "
+           "(viridis, one scale for every model of the scene, logarithmic when their errors span "
+           "more than a decade; the tick marks the tolerance, "
+        << significant(v.tolerance_mm.value_or(0.0)) << " mm). " << escape_xml(v.reference_note)
+        << "Grey ghost: the reference's deformed wall. Red sphere: the QoI point"
+        << (v.contact_patch ? "; red disc: the contact patch the force is spread over (both" : " (")
+        << " at rest, drawn through the wall). Drag to turn, wheel to zoom; both panes share "
+           "the camera; hover a node for its error and both displacements."
+        << wire_caption(v);
+  }
+  out << "</p>\n";
   if (!v.missing.empty()) {
     out << "<p class=\"vv-note\">" << v.missing.size() << " finished model(s) have no VTU here ("
         << escape_xml(v.missing.front()) << (v.missing.size() > 1 ? ", …" : "") << ").</p>\n";
@@ -480,11 +485,17 @@ std::string interactive_html(const Document& doc, const std::vector<SceneCard>& 
     out << "<script type=\"application/json\" id=\"vv-plots\">" << script_safe(plots.dump())
         << "</script>\n";
     for (std::size_t i = 0; i < views.size(); ++i) {
-      json scene{{"name", views[i].scene}, {"tolerance_mm", views[i].tolerance_mm},
-                 {"qoi_mm", views[i].qoi_mm ? json(*views[i].qoi_mm) : json(nullptr)},
-                 {"patch", patch_json(views[i].contact_patch)},
-                 {"load", views[i].load_text}, {"wire", wire_json(views[i].wire)},
-                 {"views", json::array()}};
+      json scene{
+          {"name", views[i].scene},
+          {"tolerance_mm", views[i].tolerance_mm ? json(*views[i].tolerance_mm) : json(nullptr)},
+          {"colour", {{"name", views[i].colour_name}, {"unit", views[i].colour_unit}}},
+          {"true_scale", views[i].true_scale},
+          {"view_from", views[i].view_from ? json(*views[i].view_from) : json(nullptr)},
+          {"qoi_mm", views[i].qoi_mm ? json(*views[i].qoi_mm) : json(nullptr)},
+          {"patch", patch_json(views[i].contact_patch)},
+          {"load", views[i].load_text},
+          {"wire", wire_json(views[i].wire)},
+          {"views", json::array()}};
       for (const WallView& v : views[i].views) scene["views"].push_back(view_json(v));
       out << "<script type=\"application/json\" id=\"vv-scene-" << i << "\">"
           << script_safe(scene.dump()) << "</script>\n";

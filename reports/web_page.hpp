@@ -57,7 +57,14 @@ struct SceneViews {
   std::string reference_note;  ///< a sentence naming the reference when it is not the run's
   /// What the view says when it has no walls (no VTU written).
   std::string no_fields_note = "`vesselverify run` writes them unless --fields none.";
-  double tolerance_mm = 0.1;
+  std::optional<double> tolerance_mm = 0.1;  ///< the colour bar's mark (none: no mark)
+  /// What the walls' colours are (WallView::colour_code) and in what unit.
+  std::string colour_name = "|error|", colour_unit = "mm";
+  /// The caption's first sentences in place of the model-against-reference one, if set.
+  std::string caption;
+  bool true_scale = false;  ///< open the view at the displacements' true scale (the wire in place)
+  /// Where the camera first looks from: a unit vector from the view's centre (none: the default)
+  std::optional<std::vector<double>> view_from;
   std::optional<std::vector<double>> qoi_mm;
   std::optional<ContactPatchRow> contact_patch;
   std::string load_text;

@@ -185,6 +185,12 @@
     }
   }
 
+  // What the colours show and in what unit (|error| in mm unless the view says otherwise), and a
+  // wall's name with its mesh level when it has one.
+  function colourName(view) { return view.data.colour ? view.data.colour.name : '|error|'; }
+  function colourUnit(view) { return view.data.colour ? view.data.colour.unit : 'mm'; }
+  function modelName(m) { return m.level === null ? m.model : m.model + ' (L' + m.level + ')'; }
+
   /// A model's decoded arrays (decoded once, when first shown).
   function modelData(view, i) {
     const m = view.data.views[i];
@@ -303,9 +309,12 @@
     const coupled = !!wire.coupled_mm && wire.coupled_mm.length === wire.rigid_mm.length;
     const curve = new THREE.CatmullRomCurve3(wirePoints(wire, view.factor, coupled));
     const radius = Math.max(wire.radius_mm, 0.004 * view.radius);
+    // At true scale the wire sits where it is, so the wall may hide it; half transparent, so the
+    // contact under it shows. Magnified walls leave it behind: then it is drawn through them.
+    const inPlace = !!view.data.true_scale;
     const tube = new THREE.Mesh(new THREE.TubeBufferGeometry(curve, 4 * wire.rigid_mm.length,
-      radius, 10, false), new THREE.MeshLambertMaterial({color: 0xff8c00, depthTest: false,
-      depthWrite: false, transparent: true, opacity: 1}));
+      radius, 10, false), new THREE.MeshLambertMaterial({color: 0xff8c00, depthTest: inPlace,
+      depthWrite: false, transparent: true, opacity: inPlace ? 0.5 : 1}));
     tube.renderOrder = 5;
     pane.wire = tube;
     pane.scene.add(tube);
@@ -398,7 +407,8 @@
     }
     pane.scene.add(pane.mesh);
     pane.model = i;
-    pane.label.textContent = m.model + ' (L' + m.level + '), max error ' + fmt(m.max) + ' mm';
+    pane.label.textContent = modelName(m) + ', max ' + colourName(view) + ' ' + fmt(m.max) + ' ' +
+      colourUnit(view);
     fitSphere(view);
   }
 
@@ -436,13 +446,15 @@
       if (cls) s.className = cls;
       bar.appendChild(s);
     };
-    tick(0, view.logScale ? '≤ ' + fmt(view.scaleMax * 1e-3) + ' mm' : '0 mm');
+    const unit = ' ' + colourUnit(view);
+    tick(0, view.logScale ? '≤ ' + fmt(view.scaleMax * 1e-3) + unit : '0' + unit);
     if (view.logScale) {
-      tick(1 / 3, fmt(view.scaleMax * 1e-2) + ' mm');
-      tick(2 / 3, fmt(view.scaleMax * 1e-1) + ' mm');
+      tick(1 / 3, fmt(view.scaleMax * 1e-2) + unit);
+      tick(2 / 3, fmt(view.scaleMax * 1e-1) + unit);
     }
-    tick(1, fmt(view.scaleMax) + ' mm');
+    tick(1, fmt(view.scaleMax) + unit);
     const tol = view.data.tolerance_mm;
+    if (tol === null || tol === undefined) return;  // a view without a tolerance (the insertion's)
     if (tol < view.scaleMax) {
       const line = document.createElement('div');
       line.className = 'vv-tol';
@@ -503,7 +515,7 @@
       if (dk < dist) { dist = dk; best = k; }
     }
     const vec = (a) => [a[3 * best], a[3 * best + 1], a[3 * best + 2]];
-    return {model: m.model, level: m.level, node: best, error_mm: d.err[best] * m.step,
+    return {model: modelName(m), node: best, colour_value: d.err[best] * m.step,
       u_model_mm: vec(d.um), u_reference_mm: vec(d.ur)};
   }
   report.nodeAt = nodeAt;
@@ -512,8 +524,9 @@
     const n = nodeAt(view, pane, e.clientX, e.clientY);
     if (!n) { tip.style.display = 'none'; return; }
     const v = (u) => '(' + u.map(fmt).join(', ') + ') mm, |u| ' + fmt(Math.hypot(u[0], u[1], u[2])) + ' mm';
-    tip.textContent = n.model + ' (L' + n.level + '), node ' + n.node + '\n|error| ' + fmt(n.error_mm) +
-      ' mm\nmodel u ' + v(n.u_model_mm) + '\nreference u ' + v(n.u_reference_mm);
+    tip.textContent = n.model + ', node ' + n.node + '\n' + colourName(view) + ' ' +
+      fmt(n.colour_value) + ' ' + colourUnit(view) + '\nmodel u ' + v(n.u_model_mm) +
+      '\nreference u ' + v(n.u_reference_mm);
     Object.assign(tip.style, {display: 'block', left: (e.clientX + 14) + 'px', top: (e.clientY + 10) + 'px'});
   }
 
@@ -529,7 +542,7 @@
       view.scaleMax = Math.max(view.scaleMax, m.max);
       if (view.ghost < 0 || (m.nodes > data.views[view.ghost].nodes && !m.lines)) view.ghost = i;
     });
-    if (view.scaleMax <= 0) view.scaleMax = data.tolerance_mm;
+    if (view.scaleMax <= 0) view.scaleMax = data.tolerance_mm || 1;
     // Size and default magnification from the ghost: its largest reference displacement shown
     // as a tenth of the vessel's radius of gyration (at least true scale).
     const g = modelData(view, view.ghost).decoded;
@@ -538,7 +551,7 @@
     view.radius = box.getSize(new THREE.Vector3()).length() / 2;
     let umax = 0;
     for (let i = 0; i < g.ur.length; i += 3) umax = Math.max(umax, Math.hypot(g.ur[i], g.ur[i + 1], g.ur[i + 2]));
-    view.factor = umax > 0 ? Math.max(1, 0.1 * view.radius / umax) : 1;
+    view.factor = umax > 0 && !data.true_scale ? Math.max(1, 0.1 * view.radius / umax) : 1;
     view.camera = new THREE.PerspectiveCamera(35, 1.5, view.radius * 0.01, view.radius * 20);
     view.fit = {centre: view.centre, radius: view.radius};  // until the models are shown
     // Looking at the QoI point's side of the vessel, a little from above and askew.
@@ -550,6 +563,11 @@
         view.orbit.theta = Math.atan2(dx, dz) + 0.45;
         view.orbit.phi = Math.min(2.6, Math.max(0.5, Math.acos(dy / d) - 0.35));
       }
+    }
+    if (data.view_from) {  // a unit vector from the centre towards the camera, a little askew
+      const v = data.view_from;
+      view.orbit.theta = Math.atan2(v[0], v[2]) + 0.3;
+      view.orbit.phi = Math.min(2.9, Math.max(0.25, Math.acos(Math.max(-1, Math.min(1, v[1]))) - 0.2));
     }
     section.querySelectorAll('.vv-pane').forEach((el) => view.panes.push({el: el}));
     view.panes.forEach((p) => buildPane(view, p));
@@ -563,7 +581,7 @@
       data.views.forEach((m, i) => {
         const o = document.createElement('option');
         o.value = i;
-        o.textContent = m.model + ' (L' + m.level + ')';
+        o.textContent = modelName(m);
         select.appendChild(o);
       });
       const chosen = k === 0 ? first : (second === undefined ? first : second);

@@ -135,7 +135,7 @@ TEST(WallView, KeepsOnlyTheBoundaryNodesAndQuantisesTheErrorToHalfAStep) {
     }
     EXPECT_NEAR(v.u_model_mm[3 * k], 1e-3 * i, 1e-9);
     EXPECT_NEAR(v.u_reference_mm[3 * k + 1], 2e-3 * i, 1e-9);
-    EXPECT_NEAR(v.error_code[k] * v.error_step_mm, err.values[i], 0.5 * v.error_step_mm + 1e-15);
+    EXPECT_NEAR(v.colour_code[k] * v.colour_step, err.values[i], 0.5 * v.colour_step + 1e-15);
   }
 }
 

@@ -235,6 +235,86 @@ TEST(ContactInsertion,
                      {"bad.json: insertions[0].steps[0]", "missing field 'force_N'"});
 }
 
+// The insertion's 3D view (a hand-made pair of insertions, the reference and a model, each with
+// the wall near the wire at its last converged step): the document with views conforms to its
+// schema; read back, report.html gets one view of the scene at true scale, one wall per
+// insertion coloured by its contact force in mN, the ghost the reference's displacement at the
+// same mesh node (at rest where the reference's view lacks it), the wire the reference's at that
+// step in mm where it is near the drawn wall, the contact's centroid, no tolerance mark; the
+// section has the view's slot; a view whose triangle names a node it does not have is refused
+// naming it.
+TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
+  const auto insertion = [](const std::string& model, double push) {
+    ContactInsertion r;
+    r.scene = "hand";
+    r.model = model;
+    r.model_detail = model;
+    r.bending_stiffness = 4e-7;
+    r.wire_radius = 0.178e-3;
+    InsertionStep s;
+    s.insertion = 20e-3;
+    s.converged = true;
+    s.force = 4e-4;
+    s.centreline = {Vec3(0, 0, 0), Vec3(2.5e-3, 0, 19e-3), Vec3(2.8e-3, 0, 20e-3)};
+    r.steps = {s};
+    r.view.step = 0;
+    // Mesh nodes 7, 8, 9 (the model's) or 7, 8, 5 (the reference's: node 9 is not in its view).
+    r.view.nodes = {7, 8, model == "reference" ? 5 : 9};
+    r.view.rest = {Vec3(3e-3, 0, 19e-3), Vec3(3e-3, 0, 20e-3), Vec3(2.9e-3, 0.5e-3, 19.5e-3)};
+    r.view.displacement = {Vec3(push, 0, 0), Vec3(2 * push, 0, 0), Vec3(0, push, 0)};
+    r.view.force = {0.0, 1.5e-4, 2.5e-4};
+    r.view.triangles = {{0, 1, 2}};
+    return r;
+  };
+  nlohmann::json j = nlohmann::json::parse(document_of(insertion("reference", 1e-4), "hand", 1.0));
+  j["insertions"].push_back(
+      nlohmann::json::parse(contact_insertion_entry(insertion("model", 2e-4))));
+  const auto problems =
+      test::schema_problems(j, nlohmann::json::parse(test::read_text(VESSEL_INSERTION_SCHEMA)));
+  EXPECT_TRUE(problems.empty()) << test::joined(problems);
+
+  const reports::InsertionFile file = reports::parse_insertion(j.dump(), "ins.json");
+  const std::vector<reports::SceneViews> views = reports::insertion_views(file);
+  ASSERT_EQ(views.size(), 1U);
+  const reports::SceneViews& v = views[0];
+  EXPECT_EQ(v.scene, "insertion-hand");
+  EXPECT_FALSE(v.tolerance_mm.has_value());
+  EXPECT_EQ(v.colour_unit, "mN");
+  EXPECT_TRUE(v.true_scale);
+  ASSERT_EQ(v.views.size(), 2U);
+  for (const reports::WallView& w : v.views) {
+    EXPECT_NEAR(w.colour_max, 0.25, 1e-12) << w.model;
+    EXPECT_NEAR(w.colour_code[1] * w.colour_step, 0.15, 0.5 * w.colour_step) << w.model;
+    EXPECT_EQ(w.indices, (std::vector<std::uint32_t>{0, 1, 2}));
+    EXPECT_NEAR(w.rest_mm[3], 3.0, 1e-6);
+  }
+  const reports::WallView& model = v.views[1];
+  EXPECT_NE(model.model.find("20.000 mm"), std::string::npos) << model.model;
+  EXPECT_NEAR(model.u_model_mm[3], 0.4, 1e-6);      // its own: 2 × 2e-4 m at node 8
+  EXPECT_NEAR(model.u_reference_mm[3], 0.2, 1e-6);  // the reference's at node 8
+  EXPECT_EQ(model.u_reference_mm[7], 0.0F);         // node 9: not in the reference's view
+  // The contact's centroid on the reference's deformed wall: nodes 8 and 5 weighted 1.5 : 2.5.
+  ASSERT_TRUE(v.qoi_mm.has_value());
+  EXPECT_NEAR((*v.qoi_mm)[0], (1.5 * (3.0 + 0.2) + 2.5 * 2.9) / 4.0, 1e-9);
+  EXPECT_NEAR((*v.qoi_mm)[1], 2.5 * (0.5 + 0.1) / 4.0, 1e-9);
+  ASSERT_TRUE(v.wire.has_value());
+  EXPECT_NEAR(v.wire->radius_mm, 0.178, 1e-12);
+  ASSERT_EQ(v.wire->rigid_mm.size(), 2U);  // the clamp's node is not near the drawn wall
+  EXPECT_NEAR(v.wire->rigid_mm[1][2], 20.0, 1e-9);
+
+  reports::Document doc;
+  reports::insertion_section(doc, file);
+  const auto& blocks = doc.blocks();
+  EXPECT_TRUE(std::any_of(blocks.begin(), blocks.end(), [](const reports::Block& b) {
+    return b.kind == reports::Block::Kind::slot && b.text == "view:insertion-hand";
+  }));
+
+  auto broken = j;
+  broken["insertions"][1]["view"]["triangles"] = {0, 1, 3};
+  expect_input_error([&] { (void)reports::parse_insertion(broken.dump(), "bad.json"); },
+                     {"bad.json: insertions[1].view", "triangles of 3 indices into nodes"});
+}
+
 // guidewire_straight's floppy wire (EI 4e-7 N·m²) on its neo-Hookean wall, pushed from 19.25 to
 // 20.25 mm in four steps of 0.25 mm.
 TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes) {

@@ -214,6 +214,44 @@ struct InsertionPath {
     step.push = step.clamp_axial - step.clamp_moment * step.clamp_moment / (2.0 * EI);
     step.energy = rod->energy(s.x) + wall.evaluate(s.u, nullptr, nullptr);
     step.tip = s.x.segment<3>(3 * rod->layout().tip_node);
+    for (int i = rod->layout().first_node; i <= rod->layout().tip_node; ++i) {
+      step.centreline.emplace_back(s.x.segment<3>(3 * i));
+    }
+  }
+
+  /// The inner wall where the wire bears at the equilibrium in hand (step `index`).
+  [[nodiscard]] InsertionView view(int index) const {
+    InsertionView v;
+    v.step = index;
+    const std::vector<Vec3> displacement = wall.nodal(solution.u);
+    const auto near = [&](int n) {
+      const Vec3& x = mesh.nodes[static_cast<std::size_t>(n)];
+      return std::any_of(solution.pressed.begin(), solution.pressed.end(), [&](int p) {
+        return (mesh.nodes[static_cast<std::size_t>(p)] - x).norm() < kInsertionViewReach;
+      });
+    };
+    std::vector<int> drawn(mesh.nodes.size(), -1);
+    const auto index_of = [&](int n) {
+      int& d = drawn[static_cast<std::size_t>(n)];
+      if (d < 0) {
+        d = static_cast<int>(v.nodes.size());
+        v.nodes.push_back(n);
+        v.rest.push_back(mesh.nodes[static_cast<std::size_t>(n)]);
+        v.displacement.push_back(displacement[static_cast<std::size_t>(n)]);
+        v.force.push_back(0.0);
+      }
+      return d;
+    };
+    for (const Triangle& t : mesh.group_triangles(mesh.require_group("inner_wall", 2, "vessel"))) {
+      if (near(t[0]) || near(t[1]) || near(t[2])) {
+        v.triangles.push_back({index_of(t[0]), index_of(t[1]), index_of(t[2])});
+      }
+    }
+    for (std::size_t j = 0; j < solution.pressed.size(); ++j) {
+      const int d = drawn[static_cast<std::size_t>(solution.pressed[j])];
+      if (d >= 0) v.force[static_cast<std::size_t>(d)] = solution.force[j];
+    }
+    return v;
   }
 };
 
@@ -344,6 +382,7 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
   out.mesh_nodes = static_cast<int>(mesh.nodes.size());
   out.refined_balls = static_cast<int>(balls.size());
   out.mesh_seconds = seconds_since(t_mesh);
+  out.wire_radius = 0.5 * spec.diameter;
   if (o.log) {
     *o.log << "insertion: " << scene.name << ", EI " << EI << " N·m², " << out.model << " ("
            << made.detail << "), " << mesh.nodes.size() << " nodes (" << o.fine_size * 1e3
@@ -364,6 +403,7 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
     try {
       path.advance_to(L, 0);
       path.describe(step);
+      out.view = path.view(static_cast<int>(out.steps.size()));
     } catch (const std::runtime_error& e) {
       step.failure = e.what();
     }
@@ -380,6 +420,11 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
 std::string contact_insertion_entry(const ContactInsertion& r) {
   using nlohmann::json;
   const auto vec = [](const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); };
+  const auto points = [](const std::vector<Vec3>& p) {  // flat: x, y, z per point
+    json out = json::array();
+    for (const Vec3& v : p) out.insert(out.end(), {v.x(), v.y(), v.z()});
+    return out;
+  };
   json steps = json::array();
   for (const InsertionStep& s : r.steps) {
     json zones = json::array();
@@ -403,18 +448,28 @@ std::string contact_insertion_entry(const ContactInsertion& r) {
                      {"energy_J", s.energy},
                      {"tip_m", vec(s.tip)},
                      {"dent_m", s.dent},
+                     {"centreline_m", points(s.centreline)},
                      {"newton_steps", s.newton_steps},
                      {"seconds", s.seconds}});
   }
-  const json entry{{"scene", r.scene},
-                   {"model", r.model},
-                   {"model_detail", r.model_detail},
-                   {"bending_stiffness_Nm2", r.bending_stiffness},
-                   {"wall", to_string(r.wall)},
-                   {"mesh_nodes", r.mesh_nodes},
-                   {"refined_balls", r.refined_balls},
-                   {"mesh_seconds", r.mesh_seconds},
-                   {"steps", steps}};
+  json entry{{"scene", r.scene},
+             {"model", r.model},
+             {"model_detail", r.model_detail},
+             {"bending_stiffness_Nm2", r.bending_stiffness},
+             {"wall", to_string(r.wall)},
+             {"mesh_nodes", r.mesh_nodes},
+             {"refined_balls", r.refined_balls},
+             {"mesh_seconds", r.mesh_seconds},
+             {"wire_radius_m", r.wire_radius},
+             {"steps", steps}};
+  if (r.view.step >= 0) {
+    json triangles = json::array();
+    for (const auto& t : r.view.triangles) triangles.insert(triangles.end(), {t[0], t[1], t[2]});
+    entry["view"] = {
+        {"step", r.view.step},           {"nodes", r.view.nodes},
+        {"rest_m", points(r.view.rest)}, {"displacement_m", points(r.view.displacement)},
+        {"force_N", r.view.force},       {"triangles", triangles}};
+  }
   return entry.dump();
 }
 

@@ -16,6 +16,7 @@
 /// acting on elastic structures", J. Mech. Phys. Solids 2015), so P = R·t − M²/(2EI), and by
 /// virtual work P = dΠ/dL with Π the equilibrium's stored energy (wire and wall); both are
 /// reported, the second by central differences between steps.
+#include <array>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -69,9 +70,24 @@ struct InsertionStep {
   double energy = 0.0;      ///< the wire's and the wall's stored energy at equilibrium, J
   Vec3 tip = Vec3::Zero();  ///< m
   double dent = 0.0;        ///< largest wall displacement of a pressed node, m
+  std::vector<Vec3> centreline;  ///< the wire's nodes, clamp to tip, m
   int newton_steps = 0;
   double seconds = 0.0;
 };
+
+/// The wall where the wire bears at one step, for a 3D view: the inner wall's triangles with a
+/// node within kInsertionViewReach of a pressed node.
+struct InsertionView {
+  int step = -1;                              ///< index into the steps (−1: none converged)
+  std::vector<int> nodes;                     ///< mesh indices of the drawn nodes
+  std::vector<Vec3> rest;                     ///< their rest positions, m
+  std::vector<Vec3> displacement;             ///< their displacements, m
+  std::vector<double> force;                  ///< the wire's contact force on each, N
+  std::vector<std::array<int, 3>> triangles;  ///< into `nodes`
+};
+
+/// m: the drawn wall's reach from the pressed nodes.
+inline constexpr double kInsertionViewReach = 2e-3;
 
 struct ContactInsertion {
   std::string scene;
@@ -82,7 +98,9 @@ struct ContactInsertion {
   int mesh_nodes = 0;
   int refined_balls = 0;
   double mesh_seconds = 0.0;  ///< meshing and the wall's set-up
+  double wire_radius = 0.0;   ///< m
   std::vector<InsertionStep> steps;
+  InsertionView view;  ///< at the last converged step
 };
 
 /// The insertion of `scene`'s guidewire at bending stiffness EI (N·m²) against the scene's wall
