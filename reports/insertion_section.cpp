@@ -1,6 +1,8 @@
 #include "reports/insertion_section.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <set>
@@ -54,6 +56,50 @@ Table insertion_table(const InsertionEntry& e) {
   return t;
 }
 
+/// Each model's insertion against the reference's of the same scene and EI, step by step at the
+/// lengths both solved: the contact force and its error, the dent and the tip's distance from
+/// the reference's. Empty when there is no such pair.
+Table models_against_reference(const InsertionFile& f) {
+  Table t;
+  t.header = {"scene",          "EI (N·m²)",      "model",     "insertion (mm)",
+              "force (mN)",     "reference (mN)", "error (mN)", "error (%)",
+              "dent (mm)",      "reference dent (mm)", "tip from the reference's (mm)"};
+  for (const InsertionEntry& r : f.insertions) {
+    if (r.model != "reference") continue;
+    for (const InsertionEntry& m : f.insertions) {
+      if (m.model == "reference" || m.scene != r.scene ||
+          m.bending_stiffness != r.bending_stiffness) {
+        continue;
+      }
+      for (const InsertionStepEntry& s : m.steps) {
+        const auto ref = std::find_if(r.steps.begin(), r.steps.end(), [&](const auto& q) {
+          return std::abs(q.insertion - s.insertion) < 1e-9;
+        });
+        if (ref == r.steps.end()) continue;
+        std::vector<std::string> row{r.scene, significant(r.bending_stiffness, 3), m.model,
+                                     decimals(s.insertion * 1e3, 3)};
+        if (!s.converged || !ref->converged) {
+          row.push_back(!s.converged ? "not converged" : decimals(s.force * 1e3, 5));
+          row.push_back(!ref->converged ? "not converged" : decimals(ref->force * 1e3, 5));
+          row.resize(t.header.size(), "—");
+          t.rows.push_back(row);
+          continue;
+        }
+        const double tip_error = std::sqrt(std::pow(s.tip[0] - ref->tip[0], 2) +
+                                           std::pow(s.tip[1] - ref->tip[1], 2) +
+                                           std::pow(s.tip[2] - ref->tip[2], 2));
+        row.insert(row.end(),
+                   {decimals(s.force * 1e3, 5), decimals(ref->force * 1e3, 5),
+                    decimals((s.force - ref->force) * 1e3, 5),
+                    decimals(100.0 * (s.force / ref->force - 1.0), 2), decimals(s.dent * 1e3, 3),
+                    decimals(ref->dent * 1e3, 3), decimals(tip_error * 1e3, 3)});
+        t.rows.push_back(row);
+      }
+    }
+  }
+  return t;
+}
+
 /// The section without its figure: the text, and a heading, a line and a table per insertion.
 void insertion_text(Document& doc, const InsertionFile& f) {
   doc.heading(2, "The guidewire pushed in");
@@ -81,6 +127,16 @@ void insertion_text(Document& doc, const InsertionFile& f) {
                                          : "; read from the cache, computed " + e.cached_from +
                                                " (the times are that run's)."));
     doc.table(insertion_table(e));
+  }
+  const Table against = models_against_reference(f);
+  if (!against.rows.empty()) {
+    doc.heading(3, "Each model against the reference");
+    doc.paragraph(
+        "Each model's wall in the same insertion (the same mesh, wire and contact law, its own "
+        "equilibrium) against the reference's at the lengths both solved: the wire's net contact "
+        "force and its error, the dent, and how far the wire's tip is from where it is on the "
+        "reference's wall.");
+    doc.table(against);
   }
 }
 

@@ -241,10 +241,11 @@ TEST(ContactInsertion,
 // insertion coloured by its contact force in mN, the ghost the reference's displacement at the
 // same mesh node (at rest where the reference's view lacks it), the wire the reference's at that
 // step in mm where it is near the drawn wall, the contact's centroid, no tolerance mark; the
+// section's table of the model against the reference gives the force's, dent's and tip's errors; the
 // section has the view's slot; a view whose triangle names a node it does not have is refused
 // naming it.
 TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
-  const auto insertion = [](const std::string& model, double push) {
+  const auto insertion = [](const std::string& model, double push, double force) {
     ContactInsertion r;
     r.scene = "hand";
     r.model = model;
@@ -254,8 +255,10 @@ TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
     InsertionStep s;
     s.insertion = 20e-3;
     s.converged = true;
-    s.force = 4e-4;
-    s.centreline = {Vec3(0, 0, 0), Vec3(2.5e-3, 0, 19e-3), Vec3(2.8e-3, 0, 20e-3)};
+    s.force = force;
+    s.dent = 2 * push;
+    s.centreline = {Vec3(0, 0, 0), Vec3(2.5e-3, 0, 19e-3), Vec3(2.8e-3, 0, 20e-3 + push)};
+    s.tip = s.centreline.back();
     r.steps = {s};
     r.view.step = 0;
     // Mesh nodes 7, 8, 9 (the model's) or 7, 8, 5 (the reference's: node 9 is not in its view).
@@ -266,9 +269,9 @@ TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
     r.view.triangles = {{0, 1, 2}};
     return r;
   };
-  nlohmann::json j = nlohmann::json::parse(document_of(insertion("reference", 1e-4), "hand", 1.0));
+  nlohmann::json j = nlohmann::json::parse(document_of(insertion("reference", 1e-4, 4e-4), "hand", 1.0));
   j["insertions"].push_back(
-      nlohmann::json::parse(contact_insertion_entry(insertion("model", 2e-4))));
+      nlohmann::json::parse(contact_insertion_entry(insertion("model", 2e-4, 4.4e-4))));
   const auto problems =
       test::schema_problems(j, nlohmann::json::parse(test::read_text(VESSEL_INSERTION_SCHEMA)));
   EXPECT_TRUE(problems.empty()) << test::joined(problems);
@@ -300,7 +303,7 @@ TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
   ASSERT_TRUE(v.wire.has_value());
   EXPECT_NEAR(v.wire->radius_mm, 0.178, 1e-12);
   ASSERT_EQ(v.wire->rigid_mm.size(), 2U);  // the clamp's node is not near the drawn wall
-  EXPECT_NEAR(v.wire->rigid_mm[1][2], 20.0, 1e-9);
+  EXPECT_NEAR(v.wire->rigid_mm[1][2], 20.1, 1e-9);  // the reference's tip
 
   reports::Document doc;
   reports::insertion_section(doc, file);
@@ -308,6 +311,14 @@ TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
   EXPECT_TRUE(std::any_of(blocks.begin(), blocks.end(), [](const reports::Block& b) {
     return b.kind == reports::Block::Kind::slot && b.text == "view:insertion-hand";
   }));
+
+  // The model against the reference at 20 mm: +0.04 mN (+10 %), dents 0.4 and 0.2 mm, the tip
+  // 0.1 mm further along.
+  const std::string md = reports::insertion_markdown(file);
+  EXPECT_NE(md.find("| hand | 4e-07 | model | 20.000 | 0.44000 | 0.40000 | 0.04000 | 10.00 | "
+                    "0.400 | 0.200 | 0.100 |"),
+            std::string::npos)
+      << md;
 
   auto broken = j;
   broken["insertions"][1]["view"]["triangles"] = {0, 1, 3};
