@@ -214,6 +214,27 @@ WallView insertion_wall(const InsertionFile& f, const InsertionEntry& e) {
   return w;
 }
 
+/// The wire of e's view step, its nodes within 2 mm of the drawn wall's box (the camera frames
+/// the wall, not the whole wire); none without a centreline.
+std::optional<WireView> wire_near_wall(const InsertionEntry& e) {
+  const InsertionStepEntry& step = e.steps[static_cast<std::size_t>(e.view->step)];
+  if (step.centreline.empty()) return std::nullopt;
+  Eigen::AlignedBox3d box;
+  const std::vector<double>& rest = e.view->rest;
+  for (std::size_t k = 0; k + 2 < rest.size(); k += 3) {
+    box.extend(Vec3(rest[k], rest[k + 1], rest[k + 2]));
+  }
+  box.min().array() -= 2e-3;
+  box.max().array() += 2e-3;
+  WireView wire;
+  wire.radius_mm = e.wire_radius * 1e3;
+  for (std::size_t k = 0; k + 2 < step.centreline.size(); k += 3) {
+    const Vec3 p(step.centreline[k], step.centreline[k + 1], step.centreline[k + 2]);
+    if (box.contains(p)) wire.rigid_mm.push_back({p.x() * 1e3, p.y() * 1e3, p.z() * 1e3});
+  }
+  return wire;
+}
+
 }  // namespace
 
 std::vector<SceneViews> insertion_views(const InsertionFile& f) {
@@ -236,35 +257,17 @@ std::vector<SceneViews> insertion_views(const InsertionFile& f) {
     }
     s.qoi_mm = contact_centroid_mm(*drawn->view);
     s.view_from = dent_direction(*drawn->view);
-    const InsertionStepEntry& step = drawn->steps[static_cast<std::size_t>(drawn->view->step)];
-    if (!step.centreline.empty()) {
-      WireView wire;
-      wire.radius_mm = drawn->wire_radius * 1e3;
-      // Its nodes within 2 mm of the drawn wall's box (the camera frames the wall, not the wire).
-      Eigen::AlignedBox3d box;
-      const std::vector<double>& rest = drawn->view->rest;
-      for (std::size_t k = 0; k + 2 < rest.size(); k += 3)
-        box.extend(Vec3(rest[k], rest[k + 1], rest[k + 2]));
-      box.min().array() -= 2e-3;
-      box.max().array() += 2e-3;
-      for (std::size_t k = 0; k + 2 < step.centreline.size(); k += 3) {
-        const Vec3 p(step.centreline[k], step.centreline[k + 1], step.centreline[k + 2]);
-        if (box.contains(p)) wire.rigid_mm.push_back({p.x() * 1e3, p.y() * 1e3, p.z() * 1e3});
-      }
-      s.wire = wire;
-    }
+    s.wire = wire_near_wall(*drawn);
     s.caption =
-        "Each wall within 2 mm of where the wire bears at the last converged step of "
-        "its insertion, "
-        "at true scale, coloured by the wire's contact force on each node (mN, viridis, "
-        "one scale for every wall). Grey ghost: the reference's wall at the same step "
-        "(at rest where the file has none). Red sphere: the force-weighted centroid of "
-        "the contact on the wire's wall. Orange tube: the wire on " +
+        "Each wall within 2 mm of where the wire bears at the last converged step of its "
+        "insertion, at true scale, coloured by the wire's contact force on each node (mN, "
+        "viridis, one scale for every wall). Grey ghost: the reference's wall at the same step "
+        "(at rest where the file has none). Red sphere: the force-weighted centroid of the "
+        "contact on the wire's wall. Orange tube: the wire on " +
         drawn->model + "'s wall (" + stiffness_label(drawn->bending_stiffness) +
         "; its part near the drawn wall, in place and half transparent). The camera starts "
         "outside the lumen, looking onto the dent. Drag to turn, wheel to zoom; both panes share "
-        "the "
-        "camera; hover a node for its force and both displacements.";
+        "the camera; hover a node for its force and both displacements.";
     out.push_back(std::move(s));
   }
   return out;
