@@ -394,6 +394,11 @@ std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
   return balls;
 }
 
+/// The first level, if its zone leaves the refined patch, is solved again on a patch grown to
+/// that zone at most this many times (every level then shares the patch; a finer level's zone
+/// that leaves it makes the verdict "not a reference").
+constexpr int kPatchGrowths = 2;
+
 /// The levels' order, Richardson estimate and GCI on the force, and the verdict.
 void judge(const ContactReferenceOptions& o, ContactReference& r) {
   const ContactLevel& finest = r.levels.back();
@@ -508,6 +513,23 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
     const double fine = o.coarsest_size / std::pow(o.ratio, l);
     ContactLevel level =
         solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point, rigid.force, o);
+    // A zone that leaves the patch (the scout's coarser wall under-reports a long line of
+    // contact): the patch grown to this level's zone, the old one kept, and the level solved
+    // again.
+    while (l == 0 && level.converged && !level.zone_inside_patch &&
+           r.patch_growths < kPatchGrowths) {
+      ++r.patch_growths;
+      r.patch_centre = level.middle;
+      r.patch_radius = level.reach + o.margin;
+      balls.insert(balls.begin(), {r.patch_centre, r.patch_radius});
+      if (o.log) {
+        *o.log << "contact:   the zone (" << level.extent * 1e3
+               << " mm) left the patch: refined within " << r.patch_radius * 1e3
+               << " mm of its middle and solved again" << std::endl;
+      }
+      level =
+          solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point, rigid.force, o);
+    }
     level.level = l;
     r.levels.push_back(level);
   }
@@ -530,7 +552,11 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
                                          " inner-wall points along the band the wire may bear "
                                          "on, after a scout wire crossed the wall"
                                    : std::string())
-      << " (the zone of a scout solve at " << fixed(r.scout.fine_size * 1e3, 3)
+      << (r.patch_growths > 0 ? "; the patch grown " + std::to_string(r.patch_growths) +
+                                    " time(s) to a level's zone that left it (that zone's reach "
+                                    "plus the margin)"
+                              : std::string())
+      << " (first the zone of a scout solve at " << fixed(r.scout.fine_size * 1e3, 3)
       << " mm within 1 mm of the rigid wall point: "
       << (r.scout.converged
               ? std::to_string(r.scout.pressed) + " pressed, " + fixed(r.scout.seconds, 1) + " s"
