@@ -248,7 +248,7 @@ std::vector<SceneViews> insertion_views(const InsertionFile& f) {
     s.colour_name = "contact force";
     s.colour_unit = "mN";
     s.true_scale = true;
-    s.load_text = "the last converged step";
+    s.load_text = "the step each names";
     const InsertionEntry* drawn = nullptr;  // whose wire is drawn: the reference's, else the first
     for (const InsertionEntry& e : f.insertions) {
       if (e.scene != first.scene || !e.view) continue;
@@ -259,8 +259,9 @@ std::vector<SceneViews> insertion_views(const InsertionFile& f) {
     s.view_from = dent_direction(*drawn->view);
     s.wire = wire_near_wall(*drawn);
     s.caption =
-        "Each wall within 2 mm of where the wire bears at the last converged step of its "
-        "insertion, at true scale, coloured by the wire's contact force on each node (mN, "
+        "Each wall within 2 mm of where the wire bears at the insertion length in its name (its "
+        "last converged step, or the one nearest vesselverify insertion --view-at), at true "
+        "scale, coloured by the wire's contact force on each node (mN, "
         "viridis, one scale for every wall). Grey ghost: the reference's wall at the same step "
         "(at rest where the file has none). Red sphere: the force-weighted centroid of the "
         "contact on the wire's wall. Orange tube: the wire on " +

@@ -19,7 +19,8 @@ namespace vessel::reports {
 void insertion_section(Document& doc, const InsertionFile& insertion);
 
 /// Per scene with an insertion's view, report.html's 3D view of the wall near the wire at the
-/// last converged step (scene "insertion-<scene>", filling the section's slot): each insertion's
+/// step its document chose (the last converged one, or the one nearest --view-at; scene
+/// "insertion-<scene>", filling the section's slot): each insertion's
 /// wall at true scale, coloured by the wire's contact force per node (mN); the ghost the
 /// reference's wall at the same nodes (at rest where the file has no reference at that step);
 /// the wire on the first wall drawn, its part within 2 mm of that wall.

@@ -151,6 +151,10 @@ TEST(ContactInsertion, RefusesASceneWithoutAGuidewireAnEmptyRangeAndAModelItDoes
   backwards.last = 20e-3;
   expect_input_error([&] { (void)solve_contact_insertion(wire, 4e-7, backwards); },
                      {"guidewire_straight.toml", "first length", "shorter than the last"});
+  ContactInsertionOptions view_before_zero;
+  view_before_zero.view_at = -1e-3;
+  expect_input_error([&] { (void)solve_contact_insertion(wire, 4e-7, view_before_zero); },
+                     {"guidewire_straight.toml", "a view length ≥ 0"});
   ContactInsertionOptions no_steps;
   no_steps.steps = 0;
   expect_input_error([&] { (void)solve_contact_insertion(wire, 4e-7, no_steps); },
@@ -335,8 +339,11 @@ TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes
   o.first = 19.25e-3;
   o.last = 20.25e-3;
   o.steps = 4;
+  o.view_at = 19.6e-3;  // the 3D view's step: the converged one nearest, 19.5 mm
   o.log = &std::cerr;
   const ContactInsertion r = solve_contact_insertion(scene, EI, o);
+  EXPECT_EQ(r.view.step, 1);
+  EXPECT_FALSE(r.view.triangles.empty());
   std::cout << reports::insertion_markdown(
       reports::parse_insertion(document_of(r, "test", 0.0), "insertion"));
   ASSERT_EQ(r.steps.size(), 5u);

@@ -183,6 +183,11 @@ void add_insertion_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--max-steps", o->options.max_steps, "Newton steps per insertion step")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
+  cmd->add_option("--view-at", o->options.view_at,
+                  "The report's 3D view shows the converged step nearest this insertion length, "
+                  "m (0: the last converged step)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--svg", o->svg,
                   "Also write the forces against the insertion length as an SVG figure here");
   cmd->add_option("--json", o->json,

@@ -225,9 +225,9 @@ struct InsertionPath {
     v.step = index;
     const std::vector<Vec3> displacement = wall.nodal(solution.u);
     const auto near = [&](int n) {
-      const Vec3& x = mesh.nodes[static_cast<std::size_t>(n)];
+      const Vec3& at = mesh.nodes[static_cast<std::size_t>(n)];
       return std::any_of(solution.pressed.begin(), solution.pressed.end(), [&](int p) {
-        return (mesh.nodes[static_cast<std::size_t>(p)] - x).norm() < kInsertionViewReach;
+        return (mesh.nodes[static_cast<std::size_t>(p)] - at).norm() < kInsertionViewReach;
       });
     };
     std::vector<int> drawn(mesh.nodes.size(), -1);
@@ -299,11 +299,12 @@ void log_step(std::ostream& log, const InsertionStep& step) {
 
 void require_options(const std::string& file, const ContactInsertionOptions& o) {
   if (o.steps < 1 || !(o.first >= 0.0) || !(o.last >= 0.0) || !(o.fine_size > 0.0) ||
-      !(o.refine_radius > 0.0) || (o.degree != 1 && o.degree != 2) || o.max_steps < 1) {
+      !(o.refine_radius > 0.0) || (o.degree != 1 && o.degree != 2) || o.max_steps < 1 ||
+      !(o.view_at >= 0.0)) {
     throw InputError(file +
                      ": insertion options: expected steps ≥ 1, first and last ≥ 0 (0: the "
-                     "defaults), a positive fine size and refined radius, degree 1 or 2 and "
-                     "Newton steps ≥ 1");
+                     "defaults), a positive fine size and refined radius, degree 1 or 2, "
+                     "Newton steps ≥ 1 and a view length ≥ 0 (0: the last step)");
   }
 }
 
@@ -342,7 +343,7 @@ std::string insertion_key(const Scene& scene, double EI, const ContactInsertionO
   ContentHash h;
   h.text(file_contents(scene.source)).real(EI).integer(static_cast<int>(o.wall));
   h.real(o.first).real(o.last).integer(o.steps).real(o.fine_size).real(o.refine_radius);
-  h.integer(o.degree).integer(o.max_steps).text(o.model);
+  h.integer(o.degree).integer(o.max_steps).text(o.model).real(o.view_at);
   return "contact-insertion " + h.hex();
 }
 
@@ -403,7 +404,11 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
     try {
       path.advance_to(L, 0);
       path.describe(step);
-      out.view = path.view(static_cast<int>(out.steps.size()));
+      if (o.view_at == 0.0 || out.view.step < 0 ||
+          std::abs(L - o.view_at) <
+              std::abs(out.steps[static_cast<std::size_t>(out.view.step)].insertion - o.view_at)) {
+        out.view = path.view(static_cast<int>(out.steps.size()));
+      }
     } catch (const std::runtime_error& e) {
       step.failure = e.what();
     }

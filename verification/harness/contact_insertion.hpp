@@ -38,6 +38,8 @@ struct ContactInsertionOptions {
   double refine_radius = 1.0e-3;  ///< m: the refined ball around each rigid-lumen wall point
   int degree = 1;                 ///< the wall's elements
   int max_steps = 300;            ///< Newton steps per insertion step
+  /// m: the 3D view's step, the converged one nearest this length (0: the last converged)
+  double view_at = 0.0;
   /// The wall: empty for the reference (deal.II's FEM as `wall` says), else the name of one of
   /// the scene's models, its own wall on the same mesh (a mass-spring or tet model's own energy,
   /// so its own nonlinear equilibrium; a linear FEM model's linear wall; contact_models/
@@ -100,7 +102,7 @@ struct ContactInsertion {
   double mesh_seconds = 0.0;  ///< meshing and the wall's set-up
   double wire_radius = 0.0;   ///< m
   std::vector<InsertionStep> steps;
-  InsertionView view;  ///< at the last converged step
+  InsertionView view;  ///< at the converged step options.view_at chooses
 };
 
 /// The insertion of `scene`'s guidewire at bending stiffness EI (N·m²) against the scene's wall
