@@ -82,6 +82,30 @@ TEST(ContactReference, RefusesASceneWithoutAGuidewireAndABadStiffness) {
 // discrete wire's; the levels agree within 0.2 %; Roache's GCI comes out small; the strain under
 // the wire (a dent of more than the wire's radius) is flagged beyond the linear wall's validity.
 // About 2 minutes with the load average at 6 on 2 cores.
+// A first level whose zone leaves the refined patch (no margin beyond the scout's zone, so the
+// level's finer wall finds the line of contact a little longer) is solved again on a patch grown
+// to that zone, which then holds it: a reference, not "leaves the refined patch".
+TEST(ContactReferenceSlow, AZoneThatLeavesThePatchIsSolvedAgainOnAGrownPatch) {
+  const Scene scene = shipped("guidewire_straight.toml");
+  ContactReferenceOptions o;
+  o.wall = ContactWall::neo_hookean;
+  o.coarsest_size = 0.1e-3;
+  o.levels = 1;
+  o.margin = 0.0;
+  o.log = &std::cerr;
+  const ContactReference r = solve_contact_reference(scene, 4e-7, o);
+  std::ostringstream printed;
+  print_contact_reference(r, printed);
+  std::cout << printed.str();
+  ASSERT_EQ(r.levels.size(), 1u);
+  ASSERT_TRUE(r.levels[0].converged) << r.levels[0].failure;
+  EXPECT_GE(r.patch_growths, 1);
+  EXPECT_NE(printed.str().find("(the patch grown " + std::to_string(r.patch_growths) + " time(s)"),
+            std::string::npos);
+  EXPECT_TRUE(r.levels[0].zone_inside_patch);
+  EXPECT_EQ(r.verdict.find("leaves the refined patch"), std::string::npos) << r.verdict;
+}
+
 TEST(ContactReferenceSlow, StraightSceneFloppyWireConverges) {
   const Scene scene = shipped("guidewire_straight.toml");
   const double EI = 4e-7;

@@ -552,11 +552,10 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
                                          " inner-wall points along the band the wire may bear "
                                          "on, after a scout wire crossed the wall"
                                    : std::string())
-      << (r.patch_growths > 0 ? "; the patch grown " + std::to_string(r.patch_growths) +
-                                    " time(s) to a level's zone that left it (that zone's reach "
-                                    "plus the margin)"
-                              : std::string())
-      << " (first the zone of a scout solve at " << fixed(r.scout.fine_size * 1e3, 3)
+      << (r.patch_growths > 0 ? " (the patch grown " + std::to_string(r.patch_growths) +
+                                    " time(s) to a level's zone that left it; the first patch: "
+                              : std::string(" ("))
+      << "the zone of a scout solve at " << fixed(r.scout.fine_size * 1e3, 3)
       << " mm within 1 mm of the rigid wall point: "
       << (r.scout.converged
               ? std::to_string(r.scout.pressed) + " pressed, " + fixed(r.scout.seconds, 1) + " s"
