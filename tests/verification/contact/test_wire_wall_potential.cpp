@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <iostream>
 #include <random>
+#include <utility>
 
 #include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/rod_theory/tube_contact.hpp"
@@ -40,6 +41,25 @@ contact::PointSegmentDistance at(const Vec9& q, bool hessian) {
   return contact::point_segment_distance(q.head<3>(), q.segment<3>(3), q.tail<3>(), hessian);
 }
 
+/// The largest differences of a distance's gradient and Hessian from central differences of its
+/// value and gradient (step 1e-6) at coordinates q: {gradient's, Hessian's}.
+template <class Q, class Distance>
+std::pair<double, double> central_difference_errors(const Q& q, Distance at) {
+  constexpr double h = 1e-6;
+  const auto d = at(q, true);
+  double g_err = 0.0, h_err = 0.0;
+  for (int k = 0; k < q.size(); ++k) {
+    Q qp = q, qm = q;
+    qp[k] += h;
+    qm[k] -= h;
+    const auto dp = at(qp, true), dm = at(qm, true);
+    g_err = std::max(g_err, std::abs((dp.distance - dm.distance) / (2 * h) - d.gradient[k]));
+    h_err = std::max(
+        h_err, ((dp.gradient - dm.gradient) / (2 * h) - d.hessian.col(k)).cwiseAbs().maxCoeff());
+  }
+  return {g_err, h_err};
+}
+
 }  // namespace
 
 // d and its derivatives against central differences, inside the segment and beyond either end.
@@ -54,17 +74,7 @@ TEST(PointSegmentDistance, DerivativesMatchFiniteDifferences) {
       const Eigen::Vector3d p = a + along * (b - a) + 0.5 * off;
       const Vec9 q = stack(p, a + 0.01 * off, b - 0.02 * off);
       const auto d = at(q, true);
-      constexpr double h = 1e-6;
-      double g_err = 0.0, h_err = 0.0;
-      for (int k = 0; k < 9; ++k) {
-        Vec9 qp = q, qm = q;
-        qp[k] += h;
-        qm[k] -= h;
-        const auto dp = at(qp, true), dm = at(qm, true);
-        g_err = std::max(g_err, std::abs((dp.distance - dm.distance) / (2 * h) - d.gradient[k]));
-        h_err = std::max(h_err,
-                         ((dp.gradient - dm.gradient) / (2 * h) - d.hessian.col(k)).cwiseAbs().maxCoeff());
-      }
+      const auto [g_err, h_err] = central_difference_errors(q, at);
       EXPECT_LT(g_err, 1e-8) << "along " << along;
       EXPECT_LT(h_err, 1e-6 * std::max(1.0, d.hessian.cwiseAbs().maxCoeff())) << "along " << along;
       EXPECT_LT((d.hessian - d.hessian.transpose()).cwiseAbs().maxCoeff(), 1e-12);
@@ -109,18 +119,7 @@ TEST(PointTriangleDistance, DerivativesMatchFiniteDifferences) {
                  d.weights[2] * q.tail<3>() - nearest)
                     .norm(),
                 1e-13);
-      constexpr double h = 1e-6;
-      double g_err = 0.0, h_err = 0.0;
-      for (int k = 0; k < 12; ++k) {
-        Vec12 qp = q, qm = q;
-        qp[k] += h;
-        qm[k] -= h;
-        const auto dp = at(qp, true), dm = at(qm, true);
-        g_err = std::max(g_err, std::abs((dp.distance - dm.distance) / (2 * h) - d.gradient[k]));
-        h_err = std::max(
-            h_err,
-            ((dp.gradient - dm.gradient) / (2 * h) - d.hessian.col(k)).cwiseAbs().maxCoeff());
-      }
+      const auto [g_err, h_err] = central_difference_errors(q, at);
       EXPECT_LT(g_err, 1e-8) << "barycentric target " << w.transpose();
       EXPECT_LT(h_err, 1e-6 * std::max(1.0, d.hessian.cwiseAbs().maxCoeff()))
           << "barycentric target " << w.transpose();
