@@ -293,10 +293,27 @@ CholmodSolver::~CholmodSolver() {
   cholmod_free_dense(&e_, &llt_.common());
 }
 
+bool CholmodSolver::same_pattern(const SparseMatrix& A) const {
+  if (A.rows() != pattern_rows_ || !A.isCompressed() || pattern_inner_.empty()) return false;
+  const auto n = static_cast<std::size_t>(A.outerSize()) + 1;
+  const auto nnz = static_cast<std::size_t>(A.nonZeros());
+  return pattern_outer_.size() == n && pattern_inner_.size() == nnz &&
+         std::equal(pattern_outer_.begin(), pattern_outer_.end(), A.outerIndexPtr()) &&
+         std::equal(pattern_inner_.begin(), pattern_inner_.end(), A.innerIndexPtr());
+}
+
+void CholmodSolver::keep_pattern(const SparseMatrix& A) {
+  pattern_outer_.clear();
+  pattern_inner_.clear();
+  if (!A.isCompressed()) return;  // never matched: analysed afresh each time
+  pattern_outer_.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
+  pattern_inner_.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+}
+
 bool CholmodSolver::try_factorize(const SparseMatrix& A) {
   apply_solver_threads();
   const double t0 = now();
-  if (A.rows() != pattern_rows_ || A.nonZeros() != pattern_nonzeros_) {
+  if (!same_pattern(A)) {
     // Supernodal from 1000 unknowns (measured here with OpenBLAS, CPU time of whole static
     // solves: 6.5k-unknown surface model 2.9 vs 8.3 s simplicial, 1.6k: 0.63 vs 0.85 s; with
     // Debian's reference BLAS the crossing was near 10k). Simplicial for the tiny test problems.
@@ -304,7 +321,7 @@ bool CholmodSolver::try_factorize(const SparseMatrix& A) {
     llt_.analyzePattern(A);
     tree_.reset();  // planned for the old symbolic factor
     pattern_rows_ = A.rows();
-    pattern_nonzeros_ = A.nonZeros();
+    keep_pattern(A);
     ++analyses_;
   }
   mu_ = 0.0;

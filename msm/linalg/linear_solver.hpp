@@ -3,6 +3,7 @@
 /// reusing the symbolic factorisation while the matrix pattern stays the same.
 #include <Eigen/CholmodSupport>
 #include <memory>
+#include <vector>
 
 #include "meshes/foundation/solver_threads.hpp"
 #include "msm/form/form.hpp"
@@ -31,9 +32,9 @@ class CholmodSolver {
   CholmodSolver(const CholmodSolver&) = delete;
   CholmodSolver& operator=(const CholmodSolver&) = delete;
   /// Factorises A (symmetric, lower triangle read). The symbolic analysis is done once per
-  /// pattern (nonzero count and dimension). If A is not positive definite, retries with
-  /// A + μ·max(diag(A), 1e-3·mean|diag(A)|) for growing μ (1e-10 … 1e-2) and records μ; throws std::runtime_error if even
-  /// that fails.
+  /// pattern (the same rows and nonzero positions as the last analysed matrix). If A is not
+  /// positive definite, retries with A + μ·max(diag(A), 1e-3·mean|diag(A)|) for growing μ (1e-10 …
+  /// 1e-2) and records μ; throws std::runtime_error if even that fails.
   void factorize(const SparseMatrix& A);
   /// Factorises A without regularisation; false if A is not positive definite.
   [[nodiscard]] bool try_factorize(const SparseMatrix& A);
@@ -78,8 +79,11 @@ class CholmodSolver {
   /// first parallel solve after an analysis).
   mutable std::unique_ptr<detail::SupernodalTreeSolve> tree_;
   mutable int last_solve_threads_ = 1;
+  [[nodiscard]] bool same_pattern(const SparseMatrix& A) const;
+  void keep_pattern(const SparseMatrix& A);
   Eigen::Index pattern_rows_ = -1;
-  Eigen::Index pattern_nonzeros_ = -1;
+  std::vector<SparseMatrix::StorageIndex> pattern_outer_;  ///< the analysed matrix's pattern
+  std::vector<SparseMatrix::StorageIndex> pattern_inner_;
   int analyses_ = 0;
   int factorisations_ = 0;
   double mu_ = 0.0;
