@@ -551,6 +551,40 @@ void add_pair(const Linearisation& lin, std::size_t j, double s, VectorXd& v) {
   }
 }
 
+/// The Newton steps' factor: one CHOLMOD solver over a solve, its matrices padded with explicit
+/// zeros to the union of the patterns met so far, so the symbolic analysis (the fill-reducing
+/// ordering) is redone only when a pair near contact brings a block not seen before, not at
+/// every step as the zone moves.
+class NewtonFactor {
+ public:
+  /// Factorises h (padded to the pattern). `regularise`: a matrix that is not positive definite
+  /// is shifted until it is (msm::CholmodSolver::factorize); otherwise false for it.
+  bool factorize(Eigen::SparseMatrix<double> h, bool regularise) {
+    ++factorisations_;
+    if (pattern_.rows() != h.rows()) {
+      pattern_ = 0.0 * h;
+    } else {
+      Eigen::SparseMatrix<double> grown = pattern_ + 0.0 * h;
+      if (grown.nonZeros() != pattern_.nonZeros()) pattern_ = std::move(grown);
+      h = h + pattern_;
+    }
+    if (!regularise) return solver_.try_factorize(h);
+    try {
+      solver_.factorize(h);
+    } catch (const std::runtime_error&) {
+      return false;
+    }
+    return true;
+  }
+  [[nodiscard]] const msm::CholmodSolver& solver() const { return solver_; }
+  [[nodiscard]] int factorisations() const { return factorisations_; }
+
+ private:
+  msm::CholmodSolver solver_;
+  Eigen::SparseMatrix<double> pattern_;  ///< the union so far, every value zero
+  int factorisations_ = 0;
+};
+
 /// The Newton model's matrix H(A) = B + Σ_{j∈A} k a_j a_jᵀ for the active sets A of one step's
 /// passes: H(A₀) factorised once, a later set's pairs that differ from A₀ applied as rank-one
 /// terms (+k entering, −k leaving; msm::LowRankUpdatedSolve), so a pass costs solves with the
@@ -559,9 +593,11 @@ class ModelMatrix {
  public:
   static constexpr std::size_t kMaxChanged = 64;
 
-  /// `shift` μ ≥ 0: Levenberg–Marquardt's damping, B + μ diag(|B|) in place of B.
-  ModelMatrix(const Coupled& p, const Linearisation& lin, int& factorisations, double shift)
-      : p_(p), lin_(lin), factorisations_(factorisations), base_(p.size(), p.size()) {
+  /// `shift` μ ≥ 0: Levenberg–Marquardt's damping, B + μ diag(|B|) in place of B. `regularise`
+  /// as NewtonFactor::factorize.
+  ModelMatrix(const Coupled& p, const Linearisation& lin, NewtonFactor& factor, double shift,
+              bool regularise)
+      : p_(p), lin_(lin), factor_(factor), regularise_(regularise), base_(p.size(), p.size()) {
     base_.setFromTriplets(lin.base.begin(), lin.base.end());
     if (shift > 0.0) {
       for (int i = 0; i < base_.rows(); ++i) {
@@ -614,15 +650,10 @@ class ModelMatrix {
     }
     Eigen::SparseMatrix<double> near(p_.size(), p_.size());
     near.setFromTriplets(t.begin(), t.end());
-    ++factorisations_;
     update_.reset();
-    try {
-      solver_.factorize(base_ + near);
-    } catch (const std::runtime_error&) {
-      return false;
-    }
+    if (!factor_.factorize(base_ + near, regularise_)) return false;
     factored_ = active;
-    update_ = std::make_unique<msm::LowRankUpdatedSolve>(solver_);
+    update_ = std::make_unique<msm::LowRankUpdatedSolve>(factor_.solver());
     return true;
   }
 
@@ -648,9 +679,9 @@ class ModelMatrix {
 
   const Coupled& p_;
   const Linearisation& lin_;
-  int& factorisations_;
+  NewtonFactor& factor_;
+  bool regularise_;
   Eigen::SparseMatrix<double> base_;
-  msm::CholmodSolver solver_;
   std::vector<char> factored_;
   std::unique_ptr<msm::LowRankUpdatedSolve> update_;
 };
@@ -658,9 +689,10 @@ class ModelMatrix {
 /// The Newton step: the minimiser of the model ½dzᵀH dz + ∇Πᵀdz in which every pair near
 /// contact keeps its piecewise penalty of the linearised gap, k/2 max(0, c − ∇g·dz)², found by
 /// an active-set iteration (ModelMatrix): a wire about to touch is stopped by the wall within the
-/// step instead of passing it in the model. false if H cannot be factorised.
+/// step instead of passing it in the model. false if H cannot be factorised (`regularise`:
+/// even shifted).
 bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gradient, VectorXd& dz,
-                 int& factorisations, double shift) {
+                 NewtonFactor& factor, double shift, bool regularise) {
   const double k = p.stiffness();
   const std::size_t m = lin.c.size();
   // ∇Π without the pressed pairs' −λ∇g: the model adds each pair's own term.
@@ -670,7 +702,7 @@ bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gra
   }
   std::vector<char> active(m), next(m);
   for (std::size_t j = 0; j < m; ++j) active[j] = lin.c[j] > 0.0;
-  ModelMatrix H(p, lin, factorisations, shift);
+  ModelMatrix H(p, lin, factor, shift, regularise);
   for (int pass = 0; pass < 20; ++pass) {
     VectorXd rhs = -g0;
     for (std::size_t j = 0; j < m; ++j) {
@@ -711,8 +743,10 @@ struct RecentSteps {
 };
 
 /// Newton's method on Π from z (left at the last accepted iterate).
-NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o) {
+NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o,
+                       NewtonFactor& factor) {
   NewtonOutcome out;
+  const int factorisations_before = factor.factorisations();
   VectorXd g, dz, trial;
   Linearisation lin;
   const double target = o.tolerance * o.force_scale;
@@ -729,12 +763,16 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     }
     if (it == o.max_newton) break;
     if (o.log && it > 0 && it % RecentSteps::kEvery == 0) recent.report(*o.log, it, out, shift);
-    bool descent = newton_step(p, lin, g, dz, out.factorisations, shift) && g.dot(dz) < 0.0;
+    // The exact model where it is positive definite, else the PSD-projected one (shifted if
+    // need be): a shift of the exact, indefinite model costs a factorisation per try and gives no
+    // better a step.
+    bool descent = newton_step(p, lin, g, dz, factor, shift, false) && g.dot(dz) < 0.0;
     if (!descent) {
       ++recent.projected;
       (void)p.evaluate(z, g, &lin, true, band);
-      descent = newton_step(p, lin, g, dz, out.factorisations, shift) && g.dot(dz) < 0.0;
+      descent = newton_step(p, lin, g, dz, factor, shift, true) && g.dot(dz) < 0.0;
     }
+    out.factorisations = factor.factorisations() - factorisations_before;
     if (!descent) {
       ++recent.steepest;
       dz = -g * (p.radius() / std::max(g.norm(), 1e-300));
@@ -821,8 +859,9 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
   PotentialContactSolution out;
   out.penalty_stiffness = k;
   const int rounds = options.augmented_lagrangian ? options.max_rounds : 1;
+  NewtonFactor factor;
   for (int round = 1; round <= rounds; ++round) {
-    const NewtonOutcome n = minimise(problem, z, options);
+    const NewtonOutcome n = minimise(problem, z, options, factor);
     out.newton_iterations += n.iterations;
     out.factorisations += n.factorisations;
     out.rounds = round;
