@@ -742,6 +742,28 @@ struct RecentSteps {
   }
 };
 
+/// Where the exact model was indefinite, the next 1, 2, 4 … (at most kLongest) steps go straight
+/// to the projected one: each skipped try saves a factorisation and an assembly of the wall, and
+/// a step the exact model takes again restores Newton's quadratic rate near the solution.
+class ExactBackoff {
+ public:
+  static constexpr int kLongest = 8;
+  /// Whether this step tries the exact model.
+  bool try_exact() {
+    if (skip_ == 0) return true;
+    --skip_;
+    return false;
+  }
+  void record(bool exact_gave_descent) {
+    length_ = exact_gave_descent ? 0 : std::min(std::max(2 * length_, 1), kLongest);
+    skip_ = length_;
+  }
+
+ private:
+  int length_ = 0;
+  int skip_ = 0;
+};
+
 /// Newton's method on Π from z (left at the last accepted iterate).
 NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o,
                        NewtonFactor& factor) {
@@ -753,8 +775,10 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
   const double band = o.max_move * p.radius();
   RecentSteps recent;
   double shift = 0.0;  // Levenberg–Marquardt's μ (damped_newton)
+  ExactBackoff backoff;
   for (int it = 0; it <= o.max_newton; ++it) {
-    const double pi = p.evaluate(z, g, &lin, false, band);
+    const bool exact = backoff.try_exact();
+    const double pi = p.evaluate(z, g, &lin, !exact, band);
     out.residual = g.norm();
     out.iterations = it;
     if (out.residual <= target) {
@@ -766,10 +790,11 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     // The exact model where it is positive definite, else the PSD-projected one (shifted if
     // need be): a shift of the exact, indefinite model costs a factorisation per try and gives no
     // better a step.
-    bool descent = newton_step(p, lin, g, dz, factor, shift, false) && g.dot(dz) < 0.0;
+    bool descent = exact && newton_step(p, lin, g, dz, factor, shift, false) && g.dot(dz) < 0.0;
+    if (exact) backoff.record(descent);
     if (!descent) {
       ++recent.projected;
-      (void)p.evaluate(z, g, &lin, true, band);
+      if (exact) (void)p.evaluate(z, g, &lin, true, band);
       descent = newton_step(p, lin, g, dz, factor, shift, true) && g.dot(dz) < 0.0;
     }
     out.factorisations = factor.factorisations() - factorisations_before;
