@@ -88,9 +88,10 @@ def main():
     with open("/proc/loadavg") as f:
         load_before = " ".join(f.read().split()[:3])
     start = time.time()
-    run = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    # stderr passes through: a line per wall and EI as it is solved
+    run = subprocess.run(cmd, cwd=ROOT, stdout=subprocess.PIPE, text=True)
     if run.returncode != 0:
-        sys.stderr.write(run.stdout + run.stderr)
+        sys.stderr.write(run.stdout)
         sys.exit(f"measure_contact_models: {' '.join(cmd)} failed (exit {run.returncode})")
     with open("/proc/loadavg") as f:
         load_after = " ".join(f.read().split()[:3])

@@ -139,6 +139,7 @@ void add_contact_models_command(CLI::App& app) {
       models = chosen;
     }
     o->options.bending_stiffness = o->ei;
+    o->options.log = &std::cerr;  // progress: a wall at its own equilibrium takes minutes
     const contact::ContactModels result = contact::solve_contact_models(scene, models, o->options);
     std::cout << "Scene " << scene.name << ": nu = " << result.nu << ", mesh " << result.mesh_nodes
               << " nodes, " << result.mesh_tets << " tets (refined to "

@@ -353,6 +353,17 @@ ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSp
           c.linearisation = to_string(wall->linearisation);
         }
       }
+      if (options.log) {
+        *options.log << "contact-models: " << walls[k]->name << " (" << k + 1 << " of "
+                     << walls.size() << "), EI " << EIs[e] << " N·m²: ";
+        if (c.failure.empty()) {
+          *options.log << "F " << c.force * 1e3 << " mN, " << c.pressed << " pressed, "
+                       << c.setup_seconds + c.solve_seconds << " s";
+        } else {
+          *options.log << "failed";
+        }
+        *options.log << std::endl;
+      }
       if (k == 0) {
         out.runs[e].reference = c;  // a failed reference leaves the run's errors undefined
       } else {

@@ -5,6 +5,7 @@
 /// inner wall found by solve_wire_wall_contact_growing, on one tet mesh refined around the rigid
 /// wire's contact: every model and the reference (FEM P2 on the same mesh) are solved on the same
 /// mesh, the same candidates' growth and the same contact law, so their contact forces compare.
+#include <ostream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +31,7 @@ struct ContactModelsOptions {
   /// FormWall) and the reference at finite strain (the neo-Hookean FEM), each with the wire as one
   /// potential (wire_wall_potential.hpp); every inner-wall node a candidate.
   bool own_equilibrium = false;
+  std::ostream* log = nullptr;  ///< one line per wall and EI as it is solved, if set
 };
 
 /// One wall's contact with the wire.
