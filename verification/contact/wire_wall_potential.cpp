@@ -764,6 +764,58 @@ class ExactBackoff {
   int skip_ = 0;
 };
 
+/// The step from z: Newton's on the exact model where it is positive definite, else on the
+/// PSD-projected one (shifted if need be; a shift of the exact, indefinite model costs a
+/// factorisation per try and gives no better a step), else steepest descent of length r_w. `lin`
+/// holds the linearisation at z (projected when `exact` is false).
+VectorXd search_direction(const Coupled& p, const VectorXd& z, const VectorXd& g, Linearisation& lin,
+                          bool exact, double band, double shift, NewtonFactor& factor,
+                          ExactBackoff& backoff, RecentSteps& recent) {
+  VectorXd dz;
+  bool descent = exact && newton_step(p, lin, g, dz, factor, shift, false) && g.dot(dz) < 0.0;
+  if (exact) backoff.record(descent);
+  if (!descent) {
+    ++recent.projected;
+    VectorXd same;
+    if (exact) (void)p.evaluate(z, same, &lin, true, band);
+    descent = newton_step(p, lin, g, dz, factor, shift, true) && g.dot(dz) < 0.0;
+  }
+  if (!descent) {
+    ++recent.steepest;
+    dz = -g * (p.radius() / std::max(g.norm(), 1e-300));
+  }
+  return dz;
+}
+
+/// The accepted step length along dz from z (Π(z) = pi, ∇Π(z) = g), at most alpha0, with the
+/// point reached in `trial`; 0 if none is found, `inverted` then counting the trials whose wall
+/// had an inverted element (Π = +∞). Armijo's condition on Π first. Near the solution the
+/// decrease a step makes can fall below the energy's round-off (a neo-Hookean Ψ at small strain
+/// is a difference of O(ε) terms, its value O(ε²)); if no step passes, a step is accepted when it
+/// lowers ‖∇Π‖ instead.
+double line_search(const Coupled& p, const VectorXd& z, const VectorXd& dz, double pi,
+                   const VectorXd& g, double alpha0, VectorXd& trial, int& inverted) {
+  const double slope = g.dot(dz);
+  double alpha = alpha0;
+  for (int ls = 0; ls < 12; ++ls, alpha *= 0.5) {
+    trial = z + alpha * dz;
+    const double next = p.potential(trial);
+    inverted += !std::isfinite(next);
+    if (std::isfinite(next) && next <= pi + 1e-4 * alpha * slope) return alpha;
+  }
+  const double residual = g.norm();
+  VectorXd g_trial;
+  alpha = alpha0;
+  for (int ls = 0; ls < 30; ++ls, alpha *= 0.5) {
+    trial = z + alpha * dz;
+    if (std::isfinite(p.evaluate(trial, g_trial, nullptr, false)) &&
+        g_trial.norm() < (1.0 - 1e-4 * alpha) * residual) {
+      return alpha;
+    }
+  }
+  return 0.0;
+}
+
 /// Newton's method on Π from z (left at the last accepted iterate).
 NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o,
                        NewtonFactor& factor) {
@@ -787,47 +839,13 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     }
     if (it == o.max_newton) break;
     if (o.log && it > 0 && it % RecentSteps::kEvery == 0) recent.report(*o.log, it, out, shift);
-    // The exact model where it is positive definite, else the PSD-projected one (shifted if
-    // need be): a shift of the exact, indefinite model costs a factorisation per try and gives no
-    // better a step.
-    bool descent = exact && newton_step(p, lin, g, dz, factor, shift, false) && g.dot(dz) < 0.0;
-    if (exact) backoff.record(descent);
-    if (!descent) {
-      ++recent.projected;
-      if (exact) (void)p.evaluate(z, g, &lin, true, band);
-      descent = newton_step(p, lin, g, dz, factor, shift, true) && g.dot(dz) < 0.0;
-    }
+    dz = search_direction(p, z, g, lin, exact, band, shift, factor, backoff, recent);
     out.factorisations = factor.factorisations() - factorisations_before;
-    if (!descent) {
-      ++recent.steepest;
-      dz = -g * (p.radius() / std::max(g.norm(), 1e-300));
-    }
     const double move = p.largest_move(dz);
-    double alpha = std::min(1.0, o.max_move * p.radius() / std::max(move, 1e-300));
-    const double slope = g.dot(dz);
-    // Armijo's condition on Π first. Near the solution the decrease a step makes can fall below
-    // the energy's round-off (a neo-Hookean Ψ at small strain is a difference of O(ε) terms, its
-    // value O(ε²)); if no step passes, a step is accepted when it lowers ‖∇Π‖ instead.
-    const double alpha0 = alpha;
-    bool accepted = false;
-    VectorXd g_trial;
-    int inverted = 0;  // trials whose wall had an inverted element (Π = +∞), for the message
-    for (int ls = 0; ls < 12 && !accepted; ++ls, alpha *= 0.5) {
-      trial = z + alpha * dz;
-      const double next = p.potential(trial);
-      inverted += !std::isfinite(next);
-      accepted = std::isfinite(next) && next <= pi + 1e-4 * alpha * slope;
-    }
-    if (!accepted) {
-      alpha = alpha0;
-      for (int ls = 0; ls < 30 && !accepted; ++ls, alpha *= 0.5) {
-        trial = z + alpha * dz;
-        accepted = std::isfinite(p.evaluate(trial, g_trial, nullptr, false)) &&
-                   g_trial.norm() < (1.0 - 1e-4 * alpha) * out.residual;
-      }
-    }
-    alpha *= 2.0;  // the loops halve once past the accepted step
-    if (!accepted) {
+    const double alpha0 = std::min(1.0, o.max_move * p.radius() / std::max(move, 1e-300));
+    int inverted = 0;
+    const double alpha = line_search(p, z, dz, pi, g, alpha0, trial, inverted);
+    if (alpha == 0.0) {
       out.converged = out.residual <= 1e3 * target;  // at the round-off floor of ‖∇Π‖
       if (!out.converged) {
         out.reason = "the line search found no decrease of the potential (" +
