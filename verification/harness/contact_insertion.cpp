@@ -396,6 +396,7 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
   InsertionPath path{spec, EI, *wall, mesh, candidates, {}, start, {}, first, 0, nullptr, {}};
   path.options.tolerance = 1e-8;
   path.options.max_newton = o.max_steps;
+  path.options.log = o.log;  // a round's line and one per 25 Newton steps: a step can take minutes
   for (const double L : lengths) {
     const auto t0 = Clock::now();
     InsertionStep step;

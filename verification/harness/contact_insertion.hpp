@@ -45,7 +45,7 @@ struct ContactInsertionOptions {
   /// so its own nonlinear equilibrium; a linear FEM model's linear wall; contact_models/
   /// model_walls.hpp says how a surface model's thickness enters)
   std::string model;
-  std::ostream* log = nullptr;    ///< one line per step, if set
+  std::ostream* log = nullptr;  ///< per step a line, and the contact solve's progress, if set
 };
 
 /// One pressed region: pressed nodes closer than 1 mm to each other.
