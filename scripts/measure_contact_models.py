@@ -95,10 +95,13 @@ def main():
         sys.exit(f"measure_contact_models: {' '.join(cmd)} failed (exit {run.returncode})")
     with open("/proc/loadavg") as f:
         load_after = " ".join(f.read().split()[:3])
+    # a run uses one core: a 1-minute load above 1.5 means other work shared the machine
+    busy = max(float(load_before.split()[0]), float(load_after.split()[0])) > 1.5
+    shared = " (other work sharing it: the times are upper bounds)" if busy else ""
     shown = ["vesselverify"] + cmd[1:]
     page = (OWN_EQUILIBRIUM if args.own_equilibrium else INTRO) + f"""
 Measured {datetime.date.today().isoformat()} on the 2-core machine, load average {load_before}
-before and {load_after} after (other builds sharing it), {time.time() - start:.0f} s in all:
+before and {load_after} after{shared}, {time.time() - start:.0f} s in all:
 
 ```sh
 {' '.join(shown)}

@@ -262,6 +262,24 @@ std::vector<ModelSpec> contact_model_kinds(const Scene& scene) {
   return out;
 }
 
+namespace {
+
+/// The progress line of one wall's contact at one EI.
+void log_contact(std::ostream& log, const ModelSpec& wall, std::size_t index, std::size_t walls,
+                 double EI, const ModelContact& c) {
+  log << "contact-models: " << wall.name << " (" << index + 1 << " of " << walls << "), EI " << EI
+      << " N·m²: ";
+  if (c.failure.empty()) {
+    log << "F " << c.force * 1e3 << " mN, " << c.pressed << " pressed, "
+        << c.setup_seconds + c.solve_seconds << " s";
+  } else {
+    log << "failed";
+  }
+  log << std::endl;
+}
+
+}  // namespace
+
 ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSpec>& models,
                                    const ContactModelsOptions& options) {
   const std::string file = scene.source.string();
@@ -353,17 +371,7 @@ ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSp
           c.linearisation = to_string(wall->linearisation);
         }
       }
-      if (options.log) {
-        *options.log << "contact-models: " << walls[k]->name << " (" << k + 1 << " of "
-                     << walls.size() << "), EI " << EIs[e] << " N·m²: ";
-        if (c.failure.empty()) {
-          *options.log << "F " << c.force * 1e3 << " mN, " << c.pressed << " pressed, "
-                       << c.setup_seconds + c.solve_seconds << " s";
-        } else {
-          *options.log << "failed";
-        }
-        *options.log << std::endl;
-      }
+      if (options.log) log_contact(*options.log, *walls[k], k, walls.size(), EIs[e], c);
       if (k == 0) {
         out.runs[e].reference = c;  // a failed reference leaves the run's errors undefined
       } else {
