@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -14,6 +15,7 @@
 #include "verification/contact/condensed_wall.hpp"
 #include "verification/contact/point_segment_distance.hpp"
 #include "verification/contact/point_triangle_distance.hpp"
+#include "verification/contact/wall_crossing.hpp"
 
 namespace vessel::contact {
 
@@ -202,7 +204,7 @@ class Coupled {
  public:
   Coupled(msm::rods::Rod& rod, double radius, const WallPotential& wall, const TetMesh& mesh,
           const std::vector<int>& candidates, const VectorXd& start, double k)
-      : rod_(rod), r_(radius), wall_(wall), k_(k), x0_(start) {
+      : rod_(rod), r_(radius), wall_(wall), mesh_(mesh), k_(k), x0_(start) {
     fixed_ = rod.clamp_fixed();
     rod_row_.assign(fixed_.size(), -1);
     for (std::size_t i = 0; i < fixed_.size(); ++i) {
@@ -495,6 +497,20 @@ class Coupled {
 
   void prepare(const VectorXd& z) { rod_.prepare(rod_dofs(z)); }
 
+  /// Throws WireThroughWall (its message beginning with `when`) if the centreline at z crosses
+  /// the wall's inner surface (none for a mesh without that group).
+  void require_inside_lumen(const VectorXd& z, const std::string& when) const {
+    if (mesh_.find_group(group_names::inner_wall, 2) == nullptr) return;
+    const VectorXd x = rod_dofs(z);
+    std::vector<Vec3> centreline;
+    for (int i = first_; i <= last_; ++i) centreline.emplace_back(x.segment<3>(3 * i));
+    if (const auto crossing =
+            describe_wall_crossing(mesh_, wall_.nodal(wall_rows(z)), centreline)) {
+      throw WireThroughWall("the wire-wall potential " + when + ": " + *crossing,
+                            std::move(centreline));
+    }
+  }
+
  private:
   static Mat12 projected(const Mat12& h) {
     const Eigen::SelfAdjointEigenSolver<Mat12> es(h);
@@ -505,6 +521,7 @@ class Coupled {
   msm::rods::Rod& rod_;
   double r_;
   const WallPotential& wall_;
+  const TetMesh& mesh_;
   double k_;
   VectorXd x0_;
   std::vector<char> fixed_;
@@ -860,6 +877,9 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     }
     z = trial;
     p.prepare(z);
+    // A centreline through the wall (between its nodes) does not come back: every node's gap is
+    // open again on the far side. Stop there rather than converge outside the lumen.
+    p.require_inside_lumen(z, "stopped after Newton step " + std::to_string(it + 1));
     recent.capped += alpha0 < 1.0 && alpha == alpha0;
     recent.move += alpha * move / p.radius();
     // A stiff wall's forces (K u with K up to ~1e6 N/m) floor ‖∇Π‖ above the target by round-off:
@@ -899,6 +919,7 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
   rod.prepare(start);
   VectorXd z =
       problem.pack(start, wall_start.size() != 0 ? wall_start : VectorXd::Zero(wall.num_dofs()));
+  problem.require_inside_lumen(z, "cannot start outside the lumen");
   PotentialContactSolution out;
   out.penalty_stiffness = k;
   const int rounds = options.augmented_lagrangian ? options.max_rounds : 1;

@@ -26,6 +26,8 @@
 #include <array>
 #include <memory>
 #include <ostream>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -166,12 +168,23 @@ struct PotentialContactSolution {
   [[nodiscard]] Vec3 total_force_on_wall() const;
 };
 
+/// The wire's centreline crossed the wall's inner surface (describe_wall_crossing) at the solve's
+/// start or after a Newton step: the capsule passed between the wall's nodes, whose gaps are open
+/// again on the far side, and a solve from there would converge outside the lumen. Holds that
+/// iterate's centreline nodes (m), for a caller that refines the wall where the wire bears.
+struct WireThroughWall : std::runtime_error {
+  WireThroughWall(const std::string& what, std::vector<Vec3> at)
+      : std::runtime_error(what), centreline(std::move(at)) {}
+  std::vector<Vec3> centreline;
+};
+
 /// Minimises Π from the wire at `start` (e.g. its rigid-lumen state) and the wall at
 /// `wall_start` (its free rows, m; empty: at rest), e.g. the equilibrium of a softer wire on the
 /// same wall. The contact candidates are `candidates` (mesh nodes; e.g. the whole inner wall):
 /// each one's gap to the capsule enters Π. `rod`: without equality constraints (DER); its clamps
-/// are held; it is left prepared at the solution. Throws std::runtime_error naming the round, the
-/// residual and the penetration without convergence; InputError for a rod with constraints,
+/// are held; it is left prepared at the solution. Throws WireThroughWall where the centreline
+/// crosses the wall; std::runtime_error naming the round, the residual and the penetration
+/// without convergence; InputError for a rod with constraints,
 /// r_w ≤ 0, a start of the wrong size or a candidate not in the mesh.
 PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double radius,
                                                    const WallPotential& wall, const TetMesh& mesh,

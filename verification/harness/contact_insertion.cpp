@@ -13,7 +13,6 @@
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/rods/der_rod.hpp"
-#include "verification/contact/wall_crossing.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
 #include "verification/contact_models/model_walls.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
@@ -173,14 +172,6 @@ struct InsertionPath {
       contact::PotentialContactSolution s = contact::solve_wire_wall_potential(
           *next, 0.5 * spec.diameter, wall, mesh, candidates, from, options, u);
       newton_steps += s.newton_iterations;
-      std::vector<Vec3> centreline;
-      for (int i = next->layout().first_node; i <= next->layout().tip_node; ++i) {
-        centreline.emplace_back(s.x.segment<3>(3 * i));
-      }
-      if (const auto crossing =
-              contact::describe_wall_crossing(mesh, wall.nodal(s.u), centreline)) {
-        throw std::runtime_error(*crossing);
-      }
       x = s.x;
       u = s.u;
       x_length = L;

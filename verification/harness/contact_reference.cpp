@@ -78,18 +78,11 @@ constexpr double kNearWall = 1.5e-3;
 /// m: the radius refined around each of them.
 constexpr double kAlongWireRadius = 0.5e-3;
 
-/// Throws WallCrossed when the solved wire's centreline (rod dofs x) crosses the inner wall
-/// displaced by u (per mesh node): the capsule passed between the wall's nodes, which the
-/// nodes' gaps cannot see (verification/contact/wall_crossing.hpp).
-void require_wire_inside_lumen(const TetMesh& mesh, const msm::rods::Rod& rod,
-                               const Eigen::VectorXd& x, const std::vector<Vec3>& u) {
-  std::vector<Vec3> centreline;
-  for (int i = rod.layout().first_node; i <= rod.layout().tip_node; ++i) {
-    centreline.emplace_back(x.segment<3>(3 * i));
-  }
-  const auto failure = contact::describe_wall_crossing(mesh, u, centreline);
-  if (!failure) return;
-  WallCrossed crossed(*failure);
+/// The crossing named `what` of a wire whose centreline nodes are `centreline`, with where to
+/// refine: the inner-wall nodes nearest those within kNearWall of it.
+WallCrossed wall_crossed(const TetMesh& mesh, const std::string& what,
+                         const std::vector<Vec3>& centreline) {
+  WallCrossed crossed(what);
   const std::vector<int> wall_nodes =
       mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
   for (const Vec3& p : centreline) {
@@ -104,7 +97,21 @@ void require_wire_inside_lumen(const TetMesh& mesh, const msm::rods::Rod& rod,
     }
     if (nearest <= kNearWall) crossed.near_wall.push_back(at);
   }
-  throw crossed;
+  return crossed;
+}
+
+/// Throws WallCrossed when the solved wire's centreline (rod dofs x) crosses the inner wall
+/// displaced by u (per mesh node): the capsule passed between the wall's nodes, which the
+/// nodes' gaps cannot see (verification/contact/wall_crossing.hpp).
+void require_wire_inside_lumen(const TetMesh& mesh, const msm::rods::Rod& rod,
+                               const Eigen::VectorXd& x, const std::vector<Vec3>& u) {
+  std::vector<Vec3> centreline;
+  for (int i = rod.layout().first_node; i <= rod.layout().tip_node; ++i) {
+    centreline.emplace_back(x.segment<3>(3 * i));
+  }
+  if (const auto failure = contact::describe_wall_crossing(mesh, u, centreline)) {
+    throw wall_crossed(mesh, *failure, centreline);
+  }
 }
 
 bool inside_any(const std::vector<RefinedBall>& balls, const Vec3& p) {
@@ -252,6 +259,8 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
     po.force_scale = force_scale * rungs[k] / target;
     try {
       s = contact::solve_wire_wall_potential(rung.rod, wire.radius, wall, mesh, nodes, x, po, u);
+    } catch (const contact::WireThroughWall& e) {  // the mesh, not the rung, is at fault
+      throw wall_crossed(mesh, e.what(), e.centreline);
     } catch (const std::runtime_error& e) {
       if (splits == 3 || done == 0.0) throw;
       ++splits;
@@ -275,7 +284,6 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
     ++k;
   }
   const std::vector<Vec3> displacement = wall.nodal(s.u);
-  require_wire_inside_lumen(mesh, wire.rod, s.x, displacement);
   out.converged = true;
   out.candidates = static_cast<int>(nodes.size());
   out.force = s.total_force_on_wall().norm();

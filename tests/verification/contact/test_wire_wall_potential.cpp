@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <iostream>
 #include <random>
+#include <string>
 #include <utility>
 
 #include "fem_reference/hyperelastic.hpp"
@@ -169,6 +170,52 @@ TEST(WallCrossing, CentrelineThroughTheTubeWall) {
     out[n] = 0.3 * Vec3(mesh.nodes[n].x(), mesh.nodes[n].y(), 0.0);
   }
   EXPECT_FALSE(contact::first_wall_crossing(mesh, inner, out, wire));
+}
+
+// A wire whose centreline goes through the wall: on the structured tube (nodes ~1 mm apart, far
+// more than the wire's diameter) every node's gap is open on the far side, so a solve from there
+// would "converge" outside the lumen. Started through the wall (the rigid solution carried out
+// about the clamp to 1.4 times its reach, the tip 1 mm beyond the inner wall), it refuses with
+// the crossing named; started from the inside with no candidate near the wire (only the
+// outlet's nodes), the wire springs back towards straight, through the wall, and the first step
+// that carries its centreline through ends the solve with the crossing named.
+TEST(WireWallPotential, ACentrelineThroughTheWallIsRefusedNotSolved) {
+  const TetMesh& mesh = tube_mesh();
+  const std::vector<int> nodes = inner_nodes(mesh);
+  const double d = 0.356e-3;
+  const double length = rod_theory::straight_tube_contact(kTheta, (kA - d / 2) / kZc).length * kZc;
+  const Vec3 origin(0, 0, 5e-3);
+  Wire w(d, length, 32, origin);
+  const RigidRun rigid = rigid_run(w);
+  VectorXd outside = rigid.x;
+  for (int i = 0; i < w.rod.num_nodes(); ++i) {
+    outside.segment<3>(3 * i) = origin + 1.4 * (rigid.x.segment<3>(3 * i) - origin);
+  }
+  contact::PotentialContactOptions o;
+  o.force_scale = w.EI / (kZc * kZc);
+  const contact::NeoHookeanWall wall(mesh, wall_problem(kWallE));
+  const auto message = [&](const VectorXd& start, const std::vector<int>& candidates) {
+    try {
+      (void)contact::solve_wire_wall_potential(w.rod, w.radius, wall, mesh, candidates, start, o);
+    } catch (const contact::WireThroughWall& e) {
+      EXPECT_EQ(static_cast<int>(e.centreline.size()), w.layout.tip_node - w.layout.first_node + 1);
+      return std::string(e.what());
+    } catch (const std::runtime_error& e) {
+      return std::string("another error: ") + e.what();
+    }
+    return std::string("solved");
+  };
+  const std::string from_outside = message(outside, nodes);
+  EXPECT_NE(from_outside.find("cannot start outside the lumen"), std::string::npos) << from_outside;
+  EXPECT_NE(from_outside.find("crosses the wall"), std::string::npos) << from_outside;
+  std::vector<int> outlet;
+  for (const int n : nodes) {
+    if (mesh.nodes[static_cast<std::size_t>(n)].z() > kTubeLength - 1e-3) outlet.push_back(n);
+  }
+  ASSERT_FALSE(outlet.empty());
+  const std::string through = message(rigid.x, outlet);
+  EXPECT_NE(through.find("stopped after Newton step"), std::string::npos) << through;
+  EXPECT_NE(through.find("crosses the wall"), std::string::npos) << through;
 }
 
 // The finite-strain wall's energy, gradient and tangent (fem::HyperelasticSolver::free_state): at
