@@ -11,6 +11,7 @@
 
 #include "meshes/foundation/errors.hpp"
 #include "msm/linalg/linear_solver.hpp"
+#include "msm/solvers/exact_backoff.hpp"
 
 namespace vessel::msm {
 
@@ -313,7 +314,9 @@ struct NewtonState {
   SparseMatrix H, Hp;            ///< exact and projected Hessians at the current point
   VectorXd curvature_direction;  ///< the power iteration's warm start
   double roundoff = 0.0;         ///< see roundoff_floor; 0 until the first Hessian
-  int backoff = 0, skip_exact = 0;
+  ExactBackoff backoff;          ///< StaticOptions::exact_backoff
+
+  explicit NewtonState(const StaticOptions& o) : backoff(o.exact_backoff) {}
 };
 
 /// Factorises the Newton matrix at r.x: the exact Hessian where it is positive definite
@@ -326,17 +329,9 @@ bool factorise_newton_matrix(const Problem& p, const StaticOptions& o, CholmodSo
   r.assembly_seconds += now() - ta;
   if (s.roundoff == 0.0) s.roundoff = roundoff_floor(p, s.H);
   apply_dirichlet(s.H, p.fixed);
-  // A failed (indefinite) factorisation costs as much as a good one. After a failure, skip the
-  // exact attempt for 1, 2, 4 (at most `exact_backoff`) iterations while it keeps failing.
-  const bool try_exact = s.skip_exact == 0;
-  if (s.skip_exact > 0) --s.skip_exact;
+  const bool try_exact = s.backoff.try_exact();
   const bool exact = try_exact && solver.try_factorize(s.H);
-  if (exact) {
-    s.backoff = 0;
-  } else if (try_exact && o.exact_backoff > 0) {
-    s.backoff = std::min(std::max(1, 2 * s.backoff), o.exact_backoff);
-    s.skip_exact = s.backoff;
-  }
+  if (try_exact) s.backoff.record(exact);
   if (!exact) {
     ++r.indefinite_iterations;
     ta = now();
@@ -469,7 +464,7 @@ StaticResult newton(const Problem& p, const StaticOptions& o, const VectorXd& st
   r.x = initial_point(p, start);
   const double target = o.tolerance * std::max(p.external_force.norm(), o.force_scale);
   VectorXd g;
-  NewtonState s;
+  NewtonState s(o);
   double energy = p.potential(r.x);
   for (r.iterations = 0; r.iterations <= o.max_iterations; ++r.iterations) {
     p.potential_gradient(r.x, g);

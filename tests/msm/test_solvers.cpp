@@ -6,17 +6,19 @@
 #include <Eigen/SparseCholesky>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/surface_loads.hpp"
 #include "msm/mass/mass_rules.hpp"
 #include "msm/model/build_network.hpp"
-#include "msm/terms/spring_model.hpp"
+#include "msm/solvers/exact_backoff.hpp"
 #include "msm/solvers/integrators.hpp"
 #include "msm/solvers/solve.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/stiffness/stiffness_rules.hpp"
+#include "msm/terms/spring_model.hpp"
 
 using namespace vessel;
 using namespace vessel::msm;
@@ -452,5 +454,25 @@ TEST(StaticSolver, TrustRegionEqualsLineSearchNewtonWhereBothConverge) {
     EXPECT_LE(tr.residual, 1e-8 * p.external_force.norm());
     // One factorisation per iteration, never of an indefinite Hessian.
     EXPECT_EQ(tr.numeric_factorisations, tr.iterations);
+  }
+}
+
+// The exact Hessian's back-off by hand: after each failure the next 1, 2, 4, then at most
+// `longest` (4) iterations skip it; a success resets it; with longest 0 every iteration tries.
+TEST(ExactBackoff, SkipsDoubleAfterEachFailureUpToTheLongestAndResetOnSuccess) {
+  msm::ExactBackoff b(4);
+  std::string tried;
+  // The exact Hessian fails at every iteration before 14 and works from 14 on.
+  for (int it = 0; it < 18; ++it) {
+    const bool t = b.try_exact();
+    tried += t ? 'T' : '.';
+    if (t) b.record(it >= 14);
+  }
+  // Tried and failed at 0, 2, 5, 10 (skipping 1, 2, 4, 4 after them); tried at 15: it works.
+  EXPECT_EQ(tried, "T.T..T....T....TTT");
+  msm::ExactBackoff never(0);
+  for (int it = 0; it < 5; ++it) {
+    EXPECT_TRUE(never.try_exact());
+    never.record(false);
   }
 }

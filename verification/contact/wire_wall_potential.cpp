@@ -12,6 +12,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "msm/linalg/linear_solver.hpp"
 #include "msm/linalg/low_rank_update.hpp"
+#include "msm/solvers/exact_backoff.hpp"
 #include "verification/contact/condensed_wall.hpp"
 #include "verification/contact/point_segment_distance.hpp"
 #include "verification/contact/point_triangle_distance.hpp"
@@ -759,35 +760,13 @@ struct RecentSteps {
   }
 };
 
-/// Where the exact model was indefinite, the next 1, 2, 4 … (at most kLongest) steps go straight
-/// to the projected one: each skipped try saves a factorisation and an assembly of the wall, and
-/// a step the exact model takes again restores Newton's quadratic rate near the solution.
-class ExactBackoff {
- public:
-  static constexpr int kLongest = 8;
-  /// Whether this step tries the exact model.
-  bool try_exact() {
-    if (skip_ == 0) return true;
-    --skip_;
-    return false;
-  }
-  void record(bool exact_gave_descent) {
-    length_ = exact_gave_descent ? 0 : std::min(std::max(2 * length_, 1), kLongest);
-    skip_ = length_;
-  }
-
- private:
-  int length_ = 0;
-  int skip_ = 0;
-};
-
 /// The step from z: Newton's on the exact model where it is positive definite, else on the
 /// PSD-projected one (shifted if need be; a shift of the exact, indefinite model costs a
 /// factorisation per try and gives no better a step), else steepest descent of length r_w. `lin`
 /// holds the linearisation at z (projected when `exact` is false).
-VectorXd search_direction(const Coupled& p, const VectorXd& z, const VectorXd& g, Linearisation& lin,
-                          bool exact, double band, double shift, NewtonFactor& factor,
-                          ExactBackoff& backoff, RecentSteps& recent) {
+VectorXd search_direction(const Coupled& p, const VectorXd& z, const VectorXd& g,
+                          Linearisation& lin, bool exact, double band, double shift,
+                          NewtonFactor& factor, msm::ExactBackoff& backoff, RecentSteps& recent) {
   VectorXd dz;
   bool descent = exact && newton_step(p, lin, g, dz, factor, shift, false) && g.dot(dz) < 0.0;
   if (exact) backoff.record(descent);
@@ -844,7 +823,8 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
   const double band = o.max_move * p.radius();
   RecentSteps recent;
   double shift = 0.0;  // Levenberg–Marquardt's μ (damped_newton)
-  ExactBackoff backoff;
+  // Where the exact model was indefinite, the next 1, 2, 4 … 8 steps go to the projected one.
+  msm::ExactBackoff backoff(8);
   for (int it = 0; it <= o.max_newton; ++it) {
     const bool exact = backoff.try_exact();
     const double pi = p.evaluate(z, g, &lin, !exact, band);
