@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
@@ -37,8 +39,51 @@ GateFinding finding(const Key& k, std::string what, std::string baseline, std::s
           std::move(what), std::move(baseline), std::move(current), failure};
 }
 
-/// The guidewire's figures: the wire's force error against the continuum per EI, and each coupled
-/// row's contact-force error, may not grow (nor a finished row fail, nor a row disappear).
+/// coupling = "contact": each model's contact-force error against the reference's in the same
+/// contact solve, per EI, may not grow (nor a finished row fail, nor a row disappear).
+void compare_contact_rows(const std::string& scene, const GuidewireContactRows& b,
+                          const std::optional<GuidewireContactRows>& c,
+                          const std::function<bool(double, double)>& grew, GateOutcome& out) {
+  const std::string what = "wire-wall contact-force error |F − F_ref|";
+  for (const ContactRun& run : b.runs) {
+    const ContactRun* now = nullptr;
+    if (c) {
+      for (const ContactRun& r : c->runs) {
+        if (r.bending_stiffness == run.bending_stiffness) now = &r;
+      }
+    }
+    for (const ContactWallRow& m : run.models) {
+      ++out.compared;
+      const ContactWallRow* is = nullptr;
+      if (now) {
+        for (const ContactWallRow& r : now->models) {
+          if (r.model == m.model) is = &r;
+        }
+      }
+      if (!is) {
+        out.findings.push_back({scene, m.model, b.poisson_ratio, 0, run.bending_stiffness,
+                                what + " missing", "present", "absent", true});
+        continue;
+      }
+      if (!m.ok || !m.force_error_mN) continue;
+      if (!is->ok || !is->force_error_mN) {
+        out.findings.push_back({scene, m.model, b.poisson_ratio, 0, run.bending_stiffness,
+                                "contact solve now fails", "finished",
+                                is->ok ? "the reference failed" : is->failure, true});
+        continue;
+      }
+      const double was = std::abs(*m.force_error_mN), is_now = std::abs(*is->force_error_mN);
+      if (grew(was, is_now)) {
+        out.findings.push_back({scene, m.model, b.poisson_ratio, 0, run.bending_stiffness,
+                                what + " grew", num(was) + " mN", num(is_now) + " mN", true});
+      }
+    }
+  }
+}
+
+/// The guidewire's figures: the wire's force error against the continuum per EI, each coupled
+/// row's contact-force error and each contact row's, may not grow (nor a finished row fail, nor a
+/// row disappear).
 void compare_guidewires(const ResultsFile& baseline, const ResultsFile& current,
                         const GateTolerances& tol, GateOutcome& out) {
   const auto grew = [&](double was, double is) {
@@ -96,6 +141,8 @@ void compare_guidewires(const ResultsFile& baseline, const ResultsFile& current,
                                 what + " grew", num(was) + " mN", num(is) + " mN", true});
       }
     }
+    if (b.guidewire->contact)
+      compare_contact_rows(b.name, *b.guidewire->contact, c.contact, grew, out);
   }
 }
 

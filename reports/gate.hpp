@@ -43,8 +43,10 @@ struct GateOutcome {
 
 /// Compares every (scene, model, ν, level, load) case of the baseline with this run's, and each
 /// guidewire scene's wire: per EI its force error against the continuum wire, and per coupled
-/// row (model, ν, level, EI) the contact-force error |F − F_ref| (their findings name the model
-/// "wire (<rod model>)" or the vessel model, with EI in the load column).
+/// row (model, ν, level, EI) the contact-force error |F − F_ref|, and with coupling = "contact"
+/// per model and EI its contact-force error against the reference's in the same contact solve
+/// (their findings name the model "wire (<rod model>)" or the vessel model, with EI in the load
+/// column; a contact row's level is 0: every wall is on the contact's own mesh).
 /// Timings are compared only when both files carry reference_kernel_seconds.
 GateOutcome compare_with_baseline(const ResultsFile& baseline, const ResultsFile& current,
                                   const GateTolerances& tolerances = {});

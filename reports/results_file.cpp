@@ -91,6 +91,57 @@ ModalRow read_modal(const json& j, const std::string& where) {
   return m;
 }
 
+ContactWallRow read_contact_wall(const json& j, const std::string& where) {
+  ContactWallRow w;
+  w.model = field<std::string>(j, "model", where);
+  w.wall = field<std::string>(j, "wall", where);
+  w.ok = field<bool>(j, "ok", where);
+  if (!w.ok) {
+    w.failure = field<std::string>(j, "failure", where);
+    return w;
+  }
+  w.force_mN = field<double>(j, "force_mN", where);
+  w.force_error_mN = json_fields::optional_field<double>(j, "force_error_mN", where);
+  w.force_error_percent = json_fields::optional_field<double>(j, "force_error_percent", where);
+  w.tip_error_mm = json_fields::optional_field<double>(j, "tip_error_mm", where);
+  w.pressed = field<int>(j, "pressed", where);
+  w.axial_extent_mm = field<double>(j, "axial_extent_mm", where);
+  w.circumferential_extent_mm = field<double>(j, "circumferential_extent_mm", where);
+  w.dent_mm = field<double>(j, "dent_mm", where);
+  w.largest_strain = field<double>(j, "largest_strain", where);
+  w.setup_seconds = field<double>(j, "setup_seconds", where);
+  w.solve_seconds = field<double>(j, "solve_seconds", where);
+  return w;
+}
+
+GuidewireContactRows read_guidewire_contact(const json& c, const std::string& where) {
+  GuidewireContactRows out;
+  out.poisson_ratio = field<double>(c, "poisson_ratio", where);
+  out.fine_size_mm = field<double>(c, "fine_size_mm", where);
+  out.fine_radius_mm = field<double>(c, "fine_radius_mm", where);
+  out.strain_limit = field<double>(c, "strain_limit", where);
+  out.mesh_nodes = field<int>(c, "mesh_nodes", where);
+  out.reference_degree = field<int>(c, "reference_degree", where);
+  for (const json& r : field<json>(c, "runs", where)) {
+    const std::string rw = where + ".runs";
+    ContactRun run;
+    run.bending_stiffness = field<double>(r, "bending_stiffness_Nm2", rw);
+    run.rigid_force_mN = field<double>(r, "rigid_force_mN", rw);
+    run.within_linear_validity = field<bool>(r, "within_linear_validity", rw);
+    run.reference = read_contact_wall(field<json>(r, "reference", rw), rw + ".reference");
+    for (const json& m : field<json>(r, "models", rw)) {
+      run.models.push_back(read_contact_wall(m, rw + ".models"));
+    }
+    for (const json& s : field<json>(r, "shortcuts", rw)) {
+      const std::string sw = rw + ".shortcuts";
+      run.shortcuts.push_back({field<std::string>(s, "name", sw), field<double>(s, "force_mN", sw),
+                               json_fields::optional_field<double>(s, "force_error_percent", sw)});
+    }
+    out.runs.push_back(std::move(run));
+  }
+  return out;
+}
+
 GuidewireRows read_guidewire(const json& g, const std::string& where) {
   GuidewireRows w;
   w.model = field<std::string>(g, "model", where);
@@ -134,6 +185,9 @@ GuidewireRows read_guidewire(const json& g, const std::string& where) {
       c.field_relative_l2 = json_fields::optional_field<double>(r, "field_relative_l2", rw);
     }
     w.coupled.push_back(std::move(c));
+  }
+  if (const auto c = g.find("contact"); c != g.end()) {
+    w.contact = read_guidewire_contact(*c, where + ".contact");
   }
   return w;
 }

@@ -127,11 +127,40 @@ struct GuidewireCoupledRow {
   /// The field's relative L2 error at the rigid wire's force and at each wall's coupled force.
   std::optional<double> field_relative_l2_rigid, field_relative_l2;
 };
+/// One wall in the wire–wall contact solve at one EI (coupling = "contact").
+struct ContactWallRow {
+  std::string model, wall, failure;
+  bool ok = false;
+  double force_mN = 0.0;
+  std::optional<double> force_error_mN, force_error_percent, tip_error_mm;  ///< vs the reference
+  int pressed = 0;
+  double axial_extent_mm = 0.0, circumferential_extent_mm = 0.0, dent_mm = 0.0;
+  double largest_strain = 0.0, setup_seconds = 0.0, solve_seconds = 0.0;
+};
+/// A force a simulator uses instead of the contact solve's, against the reference's.
+struct ContactShortcutRow {
+  std::string name;
+  double force_mN = 0.0;
+  std::optional<double> force_error_percent;
+};
+struct ContactRun {
+  double bending_stiffness = 0.0, rigid_force_mN = 0.0;
+  bool within_linear_validity = true;
+  ContactWallRow reference;
+  std::vector<ContactWallRow> models;
+  std::vector<ContactShortcutRow> shortcuts;
+};
+struct GuidewireContactRows {
+  double poisson_ratio = 0.0, fine_size_mm = 0.0, fine_radius_mm = 0.0, strain_limit = 0.0;
+  int mesh_nodes = 0, reference_degree = 2;
+  std::vector<ContactRun> runs;
+};
 struct GuidewireRows {
-  std::string model, coupling;  ///< the wire's rod model; rigid | compliant
+  std::string model, coupling;  ///< the wire's rod model; rigid | compliant | contact
   double diameter_mm = 0.0;     ///< 0 in files without it
   std::vector<GuidewireRigidRow> rigid;
   std::vector<GuidewireCoupledRow> coupled;
+  std::optional<GuidewireContactRows> contact;  ///< coupling = "contact"
 };
 
 struct SceneRows {

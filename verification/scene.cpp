@@ -441,11 +441,14 @@ GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
       r.fail(towards, "tilt_towards", e.what());
     }
   }
-  w.coupling = r.string_or("coupling") == "compliant" ? GuidewireCoupling::compliant
-                                                       : GuidewireCoupling::rigid;
+  const std::string coupling = r.string_or("coupling", "rigid");
+  w.coupling = coupling == "contact"     ? GuidewireCoupling::contact
+               : coupling == "compliant" ? GuidewireCoupling::compliant
+                                         : GuidewireCoupling::rigid;
   if (const toml::node* sweep = r.get("stiffness_sweep")) {
-    if (w.coupling != GuidewireCoupling::compliant) {
-      r.fail(sweep, "stiffness_sweep", "found with coupling = \"rigid\"; expected \"compliant\"");
+    if (w.coupling == GuidewireCoupling::rigid) {
+      r.fail(sweep, "stiffness_sweep",
+             "found with coupling = \"rigid\"; expected \"compliant\" or \"contact\"");
     }
     w.stiffness_sweep = r.numbers(*sweep, "stiffness_sweep");
   }

@@ -150,11 +150,13 @@ std::vector<Row> guidewire_rows() {
           .dflt("[1.0, 0.0, 0.0]").in(g),
       Row("load", "coupling", KeyType::string,
           "rigid: every model gets the wire's force against the rigid lumen; compliant: also each "
-          "model's own force with its wall giving way (linear walls)")
-          .dflt("\"rigid\"").one_of({"rigid", "compliant"}).in(g),
+          "model's own force with its wall giving way (linear walls, series springs); contact: "
+          "also each model's wall in a contact solve with the wire's surface, against the FEM "
+          "wall's")
+          .dflt("\"rigid\"").one_of({"rigid", "compliant", "contact"}).in(g),
       Row("load", "stiffness_sweep", KeyType::number,
-          "Compliant coupling: wire bending stiffnesses EI the coupling is repeated at (E scaled), "
-          "with each wall's compliance of the run")
+          "Compliant or contact coupling: wire bending stiffnesses EI the coupling is repeated at "
+          "(E scaled), with each wall's compliance of the run")
           .unit("N·m²").positive().sweep().in(g),
   };
 }

@@ -433,6 +433,51 @@ TEST(Gate, TheWiresForceErrorAndEachCoupledForceErrorMayNotGrow) {
   EXPECT_FALSE(compare_with_baseline(base, gone).passed());
 }
 
+namespace {
+/// with_wire's results with a contact block at EI 4e-7: model "m"'s contact force error (mN)
+/// against the reference's, or its failed solve.
+ResultsFile with_contact(double error_mN, bool ok = true) {
+  ResultsFile r = with_wire(2.0e-4, 0.45);
+  GuidewireContactRows c;
+  ContactRun run;
+  run.bending_stiffness = 4e-7;
+  run.reference.model = "reference_fem_p2";
+  run.reference.ok = true;
+  run.reference.force_mN = 0.43;
+  ContactWallRow m;
+  m.model = "m";
+  m.ok = ok;
+  m.failure = ok ? "" : "did not converge in 400 Newton steps";
+  m.force_mN = 0.43 + error_mN;
+  if (ok) m.force_error_mN = error_mN;
+  run.models.push_back(m);
+  c.runs.push_back(run);
+  r.scenes[0].guidewire->contact = c;
+  return r;
+}
+}  // namespace
+
+TEST(Gate, EachModelsContactForceErrorMayNotGrow) {
+  const auto base = with_contact(-0.01);
+  EXPECT_TRUE(compare_with_baseline(base, with_contact(-0.01)).passed());
+  EXPECT_TRUE(compare_with_baseline(base, with_contact(0.005)).passed());  // smaller |error|
+  const GateOutcome grew = compare_with_baseline(base, with_contact(0.02));
+  ASSERT_FALSE(grew.passed());
+  EXPECT_EQ(grew.findings.front().model, "m");
+  EXPECT_EQ(grew.findings.front().magnitude, 4e-7);  // the EI
+  EXPECT_NE(grew.findings.front().what.find("contact-force error"), std::string::npos);
+  const GateOutcome fails = compare_with_baseline(base, with_contact(-0.01, false));
+  ASSERT_FALSE(fails.passed());
+  EXPECT_EQ(fails.findings.front().current, "did not converge in 400 Newton steps");
+  // The contact block gone, or the model's row gone from it.
+  auto gone = with_contact(-0.01);
+  gone.scenes[0].guidewire->contact.reset();
+  EXPECT_FALSE(compare_with_baseline(base, gone).passed());
+  auto no_row = with_contact(-0.01);
+  no_row.scenes[0].guidewire->contact->runs[0].models.clear();
+  EXPECT_FALSE(compare_with_baseline(base, no_row).passed());
+}
+
 TEST(Gate, IdenticalResultsPass) {
   const auto r = results_with({outcome("m", 1e-3, 0.1, 1.0)});
   const auto g = compare_with_baseline(r, r);
@@ -526,4 +571,82 @@ TEST(GuidewireSection, TheWiresForcesAndEachModelsCoupledForceAsResultsJsonGives
                       .markdown_text("figures"),
                   "The guidewire"),
             0u);
+}
+
+TEST(GuidewireSection, TheContactSolvesModelsAndShortcutsAsResultsJsonGivesThem) {
+  // A contact block written by hand: at EI 4e-7 a reference, a model 2 % low and a failed one;
+  // at 4e-5 a reference beyond the linear wall's validity.
+  auto j = nlohmann::json::parse(
+      test::read_text(std::filesystem::path(VESSEL_REPORT_FIXTURE) / "results.json"));
+  const auto wall = [](const std::string& model, double force, double error_percent) {
+    return nlohmann::json{{"model", model},
+                          {"wall", "at rest"},
+                          {"ok", true},
+                          {"force_mN", force},
+                          {"force_error_mN", force - 0.43},
+                          {"force_error_percent", error_percent},
+                          {"pressed", 12},
+                          {"axial_extent_mm", 0.75},
+                          {"circumferential_extent_mm", 0.35},
+                          {"dent_mm", 0.21},
+                          {"largest_strain", 0.04},
+                          {"tip_error_mm", 0.012},
+                          {"setup_seconds", 1.5},
+                          {"solve_seconds", 0.25}};
+  };
+  nlohmann::json failed{{"model", "volume_springs"},
+                        {"wall", "at rest"},
+                        {"ok", false},
+                        {"failure", "did not converge"}};
+  nlohmann::json stiff_reference = wall("reference_fem_p2", 5.2, 0.0);
+  stiff_reference["largest_strain"] = 0.31;
+  const auto run = [&](double ei, bool valid, const nlohmann::json& reference,
+                       const nlohmann::json& models) {
+    return nlohmann::json{
+        {"bending_stiffness_Nm2", ei},
+        {"rigid_force_mN", 0.471},
+        {"within_linear_validity", valid},
+        {"reference", reference},
+        {"models", models},
+        {"shortcuts",
+         {{{"name", "rigid lumen"}, {"force_mN", 0.471}, {"force_error_percent", 9.53}}}}};
+  };
+  j["scenes"][0]["guidewire"] = {
+      {"model", "der"},
+      {"coupling", "contact"},
+      {"rigid", {{{"bending_stiffness_Nm2", 4e-7}, {"contact_force_N", 4.71e-4}}}},
+      {"coupling_rows", nlohmann::json::array()},
+      {"contact",
+       {{"poisson_ratio", 0.45},
+        {"mesh_nodes", 7072},
+        {"mesh_tets", 30000},
+        {"fine_size_mm", 0.08},
+        {"fine_radius_mm", 1.0},
+        {"reference_degree", 2},
+        {"strain_limit", 0.1},
+        {"runs",
+         {run(4e-7, true, wall("reference_fem_p2", 0.43, 0.0),
+              {wall("fem_p1", 0.4214, -2.0), failed}),
+          run(4e-5, false, stiff_reference, nlohmann::json::array())}}}}};
+  const ResultsFile r = parse_results(j.dump(), "results.json");
+  const GuidewireRows& g = *r.scenes[0].guidewire;
+  ASSERT_TRUE(g.contact.has_value());
+  ASSERT_EQ(g.contact->runs.size(), 2u);
+  EXPECT_FALSE(g.contact->runs[1].within_linear_validity);
+  const std::string md = build_report(r, std::nullopt, "test").markdown_text("figures");
+  EXPECT_EQ(count(md, "7072 nodes refined to 0.08 mm"), 1u) << md;
+  EXPECT_EQ(count(md, "| fem_p1 | 0.4214 | -2 | 12 | 0.75 × 0.35 | 0.21 | 0.012 | 1.5 | 0.25 |"),
+            1u)
+      << md;
+  EXPECT_EQ(count(md, "failed: did not converge"), 1u) << md;
+  EXPECT_EQ(count(md, "| rigid lumen | 0.471 | 9.53 |"), 2u) << md;
+  EXPECT_EQ(count(md, "⚠ Beyond the linear reference's validity"), 1u) << md;
+  // A contact block without its runs is a clear error naming the field.
+  j["scenes"][0]["guidewire"]["contact"].erase("runs");
+  try {
+    (void)parse_results(j.dump(), "results.json");
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("runs"), std::string::npos) << e.what();
+  }
 }

@@ -66,6 +66,7 @@ TEST(GuidewireCouplingRun, ModelForceIsTheSeriesSpringsOnTheModelsOwnCompliance)
   }
   s.models = keep;
   s.load.guidewire->stiffness_sweep.clear();
+  s.load.guidewire->coupling = GuidewireCoupling::compliant;  // the series springs alone
   const SceneResult r = run_scene(s, HarnessOptions{});
   ASSERT_TRUE(r.guidewire.has_value());
   ASSERT_EQ(r.guidewire->rows.size(), 1u);

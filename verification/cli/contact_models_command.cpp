@@ -7,6 +7,7 @@
 #include <string>
 
 #include "meshes/foundation/errors.hpp"
+#include "meshes/vessel_geometry.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/contact_models/contact_models.hpp"
 
@@ -38,7 +39,12 @@ std::string fmt(const char* format, double v) {
   return buf;
 }
 
-void print_run(const contact::ContactModelsRun& run) {
+/// The centroid's arc length along the vessel's centreline, mm (z on the straight tube).
+std::string along(const VesselParams& vessel, const Vec3& centroid) {
+  return fmt("%.3f", centreline_coordinates(vessel, centroid).s * 1e3);
+}
+
+void print_run(const contact::ContactModelsRun& run, const VesselParams& vessel) {
   const contact::ModelContact& ref = run.reference;
   std::cout << "\n### EI = " << fmt("%.3g", run.bending_stiffness) << " N·m²\n\n"
             << "Rigid lumen: " << fmt("%.4f", run.rigid_force * 1e3) << " mN. Reference ("
@@ -47,12 +53,11 @@ void print_run(const contact::ContactModelsRun& run) {
     std::cout << "FAILED: " << cell(ref.failure) << "\n";
   } else {
     std::cout << fmt("%.4f", ref.force * 1e3) << " mN, " << ref.pressed << " pressed, dent "
-              << fmt("%.4f", ref.dent * 1e3) << " mm, centroid z "
-              << fmt("%.3f", ref.centroid.z() * 1e3) << " mm, " << ref.candidates
-              << " candidates.\n";
+              << fmt("%.4f", ref.dent * 1e3) << " mm, centroid at " << along(vessel, ref.centroid)
+              << " mm along the centreline, " << ref.candidates << " candidates.\n";
   }
   constexpr int kColumns = 14;
-  std::cout << "\n| model | wall | F (mN) | error (mN) | error (%) | pressed | centroid z (mm) "
+  std::cout << "\n| model | wall | F (mN) | error (mN) | error (%) | pressed | centroid s (mm) "
                "| zone axial × circ. (mm) | dent (mm) | tip error (mm) | own imbalance "
                "| set-up (s) | solve (s) | steps |\n|";
   for (int c = 0; c < kColumns; ++c) std::cout << " --- |";
@@ -69,7 +74,7 @@ void print_run(const contact::ContactModelsRun& run) {
     std::cout << m.linearisation << " | " << fmt("%.4f", m.force * 1e3) << " | "
               << (judged ? fmt("%+.4f", (m.force - ref.force) * 1e3) : "n/a") << " | "
               << (judged ? fmt("%+.2f", 100 * (m.force / ref.force - 1)) : "n/a") << " | "
-              << m.pressed << " | " << fmt("%.3f", m.centroid.z() * 1e3) << " | "
+              << m.pressed << " | " << along(vessel, m.centroid) << " | "
               << fmt("%.3f", m.axial_extent * 1e3) << " × "
               << fmt("%.3f", m.circumferential_extent * 1e3) << " | " << fmt("%.4f", m.dent * 1e3)
               << " | " << (judged ? fmt("%.4f", (m.tip - ref.tip).norm() * 1e3) : "n/a") << " | "
@@ -94,7 +99,8 @@ void add_contact_models_command(CLI::App& app) {
       "lengths in mm).\n"
       "Example:\n  vesselverify contact-models verification/scenes/guidewire_straight.toml "
       "--ei 4e-7");
-  cmd->add_option("scene", o->scene, "A guidewire scene on a straight tube")->required();
+  cmd->add_option("scene", o->scene, "A guidewire scene (the straight tube or the arch)")
+      ->required();
   cmd->add_option("--ei", o->ei,
                   "Bending stiffness of the wire, N*m^2 (repeatable; default: the scene wire's)");
   cmd->add_flag("--scene-models-only", o->scene_models_only,
@@ -117,6 +123,10 @@ void add_contact_models_command(CLI::App& app) {
                   "Degree of the reference FEM wall (deal.II)")
       ->check(CLI::IsMember({1, 2}))
       ->capture_default_str();
+  cmd->add_flag("--potential", o->options.potential,
+                "Every wall linearised at rest, each solved with the wire as one potential (every "
+                "inner-wall node a candidate, a wire through the wall refused) instead of the "
+                "active set on the condensed wall: slower, and it converges on the arch");
   cmd->add_flag("--own-equilibrium", o->options.own_equilibrium,
                 "Each model at its own nonlinear equilibrium (its own energy) and the reference at "
                 "finite strain (neo-Hookean FEM), the wire and each wall solved as one potential; "
@@ -145,7 +155,7 @@ void add_contact_models_command(CLI::App& app) {
               << " nodes, " << result.mesh_tets << " tets (refined to "
               << o->options.fine_size * 1e3 << " mm within " << o->options.fine_radius * 1e3
               << " mm of the rigid contact).\n";
-    for (const contact::ContactModelsRun& run : result.runs) print_run(run);
+    for (const contact::ContactModelsRun& run : result.runs) print_run(run, scene.vessel);
   });
 }
 

@@ -30,6 +30,7 @@ struct RunOptions {
   int modes = -1;                 ///< natural frequencies per model (−1: the scenes' [modes])
   int modes_reference_level = -1;  ///< level of the modal reference (−1: the scenes')
   std::string fields = "representative";
+  double contact_fine_size = 0.0;  ///< m; 0: ContactModelsOptions's default
   std::string command;
 };
 
@@ -83,6 +84,7 @@ void run(const RunOptions& o) {
   if (o.fields != "none") h.fields_dir = o.output_dir / "fields";
   h.fields_every_load = o.fields == "all";
   h.exchange_dir = o.output_dir / "exchange";  // external models' case folders
+  h.contact_fine_size = o.contact_fine_size;
   run_and_write(scenes, h, o.output_dir, o.command);
   std::cout << solution_cache->summary() << "\n" << outcome_cache->summary() << "\n";
 }
@@ -107,7 +109,8 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
   add_retime_option(*cmd, o->cache.retime);
   add_jobs_option(*cmd, o->jobs, kReferencesAtATime);
   cmd->add_flag("--quick", o->quick,
-                "Coarse levels (models 0, reference 1) and the smallest and largest load only");
+                "Coarse levels (models 0, reference 1) and the smallest and largest load only; a "
+                "guidewire's contact coupling without its contact solve (the series springs)");
   add_timing_options(*cmd, o->repeats, o->updates);
   cmd->add_option("--nu", o->poisson_ratios,
                   "Sweep Poisson's ratio over these values instead of the scenes' (e.g. "
@@ -142,6 +145,10 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
                   "every load, or none")
       ->check(CLI::IsMember({"representative", "all", "none"}))
       ->capture_default_str();
+  cmd->add_option("--contact-fine-size", o->contact_fine_size,
+                  "Guidewire scenes with coupling = \"contact\": the contact mesh's element size "
+                  "near the wire's contact, m (default: 0.08e-3)")
+      ->check(CLI::PositiveNumber);
   cmd->callback([o] { run(*o); });
 }
 

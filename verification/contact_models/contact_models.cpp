@@ -9,10 +9,11 @@
 
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
+#include "meshes/vessel_geometry.hpp"
 #include "msm/rods/der_rod.hpp"
-#include "msm/rods/rigid_wall.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
 #include "verification/scene_problems.hpp"
 
 namespace vessel::contact {
@@ -24,92 +25,76 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 /// The scene's wire as a DER rod at bending stiffness EI (E and G scaled, the section kept),
-/// clamped where the scene clamps it.
+/// clamped where the scene clamps it, with its state against the rigid lumen.
 struct SceneWire {
+  GuidewireSpec spec;
   msm::rods::RodLayout layout;
   msm::rods::DerRod rod;
   double radius = 0.0;
   double length = 0.0;
-  SceneWire(const GuidewireSpec& spec, double EI)
-      : layout([&] {
-          const msm::rods::RodMaterial own{spec.young, spec.shear, spec.density};
-          const double scale = EI / msm::rods::solid_section(own, spec.diameter).EI;
-          const msm::rods::RodMaterial m{spec.young * scale, spec.shear * scale, spec.density};
-          msm::rods::RodSpec s =
-              msm::rods::uniform_rod(m, spec.insertion, spec.diameter, spec.segments);
-          s.origin = spec.clamp_point;
-          s.direction = spec.clamp_direction;
-          return msm::rods::make_layout(s);
+  SceneWire(const GuidewireSpec& scene_wire, double EI)
+      : spec([&] {
+          GuidewireSpec s = with_stiffness(scene_wire, EI);
+          s.model = WireModel::der;
+          return s;
         }()),
+        layout(msm::rods::make_layout(guidewire_rod_spec(spec, spec.insertion))),
         rod(layout),
         radius(spec.diameter / 2),
         length(spec.insertion) {}
   [[nodiscard]] ContactWire contact() const { return contact_wire(rod, radius); }
 };
 
-/// The wire against the straight tube's rigid lumen (its centreline kept a − r_w off the axis).
+/// The wire against the vessel's rigid lumen (GuidewireSolver: the straight tube or the arch).
 struct RigidContact {
   Eigen::VectorXd x;
   double force = 0.0;
   Vec3 wall_point = Vec3::Zero();
 };
 
-RigidContact rigid_contact(SceneWire& w, const VesselParams& vessel, double EI) {
-  const msm::rods::StraightTube tube(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(),
-                                     vessel.inner_radius - w.radius);
-  Eigen::VectorXd x = w.rod.rest_state();
-  w.rod.update_reference(x);
-  msm::rods::ConstrainedOptions o;
-  o.force_scale = EI / (w.length * w.length);
-  const msm::rods::ContactSolution s = msm::rods::solve_wall_contact(
-      w.rod, nullptr, w.rod.clamp_fixed(), x, tube, 2, w.layout.tip_node, o);
-  RigidContact out{s.x, 0.0, Vec3::Zero()};
-  double largest = -1.0;
-  for (std::size_t k = 0; k < s.nodes.size(); ++k) {
-    out.force += s.forces[k];
-    if (s.forces[k] > largest) {
-      largest = s.forces[k];
-      const Vec3 c = s.x.segment<3>(3 * s.nodes[k]);
-      out.wall_point = c + w.radius * Vec3(c.x(), c.y(), 0.0).normalized();
-    }
-  }
-  if (largest <= 0.0) {
+RigidContact rigid_contact(const SceneWire& w, const VesselParams& vessel) {
+  GuidewireSolver solver(vessel, w.spec);
+  const GuidewireSolution s = solver.solve_rigid();
+  if (!(s.force > 0.0)) {
     throw std::runtime_error("the wire does not touch the rigid lumen: no contact to solve");
   }
-  return out;
+  return {solver.rod_state(), s.force, s.wall_point};
 }
 
 /// The contact problem's fixed parts, shared by every wall at one EI.
 struct Problem {
   const TetMesh* mesh = nullptr;
+  const VesselParams* vessel = nullptr;
   std::vector<int> nodes;  ///< the first candidates
   int first = 0;           ///< the candidate nearest the rigid wall point
-  double lumen_radius = 0.0;
 };
 
-/// The pressed zone: its centroid, its spans along and around the axis, the dent.
-void describe_zone(const TetMesh& mesh, double lumen_radius, const std::vector<int>& pressed,
+/// The pressed zone: its centroid, its spans along the vessel's centreline and around it (as arc
+/// length at the lumen), the dent.
+void describe_zone(const Problem& p, const std::vector<int>& pressed,
                    const std::vector<double>& force, const std::vector<Vec3>& u,
                    ModelContact& out) {
-  double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
-  double t_lo = z_lo, t_hi = z_hi, total = 0.0;
+  double s_lo = std::numeric_limits<double>::infinity(), s_hi = -s_lo;
+  double t_lo = s_lo, t_hi = s_hi, total = 0.0, theta0 = 0.0;
   out.pressed = static_cast<int>(pressed.size());
   for (std::size_t j = 0; j < pressed.size(); ++j) {
     const auto node = static_cast<std::size_t>(pressed[j]);
-    const Vec3& X = mesh.nodes[node];
+    const Vec3& X = p.mesh->nodes[node];
     out.centroid += force[j] * X;
     total += force[j];
     out.dent = std::max(out.dent, u[node].norm());
-    z_lo = std::min(z_lo, X.z());
-    z_hi = std::max(z_hi, X.z());
-    const double theta = std::atan2(X.y(), X.x());
+    const CentrelineCoordinates c = centreline_coordinates(*p.vessel, X);
+    s_lo = std::min(s_lo, c.s);
+    s_hi = std::max(s_hi, c.s);
+    if (j == 0) theta0 = c.theta;  // angles about the first pressed node's: no wrap at ±π
+    const double theta = std::remainder(c.theta - theta0, 2.0 * std::numbers::pi);
     t_lo = std::min(t_lo, theta);
     t_hi = std::max(t_hi, theta);
   }
   if (total > 0.0) {
     out.centroid /= total;
-    out.axial_extent = z_hi - z_lo;
-    out.circumferential_extent = lumen_radius * (t_hi - t_lo);
+    out.axial_extent = s_hi - s_lo;
+    out.circumferential_extent = p.vessel->inner_radius * (t_hi - t_lo);
   }
 }
 
@@ -139,7 +124,8 @@ ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidCo
   std::vector<int> pressed;
   std::vector<double> force;
   grown.pressed(pressed, force);
-  describe_zone(*p.mesh, p.lumen_radius, pressed, force, u, out);
+  describe_zone(p, pressed, force, u, out);
+  out.strain = largest_strain(*p.mesh, u).small;
   std::vector<Vec3> loads(p.mesh->nodes.size(), Vec3::Zero());
   for (std::size_t j = 0; j < grown.nodes.size(); ++j) {
     loads[static_cast<std::size_t>(grown.nodes[j])] +=
@@ -149,19 +135,23 @@ ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidCo
   return out;
 }
 
-/// The wall at its own equilibrium with the wire as one potential: a msm model's own energy
-/// (FormWall), deal.II's FEM as the neo-Hookean wall (the reference) or the linear one (a linear
+/// The wall and the wire as one potential: the wall linearised at rest (LinearWall on its
+/// stiffness) or, with options.own_equilibrium, at its own equilibrium (a msm model's own energy,
+/// FormWall; deal.II's FEM as the neo-Hookean wall for the reference, the linear one for a linear
 /// FEM model).
-ModelContact solve_wall_own(const Scene& scene, const ModelSpec& spec, const ModelWall& wall,
-                            SceneWire& w, const RigidContact& rigid, const Problem& p, double EI,
-                            double nu, bool reference, const ContactModelsOptions& options) {
+ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, const ModelWall& wall,
+                                  SceneWire& w, const RigidContact& rigid, const Problem& p,
+                                  double EI, double nu, bool reference,
+                                  const ContactModelsOptions& options) {
   ModelContact out;
   out.name = wall.name;
   out.detail = wall.detail;
-  out.linearisation = "own equilibrium";
+  out.linearisation = options.own_equilibrium ? "own equilibrium" : to_string(wall.linearisation);
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<WallPotential> potential;
-  if (wall.energy.form) {
+  if (!options.own_equilibrium) {
+    potential = std::make_unique<LinearWall>(wall.system);
+  } else if (wall.energy.form) {
     potential = std::make_unique<FormWall>(*wall.energy.form, wall.energy.rest,
                                            wall.system.free_index, wall.system.node_rows);
   } else if (reference) {
@@ -186,7 +176,8 @@ ModelContact solve_wall_own(const Scene& scene, const ModelSpec& spec, const Mod
   out.candidates = static_cast<int>(candidates.size());
   out.steps = s.newton_iterations;
   out.tip = s.x.segment<3>(3 * w.layout.tip_node);
-  describe_zone(*p.mesh, p.lumen_radius, s.pressed, s.force, potential->nodal(s.u), out);
+  describe_zone(p, s.pressed, s.force, potential->nodal(s.u), out);
+  out.strain = potential->largest_strain(*p.mesh, s.u);
   return out;
 }
 
@@ -206,13 +197,16 @@ ModelSpec spec_of(std::string name, ModelKind kind) {
 
 }  // namespace
 
+bool has_contact_wall(const ModelSpec& m) {
+  return !(m.kind == ModelKind::network || m.kind == ModelKind::external ||
+           m.kind == ModelKind::displacements ||
+           (m.kind == ModelKind::surface_msm && m.surface == msm::WallSurface::outer));
+}
+
 std::vector<ModelSpec> contact_model_kinds(const Scene& scene) {
   std::vector<ModelSpec> out;
   for (const ModelSpec& m : scene.models) {
-    const bool no_wall = m.kind == ModelKind::network || m.kind == ModelKind::external ||
-                         m.kind == ModelKind::displacements ||
-                         (m.kind == ModelKind::surface_msm && m.surface == msm::WallSurface::outer);
-    if (!no_wall) out.push_back(m);
+    if (has_contact_wall(m)) out.push_back(m);
   }
   std::vector<ModelSpec> extra;
   ModelSpec p1 = spec_of("fem_p1", ModelKind::fem);
@@ -288,10 +282,10 @@ ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSp
                      ": load: expected type = \"guidewire\" (the wire the walls are "
                      "pressed by)");
   }
-  if (scene.vessel.kind != VesselKind::straight) {
+  if (scene.vessel.kind != VesselKind::straight && scene.vessel.kind != VesselKind::arch) {
     throw InputError(file +
-                     ": vessel.kind: the contact models' mesh is refined around the "
-                     "contact on a straight tube; expected kind = \"straight\"");
+                     ": vessel.kind: the contact models' mesh is refined around the wire's "
+                     "contact by gmsh; expected kind = \"straight\" or \"arch\"");
   }
   const GuidewireSpec& spec = *scene.load.guidewire;
   ContactModels out;
@@ -300,23 +294,30 @@ ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSp
   if (EIs.empty()) {
     EIs = {msm::rods::solid_section({spec.young, spec.shear, spec.density}, spec.diameter).EI};
   }
-  // The rigid contact's place does not depend on EI (the wire's shape against a rigid wall is
-  // EI's alone): one mesh for every run.
   std::vector<std::unique_ptr<SceneWire>> wires;
   std::vector<RigidContact> rigid;
+  std::vector<RefinedBall> balls;  // one per distinct rigid contact (EI scales the force alone)
   for (const double EI : EIs) {
     wires.push_back(std::make_unique<SceneWire>(spec, EI));
-    rigid.push_back(rigid_contact(*wires.back(), scene.vessel, EI));
+    try {
+      rigid.push_back(rigid_contact(*wires.back(), scene.vessel));
+    } catch (const InputError& e) {
+      throw InputError(file + ": " + e.what());
+    }
+    const Vec3& point = rigid.back().wall_point;
+    const bool covered = std::any_of(balls.begin(), balls.end(), [&](const RefinedBall& b) {
+      return (b.centre - point).norm() < 0.25 * b.radius;
+    });
+    if (!covered) balls.push_back({point, options.fine_radius});
   }
   VesselParams vessel = scene.vessel;
   vessel.style = MeshStyle::unstructured;
-  const TetMesh mesh =
-      refined_patch_mesh(vessel, rigid.front().wall_point, options.fine_size, options.fine_radius);
+  const TetMesh mesh = refined_balls_mesh(vessel, balls, options.fine_size);
   out.mesh_nodes = mesh.nodes.size();
   out.mesh_tets = mesh.tets.size();
   Problem p;
   p.mesh = &mesh;
-  p.lumen_radius = vessel.inner_radius;
+  p.vessel = &vessel;
   const PhysicalGroup& inner = mesh.require_group("inner_wall", 2, "contact mesh");
   for (const int n : mesh.group_nodes(inner)) {
     if ((mesh.nodes[n] - rigid.front().wall_point).norm() < options.band_radius) {
@@ -361,9 +362,9 @@ ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSp
         c = failed(*walls[k], why);
       } else {
         try {
-          c = options.own_equilibrium
-                  ? solve_wall_own(scene, *walls[k], *wall, *wires[e], rigid[e], p, EIs[e],
-                                   out.nu, k == 0, options)
+          c = options.own_equilibrium || options.potential
+                  ? solve_wall_potential(scene, *walls[k], *wall, *wires[e], rigid[e], p, EIs[e],
+                                         out.nu, k == 0, options)
                   : solve_wall(*wall, *wires[e], rigid[e], p, EIs[e], options);
         } catch (const std::exception& ex) {
           c = failed(*walls[k], ex.what());

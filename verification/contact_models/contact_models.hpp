@@ -1,10 +1,11 @@
 #pragma once
-/// Every vessel model in the same wire–wall contact problem: a straight-tube guidewire scene's wire
-/// (Discrete Elastic Rods at the scene's segments, clamped as the scene clamps it, at a chosen EI)
-/// against each model's wall (model_walls.hpp), the contact between the wire's capsule and the
-/// inner wall found by solve_wire_wall_contact_growing, on one tet mesh refined around the rigid
-/// wire's contact: every model and the reference (FEM P2 on the same mesh) are solved on the same
-/// mesh, the same candidates' growth and the same contact law, so their contact forces compare.
+/// Every vessel model in the same wire–wall contact problem: a guidewire scene's wire (Discrete
+/// Elastic Rods at the scene's segments, clamped as the scene clamps it, at a chosen EI) in the
+/// straight tube or the arch against each model's wall (model_walls.hpp), the contact between the
+/// wire's capsule and the inner wall found by solve_wire_wall_contact_growing, on one tet mesh
+/// refined around the rigid wire's contact: every model and the reference (FEM P2 on the same
+/// mesh) are solved on the same mesh, the same candidates' growth and the same contact law, so
+/// their contact forces compare.
 #include <ostream>
 #include <optional>
 #include <string>
@@ -31,6 +32,12 @@ struct ContactModelsOptions {
   /// FormWall) and the reference at finite strain (the neo-Hookean FEM), each with the wire as one
   /// potential (wire_wall_potential.hpp); every inner-wall node a candidate.
   bool own_equilibrium = false;
+  /// Every wall linearised at rest, each with the wire as one potential (LinearWall,
+  /// wire_wall_potential.hpp) instead of the condensed active set: every inner-wall node a
+  /// candidate, an energy line search, a wire through the wall refused. Slower; it converges where
+  /// the active set does not, as for the arch's buckled wire, whose force hardly changes with its
+  /// shape.
+  bool potential = false;
   std::ostream* log = nullptr;  ///< one line per wall and EI as it is solved, if set
 };
 
@@ -46,9 +53,12 @@ struct ModelContact {
   int candidates = 0;            ///< after growth
   int rounds = 0;                ///< growths
   Vec3 centroid = Vec3::Zero();  ///< force-weighted mean rest position of the pressed nodes, m
-  double axial_extent = 0.0;     ///< span of the pressed nodes along the tube's axis (z), m
+  double axial_extent = 0.0;     ///< span of the pressed nodes along the vessel's centreline, m
   double circumferential_extent = 0.0;  ///< their span around it, as arc length at the lumen, m
   double dent = 0.0;                    ///< the largest displacement of a pressed node, m
+  /// The wall's largest principal strain: small strain from the P1 gradient of the vertex
+  /// displacements (linearised walls), the wall's own measure at its own equilibrium.
+  double strain = 0.0;
   Vec3 tip = Vec3::Zero();              ///< the wire's tip, m
   /// own_imbalance at the dent: the share of the contact load the model's own (nonlinear) energy
   /// does not balance there (0 for deal.II's FEM).
@@ -62,7 +72,7 @@ struct ModelContact {
 struct ContactModelsRun {
   double bending_stiffness = 0.0;        ///< N·m²
   double rigid_force = 0.0;              ///< the same wire against the rigid lumen, N
-  Vec3 rigid_wall_point = Vec3::Zero();  ///< where it touches (tip + r_w along the radius), m
+  Vec3 rigid_wall_point = Vec3::Zero();  ///< the wall under the wire's contact node, m
   ModelContact reference;                ///< FEM P(reference_degree)
   std::vector<ModelContact> models;
 };
@@ -73,17 +83,20 @@ struct ContactModels {
   std::vector<ContactModelsRun> runs;  ///< one per EI
 };
 
+/// Whether the model has a wall the wire can press: not a network, an external program, given
+/// displacements or a surface model on the outer wall.
+bool has_contact_wall(const ModelSpec& model);
+
 /// The scene's models and the model kinds the suite runs that the scene lacks, one each: the
 /// spring networks (seed001, van-gelder), the hybrid volume model, the edge pairs, corotational P1,
 /// XPBD FEM, the surface models (seed 000 on the mid-surface and on the inner wall, Discrete Shells
-/// on the mid-surface) and FEM P1. Kinds with no wall in the contact (network, external,
-/// displacements; surface models on the outer wall) are left out.
+/// on the mid-surface) and FEM P1. Models without a contact wall (has_contact_wall) are left out.
 std::vector<ModelSpec> contact_model_kinds(const Scene& scene);
 
-/// The scene's wire (a guidewire load in a straight tube) against every wall of `models` and the
-/// reference's, at each EI, at the scene's first ν. InputError naming the scene's file for a scene
-/// without a guidewire or a vessel that is not a straight tube. A model whose contact solve fails
-/// is recorded with its reason (ModelContact::failure) and the others go on.
+/// The scene's wire (a guidewire load in the straight tube or the arch) against every wall of
+/// `models` and the reference's, at each EI, at the scene's first ν. InputError naming the scene's
+/// file for a scene without a guidewire or a vessel that is neither. A model whose contact solve
+/// fails is recorded with its reason (ModelContact::failure) and the others go on.
 ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSpec>& models,
                                    const ContactModelsOptions& options);
 

@@ -57,7 +57,22 @@ inline std::vector<std::string> wire_model_names() {
 enum class GuidewireCoupling {
   rigid,      ///< the wire's force against the rigid lumen loads every model
   compliant,  ///< and each model's own force, the wire pushing a wall that gives way
+  /// and each model's wall in a contact solve with the wire, judged against the FEM wall's
+  /// (verification/contact_models/contact_models.hpp); the compliant rows stay, as a shortcut
+  contact,
 };
+/// The coupling's scene name: "rigid", "compliant" or "contact".
+inline std::string to_string(GuidewireCoupling coupling) {
+  switch (coupling) {
+    case GuidewireCoupling::compliant:
+      return "compliant";
+    case GuidewireCoupling::contact:
+      return "contact";
+    case GuidewireCoupling::rigid:
+      break;
+  }
+  return "rigid";
+}
 
 struct GuidewireSpec {
   double young = 0.0;     ///< E, Pa
@@ -77,8 +92,8 @@ struct GuidewireSpec {
   Vec3 clamp_point = Vec3::Zero();
   Vec3 clamp_direction = Vec3::UnitZ();
   GuidewireCoupling coupling = GuidewireCoupling::rigid;
-  /// Compliant coupling: the bending stiffnesses EI (N·m²) the coupling is repeated at (E scaled,
-  /// the section kept), with the walls' compliances of the scene's run.
+  /// Compliant or contact coupling: the bending stiffnesses EI (N·m²) the coupling is repeated at
+  /// (E scaled, the section kept), with the walls' compliances of the scene's run.
   std::vector<double> stiffness_sweep;
 };
 

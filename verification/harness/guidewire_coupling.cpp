@@ -56,10 +56,10 @@ void couple_at(const Scene& s, double EI, const std::vector<ModelOutcome>& outco
   rigid.solution = solver.solve_rigid();
   std::string why;
   if (const auto c = continuum_wire(s.vessel, spec, why)) rigid.continuum_force = c->force;
-  if (spec.coupling == GuidewireCoupling::compliant && rigid.solution.force > 0.0) {
+  if (spec.coupling != GuidewireCoupling::rigid && rigid.solution.force > 0.0) {
     rigid.wire_compliance = solver.compliance();
   }
-  if (spec.coupling != GuidewireCoupling::compliant) {
+  if (spec.coupling == GuidewireCoupling::rigid) {
     g.rigid.push_back(rigid);
     return;
   }
@@ -148,7 +148,7 @@ GuidewireOutcome couple_guidewire(const Scene& s, const std::vector<ModelOutcome
 }
 
 void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g) {
-  const bool compliant = g.spec.coupling == GuidewireCoupling::compliant;
+  const bool compliant = g.spec.coupling != GuidewireCoupling::rigid;
   out << "Guidewire (" << to_string(g.spec.model) << ", " << g.spec.segments << " segments, d = "
       << g.spec.diameter * 1e3 << " mm, insertion " << g.spec.insertion * 1e3
       << " mm): against the rigid lumen, its force loads every model above"
@@ -232,18 +232,19 @@ nlohmann::json guidewire_json(const GuidewireOutcome& g) {
                     {"ok", r.ok},
                     {"failure", r.failure}});
   }
-  return {{"model", to_string(w.model)},
-          {"coupling", w.coupling == GuidewireCoupling::compliant ? "compliant" : "rigid"},
-          {"young_pa", w.young},
-          {"shear_pa", w.shear},
-          {"diameter_m", w.diameter},
-          {"insertion_m", w.insertion},
-          {"segments", w.segments},
-          {"clamp_point_mm", vec_mm(w.clamp_point)},
-          {"clamp_direction", {w.clamp_direction.x(), w.clamp_direction.y(), w.clamp_direction.z()}},
-          {"patch_radius_m", g.patch_radius},
-          {"rigid", rigid},
-          {"coupling_rows", rows}};
+  return {
+      {"model", to_string(w.model)},
+      {"coupling", to_string(w.coupling)},
+      {"young_pa", w.young},
+      {"shear_pa", w.shear},
+      {"diameter_m", w.diameter},
+      {"insertion_m", w.insertion},
+      {"segments", w.segments},
+      {"clamp_point_mm", vec_mm(w.clamp_point)},
+      {"clamp_direction", {w.clamp_direction.x(), w.clamp_direction.y(), w.clamp_direction.z()}},
+      {"patch_radius_m", g.patch_radius},
+      {"rigid", rigid},
+      {"coupling_rows", rows}};
 }
 
 }  // namespace vessel

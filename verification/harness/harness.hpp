@@ -23,7 +23,8 @@ namespace vessel {
 /// The --quick variant of a scene: the coarsest useful levels (models at 0, reference at 1 so that
 /// level 0 gives its uncertainty) and only the smallest and largest load. Taylor–Hood (ν ≥ 0.49)
 /// goes to a direct solver that needs minutes and gigabytes at level 1, so scenes with such a ν
-/// keep their reference at level 0 (then without an uncertainty estimate).
+/// keep their reference at level 0 (then without an uncertainty estimate). A guidewire's
+/// coupling = "contact" becomes "compliant" (the series springs without the contact solve).
 Scene quick_variant(Scene scene);
 
 /// Runs the scene. Throws InputError for inputs the scene validation cannot see (a contact point

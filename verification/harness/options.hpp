@@ -43,6 +43,10 @@ struct HarnessOptions {
   /// Models of kind `external`: their case folders go under exchange_dir/<scene>/<model>/<case>
   /// (verification/harness/external_model.hpp); empty: a folder under the system's temporary directory.
   std::filesystem::path exchange_dir;
+  /// Guidewire scenes with coupling = "contact": the contact mesh's element size near the wire's
+  /// contact, m (0: ContactModelsOptions's default,
+  /// verification/contact_models/contact_models.hpp).
+  double contact_fine_size = 0.0;
 };
 
 }  // namespace vessel

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,6 +21,8 @@ namespace vessel {
 
 /// A model's nodal error against the reference at the same points: the statistics seed 000
 /// reports (max, mean, standard deviation, RMS of the nodal error) plus the relative L2 error, mm.
+struct GuidewireContact;  // verification/harness/guidewire_contact.hpp
+
 struct ErrorStatistics {
   double max_mm = 0.0;     ///< max_i |u_i − u_ref,i|
   double mean_mm = 0.0;    ///< mean of |e_i|
@@ -192,6 +195,9 @@ struct SceneResult {
   std::vector<ModalOutcome> model_modes;
   /// A guidewire load: the wire and each model's coupled contact force (guidewire_coupling.hpp).
   std::optional<GuidewireOutcome> guidewire;
+  /// coupling = "contact": each model's wall in a contact solve with the wire
+  /// (guidewire_contact.hpp); null otherwise.
+  std::shared_ptr<const GuidewireContact> guidewire_contact;
   /// A vessel from a lumen file: its ends, each with its group (inlet or outlet).
   std::vector<std::pair<std::string, LumenEnd>> lumen_ends;
   /// Each mesh the scene ran on (models' levels and the reference's): its dihedral extremes and

@@ -1,3 +1,5 @@
+#include "verification/harness/results.hpp"
+
 #include <unistd.h>
 
 #include <cmath>
@@ -9,7 +11,7 @@
 
 #include "meshes/foundation/atomic_file.hpp"
 #include "meshes/foundation/errors.hpp"
-#include "verification/harness/results.hpp"
+#include "verification/harness/guidewire_contact.hpp"
 #include "verification/harness/guidewire_coupling.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/harness/metrics.hpp"
@@ -241,6 +243,7 @@ nlohmann::json scene_json(const SceneResult& r, const std::filesystem::path& res
       {"outcomes", outcomes},
       {"modes", modes}};
   if (r.guidewire) j["guidewire"] = guidewire_json(*r.guidewire);
+  if (r.guidewire_contact) j["guidewire"]["contact"] = guidewire_contact_json(*r.guidewire_contact);
   if (!r.lumen_ends.empty()) {
     j["lumen_ends"] = nlohmann::json::array();
     for (const auto& [group, end] : r.lumen_ends)
@@ -429,6 +432,7 @@ void write_summary_markdown(const std::filesystem::path& path,
       const std::string provenance = timing_provenance_line(r.outcomes);
       if (!provenance.empty()) out << "Timings: " << provenance << ".\n\n";
       if (r.guidewire) write_guidewire_markdown(out, *r.guidewire);
+      if (r.guidewire_contact) write_guidewire_contact_markdown(out, *r.guidewire_contact);
       if (r.reference_modes.empty() && r.model_modes.empty()) continue;
       // Natural frequencies ([modes]): each model's beside the modal reference's, by rank.
       out << "Natural frequencies (Hz) at rest, the scene's supports held; f/f_ref mode by mode "

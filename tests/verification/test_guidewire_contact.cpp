@@ -1,0 +1,175 @@
+// A guidewire scene with coupling = "contact" (verification/harness/guidewire_contact.hpp, on
+// verification/contact_models/contact_models.hpp): on a wall 10^4–10^6 times stiffer than the
+// shipped scenes' the contact solve's force is the rigid lumen's, so the continuum wire's closed
+// forms judge it (the straight tube's Kirchhoff shooting, F·z²/EI = 0.470968; the arch's
+// quarter-wave elastica at the apex, F·R²/EI = 1.0648702), within the rod's own discretisation
+// error and the faceted wall's; the solve kept in the outcome cache is read back unchanged; the
+// results.json object conforms to its schema.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+
+#include "meshes/foundation/errors.hpp"
+#include "meshes/vessel_geometry.hpp"
+#include "schema_check.hpp"
+#include "test_helpers.hpp"
+#include "test_paths.hpp"
+#include "verification/guidewire/guidewire_load.hpp"
+#include "verification/harness/guidewire_contact.hpp"
+#include "verification/harness/outcome_cache.hpp"
+
+namespace vessel {
+namespace {
+
+/// A shipped guidewire scene with its wall `stiffer` times stiffer and only `models` kept.
+Scene stiff_scene(const std::string& name, double stiffer, const std::vector<std::string>& models) {
+  Scene s = read_scene(VESSEL_SCENES_DIR + "/" + name);
+  s.youngs_modulus *= stiffer;
+  std::vector<ModelSpec> kept;
+  for (const ModelSpec& m : s.models) {
+    if (std::find(models.begin(), models.end(), m.name) != models.end()) kept.push_back(m);
+  }
+  s.models = kept;
+  return s;
+}
+
+/// The continuum wire's force (N) for the scene's wire at EI against the rigid lumen.
+double continuum_force(const Scene& s, double EI) {
+  std::string why;
+  const auto w = continuum_wire(s.vessel, with_stiffness(*s.load.guidewire, EI), why);
+  if (!w) throw std::runtime_error("no continuum wire: " + why);
+  return w->force;
+}
+
+// The arch's floppy wire against its wall made 10^4 times stiffer (its dent ~0.1 µm), the reference
+// P1 on a mesh refined to 0.1 mm at the apex, solved as one potential (the condensed active set
+// does not converge on the buckled wire): the contact solve's force is the discrete wire's on the
+// rigid lumen within 0.5 % (the wall's faceting and the capsule's sink between its nodes), the
+// continuum quarter-wave elastica's within the rod's own error (N = 32) plus that, and the zone is
+// at the rigid wire's contact, on the outer wall at the apex. (At 10^6 the potential's Newton
+// stalls at a residual of 3e-8 N, 4e-5 of the force scale.)
+TEST(GuidewireContact, TheArchOnAWallTenThousandTimesStifferIsTheQuarterWaveElastica) {
+  const Scene scene = stiff_scene("guidewire_arch.toml", 1e4, {});
+  contact::ContactModelsOptions o;
+  o.bending_stiffness = {4e-7};
+  o.reference_degree = 1;
+  o.fine_size = 0.1e-3;
+  o.fine_radius = 0.6e-3;
+  o.potential = true;  // the condensed active set does not converge on the arch's buckled wire
+  o.log = &std::cerr;
+  const contact::ContactModels c = contact::solve_contact_models(scene, {}, o);
+  ASSERT_EQ(c.runs.size(), 1u);
+  const contact::ContactModelsRun& run = c.runs.front();
+  ASSERT_EQ(run.reference.failure, "") << run.reference.failure;
+  const double F = run.reference.force, F_rigid = run.rigid_force;
+  const double F_continuum = continuum_force(scene, 4e-7);
+  const double rod_error = std::abs(F_rigid / F_continuum - 1.0);
+  const double R = scene.vessel.bend_radius;
+  std::printf(
+      "GUIDEWIRE-CONTACT arch, wall x1e4: F R^2/EI = %.6f (contact), %.6f (rigid lumen, "
+      "discrete wire), %.7f (continuum); %d pressed, centroid %.3f mm from the rigid "
+      "wall point\n",
+      F * R * R / 4e-7, F_rigid * R * R / 4e-7, F_continuum * R * R / 4e-7, run.reference.pressed,
+      (run.reference.centroid - run.rigid_wall_point).norm() * 1e3);
+  EXPECT_NEAR(F_continuum * R * R / 4e-7, 1.0648702, 1e-6);
+  EXPECT_LT(std::abs(F / F_rigid - 1.0), 5e-3);
+  EXPECT_LT(std::abs(F / F_continuum - 1.0), rod_error + 5e-3);
+  EXPECT_LT((run.reference.centroid - run.rigid_wall_point).norm(), 0.3e-3);
+  const CentrelineCoordinates at = centreline_coordinates(scene.vessel, run.reference.centroid);
+  EXPECT_NEAR(at.s, 0.5 * std::numbers::pi * R, 1e-3);  // the apex
+  EXPECT_LT(std::abs(at.theta), 0.2);                   // on the outer bend
+}
+
+// The straight scene with coupling = "contact" on its wall made 10^6 times stiffer, its fem_p1
+// model and the P2 reference at EI 4e-7 and 4e-6 on a mesh refined to 0.12 mm: against a rigid
+// wall the wire's shape does not depend on EI, so F/EI is the same at both (1e-3) and equals the
+// continuum wire's 0.470968/z² within the rod's error plus the faceted wall's 1 %; fem_p1's force
+// is the reference's within 1 % (both walls rigid); the shortcut "rigid lumen" is the rigid
+// force. The solve kept in the outcome cache is read back (the same forces, marked cached), and
+// results.json's object conforms to the schema.
+TEST(GuidewireContactSlow, TheStraightSceneOnAStiffWallScalesWithEiAndIsReadBackFromTheCache) {
+  Scene scene = stiff_scene("guidewire_straight.toml", 1e6, {"fem_p1"});
+  scene.load.guidewire->coupling = GuidewireCoupling::contact;
+  scene.load.guidewire->stiffness_sweep = {4e-7, 4e-6};
+  test::TempDir dir;
+  std::ostringstream cache_log;
+  OutcomeCache cache(dir.path(), false, &cache_log);
+  HarnessOptions o;
+  o.outcome_cache = &cache;
+  o.contact_fine_size = 0.12e-3;
+  o.log = &std::cerr;
+  const GuidewireContact first = solve_guidewire_contact(scene, GuidewireOutcome{}, o);
+  ASSERT_EQ(first.solve.runs.size(), 2u);
+  EXPECT_FALSE(first.provenance.cached);
+  const double z = 20e-3;  // the scene's contact distance from the clamp
+  double per_EI[2] = {0.0, 0.0};
+  for (std::size_t k = 0; k < 2; ++k) {
+    const contact::ContactModelsRun& run = first.solve.runs[k];
+    const double EI = run.bending_stiffness;
+    ASSERT_EQ(run.reference.failure, "") << run.reference.failure;
+    ASSERT_EQ(run.models.size(), 1u);
+    ASSERT_EQ(run.models[0].failure, "") << run.models[0].failure;
+    const double F = run.reference.force, F_continuum = continuum_force(scene, EI);
+    per_EI[k] = F / EI;
+    std::printf(
+        "GUIDEWIRE-CONTACT straight, wall x1e6, EI %g: F z^2/EI = %.6f (P2), %.6f "
+        "(fem_p1), %.6f (rigid lumen), %.6f (continuum)\n",
+        EI, F * z * z / EI, run.models[0].force * z * z / EI, run.rigid_force * z * z / EI,
+        F_continuum * z * z / EI);
+    EXPECT_NEAR(F_continuum * z * z / EI, 0.470968, 2e-6);
+    const double rod_error = std::abs(run.rigid_force / F_continuum - 1.0);
+    EXPECT_LT(std::abs(F / F_continuum - 1.0), rod_error + 1e-2);
+    EXPECT_LT(std::abs(run.models[0].force / F - 1.0), 1e-2);
+    ASSERT_FALSE(first.shortcuts[k].empty());
+    EXPECT_EQ(first.shortcuts[k].front().name, "rigid lumen");
+    EXPECT_EQ(first.shortcuts[k].front().force, run.rigid_force);
+    EXPECT_TRUE(first.within_linear_validity(run));
+  }
+  EXPECT_NEAR(per_EI[1] / per_EI[0], 1.0, 1e-3);
+
+  const GuidewireContact again = solve_guidewire_contact(scene, GuidewireOutcome{}, o);
+  EXPECT_TRUE(again.provenance.cached);
+  ASSERT_EQ(again.solve.runs.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(again.solve.runs[k].reference.force, first.solve.runs[k].reference.force);
+    EXPECT_EQ(again.solve.runs[k].models[0].force, first.solve.runs[k].models[0].force);
+    EXPECT_EQ(again.solve.runs[k].models[0].tip, first.solve.runs[k].models[0].tip);
+  }
+
+  const nlohmann::json results = nlohmann::json::parse(test::read_text(VESSEL_RESULTS_SCHEMA));
+  const nlohmann::json contact_schema =
+      results["properties"]["scenes"]["items"]["properties"]["guidewire"]["properties"]["contact"];
+  ASSERT_TRUE(contact_schema.is_object());
+  const nlohmann::json doc = guidewire_contact_json(again);
+  EXPECT_EQ(test::schema_problems(doc, contact_schema), std::vector<std::string>{});
+  EXPECT_EQ(doc["runs"].size(), 2u);
+  EXPECT_TRUE(doc.contains("cached_from"));
+  std::ostringstream md;
+  write_guidewire_contact_markdown(md, again);
+  EXPECT_NE(md.str().find("| fem_p1 |"), std::string::npos) << md.str();
+  EXPECT_NE(md.str().find("| rigid lumen |"), std::string::npos) << md.str();
+}
+
+// A scene whose vessel is read from a file has no parametric lumen to refine around: refused,
+// naming the file and what is expected.
+TEST(GuidewireContact, AVesselThatIsNeitherTheTubeNorTheArchIsRefused) {
+  Scene scene = read_scene(VESSEL_SCENES_DIR + "/guidewire_straight.toml");
+  scene.vessel.kind = VesselKind::mesh_file;
+  try {
+    (void)contact::solve_contact_models(scene, {}, {});
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("guidewire_straight.toml"), std::string::npos) << what;
+    EXPECT_NE(what.find("\"arch\""), std::string::npos) << what;
+  }
+}
+
+}  // namespace
+}  // namespace vessel

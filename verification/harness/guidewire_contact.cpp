@@ -1,0 +1,304 @@
+#include "verification/harness/guidewire_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "meshes/foundation/content_hash.hpp"
+#include "msm/rods/rod_layout.hpp"
+#include "verification/harness/outcome_cache.hpp"
+
+namespace vessel {
+
+namespace {
+
+using nlohmann::json;
+
+json vec_json(const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); }
+Vec3 vec_of(const json& j) {
+  return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
+}
+
+/// One wall's contact as the cache keeps it (SI units).
+json wall_json(const contact::ModelContact& m) {
+  return {{"name", m.name},
+          {"detail", m.detail},
+          {"linearisation", m.linearisation},
+          {"failure", m.failure},
+          {"force", m.force},
+          {"force_on_wall", vec_json(m.force_on_wall)},
+          {"pressed", m.pressed},
+          {"candidates", m.candidates},
+          {"rounds", m.rounds},
+          {"centroid", vec_json(m.centroid)},
+          {"axial_extent", m.axial_extent},
+          {"circumferential_extent", m.circumferential_extent},
+          {"dent", m.dent},
+          {"strain", m.strain},
+          {"tip", vec_json(m.tip)},
+          {"own_imbalance", m.own_imbalance},
+          {"steps", m.steps},
+          {"setup_seconds", m.setup_seconds},
+          {"solve_seconds", m.solve_seconds}};
+}
+
+contact::ModelContact wall_of(const json& j) {
+  contact::ModelContact m;
+  m.name = j.at("name");
+  m.detail = j.at("detail");
+  m.linearisation = j.at("linearisation");
+  m.failure = j.at("failure");
+  m.force = j.at("force");
+  m.force_on_wall = vec_of(j.at("force_on_wall"));
+  m.pressed = j.at("pressed");
+  m.candidates = j.at("candidates");
+  m.rounds = j.at("rounds");
+  m.centroid = vec_of(j.at("centroid"));
+  m.axial_extent = j.at("axial_extent");
+  m.circumferential_extent = j.at("circumferential_extent");
+  m.dent = j.at("dent");
+  m.strain = j.at("strain");
+  m.tip = vec_of(j.at("tip"));
+  m.own_imbalance = j.at("own_imbalance");
+  m.steps = j.at("steps");
+  m.setup_seconds = j.at("setup_seconds");
+  m.solve_seconds = j.at("solve_seconds");
+  return m;
+}
+
+std::string serialise(const contact::ContactModels& s) {
+  json runs = json::array();
+  for (const contact::ContactModelsRun& r : s.runs) {
+    json walls = json::array();
+    for (const contact::ModelContact& m : r.models) walls.push_back(wall_json(m));
+    runs.push_back({{"bending_stiffness", r.bending_stiffness},
+                    {"rigid_force", r.rigid_force},
+                    {"rigid_wall_point", vec_json(r.rigid_wall_point)},
+                    {"reference", wall_json(r.reference)},
+                    {"models", walls}});
+  }
+  return json{
+      {"mesh_nodes", s.mesh_nodes}, {"mesh_tets", s.mesh_tets}, {"nu", s.nu}, {"runs", runs}}
+      .dump();
+}
+
+contact::ContactModels deserialise(const std::string& bytes) {
+  const json j = json::parse(bytes);
+  contact::ContactModels s;
+  s.mesh_nodes = j.at("mesh_nodes");
+  s.mesh_tets = j.at("mesh_tets");
+  s.nu = j.at("nu");
+  for (const json& r : j.at("runs")) {
+    contact::ContactModelsRun run;
+    run.bending_stiffness = r.at("bending_stiffness");
+    run.rigid_force = r.at("rigid_force");
+    run.rigid_wall_point = vec_of(r.at("rigid_wall_point"));
+    run.reference = wall_of(r.at("reference"));
+    for (const json& m : r.at("models")) run.models.push_back(wall_of(m));
+    s.runs.push_back(std::move(run));
+  }
+  return s;
+}
+
+/// The outcome cache's key: the scene file's bytes (its wire, vessel, material and models), the
+/// stiffnesses and the solve's options (OutcomeCache adds the code and the machine).
+std::string contact_key(const Scene& scene, const std::vector<std::string>& models,
+                        const contact::ContactModelsOptions& o) {
+  ContentHash h;
+  h.text(file_contents(scene.source));
+  for (const double EI : o.bending_stiffness) h.real(EI);
+  for (const std::string& m : models) h.text(m);
+  h.real(o.fine_size).real(o.fine_radius).real(o.band_radius).integer(o.reference_degree);
+  h.integer(o.max_newton).real(o.max_move).integer(o.own_equilibrium ? 1 : 0);
+  h.integer(o.potential ? 1 : 0);
+  return "guidewire-contact " + h.hex();
+}
+
+bool same_stiffness(double a, double b) { return std::abs(a / b - 1.0) <= 1e-6; }
+
+/// The shortcuts at one run's EI: the rigid lumen's force and the series springs' (the reference's
+/// wall once per level, then each model's) at the contact's ν.
+std::vector<GuidewireShortcut> shortcuts_at(const contact::ContactModelsRun& run, double nu,
+                                            const GuidewireOutcome& coupled) {
+  std::vector<GuidewireShortcut> out{{"rigid lumen", run.rigid_force}};
+  std::vector<int> reference_levels;
+  for (const GuidewireCouplingRow& r : coupled.rows) {
+    if (!r.ok || !same_stiffness(r.bending_stiffness, run.bending_stiffness) ||
+        std::abs(r.poisson_ratio - nu) > 1e-12) {
+      continue;
+    }
+    const std::string level = " (level " + std::to_string(r.level) + ")";
+    if (std::find(reference_levels.begin(), reference_levels.end(), r.level) ==
+        reference_levels.end()) {
+      reference_levels.push_back(r.level);
+      out.push_back({"series springs, reference's wall" + level, r.reference_force_mN * 1e-3});
+    }
+    out.push_back({"series springs, " + r.model + level, r.force_mN * 1e-3});
+  }
+  return out;
+}
+
+std::string fmt(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+json mm(const Vec3& v) { return vec_json(1e3 * v); }
+
+/// results.json's row of one wall at one EI (mm and mN; errors against `reference`).
+json wall_row(const contact::ModelContact& m, const contact::ModelContact& reference) {
+  const bool ok = m.failure.empty();
+  const bool judged = ok && reference.failure.empty() && reference.force > 0.0;
+  json row{{"model", m.name}, {"wall", m.linearisation}, {"detail", m.detail}, {"ok", ok}};
+  if (!ok) {
+    row["failure"] = m.failure;
+    return row;
+  }
+  row.update(
+      {{"force_mN", m.force * 1e3},
+       {"force_error_mN", judged ? json((m.force - reference.force) * 1e3) : json()},
+       {"force_error_percent", judged ? json(100.0 * (m.force / reference.force - 1.0)) : json()},
+       {"pressed", m.pressed},
+       {"candidates", m.candidates},
+       {"centroid_mm", mm(m.centroid)},
+       {"axial_extent_mm", m.axial_extent * 1e3},
+       {"circumferential_extent_mm", m.circumferential_extent * 1e3},
+       {"dent_mm", m.dent * 1e3},
+       {"largest_strain", m.strain},
+       {"tip_mm", mm(m.tip)},
+       {"tip_error_mm", judged ? json((m.tip - reference.tip).norm() * 1e3) : json()},
+       {"setup_seconds", m.setup_seconds},
+       {"solve_seconds", m.solve_seconds},
+       {"steps", m.steps}});
+  return row;
+}
+
+}  // namespace
+
+std::vector<double> guidewire_stiffnesses(const GuidewireSpec& spec) {
+  const double own =
+      msm::rods::solid_section({spec.young, spec.shear, spec.density}, spec.diameter).EI;
+  std::vector<double> out{own};
+  for (const double EI : spec.stiffness_sweep) {
+    if (std::abs(EI / own - 1.0) > 1e-3) out.push_back(EI);
+  }
+  return out;
+}
+
+GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutcome& coupled,
+                                         const HarnessOptions& options) {
+  GuidewireContact c;
+  c.options.bending_stiffness = guidewire_stiffnesses(*scene.load.guidewire);
+  if (options.contact_fine_size > 0.0) c.options.fine_size = options.contact_fine_size;
+  // The arch's buckled wire hardly changes its force with its shape: the condensed active set
+  // loses its contact there (the tip slides off the candidates or sinks between the wall's nodes),
+  // the potential's energy line search holds it.
+  c.options.potential = scene.vessel.kind == VesselKind::arch;
+  std::vector<ModelSpec> walls;
+  std::vector<std::string> names;
+  for (const ModelSpec& m : scene.models) {
+    if (!contact::has_contact_wall(m)) continue;
+    walls.push_back(m);
+    names.push_back(m.name);
+  }
+  contact::ContactModelsOptions o = c.options;
+  o.log = options.log;
+  const auto solve = [&] { return serialise(contact::solve_contact_models(scene, walls, o)); };
+  if (options.outcome_cache && options.outcome_cache->enabled()) {
+    c.solve = deserialise(
+        options.outcome_cache->get(contact_key(scene, names, c.options), solve, c.provenance));
+  } else {
+    c.solve = deserialise(solve());
+  }
+  for (const contact::ContactModelsRun& run : c.solve.runs) {
+    c.shortcuts.push_back(shortcuts_at(run, c.solve.nu, coupled));
+  }
+  return c;
+}
+
+json guidewire_contact_json(const GuidewireContact& c) {
+  json runs = json::array();
+  for (std::size_t k = 0; k < c.solve.runs.size(); ++k) {
+    const contact::ContactModelsRun& run = c.solve.runs[k];
+    const contact::ModelContact& ref = run.reference;
+    json models = json::array();
+    for (const contact::ModelContact& m : run.models) models.push_back(wall_row(m, ref));
+    json shortcuts = json::array();
+    for (const GuidewireShortcut& s : c.shortcuts[k]) {
+      const bool judged = ref.failure.empty() && ref.force > 0.0;
+      shortcuts.push_back(
+          {{"name", s.name},
+           {"force_mN", s.force * 1e3},
+           {"force_error_percent", judged ? json(100.0 * (s.force / ref.force - 1.0)) : json()}});
+    }
+    runs.push_back({{"bending_stiffness_Nm2", run.bending_stiffness},
+                    {"rigid_force_mN", run.rigid_force * 1e3},
+                    {"rigid_wall_point_mm", mm(run.rigid_wall_point)},
+                    {"within_linear_validity", c.within_linear_validity(run)},
+                    {"reference", wall_row(ref, ref)},
+                    {"models", models},
+                    {"shortcuts", shortcuts}});
+  }
+  json out{{"poisson_ratio", c.solve.nu},
+           {"mesh_nodes", c.solve.mesh_nodes},
+           {"mesh_tets", c.solve.mesh_tets},
+           {"fine_size_mm", c.options.fine_size * 1e3},
+           {"fine_radius_mm", c.options.fine_radius * 1e3},
+           {"reference_degree", c.options.reference_degree},
+           {"strain_limit", c.strain_limit},
+           {"runs", runs}};
+  if (c.provenance.cached) out["cached_from"] = c.provenance.measured_at;
+  return out;
+}
+
+void write_guidewire_contact_markdown(std::ostream& out, const GuidewireContact& c) {
+  out << "Contact (coupling = \"contact\"): the wire's surface against each wall linearised at "
+         "rest, the contact found by the solve, on one mesh of "
+      << c.solve.mesh_nodes << " nodes refined to " << c.options.fine_size * 1e3 << " mm within "
+      << c.options.fine_radius * 1e3 << " mm of the rigid wire's contact (ν = " << c.solve.nu
+      << "); each force against the FEM P" << c.options.reference_degree
+      << " wall's in the same solve"
+      << (c.provenance.cached ? "; solved " + c.provenance.measured_at + ", from the cache" : "")
+      << ".\n\n";
+  for (std::size_t k = 0; k < c.solve.runs.size(); ++k) {
+    const contact::ContactModelsRun& run = c.solve.runs[k];
+    const contact::ModelContact& ref = run.reference;
+    out << "EI " << run.bending_stiffness << " N·m²: reference ";
+    if (!ref.failure.empty()) {
+      out << "FAILED (" << ref.failure << "): no model is judged.\n\n";
+      continue;
+    }
+    out << fmt("%.4f", ref.force * 1e3) << " mN (rigid lumen " << fmt("%.4f", run.rigid_force * 1e3)
+        << " mN), dent " << fmt("%.4f", ref.dent * 1e3) << " mm, largest strain "
+        << fmt("%.3f", ref.strain);
+    if (!c.within_linear_validity(run)) {
+      out << " ⚠ beyond the linear reference's validity (strain > " << c.strain_limit
+          << "): the rows show the regime, not a prediction (the finite-strain reference: "
+             "`vesselverify contact-models --own-equilibrium`)";
+    }
+    out << ".\n\n| model | F mN | error % | pressed | zone along × around mm | dent mm | tip "
+           "error mm | set-up s | solve s |\n|---|---|---|---|---|---|---|---|---|\n";
+    for (const contact::ModelContact& m : run.models) {
+      if (!m.failure.empty()) {
+        out << "| " << m.name << " | failed: " << m.failure << " | | | | | | | |\n";
+        continue;
+      }
+      out << "| " << m.name << " | " << fmt("%.4f", m.force * 1e3) << " | "
+          << fmt("%+.2f", 100.0 * (m.force / ref.force - 1.0)) << " | " << m.pressed << " | "
+          << fmt("%.3f", m.axial_extent * 1e3) << " × "
+          << fmt("%.3f", m.circumferential_extent * 1e3) << " | " << fmt("%.4f", m.dent * 1e3)
+          << " | " << fmt("%.4f", (m.tip - ref.tip).norm() * 1e3) << " | "
+          << fmt("%.2f", m.setup_seconds) << " | " << fmt("%.2f", m.solve_seconds) << " |\n";
+    }
+    out << "\n| shortcut | F mN | error % |\n|---|---|---|\n";
+    for (const GuidewireShortcut& s : c.shortcuts[k]) {
+      out << "| " << s.name << " | " << fmt("%.4f", s.force * 1e3) << " | "
+          << fmt("%+.2f", 100.0 * (s.force / ref.force - 1.0)) << " |\n";
+    }
+    out << "\n";
+  }
+}
+
+}  // namespace vessel

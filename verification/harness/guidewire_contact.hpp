@@ -1,0 +1,60 @@
+#pragma once
+/// A guidewire scene with coupling = "contact": each of the scene's models with a wall, and the FEM
+/// P2 wall as the reference, in the same wire–wall contact solve
+/// (verification/contact_models/contact_models.hpp: every wall linearised at rest, the contact
+/// between the wire's surface and the inner wall found by the solve, on one mesh refined around
+/// the wire's contact; the active set on the condensed walls in the straight tube, the wire and
+/// each wall as one potential in the arch) at each EI of the scene (its wire's, then its
+/// stiffness_sweep); each model's contact force, zone, dent and tip judged against the reference's,
+/// and the shortcuts a simulator takes instead of a contact solve (the rigid lumen's force, the
+/// series springs of guidewire_coupling.hpp) judged against the same reference.
+#include <nlohmann/json_fwd.hpp>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "verification/contact_models/contact_models.hpp"
+#include "verification/guidewire/guidewire_outcome.hpp"
+#include "verification/harness/options.hpp"
+#include "verification/harness/outcome.hpp"
+
+namespace vessel {
+
+/// A force a simulator would use instead of the contact solve's, at one EI.
+struct GuidewireShortcut {
+  std::string name;    ///< "rigid lumen", "series springs, <model> (level L)", ...
+  double force = 0.0;  ///< N
+};
+
+struct GuidewireContact {
+  contact::ContactModels solve;
+  contact::ContactModelsOptions options;  ///< what it was solved with (its log unset)
+  /// The linear reference's validity: its largest small strain at most this (the contact
+  /// reference's limit, contact_reference.hpp); a run beyond it is the regime, not a prediction.
+  double strain_limit = 0.1;
+  std::vector<std::vector<GuidewireShortcut>> shortcuts;  ///< per run (EI)
+  TimingProvenance provenance;
+  [[nodiscard]] bool within_linear_validity(const contact::ContactModelsRun& run) const {
+    return run.reference.failure.empty() && run.reference.strain <= strain_limit;
+  }
+};
+
+/// The stiffnesses (N·m²) a guidewire scene's coupling runs at: its wire's EI, then each of its
+/// stiffness_sweep that differs from it by more than 1e-3 (relative).
+std::vector<double> guidewire_stiffnesses(const GuidewireSpec& spec);
+
+/// The contact of `scene` (coupling = "contact"), its solve read from options.outcome_cache when a
+/// run of the same executable on this machine kept it (keyed by the scene file's text and the
+/// solve's options); the shortcuts from `coupled` (its rigid forces and series-spring rows at the
+/// contact's ν). Progress lines on options.log.
+GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutcome& coupled,
+                                         const HarnessOptions& options);
+
+/// results.json's "guidewire"."contact" object (schema verification/results.schema.json).
+nlohmann::json guidewire_contact_json(const GuidewireContact& c);
+
+/// summary.md's table per EI: the reference, each model's force error, zone, dent and tip error,
+/// and the shortcuts' force errors.
+void write_guidewire_contact_markdown(std::ostream& out, const GuidewireContact& c);
+
+}  // namespace vessel
