@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <limits>
 #include <numbers>
@@ -61,6 +62,19 @@ RigidContact rigid_contact(const SceneWire& w, const VesselParams& vessel) {
   return {solver.rod_state(), s.force, s.wall_point};
 }
 
+/// A ball of `radius` at each distinct rigid contact (against a rigid wall the wire's shape does
+/// not depend on EI, so the EIs share one).
+std::vector<RefinedBall> refined_balls(const std::vector<RigidContact>& rigid, double radius) {
+  std::vector<RefinedBall> balls;
+  for (const RigidContact& r : rigid) {
+    const bool covered = std::any_of(balls.begin(), balls.end(), [&](const RefinedBall& b) {
+      return (b.centre - r.wall_point).norm() < 0.25 * b.radius;
+    });
+    if (!covered) balls.push_back({r.wall_point, radius});
+  }
+  return balls;
+}
+
 /// The contact problem's fixed parts, shared by every wall at one EI.
 struct Problem {
   const TetMesh* mesh = nullptr;
@@ -68,6 +82,22 @@ struct Problem {
   std::vector<int> nodes;  ///< the first candidates
   int first = 0;           ///< the candidate nearest the rigid wall point
 };
+
+/// The first candidates: the inner-wall nodes within `band` of the rigid contact's wall point,
+/// and the one nearest it.
+void set_first_candidates(Problem& p, const Vec3& wall_point, double band) {
+  const TetMesh& mesh = *p.mesh;
+  for (const int n : mesh.group_nodes(mesh.require_group("inner_wall", 2, "contact mesh"))) {
+    if ((mesh.nodes[n] - wall_point).norm() < band) p.nodes.push_back(n);
+  }
+  if (p.nodes.empty()) {
+    throw std::runtime_error("no inner-wall node within the band radius of the rigid contact");
+  }
+  const auto distance = [&](std::size_t j) { return (mesh.nodes[p.nodes[j]] - wall_point).norm(); };
+  for (std::size_t j = 1; j < p.nodes.size(); ++j) {
+    if (distance(j) < distance(static_cast<std::size_t>(p.first))) p.first = static_cast<int>(j);
+  }
+}
 
 /// The pressed zone: its centroid, its spans along the vessel's centreline and around it (as arc
 /// length at the lumen), the dent.
@@ -261,15 +291,64 @@ namespace {
 /// The progress line of one wall's contact at one EI.
 void log_contact(std::ostream& log, const ModelSpec& wall, std::size_t index, std::size_t walls,
                  double EI, const ModelContact& c) {
-  log << "contact-models: " << wall.name << " (" << index + 1 << " of " << walls << "), EI " << EI
-      << " N·m²: ";
+  char line[160];
   if (c.failure.empty()) {
-    log << "F " << c.force * 1e3 << " mN, " << c.pressed << " pressed, "
-        << c.setup_seconds + c.solve_seconds << " s";
+    std::snprintf(line, sizeof line, "F %.4f mN, %d pressed, %.1f s", c.force * 1e3, c.pressed,
+                  c.setup_seconds + c.solve_seconds);
   } else {
-    log << "failed";
+    std::snprintf(line, sizeof line, "failed");
   }
-  log << std::endl;
+  char ei[32];
+  std::snprintf(ei, sizeof ei, "%.3g", EI);
+  log << "contact-models: " << wall.name << " (" << index + 1 << " of " << walls << "), EI " << ei
+      << " N·m²: " << line << std::endl;
+}
+
+/// Every wall once, solved at each run's EI: the reference first, then the models; a wall whose
+/// solve fails is recorded with its reason.
+void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
+                      const std::vector<std::unique_ptr<SceneWire>>& wires,
+                      const std::vector<RigidContact>& rigid, const Problem& p,
+                      const ContactModelsOptions& options, ContactModels& out) {
+  ModelSpec reference;
+  reference.name = "reference_fem_p" + std::to_string(options.reference_degree);
+  reference.kind = ModelKind::fem;
+  reference.degree = options.reference_degree;
+  std::vector<const ModelSpec*> walls{&reference};
+  for (const ModelSpec& m : models) walls.push_back(&m);
+  for (std::size_t k = 0; k < walls.size(); ++k) {
+    std::optional<ModelWall> wall;
+    std::string why;
+    try {
+      wall.emplace(model_wall(scene, *walls[k], *p.mesh, *p.vessel, out.nu));
+    } catch (const std::exception& ex) {
+      why = ex.what();
+    }
+    for (std::size_t e = 0; e < out.runs.size(); ++e) {
+      const double EI = out.runs[e].bending_stiffness;
+      ModelContact c;
+      if (!wall) {
+        c = failed(*walls[k], why);
+      } else {
+        try {
+          c = options.own_equilibrium || options.potential
+                  ? solve_wall_potential(scene, *walls[k], *wall, *wires[e], rigid[e], p, EI,
+                                         out.nu, k == 0, options)
+                  : solve_wall(*wall, *wires[e], rigid[e], p, EI, options);
+        } catch (const std::exception& ex) {
+          c = failed(*walls[k], ex.what());
+          c.detail = wall->detail;
+          c.linearisation = to_string(wall->linearisation);
+        }
+      }
+      if (options.log) log_contact(*options.log, *walls[k], k, walls.size(), EI, c);
+      if (k == 0) {
+        out.runs[e].reference = c;  // a failed reference leaves the run's errors undefined
+      } else {
+        out.runs[e].models.push_back(c);
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -296,7 +375,6 @@ ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSp
   }
   std::vector<std::unique_ptr<SceneWire>> wires;
   std::vector<RigidContact> rigid;
-  std::vector<RefinedBall> balls;  // one per distinct rigid contact (EI scales the force alone)
   for (const double EI : EIs) {
     wires.push_back(std::make_unique<SceneWire>(spec, EI));
     try {
@@ -304,36 +382,17 @@ ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSp
     } catch (const InputError& e) {
       throw InputError(file + ": " + e.what());
     }
-    const Vec3& point = rigid.back().wall_point;
-    const bool covered = std::any_of(balls.begin(), balls.end(), [&](const RefinedBall& b) {
-      return (b.centre - point).norm() < 0.25 * b.radius;
-    });
-    if (!covered) balls.push_back({point, options.fine_radius});
   }
   VesselParams vessel = scene.vessel;
   vessel.style = MeshStyle::unstructured;
-  const TetMesh mesh = refined_balls_mesh(vessel, balls, options.fine_size);
+  const TetMesh mesh =
+      refined_balls_mesh(vessel, refined_balls(rigid, options.fine_radius), options.fine_size);
   out.mesh_nodes = mesh.nodes.size();
   out.mesh_tets = mesh.tets.size();
   Problem p;
   p.mesh = &mesh;
   p.vessel = &vessel;
-  const PhysicalGroup& inner = mesh.require_group("inner_wall", 2, "contact mesh");
-  for (const int n : mesh.group_nodes(inner)) {
-    if ((mesh.nodes[n] - rigid.front().wall_point).norm() < options.band_radius) {
-      p.nodes.push_back(n);
-    }
-  }
-  if (p.nodes.empty()) {
-    throw std::runtime_error("no inner-wall node within the band radius of the rigid contact");
-  }
-  for (std::size_t j = 1; j < p.nodes.size(); ++j) {
-    const Vec3& w = rigid.front().wall_point;
-    if ((mesh.nodes[p.nodes[j]] - w).norm() <
-        (mesh.nodes[p.nodes[static_cast<std::size_t>(p.first)]] - w).norm()) {
-      p.first = static_cast<int>(j);
-    }
-  }
+  set_first_candidates(p, rigid.front().wall_point, options.band_radius);
   for (std::size_t e = 0; e < EIs.size(); ++e) {
     ContactModelsRun run;
     run.bending_stiffness = EIs[e];
@@ -341,45 +400,7 @@ ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSp
     run.rigid_wall_point = rigid[e].wall_point;
     out.runs.push_back(run);
   }
-  // Every wall once, solved at each EI: the reference first, then the models.
-  ModelSpec reference;
-  reference.name = "reference_fem_p" + std::to_string(options.reference_degree);
-  reference.kind = ModelKind::fem;
-  reference.degree = options.reference_degree;
-  std::vector<const ModelSpec*> walls{&reference};
-  for (const ModelSpec& m : models) walls.push_back(&m);
-  for (std::size_t k = 0; k < walls.size(); ++k) {
-    std::optional<ModelWall> wall;
-    std::string why;
-    try {
-      wall.emplace(model_wall(scene, *walls[k], mesh, vessel, out.nu));
-    } catch (const std::exception& ex) {
-      why = ex.what();
-    }
-    for (std::size_t e = 0; e < EIs.size(); ++e) {
-      ModelContact c;
-      if (!wall) {
-        c = failed(*walls[k], why);
-      } else {
-        try {
-          c = options.own_equilibrium || options.potential
-                  ? solve_wall_potential(scene, *walls[k], *wall, *wires[e], rigid[e], p, EIs[e],
-                                         out.nu, k == 0, options)
-                  : solve_wall(*wall, *wires[e], rigid[e], p, EIs[e], options);
-        } catch (const std::exception& ex) {
-          c = failed(*walls[k], ex.what());
-          c.detail = wall->detail;
-          c.linearisation = to_string(wall->linearisation);
-        }
-      }
-      if (options.log) log_contact(*options.log, *walls[k], k, walls.size(), EIs[e], c);
-      if (k == 0) {
-        out.runs[e].reference = c;  // a failed reference leaves the run's errors undefined
-      } else {
-        out.runs[e].models.push_back(c);
-      }
-    }
-  }
+  solve_every_wall(scene, models, wires, rigid, p, options, out);
   return out;
 }
 

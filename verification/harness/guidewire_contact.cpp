@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <ostream>
 
 #include "meshes/foundation/content_hash.hpp"
 #include "msm/rods/rod_layout.hpp"
@@ -147,6 +148,16 @@ std::string fmt(const char* format, double v) {
 
 json mm(const Vec3& v) { return vec_json(1e3 * v); }
 
+/// `text` fit for a Markdown table's cell: its bars escaped.
+std::string table_cell(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '|') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
 /// results.json's row of one wall at one EI (mm and mN; errors against `reference`).
 json wall_row(const contact::ModelContact& m, const contact::ModelContact& reference) {
   const bool ok = m.failure.empty();
@@ -205,7 +216,14 @@ GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutc
   }
   contact::ContactModelsOptions o = c.options;
   o.log = options.log;
-  const auto solve = [&] { return serialise(contact::solve_contact_models(scene, walls, o)); };
+  const auto solve = [&] {
+    if (options.log) {
+      *options.log << scene.name << ": the wire-wall contact, the reference and " << walls.size()
+                   << " model walls at " << o.bending_stiffness.size()
+                   << " bending stiffnesses (a contact solve each; minutes)" << std::endl;
+    }
+    return serialise(contact::solve_contact_models(scene, walls, o));
+  };
   if (options.outcome_cache && options.outcome_cache->enabled()) {
     c.solve = deserialise(
         options.outcome_cache->get(contact_key(scene, names, c.options), solve, c.provenance));
@@ -282,7 +300,7 @@ void write_guidewire_contact_markdown(std::ostream& out, const GuidewireContact&
            "error mm | set-up s | solve s |\n|---|---|---|---|---|---|---|---|---|\n";
     for (const contact::ModelContact& m : run.models) {
       if (!m.failure.empty()) {
-        out << "| " << m.name << " | failed: " << m.failure << " | | | | | | | |\n";
+        out << "| " << m.name << " | failed: " << table_cell(m.failure) << " | | | | | | | |\n";
         continue;
       }
       out << "| " << m.name << " | " << fmt("%.4f", m.force * 1e3) << " | "
