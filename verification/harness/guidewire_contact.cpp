@@ -7,7 +7,7 @@
 #include <ostream>
 
 #include "meshes/foundation/content_hash.hpp"
-#include "msm/rods/rod_layout.hpp"
+#include "verification/harness/guidewire_coupling.hpp"
 #include "verification/harness/outcome_cache.hpp"
 
 namespace vessel {
@@ -187,16 +187,6 @@ json wall_row(const contact::ModelContact& m, const contact::ModelContact& refer
 }
 
 }  // namespace
-
-std::vector<double> guidewire_stiffnesses(const GuidewireSpec& spec) {
-  const double own =
-      msm::rods::solid_section({spec.young, spec.shear, spec.density}, spec.diameter).EI;
-  std::vector<double> out{own};
-  for (const double EI : spec.stiffness_sweep) {
-    if (std::abs(EI / own - 1.0) > 1e-3) out.push_back(EI);
-  }
-  return out;
-}
 
 GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutcome& coupled,
                                          const HarnessOptions& options) {

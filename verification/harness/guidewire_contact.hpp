@@ -39,14 +39,10 @@ struct GuidewireContact {
   }
 };
 
-/// The stiffnesses (N·m²) a guidewire scene's coupling runs at: its wire's EI, then each of its
-/// stiffness_sweep that differs from it by more than 1e-3 (relative).
-std::vector<double> guidewire_stiffnesses(const GuidewireSpec& spec);
-
-/// The contact of `scene` (coupling = "contact"), its solve read from options.outcome_cache when a
-/// run of the same executable on this machine kept it (keyed by the scene file's text and the
-/// solve's options); the shortcuts from `coupled` (its rigid forces and series-spring rows at the
-/// contact's ν). Progress lines on options.log.
+/// The contact of `scene` (coupling = "contact") at guidewire_stiffnesses, its solve read from
+/// options.outcome_cache when a run of the same executable on this machine kept it (keyed by the
+/// scene file's text and the solve's options); the shortcuts from `coupled` (its rigid forces and
+/// series-spring rows at the contact's ν). Progress lines on options.log.
 GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutcome& coupled,
                                          const HarnessOptions& options);
 

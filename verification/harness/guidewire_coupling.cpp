@@ -138,13 +138,18 @@ GuidewireOutcome couple_guidewire(const Scene& s, const std::vector<ModelOutcome
   GuidewireOutcome g;
   g.spec = *s.load.guidewire;
   g.patch_radius = s.load.contact.radius;
-  const double EI = msm::rods::solid_section({g.spec.young, g.spec.shear, g.spec.density},
-                                             g.spec.diameter).EI;
-  couple_at(s, EI, outcomes, g);
-  for (const double sweep_EI : g.spec.stiffness_sweep) {
-    if (std::abs(sweep_EI / EI - 1.0) > 1e-3) couple_at(s, sweep_EI, outcomes, g);
-  }
+  for (const double EI : guidewire_stiffnesses(g.spec)) couple_at(s, EI, outcomes, g);
   return g;
+}
+
+std::vector<double> guidewire_stiffnesses(const GuidewireSpec& spec) {
+  const double own =
+      msm::rods::solid_section({spec.young, spec.shear, spec.density}, spec.diameter).EI;
+  std::vector<double> out{own};
+  for (const double EI : spec.stiffness_sweep) {
+    if (std::abs(EI / own - 1.0) > 1e-3) out.push_back(EI);
+  }
+  return out;
 }
 
 void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g) {

@@ -18,6 +18,10 @@ namespace vessel {
 /// indentation; the scene's EI first, then each of the spec's stiffness_sweep).
 GuidewireOutcome couple_guidewire(const Scene& scene, const std::vector<ModelOutcome>& outcomes);
 
+/// The stiffnesses (N·m²) a guidewire scene's coupling runs at: its wire's EI, then each of its
+/// stiffness_sweep that differs from it by more than 1e-3 (relative).
+std::vector<double> guidewire_stiffnesses(const GuidewireSpec& spec);
+
 /// summary.md's guidewire section: the wire against the rigid lumen per EI, and the coupled
 /// contact force of each model beside the reference's (mN), with the contact displacements (mm).
 void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g);
