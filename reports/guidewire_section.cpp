@@ -6,6 +6,28 @@ namespace {
 
 std::string optional_number(const std::optional<double>& v) { return v ? significant(*v) : "–"; }
 
+/// One EI's walls in the contact solve against the reference's.
+Table contact_wall_table(const ContactRun& run) {
+  Table t;
+  t.header = {"model",   "force mN",     "error %",  "pressed", "zone along × around mm",
+              "dent mm", "tip error mm", "set-up s", "solve s"};
+  for (const ContactWallRow& m : run.models) {
+    if (!m.ok) {
+      std::vector<std::string> row{m.model, "failed: " + m.failure};
+      row.resize(t.header.size(), "");
+      t.rows.push_back(std::move(row));
+      continue;
+    }
+    t.rows.push_back(
+        {m.model, significant(m.force_mN, 4), optional_number(m.force_error_percent),
+         std::to_string(m.pressed),
+         significant(m.axial_extent_mm) + " × " + significant(m.circumferential_extent_mm),
+         significant(m.dent_mm), optional_number(m.tip_error_mm), significant(m.setup_seconds),
+         significant(m.solve_seconds)});
+  }
+  return t;
+}
+
 /// The contact solve's tables: per EI the models against the reference, then the shortcuts.
 void contact_tables(Document& doc, const GuidewireContactRows& c) {
   doc.paragraph(
@@ -35,24 +57,7 @@ void contact_tables(Document& doc, const GuidewireContactRows& c) {
               "`vesselverify contact-models --own-equilibrium`.";
     }
     doc.paragraph(line);
-    Table t;
-    t.header = {"model",   "force mN",     "error %",  "pressed", "zone along × around mm",
-                "dent mm", "tip error mm", "set-up s", "solve s"};
-    for (const ContactWallRow& m : run.models) {
-      if (!m.ok) {
-        std::vector<std::string> row{m.model, "failed: " + m.failure};
-        row.resize(t.header.size(), "");
-        t.rows.push_back(std::move(row));
-        continue;
-      }
-      t.rows.push_back(
-          {m.model, significant(m.force_mN, 4), optional_number(m.force_error_percent),
-           std::to_string(m.pressed),
-           significant(m.axial_extent_mm) + " × " + significant(m.circumferential_extent_mm),
-           significant(m.dent_mm), optional_number(m.tip_error_mm), significant(m.setup_seconds),
-           significant(m.solve_seconds)});
-    }
-    doc.table(t);
+    doc.table(contact_wall_table(run));
     Table s;
     s.header = {"shortcut", "force mN", "error %"};
     for (const ContactShortcutRow& r : run.shortcuts) {
