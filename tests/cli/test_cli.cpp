@@ -216,6 +216,31 @@ TEST(Cli, SceneValidatesShippedScenesAndRefusesBadOnes) {
   EXPECT_TRUE(contains(bad.output, "bad.toml:4: key 'vessel.radius': unknown key")) << bad.output;
 }
 
+TEST(Cli, SceneSaysWhatAContactCouplingWouldSolveAndRefusesAnUnknownCoupling) {
+  // The shipped straight guidewire scene is coupled by contact: `scene` names the contact solve a
+  // run would add, and solves nothing (it returns at once). A coupling it does not know is refused
+  // with the key and the values it takes.
+  const auto ok = vv("scene " + std::string(VESSEL_SCENES_DIR) + "/guidewire_straight.toml");
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_TRUE(contains(ok.output,
+                       "coupling contact: `vesselverify run` would then press each "
+                       "model's wall"))
+      << ok.output;
+  EXPECT_TRUE(contains(ok.output, "not solved now")) << ok.output;
+  std::ifstream in(std::string(VESSEL_SCENES_DIR) + "/guidewire_straight.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find("coupling = \"contact\"");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, std::string("coupling = \"contact\"").size(), "coupling = \"mortar\"");
+  TempDir dir;
+  write_text(dir / "wire.toml", text);
+  const auto bad = vv("scene " + (dir / "wire.toml").string());
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "coupling")) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "contact")) << bad.output;
+  EXPECT_TRUE(contains(bad.output, "mortar")) << bad.output;
+}
+
 TEST(Cli, RunPrintsTheGuidewiresSolvedForceAndWallPoint) {
   // The shipped straight guidewire scene with one model and one wire: its log names the force the
   // solved wire puts on the wall, which must be the continuum wire's against the rigid lumen,

@@ -454,6 +454,11 @@ std::string describe_guidewire_solve(const GuidewireSpec& spec) {
       << " N·m²) against the rigid lumen would be solved by `vesselverify run` (and the other "
          "commands that solve the scene); not solved now";
   }
+  if (spec.coupling == GuidewireCoupling::contact) {
+    s << "; coupling contact: `vesselverify run` would then press each model's wall and the FEM "
+         "P2 wall with the wire in a contact solve at the wire's EI and each of stiffness_sweep "
+         "(minutes; --quick keeps the series springs)";
+  }
   return s.str();
 }
 
