@@ -19,14 +19,14 @@ std::string decimals(double v, int digits) {
   return s.str();
 }
 
-namespace {
-
-std::string cell_md(const std::string& s) {
+std::string markdown_cell(const std::string& s) {
   std::string out;
   // A pipe would end the cell and a line break the row.
   for (const char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c == '\n' ? ' ' : c);
   return out;
 }
+
+namespace {
 
 std::string table_html(const Table& t) {
   std::ostringstream out;
@@ -149,13 +149,13 @@ std::string Document::markdown_text(const std::string& figures_dir) const {
         break;
       case Block::Kind::table: {
         out << '|';
-        for (const auto& h : b.table.header) out << ' ' << cell_md(h) << " |";
+        for (const auto& h : b.table.header) out << ' ' << markdown_cell(h) << " |";
         out << "\n|";
         for (std::size_t i = 0; i < b.table.header.size(); ++i) out << "---|";
         out << '\n';
         for (const auto& row : b.table.rows) {
           out << '|';
-          for (const auto& c : row) out << ' ' << cell_md(c) << " |";
+          for (const auto& c : row) out << ' ' << markdown_cell(c) << " |";
           out << '\n';
         }
         out << '\n';

@@ -15,6 +15,8 @@ namespace vessel::reports {
 std::string significant(double v, int digits = 3);
 /// `v` with `digits` digits after the point (0.441, 19.750), for columns read down a table.
 std::string decimals(double v, int digits);
+/// `text` fit for a Markdown table's cell: its bars escaped, its line breaks spaces.
+std::string markdown_cell(const std::string& text);
 
 struct Table {
   std::vector<std::string> header;

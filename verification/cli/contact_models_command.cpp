@@ -8,6 +8,7 @@
 
 #include "meshes/foundation/errors.hpp"
 #include "meshes/vessel_geometry.hpp"
+#include "reports/document.hpp"
 #include "verification/cli/commands.hpp"
 #include "verification/contact_models/contact_models.hpp"
 
@@ -22,16 +23,6 @@ struct ContactModelsCli {
   std::vector<std::string> only;
   contact::ContactModelsOptions options;
 };
-
-/// `text` fit for a Markdown table's cell (its bars escaped).
-std::string cell(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    if (c == '|') out += '\\';
-    out += c;
-  }
-  return out;
-}
 
 std::string fmt(const char* format, double v) {
   char buf[64];
@@ -50,7 +41,7 @@ void print_run(const contact::ContactModelsRun& run, const VesselParams& vessel)
             << "Rigid lumen: " << fmt("%.4f", run.rigid_force * 1e3) << " mN. Reference ("
             << ref.name << ", " << ref.detail << "): ";
   if (!ref.failure.empty()) {
-    std::cout << "FAILED: " << cell(ref.failure) << "\n";
+    std::cout << "FAILED: " << reports::markdown_cell(ref.failure) << "\n";
   } else {
     std::cout << fmt("%.4f", ref.force * 1e3) << " mN, " << ref.pressed << " pressed, dent "
               << fmt("%.4f", ref.dent * 1e3) << " mm, centroid at " << along(vessel, ref.centroid)
@@ -65,7 +56,7 @@ void print_run(const contact::ContactModelsRun& run, const VesselParams& vessel)
   const auto row = [&](const contact::ModelContact& m) {
     std::cout << "| " << m.name << " | ";
     if (!m.failure.empty()) {
-      std::cout << m.linearisation << " | failed: " << cell(m.failure) << " |";
+      std::cout << m.linearisation << " | failed: " << reports::markdown_cell(m.failure) << " |";
       for (int c = 3; c < kColumns; ++c) std::cout << " |";
       std::cout << "\n";
       return;

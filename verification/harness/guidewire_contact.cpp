@@ -7,6 +7,7 @@
 #include <ostream>
 
 #include "meshes/foundation/content_hash.hpp"
+#include "reports/document.hpp"
 #include "verification/harness/guidewire_coupling.hpp"
 #include "verification/harness/outcome_cache.hpp"
 
@@ -148,16 +149,6 @@ std::string fmt(const char* format, double v) {
 
 json mm(const Vec3& v) { return vec_json(1e3 * v); }
 
-/// `text` fit for a Markdown table's cell: its bars escaped.
-std::string table_cell(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    if (c == '|') out += '\\';
-    out += c;
-  }
-  return out;
-}
-
 /// results.json's row of one wall at one EI (mm and mN; errors against `reference`).
 json wall_row(const contact::ModelContact& m, const contact::ModelContact& reference) {
   const bool ok = m.failure.empty();
@@ -290,7 +281,8 @@ void write_guidewire_contact_markdown(std::ostream& out, const GuidewireContact&
            "error mm | set-up s | solve s |\n|---|---|---|---|---|---|---|---|---|\n";
     for (const contact::ModelContact& m : run.models) {
       if (!m.failure.empty()) {
-        out << "| " << m.name << " | failed: " << table_cell(m.failure) << " | | | | | | | |\n";
+        out << "| " << m.name << " | failed: " << reports::markdown_cell(m.failure)
+            << " | | | | | | | |\n";
         continue;
       }
       out << "| " << m.name << " | " << fmt("%.4f", m.force * 1e3) << " | "
