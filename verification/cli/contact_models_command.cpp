@@ -115,9 +115,9 @@ void add_contact_models_command(CLI::App& app) {
       ->check(CLI::IsMember({1, 2}))
       ->capture_default_str();
   cmd->add_flag("--potential", o->options.potential,
-                "Every wall linearised at rest, each solved with the wire as one potential (every "
-                "inner-wall node a candidate, a wire through the wall refused) instead of the "
-                "active set on the condensed wall: slower, and it converges on the arch");
+                "Every wall linearised at rest, each solved with the wire as one potential on the "
+                "wall condensed on a growing band (a line search on the energy, a wire through the "
+                "wall refused) instead of the active set: it converges on the arch");
   cmd->add_flag("--own-equilibrium", o->options.own_equilibrium,
                 "Each model at its own nonlinear equilibrium (its own energy) and the reference at "
                 "finite strain (neo-Hookean FEM), the wire and each wall solved as one potential; "

@@ -114,6 +114,9 @@ struct BandGrowth {
   std::string surface_group = "inner_wall";
   double margin = 0.0;  ///< m
   int max_rounds = 8;
+  /// m: where a solve on the band stops with the wire through the wall beyond it (the potential's
+  /// WireThroughWall), the surface nodes this near that iterate's centreline join.
+  double crossing_reach = 0.5e-3;
 };
 
 struct GrownContact {

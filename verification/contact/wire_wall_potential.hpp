@@ -55,8 +55,9 @@ class WallPotential {
   /// finite-strain one.
   [[nodiscard]] virtual double largest_strain(const TetMesh& mesh,
                                               const Eigen::VectorXd& u) const = 0;
-  /// Per mesh node its displacement (m) at u.
-  [[nodiscard]] std::vector<Vec3> nodal(const Eigen::VectorXd& u) const;
+  /// Per mesh node its displacement (m) at u: zero where held, unless the wall knows its whole
+  /// field (a condensed one does).
+  [[nodiscard]] virtual std::vector<Vec3> nodal(const Eigen::VectorXd& u) const;
 };
 
 /// The linear wall: ½uᵀKu − fᵀu of the FEM's free displacement system.

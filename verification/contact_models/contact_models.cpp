@@ -12,6 +12,7 @@
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/vessel_geometry.hpp"
 #include "msm/rods/der_rod.hpp"
+#include "verification/contact/condensed_wall_potential.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
@@ -144,8 +145,8 @@ ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidCo
   const WireWallSolution& s = grown.solution;
   out.solve_seconds = s.seconds;
   out.setup_seconds = wall.setup_seconds + seconds_since(t0) - s.seconds;
-  out.force = s.force.sum();
   out.force_on_wall = s.total_force_on_wall();
+  out.force = out.force_on_wall.norm();
   out.candidates = static_cast<int>(grown.nodes.size());
   out.rounds = grown.rounds;
   out.steps = s.newton_iterations;
@@ -165,10 +166,10 @@ ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidCo
   return out;
 }
 
-/// The wall and the wire as one potential: the wall linearised at rest (LinearWall on its
-/// stiffness) or, with options.own_equilibrium, at its own equilibrium (a msm model's own energy,
-/// FormWall; deal.II's FEM as the neo-Hookean wall for the reference, the linear one for a linear
-/// FEM model).
+/// The wall and the wire as one potential: the wall linearised at rest (condensed on a band
+/// grown from the first candidates, CondensedLinearWall) or, with options.own_equilibrium, at its
+/// own equilibrium (a msm model's own energy, FormWall; deal.II's FEM as the neo-Hookean wall for
+/// the reference, every inner-wall node a candidate; a linear FEM model stays condensed).
 ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, const ModelWall& wall,
                                   SceneWire& w, const RigidContact& rigid, const Problem& p,
                                   double EI, double nu, bool reference,
@@ -178,32 +179,39 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
   out.detail = wall.detail;
   out.linearisation = options.own_equilibrium ? "own equilibrium" : to_string(wall.linearisation);
   const auto t0 = std::chrono::steady_clock::now();
-  std::unique_ptr<WallPotential> potential;
-  if (!options.own_equilibrium) {
-    potential = std::make_unique<LinearWall>(wall.system);
-  } else if (wall.energy.form) {
-    potential = std::make_unique<FormWall>(*wall.energy.form, wall.energy.rest,
-                                           wall.system.free_index, wall.system.node_rows);
-  } else if (reference) {
-    potential = std::make_unique<NeoHookeanWall>(*p.mesh, wall_problem(scene, nu, spec.degree));
-    out.detail += ", compressible neo-Hookean";
-  } else {
-    potential = std::make_unique<LinearWall>(wall.system);
-  }
-  const std::vector<int> candidates =
-      p.mesh->group_nodes(p.mesh->require_group("inner_wall", 2, "contact mesh"));
   PotentialContactOptions o;
   o.force_scale = EI / (w.length * w.length);
   o.max_newton = options.max_newton;
   o.max_move = options.max_move;
   msm::rods::DerRod rod = w.rod;
-  const PotentialContactSolution s =
-      solve_wire_wall_potential(rod, w.radius, *potential, *p.mesh, candidates, rigid.x, o);
+  std::unique_ptr<WallPotential> potential;
+  PotentialContactSolution s;
+  // A linear wall's own equilibrium is its linearisation at rest: condensed on a band.
+  const bool linear = !options.own_equilibrium || (!wall.energy.form && !reference);
+  if (linear) {
+    GrownPotentialContact grown =
+        solve_wire_wall_potential_growing(rod, w.radius, wall.system, *p.mesh, p.nodes, rigid.x, o);
+    s = std::move(grown.solution);
+    out.candidates = static_cast<int>(grown.wall->band().size());
+    out.rounds = grown.rounds;
+    potential = std::move(grown.wall);
+  } else {
+    if (wall.energy.form) {
+      potential = std::make_unique<FormWall>(*wall.energy.form, wall.energy.rest,
+                                             wall.system.free_index, wall.system.node_rows);
+    } else {
+      potential = std::make_unique<NeoHookeanWall>(*p.mesh, wall_problem(scene, nu, spec.degree));
+      out.detail += ", compressible neo-Hookean";
+    }
+    const std::vector<int> candidates =
+        p.mesh->group_nodes(p.mesh->require_group("inner_wall", 2, "contact mesh"));
+    s = solve_wire_wall_potential(rod, w.radius, *potential, *p.mesh, candidates, rigid.x, o);
+    out.candidates = static_cast<int>(candidates.size());
+  }
   out.solve_seconds = s.seconds;
   out.setup_seconds = wall.setup_seconds + seconds_since(t0) - s.seconds;
-  for (const double f : s.force) out.force += f;
   out.force_on_wall = s.total_force_on_wall();
-  out.candidates = static_cast<int>(candidates.size());
+  out.force = out.force_on_wall.norm();
   out.steps = s.newton_iterations;
   out.tip = s.x.segment<3>(3 * w.layout.tip_node);
   describe_zone(p, s.pressed, s.force, potential->nodal(s.u), out);

@@ -32,10 +32,10 @@ struct ContactModelsOptions {
   /// FormWall) and the reference at finite strain (the neo-Hookean FEM), each with the wire as one
   /// potential (wire_wall_potential.hpp); every inner-wall node a candidate.
   bool own_equilibrium = false;
-  /// Every wall linearised at rest, each with the wire as one potential (LinearWall,
-  /// wire_wall_potential.hpp) instead of the condensed active set: every inner-wall node a
-  /// candidate, an energy line search, a wire through the wall refused. Slower; it converges where
-  /// the active set does not, as for the arch's buckled wire, whose force hardly changes with its
+  /// Every wall linearised at rest, each with the wire as one potential on the wall condensed on
+  /// a band of candidates grown from the first (condensed_wall_potential.hpp) instead of the
+  /// active set: an energy line search, a wire through the wall refused. It converges where the
+  /// active set does not, as for the arch's buckled wire, whose force hardly changes with its
   /// shape.
   bool potential = false;
   std::ostream* log = nullptr;  ///< one line per wall and EI as it is solved, if set
@@ -47,7 +47,9 @@ struct ModelContact {
   std::string detail;
   std::string linearisation;  ///< to_string(WallLinearisation), or "own equilibrium"
   std::string failure;                ///< empty when solved
-  double force = 0.0;                 ///< Σλ over the pressed nodes, N
+  /// |Σλn|: the net force the wire puts on the wall, N (a zone whose normals fan out round the
+  /// wire presses harder node by node than its sum, Σλ, says).
+  double force = 0.0;
   Vec3 force_on_wall = Vec3::Zero();  ///< Σλn, N
   int pressed = 0;
   int candidates = 0;            ///< after growth

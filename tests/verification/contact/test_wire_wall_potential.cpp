@@ -2,7 +2,8 @@
 // derivatives against finite differences, the finite-strain wall's energy against its linear
 // limit and finite differences, the rigid limit against the shooting reference, two contact
 // formulations (augmented Lagrangian, penalty extrapolated to infinite stiffness) against each
-// other, action and reaction through the wall's own support reactions. Rows "WIRE-WALL-POTENTIAL".
+// other, action and reaction through the wall's own support reactions, the wall condensed on a
+// band against the whole wall and a direct solve. Rows "WIRE-WALL-POTENTIAL".
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -18,6 +19,7 @@
 #include "fem_reference/rod_theory/tube_contact.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "msm/fem/linear_tet.hpp"
+#include "verification/contact/condensed_wall_potential.hpp"
 #include "verification/contact/point_segment_distance.hpp"
 #include "verification/contact/point_triangle_distance.hpp"
 #include "verification/contact/wall_crossing.hpp"
@@ -561,4 +563,102 @@ TEST(WireWallPotentialSlow, ContinuationFromASofterWireReachesTheDirectSolve) {
   EXPECT_THROW((void)contact::solve_wire_wall_potential(w.rod, w.radius, wall, mesh, nodes,
                                                         s_soft.x, o, VectorXd::Zero(5)),
                InputError);
+}
+
+// The wall condensed on a band (CondensedLinearWall) against a direct sparse solve of the whole
+// wall (Eigen's LDLᵀ, not the condensation's CHOLMOD): under forces f on the band's nodes and
+// none elsewhere the whole field v solves K v = f; at the band's rows u = v the condensed energy
+// is ½ fᵀv, its gradient is f, and its whole field (nodal) is v.
+TEST(CondensedLinearWall, IsTheWholeWallLoadedOnlyOnItsBand) {
+  const TetMesh& mesh = tube_mesh();
+  const fem::ElasticitySolver linear(mesh, wall_problem(kWallE));
+  const fem::FreeDisplacementSystem system = linear.free_displacement_system();
+  const std::vector<int> band = nodes_within(mesh, mesh.nodes[aim_node(mesh)], 2.5e-3);
+  ASSERT_GE(band.size(), 4u);
+  const contact::CondensedLinearWall wall(system, band);
+  ASSERT_EQ(wall.num_dofs(), static_cast<int>(3 * band.size()));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  VectorXd f = VectorXd::Zero(system.K.rows()), f_band(wall.num_dofs());
+  for (std::size_t k = 0; k < band.size(); ++k) {
+    for (int c = 0; c < 3; ++c) {
+      const double value = 1e-3 * unit(rng);
+      f[system.node_rows[static_cast<std::size_t>(band[k])][c]] = value;
+      f_band[static_cast<Eigen::Index>(3 * k) + c] = value;
+    }
+  }
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> direct(system.K);
+  ASSERT_EQ(direct.info(), Eigen::Success);
+  const VectorXd v = direct.solve(f);
+  std::vector<Vec3> field(mesh.nodes.size(), Vec3::Zero());
+  for (std::size_t n = 0; n < field.size(); ++n) {
+    for (int c = 0; c < 3; ++c) {
+      if (system.node_rows[n][c] >= 0) field[n][c] = v[system.node_rows[n][c]];
+    }
+  }
+  const VectorXd u = wall.band_rows(field);
+  VectorXd gradient;
+  Eigen::SparseMatrix<double> hessian;
+  const double energy = wall.evaluate(u, &gradient, &hessian);
+  EXPECT_NEAR(energy, 0.5 * f.dot(v), 1e-10 * std::abs(f.dot(v)));
+  EXPECT_LT((gradient - f_band).cwiseAbs().maxCoeff(), 1e-9 * f_band.cwiseAbs().maxCoeff());
+  EXPECT_LT((VectorXd(hessian * u) - gradient).norm(), 1e-12 * gradient.norm());
+  const std::vector<Vec3> whole = wall.nodal(u);
+  double largest = 0.0, difference = 0.0;
+  for (std::size_t n = 0; n < whole.size(); ++n) {
+    largest = std::max(largest, field[n].norm());
+    difference = std::max(difference, (whole[n] - field[n]).norm());
+  }
+  EXPECT_LT(difference, 1e-9 * largest);
+  // A band node held by a support is refused.
+  std::vector<int> held = band;
+  held.push_back(mesh.group_nodes(mesh.require_group("inlet", 2, "tube")).front());
+  EXPECT_THROW(contact::CondensedLinearWall(system, held), InputError);
+}
+
+// The wire on a band grown from the 0.25 mm round the aimed point (solve_wire_wall_potential_
+// growing) reaches the equilibrium of the same potential on the whole wall (LinearWall, every
+// inner-wall node within 2.5 mm a candidate; the line of contact reaches 1.7 mm), 30 times the
+// scenes' wall (a dent of about 2 r_w):
+// the same pressed nodes, the force to 1e-7 and the pressed nodes' displacements to 1e-6 of the
+// dent.
+TEST(WireWallPotentialSlow, AGrownCondensedBandReachesTheWholeWallsEquilibrium) {
+  const TetMesh mesh = line_of_contact_mesh();
+  const fem::ElasticitySolver linear(mesh, wall_problem(kWallE * 30));
+  const fem::FreeDisplacementSystem system = linear.free_displacement_system();
+  const contact::LinearWall whole_wall(system);
+  const PotentialRun whole =
+      potential_run(mesh, kAimPoint, whole_wall, nodes_within(mesh, kAimPoint, 2.5e-3));
+
+  const double d = 0.356e-3, c = kA - d / 2;
+  const double length = rod_theory::straight_tube_contact(kTheta, c / kZc).length * kZc;
+  Wire w(d, length, 32, Vec3(0, 0, kAimPoint.z() - kZc));
+  const RigidRun rigid = rigid_run(w);
+  contact::PotentialContactOptions o;
+  o.force_scale = w.EI / (kZc * kZc);
+  const contact::GrownPotentialContact grown = contact::solve_wire_wall_potential_growing(
+      w.rod, w.radius, system, mesh, nodes_within(mesh, kAimPoint, 0.25e-3), rigid.x, o);
+  const double F = grown.solution.total_force_on_wall().norm();
+  const double F_whole = whole.solution.total_force_on_wall().norm();
+  const std::vector<Vec3> u_whole = whole_wall.nodal(whole.solution.u);
+  const std::vector<Vec3> u_band = grown.wall->nodal(grown.solution.u);
+  double dent = 0.0, difference = 0.0;
+  for (const int n : whole.solution.pressed) {
+    dent = std::max(dent, u_whole[static_cast<std::size_t>(n)].norm());
+    difference = std::max(
+        difference,
+        (u_band[static_cast<std::size_t>(n)] - u_whole[static_cast<std::size_t>(n)]).norm());
+  }
+  std::printf(
+      "WIRE-WALL-POTENTIAL condensed band: %.10e N (%zu pressed, %zu band nodes after %d growths, "
+      "%d Newton, set-up %.2f s, solve %.2f s) against the whole wall %.10e N (%zu pressed, %d "
+      "Newton, %.2f s), %+.1e; dent %.3f mm, displacements within %.1e m\n",
+      F, grown.solution.pressed.size(), grown.wall->band().size(), grown.rounds,
+      grown.solution.newton_iterations, grown.setup_seconds, grown.solution.seconds, F_whole,
+      whole.solution.pressed.size(), whole.solution.newton_iterations, whole.solution.seconds,
+      F / F_whole - 1, dent * 1e3, difference);
+  EXPECT_GE(grown.rounds, 1);
+  EXPECT_EQ(grown.solution.pressed, whole.solution.pressed);
+  EXPECT_NEAR(F, F_whole, 1e-7 * F_whole);
+  EXPECT_LT(difference, 1e-6 * dent);
 }
