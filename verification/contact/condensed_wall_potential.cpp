@@ -19,35 +19,67 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-CondensedLinearWall::CondensedLinearWall(const fem::FreeDisplacementSystem& system,
-                                         std::vector<int> band)
-    : band_(std::move(band)), node_rows_(system.node_rows.size(), {-1, -1, -1}) {
+CondensedLinearWall::CondensedLinearWall(fem::FreeDisplacementSystem system,
+                                         const std::vector<int>& band)
+    : system_(std::move(system)), node_rows_(system_.node_rows.size(), {-1, -1, -1}) {
   const auto t0 = std::chrono::steady_clock::now();
-  for (std::size_t k = 0; k < band_.size(); ++k) {
-    const int n = band_[k];
-    if (n < 0 || static_cast<std::size_t>(n) >= system.node_rows.size()) {
+  factor_ = std::make_unique<fem::CholmodFactor>(system_.K);
+  setup_seconds_ = seconds_since(t0);
+  grow(band);
+}
+
+CondensedLinearWall::~CondensedLinearWall() = default;
+
+void CondensedLinearWall::grow(const std::vector<int>& added) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto old_dofs = static_cast<Eigen::Index>(3 * band_.size());
+  for (const int n : added) {
+    if (n < 0 || static_cast<std::size_t>(n) >= system_.node_rows.size()) {
       throw InputError("the condensed wall's band node " + std::to_string(n) +
                        " is not a node of the wall's mesh");
     }
+    auto& rows = node_rows_[static_cast<std::size_t>(n)];
+    if (rows[0] >= 0) {
+      throw InputError("the condensed wall's band node " + std::to_string(n) + " is given twice");
+    }
     for (int c = 0; c < 3; ++c) {
-      if (system.node_rows[static_cast<std::size_t>(n)][c] < 0) {
+      if (system_.node_rows[static_cast<std::size_t>(n)][c] < 0) {
         throw InputError("the condensed wall's band node " + std::to_string(n) +
                          " is held by a support: a band is the wall near the contact, away "
                          "from its supports");
       }
-      node_rows_[static_cast<std::size_t>(n)][c] = static_cast<int>(3 * k) + c;
+      rows[c] = static_cast<int>(3 * band_.size()) + c;
+    }
+    band_.push_back(n);
+  }
+  // W's new columns (a unit force along each new component; by symmetry also its new rows).
+  const Eigen::Index dofs = num_dofs();
+  compliance_.conservativeResize(dofs, dofs);
+  constexpr Eigen::Index kBlock = 32;  // columns per blocked solve: n × 32 doubles at a time
+  for (Eigen::Index first = old_dofs; first < dofs; first += kBlock) {
+    const Eigen::Index cols = std::min(kBlock, dofs - first);
+    Eigen::MatrixXd B = Eigen::MatrixXd::Zero(system_.K.rows(), cols);
+    for (Eigen::Index j = 0; j < cols; ++j) {
+      const Eigen::Index d = first + j;
+      B(system_.node_rows[static_cast<std::size_t>(band_[d / 3])][d % 3], j) = 1.0;
+    }
+    const Eigen::MatrixXd U = factor_->solve_block(B);
+    for (Eigen::Index i = 0; i < dofs; ++i) {
+      const int row = system_.node_rows[static_cast<std::size_t>(band_[i / 3])][i % 3];
+      for (Eigen::Index j = 0; j < cols; ++j) compliance_(i, first + j) = U(row, j);
     }
   }
-  const ComponentCandidates all = every_component(band_);
-  wall_ = std::make_unique<CondensedWall>(system, all.nodes, all.directions);
-  const Eigen::LLT<Eigen::MatrixXd> llt(wall_->compliance());
+  compliance_.bottomLeftCorner(dofs - old_dofs, old_dofs) =
+      compliance_.topRightCorner(old_dofs, dofs - old_dofs).transpose();
+  compliance_ = 0.5 * (compliance_ + compliance_.transpose()).eval();  // symmetric to round-off
+  const Eigen::LLT<Eigen::MatrixXd> llt(compliance_);
   if (llt.info() != Eigen::Success) {
     throw std::runtime_error("the wall's compliance on the band is not positive definite");
   }
-  stiffness_ = llt.solve(Eigen::MatrixXd::Identity(num_dofs(), num_dofs()));
+  stiffness_ = llt.solve(Eigen::MatrixXd::Identity(dofs, dofs));
   stiffness_ = 0.5 * (stiffness_ + stiffness_.transpose()).eval();
   sparse_stiffness_ = stiffness_.sparseView();
-  setup_seconds_ = seconds_since(t0);
+  setup_seconds_ += seconds_since(t0);
 }
 
 double CondensedLinearWall::evaluate(const VectorXd& u, VectorXd* gradient,
@@ -64,7 +96,26 @@ double CondensedLinearWall::largest_strain(const TetMesh& mesh, const VectorXd& 
 }
 
 std::vector<Vec3> CondensedLinearWall::nodal(const VectorXd& u) const {
-  return wall_->displacement(stiffness_ * u);
+  const VectorXd forces = stiffness_ * u;
+  VectorXd f = VectorXd::Zero(system_.K.rows());
+  for (std::size_t k = 0; k < band_.size(); ++k) {
+    for (int c = 0; c < 3; ++c) {
+      f[system_.node_rows[static_cast<std::size_t>(band_[k])][c]] =
+          forces[static_cast<Eigen::Index>(3 * k) + c];
+    }
+  }
+  return field(factor_->solve(f));
+}
+
+std::vector<Vec3> CondensedLinearWall::field(const VectorXd& x) const {
+  std::vector<Vec3> out(system_.node_rows.size(), Vec3::Zero());
+  for (std::size_t n = 0; n < out.size(); ++n) {
+    for (int c = 0; c < 3; ++c) {
+      const int r = system_.node_rows[n][c];
+      if (r >= 0) out[n][c] = x[r];
+    }
+  }
+  return out;
 }
 
 VectorXd CondensedLinearWall::band_rows(const std::vector<Vec3>& field) const {
@@ -140,7 +191,6 @@ GrownPotentialContact solve_wire_wall_potential_growing(msm::rods::Rod& rod, dou
   const std::vector<Triangle> triangles = mesh.group_triangles(group);
   const std::vector<int> surface = mesh.group_nodes(group);
   const ContactWire wire = contact_wire(rod, radius);
-  std::sort(band.begin(), band.end());
   GrownPotentialContact out;
   // The last equilibrium (the wire's start and the wall at rest before the first): every band's
   // solve starts from it.
@@ -148,12 +198,13 @@ GrownPotentialContact solve_wire_wall_potential_growing(msm::rods::Rod& rod, dou
   std::vector<Vec3> field(mesh.nodes.size(), Vec3::Zero());
   int newton = 0, factorisations = 0;
   double seconds = 0.0;
+  out.wall = std::make_unique<CondensedLinearWall>(system, band);
   for (;; ++out.rounds) {
-    out.wall = std::make_unique<CondensedLinearWall>(system, band);
-    out.setup_seconds += out.wall->setup_seconds();
     std::vector<int> added;
     try {
-      out.solution = solve_wire_wall_potential(rod, radius, *out.wall, mesh, band, x, options,
+      std::vector<int> candidates = band;  // ascending: so are the pressed nodes
+      std::sort(candidates.begin(), candidates.end());
+      out.solution = solve_wire_wall_potential(rod, radius, *out.wall, mesh, candidates, x, options,
                                                out.wall->band_rows(field));
       newton += out.solution.newton_iterations;
       factorisations += out.solution.factorisations;
@@ -174,8 +225,8 @@ GrownPotentialContact solve_wire_wall_potential_growing(msm::rods::Rod& rod, dou
           std::to_string(growth.max_rounds) + " growths (" + std::to_string(band.size()) +
           " band nodes)");
     }
-    band.insert(band.end(), added.begin(), added.end());
-    std::sort(band.begin(), band.end());  // the pressed nodes come out ascending
+    out.wall->grow(added);
+    band = out.wall->band();
   }
   out.solution.newton_iterations = newton;
   out.solution.factorisations = factorisations;

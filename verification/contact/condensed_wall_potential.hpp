@@ -5,30 +5,34 @@
 ///
 /// For a linear wall loaded only on the band B, the energy of the displacement field that takes
 /// the values u_B on B and minimises ½vᵀKv elsewhere is ½u_Bᵀ S u_B, S = W⁻¹ the Schur complement
-/// of K on B's components (W the wall's compliance on them, CondensedWall on every_component):
+/// of K on B's components (W the wall's compliance on them, as CondensedWall's on every_component):
 /// minimising Π over (x, u_B) is minimising it over (x, v) with no load off the band. The whole
-/// field follows from the band's forces S u_B by one back-solve (CondensedWall::displacement).
+/// field follows from the band's forces S u_B by one back-solve.
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <array>
 #include <memory>
 #include <vector>
 
+#include "fem_reference/cholmod_solve.hpp"
 #include "fem_reference/elasticity.hpp"
 #include "meshes/tet_mesh.hpp"
-#include "verification/contact/condensed_wall.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
 
 namespace vessel::contact {
 
 /// The linear wall ½u_BᵀS u_B on the displacements of the band's nodes (rows 3k, 3k+1, 3k+2 for
-/// band node k; every other node held, its displacement the condensed field's).
+/// band node k; every other node held, its displacement the condensed field's). K is factorised
+/// once; a growth solves only the new nodes' columns of W.
 class CondensedLinearWall final : public WallPotential {
  public:
   /// `system`: the wall's free displacement system (homogeneous supports). InputError for a band
-  /// node not in the mesh or with a component held by a support.
-  CondensedLinearWall(const fem::FreeDisplacementSystem& system, std::vector<int> band);
+  /// node not in the mesh, given twice or with a component held by a support.
+  CondensedLinearWall(fem::FreeDisplacementSystem system, const std::vector<int>& band);
+  ~CondensedLinearWall() override;
+  /// Adds nodes to the band (the same errors): 3 back-solves per node, W's old block kept.
+  void grow(const std::vector<int>& added);
   [[nodiscard]] int num_dofs() const override { return static_cast<int>(3 * band_.size()); }
   [[nodiscard]] const std::vector<std::array<int, 3>>& node_rows() const override {
     return node_rows_;
@@ -43,14 +47,17 @@ class CondensedLinearWall final : public WallPotential {
   [[nodiscard]] const std::vector<int>& band() const { return band_; }
   /// The band's rows of a whole-wall field given per mesh node.
   [[nodiscard]] Eigen::VectorXd band_rows(const std::vector<Vec3>& field) const;
-  /// Seconds spent factorising K, solving for W and inverting it.
+  /// Seconds spent factorising K, solving for W and inverting it, over every growth.
   [[nodiscard]] double setup_seconds() const { return setup_seconds_; }
 
  private:
+  [[nodiscard]] std::vector<Vec3> field(const Eigen::VectorXd& x) const;
+  fem::FreeDisplacementSystem system_;
+  std::unique_ptr<fem::CholmodFactor> factor_;
   std::vector<int> band_;
   std::vector<std::array<int, 3>> node_rows_;
-  std::unique_ptr<CondensedWall> wall_;
-  Eigen::MatrixXd stiffness_;  ///< S, N/m
+  Eigen::MatrixXd compliance_;  ///< W, m/N
+  Eigen::MatrixXd stiffness_;   ///< S = W⁻¹, N/m
   Eigen::SparseMatrix<double> sparse_stiffness_;
   double setup_seconds_ = 0.0;
 };
@@ -61,7 +68,6 @@ struct GrownPotentialContact {
   PotentialContactSolution solution;
   std::unique_ptr<CondensedLinearWall> wall;  ///< on the final band
   int rounds = 0;                             ///< growths
-  double setup_seconds = 0.0;                 ///< every band's condensation
 };
 
 /// solve_wire_wall_potential on the wall condensed on `band` (every band node a candidate), the

@@ -214,8 +214,16 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
   out.force = out.force_on_wall.norm();
   out.steps = s.newton_iterations;
   out.tip = s.x.segment<3>(3 * w.layout.tip_node);
-  describe_zone(p, s.pressed, s.force, potential->nodal(s.u), out);
+  const std::vector<Vec3> u = potential->nodal(s.u);
+  describe_zone(p, s.pressed, s.force, u, out);
   out.strain = potential->largest_strain(*p.mesh, s.u);
+  if (linear) {
+    std::vector<Vec3> loads(p.mesh->nodes.size(), Vec3::Zero());
+    for (std::size_t j = 0; j < s.pressed.size(); ++j) {
+      loads[static_cast<std::size_t>(s.pressed[j])] += s.force[j] * s.direction[j];
+    }
+    out.own_imbalance = own_imbalance(wall, u, loads);
+  }
   return out;
 }
 
