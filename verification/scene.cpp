@@ -452,6 +452,13 @@ GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
     }
     w.stiffness_sweep = r.numbers(*sweep, "stiffness_sweep");
   }
+  if (const toml::node* size = r.get("contact_fine_size")) {
+    if (w.coupling != GuidewireCoupling::contact) {
+      r.fail(size, "contact_fine_size",
+             "found with coupling = \"" + coupling + "\"; expected coupling = \"contact\"");
+    }
+    w.contact_fine_size = r.number(*size, "contact_fine_size");
+  }
   return w;
 }
 

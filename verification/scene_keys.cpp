@@ -158,6 +158,9 @@ std::vector<Row> guidewire_rows() {
           "Compliant or contact coupling: wire bending stiffnesses EI the coupling is repeated at "
           "(E scaled), with each wall's compliance of the run")
           .unit("N·m²").positive().sweep().in(g),
+      Row("load", "contact_fine_size", KeyType::number,
+          "Contact coupling: the contact mesh's element size near the wire's rigid contact")
+          .dflt("0.08e-3").unit("m").positive().in(g),
   };
 }
 

@@ -239,6 +239,14 @@ TEST(Cli, SceneSaysWhatAContactCouplingWouldSolveAndRefusesAnUnknownCoupling) {
   EXPECT_TRUE(contains(bad.output, "coupling")) << bad.output;
   EXPECT_TRUE(contains(bad.output, "contact")) << bad.output;
   EXPECT_TRUE(contains(bad.output, "mortar")) << bad.output;
+  // The contact mesh's size belongs to the contact coupling alone.
+  text.replace(text.find("coupling = \"mortar\""), std::string("coupling = \"mortar\"").size(),
+               "coupling = \"compliant\"\ncontact_fine_size = 0.1e-3");
+  write_text(dir / "sized.toml", text);
+  const auto sized = vv("scene " + (dir / "sized.toml").string());
+  EXPECT_EQ(sized.exit_code, 1) << sized.output;
+  EXPECT_TRUE(contains(sized.output, "contact_fine_size")) << sized.output;
+  EXPECT_TRUE(contains(sized.output, "expected coupling = \"contact\"")) << sized.output;
 }
 
 TEST(Cli, RunPrintsTheGuidewiresSolvedForceAndWallPoint) {
@@ -250,6 +258,8 @@ TEST(Cli, RunPrintsTheGuidewiresSolvedForceAndWallPoint) {
   text = text.substr(0, text.find("[[models]]"));
   const auto sweep = text.find("stiffness_sweep");
   text.erase(sweep, text.find('\n', sweep) - sweep);
+  const auto coupling = text.find("coupling = \"contact\"");  // the log line, not the contact solve
+  text.replace(coupling, std::string("coupling = \"contact\"").size(), "coupling = \"compliant\"");
   text += "[[models]]\nname = \"fem_p1\"\nkind = \"fem\"\ndegree = 1\n";
   TempDir dir;
   write_text(dir / "wire.toml", text);

@@ -30,7 +30,7 @@ struct RunOptions {
   int modes = -1;                 ///< natural frequencies per model (−1: the scenes' [modes])
   int modes_reference_level = -1;  ///< level of the modal reference (−1: the scenes')
   std::string fields = "representative";
-  double contact_fine_size = 0.0;  ///< m; 0: ContactModelsOptions's default
+  double contact_fine_size = 0.0;  ///< m; 0: the scene's contact_fine_size
   std::string command;
 };
 
@@ -110,7 +110,7 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
   add_jobs_option(*cmd, o->jobs, kReferencesAtATime);
   cmd->add_flag("--quick", o->quick,
                 "Coarse levels (models 0, reference 1) and the smallest and largest load only; a "
-                "guidewire's contact coupling without its contact solve (the series springs)");
+                "guidewire's contact solve at the scene wire's EI alone, its mesh at 0.12 mm");
   add_timing_options(*cmd, o->repeats, o->updates);
   cmd->add_option("--nu", o->poisson_ratios,
                   "Sweep Poisson's ratio over these values instead of the scenes' (e.g. "
@@ -147,7 +147,7 @@ void add_run_command(CLI::App& app, const std::string& command_line) {
       ->capture_default_str();
   cmd->add_option("--contact-fine-size", o->contact_fine_size,
                   "Guidewire scenes with coupling = \"contact\": the contact mesh's element size "
-                  "near the wire's contact, m (default: 0.08e-3)")
+                  "near the wire's contact, m (default: the scene's contact_fine_size)")
       ->check(CLI::PositiveNumber);
   cmd->callback([o] { run(*o); });
 }

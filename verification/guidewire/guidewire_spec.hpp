@@ -95,6 +95,11 @@ struct GuidewireSpec {
   /// Compliant or contact coupling: the bending stiffnesses EI (N·m²) the coupling is repeated at
   /// (E scaled, the section kept), with the walls' compliances of the scene's run.
   std::vector<double> stiffness_sweep;
+  /// Contact coupling: the contact mesh's element size near the wire's rigid contact, m.
+  double contact_fine_size = 0.08e-3;
+  /// Contact coupling: the contact solved at the wire's own EI alone, not at stiffness_sweep's
+  /// (the series springs still are). Not a scene key: set by the quick variant.
+  bool contact_at_own_stiffness_only = false;
 };
 
 /// The wire solved against a rigid lumen (or one that gives way by `wall_give` along the normal).

@@ -182,12 +182,15 @@ json wall_row(const contact::ModelContact& m, const contact::ModelContact& refer
 GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutcome& coupled,
                                          const HarnessOptions& options) {
   GuidewireContact c;
-  c.options.bending_stiffness = guidewire_stiffnesses(*scene.load.guidewire);
-  if (options.contact_fine_size > 0.0) c.options.fine_size = options.contact_fine_size;
-  // The arch's buckled wire hardly changes its force with its shape: the condensed active set
-  // loses its contact there (the tip slides off the candidates or sinks between the wall's nodes),
-  // the potential's energy line search holds it.
-  c.options.potential = scene.vessel.kind == VesselKind::arch;
+  const GuidewireSpec& spec = *scene.load.guidewire;
+  c.options.bending_stiffness = guidewire_stiffnesses(spec);
+  if (spec.contact_at_own_stiffness_only) c.options.bending_stiffness.resize(1);  // its own first
+  c.options.fine_size =
+      options.contact_fine_size > 0.0 ? options.contact_fine_size : spec.contact_fine_size;
+  // The wire and each wall as one potential on the condensed band: its energy line search holds
+  // the contacts the active set loses (the arch's buckled wire, whose force hardly changes with
+  // its shape; the mass-spring walls the wire dents deepest).
+  c.options.potential = true;
   std::vector<ModelSpec> walls;
   std::vector<std::string> names;
   for (const ModelSpec& m : scene.models) {

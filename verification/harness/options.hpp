@@ -44,8 +44,7 @@ struct HarnessOptions {
   /// (verification/harness/external_model.hpp); empty: a folder under the system's temporary directory.
   std::filesystem::path exchange_dir;
   /// Guidewire scenes with coupling = "contact": the contact mesh's element size near the wire's
-  /// contact, m (0: ContactModelsOptions's default,
-  /// verification/contact_models/contact_models.hpp).
+  /// contact, m (0: the scene's contact_fine_size).
   double contact_fine_size = 0.0;
 };
 
