@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
+#include <tuple>
 
 #include "meshes/foundation/errors.hpp"
 #include "meshes/vessel_geometry.hpp"
@@ -22,6 +23,7 @@
 #include "test_paths.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
 #include "verification/harness/guidewire_contact.hpp"
+#include "verification/harness/guidewire_coupling.hpp"
 #include "verification/harness/outcome_cache.hpp"
 
 namespace vessel {
@@ -169,6 +171,43 @@ TEST(GuidewireContact, AVesselThatIsNeitherTheTubeNorTheArchIsRefused) {
     EXPECT_NE(what.find("guidewire_straight.toml"), std::string::npos) << what;
     EXPECT_NE(what.find("\"arch\""), std::string::npos) << what;
   }
+}
+
+// A linear wall dented deeper than it is thick cannot hold the wire: where the series springs
+// put the reference's wall in by more (C_ref·F_ref from the run's coupling, here written by hand
+// on either side of the 1 mm wall) the contact is not solved, and the run says why at that EI,
+// in the scene's order, with the rigid lumen's force kept for the shortcuts. Nothing is solved
+// when no EI can be (the test returns at once).
+TEST(GuidewireContact, AnEiWhoseSeriesSpringsDentTheWallDeeperThanItIsThickIsNotSolved) {
+  Scene scene = read_scene(VESSEL_SCENES_DIR + "/guidewire_straight.toml");
+  ASSERT_EQ(scene.vessel.wall_thickness, 1e-3);
+  scene.load.guidewire->stiffness_sweep = {4e-6};
+  const double own = guidewire_stiffnesses(*scene.load.guidewire).front();
+  GuidewireOutcome coupled;
+  for (const auto& [EI, compliance, force] :
+       std::vector<std::tuple<double, double, double>>{{own, 0.5, 2.1e-3}, {4e-6, 0.5, 2.8e-3}}) {
+    GuidewireRigid r;
+    r.bending_stiffness = EI;
+    r.reference_compliance = compliance;  // m/N
+    r.reference_force = force;            // N: 1.05 mm and 1.4 mm in
+    r.solution.force = 1.1 * force;
+    coupled.rigid.push_back(r);
+  }
+  const GuidewireContact c = solve_guidewire_contact(scene, coupled, HarnessOptions{});
+  ASSERT_EQ(c.solve.runs.size(), 2u);
+  EXPECT_NEAR(c.solve.runs[0].bending_stiffness, own, 1e-12 * own);
+  EXPECT_DOUBLE_EQ(c.solve.runs[1].bending_stiffness, 4e-6);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const std::string& why = c.solve.runs[k].reference.failure;
+    EXPECT_NE(why.find("not solved"), std::string::npos) << why;
+    EXPECT_NE(why.find(k == 0 ? "1.05 mm in under 2.100 mN" : "1.40 mm in under 2.800 mN"),
+              std::string::npos)
+        << why;
+    EXPECT_NE(why.find("--own-equilibrium"), std::string::npos) << why;
+    EXPECT_DOUBLE_EQ(c.solve.runs[k].rigid_force, coupled.rigid[k].solution.force);
+    EXPECT_TRUE(c.solve.runs[k].models.empty());
+  }
+  EXPECT_EQ(c.shortcuts.size(), 2u);
 }
 
 }  // namespace

@@ -157,24 +157,23 @@ std::vector<int> joining(const TetMesh& mesh, const std::vector<Triangle>& trian
   return added;
 }
 
-/// The surface nodes outside the band within `reach` of a centreline polyline.
-std::vector<int> near_centreline(const TetMesh& mesh, const std::vector<int>& surface,
-                                 const std::vector<int>& band, const std::vector<Vec3>& centreline,
-                                 double reach) {
+/// Where the wire went through the wall: the crossed triangle's nodes outside the band and every
+/// surface node outside it within `reach` of the crossing; none if the triangle is the band's own
+/// (the wire passed between candidates: no growth helps).
+std::vector<int> near_crossing(const TetMesh& mesh, const std::vector<int>& surface,
+                               const std::vector<int>& band, const WireThroughWall& crossing,
+                               double reach) {
   std::vector<char> in(mesh.nodes.size(), 0);
   for (const int n : band) in[static_cast<std::size_t>(n)] = 1;
+  const bool own = std::all_of(crossing.triangle.begin(), crossing.triangle.end(),
+                               [&](int n) { return in[static_cast<std::size_t>(n)] != 0; });
   std::vector<int> added;
+  if (own) return added;
   for (const int n : surface) {
-    if (in[static_cast<std::size_t>(n)]) continue;
-    const Vec3& p = mesh.nodes[static_cast<std::size_t>(n)];
-    for (std::size_t i = 0; i + 1 < centreline.size(); ++i) {
-      const Vec3 e = centreline[i + 1] - centreline[i];
-      const double t = std::clamp((p - centreline[i]).dot(e) / e.squaredNorm(), 0.0, 1.0);
-      if ((p - centreline[i] - t * e).norm() < reach) {
-        added.push_back(n);
-        break;
-      }
-    }
+    const auto i = static_cast<std::size_t>(n);
+    const bool corner =
+        std::find(crossing.triangle.begin(), crossing.triangle.end(), n) != crossing.triangle.end();
+    if (!in[i] && (corner || (mesh.nodes[i] - crossing.point).norm() < reach)) added.push_back(n);
   }
   return added;
 }
@@ -214,7 +213,7 @@ GrownPotentialContact solve_wire_wall_potential_growing(msm::rods::Rod& rod, dou
       added = joining(mesh, triangles, surface, band, out.solution, field, wire, growth.margin);
     } catch (const WireThroughWall& e) {
       // The wire left the band through the wall, between nodes that were not candidates.
-      added = near_centreline(mesh, surface, band, e.centreline, growth.crossing_reach);
+      added = near_crossing(mesh, surface, band, e, growth.crossing_reach);
       if (added.empty() || out.rounds == growth.max_rounds) throw;
     }
     if (added.empty()) break;

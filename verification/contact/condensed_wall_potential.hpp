@@ -73,7 +73,8 @@ struct GrownPotentialContact {
 /// solve_wire_wall_potential on the wall condensed on `band` (every band node a candidate), the
 /// band grown as BandGrowth says (a pressed node on its edge brings its surface neighbours, a
 /// surface node outside it within `margin` of the wire's surface joins; a solve that stops with
-/// the wire through the wall brings the nodes within `crossing_reach` of that centreline) and the
+/// the wire through the wall beyond the band brings the nodes within `crossing_reach` of the
+/// crossing, one through the band's own triangles is rethrown) and the
 /// contact re-solved from the last equilibrium (the wire's state, the band's displacements from
 /// the whole field) until nothing joins. std::runtime_error after growth.max_rounds growths that
 /// still add nodes; solve_wire_wall_potential's errors.

@@ -32,6 +32,10 @@ std::optional<WallCrossing> first_wall_crossing(const TetMesh& mesh,
                                                 const std::vector<Vec3>& displacement,
                                                 const std::vector<Vec3>& centreline);
 
+/// The crossing as a sentence for a failed solve ("the wire's centreline crosses the wall at
+/// (x, y, z) mm (segment k): ...").
+std::string describe(const WallCrossing& crossing);
+
 /// Where `centreline` crosses `mesh`'s inner wall (group "inner_wall") displaced by
 /// `displacement`, as a sentence for a failed solve ("the wire's centreline crosses the wall at
 /// (x, y, z) mm (segment k): ..."), or nullopt when it stays inside the lumen.

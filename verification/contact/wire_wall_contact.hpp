@@ -115,7 +115,8 @@ struct BandGrowth {
   double margin = 0.0;  ///< m
   int max_rounds = 8;
   /// m: where a solve on the band stops with the wire through the wall beyond it (the potential's
-  /// WireThroughWall), the surface nodes this near that iterate's centreline join.
+  /// WireThroughWall on a triangle not all of whose nodes are in the band), the surface nodes
+  /// this near the crossing join.
   double crossing_reach = 0.5e-3;
 };
 

@@ -500,14 +500,17 @@ class Coupled {
   /// Throws WireThroughWall (its message beginning with `when`) if the centreline at z crosses
   /// the wall's inner surface (none for a mesh without that group).
   void require_inside_lumen(const VectorXd& z, const std::string& when) const {
-    if (mesh_.find_group(group_names::inner_wall, 2) == nullptr) return;
+    const PhysicalGroup* inner = mesh_.find_group(group_names::inner_wall, 2);
+    if (inner == nullptr) return;
     const VectorXd x = rod_dofs(z);
     std::vector<Vec3> centreline;
     for (int i = first_; i <= last_; ++i) centreline.emplace_back(x.segment<3>(3 * i));
+    const std::vector<Triangle> triangles = mesh_.group_triangles(*inner);
     if (const auto crossing =
-            describe_wall_crossing(mesh_, wall_.nodal(wall_rows(z)), centreline)) {
-      throw WireThroughWall("the wire-wall potential " + when + ": " + *crossing,
-                            std::move(centreline));
+            first_wall_crossing(mesh_, triangles, wall_.nodal(wall_rows(z)), centreline)) {
+      throw WireThroughWall("the wire-wall potential " + when + ": " + describe(*crossing),
+                            std::move(centreline), crossing->point,
+                            triangles[static_cast<std::size_t>(crossing->triangle)]);
     }
   }
 

@@ -172,11 +172,15 @@ struct PotentialContactSolution {
 /// The wire's centreline crossed the wall's inner surface (describe_wall_crossing) at the solve's
 /// start or after a Newton step: the capsule passed between the wall's nodes, whose gaps are open
 /// again on the far side, and a solve from there would converge outside the lumen. Holds that
-/// iterate's centreline nodes (m), for a caller that refines the wall where the wire bears.
+/// iterate's centreline nodes (m), where it crossed (m) and the crossed inner-wall triangle's
+/// mesh nodes, for a caller that refines the wall or widens its candidates where the wire bears.
 struct WireThroughWall : std::runtime_error {
-  WireThroughWall(const std::string& what, std::vector<Vec3> at)
-      : std::runtime_error(what), centreline(std::move(at)) {}
+  WireThroughWall(const std::string& what, std::vector<Vec3> at, const Vec3& where,
+                  const Triangle& crossed)
+      : std::runtime_error(what), centreline(std::move(at)), point(where), triangle(crossed) {}
   std::vector<Vec3> centreline;
+  Vec3 point;
+  Triangle triangle;
 };
 
 /// Minimises Π from the wire at `start` (e.g. its rigid-lumen state) and the wall at

@@ -177,14 +177,51 @@ json wall_row(const contact::ModelContact& m, const contact::ModelContact& refer
   return row;
 }
 
+/// Why the contact at EI is not solved, or empty: a linear wall dented deeper than it is thick
+/// cannot hold the wire (its solve stops with the wire through the wall, after minutes), and the
+/// series springs of the reference's wall (C_ref·F_ref) say beforehand whether it will be.
+std::string beyond_the_linear_wall(const Scene& scene, const GuidewireOutcome& coupled, double EI) {
+  for (const GuidewireRigid& r : coupled.rigid) {
+    if (!same_stiffness(r.bending_stiffness, EI)) continue;
+    const double dent = r.reference_compliance * r.reference_force;
+    if (!(dent > scene.vessel.wall_thickness)) return {};
+    return "not solved: the series springs put the reference's wall " + fmt("%.2f", dent * 1e3) +
+           " mm in under " + fmt("%.3f", r.reference_force * 1e3) +
+           " mN, deeper than the wall is thick (" + fmt("%.2f", scene.vessel.wall_thickness * 1e3) +
+           " mm): a linear wall cannot hold the wire there (the finite-strain reference can: "
+           "vesselverify contact-models --own-equilibrium)";
+  }
+  return {};
+}
+
+/// A run at EI that was not solved, for `why`.
+contact::ContactModelsRun unsolved_run(const GuidewireOutcome& coupled, double EI, int degree,
+                                       const std::string& why) {
+  contact::ContactModelsRun run;
+  run.bending_stiffness = EI;
+  for (const GuidewireRigid& r : coupled.rigid) {
+    if (!same_stiffness(r.bending_stiffness, EI)) continue;
+    run.rigid_force = r.solution.force;
+    run.rigid_wall_point = r.solution.wall_point;
+  }
+  run.reference.name = "reference_fem_p" + std::to_string(degree);
+  run.reference.failure = why;
+  return run;
+}
+
 }  // namespace
 
 GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutcome& coupled,
                                          const HarnessOptions& options) {
   GuidewireContact c;
   const GuidewireSpec& spec = *scene.load.guidewire;
-  c.options.bending_stiffness = guidewire_stiffnesses(spec);
-  if (spec.contact_at_own_stiffness_only) c.options.bending_stiffness.resize(1);  // its own first
+  std::vector<double> stiffnesses = guidewire_stiffnesses(spec);
+  if (spec.contact_at_own_stiffness_only) stiffnesses.resize(1);  // its own first
+  for (const double EI : stiffnesses) {
+    if (beyond_the_linear_wall(scene, coupled, EI).empty()) {
+      c.options.bending_stiffness.push_back(EI);
+    }
+  }
   c.options.fine_size =
       options.contact_fine_size > 0.0 ? options.contact_fine_size : spec.contact_fine_size;
   // The wire and each wall as one potential on the condensed band: its energy line search holds
@@ -208,12 +245,23 @@ GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutc
     }
     return serialise(contact::solve_contact_models(scene, walls, o));
   };
-  if (options.outcome_cache && options.outcome_cache->enabled()) {
+  if (c.options.bending_stiffness.empty()) {
+    c.solve.nu = scene.poisson_ratios.front();
+  } else if (options.outcome_cache && options.outcome_cache->enabled()) {
     c.solve = deserialise(
         options.outcome_cache->get(contact_key(scene, names, c.options), solve, c.provenance));
   } else {
     c.solve = deserialise(solve());
   }
+  // Every EI in the scene's order, those not solved with their reason.
+  std::vector<contact::ContactModelsRun> runs;
+  std::size_t solved = 0;
+  for (const double EI : stiffnesses) {
+    const std::string why = beyond_the_linear_wall(scene, coupled, EI);
+    runs.push_back(why.empty() ? c.solve.runs.at(solved++)
+                               : unsolved_run(coupled, EI, c.options.reference_degree, why));
+  }
+  c.solve.runs = std::move(runs);
   for (const contact::ContactModelsRun& run : c.solve.runs) {
     c.shortcuts.push_back(shortcuts_at(run, c.solve.nu, coupled));
   }
