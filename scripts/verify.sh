@@ -6,8 +6,8 @@
 #      on the arch, Lamé pressure, gravity sag, the dynamic step contact, the region-of-interest
 #      radii, the guidewire pushing the straight tube and the arch) against the FEM reference →
 #      results.json, results.csv, summary.md, fields/; the straight tube's guidewire also presses
-#      each model's wall and the FEM P2 wall in a wire–wall contact solve (coupling = "contact",
-#      not in --quick);
+#      each model's wall and the FEM P2 wall in a wire–wall contact solve (coupling = "contact";
+#      --quick at the wire's own EI alone);
 #   3. `vesselverify validity` on the contact scenes and gravity: where the linear reference stops
 #      being valid, and the seed models against the finite-strain reference up to 70 mN and 1 g
 #      → validity.json;
