@@ -177,6 +177,14 @@ json wall_row(const contact::ModelContact& m, const contact::ModelContact& refer
   return row;
 }
 
+/// The EIs of the contact coupling: the wire's own first, then its stiffness_sweep's (the wire's
+/// own alone in the quick variant).
+std::vector<double> contact_stiffnesses(const GuidewireSpec& spec) {
+  std::vector<double> out = guidewire_stiffnesses(spec);
+  if (spec.contact_at_own_stiffness_only) out.resize(1);
+  return out;
+}
+
 /// Why the contact at EI is not solved, or empty: a linear wall dented deeper than it is thick
 /// cannot hold the wire (its solve stops with the wire through the wall, after minutes), and the
 /// series springs of the reference's wall (C_ref·F_ref) say beforehand whether it will be.
@@ -209,25 +217,30 @@ contact::ContactModelsRun unsolved_run(const GuidewireOutcome& coupled, double E
   return run;
 }
 
+/// The scene's solve options: the EIs a linear wall can hold (the wire's own alone in the quick
+/// variant), the contact mesh's size, the potential on the condensed band.
+contact::ContactModelsOptions contact_options(const Scene& scene, const GuidewireOutcome& coupled,
+                                              const HarnessOptions& options) {
+  const GuidewireSpec& spec = *scene.load.guidewire;
+  contact::ContactModelsOptions o;
+  for (const double EI : contact_stiffnesses(spec)) {
+    if (beyond_the_linear_wall(scene, coupled, EI).empty()) o.bending_stiffness.push_back(EI);
+  }
+  o.fine_size =
+      options.contact_fine_size > 0.0 ? options.contact_fine_size : spec.contact_fine_size;
+  // The wire and each wall as one potential on the condensed band: its energy line search holds
+  // the contacts the active set loses (the arch's buckled wire, whose force hardly changes with
+  // its shape; the mass-spring walls the wire dents deepest).
+  o.potential = true;
+  return o;
+}
+
 }  // namespace
 
 GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutcome& coupled,
                                          const HarnessOptions& options) {
   GuidewireContact c;
-  const GuidewireSpec& spec = *scene.load.guidewire;
-  std::vector<double> stiffnesses = guidewire_stiffnesses(spec);
-  if (spec.contact_at_own_stiffness_only) stiffnesses.resize(1);  // its own first
-  for (const double EI : stiffnesses) {
-    if (beyond_the_linear_wall(scene, coupled, EI).empty()) {
-      c.options.bending_stiffness.push_back(EI);
-    }
-  }
-  c.options.fine_size =
-      options.contact_fine_size > 0.0 ? options.contact_fine_size : spec.contact_fine_size;
-  // The wire and each wall as one potential on the condensed band: its energy line search holds
-  // the contacts the active set loses (the arch's buckled wire, whose force hardly changes with
-  // its shape; the mass-spring walls the wire dents deepest).
-  c.options.potential = true;
+  c.options = contact_options(scene, coupled, options);
   std::vector<ModelSpec> walls;
   std::vector<std::string> names;
   for (const ModelSpec& m : scene.models) {
@@ -256,7 +269,7 @@ GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutc
   // Every EI in the scene's order, those not solved with their reason.
   std::vector<contact::ContactModelsRun> runs;
   std::size_t solved = 0;
-  for (const double EI : stiffnesses) {
+  for (const double EI : contact_stiffnesses(*scene.load.guidewire)) {
     const std::string why = beyond_the_linear_wall(scene, coupled, EI);
     runs.push_back(why.empty() ? c.solve.runs.at(solved++)
                                : unsolved_run(coupled, EI, c.options.reference_degree, why));
