@@ -304,15 +304,15 @@ std::vector<ModelSpec> contact_model_kinds(const Scene& scene) {
 
 namespace {
 
-/// The progress line of one wall's contact at one EI.
+/// The progress line of one wall's contact at one EI (a failed one: the seconds it took to fail).
 void log_contact(std::ostream& log, const ModelSpec& wall, std::size_t index, std::size_t walls,
-                 double EI, const ModelContact& c) {
+                 double EI, const ModelContact& c, double failed_after) {
   char line[160];
   if (c.failure.empty()) {
     std::snprintf(line, sizeof line, "F %.4f mN, %d pressed, %.1f s", c.force * 1e3, c.pressed,
                   c.setup_seconds + c.solve_seconds);
   } else {
-    std::snprintf(line, sizeof line, "failed");
+    std::snprintf(line, sizeof line, "failed after %.1f s", failed_after);
   }
   char ei[32];
   std::snprintf(ei, sizeof ei, "%.3g", EI);
@@ -343,6 +343,7 @@ void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
     for (std::size_t e = 0; e < out.runs.size(); ++e) {
       const double EI = out.runs[e].bending_stiffness;
       ModelContact c;
+      const auto t0 = std::chrono::steady_clock::now();
       if (!wall) {
         c = failed(*walls[k], why);
       } else {
@@ -357,7 +358,9 @@ void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
           c.linearisation = to_string(wall->linearisation);
         }
       }
-      if (options.log) log_contact(*options.log, *walls[k], k, walls.size(), EI, c);
+      if (options.log) {
+        log_contact(*options.log, *walls[k], k, walls.size(), EI, c, seconds_since(t0));
+      }
       if (k == 0) {
         out.runs[e].reference = c;  // a failed reference leaves the run's errors undefined
       } else {
