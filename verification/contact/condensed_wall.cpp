@@ -70,12 +70,15 @@ Eigen::VectorXd CondensedWall::load_vector(const Eigen::VectorXd& forces) const 
 }
 
 std::vector<Vec3> CondensedWall::displacement(const Eigen::VectorXd& forces) const {
-  const Eigen::VectorXd u = factor_->solve(load_vector(forces));
-  std::vector<Vec3> out(system_.node_rows.size(), Vec3::Zero());
+  return per_node(system_.node_rows, factor_->solve(load_vector(forces)));
+}
+
+std::vector<Vec3> per_node(const std::vector<std::array<int, 3>>& node_rows,
+                           const Eigen::VectorXd& x) {
+  std::vector<Vec3> out(node_rows.size(), Vec3::Zero());
   for (std::size_t n = 0; n < out.size(); ++n) {
     for (int c = 0; c < 3; ++c) {
-      const int r = system_.node_rows[n][c];
-      if (r >= 0) out[n][c] = u[r];
+      if (node_rows[n][c] >= 0) out[n][c] = x[node_rows[n][c]];
     }
   }
   return out;

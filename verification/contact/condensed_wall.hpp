@@ -5,6 +5,7 @@
 /// own: the compliance W of contact::solve_signorini. One factorisation and one solve per
 /// candidate; then any contact forces give the wall's whole displacement field by one more solve.
 #include <Eigen/Dense>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -44,6 +45,11 @@ class CondensedWall {
   Eigen::MatrixXd compliance_;
   double setup_seconds_ = 0.0;
 };
+
+/// Per mesh node, its x, y, z entries of the row vector x (`node_rows` as
+/// FreeDisplacementSystem's; zero where a component has no row).
+std::vector<Vec3> per_node(const std::vector<std::array<int, 3>>& node_rows,
+                           const Eigen::VectorXd& x);
 
 /// Every displacement component of `nodes` as a candidate: candidate 3k + c is nodes[k] along the
 /// unit axis e_c, so a CondensedWall on them holds the wall's full 3 × 3 compliance block per pair

@@ -104,18 +104,7 @@ std::vector<Vec3> CondensedLinearWall::nodal(const VectorXd& u) const {
           forces[static_cast<Eigen::Index>(3 * k) + c];
     }
   }
-  return field(factor_->solve(f));
-}
-
-std::vector<Vec3> CondensedLinearWall::field(const VectorXd& x) const {
-  std::vector<Vec3> out(system_.node_rows.size(), Vec3::Zero());
-  for (std::size_t n = 0; n < out.size(); ++n) {
-    for (int c = 0; c < 3; ++c) {
-      const int r = system_.node_rows[n][c];
-      if (r >= 0) out[n][c] = x[r];
-    }
-  }
-  return out;
+  return per_node(system_.node_rows, factor_->solve(f));
 }
 
 VectorXd CondensedLinearWall::band_rows(const std::vector<Vec3>& field) const {
@@ -127,35 +116,6 @@ VectorXd CondensedLinearWall::band_rows(const std::vector<Vec3>& field) const {
 }
 
 namespace {
-
-/// The surface nodes that join the band: the neighbours outside it of a pressed node on its edge,
-/// and the nodes outside it the displaced wall brings within `margin` of the wire's surface.
-std::vector<int> joining(const TetMesh& mesh, const std::vector<Triangle>& triangles,
-                         const std::vector<int>& surface, const std::vector<int>& band,
-                         const PotentialContactSolution& s, const std::vector<Vec3>& field,
-                         const ContactWire& wire, double margin) {
-  std::vector<char> in(mesh.nodes.size(), 0), pressed(mesh.nodes.size(), 0),
-      grow(mesh.nodes.size(), 0);
-  for (const int n : band) in[static_cast<std::size_t>(n)] = 1;
-  for (const int n : s.pressed) pressed[static_cast<std::size_t>(n)] = 1;
-  for (const Triangle& t : triangles) {
-    bool any = false;
-    for (int k = 0; k < 3; ++k) any = any || pressed[static_cast<std::size_t>(t[k])];
-    if (!any) continue;
-    for (int k = 0; k < 3; ++k) {
-      if (!in[static_cast<std::size_t>(t[k])]) grow[static_cast<std::size_t>(t[k])] = 1;
-    }
-  }
-  for (const int n : surface) {
-    const auto i = static_cast<std::size_t>(n);
-    if (!in[i] && capsule_gap(wire, s.x, mesh.nodes[i] + field[i]) < margin) grow[i] = 1;
-  }
-  std::vector<int> added;
-  for (std::size_t n = 0; n < grow.size(); ++n) {
-    if (grow[n]) added.push_back(static_cast<int>(n));
-  }
-  return added;
-}
 
 /// Where the wire went through the wall: the crossed triangle's nodes outside the band and every
 /// surface node outside it within `reach` of the crossing; none if the triangle is the band's own
@@ -210,7 +170,8 @@ GrownPotentialContact solve_wire_wall_potential_growing(msm::rods::Rod& rod, dou
       seconds += out.solution.seconds;
       x = out.solution.x;
       field = out.wall->nodal(out.solution.u);
-      added = joining(mesh, triangles, surface, band, out.solution, field, wire, growth.margin);
+      added = joining_the_band(mesh, triangles, surface, band, out.solution.pressed, wire, x, field,
+                               growth.margin);
     } catch (const WireThroughWall& e) {
       // The wire left the band through the wall, between nodes that were not candidates.
       added = near_crossing(mesh, surface, band, e, growth.crossing_reach);

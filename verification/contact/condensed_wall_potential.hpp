@@ -51,7 +51,6 @@ class CondensedLinearWall final : public WallPotential {
   [[nodiscard]] double setup_seconds() const { return setup_seconds_; }
 
  private:
-  [[nodiscard]] std::vector<Vec3> field(const Eigen::VectorXd& x) const;
   fem::FreeDisplacementSystem system_;
   std::unique_ptr<fem::CholmodFactor> factor_;
   std::vector<int> band_;

@@ -426,31 +426,11 @@ GrownContact solve_wire_wall_contact_growing(
                                          into_wall_directions(mesh, nodes, growth.surface_group),
                                          mesh, start, initial_active, options);
   for (;;) {
-    std::vector<char> in(mesh.nodes.size(), 0), grow(mesh.nodes.size(), 0);
-    for (const int node : nodes) in[static_cast<std::size_t>(node)] = 1;
-    std::vector<char> pressed(mesh.nodes.size(), 0);
-    for (const int j : out.solution.active) pressed[static_cast<std::size_t>(nodes[j])] = 1;
-    // A pressed candidate on the band's edge: its surface neighbours outside the band join.
-    for (const Triangle& t : triangles) {
-      bool any = false;
-      for (int k = 0; k < 3; ++k) any = any || pressed[static_cast<std::size_t>(t[k])];
-      if (!any) continue;
-      for (int k = 0; k < 3; ++k) {
-        if (!in[static_cast<std::size_t>(t[k])]) grow[static_cast<std::size_t>(t[k])] = 1;
-      }
-    }
-    // A non-candidate that the displaced wall brings within `margin` of the wire's surface.
+    std::vector<int> pressed;
+    for (const int j : out.solution.active) pressed.push_back(nodes[static_cast<std::size_t>(j)]);
     const std::vector<Vec3> u = out.wall->displacement(out.solution.wall_loads());
-    for (const int node : surface) {
-      if (in[static_cast<std::size_t>(node)]) continue;
-      if (capsule_gap(wire, out.solution.x, mesh.nodes[node] + u[node]) < growth.margin) {
-        grow[static_cast<std::size_t>(node)] = 1;
-      }
-    }
-    std::vector<int> added;
-    for (std::size_t node = 0; node < grow.size(); ++node) {
-      if (grow[node]) added.push_back(static_cast<int>(node));
-    }
+    const std::vector<int> added = joining_the_band(mesh, triangles, surface, nodes, pressed, wire,
+                                                    out.solution.x, u, growth.margin);
     if (added.empty()) break;
     if (out.rounds == growth.max_rounds) {
       throw std::runtime_error(
@@ -482,6 +462,36 @@ GrownContact solve_wire_wall_contact_growing(
   }
   out.nodes = nodes;
   return out;
+}
+
+std::vector<int> joining_the_band(const TetMesh& mesh, const std::vector<Triangle>& triangles,
+                                  const std::vector<int>& surface, const std::vector<int>& band,
+                                  const std::vector<int>& pressed, const ContactWire& wire,
+                                  const Eigen::VectorXd& x, const std::vector<Vec3>& displacement,
+                                  double margin) {
+  std::vector<char> in(mesh.nodes.size(), 0), bears(mesh.nodes.size(), 0),
+      grow(mesh.nodes.size(), 0);
+  for (const int n : band) in[static_cast<std::size_t>(n)] = 1;
+  for (const int n : pressed) bears[static_cast<std::size_t>(n)] = 1;
+  // A pressed candidate on the band's edge: its surface neighbours outside the band join.
+  for (const Triangle& t : triangles) {
+    bool any = false;
+    for (int k = 0; k < 3; ++k) any = any || bears[static_cast<std::size_t>(t[k])];
+    if (!any) continue;
+    for (int k = 0; k < 3; ++k) {
+      if (!in[static_cast<std::size_t>(t[k])]) grow[static_cast<std::size_t>(t[k])] = 1;
+    }
+  }
+  // A node outside the band that the displaced wall brings within `margin` of the wire's surface.
+  for (const int n : surface) {
+    const auto i = static_cast<std::size_t>(n);
+    if (!in[i] && capsule_gap(wire, x, mesh.nodes[i] + displacement[i]) < margin) grow[i] = 1;
+  }
+  std::vector<int> added;
+  for (std::size_t n = 0; n < grow.size(); ++n) {
+    if (grow[n]) added.push_back(static_cast<int>(n));
+  }
+  return added;
 }
 
 void GrownContact::pressed(std::vector<int>& mesh_nodes, std::vector<double>& forces) const {

@@ -120,6 +120,16 @@ struct BandGrowth {
   double crossing_reach = 0.5e-3;
 };
 
+/// The surface nodes (`surface`, its `triangles`) that join a band of candidates: the neighbours
+/// outside it of a pressed node (mesh indices) on its edge, and the nodes outside it that the
+/// wall displaced by `displacement` (per mesh node, m) brings within `margin` of the wire's
+/// surface at x. Ascending.
+std::vector<int> joining_the_band(const TetMesh& mesh, const std::vector<Triangle>& triangles,
+                                  const std::vector<int>& surface, const std::vector<int>& band,
+                                  const std::vector<int>& pressed, const ContactWire& wire,
+                                  const Eigen::VectorXd& x, const std::vector<Vec3>& displacement,
+                                  double margin);
+
 struct GrownContact {
   WireWallSolution solution;  ///< indices into `nodes`; steps, changes, seconds over all rounds
   std::vector<int> nodes;     ///< the final candidates' mesh nodes

@@ -22,16 +22,7 @@ namespace vessel::contact {
 using Eigen::VectorXd;
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
-std::vector<Vec3> WallPotential::nodal(const VectorXd& u) const {
-  const auto& rows = node_rows();
-  std::vector<Vec3> out(rows.size(), Vec3::Zero());
-  for (std::size_t n = 0; n < rows.size(); ++n) {
-    for (int c = 0; c < 3; ++c) {
-      if (rows[n][c] >= 0) out[n][c] = u[rows[n][c]];
-    }
-  }
-  return out;
-}
+std::vector<Vec3> WallPotential::nodal(const VectorXd& u) const { return per_node(node_rows(), u); }
 
 double LinearWall::evaluate(const VectorXd& u, VectorXd* gradient,
                             Eigen::SparseMatrix<double>* hessian, bool /*project_psd*/) const {
