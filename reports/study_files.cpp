@@ -145,6 +145,28 @@ WireEntry read_wire(const json& j, const std::string& where) {
   return w;
 }
 
+PairCandidateEntry read_pair(const json& j, const std::string& where) {
+  PairCandidateEntry e;
+  e.name = field<std::string>(j, "name", where);
+  e.wire = field<std::string>(j, "wire", where);
+  e.vessel = field<std::string>(j, "vessel", where);
+  e.error = optional_field<double>(j, "error", where);
+  e.update_seconds = field<double>(j, "update_seconds", where);
+  e.setup_seconds = field<double>(j, "setup_seconds", where);
+  e.pareto = field<bool>(j, "pareto", where);
+  e.verdict = field<std::string>(j, "verdict", where);
+  e.reason = field<std::string>(j, "reason", where);
+  return e;
+}
+
+PairsEntry read_pairs(const json& j, const std::string& where) {
+  PairsEntry p;
+  p.recommended = optional_field<std::string>(j, "recommended", where);
+  p.closest = optional_field<std::string>(j, "closest", where);
+  p.pairs = read_array(j, "pairs", where, read_pair);
+  return p;
+}
+
 CandidateEntry read_candidate(const json& j, const std::string& where) {
   CandidateEntry e;
   e.name = field<std::string>(j, "name", where);
@@ -451,6 +473,9 @@ RecommendFile parse_recommend(const std::string& text, const std::filesystem::pa
   r.candidates = read_array(j, "candidates", file, read_candidate);
   if (const auto w = j.find("wire"); w != j.end() && !w->is_null()) {
     r.wire = read_wire(*w, file + ": wire");
+  }
+  if (const auto p = j.find("pairs"); p != j.end() && !p->is_null()) {
+    r.pairs = read_pairs(*p, file + ": pairs");
   }
   return r;
 }

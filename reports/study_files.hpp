@@ -124,6 +124,18 @@ struct WireEntry {
   std::vector<WireCandidateEntry> candidates;
 };
 
+/// One wire–vessel pair of a guidewire scene's recommendation (recommend.json's "pairs").
+struct PairCandidateEntry {
+  std::string name, wire, vessel, verdict, reason;
+  std::optional<double> error;  ///< absent where the vessel's is not computable
+  double update_seconds = 0.0, setup_seconds = 0.0;
+  bool pareto = false;
+};
+struct PairsEntry {
+  std::optional<std::string> recommended, closest;
+  std::vector<PairCandidateEntry> pairs;
+};
+
 struct RecommendFile {
   std::filesystem::path path;
   std::string command, scene;
@@ -148,7 +160,8 @@ struct RecommendFile {
   bool whole_vessel_reported = false;       ///< the file has "whole_vessel" (null: none meets it)
   double reference_contact_point_mm = 0.0;  ///< the reference's largest QoI displacement
   std::vector<CandidateEntry> candidates;
-  std::optional<WireEntry> wire;  ///< guidewire scenes only
+  std::optional<WireEntry> wire;    ///< guidewire scenes only
+  std::optional<PairsEntry> pairs;  ///< guidewire scenes with a continuum wire only
 };
 
 /// validity.json of `vesselverify validity` (schema "vesselverify.validity", version 1;

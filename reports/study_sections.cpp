@@ -403,6 +403,44 @@ void wire_candidates(Document& doc, const RecommendFile& r) {
   doc.table(t);
 }
 
+/// A guidewire scene's wire–vessel pairs: the recommended (or closest) pair and the Pareto front.
+void pair_candidates(Document& doc, const RecommendFile& r) {
+  if (!r.pairs) return;
+  const PairsEntry& p = *r.pairs;
+  doc.heading(3, "The wire and the vessel together");
+  std::string answer =
+      "**Recommended: " + (p.recommended ? "`" + *p.recommended + "`" : std::string("none")) + "**";
+  if (!p.recommended && p.closest) answer += "; closest: `" + *p.closest + "`";
+  doc.paragraph(
+      "A simulator runs a rod model and a vessel model together: every finished wire candidate "
+      "with every finished vessel candidate (" +
+      std::to_string(p.pairs.size()) +
+      " pairs), judged against the same budget. A pair's error is the sum of the two errors "
+      "above, each against its own reference (the wire's against the continuum wire in the rigid "
+      "lumen, the vessel's against the FEM reference under the wire's load): a bound on the "
+      "pair's error as long as the wire's error does not change with the wall's compliance, an "
+      "estimate rather than a solve of the pair. Its time per update is the sum of the two; the "
+      "exchange of the contact force between them is not timed. " +
+      answer + ". The table lists the Pareto front (no other pair both faster and more accurate)" +
+      (p.recommended ? " and the recommended pair." : "."));
+  Table t;
+  t.header = {"pair", "error (" + r.unit + ")", "time per update (ms)", "set-up (ms)", "verdict",
+              "why"};
+  std::vector<const PairCandidateEntry*> shown;
+  for (const PairCandidateEntry& c : p.pairs) {
+    if (c.pareto || (p.recommended && c.name == *p.recommended)) shown.push_back(&c);
+  }
+  std::stable_sort(shown.begin(), shown.end(), [](const auto* a, const auto* b) {
+    return a->update_seconds < b->update_seconds;
+  });
+  for (const PairCandidateEntry* c : shown) {
+    t.rows.push_back({"`" + c->name + "`", c->error ? significant(*c->error, 3) : "–",
+                      significant(c->update_seconds * 1e3, 3),
+                      significant(c->setup_seconds * 1e3, 3), c->verdict, c->reason});
+  }
+  doc.table(t);
+}
+
 }  // namespace
 
 void recommendation_section(Document& doc, const RecommendFile& r) {
@@ -433,6 +471,7 @@ void recommendation_section(Document& doc, const RecommendFile& r) {
   doc.table(evidence_table(r));
   if (!r.timing_provenance.empty()) doc.paragraph("Timings: " + r.timing_provenance + ".");
   wire_candidates(doc, r);
+  pair_candidates(doc, r);
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include "verification/cli/commands.hpp"
 #include "verification/cli/jobs_option.hpp"
 #include "verification/scene_problems.hpp"
+#include "verification/studies/recommend/pair_candidates.hpp"
 #include "verification/studies/recommend/recommend.hpp"
 
 namespace vessel::cli {
@@ -56,6 +57,20 @@ void print_recommendation(const Recommendation& rec, const std::filesystem::path
               << c.setup_seconds * 1e3 << " ms set-up\n";
   } else {
     std::cout << "no whole-vessel candidate (without a region of interest) meets the budget\n";
+  }
+  if (rec.pairs) {
+    const Selection& p = rec.pairs->selection;
+    if (p.recommended) {
+      const Candidate& c = rec.pairs->pairs[*p.recommended];
+      std::cout << "wire and vessel together: " << c.name << ": error " << c.error << " " << unit
+                << " (the sum of theirs), " << c.update_seconds * 1e3 << " ms per update\n";
+    } else {
+      std::cout << "no wire-vessel pair meets the budget"
+                << (p.closest ? "; closest: " + rec.pairs->pairs[*p.closest].name + ": " +
+                                    p.reasons[*p.closest]
+                              : std::string())
+                << "\n";
+    }
   }
   std::cout << "wrote " << (dir / "recommend.md").string()
             << ", recommend.json and the candidates' results.json\n";
@@ -133,8 +148,9 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
       "and a rate or time per update). Runs generated candidates (FEM P1; surface and volume "
       "mass-spring models with every stiffness rule, static Newton and linearised solvers or, "
       "for dynamic scenes, every integrator; mesh levels 0-1; region-of-interest radii) against "
-      "the FEM reference at the budget's load; writes recommend.md (a report section), "
-      "recommend.json and the candidates' results.json.\n"
+      "the FEM reference at the budget's load; in a guidewire scene also the wire's rod models "
+      "against the continuum wire, and every wire-vessel pair; writes recommend.md (a report "
+      "section), recommend.json and the candidates' results.json.\n"
       "Examples:\n"
       "  vesselverify recommend verification/scenes/contact_straight.toml --rate 1000\n"
       "  vesselverify recommend --quick --time-budget 0.005 --tolerance 0.05 SCENE");

@@ -16,6 +16,7 @@
 #include "reports/study_sections.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
 #include "verification/scene_problems.hpp"
+#include "verification/studies/recommend/pair_candidates.hpp"
 #include "verification/studies/recommend/wire_candidates.hpp"
 
 using namespace vessel;
@@ -160,4 +161,101 @@ TEST(WireCandidates, ErrorsFallWithSegmentsAndTheCheapestPassingOneIsRecommended
   for (const WireCandidate& c : w.candidates) {
     EXPECT_NE(md.find("`" + c.name + "`"), std::string::npos) << c.name;
   }
+}
+
+namespace {
+
+WireCandidate wire_part(const std::string& name, double error, double seconds, bool ok = true) {
+  WireCandidate w;
+  w.name = name;
+  w.model = "der";
+  w.ok = ok;
+  w.failure = ok ? "" : "did not converge";
+  w.error = error;
+  w.update_seconds = seconds;
+  w.setup_seconds = 1e-3;
+  return w;
+}
+
+Candidate vessel_part(const std::string& name, double error, double seconds, bool ok = true) {
+  Candidate c;
+  c.name = name;
+  c.model = name;
+  c.ok = ok;
+  c.failure = ok ? "" : "diverged";
+  c.error = error;
+  c.update_seconds = seconds;
+  c.setup_seconds = 2e-3;
+  return c;
+}
+
+}  // namespace
+
+TEST(PairCandidates, APairsErrorAndTimeAreItsPartsSumsAndTheCheapestPairMeetingTheBudgetWins) {
+  // Hand-written parts (mm, s): the cheapest wire and the cheapest vessel that each meet 0.05 mm
+  // on their own (B, X) miss it together (0.03 + 0.03); the pair meeting it is A + X.
+  const std::vector<WireCandidate> wires = {
+      wire_part("A", 0.01, 1e-3), wire_part("B", 0.03, 0.1e-3), wire_part("C", 0.0, 0.0, false)};
+  const std::vector<Candidate> vessels = {
+      vessel_part("X", 0.03, 0.5e-3), vessel_part("Y", 0.01, 2e-3),
+      vessel_part("Z", 0.0, 0.0, false), vessel_part("W", NAN, 0.01e-3)};
+  Budget b;
+  b.stated = true;
+  b.quantity = BudgetQuantity::contact_point;
+  b.tolerance = 0.05;
+  b.time_budget_s = 2e-3;
+  const PairCandidates p = pair_candidates(wires, vessels, b);
+  ASSERT_EQ(p.pairs.size(), 6u);  // the failed wire C and vessel Z make no pair
+  const auto find = [&](const std::string& name) {
+    for (std::size_t i = 0; i < p.pairs.size(); ++i) {
+      if (p.pairs[i].name == name) return i;
+    }
+    ADD_FAILURE() << name << " missing";
+    return std::size_t{0};
+  };
+  const Candidate& ax = p.pairs[find("A + X")];
+  EXPECT_DOUBLE_EQ(ax.error, 0.04);
+  EXPECT_DOUBLE_EQ(ax.update_seconds, 1.5e-3);
+  EXPECT_DOUBLE_EQ(ax.setup_seconds, 3e-3);
+  ASSERT_TRUE(p.selection.recommended.has_value());
+  EXPECT_EQ(p.pairs[*p.selection.recommended].name, "A + X");
+  EXPECT_EQ(p.selection.verdicts[find("B + X")], Verdict::too_inaccurate);  // 0.06 mm
+  EXPECT_EQ(p.selection.verdicts[find("A + Y")], Verdict::too_slow);        // 3 ms
+  EXPECT_EQ(p.selection.verdicts[find("B + Y")], Verdict::too_slow);        // 2.1 ms
+  EXPECT_TRUE(std::isnan(p.pairs[find("A + W")].error));  // the vessel's is not computable
+  EXPECT_EQ(p.selection.verdicts[find("A + W")], Verdict::failed);
+
+  // The same pairs at 1000 Hz (1 ms per update): none meets both; the whole recommendation is
+  // judged again without running anything.
+  Recommendation rec;
+  rec.scene.name = "pairs";
+  rec.scene.budget = b;
+  rec.candidates = vessels;
+  rec.selection = select_model(vessels, b.tolerance, b.seconds_per_update());
+  WireRecommendation w;
+  w.candidates = wires;
+  w.selection = judge_wire(wires, b);
+  rec.wire = std::make_shared<const WireRecommendation>(w);
+  rec.pairs = std::make_shared<const PairCandidates>(p);
+  const Recommendation at_1000 = rejudged(rec, 1000.0);
+  ASSERT_TRUE(at_1000.pairs);
+  EXPECT_FALSE(at_1000.pairs->selection.recommended.has_value());
+  ASSERT_TRUE(at_1000.pairs->selection.closest.has_value());
+
+  // recommend.json's "pairs" meets the schema and names each pair's parts; the report's section
+  // shows the recommended pair.
+  const std::string text = recommendation_json(rec, "vesselverify recommend", "out");
+  const auto schema = nlohmann::json::parse(test::read_text(VESSEL_RECOMMEND_SCHEMA));
+  const nlohmann::json doc = nlohmann::json::parse(text);
+  const auto problems = test::schema_problems(doc, schema);
+  EXPECT_TRUE(problems.empty()) << test::joined(problems);
+  EXPECT_EQ(doc["pairs"]["recommended"], "A + X");
+  EXPECT_EQ(doc["pairs"]["pairs"][0]["wire"], "A");
+  EXPECT_EQ(doc["pairs"]["pairs"][0]["vessel"], "X");
+  const reports::RecommendFile file = reports::parse_recommend(text, "out/recommend.json");
+  ASSERT_TRUE(file.pairs.has_value());
+  EXPECT_EQ(file.pairs->pairs.size(), 6u);
+  const std::string md = reports::recommendation_markdown(file);
+  EXPECT_NE(md.find("### The wire and the vessel together"), std::string::npos) << md;
+  EXPECT_NE(md.find("**Recommended: `A + X`**"), std::string::npos) << md;
 }

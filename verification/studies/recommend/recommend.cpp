@@ -1,8 +1,4 @@
 #include "verification/studies/recommend/recommend.hpp"
-#include "verification/studies/recommend/wire_candidates.hpp"
-
-#include "verification/harness/harness.hpp"
-#include "verification/harness/results.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -20,6 +16,10 @@
 #include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
 #include "reports/svg_plot.hpp"
+#include "verification/harness/harness.hpp"
+#include "verification/harness/results.hpp"
+#include "verification/studies/recommend/pair_candidates.hpp"
+#include "verification/studies/recommend/wire_candidates.hpp"
 
 namespace vessel {
 
@@ -425,6 +425,10 @@ Recommendation recommend(const Scene& scene, const RecommendOptions& o,
   if (s.load.guidewire) {
     if (h.log) *h.log << "recommend " << s.name << ": the wire's candidates (DER, CORDE)\n";
     rec.wire = std::make_shared<const WireRecommendation>(recommend_wire(s));
+    if (rec.wire->reference) {
+      rec.pairs = std::make_shared<const PairCandidates>(
+          pair_candidates(rec.wire->candidates, rec.candidates, s.budget));
+    }
   }
   write_recommendation(rec, output_dir, command);
   return rec;
@@ -450,6 +454,10 @@ Recommendation rejudged(const Recommendation& rec, double rate_hz) {
     auto wire = std::make_shared<WireRecommendation>(*out.wire);
     wire->selection = judge_wire(wire->candidates, b);
     out.wire = wire;
+  }
+  if (out.pairs) {
+    out.pairs = std::make_shared<const PairCandidates>(
+        pair_candidates(out.wire->candidates, out.candidates, b));
   }
   return out;
 }
@@ -529,6 +537,9 @@ std::string recommendation_json(const Recommendation& rec, const std::string& co
                          {"whole_vessel", name_of(sel.whole_vessel)},
                          {"candidates", candidates}};
   if (rec.wire) j["wire"] = wire_recommendation_json(*rec.wire);
+  if (rec.pairs) {
+    j["pairs"] = pair_recommendation_json(*rec.pairs, rec.wire->candidates, rec.candidates);
+  }
   if (!rec.results_dir.empty()) {
     // The candidates' results.json, relative to recommend.json's folder.
     j["results"] =

@@ -92,6 +92,7 @@ std::vector<ModelSpec> candidate_models(const Scene& scene, const std::vector<do
 std::vector<Candidate> collect_candidates(const SceneResult& result);
 
 struct WireRecommendation;  // wire_candidates.hpp
+struct PairCandidates;      // pair_candidates.hpp
 
 struct Recommendation {
   Scene scene;  ///< as run (budget, candidate models, levels)
@@ -100,6 +101,9 @@ struct Recommendation {
   Selection selection;
   /// A guidewire scene's wire candidates (wire_candidates.hpp), judged apart: null otherwise.
   std::shared_ptr<const WireRecommendation> wire;
+  /// With a wire's continuum reference: every finished wire with every finished vessel candidate
+  /// (pair_candidates.hpp), judged apart: null otherwise.
+  std::shared_ptr<const PairCandidates> pairs;
   /// Where the candidates' run wrote results.json (a rate judged again shares the first's).
   std::filesystem::path results_dir;
 };
