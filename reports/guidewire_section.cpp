@@ -32,8 +32,11 @@ Table contact_wall_table(const ContactRun& run) {
 void contact_tables(Document& doc, const GuidewireContactRows& c) {
   doc.paragraph(
       "The wire–wall contact (coupling = \"contact\"): the wire's surface against each "
-      "model's wall linearised at rest, the contact zone found by the solve (no patch), "
-      "every wall on one mesh of " +
+      "model's wall " +
+      std::string(c.wall == "neo-Hookean"
+                      ? "at its own nonlinear equilibrium (the reference the neo-Hookean FEM wall)"
+                      : "linearised at rest") +
+      ", the contact zone found by the solve (no patch), every wall on one mesh of " +
       std::to_string(c.mesh_nodes) + " nodes refined to " + significant(c.fine_size_mm) +
       " mm within " + significant(c.fine_radius_mm) +
       " mm of the rigid wire's contact, at ν = " + significant(c.poisson_ratio) +

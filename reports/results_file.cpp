@@ -122,6 +122,7 @@ GuidewireContactRows read_guidewire_contact(const json& c, const std::string& wh
   out.strain_limit = field<double>(c, "strain_limit", where);
   out.mesh_nodes = field<int>(c, "mesh_nodes", where);
   out.reference_degree = field<int>(c, "reference_degree", where);
+  out.wall = json_fields::field_or<std::string>(c, "wall", "linear", where);
   for (const json& r : field<json>(c, "runs", where)) {
     const std::string rw = where + ".runs";
     ContactRun run;

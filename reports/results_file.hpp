@@ -153,6 +153,7 @@ struct ContactRun {
 struct GuidewireContactRows {
   double poisson_ratio = 0.0, fine_size_mm = 0.0, fine_radius_mm = 0.0, strain_limit = 0.0;
   int mesh_nodes = 0, reference_degree = 2;
+  std::string wall = "linear";  ///< linear | neo-Hookean (linear in files without it)
   std::vector<ContactRun> runs;
 };
 struct GuidewireRows {

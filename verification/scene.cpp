@@ -459,6 +459,20 @@ GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
     }
     w.contact_fine_size = r.number(*size, "contact_fine_size");
   }
+  if (const toml::node* radius = r.get("contact_fine_radius")) {
+    if (w.coupling != GuidewireCoupling::contact) {
+      r.fail(radius, "contact_fine_radius",
+             "found with coupling = \"" + coupling + "\"; expected coupling = \"contact\"");
+    }
+    w.contact_fine_radius = r.number(*radius, "contact_fine_radius");
+  }
+  if (const toml::node* wall = r.get("contact_wall")) {
+    if (w.coupling != GuidewireCoupling::contact) {
+      r.fail(wall, "contact_wall",
+             "found with coupling = \"" + coupling + "\"; expected coupling = \"contact\"");
+    }
+    w.contact_wall = parse_contact_wall(r.string_or("contact_wall", "linear"));
+  }
   return w;
 }
 

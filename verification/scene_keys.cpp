@@ -161,6 +161,16 @@ std::vector<Row> guidewire_rows() {
       Row("load", "contact_fine_size", KeyType::number,
           "Contact coupling: the contact mesh's element size near the wire's rigid contact")
           .dflt("0.08e-3").unit("m").positive().in(g),
+      Row("load", "contact_fine_radius", KeyType::number,
+          "Contact coupling: the radius of the contact mesh's refined region around the wire's "
+          "rigid contact (wider for a stiff wire whose contact slides)")
+          .dflt("1e-3").unit("m").positive().in(g),
+      Row("load", "contact_wall", KeyType::string,
+          "Contact coupling: linear: every wall linearised at rest, an EI whose series springs "
+          "dent the reference's wall deeper than it is thick not solved; neo-hookean: the "
+          "reference the finite-strain neo-Hookean FEM wall and each model at its own nonlinear "
+          "equilibrium, at every EI (minutes per EI)")
+          .dflt("\"linear\"").one_of({"linear", "neo-hookean"}).in(g),
   };
 }
 

@@ -247,6 +247,27 @@ TEST(Cli, SceneSaysWhatAContactCouplingWouldSolveAndRefusesAnUnknownCoupling) {
   EXPECT_EQ(sized.exit_code, 1) << sized.output;
   EXPECT_TRUE(contains(sized.output, "contact_fine_size")) << sized.output;
   EXPECT_TRUE(contains(sized.output, "expected coupling = \"contact\"")) << sized.output;
+  // So does its wall; with the contact coupling, a wall it does not know is refused with the
+  // values it takes, and a neo-Hookean one is what `scene` says a run would solve.
+  text.replace(text.find("contact_fine_size = 0.1e-3"),
+               std::string("contact_fine_size = 0.1e-3").size(), "contact_wall = \"neo-hookean\"");
+  write_text(dir / "walled.toml", text);
+  const auto walled = vv("scene " + (dir / "walled.toml").string());
+  EXPECT_EQ(walled.exit_code, 1) << walled.output;
+  EXPECT_TRUE(contains(walled.output, "contact_wall")) << walled.output;
+  text.replace(text.find("coupling = \"compliant\""),
+               std::string("coupling = \"compliant\"").size(), "coupling = \"contact\"");
+  write_text(dir / "neo.toml", text);
+  const auto neo = vv("scene " + (dir / "neo.toml").string());
+  EXPECT_EQ(neo.exit_code, 0) << neo.output;
+  EXPECT_TRUE(contains(neo.output, "at finite strain: the neo-Hookean reference")) << neo.output;
+  text.replace(text.find("\"neo-hookean\""), std::string("\"neo-hookean\"").size(),
+               "\"hyperelastic\"");
+  write_text(dir / "unknown.toml", text);
+  const auto unknown = vv("scene " + (dir / "unknown.toml").string());
+  EXPECT_EQ(unknown.exit_code, 1) << unknown.output;
+  EXPECT_TRUE(contains(unknown.output, "contact_wall")) << unknown.output;
+  EXPECT_TRUE(contains(unknown.output, "neo-hookean")) << unknown.output;
 }
 
 TEST(Cli, RunPrintsTheGuidewiresSolvedForceAndWallPoint) {

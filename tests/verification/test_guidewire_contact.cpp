@@ -204,10 +204,62 @@ TEST(GuidewireContact, AnEiWhoseSeriesSpringsDentTheWallDeeperThanItIsThickIsNot
               std::string::npos)
         << why;
     EXPECT_NE(why.find("--own-equilibrium"), std::string::npos) << why;
+    EXPECT_NE(why.find("contact_wall = \"neo-hookean\""), std::string::npos) << why;
     EXPECT_DOUBLE_EQ(c.solve.runs[k].rigid_force, coupled.rigid[k].solution.force);
     EXPECT_TRUE(c.solve.runs[k].models.empty());
   }
   EXPECT_EQ(c.shortcuts.size(), 2u);
+}
+
+// contact_wall = "neo-hookean": the EI the linear wall refuses (series springs 1.4 mm into the
+// 1 mm wall, hand-written) is solved, with the P2 reference the neo-Hookean wall at its own
+// equilibrium. On the wall made 10^4 times stiffer (its dent ~0.1 µm, its strains far below any
+// nonlinearity) that force is the continuum wire's F·z²/EI = 0.470968 within the rod's own error
+// plus the faceted wall's 1 %, and the run is judged (valid at any strain), its results.json
+// object naming the wall and meeting the schema.
+TEST(GuidewireContactSlow, ANeoHookeanContactWallSolvesTheEiALinearWallCannotHold) {
+  Scene scene = stiff_scene("guidewire_straight.toml", 1e4, {});
+  scene.load.guidewire->coupling = GuidewireCoupling::contact;
+  scene.load.guidewire->contact_wall = ContactWall::neo_hookean;
+  *scene.load.guidewire = with_stiffness(*scene.load.guidewire, 4e-6);  // its one EI
+  scene.load.guidewire->stiffness_sweep.clear();
+  GuidewireRigid r;
+  r.bending_stiffness = 4e-6;
+  r.reference_compliance = 0.5;  // m/N
+  r.reference_force = 2.8e-3;    // N: 1.4 mm in
+  GuidewireOutcome coupled;
+  coupled.rigid.push_back(r);
+  HarnessOptions o;
+  o.contact_fine_size = 0.12e-3;
+  o.log = &std::cerr;
+  const GuidewireContact c = solve_guidewire_contact(scene, coupled, o);
+  ASSERT_EQ(c.solve.runs.size(), 1u);
+  const contact::ContactModelsRun& run = c.solve.runs.front();
+  ASSERT_EQ(run.reference.failure, "") << run.reference.failure;
+  EXPECT_EQ(run.reference.linearisation, "own equilibrium");
+  EXPECT_NE(run.reference.detail.find("neo-Hookean"), std::string::npos) << run.reference.detail;
+  EXPECT_NEAR(run.bending_stiffness, 4e-6, 1e-12);
+  const double z = 20e-3, EI = 4e-6;
+  const double F = run.reference.force, F_continuum = continuum_force(scene, EI);
+  std::printf(
+      "GUIDEWIRE-CONTACT straight, neo-Hookean wall x1e4, EI %g: F z^2/EI = %.6f (P2), "
+      "%.6f (rigid lumen), %.6f (continuum), largest strain %.2e\n",
+      EI, F * z * z / EI, run.rigid_force * z * z / EI, F_continuum * z * z / EI,
+      run.reference.strain);
+  const double rod_error = std::abs(run.rigid_force / F_continuum - 1.0);
+  EXPECT_LT(std::abs(F / F_continuum - 1.0), rod_error + 1e-2);
+  EXPECT_TRUE(c.within_linear_validity(run));
+  const nlohmann::json j = guidewire_contact_json(c);
+  EXPECT_EQ(j.at("wall"), "neo-Hookean");
+  const auto schema = nlohmann::json::parse(test::read_text(VESSEL_RESULTS_SCHEMA));
+  const auto problems = test::schema_problems(j, schema.at("properties")
+                                                     .at("scenes")
+                                                     .at("items")
+                                                     .at("properties")
+                                                     .at("guidewire")
+                                                     .at("properties")
+                                                     .at("contact"));
+  EXPECT_TRUE(problems.empty()) << test::joined(problems);
 }
 
 }  // namespace

@@ -18,6 +18,12 @@ namespace vessel {
 
 namespace rods = msm::rods;
 
+ContactWall parse_contact_wall(const std::string& name) {
+  if (name == "linear") return ContactWall::linear;
+  if (name == "neo-hookean") return ContactWall::neo_hookean;
+  throw InputError("wall: expected \"linear\" or \"neo-hookean\", got \"" + name + "\"");
+}
+
 // XPBD's static solve is a damped dynamic run to rest, 30 % of the velocity removed per step,
 // in steps of a haptic frame. Its steady state does not depend on the step (the same force to 8
 // digits from 0.05 to 2 ms, N = 32, guidewire_straight; tests/rods/test_rigid_wall.cpp).
@@ -456,9 +462,14 @@ std::string describe_guidewire_solve(const GuidewireSpec& spec) {
   }
   if (spec.coupling == GuidewireCoupling::contact) {
     s << "; coupling contact: `vesselverify run` would then press each model's wall and the FEM "
-         "P2 wall with the wire in a contact solve at the wire's EI and each of stiffness_sweep "
-         "on a mesh refined to "
-      << spec.contact_fine_size * 1e3 << " mm (minutes; --quick at the wire's EI alone)";
+         "P2 wall"
+      << (spec.contact_wall == ContactWall::neo_hookean
+              ? " (at finite strain: the neo-Hookean reference, each model at its own equilibrium)"
+              : " (linearised at rest)")
+      << " with the wire in a contact solve at the wire's EI and each of stiffness_sweep on a "
+         "mesh refined to "
+      << spec.contact_fine_size * 1e3 << " mm within " << spec.contact_fine_radius * 1e3
+      << " mm of its contact (minutes; --quick at the wire's EI alone)";
   }
   return s.str();
 }

@@ -74,6 +74,17 @@ inline std::string to_string(GuidewireCoupling coupling) {
   return "rigid";
 }
 
+/// The wall of a contact solve: linear elasticity, or the finite-strain compressible neo-Hookean
+/// wall (fem::NeoHookean; each mass-spring model then at its own nonlinear equilibrium).
+enum class ContactWall { linear, neo_hookean };
+/// "linear" or "neo-Hookean".
+inline std::string to_string(ContactWall wall) {
+  return wall == ContactWall::linear ? "linear" : "neo-Hookean";
+}
+/// "linear" or "neo-hookean" (the scene's and the command line's name); InputError naming both
+/// otherwise.
+ContactWall parse_contact_wall(const std::string& name);
+
 struct GuidewireSpec {
   double young = 0.0;     ///< E, Pa
   double shear = 0.0;     ///< G, Pa
@@ -95,8 +106,14 @@ struct GuidewireSpec {
   /// Compliant or contact coupling: the bending stiffnesses EI (N·m²) the coupling is repeated at
   /// (E scaled, the section kept), with the walls' compliances of the scene's run.
   std::vector<double> stiffness_sweep;
-  /// Contact coupling: the contact mesh's element size near the wire's rigid contact, m.
+  /// Contact coupling: the contact mesh's element size near the wire's rigid contact, m, and the
+  /// radius of that refined region, m.
   double contact_fine_size = 0.08e-3;
+  double contact_fine_radius = 1.0e-3;
+  /// Contact coupling: the walls of the run's contact solve. linear: an EI whose series springs
+  /// dent the reference's wall deeper than it is thick is not solved (a linear wall cannot hold
+  /// the wire there); neo_hookean: every EI.
+  ContactWall contact_wall = ContactWall::linear;
   /// Contact coupling: the contact solved at the wire's own EI alone, not at stiffness_sweep's
   /// (the series springs still are). Not a scene key: set by the quick variant.
   bool contact_at_own_stiffness_only = false;

@@ -453,16 +453,6 @@ void judge(const ContactReferenceOptions& o, ContactReference& r) {
 
 }  // namespace
 
-std::string to_string(ContactWall wall) {
-  return wall == ContactWall::linear ? "linear" : "neo-Hookean";
-}
-
-ContactWall parse_contact_wall(const std::string& name) {
-  if (name == "linear") return ContactWall::linear;
-  if (name == "neo-hookean") return ContactWall::neo_hookean;
-  throw InputError("wall: expected \"linear\" or \"neo-hookean\", got \"" + name + "\"");
-}
-
 std::vector<double> contact_reference_stiffnesses(const Scene& scene) {
   require_guidewire(scene);
   const GuidewireSpec& g = *scene.load.guidewire;

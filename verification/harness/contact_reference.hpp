@@ -22,15 +22,6 @@
 
 namespace vessel {
 
-/// The wall of the contact reference: linear elasticity (condensed on the candidates, Signorini's
-/// conditions by an active set: verification/contact/wire_wall_contact.hpp) or the finite-strain
-/// compressible neo-Hookean wall (the wire and the wall as one potential:
-/// verification/contact/wire_wall_potential.hpp).
-enum class ContactWall { linear, neo_hookean };
-std::string to_string(ContactWall wall);
-/// "linear" or "neo-hookean"; InputError naming both otherwise.
-ContactWall parse_contact_wall(const std::string& name);
-
 struct ContactReferenceOptions {
   ContactWall wall = ContactWall::linear;
   int levels = 3;  ///< refinement levels (three give an observed order)

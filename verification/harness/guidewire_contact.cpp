@@ -197,7 +197,8 @@ std::string beyond_the_linear_wall(const Scene& scene, const GuidewireOutcome& c
            " mm in under " + fmt("%.3f", r.reference_force * 1e3) +
            " mN, deeper than the wall is thick (" + fmt("%.2f", scene.vessel.wall_thickness * 1e3) +
            " mm): a linear wall cannot hold the wire there (the finite-strain reference can: "
-           "vesselverify contact-models --own-equilibrium)";
+           "contact_wall = \"neo-hookean\" in the scene, or vesselverify contact-models "
+           "--own-equilibrium)";
   }
   return {};
 }
@@ -217,21 +218,31 @@ contact::ContactModelsRun unsolved_run(const GuidewireOutcome& coupled, double E
   return run;
 }
 
-/// The scene's solve options: the EIs a linear wall can hold (the wire's own alone in the quick
-/// variant), the contact mesh's size, the potential on the condensed band.
+/// Why the contact at EI is not solved with the scene's walls, or empty: only a linear wall has
+/// EIs it cannot hold.
+std::string not_solved(const Scene& scene, const GuidewireOutcome& coupled, double EI) {
+  if (scene.load.guidewire->contact_wall == ContactWall::neo_hookean) return {};
+  return beyond_the_linear_wall(scene, coupled, EI);
+}
+
+/// The scene's solve options: the EIs its walls can hold (the wire's own alone in the quick
+/// variant), the contact mesh's size and refined radius, the wire and each wall as one potential
+/// (linear walls condensed on the band; at finite strain each at its own equilibrium).
 contact::ContactModelsOptions contact_options(const Scene& scene, const GuidewireOutcome& coupled,
                                               const HarnessOptions& options) {
   const GuidewireSpec& spec = *scene.load.guidewire;
   contact::ContactModelsOptions o;
   for (const double EI : contact_stiffnesses(spec)) {
-    if (beyond_the_linear_wall(scene, coupled, EI).empty()) o.bending_stiffness.push_back(EI);
+    if (not_solved(scene, coupled, EI).empty()) o.bending_stiffness.push_back(EI);
   }
   o.fine_size =
       options.contact_fine_size > 0.0 ? options.contact_fine_size : spec.contact_fine_size;
-  // The wire and each wall as one potential on the condensed band: its energy line search holds
-  // the contacts the active set loses (the arch's buckled wire, whose force hardly changes with
-  // its shape; the mass-spring walls the wire dents deepest).
+  o.fine_radius = spec.contact_fine_radius;
+  // The wire and each wall as one potential: its energy line search holds the contacts the
+  // active set loses (the arch's buckled wire, whose force hardly changes with its shape; the
+  // mass-spring walls the wire dents deepest).
   o.potential = true;
+  o.own_equilibrium = spec.contact_wall == ContactWall::neo_hookean;
   return o;
 }
 
@@ -240,6 +251,7 @@ contact::ContactModelsOptions contact_options(const Scene& scene, const Guidewir
 GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutcome& coupled,
                                          const HarnessOptions& options) {
   GuidewireContact c;
+  c.wall = scene.load.guidewire->contact_wall;
   c.options = contact_options(scene, coupled, options);
   std::vector<ModelSpec> walls;
   std::vector<std::string> names;
@@ -253,7 +265,9 @@ GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutc
   const auto solve = [&] {
     if (options.log) {
       *options.log << scene.name << ": the wire-wall contact, the reference and " << walls.size()
-                   << " model walls at " << o.bending_stiffness.size()
+                   << " model walls"
+                   << (o.own_equilibrium ? " at finite strain (each at its own equilibrium)" : "")
+                   << " at " << o.bending_stiffness.size()
                    << " bending stiffnesses (a contact solve each; minutes)" << std::endl;
     }
     return serialise(contact::solve_contact_models(scene, walls, o));
@@ -270,7 +284,7 @@ GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutc
   std::vector<contact::ContactModelsRun> runs;
   std::size_t solved = 0;
   for (const double EI : contact_stiffnesses(*scene.load.guidewire)) {
-    const std::string why = beyond_the_linear_wall(scene, coupled, EI);
+    const std::string why = not_solved(scene, coupled, EI);
     runs.push_back(why.empty() ? c.solve.runs.at(solved++)
                                : unsolved_run(coupled, EI, c.options.reference_degree, why));
   }
@@ -309,6 +323,7 @@ json guidewire_contact_json(const GuidewireContact& c) {
            {"mesh_tets", c.solve.mesh_tets},
            {"fine_size_mm", c.options.fine_size * 1e3},
            {"fine_radius_mm", c.options.fine_radius * 1e3},
+           {"wall", to_string(c.wall)},
            {"reference_degree", c.options.reference_degree},
            {"strain_limit", c.strain_limit},
            {"runs", runs}};
@@ -317,9 +332,12 @@ json guidewire_contact_json(const GuidewireContact& c) {
 }
 
 void write_guidewire_contact_markdown(std::ostream& out, const GuidewireContact& c) {
-  out << "Contact (coupling = \"contact\"): the wire's surface against each wall linearised at "
-         "rest, the contact found by the solve, on one mesh of "
-      << c.solve.mesh_nodes << " nodes refined to " << c.options.fine_size * 1e3 << " mm within "
+  out << "Contact (coupling = \"contact\"): the wire's surface against each wall "
+      << (c.wall == ContactWall::neo_hookean
+              ? "at its own nonlinear equilibrium (the reference the neo-Hookean FEM wall)"
+              : "linearised at rest")
+      << ", the contact found by the solve, on one mesh of " << c.solve.mesh_nodes
+      << " nodes refined to " << c.options.fine_size * 1e3 << " mm within "
       << c.options.fine_radius * 1e3 << " mm of the rigid wire's contact (ν = " << c.solve.nu
       << "); each force against the FEM P" << c.options.reference_degree
       << " wall's in the same solve"
