@@ -166,6 +166,11 @@ ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidCo
   return out;
 }
 
+/// How a wall enters the contact solve: at its own equilibrium, or its linearisation at rest.
+std::string wall_label(const ModelWall& wall, const ContactModelsOptions& options) {
+  return options.own_equilibrium ? "own equilibrium" : to_string(wall.linearisation);
+}
+
 /// The wall and the wire as one potential: the wall linearised at rest (condensed on a band
 /// grown from the first candidates, CondensedLinearWall) or, with options.own_equilibrium, at its
 /// own equilibrium (a msm model's own energy, FormWall; deal.II's FEM as the neo-Hookean wall for
@@ -177,7 +182,7 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
   ModelContact out;
   out.name = wall.name;
   out.detail = wall.detail;
-  out.linearisation = options.own_equilibrium ? "own equilibrium" : to_string(wall.linearisation);
+  out.linearisation = wall_label(wall, options);
   const auto t0 = std::chrono::steady_clock::now();
   PotentialContactOptions o;
   o.force_scale = EI / (w.length * w.length);
@@ -355,7 +360,7 @@ void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
         } catch (const std::exception& ex) {
           c = failed(*walls[k], ex.what());
           c.detail = wall->detail;
-          c.linearisation = to_string(wall->linearisation);
+          c.linearisation = wall_label(*wall, options);
         }
       }
       if (options.log) {
