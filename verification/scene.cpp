@@ -452,25 +452,21 @@ GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
     }
     w.stiffness_sweep = r.numbers(*sweep, "stiffness_sweep");
   }
-  if (const toml::node* size = r.get("contact_fine_size")) {
-    if (w.coupling != GuidewireCoupling::contact) {
-      r.fail(size, "contact_fine_size",
-             "found with coupling = \"" + coupling + "\"; expected coupling = \"contact\"");
+  // The contact coupling's own keys: refused with another coupling.
+  const auto contact_key = [&](const char* key) {
+    const toml::node* node = r.get(key);
+    if (node && w.coupling != GuidewireCoupling::contact) {
+      r.fail(node, key, "found with coupling = \"" + coupling + "\"; expected coupling = \"contact\"");
     }
+    return node;
+  };
+  if (const toml::node* size = contact_key("contact_fine_size")) {
     w.contact_fine_size = r.number(*size, "contact_fine_size");
   }
-  if (const toml::node* radius = r.get("contact_fine_radius")) {
-    if (w.coupling != GuidewireCoupling::contact) {
-      r.fail(radius, "contact_fine_radius",
-             "found with coupling = \"" + coupling + "\"; expected coupling = \"contact\"");
-    }
+  if (const toml::node* radius = contact_key("contact_fine_radius")) {
     w.contact_fine_radius = r.number(*radius, "contact_fine_radius");
   }
-  if (const toml::node* wall = r.get("contact_wall")) {
-    if (w.coupling != GuidewireCoupling::contact) {
-      r.fail(wall, "contact_wall",
-             "found with coupling = \"" + coupling + "\"; expected coupling = \"contact\"");
-    }
+  if (contact_key("contact_wall")) {
     w.contact_wall = parse_contact_wall(r.string_or("contact_wall", "linear"));
   }
   return w;
