@@ -1,6 +1,7 @@
 #include "reports/results_file.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "reports/json_fields.hpp"
@@ -108,7 +109,8 @@ ContactWallRow read_contact_wall(const json& j, const std::string& where) {
   w.axial_extent_mm = field<double>(j, "axial_extent_mm", where);
   w.circumferential_extent_mm = field<double>(j, "circumferential_extent_mm", where);
   w.dent_mm = field<double>(j, "dent_mm", where);
-  w.largest_strain = field<double>(j, "largest_strain", where);
+  // null: not computable (a surface model's wall has no tets)
+  w.largest_strain = json_fields::optional_field<double>(j, "largest_strain", where).value_or(NAN);
   w.setup_seconds = field<double>(j, "setup_seconds", where);
   w.solve_seconds = field<double>(j, "solve_seconds", where);
   return w;

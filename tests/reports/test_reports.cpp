@@ -641,6 +641,24 @@ TEST(GuidewireSection, TheContactSolvesModelsAndShortcutsAsResultsJsonGivesThem)
   EXPECT_EQ(count(md, "failed: did not converge"), 1u) << md;
   EXPECT_EQ(count(md, "| rigid lumen | 0.471 | 9.53 |"), 2u) << md;
   EXPECT_EQ(count(md, "⚠ Beyond the linear reference's validity"), 1u) << md;
+  EXPECT_EQ(count(md, "model's wall linearised at rest"), 1u) << md;
+  // A finite-strain contact: the walls at their own equilibrium, and a surface model's strain,
+  // which it cannot compute (no tets), written as null.
+  j["scenes"][0]["guidewire"]["contact"]["wall"] = "neo-Hookean";
+  nlohmann::json surface = wall("surface_seed000", 0.3994, -7.0);
+  surface["largest_strain"] = nullptr;
+  j["scenes"][0]["guidewire"]["contact"]["runs"][0]["models"].push_back(surface);
+  const ResultsFile neo = parse_results(j.dump(), "results.json");
+  const GuidewireContactRows& c = *neo.scenes[0].guidewire->contact;
+  EXPECT_EQ(c.wall, "neo-Hookean");
+  ASSERT_EQ(c.runs[0].models.size(), 3u);
+  EXPECT_TRUE(std::isnan(c.runs[0].models[2].largest_strain));
+  const std::string neo_md = build_report(neo, std::nullopt, "test").markdown_text("figures");
+  EXPECT_EQ(count(neo_md, "at its own nonlinear equilibrium (the reference the neo-Hookean FEM "
+                          "wall)"),
+            1u)
+      << neo_md;
+  EXPECT_EQ(count(neo_md, "| surface_seed000 | 0.3994 |"), 1u) << neo_md;
   // A contact block without its runs is a clear error naming the field.
   j["scenes"][0]["guidewire"]["contact"].erase("runs");
   try {

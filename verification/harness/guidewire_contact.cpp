@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <ostream>
 
@@ -45,27 +46,34 @@ json wall_json(const contact::ModelContact& m) {
           {"solve_seconds", m.solve_seconds}};
 }
 
+/// j[key] as a number; NaN where it is null (a NaN, e.g. the strain of a wall without tets, is
+/// written as null).
+double number(const json& j, const char* key) {
+  const json& v = j.at(key);
+  return v.is_null() ? std::numeric_limits<double>::quiet_NaN() : v.get<double>();
+}
+
 contact::ModelContact wall_of(const json& j) {
   contact::ModelContact m;
   m.name = j.at("name");
   m.detail = j.at("detail");
   m.linearisation = j.at("linearisation");
   m.failure = j.at("failure");
-  m.force = j.at("force");
+  m.force = number(j, "force");
   m.force_on_wall = vec_of(j.at("force_on_wall"));
   m.pressed = j.at("pressed");
   m.candidates = j.at("candidates");
   m.rounds = j.at("rounds");
   m.centroid = vec_of(j.at("centroid"));
-  m.axial_extent = j.at("axial_extent");
-  m.circumferential_extent = j.at("circumferential_extent");
-  m.dent = j.at("dent");
-  m.strain = j.at("strain");
+  m.axial_extent = number(j, "axial_extent");
+  m.circumferential_extent = number(j, "circumferential_extent");
+  m.dent = number(j, "dent");
+  m.strain = number(j, "strain");
   m.tip = vec_of(j.at("tip"));
-  m.own_imbalance = j.at("own_imbalance");
+  m.own_imbalance = number(j, "own_imbalance");
   m.steps = j.at("steps");
-  m.setup_seconds = j.at("setup_seconds");
-  m.solve_seconds = j.at("solve_seconds");
+  m.setup_seconds = number(j, "setup_seconds");
+  m.solve_seconds = number(j, "solve_seconds");
   return m;
 }
 
