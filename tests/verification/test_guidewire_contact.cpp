@@ -212,13 +212,13 @@ TEST(GuidewireContact, AnEiWhoseSeriesSpringsDentTheWallDeeperThanItIsThickIsNot
 }
 
 // contact_wall = "neo-hookean": the EI the linear wall refuses (series springs 1.4 mm into the
-// 1 mm wall, hand-written) is solved, with the P2 reference the neo-Hookean wall at its own
-// equilibrium. On the wall made 10^4 times stiffer (its dent ~0.1 µm, its strains far below any
+// 1 mm wall, hand-written) is solved, with the P2 reference the neo-Hookean wall and the surface
+// model at their own equilibria, and read back from the outcome cache. On the wall made 10^4 times stiffer (its dent ~0.1 µm, its strains far below any
 // nonlinearity) that force is the continuum wire's F·z²/EI = 0.470968 within the rod's own error
 // plus the faceted wall's 1 %, and the run is judged (valid at any strain), its results.json
 // object naming the wall and meeting the schema.
 TEST(GuidewireContactSlow, ANeoHookeanContactWallSolvesTheEiALinearWallCannotHold) {
-  Scene scene = stiff_scene("guidewire_straight.toml", 1e4, {});
+  Scene scene = stiff_scene("guidewire_straight.toml", 1e4, {"surface_seed000"});
   scene.load.guidewire->coupling = GuidewireCoupling::contact;
   scene.load.guidewire->contact_wall = ContactWall::neo_hookean;
   *scene.load.guidewire = with_stiffness(*scene.load.guidewire, 4e-6);  // its one EI
@@ -229,12 +229,23 @@ TEST(GuidewireContactSlow, ANeoHookeanContactWallSolvesTheEiALinearWallCannotHol
   r.reference_force = 2.8e-3;    // N: 1.4 mm in
   GuidewireOutcome coupled;
   coupled.rigid.push_back(r);
+  test::TempDir dir;
+  std::ostringstream cache_log;
+  OutcomeCache cache(dir.path(), false, &cache_log);
   HarnessOptions o;
+  o.outcome_cache = &cache;
   o.contact_fine_size = 0.12e-3;
   o.log = &std::cerr;
+  (void)solve_guidewire_contact(scene, coupled, o);
+  // Read back from the cache: the surface model's wall has no tets, its strain NaN.
   const GuidewireContact c = solve_guidewire_contact(scene, coupled, o);
+  EXPECT_TRUE(c.provenance.cached);
   ASSERT_EQ(c.solve.runs.size(), 1u);
   const contact::ContactModelsRun& run = c.solve.runs.front();
+  ASSERT_EQ(run.models.size(), 1u);
+  ASSERT_EQ(run.models[0].failure, "") << run.models[0].failure;
+  EXPECT_EQ(run.models[0].linearisation, "own equilibrium");
+  EXPECT_TRUE(std::isnan(run.models[0].strain));
   ASSERT_EQ(run.reference.failure, "") << run.reference.failure;
   EXPECT_EQ(run.reference.linearisation, "own equilibrium");
   EXPECT_NE(run.reference.detail.find("neo-Hookean"), std::string::npos) << run.reference.detail;
