@@ -213,10 +213,11 @@ TEST(GuidewireContact, AnEiWhoseSeriesSpringsDentTheWallDeeperThanItIsThickIsNot
 
 // contact_wall = "neo-hookean": the EI the linear wall refuses (series springs 1.4 mm into the
 // 1 mm wall, hand-written) is solved, with the P2 reference the neo-Hookean wall and the surface
-// model at their own equilibria, and read back from the outcome cache. On the wall made 10^4 times stiffer (its dent ~0.1 µm, its strains far below any
-// nonlinearity) that force is the continuum wire's F·z²/EI = 0.470968 within the rod's own error
-// plus the faceted wall's 1 %, and the run is judged (valid at any strain), its results.json
-// object naming the wall and meeting the schema.
+// model at their own equilibria, and read back from the outcome cache. On the wall made 10^4
+// times stiffer (its dent ~0.1 µm, its strains far below any nonlinearity) the reference's force
+// is the continuum wire's F·z²/EI = 0.470968 within the rod's own error plus the faceted wall's
+// 1 %, and the run is judged (valid at any strain), its results.json object naming the wall and
+// meeting the schema.
 TEST(GuidewireContactSlow, ANeoHookeanContactWallSolvesTheEiALinearWallCannotHold) {
   Scene scene = stiff_scene("guidewire_straight.toml", 1e4, {"surface_seed000"});
   scene.load.guidewire->coupling = GuidewireCoupling::contact;
