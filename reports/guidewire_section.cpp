@@ -53,7 +53,7 @@ void contact_tables(Document& doc, const GuidewireContactRows& c) {
     line += significant(ref.force_mN, 4) + " mN (rigid lumen " +
             significant(run.rigid_force_mN, 4) + " mN), dent " + significant(ref.dent_mm) +
             " mm, largest strain " + significant(ref.largest_strain) + ".";
-    if (!run.within_linear_validity) {
+    if (c.wall == "linear" && !run.within_linear_validity) {  // neo-Hookean: no strain limit
       line += " ⚠ Beyond the linear reference's validity (largest strain above " +
               significant(c.strain_limit) +
               "): these rows show the regime, not a prediction; the finite-strain reference is "

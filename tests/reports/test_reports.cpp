@@ -659,6 +659,8 @@ TEST(GuidewireSection, TheContactSolvesModelsAndShortcutsAsResultsJsonGivesThem)
             1u)
       << neo_md;
   EXPECT_EQ(count(neo_md, "| surface_seed000 | 0.3994 |"), 1u) << neo_md;
+  // Its strained run (largest strain 0.31) is judged: the strain limit is the linear wall's.
+  EXPECT_EQ(count(neo_md, "⚠ Beyond the linear reference's validity"), 0u) << neo_md;
   // A contact block without its runs is a clear error naming the field.
   j["scenes"][0]["guidewire"]["contact"].erase("runs");
   try {

@@ -41,6 +41,20 @@ Scene stiff_scene(const std::string& name, double stiffer, const std::vector<std
   return s;
 }
 
+/// A run's options with an outcome cache of its own (a temporary folder) and a 0.12 mm contact
+/// mesh.
+struct CachedContactOptions {
+  CachedContactOptions() {
+    options.outcome_cache = &cache;
+    options.contact_fine_size = 0.12e-3;
+    options.log = &std::cerr;
+  }
+  test::TempDir dir;
+  std::ostringstream cache_log;
+  OutcomeCache cache{dir.path(), false, &cache_log};
+  HarnessOptions options;
+};
+
 /// The continuum wire's force (N) for the scene's wire at EI against the rigid lumen.
 double continuum_force(const Scene& s, double EI) {
   std::string why;
@@ -99,13 +113,8 @@ TEST(GuidewireContactSlow, TheStraightSceneOnAStiffWallScalesWithEiAndIsReadBack
   Scene scene = stiff_scene("guidewire_straight.toml", 1e6, {"fem_p1"});
   scene.load.guidewire->coupling = GuidewireCoupling::contact;
   scene.load.guidewire->stiffness_sweep = {4e-7, 4e-6};
-  test::TempDir dir;
-  std::ostringstream cache_log;
-  OutcomeCache cache(dir.path(), false, &cache_log);
-  HarnessOptions o;
-  o.outcome_cache = &cache;
-  o.contact_fine_size = 0.12e-3;
-  o.log = &std::cerr;
+  CachedContactOptions cached;
+  const HarnessOptions& o = cached.options;
   const GuidewireContact first = solve_guidewire_contact(scene, GuidewireOutcome{}, o);
   ASSERT_EQ(first.solve.runs.size(), 2u);
   EXPECT_FALSE(first.provenance.cached);
@@ -230,13 +239,8 @@ TEST(GuidewireContactSlow, ANeoHookeanContactWallSolvesTheEiALinearWallCannotHol
   r.reference_force = 2.8e-3;    // N: 1.4 mm in
   GuidewireOutcome coupled;
   coupled.rigid.push_back(r);
-  test::TempDir dir;
-  std::ostringstream cache_log;
-  OutcomeCache cache(dir.path(), false, &cache_log);
-  HarnessOptions o;
-  o.outcome_cache = &cache;
-  o.contact_fine_size = 0.12e-3;
-  o.log = &std::cerr;
+  CachedContactOptions cached;
+  const HarnessOptions& o = cached.options;
   (void)solve_guidewire_contact(scene, coupled, o);
   // Read back from the cache: the surface model's wall has no tets, its strain NaN.
   const GuidewireContact c = solve_guidewire_contact(scene, coupled, o);
@@ -260,7 +264,7 @@ TEST(GuidewireContactSlow, ANeoHookeanContactWallSolvesTheEiALinearWallCannotHol
       run.reference.strain);
   const double rod_error = std::abs(run.rigid_force / F_continuum - 1.0);
   EXPECT_LT(std::abs(F / F_continuum - 1.0), rod_error + 1e-2);
-  EXPECT_TRUE(c.within_linear_validity(run));
+  EXPECT_FALSE(c.beyond_its_reference(run));
   const nlohmann::json j = guidewire_contact_json(c);
   EXPECT_EQ(j.at("wall"), "neo-Hookean");
   const auto schema = nlohmann::json::parse(test::read_text(VESSEL_RESULTS_SCHEMA));

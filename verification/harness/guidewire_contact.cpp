@@ -362,7 +362,7 @@ void write_guidewire_contact_markdown(std::ostream& out, const GuidewireContact&
     out << fmt("%.4f", ref.force * 1e3) << " mN (rigid lumen " << fmt("%.4f", run.rigid_force * 1e3)
         << " mN), dent " << fmt("%.4f", ref.dent * 1e3) << " mm, largest strain "
         << fmt("%.3f", ref.strain);
-    if (!c.within_linear_validity(run)) {
+    if (c.beyond_its_reference(run)) {
       out << " ⚠ beyond the linear reference's validity (strain > " << c.strain_limit
           << "): the rows show the regime, not a prediction (the finite-strain reference: "
              "`vesselverify contact-models --own-equilibrium`)";

@@ -36,11 +36,13 @@ struct GuidewireContact {
   double strain_limit = 0.1;
   std::vector<std::vector<GuidewireShortcut>> shortcuts;  ///< per run (EI)
   TimingProvenance provenance;
-  /// The reference solved and valid at its strains: the finite-strain reference at any, the
-  /// linear one up to strain_limit.
   [[nodiscard]] bool within_linear_validity(const contact::ContactModelsRun& run) const {
-    return run.reference.failure.empty() &&
-           (wall == ContactWall::neo_hookean || run.reference.strain <= strain_limit);
+    return run.reference.failure.empty() && run.reference.strain <= strain_limit;
+  }
+  /// A run whose rows show the regime rather than a prediction: a linear reference strained
+  /// beyond its validity (the neo-Hookean reference has no such limit).
+  [[nodiscard]] bool beyond_its_reference(const contact::ContactModelsRun& run) const {
+    return wall == ContactWall::linear && !within_linear_validity(run);
   }
 };
 
