@@ -75,55 +75,12 @@ void PcgSolver::precondition(const VectorXd& r, VectorXd& z) const {
 }
 
 PcgResult PcgSolver::solve(const VectorXd& b, VectorXd& x) const {
-  const Eigen::Index n = A_.rows();
-  if (b.size() != n) throw std::invalid_argument("PcgSolver::solve: right-hand side of wrong size");
-  if (x.size() != n) x = VectorXd::Zero(n);
-  PcgResult res;
-  const double bnorm = b.norm();
-  if (bnorm == 0.0) {
-    x.setZero();
-    res.converged = true;
-    return res;
+  if (b.size() != A_.rows()) {
+    throw std::invalid_argument("PcgSolver::solve: right-hand side of wrong size");
   }
-  const double target = options_.tolerance * bnorm;
-  multiply(x, q_);
-  r_ = b - q_;
-  double rnorm = r_.norm();
-  precondition(r_, z_);
-  p_ = z_;
-  double rz = r_.dot(z_);
-  bool fresh = true;  // r_ is b − A x computed from A, not from the recurrence
-  while (true) {
-    if (rnorm <= target) {
-      if (fresh) break;
-      // Confirm with the true residual (the recurrence drifts by round-off); restart if it fails.
-      multiply(x, q_);
-      r_ = b - q_;
-      rnorm = r_.norm();
-      fresh = true;
-      if (rnorm <= target) break;
-      precondition(r_, z_);
-      p_ = z_;
-      rz = r_.dot(z_);
-    }
-    if (res.iterations >= options_.max_iterations) break;
-    multiply(p_, q_);
-    const double pq = p_.dot(q_);
-    if (!(pq > 0.0)) break;  // not positive definite along p (or a breakdown): stop, report
-    const double alpha = rz / pq;
-    x.noalias() += alpha * p_;
-    r_.noalias() -= alpha * q_;
-    rnorm = r_.norm();
-    fresh = false;
-    ++res.iterations;
-    precondition(r_, z_);
-    const double rz_next = r_.dot(z_);
-    p_ = z_ + (rz_next / rz) * p_;
-    rz = rz_next;
-  }
-  res.relative_residual = rnorm / bnorm;
-  res.converged = rnorm <= target;
-  return res;
+  return conjugate_gradients([this](const VectorXd& v, VectorXd& out) { multiply(v, out); },
+                             [this](const VectorXd& r, VectorXd& z) { precondition(r, z); }, b,
+                             x, options_.tolerance, options_.max_iterations, work_);
 }
 
 }  // namespace vessel::msm

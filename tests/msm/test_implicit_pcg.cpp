@@ -180,6 +180,42 @@ TEST(Pcg, RefusesANonPositiveDiagonalAndReportsNonConvergence) {
   EXPECT_THROW((void)parse_pcg_preconditioner("ilu"), InputError);
 }
 
+TEST(ConjugateGradients, ANearbyMatrixsInverseAsPreconditionerNeedsAsManyStepsAsTheChangesRank) {
+  // A = M + Σ_{k<3} v_k v_kᵀ: with M⁻¹ as preconditioner, M⁻¹A = I + rank 3 has four distinct
+  // eigenvalues, so CG is exact in at most four steps (Saad 2003, Theorem 6.29's corollary).
+  const SparseMatrix M = random_spd(40, 3);
+  const Eigen::MatrixXd Md(M);
+  const Eigen::LLT<Eigen::MatrixXd> m(Md);
+  Eigen::MatrixXd A = Md;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 3; ++k) {
+    Eigen::VectorXd v(120);
+    for (int i = 0; i < 120; ++i) v[i] = u(rng);
+    A += v * v.transpose();
+  }
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(120, -1.0, 2.0);
+  Eigen::VectorXd x;
+  PcgWorkspace w;
+  const PcgResult r = conjugate_gradients(
+      [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = A * v; },
+      [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = m.solve(v); }, b, x, 1e-12, 50,
+      w);
+  EXPECT_TRUE(r.converged);
+  EXPECT_LE(r.iterations, 5);  // four in exact arithmetic, one more for round-off
+  EXPECT_LE((A.llt().solve(b) - x).norm(), 1e-10 * x.norm());
+  EXPECT_FALSE(r.negative_curvature);
+
+  // An indefinite operator: −A along every direction, found on the first step.
+  const PcgResult n = conjugate_gradients(
+      [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = -(A * v); },
+      [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = m.solve(v); }, b, x, 1e-12, 50,
+      w);
+  EXPECT_TRUE(n.negative_curvature);
+  EXPECT_FALSE(n.converged);
+  EXPECT_EQ(n.iterations, 0);
+}
+
 TEST(ImplicitEulerPcg, RestPcgConvergesToTheFactorisedStepOver100Steps) {
   const Tube t = tube();
   const Problem& p = t.problem;
