@@ -305,19 +305,24 @@ ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double n
   const double radius = balls.front().radius;
   const TetMesh mesh = refined_balls_mesh(scene.vessel, balls, fine);
   out.mesh_nodes = static_cast<int>(mesh.nodes.size());
-  const contact::ContactWire cw = wire.contact();
-  const std::vector<int> nodes = candidates(mesh, cw, wire.rigid_state, centre, radius, o.band);
-  out.candidates = static_cast<int>(nodes.size());
-  if (nodes.empty()) {
-    out.failure = "no inner-wall node within the band of the wire's surface";
-    out.seconds = seconds_since(t0);
-    return out;
+  // The linear wall's candidates: near the rigid-lumen wire in the zone's ball. (The
+  // finite-strain wall's are every inner-wall node: its wire may have moved far from that shape.)
+  std::vector<int> nodes;
+  if (o.wall == ContactWall::linear) {
+    nodes = candidates(mesh, wire.contact(), wire.rigid_state, centre, radius, o.band);
+    if (nodes.empty()) {
+      out.failure = "no inner-wall node within the band of the wire's surface";
+      out.seconds = seconds_since(t0);
+      return out;
+    }
   }
   if (o.log) {
     *o.log << "contact: fine " << fine * 1e3 << " mm within " << radius * 1e3 << " mm"
            << (balls.size() > 1 ? " and " + std::to_string(balls.size() - 1) + " balls more" : "")
-           << ", " << mesh.nodes.size() << " nodes, " << nodes.size() << " candidates, "
-           << to_string(o.wall) << " wall" << std::endl;
+           << ", " << mesh.nodes.size() << " nodes, "
+           << (nodes.empty() ? std::string("every inner-wall node a candidate")
+                             : std::to_string(nodes.size()) + " candidates")
+           << ", " << to_string(o.wall) << " wall" << std::endl;
   }
   try {
     if (o.wall == ContactWall::linear) {
