@@ -79,8 +79,8 @@ PcgResult PcgSolver::solve(const VectorXd& b, VectorXd& x) const {
     throw std::invalid_argument("PcgSolver::solve: right-hand side of wrong size");
   }
   return conjugate_gradients([this](const VectorXd& v, VectorXd& out) { multiply(v, out); },
-                             [this](const VectorXd& r, VectorXd& z) { precondition(r, z); }, b,
-                             x, options_.tolerance, options_.max_iterations, work_);
+                             [this](const VectorXd& r, VectorXd& z) { precondition(r, z); }, b, x,
+                             options_.tolerance, options_.max_iterations, work_);
 }
 
 }  // namespace vessel::msm

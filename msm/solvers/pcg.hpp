@@ -47,8 +47,8 @@ struct PcgWorkspace {
 /// at most max_iterations; stops early, negative_curvature set, where pᵀAp ≤ 0.
 template <class Apply, class Precondition>
 PcgResult conjugate_gradients(const Apply& apply, const Precondition& precondition,
-                              const VectorXd& b, VectorXd& x, double tolerance,
-                              int max_iterations, PcgWorkspace& w) {
+                              const VectorXd& b, VectorXd& x, double tolerance, int max_iterations,
+                              PcgWorkspace& w) {
   const Eigen::Index n = b.size();
   if (x.size() != n) x = VectorXd::Zero(n);
   PcgResult res;

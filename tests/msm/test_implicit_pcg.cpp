@@ -197,20 +197,20 @@ TEST(ConjugateGradients, ANearbyMatrixsInverseAsPreconditionerNeedsAsManyStepsAs
   const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(120, -1.0, 2.0);
   Eigen::VectorXd x;
   PcgWorkspace w;
-  const PcgResult r = conjugate_gradients(
-      [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = A * v; },
-      [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = m.solve(v); }, b, x, 1e-12, 50,
-      w);
+  const PcgResult r =
+      conjugate_gradients([&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = A * v; },
+                          [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = m.solve(v); },
+                          b, x, 1e-12, 50, w);
   EXPECT_TRUE(r.converged);
   EXPECT_LE(r.iterations, 5);  // four in exact arithmetic, one more for round-off
   EXPECT_LE((A.llt().solve(b) - x).norm(), 1e-10 * x.norm());
   EXPECT_FALSE(r.negative_curvature);
 
   // An indefinite operator: −A along every direction, found on the first step.
-  const PcgResult n = conjugate_gradients(
-      [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = -(A * v); },
-      [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = m.solve(v); }, b, x, 1e-12, 50,
-      w);
+  const PcgResult n =
+      conjugate_gradients([&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = -(A * v); },
+                          [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) { out = m.solve(v); },
+                          b, x, 1e-12, 50, w);
   EXPECT_TRUE(n.negative_curvature);
   EXPECT_FALSE(n.converged);
   EXPECT_EQ(n.iterations, 0);
