@@ -12,7 +12,6 @@
 #include "msm/linalg/linear_solver.hpp"
 #include "msm/linalg/low_rank_update.hpp"
 #include "msm/solvers/exact_backoff.hpp"
-#include "msm/solvers/pcg.hpp"
 #include "verification/contact/condensed_wall.hpp"
 #include "verification/contact/point_segment_distance.hpp"
 #include "verification/contact/point_triangle_distance.hpp"
@@ -141,10 +140,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using Mat12 = Eigen::Matrix<double, 12, 12>;
 using Vec12 = Eigen::Matrix<double, 12, 1>;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 /// The rows (in the coupled unknown z = (the rod's free dofs, the wall's rows)) of one contact
 /// pair's twelve coordinates (its four points'); −1 where held or unused.
@@ -584,56 +579,30 @@ class NewtonFactor {
       if (grown.nonZeros() != pattern_.nonZeros()) pattern_ = std::move(grown);
       h = h + pattern_;
     }
-    valid_ = false;
-    const auto start = Clock::now();
-    if (!regularise) {
-      valid_ = solver_.try_factorize(h);
-    } else {
-      try {
-        solver_.factorize(h);
-        valid_ = true;
-      } catch (const std::runtime_error&) {
-      }
+    if (!regularise) return solver_.try_factorize(h);
+    try {
+      solver_.factorize(h);
+    } catch (const std::runtime_error&) {
+      return false;
     }
-    if (valid_) factor_seconds_ = seconds_since(start);
-    return valid_;
-  }
-  /// CG iterations preconditioned by this factor that cost at most half a factorisation, from
-  /// the last factorisation's time and the last CG's time per iteration (10 before one is known).
-  [[nodiscard]] int iteration_budget() const {
-    if (iteration_seconds_ <= 0.0) return 10;
-    return static_cast<int>(std::clamp(0.5 * factor_seconds_ / iteration_seconds_, 2.0, 200.0));
-  }
-  void record_iterations(int iterations, double seconds) {
-    if (iterations > 0) iteration_seconds_ = seconds / iterations;
+    return true;
   }
   [[nodiscard]] const msm::CholmodSolver& solver() const { return solver_; }
-  /// Whether the last factorisation succeeded (its factor can precondition a later step).
-  [[nodiscard]] bool valid() const { return valid_; }
   [[nodiscard]] int factorisations() const { return factorisations_; }
-  msm::PcgWorkspace& workspace() { return work_; }
 
  private:
   msm::CholmodSolver solver_;
   Eigen::SparseMatrix<double> pattern_;  ///< the union so far, every value zero
   int factorisations_ = 0;
-  bool valid_ = false;
-  double factor_seconds_ = 0.0;
-  double iteration_seconds_ = 0.0;
-  msm::PcgWorkspace work_;
 };
 
 /// The Newton model's matrix H(A) = B + Σ_{j∈A} k a_j a_jᵀ for the active sets A of one step's
 /// passes: H(A₀) factorised once, a later set's pairs that differ from A₀ applied as rank-one
 /// terms (+k entering, −k leaving; msm::LowRankUpdatedSolve), so a pass costs solves with the
-/// factor, not a factorisation. Past kMaxChanged such pairs H(A) is factorised afresh. Before
-/// it factorises, a step tries conjugate gradients on H(A) preconditioned by the last factor (an
-/// earlier step's matrix): the tangent changes little from one step to the next, and a few
-/// solves with that factor cost far less than factorising the whole wall again.
+/// factor, not a factorisation. Past kMaxChanged such pairs H(A) is factorised afresh.
 class ModelMatrix {
  public:
   static constexpr std::size_t kMaxChanged = 64;
-  static constexpr double kCgTolerance = 1e-10;  ///< ‖H dz − rhs‖ relative to ‖rhs‖
 
   /// `shift` μ ≥ 0: Levenberg–Marquardt's damping, B + μ diag(|B|) in place of B. `regularise`
   /// as NewtonFactor::factorize.
@@ -651,12 +620,6 @@ class ModelMatrix {
 
   /// dz = H(active)⁻¹ rhs; false if H cannot be factorised.
   bool solve(const std::vector<char>& active, const VectorXd& rhs, VectorXd& dz) {
-    if (!update_ && factor_.valid()) {
-      const msm::PcgResult cg = iterate_on_last_factor(active, rhs, dz);
-      if (cg.converged) return true;
-      // pᵀHp ≤ 0 certifies the exact model is not positive definite: no factorisation needed.
-      if (cg.negative_curvature && !regularise_) return false;
-    }
     std::vector<int> ids;
     std::vector<msm::SparseColumn> columns;
     std::vector<double> weights;
@@ -687,19 +650,6 @@ class ModelMatrix {
   }
 
  private:
-  msm::PcgResult iterate_on_last_factor(const std::vector<char>& active, const VectorXd& rhs,
-                                        VectorXd& dz) {
-    dz = VectorXd::Zero(rhs.size());
-    const msm::CholmodSolver& last = factor_.solver();
-    const auto start = Clock::now();
-    const msm::PcgResult cg = msm::conjugate_gradients(
-        [&](const VectorXd& v, VectorXd& out) { out = product(active, v); },
-        [&](const VectorXd& r, VectorXd& z) { last.solve_into(r, z); }, rhs, dz, kCgTolerance,
-        factor_.iteration_budget(), factor_.workspace());
-    factor_.record_iterations(cg.iterations, seconds_since(start));
-    return cg;
-  }
-
   bool factorize(const std::vector<char>& active) {
     Triplets t;
     t.reserve(81 * active.size());
@@ -986,7 +936,7 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
   }
   out.x = problem.rod_dofs(z);
   out.u = problem.wall_rows(z);
-  out.seconds = seconds_since(t0);
+  out.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return out;
 }
 
