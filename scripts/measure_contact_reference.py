@@ -9,8 +9,9 @@ loaded machine are upper bounds on time.
 
 With --outputs DIR the runs are not made here: each scene's output is read from DIR/SCENE.md (the
 command's stdout) and DIR/SCENE.meta (its command line, "load before L start T" and "exit C load
-after L end T" lines), as written by a run by hand; a stiffness of the scene's sweep missing from
-an output is listed as not measured.
+after L end T" lines), as written by a run by hand; runs made one after the other (say one per
+stiffness) append to both files, a "command" line each; a stiffness of the scene's sweep missing
+from an output is listed as not measured.
 
 The finite-strain wall's page: --out docs/measurements/contact_reference_neo_hookean.md -- --wall
 neo-hookean (the page then describes that wall).
@@ -100,12 +101,12 @@ def saved_section(folder, scene):
     with open(os.path.join(folder, scene + ".meta")) as f:
         text = f.read()
     for key, pattern in (("before", r"load before (\S+)"), ("start", r"start (\S+)"),
-                         ("after", r"load after (\S+)"), ("end", r"end (\S+)"), ("exit", r"exit (\S+)"),
-                         ("command", r"^command (.+)$")):
-        m = re.search(pattern, text, re.M)
-        if m:
-            meta[key] = m.group(1)
-    head = f"## {scene}\n\n`{meta.get('command', 'vesselverify contact')}`"
+                         ("after", r"load after (\S+)"), ("end", r"end (\S+)"), ("exit", r"exit (\S+)")):
+        found = re.findall(pattern, text, re.M)
+        if found:  # several runs (one per stiffness): the first start, the last end and exit
+            meta[key] = found[0] if key in ("before", "start") else found[-1]
+    commands = re.findall(r"^command (.+)$", text, re.M) or ["vesselverify contact"]
+    head = f"## {scene}\n\n" + ", then ".join(f"`{c}`" for c in commands)
     finished = meta.get("exit") == "0"
     if finished:
         head += (f": {float(meta['end']) - float(meta['start']):.0f} s (the scenes side by side), "
@@ -148,7 +149,11 @@ def wall_description(args, sections):
                               how="the wire and the wall as one potential, frictionless contact by "
                                   "an augmented Lagrangian") +
                 "A row is a reference if every level converged and the zone stayed inside the "
-                "refined patch; its uncertainty is the GCI. The largest strain is Green–Lagrange's.")
+                "refined patch; its uncertainty is the GCI. The largest strain is Green–Lagrange's. "
+                "The wall is P1 unless the command says `--degree 2`, and the GCI is the contact "
+                "zone's mesh at that degree: at ν = 0.45 linear tets are stiffer than the "
+                "continuum at every size, an error the levels do not see (the P1 and P2 forces "
+                "side by side are in [contact.md](../physics/contact.md)).")
     return (common.format(wall="linear FEM", how="Signorini's conditions") +
             "A row is a reference only if every level converged and the wall's largest strain "
             "stays within the linear wall's validity (0.1); otherwise its verdict says why, and its "

@@ -102,6 +102,7 @@ TEST(ContactReferenceSlow, AZoneThatLeavesThePatchIsSolvedAgainOnAGrownPatch) {
   EXPECT_GE(r.patch_growths, 1);
   EXPECT_NE(printed.str().find("(the patch grown " + std::to_string(r.patch_growths) + " time(s)"),
             std::string::npos);
+  EXPECT_NE(printed.str().find("neo-Hookean P1 wall"), std::string::npos);
   EXPECT_TRUE(r.levels[0].zone_inside_patch);
   EXPECT_EQ(r.verdict.find("leaves the refined patch"), std::string::npos) << r.verdict;
 }
