@@ -544,8 +544,9 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
 
 void print_contact_reference(const ContactReference& r, std::ostream& out) {
   out << "### " << r.scene << ", EI = " << r.bending_stiffness << " N·m²\n\n"
-      << to_string(r.wall) << " P" << r.degree << " wall, E = " << r.wall_modulus << " Pa, ν = " << r.poisson_ratio
-      << "; rigid wall: " << fixed(r.rigid_force * 1e3, 4) << " mN (discrete wire)";
+      << to_string(r.wall) << " P" << r.degree << " wall, E = " << r.wall_modulus
+      << " Pa, ν = " << r.poisson_ratio << "; rigid wall: " << fixed(r.rigid_force * 1e3, 4)
+      << " mN (discrete wire)";
   if (r.continuum_rigid_force)
     out << ", " << fixed(*r.continuum_rigid_force * 1e3, 4) << " mN (continuum)";
   out << "; refined within " << fixed(r.patch_radius * 1e3, 3) << " mm of ("

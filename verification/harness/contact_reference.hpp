@@ -86,7 +86,7 @@ struct ContactReference {
   int patch_growths = 0;
   double strain_limit = 0.0;
   ContactWall wall = ContactWall::linear;
-  int degree = 1;  ///< the wall's element degree
+  int degree = 1;      ///< the wall's element degree
   ContactLevel scout;  ///< the coarsest size at the rigid wall point: where the zone is
   std::vector<ContactLevel> levels;
   /// From the three finest levels when all converged: Roache's order and GCI on the force.
