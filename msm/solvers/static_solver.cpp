@@ -12,6 +12,7 @@
 #include "meshes/foundation/errors.hpp"
 #include "msm/linalg/linear_solver.hpp"
 #include "msm/solvers/exact_backoff.hpp"
+#include "msm/solvers/steihaug.hpp"
 
 namespace vessel::msm {
 
@@ -51,70 +52,18 @@ double negative_curvature(const SparseMatrix& H, const SparseMatrix& Hp,
   return c < -1e-8 * std::abs(cp) ? c : 0.0;
 }
 
-/// The step s ≥ 0 at which ‖z + s·p‖_P = Δ (the positive root of a quadratic in s), given
-/// zᵀPz, zᵀPp and pᵀPp.
-double to_boundary(double zz, double zp, double pp, double radius) {
-  const double c = zz - radius * radius;  // ≤ 0: z is inside
-  const double disc = std::max(zp * zp - pp * c, 0.0);
-  // The positive root (−zp + √disc)/pp, written without cancellation.
-  return zp > 0.0 ? -c / (zp + std::sqrt(disc)) : (-zp + std::sqrt(disc)) / pp;
-}
-
-struct SteihaugStep {
-  VectorXd d;
-  int iterations = 0;
-  bool boundary = false;            ///< stopped on the trust-region boundary
-  bool negative_curvature = false;  ///< stopped along a direction with pᵀHp ≤ 0
-};
-
-/// Steihaug–Toint truncated conjugate gradients for min m(d) = gᵀd + ½dᵀHd subject to
-/// ‖d‖_P ≤ Δ (Steihaug 1983; Nocedal & Wright 2006, Algorithm 7.2, here preconditioned with P,
-/// Gould, Lucidi, Roma & Toint 1999): CG on H d = −g with the preconditioner P = the factorised
-/// PSD-projected Hessian, stopped at the boundary, at a direction of non-positive curvature (then
-/// followed to the boundary: the step exploits the negative curvature a projected Newton step
-/// cannot see), or at the relative residual `forcing`. P ⪰ H differs from H only on the springs
-/// whose block was projected, so P⁻¹H is the identity plus a perturbation of low rank and CG
-/// needs few iterations. ‖v‖²_P = vᵀ(Pm)v with Pm the matrix whose factorisation `solver` holds
-/// (up to its regularisation).
-SteihaugStep steihaug_cg(const SparseMatrix& H, const SparseMatrix& Pm, const CholmodSolver& solver,
-                         const VectorXd& g, double radius, double forcing, int max_iterations) {
-  SteihaugStep out;
-  const Eigen::Index n = g.size();
-  VectorXd z = VectorXd::Zero(n), r = g, y = solver.solve(r), p = -y, Hp(n), Pp(n),
-           Pz = VectorXd::Zero(n);
-  double ry = r.dot(y);
-  const double stop = forcing * g.norm();
-  double zz = 0.0;
-  for (out.iterations = 1; out.iterations <= max_iterations; ++out.iterations) {
-    Hp.noalias() = H * p;
-    Pp.noalias() = Pm * p;
-    const double kappa = p.dot(Hp);
-    const double pp = p.dot(Pp), zp = Pz.dot(p);
-    if (!(kappa > 0.0)) {
-      out.negative_curvature = out.boundary = true;
-      out.d = z + to_boundary(zz, zp, pp, radius) * p;
-      return out;
-    }
-    const double alpha = ry / kappa;
-    const double zz_next = zz + 2.0 * alpha * zp + alpha * alpha * pp;
-    if (zz_next >= radius * radius) {
-      out.boundary = true;
-      out.d = z + to_boundary(zz, zp, pp, radius) * p;
-      return out;
-    }
-    z += alpha * p;
-    Pz += alpha * Pp;
-    zz = zz_next;
-    r += alpha * Hp;
-    if (r.norm() <= stop) break;
-    y = solver.solve(r);
-    const double ry_next = r.dot(y);
-    p = -y + (ry_next / ry) * p;
-    ry = ry_next;
-  }
-  out.iterations = std::min(out.iterations, max_iterations);
-  out.d = std::move(z);
-  return out;
+/// Steihaug–Toint CG (msm/solvers/steihaug.hpp) on the exact Hessian H with the factorised
+/// PSD-projected Hessian P as preconditioner and norm (‖v‖²_P = vᵀ(Pm)v, Pm the matrix whose
+/// factorisation `solver` holds, up to its regularisation). P ⪰ H differs from H only on the
+/// springs whose block was projected, so P⁻¹H is the identity plus a perturbation of low rank and
+/// CG needs few iterations.
+SteihaugStep steihaug_step(const SparseMatrix& H, const SparseMatrix& Pm,
+                           const CholmodSolver& solver, const VectorXd& g, double radius,
+                           double forcing, int max_iterations) {
+  return steihaug_cg([&](const VectorXd& v, VectorXd& out) { out.noalias() = H * v; },
+                     [&](const VectorXd& v, VectorXd& out) { out.noalias() = Pm * v; },
+                     [&](const VectorXd& r, VectorXd& out) { out = solver.solve(r); }, g, radius,
+                     forcing, max_iterations);
 }
 
 /// The first iterate: `start` if it has the model's size, else the rest shape; fixed dofs at rest.
@@ -216,7 +165,7 @@ TrustRegionStep trust_region_trials(const Problem& p, const SparseMatrix& H, con
   TrustRegionStep t;
   VectorXd gt, Hd, trial;
   for (int attempt = 0; attempt < 60 && !t.accepted; ++attempt) {
-    t.step = steihaug_cg(H, P, solver, g, radius, forcing, 200);
+    t.step = steihaug_step(H, P, solver, g, radius, forcing, 200);
     const SteihaugStep& step = t.step;
     Hd.noalias() = H * step.d;
     const double predicted = -(g.dot(step.d) + 0.5 * step.d.dot(Hd));
