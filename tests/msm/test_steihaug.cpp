@@ -55,9 +55,9 @@ TEST(Steihaug, ATightRegionCutsTheFirstStepOnTheBoundary) {
 
 TEST(Steihaug, NegativeCurvatureIsFollowedToTheBoundary) {
   // H = diag(2, −1), P = I, g = (2, 1), Δ = 3, by hand: the first direction p₀ = −g has
-  // p₀ᵀHp₀ = 7, α₀ = 5/7, z₁ = (−10/7, −5/7) (inside: ‖z₁‖² = 125/49), r₁ = g + α₀Hp₀ = (−6/7, 12/7),
-  // β = ‖r₁‖²/‖g‖² = 36/49, p₁ = −r₁ + βp₀ = (−30/49, −120/49) with p₁ᵀHp₁ = −12600/2401 < 0: the
-  // step is z₁ + τp₁ with ‖z₁ + τp₁‖ = 3, τ > 0.
+  // p₀ᵀHp₀ = 7, α₀ = 5/7, z₁ = (−10/7, −5/7) (inside: ‖z₁‖² = 125/49), r₁ = g + α₀Hp₀ = (−6/7,
+  // 12/7), β = ‖r₁‖²/‖g‖² = 36/49, p₁ = −r₁ + βp₀ = (−30/49, −120/49) with p₁ᵀHp₁ = −12600/2401 <
+  // 0: the step is z₁ + τp₁ with ‖z₁ + τp₁‖ = 3, τ > 0.
   Model s;
   s.H = Eigen::MatrixXd{{2, 0}, {0, -1}};
   s.P = Eigen::MatrixXd::Identity(2, 2);
