@@ -12,6 +12,7 @@
 #include "msm/linalg/linear_solver.hpp"
 #include "msm/linalg/low_rank_update.hpp"
 #include "msm/solvers/exact_backoff.hpp"
+#include "msm/solvers/steihaug.hpp"
 #include "verification/contact/condensed_wall.hpp"
 #include "verification/contact/point_segment_distance.hpp"
 #include "verification/contact/point_triangle_distance.hpp"
@@ -618,6 +619,17 @@ class ModelMatrix {
     }
   }
 
+  [[nodiscard]] NewtonFactor& factor() const { return factor_; }
+
+  /// H(active) v.
+  [[nodiscard]] VectorXd product(const std::vector<char>& active, const VectorXd& v) const {
+    VectorXd out = base_ * v;  // both triangles stored
+    for (std::size_t j = 0; j < active.size(); ++j) {
+      if (active[j]) add_pair(lin_, j, p_.stiffness() * pair_dot(lin_, j, v), out);
+    }
+    return out;
+  }
+
   /// dz = H(active)⁻¹ rhs; false if H cannot be factorised.
   bool solve(const std::vector<char>& active, const VectorXd& rhs, VectorXd& dz) {
     std::vector<int> ids;
@@ -668,15 +680,6 @@ class ModelMatrix {
     return true;
   }
 
-  /// H(active) v.
-  [[nodiscard]] VectorXd product(const std::vector<char>& active, const VectorXd& v) const {
-    VectorXd out = base_ * v;  // both triangles stored
-    for (std::size_t j = 0; j < active.size(); ++j) {
-      if (active[j]) add_pair(lin_, j, p_.stiffness() * pair_dot(lin_, j, v), out);
-    }
-    return out;
-  }
-
   /// Pair j's gap gradient a_j on its free rows.
   [[nodiscard]] msm::SparseColumn column(std::size_t j) const {
     msm::SparseColumn u;
@@ -697,29 +700,32 @@ class ModelMatrix {
   std::unique_ptr<msm::LowRankUpdatedSolve> update_;
 };
 
+/// The gradient at dz = 0 of the Newton model's quadratic piece for the active set A:
+/// ∇Π without the pressed pairs' −λ∇g, plus −k c_j a_j for each pair of A.
+VectorXd model_gradient(const Coupled& p, const Linearisation& lin, const VectorXd& gradient,
+                        const std::vector<char>& active) {
+  VectorXd out = gradient;
+  for (std::size_t j = 0; j < lin.c.size(); ++j) {
+    const double pressed = lin.c[j] > 0.0 ? 1.0 : 0.0;
+    const double in_model = active[j] ? 1.0 : 0.0;
+    if (pressed != in_model) add_pair(lin, j, p.stiffness() * lin.c[j] * (pressed - in_model), out);
+  }
+  return out;
+}
+
 /// The Newton step: the minimiser of the model ½dzᵀH dz + ∇Πᵀdz in which every pair near
 /// contact keeps its piecewise penalty of the linearised gap, k/2 max(0, c − ∇g·dz)², found by
-/// an active-set iteration (ModelMatrix): a wire about to touch is stopped by the wall within the
-/// step instead of passing it in the model. false if H cannot be factorised (`regularise`:
-/// even shifted).
-bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gradient, VectorXd& dz,
-                 NewtonFactor& factor, double shift, bool regularise) {
-  const double k = p.stiffness();
+/// an active-set iteration on H's matrices: a wire about to touch is stopped by the wall within
+/// the step instead of passing it in the model. `active` ends as the step's pressed pairs (its
+/// model's quadratic piece). false if H cannot be factorised.
+bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gradient,
+                 ModelMatrix& H, VectorXd& dz, std::vector<char>& active) {
   const std::size_t m = lin.c.size();
-  // ∇Π without the pressed pairs' −λ∇g: the model adds each pair's own term.
-  VectorXd g0 = gradient;
-  for (std::size_t j = 0; j < m; ++j) {
-    if (lin.c[j] > 0.0) add_pair(lin, j, k * lin.c[j], g0);
-  }
-  std::vector<char> active(m), next(m);
+  std::vector<char> next(m);
+  active.assign(m, 0);
   for (std::size_t j = 0; j < m; ++j) active[j] = lin.c[j] > 0.0;
-  ModelMatrix H(p, lin, factor, shift, regularise);
   for (int pass = 0; pass < 20; ++pass) {
-    VectorXd rhs = -g0;
-    for (std::size_t j = 0; j < m; ++j) {
-      if (active[j]) add_pair(lin, j, k * lin.c[j], rhs);
-    }
-    if (!H.solve(active, rhs, dz)) return false;
+    if (!H.solve(active, -model_gradient(p, lin, gradient, active), dz)) return false;
     for (std::size_t j = 0; j < m; ++j) next[j] = lin.c[j] - pair_dot(lin, j, dz) > 0.0;
     if (next == active) break;
     active = next;
@@ -739,13 +745,15 @@ struct NewtonOutcome {
 struct RecentSteps {
   static constexpr int kEvery = 25;
   int projected = 0;  ///< steps on the PSD-projected model (the exact one not factorisable)
+  int curvature = 0;  ///< of those, extended to the trust region's boundary by the exact model
   int steepest = 0;   ///< steps that fell back to steepest descent
   int capped = 0;     ///< steps cut to the largest move
   double move = 0.0;  ///< the steps' node moves summed, r_w
   void report(std::ostream& log, int step, const NewtonOutcome& out, double shift) {
     log << "potential contact:   step " << step << ", residual " << out.residual << " N, "
         << out.factorisations << " factorisations; the last " << kEvery << " steps: " << projected
-        << " on the PSD-projected Hessian, " << steepest << " steepest descent, " << capped
+        << " on the PSD-projected Hessian (" << curvature
+        << " extended to the boundary by the exact curvature), " << steepest << " steepest descent, " << capped
         << " capped at the largest move, mean move " << move / kEvery << " r_w"
         << (shift > 0.0 ? ", Levenberg–Marquardt μ " + std::to_string(shift) : std::string())
         << std::endl;
@@ -753,27 +761,77 @@ struct RecentSteps {
   }
 };
 
-/// The step from z: Newton's on the exact model where it is positive definite, else on the
-/// PSD-projected one (shifted if need be; a shift of the exact, indefinite model costs a
-/// factorisation per try and gives no better a step), else steepest descent of length r_w. `lin`
-/// holds the linearisation at z (projected when `exact` is false).
-VectorXd search_direction(const Coupled& p, const VectorXd& z, const VectorXd& g,
-                          Linearisation& lin, bool exact, double band, double shift,
-                          NewtonFactor& factor, msm::ExactBackoff& backoff, RecentSteps& recent) {
+/// A search direction and what it was.
+struct Direction {
   VectorXd dz;
-  bool descent = exact && newton_step(p, lin, g, dz, factor, shift, false) && g.dot(dz) < 0.0;
-  if (exact) backoff.record(descent);
-  if (!descent) {
-    ++recent.projected;
-    VectorXd same;
-    if (exact) (void)p.evaluate(z, same, &lin, true, band);
-    descent = newton_step(p, lin, g, dz, factor, shift, true) && g.dot(dz) < 0.0;
+  bool exact = false;  ///< Newton's step on the exact model
+  /// On the projected model, extended by Steihaug's CG on the exact one: its P-norm and whether
+  /// it ended on the trust region's boundary (0 and false otherwise).
+  double steihaug_length = 0.0;
+  bool steihaug_boundary = false;
+};
+
+/// Where the exact model is indefinite, the projected model's step dz (its matrix Hp factorised
+/// for the active set A) extended by Steihaug–Toint CG on the exact model's quadratic piece for
+/// A, preconditioned by Hp, within ‖d‖_Hp ≤ max(Δ, ‖dz‖_Hp) (msm/solvers/steihaug.hpp): CG's first
+/// iterate is dz itself, so the step lowers the exact model at least as much, and a direction of
+/// negative curvature is followed to the boundary. Near a saddle of Π, where Π falls along a
+/// direction the per-element projection clamps to zero curvature, projected steps shrink to
+/// 1e-2–1e-4 r_w and Newton stalls; the exact curvature leaves it. Keeps dz if the extended step
+/// is not a descent direction of Π.
+void extend_by_exact_curvature(const Coupled& p, const Linearisation& exact_lin,
+                               const VectorXd& g, ModelMatrix& Hp, const std::vector<char>& active,
+                               double radius, Direction& d) {
+  const ModelMatrix H(p, exact_lin, Hp.factor(), 0.0, false);  // products only
+  const double own = std::sqrt(std::max(d.dz.dot(Hp.product(active, d.dz)), 0.0));
+  bool solved = true;
+  const msm::SteihaugStep step = msm::steihaug_cg(
+      [&](const VectorXd& v, VectorXd& out) { out = H.product(active, v); },
+      [&](const VectorXd& v, VectorXd& out) { out = Hp.product(active, v); },
+      [&](const VectorXd& r, VectorXd& out) { solved = Hp.solve(active, r, out) && solved; },
+      model_gradient(p, exact_lin, g, active), std::max(radius, own), 0.1, 20);
+  if (!solved || !(g.dot(step.d) < 0.0) || !step.d.allFinite()) return;
+  d.dz = step.d;
+  d.steihaug_length = std::sqrt(std::max(step.d.dot(Hp.product(active, step.d)), 0.0));
+  d.steihaug_boundary = step.boundary;
+}
+
+/// The step from z: Newton's on the exact model where it is positive definite, else on the
+/// PSD-projected one extended along the exact model's curvature (extend_by_exact_curvature; the
+/// projected model shifted if need be: a shift of the exact, indefinite model costs a
+/// factorisation per try and gives no better a step), else steepest descent of length r_w. `lin`
+/// holds the linearisation at z (projected when `exact` is false). `radius`: the trust region
+/// of the extension (0: none yet).
+Direction search_direction(const Coupled& p, const VectorXd& z, const VectorXd& g,
+                           Linearisation& lin, bool exact, double band, double shift,
+                           double radius, NewtonFactor& factor, msm::ExactBackoff& backoff,
+                           RecentSteps& recent) {
+  Direction d;
+  std::vector<char> active;
+  if (exact) {
+    ModelMatrix H(p, lin, factor, shift, false);
+    d.exact = newton_step(p, lin, g, H, d.dz, active) && g.dot(d.dz) < 0.0;
+    backoff.record(d.exact);
+    if (d.exact) return d;
   }
-  if (!descent) {
-    ++recent.steepest;
-    dz = -g * (p.radius() / std::max(g.norm(), 1e-300));
+  ++recent.projected;
+  Linearisation exact_lin;
+  VectorXd same;
+  if (exact) {
+    exact_lin = std::move(lin);
+    (void)p.evaluate(z, same, &lin, true, band);
+  } else {
+    (void)p.evaluate(z, same, &exact_lin, false, band);
   }
-  return dz;
+  ModelMatrix Hp(p, lin, factor, shift, true);
+  if (newton_step(p, lin, g, Hp, d.dz, active) && g.dot(d.dz) < 0.0) {
+    extend_by_exact_curvature(p, exact_lin, g, Hp, active, radius, d);
+    recent.curvature += d.steihaug_boundary;
+    return d;
+  }
+  ++recent.steepest;
+  d.dz = -g * (p.radius() / std::max(g.norm(), 1e-300));
+  return d;
 }
 
 /// The accepted step length along dz from z (Π(z) = pi, ∇Π(z) = g), at most alpha0, with the
@@ -816,6 +874,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
   const double band = o.max_move * p.radius();
   RecentSteps recent;
   double shift = 0.0;  // Levenberg–Marquardt's μ (damped_newton)
+  double radius = 0.0;  // the trust region of the steps extended by the exact curvature
   // Where the exact model was indefinite, the next 1, 2, 4 … 8 steps go to the projected one.
   msm::ExactBackoff backoff(8);
   for (int it = 0; it <= o.max_newton; ++it) {
@@ -829,7 +888,9 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     }
     if (it == o.max_newton) break;
     if (o.log && it > 0 && it % RecentSteps::kEvery == 0) recent.report(*o.log, it, out, shift);
-    dz = search_direction(p, z, g, lin, exact, band, shift, factor, backoff, recent);
+    const Direction d =
+        search_direction(p, z, g, lin, exact, band, shift, radius, factor, backoff, recent);
+    dz = d.dz;
     out.factorisations = factor.factorisations() - factorisations_before;
     const double move = p.largest_move(dz);
     const double alpha0 = std::min(1.0, o.max_move * p.radius() / std::max(move, 1e-300));
@@ -842,6 +903,12 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
                      std::to_string(inverted) + " of its 12 trial steps inverted a wall element)";
       }
       return out;
+    }
+    if (d.steihaug_length > 0.0) {
+      // The trust region (Nocedal & Wright §4.1, judged by the line search): the length the line
+      // search accepted after a cut step, twice it after a full step to the boundary.
+      const double accepted = alpha * d.steihaug_length;
+      radius = alpha < alpha0 ? accepted : d.steihaug_boundary ? 2.0 * accepted : radius;
     }
     if (o.damped_newton) {
       // Levenberg–Marquardt's update of μ (Nocedal & Wright §10.3): a step the line search had to
