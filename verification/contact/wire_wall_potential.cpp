@@ -753,8 +753,9 @@ struct RecentSteps {
     log << "potential contact:   step " << step << ", residual " << out.residual << " N, "
         << out.factorisations << " factorisations; the last " << kEvery << " steps: " << projected
         << " on the PSD-projected Hessian (" << curvature
-        << " extended to the boundary by the exact curvature), " << steepest << " steepest descent, " << capped
-        << " capped at the largest move, mean move " << move / kEvery << " r_w"
+        << " extended to the boundary by the exact curvature), " << steepest
+        << " steepest descent, " << capped << " capped at the largest move, mean move "
+        << move / kEvery << " r_w"
         << (shift > 0.0 ? ", Levenberg–Marquardt μ " + std::to_string(shift) : std::string())
         << std::endl;
     *this = {};
@@ -779,9 +780,9 @@ struct Direction {
 /// direction the per-element projection clamps to zero curvature, projected steps shrink to
 /// 1e-2–1e-4 r_w and Newton stalls; the exact curvature leaves it. Keeps dz if the extended step
 /// is not a descent direction of Π.
-void extend_by_exact_curvature(const Coupled& p, const Linearisation& exact_lin,
-                               const VectorXd& g, ModelMatrix& Hp, const std::vector<char>& active,
-                               double radius, Direction& d) {
+void extend_by_exact_curvature(const Coupled& p, const Linearisation& exact_lin, const VectorXd& g,
+                               ModelMatrix& Hp, const std::vector<char>& active, double radius,
+                               Direction& d) {
   const ModelMatrix H(p, exact_lin, Hp.factor(), 0.0, false);  // products only
   const double own = std::sqrt(std::max(d.dz.dot(Hp.product(active, d.dz)), 0.0));
   bool solved = true;
@@ -803,9 +804,8 @@ void extend_by_exact_curvature(const Coupled& p, const Linearisation& exact_lin,
 /// holds the linearisation at z (projected when `exact` is false). `radius`: the trust region
 /// of the extension (0: none yet).
 Direction search_direction(const Coupled& p, const VectorXd& z, const VectorXd& g,
-                           Linearisation& lin, bool exact, double band, double shift,
-                           double radius, NewtonFactor& factor, msm::ExactBackoff& backoff,
-                           RecentSteps& recent) {
+                           Linearisation& lin, bool exact, double band, double shift, double radius,
+                           NewtonFactor& factor, msm::ExactBackoff& backoff, RecentSteps& recent) {
   Direction d;
   std::vector<char> active;
   if (exact) {
