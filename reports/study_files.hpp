@@ -141,7 +141,8 @@ struct RecommendFile {
   std::string command, scene;
   std::vector<int> model_levels;
   int reference_level = 0;
-  // The budget: quantity (contact_point | patch | field | reaction) and its unit (mm or mN).
+  // The budget: quantity (contact_point | patch | field | reaction | contact_force) and its unit
+  // (mm or mN).
   std::string quantity, unit;
   double tolerance = 0.0, seconds_per_update = 0.0;
   std::optional<double> rate_hz, radius_mm;

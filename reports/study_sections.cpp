@@ -314,7 +314,7 @@ void answer(Document& doc, const RecommendFile& r) {
   }
   // A tolerance at or above the reference's own contact displacement is met by a model that does
   // not move at all: the answer then says nothing about accuracy.
-  if (r.quantity != "reaction" && r.reference_contact_point_mm > 0.0 &&
+  if (r.unit == "mm" && r.reference_contact_point_mm > 0.0 &&
       r.tolerance >= r.reference_contact_point_mm) {
     doc.paragraph(
         "⚠ **The tolerance does not discriminate**: at this load the reference's "

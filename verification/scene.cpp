@@ -556,6 +556,14 @@ Budget read_budget(TableReader r, const Scene& scene) {
            "found \"reaction\" with a " + to_string(scene.load.kind) +
                " load; expected a contact load (the instrument's force)");
   }
+  if (b.quantity == BudgetQuantity::contact_force &&
+      !(scene.load.guidewire && scene.load.guidewire->coupling == GuidewireCoupling::contact)) {
+    r.fail(q, "quantity",
+           "found \"contact_force\"; expected a guidewire load with coupling = \"contact\" (the "
+           "force comes from the wire-wall contact solve)");
+  }
+  const bool force = b.quantity == BudgetQuantity::reaction ||
+                     b.quantity == BudgetQuantity::contact_force;
   const bool patch = b.quantity == BudgetQuantity::patch;
   if (const toml::node* radius = r.get("radius"); radius && !patch) {
     r.fail(radius, "radius",
@@ -565,13 +573,13 @@ Budget read_budget(TableReader r, const Scene& scene) {
   b.radius = quantity_number(r, "radius", patch, "quantity \"patch\"");
   const toml::node* mm = r.get("tolerance_mm");
   const toml::node* mn = r.get("tolerance_mN");
-  if (b.quantity == BudgetQuantity::reaction) {
+  if (force) {
+    const std::string quantity = "quantity \"" + to_string(b.quantity) + "\"";
     if (mm) {
       r.fail(mm, "tolerance_mm",
-             "found a displacement tolerance; quantity \"reaction\" expected tolerance_mN (a "
-             "force, mN)");
+             "found a displacement tolerance; " + quantity + " expected tolerance_mN (a force, mN)");
     }
-    b.tolerance = quantity_number(r, "tolerance_mN", true, "quantity \"reaction\"");
+    b.tolerance = quantity_number(r, "tolerance_mN", true, quantity);
   } else {
     if (mn) {
       r.fail(mn, "tolerance_mN",
@@ -690,20 +698,26 @@ std::string to_string(BudgetQuantity q) {
       return "field";
     case BudgetQuantity::reaction:
       return "reaction";
+    case BudgetQuantity::contact_force:
+      return "contact_force";
   }
   return "?";
 }
 
 BudgetQuantity parse_budget_quantity(const std::string& name) {
   for (const auto q : {BudgetQuantity::contact_point, BudgetQuantity::patch, BudgetQuantity::field,
-                       BudgetQuantity::reaction}) {
+                       BudgetQuantity::reaction, BudgetQuantity::contact_force}) {
     if (name == to_string(q)) return q;
   }
-  throw InputError("budget quantity: expected one of contact_point, patch, field, reaction; got '" +
-                   name + "'");
+  throw InputError(
+      "budget quantity: expected one of contact_point, patch, field, reaction, contact_force; got "
+      "'" +
+      name + "'");
 }
 
-const char* budget_unit(BudgetQuantity q) { return q == BudgetQuantity::reaction ? "mN" : "mm"; }
+const char* budget_unit(BudgetQuantity q) {
+  return q == BudgetQuantity::reaction || q == BudgetQuantity::contact_force ? "mN" : "mm";
+}
 
 std::string to_string(ModelKind kind) {
   switch (kind) {

@@ -142,6 +142,9 @@ enum class BudgetQuantity {
   patch,     ///< max |u_model − u_ref| over the model nodes within `radius` of the QoI point, mm
   field,     ///< max |u_model − u_ref| over all model nodes, mm
   reaction,  ///< the force the instrument feels at the reference's indentation, mN
+  /// The wire's contact force on the wall from the wire–wall contact solve (a guidewire load with
+  /// coupling = "contact", guidewire_contact.hpp): |F_model − F_reference| at the worst EI, mN
+  contact_force,
 };
 
 /// An accuracy and rate budget: what the scene needs (issue #7). Rate: `rate_hz` sets the update
@@ -151,7 +154,7 @@ struct Budget {
   bool stated = false;  ///< the scene has a [budget] table
   BudgetQuantity quantity = BudgetQuantity::contact_point;
   double radius = 0.0;         ///< m, quantity patch only
-  double tolerance = 0.1;      ///< mm (mN for reaction); seed 000's 0.1 mm visual threshold
+  double tolerance = 0.1;      ///< mm (mN for reaction, contact_force); seed 000's 0.1 mm
   double rate_hz = 0.0;        ///< 0: not given
   double time_budget_s = 0.0;  ///< 0: not given
   double magnitude = 0.0;      ///< load the budget applies at (scene's unit); 0: representative

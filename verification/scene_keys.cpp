@@ -320,14 +320,16 @@ std::vector<SceneKey> tolerances_to_transient() {
       Row("tolerances", "max_error_mm", KeyType::number, "The error a model may make")
           .dflt("0.1").unit("mm").positive(),
       Row("budget", "quantity", KeyType::string,
-          "What the budget is measured on: the contact node, a patch, the whole field or the "
-          "instrument's force (contact loads)")
-          .dflt("\"contact_point\"").one_of({"contact_point", "patch", "field", "reaction"}),
+          "What the budget is measured on: the contact node, a patch, the whole field, the "
+          "instrument's force (contact loads) or the wire's contact force (guidewire loads with "
+          "coupling = \"contact\")")
+          .dflt("\"contact_point\"")
+          .one_of({"contact_point", "patch", "field", "reaction", "contact_force"}),
       Row("budget", "radius", KeyType::number, "The patch's radius (quantity patch only; required there)")
           .unit("m").positive(),
       Row("budget", "tolerance_mm", KeyType::number, "The displacement error allowed")
           .note("tolerances.max_error_mm").unit("mm").positive(),
-      Row("budget", "tolerance_mN", KeyType::number, "The force error allowed (quantity reaction; required there)")
+      Row("budget", "tolerance_mN", KeyType::number, "The force error allowed (quantity reaction or contact_force; required there)")
           .unit("mN").positive(),
       Row("budget", "rate_hz", KeyType::number,
           "Update rate: 30 visual, 1000 haptic (this or time_budget_s is required)")

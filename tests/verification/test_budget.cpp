@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "meshes/foundation/errors.hpp"
+#include "test_paths.hpp"
 #include "verification/scene.hpp"
 
 using namespace vessel;
@@ -103,6 +106,29 @@ TEST(Budget, ReactionTakesAForceTolerance) {
   EXPECT_STREQ(budget_unit(s.budget.quantity), "mN");
 }
 
+TEST(Budget, ContactForceTakesAForceToleranceAndAGuidewireInContact) {
+  std::ifstream in(std::string(VESSEL_SCENES_DIR) + "/guidewire_straight.toml");
+  std::stringstream text;
+  text << in.rdbuf();
+  ASSERT_NE(text.str().find("coupling = \"contact\""), std::string::npos);
+  const std::string table = "[budget]\nquantity = \"contact_force\"\ntolerance_mN = 0.5\nrate_hz = 60\n";
+  const Scene s = parse_scene(text.str() + table, "guidewire_straight.toml");
+  EXPECT_EQ(s.budget.quantity, BudgetQuantity::contact_force);
+  EXPECT_DOUBLE_EQ(s.budget.tolerance, 0.5);
+  EXPECT_STREQ(budget_unit(s.budget.quantity), "mN");
+  // The same wire coupled by series springs has no contact solve to judge by.
+  std::string compliant = text.str();
+  compliant.replace(compliant.find("coupling = \"contact\""), 20, "coupling = \"compliant\"");
+  std::string e;
+  try {
+    (void)parse_scene(compliant + table, "scene.toml");
+  } catch (const InputError& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find("budget.quantity"), std::string::npos) << e;
+  EXPECT_NE(e.find("coupling = \"contact\""), std::string::npos) << e;
+}
+
 TEST(Budget, RefusalsNameTheKeyWhatWasFoundAndWhatWasExpected) {
   const auto refused = [](const std::string& text, const std::vector<std::string>& parts) {
     const std::string e = error_of(text);
@@ -131,6 +157,9 @@ TEST(Budget, RefusalsNameTheKeyWhatWasFoundAndWhatWasExpected) {
           {"budget.magnitude", "found 0.5", "one of the load's magnitudes"});
   refused(budget("rate = 30"), {"budget.rate", "unknown key"});
   refused("budget = 3\n" + std::string(kContact), {"key 'budget'", "expected a table"});
+  refused(budget("quantity = \"contact_force\"\ntolerance_mN = 1\nrate_hz = 30"),
+          {"budget.quantity", "contact_force", "guidewire load"});
+  refused(budget("quantity = \"contact_force\"\nrate_hz = 30"), {"budget.quantity"});
   refused(std::string(kPressure) +
               "[budget]\nquantity = \"reaction\"\ntolerance_mN = 1\n"
               "rate_hz = 30\n",

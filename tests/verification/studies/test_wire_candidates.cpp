@@ -15,8 +15,10 @@
 #include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
+#include "verification/harness/guidewire_contact.hpp"
 #include "verification/scene_problems.hpp"
 #include "verification/studies/recommend/pair_candidates.hpp"
+#include "verification/studies/recommend/recommend.hpp"
 #include "verification/studies/recommend/wire_candidates.hpp"
 
 using namespace vessel;
@@ -258,4 +260,62 @@ TEST(PairCandidates, APairsErrorAndTimeAreItsPartsSumsAndTheCheapestPairMeetingT
   const std::string md = reports::recommendation_markdown(file);
   EXPECT_NE(md.find("### The wire and the vessel together"), std::string::npos) << md;
   EXPECT_NE(md.find("**Recommended: `A + X`**"), std::string::npos) << md;
+}
+
+TEST(ContactForceBudget, EachCandidateTakesItsWallsWorstContactForceErrorOverTheEIs) {
+  // Two EIs, hand-set forces (N): the reference 1 and 3 mN; wall a 1.2 and 2.5 mN (errors 0.2
+  // and 0.5 mN), wall b 0.9 and 3.05 mN (0.1 and 0.05 mN), wall c failed at the first EI.
+  const auto wall = [](const std::string& name, double force, const std::string& failure = "") {
+    contact::ModelContact m;
+    m.name = name;
+    m.force = force;
+    m.failure = failure;
+    return m;
+  };
+  const auto run = [&](double ei, double reference, double strain, double a, double b) {
+    contact::ContactModelsRun r;
+    r.bending_stiffness = ei;
+    r.reference = wall("reference_fem_p2", reference);
+    r.reference.strain = strain;
+    r.models = {wall("a", a), wall("b", b), wall("c", reference, ei < 1e-6 ? "diverged" : "")};
+    return r;
+  };
+  GuidewireContact contact;
+  contact.solve.runs = {run(4e-7, 1e-3, 0.01, 1.2e-3, 0.9e-3), run(4e-6, 3e-3, 0.05, 2.5e-3, 3.05e-3)};
+  const auto candidate = [](const std::string& model, int level) {
+    Candidate c;
+    c.name = model + " @ L" + std::to_string(level);
+    c.model = model;
+    c.level = level;
+    c.ok = true;
+    c.error = NAN;  // the model's own run has no contact force
+    return c;
+  };
+  std::vector<Candidate> cs{candidate("a", 0), candidate("a", 1), candidate("b", 0),
+                            candidate("c", 0), candidate("network", 0)};
+  judge_by_contact_force(contact, cs);
+  EXPECT_TRUE(cs[0].ok);
+  EXPECT_NEAR(cs[0].error, 0.5, 1e-12);  // mN
+  EXPECT_NEAR(cs[1].error, 0.5, 1e-12);  // the contact solve's own mesh: every level alike
+  EXPECT_TRUE(cs[2].ok);
+  EXPECT_NEAR(cs[2].error, 0.1, 1e-12);
+  EXPECT_FALSE(cs[3].ok);
+  EXPECT_NE(cs[3].failure.find("its contact solve failed at EI 4e-07"), std::string::npos)
+      << cs[3].failure;
+  EXPECT_FALSE(cs[4].ok);
+  EXPECT_NE(cs[4].failure.find("no wall"), std::string::npos) << cs[4].failure;
+
+  // A third EI whose linear reference is strained past its validity (0.2 > 0.1) judges no one;
+  // the finite-strain reference has no such limit.
+  contact.solve.runs.push_back(run(4e-5, 6e-3, 0.2, 6e-3, 6e-3));
+  std::vector<Candidate> beyond{candidate("b", 0)};
+  judge_by_contact_force(contact, beyond);
+  EXPECT_FALSE(beyond[0].ok);
+  EXPECT_NE(beyond[0].failure.find("beyond its validity at EI 4e-05"), std::string::npos)
+      << beyond[0].failure;
+  contact.wall = ContactWall::neo_hookean;
+  std::vector<Candidate> finite{candidate("b", 0)};
+  judge_by_contact_force(contact, finite);
+  EXPECT_TRUE(finite[0].ok);
+  EXPECT_NEAR(finite[0].error, 0.1, 1e-12);
 }

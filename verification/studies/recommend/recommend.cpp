@@ -16,6 +16,7 @@
 #include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
 #include "reports/svg_plot.hpp"
+#include "verification/harness/guidewire_contact.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/harness/results.hpp"
 #include "verification/studies/recommend/pair_candidates.hpp"
@@ -382,6 +383,34 @@ std::vector<Candidate> collect_candidates(const SceneResult& r) {
   return out;
 }
 
+void judge_by_contact_force(const GuidewireContact& contact, std::vector<Candidate>& candidates) {
+  for (Candidate& c : candidates) {
+    if (!c.ok) continue;
+    c.error = 0.0;
+    for (const contact::ContactModelsRun& run : contact.solve.runs) {
+      const std::string at = " at EI " + significant(run.bending_stiffness) + " N·m²";
+      const auto row = std::find_if(run.models.begin(), run.models.end(),
+                                    [&](const contact::ModelContact& m) { return m.name == c.model; });
+      if (row == run.models.end()) {
+        c.failure = "it has no wall in the wire-wall contact solve (a network, an external "
+                    "program or a surface model on the outer wall)";
+      } else if (!run.reference.failure.empty()) {
+        c.failure = "the contact reference failed" + at + ": " + run.reference.failure;
+      } else if (contact.beyond_its_reference(run)) {
+        c.failure = "the linear contact reference is strained beyond its validity" + at +
+                    " (contact_wall = \"neo-hookean\" judges that regime)";
+      } else if (!row->failure.empty()) {
+        c.failure = "its contact solve failed" + at + ": " + row->failure;
+      } else {
+        c.error = std::max(c.error, std::abs(row->force - run.reference.force) * 1e3);
+        continue;
+      }
+      c.ok = false;
+      break;
+    }
+  }
+}
+
 Recommendation recommend(const Scene& scene, const RecommendOptions& o,
                          const std::filesystem::path& output_dir, const std::string& command) {
   if (!scene.budget.stated || scene.budget.seconds_per_update() <= 0.0) {
@@ -420,6 +449,12 @@ Recommendation recommend(const Scene& scene, const RecommendOptions& o,
   rec.result = run_and_write({s}, h, output_dir, command).front();
   rec.results_dir = output_dir;
   rec.candidates = collect_candidates(rec.result);
+  if (s.budget.quantity == BudgetQuantity::contact_force) {
+    if (!rec.result.guidewire_contact) {
+      throw std::logic_error("recommend: quantity contact_force without the run's contact solve");
+    }
+    judge_by_contact_force(*rec.result.guidewire_contact, rec.candidates);
+  }
   rec.selection = select_model(rec.candidates, s.budget.tolerance, s.budget.seconds_per_update(),
                                budget_unit(s.budget.quantity));
   if (s.load.guidewire) {

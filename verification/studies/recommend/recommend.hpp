@@ -91,6 +91,14 @@ std::vector<ModelSpec> candidate_models(const Scene& scene, const std::vector<do
 /// budget's load (SceneResult run with budget_load_only).
 std::vector<Candidate> collect_candidates(const SceneResult& result);
 
+/// Budget quantity contact_force: each candidate's error is its wall's in the run's wire–wall
+/// contact solve (guidewire_contact.hpp), |F_model − F_reference| at the worst EI, mN. The solve
+/// is on its own mesh refined around the wire, so every level of a model gets its model's error.
+/// A candidate fails where it has no wall in the solve, where its solve or the reference's
+/// failed, or where the linear reference is strained beyond its validity (the finite-strain one,
+/// contact_wall = "neo-hookean", judges that regime).
+void judge_by_contact_force(const GuidewireContact& contact, std::vector<Candidate>& candidates);
+
 struct WireRecommendation;  // wire_candidates.hpp
 struct PairCandidates;      // pair_candidates.hpp
 
