@@ -562,8 +562,8 @@ Budget read_budget(TableReader r, const Scene& scene) {
            "found \"contact_force\"; expected a guidewire load with coupling = \"contact\" (the "
            "force comes from the wire-wall contact solve)");
   }
-  const bool force = b.quantity == BudgetQuantity::reaction ||
-                     b.quantity == BudgetQuantity::contact_force;
+  const bool force =
+      b.quantity == BudgetQuantity::reaction || b.quantity == BudgetQuantity::contact_force;
   const bool patch = b.quantity == BudgetQuantity::patch;
   if (const toml::node* radius = r.get("radius"); radius && !patch) {
     r.fail(radius, "radius",
@@ -576,8 +576,9 @@ Budget read_budget(TableReader r, const Scene& scene) {
   if (force) {
     const std::string quantity = "quantity \"" + to_string(b.quantity) + "\"";
     if (mm) {
-      r.fail(mm, "tolerance_mm",
-             "found a displacement tolerance; " + quantity + " expected tolerance_mN (a force, mN)");
+      r.fail(
+          mm, "tolerance_mm",
+          "found a displacement tolerance; " + quantity + " expected tolerance_mN (a force, mN)");
     }
     b.tolerance = quantity_number(r, "tolerance_mN", true, quantity);
   } else {

@@ -111,7 +111,8 @@ TEST(Budget, ContactForceTakesAForceToleranceAndAGuidewireInContact) {
   std::stringstream text;
   text << in.rdbuf();
   ASSERT_NE(text.str().find("coupling = \"contact\""), std::string::npos);
-  const std::string table = "[budget]\nquantity = \"contact_force\"\ntolerance_mN = 0.5\nrate_hz = 60\n";
+  const std::string table =
+      "[budget]\nquantity = \"contact_force\"\ntolerance_mN = 0.5\nrate_hz = 60\n";
   const Scene s = parse_scene(text.str() + table, "guidewire_straight.toml");
   EXPECT_EQ(s.budget.quantity, BudgetQuantity::contact_force);
   EXPECT_DOUBLE_EQ(s.budget.tolerance, 0.5);

@@ -149,8 +149,10 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
       "mass-spring models with every stiffness rule, static Newton and linearised solvers or, "
       "for dynamic scenes, every integrator; mesh levels 0-1; region-of-interest radii) against "
       "the FEM reference at the budget's load; in a guidewire scene also the wire's rod models "
-      "against the continuum wire, and every wire-vessel pair (with quantity = \"contact_force\" each "
-      "vessel model judged by its wall's force in the wire-wall contact solve); writes recommend.md (a report "
+      "against the continuum wire, and every wire-vessel pair (with quantity = \"contact_force\" "
+      "each "
+      "vessel model judged by its wall's force in the wire-wall contact solve); writes "
+      "recommend.md (a report "
       "section), recommend.json and the candidates' results.json.\n"
       "Examples:\n"
       "  vesselverify recommend verification/scenes/contact_straight.toml --rate 1000\n"
@@ -166,8 +168,9 @@ void add_recommend_command(CLI::App& app, const std::string& command_line) {
                   "Compute time allowed per update, s; replaces the scene's")
       ->check(CLI::PositiveNumber)
       ->excludes(rate);
-  cmd->add_option("--tolerance", o->tolerance,
-                  "Error tolerance in the budget quantity's unit (mm; mN for reaction and contact_force)")
+  cmd->add_option(
+         "--tolerance", o->tolerance,
+         "Error tolerance in the budget quantity's unit (mm; mN for reaction and contact_force)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--output-dir", o->output_dir, "Where the outputs go")->capture_default_str();
   add_cache_options(*cmd, o->cache);

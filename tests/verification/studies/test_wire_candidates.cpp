@@ -281,7 +281,8 @@ TEST(ContactForceBudget, EachCandidateTakesItsWallsWorstContactForceErrorOverThe
     return r;
   };
   GuidewireContact contact;
-  contact.solve.runs = {run(4e-7, 1e-3, 0.01, 1.2e-3, 0.9e-3), run(4e-6, 3e-3, 0.05, 2.5e-3, 3.05e-3)};
+  contact.solve.runs = {run(4e-7, 1e-3, 0.01, 1.2e-3, 0.9e-3),
+                        run(4e-6, 3e-3, 0.05, 2.5e-3, 3.05e-3)};
   const auto candidate = [](const std::string& model, int level) {
     Candidate c;
     c.name = model + " @ L" + std::to_string(level);

@@ -389,11 +389,13 @@ void judge_by_contact_force(const GuidewireContact& contact, std::vector<Candida
     c.error = 0.0;
     for (const contact::ContactModelsRun& run : contact.solve.runs) {
       const std::string at = " at EI " + significant(run.bending_stiffness) + " N·m²";
-      const auto row = std::find_if(run.models.begin(), run.models.end(),
-                                    [&](const contact::ModelContact& m) { return m.name == c.model; });
+      const auto row =
+          std::find_if(run.models.begin(), run.models.end(),
+                       [&](const contact::ModelContact& m) { return m.name == c.model; });
       if (row == run.models.end()) {
-        c.failure = "it has no wall in the wire-wall contact solve (a network, an external "
-                    "program or a surface model on the outer wall)";
+        c.failure =
+            "it has no wall in the wire-wall contact solve (a network, an external "
+            "program or a surface model on the outer wall)";
       } else if (!run.reference.failure.empty()) {
         c.failure = "the contact reference failed" + at + ": " + run.reference.failure;
       } else if (contact.beyond_its_reference(run)) {
