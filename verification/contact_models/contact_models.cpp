@@ -307,6 +307,18 @@ std::vector<ModelSpec> contact_model_kinds(const Scene& scene) {
   return out;
 }
 
+bool same_contact_wall(const ModelSpec& a, const ModelSpec& b) {
+  const TetFemSpec &ta = a.tet_fem, &tb = b.tet_fem;
+  return a.kind == b.kind && a.degree == b.degree && a.surface == b.surface &&
+         a.topology == b.topology && a.stiffness == b.stiffness &&
+         a.volume_term == b.volume_term && a.volume_moduli == b.volume_moduli &&
+         a.edge_pairs == b.edge_pairs && a.bending == b.bending && a.mass == b.mass &&
+         a.calibration == b.calibration && a.calibration_transfer == b.calibration_transfer &&
+         a.network_file == b.network_file && ta.dt == tb.dt && ta.iterations == tb.iterations &&
+         ta.velocity_damping == tb.velocity_damping &&
+         ta.settle_relative_change == tb.settle_relative_change && ta.max_steps == tb.max_steps;
+}
+
 namespace {
 
 /// The progress line of one wall's contact at one EI (a failed one: the seconds it took to fail).
@@ -326,7 +338,8 @@ void log_contact(std::ostream& log, const ModelSpec& wall, std::size_t index, st
 }
 
 /// Every wall once, solved at each run's EI: the reference first, then the models; a wall whose
-/// solve fails is recorded with its reason.
+/// solve fails is recorded with its reason. A model whose wall an earlier model has
+/// (same_contact_wall) takes that model's contacts under its own name, without a solve.
 void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
                       const std::vector<std::unique_ptr<SceneWire>>& wires,
                       const std::vector<RigidContact>& rigid, const Problem& p,
@@ -338,6 +351,24 @@ void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
   std::vector<const ModelSpec*> walls{&reference};
   for (const ModelSpec& m : models) walls.push_back(&m);
   for (std::size_t k = 0; k < walls.size(); ++k) {
+    const auto here = walls.begin() + static_cast<std::ptrdiff_t>(k);
+    const auto twin = k == 0 ? here : std::find_if(walls.begin() + 1, here, [&](const ModelSpec* w) {
+      return same_contact_wall(*w, *walls[k]);
+    });
+    if (twin != here) {
+      const std::size_t j = static_cast<std::size_t>(twin - walls.begin()) - 1;
+      for (ContactModelsRun& run : out.runs) {
+        ModelContact c = run.models[j];
+        c.name = walls[k]->name;
+        run.models.push_back(c);
+      }
+      if (options.log) {
+        *options.log << "contact-models: " << walls[k]->name << " (" << k + 1 << " of "
+                     << walls.size() << "): the wall of " << (*twin)->name << ", its contacts"
+                     << std::endl;
+      }
+      continue;
+    }
     std::optional<ModelWall> wall;
     std::string why;
     try {

@@ -89,6 +89,12 @@ struct ContactModels {
 /// displacements or a surface model on the outer wall.
 bool has_contact_wall(const ModelSpec& model);
 
+/// Whether two models press the wire with the same wall: they differ at most in what the
+/// contact solve does not read (their names, solvers, damping and regions of interest), as
+/// recommend's candidates of one model under several solvers and radii do. The contact solve
+/// solves such a wall once.
+bool same_contact_wall(const ModelSpec& a, const ModelSpec& b);
+
 /// The scene's models and the model kinds the suite runs that the scene lacks, one each: the
 /// spring networks (seed001, van-gelder), the hybrid volume model, the edge pairs, corotational P1,
 /// XPBD FEM, the surface models (seed 000 on the mid-surface and on the inner wall, Discrete Shells

@@ -15,9 +15,11 @@
 #include "msm/fem/linear_tet.hpp"
 #include "msm/model/build_network.hpp"
 #include "msm/model/mass_spring_model.hpp"
+#include "msm/solvers/solve.hpp"
 #include "msm/solvers/static_solver.hpp"
 #include "msm/terms/edge_pair_term.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
+#include "verification/contact_models/contact_models.hpp"
 #include "verification/contact_models/model_walls.hpp"
 #include "verification/scene_problems.hpp"
 #include "wire_in_tube.hpp"
@@ -245,6 +247,33 @@ TEST(ContactModels, ActionEqualsReactionThroughASurfaceModelsSupports) {
 }
 
 // Kinds and surfaces with no wall the wire can touch are refused by name.
+// Models that differ only in their solver or region of interest are solved once in the contact
+// (same_contact_wall): their walls, built independently, are the same matrix to the last bit;
+// a different stiffness rule is another wall.
+TEST(ContactModels, ASolverOrARegionOfInterestLeavesTheWallAsItIs) {
+  const TetMesh& mesh = tube_mesh();
+  const Scene scene = tube_scene(kWallE);
+  ModelSpec a = spec("volume/lloyd/static", ModelKind::volume_msm);
+  a.stiffness = msm::StiffnessRule::lloyd;
+  ModelSpec b = a;
+  b.name = "volume/lloyd/linear/R=4mm";
+  b.solver = msm::parse_solver("linear");
+  b.roi_radius = 4e-3;
+  ModelSpec c = a;
+  c.stiffness = msm::StiffnessRule::van_gelder;
+  EXPECT_TRUE(contact::same_contact_wall(a, b));
+  EXPECT_FALSE(contact::same_contact_wall(a, c));
+  const auto K = [&](const ModelSpec& m) {
+    return contact::model_wall(scene, m, mesh, scene.vessel, 0.45).system.K;
+  };
+  const auto largest = [](const Eigen::SparseMatrix<double>& m) {
+    return m.nonZeros() == 0 ? 0.0 : m.coeffs().cwiseAbs().maxCoeff();
+  };
+  const Eigen::SparseMatrix<double> Ka = K(a);
+  EXPECT_EQ(largest(Ka - K(b)), 0.0);
+  EXPECT_GT(largest(Ka - K(c)), 1e-3 * largest(Ka));
+}
+
 TEST(ContactModels, OuterSurfaceModelIsRefused) {
   const Scene scene = tube_scene(kWallE);
   ModelSpec outer = spec("outer", ModelKind::surface_msm);
