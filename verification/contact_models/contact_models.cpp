@@ -310,11 +310,11 @@ std::vector<ModelSpec> contact_model_kinds(const Scene& scene) {
 bool same_contact_wall(const ModelSpec& a, const ModelSpec& b) {
   const TetFemSpec &ta = a.tet_fem, &tb = b.tet_fem;
   return a.kind == b.kind && a.degree == b.degree && a.surface == b.surface &&
-         a.topology == b.topology && a.stiffness == b.stiffness &&
-         a.volume_term == b.volume_term && a.volume_moduli == b.volume_moduli &&
-         a.edge_pairs == b.edge_pairs && a.bending == b.bending && a.mass == b.mass &&
-         a.calibration == b.calibration && a.calibration_transfer == b.calibration_transfer &&
-         a.network_file == b.network_file && ta.dt == tb.dt && ta.iterations == tb.iterations &&
+         a.topology == b.topology && a.stiffness == b.stiffness && a.volume_term == b.volume_term &&
+         a.volume_moduli == b.volume_moduli && a.edge_pairs == b.edge_pairs &&
+         a.bending == b.bending && a.mass == b.mass && a.calibration == b.calibration &&
+         a.calibration_transfer == b.calibration_transfer && a.network_file == b.network_file &&
+         ta.dt == tb.dt && ta.iterations == tb.iterations &&
          ta.velocity_damping == tb.velocity_damping &&
          ta.settle_relative_change == tb.settle_relative_change && ta.max_steps == tb.max_steps;
 }
@@ -352,9 +352,10 @@ void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
   for (const ModelSpec& m : models) walls.push_back(&m);
   for (std::size_t k = 0; k < walls.size(); ++k) {
     const auto here = walls.begin() + static_cast<std::ptrdiff_t>(k);
-    const auto twin = k == 0 ? here : std::find_if(walls.begin() + 1, here, [&](const ModelSpec* w) {
-      return same_contact_wall(*w, *walls[k]);
-    });
+    const auto twin =
+        k == 0 ? here : std::find_if(walls.begin() + 1, here, [&](const ModelSpec* w) {
+          return same_contact_wall(*w, *walls[k]);
+        });
     if (twin != here) {
       const std::size_t j = static_cast<std::size_t>(twin - walls.begin()) - 1;
       for (ContactModelsRun& run : out.runs) {
