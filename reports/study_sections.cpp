@@ -289,6 +289,17 @@ std::string error_text(const CandidateEntry& c, const std::string& unit) {
   return c.error ? significant(*c.error, 3) + " " + unit : "not computable";
 }
 
+/// The reason every candidate gives, if they all give the same one (e.g. a reference that judges
+/// none of them); empty otherwise.
+std::string shared_reason(const RecommendFile& r) {
+  if (r.candidates.empty()) return "";
+  const std::string& first = r.candidates.front().reason;
+  for (const auto& c : r.candidates) {
+    if (c.reason != first) return "";
+  }
+  return first;
+}
+
 void answer(Document& doc, const RecommendFile& r) {
   if (const CandidateEntry* best = candidate_named(r, r.recommended)) {
     doc.paragraph("**Recommended: `" + best->name + "`** (" + best->detail + "): error " +
@@ -300,6 +311,8 @@ void answer(Document& doc, const RecommendFile& r) {
     doc.paragraph("**No candidate meets the budget.** The closest is `" + near->name + "` (" +
                   near->detail + "): error " + error_text(*near, r.unit) + ", " +
                   ms(near->update_seconds.value_or(0.0)) + " per update; " + near->reason + ".");
+  } else if (const std::string why = shared_reason(r); !why.empty()) {
+    doc.paragraph("**No candidate meets the budget**, and none finished; every one " + why + ".");
   } else {
     doc.paragraph("**No candidate meets the budget**, and none finished.");
   }

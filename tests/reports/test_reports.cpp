@@ -13,6 +13,7 @@
 #include "reports/report.hpp"
 #include "reports/representative_load.hpp"
 #include "reports/study_files.hpp"
+#include "reports/study_sections.hpp"
 #include "reports/svg_plot.hpp"
 #include "reports/web_page.hpp"
 
@@ -354,6 +355,24 @@ TEST(StudyFiles, TheReportDrawsTheRecommendationWithItsRunsUnitAndReference) {
   EXPECT_LT(slow, failed);
   // 0.1 mm against a reference moving 0.25 mm: the tolerance discriminates, no warning.
   EXPECT_EQ(md.find("does not discriminate"), std::string::npos);
+}
+
+TEST(StudyFiles, ARecommendationWhoseCandidatesAllFailAlikeSaysWhyOnce) {
+  RecommendFile rec = parse_recommend(kRecommend, "rec/recommend.json");
+  rec.recommended.reset();
+  rec.closest.reset();
+  rec.whole_vessel.reset();
+  for (auto& c : rec.candidates) {
+    c.verdict = "failed";
+    c.reason = "failed: the reference is beyond its validity";
+  }
+  EXPECT_NE(recommendation_markdown(rec).find(
+                "**No candidate meets the budget**, and none finished; every one failed: the "
+                "reference is beyond its validity."),
+            std::string::npos)
+      << recommendation_markdown(rec);
+  rec.candidates.back().reason = "failed: diverged";
+  EXPECT_EQ(recommendation_markdown(rec).find("every one"), std::string::npos);
 }
 
 TEST(StudyFiles, MalformedOrForeignFilesAreClearErrorsNamingTheFile) {
