@@ -256,6 +256,32 @@ contact::ContactModelsOptions contact_options(const Scene& scene, const Guidewir
 
 }  // namespace
 
+std::optional<double> worst_contact_force_error_mN(const GuidewireContact& contact,
+                                                   const std::string& model, std::string& why) {
+  double worst = 0.0;
+  for (const contact::ContactModelsRun& run : contact.solve.runs) {
+    const std::string at = " at EI " + reports::significant(run.bending_stiffness) + " N·m²";
+    const auto row = std::find_if(run.models.begin(), run.models.end(),
+                                  [&](const contact::ModelContact& m) { return m.name == model; });
+    if (row == run.models.end()) {
+      why = "it has no wall in the wire-wall contact solve (a network, an external program or a "
+            "surface model on the outer wall)";
+    } else if (!run.reference.failure.empty()) {
+      why = "the contact reference failed" + at + ": " + run.reference.failure;
+    } else if (contact.beyond_its_reference(run)) {
+      why = "the linear contact reference is strained beyond its validity" + at +
+            " (contact_wall = \"neo-hookean\" judges that regime)";
+    } else if (!row->failure.empty()) {
+      why = "its contact solve failed" + at + ": " + row->failure;
+    } else {
+      worst = std::max(worst, std::abs(row->force - run.reference.force) * 1e3);
+      continue;
+    }
+    return std::nullopt;
+  }
+  return worst;
+}
+
 GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutcome& coupled,
                                          const HarnessOptions& options) {
   GuidewireContact c;

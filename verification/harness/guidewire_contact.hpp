@@ -10,6 +10,7 @@
 /// and the shortcuts a simulator takes instead of a contact solve (the rigid lumen's force, the
 /// series springs of guidewire_coupling.hpp) judged against the same reference.
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -45,6 +46,13 @@ struct GuidewireContact {
     return wall == ContactWall::linear && !within_linear_validity(run);
   }
 };
+
+/// Budget quantity contact_force: `model`'s contact-force error over the runs (EIs),
+/// |F_model − F_reference| at the worst EI, mN; nullopt with `why` set where the model has no wall
+/// in the solve, its solve or the reference's failed at an EI, or the linear reference is
+/// strained beyond its validity there (the finite-strain reference judges that regime).
+std::optional<double> worst_contact_force_error_mN(const GuidewireContact& contact,
+                                                   const std::string& model, std::string& why);
 
 /// The contact of `scene` (coupling = "contact") at guidewire_stiffnesses, its solve read from
 /// options.outcome_cache when a run of the same executable on this machine kept it (keyed by the

@@ -1,6 +1,7 @@
 #include "verification/harness/harness.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <fstream>
 #include <functional>
 #include <iterator>
@@ -190,6 +191,13 @@ SceneResult run_models(SceneReferences& r, const HarnessOptions& o, Progress& pr
   if (s.load.guidewire && s.load.guidewire->coupling == GuidewireCoupling::contact) {
     result.guidewire_contact =
         std::make_shared<const GuidewireContact>(solve_guidewire_contact(s, *result.guidewire, o));
+    if (s.budget.quantity == BudgetQuantity::contact_force) {
+      for (ModelOutcome& m : result.outcomes) {
+        std::string why;
+        m.budget_error = worst_contact_force_error_mN(*result.guidewire_contact, m.model, why)
+                             .value_or(std::numeric_limits<double>::quiet_NaN());
+      }
+    }
   }
   return result;
 }

@@ -97,7 +97,7 @@ double budget_quantity_error(const QuantityErrors& q, BudgetQuantity quantity) {
       return q.patch_mm.value_or(nan);
     case BudgetQuantity::reaction:
       return q.reaction_mN.value_or(nan);
-    case BudgetQuantity::contact_force:  // from the contact solve, not the model's own run
+    case BudgetQuantity::contact_force:  // from the contact solve (the harness sets it after)
       return nan;
   }
   return nan;

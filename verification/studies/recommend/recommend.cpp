@@ -386,30 +386,9 @@ std::vector<Candidate> collect_candidates(const SceneResult& r) {
 void judge_by_contact_force(const GuidewireContact& contact, std::vector<Candidate>& candidates) {
   for (Candidate& c : candidates) {
     if (!c.ok) continue;
-    c.error = 0.0;
-    for (const contact::ContactModelsRun& run : contact.solve.runs) {
-      const std::string at = " at EI " + significant(run.bending_stiffness) + " N·m²";
-      const auto row =
-          std::find_if(run.models.begin(), run.models.end(),
-                       [&](const contact::ModelContact& m) { return m.name == c.model; });
-      if (row == run.models.end()) {
-        c.failure =
-            "it has no wall in the wire-wall contact solve (a network, an external "
-            "program or a surface model on the outer wall)";
-      } else if (!run.reference.failure.empty()) {
-        c.failure = "the contact reference failed" + at + ": " + run.reference.failure;
-      } else if (contact.beyond_its_reference(run)) {
-        c.failure = "the linear contact reference is strained beyond its validity" + at +
-                    " (contact_wall = \"neo-hookean\" judges that regime)";
-      } else if (!row->failure.empty()) {
-        c.failure = "its contact solve failed" + at + ": " + row->failure;
-      } else {
-        c.error = std::max(c.error, std::abs(row->force - run.reference.force) * 1e3);
-        continue;
-      }
-      c.ok = false;
-      break;
-    }
+    const std::optional<double> error = worst_contact_force_error_mN(contact, c.model, c.failure);
+    c.ok = error.has_value();
+    c.error = error.value_or(NAN);
   }
 }
 
