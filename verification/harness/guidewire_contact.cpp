@@ -264,8 +264,9 @@ std::optional<double> worst_contact_force_error_mN(const GuidewireContact& conta
     const auto row = std::find_if(run.models.begin(), run.models.end(),
                                   [&](const contact::ModelContact& m) { return m.name == model; });
     if (row == run.models.end()) {
-      why = "it has no wall in the wire-wall contact solve (a network, an external program or a "
-            "surface model on the outer wall)";
+      why =
+          "it has no wall in the wire-wall contact solve (a network, an external program or a "
+          "surface model on the outer wall)";
     } else if (!run.reference.failure.empty()) {
       why = "the contact reference failed" + at + ": " + run.reference.failure;
     } else if (contact.beyond_its_reference(run)) {

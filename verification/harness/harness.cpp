@@ -1,10 +1,10 @@
 #include "verification/harness/harness.hpp"
 
 #include <algorithm>
-#include <limits>
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <limits>
 #include <memory>
 #include <sstream>
 
