@@ -92,11 +92,8 @@ std::vector<ModelSpec> candidate_models(const Scene& scene, const std::vector<do
 std::vector<Candidate> collect_candidates(const SceneResult& result);
 
 /// Budget quantity contact_force: each candidate's error is its wall's in the run's wire–wall
-/// contact solve (guidewire_contact.hpp), |F_model − F_reference| at the worst EI, mN. The solve
-/// is on its own mesh refined around the wire, so every level of a model gets its model's error.
-/// A candidate fails where it has no wall in the solve, where its solve or the reference's
-/// failed, or where the linear reference is strained beyond its validity (the finite-strain one,
-/// contact_wall = "neo-hookean", judges that regime).
+/// contact solve (worst_contact_force_error_mN, guidewire_contact.hpp; every level of a model
+/// alike, the solve having its own mesh); a candidate it cannot judge fails with its reason.
 void judge_by_contact_force(const GuidewireContact& contact, std::vector<Candidate>& candidates);
 
 struct WireRecommendation;  // wire_candidates.hpp
