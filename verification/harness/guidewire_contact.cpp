@@ -258,6 +258,10 @@ contact::ContactModelsOptions contact_options(const Scene& scene, const Guidewir
 
 std::optional<double> worst_contact_force_error_mN(const GuidewireContact& contact,
                                                    const std::string& model, std::string& why) {
+  if (contact.solve.runs.empty()) {
+    why = "the wire-wall contact solve has no EI";
+    return std::nullopt;
+  }
   double worst = 0.0;
   for (const contact::ContactModelsRun& run : contact.solve.runs) {
     const std::string at = " at EI " + reports::significant(run.bending_stiffness) + " N·m²";

@@ -315,6 +315,9 @@ TEST(ContactForceBudget, EachCandidateTakesItsWallsWorstContactForceErrorOverThe
   EXPECT_NE(beyond[0].failure.find("beyond its validity at EI 4e-05"), std::string::npos)
       << beyond[0].failure;
   contact.wall = ContactWall::neo_hookean;
+  std::vector<Candidate> none{candidate("b", 0)};
+  judge_by_contact_force(GuidewireContact{}, none);  // no EI solved: nothing to judge by
+  EXPECT_FALSE(none[0].ok);
   std::vector<Candidate> finite{candidate("b", 0)};
   judge_by_contact_force(contact, finite);
   EXPECT_TRUE(finite[0].ok);
