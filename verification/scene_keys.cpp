@@ -318,50 +318,33 @@ std::vector<SceneKey> models() {
 std::vector<SceneKey> tolerances_to_transient() {
   std::vector<Row> rows{
       Row("tolerances", "max_error_mm", KeyType::number, "The error a model may make")
-          .dflt("0.1")
-          .unit("mm")
-          .positive(),
+          .dflt("0.1").unit("mm").positive(),
       Row("budget", "quantity", KeyType::string,
           "What the budget is measured on: the contact node, a patch, the whole field, the "
           "instrument's force (contact loads) or the wire's contact force (guidewire loads with "
           "coupling = \"contact\")")
           .dflt("\"contact_point\"")
           .one_of({"contact_point", "patch", "field", "reaction", "contact_force"}),
-      Row("budget", "radius", KeyType::number,
-          "The patch's radius (quantity patch only; required there)")
-          .unit("m")
-          .positive(),
+      Row("budget", "radius", KeyType::number, "The patch's radius (quantity patch only; required there)")
+          .unit("m").positive(),
       Row("budget", "tolerance_mm", KeyType::number, "The displacement error allowed")
-          .note("tolerances.max_error_mm")
-          .unit("mm")
-          .positive(),
-      Row("budget", "tolerance_mN", KeyType::number,
-          "The force error allowed (quantity reaction or contact_force; required there)")
-          .unit("mN")
-          .positive(),
+          .note("tolerances.max_error_mm").unit("mm").positive(),
+      Row("budget", "tolerance_mN", KeyType::number, "The force error allowed (quantity reaction or contact_force; required there)")
+          .unit("mN").positive(),
       Row("budget", "rate_hz", KeyType::number,
           "Update rate: 30 visual, 1000 haptic (this or time_budget_s is required)")
-          .unit("Hz")
-          .positive(),
+          .unit("Hz").positive(),
       Row("budget", "time_budget_s", KeyType::number, "Compute time allowed per update")
-          .note("1/rate_hz")
-          .unit("s")
-          .positive(),
-      Row("budget", "magnitude", KeyType::number,
-          "The load the budget applies at, one of the load's magnitudes")
-          .note("a representative magnitude")
-          .unit("the load's")
-          .at_least(0.0),
+          .note("1/rate_hz").unit("s").positive(),
+      Row("budget", "magnitude", KeyType::number, "The load the budget applies at, one of the load's magnitudes")
+          .note("a representative magnitude").unit("the load's").at_least(0.0),
       Row("modes", "count", KeyType::integer, "Lowest natural frequencies per model; 0: none")
-          .dflt("0")
-          .range(0, 100),
+          .dflt("0").range(0, 100),
       Row("modes", "reference_level", KeyType::integer, "Mesh level of the modal reference (P2)")
-          .note("vessel.reference_level")
-          .range(0, kMaxLevel),
+          .note("vessel.reference_level").range(0, kMaxLevel),
       Row("transient", "reference_level", KeyType::integer,
           "Mesh level of the FEM transient (P2, Newmark)")
-          .note("vessel.reference_level")
-          .range(0, kMaxLevel),
+          .note("vessel.reference_level").range(0, kMaxLevel),
   };
   std::vector<SceneKey> out;
   for (auto& r : rows) out.push_back(std::move(r.k));
