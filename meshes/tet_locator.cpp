@@ -6,12 +6,16 @@
 
 namespace vessel {
 
-double min_barycentric(const TetMesh& mesh, const Tet& tet, const Vec3& x) {
+Eigen::Vector4d barycentric(const TetMesh& mesh, const Tet& tet, const Vec3& x) {
   const Vec3& p0 = mesh.nodes[static_cast<std::size_t>(tet[0])];
   Eigen::Matrix3d m;
   for (int c = 0; c < 3; ++c) m.col(c) = mesh.nodes[static_cast<std::size_t>(tet[c + 1])] - p0;
   const Vec3 l = m.partialPivLu().solve(x - p0);
-  return std::min({1.0 - l.sum(), l[0], l[1], l[2]});
+  return {1.0 - l.sum(), l[0], l[1], l[2]};
+}
+
+double min_barycentric(const TetMesh& mesh, const Tet& tet, const Vec3& x) {
+  return barycentric(mesh, tet, x).minCoeff();
 }
 
 TetLocator::TetLocator(const TetMesh& mesh) : mesh_(&mesh) {

@@ -31,6 +31,8 @@ class TetLocator {
   std::vector<std::vector<int>> buckets_;
 };
 
+/// x's barycentric coordinates in `tet` (λ0..λ3, summing to 1; all ≥ 0 inside).
+Eigen::Vector4d barycentric(const TetMesh& mesh, const Tet& tet, const Vec3& x);
 /// The smallest barycentric coordinate of x in `tet` (≥ 0 inside).
 double min_barycentric(const TetMesh& mesh, const Tet& tet, const Vec3& x);
 
