@@ -256,7 +256,17 @@ struct FreeDisplacementSystem {
   std::vector<int> free_index;    ///< per DoF (this solver's numbering) its row, −1 if constrained
   /// Per TetMesh node, the rows of its x, y and z displacement (−1 where constrained).
   std::vector<std::array<int, 3>> node_rows;
+  /// Per row, its DoF's support point (m, through the solver's mapping: a P2 row on a curved wall
+  /// lies on the curved surface) and displacement component (0–2): where a field's interpolant
+  /// takes the row's value (interpolate_rows).
+  std::vector<Vec3> row_points;
+  std::vector<int> row_components;
 };
+
+/// The rows of `system` of the field's interpolant: row r takes field(row_points[r]) in its
+/// component (m). For a start state on a mesh from a displacement known elsewhere (another mesh's).
+Eigen::VectorXd interpolate_rows(const FreeDisplacementSystem& system,
+                                 const std::function<Vec3(const Vec3&)>& field);
 
 /// Solves a linear-elastic problem on one mesh and keeps the solution for point evaluation.
 class ElasticitySolver {

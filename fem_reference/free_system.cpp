@@ -4,6 +4,7 @@
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "fem_reference/detail/serial_solver.hpp"
@@ -114,7 +115,34 @@ FreeDisplacementSystem ElasticitySolver::free_displacement_system() const {
   }
   Impl::FreeSystem sys = impl_->assemble_free_system(false);
   std::vector<std::array<int, 3>> rows = impl_->node_rows(sys.free_index);
-  return {std::move(sys.K), std::move(sys.f), std::move(sys.free_index), std::move(rows)};
+  FreeDisplacementSystem out{std::move(sys.K), std::move(sys.f), std::move(sys.free_index),
+                             std::move(rows), {}, {}};
+  impl_->set_row_points(out);
+  return out;
+}
+
+void ElasticitySolver::Impl::set_row_points(FreeDisplacementSystem& system) const {
+  const detail::DisplacementRows all = displacement_rows({});
+  const auto n = static_cast<std::size_t>(
+      std::count_if(system.free_index.begin(), system.free_index.end(), [](int r) { return r >= 0; }));
+  system.row_points.assign(n, Vec3::Zero());
+  system.row_components.assign(n, 0);
+  for (std::size_t d = 0; d < system.free_index.size(); ++d) {
+    const int r = system.free_index[d];
+    if (r < 0) continue;
+    const auto& x = all.support[d];
+    system.row_points[static_cast<std::size_t>(r)] = Vec3(x[0], x[1], x[2]);
+    system.row_components[static_cast<std::size_t>(r)] = static_cast<int>(all.component[d]);
+  }
+}
+
+Eigen::VectorXd interpolate_rows(const FreeDisplacementSystem& system,
+                                 const std::function<Vec3(const Vec3&)>& field) {
+  Eigen::VectorXd out(static_cast<Eigen::Index>(system.row_points.size()));
+  for (std::size_t r = 0; r < system.row_points.size(); ++r) {
+    out[static_cast<Eigen::Index>(r)] = field(system.row_points[r])[system.row_components[r]];
+  }
+  return out;
 }
 
 std::vector<std::array<int, 3>> ElasticitySolver::Impl::node_rows(

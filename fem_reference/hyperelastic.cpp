@@ -813,6 +813,7 @@ FreeDisplacementSystem HyperelasticSolver::free_dofs() const {
   FreeDisplacementSystem out;
   out.free_index = impl_->free_index;
   out.node_rows = impl_->d.node_rows(out.free_index);
+  impl_->d.set_row_points(out);
   return out;
 }
 

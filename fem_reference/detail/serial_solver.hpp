@@ -150,6 +150,8 @@ struct ElasticitySolver::Impl {
   /// Per TetMesh node, the rows of its x, y and z displacement (−1 where constrained) under
   /// `free_index` (FreeDisplacementSystem::node_rows).
   [[nodiscard]] std::vector<std::array<int, 3>> node_rows(const std::vector<int>& free_index) const;
+  /// Fills `system`'s row_points and row_components from its free_index.
+  void set_row_points(FreeDisplacementSystem& system) const;
   /// The rows and columns of `a` at free DoFs (free_index ≥ 0), renumbered by free_index.
   [[nodiscard]] static Eigen::SparseMatrix<double> free_block(const dl::SparseMatrix<double>& a,
                                                               const std::vector<int>& free_index,

@@ -269,6 +269,33 @@ TEST(ElasticitySolvers, AmgCgAgreesWithTheDirectSolver) {
   }
 }
 
+TEST(FreeDisplacementSystem, AnAffineFieldsInterpolantStoresItsClosedFormEnergy) {
+  // u(x) = x₀ b vanishes on the clamped face x₀ = 0 and is affine, so P1 and P2 hold it exactly:
+  // ½ uᵀK u over the rows interpolate_rows fills must be the uniform strain's energy
+  // (μ ε:ε + λ/2 (tr ε)²) L³, ε = sym(b ⊗ e₀). A row given another point or component breaks it.
+  const double L = 1e-3;
+  const vessel::TetMesh mesh = vessel::test::cube_mesh(2, L);
+  const vessel::Vec3 b(1e-3, 2e-3, -1.5e-3);
+  for (const int degree : {1, 2}) {
+    ElasticityProblem p;
+    p.material.poisson_ratio = 0.3;
+    p.options.degree = degree;
+    p.dirichlet = {DirichletCondition::clamped("x0")};
+    const FreeDisplacementSystem sys = ElasticitySolver(mesh, p).free_displacement_system();
+    ASSERT_EQ(static_cast<Eigen::Index>(sys.row_points.size()), sys.K.rows());
+    const Eigen::VectorXd u =
+        interpolate_rows(sys, [&](const vessel::Vec3& x) -> vessel::Vec3 { return x[0] * b; });
+    Eigen::Matrix3d eps = Eigen::Matrix3d::Zero();
+    eps.col(0) += 0.5 * b;
+    eps.row(0) += 0.5 * b.transpose();
+    const double E = p.material.youngs_modulus, nu = p.material.poisson_ratio;
+    const double mu = E / (2 * (1 + nu)), lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+    const double exact = (mu * eps.squaredNorm() + 0.5 * lambda * eps.trace() * eps.trace()) *
+                         L * L * L;
+    EXPECT_NEAR(0.5 * u.dot(sys.K * u), exact, 1e-10 * exact) << "P" << degree;
+  }
+}
+
 TEST(FreeDisplacementSystem, SolvedByASecondSolverItGivesTheStaticSolution) {
   // What the harness factorises to time P1 and P2 as a simulator runs them: the system on the
   // free DoFs, solved here by Eigen's LDLT, must give solve()'s displacements (CHOLMOD on the
