@@ -104,7 +104,47 @@ TEST(ContactReferenceSlow, AZoneThatLeavesThePatchIsSolvedAgainOnAGrownPatch) {
             std::string::npos);
   EXPECT_NE(printed.str().find("neo-Hookean P1 wall"), std::string::npos);
   EXPECT_TRUE(r.levels[0].zone_inside_patch);
-  EXPECT_EQ(r.verdict.find("leaves the refined patch"), std::string::npos) << r.verdict;
+  // One level converged inside its patch, but with nothing to measure its mesh error against.
+  EXPECT_EQ(r.verdict.rfind("one level: no estimate of its mesh error", 0), 0u) << r.verdict;
+  EXPECT_FALSE(r.is_reference());
+}
+
+// Each finite-strain solve after the scout starts at the target EI from the solve before's
+// equilibrium (its wall interpolated onto the finer mesh): level by level, in fewer Newton steps,
+// an equilibrium whose force is within 0.1 % of the one the rungs from the wall at rest reach.
+// (Not to the solver's tolerance: the wire in the straight tube bends in its plane of symmetry,
+// and the two paths settled on either side of it, zone centroids 0.07 mm and −0.06 mm off it,
+// on a mesh that is not symmetric: forces 0.05 % and 0.03 % apart, where the two-level GCI is
+// 9 %.)
+TEST(ContactReferenceSlow, ALevelFromTheLevelBeforeReachesTheEquilibriumFromRest) {
+  const Scene scene = shipped("guidewire_straight.toml");
+  ContactReferenceOptions o;
+  o.wall = ContactWall::neo_hookean;
+  o.levels = 2;
+  o.coarsest_size = 0.16e-3;
+  o.ratio = 1.2;
+  const double EI = 1.26e-6;  // two rungs from rest
+  const ContactReference warm = solve_contact_reference(scene, EI, o);
+  o.from_previous_solve = false;
+  const ContactReference rest = solve_contact_reference(scene, EI, o);
+  print_contact_reference(warm, std::cout);
+  print_contact_reference(rest, std::cout);
+  ASSERT_EQ(warm.levels.size(), 2u);
+  ASSERT_EQ(rest.levels.size(), 2u);
+  int warm_steps = 0, rest_steps = 0;
+  for (std::size_t l = 0; l < 2; ++l) {
+    ASSERT_TRUE(warm.levels[l].converged) << warm.levels[l].failure;
+    ASSERT_TRUE(rest.levels[l].converged) << rest.levels[l].failure;
+    EXPECT_TRUE(warm.levels[l].from_previous_solve);
+    EXPECT_FALSE(rest.levels[l].from_previous_solve);
+    EXPECT_EQ(rest.levels[l].rungs, 2);
+    EXPECT_EQ(warm.levels[l].mesh_nodes, rest.levels[l].mesh_nodes);
+    EXPECT_NEAR(warm.levels[l].force, rest.levels[l].force, 1e-3 * rest.levels[l].force);
+    warm_steps += warm.levels[l].steps;
+    rest_steps += rest.levels[l].steps;
+  }
+  EXPECT_LT(warm_steps, rest_steps);
+  EXPECT_EQ(warm.verdict, "reference");
 }
 
 TEST(ContactReferenceSlow, StraightSceneFloppyWireConverges) {

@@ -25,6 +25,7 @@ struct ContactCli {
   std::filesystem::path scene;
   std::vector<double> ei;
   std::string wall = "linear";
+  bool from_rest = false;
   ContactReferenceOptions options;
 };
 
@@ -133,9 +134,13 @@ void add_contact_command(CLI::App& app) {
                   "Neo-Hookean wall: the EI ratio between the continuation's rungs (> 1)")
       ->check(CLI::Range(1.01, 1e6))
       ->capture_default_str();
+  cmd->add_flag("--from-rest", o->from_rest,
+                "Neo-Hookean wall: every level climbs the EI rungs from the wall at rest, instead "
+                "of starting from the level before's equilibrium");
   cmd->callback([o] {
     o->options.log = &std::cerr;  // progress; the table goes to stdout
     o->options.wall = parse_contact_wall(o->wall);
+    o->options.from_previous_solve = !o->from_rest;
     const Scene scene = read_scene(o->scene);
     for (const double EI : stiffnesses(scene, o->ei)) {
       print_contact_reference(solve_contact_reference(scene, EI, o->options), std::cout);

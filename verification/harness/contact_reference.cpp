@@ -5,11 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "fem_reference/elasticity.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
+#include "meshes/tet_locator.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "verification/contact/wall_crossing.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
@@ -227,16 +229,67 @@ std::vector<double> continuation_rungs(double first, double ratio, double target
   return rungs;
 }
 
+/// A level's solved finite-strain equilibrium, where the next level starts: the wire's state and
+/// the wall's displacement at its mesh's nodes (m).
+struct LevelEquilibrium {
+  TetMesh mesh;
+  std::vector<Vec3> displacement;
+  Eigen::VectorXd wire;
+};
+
+/// Barycentric tolerance of the coarser mesh's tet holding a finer mesh's point: the two
+/// meshes' chords of the curved walls differ, so a point on one's surface may lie just outside
+/// the other's.
+constexpr double kOutsideTolerance = 0.25;
+
+/// `from`'s displacement at x: linear in `from`'s tets (its vertex values), the nearest node's
+/// where x lies outside them.
+Vec3 displacement_at(const LevelEquilibrium& from, const TetLocator& locator, const Vec3& x) {
+  const int t = locator.find(x, kOutsideTolerance);
+  if (t >= 0) {
+    const Tet& tet = from.mesh.tets[static_cast<std::size_t>(t)];
+    const Eigen::Vector4d l = barycentric(from.mesh, tet, x);
+    Vec3 u = Vec3::Zero();
+    for (int k = 0; k < 4; ++k) u += l[k] * from.displacement[static_cast<std::size_t>(tet[k])];
+    return u;
+  }
+  std::size_t nearest = 0;
+  for (std::size_t n = 1; n < from.mesh.nodes.size(); ++n) {
+    if ((from.mesh.nodes[n] - x).squaredNorm() < (from.mesh.nodes[nearest] - x).squaredNorm())
+      nearest = n;
+  }
+  return from.displacement[nearest];
+}
+
+/// `from`'s displacement interpolated onto `wall`'s rows (a start, not a projection), each point
+/// the interpolant puts inside `from`'s wire moved out to its surface: the coarser wall's facets
+/// are cut by the capsule between their nodes (only nodes bear), and a finer mesh's points on
+/// them would start deep in the penalty's stiff range.
+Eigen::VectorXd wall_start_from(const LevelEquilibrium& from, const contact::ContactWire& wire,
+                                const contact::NeoHookeanWall& wall) {
+  const TetLocator locator(from.mesh);
+  return fem::interpolate_rows(wall.dofs(), [&](const Vec3& x) -> Vec3 {
+    Vec3 u = displacement_at(from, locator, x);
+    const Vec3 d = x + u - contact::nearest_on_centreline(wire, from.wire, x + u);
+    if (d.norm() < wire.radius && d.norm() > 0.0) u += (wire.radius - d.norm()) * d.normalized();
+    return u;
+  });
+}
+
 /// The finite-strain wall: the wire and the neo-Hookean wall as one potential
 /// (solve_wire_wall_potential), every inner-wall node a candidate. A stiff wire dents the wall
 /// by millimetres, and Newton's method from the rigid-lumen state (the wall at rest) does not
 /// reach that equilibrium; so the wire's stiffness is raised in rungs (continuation_rungs), each
 /// solved from the last rung's equilibrium (the wire's rigid-lumen shape holds at every EI). A
 /// rung that fails is split at its geometric mean with the last converged one, up to 3 times.
+/// With `from` (a coarser level's equilibrium at the same EI) the target is first solved from it,
+/// its wall interpolated onto this mesh; the rungs only if that fails. The equilibrium reached
+/// is left in `reached`.
 void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, double nu,
                             const TetMesh& mesh, const std::vector<RefinedBall>& balls,
                             double force_scale, const ContactReferenceOptions& o,
-                            ContactLevel& out) {
+                            const LevelEquilibrium* from, ContactLevel& out,
+                            LevelEquilibrium& reached) {
   const contact::NeoHookeanWall wall(mesh, wall_problem(scene, nu, o.degree));
   const std::vector<int> nodes = mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
   const double target = wire.bending_stiffness;
@@ -254,6 +307,24 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
   double done = 0.0;  // the EI of the equilibrium in hand (0: the rigid-lumen state, wall at rest)
   int splits = 0;
   contact::PotentialContactSolution s;
+  if (from != nullptr) {
+    ReferenceWire at_target = wire.with_bending_stiffness(target);
+    po.force_scale = force_scale;
+    try {
+      s = contact::solve_wire_wall_potential(at_target.rod, wire.radius, wall, mesh, nodes,
+                                             from->wire, po,
+                                             wall_start_from(*from, at_target.contact(), wall));
+      out.steps = s.newton_iterations;
+      out.rungs = 1;
+      out.from_previous_solve = true;
+      rungs.clear();
+    } catch (const std::runtime_error& e) {
+      if (o.log) {
+        *o.log << "contact:   from the solve before's equilibrium: " << e.what()
+               << "; the EI rungs from the wall at rest" << std::endl;
+      }
+    }
+  }
   for (std::size_t k = 0; k < rungs.size();) {
     ReferenceWire rung = wire.with_bending_stiffness(rungs[k]);
     po.force_scale = force_scale * rungs[k] / target;
@@ -289,14 +360,17 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
   out.force = s.total_force_on_wall().norm();
   describe_zone(mesh, s.pressed, s.force, displacement, balls, out);
   out.strain = wall.largest_strain(mesh, s.u);
+  reached = {mesh, displacement, s.x};
 }
 
 /// One contact solve on a mesh refined to `fine` within the balls (the first: the zone; its
-/// candidates for the linear wall). A wire that crossed the wall leaves its centreline nodes near
-/// the wall in `near_wall`.
+/// candidates for the linear wall). The finite-strain wall starts from `last` where it holds a
+/// coarser solve's equilibrium, and leaves its own there. A wire that crossed the wall leaves its
+/// centreline nodes near the wall in `near_wall`.
 ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double nu, double fine,
                          const std::vector<RefinedBall>& balls, const Vec3& wall_point,
                          double force_scale, const ContactReferenceOptions& o,
+                         std::optional<LevelEquilibrium>& last,
                          std::vector<Vec3>* near_wall = nullptr) {
   const auto t0 = Clock::now();
   ContactLevel out;
@@ -328,7 +402,10 @@ ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double n
     if (o.wall == ContactWall::linear) {
       solve_linear_wall(scene, wire, nu, mesh, nodes, wall_point, balls, force_scale, o, out);
     } else {
-      solve_neo_hookean_wall(scene, wire, nu, mesh, balls, force_scale, o, out);
+      LevelEquilibrium reached;
+      solve_neo_hookean_wall(scene, wire, nu, mesh, balls, force_scale, o,
+                             last && o.from_previous_solve ? &*last : nullptr, out, reached);
+      last = std::move(reached);
     }
   } catch (const WallCrossed& e) {
     out.converged = false;
@@ -379,13 +456,14 @@ constexpr int kScoutSolves = 4;
 /// balls every level is refined in: the zone's first, then those along the wire.
 std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
                                const Vec3& wall_point, double force_scale,
-                               const ContactReferenceOptions& o, ContactReference& r) {
+                               const ContactReferenceOptions& o, ContactReference& r,
+                               std::optional<LevelEquilibrium>& last) {
   const double scout_radius = 1.0e-3;
   std::vector<RefinedBall> balls{{wall_point, scout_radius}};
   for (int solve = 1; solve <= kScoutSolves; ++solve) {
     std::vector<Vec3> near_wall;
     r.scout = solve_level(scene, wire, r.poisson_ratio, o.coarsest_size, balls, wall_point,
-                          force_scale, o, &near_wall);
+                          force_scale, o, last, &near_wall);
     const std::size_t before = balls.size();
     if (!near_wall.empty() && solve == 1) {
       const std::vector<Vec3> band = bearing_band(scene, wire);
@@ -451,6 +529,8 @@ void judge(const ContactReferenceOptions& o, ContactReference& r) {
                 fixed(o.strain_limit, 3) + ")";
   } else if (!inside) {
     r.verdict = "not a reference: the contact zone leaves the refined patch";
+  } else if (r.levels.size() < 2) {
+    r.verdict = "one level: no estimate of its mesh error (two or more levels give a GCI)";
   } else {
     r.verdict = "reference";
   }
@@ -512,11 +592,13 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
   if (const auto c = continuum_wire(scene.vessel, spec, why)) r.continuum_rigid_force = c->force;
   const ReferenceWire wire(spec, rigid_solver.rod_state());
 
-  std::vector<RefinedBall> balls = scout(scene, wire, rigid.wall_point, rigid.force, o, r);
+  // The finite-strain wall's last equilibrium: each solve starts from the one before it.
+  std::optional<LevelEquilibrium> last;
+  std::vector<RefinedBall> balls = scout(scene, wire, rigid.wall_point, rigid.force, o, r, last);
   for (int l = 0; l < o.levels; ++l) {
     const double fine = o.coarsest_size / std::pow(o.ratio, l);
-    ContactLevel level =
-        solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point, rigid.force, o);
+    ContactLevel level = solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point,
+                                     rigid.force, o, last);
     // A zone that leaves the patch (the scout's coarser wall under-reports a long line of
     // contact): the patch grown to this level's zone, the old one kept, and the level solved
     // again.
@@ -531,8 +613,8 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
                << " mm) left the patch: refined within " << r.patch_radius * 1e3
                << " mm of its middle and solved again" << std::endl;
       }
-      level =
-          solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point, rigid.force, o);
+      level = solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point,
+                          rigid.force, o, last);
     }
     level.level = l;
     r.levels.push_back(level);
@@ -581,7 +663,8 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
         << ", " << fixed(l.centroid.y() * 1e3, 2) << ", " << fixed(l.centroid.z() * 1e3, 2)
         << ") | " << fixed(l.extent * 1e3, 3) << (l.zone_inside_patch ? "" : " (leaves the patch)")
         << " | " << fixed(l.dent * 1e3, 3) << " | " << fixed(l.strain, 3) << " | " << l.steps
-        << (l.rungs > 1 ? " in " + std::to_string(l.rungs) + " EI rungs" : std::string()) << " | "
+        << (l.rungs > 1 ? " in " + std::to_string(l.rungs) + " EI rungs" : std::string())
+        << (l.from_previous_solve ? " from the solve before" : "") << " | "
         << fixed(l.seconds, 1) << " |\n";
   }
   for (const ContactLevel& l : r.levels) {

@@ -43,6 +43,10 @@ struct ContactReferenceOptions {
   /// 300, measured with the wall's tangent left unprojected)
   double continuation_from = 4e-7;
   double continuation_ratio = 3.1622776601683795;
+  /// The neo-Hookean wall: each solve after the first starts at the target EI from the solve
+  /// before's equilibrium (its wall interpolated onto the new mesh), the rungs only if that
+  /// fails; false: every solve climbs the rungs from the wall at rest.
+  bool from_previous_solve = true;
   std::ostream* log = nullptr;  ///< one line per solve (mesh, candidates, result), if set
 };
 
@@ -67,6 +71,9 @@ struct ContactLevel {
   bool zone_inside_patch = true;  ///< every pressed node within the refined ball
   int steps = 0;         ///< linearised steps over all growth rounds or rungs (0 if not converged)
   int rungs = 0;         ///< the neo-Hookean wall's stiffness continuation: solves to reach the EI
+  /// the neo-Hookean wall solved at the EI from the solve before (a coarser level's or the
+  /// ungrown patch's equilibrium, interpolated onto this mesh), not from the wall at rest
+  bool from_previous_solve = false;
   double seconds = 0.0;  ///< meshing, condensing and solving this level
 };
 
@@ -92,8 +99,9 @@ struct ContactReference {
   /// From the three finest levels when all converged: Roache's order and GCI on the force.
   std::optional<fem::GciOrder> order;
   std::optional<fem::RichardsonEstimate> estimate;
-  /// "reference", "beyond the linear wall's validity (largest strain ...)" or "did not
-  /// converge: ...": what the finest level's force may be used as.
+  /// "reference", "beyond the linear wall's validity (largest strain ...)", "did not
+  /// converge: ..." or "one level: ..." (no convergence estimate): what the finest level's force
+  /// may be used as.
   std::string verdict;
   [[nodiscard]] bool is_reference() const { return verdict == "reference"; }
 };
