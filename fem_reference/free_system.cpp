@@ -115,16 +115,16 @@ FreeDisplacementSystem ElasticitySolver::free_displacement_system() const {
   }
   Impl::FreeSystem sys = impl_->assemble_free_system(false);
   std::vector<std::array<int, 3>> rows = impl_->node_rows(sys.free_index);
-  FreeDisplacementSystem out{std::move(sys.K), std::move(sys.f), std::move(sys.free_index),
-                             std::move(rows), {}, {}};
+  FreeDisplacementSystem out{
+      std::move(sys.K), std::move(sys.f), std::move(sys.free_index), std::move(rows), {}, {}};
   impl_->set_row_points(out);
   return out;
 }
 
 void ElasticitySolver::Impl::set_row_points(FreeDisplacementSystem& system) const {
   const detail::DisplacementRows all = displacement_rows({});
-  const auto n = static_cast<std::size_t>(
-      std::count_if(system.free_index.begin(), system.free_index.end(), [](int r) { return r >= 0; }));
+  const auto n = static_cast<std::size_t>(std::count_if(
+      system.free_index.begin(), system.free_index.end(), [](int r) { return r >= 0; }));
   system.row_points.assign(n, Vec3::Zero());
   system.row_components.assign(n, 0);
   for (std::size_t d = 0; d < system.free_index.size(); ++d) {

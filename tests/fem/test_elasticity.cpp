@@ -290,8 +290,8 @@ TEST(FreeDisplacementSystem, AnAffineFieldsInterpolantStoresItsClosedFormEnergy)
     eps.row(0) += 0.5 * b.transpose();
     const double E = p.material.youngs_modulus, nu = p.material.poisson_ratio;
     const double mu = E / (2 * (1 + nu)), lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
-    const double exact = (mu * eps.squaredNorm() + 0.5 * lambda * eps.trace() * eps.trace()) *
-                         L * L * L;
+    const double exact =
+        (mu * eps.squaredNorm() + 0.5 * lambda * eps.trace() * eps.trace()) * L * L * L;
     EXPECT_NEAR(0.5 * u.dot(sys.K * u), exact, 1e-10 * exact) << "P" << degree;
   }
 }

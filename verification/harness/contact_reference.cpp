@@ -613,8 +613,8 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
                << " mm) left the patch: refined within " << r.patch_radius * 1e3
                << " mm of its middle and solved again" << std::endl;
       }
-      level = solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point,
-                          rigid.force, o, last);
+      level = solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point, rigid.force,
+                          o, last);
     }
     level.level = l;
     r.levels.push_back(level);
@@ -664,8 +664,8 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
         << ") | " << fixed(l.extent * 1e3, 3) << (l.zone_inside_patch ? "" : " (leaves the patch)")
         << " | " << fixed(l.dent * 1e3, 3) << " | " << fixed(l.strain, 3) << " | " << l.steps
         << (l.rungs > 1 ? " in " + std::to_string(l.rungs) + " EI rungs" : std::string())
-        << (l.from_previous_solve ? " from the solve before" : "") << " | "
-        << fixed(l.seconds, 1) << " |\n";
+        << (l.from_previous_solve ? " from the solve before" : "") << " | " << fixed(l.seconds, 1)
+        << " |\n";
   }
   for (const ContactLevel& l : r.levels) {
     if (!l.converged) out << "\nLevel " << l.level << " did not converge: " << l.failure << "\n";
