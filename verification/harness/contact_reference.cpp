@@ -276,55 +276,44 @@ Eigen::VectorXd wall_start_from(const LevelEquilibrium& from, const contact::Con
   });
 }
 
-/// The finite-strain wall: the wire and the neo-Hookean wall as one potential
-/// (solve_wire_wall_potential), every inner-wall node a candidate. A stiff wire dents the wall
-/// by millimetres, and Newton's method from the rigid-lumen state (the wall at rest) does not
-/// reach that equilibrium; so the wire's stiffness is raised in rungs (continuation_rungs), each
-/// solved from the last rung's equilibrium (the wire's rigid-lumen shape holds at every EI). A
-/// rung that fails is split at its geometric mean with the last converged one, up to 3 times.
-/// With `from` (a coarser level's equilibrium at the same EI) the target is first solved from it,
-/// its wall interpolated onto this mesh; the rungs only if that fails. The equilibrium reached
-/// is left in `reached`.
-void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, double nu,
-                            const TetMesh& mesh, const std::vector<RefinedBall>& balls,
-                            double force_scale, const ContactReferenceOptions& o,
-                            const LevelEquilibrium* from, ContactLevel& out,
-                            LevelEquilibrium& reached) {
-  const contact::NeoHookeanWall wall(mesh, wall_problem(scene, nu, o.degree));
-  const std::vector<int> nodes = mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
+/// The wire at EI `target` on `wall` from the solve before's equilibrium `from`, its wall
+/// interpolated onto this mesh (wall_start_from); nothing, the reason logged, if that solve fails.
+std::optional<contact::PotentialContactSolution> solve_from_previous(
+    const ReferenceWire& wire, const contact::NeoHookeanWall& wall, const TetMesh& mesh,
+    const std::vector<int>& nodes, const LevelEquilibrium& from,
+    contact::PotentialContactOptions po, double force_scale, std::ostream* log) {
+  // The wire's own copy: the solve leaves its rod prepared at the solution.
+  ReferenceWire at_target = wire.with_bending_stiffness(wire.bending_stiffness);
+  po.force_scale = force_scale;
+  try {
+    return contact::solve_wire_wall_potential(at_target.rod, wire.radius, wall, mesh, nodes,
+                                              from.wire, po,
+                                              wall_start_from(from, at_target.contact(), wall));
+  } catch (const std::runtime_error& e) {
+    if (log) {
+      *log << "contact:   from the solve before's equilibrium: " << e.what()
+           << "; the EI rungs from the wall at rest" << std::endl;
+    }
+    return std::nullopt;
+  }
+}
+
+/// The wire's stiffness raised in rungs (continuation_rungs) to its own EI, each solved from the
+/// last rung's equilibrium, the first from the rigid-lumen state with the wall at rest (the wire's
+/// rigid-lumen shape holds at every EI). A rung that fails is split at its geometric mean with the
+/// last converged one, up to 3 times. Counts the steps and rungs in `out`.
+contact::PotentialContactSolution climb_rungs(const ReferenceWire& wire,
+                                              const contact::NeoHookeanWall& wall,
+                                              const TetMesh& mesh, const std::vector<int>& nodes,
+                                              contact::PotentialContactOptions po,
+                                              double force_scale, const ContactReferenceOptions& o,
+                                              ContactLevel& out) {
   const double target = wire.bending_stiffness;
-  contact::PotentialContactOptions po;
-  // ‖∇Π‖ to 1e-8 of the rigid-wall force: the force to ~1e-8 of itself, short of the
-  // neo-Hookean energy's round-off floor where the line search stalls.
-  po.tolerance = 1e-8;
-  po.max_newton = o.max_steps;
-  po.log = o.log;
-  // On the straight scene's scout refined along the stiff wire (13 239 nodes) the 1.26e-5 N·m²
-  // rung converged in 45 damped steps; undamped it oscillated for 175 (residual 5e-4-2.6e-3 N).
-  po.damped_newton = true;
   std::vector<double> rungs = continuation_rungs(o.continuation_from, o.continuation_ratio, target);
   Eigen::VectorXd x = wire.rigid_state, u;
   double done = 0.0;  // the EI of the equilibrium in hand (0: the rigid-lumen state, wall at rest)
   int splits = 0;
   contact::PotentialContactSolution s;
-  if (from != nullptr) {
-    ReferenceWire at_target = wire.with_bending_stiffness(target);
-    po.force_scale = force_scale;
-    try {
-      s = contact::solve_wire_wall_potential(at_target.rod, wire.radius, wall, mesh, nodes,
-                                             from->wire, po,
-                                             wall_start_from(*from, at_target.contact(), wall));
-      out.steps = s.newton_iterations;
-      out.rungs = 1;
-      out.from_previous_solve = true;
-      rungs.clear();
-    } catch (const std::runtime_error& e) {
-      if (o.log) {
-        *o.log << "contact:   from the solve before's equilibrium: " << e.what()
-               << "; the EI rungs from the wall at rest" << std::endl;
-      }
-    }
-  }
   for (std::size_t k = 0; k < rungs.size();) {
     ReferenceWire rung = wire.with_bending_stiffness(rungs[k]);
     po.force_scale = force_scale * rungs[k] / target;
@@ -354,13 +343,48 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
     done = rungs[k];
     ++k;
   }
-  const std::vector<Vec3> displacement = wall.nodal(s.u);
+  return s;
+}
+
+/// The finite-strain wall: the wire and the neo-Hookean wall as one potential
+/// (solve_wire_wall_potential), every inner-wall node a candidate. A stiff wire dents the wall
+/// by millimetres, and Newton's method from the rigid-lumen state (the wall at rest) does not
+/// reach that equilibrium: with `from` (the solve before's equilibrium) the wire's EI is solved
+/// from there (solve_from_previous), else, or if that fails, reached in rungs (climb_rungs).
+/// The equilibrium reached is left in `reached`.
+void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, double nu,
+                            const TetMesh& mesh, const std::vector<RefinedBall>& balls,
+                            double force_scale, const ContactReferenceOptions& o,
+                            const LevelEquilibrium* from, ContactLevel& out,
+                            LevelEquilibrium& reached) {
+  const contact::NeoHookeanWall wall(mesh, wall_problem(scene, nu, o.degree));
+  const std::vector<int> nodes = mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
+  contact::PotentialContactOptions po;
+  // ‖∇Π‖ to 1e-8 of the rigid-wall force: the force to ~1e-8 of itself, short of the
+  // neo-Hookean energy's round-off floor where the line search stalls.
+  po.tolerance = 1e-8;
+  po.max_newton = o.max_steps;
+  po.log = o.log;
+  // On the straight scene's scout refined along the stiff wire (13 239 nodes) the 1.26e-5 N·m²
+  // rung converged in 45 damped steps; undamped it oscillated for 175 (residual 5e-4-2.6e-3 N).
+  po.damped_newton = true;
+  std::optional<contact::PotentialContactSolution> s;
+  if (from != nullptr)
+    s = solve_from_previous(wire, wall, mesh, nodes, *from, po, force_scale, o.log);
+  if (s) {
+    out.steps = s->newton_iterations;
+    out.rungs = 1;
+    out.from_previous_solve = true;
+  } else {
+    s = climb_rungs(wire, wall, mesh, nodes, po, force_scale, o, out);
+  }
+  const std::vector<Vec3> displacement = wall.nodal(s->u);
   out.converged = true;
   out.candidates = static_cast<int>(nodes.size());
-  out.force = s.total_force_on_wall().norm();
-  describe_zone(mesh, s.pressed, s.force, displacement, balls, out);
-  out.strain = wall.largest_strain(mesh, s.u);
-  reached = {mesh, displacement, s.x};
+  out.force = s->total_force_on_wall().norm();
+  describe_zone(mesh, s->pressed, s->force, displacement, balls, out);
+  out.strain = wall.largest_strain(mesh, s->u);
+  reached = {mesh, displacement, s->x};
 }
 
 /// One contact solve on a mesh refined to `fine` within the balls (the first: the zone; its
