@@ -24,6 +24,7 @@
 #include "verification/contact/point_triangle_distance.hpp"
 #include "verification/contact/wall_crossing.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
+#include "../../fem/cube_mesh.hpp"
 #include "wire_in_tube.hpp"
 
 using namespace vessel;
@@ -668,4 +669,86 @@ TEST(WireWallPotentialSlow, AGrownCondensedBandReachesTheWholeWallsEquilibrium) 
   EXPECT_NEAR(F, F_whole, 1e-7 * F_whole);
   // Both stop when no pressed node is open or penetrating by more than the gap tolerance.
   EXPECT_LT(difference, 5 * o.gap_tolerance);
+}
+
+namespace {
+
+/// The clamped–free elastica under a dead end load P along the clamp's axis (the wall's normal:
+/// the tip slides on the frictionless wall) at end shortening Δ (Timoshenko & Gere, Theory of
+/// Elastic Stability, §2.7): with k = sin(α/2), α the tip's rotation, λ = K(k)/L and
+/// Δ/L = 2 − 2E(k)/K(k); the load P = EI λ², the tip's sideways deflection 2k/λ. The rod is
+/// inextensible there; here its axial strain P/EA takes P·L/EA of the shortening (to first order:
+/// the axial force is P cos θ, θ ≤ α ≈ 8°), found by fixed point.
+struct Elastica {
+  double force = 0.0;       ///< N
+  double deflection = 0.0;  ///< m
+};
+Elastica clamped_free_elastica(double EI, double EA, double L, double shortening) {
+  Elastica out;
+  for (int pass = 0; pass < 20; ++pass) {
+    const double bent = shortening - out.force * L / EA;
+    double lo = 1e-9, hi = 0.99;  // k: Δ/L rises with k
+    for (int i = 0; i < 200; ++i) {
+      const double k = 0.5 * (lo + hi);
+      const double d = 2.0 - 2.0 * std::comp_ellint_2(k) / std::comp_ellint_1(k);
+      (d < bent / L ? lo : hi) = k;
+    }
+    const double k = 0.5 * (lo + hi), lambda = std::comp_ellint_1(k) / L;
+    out = {EI * lambda * lambda, 2.0 * k / lambda};
+  }
+  return out;
+}
+
+}  // namespace
+
+// A wire pushed end-on against a wall buckles (a guidewire meeting an obstruction): the nitinol
+// wire (d = 0.356 mm, 10 mm, DER N = 32) clamped 0.5 % of its length closer to a steel-stiff block
+// (E = 1.424e11 Pa, 3 mm, clamped at its far face) than the tip's hemisphere reaches, its axis
+// along the face's normal within 1e-4 rad. Straight, the wire would press with EA·Δ/L ≈ 24 N, 26
+// times Euler's load π²EI/4L²: a saddle of Π, which the minimiser must leave for the bent
+// minimum. The force and the tip's sideways deflection are the clamped–free elastica's at that
+// end shortening (1.0024 Euler loads, 0.88 mm) within DER's and the tilt's error (the tilt moves
+// the force by ∓0.12 % on the two branches). Leaving the saddle along Π's negative curvature, the
+// wire bends the way its clamp leans, the branch of lower energy; steps on the PSD-projected
+// Hessian alone, which does not see that curvature, end on the other branch (1.0035 Euler
+// loads).
+TEST(WireWallPotential, AWirePushedEndOnAgainstAWallBucklesIntoTheElastica) {
+  const double block = 3e-3, length = 10e-3, diameter = 0.356e-3, r = diameter / 2;
+  const double shortening = 0.005 * length, tilt = 1e-4;
+  TetMesh mesh = test::cube_mesh(6, block);
+  const PhysicalGroup& top = mesh.require_group("z1", 2, "block");
+  mesh.groups.push_back({"inner_wall", 2, 20, top.elements});
+  fem::ElasticityProblem problem;
+  problem.material.youngs_modulus = kWallE * 1e7;
+  problem.material.poisson_ratio = 0.3;
+  problem.dirichlet = {fem::DirichletCondition::clamped("z0")};
+  const fem::ElasticitySolver linear(mesh, problem);
+  const contact::LinearWall wall(linear.free_displacement_system());
+  const std::vector<int> candidates = mesh.group_nodes(mesh.require_group("inner_wall", 2, "block"));
+
+  msm::rods::RodSpec spec = msm::rods::uniform_rod(kNitinol, length, diameter, 32);
+  const Vec3 clamp(0.5 * block, 0.5 * block, block + r + length - shortening);
+  spec.origin = clamp;
+  spec.direction = Vec3(std::sin(tilt), 0.0, -std::cos(tilt));
+  msm::rods::DerRod rod(msm::rods::make_layout(spec));
+  const msm::rods::SectionStiffness section = msm::rods::solid_section(kNitinol, diameter);
+  const double EI = section.EI;
+  const Elastica truth = clamped_free_elastica(EI, section.EA, length, shortening);
+  contact::PotentialContactOptions o;
+  o.force_scale = truth.force;
+  const contact::PotentialContactSolution s =
+      contact::solve_wire_wall_potential(rod, r, wall, mesh, candidates, rod.rest_state(), o);
+  const int tip = rod.layout().tip_node;
+  const Vec3 tip_at = s.x.segment<3>(3 * tip);
+  const double F = s.total_force_on_wall().norm();
+  const double sideways = std::hypot(tip_at.x() - clamp.x(), tip_at.y() - clamp.y());
+  const double euler = M_PI * M_PI * EI / (4 * length * length);
+  std::printf(
+      "WIRE-WALL-POTENTIAL end-on wire: F %.6e N (%.5f Euler loads; elastica %.5f), tip %.4f mm "
+      "sideways (elastica %.4f), tip node %.2e m above the face less r_w, %d Newton, %d rounds\n",
+      F, F / euler, truth.force / euler, sideways * 1e3, truth.deflection * 1e3,
+      tip_at.z() - block - r, s.newton_iterations, s.rounds);
+  EXPECT_NEAR(F / truth.force, 1.0, 3e-3);
+  EXPECT_NEAR(sideways / truth.deflection, 1.0, 5e-3);
+  EXPECT_GT(tip_at.x(), clamp.x());  // bent the way the clamp leans
 }
