@@ -15,6 +15,7 @@
 #include <string>
 #include <utility>
 
+#include "../../fem/cube_mesh.hpp"
 #include "fem_reference/hyperelastic.hpp"
 #include "fem_reference/rod_theory/tube_contact.hpp"
 #include "meshes/foundation/errors.hpp"
@@ -24,7 +25,6 @@
 #include "verification/contact/point_triangle_distance.hpp"
 #include "verification/contact/wall_crossing.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
-#include "../../fem/cube_mesh.hpp"
 #include "wire_in_tube.hpp"
 
 using namespace vessel;
@@ -724,7 +724,8 @@ TEST(WireWallPotential, AWirePushedEndOnAgainstAWallBucklesIntoTheElastica) {
   problem.dirichlet = {fem::DirichletCondition::clamped("z0")};
   const fem::ElasticitySolver linear(mesh, problem);
   const contact::LinearWall wall(linear.free_displacement_system());
-  const std::vector<int> candidates = mesh.group_nodes(mesh.require_group("inner_wall", 2, "block"));
+  const std::vector<int> candidates =
+      mesh.group_nodes(mesh.require_group("inner_wall", 2, "block"));
 
   msm::rods::RodSpec spec = msm::rods::uniform_rod(kNitinol, length, diameter, 32);
   const Vec3 clamp(0.5 * block, 0.5 * block, block + r + length - shortening);
