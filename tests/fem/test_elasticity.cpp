@@ -6,6 +6,7 @@
 #include <Eigen/SparseCholesky>
 
 #include <memory>
+#include <set>
 
 #include <cmath>
 #include <string>
@@ -294,6 +295,36 @@ TEST(FreeDisplacementSystem, AnAffineFieldsInterpolantStoresItsClosedFormEnergy)
         (mu * eps.squaredNorm() + 0.5 * lambda * eps.trace() * eps.trace()) * L * L * L;
     EXPECT_NEAR(0.5 * u.dot(sys.K * u), exact, 1e-10 * exact) << "P" << degree;
   }
+}
+
+TEST(FreeDisplacementSystem, P2RowsOnACurvedWallLieOnItsCylinders) {
+  // The tube's walls (r = 3 and 4 mm) as curved P2 geometry: every row's support point lies in
+  // the wall, r ∈ [3, 4] mm, and the rows on the walls that are not mesh nodes (edge midpoints)
+  // lie on the cylinders themselves. Through the flat tets' mapping an inner-wall edge's midpoint
+  // would lie inside r = 3 mm (its chord).
+  const vessel::TetMesh& mesh = vessel::test::short_tube_mesh(0);
+  ElasticityProblem p;
+  p.options.degree = 2;
+  p.dirichlet = {DirichletCondition::clamped("inlet")};
+  p.curved_surfaces = tube_curved_walls(3e-3, 4e-3);
+  const FreeDisplacementSystem sys = ElasticitySolver(mesh, p).free_displacement_system();
+  std::set<std::array<long long, 3>> nodes;
+  const auto key = [](const vessel::Vec3& x) {
+    return std::array<long long, 3>{std::llround(x.x() * 1e9), std::llround(x.y() * 1e9),
+                                    std::llround(x.z() * 1e9)};
+  };
+  for (const vessel::Vec3& x : mesh.nodes) nodes.insert(key(x));
+  int inner_midpoints = 0, outer_midpoints = 0;
+  for (const vessel::Vec3& x : sys.row_points) {
+    const double r = std::hypot(x.x(), x.y());
+    EXPECT_GE(r, 3e-3 * (1 - 1e-12));
+    EXPECT_LE(r, 4e-3 * (1 + 1e-12));
+    if (nodes.count(key(x)) != 0) continue;
+    inner_midpoints += std::abs(r - 3e-3) < 1e-15;
+    outer_midpoints += std::abs(r - 4e-3) < 1e-15;
+  }
+  EXPECT_GT(inner_midpoints, 0);
+  EXPECT_GT(outer_midpoints, 0);
 }
 
 TEST(FreeDisplacementSystem, SolvedByASecondSolverItGivesTheStaticSolution) {
