@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -171,14 +172,44 @@ std::string wall_label(const ModelWall& wall, const ContactModelsOptions& option
   return options.own_equilibrium ? "own equilibrium" : to_string(wall.linearisation);
 }
 
+/// A wall's equilibrium with the wire at its own equilibrium: the wire's dofs and the wall's
+/// free rows, where the next (stiffer) wire starts.
+struct PotentialState {
+  double bending_stiffness = 0.0;  ///< the wire's EI, N·m²
+  Eigen::VectorXd x, u;
+};
+
+/// The own-equilibrium solve from `start` (the softer wire's equilibrium) if given and it
+/// converges, else from the rigid-lumen state with the wall at rest.
+PotentialContactSolution solve_own_equilibrium(msm::rods::DerRod& rod, double radius,
+                                               const WallPotential& wall, const TetMesh& mesh,
+                                               const std::vector<int>& candidates,
+                                               const RigidContact& rigid,
+                                               const PotentialContactOptions& o,
+                                               const PotentialState* start, bool& from_start) {
+  from_start = false;
+  if (start != nullptr) {
+    try {
+      PotentialContactSolution s =
+          solve_wire_wall_potential(rod, radius, wall, mesh, candidates, start->x, o, start->u);
+      from_start = true;
+      return s;
+    } catch (const std::runtime_error&) {  // from rest below
+    }
+  }
+  return solve_wire_wall_potential(rod, radius, wall, mesh, candidates, rigid.x, o);
+}
+
 /// The wall and the wire as one potential: the wall linearised at rest (condensed on a band
 /// grown from the first candidates, CondensedLinearWall) or, with options.own_equilibrium, at its
 /// own equilibrium (a msm model's own energy, FormWall; deal.II's FEM as the neo-Hookean wall for
-/// the reference, every inner-wall node a candidate; a linear FEM model stays condensed).
+/// the reference, every inner-wall node a candidate; a linear FEM model stays condensed), from
+/// `start` where given (solve_own_equilibrium). The own equilibrium reached is left in `reached`.
 ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, const ModelWall& wall,
                                   SceneWire& w, const RigidContact& rigid, const Problem& p,
                                   double EI, double nu, bool reference,
-                                  const ContactModelsOptions& options) {
+                                  const ContactModelsOptions& options,
+                                  const PotentialState* start, std::optional<PotentialState>& reached) {
   ModelContact out;
   out.name = wall.name;
   out.detail = wall.detail;
@@ -210,8 +241,10 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
     }
     const std::vector<int> candidates =
         p.mesh->group_nodes(p.mesh->require_group("inner_wall", 2, "contact mesh"));
-    s = solve_wire_wall_potential(rod, w.radius, *potential, *p.mesh, candidates, rigid.x, o);
+    s = solve_own_equilibrium(rod, w.radius, *potential, *p.mesh, candidates, rigid, o, start,
+                              out.from_softer_wire);
     out.candidates = static_cast<int>(candidates.size());
+    reached = PotentialState{EI, s.x, s.u};
   }
   out.solve_seconds = s.seconds;
   out.setup_seconds = wall.setup_seconds + seconds_since(t0) - s.seconds;
@@ -326,7 +359,8 @@ void log_contact(std::ostream& log, const ModelSpec& wall, std::size_t index, st
                  double EI, const ModelContact& c, double failed_after) {
   char line[160];
   if (c.failure.empty()) {
-    std::snprintf(line, sizeof line, "F %.4f mN, %d pressed, %.1f s", c.force * 1e3, c.pressed,
+    std::snprintf(line, sizeof line, "F %.4f mN, %d pressed, %d steps%s, %.1f s", c.force * 1e3,
+                  c.pressed, c.steps, c.from_softer_wire ? " from the softer wire's equilibrium" : "",
                   c.setup_seconds + c.solve_seconds);
   } else {
     std::snprintf(line, sizeof line, "failed after %.1f s", failed_after);
@@ -377,6 +411,7 @@ void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
     } catch (const std::exception& ex) {
       why = ex.what();
     }
+    std::optional<PotentialState> softer;  // this wall's equilibrium at the EI before
     for (std::size_t e = 0; e < out.runs.size(); ++e) {
       const double EI = out.runs[e].bending_stiffness;
       ModelContact c;
@@ -384,11 +419,16 @@ void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
       if (!wall) {
         c = failed(*walls[k], why);
       } else {
+        const bool chain =
+            softer && options.from_softer_wire && softer->bending_stiffness < EI;
+        std::optional<PotentialState> reached;
         try {
           c = options.own_equilibrium || options.potential
                   ? solve_wall_potential(scene, *walls[k], *wall, *wires[e], rigid[e], p, EI,
-                                         out.nu, k == 0, options)
+                                         out.nu, k == 0, options, chain ? &*softer : nullptr,
+                                         reached)
                   : solve_wall(*wall, *wires[e], rigid[e], p, EI, options);
+          softer = std::move(reached);
         } catch (const std::exception& ex) {
           c = failed(*walls[k], ex.what());
           c.detail = wall->detail;

@@ -32,6 +32,10 @@ struct ContactModelsOptions {
   /// FormWall) and the reference at finite strain (the neo-Hookean FEM), each with the wire as one
   /// potential (wire_wall_potential.hpp); every inner-wall node a candidate.
   bool own_equilibrium = false;
+  /// At own equilibrium, each EI after the first is solved from the wall's equilibrium at the EI
+  /// before (the same mesh; from rest only if that fails): a stiffer wire dents a soft wall by
+  /// millimetres, which Newton from the wall at rest may not reach. false: every EI from rest.
+  bool from_softer_wire = true;
   /// Every wall linearised at rest, each with the wire as one potential on the wall condensed on
   /// a band of candidates grown from the first (condensed_wall_potential.hpp) instead of the
   /// active set: an energy line search, a wire through the wall refused. It converges where the
@@ -66,6 +70,8 @@ struct ModelContact {
   /// does not balance there (0 for deal.II's FEM).
   double own_imbalance = 0.0;
   int steps = 0;               ///< linearised steps over every round
+  /// solved from the wall's equilibrium under the softer wire of the EI before (own_equilibrium)
+  bool from_softer_wire = false;
   double setup_seconds = 0.0;  ///< the model's stiffness and its condensation (every round), s
   double solve_seconds = 0.0;  ///< the contact solves, s
 };

@@ -121,7 +121,7 @@ std::string contact_key(const Scene& scene, const std::vector<std::string>& mode
   for (const std::string& m : models) h.text(m);
   h.real(o.fine_size).real(o.fine_radius).real(o.band_radius).integer(o.reference_degree);
   h.integer(o.max_newton).real(o.max_move).integer(o.own_equilibrium ? 1 : 0);
-  h.integer(o.potential ? 1 : 0);
+  h.integer(o.potential ? 1 : 0).integer(o.from_softer_wire ? 1 : 0);
   return "guidewire-contact " + h.hex();
 }
 
