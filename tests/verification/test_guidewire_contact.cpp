@@ -313,10 +313,12 @@ TEST(GuidewireContactSlow, AStifferWireFromTheSofterWiresEquilibriumReachesItsOw
       EXPECT_EQ(x->from_softer_wire, e > 0) << x->name;
       EXPECT_FALSE(y->from_softer_wire);
       if (x->centroid.y() * y->centroid.y() > 0.0) {
-        EXPECT_NEAR(x->force, y->force, 1e-6 * y->force) << x->name << " EI " << a.bending_stiffness;
+        EXPECT_NEAR(x->force, y->force, 1e-6 * y->force)
+            << x->name << " EI " << a.bending_stiffness;
         EXPECT_EQ(x->pressed, y->pressed) << x->name;
       } else {
-        EXPECT_NEAR(x->force, y->force, 5e-3 * y->force) << x->name << " EI " << a.bending_stiffness;
+        EXPECT_NEAR(x->force, y->force, 5e-3 * y->force)
+            << x->name << " EI " << a.bending_stiffness;
       }
     }
   }

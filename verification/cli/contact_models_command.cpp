@@ -123,8 +123,7 @@ void add_contact_models_command(CLI::App& app) {
                 "finite strain (neo-Hookean FEM), the wire and each wall solved as one potential; "
                 "default: every wall linearised at rest");
   cmd->add_flag(
-      "--from-rest",
-      [o](std::int64_t) { o->options.from_softer_wire = false; },
+      "--from-rest", [o](std::int64_t) { o->options.from_softer_wire = false; },
       "With --own-equilibrium: every EI solved from the wall at rest, instead of from the wall's "
       "equilibrium under the softer wire before it");
   cmd->callback([o] {

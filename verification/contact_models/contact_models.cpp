@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
-#include <optional>
 #include <cmath>
 #include <cstdio>
 #include <exception>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
@@ -208,8 +208,8 @@ PotentialContactSolution solve_own_equilibrium(msm::rods::DerRod& rod, double ra
 ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, const ModelWall& wall,
                                   SceneWire& w, const RigidContact& rigid, const Problem& p,
                                   double EI, double nu, bool reference,
-                                  const ContactModelsOptions& options,
-                                  const PotentialState* start, std::optional<PotentialState>& reached) {
+                                  const ContactModelsOptions& options, const PotentialState* start,
+                                  std::optional<PotentialState>& reached) {
   ModelContact out;
   out.name = wall.name;
   out.detail = wall.detail;
@@ -360,7 +360,8 @@ void log_contact(std::ostream& log, const ModelSpec& wall, std::size_t index, st
   char line[160];
   if (c.failure.empty()) {
     std::snprintf(line, sizeof line, "F %.4f mN, %d pressed, %d steps%s, %.1f s", c.force * 1e3,
-                  c.pressed, c.steps, c.from_softer_wire ? " from the softer wire's equilibrium" : "",
+                  c.pressed, c.steps,
+                  c.from_softer_wire ? " from the softer wire's equilibrium" : "",
                   c.setup_seconds + c.solve_seconds);
   } else {
     std::snprintf(line, sizeof line, "failed after %.1f s", failed_after);
@@ -419,8 +420,7 @@ void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
       if (!wall) {
         c = failed(*walls[k], why);
       } else {
-        const bool chain =
-            softer && options.from_softer_wire && softer->bending_stiffness < EI;
+        const bool chain = softer && options.from_softer_wire && softer->bending_stiffness < EI;
         std::optional<PotentialState> reached;
         try {
           c = options.own_equilibrium || options.potential
