@@ -372,6 +372,52 @@ void log_contact(std::ostream& log, const ModelSpec& wall, std::size_t index, st
       << " N·m²: " << line << std::endl;
 }
 
+/// One wall (`spec`, the k-th of `walls`; k = 0 the reference) solved at each run's EI, at own
+/// equilibrium each EI from the last one's equilibrium (ContactModelsOptions::from_softer_wire);
+/// its failures recorded with their reasons.
+void solve_wall_at_every_stiffness(const Scene& scene, const ModelSpec& spec, std::size_t k,
+                                   std::size_t walls,
+                                   const std::vector<std::unique_ptr<SceneWire>>& wires,
+                                   const std::vector<RigidContact>& rigid, const Problem& p,
+                                   const ContactModelsOptions& options, ContactModels& out) {
+  std::optional<ModelWall> wall;
+  std::string why;
+  try {
+    wall.emplace(model_wall(scene, spec, *p.mesh, *p.vessel, out.nu));
+  } catch (const std::exception& ex) {
+    why = ex.what();
+  }
+  std::optional<PotentialState> softer;  // this wall's equilibrium at the EI before
+  for (std::size_t e = 0; e < out.runs.size(); ++e) {
+    const double EI = out.runs[e].bending_stiffness;
+    ModelContact c;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!wall) {
+      c = failed(spec, why);
+    } else {
+      const bool chain = softer && options.from_softer_wire && softer->bending_stiffness < EI;
+      std::optional<PotentialState> reached;
+      try {
+        c = options.own_equilibrium || options.potential
+                ? solve_wall_potential(scene, spec, *wall, *wires[e], rigid[e], p, EI, out.nu,
+                                       k == 0, options, chain ? &*softer : nullptr, reached)
+                : solve_wall(*wall, *wires[e], rigid[e], p, EI, options);
+        softer = std::move(reached);
+      } catch (const std::exception& ex) {
+        c = failed(spec, ex.what());
+        c.detail = wall->detail;
+        c.linearisation = wall_label(*wall, options);
+      }
+    }
+    if (options.log) log_contact(*options.log, spec, k, walls, EI, c, seconds_since(t0));
+    if (k == 0) {
+      out.runs[e].reference = c;  // a failed reference leaves the run's errors undefined
+    } else {
+      out.runs[e].models.push_back(c);
+    }
+  }
+}
+
 /// Every wall once, solved at each run's EI: the reference first, then the models; a wall whose
 /// solve fails is recorded with its reason. A model whose wall an earlier model has
 /// (same_contact_wall) takes that model's contacts under its own name, without a solve.
@@ -391,58 +437,21 @@ void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
         k == 0 ? here : std::find_if(walls.begin() + 1, here, [&](const ModelSpec* w) {
           return same_contact_wall(*w, *walls[k]);
         });
-    if (twin != here) {
-      const std::size_t j = static_cast<std::size_t>(twin - walls.begin()) - 1;
-      for (ContactModelsRun& run : out.runs) {
-        ModelContact c = run.models[j];
-        c.name = walls[k]->name;
-        run.models.push_back(c);
-      }
-      if (options.log) {
-        *options.log << "contact-models: " << walls[k]->name << " (" << k + 1 << " of "
-                     << walls.size() << "): the wall of " << (*twin)->name << ", its contacts"
-                     << std::endl;
-      }
+    if (twin == here) {
+      solve_wall_at_every_stiffness(scene, *walls[k], k, walls.size(), wires, rigid, p, options,
+                                    out);
       continue;
     }
-    std::optional<ModelWall> wall;
-    std::string why;
-    try {
-      wall.emplace(model_wall(scene, *walls[k], *p.mesh, *p.vessel, out.nu));
-    } catch (const std::exception& ex) {
-      why = ex.what();
+    const std::size_t j = static_cast<std::size_t>(twin - walls.begin()) - 1;
+    for (ContactModelsRun& run : out.runs) {
+      ModelContact c = run.models[j];
+      c.name = walls[k]->name;
+      run.models.push_back(c);
     }
-    std::optional<PotentialState> softer;  // this wall's equilibrium at the EI before
-    for (std::size_t e = 0; e < out.runs.size(); ++e) {
-      const double EI = out.runs[e].bending_stiffness;
-      ModelContact c;
-      const auto t0 = std::chrono::steady_clock::now();
-      if (!wall) {
-        c = failed(*walls[k], why);
-      } else {
-        const bool chain = softer && options.from_softer_wire && softer->bending_stiffness < EI;
-        std::optional<PotentialState> reached;
-        try {
-          c = options.own_equilibrium || options.potential
-                  ? solve_wall_potential(scene, *walls[k], *wall, *wires[e], rigid[e], p, EI,
-                                         out.nu, k == 0, options, chain ? &*softer : nullptr,
-                                         reached)
-                  : solve_wall(*wall, *wires[e], rigid[e], p, EI, options);
-          softer = std::move(reached);
-        } catch (const std::exception& ex) {
-          c = failed(*walls[k], ex.what());
-          c.detail = wall->detail;
-          c.linearisation = wall_label(*wall, options);
-        }
-      }
-      if (options.log) {
-        log_contact(*options.log, *walls[k], k, walls.size(), EI, c, seconds_since(t0));
-      }
-      if (k == 0) {
-        out.runs[e].reference = c;  // a failed reference leaves the run's errors undefined
-      } else {
-        out.runs[e].models.push_back(c);
-      }
+    if (options.log) {
+      *options.log << "contact-models: " << walls[k]->name << " (" << k + 1 << " of "
+                   << walls.size() << "): the wall of " << (*twin)->name << ", its contacts"
+                   << std::endl;
     }
   }
 }
