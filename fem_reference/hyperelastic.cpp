@@ -806,6 +806,27 @@ double HyperelasticSolver::relative_l2_error(const std::function<Vec3(const Vec3
   return impl_->linear.relative_l2_error(exact);
 }
 
+std::vector<Vec3> HyperelasticSolver::free_displacement_at(const Eigen::VectorXd& u_free,
+                                                           const std::vector<Vec3>& points,
+                                                           double outside_tolerance) const {
+  const auto& im = *impl_;
+  if (u_free.size() != im.n_free) {
+    throw std::invalid_argument("free_displacement_at: wrong number of free DoF values");
+  }
+  std::vector<Vec3> out;
+  out.reserve(points.size());
+  for (const Vec3& x : points) {
+    const auto st = im.d.point_stencil(x, outside_tolerance);
+    Vec3 u = Vec3::Zero();
+    for (std::size_t i = 0; i < st.dofs.size(); ++i) {
+      const int row = im.free_index[st.dofs[i]];
+      if (row >= 0) u[st.components[i]] += u_free[row] * st.weights[i];
+    }
+    out.push_back(u);
+  }
+  return out;
+}
+
 FreeDisplacementSystem HyperelasticSolver::free_dofs() const {
   if (impl_->mixed) {
     throw InputError("the free DoFs' state is for the displacement formulation, not the mixed one");

@@ -155,6 +155,12 @@ class HyperelasticSolver {
   /// ‖u_h − u‖_L2 / ‖u‖_L2, as ElasticitySolver::relative_l2_error.
   [[nodiscard]] double relative_l2_error(const std::function<Vec3(const Vec3&)>& exact) const;
 
+  /// The displacement (m) at points inside the mesh of the free rows u_free (free_dofs()' rows;
+  /// the constrained DoFs at zero): the elements' shape functions there, as displacement_at.
+  /// InputError for a point outside the mesh beyond `outside_tolerance` (barycentric).
+  [[nodiscard]] std::vector<Vec3> free_displacement_at(const Eigen::VectorXd& u_free,
+                                                       const std::vector<Vec3>& points,
+                                                       double outside_tolerance = 1e-9) const;
   /// The unconstrained DoFs' layout as ElasticitySolver::free_displacement_system gives it
   /// (free_index, node_rows; K and f left empty). InputError for the mixed formulation, loads, or
   /// supports that prescribe a non-zero displacement: free_state() is the energy of a wall held

@@ -432,3 +432,35 @@ TEST(HyperelasticContinuation, RefusesCheckpointsOutOfOrderOrBeyondTheTarget) {
     EXPECT_THROW({ HyperelasticSolver s(mesh, p, o); }, InputError);
   }
 }
+
+namespace vessel::fem {
+namespace {
+
+// The free rows' field at points (free_displacement_at) against an affine field: its interpolant
+// on the rows (interpolate_rows) is exact at P1 and P2, so at any point inside the cube the
+// field comes back, and a point outside is refused.
+TEST(HyperelasticFreeRows, AnAffineFieldsRowsGiveItBackAtAnyPoint) {
+  const double L = 1e-3;
+  const TetMesh mesh = test::cube_mesh(2, L);
+  const Vec3 b(1e-4, -2e-4, 3e-4);
+  const auto field = [&](const Vec3& x) -> Vec3 { return x[0] * b; };  // zero on x0
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> in(0.05 * L, 0.95 * L);
+  std::vector<Vec3> points;
+  for (int i = 0; i < 20; ++i) points.emplace_back(in(rng), in(rng), in(rng));
+  for (const int degree : {1, 2}) {
+    ElasticityProblem p;
+    p.options.degree = degree;
+    p.dirichlet = {DirichletCondition::clamped("x0")};
+    const HyperelasticSolver s(mesh, p);
+    const Eigen::VectorXd u = interpolate_rows(s.free_dofs(), field);
+    const std::vector<Vec3> at = s.free_displacement_at(u, points);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      EXPECT_LT((at[i] - field(points[i])).norm(), 1e-12 * b.norm() * L) << "P" << degree;
+    }
+    EXPECT_THROW((void)s.free_displacement_at(u, {Vec3(2 * L, 0, 0)}), InputError);
+  }
+}
+
+}  // namespace
+}  // namespace vessel::fem

@@ -92,6 +92,13 @@ class NeoHookeanWall final : public WallPotential {
   /// component.
   [[nodiscard]] Vec3 support_reaction(const Eigen::VectorXd& u) const;
   [[nodiscard]] const fem::FreeDisplacementSystem& dofs() const { return dofs_; }
+  /// The wall's displacement at u (its free rows) at points inside its mesh, m
+  /// (fem::HyperelasticSolver::free_displacement_at).
+  [[nodiscard]] std::vector<Vec3> displacement_at(const Eigen::VectorXd& u,
+                                                  const std::vector<Vec3>& points,
+                                                  double outside_tolerance) const {
+    return solver_->free_displacement_at(u, points, outside_tolerance);
+  }
 
  private:
   std::unique_ptr<fem::HyperelasticSolver> solver_;

@@ -5,13 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
 
 #include "fem_reference/elasticity.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
-#include "meshes/tet_locator.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "verification/contact/wall_crossing.hpp"
 #include "verification/contact/wire_wall_contact.hpp"
@@ -229,9 +229,12 @@ std::vector<double> continuation_rungs(double first, double ratio, double target
   return rungs;
 }
 
-/// A level's solved finite-strain equilibrium, where the next level starts: the wire's state and
-/// the wall's displacement at its mesh's nodes (m).
+/// A level's solved finite-strain equilibrium, where the next level starts: the wire's state, and
+/// the wall (kept for its elements' shape functions) with its free rows and its nodes'
+/// displacement (m).
 struct LevelEquilibrium {
+  std::shared_ptr<const contact::NeoHookeanWall> wall;
+  Eigen::VectorXd u;
   TetMesh mesh;
   std::vector<Vec3> displacement;
   Eigen::VectorXd wire;
@@ -242,36 +245,35 @@ struct LevelEquilibrium {
 /// the other's.
 constexpr double kOutsideTolerance = 0.25;
 
-/// `from`'s displacement at x: linear in `from`'s tets (its vertex values), the nearest node's
-/// where x lies outside them.
-Vec3 displacement_at(const LevelEquilibrium& from, const TetLocator& locator, const Vec3& x) {
-  const int t = locator.find(x, kOutsideTolerance);
-  if (t >= 0) {
-    const Tet& tet = from.mesh.tets[static_cast<std::size_t>(t)];
-    const Eigen::Vector4d l = barycentric(from.mesh, tet, x);
-    Vec3 u = Vec3::Zero();
-    for (int k = 0; k < 4; ++k) u += l[k] * from.displacement[static_cast<std::size_t>(tet[k])];
-    return u;
+/// `from`'s displacement at x: its wall's field (P1 or P2) there, the nearest node's where x
+/// lies outside its tets.
+Vec3 displacement_at(const LevelEquilibrium& from, const Vec3& x) {
+  try {
+    return from.wall->displacement_at(from.u, {x}, kOutsideTolerance).front();
+  } catch (const InputError&) {
+    std::size_t nearest = 0;
+    for (std::size_t n = 1; n < from.mesh.nodes.size(); ++n) {
+      if ((from.mesh.nodes[n] - x).squaredNorm() < (from.mesh.nodes[nearest] - x).squaredNorm())
+        nearest = n;
+    }
+    return from.displacement[nearest];
   }
-  std::size_t nearest = 0;
-  for (std::size_t n = 1; n < from.mesh.nodes.size(); ++n) {
-    if ((from.mesh.nodes[n] - x).squaredNorm() < (from.mesh.nodes[nearest] - x).squaredNorm())
-      nearest = n;
-  }
-  return from.displacement[nearest];
 }
 
 /// `from`'s displacement interpolated onto `wall`'s rows (a start, not a projection), each point
-/// the interpolant puts inside `from`'s wire moved out to its surface: the coarser wall's facets
-/// are cut by the capsule between their nodes (only nodes bear), and a finer mesh's points on
-/// them would start deep in the penalty's stiff range.
+/// the interpolant puts inside `from`'s wire moved out to its surface: the coarser wall is cut
+/// by the capsule between its nodes (only nodes bear), and a finer mesh's points there would
+/// start deep in the penalty's stiff range.
 Eigen::VectorXd wall_start_from(const LevelEquilibrium& from, const contact::ContactWire& wire,
                                 const contact::NeoHookeanWall& wall) {
-  const TetLocator locator(from.mesh);
+  Vec3 at = Vec3::Constant(std::numeric_limits<double>::quiet_NaN()), value = Vec3::Zero();
   return fem::interpolate_rows(wall.dofs(), [&](const Vec3& x) -> Vec3 {
-    Vec3 u = displacement_at(from, locator, x);
+    if (x == at) return value;  // a point's three rows are asked in turn
+    Vec3 u = displacement_at(from, x);
     const Vec3 d = x + u - contact::nearest_on_centreline(wire, from.wire, x + u);
     if (d.norm() < wire.radius && d.norm() > 0.0) u += (wire.radius - d.norm()) * d.normalized();
+    at = x;
+    value = u;
     return u;
   });
 }
@@ -357,7 +359,9 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
                             double force_scale, const ContactReferenceOptions& o,
                             const LevelEquilibrium* from, ContactLevel& out,
                             LevelEquilibrium& reached) {
-  const contact::NeoHookeanWall wall(mesh, wall_problem(scene, nu, o.degree));
+  const auto shared =
+      std::make_shared<const contact::NeoHookeanWall>(mesh, wall_problem(scene, nu, o.degree));
+  const contact::NeoHookeanWall& wall = *shared;
   const std::vector<int> nodes = mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
   contact::PotentialContactOptions po;
   // ‖∇Π‖ to 1e-8 of the rigid-wall force: the force to ~1e-8 of itself, short of the
@@ -384,7 +388,7 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
   out.force = s->total_force_on_wall().norm();
   describe_zone(mesh, s->pressed, s->force, displacement, balls, out);
   out.strain = wall.largest_strain(mesh, s->u);
-  reached = {mesh, displacement, s->x};
+  reached = {shared, s->u, mesh, displacement, s->x};
 }
 
 /// One contact solve on a mesh refined to `fine` within the balls (the first: the zone; its
