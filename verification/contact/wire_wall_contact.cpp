@@ -504,11 +504,8 @@ void GrownContact::pressed(std::vector<int>& mesh_nodes, std::vector<double>& fo
 }
 
 double capsule_gap(const ContactWire& wire, const Eigen::VectorXd& x, const Vec3& point) {
-  return (point - nearest_on_centreline(wire, x, point)).norm() - wire.radius;
-}
-
-Vec3 nearest_on_centreline(const ContactWire& wire, const Eigen::VectorXd& x, const Vec3& point) {
-  return nearest_on_centreline(x, wire.first_node, wire.last_node, point).c;
+  const Nearest c = nearest_on_centreline(x, wire.first_node, wire.last_node, point);
+  return (point - c.c).norm() - wire.radius;
 }
 
 Vec3 clamp_reaction(const ContactWire& wire, const CondensedWall& wall, const TetMesh& mesh,

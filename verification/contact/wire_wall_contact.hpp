@@ -153,8 +153,6 @@ GrownContact solve_wire_wall_contact_growing(
 /// first_node..last_node less r_w, m (negative inside the wire). For checking wall points that
 /// are not candidates (a band too narrow lets the wire pass through them unseen).
 double capsule_gap(const ContactWire& wire, const Eigen::VectorXd& x, const Vec3& point);
-/// The point of the wire's centreline polyline (first_node..last_node at x) nearest `point`, m.
-Vec3 nearest_on_centreline(const ContactWire& wire, const Eigen::VectorXd& x, const Vec3& point);
 
 /// The force the clamp exerts on the wire (N): on each held node's position the balance of the
 /// rod's internal force −∇E, the wall's −λ_k n_k share and the constraint force −J_cᵀμ, summed

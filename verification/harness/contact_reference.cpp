@@ -260,21 +260,17 @@ Vec3 displacement_at(const LevelEquilibrium& from, const Vec3& x) {
   }
 }
 
-/// `from`'s displacement interpolated onto `wall`'s rows (a start, not a projection), each point
-/// the interpolant puts inside `from`'s wire moved out to its surface: the coarser wall is cut
-/// by the capsule between its nodes (only nodes bear), and a finer mesh's points there would
-/// start deep in the penalty's stiff range.
-Eigen::VectorXd wall_start_from(const LevelEquilibrium& from, const contact::ContactWire& wire,
-                                const contact::NeoHookeanWall& wall) {
+/// `from`'s displacement interpolated onto `wall`'s rows: a start, not a projection. (Points it
+/// puts inside the wire are left there: moved out to its surface, they bent a P2 wall's edges
+/// until every trial step of the first Newton step inverted an element.)
+Eigen::VectorXd wall_start_from(const LevelEquilibrium& from, const contact::NeoHookeanWall& wall) {
   Vec3 at = Vec3::Constant(std::numeric_limits<double>::quiet_NaN()), value = Vec3::Zero();
   return fem::interpolate_rows(wall.dofs(), [&](const Vec3& x) -> Vec3 {
-    if (x == at) return value;  // a point's three rows are asked in turn
-    Vec3 u = displacement_at(from, x);
-    const Vec3 d = x + u - contact::nearest_on_centreline(wire, from.wire, x + u);
-    if (d.norm() < wire.radius && d.norm() > 0.0) u += (wire.radius - d.norm()) * d.normalized();
-    at = x;
-    value = u;
-    return u;
+    if (x != at) {  // a point's three rows are asked in turn
+      at = x;
+      value = displacement_at(from, x);
+    }
+    return value;
   });
 }
 
@@ -290,7 +286,7 @@ std::optional<contact::PotentialContactSolution> solve_from_previous(
   try {
     return contact::solve_wire_wall_potential(at_target.rod, wire.radius, wall, mesh, nodes,
                                               from.wire, po,
-                                              wall_start_from(from, at_target.contact(), wall));
+                                              wall_start_from(from, wall));
   } catch (const std::runtime_error& e) {
     if (log) {
       *log << "contact:   from the solve before's equilibrium: " << e.what()
