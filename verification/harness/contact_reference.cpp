@@ -285,8 +285,7 @@ std::optional<contact::PotentialContactSolution> solve_from_previous(
   po.force_scale = force_scale;
   try {
     return contact::solve_wire_wall_potential(at_target.rod, wire.radius, wall, mesh, nodes,
-                                              from.wire, po,
-                                              wall_start_from(from, wall));
+                                              from.wire, po, wall_start_from(from, wall));
   } catch (const std::runtime_error& e) {
     if (log) {
       *log << "contact:   from the solve before's equilibrium: " << e.what()
