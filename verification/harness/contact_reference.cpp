@@ -274,7 +274,7 @@ Eigen::VectorXd wall_start_from(const LevelEquilibrium& from, const contact::Neo
   });
 }
 
-/// The wire at EI `target` on `wall` from the solve before's equilibrium `from`, its wall
+/// The wire at its own EI on `wall` from the solve before's equilibrium `from`, its wall
 /// interpolated onto this mesh (wall_start_from); nothing, the reason logged, if that solve fails.
 std::optional<contact::PotentialContactSolution> solve_from_previous(
     const ReferenceWire& wire, const contact::NeoHookeanWall& wall, const TetMesh& mesh,
