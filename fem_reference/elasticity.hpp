@@ -258,7 +258,9 @@ struct FreeDisplacementSystem {
   std::vector<std::array<int, 3>> node_rows;
   /// Per row, its DoF's support point (m, through the solver's mapping: a P2 row on a curved wall
   /// lies on the curved surface) and displacement component (0–2): where a field's interpolant
-  /// takes the row's value (interpolate_rows).
+  /// takes the row's value (interpolate_rows). Filled by HyperelasticSolver::free_dofs and
+  /// ElasticitySolver::set_row_points, not by free_displacement_system (a simulator's set-up,
+  /// timed, does not pay for them).
   std::vector<Vec3> row_points;
   std::vector<int> row_components;
 };
@@ -285,6 +287,8 @@ class ElasticitySolver {
   /// Assembles the displacement formulation's system on its unconstrained DoFs (no solve; does
   /// not need solve()). InputError for the mixed formulation (its system is indefinite).
   [[nodiscard]] FreeDisplacementSystem free_displacement_system() const;
+  /// Fills `system`'s row_points and row_components (`system` from free_displacement_system()).
+  void set_row_points(FreeDisplacementSystem& system) const;
 
   [[nodiscard]] const ElasticityResult& result() const;
 

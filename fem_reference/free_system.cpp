@@ -115,10 +115,11 @@ FreeDisplacementSystem ElasticitySolver::free_displacement_system() const {
   }
   Impl::FreeSystem sys = impl_->assemble_free_system(false);
   std::vector<std::array<int, 3>> rows = impl_->node_rows(sys.free_index);
-  FreeDisplacementSystem out{
-      std::move(sys.K), std::move(sys.f), std::move(sys.free_index), std::move(rows), {}, {}};
-  impl_->set_row_points(out);
-  return out;
+  return {std::move(sys.K), std::move(sys.f), std::move(sys.free_index), std::move(rows), {}, {}};
+}
+
+void ElasticitySolver::set_row_points(FreeDisplacementSystem& system) const {
+  impl_->set_row_points(system);
 }
 
 void ElasticitySolver::Impl::set_row_points(FreeDisplacementSystem& system) const {
