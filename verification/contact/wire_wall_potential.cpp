@@ -959,6 +959,12 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
   rod.prepare(start);
   VectorXd z =
       problem.pack(start, wall_start.size() != 0 ? wall_start : VectorXd::Zero(wall.num_dofs()));
+  if (!std::isfinite(wall.evaluate(problem.wall_rows(z), nullptr, nullptr))) {
+    // Newton's line search could not leave it: every trial near an inverted start is inverted.
+    throw InputError(
+        "the wire-wall potential cannot start from a wall that inverts an element "
+        "(its energy is infinite there)");
+  }
   problem.require_inside_lumen(z, "cannot start outside the lumen");
   PotentialContactSolution out;
   out.penalty_stiffness = k;

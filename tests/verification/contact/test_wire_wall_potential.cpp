@@ -181,7 +181,9 @@ TEST(WallCrossing, CentrelineThroughTheTubeWall) {
 // about the clamp to 1.4 times its reach, the tip 1 mm beyond the inner wall), it refuses with
 // the crossing named; started from the inside with no candidate near the wire (only the
 // outlet's nodes), the wire springs back towards straight, through the wall, and the first step
-// that carries its centreline through ends the solve with the crossing named.
+// that carries its centreline through ends the solve with the crossing named. A wall start that
+// turns cells inside out (a level's start interpolated from a coarser level's deep dent can) is
+// refused before any Newton step: every trial step near it is inverted too.
 TEST(WireWallPotential, ACentrelineThroughTheWallIsRefusedNotSolved) {
   const TetMesh& mesh = tube_mesh();
   const std::vector<int> nodes = inner_nodes(mesh);
@@ -219,6 +221,17 @@ TEST(WireWallPotential, ACentrelineThroughTheWallIsRefusedNotSolved) {
   const std::string through = message(rigid.x, outlet);
   EXPECT_NE(through.find("stopped after Newton step"), std::string::npos) << through;
   EXPECT_NE(through.find("crosses the wall"), std::string::npos) << through;
+  // A wall start mirrored through the tube's middle turns every cell inside out (det F = −1).
+  const Vec3 middle(0, 0, 0.5 * kTubeLength);
+  const VectorXd inverted =
+      fem::interpolate_rows(wall.dofs(), [&](const Vec3& x) -> Vec3 { return 2.0 * (middle - x); });
+  try {
+    (void)contact::solve_wire_wall_potential(w.rod, w.radius, wall, mesh, nodes, rigid.x, o,
+                                             inverted);
+    ADD_FAILURE() << "an inverted wall start was solved";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("inverts an element"), std::string::npos) << e.what();
+  }
 }
 
 // The finite-strain wall's energy, gradient and tangent (fem::HyperelasticSolver::free_state): at
