@@ -221,7 +221,8 @@ TEST(WireWallPotential, ACentrelineThroughTheWallIsRefusedNotSolved) {
   const std::string through = message(rigid.x, outlet);
   EXPECT_NE(through.find("stopped after Newton step"), std::string::npos) << through;
   EXPECT_NE(through.find("crosses the wall"), std::string::npos) << through;
-  // A wall start mirrored through the tube's middle turns every cell inside out (det F = −1).
+  // A wall start mirrored through the tube's middle turns the cells inside out (det F = −1 away
+  // from the clamped ends, whose held rows stay at rest).
   const Vec3 middle(0, 0, 0.5 * kTubeLength);
   const VectorXd inverted =
       fem::interpolate_rows(wall.dofs(), [&](const Vec3& x) -> Vec3 { return 2.0 * (middle - x); });
