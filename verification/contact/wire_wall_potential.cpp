@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -169,7 +170,25 @@ struct Linearisation {
   std::vector<PairRows> rows;
   std::vector<Vec12> gap_gradient;
   std::vector<double> c;
+  std::vector<int> multiplier;  ///< each pair's multiplier index
+  std::vector<double> weight;   ///< each pair's curvature weight in base (its λ)
 };
+
+/// a_jᵀ v over pair j's free rows (a_j its gap gradient).
+double pair_dot(const Linearisation& lin, std::size_t j, const VectorXd& v) {
+  double s = 0.0;
+  for (int i = 0; i < 12; ++i) {
+    if (lin.rows[j][i] >= 0) s += lin.gap_gradient[j][i] * v[lin.rows[j][i]];
+  }
+  return s;
+}
+
+/// v += s a_j over pair j's free rows.
+void add_pair(const Linearisation& lin, std::size_t j, double s, VectorXd& v) {
+  for (int i = 0; i < 12; ++i) {
+    if (lin.rows[j][i] >= 0) v[lin.rows[j][i]] += s * lin.gap_gradient[j][i];
+  }
+}
 
 /// The inner wall's triangles whose three nodes are all candidates, as candidate indices (none
 /// for a mesh without the group).
@@ -280,7 +299,7 @@ class Coupled {
             "a wall node lies on the wire's centreline: the wire passed through the wall");
       }
       const double g = std::sqrt(best) - r_;
-      if (force_at(j, g - band) <= 0.0) continue;
+      if (!bears(j, g - band)) continue;
       const PointSegmentDistance d =
           point_segment_distance(p, x.segment<3>(3 * seg), x.segment<3>(3 * seg + 3), with_hessian);
       Pair pair{j, {{{true, j}, {false, seg}, {false, seg + 1}, {}}}, d.distance};
@@ -305,7 +324,7 @@ class Coupled {
       const double size = std::max({(a - centre).norm(), (b - centre).norm(), (c - centre).norm()});
       if ((tip - centre).norm() > size + reach) continue;
       const PointTriangleDistance d = point_triangle_distance(tip, a, b, c, with_hessian);
-      if (force_at(offset + f, d.distance - r_ - band) <= 0.0) continue;
+      if (!bears(offset + f, d.distance - r_ - band)) continue;
       out.push_back({offset + f,
                      {{{false, last_}, {true, face[0]}, {true, face[1]}, {true, face[2]}}},
                      d.distance,
@@ -317,6 +336,17 @@ class Coupled {
   /// λ = max(0, λ̂ − k g).
   [[nodiscard]] double force_at(int j, double gap) const {
     return std::max(0.0, multiplier_[static_cast<std::size_t>(j)] - k_ * gap);
+  }
+  /// Whether pair j at `gap` enters Π, the forces and the residuals: where it presses, and
+  /// wherever its multiplier is positive while the multipliers lead.
+  [[nodiscard]] bool bears(int j, double gap) const {
+    return force_at(j, gap) > 0.0 ||
+           (multipliers_lead_ && multiplier_[static_cast<std::size_t>(j)] > 0.0);
+  }
+  /// The weight of pair j's curvature −∇²d in the Newton model: its multiplier while they lead
+  /// (the Lagrangian's Hessian), else its force λ at the iterate (Π's Hessian).
+  [[nodiscard]] double curvature_weight(int j, double lambda) const {
+    return multipliers_lead_ ? multiplier_[static_cast<std::size_t>(j)] : lambda;
   }
   /// ψ(g) + λ̂²/(2k) = λ²/(2k): shifted by a constant so that it vanishes where the candidate
   /// is open (ψ' = −λ unchanged) and Π stays continuous as candidates open and close.
@@ -352,10 +382,10 @@ class Coupled {
   }
 
   /// ∇Π at z and, with `lin`, the Newton model's pieces: the rod's and the wall's Hessians and
-  /// each pressed pair's curvature −λ∇²d (with `project`, the rod's and the wall's element
-  /// blocks and those 9 × 9 blocks projected onto the PSD cone), and every pair within `band`
-  /// of pressing with its gap's gradient and c = λ̂/k − g (pressed while c − ∇g·dz > 0 in the
-  /// model).
+  /// each bearing pair's curvature −w∇²d (w its curvature_weight; with `project`, the rod's and
+  /// the wall's element blocks and those 12 × 12 blocks projected onto the PSD cone), and every
+  /// pair within `band` of pressing with its gap's gradient, c = λ̂/k − g (pressed while
+  /// c − ∇g·dz > 0 in the model) and its multiplier.
   double evaluate(const VectorXd& z, VectorXd& gradient, Linearisation* lin, bool project,
                   double band = 0.0) const {
     const VectorXd x = rod_dofs(z), u = wall_rows(z);
@@ -397,15 +427,19 @@ class Coupled {
         lin->rows.push_back(rows);
         lin->gap_gradient.push_back(p.gradient);
         lin->c.push_back(multiplier_[static_cast<std::size_t>(p.multiplier)] / k_ - g);
+        lin->multiplier.push_back(p.multiplier);
+        lin->weight.push_back(curvature_weight(p.multiplier, lambda));
       }
-      if (lambda <= 0.0) continue;
-      pi += contact_energy(p.multiplier, g);
-      // ψ'(g) = −λ, ψ''(g) = k while λ > 0 (k∇d∇dᵀ is the model's, added per pair by the step).
-      for (int a = 0; a < 12; ++a) {
-        if (rows[a] >= 0) gradient[rows[a]] -= lambda * p.gradient[a];
+      if (lambda > 0.0) {
+        pi += contact_energy(p.multiplier, g);
+        // ψ'(g) = −λ, ψ''(g) = k while λ > 0 (k∇d∇dᵀ is the model's, added per pair by the step).
+        for (int a = 0; a < 12; ++a) {
+          if (rows[a] >= 0) gradient[rows[a]] -= lambda * p.gradient[a];
+        }
       }
-      if (!lin) continue;
-      Mat12 h = -lambda * p.hessian;
+      const double weight = curvature_weight(p.multiplier, lambda);
+      if (!lin || weight <= 0.0) continue;
+      Mat12 h = -weight * p.hessian;
       if (project) h = projected(h);
       add_block(lin->base, rows, h);
     }
@@ -430,7 +464,8 @@ class Coupled {
     for (const Pair& p : pairs(x, u, false)) {
       const double g = p.distance - r_;
       out.max_penetration = std::max(out.max_penetration, -g);
-      const double lambda = force_at(p.multiplier, g);
+      const double lambda = multipliers_lead_ ? multiplier_[static_cast<std::size_t>(p.multiplier)]
+                                              : force_at(p.multiplier, g);
       for (int k = 0; k < 4; ++k) {
         const PairPoint& point = p.points[static_cast<std::size_t>(k)];
         if (point.index < 0) continue;
@@ -464,6 +499,49 @@ class Coupled {
     }
     multiplier_ = std::move(next);
     return change;
+  }
+
+  /// Whether the multipliers are the contact forces (Alart–Curnier's steps), or estimates λ̂
+  /// that Π's forces max(0, λ̂ − k g) follow (the augmented Lagrangian's).
+  void set_multipliers_lead(bool on) { multipliers_lead_ = on; }
+  [[nodiscard]] bool multipliers_lead() const { return multipliers_lead_; }
+
+  /// Alart–Curnier's multipliers after a step α dz from the model `lin`: λ ← (1 − α)λ + α λ_model,
+  /// λ_model = k max(0, c − a·dz) the model's force (0 for a pair it does not hold).
+  void step_multipliers(const Linearisation& lin, const VectorXd& dz, double alpha) {
+    std::vector<double> next(multiplier_.size());
+    for (std::size_t j = 0; j < next.size(); ++j) next[j] = (1.0 - alpha) * multiplier_[j];
+    for (std::size_t j = 0; j < lin.c.size(); ++j) {
+      const double model = k_ * std::max(0.0, lin.c[j] - pair_dot(lin, j, dz));
+      next[static_cast<std::size_t>(lin.multiplier[j])] += alpha * model;
+    }
+    multiplier_ = std::move(next);
+  }
+
+  /// Alart–Curnier's residuals at (z, λ) from ∇Π at z (`gradient`): the force balance
+  /// ‖∇E − Σ λ_j ∇g_j‖ (N) and Signorini's conditions max_j |min(λ_j/k, g_j)| (m: a pressed pair's
+  /// gap, a penetration).
+  void multiplier_residual(const VectorXd& z, const VectorXd& gradient, double& force,
+                           double& complementarity) const {
+    const VectorXd x = rod_dofs(z), u = wall_rows(z);
+    VectorXd r = gradient;
+    complementarity = 0.0;
+    std::vector<char> seen(multiplier_.size(), 0);
+    for (const Pair& p : pairs(x, u, false)) {
+      const double g = p.distance - r_;
+      const double l = multiplier_[static_cast<std::size_t>(p.multiplier)];
+      seen[static_cast<std::size_t>(p.multiplier)] = 1;
+      const double diff = force_at(p.multiplier, g) - l;
+      const PairRows rows = pair_rows(p);
+      for (int a = 0; a < 12; ++a) {
+        if (rows[a] >= 0) r[rows[a]] += diff * p.gradient[a];
+      }
+      complementarity = std::max(complementarity, std::abs(std::min(l / k_, g)));
+    }
+    for (std::size_t j = 0; j < multiplier_.size(); ++j) {
+      if (!seen[j]) complementarity = std::max(complementarity, multiplier_[j] / k_);
+    }
+    force = r.norm();
   }
 
   /// Largest move of a centreline node or a candidate under the step dz.
@@ -528,6 +606,7 @@ class Coupled {
   std::vector<std::array<int, 3>> rows_;
   std::vector<std::array<int, 3>> faces_;  ///< the wall's faces, as candidate indices
   std::vector<double> multiplier_;
+  bool multipliers_lead_ = false;
 };
 
 /// k from the wall's stiffness at rest: penalty_factor × its largest diagonal entry on the
@@ -545,22 +624,6 @@ double default_penalty(const WallPotential& wall, const std::vector<int>& candid
     }
   }
   return factor * largest;
-}
-
-/// a_jᵀ v over pair j's free rows (a_j its gap gradient).
-double pair_dot(const Linearisation& lin, std::size_t j, const VectorXd& v) {
-  double s = 0.0;
-  for (int i = 0; i < 12; ++i) {
-    if (lin.rows[j][i] >= 0) s += lin.gap_gradient[j][i] * v[lin.rows[j][i]];
-  }
-  return s;
-}
-
-/// v += s a_j over pair j's free rows.
-void add_pair(const Linearisation& lin, std::size_t j, double s, VectorXd& v) {
-  for (int i = 0; i < 12; ++i) {
-    if (lin.rows[j][i] >= 0) v[lin.rows[j][i]] += s * lin.gap_gradient[j][i];
-  }
 }
 
 /// The Newton steps' factor: one CHOLMOD solver over a solve, its matrices padded with explicit
@@ -723,7 +786,9 @@ bool newton_step(const Coupled& p, const Linearisation& lin, const VectorXd& gra
   const std::size_t m = lin.c.size();
   std::vector<char> next(m);
   active.assign(m, 0);
-  for (std::size_t j = 0; j < m; ++j) active[j] = lin.c[j] > 0.0;
+  // A pair whose curvature is in the matrix starts pressed: its −λ∇²d without its k a aᵀ would
+  // make the model indefinite (Alart–Curnier's multipliers outlive a gap the last step opened).
+  for (std::size_t j = 0; j < m; ++j) active[j] = lin.c[j] > 0.0 || lin.weight[j] > 0.0;
   for (int pass = 0; pass < 20; ++pass) {
     if (!H.solve(active, -model_gradient(p, lin, gradient, active), dz)) return false;
     for (std::size_t j = 0; j < m; ++j) next[j] = lin.c[j] - pair_dot(lin, j, dz) > 0.0;
@@ -863,9 +928,82 @@ double line_search(const Coupled& p, const VectorXd& z, const VectorXd& dz, doub
   return 0.0;
 }
 
-/// Newton's method on Π from z (left at the last accepted iterate).
+/// What an iterate leaves to balance: the force balance's residual (N; ‖∇Π‖, or
+/// ‖∇E − Σ λ_j∇g_j‖ while the multipliers lead) and Signorini's (m; Coupled::multiplier_residual).
+struct Balance {
+  double residual = 0.0;
+  double complementarity = 0.0;
+};
+
+/// Alart–Curnier's bookkeeping over one minimise: which forces lead (the multipliers, or Π's for
+/// held multipliers), what is left to balance, and the fall-back to the augmented Lagrangian's
+/// rounds after kPatience Newton steps without halving the residual (the end-on push on a
+/// faceted block, whose tip bears on faces that share an edge).
+class MultiplierSteps {
+ public:
+  static constexpr int kPatience = 12;
+
+  /// `on`: Alart–Curnier's law, set false where it stalls. `floor`: the residual at which a
+  /// Newton step on Π stalls by round-off (Π's minimiser for the held multipliers).
+  MultiplierSteps(Coupled& p, bool& on, const PotentialContactOptions& o, double floor)
+      : p_(p), on_(on), o_(o), floor_(floor) {
+    p_.set_multipliers_lead(on_);
+  }
+
+  /// The balance at z, whose ∇Π `evaluate` puts in g (called again when the multipliers or the
+  /// forces that lead change: at Π's minimiser for held multipliers they take its forces, the
+  /// augmented Lagrangian's update, and lead again).
+  Balance at(const VectorXd& z, const VectorXd& g, int step,
+             const std::function<void()>& evaluate) {
+    Balance b{g.norm()};
+    if (!on_) return b;
+    if (!p_.multipliers_lead() && b.residual <= floor_) {
+      (void)p_.update_multipliers(z);
+      p_.set_multipliers_lead(true);
+      evaluate();
+    }
+    if (p_.multipliers_lead()) p_.multiplier_residual(z, g, b.residual, b.complementarity);
+    const double target = o_.tolerance * o_.force_scale;
+    if (b.residual <= target && b.complementarity <= o_.gap_tolerance) return b;
+    if (p_.multipliers_lead() && b.residual < 0.5 * best_) {
+      best_ = b.residual;
+      stalled_ = 0;
+      return b;
+    }
+    if (++stalled_ <= kPatience) return b;
+    on_ = false;
+    if (o_.log) {
+      *o_.log << "potential contact: Alart-Curnier stalled at step " << step << " (residual "
+              << best_ << " N); on by augmented-Lagrangian rounds" << std::endl;
+    }
+    p_.set_multipliers_lead(false);
+    evaluate();
+    return {g.norm()};
+  }
+
+  /// After a step α dz on the model `lin`: Alart–Curnier's update after a step of the exact
+  /// model. Where that model is indefinite the projected one's forces are no estimate (its
+  /// curvature clipped): the multipliers are held (λ̂) and Π's forces lead until the next exact
+  /// step or Π's minimiser for them.
+  void after_step(const Linearisation& lin, const VectorXd& dz, double alpha, bool exact) {
+    if (!on_) return;
+    if (exact) p_.step_multipliers(lin, dz, alpha);
+    p_.set_multipliers_lead(exact);
+  }
+
+ private:
+  Coupled& p_;
+  bool& on_;
+  const PotentialContactOptions& o_;
+  double floor_;
+  double best_ = std::numeric_limits<double>::infinity();
+  int stalled_ = 0;
+};
+
+/// Newton's method from z (left at the last accepted iterate): on (z, λ) while `alart_curnier`
+/// (set false where it stalls, MultiplierSteps), else on Π for the held multipliers.
 NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o,
-                       NewtonFactor& factor) {
+                       NewtonFactor& factor, bool& alart_curnier) {
   NewtonOutcome out;
   const int factorisations_before = factor.factorisations();
   VectorXd g, dz, trial;
@@ -877,15 +1015,23 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
   double radius = 0.0;  // the trust region of the steps extended by the exact curvature
   // Where the exact model was indefinite, the next 1, 2, 4 … 8 steps go to the projected one.
   msm::ExactBackoff backoff(8);
+  // Where round-off keeps ‖∇Π‖ above the target (a stiff wall's K u, a neo-Hookean energy's
+  // O(ε²) value), a Newton step that stalls there is at Π's minimiser.
+  const double floor = 1e3 * target;
+  MultiplierSteps multipliers(p, alart_curnier, o, floor);
   for (int it = 0; it <= o.max_newton; ++it) {
     const bool exact = backoff.try_exact();
-    const double pi = p.evaluate(z, g, &lin, !exact, band);
-    out.residual = g.norm();
+    double pi = 0.0;
+    const auto evaluate = [&] { pi = p.evaluate(z, g, &lin, !exact, band); };
+    evaluate();
+    const Balance b = multipliers.at(z, g, it, evaluate);
+    out.residual = b.residual;
     out.iterations = it;
-    if (out.residual <= target) {
+    if (b.residual <= target && b.complementarity <= o.gap_tolerance) {
       out.converged = true;
       return out;
     }
+    const bool at_floor = b.residual <= floor && b.complementarity <= o.gap_tolerance;
     if (it == o.max_newton) break;
     if (o.log && it > 0 && it % RecentSteps::kEvery == 0) recent.report(*o.log, it, out, shift);
     const Direction d =
@@ -897,7 +1043,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     int inverted = 0;
     const double alpha = line_search(p, z, dz, pi, g, alpha0, trial, inverted);
     if (alpha == 0.0) {
-      out.converged = out.residual <= 1e3 * target;  // at the round-off floor of ‖∇Π‖
+      out.converged = at_floor;
       if (!out.converged) {
         out.reason = "the line search found no decrease of the potential (" +
                      std::to_string(inverted) + " of its 12 trial steps inverted a wall element)";
@@ -915,6 +1061,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
       // cut was longer than the model can be trusted for; a full one says it can be trusted more.
       shift = alpha < alpha0 ? std::max(10.0 * shift, 1e-4) : (shift < 1e-7 ? 0.0 : 0.1 * shift);
     }
+    multipliers.after_step(lin, dz, alpha, d.exact);
     z = trial;
     p.prepare(z);
     // A centreline through the wall (between its nodes) does not come back: every node's gap is
@@ -924,7 +1071,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     recent.move += alpha * move / p.radius();
     // A stiff wall's forces (K u with K up to ~1e6 N/m) floor ‖∇Π‖ above the target by round-off:
     // a step that moves nothing by 1e-12 r_w ends the iteration there.
-    if (alpha * move <= 1e-12 * p.radius() && out.residual <= 1e3 * target) {
+    if (alpha * move <= 1e-12 * p.radius() && at_floor) {
       out.converged = true;
       return out;
     }
@@ -968,10 +1115,11 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
   problem.require_inside_lumen(z, "cannot start outside the lumen");
   PotentialContactSolution out;
   out.penalty_stiffness = k;
-  const int rounds = options.augmented_lagrangian ? options.max_rounds : 1;
+  bool alart_curnier = options.law == ContactLaw::alart_curnier;
+  const int rounds = options.law == ContactLaw::penalty ? 1 : options.max_rounds;
   NewtonFactor factor;
   for (int round = 1; round <= rounds; ++round) {
-    const NewtonOutcome n = minimise(problem, z, options, factor);
+    const NewtonOutcome n = minimise(problem, z, options, factor, alart_curnier);
     out.newton_iterations += n.iterations;
     out.factorisations += n.factorisations;
     out.rounds = round;
@@ -996,7 +1144,7 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
           "no wall node bears on the wire: it passed between the wall's nodes (refine the wall "
           "where the wire bears)");
     }
-    if (!options.augmented_lagrangian) break;
+    if (options.law == ContactLaw::penalty || alart_curnier) break;
     const double change = problem.update_multipliers(z);
     if (change <= options.gap_tolerance) break;
     if (round == rounds) {

@@ -7,20 +7,30 @@
 /// at the ends: the wire's surface is a capsule of radius r_w); and as many pairs of the wire's
 /// tip against each face of the inner wall (its three nodes candidates), d the distance of the
 /// tip's centre to the face, so a wall that wraps round the tip between its nodes still meets its
-/// hemisphere (point_triangle_distance.hpp). The contact law is the augmented
-/// Lagrangian of Signorini's conditions (g ≥ 0, λ ≥ 0, λg = 0):
-///   ψ(g) = max(0, λ̂ − k g)²/(2k),  λ = −ψ'(g) = max(0, λ̂ − k g)
-/// (the augmented Lagrangian's term shifted by λ̂²/(2k) so it vanishes where a node is open);
-/// Newton's method on Π for fixed multiplier estimates λ̂ (the exact Hessian of the gap,
-/// point_segment_distance.hpp), then λ̂ ← λ, until no force changes by more than k × the gap
-/// tolerance (Nocedal & Wright, Numerical Optimization, 2nd ed., Framework 17.3; with λ̂ = 0 the
-/// penalty law λ = k max(0, −g)). The forces act along the capsule's normal at every iterate,
-/// exactly frictionless, equal and opposite by construction (d is invariant under translation).
+/// hemisphere (point_triangle_distance.hpp). Signorini's conditions (g ≥ 0, λ ≥ 0, λg = 0) enter
+/// through the augmented Lagrangian's term for multiplier estimates λ̂,
+///   ψ(g) = max(0, λ̂ − k g)²/(2k),  −ψ'(g) = max(0, λ̂ − k g)
+/// (shifted by λ̂²/(2k) so it vanishes where a node is open), with the exact Hessian of the gap
+/// (point_segment_distance.hpp). Three laws (ContactLaw):
+/// - Alart–Curnier (the default): the multipliers are unknowns beside z, solved by one
+///   semismooth Newton iteration on ∇E − Σ λ_j ∇g_j = 0 and λ_j = max(0, λ_j − k g_j)
+///   (Alart & Curnier 1991, CMAME 92: 353). Its step, condensed with k, is Newton's step on Π for
+///   λ̂ = λ; the model's own forces k max(0, λ̂/k − g − ∇g·dz) become the next λ. The force
+///   balance then uses the multipliers, so the gap's second-order error after a step (s²/2r_w for
+///   a slide s along the capsule) stays a gap error, corrected by the next step, instead of a
+///   force error k times it that a penalty's iterates chase: each solve converges
+///   quadratically in a few steps where a penalty's Newton creeps for tens.
+/// - augmented Lagrangian: Newton's method on Π for fixed λ̂, then λ̂ ← max(0, λ̂ − k g), until no
+///   force changes by more than k × the gap tolerance (Nocedal & Wright, Numerical Optimization,
+///   2nd ed., Framework 17.3);
+/// - penalty: λ̂ = 0, the force k max(0, −g) (a second formulation: extrapolated in 1/k).
+/// The forces act along the capsule's normal at every iterate, exactly frictionless, equal and
+/// opposite by construction (d is invariant under translation).
 ///
 /// The wall re-linearises at every Newton step, so dents of many wire radii, strains of order
 /// one and a zone that slides are one solve; each step is cut so no centreline or wall node moves
 /// by more than max_move · r_w (a longer step can carry a node across the wire), and accepted by
-/// Armijo's condition on Π (an inverted wall element makes Π infinite).
+/// Armijo's condition on Π (an inverted wall element makes Π infinite) for the step's λ̂.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <array>
@@ -133,24 +143,29 @@ class FormWall final : public WallPotential {
   double rest_energy_ = 0.0;
 };
 
+/// How Signorini's conditions are solved (the file's comment).
+enum class ContactLaw { alart_curnier, augmented_lagrangian, penalty };
+
 struct PotentialContactOptions {
   /// k (N/m). 0: penalty_factor × the wall's largest diagonal stiffness at rest on the
   /// candidates' rows.
   double penalty_stiffness = 0.0;
   double penalty_factor = 100.0;
-  /// true: augmented-Lagrangian rounds to Signorini's conditions; false: the penalty law at k.
-  bool augmented_lagrangian = true;
-  /// m: the augmented Lagrangian stops when no force changes by more than k × this in a round
-  /// (then no pressed node is open or penetrating by more than this)
+  ContactLaw law = ContactLaw::alart_curnier;
+  /// m: Alart–Curnier's stops when no multiplier's pair penetrates or, pressed, is open by more
+  /// than this (|min(λ_j/k, g_j)|); the augmented Lagrangian when no force changes by more than
+  /// k × this in a round (then no pressed node is open or penetrating by more than this)
   double gap_tolerance = 1e-9;
-  double tolerance = 1e-9;      ///< on ‖∇Π‖ over the free dofs, relative to force_scale
+  /// on the force balance over the free dofs, relative to force_scale: ‖∇E − Σ λ_j∇g_j‖
+  /// (Alart–Curnier), ‖∇Π‖ (otherwise)
+  double tolerance = 1e-9;
   double force_scale = 1e-3;    ///< N
   double max_move = 0.5;        ///< × r_w: the largest node move of one Newton step
   int max_newton = 300;         ///< Newton steps per round
   /// Levenberg–Marquardt: the Newton model's matrix B + μ diag(|B|), μ raised tenfold (from 1e-4)
   /// after a step the line search cut and lowered tenfold after a full one.
   bool damped_newton = false;
-  int max_rounds = 40;          ///< augmented-Lagrangian rounds
+  int max_rounds = 40;          ///< augmented-Lagrangian rounds (the other laws take one)
   std::ostream* log = nullptr;  ///< one line per round and per 25 Newton steps, if set
 };
 
@@ -169,8 +184,8 @@ struct PotentialContactSolution {
   double penalty_stiffness = 0.0;  ///< the k used, N/m
   int newton_iterations = 0;       ///< over all rounds
   int factorisations = 0;          ///< of the coupled Newton matrix, over all rounds
-  int rounds = 0;                  ///< augmented-Lagrangian rounds (1 for the penalty law)
-  double residual = 0.0;           ///< ‖∇Π‖ on the free dofs at the end, N
+  int rounds = 0;                  ///< augmented-Lagrangian rounds (1 for the other laws)
+  double residual = 0.0;           ///< the force balance's residual at the end, N (tolerance)
   double seconds = 0.0;
   /// Σ λ_j n_j: the wire's total force on the wall, N.
   [[nodiscard]] Vec3 total_force_on_wall() const;
