@@ -444,7 +444,8 @@ TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes
   // command's document with an outcome cache: solved once, then read back with the same numbers
   // and the date it was computed. The wire bends in the tube's plane of symmetry y = 0 and may
   // settle on either side of it (the last of the four steps crossed it): the two ends are mirror
-  // images up to the mesh, which is not symmetric (forces 0.13 % apart).
+  // images up to the mesh, which is not symmetric (forces 0.13 % apart, the tips 57 µm apart and
+  // 4.8 µm once mirrored).
   ContactInsertionOptions one = o;
   one.steps = 1;
   test::TempDir dir;
@@ -470,7 +471,7 @@ TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes
       "mirrored across y = 0)\n",
       direct.steps.back().force / r.steps.back().force - 1, (tip - four).norm(),
       (tip - mirrored).norm());
-  EXPECT_LT((tip - mirrored).norm(), 0.05 * 0.178e-3);
+  EXPECT_LT((tip - mirrored).norm(), 0.1 * 0.178e-3);  // 4.8 µm of 57 µm; r_w = 0.178 mm
   ASSERT_EQ(again.insertions.size(), 1u);
   EXPECT_FALSE(again.insertions[0].cached_from.empty());
   EXPECT_EQ(again.insertions[0].steps.back().force, direct.steps.back().force);

@@ -937,8 +937,9 @@ struct Balance {
 
 /// Alart–Curnier's bookkeeping over one minimise: which forces lead (the multipliers, or Π's for
 /// held multipliers), what is left to balance, and the fall-back to the augmented Lagrangian's
-/// rounds after kPatience Newton steps without halving the residual (the end-on push on a
-/// faceted block, whose tip bears on faces that share an edge).
+/// rounds after kPatience full-length Newton steps without halving the residual (the end-on push
+/// on a faceted block, whose tip bears on faces that share an edge). Steps cut to the largest
+/// move or by the line search do not count: far from the solution the residual need not fall.
 class MultiplierSteps {
  public:
   static constexpr int kPatience = 12;
@@ -970,7 +971,8 @@ class MultiplierSteps {
       stalled_ = 0;
       return b;
     }
-    if (++stalled_ <= kPatience) return b;
+    if (last_step_full_) ++stalled_;
+    if (stalled_ <= kPatience) return b;
     on_ = false;
     if (o_.log) {
       *o_.log << "potential contact: Alart-Curnier stalled at step " << step << " (residual "
@@ -986,6 +988,7 @@ class MultiplierSteps {
   /// curvature clipped): the multipliers are held (λ̂) and Π's forces lead until the next exact
   /// step or Π's minimiser for them.
   void after_step(const Linearisation& lin, const VectorXd& dz, double alpha, bool exact) {
+    last_step_full_ = alpha == 1.0;
     if (!on_) return;
     if (exact) p_.step_multipliers(lin, dz, alpha);
     p_.set_multipliers_lead(exact);
@@ -998,6 +1001,7 @@ class MultiplierSteps {
   double floor_;
   double best_ = std::numeric_limits<double>::infinity();
   int stalled_ = 0;
+  bool last_step_full_ = false;
 };
 
 /// Newton's method from z (left at the last accepted iterate): on (z, λ) while `alart_curnier`
