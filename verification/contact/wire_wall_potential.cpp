@@ -171,7 +171,7 @@ struct Linearisation {
   std::vector<Vec12> gap_gradient;
   std::vector<double> c;
   std::vector<int> multiplier;  ///< each pair's multiplier index
-  std::vector<double> weight;   ///< each pair's curvature weight in base (its λ)
+  std::vector<double> weight;   ///< each pair's curvature weight in base (curvature_weight)
 };
 
 /// a_jᵀ v over pair j's free rows (a_j its gap gradient).
