@@ -167,7 +167,8 @@ struct PotentialContactOptions {
   /// Levenberg–Marquardt: the Newton model's matrix B + μ diag(|B|), μ raised tenfold (from 1e-4)
   /// after a step the line search cut and lowered tenfold after a full one.
   bool damped_newton = false;
-  int max_rounds = 40;          ///< augmented-Lagrangian rounds (the other laws take one)
+  /// augmented-Lagrangian rounds (also Alart–Curnier's after it falls back; the penalty's: one)
+  int max_rounds = 40;
   std::ostream* log = nullptr;  ///< one line per round and per 25 Newton steps, if set
 };
 
@@ -186,7 +187,7 @@ struct PotentialContactSolution {
   double penalty_stiffness = 0.0;  ///< the k used, N/m
   int newton_iterations = 0;       ///< over all rounds
   int factorisations = 0;          ///< of the coupled Newton matrix, over all rounds
-  int rounds = 0;                  ///< augmented-Lagrangian rounds (1 for the other laws)
+  int rounds = 0;                  ///< augmented-Lagrangian rounds (1 without any)
   double residual = 0.0;           ///< the force balance's residual at the end, N (tolerance)
   double seconds = 0.0;
   /// Σ λ_j n_j: the wire's total force on the wall, N.
