@@ -451,8 +451,8 @@ TEST(WireWallPotentialSlow, RigidLimitApproachesTheRigidWallSolve) {
 
 // A wall 30 times the scenes' (the dent twice r_w, strains beyond 0.4), neo-Hookean: the wire's
 // clamp and the wall's supports (their reactions from the wall's own internal forces at the held
-// DoFs) balance to 1e-9 of the force; Alart–Curnier's force equals the penalty law's
-// extrapolated to infinite stiffness (k, 2k, 4k; Richardson in 1/k, first order) within the
+// DoFs) balance to 1e-9 of the force; the penalty law's force tends to Alart–Curnier's at first
+// order in 1/k (k, 2k, 4k) and its extrapolation to infinite stiffness meets it within the
 // extrapolation's own error estimate and 1e-5 relative; Levenberg–Marquardt's damped Newton steps
 // end at the same pressed nodes and force (1e-8), the augmented Lagrangian's rounds at the same
 // pressed nodes and force (1e-6) in more Newton steps.
@@ -505,16 +505,23 @@ TEST(WireWallPotentialSlow, TwoFormulationsAndActionReactionOnAFiniteStrainWall)
     const PotentialRun p = potential_run(mesh, kAimPoint, wall, nodes, o);
     penalty.push_back(p.solution.total_force_on_wall().norm());
   }
-  // F(k) = F∞ + c/k: two finest give F∞ = 2 F(4k) − F(2k); the observed order from all three.
-  const double order = std::log((penalty[1] - penalty[0]) / (penalty[2] - penalty[1])) / std::log(2.0);
+  // F(k) = F∞ + c/k: the penalty's distance from Alart–Curnier's force halves with each doubling
+  // of k (a wrong F would leave a floor: the ratio would fall towards 1). The differences between
+  // the penalty's own forces are no measure of the order here: they are 1–2e-8 N, and each
+  // solve's force moves by ~2e-9 N between builds (the solves stop at their round-off floor): their
+  // observed order is 0.9 on one build, 1.35 on another. Two finest give F∞ = 2 F(4k) − F(2k).
+  const double halving_1 = (penalty[0] - F) / (penalty[1] - F);
+  const double halving_2 = (penalty[1] - F) / (penalty[2] - F);
   const double extrapolated = 2 * penalty[2] - penalty[1];
   const double estimate = std::abs(penalty[2] - penalty[1]);
   std::printf(
-      "WIRE-WALL-POTENTIAL penalty k x1,2,4: %.8e %.8e %.8e N (order in 1/k %.2f), extrapolated "
-      "%.8e, Alart-Curnier %.8e (%+.1e, estimate %.1e)\n",
-      penalty[0], penalty[1], penalty[2], order, extrapolated, F, extrapolated / F - 1,
-      estimate / F);
-  EXPECT_NEAR(order, 1.0, 0.1);
+      "WIRE-WALL-POTENTIAL penalty k x1,2,4: %.8e %.8e %.8e N (their distance from "
+      "Alart-Curnier's halves by %.2f, %.2f), extrapolated %.8e, Alart-Curnier %.8e (%+.1e, "
+      "estimate %.1e)\n",
+      penalty[0], penalty[1], penalty[2], halving_1, halving_2, extrapolated, F,
+      extrapolated / F - 1, estimate / F);
+  EXPECT_NEAR(halving_1, 2.0, 0.6);
+  EXPECT_NEAR(halving_2, 2.0, 0.6);
   EXPECT_LT(std::abs(extrapolated - F), std::max(estimate, 1e-5 * F));
 }
 
