@@ -983,15 +983,18 @@ class MultiplierSteps {
     return {g.norm()};
   }
 
-  /// After a step α dz on the model `lin`: Alart–Curnier's update after a step of the exact
-  /// model. Where that model is indefinite the projected one's forces are no estimate (its
-  /// curvature clipped): the multipliers are held (λ̂) and Π's forces lead until the next exact
-  /// step or Π's minimiser for them.
-  void after_step(const Linearisation& lin, const VectorXd& dz, double alpha, bool exact) {
+  /// After a step α dz on the model `lin`: Alart–Curnier's update where the model's forces are
+  /// an estimate (`model_holds`): a step of the exact model, or one of the projected model (its
+  /// curvature clipped, its gaps' linearisation the same) that the line search took whole inside
+  /// its trust region. After a projected step the line search cut, or one that Steihaug's CG took
+  /// to the trust region's boundary (up to a few r_w, accepted at α ~ 1e-3), the model's forces
+  /// at the step's end are far from the contact's: the multipliers are held (λ̂) and Π's forces
+  /// lead until the next such step or Π's minimiser for them.
+  void after_step(const Linearisation& lin, const VectorXd& dz, double alpha, bool model_holds) {
     last_step_full_ = alpha == 1.0;
     if (!on_) return;
-    if (exact) p_.step_multipliers(lin, dz, alpha);
-    p_.set_multipliers_lead(exact);
+    if (model_holds) p_.step_multipliers(lin, dz, alpha);
+    p_.set_multipliers_lead(model_holds);
   }
 
  private:
@@ -1065,7 +1068,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
       // cut was longer than the model can be trusted for; a full one says it can be trusted more.
       shift = alpha < alpha0 ? std::max(10.0 * shift, 1e-4) : (shift < 1e-7 ? 0.0 : 0.1 * shift);
     }
-    multipliers.after_step(lin, dz, alpha, d.exact);
+    multipliers.after_step(lin, dz, alpha, d.exact || (alpha == alpha0 && !d.steihaug_boundary));
     z = trial;
     p.prepare(z);
     // A centreline through the wall (between its nodes) does not come back: every node's gap is

@@ -16,12 +16,13 @@
 ///   semismooth Newton iteration on ∇E − Σ λ_j ∇g_j = 0 and λ_j = max(0, λ_j − k g_j)
 ///   (Alart & Curnier 1991, CMAME 92: 353). Its step, condensed with k, is Newton's step on Π for
 ///   λ̂ = λ; the model's own forces k max(0, λ̂/k − g − ∇g·dz) become the next λ (after a step of
-///   the exact model; a step of the PSD-projected one holds them). The force
-///   balance then uses the multipliers, so the gap's second-order error after a step (s²/2r_w for
-///   a slide s along the capsule) stays a gap error, corrected by the next step, instead of a
-///   force error k times it that a penalty's iterates chase (the straight tube's finite-strain
-///   levels: 5–7 Newton steps where the rounds took 19–65). Where twelve full-length steps do not
-///   halve the balance's residual the solve goes on by the augmented Lagrangian's rounds.
+///   the exact model, or of the PSD-projected one taken whole inside its trust region; any other
+///   step holds them). The force balance then uses the multipliers, so the gap's second-order
+///   error after a step (s²/2r_w for a slide s along the capsule) stays a gap error, corrected by
+///   the next step, instead of a force error k times it that a penalty's iterates chase (the
+///   straight tube's finite-strain levels: 5–7 Newton steps where the rounds took 19–65). Where
+///   twelve full-length steps do not halve the balance's residual the solve goes on by the
+///   augmented Lagrangian's rounds.
 /// - augmented Lagrangian: Newton's method on Π for fixed λ̂, then λ̂ ← max(0, λ̂ − k g), until no
 ///   force changes by more than k × the gap tolerance (Nocedal & Wright, Numerical Optimization,
 ///   2nd ed., Framework 17.3);
