@@ -506,10 +506,11 @@ TEST(WireWallPotentialSlow, TwoFormulationsAndActionReactionOnAFiniteStrainWall)
     penalty.push_back(p.solution.total_force_on_wall().norm());
   }
   // F(k) = F∞ + c/k: the penalty's distance from Alart–Curnier's force halves with each doubling
-  // of k (a wrong F would leave a floor: the ratio would fall towards 1). The differences between
-  // the penalty's own forces are no measure of the order here: they are 1–2e-8 N, and each
-  // solve's force moves by ~2e-9 N between builds (the solves stop at their round-off floor): their
-  // observed order is 0.9 on one build, 1.35 on another. Two finest give F∞ = 2 F(4k) − F(2k).
+  // of k (penalty[2] − F is ~1e-8 N: an F off by a few 1e-9 N moves the ratios out of 2 ± 0.6).
+  // The differences between the penalty's own forces are no measure of the order here: they are
+  // 1–2e-8 N, and each solve's force moves by ~2e-9 N between builds (the solves stop at their
+  // round-off floor): their observed order is 0.9 on one build, 1.35 on another. The two finest
+  // give F∞ = 2 F(4k) − F(2k).
   const double halving_1 = (penalty[0] - F) / (penalty[1] - F);
   const double halving_2 = (penalty[1] - F) / (penalty[2] - F);
   const double extrapolated = 2 * penalty[2] - penalty[1];
