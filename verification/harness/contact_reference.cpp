@@ -508,9 +508,9 @@ std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
   return balls;
 }
 
-/// The first level, if its zone leaves the refined patch, is solved again on a patch grown to
-/// that zone at most this many times (every level then shares the patch; a finer level's zone
-/// that leaves it makes the verdict "not a reference").
+/// A level whose zone leaves the refined patch grows the patch to that zone and the levels are
+/// solved again from the first, at most this many times (every level shares the patch; a zone
+/// that leaves it after that makes the verdict "not a reference").
 constexpr int kPatchGrowths = 2;
 
 /// The levels' order, Richardson estimate and GCI on the force, and the verdict.
@@ -623,10 +623,9 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
     ContactLevel level = solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point,
                                      rigid.force, o, last);
     // A zone that leaves the patch (the scout's coarser wall under-reports a long line of
-    // contact): the patch grown to this level's zone, the old one kept, and the level solved
-    // again.
-    while (l == 0 && level.converged && !level.zone_inside_patch &&
-           r.patch_growths < kPatchGrowths) {
+    // contact, and a finer wall's zone reaches further): the patch grown to this level's zone,
+    // the old one kept, and the levels solved again from the first, so that all share one patch.
+    if (level.converged && !level.zone_inside_patch && r.patch_growths < kPatchGrowths) {
       ++r.patch_growths;
       r.patch_centre = level.middle;
       r.patch_radius = level.reach + o.margin;
@@ -634,10 +633,11 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
       if (o.log) {
         *o.log << "contact:   the zone (" << level.extent * 1e3
                << " mm) left the patch: refined within " << r.patch_radius * 1e3
-               << " mm of its middle and solved again" << std::endl;
+               << " mm of its middle and the levels solved again from the first" << std::endl;
       }
-      level = solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point, rigid.force,
-                          o, last);
+      r.levels.clear();
+      l = -1;
+      continue;
     }
     level.level = l;
     r.levels.push_back(level);

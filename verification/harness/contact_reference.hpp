@@ -89,7 +89,7 @@ struct ContactReference {
   double patch_radius = 0.0;                    ///< m
   /// Balls refined along a scout wire that passed between the wall's nodes (0: none)
   int refined_along_wire = 0;
-  /// Times the patch was grown to a level's zone that left it, and that level solved again
+  /// Times the patch was grown to a level's zone that left it, and the levels solved again
   int patch_growths = 0;
   double strain_limit = 0.0;
   ContactWall wall = ContactWall::linear;
