@@ -827,6 +827,50 @@ std::vector<Vec3> HyperelasticSolver::free_displacement_at(const Eigen::VectorXd
   return out;
 }
 
+std::vector<std::vector<int>> HyperelasticSolver::free_rows_per_cell() const {
+  const auto& im = *impl_;
+  std::vector<Index> dofs(im.d.fe->n_dofs_per_cell());
+  std::vector<std::vector<int>> out;
+  out.reserve(im.d.dof.get_triangulation().n_active_cells());
+  for (const auto& cell : im.d.dof.active_cell_iterators()) {
+    cell->get_dof_indices(dofs);
+    std::vector<int>& rows = out.emplace_back();
+    for (unsigned i = 0; i < dofs.size(); ++i) {
+      if (im.free_index[dofs[i]] >= 0 && im.component[dofs[i]] < 3)
+        rows.push_back(im.free_index[dofs[i]]);
+    }
+  }
+  return out;
+}
+
+std::vector<int> HyperelasticSolver::inverted_cells(const Eigen::VectorXd& u_free) const {
+  const auto& im = *impl_;
+  if (u_free.size() != im.n_free) {
+    throw std::invalid_argument("inverted_cells: wrong number of free DoF values");
+  }
+  dl::Vector<double> w(im.d.dof.n_dofs());
+  for (Index i = 0; i < w.size(); ++i) {
+    if (im.free_index[i] >= 0) w(i) = u_free[im.free_index[i]];
+  }
+  detail::CellValues values(*im.d.mapping, *im.d.fe, im.d.degree);
+  const dl::FEValuesExtractors::Vector disp(0);
+  std::vector<dl::Tensor<2, kDim>> grad_u(values.cell.n_quadrature_points);
+  std::vector<int> out;
+  int index = 0;
+  for (const auto& cell : im.d.dof.active_cell_iterators()) {
+    values.cell.reinit(cell);
+    values.cell[disp].get_function_gradients(w, grad_u);
+    for (const auto& g : grad_u) {
+      if (!((Mat3::Identity() + to_mat3(g)).determinant() > 0.0)) {
+        out.push_back(index);
+        break;
+      }
+    }
+    ++index;
+  }
+  return out;
+}
+
 FreeDisplacementSystem HyperelasticSolver::free_dofs() const {
   if (impl_->mixed) {
     throw InputError("the free DoFs' state is for the displacement formulation, not the mixed one");

@@ -166,6 +166,12 @@ class HyperelasticSolver {
   /// supports that prescribe a non-zero displacement: free_state() is the energy of a wall held
   /// at zero and loaded only from outside.
   [[nodiscard]] FreeDisplacementSystem free_dofs() const;
+  /// Per cell (deal.II's active cell order), the free rows of its displacement DoFs: which rows
+  /// share an element, for smoothing a field over the mesh.
+  [[nodiscard]] std::vector<std::vector<int>> free_rows_per_cell() const;
+  /// The cells (as free_rows_per_cell numbers them) inverted at u_free: J = det F ≤ 0 at one of
+  /// their quadrature points, where free_state's energy is +∞.
+  [[nodiscard]] std::vector<int> inverted_cells(const Eigen::VectorXd& u_free) const;
   /// The strain energy, its gradient and (with_tangent) its Hessian at the displacement u_free
   /// (m, one value per free row; the constrained DoFs at zero). An inverted element gives
   /// admissible = false. Requires what free_dofs() requires. With project_tangent each cell's

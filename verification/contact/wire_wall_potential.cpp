@@ -57,6 +57,71 @@ double NeoHookeanWall::largest_strain(const TetMesh& /*mesh*/, const VectorXd& u
   return solver_->free_state(u, false).max_abs_principal_strain;
 }
 
+namespace {
+
+/// Per row, the rows of the same displacement component that share a cell with it.
+std::vector<std::vector<int>> row_neighbours(const std::vector<std::vector<int>>& cells,
+                                             const std::vector<int>& components, int rows) {
+  std::vector<std::vector<int>> out(static_cast<std::size_t>(rows));
+  for (const std::vector<int>& cell : cells) {
+    for (const int a : cell) {
+      for (const int b : cell) {
+        if (a != b && components[a] == components[b]) out[a].push_back(b);
+      }
+    }
+  }
+  for (std::vector<int>& n : out) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  return out;
+}
+
+/// Marks the unmarked neighbours of the marked rows.
+void mark_one_ring(const std::vector<std::vector<int>>& neighbours, std::vector<char>& marked) {
+  std::vector<int> ring;
+  for (std::size_t r = 0; r < marked.size(); ++r) {
+    if (!marked[r]) continue;
+    for (const int b : neighbours[r]) {
+      if (!marked[b]) ring.push_back(b);
+    }
+  }
+  for (const int b : ring) marked[b] = 1;
+}
+
+}  // namespace
+
+std::optional<VectorXd> NeoHookeanWall::untangled(const VectorXd& u, int max_passes) const {
+  std::vector<int> bad = solver_->inverted_cells(u);
+  if (bad.empty()) return u;
+  const std::vector<std::vector<int>> cells = solver_->free_rows_per_cell();
+  const std::vector<std::vector<int>> neighbours = row_neighbours(cells, dofs_.row_components, n_);
+  constexpr int kSweeps = 10;  // Jacobi sweeps per pass
+  VectorXd out = u;
+  std::vector<char> smoothed(static_cast<std::size_t>(n_), 0);
+  for (int pass = 0; pass < max_passes && !bad.empty(); ++pass) {
+    for (const int c : bad) {
+      for (const int r : cells[static_cast<std::size_t>(c)]) smoothed[r] = 1;
+    }
+    if (pass > 0) mark_one_ring(neighbours, smoothed);
+    std::vector<int> region;
+    for (std::size_t r = 0; r < smoothed.size(); ++r) {
+      if (smoothed[r] && !neighbours[r].empty()) region.push_back(static_cast<int>(r));
+    }
+    for (int sweep = 0; sweep < kSweeps; ++sweep) {
+      const VectorXd before = out;
+      for (const int r : region) {
+        double sum = 0.0;
+        for (const int b : neighbours[r]) sum += before[b];
+        out[r] = sum / static_cast<double>(neighbours[r].size());
+      }
+    }
+    bad = solver_->inverted_cells(out);
+  }
+  if (!bad.empty()) return std::nullopt;
+  return out;
+}
+
 Vec3 NeoHookeanWall::support_reaction(const VectorXd& u) const {
   std::vector<double> w(dofs_.free_index.size(), 0.0);
   for (std::size_t i = 0; i < w.size(); ++i) {

@@ -38,6 +38,7 @@
 #include <Eigen/SparseCore>
 #include <array>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <stdexcept>
 #include <string>
@@ -105,6 +106,18 @@ class NeoHookeanWall final : public WallPotential {
   /// component.
   [[nodiscard]] Vec3 support_reaction(const Eigen::VectorXd& u) const;
   [[nodiscard]] const fem::FreeDisplacementSystem& dofs() const { return dofs_; }
+  /// The cells inverted at u (fem::HyperelasticSolver::inverted_cells).
+  [[nodiscard]] std::vector<int> inverted_cells(const Eigen::VectorXd& u) const {
+    return solver_->inverted_cells(u);
+  }
+  /// u with its folds smoothed out, where a field carried from another mesh inverts elements
+  /// (the new mesh's elements straddle the old one's kinks under a deep dent): while a cell is
+  /// inverted, the rows of the inverted cells, and one ring of neighbours more at each pass,
+  /// take their neighbours' mean displacement (Laplacian smoothing; neighbours share a cell and
+  /// a component), every other row kept. Nothing if cells are still inverted after
+  /// `max_passes`.
+  [[nodiscard]] std::optional<Eigen::VectorXd> untangled(const Eigen::VectorXd& u,
+                                                         int max_passes = 6) const;
   /// The wall's displacement at u (its free rows) at points inside its mesh, m
   /// (fem::HyperelasticSolver::free_displacement_at).
   [[nodiscard]] std::vector<Vec3> displacement_at(const Eigen::VectorXd& u,

@@ -275,17 +275,27 @@ Eigen::VectorXd wall_start_from(const LevelEquilibrium& from, const contact::Neo
 }
 
 /// The wire at its own EI on `wall` from the solve before's equilibrium `from`, its wall
-/// interpolated onto this mesh (wall_start_from); nothing, the reason logged, if that solve fails.
+/// interpolated onto this mesh (wall_start_from) and unfolded where that inverts elements
+/// (NeoHookeanWall::untangled); nothing, the reason logged, if that start or solve fails.
 std::optional<contact::PotentialContactSolution> solve_from_previous(
     const ReferenceWire& wire, const contact::NeoHookeanWall& wall, const TetMesh& mesh,
     const std::vector<int>& nodes, const LevelEquilibrium& from,
     contact::PotentialContactOptions po, double force_scale, std::ostream* log) {
+  const Eigen::VectorXd carried = wall_start_from(from, wall);
+  const std::size_t folded = wall.inverted_cells(carried).size();
+  const std::optional<Eigen::VectorXd> start = wall.untangled(carried);
+  if (log && folded > 0) {
+    *log << "contact:   the solve before's field inverts " << folded << " cells of this mesh: "
+         << (start ? "smoothed out" : "smoothing does not unfold them; the EI rungs from rest")
+         << std::endl;
+  }
+  if (!start) return std::nullopt;
   // The wire's own copy: the solve leaves its rod prepared at the solution.
   ReferenceWire at_target = wire.with_bending_stiffness(wire.bending_stiffness);
   po.force_scale = force_scale;
   try {
     return contact::solve_wire_wall_potential(at_target.rod, wire.radius, wall, mesh, nodes,
-                                              from.wire, po, wall_start_from(from, wall));
+                                              from.wire, po, *start);
   } catch (const std::runtime_error& e) {
     if (log) {
       *log << "contact:   from the solve before's equilibrium: " << e.what()

@@ -8,10 +8,13 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <random>
+#include <set>
 #include <string>
 #include <utility>
 
@@ -284,6 +287,82 @@ TEST(NeoHookeanWall, StateMatchesLinearLimitAndFiniteDifferences) {
   EXPECT_NEAR(gu.dot(dir), slope, 1e-6 * std::abs(slope));
   const VectorXd hd = Hu * dir, fd = (gp - gm) / (2 * h);
   EXPECT_LT((hd - fd).norm(), 1e-6 * hd.norm());
+}
+
+// A field carried from another mesh may fold a few cells (the solve's start is then refused):
+// fem::HyperelasticSolver::inverted_cells finds them (for P1, the tets whose deformed signed
+// volume, computed here by hand, is not positive), and NeoHookeanWall::untangled smooths their
+// rows until none is inverted, keeping the field away from the fold; a field mirrored through
+// the tube's middle (every cell inside out) is not unfolded by smoothing, and says so.
+TEST(NeoHookeanWall, UntangledUnfoldsAFewInvertedCellsAndKeepsTheFieldElsewhere) {
+  const TetMesh& mesh = tube_mesh();
+  const contact::NeoHookeanWall wall(mesh, wall_problem(kWallE));
+  const auto smooth = [](const Vec3& x) {  // a dent-like field, strain ~0.1
+    return Vec3(-0.1 * x.x() * std::exp(-std::pow((x.z() - 25e-3) / 3e-3, 2)), 0.0, 0.0);
+  };
+  VectorXd u = fem::interpolate_rows(wall.dofs(), smooth);
+  ASSERT_TRUE(std::isfinite(wall.evaluate(u, nullptr, nullptr)));
+  // The free node nearest the tube's middle section.
+  std::size_t pushed = mesh.nodes.size();
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+    const auto& rows = wall.node_rows()[n];
+    if (rows[0] < 0 || rows[1] < 0 || rows[2] < 0) continue;
+    if (pushed == mesh.nodes.size() ||
+        std::abs(mesh.nodes[n].z() - 25e-3) < std::abs(mesh.nodes[pushed].z() - 25e-3))
+      pushed = n;
+  }
+  ASSERT_LT(pushed, mesh.nodes.size());
+  double star = 0.0;  // the farthest node sharing a tet with it
+  for (const Tet& t : mesh.tets) {
+    if (std::find(t.begin(), t.end(), static_cast<int>(pushed)) == t.end()) continue;
+    for (const int n : t)
+      star = std::max(star, (mesh.nodes[static_cast<std::size_t>(n)] - mesh.nodes[pushed]).norm());
+  }
+  VectorXd folded = u;  // pushed twice its star's size along x, through its neighbours
+  folded[wall.node_rows()[pushed][0]] += 2.0 * star;
+  // The inverted tets by hand: deformed signed volume ≤ 0.
+  const std::vector<Vec3> d = wall.nodal(folded);
+  std::set<int> by_hand;
+  for (std::size_t t = 0; t < mesh.tets.size(); ++t) {
+    std::array<Vec3, 4> q;
+    for (int i = 0; i < 4; ++i) {
+      const auto n = static_cast<std::size_t>(mesh.tets[t][static_cast<std::size_t>(i)]);
+      q[static_cast<std::size_t>(i)] = mesh.nodes[n] + d[n];
+    }
+    if ((q[1] - q[0]).cross(q[2] - q[0]).dot(q[3] - q[0]) <= 0.0)
+      by_hand.insert(static_cast<int>(t));
+  }
+  const std::vector<int> inverted = wall.inverted_cells(folded);
+  std::printf("WIRE-WALL-POTENTIAL a node pushed %.2f mm: %zu cells inverted (by hand %zu)\n",
+              2e3 * star, inverted.size(), by_hand.size());
+  ASSERT_FALSE(by_hand.empty());
+  EXPECT_EQ(std::set<int>(inverted.begin(), inverted.end()), by_hand);
+  EXPECT_FALSE(std::isfinite(wall.evaluate(folded, nullptr, nullptr)));
+
+  const std::optional<VectorXd> fixed = wall.untangled(folded);
+  ASSERT_TRUE(fixed.has_value());
+  EXPECT_TRUE(wall.inverted_cells(*fixed).empty());
+  EXPECT_TRUE(std::isfinite(wall.evaluate(*fixed, nullptr, nullptr)));
+  // The pushed node back near the smooth field (its neighbours' mean), and every node beyond
+  // the smoothing's reach (its star and six rings more) untouched.
+  const Vec3 back = wall.nodal(*fixed)[pushed], expected = smooth(mesh.nodes[pushed]);
+  std::printf(
+      "WIRE-WALL-POTENTIAL after smoothing: the pushed node %.3e m from the smooth field "
+      "(pushed %.3e m)\n",
+      (back - expected).norm(), 2.0 * star);
+  EXPECT_LT((back - expected).norm(), 0.1 * star);
+  int far_changed = 0;
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+    if ((mesh.nodes[n] - mesh.nodes[pushed]).norm() < 7.0 * star) continue;
+    for (const int r : wall.node_rows()[n]) far_changed += r >= 0 && (*fixed)[r] != folded[r];
+  }
+  EXPECT_EQ(far_changed, 0);
+  EXPECT_EQ(wall.untangled(u), u);  // nothing folded: unchanged
+
+  const Vec3 middle(0, 0, 0.5 * kTubeLength);
+  const VectorXd mirrored =
+      fem::interpolate_rows(wall.dofs(), [&](const Vec3& x) -> Vec3 { return 2.0 * (middle - x); });
+  EXPECT_FALSE(wall.untangled(mirrored).has_value());
 }
 
 namespace {
