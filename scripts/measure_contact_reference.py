@@ -148,8 +148,10 @@ def wall_description(args, sections):
         return (common.format(wall="compressible neo-Hookean FEM at finite strain",
                               how="the wire and the wall as one potential, frictionless contact by "
                                   "an augmented Lagrangian") +
-                "A row is a reference if every level converged and the zone stayed inside the "
-                "refined patch; its uncertainty is the GCI. The largest strain is Green–Lagrange's. "
+                "A row is a reference if every level converged, the zone stayed inside the "
+                "refined patch and no level's dent is wider than the lumen (then the wall does not "
+                "hold the wire, and the verdict says so); its uncertainty is the GCI. The largest "
+                "strain is Green–Lagrange's. "
                 "The wall is P1 unless the command says `--degree 2`, and the GCI is the contact "
                 "zone's mesh at that degree: at ν = 0.45 linear tets are stiffer than the "
                 "continuum at every size, an error the levels do not see (the P1 and P2 forces "

@@ -76,6 +76,53 @@ TEST(ContactReference, RefusesASceneWithoutAGuidewireAndABadStiffness) {
   EXPECT_EQ(contact_reference_stiffnesses(wire), (std::vector<double>{4e-7, 4e-6, 4e-5}));
 }
 
+// The verdict's rules on levels made by hand (a 3 mm lumen): three converged levels inside the
+// patch are a reference with a GCI; a converged level whose dent is wider than the lumen (the
+// arch's stiff wire at 14.24 kPa dents its wall 9.9 mm) says the wall does not hold the wire,
+// whatever the other levels did; a dent within the lumen and a level that failed is "did not
+// converge", naming the level; the linear wall's strain beyond its limit is named.
+TEST(ContactReference, TheVerdictNamesAWallThatDoesNotHoldTheWire) {
+  const double lumen_radius = 3e-3;
+  ContactReferenceOptions o;
+  o.wall = ContactWall::neo_hookean;
+  o.ratio = 2.0;
+  ContactReference r;
+  for (int l = 0; l < 3; ++l) {
+    ContactLevel level;
+    level.level = l;
+    level.converged = true;
+    level.force = 2e-3 + 1e-3 / std::pow(2.0, l);  // differences halve: first order
+    level.dent = 1.5e-3;
+    level.strain = 2.0;
+    r.levels.push_back(level);
+  }
+  judge_contact_reference(o, lumen_radius, r);
+  EXPECT_EQ(r.verdict, "reference");
+  ASSERT_TRUE(r.estimate);
+  EXPECT_NEAR(r.estimate->extrapolated, 2e-3, 1e-9);  // 2.25 − 0.25 / (2¹ − 1) mN
+
+  r.levels[1].dent = 6.5e-3;
+  r.levels[1].strain = 17.0;
+  r.levels[2].converged = false;
+  r.levels[2].failure = "the wire crosses the wall";
+  judge_contact_reference(o, lumen_radius, r);
+  EXPECT_EQ(r.verdict,
+            "no reference: the wall does not hold this wire (level 1's dent 6.50 mm is wider than "
+            "the lumen, 6.00 mm; largest strain 17.00)");
+  EXPECT_FALSE(r.is_reference());
+
+  r.levels[1].dent = 5.9e-3;
+  judge_contact_reference(o, lumen_radius, r);
+  EXPECT_EQ(r.verdict, "did not converge (level 2: the wire crosses the wall)");
+
+  r.levels[2].converged = true;
+  o.wall = ContactWall::linear;
+  judge_contact_reference(o, lumen_radius, r);
+  EXPECT_NE(r.verdict.find("beyond the linear wall's validity (largest strain 17"),
+            std::string::npos)
+      << r.verdict;
+}
+
 // guidewire_straight's floppy wire (EI = 4e-7 N·m²) on its own wall at three levels (0.1, 0.08,
 // 0.064 mm around the zone, P1): every level converges to a line of contact whose force is below
 // the continuum wire's on the rigid lumen (F z²/EI = 0.470968, Kirchhoff shooting) and the

@@ -523,8 +523,30 @@ std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
 /// that leaves it after that makes the verdict "not a reference").
 constexpr int kPatchGrowths = 2;
 
-/// The levels' order, Richardson estimate and GCI on the force, and the verdict.
-void judge(const ContactReferenceOptions& o, ContactReference& r) {
+}  // namespace
+
+void judge_contact_reference(const ContactReferenceOptions& o, double lumen_radius,
+                             ContactReference& r) {
+  r.order.reset();
+  r.estimate.reset();
+  // A dent wider than the lumen: the wire no longer bears on a vessel's wall but pushes the wall
+  // ahead of it, so no mesh or solver makes that force one a simulator's vessel would give.
+  const ContactLevel* deepest = nullptr;
+  for (const ContactLevel& l : r.levels) {
+    if (l.converged && l.dent > 2.0 * lumen_radius && (!deepest || l.dent > deepest->dent))
+      deepest = &l;
+  }
+  if (deepest) {
+    r.verdict = "no reference: the wall does not hold this wire (level " +
+                std::to_string(deepest->level) + "'s dent " + fixed(deepest->dent * 1e3, 2) +
+                " mm is wider than the lumen, " + fixed(2e3 * lumen_radius, 2) +
+                " mm; largest strain " + fixed(deepest->strain, 2) + ")";
+    return;
+  }
+  if (r.levels.empty()) {
+    r.verdict = "did not converge (no level solved)";
+    return;
+  }
   const ContactLevel& finest = r.levels.back();
   bool all_converged = true;
   for (const ContactLevel& l : r.levels) all_converged = all_converged && l.converged;
@@ -568,8 +590,6 @@ void judge(const ContactReferenceOptions& o, ContactReference& r) {
     r.verdict = "reference";
   }
 }
-
-}  // namespace
 
 std::vector<double> contact_reference_stiffnesses(const Scene& scene) {
   require_guidewire(scene);
@@ -653,7 +673,7 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
     r.levels.push_back(level);
   }
 
-  judge(o, r);
+  judge_contact_reference(o, scene.vessel.inner_radius, r);
   return r;
 }
 

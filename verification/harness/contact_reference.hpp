@@ -99,9 +99,10 @@ struct ContactReference {
   /// From the three finest levels when all converged: Roache's order and GCI on the force.
   std::optional<fem::GciOrder> order;
   std::optional<fem::RichardsonEstimate> estimate;
-  /// "reference", "beyond the linear wall's validity (largest strain ...)", "did not
-  /// converge: ..." or "one level: ..." (no convergence estimate): what the finest level's force
-  /// may be used as.
+  /// "reference", "no reference: the wall does not hold this wire (...)", "did not converge
+  /// (...)", "beyond the linear wall's validity (largest strain ...)", "not a reference: the
+  /// contact zone leaves the refined patch" or "one level: ..." (no convergence estimate): what
+  /// the finest level's force may be used as.
   std::string verdict;
   [[nodiscard]] bool is_reference() const { return verdict == "reference"; }
 };
@@ -112,6 +113,14 @@ struct ContactReference {
 /// or options out of range. A level whose solve does not converge is reported, not thrown.
 ContactReference solve_contact_reference(const Scene& scene, double EI,
                                          const ContactReferenceOptions& options = {});
+
+/// Sets the levels' Roache order, Richardson estimate and GCI on the force (every level
+/// converged, two or more) and the verdict, in this order of precedence: a converged level whose
+/// dent is wider than the lumen (2 × lumen_radius, m) makes it "no reference: the wall does not
+/// hold this wire"; a level that did not converge, "did not converge"; the linear wall's strain
+/// beyond `options.strain_limit`; a zone outside the refined patch; a single level.
+void judge_contact_reference(const ContactReferenceOptions& options, double lumen_radius,
+                             ContactReference& reference);
 
 /// The stiffnesses a scene's contact reference is solved at: its wire's stiffness_sweep, or its
 /// wire's own EI (N·m²). InputError naming the scene's file without a guidewire load.
