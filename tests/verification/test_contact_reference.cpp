@@ -79,8 +79,9 @@ TEST(ContactReference, RefusesASceneWithoutAGuidewireAndABadStiffness) {
 // The verdict's rules on levels made by hand (a 3 mm lumen): three converged levels inside the
 // patch are a reference with a GCI; a converged level whose dent is wider than the lumen (the
 // arch's stiff wire at 14.24 kPa dents its wall 9.9 mm) says the wall does not hold the wire,
-// whatever the other levels did; a dent within the lumen and a level that failed is "did not
-// converge", naming the level; the linear wall's strain beyond its limit is named.
+// whatever the other levels did, and so does the scout's when every level failed; a dent within
+// the lumen and a level that failed is "did not converge", naming the level; the linear wall's
+// strain beyond its limit is named.
 TEST(ContactReference, TheVerdictNamesAWallThatDoesNotHoldTheWire) {
   const double lumen_radius = 3e-3;
   ContactReferenceOptions o;
@@ -114,6 +115,18 @@ TEST(ContactReference, TheVerdictNamesAWallThatDoesNotHoldTheWire) {
   r.levels[1].dent = 5.9e-3;
   judge_contact_reference(o, lumen_radius, r);
   EXPECT_EQ(r.verdict, "did not converge (level 2: the wire crosses the wall)");
+
+  // Every level failed, the scout converged with a dent past the lumen: the scout says it.
+  r.scout.converged = true;
+  r.scout.dent = 9.9e-3;
+  r.scout.strain = 17.0;
+  for (ContactLevel& l : r.levels) l.converged = false;
+  judge_contact_reference(o, lumen_radius, r);
+  EXPECT_EQ(r.verdict,
+            "no reference: the wall does not hold this wire (the scout's dent 9.90 mm is wider "
+            "than the lumen, 6.00 mm; largest strain 17.00)");
+  r.scout.dent = 1.5e-3;
+  for (ContactLevel& l : r.levels) l.converged = true;
 
   r.levels[2].converged = true;
   o.wall = ContactWall::linear;

@@ -531,16 +531,21 @@ void judge_contact_reference(const ContactReferenceOptions& o, double lumen_radi
   r.estimate.reset();
   // A dent wider than the lumen: the wire no longer bears on a vessel's wall but pushes the wall
   // ahead of it, so no mesh or solver makes that force one a simulator's vessel would give.
+  // The scout counts too: when every level fails, it may be the only converged solve.
   const ContactLevel* deepest = nullptr;
-  for (const ContactLevel& l : r.levels) {
+  auto consider = [&](const ContactLevel& l) {
     if (l.converged && l.dent > 2.0 * lumen_radius && (!deepest || l.dent > deepest->dent))
       deepest = &l;
-  }
+  };
+  consider(r.scout);
+  for (const ContactLevel& l : r.levels) consider(l);
   if (deepest) {
-    r.verdict = "no reference: the wall does not hold this wire (level " +
-                std::to_string(deepest->level) + "'s dent " + fixed(deepest->dent * 1e3, 2) +
-                " mm is wider than the lumen, " + fixed(2e3 * lumen_radius, 2) +
-                " mm; largest strain " + fixed(deepest->strain, 2) + ")";
+    const std::string which =
+        deepest == &r.scout ? "the scout" : "level " + std::to_string(deepest->level);
+    r.verdict = "no reference: the wall does not hold this wire (" + which + "'s dent " +
+                fixed(deepest->dent * 1e3, 2) + " mm is wider than the lumen, " +
+                fixed(2e3 * lumen_radius, 2) + " mm; largest strain " + fixed(deepest->strain, 2) +
+                ")";
     return;
   }
   if (r.levels.empty()) {

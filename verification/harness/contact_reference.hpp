@@ -115,9 +115,9 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
                                          const ContactReferenceOptions& options = {});
 
 /// Sets the levels' Roache order, Richardson estimate and GCI on the force (every level
-/// converged, two or more) and the verdict, in this order of precedence: a converged level whose
-/// dent is wider than the lumen (2 × lumen_radius, m) makes it "no reference: the wall does not
-/// hold this wire"; a level that did not converge, "did not converge"; the linear wall's strain
+/// converged, two or more) and the verdict, in this order of precedence: a converged level or
+/// scout whose dent is wider than the lumen (2 × lumen_radius, m) makes it "no reference: the
+/// wall does not hold this wire"; a level that did not converge, "did not converge"; the linear wall's strain
 /// beyond `options.strain_limit`; a zone outside the refined patch; a single level.
 void judge_contact_reference(const ContactReferenceOptions& options, double lumen_radius,
                              ContactReference& reference);
