@@ -334,12 +334,13 @@ TetMesh refined_balls_mesh(const VesselParams& params, const std::vector<Refined
   if (!params.parametric()) {
     throw InputError("refined_patch_mesh: expected a straight vessel or an arch");
   }
-  const bool radii_ok =
-      std::all_of(balls.begin(), balls.end(), [](const RefinedBall& b) { return b.radius >= 0.0; });
+  const bool radii_ok = std::all_of(balls.begin(), balls.end(), [](const RefinedBall& b) {
+    return b.radius >= 0.0 && b.size >= 0.0;
+  });
   if (!(fine > 0.0) || balls.empty() || !radii_ok) {
     throw InputError(
         "refined_patch_mesh: expected a positive fine size and at least one ball, each with a "
-        "non-negative radius");
+        "non-negative radius and size");
   }
   const double h = unstructured_mesh_size(params);
   GmshSession session(MeshingOptions{});
@@ -351,14 +352,16 @@ TetMesh refined_balls_mesh(const VesselParams& params, const std::vector<Refined
     p.style = MeshStyle::unstructured;
     add_physical_groups(build_geometry(p));
   }
-  // Size field: `fine` within each ball, growing linearly to h over 2 mm; the smallest wins.
+  // Size field: the ball's size within each ball, growing linearly to h over 2 mm; the smallest
+  // wins.
   const int f = gmsh::model::mesh::field::add("MathEval");
   std::ostringstream expr;
   expr << std::setprecision(17);
   for (const RefinedBall& b : balls) {
+    const double size = b.size > 0.0 ? b.size : fine;
     // Each coordinate in parentheses: "y--1e-05" (a negative one) does not parse.
-    expr << "Min(" << fine << " + Max(0, Sqrt((x-(" << b.centre.x() << "))^2+(y-(" << b.centre.y()
-         << "))^2+(z-(" << b.centre.z() << "))^2) - " << b.radius << ") * " << (h - fine) / 2e-3
+    expr << "Min(" << size << " + Max(0, Sqrt((x-(" << b.centre.x() << "))^2+(y-(" << b.centre.y()
+         << "))^2+(z-(" << b.centre.z() << "))^2) - " << b.radius << ") * " << (h - size) / 2e-3
          << ", ";
   }
   expr << h << std::string(balls.size(), ')');

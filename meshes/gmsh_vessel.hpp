@@ -31,11 +31,12 @@ TetMesh refined_patch_mesh(const VesselParams& params, const Vec3& point, double
 struct RefinedBall {
   Vec3 centre = Vec3::Zero();
   double radius = 0.0;
+  double size = 0.0;  ///< the element size within it (0: the mesh's fine size)
 };
 
-/// As refined_patch_mesh, refined to `fine` within every ball (each graded to the nominal size
-/// over 2 mm; the smallest size wins): a contact that bears in several places, or along a wire.
-/// InputError also for no ball or a negative radius.
+/// As refined_patch_mesh, refined to `fine` (or the ball's own size) within every ball (each
+/// graded to the nominal size over 2 mm; the smallest size wins): a contact that bears in several
+/// places, or along a wire. InputError also for no ball, a negative radius or a negative size.
 TetMesh refined_balls_mesh(const VesselParams& params, const std::vector<RefinedBall>& balls,
                            double fine);
 

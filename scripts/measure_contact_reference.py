@@ -100,20 +100,23 @@ def saved_section(folder, scene):
     meta = {}
     with open(os.path.join(folder, scene + ".meta")) as f:
         text = f.read()
-    for key, pattern in (("before", r"load before (\S+)"), ("start", r"start (\S+)"),
-                         ("after", r"load after (\S+)"), ("end", r"end (\S+)"), ("exit", r"exit (\S+)")):
+    for key, pattern in (("before", r"load before (\S+)"), ("after", r"load after (\S+)"),
+                         ("exit", r"exit (\S+)")):
         found = re.findall(pattern, text, re.M)
-        if found:  # several runs (one per stiffness): the first start, the last end and exit
-            meta[key] = found[0] if key in ("before", "start") else found[-1]
+        if found:  # several runs (one per stiffness): the first load before, the last after and exit
+            meta[key] = found[0] if key == "before" else found[-1]
+    # Runs made one after the other, maybe days apart: the time is the sum of each run's own.
+    starts = [float(t) for t in re.findall(r"start (\S+)", text)]
+    ends = [float(t) for t in re.findall(r"end (\S+)", text)]
+    seconds = sum(end - start for start, end in zip(starts, ends))
     commands = re.findall(r"^command (.+)$", text, re.M) or ["vesselverify contact"]
     head = f"## {scene}\n\n" + ", then ".join(f"`{c}`" for c in commands)
-    finished = meta.get("exit") == "0"
+    finished = meta.get("exit") == "0" and len(ends) == len(starts)
     if finished:
-        head += (f": {float(meta['end']) - float(meta['start']):.0f} s (the scenes side by side), "
+        head += (f": {seconds:.0f} s in all (the runs side by side with others), "
                  f"load average {meta['before']} before, {meta['after']} after.")
     else:
-        ran = (f" after {float(meta['end']) - float(meta['start']):.0f} s" if "end" in meta
-               else "")
+        ran = f" after {seconds:.0f} s" if ends else ""
         head += (f": stopped before it finished{ran} (the scenes side by side, load average "
                  f"{meta.get('before', '?')} at the start); the stiffnesses it did not reach are "
                  "not measured.")

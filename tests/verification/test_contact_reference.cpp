@@ -147,6 +147,91 @@ TEST(ContactReference, TheVerdictNamesAWallThatDoesNotHoldTheWire) {
 // that zone and the levels are solved again from the first, until the growths (two) are spent:
 // a reported level whose zone is outside the patch means both were used, and the verdict says
 // so. (Here level 0 leaves the scout's patch, and level 1 the grown one.) 15 s.
+// The levels' control (solve_contact_levels) with a made-up level solve that records its calls:
+// a dent wider than the lumen ends the levels at once (the scout's: none solved; a level's: kept
+// as the last, before its zone could grow the patch); a zone that leaves the patch grows it and
+// the levels start again on the grown patch.
+TEST(ContactReference, TheLevelsStopAtAWallThatGivesWayAndStartAgainOnAGrownPatch) {
+  const double lumen_radius = 3e-3;
+  ContactReferenceOptions o;
+  o.levels = 3;
+  o.coarsest_size = 0.2e-3;
+  o.ratio = 2.0;
+  o.margin = 0.1e-3;
+  std::vector<double> sizes;
+  std::vector<std::size_t> ball_counts;
+  auto level_with = [](bool converged, double dent, bool inside) {
+    ContactLevel l;
+    l.converged = converged;
+    l.dent = dent;
+    l.zone_inside_patch = inside;
+    l.force = 1e-3;
+    l.middle = Vec3(1e-3, 2e-3, 3e-3);
+    l.reach = 2e-3;
+    l.failure = converged ? "" : "crossed";
+    return l;
+  };
+  const std::vector<RefinedBall> patch{{Vec3::Zero(), 1e-3}};
+
+  ContactReference scout_gives_way;
+  scout_gives_way.scout = level_with(true, 9e-3, true);
+  solve_contact_levels(
+      o, lumen_radius, patch,
+      [&](double fine, const std::vector<RefinedBall>& b) {
+        sizes.push_back(fine);
+        return level_with(true, 1e-3, true);
+      },
+      scout_gives_way);
+  EXPECT_TRUE(sizes.empty());
+  EXPECT_TRUE(scout_gives_way.levels.empty());
+  judge_contact_reference(o, lumen_radius, scout_gives_way);
+  EXPECT_EQ(scout_gives_way.verdict.rfind(
+                "no reference: the wall does not hold this wire (the scout's dent 9.00 mm", 0),
+            0u)
+      << scout_gives_way.verdict;
+
+  // Level 0 fails, level 1 dents 7 mm with a zone outside the patch: no growth, no level 2.
+  ContactReference level_gives_way;
+  level_gives_way.scout = level_with(false, 0.0, true);
+  solve_contact_levels(
+      o, lumen_radius, patch,
+      [&](double fine, const std::vector<RefinedBall>& b) {
+        sizes.push_back(fine);
+        return sizes.size() == 1 ? level_with(false, 0.0, true) : level_with(true, 7e-3, false);
+      },
+      level_gives_way);
+  ASSERT_EQ(sizes, (std::vector<double>{0.2e-3, 0.1e-3}));
+  ASSERT_EQ(level_gives_way.levels.size(), 2u);
+  EXPECT_EQ(level_gives_way.levels[1].level, 1);
+  EXPECT_EQ(level_gives_way.patch_growths, 0);
+  judge_contact_reference(o, lumen_radius, level_gives_way);
+  EXPECT_EQ(level_gives_way.verdict.rfind(
+                "no reference: the wall does not hold this wire (level 1's dent 7.00 mm", 0),
+            0u)
+      << level_gives_way.verdict;
+
+  // Level 0's zone leaves the patch once: the patch grows to it (2 mm reach + 0.1 mm margin about
+  // its middle, first among the balls) and the three levels are solved on it.
+  sizes.clear();
+  ContactReference grown;
+  grown.scout = level_with(true, 1e-3, true);
+  solve_contact_levels(
+      o, lumen_radius, patch,
+      [&](double fine, const std::vector<RefinedBall>& b) {
+        sizes.push_back(fine);
+        ball_counts.push_back(b.size());
+        EXPECT_NEAR(b.front().radius, sizes.size() == 1 ? 1e-3 : 2.1e-3, 1e-12);
+        return level_with(true, 1e-3, sizes.size() > 1);
+      },
+      grown);
+  EXPECT_EQ(sizes, (std::vector<double>{0.2e-3, 0.2e-3, 0.1e-3, 0.05e-3}));
+  EXPECT_EQ(ball_counts, (std::vector<std::size_t>{1, 2, 2, 2}));
+  EXPECT_EQ(grown.patch_growths, 1);
+  ASSERT_EQ(grown.levels.size(), 3u);
+  EXPECT_EQ(grown.levels[2].level, 2);
+  EXPECT_NEAR((grown.patch_centre - Vec3(1e-3, 2e-3, 3e-3)).norm(), 0.0, 1e-15);
+}
+
 TEST(ContactReferenceSlow, AZoneThatLeavesThePatchIsSolvedAgainOnAGrownPatch) {
   const Scene scene = shipped("guidewire_straight.toml");
   ContactReferenceOptions o;

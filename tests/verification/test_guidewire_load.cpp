@@ -4,6 +4,7 @@
 // wire's and the wall's compliances from separate solves.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -70,6 +71,34 @@ TEST(GuidewireLoad, StraightTubeForceMatchesShootingAtTheTip) {
   EXPECT_NEAR(w.normal.x(), 1.0, 1e-6);
   EXPECT_NEAR(s.load.contact.point.z(), z, 1e-15);
   EXPECT_NEAR(s.load.contact.radius, 0.5e-3, 0.0);
+}
+
+// The band a wire tilted 0.3 rad from the straight tube's axis at the inlet's centre may bear on
+// (bearing_band), by hand: the straight wire along its clamp comes within 1.5 mm of the 3 mm wall
+// where its distance from the axis, z·tan 0.3, reaches 1.5 mm (z = 4.83 mm); the rigid-lumen
+// wire ends on the wall at its contact. Every point lies on the wall on the tilt's side (x > 0),
+// at least 0.25 mm from every other, from z = 4.83 mm to the rigid contact.
+TEST(GuidewireLoad, TheBearingBandRunsAlongTheWallFromWhereTheStraightWireNearsIt) {
+  const Scene s = parse_scene(straight_scene("tilt = 0.3"), "wire.toml");
+  const GuidewireSpec& spec = *s.load.guidewire;
+  GuidewireSolver solver(s.vessel, spec);
+  const GuidewireSolution rigid = solver.solve_rigid();
+  const msm::rods::RodLayout layout =
+      msm::rods::make_layout(guidewire_rod_spec(spec, spec.insertion));
+  const std::vector<Vec3> band =
+      bearing_band(s.vessel, spec, layout, solver.rod_state(), 1.5e-3, 0.25e-3);
+  ASSERT_GT(band.size(), 10u);
+  double z_lo = 1.0, z_hi = -1.0;
+  for (std::size_t i = 0; i < band.size(); ++i) {
+    const Vec3& p = band[i];
+    EXPECT_NEAR(std::hypot(p.x(), p.y()), kA, 1e-12);
+    EXPECT_GT(p.x(), 0.0);
+    for (std::size_t j = 0; j < i; ++j) EXPECT_GE((p - band[j]).norm(), 0.25e-3);
+    z_lo = std::min(z_lo, p.z());
+    z_hi = std::max(z_hi, p.z());
+  }
+  EXPECT_NEAR(z_lo, 1.5e-3 / std::tan(0.3), 0.25e-3);
+  EXPECT_NEAR(z_hi, rigid.wall_point.z(), 0.25e-3);
 }
 
 TEST(GuidewireLoad, ArchApexForceMatchesQuarterWaveElastica) {

@@ -102,6 +102,12 @@ void add_contact_models_command(CLI::App& app) {
   cmd->add_option("--fine-radius", o->options.fine_radius,
                   "Radius of the refined patch around the rigid contact, m")
       ->capture_default_str();
+  cmd->add_option(
+         "--bearing-band-size", o->options.bearing_band_size,
+         "Element size along the band the wire may bear on (its rigid-lumen shape and "
+         "the straight wire along its clamp, where near the wall), m; 0: not refined there")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--band-radius", o->options.band_radius,
                   "First contact candidates: inner-wall nodes this near the rigid contact, m "
                   "(grown while the contact reaches the band's edge)")
@@ -149,7 +155,12 @@ void add_contact_models_command(CLI::App& app) {
     std::cout << "Scene " << scene.name << ": nu = " << result.nu << ", mesh " << result.mesh_nodes
               << " nodes, " << result.mesh_tets << " tets (refined to "
               << o->options.fine_size * 1e3 << " mm within " << o->options.fine_radius * 1e3
-              << " mm of the rigid contact).\n";
+              << " mm of the rigid contact";
+    if (o->options.bearing_band_size > 0.0) {
+      std::cout << ", to " << o->options.bearing_band_size * 1e3
+                << " mm along the band the wire may bear on";
+    }
+    std::cout << ").\n";
     for (const contact::ContactModelsRun& run : result.runs) print_run(run, scene.vessel);
   });
 }

@@ -64,15 +64,25 @@ RigidContact rigid_contact(const SceneWire& w, const VesselParams& vessel) {
   return {solver.rod_state(), s.force, s.wall_point};
 }
 
-/// A ball of `radius` at each distinct rigid contact (against a rigid wall the wire's shape does
-/// not depend on EI, so the EIs share one).
-std::vector<RefinedBall> refined_balls(const std::vector<RigidContact>& rigid, double radius) {
+/// The balls the contact mesh is refined in: one of options.fine_radius at each distinct rigid
+/// contact, and balls at options.bearing_band_size along the band the wire may bear on
+/// (bearing_band). Against a rigid wall the wire's shape does not depend on EI: the EIs share one
+/// mesh.
+std::vector<RefinedBall> refined_balls(const std::vector<RigidContact>& rigid,
+                                       const SceneWire& wire, const VesselParams& vessel,
+                                       const ContactModelsOptions& options) {
   std::vector<RefinedBall> balls;
   for (const RigidContact& r : rigid) {
     const bool covered = std::any_of(balls.begin(), balls.end(), [&](const RefinedBall& b) {
       return (b.centre - r.wall_point).norm() < 0.25 * b.radius;
     });
-    if (!covered) balls.push_back({r.wall_point, radius});
+    if (!covered) balls.push_back({r.wall_point, options.fine_radius});
+  }
+  if (options.bearing_band_size > 0.0) {
+    for (const Vec3& p : bearing_band(vessel, wire.spec, wire.layout, rigid.front().x,
+                                      kBearingBandNearWall, 0.5 * kBearingBandBallRadius)) {
+      balls.push_back({p, kBearingBandBallRadius, options.bearing_band_size});
+    }
   }
   return balls;
 }
@@ -490,8 +500,8 @@ ContactModels solve_contact_models(const Scene& scene, const std::vector<ModelSp
   }
   VesselParams vessel = scene.vessel;
   vessel.style = MeshStyle::unstructured;
-  const TetMesh mesh =
-      refined_balls_mesh(vessel, refined_balls(rigid, options.fine_radius), options.fine_size);
+  const TetMesh mesh = refined_balls_mesh(
+      vessel, refined_balls(rigid, *wires.front(), vessel, options), options.fine_size);
   out.mesh_nodes = mesh.nodes.size();
   out.mesh_tets = mesh.tets.size();
   Problem p;

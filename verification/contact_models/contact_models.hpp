@@ -23,6 +23,10 @@ struct ContactModelsOptions {
   std::vector<double> bending_stiffness;
   double fine_size = 0.08e-3;   ///< m: the mesh's element size near the rigid contact
   double fine_radius = 1.0e-3;  ///< m: the refined patch's radius around the rigid contact
+  /// m: the element size along the band the wire may bear on (bearing_band: a stiff wire bears
+  /// along its body, far from its rigid contact, where coarser walls let it through; 0: not
+  /// refined there)
+  double bearing_band_size = 0.16e-3;
   double band_radius = 0.5e-3;  ///< m: the first candidates, inner-wall nodes this near it
   int reference_degree = 2;     ///< the reference wall: FEM of this degree (deal.II)
   int max_newton = 400;         ///< per contact solve (each growth round)

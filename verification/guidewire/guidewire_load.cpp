@@ -1,5 +1,6 @@
 #include "verification/guidewire/guidewire_load.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -36,6 +37,36 @@ std::unique_ptr<rods::RigidLumen> rigid_lumen(const VesselParams& vessel, double
     return std::make_unique<rods::StraightTube>(Vec3::Zero(), Vec3::UnitZ(), offset);
   }
   return std::make_unique<rods::TorusBend>(Vec3::Zero(), Vec3::UnitZ(), vessel.bend_radius, offset);
+}
+
+std::vector<Vec3> bearing_band(const VesselParams& vessel, const GuidewireSpec& spec,
+                               const rods::RodLayout& layout, const Eigen::VectorXd& rigid_state,
+                               double near_wall, double spacing) {
+  const auto lumen = rigid_lumen(vessel, vessel.inner_radius);
+  std::vector<Vec3> shape;  // the two shapes, sampled `spacing` apart, their ends included
+  auto sample = [&](const Vec3& a, const Vec3& b) {
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing)));
+    for (int k = 0; k < n; ++k) shape.push_back(a + (b - a) * (static_cast<double>(k) / n));
+  };
+  for (int i = layout.first_node; i < layout.tip_node; ++i) {
+    sample(rigid_state.segment<3>(3 * i), rigid_state.segment<3>(3 * i + 3));
+  }
+  shape.push_back(rigid_state.segment<3>(3 * layout.tip_node));
+  const Vec3 clamp = spec.clamp_point, t = spec.clamp_direction.normalized();
+  sample(clamp, clamp + spec.insertion * t);
+  shape.push_back(clamp + spec.insertion * t);
+  std::vector<Vec3> band;
+  for (const Vec3& p : shape) {
+    Vec3 gradient;
+    const double g = lumen->gap(p, &gradient, nullptr);
+    if (g > near_wall) continue;
+    // g = a − the distance from the lumen's axis: ∇g, of unit length, points inward.
+    const Vec3 on_wall = p - g * gradient;
+    const bool near = std::any_of(band.begin(), band.end(),
+                                  [&](const Vec3& q) { return (q - on_wall).norm() < spacing; });
+    if (!near) band.push_back(on_wall);
+  }
+  return band;
 }
 
 struct GuidewireSolver::Impl {

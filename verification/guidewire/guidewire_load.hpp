@@ -19,6 +19,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "meshes/vessel_geometry.hpp"
 #include "msm/rods/rigid_wall.hpp"
@@ -107,6 +108,22 @@ void check_guidewire(const VesselParams& vessel, const GuidewireSpec& spec,
 /// The parametric vessel's lumen for a centreline kept within `offset` (m) of the vessel's (the
 /// inner wall itself at offset = inner radius): its gap is + inside, − beyond, ∇g of unit length.
 std::unique_ptr<msm::rods::RigidLumen> rigid_lumen(const VesselParams& vessel, double offset);
+
+/// The inner wall a wire clamped as `spec` says may bear on, as points on it at least `spacing`
+/// (m) apart: under the two shapes that bracket a wire's on a deformable wall, its rigid-lumen
+/// shape `rigid_state` (the wall infinitely stiff; the rod's `layout`) and the straight wire
+/// along the clamp (the wire infinitely stiff), wherever they come within `near_wall` (m) of the
+/// wall or beyond it; each point the radial projection onto the lumen's wall of a point sampled
+/// `spacing` apart along a shape. A stiff wire straightens as a soft wall gives and bears along
+/// its body, far from its rigid-lumen contact: a mesh refined along this band holds it.
+std::vector<Vec3> bearing_band(const VesselParams& vessel, const GuidewireSpec& spec,
+                               const msm::rods::RodLayout& layout,
+                               const Eigen::VectorXd& rigid_state, double near_wall,
+                               double spacing);
+/// m: how near the wall the bracketing shapes count (bearing_band's near_wall), and the radius of
+/// the ball the contact solves refine at each band point (the points half a ball apart).
+inline constexpr double kBearingBandNearWall = 1.5e-3;
+inline constexpr double kBearingBandBallRadius = 0.5e-3;
 
 /// What solve_guidewire_load would run for `spec`, one line (for `vesselverify scene`, which
 /// runs nothing).

@@ -76,9 +76,9 @@ struct WallCrossed : std::runtime_error {
 
 /// m: the inner wall nearest a crossed wire's centreline nodes this near it is where a scout
 /// refines next.
-constexpr double kNearWall = 1.5e-3;
+constexpr double kNearWall = kBearingBandNearWall;
 /// m: the radius refined around each of them.
-constexpr double kAlongWireRadius = 0.5e-3;
+constexpr double kAlongWireRadius = kBearingBandBallRadius;
 
 /// The crossing named `what` of a wire whose centreline nodes are `centreline`, with where to
 /// refine: the inner-wall nodes nearest those within kNearWall of it.
@@ -119,40 +119,6 @@ void require_wire_inside_lumen(const TetMesh& mesh, const msm::rods::Rod& rod,
 bool inside_any(const std::vector<RefinedBall>& balls, const Vec3& p) {
   return std::any_of(balls.begin(), balls.end(),
                      [&](const RefinedBall& b) { return (p - b.centre).norm() <= b.radius; });
-}
-
-/// The inner wall a wire may bear on, as points a kAlongWireRadius ball apart: under the two
-/// shapes that bracket a wire's on a deformable wall, its rigid-lumen shape (the wall infinitely
-/// stiff) and the straight wire along the clamp (the wire infinitely stiff), wherever they come
-/// within kNearWall of the wall or beyond it; each point the radial projection onto the lumen's
-/// wall of a point sampled along a shape. A stiff wire straightens as the soft wall gives and
-/// bears along its body: refined only where one solve crossed, the next crosses further along.
-std::vector<Vec3> bearing_band(const Scene& scene, const ReferenceWire& wire) {
-  const auto lumen = rigid_lumen(scene.vessel, scene.vessel.inner_radius);
-  std::vector<Vec3> shape;  // the two shapes, sampled a half ball apart
-  const double spacing = 0.5 * kAlongWireRadius;
-  auto sample = [&](const Vec3& a, const Vec3& b) {
-    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing)));
-    for (int k = 0; k < n; ++k) shape.push_back(a + (b - a) * (static_cast<double>(k) / n));
-  };
-  const msm::rods::RodLayout& layout = wire.rod.layout();
-  for (int i = layout.first_node; i < layout.tip_node; ++i) {
-    sample(wire.rigid_state.segment<3>(3 * i), wire.rigid_state.segment<3>(3 * i + 3));
-  }
-  const Vec3 clamp = wire.spec.clamp_point, t = wire.spec.clamp_direction.normalized();
-  sample(clamp, clamp + wire.spec.insertion * t);
-  std::vector<Vec3> band;
-  for (const Vec3& p : shape) {
-    Vec3 gradient;
-    const double g = lumen->gap(p, &gradient, nullptr);
-    if (g > kNearWall) continue;
-    const Vec3 on_wall = p + g * gradient;  // g = a − distance from the axis, |∇g| = 1
-    const bool near = std::any_of(band.begin(), band.end(), [&](const Vec3& q) {
-      return (q - on_wall).norm() < 0.5 * kAlongWireRadius;
-    });
-    if (!near) band.push_back(on_wall);
-  }
-  return band;
 }
 
 /// The zone of a solved contact: the pressed nodes (mesh indices) with their forces, the wall's
@@ -484,7 +450,8 @@ constexpr int kScoutSolves = 4;
 /// The scout: the coarsest level refined at the rigid wall point finds the zone (r.scout,
 /// r.patch_centre, r.patch_radius, r.refined_along_wire). A wire that passed between the wall's
 /// nodes elsewhere (a stiff wire's body, straightened as the wall gives) is scouted again with
-/// the wall also refined along the band it may bear on (bearing_band) and around the inner-wall
+/// the wall also refined along the band it may bear on (bearing_band, its points half a ball
+/// apart) and around the inner-wall
 /// nodes nearest its centreline nodes near the wall, up to kScoutSolves solves in all. Returns the
 /// balls every level is refined in: the zone's first, then those along the wire.
 std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
@@ -499,7 +466,9 @@ std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
                           force_scale, o, last, &near_wall);
     const std::size_t before = balls.size();
     if (!near_wall.empty() && solve == 1) {
-      const std::vector<Vec3> band = bearing_band(scene, wire);
+      const std::vector<Vec3> band =
+          bearing_band(scene.vessel, wire.spec, wire.rod.layout(), wire.rigid_state, kNearWall,
+                       0.5 * kAlongWireRadius);
       near_wall.insert(near_wall.end(), band.begin(), band.end());
     }
     for (const Vec3& p : near_wall) {
@@ -518,24 +487,66 @@ std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
   return balls;
 }
 
-/// A level whose zone leaves the refined patch grows the patch to that zone and the levels are
-/// solved again from the first, at most this many times (every level shares the patch; a zone
-/// that leaves it after that makes the verdict "not a reference").
-constexpr int kPatchGrowths = 2;
+/// A converged solve whose dent is wider than the lumen: the wire no longer bears on a vessel's
+/// wall but pushes the wall ahead of it, so no mesh or solver makes that force one a simulator's
+/// vessel would give.
+bool wall_gives_way(const ContactLevel& l, double lumen_radius) {
+  return l.converged && l.dent > 2.0 * lumen_radius;
+}
 
 }  // namespace
+
+void solve_contact_levels(const ContactReferenceOptions& o, double lumen_radius,
+                          std::vector<RefinedBall> balls, const ContactLevelSolve& solve,
+                          ContactReference& r) {
+  const auto gives_way = [&](const ContactLevel& l, const std::string& which) {
+    if (!wall_gives_way(l, lumen_radius)) return false;
+    if (o.log) {
+      *o.log << "contact:   " << which << "'s dent (" << l.dent * 1e3
+             << " mm) is wider than the lumen: the wall does not hold this wire; no finer level "
+                "is solved"
+             << std::endl;
+    }
+    return true;
+  };
+  r.levels.clear();
+  if (gives_way(r.scout, "the scout")) return;
+  for (int l = 0; l < o.levels; ++l) {
+    ContactLevel level = solve(o.coarsest_size / std::pow(o.ratio, l), balls);
+    level.level = l;
+    if (gives_way(level, "level " + std::to_string(l))) {
+      r.levels.push_back(level);
+      return;
+    }
+    // A zone that leaves the patch (the scout's coarser wall under-reports a long line of
+    // contact, and a finer wall's zone reaches further): the patch grown to this level's zone,
+    // the old one kept, and the levels solved again from the first, so that all share one patch.
+    if (level.converged && !level.zone_inside_patch && r.patch_growths < kContactPatchGrowths) {
+      ++r.patch_growths;
+      r.patch_centre = level.middle;
+      r.patch_radius = level.reach + o.margin;
+      balls.insert(balls.begin(), {r.patch_centre, r.patch_radius});
+      if (o.log) {
+        *o.log << "contact:   the zone (" << level.extent * 1e3
+               << " mm) left the patch: refined within " << r.patch_radius * 1e3
+               << " mm of its middle and the levels solved again from the first" << std::endl;
+      }
+      r.levels.clear();
+      l = -1;
+      continue;
+    }
+    r.levels.push_back(level);
+  }
+}
 
 void judge_contact_reference(const ContactReferenceOptions& o, double lumen_radius,
                              ContactReference& r) {
   r.order.reset();
   r.estimate.reset();
-  // A dent wider than the lumen: the wire no longer bears on a vessel's wall but pushes the wall
-  // ahead of it, so no mesh or solver makes that force one a simulator's vessel would give.
   // The scout counts too: when every level fails, it may be the only converged solve.
   const ContactLevel* deepest = nullptr;
   auto consider = [&](const ContactLevel& l) {
-    if (l.converged && l.dent > 2.0 * lumen_radius && (!deepest || l.dent > deepest->dent))
-      deepest = &l;
+    if (wall_gives_way(l, lumen_radius) && (!deepest || l.dent > deepest->dent)) deepest = &l;
   };
   consider(r.scout);
   for (const ContactLevel& l : r.levels) consider(l);
@@ -653,31 +664,11 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
   // The finite-strain wall's last equilibrium: each solve starts from the one before it.
   std::optional<LevelEquilibrium> last;
   std::vector<RefinedBall> balls = scout(scene, wire, rigid.wall_point, rigid.force, o, r, last);
-  for (int l = 0; l < o.levels; ++l) {
-    const double fine = o.coarsest_size / std::pow(o.ratio, l);
-    ContactLevel level = solve_level(scene, wire, r.poisson_ratio, fine, balls, rigid.wall_point,
-                                     rigid.force, o, last);
-    // A zone that leaves the patch (the scout's coarser wall under-reports a long line of
-    // contact, and a finer wall's zone reaches further): the patch grown to this level's zone,
-    // the old one kept, and the levels solved again from the first, so that all share one patch.
-    if (level.converged && !level.zone_inside_patch && r.patch_growths < kPatchGrowths) {
-      ++r.patch_growths;
-      r.patch_centre = level.middle;
-      r.patch_radius = level.reach + o.margin;
-      balls.insert(balls.begin(), {r.patch_centre, r.patch_radius});
-      if (o.log) {
-        *o.log << "contact:   the zone (" << level.extent * 1e3
-               << " mm) left the patch: refined within " << r.patch_radius * 1e3
-               << " mm of its middle and the levels solved again from the first" << std::endl;
-      }
-      r.levels.clear();
-      l = -1;
-      continue;
-    }
-    level.level = l;
-    r.levels.push_back(level);
-  }
-
+  const auto solve = [&](double fine, const std::vector<RefinedBall>& refined) {
+    return solve_level(scene, wire, r.poisson_ratio, fine, refined, rigid.wall_point, rigid.force,
+                       o, last);
+  };
+  solve_contact_levels(o, scene.vessel.inner_radius, balls, solve, r);
   judge_contact_reference(o, scene.vessel.inner_radius, r);
   return r;
 }

@@ -11,12 +11,14 @@
 /// coarsest_size / ratio^level within the zone's reach from its middle plus a margin, graded to
 /// the scene's nominal size over 2 mm). Candidates: the inner-wall nodes within `band` of the
 /// rigid-wall wire's surface inside the refined ball, grown by solve_wire_wall_contact_growing.
+#include <functional>
 #include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include "fem_reference/convergence.hpp"
+#include "meshes/gmsh_vessel.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "verification/scene.hpp"
 
@@ -108,11 +110,32 @@ struct ContactReference {
 };
 
 /// The contact reference of `scene`'s guidewire at bending stiffness EI (N·m²; E and G scaled,
-/// with_stiffness), against the scene's wall at its first Poisson's ratio. InputError naming the
-/// scene's file for a scene without a guidewire load, a vessel from a file, EI ≤ 0 or not finite,
-/// or options out of range. A level whose solve does not converge is reported, not thrown.
+/// with_stiffness), against the scene's wall at its first Poisson's ratio: the scout, then
+/// solve_contact_levels. InputError naming the scene's file for a scene without a guidewire load,
+/// a vessel from a file, EI ≤ 0 or not finite, or options out of range. A level whose solve does
+/// not converge is reported, not thrown.
 ContactReference solve_contact_reference(const Scene& scene, double EI,
                                          const ContactReferenceOptions& options = {});
+
+/// A level's solve: its mesh refined to `fine` (m) in the balls, the patch first.
+using ContactLevelSolve =
+    std::function<ContactLevel(double fine, const std::vector<RefinedBall>& balls)>;
+
+/// A level whose zone leaves the refined patch grows the patch to that zone and the levels are
+/// solved again from the first, at most this many times (every level shares the patch; a zone
+/// that leaves it after that makes the verdict "not a reference").
+inline constexpr int kContactPatchGrowths = 2;
+
+/// The levels of a reference whose scout is solved (`r.scout`, `r.patch_centre`,
+/// `r.patch_radius`): level l at options.coarsest_size / options.ratio^l by `solve`, on `balls`.
+/// A converged level whose zone leaves the patch grows the patch to it (the ball inserted first)
+/// and the levels are solved again from the first, up to kContactPatchGrowths times. The first
+/// converged solve, the scout's included, whose dent is wider than the lumen (2 × lumen_radius, m)
+/// ends them, kept as the last level: the wall does not hold the wire and no finer level changes
+/// that verdict (judge_contact_reference's first rule).
+void solve_contact_levels(const ContactReferenceOptions& options, double lumen_radius,
+                          std::vector<RefinedBall> balls, const ContactLevelSolve& solve,
+                          ContactReference& r);
 
 /// Sets the levels' Roache order, Richardson estimate and GCI on the force (every level
 /// converged, two or more) and the verdict, in this order of precedence: a converged level or

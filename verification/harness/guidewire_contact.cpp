@@ -119,7 +119,8 @@ std::string contact_key(const Scene& scene, const std::vector<std::string>& mode
   h.text(file_contents(scene.source));
   for (const double EI : o.bending_stiffness) h.real(EI);
   for (const std::string& m : models) h.text(m);
-  h.real(o.fine_size).real(o.fine_radius).real(o.band_radius).integer(o.reference_degree);
+  h.real(o.fine_size).real(o.fine_radius).real(o.bearing_band_size).real(o.band_radius);
+  h.integer(o.reference_degree);
   h.integer(o.max_newton).real(o.max_move).integer(o.own_equilibrium ? 1 : 0);
   h.integer(o.potential ? 1 : 0).integer(o.from_softer_wire ? 1 : 0);
   return "guidewire-contact " + h.hex();
@@ -377,8 +378,12 @@ void write_guidewire_contact_markdown(std::ostream& out, const GuidewireContact&
               : "linearised at rest")
       << ", the contact found by the solve, on one mesh of " << c.solve.mesh_nodes
       << " nodes refined to " << c.options.fine_size * 1e3 << " mm within "
-      << c.options.fine_radius * 1e3 << " mm of the rigid wire's contact (ν = " << c.solve.nu
-      << "); each force against the FEM P" << c.options.reference_degree
+      << c.options.fine_radius * 1e3 << " mm of the rigid wire's contact"
+      << (c.options.bearing_band_size > 0.0
+              ? " and to " + reports::significant(c.options.bearing_band_size * 1e3) +
+                    " mm along the band it may bear on"
+              : std::string())
+      << " (ν = " << c.solve.nu << "); each force against the FEM P" << c.options.reference_degree
       << " wall's in the same solve"
       << (c.provenance.cached ? "; solved " + c.provenance.measured_at + ", from the cache" : "")
       << ".\n\n";
