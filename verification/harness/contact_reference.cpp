@@ -451,9 +451,9 @@ constexpr int kScoutSolves = 4;
 /// r.patch_centre, r.patch_radius, r.refined_along_wire). A wire that passed between the wall's
 /// nodes elsewhere (a stiff wire's body, straightened as the wall gives) is scouted again with
 /// the wall also refined along the band it may bear on (bearing_band, its points half a ball
-/// apart) and around the inner-wall
-/// nodes nearest its centreline nodes near the wall, up to kScoutSolves solves in all. Returns the
-/// balls every level is refined in: the zone's first, then those along the wire.
+/// apart) and around the inner-wall nodes nearest its centreline nodes near the wall, up to
+/// kScoutSolves solves in all. Returns the balls every level is refined in: the zone's first,
+/// then those along the wire.
 std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
                                const Vec3& wall_point, double force_scale,
                                const ContactReferenceOptions& o, ContactReference& r,
