@@ -37,7 +37,8 @@ The wire of `guidewire_straight` (DER, its segments, clamped on the axis at the 
 rest with the scene's supports held (`model_walls.hpp`), condensed on the contact candidates and
 pressed by the wire's capsule with Signorini's conditions, the candidates grown until the contact
 stays inside them. Every wall is on the same tet mesh (gmsh, refined to 0.08 mm within 1 mm of the
-rigid wire's contact) with the same candidates and the same contact law; the reference is FEM P2
+rigid wire's contact and to 0.16 mm along the band the wire may bear on) with the same candidates
+and the same contact law; the reference is FEM P2
 (deal.II) on that mesh. Column *wall*: `own (linear)` is the model's own equilibrium,
 `small-dent` its linearisation at rest (the nonlinear models). Surface models: the contact acts
 on the inner wall, a mid-surface node's contact point being its inner-wall node carried with the
@@ -59,7 +60,7 @@ wall, and as the reference deal.II's FEM at finite strain (compressible neo-Hook
 and the wire solved as one potential (`solve_wire_wall_potential`: the wire's capsule and its tip
 against the inner wall, frictionless, an augmented Lagrangian), every inner-wall node a
 candidate. Every wall is on the same tet mesh (gmsh, refined to 0.08 mm within 1 mm of the rigid
-wire's contact). Surface models: the contact acts on the inner wall, a mid-surface node's contact
+wire's contact and to 0.16 mm along the band the wire may bear on). Surface models: the contact acts on the inner wall, a mid-surface node's contact
 point being its inner-wall node carried with the mid-surface node's displacement. The zone is the
 pressed nodes' span along the axis and around it (arc length at the lumen); the dent the largest
 displacement of a pressed node; the tip error the distance between the wire's tip on the model's
