@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "meshes/foundation/errors.hpp"
+#include "meshes/gmsh_vessel.hpp"
 #include "reports/insertion_section.hpp"
 #include "reports/study_files.hpp"
 #include "schema_check.hpp"
@@ -147,6 +148,27 @@ TEST(ContactReference, TheVerdictNamesAWallThatDoesNotHoldTheWire) {
 // that zone and the levels are solved again from the first, until the growths (two) are spent:
 // a reported level whose zone is outside the patch means both were used, and the verdict says
 // so. (Here level 0 leaves the scout's patch, and level 1 the grown one.) 15 s.
+// Where a scout refines after a crossing (crossed_wire_refinement), on the shipped straight
+// tube's mesh (inner radius 3 mm): a centreline node 9 mm from the axis, far beyond the pushed
+// wall, adds nothing of its own; the crossed triangle's three nodes are refined at rest wherever
+// the wire is; a node 2.9 mm from the axis adds the inner-wall node nearest it (on the wall,
+// within 1.5 mm).
+TEST(ContactReference, ACrossedWireRefinesTheCrossedWallAtRestAndTheWallNearItsNodes) {
+  const Scene scene = shipped("guidewire_straight.toml");
+  const TetMesh mesh = generate_vessel_mesh(scene.vessel);
+  const Triangle t = mesh.group_triangles(mesh.require_group("inner_wall", 2, "test")).front();
+  const std::vector<Vec3> far{Vec3(9e-3, 0.0, 20e-3)};
+  EXPECT_TRUE(crossed_wire_refinement(mesh, far, nullptr).empty());
+  const std::vector<Vec3> through = crossed_wire_refinement(mesh, far, &t);
+  ASSERT_EQ(through.size(), 3u);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(through[k], mesh.nodes[static_cast<std::size_t>(t[k])]);
+  const std::vector<Vec3> near{Vec3(2.9e-3, 0.0, 20e-3)};
+  const std::vector<Vec3> nearest = crossed_wire_refinement(mesh, near, nullptr);
+  ASSERT_EQ(nearest.size(), 1u);
+  EXPECT_NEAR(std::hypot(nearest[0].x(), nearest[0].y()), 3e-3, 1e-9);
+  EXPECT_LT((nearest[0] - near[0]).norm(), 1.5e-3);
+}
+
 // The levels' control (solve_contact_levels) with a made-up level solve that records its calls:
 // a dent wider than the lumen ends the levels at once (the scout's: none solved; a level's: kept
 // as the last, before its zone could grow the patch); a zone that leaves the patch grows it and

@@ -68,9 +68,7 @@ std::vector<int> candidates(const TetMesh& mesh, const contact::ContactWire& wir
 /// A solved wire that passed between the wall's nodes, with where to refine the wall next.
 struct WallCrossed : std::runtime_error {
   using std::runtime_error::runtime_error;
-  /// For each of its centreline nodes within kNearWall of the (undeformed) inner wall, the
-  /// nearest inner-wall node's rest position, m: where the wall bears the wire. (The centreline
-  /// itself lies beyond the dented wall, up to ~0.7 mm off the nodes it presses.)
+  /// Where the wall bears the wire, at rest (crossed_wire_refinement), m.
   std::vector<Vec3> near_wall;
 };
 
@@ -80,25 +78,12 @@ constexpr double kNearWall = kBearingBandNearWall;
 /// m: the radius refined around each of them.
 constexpr double kAlongWireRadius = kBearingBandBallRadius;
 
-/// The crossing named `what` of a wire whose centreline nodes are `centreline`, with where to
-/// refine: the inner-wall nodes nearest those within kNearWall of it.
+/// The crossing named `what` of a wire whose centreline nodes are `centreline` through the
+/// inner-wall triangle `through` (if known), with where to refine (crossed_wire_refinement).
 WallCrossed wall_crossed(const TetMesh& mesh, const std::string& what,
-                         const std::vector<Vec3>& centreline) {
+                         const std::vector<Vec3>& centreline, const Triangle* through = nullptr) {
   WallCrossed crossed(what);
-  const std::vector<int> wall_nodes =
-      mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
-  for (const Vec3& p : centreline) {
-    double nearest = std::numeric_limits<double>::infinity();
-    Vec3 at = p;
-    for (const int n : wall_nodes) {
-      const Vec3& node = mesh.nodes[static_cast<std::size_t>(n)];
-      if ((node - p).norm() < nearest) {
-        nearest = (node - p).norm();
-        at = node;
-      }
-    }
-    if (nearest <= kNearWall) crossed.near_wall.push_back(at);
-  }
+  crossed.near_wall = crossed_wire_refinement(mesh, centreline, through);
   return crossed;
 }
 
@@ -293,7 +278,7 @@ contact::PotentialContactSolution climb_rungs(const ReferenceWire& wire,
     try {
       s = contact::solve_wire_wall_potential(rung.rod, wire.radius, wall, mesh, nodes, x, po, u);
     } catch (const contact::WireThroughWall& e) {  // the mesh, not the rung, is at fault
-      throw wall_crossed(mesh, e.what(), e.centreline);
+      throw wall_crossed(mesh, e.what(), e.centreline, &e.triangle);
     } catch (const std::runtime_error& e) {
       if (splits == 3 || done == 0.0) throw;
       ++splits;
@@ -495,6 +480,29 @@ bool wall_gives_way(const ContactLevel& l, double lumen_radius) {
 }
 
 }  // namespace
+
+std::vector<Vec3> crossed_wire_refinement(const TetMesh& mesh, const std::vector<Vec3>& centreline,
+                                          const Triangle* through) {
+  std::vector<Vec3> out;
+  if (through) {
+    for (const int n : *through) out.push_back(mesh.nodes[static_cast<std::size_t>(n)]);
+  }
+  const std::vector<int> wall_nodes =
+      mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"));
+  for (const Vec3& p : centreline) {
+    double nearest = std::numeric_limits<double>::infinity();
+    Vec3 at = p;
+    for (const int n : wall_nodes) {
+      const Vec3& node = mesh.nodes[static_cast<std::size_t>(n)];
+      if ((node - p).norm() < nearest) {
+        nearest = (node - p).norm();
+        at = node;
+      }
+    }
+    if (nearest <= kBearingBandNearWall) out.push_back(at);
+  }
+  return out;
+}
 
 void solve_contact_levels(const ContactReferenceOptions& o, double lumen_radius,
                           std::vector<RefinedBall> balls, const ContactLevelSolve& solve,

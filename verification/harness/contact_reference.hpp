@@ -117,6 +117,14 @@ struct ContactReference {
 ContactReference solve_contact_reference(const Scene& scene, double EI,
                                          const ContactReferenceOptions& options = {});
 
+/// Where a scout refines after its wire's centreline (its nodes, m) crossed the inner wall: the
+/// rest positions of the crossed triangle's nodes (`through`, mesh indices, if known; the wall
+/// material the wire passed through, however far the wall was pushed), then for each centreline
+/// node within kBearingBandNearWall of the undeformed inner wall the nearest inner-wall node (the
+/// centreline lies beyond the dented wall, up to ~0.7 mm off the nodes it presses).
+std::vector<Vec3> crossed_wire_refinement(const TetMesh& mesh, const std::vector<Vec3>& centreline,
+                                          const Triangle* through);
+
 /// A level's solve: its mesh refined to `fine` (m) in the balls, the patch first.
 using ContactLevelSolve =
     std::function<ContactLevel(double fine, const std::vector<RefinedBall>& balls)>;
