@@ -72,12 +72,6 @@ struct WallCrossed : std::runtime_error {
   std::vector<Vec3> near_wall;
 };
 
-/// m: the inner wall nearest a crossed wire's centreline nodes this near it is where a scout
-/// refines next.
-constexpr double kNearWall = kBearingBandNearWall;
-/// m: the radius refined around each of them.
-constexpr double kAlongWireRadius = kBearingBandBallRadius;
-
 /// The crossing named `what` of a wire whose centreline nodes are `centreline` through the
 /// inner-wall triangle `through` (if known), with where to refine (crossed_wire_refinement).
 WallCrossed wall_crossed(const TetMesh& mesh, const std::string& what,
@@ -452,12 +446,12 @@ std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
     const std::size_t before = balls.size();
     if (!near_wall.empty() && solve == 1) {
       const std::vector<Vec3> band =
-          bearing_band(scene.vessel, wire.spec, wire.rod.layout(), wire.rigid_state, kNearWall,
-                       0.5 * kAlongWireRadius);
+          bearing_band(scene.vessel, wire.spec, wire.rod.layout(), wire.rigid_state,
+                       kBearingBandNearWall, 0.5 * kBearingBandBallRadius);
       near_wall.insert(near_wall.end(), band.begin(), band.end());
     }
     for (const Vec3& p : near_wall) {
-      if (!inside_any(balls, p)) balls.push_back({p, kAlongWireRadius});
+      if (!inside_any(balls, p)) balls.push_back({p, kBearingBandBallRadius});
     }
     if (r.scout.converged || balls.size() == before || solve == kScoutSolves) break;
   }
@@ -691,8 +685,8 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
   out << "; refined within " << fixed(r.patch_radius * 1e3, 3) << " mm of ("
       << fixed(r.patch_centre.x() * 1e3, 3) << ", " << fixed(r.patch_centre.y() * 1e3, 3) << ", "
       << fixed(r.patch_centre.z() * 1e3, 3) << ") mm"
-      << (r.refined_along_wire > 0 ? " and within " + fixed(kAlongWireRadius * 1e3, 1) + " mm of " +
-                                         std::to_string(r.refined_along_wire) +
+      << (r.refined_along_wire > 0 ? " and within " + fixed(kBearingBandBallRadius * 1e3, 1) +
+                                         " mm of " + std::to_string(r.refined_along_wire) +
                                          " inner-wall points along the band the wire may bear "
                                          "on, after a scout wire crossed the wall"
                                    : std::string())
