@@ -127,6 +127,18 @@ TEST(ContactReference, TheVerdictNamesAWallThatDoesNotHoldTheWire) {
             "no reference: the wall does not hold this wire (the scout's dent 9.90 mm is wider "
             "than the lumen, 6.00 mm; largest strain 17.00)");
   r.scout.dent = 1.5e-3;
+
+  // A level whose climb stopped at a softer rung already dented past the lumen says it too.
+  r.levels[0].gave_way_at = 1.2649e-5;
+  r.levels[0].dent = 7.1e-3;
+  r.levels[0].strain = 12.0;
+  judge_contact_reference(o, lumen_radius, r);
+  EXPECT_EQ(r.verdict,
+            "no reference: the wall does not hold this wire (level 0's dent 7.10 mm (at EI "
+            "1.26e-05 N·m², a softer wire) is wider than the lumen, 6.00 mm; largest strain "
+            "12.00)");
+  r.levels[0].gave_way_at.reset();
+  r.levels[0].dent = 1.5e-3;
   for (ContactLevel& l : r.levels) l.converged = true;
 
   r.levels[2].converged = true;
@@ -170,9 +182,9 @@ TEST(ContactReference, ACrossedWireRefinesTheCrossedWallAtRestAndTheWallNearItsN
 }
 
 // The levels' control (solve_contact_levels) with a made-up level solve that records its calls:
-// a dent wider than the lumen ends the levels at once (the scout's: none solved; a level's: kept
-// as the last, before its zone could grow the patch); a zone that leaves the patch grows it and
-// the levels start again on the grown patch.
+// a dent wider than the lumen ends the levels at once (the scout's, or its softer rung's: none
+// solved; a level's: kept as the last, before its zone could grow the patch); a zone that leaves
+// the patch grows it and the levels start again on the grown patch.
 TEST(ContactReference, TheLevelsStopAtAWallThatGivesWayAndStartAgainOnAGrownPatch) {
   const double lumen_radius = 3e-3;
   ContactReferenceOptions o;
@@ -211,6 +223,19 @@ TEST(ContactReference, TheLevelsStopAtAWallThatGivesWayAndStartAgainOnAGrownPatc
                 "no reference: the wall does not hold this wire (the scout's dent 9.00 mm", 0),
             0u)
       << scout_gives_way.verdict;
+
+  ContactReference rung_gives_way;
+  rung_gives_way.scout = level_with(false, 7e-3, true);
+  rung_gives_way.scout.gave_way_at = 1.2649e-5;
+  solve_contact_levels(
+      o, lumen_radius, patch,
+      [&](double fine, const std::vector<RefinedBall>& b) {
+        sizes.push_back(fine);
+        return level_with(true, 1e-3, true);
+      },
+      rung_gives_way);
+  EXPECT_TRUE(sizes.empty());
+  EXPECT_TRUE(rung_gives_way.levels.empty());
 
   // Level 0 fails, level 1 dents 7 mm with a zone outside the patch: no growth, no level 2.
   ContactReference level_gives_way;

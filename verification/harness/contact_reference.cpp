@@ -29,6 +29,22 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+/// A bending stiffness to three significant digits, N·m²: "1.26e-05 N·m²".
+std::string stiffness_text(double EI) {
+  std::ostringstream s;
+  s.precision(3);
+  s << EI << " N·m²";
+  return s.str();
+}
+
 /// The wire: DER at the scene's segments, at the rigid-wall state.
 struct ReferenceWire {
   GuidewireSpec spec;
@@ -250,16 +266,25 @@ std::optional<contact::PotentialContactSolution> solve_from_previous(
   }
 }
 
+/// The largest displacement of a node the wire presses in `s` (m).
+double pressed_dent(const contact::NeoHookeanWall& wall,
+                    const contact::PotentialContactSolution& s) {
+  const std::vector<Vec3> u = wall.nodal(s.u);
+  double dent = 0.0;
+  for (const int n : s.pressed) dent = std::max(dent, u[static_cast<std::size_t>(n)].norm());
+  return dent;
+}
+
 /// The wire's stiffness raised in rungs (continuation_rungs) to its own EI, each solved from the
 /// last rung's equilibrium, the first from the rigid-lumen state with the wall at rest (the wire's
 /// rigid-lumen shape holds at every EI). A rung that fails is split at its geometric mean with the
-/// last converged one, up to 3 times. Counts the steps and rungs in `out`.
-contact::PotentialContactSolution climb_rungs(const ReferenceWire& wire,
-                                              const contact::NeoHookeanWall& wall,
-                                              const TetMesh& mesh, const std::vector<int>& nodes,
-                                              contact::PotentialContactOptions po,
-                                              double force_scale, const ContactReferenceOptions& o,
-                                              ContactLevel& out) {
+/// last converged one, up to 3 times. Counts the steps and rungs in `out`. A rung below the
+/// wire's EI whose dent is already wider than the lumen (2 × lumen_radius, m) ends the climb:
+/// nothing is returned, and `out` says at which EI the wall gave way (ContactLevel::gave_way_at).
+std::optional<contact::PotentialContactSolution> climb_rungs(
+    const ReferenceWire& wire, const contact::NeoHookeanWall& wall, const TetMesh& mesh,
+    const std::vector<int>& nodes, contact::PotentialContactOptions po, double force_scale,
+    double lumen_radius, const ContactReferenceOptions& o, ContactLevel& out) {
   const double target = wire.bending_stiffness;
   std::vector<double> rungs = continuation_rungs(o.continuation_from, o.continuation_ratio, target);
   Eigen::VectorXd x = wire.rigid_state, u;
@@ -285,10 +310,20 @@ contact::PotentialContactSolution climb_rungs(const ReferenceWire& wire,
     }
     out.steps += s.newton_iterations;
     ++out.rungs;
+    const double dent = pressed_dent(wall, s);
     if (o.log && rungs.size() > 1) {
       *o.log << "contact:   EI " << rungs[k] << " N·m²: F " << s.total_force_on_wall().norm() * 1e3
-             << " mN, " << s.pressed.size() << " pressed, " << s.newton_iterations << " steps"
-             << std::endl;
+             << " mN, " << s.pressed.size() << " pressed, dent " << dent * 1e3 << " mm, "
+             << s.newton_iterations << " steps" << std::endl;
+    }
+    if (rungs[k] < target && dent > 2.0 * lumen_radius) {
+      out.gave_way_at = rungs[k];
+      out.dent = dent;
+      out.strain = wall.largest_strain(mesh, s.u);
+      out.failure = "the wall gave way at EI " + stiffness_text(rungs[k]) +
+                    ", a softer wire than this one: its dent " + fixed(dent * 1e3, 2) +
+                    " mm is wider than the lumen";
+      return std::nullopt;
     }
     x = s.x;
     u = s.u;
@@ -303,8 +338,9 @@ contact::PotentialContactSolution climb_rungs(const ReferenceWire& wire,
 /// by millimetres, and Newton's method from the rigid-lumen state (the wall at rest) does not
 /// reach that equilibrium: with `from` (the solve before's equilibrium) the wire's EI is solved
 /// from there (solve_from_previous), else, or if that fails, reached in rungs (climb_rungs).
-/// The equilibrium reached is left in `reached`.
-void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, double nu,
+/// The equilibrium reached is left in `reached`; false if a softer rung's wall gave way (`out`
+/// says where) and none was reached.
+bool solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, double nu,
                             const TetMesh& mesh, const std::vector<RefinedBall>& balls,
                             double force_scale, const ContactReferenceOptions& o,
                             const LevelEquilibrium* from, ContactLevel& out,
@@ -330,7 +366,8 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
     out.rungs = 1;
     out.from_previous_solve = true;
   } else {
-    s = climb_rungs(wire, wall, mesh, nodes, po, force_scale, o, out);
+    s = climb_rungs(wire, wall, mesh, nodes, po, force_scale, scene.vessel.inner_radius, o, out);
+    if (!s) return false;
   }
   const std::vector<Vec3> displacement = wall.nodal(s->u);
   out.converged = true;
@@ -339,6 +376,7 @@ void solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
   describe_zone(mesh, s->pressed, s->force, displacement, balls, out);
   out.strain = wall.largest_strain(mesh, s->u);
   reached = {shared, s->u, mesh, displacement, s->x};
+  return true;
 }
 
 /// One contact solve on a mesh refined to `fine` within the balls (the first: the zone; its
@@ -381,9 +419,9 @@ ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double n
       solve_linear_wall(scene, wire, nu, mesh, nodes, wall_point, balls, force_scale, o, out);
     } else {
       LevelEquilibrium reached;
-      solve_neo_hookean_wall(scene, wire, nu, mesh, balls, force_scale, o,
-                             last && o.from_previous_solve ? &*last : nullptr, out, reached);
-      last = std::move(reached);
+      if (solve_neo_hookean_wall(scene, wire, nu, mesh, balls, force_scale, o,
+                                 last && o.from_previous_solve ? &*last : nullptr, out, reached))
+        last = std::move(reached);
     }
   } catch (const WallCrossed& e) {
     out.converged = false;
@@ -403,14 +441,6 @@ ContactLevel solve_level(const Scene& scene, const ReferenceWire& wire, double n
            << " s" << std::endl;
   }
   return out;
-}
-
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
 }
 
 void require_guidewire(const Scene& scene) {
@@ -466,11 +496,17 @@ std::vector<RefinedBall> scout(const Scene& scene, const ReferenceWire& wire,
   return balls;
 }
 
-/// A converged solve whose dent is wider than the lumen: the wire no longer bears on a vessel's
-/// wall but pushes the wall ahead of it, so no mesh or solver makes that force one a simulator's
-/// vessel would give.
+/// A converged solve, or a softer rung of one (ContactLevel::gave_way_at), whose dent is wider
+/// than the lumen: the wire no longer bears on a vessel's wall but pushes the wall ahead of it, so
+/// no mesh or solver makes that force one a simulator's vessel would give.
 bool wall_gives_way(const ContactLevel& l, double lumen_radius) {
-  return l.converged && l.dent > 2.0 * lumen_radius;
+  return (l.converged || l.gave_way_at) && l.dent > 2.0 * lumen_radius;
+}
+
+/// " (at EI … N·m², a softer wire)" for a level whose wall gave way below its EI.
+std::string softer_rung(const ContactLevel& l) {
+  return l.gave_way_at ? " (at EI " + stiffness_text(*l.gave_way_at) + ", a softer wire)"
+                       : std::string();
 }
 
 }  // namespace
@@ -504,8 +540,8 @@ void solve_contact_levels(const ContactReferenceOptions& o, double lumen_radius,
   const auto gives_way = [&](const ContactLevel& l, const std::string& which) {
     if (!wall_gives_way(l, lumen_radius)) return false;
     if (o.log) {
-      *o.log << "contact:   " << which << "'s dent (" << l.dent * 1e3
-             << " mm) is wider than the lumen: the wall does not hold this wire; no finer level "
+      *o.log << "contact:   " << which << "'s dent " << l.dent * 1e3 << " mm" << softer_rung(l)
+             << " is wider than the lumen: the wall does not hold this wire; no finer level "
                 "is solved"
              << std::endl;
     }
@@ -556,9 +592,9 @@ void judge_contact_reference(const ContactReferenceOptions& o, double lumen_radi
     const std::string which =
         deepest == &r.scout ? "the scout" : "level " + std::to_string(deepest->level);
     r.verdict = "no reference: the wall does not hold this wire (" + which + "'s dent " +
-                fixed(deepest->dent * 1e3, 2) + " mm is wider than the lumen, " +
-                fixed(2e3 * lumen_radius, 2) + " mm; largest strain " + fixed(deepest->strain, 2) +
-                ")";
+                fixed(deepest->dent * 1e3, 2) + " mm" + softer_rung(*deepest) +
+                " is wider than the lumen, " + fixed(2e3 * lumen_radius, 2) +
+                " mm; largest strain " + fixed(deepest->strain, 2) + ")";
     return;
   }
   if (r.levels.empty()) {
@@ -697,7 +733,9 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
       << " mm within 1 mm of the rigid wall point: "
       << (r.scout.converged
               ? std::to_string(r.scout.pressed) + " pressed, " + fixed(r.scout.seconds, 1) + " s"
-              : std::string("did not converge"))
+          : r.scout.gave_way_at ? "the wall gave way" + softer_rung(r.scout) + ", dent " +
+                                      fixed(r.scout.dent * 1e3, 2) + " mm"
+                                : std::string("did not converge"))
       << ").\n\n"
       << "| level | fine mm | nodes | candidates | pressed | F mN | zone centroid mm | extent mm | "
          "dent mm | largest strain | steps | s |\n"
@@ -705,6 +743,12 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
   for (const ContactLevel& l : r.levels) {
     out << "| " << l.level << " | " << fixed(l.fine_size * 1e3, 3) << " | " << l.mesh_nodes << " | "
         << l.candidates << " | ";
+    if (l.gave_way_at) {
+      out << "— | gave way" << softer_rung(l) << " | — | — | " << fixed(l.dent * 1e3, 3) << " | "
+          << fixed(l.strain, 3) << " | " << l.steps << " in " << l.rungs << " EI rungs | "
+          << fixed(l.seconds, 1) << " |\n";
+      continue;
+    }
     if (!l.converged) {
       // The step count is in the failure's message (the solve throws without it).
       out << "— | did not converge | — | — | — | — | — | " << fixed(l.seconds, 1) << " |\n";

@@ -73,6 +73,9 @@ struct ContactLevel {
   bool zone_inside_patch = true;  ///< every pressed node within the refined ball
   int steps = 0;         ///< linearised steps over all growth rounds or rungs (0 if not converged)
   int rungs = 0;         ///< the neo-Hookean wall's stiffness continuation: solves to reach the EI
+  /// The neo-Hookean wall's climb stopped at this softer rung's EI (N·m²), whose dent (`dent`,
+  /// `strain`: that rung's) was already wider than the lumen; the level is not converged
+  std::optional<double> gave_way_at;
   /// the neo-Hookean wall solved at the EI from the solve before (a coarser level's or the
   /// ungrown patch's equilibrium, interpolated onto this mesh), not from the wall at rest
   bool from_previous_solve = false;
@@ -147,9 +150,11 @@ void solve_contact_levels(const ContactReferenceOptions& options, double lumen_r
 
 /// Sets the levels' Roache order, Richardson estimate and GCI on the force (every level
 /// converged, two or more) and the verdict, in this order of precedence: a converged level or
-/// scout whose dent is wider than the lumen (2 × lumen_radius, m) makes it "no reference: the
-/// wall does not hold this wire"; a level that did not converge, "did not converge"; the linear wall's strain
-/// beyond `options.strain_limit`; a zone outside the refined patch; a single level.
+/// scout whose dent is wider than the lumen (2 × lumen_radius, m), or one whose climb stopped at a
+/// softer rung with such a dent (ContactLevel::gave_way_at: a stiffer wire presses the wall
+/// further), makes it "no reference: the wall does not hold this wire"; a level that did not
+/// converge, "did not converge"; the linear wall's strain beyond `options.strain_limit`; a zone
+/// outside the refined patch; a single level.
 void judge_contact_reference(const ContactReferenceOptions& options, double lumen_radius,
                              ContactReference& reference);
 
