@@ -137,6 +137,14 @@ TEST(ContactReference, TheVerdictNamesAWallThatDoesNotHoldTheWire) {
             "no reference: the wall does not hold this wire (level 0's dent 7.10 mm (at EI "
             "1.26e-05 N·m², a softer wire) is wider than the lumen, 6.00 mm; largest strain "
             "12.00)");
+  r.levels[0].failure = "the wall gave way at EI 1.26e-05 N·m²";
+  std::ostringstream printed;
+  print_contact_reference(r, printed);
+  EXPECT_NE(printed.str().find("| gave way (at EI 1.26e-05 N·m², a softer wire) | — | — | 7.100 | "
+                               "12.000 |"),
+            std::string::npos)
+      << printed.str();
+  EXPECT_NE(printed.str().find("Level 0 stopped: the wall gave way"), std::string::npos);
   r.levels[0].gave_way_at.reset();
   r.levels[0].dent = 1.5e-3;
   for (ContactLevel& l : r.levels) l.converged = true;

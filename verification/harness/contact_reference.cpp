@@ -509,6 +509,30 @@ std::string softer_rung(const ContactLevel& l) {
                        : std::string();
 }
 
+/// A level's row of print_contact_reference's table.
+void print_level_row(const ContactLevel& l, std::ostream& out) {
+  out << "| " << l.level << " | " << fixed(l.fine_size * 1e3, 3) << " | " << l.mesh_nodes << " | "
+      << l.candidates << " | ";
+  if (l.gave_way_at) {
+    out << "— | gave way" << softer_rung(l) << " | — | — | " << fixed(l.dent * 1e3, 3) << " | "
+        << fixed(l.strain, 3) << " | " << l.steps << " in " << l.rungs << " EI rungs | "
+        << fixed(l.seconds, 1) << " |\n";
+    return;
+  }
+  if (!l.converged) {
+    // The step count is in the failure's message (the solve throws without it).
+    out << "— | did not converge | — | — | — | — | — | " << fixed(l.seconds, 1) << " |\n";
+    return;
+  }
+  out << l.pressed << " | " << fixed(l.force * 1e3, 5) << " | (" << fixed(l.centroid.x() * 1e3, 2)
+      << ", " << fixed(l.centroid.y() * 1e3, 2) << ", " << fixed(l.centroid.z() * 1e3, 2) << ") | "
+      << fixed(l.extent * 1e3, 3) << (l.zone_inside_patch ? "" : " (leaves the patch)") << " | "
+      << fixed(l.dent * 1e3, 3) << " | " << fixed(l.strain, 3) << " | " << l.steps
+      << (l.rungs > 1 ? " in " + std::to_string(l.rungs) + " EI rungs" : std::string())
+      << (l.from_previous_solve ? " from the solve before" : "") << " | " << fixed(l.seconds, 1)
+      << " |\n";
+}
+
 }  // namespace
 
 std::vector<Vec3> crossed_wire_refinement(const TetMesh& mesh, const std::vector<Vec3>& centreline,
@@ -740,30 +764,12 @@ void print_contact_reference(const ContactReference& r, std::ostream& out) {
       << "| level | fine mm | nodes | candidates | pressed | F mN | zone centroid mm | extent mm | "
          "dent mm | largest strain | steps | s |\n"
       << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+  for (const ContactLevel& l : r.levels) print_level_row(l, out);
   for (const ContactLevel& l : r.levels) {
-    out << "| " << l.level << " | " << fixed(l.fine_size * 1e3, 3) << " | " << l.mesh_nodes << " | "
-        << l.candidates << " | ";
-    if (l.gave_way_at) {
-      out << "— | gave way" << softer_rung(l) << " | — | — | " << fixed(l.dent * 1e3, 3) << " | "
-          << fixed(l.strain, 3) << " | " << l.steps << " in " << l.rungs << " EI rungs | "
-          << fixed(l.seconds, 1) << " |\n";
-      continue;
-    }
     if (!l.converged) {
-      // The step count is in the failure's message (the solve throws without it).
-      out << "— | did not converge | — | — | — | — | — | " << fixed(l.seconds, 1) << " |\n";
-      continue;
+      out << "\nLevel " << l.level << (l.gave_way_at ? " stopped: " : " did not converge: ")
+          << l.failure << "\n";
     }
-    out << l.pressed << " | " << fixed(l.force * 1e3, 5) << " | (" << fixed(l.centroid.x() * 1e3, 2)
-        << ", " << fixed(l.centroid.y() * 1e3, 2) << ", " << fixed(l.centroid.z() * 1e3, 2)
-        << ") | " << fixed(l.extent * 1e3, 3) << (l.zone_inside_patch ? "" : " (leaves the patch)")
-        << " | " << fixed(l.dent * 1e3, 3) << " | " << fixed(l.strain, 3) << " | " << l.steps
-        << (l.rungs > 1 ? " in " + std::to_string(l.rungs) + " EI rungs" : std::string())
-        << (l.from_previous_solve ? " from the solve before" : "") << " | " << fixed(l.seconds, 1)
-        << " |\n";
-  }
-  for (const ContactLevel& l : r.levels) {
-    if (!l.converged) out << "\nLevel " << l.level << " did not converge: " << l.failure << "\n";
   }
   if (r.estimate && r.order) {
     out << "\nRichardson: F = " << fixed(r.estimate->extrapolated * 1e3, 5) << " mN ("
