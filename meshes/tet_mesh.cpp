@@ -97,6 +97,14 @@ double signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
   return (b - a).dot((c - a).cross(d - a)) / 6.0;
 }
 
+std::size_t inverted_tets(const TetMesh& mesh, const std::vector<Vec3>& x) {
+  std::size_t n = 0;
+  for (const Tet& t : mesh.tets) {
+    if (!(signed_volume(x[t[0]], x[t[1]], x[t[2]], x[t[3]]) > 0)) ++n;
+  }
+  return n;
+}
+
 double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
   return 0.5 * (b - a).cross(c - a).norm();
 }

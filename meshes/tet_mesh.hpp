@@ -69,6 +69,8 @@ struct TetMesh {
 
 /// Signed volume of a tetrahedron, m³ (positive when (b−a, c−a, d−a) is right-handed).
 double signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d);
+/// Tets of `mesh` with non-positive signed volume when its nodes are at `x` (one per node).
+std::size_t inverted_tets(const TetMesh& mesh, const std::vector<Vec3>& x);
 /// Area of a triangle, m².
 double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c);
 /// The point of triangle (a, b, c) nearest to x: x's projection on the plane if it falls inside,

@@ -47,10 +47,10 @@ void print_run(const contact::ContactModelsRun& run, const VesselParams& vessel)
               << fmt("%.4f", ref.dent * 1e3) << " mm, centroid at " << along(vessel, ref.centroid)
               << " mm along the centreline, " << ref.candidates << " candidates.\n";
   }
-  constexpr int kColumns = 14;
+  constexpr int kColumns = 15;
   std::cout << "\n| model | wall | F (mN) | error (mN) | error (%) | pressed | centroid s (mm) "
                "| zone axial × circ. (mm) | dent (mm) | tip error (mm) | own imbalance "
-               "| set-up (s) | solve (s) | steps |\n|";
+               "| inverted tets | set-up (s) | solve (s) | steps |\n|";
   for (int c = 0; c < kColumns; ++c) std::cout << " --- |";
   std::cout << "\n";
   const auto row = [&](const contact::ModelContact& m) {
@@ -69,8 +69,10 @@ void print_run(const contact::ContactModelsRun& run, const VesselParams& vessel)
               << fmt("%.3f", m.axial_extent * 1e3) << " × "
               << fmt("%.3f", m.circumferential_extent * 1e3) << " | " << fmt("%.4f", m.dent * 1e3)
               << " | " << (judged ? fmt("%.4f", (m.tip - ref.tip).norm() * 1e3) : "n/a") << " | "
-              << fmt("%.1e", m.own_imbalance) << " | " << fmt("%.1f", m.setup_seconds) << " | "
-              << fmt("%.1f", m.solve_seconds) << " | " << m.steps << " |\n";
+              << fmt("%.1e", m.own_imbalance) << " | "
+              << (m.inverted_tets ? std::to_string(*m.inverted_tets) : "—") << " | "
+              << fmt("%.1f", m.setup_seconds) << " | " << fmt("%.1f", m.solve_seconds) << " | "
+              << m.steps << " |\n";
   };
   row(ref);
   for (const contact::ModelContact& m : run.models) row(m);

@@ -26,6 +26,13 @@ using Triplets = std::vector<Eigen::Triplet<double>>;
 
 std::vector<Vec3> WallPotential::nodal(const VectorXd& u) const { return per_node(node_rows(), u); }
 
+std::optional<std::size_t> WallPotential::inverted_tets(const TetMesh& mesh,
+                                                        const VectorXd& u) const {
+  std::vector<Vec3> x = nodal(u);
+  for (std::size_t n = 0; n < x.size(); ++n) x[n] += mesh.nodes[n];
+  return vessel::inverted_tets(mesh, x);
+}
+
 double LinearWall::evaluate(const VectorXd& u, VectorXd* gradient,
                             Eigen::SparseMatrix<double>* hessian, bool /*project_psd*/) const {
   const VectorXd Ku = s_.K * u;
@@ -184,7 +191,7 @@ double FormWall::evaluate(const VectorXd& u, VectorXd* gradient,
   return form_.energy(x) - rest_energy_;
 }
 
-double FormWall::largest_strain(const TetMesh& mesh, const VectorXd& u) const {
+TetMesh FormWall::carried_tets(const TetMesh& mesh) const {
   TetMesh carried = mesh;
   carried.tets.clear();
   for (const Tet& t : mesh.tets) {
@@ -192,8 +199,19 @@ double FormWall::largest_strain(const TetMesh& mesh, const VectorXd& u) const {
     for (const int n : t) all = all && node_rows_[static_cast<std::size_t>(n)][0] >= 0;
     if (all) carried.tets.push_back(t);
   }
+  return carried;
+}
+
+double FormWall::largest_strain(const TetMesh& mesh, const VectorXd& u) const {
+  const TetMesh carried = carried_tets(mesh);
   if (carried.tets.empty()) return std::numeric_limits<double>::quiet_NaN();
   return contact::largest_strain(carried, nodal(u)).small;
+}
+
+std::optional<std::size_t> FormWall::inverted_tets(const TetMesh& mesh, const VectorXd& u) const {
+  const TetMesh carried = carried_tets(mesh);
+  if (carried.tets.empty()) return std::nullopt;
+  return WallPotential::inverted_tets(carried, u);
 }
 
 Vec3 PotentialContactSolution::total_force_on_wall() const {

@@ -72,6 +72,10 @@ class WallPotential {
   /// Per mesh node its displacement (m) at u: zero where held, unless the wall knows its whole
   /// field (a condensed one does).
   [[nodiscard]] virtual std::vector<Vec3> nodal(const Eigen::VectorXd& u) const;
+  /// The tets the wall carries that are inverted at u (non-positive volume; by default every
+  /// tet of `mesh` with its nodes moved by nodal(u)); nothing for a wall without tets.
+  [[nodiscard]] virtual std::optional<std::size_t> inverted_tets(const TetMesh& mesh,
+                                                                 const Eigen::VectorXd& u) const;
 };
 
 /// The linear wall: ½uᵀKu − fᵀu of the FEM's free displacement system.
@@ -102,6 +106,11 @@ class NeoHookeanWall final : public WallPotential {
   double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
                   Eigen::SparseMatrix<double>* hessian, bool project_psd = false) const override;
   [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
+  /// The cells with J ≤ 0 at a quadrature point (none where the energy is finite).
+  [[nodiscard]] std::optional<std::size_t> inverted_tets(const TetMesh& mesh,
+                                                         const Eigen::VectorXd& u) const override {
+    return inverted_cells(u).size();
+  }
   /// The supports' total reaction at u (N): the internal forces on the held DoFs, summed per
   /// component.
   [[nodiscard]] Vec3 support_reaction(const Eigen::VectorXd& u) const;
@@ -148,9 +157,15 @@ class FormWall final : public WallPotential {
                   Eigen::SparseMatrix<double>* hessian, bool project_psd = false) const override;
   /// The P1 small strain of the tets whose four nodes the model carries (NaN if none).
   [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
+  /// Of the tets whose four nodes the model carries, those inverted at u (nothing if none): a
+  /// spring network's energy does not forbid a tet to fold.
+  [[nodiscard]] std::optional<std::size_t> inverted_tets(const TetMesh& mesh,
+                                                         const Eigen::VectorXd& u) const override;
 
  private:
   [[nodiscard]] Eigen::VectorXd positions(const Eigen::VectorXd& u) const;
+  /// `mesh` with only the tets whose four nodes the model carries.
+  [[nodiscard]] TetMesh carried_tets(const TetMesh& mesh) const;
   const msm::Form& form_;
   Eigen::VectorXd rest_;
   std::vector<int> free_index_;

@@ -254,6 +254,7 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
     s = solve_own_equilibrium(rod, w.radius, *potential, *p.mesh, candidates, rigid, o, start,
                               out.from_softer_wire);
     out.candidates = static_cast<int>(candidates.size());
+    out.inverted_tets = potential->inverted_tets(*p.mesh, s.u);
     reached = PotentialState{EI, s.x, s.u};
   }
   out.solve_seconds = s.seconds;

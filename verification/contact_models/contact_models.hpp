@@ -69,6 +69,10 @@ struct ModelContact {
   /// The wall's largest principal strain: small strain from the P1 gradient of the vertex
   /// displacements (linearised walls), the wall's own measure at its own equilibrium.
   double strain = 0.0;
+  /// At its own nonlinear equilibrium, the tets the wall carries that are inverted there
+  /// (WallPotential::inverted_tets; 0 for the finite-strain FEM, whose energy forbids it);
+  /// nothing for a linearised wall or a wall without tets.
+  std::optional<std::size_t> inverted_tets;
   Vec3 tip = Vec3::Zero();              ///< the wire's tip, m
   /// own_imbalance at the dent: the share of the contact load the model's own (nonlinear) energy
   /// does not balance there (0 for deal.II's FEM).

@@ -39,6 +39,7 @@ json wall_json(const contact::ModelContact& m) {
           {"circumferential_extent", m.circumferential_extent},
           {"dent", m.dent},
           {"strain", m.strain},
+          {"inverted_tets", m.inverted_tets ? json(*m.inverted_tets) : json()},
           {"tip", vec_json(m.tip)},
           {"own_imbalance", m.own_imbalance},
           {"steps", m.steps},
@@ -69,6 +70,7 @@ contact::ModelContact wall_of(const json& j) {
   m.circumferential_extent = number(j, "circumferential_extent");
   m.dent = number(j, "dent");
   m.strain = number(j, "strain");
+  if (!j.at("inverted_tets").is_null()) m.inverted_tets = j.at("inverted_tets").get<std::size_t>();
   m.tip = vec_of(j.at("tip"));
   m.own_imbalance = number(j, "own_imbalance");
   m.steps = j.at("steps");
@@ -178,6 +180,7 @@ json wall_row(const contact::ModelContact& m, const contact::ModelContact& refer
        {"circumferential_extent_mm", m.circumferential_extent * 1e3},
        {"dent_mm", m.dent * 1e3},
        {"largest_strain", m.strain},
+       {"inverted_tets", m.inverted_tets ? json(*m.inverted_tets) : json()},
        {"tip_mm", mm(m.tip)},
        {"tip_error_mm", judged ? json((m.tip - reference.tip).norm() * 1e3) : json()},
        {"setup_seconds", m.setup_seconds},

@@ -641,6 +641,51 @@ TEST(WireWallPotentialSlow, ModelEnergyWallEqualsTheFemWall) {
   EXPECT_NEAR(Fa, Fb, 1e-8 * Fa);
 }
 
+// A model's wall counts the tets it carries that are inverted (FormWall::inverted_tets): two
+// tets sharing the face 0-1-2, the apex 3 above it and 4 below; apex 3 pushed 1.5 units down,
+// through the shared face, folds the first tet and leaves the second, whose nodes did not move,
+// as it is. With node 4 held, only the first tet is the wall's.
+TEST(WireWallPotential, AModelWallCountsItsInvertedTets) {
+  TetMesh mesh;
+  mesh.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.2, 0.2, 1), Vec3(0.2, 0.2, -1)};
+  mesh.tets = {{0, 1, 2, 3}, {0, 2, 1, 4}};
+  ASSERT_GT(signed_volume(mesh.nodes[0], mesh.nodes[1], mesh.nodes[2], mesh.nodes[3]), 0.0);
+  ASSERT_GT(signed_volume(mesh.nodes[0], mesh.nodes[2], mesh.nodes[1], mesh.nodes[4]), 0.0);
+  const msm::LinearTetTerm term(mesh.nodes, mesh.tets, msm::lame_parameters(1e4, 0.3));
+  Eigen::VectorXd rest(15);
+  for (int n = 0; n < 5; ++n) rest.segment<3>(3 * n) = mesh.nodes[static_cast<std::size_t>(n)];
+  const auto wall_with = [&](bool hold_4, std::vector<int>& free_index,
+                             std::vector<std::array<int, 3>>& rows) {
+    free_index.assign(15, -1);
+    rows.assign(5, {-1, -1, -1});
+    int next = 0;
+    for (int n = 0; n < 5; ++n) {
+      if (hold_4 && n == 4) continue;
+      for (int c = 0; c < 3; ++c) rows[n][c] = free_index[3 * n + c] = next++;
+    }
+    return next;
+  };
+  std::vector<int> free_index;
+  std::vector<std::array<int, 3>> rows;
+  const int all = wall_with(false, free_index, rows);
+  const contact::FormWall wall(term, rest, free_index, rows);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(all);
+  EXPECT_EQ(wall.inverted_tets(mesh, u), std::optional<std::size_t>(0));
+  u[rows[3][2]] = -1.5;
+  EXPECT_EQ(wall.inverted_tets(mesh, u), std::optional<std::size_t>(1));
+
+  const int some = wall_with(true, free_index, rows);
+  const contact::FormWall held(term, rest, free_index, rows);
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(some);
+  v[rows[3][2]] = -1.5;
+  EXPECT_EQ(held.inverted_tets(mesh, v), std::optional<std::size_t>(1));
+  v[rows[3][2]] = 0.0;
+  EXPECT_EQ(held.inverted_tets(mesh, v), std::optional<std::size_t>(0));
+  rows.assign(5, {-1, -1, -1});  // no node free: no tet is the wall's
+  const contact::FormWall none(term, rest, std::vector<int>(15, -1), rows);
+  EXPECT_FALSE(none.inverted_tets(mesh, Eigen::VectorXd()).has_value());
+}
+
 // The wall's start (a stiffness continuation's rung): the wire at a tenth of its EI solved first,
 // then the wire at its EI from that equilibrium (the softer wire's centreline, the wall's dented
 // displacement) reaches the equilibrium the solve from the rigid-lumen state with the wall at rest

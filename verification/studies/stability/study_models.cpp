@@ -106,14 +106,6 @@ FemRun run_fem(const Scene& scene, const TetMesh& mesh, double nu, int degree,
 }
 
 /// Tets of `mesh` with non-positive signed volume when its nodes are at `x` (flat, 3 per node).
-std::size_t inverted_tets(const TetMesh& mesh, const std::vector<Vec3>& x) {
-  std::size_t n = 0;
-  for (const Tet& t : mesh.tets) {
-    if (!(signed_volume(x[t[0]], x[t[1]], x[t[2]], x[t[3]]) > 0)) ++n;
-  }
-  return n;
-}
-
 std::string short_error(const std::string& what) {
   return what.size() > 300 ? what.substr(0, 300) + " …" : what;
 }

@@ -75,8 +75,6 @@ struct FemRun {
 /// direct solver. Errors are recorded in the run, not thrown.
 FemRun run_fem(const Scene& scene, const TetMesh& mesh, double nu, int degree, fem::Formulation f);
 
-/// Tets of `mesh` with non-positive signed volume when its nodes are at `x`.
-std::size_t inverted_tets(const TetMesh& mesh, const std::vector<Vec3>& x);
 std::vector<Vec3> unflatten(const Eigen::VectorXd& x);
 
 HardCaseOutcome fem_outcome(const std::string& name, const FemRun& r);
