@@ -83,7 +83,7 @@ TEST(ContactReference, RefusesASceneWithoutAGuidewireAndABadStiffness) {
 // arch's stiff wire at 14.24 kPa dents its wall 9.9 mm) says the wall does not hold the wire,
 // whatever the other levels did, and so does the scout's when every level failed; a dent within
 // the lumen and a level that failed is "did not converge", naming the level; the linear wall's
-// strain beyond its limit is named.
+// strain beyond its limit is named; a GCI above its limit is not a reference.
 TEST(ContactReference, TheVerdictNamesAWallThatDoesNotHoldTheWire) {
   const double lumen_radius = 3e-3;
   ContactReferenceOptions o;
@@ -103,6 +103,13 @@ TEST(ContactReference, TheVerdictNamesAWallThatDoesNotHoldTheWire) {
   EXPECT_EQ(r.verdict, "reference");
   ASSERT_TRUE(r.estimate);
   EXPECT_NEAR(r.estimate->extrapolated, 2e-3, 1e-9);  // 2.25 − 0.25 / (2¹ − 1) mN
+  // GCI = 1.25 · 0.25 / (2.25 · (2¹ − 1)) = 13.89 %: above a 10 % limit, not a reference.
+  o.gci_limit = 0.1;
+  judge_contact_reference(o, lumen_radius, r);
+  EXPECT_EQ(r.verdict,
+            "not a reference: the levels' GCI 13.89 % is above 10.00 % (the levels are not in "
+            "the asymptotic range: finer levels are needed)");
+  o.gci_limit = 0.2;
 
   r.levels[1].dent = 6.5e-3;
   r.levels[1].strain = 17.0;

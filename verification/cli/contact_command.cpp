@@ -99,8 +99,8 @@ void add_contact_command(CLI::App& app) {
       "level around the contact zone. "
       "Per level: the total contact force, the zone's centroid and extent, the dent, the largest "
       "strain, steps and time; then the force's Richardson extrapolate, observed order and GCI, "
-      "and whether the answer is a reference (converged, the zone inside the refined patch, and "
-      "for the linear wall the strain within its validity).\n"
+      "and whether the answer is a reference (converged, the zone inside the refined patch, the "
+      "GCI within its limit, and for the linear wall the strain within its validity).\n"
       "Example:\n"
       "  vesselverify contact verification/scenes/guidewire_straight.toml --ei 4e-7 "
       "--wall neo-hookean");
@@ -120,6 +120,11 @@ void add_contact_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--strain-limit", o->options.strain_limit,
                   "The linear wall's validity: largest strain at most this")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--gci-limit", o->options.gci_limit,
+                  "A reference's GCI on the force (relative) at most this; larger: not a "
+                  "reference")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--max-steps", o->options.max_steps, "Linearised contact steps per solve")

@@ -664,6 +664,10 @@ void judge_contact_reference(const ContactReferenceOptions& o, double lumen_radi
     r.verdict = "not a reference: the contact zone leaves the refined patch";
   } else if (r.levels.size() < 2) {
     r.verdict = "one level: no estimate of its mesh error (two or more levels give a GCI)";
+  } else if (r.estimate->gci_fine > o.gci_limit) {
+    r.verdict = "not a reference: the levels' GCI " + fixed(100.0 * r.estimate->gci_fine, 2) +
+                " % is above " + fixed(100.0 * o.gci_limit, 2) +
+                " % (the levels are not in the asymptotic range: finer levels are needed)";
   } else {
     r.verdict = "reference";
   }
@@ -682,12 +686,12 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
   require_guidewire(scene);
   if (o.levels < 1 || !(o.coarsest_size > 0.0) || !(o.ratio > 1.0) ||
       (o.degree != 1 && o.degree != 2) || !(o.margin >= 0.0) || !(o.band > 0.0) ||
-      !(o.strain_limit > 0.0) || o.max_steps < 1 || !(o.continuation_from > 0.0) ||
-      !(o.continuation_ratio > 1.0)) {
+      !(o.strain_limit > 0.0) || !(o.gci_limit > 0.0) || o.max_steps < 1 ||
+      !(o.continuation_from > 0.0) || !(o.continuation_ratio > 1.0)) {
     throw InputError(
         "contact reference options: expected levels ≥ 1, a positive coarsest size, "
-        "ratio > 1, degree 1 or 2, margin ≥ 0, band > 0, strain limit > 0, steps ≥ 1, a "
-        "positive continuation start and a continuation ratio > 1");
+        "ratio > 1, degree 1 or 2, margin ≥ 0, band > 0, strain limit > 0, GCI limit > 0, "
+        "steps ≥ 1, a positive continuation start and a continuation ratio > 1");
   }
   GuidewireSpec spec;
   try {

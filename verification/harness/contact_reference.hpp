@@ -37,6 +37,9 @@ struct ContactReferenceOptions {
   double band = 0.5e-3;    ///< m: candidates within this of the rigid-wall wire's surface
   /// the linear wall's validity: largest strain at most this (the neo-Hookean wall has no limit)
   double strain_limit = 0.1;
+  /// A reference's GCI on the force (relative) at most this: levels whose GCI is larger bound the
+  /// force no better than that (not yet in the asymptotic range) and are not a reference
+  double gci_limit = 0.2;
   int max_steps = 300;  ///< linearised contact steps per solve
   /// The neo-Hookean wall: a stiffer wire is reached by raising EI from this (N·m²) in steps of
   /// continuation_ratio, each solved from the last one's equilibrium (4e-7: the floppy wire of
@@ -106,8 +109,9 @@ struct ContactReference {
   std::optional<fem::RichardsonEstimate> estimate;
   /// "reference", "no reference: the wall does not hold this wire (...)", "did not converge
   /// (...)", "beyond the linear wall's validity (largest strain ...)", "not a reference: the
-  /// contact zone leaves the refined patch" or "one level: ..." (no convergence estimate): what
-  /// the finest level's force may be used as.
+  /// contact zone leaves the refined patch", "one level: ..." (no convergence estimate) or "not
+  /// a reference: the levels' GCI ... is above ...": what the finest level's force may be used
+  /// as.
   std::string verdict;
   [[nodiscard]] bool is_reference() const { return verdict == "reference"; }
 };
@@ -154,7 +158,7 @@ void solve_contact_levels(const ContactReferenceOptions& options, double lumen_r
 /// softer rung with such a dent (ContactLevel::gave_way_at: a stiffer wire presses the wall
 /// further), makes it "no reference: the wall does not hold this wire"; a level that did not
 /// converge, "did not converge"; the linear wall's strain beyond `options.strain_limit`; a zone
-/// outside the refined patch; a single level.
+/// outside the refined patch; a single level; a GCI above `options.gci_limit`.
 void judge_contact_reference(const ContactReferenceOptions& options, double lumen_radius,
                              ContactReference& reference);
 
