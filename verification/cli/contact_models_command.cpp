@@ -76,6 +76,11 @@ void print_run(const contact::ContactModelsRun& run, const VesselParams& vessel)
   };
   row(ref);
   for (const contact::ModelContact& m : run.models) row(m);
+  const std::string folded = contact::folded_walls(run);
+  if (!folded.empty()) {
+    std::cout << "\nInverted tets at the model's own equilibrium: " << folded
+              << ". Such a wall has folded: its force is not an elastic wall's.\n";
+  }
 }
 
 }  // namespace

@@ -292,6 +292,15 @@ ModelSpec spec_of(std::string name, ModelKind kind) {
 
 }  // namespace
 
+std::string folded_walls(const ContactModelsRun& run) {
+  std::string folded;
+  for (const ModelContact& m : run.models) {
+    if (!m.failure.empty() || !m.inverted_tets || *m.inverted_tets == 0) continue;
+    folded += (folded.empty() ? "" : ", ") + m.name + " (" + std::to_string(*m.inverted_tets) + ")";
+  }
+  return folded;
+}
+
 bool has_contact_wall(const ModelSpec& m) {
   return !(m.kind == ModelKind::network || m.kind == ModelKind::external ||
            m.kind == ModelKind::displacements ||

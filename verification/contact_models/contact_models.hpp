@@ -99,6 +99,11 @@ struct ContactModels {
   std::vector<ContactModelsRun> runs;  ///< one per EI
 };
 
+/// The solved models of `run` whose wall has inverted tets at its own equilibrium, each as "name
+/// (count)", comma-separated; empty if none. Such a wall has folded: its force is not an elastic
+/// wall's.
+std::string folded_walls(const ContactModelsRun& run);
+
 /// Whether the model has a wall the wire can press: not a network, an external program, given
 /// displacements or a surface model on the outer wall.
 bool has_contact_wall(const ModelSpec& model);

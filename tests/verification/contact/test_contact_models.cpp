@@ -274,6 +274,27 @@ TEST(ContactModels, ASolverOrARegionOfInterestLeavesTheWallAsItIs) {
   EXPECT_GT(largest(Ka - K(c)), 1e-3 * largest(Ka));
 }
 
+// The folded walls named under a run's table: a solved model with inverted tets at its own
+// equilibrium, not one with none, a linearised wall (no count) or a failed solve.
+TEST(ContactModels, TheFoldedWallsAreTheSolvedOnesWithInvertedTets) {
+  contact::ContactModelsRun run;
+  const auto model = [](const std::string& name, std::optional<std::size_t> inverted,
+                        const std::string& failure) {
+    contact::ModelContact m;
+    m.name = name;
+    m.inverted_tets = inverted;
+    m.failure = failure;
+    return m;
+  };
+  run.models = {model("volume_mollemans", 890, ""), model("volume_van_gelder", 0, ""),
+                model("fem_p1", std::nullopt, ""), model("surface_seed000", 12, "crossed"),
+                model("xpbd_fem", 3, "")};
+  EXPECT_EQ(contact::folded_walls(run), "volume_mollemans (890), xpbd_fem (3)");
+  run.models.erase(run.models.begin());
+  run.models.pop_back();
+  EXPECT_EQ(contact::folded_walls(run), "");
+}
+
 TEST(ContactModels, OuterSurfaceModelIsRefused) {
   const Scene scene = tube_scene(kWallE);
   ModelSpec outer = spec("outer", ModelKind::surface_msm);
