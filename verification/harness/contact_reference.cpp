@@ -601,56 +601,63 @@ void solve_contact_levels(const ContactReferenceOptions& o, double lumen_radius,
   }
 }
 
-void judge_contact_reference(const ContactReferenceOptions& o, double lumen_radius,
-                             ContactReference& r) {
-  r.order.reset();
-  r.estimate.reset();
-  // The scout counts too: when every level fails, it may be the only converged solve.
+namespace {
+
+/// "no reference: the wall does not hold this wire (...)" for the deepest solve, the scout's
+/// included (when every level fails it may be the only converged one), whose wall gives way;
+/// nothing if none does.
+std::optional<std::string> gave_way_verdict(const ContactReference& r, double lumen_radius) {
   const ContactLevel* deepest = nullptr;
   auto consider = [&](const ContactLevel& l) {
     if (wall_gives_way(l, lumen_radius) && (!deepest || l.dent > deepest->dent)) deepest = &l;
   };
   consider(r.scout);
   for (const ContactLevel& l : r.levels) consider(l);
-  if (deepest) {
-    const std::string which =
-        deepest == &r.scout ? "the scout" : "level " + std::to_string(deepest->level);
-    r.verdict = "no reference: the wall does not hold this wire (" + which + "'s dent " +
-                fixed(deepest->dent * 1e3, 2) + " mm" + softer_rung(*deepest) +
-                " is wider than the lumen, " + fixed(2e3 * lumen_radius, 2) +
-                " mm; largest strain " + fixed(deepest->strain, 2) + ")";
+  if (!deepest) return std::nullopt;
+  const std::string which =
+      deepest == &r.scout ? "the scout" : "level " + std::to_string(deepest->level);
+  return "no reference: the wall does not hold this wire (" + which + "'s dent " +
+         fixed(deepest->dent * 1e3, 2) + " mm" + softer_rung(*deepest) +
+         " is wider than the lumen, " + fixed(2e3 * lumen_radius, 2) + " mm; largest strain " +
+         fixed(deepest->strain, 2) + ")";
+}
+
+/// Roache's order and the Richardson estimate of the force from the finest levels (two or
+/// more, all converged).
+void estimate_force(const ContactReferenceOptions& o, ContactReference& r) {
+  const std::size_t n = r.levels.size();
+  std::optional<std::vector<double>> three;
+  if (n >= 3)
+    three =
+        std::vector<double>{r.levels[n - 3].force, r.levels[n - 2].force, r.levels[n - 1].force};
+  // Assumed first order where three levels do not give one: a contact zone's edge cuts
+  // elements, which limits the force's convergence.
+  r.order = fem::gci_order(three, 1.0, o.ratio);
+  r.estimate = fem::richardson(r.levels[n - 2].force, r.levels[n - 1].force, r.order->order,
+                               o.ratio, r.order->safety_factor);
+}
+
+}  // namespace
+
+void judge_contact_reference(const ContactReferenceOptions& o, double lumen_radius,
+                             ContactReference& r) {
+  r.order.reset();
+  r.estimate.reset();
+  if (const std::optional<std::string> gave_way = gave_way_verdict(r, lumen_radius)) {
+    r.verdict = *gave_way;
     return;
   }
   if (r.levels.empty()) {
     r.verdict = "did not converge (no level solved)";
     return;
   }
-  const ContactLevel& finest = r.levels.back();
-  bool all_converged = true;
-  for (const ContactLevel& l : r.levels) all_converged = all_converged && l.converged;
-  if (!all_converged) {
-    std::string reason;
-    for (const ContactLevel& l : r.levels) {
-      if (!l.converged) {
-        reason = "level " + std::to_string(l.level) + ": " + l.failure;
-        break;
-      }
+  for (const ContactLevel& l : r.levels) {
+    if (!l.converged) {
+      r.verdict = "did not converge (level " + std::to_string(l.level) + ": " + l.failure + ")";
+      return;
     }
-    r.verdict = "did not converge (" + reason + ")";
-    return;
   }
-  if (r.levels.size() >= 2) {
-    const std::size_t n = r.levels.size();
-    std::optional<std::vector<double>> three;
-    if (n >= 3)
-      three =
-          std::vector<double>{r.levels[n - 3].force, r.levels[n - 2].force, r.levels[n - 1].force};
-    // Assumed first order where three levels do not give one: a contact zone's edge cuts
-    // elements, which limits the force's convergence.
-    r.order = fem::gci_order(three, 1.0, o.ratio);
-    r.estimate = fem::richardson(r.levels[n - 2].force, finest.force, r.order->order, o.ratio,
-                                 r.order->safety_factor);
-  }
+  if (r.levels.size() >= 2) estimate_force(o, r);
   double strain = 0.0;
   bool inside = true;
   for (const ContactLevel& l : r.levels) {
