@@ -251,6 +251,7 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
     }
     const std::vector<int> candidates =
         p.mesh->group_nodes(p.mesh->require_group("inner_wall", 2, "contact mesh"));
+    o.log = options.log;  // an own-equilibrium solve takes minutes (the reference's, an hour)
     s = solve_own_equilibrium(rod, w.radius, *potential, *p.mesh, candidates, rigid, o, start,
                               out.from_softer_wire);
     out.candidates = static_cast<int>(candidates.size());

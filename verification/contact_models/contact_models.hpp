@@ -46,7 +46,9 @@ struct ContactModelsOptions {
   /// active set does not, as for the arch's buckled wire, whose force hardly changes with its
   /// shape.
   bool potential = false;
-  std::ostream* log = nullptr;  ///< one line per wall and EI as it is solved, if set
+  /// One line per wall and EI as it is solved, and an own-equilibrium solve's progress (per
+  /// round and per 25 Newton steps), if set
+  std::ostream* log = nullptr;
 };
 
 /// One wall's contact with the wire.
