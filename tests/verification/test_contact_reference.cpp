@@ -15,6 +15,7 @@
 
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
+#include "msm/rods/rod_layout.hpp"
 #include "reports/insertion_section.hpp"
 #include "reports/study_files.hpp"
 #include "schema_check.hpp"
@@ -443,6 +444,34 @@ TEST(ContactInsertion, RefusesASceneWithoutAGuidewireAnEmptyRangeAndAModelItDoes
       {"guidewire_straight.toml", "no model \"no_such_model\"", "fem_p1", "volume_hybrid"});
 }
 
+// An insertion step's start: a wire of 4 mm (4 segments, clamped at the origin along x) bent at a
+// right angle at 2 mm, pushed to 5 mm. Its nodes (rest arclengths 0, 1.25, 2.5, 3.75, 5 mm) land
+// on the old path at those arclengths, the tip 1 mm past the old tip along its last edge (hand
+// values); the ghost node and the twist angles are kept.
+TEST(ContactInsertion, AStepFeedsTheWireAlongItsOwnPathAndItsTipAlongItsLastEdge) {
+  const msm::rods::RodMaterial material{1e9, 4e8, 6450.0};
+  const msm::rods::RodLayout layout =
+      msm::rods::make_layout(msm::rods::uniform_rod(material, 5e-3, 0.3e-3, 4));
+  ASSERT_EQ(layout.num_nodes(), 6);  // the ghost node, the clamp's and four more
+  ASSERT_EQ(layout.first_node, 1);
+  ASSERT_EQ(layout.tip_node, 5);
+  const std::vector<Vec3> old_path = {Vec3(-1, 0, 0), Vec3(0, 0, 0), Vec3(1, 0, 0),
+                                      Vec3(2, 0, 0),  Vec3(2, 1, 0), Vec3(2, 2, 0)};  // mm
+  Eigen::VectorXd x(3 * layout.num_nodes() + layout.num_edges());
+  for (int i = 0; i < layout.num_nodes(); ++i) x.segment<3>(3 * i) = 1e-3 * old_path[i];
+  for (int e = 0; e < layout.num_edges(); ++e) x[3 * layout.num_nodes() + e] = 0.1 * e;
+
+  const Eigen::VectorXd fed = fed_through_clamp(x, layout, 4e-3);
+  const std::vector<Vec3> expected = {Vec3(-1, 0, 0),  Vec3(0, 0, 0),    Vec3(1.25, 0, 0),
+                                      Vec3(2, 0.5, 0), Vec3(2, 1.75, 0), Vec3(2, 3, 0)};
+  for (int i = 0; i < layout.num_nodes(); ++i) {
+    EXPECT_LT((Vec3(fed.segment<3>(3 * i)) - 1e-3 * expected[i]).norm(), 1e-15) << "node " << i;
+  }
+  EXPECT_EQ(fed.tail(layout.num_edges()), x.tail(layout.num_edges()));
+  // Fed to its own length it stays where it is.
+  EXPECT_LT((fed_through_clamp(fed, layout, 5e-3) - fed).norm(), 1e-15);
+}
+
 // The insertion's document (a hand-made insertion: the mapping, not a solve): it conforms to its
 // schema; read back, the figure's curves carry each force of each converged step in mN at its
 // length in mm, a failed step left out of every curve and dΠ/dL's undefined end left out of its
@@ -651,9 +680,8 @@ TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes
   // The same range in one step (the same mesh: it follows the range, not the steps), as the
   // command's document with an outcome cache: solved once, then read back with the same numbers
   // and the date it was computed. The wire bends in the tube's plane of symmetry y = 0 and may
-  // settle on either side of it (the last of the four steps crossed it): the two ends are mirror
-  // images up to the mesh, which is not symmetric (forces 0.13 % apart, the tips 57 µm apart and
-  // 4.8 µm once mirrored).
+  // settle on either side of it: the two ends are then mirror images up to the mesh, which is not
+  // symmetric (fed through the clamp, both end on the same side, 1e-9 of the force apart).
   ContactInsertionOptions one = o;
   one.steps = 1;
   test::TempDir dir;
@@ -679,7 +707,7 @@ TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes
       "mirrored across y = 0)\n",
       direct.steps.back().force / r.steps.back().force - 1, (tip - four).norm(),
       (tip - mirrored).norm());
-  EXPECT_LT((tip - mirrored).norm(), 0.1 * 0.178e-3);  // 4.8 µm of 57 µm; r_w = 0.178 mm
+  EXPECT_LT((tip - mirrored).norm(), 0.1 * 0.178e-3);  // r_w = 0.178 mm
   ASSERT_EQ(again.insertions.size(), 1u);
   EXPECT_FALSE(again.insertions[0].cached_from.empty());
   EXPECT_EQ(again.insertions[0].steps.back().force, direct.steps.back().force);

@@ -81,16 +81,37 @@ std::vector<ContactZone> contact_zones(const TetMesh& mesh,
   return out;
 }
 
-/// The rod's dofs x with its node positions scaled about `origin` by `factor` (its frames' angles
-/// unchanged): the last step's shape at the next step's length.
-Eigen::VectorXd scaled_about(const Eigen::VectorXd& x, int nodes, const Vec3& origin,
-                             double factor) {
+}  // namespace
+
+Eigen::VectorXd fed_through_clamp(const Eigen::VectorXd& x, const msm::rods::RodLayout& layout,
+                                  double from_length) {
+  const int first = layout.first_node, tip = layout.tip_node;
+  const auto node = [&](int i) -> Vec3 { return x.segment<3>(3 * i); };
+  // Rest arclength from the clamp at the new length; the sections scale with the length.
+  const auto arclength = [&](int i) {
+    return (layout.rest[static_cast<std::size_t>(i)] - layout.rest[static_cast<std::size_t>(first)])
+        .norm();
+  };
+  const double shrink = from_length / layout.total_length();  // new arclength → old
+  const Vec3 tangent = (node(tip) - node(tip - 1)).normalized();
   Eigen::VectorXd out = x;
-  for (int i = 0; i < nodes; ++i) {
-    out.segment<3>(3 * i) = origin + factor * (x.segment<3>(3 * i) - origin);
+  int k = first;  // the old edge [k, k + 1] that holds the new node's arclength
+  for (int i = first + 1; i <= tip; ++i) {
+    const double s = arclength(i);
+    while (k < tip && arclength(k + 1) * shrink < s) ++k;
+    Vec3 at;
+    if (k == tip) {
+      at = node(tip) + (s - arclength(tip) * shrink) * tangent;
+    } else {
+      const double a = arclength(k) * shrink, b = arclength(k + 1) * shrink;
+      at = node(k) + (s - a) / (b - a) * (node(k + 1) - node(k));
+    }
+    out.segment<3>(3 * i) = at;
   }
   return out;
 }
+
+namespace {
 
 /// The insertion's wall: deal.II's FEM (the reference) or one of the scene's models on the mesh,
 /// with what keeps the model alive.
@@ -140,8 +161,8 @@ InsertionWall make_wall(const Scene& scene, const TetMesh& mesh, const ContactIn
   return w;
 }
 
-/// A failed insertion step is retried after one halfway, this many times deep: a long step scales
-/// the last shape so far that its tip starts beyond the wall.
+/// A failed insertion step is retried after one halfway, this many times deep: a long step feeds
+/// the tip so far along its last edge that it starts beyond the wall.
 constexpr int kMaxSplits = 3;
 
 /// The equilibrium in hand along the insertion: the wire's dofs x at length x_length and the
@@ -159,7 +180,7 @@ struct InsertionPath {
   std::unique_ptr<msm::rods::DerRod> rod;  ///< at x_length, prepared at x
   contact::PotentialContactSolution solution;
 
-  /// Solves at length L from the equilibrium in hand (its shape scaled about the clamp to L);
+  /// Solves at length L from the equilibrium in hand (fed through the clamp to L);
   /// a failure (Newton, or a centreline through the wall) is retried via L's midpoint with the
   /// last length, up to kMaxSplits deep. Throws std::runtime_error beyond that.
   void advance_to(double L, int depth) {
@@ -167,8 +188,7 @@ struct InsertionPath {
         std::make_unique<msm::rods::DerRod>(msm::rods::make_layout(guidewire_rod_spec(spec, L)));
     options.force_scale = EI / (L * L);
     try {
-      const Eigen::VectorXd from =
-          scaled_about(x, next->num_nodes(), spec.clamp_point, L / x_length);
+      const Eigen::VectorXd from = fed_through_clamp(x, next->layout(), x_length);
       contact::PotentialContactSolution s = contact::solve_wire_wall_potential(
           *next, 0.5 * spec.diameter, wall, mesh, candidates, from, options, u);
       newton_steps += s.newton_iterations;

@@ -2,8 +2,8 @@
 /// The wire pushed into the vessel in steps, quasi-statically, against a deformable wall: at each
 /// insertion length the wire and the wall are solved together as one potential
 /// (verification/contact/wire_wall_potential.hpp), each step from the last step's equilibrium
-/// (the wire's shape scaled about the clamp to the new length, the wall's displacement kept), so
-/// contacts appear, slide and separate as the solve finds them.
+/// (the wire fed through the clamp to the new length, fed_through_clamp; the wall's displacement
+/// kept), so contacts appear, slide and separate as the solve finds them.
 ///
 /// The wall is meshed once, refined to `fine_size` within `refine_radius` of every point where
 /// the same wire touches the rigid lumen over the insertion (sampled every quarter of that radius,
@@ -16,12 +16,14 @@
 /// acting on elastic structures", J. Mech. Phys. Solids 2015), so P = R·t − M²/(2EI), and by
 /// virtual work P = dΠ/dL with Π the equilibrium's stored energy (wire and wall); both are
 /// reported, the second by central differences between steps.
+#include <Eigen/Core>
 #include <array>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include "meshes/tet_mesh.hpp"
+#include "msm/rods/rod_layout.hpp"
 #include "verification/harness/contact_reference.hpp"
 #include "verification/scene.hpp"
 
@@ -104,6 +106,15 @@ struct ContactInsertion {
   std::vector<InsertionStep> steps;
   InsertionView view;  ///< at the converged step options.view_at chooses
 };
+
+/// The start of an insertion step: the rod's dofs x at length `from_length` (m) pushed through its
+/// clamp to `layout`'s length, as a pushed wire slides along its own path: each node where the
+/// centreline was at the node's new arclength from the clamp (linear between the old nodes), past
+/// the old tip along the tip's last edge; the ghost node and the frames' angles unchanged. The
+/// rod's sections scale with its length (guidewire_rod_spec), so the old nodes' arclengths are
+/// the new ones times from_length / length.
+Eigen::VectorXd fed_through_clamp(const Eigen::VectorXd& x, const msm::rods::RodLayout& layout,
+                                  double from_length);
 
 /// The insertion of `scene`'s guidewire at bending stiffness EI (N·m²) against the scene's wall
 /// (or options.model's) at its first Poisson's ratio. InputError naming the scene's file for a
