@@ -447,7 +447,8 @@ TEST(ContactInsertion, RefusesASceneWithoutAGuidewireAnEmptyRangeAndAModelItDoes
 // An insertion step's start: a wire of 4 mm (4 segments, clamped at the origin along x) bent at a
 // right angle at 2 mm, pushed to 5 mm. Its nodes (rest arclengths 0, 1.25, 2.5, 3.75, 5 mm) land
 // on the old path at those arclengths, the tip 1 mm past the old tip along its last edge (hand
-// values); the ghost node and the twist angles are kept.
+// values); the ghost node and the twist angles are kept. A tip pressed on the wall slides along
+// it.
 TEST(ContactInsertion, AStepFeedsTheWireAlongItsOwnPathAndItsTipAlongItsLastEdge) {
   const msm::rods::RodMaterial material{1e9, 4e8, 6450.0};
   const msm::rods::RodLayout layout =
@@ -468,6 +469,13 @@ TEST(ContactInsertion, AStepFeedsTheWireAlongItsOwnPathAndItsTipAlongItsLastEdge
     EXPECT_LT((Vec3(fed.segment<3>(3 * i)) - 1e-3 * expected[i]).norm(), 1e-15) << "node " << i;
   }
   EXPECT_EQ(fed.tail(layout.num_edges()), x.tail(layout.num_edges()));
+  // A tip the wall pushes on along (−1, −1, 0)/√2 (a wall ahead and to the side of its edge
+  // (0, 1, 0)) goes on along the wall, (−1, 1, 0)/√2; a push from behind changes nothing.
+  const Eigen::VectorXd slid = fed_through_clamp(x, layout, 4e-3, Vec3(-1e-3, -1e-3, 0.0));
+  const Vec3 slid_tip = 1e-3 * (Vec3(2, 2, 0) + Vec3(-1, 1, 0) / std::sqrt(2.0));
+  EXPECT_LT((Vec3(slid.segment<3>(15)) - slid_tip).norm(), 1e-15);
+  EXPECT_EQ(slid.head(15), fed.head(15));
+  EXPECT_EQ(fed_through_clamp(x, layout, 4e-3, Vec3(0.0, 1e-3, 0.0)), fed);
   // Fed to its own length it stays where it is.
   EXPECT_LT((fed_through_clamp(fed, layout, 5e-3) - fed).norm(), 1e-15);
 }

@@ -84,7 +84,7 @@ std::vector<ContactZone> contact_zones(const TetMesh& mesh,
 }  // namespace
 
 Eigen::VectorXd fed_through_clamp(const Eigen::VectorXd& x, const msm::rods::RodLayout& layout,
-                                  double from_length) {
+                                  double from_length, const Vec3& tip_push) {
   const int first = layout.first_node, tip = layout.tip_node;
   const auto node = [&](int i) -> Vec3 { return x.segment<3>(3 * i); };
   // Rest arclength from the clamp at the new length; the sections scale with the length.
@@ -93,7 +93,12 @@ Eigen::VectorXd fed_through_clamp(const Eigen::VectorXd& x, const msm::rods::Rod
         .norm();
   };
   const double shrink = from_length / layout.total_length();  // new arclength → old
-  const Vec3 tangent = (node(tip) - node(tip - 1)).normalized();
+  Vec3 tangent = (node(tip) - node(tip - 1)).normalized();
+  const double into_wall = tangent.dot(tip_push.normalized());
+  if (tip_push.norm() > 0.0 && into_wall < 0.0) {  // a pressed tip slides along the wall
+    const Vec3 along = tangent - into_wall * tip_push.normalized();
+    if (along.norm() > 1e-6) tangent = along.normalized();
+  }
   Eigen::VectorXd out = x;
   int k = first;  // the old edge [k, k + 1] that holds the new node's arclength
   for (int i = first + 1; i <= tip; ++i) {
@@ -180,6 +185,14 @@ struct InsertionPath {
   std::unique_ptr<msm::rods::DerRod> rod;  ///< at x_length, prepared at x
   contact::PotentialContactSolution solution;
 
+  /// The wall's contact force on the tip's edge at the equilibrium in hand (N; zero before the
+  /// first solve).
+  [[nodiscard]] Vec3 tip_push() const {
+    if (!rod || solution.force_on_wire.empty()) return Vec3::Zero();
+    const auto tip = static_cast<std::size_t>(rod->layout().tip_node);
+    return solution.force_on_wire[tip] + solution.force_on_wire[tip - 1];
+  }
+
   /// Solves at length L from the equilibrium in hand (fed through the clamp to L);
   /// a failure (Newton, or a centreline through the wall) is retried via L's midpoint with the
   /// last length, up to kMaxSplits deep. Throws std::runtime_error beyond that.
@@ -188,7 +201,7 @@ struct InsertionPath {
         std::make_unique<msm::rods::DerRod>(msm::rods::make_layout(guidewire_rod_spec(spec, L)));
     options.force_scale = EI / (L * L);
     try {
-      const Eigen::VectorXd from = fed_through_clamp(x, next->layout(), x_length);
+      const Eigen::VectorXd from = fed_through_clamp(x, next->layout(), x_length, tip_push());
       contact::PotentialContactSolution s = contact::solve_wire_wall_potential(
           *next, 0.5 * spec.diameter, wall, mesh, candidates, from, options, u);
       newton_steps += s.newton_iterations;
@@ -197,8 +210,13 @@ struct InsertionPath {
       x_length = L;
       rod = std::move(next);
       solution = std::move(s);
-    } catch (const std::runtime_error&) {
+    } catch (const std::runtime_error& e) {
       if (depth == kMaxSplits || L == x_length) throw;
+      if (options.log) {
+        *options.log << "insertion:   " << L * 1e3 << " mm from " << x_length * 1e3
+                     << " mm: " << e.what() << "; split at " << 0.5 * (x_length + L) * 1e3 << " mm"
+                     << std::endl;
+      }
       advance_to(0.5 * (x_length + L), depth + 1);
       advance_to(L, depth + 1);
     }

@@ -110,11 +110,13 @@ struct ContactInsertion {
 /// The start of an insertion step: the rod's dofs x at length `from_length` (m) pushed through its
 /// clamp to `layout`'s length, as a pushed wire slides along its own path: each node where the
 /// centreline was at the node's new arclength from the clamp (linear between the old nodes), past
-/// the old tip along the tip's last edge; the ghost node and the frames' angles unchanged. The
+/// the old tip along the tip's last edge; the ghost node and the frames' angles unchanged. A tip
+/// the wall pushes on (`tip_push`, the wall's contact force on the tip's edge, N; zero: none)
+/// goes on along the wall: the part of its edge's direction against that force is removed. The
 /// rod's sections scale with its length (guidewire_rod_spec), so the old nodes' arclengths are
 /// the new ones times from_length / length.
 Eigen::VectorXd fed_through_clamp(const Eigen::VectorXd& x, const msm::rods::RodLayout& layout,
-                                  double from_length);
+                                  double from_length, const Vec3& tip_push = Vec3::Zero());
 
 /// The insertion of `scene`'s guidewire at bending stiffness EI (N·m²) against the scene's wall
 /// (or options.model's) at its first Poisson's ratio. InputError naming the scene's file for a
