@@ -54,15 +54,14 @@ std::optional<std::string> describe_wall_crossing(const TetMesh& mesh,
   const PhysicalGroup& inner = mesh.require_group("inner_wall", 2, "vessel");
   const auto c = first_wall_crossing(mesh, mesh.group_triangles(inner), displacement, centreline);
   if (!c) return std::nullopt;
-  return describe(*c);
+  return describe(*c) + ": " + kPassedBetweenNodes;
 }
 
 std::string describe(const WallCrossing& c) {
   std::ostringstream m;
   m.precision(3);
   m << "the wire's centreline crosses the wall at (" << c.point.x() * 1e3 << ", "
-    << c.point.y() * 1e3 << ", " << c.point.z() * 1e3 << ") mm (segment " << c.segment
-    << "): it passed between the wall's nodes, whose spacing there exceeds the wire's diameter";
+    << c.point.y() * 1e3 << ", " << c.point.z() * 1e3 << ") mm (segment " << c.segment << ")";
   return m.str();
 }
 

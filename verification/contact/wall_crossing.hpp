@@ -32,8 +32,13 @@ std::optional<WallCrossing> first_wall_crossing(const TetMesh& mesh,
                                                 const std::vector<Vec3>& displacement,
                                                 const std::vector<Vec3>& centreline);
 
-/// The crossing as a sentence for a failed solve ("the wire's centreline crosses the wall at
-/// (x, y, z) mm (segment k): ...").
+/// Why a solved (or iterated) centreline ends up across the wall: the gaps of the nodes it passed
+/// between are open again on the far side, so nothing held it back.
+inline constexpr const char* kPassedBetweenNodes =
+    "it passed between the wall's nodes, whose spacing there exceeds the wire's diameter";
+
+/// Where the crossing is, as a clause for a failed solve ("the wire's centreline crosses the wall
+/// at (x, y, z) mm (segment k)"); the caller says why.
 std::string describe(const WallCrossing& crossing);
 
 /// Where `centreline` crosses `mesh`'s inner wall (group "inner_wall") displaced by

@@ -650,9 +650,10 @@ class Coupled {
 
   void prepare(const VectorXd& z) { rod_.prepare(rod_dofs(z)); }
 
-  /// Throws WireThroughWall (its message beginning with `when`) if the centreline at z crosses
-  /// the wall's inner surface (none for a mesh without that group).
-  void require_inside_lumen(const VectorXd& z, const std::string& when) const {
+  /// Throws WireThroughWall ("the wire-wall potential <when>: <where it crosses><why>") if the
+  /// centreline at z crosses the wall's inner surface (none for a mesh without that group).
+  void require_inside_lumen(const VectorXd& z, const std::string& when,
+                            const std::string& why) const {
     const PhysicalGroup* inner = mesh_.find_group(group_names::inner_wall, 2);
     if (inner == nullptr) return;
     const VectorXd x = rod_dofs(z);
@@ -661,7 +662,7 @@ class Coupled {
     const std::vector<Triangle> triangles = mesh_.group_triangles(*inner);
     if (const auto crossing =
             first_wall_crossing(mesh_, triangles, wall_.nodal(wall_rows(z)), centreline)) {
-      throw WireThroughWall("the wire-wall potential " + when + ": " + describe(*crossing),
+      throw WireThroughWall("the wire-wall potential " + when + ": " + describe(*crossing) + why,
                             std::move(centreline), crossing->point,
                             triangles[static_cast<std::size_t>(crossing->triangle)]);
     }
@@ -1156,7 +1157,8 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     p.prepare(z);
     // A centreline through the wall (between its nodes) does not come back: every node's gap is
     // open again on the far side. Stop there rather than converge outside the lumen.
-    p.require_inside_lumen(z, "stopped after Newton step " + std::to_string(it + 1));
+    p.require_inside_lumen(z, "stopped after Newton step " + std::to_string(it + 1),
+                           std::string(": ") + kPassedBetweenNodes);
     recent.capped += alpha0 < 1.0 && alpha == alpha0;
     recent.move += alpha * move / p.radius();
     // A stiff wall's forces (K u with K up to ~1e6 N/m) floor ‖∇Π‖ above the target by round-off:
@@ -1202,7 +1204,8 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
         "the wire-wall potential cannot start from a wall that inverts an element "
         "(its energy is infinite there)");
   }
-  problem.require_inside_lumen(z, "cannot start outside the lumen");
+  problem.require_inside_lumen(z, "cannot start outside the lumen",
+                               " in the start it was given");
   PotentialContactSolution out;
   out.penalty_stiffness = k;
   bool alart_curnier = options.law == ContactLaw::alart_curnier;

@@ -94,9 +94,10 @@ Eigen::VectorXd fed_through_clamp(const Eigen::VectorXd& x, const msm::rods::Rod
   };
   const double shrink = from_length / layout.total_length();  // new arclength → old
   Vec3 tangent = (node(tip) - node(tip - 1)).normalized();
-  const double into_wall = tangent.dot(tip_push.normalized());
-  if (tip_push.norm() > 0.0 && into_wall < 0.0) {  // a pressed tip slides along the wall
-    const Vec3 along = tangent - into_wall * tip_push.normalized();
+  const Vec3 push = tip_push.normalized();  // zero when nothing pushes
+  const double into_wall = tangent.dot(push);
+  if (into_wall < 0.0) {  // a pressed tip slides along the wall
+    const Vec3 along = tangent - into_wall * push;
     if (along.norm() > 1e-6) tangent = along.normalized();
   }
   Eigen::VectorXd out = x;

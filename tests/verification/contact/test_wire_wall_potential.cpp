@@ -216,6 +216,8 @@ TEST(WireWallPotential, ACentrelineThroughTheWallIsRefusedNotSolved) {
   const std::string from_outside = message(outside, nodes);
   EXPECT_NE(from_outside.find("cannot start outside the lumen"), std::string::npos) << from_outside;
   EXPECT_NE(from_outside.find("crosses the wall"), std::string::npos) << from_outside;
+  // The start, not the solve, put it there: no claim that it slipped between the wall's nodes.
+  EXPECT_EQ(from_outside.find("passed between"), std::string::npos) << from_outside;
   std::vector<int> outlet;
   for (const int n : nodes) {
     if (mesh.nodes[static_cast<std::size_t>(n)].z() > kTubeLength - 1e-3) outlet.push_back(n);
@@ -224,6 +226,7 @@ TEST(WireWallPotential, ACentrelineThroughTheWallIsRefusedNotSolved) {
   const std::string through = message(rigid.x, outlet);
   EXPECT_NE(through.find("stopped after Newton step"), std::string::npos) << through;
   EXPECT_NE(through.find("crosses the wall"), std::string::npos) << through;
+  EXPECT_NE(through.find("passed between the wall's nodes"), std::string::npos) << through;
   // A wall start mirrored through the tube's middle turns the cells inside out (det F = −1 away
   // from the clamped ends, whose held rows stay at rest).
   const Vec3 middle(0, 0, 0.5 * kTubeLength);
