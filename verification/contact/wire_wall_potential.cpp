@@ -1204,8 +1204,7 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
         "the wire-wall potential cannot start from a wall that inverts an element "
         "(its energy is infinite there)");
   }
-  problem.require_inside_lumen(z, "cannot start outside the lumen",
-                               " in the start it was given");
+  problem.require_inside_lumen(z, "cannot start outside the lumen", " in the start it was given");
   PotentialContactSolution out;
   out.penalty_stiffness = k;
   bool alart_curnier = options.law == ContactLaw::alart_curnier;
