@@ -127,10 +127,11 @@ void add_contact_models_command(CLI::App& app) {
                   "Degree of the reference FEM wall (deal.II)")
       ->check(CLI::IsMember({1, 2}))
       ->capture_default_str();
-  cmd->add_flag("--potential", o->options.potential,
-                "Every wall linearised at rest, each solved with the wire as one potential on the "
-                "wall condensed on a growing band (a line search on the energy, a wire through the "
-                "wall refused) instead of the active set: it converges on the arch");
+  cmd->add_flag("--active-set", o->options.active_set,
+                "Every wall linearised at rest, its contact solved by the active set on the wall "
+                "condensed on a growing band (the second formulation) instead of with the wire as "
+                "one potential (an energy line search, a wire through the wall refused); it loses "
+                "contacts the potential holds");
   cmd->add_flag("--own-equilibrium", o->options.own_equilibrium,
                 "Each model at its own nonlinear equilibrium (its own energy) and the reference at "
                 "finite strain (neo-Hookean FEM), the wire and each wall solved as one potential; "

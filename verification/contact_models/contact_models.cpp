@@ -140,8 +140,9 @@ void describe_zone(const Problem& p, const std::vector<int>& pressed,
   }
 }
 
-ModelContact solve_wall(const ModelWall& wall, const SceneWire& w, const RigidContact& rigid,
-                        const Problem& p, double EI, const ContactModelsOptions& options) {
+ModelContact solve_wall_active_set(const ModelWall& wall, const SceneWire& w,
+                                   const RigidContact& rigid, const Problem& p, double EI,
+                                   const ContactModelsOptions& options) {
   ModelContact out;
   out.name = wall.name;
   out.detail = wall.detail;
@@ -419,10 +420,10 @@ void solve_wall_at_every_stiffness(const Scene& scene, const ModelSpec& spec, st
       const bool chain = softer && options.from_softer_wire && softer->bending_stiffness < EI;
       std::optional<PotentialState> reached;
       try {
-        c = options.own_equilibrium || options.potential
+        c = options.own_equilibrium || !options.active_set
                 ? solve_wall_potential(scene, spec, *wall, *wires[e], rigid[e], p, EI, out.nu,
                                        k == 0, options, chain ? &*softer : nullptr, reached)
-                : solve_wall(*wall, *wires[e], rigid[e], p, EI, options);
+                : solve_wall_active_set(*wall, *wires[e], rigid[e], p, EI, options);
         softer = std::move(reached);
       } catch (const std::exception& ex) {
         c = failed(spec, ex.what());

@@ -2,10 +2,11 @@
 /// Every vessel model in the same wire–wall contact problem: a guidewire scene's wire (Discrete
 /// Elastic Rods at the scene's segments, clamped as the scene clamps it, at a chosen EI) in the
 /// straight tube or the arch against each model's wall (model_walls.hpp), the contact between the
-/// wire's capsule and the inner wall found by solve_wire_wall_contact_growing, on one tet mesh
-/// refined around the rigid wire's contact: every model and the reference (FEM P2 on the same
-/// mesh) are solved on the same mesh, the same candidates' growth and the same contact law, so
-/// their contact forces compare.
+/// wire's capsule and the inner wall found by the solve (the wire and the wall as one potential,
+/// solve_wire_wall_potential_growing; or the active set, solve_wire_wall_contact_growing), on one
+/// tet mesh refined around the rigid wire's contact: every model and the reference (FEM P2 on the
+/// same mesh) are solved on the same mesh, the same candidates' growth and the same contact law,
+/// so their contact forces compare.
 #include <ostream>
 #include <optional>
 #include <string>
@@ -31,8 +32,8 @@ struct ContactModelsOptions {
   int reference_degree = 2;     ///< the reference wall: FEM of this degree (deal.II)
   int max_newton = 400;         ///< per contact solve (each growth round)
   double max_move = 0.5;        ///< WireWallOptions::max_move
-  /// false: every wall linearised at rest, the contact by the active set on the condensed wall
-  /// (wire_wall_contact.hpp). true: every model at its own equilibrium (its own nonlinear energy,
+  /// false: every wall linearised at rest (see active_set for how its contact is solved).
+  /// true: every model at its own equilibrium (its own nonlinear energy,
   /// FormWall) and the reference at finite strain (the neo-Hookean FEM), each with the wire as one
   /// potential (wire_wall_potential.hpp); every inner-wall node a candidate.
   bool own_equilibrium = false;
@@ -40,12 +41,13 @@ struct ContactModelsOptions {
   /// before (the same mesh; from rest only if that fails): a stiffer wire dents a soft wall by
   /// millimetres, which Newton from the wall at rest may not reach. false: every EI from rest.
   bool from_softer_wire = true;
-  /// Every wall linearised at rest, each with the wire as one potential on the wall condensed on
-  /// a band of candidates grown from the first (condensed_wall_potential.hpp) instead of the
-  /// active set: an energy line search, a wire through the wall refused. It converges where the
-  /// active set does not, as for the arch's buckled wire, whose force hardly changes with its
-  /// shape.
-  bool potential = false;
+  /// For walls linearised at rest. false: each wall with the wire as one potential on the wall
+  /// condensed on a band of candidates grown from the first (condensed_wall_potential.hpp): an
+  /// energy line search, a wire through the wall refused. true: the active set on the condensed
+  /// wall (wire_wall_contact.hpp), the second formulation, which loses contacts the potential
+  /// holds (the arch's buckled wire, whose force hardly changes with its shape; most walls at
+  /// EI 4e-6 on the straight tube's band-refined mesh).
+  bool active_set = false;
   /// One line per wall and EI as it is solved, and an own-equilibrium solve's progress (per
   /// round and per 25 Newton steps), if set
   std::ostream* log = nullptr;

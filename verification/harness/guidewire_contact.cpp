@@ -124,7 +124,8 @@ std::string contact_key(const Scene& scene, const std::vector<std::string>& mode
   h.real(o.fine_size).real(o.fine_radius).real(o.bearing_band_size).real(o.band_radius);
   h.integer(o.reference_degree);
   h.integer(o.max_newton).real(o.max_move).integer(o.own_equilibrium ? 1 : 0);
-  h.integer(o.potential ? 1 : 0).integer(o.from_softer_wire ? 1 : 0);
+  h.integer(o.active_set ? 0 : 1);  // the formulation: 1 the potential, 0 the active set
+  h.integer(o.from_softer_wire ? 1 : 0);
   return "guidewire-contact " + h.hex();
 }
 
@@ -250,10 +251,6 @@ contact::ContactModelsOptions contact_options(const Scene& scene, const Guidewir
   o.fine_size =
       options.contact_fine_size > 0.0 ? options.contact_fine_size : spec.contact_fine_size;
   o.fine_radius = spec.contact_fine_radius;
-  // The wire and each wall as one potential: its energy line search holds the contacts the
-  // active set loses (the arch's buckled wire, whose force hardly changes with its shape; the
-  // mass-spring walls the wire dents deepest).
-  o.potential = true;
   o.own_equilibrium = spec.contact_wall == ContactWall::neo_hookean;
   // A linear wall's run solves only the EIs whose dent stays within the wall's thickness, where
   // the wire bears near its rigid contact: the band along its body is refined at finite strain
