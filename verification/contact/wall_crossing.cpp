@@ -1,5 +1,6 @@
 #include "verification/contact/wall_crossing.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -41,7 +42,8 @@ std::optional<WallCrossing> first_wall_crossing(const TetMesh& mesh,
           (p.cwiseMin(q).cwiseMin(r).array() > hi.array()).any())
         continue;
       if (const auto s = segment_triangle_crossing(a, b, p, q, r)) {
-        return WallCrossing{static_cast<int>(i), static_cast<int>(t), a + *s * (b - a)};
+        const double longest = std::max({(q - p).norm(), (r - q).norm(), (p - r).norm()});
+        return WallCrossing{static_cast<int>(i), static_cast<int>(t), a + *s * (b - a), longest};
       }
     }
   }
@@ -61,7 +63,8 @@ std::string describe(const WallCrossing& c) {
   std::ostringstream m;
   m.precision(3);
   m << "the wire's centreline crosses the wall at (" << c.point.x() * 1e3 << ", "
-    << c.point.y() * 1e3 << ", " << c.point.z() * 1e3 << ") mm (segment " << c.segment << ")";
+    << c.point.y() * 1e3 << ", " << c.point.z() * 1e3 << ") mm (segment " << c.segment
+    << "), through a triangle whose longest edge is " << c.longest_edge * 1e3 << " mm as deformed";
   return m.str();
 }
 

@@ -23,6 +23,7 @@ struct WallCrossing {
   int segment = 0;            ///< the centreline segment's first node
   int triangle = 0;           ///< index into the triangles given
   Vec3 point = Vec3::Zero();  ///< where it crosses, m
+  double longest_edge = 0.0;  ///< the crossed triangle's longest edge as displaced, m
 };
 
 /// The first centreline segment (nodes `centreline`, in order) crossing one of `triangles` of
@@ -33,12 +34,15 @@ std::optional<WallCrossing> first_wall_crossing(const TetMesh& mesh,
                                                 const std::vector<Vec3>& centreline);
 
 /// Why a solved (or iterated) centreline ends up across the wall: the gaps of the nodes it passed
-/// between are open again on the far side, so nothing held it back.
-inline constexpr const char* kPassedBetweenNodes =
-    "it passed between the wall's nodes, whose spacing there exceeds the wire's diameter";
+/// between are open again on the far side, so nothing held it back. Whether the wall's nodes are
+/// too far apart there (refine it) or its elements are dented past what they hold (a linear wall
+/// far beyond its validity) the crossed triangle's deformed edge, against the wire's diameter,
+/// tells.
+inline constexpr const char* kPassedBetweenNodes = "it passed between the wall's nodes";
 
 /// Where the crossing is, as a clause for a failed solve ("the wire's centreline crosses the wall
-/// at (x, y, z) mm (segment k)"); the caller says why.
+/// at (x, y, z) mm (segment k), through a triangle whose longest edge is e mm as deformed"); the
+/// caller says why.
 std::string describe(const WallCrossing& crossing);
 
 /// Where `centreline` crosses `mesh`'s inner wall (group "inner_wall") displaced by

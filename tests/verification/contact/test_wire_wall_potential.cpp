@@ -171,6 +171,13 @@ TEST(WallCrossing, CentrelineThroughTheTubeWall) {
   const auto c = contact::first_wall_crossing(mesh, inner, rest, wire);
   ASSERT_TRUE(c);
   EXPECT_NEAR(std::hypot(c->point.x(), c->point.y()), kA, 0.02 * kA);  // chords of the circle
+  // The crossed triangle's longest edge (at rest here), which the failure's message reports.
+  const Triangle& t = inner[static_cast<std::size_t>(c->triangle)];
+  const auto node = [&](int k) { return mesh.nodes[static_cast<std::size_t>(t[k])]; };
+  EXPECT_DOUBLE_EQ(c->longest_edge,
+                   std::max({(node(0) - node(1)).norm(), (node(1) - node(2)).norm(),
+                             (node(2) - node(0)).norm()}));
+  EXPECT_NE(contact::describe(*c).find("longest edge is"), std::string::npos);
   std::vector<Vec3> out(mesh.nodes.size());
   for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
     out[n] = 0.3 * Vec3(mesh.nodes[n].x(), mesh.nodes[n].y(), 0.0);
