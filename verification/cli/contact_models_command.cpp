@@ -81,6 +81,13 @@ void print_run(const contact::ContactModelsRun& run, const VesselParams& vessel)
     std::cout << "\nInverted tets at the model's own equilibrium: " << folded
               << ". Such a wall has folded: its force is not an elastic wall's.\n";
   }
+  const std::string through = contact::linear_walls_dented_through(run, vessel.wall_thickness);
+  if (!through.empty()) {
+    std::cout << "\nLinear walls dented deeper than the wall is thick ("
+              << fmt("%.3g", vessel.wall_thickness * 1e3) << " mm): " << through
+              << ". A linear wall there is far beyond its validity: judge this EI by the "
+                 "finite-strain walls (--own-equilibrium).\n";
+  }
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <sstream>
 
 #include "meshes/foundation/errors.hpp"
 #include "meshes/gmsh_vessel.hpp"
@@ -180,7 +181,7 @@ ModelContact solve_wall_active_set(const ModelWall& wall, const SceneWire& w,
 
 /// How a wall enters the contact solve: at its own equilibrium, or its linearisation at rest.
 std::string wall_label(const ModelWall& wall, const ContactModelsOptions& options) {
-  return options.own_equilibrium ? "own equilibrium" : to_string(wall.linearisation);
+  return options.own_equilibrium ? kOwnEquilibrium : to_string(wall.linearisation);
 }
 
 /// A wall's equilibrium with the wire at its own equilibrium: the wire's dofs and the wall's
@@ -301,6 +302,22 @@ std::string folded_walls(const ContactModelsRun& run) {
     folded += (folded.empty() ? "" : ", ") + m.name + " (" + std::to_string(*m.inverted_tets) + ")";
   }
   return folded;
+}
+
+std::string linear_walls_dented_through(const ContactModelsRun& run, double wall_thickness) {
+  std::ostringstream out;
+  out.precision(3);
+  bool first = true;
+  const auto add = [&](const ModelContact& m) {
+    if (!m.failure.empty() || m.linearisation == kOwnEquilibrium || m.dent <= wall_thickness) {
+      return;
+    }
+    out << (first ? "" : ", ") << m.name << " (" << m.dent * 1e3 << " mm)";
+    first = false;
+  };
+  add(run.reference);
+  for (const ModelContact& m : run.models) add(m);
+  return out.str();
 }
 
 bool has_contact_wall(const ModelSpec& m) {

@@ -53,11 +53,14 @@ struct ContactModelsOptions {
   std::ostream* log = nullptr;
 };
 
+/// ModelContact::linearisation of a wall solved at its own equilibrium.
+inline constexpr const char* kOwnEquilibrium = "own equilibrium";
+
 /// One wall's contact with the wire.
 struct ModelContact {
   std::string name;
   std::string detail;
-  std::string linearisation;  ///< to_string(WallLinearisation), or "own equilibrium"
+  std::string linearisation;  ///< to_string(WallLinearisation), or kOwnEquilibrium
   std::string failure;                ///< empty when solved
   /// |Σλn|: the net force the wire puts on the wall, N (a zone whose normals fan out round the
   /// wire presses harder node by node than its sum, Σλ, says).
@@ -107,6 +110,11 @@ struct ContactModels {
 /// (count)", comma-separated; empty if none. Such a wall has folded: its force is not an elastic
 /// wall's.
 std::string folded_walls(const ContactModelsRun& run);
+
+/// The solved walls of `run` linearised at rest (the reference's included) whose dent exceeds the
+/// wall's thickness `wall_thickness` (m), each as "name (dent in mm)", comma-separated; empty if
+/// none. A linear wall dented through its thickness is far beyond its validity.
+std::string linear_walls_dented_through(const ContactModelsRun& run, double wall_thickness);
 
 /// Whether the model has a wall the wire can press: not a network, an external program, given
 /// displacements or a surface model on the outer wall.

@@ -295,6 +295,30 @@ TEST(ContactModels, TheFoldedWallsAreTheSolvedOnesWithInvertedTets) {
   EXPECT_EQ(contact::folded_walls(run), "");
 }
 
+// The linear walls dented through a 1 mm wall, by hand: solved, linearised at rest, dent above the
+// thickness (the reference's row included; a failed row and a wall at its own equilibrium not).
+TEST(ContactModels, TheLinearWallsDentedThroughAreTheSolvedLinearOnesDeeperThanTheWall) {
+  const auto model = [](const std::string& name, double dent, const std::string& linearisation,
+                        const std::string& failure) {
+    contact::ModelContact m;
+    m.name = name;
+    m.dent = dent;
+    m.linearisation = linearisation;
+    m.failure = failure;
+    return m;
+  };
+  contact::ContactModelsRun run;
+  run.reference = model("reference_fem_p2", 1.2e-3, "own (linear)", "");
+  run.models = {model("fem_p1", 1.36e-3, "own (linear)", ""),
+                model("volume_hybrid", 0.9e-3, "small-dent", ""),
+                model("surface_shells", 1.43e-3, "small-dent", ""),
+                model("volume_mollemans", 2e-3, "small-dent", "crossed"),
+                model("xpbd_fem", 2.35e-3, contact::kOwnEquilibrium, "")};
+  EXPECT_EQ(contact::linear_walls_dented_through(run, 1e-3),
+            "reference_fem_p2 (1.2 mm), fem_p1 (1.36 mm), surface_shells (1.43 mm)");
+  EXPECT_EQ(contact::linear_walls_dented_through(run, 1.5e-3), "");
+}
+
 TEST(ContactModels, OuterSurfaceModelIsRefused) {
   const Scene scene = tube_scene(kWallE);
   ModelSpec outer = spec("outer", ModelKind::surface_msm);
