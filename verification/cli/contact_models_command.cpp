@@ -146,7 +146,7 @@ void add_contact_models_command(CLI::App& app) {
   cmd->add_flag(
       "--from-rest", [o](std::int64_t) { o->options.from_softer_wire = false; },
       "With --own-equilibrium: every EI solved from the wall at rest, instead of from the wall's "
-      "equilibrium under the softer wire before it");
+      "equilibrium under the softer wire before it (in EI rungs a factor sqrt(10) apart)");
   cmd->callback([o] {
     const Scene scene = read_scene(o->scene);
     std::vector<ModelSpec> models =

@@ -1174,6 +1174,16 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
 
 }  // namespace
 
+std::vector<double> continuation_rungs(double first, double ratio, double target) {
+  std::vector<double> rungs;
+  if (target > first) {
+    const int n = static_cast<int>(std::ceil(std::log(target / first) / std::log(ratio) - 1e-9));
+    for (int k = n; k >= 1; --k) rungs.push_back(target / std::pow(ratio, k));
+  }
+  rungs.push_back(target);
+  return rungs;
+}
+
 PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double radius,
                                                    const WallPotential& wall, const TetMesh& mesh,
                                                    const std::vector<int>& candidates,

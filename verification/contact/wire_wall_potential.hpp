@@ -252,6 +252,11 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
                                                    const PotentialContactOptions& options = {},
                                                    const Eigen::VectorXd& wall_start = {});
 
+/// The bending stiffnesses of a continuation towards `target` (N·m², ascending, ending at
+/// target): from `first` in steps of `ratio`, or the target alone when it is not above `first`.
+/// A stiff wire's equilibrium on a soft wall is reached by solving each from the last.
+std::vector<double> continuation_rungs(double first, double ratio, double target);
+
 /// The forces the clamp exerts on the wire at a solution, per node with a held position
 /// component (N): the rod's internal force and its contact share there.
 std::vector<std::pair<int, Vec3>> potential_clamp_forces(const msm::rods::Rod& rod,

@@ -148,6 +148,7 @@ ModelContact solve_wall_active_set(const ModelWall& wall, const SceneWire& w,
   out.name = wall.name;
   out.detail = wall.detail;
   out.linearisation = to_string(wall.linearisation);
+  out.linear_wall = true;
   WireWallOptions o;
   o.force_scale = EI / (w.length * w.length);
   o.max_newton = options.max_newton;
@@ -191,25 +192,61 @@ struct PotentialState {
   Eigen::VectorXd x, u;
 };
 
-/// The own-equilibrium solve from `start` (the softer wire's equilibrium) if given and it
-/// converges, else from the rigid-lumen state with the wall at rest.
-PotentialContactSolution solve_own_equilibrium(msm::rods::DerRod& rod, double radius,
-                                               const WallPotential& wall, const TetMesh& mesh,
-                                               const std::vector<int>& candidates,
-                                               const RigidContact& rigid,
-                                               const PotentialContactOptions& o,
-                                               const PotentialState* start, bool& from_start) {
+/// The EI ratio between the rungs from a softer wire's equilibrium to a stiffer one's (√10, the
+/// contact reference's default ContactReferenceOptions::continuation_ratio).
+constexpr double kStiffnessStep = 3.1622776601683795;
+
+/// The own-equilibrium solve of the wall under `w` (at bending stiffness EI, its rod `rod`).
+/// From `start` (the softer wire's equilibrium) if given: in rungs of EI (continuation_rungs,
+/// steps of kStiffnessStep), each solved from the last. Without a start, or if a rung fails (the
+/// log says which and why), from the rigid-lumen state with the wall at rest. The solution's time
+/// and Newton steps are the whole climb's (a failed rung's steps are not counted, its time is).
+PotentialContactSolution solve_own_equilibrium(
+    msm::rods::DerRod& rod, const SceneWire& w, double EI, const WallPotential& wall,
+    const TetMesh& mesh, const std::vector<int>& candidates, const RigidContact& rigid,
+    const PotentialContactOptions& o, const PotentialState* start, bool& from_start) {
   from_start = false;
+  const auto t0 = std::chrono::steady_clock::now();
+  int climbed = 0;  // the converged softer rungs' Newton steps
+  const auto whole_climb = [&](PotentialContactSolution s) {
+    s.seconds = seconds_since(t0);
+    s.newton_iterations += climbed;
+    return s;
+  };
   if (start != nullptr) {
-    try {
-      PotentialContactSolution s =
-          solve_wire_wall_potential(rod, radius, wall, mesh, candidates, start->x, o, start->u);
-      from_start = true;
-      return s;
-    } catch (const std::runtime_error&) {  // from rest below
+    Eigen::VectorXd x = start->x, u = start->u;
+    for (const double rung :
+         continuation_rungs(start->bending_stiffness * kStiffnessStep, kStiffnessStep, EI)) {
+      PotentialContactOptions ro = o;
+      ro.force_scale = o.force_scale * rung / EI;
+      try {
+        std::optional<SceneWire> softer;
+        msm::rods::DerRod& r = rung == EI ? rod : softer.emplace(w.spec, rung).rod;
+        PotentialContactSolution s =
+            solve_wire_wall_potential(r, w.radius, wall, mesh, candidates, x, ro, u);
+        if (rung == EI) {
+          from_start = true;
+          return whole_climb(std::move(s));
+        }
+        if (o.log) {
+          *o.log << "contact-models:   EI " << rung << " N·m² on the way: F "
+                 << s.total_force_on_wall().norm() * 1e3 << " mN, " << s.newton_iterations
+                 << " steps" << std::endl;
+        }
+        climbed += s.newton_iterations;
+        x = s.x;
+        u = s.u;
+      } catch (const std::runtime_error& e) {
+        if (o.log) {
+          *o.log << "contact-models:   from the softer wire's equilibrium, EI " << rung
+                 << " N·m² failed (" << e.what() << "); solved again from the wall at rest"
+                 << std::endl;
+        }
+        break;
+      }
     }
   }
-  return solve_wire_wall_potential(rod, radius, wall, mesh, candidates, rigid.x, o);
+  return whole_climb(solve_wire_wall_potential(rod, w.radius, wall, mesh, candidates, rigid.x, o));
 }
 
 /// The wall and the wire as one potential: the wall linearised at rest (condensed on a band
@@ -236,6 +273,7 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
   PotentialContactSolution s;
   // A linear wall's own equilibrium is its linearisation at rest: condensed on a band.
   const bool linear = !options.own_equilibrium || (!wall.energy.form && !reference);
+  out.linear_wall = linear;
   if (linear) {
     GrownPotentialContact grown =
         solve_wire_wall_potential_growing(rod, w.radius, wall.system, *p.mesh, p.nodes, rigid.x, o);
@@ -254,7 +292,10 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
     const std::vector<int> candidates =
         p.mesh->group_nodes(p.mesh->require_group("inner_wall", 2, "contact mesh"));
     o.log = options.log;  // an own-equilibrium solve takes minutes (the reference's, an hour)
-    s = solve_own_equilibrium(rod, w.radius, *potential, *p.mesh, candidates, rigid, o, start,
+    // Undamped, Newton on a soft wall dented by millimetres oscillates (the contact reference's
+    // solve_neo_hookean_wall): the P2 reference at EI 4e-5 hovered at a residual of 3e-3 N.
+    o.damped_newton = true;
+    s = solve_own_equilibrium(rod, w, EI, *potential, *p.mesh, candidates, rigid, o, start,
                               out.from_softer_wire);
     out.candidates = static_cast<int>(candidates.size());
     out.inverted_tets = potential->inverted_tets(*p.mesh, s.u);
@@ -309,9 +350,7 @@ std::string linear_walls_dented_through(const ContactModelsRun& run, double wall
   out.precision(3);
   bool first = true;
   const auto add = [&](const ModelContact& m) {
-    if (!m.failure.empty() || m.linearisation == kOwnEquilibrium || m.dent <= wall_thickness) {
-      return;
-    }
+    if (!m.failure.empty() || !m.linear_wall || m.dent <= wall_thickness) return;
     out << (first ? "" : ", ") << m.name << " (" << m.dent * 1e3 << " mm)";
     first = false;
   };

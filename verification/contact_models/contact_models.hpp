@@ -38,8 +38,9 @@ struct ContactModelsOptions {
   /// potential (wire_wall_potential.hpp); every inner-wall node a candidate.
   bool own_equilibrium = false;
   /// At own equilibrium, each EI after the first is solved from the wall's equilibrium at the EI
-  /// before (the same mesh; from rest only if that fails): a stiffer wire dents a soft wall by
-  /// millimetres, which Newton from the wall at rest may not reach. false: every EI from rest.
+  /// before, through EI rungs a factor √10 apart (the same mesh; from rest only if a rung fails):
+  /// a stiffer wire dents a soft wall by millimetres, which Newton from the wall at rest may not
+  /// reach. false: every EI from rest.
   bool from_softer_wire = true;
   /// For walls linearised at rest. false: each wall with the wire as one potential on the wall
   /// condensed on a band of candidates grown from the first (condensed_wall_potential.hpp): an
@@ -61,6 +62,9 @@ struct ModelContact {
   std::string name;
   std::string detail;
   std::string linearisation;  ///< to_string(WallLinearisation), or kOwnEquilibrium
+  /// The wall's energy is quadratic: linearised at rest, or a linear FEM model (whose own
+  /// equilibrium is its linearisation) under own_equilibrium.
+  bool linear_wall = false;
   std::string failure;                ///< empty when solved
   /// |Σλn|: the net force the wire puts on the wall, N (a zone whose normals fan out round the
   /// wire presses harder node by node than its sum, Σλ, says).
@@ -84,7 +88,7 @@ struct ModelContact {
   /// own_imbalance at the dent: the share of the contact load the model's own (nonlinear) energy
   /// does not balance there (0 for deal.II's FEM).
   double own_imbalance = 0.0;
-  int steps = 0;               ///< linearised steps over every round
+  int steps = 0;  ///< Newton steps over every round (and every EI rung from the softer wire)
   /// solved from the wall's equilibrium under the softer wire of the EI before (own_equilibrium)
   bool from_softer_wire = false;
   double setup_seconds = 0.0;  ///< the model's stiffness and its condensation (every round), s
@@ -111,9 +115,10 @@ struct ContactModels {
 /// wall's.
 std::string folded_walls(const ContactModelsRun& run);
 
-/// The solved walls of `run` linearised at rest (the reference's included) whose dent exceeds the
-/// wall's thickness `wall_thickness` (m), each as "name (dent in mm)", comma-separated; empty if
-/// none. A linear wall dented through its thickness is far beyond its validity.
+/// The solved linear walls of `run` (ModelContact::linear_wall; the reference's included) whose
+/// dent exceeds the wall's thickness `wall_thickness` (m), each as "name (dent in mm)",
+/// comma-separated; empty if none. A linear wall dented through its thickness is far beyond its
+/// validity.
 std::string linear_walls_dented_through(const ContactModelsRun& run, double wall_thickness);
 
 /// Whether the model has a wall the wire can press: not a network, an external program, given

@@ -178,18 +178,6 @@ void solve_linear_wall(const Scene& scene, const ReferenceWire& wire, double nu,
   out.strain = contact::largest_strain(mesh, u).small;
 }
 
-/// The bending stiffnesses of the continuation towards `target` (N·m², ascending, ending at
-/// target): from `first` in steps of `ratio`, or the target alone when it is not above `first`.
-std::vector<double> continuation_rungs(double first, double ratio, double target) {
-  std::vector<double> rungs;
-  if (target > first) {
-    const int n = static_cast<int>(std::ceil(std::log(target / first) / std::log(ratio) - 1e-9));
-    for (int k = n; k >= 1; --k) rungs.push_back(target / std::pow(ratio, k));
-  }
-  rungs.push_back(target);
-  return rungs;
-}
-
 /// A level's solved finite-strain equilibrium, where the next level starts: the wire's state, and
 /// the wall (kept for its elements' shape functions) with its free rows and its nodes'
 /// displacement (m).
@@ -286,7 +274,8 @@ std::optional<contact::PotentialContactSolution> climb_rungs(
     const std::vector<int>& nodes, contact::PotentialContactOptions po, double force_scale,
     double lumen_radius, const ContactReferenceOptions& o, ContactLevel& out) {
   const double target = wire.bending_stiffness;
-  std::vector<double> rungs = continuation_rungs(o.continuation_from, o.continuation_ratio, target);
+  std::vector<double> rungs =
+      contact::continuation_rungs(o.continuation_from, o.continuation_ratio, target);
   Eigen::VectorXd x = wire.rigid_state, u;
   double done = 0.0;  // the EI of the equilibrium in hand (0: the rigid-lumen state, wall at rest)
   int splits = 0;

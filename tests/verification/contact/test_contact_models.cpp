@@ -298,22 +298,21 @@ TEST(ContactModels, TheFoldedWallsAreTheSolvedOnesWithInvertedTets) {
 // The linear walls dented through a 1 mm wall, by hand: solved, linearised at rest, dent above the
 // thickness (the reference's row included; a failed row and a wall at its own equilibrium not).
 TEST(ContactModels, TheLinearWallsDentedThroughAreTheSolvedLinearOnesDeeperThanTheWall) {
-  const auto model = [](const std::string& name, double dent, const std::string& linearisation,
+  const auto model = [](const std::string& name, double dent, bool linear,
                         const std::string& failure) {
     contact::ModelContact m;
     m.name = name;
     m.dent = dent;
-    m.linearisation = linearisation;
+    m.linear_wall = linear;
     m.failure = failure;
     return m;
   };
   contact::ContactModelsRun run;
-  run.reference = model("reference_fem_p2", 1.2e-3, "own (linear)", "");
-  run.models = {model("fem_p1", 1.36e-3, "own (linear)", ""),
-                model("volume_hybrid", 0.9e-3, "small-dent", ""),
-                model("surface_shells", 1.43e-3, "small-dent", ""),
-                model("volume_mollemans", 2e-3, "small-dent", "crossed"),
-                model("xpbd_fem", 2.35e-3, contact::kOwnEquilibrium, "")};
+  run.reference = model("reference_fem_p2", 1.2e-3, true, "");
+  run.models = {
+      model("fem_p1", 1.36e-3, true, ""),  // at own equilibrium too: FEM P1 is linear
+      model("volume_hybrid", 0.9e-3, true, ""), model("surface_shells", 1.43e-3, true, ""),
+      model("volume_mollemans", 2e-3, true, "crossed"), model("xpbd_fem", 2.35e-3, false, "")};
   EXPECT_EQ(contact::linear_walls_dented_through(run, 1e-3),
             "reference_fem_p2 (1.2 mm), fem_p1 (1.36 mm), surface_shells (1.43 mm)");
   EXPECT_EQ(contact::linear_walls_dented_through(run, 1.5e-3), "");

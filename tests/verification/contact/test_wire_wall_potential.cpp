@@ -702,6 +702,23 @@ TEST(WireWallPotential, AModelWallCountsItsInvertedTets) {
 // reaches (the same minimiser of Π: the same pressed nodes, the force to 1e-7). The rigid-lumen
 // shape a continuation starts every rung from does not depend on EI (the rod's energy scales
 // with E): the softer wire's rigid-wall solve gives the same centreline to 1e-9 of the radius.
+// By hand: from 4e-7 towards 4e-5 in steps of 10 are 4e-7, 4e-6 and the target; in steps of √10,
+// five rungs; a target at or below the first is solved alone; with a ratio that does not divide
+// the span evenly the steps are still the ratio, ending on the target, the first at or below
+// `first`.
+TEST(ContinuationRungs, StepsOfTheRatioEndingOnTheTarget) {
+  const auto near = [](const std::vector<double>& got, const std::vector<double>& want) {
+    ASSERT_EQ(got.size(), want.size());
+    for (std::size_t k = 0; k < want.size(); ++k) EXPECT_NEAR(got[k], want[k], 1e-12 * want[k]);
+  };
+  near(contact::continuation_rungs(4e-7, 10.0, 4e-5), {4e-7, 4e-6, 4e-5});
+  near(contact::continuation_rungs(4e-7, std::sqrt(10.0), 4e-5),
+       {4e-7, 4e-7 * std::sqrt(10.0), 4e-6, 4e-6 * std::sqrt(10.0), 4e-5});
+  near(contact::continuation_rungs(4e-6, 10.0, 4e-6), {4e-6});
+  near(contact::continuation_rungs(4e-6, 10.0, 1e-6), {1e-6});
+  near(contact::continuation_rungs(1e-6, 3.0, 4e-6), {4e-6 / 9.0, 4e-6 / 3.0, 4e-6});
+}
+
 TEST(WireWallPotentialSlow, ContinuationFromASofterWireReachesTheDirectSolve) {
   const TetMesh mesh = line_of_contact_mesh();
   const std::vector<int> nodes = nodes_within(mesh, kAimPoint, 1.6e-3);
