@@ -29,8 +29,9 @@
 namespace vessel {
 namespace {
 
-/// A shipped guidewire scene with its wall `stiffer` times stiffer and only `models` kept.
-Scene stiff_scene(const std::string& name, double stiffer, const std::vector<std::string>& models) {
+/// A shipped guidewire scene with only `models` kept and its wall `stiffer` times stiffer.
+Scene shipped_scene(const std::string& name, const std::vector<std::string>& models,
+                    double stiffer = 1.0) {
   Scene s = read_scene(VESSEL_SCENES_DIR + "/" + name);
   s.youngs_modulus *= stiffer;
   std::vector<ModelSpec> kept;
@@ -71,7 +72,7 @@ double continuum_force(const Scene& s, double EI) {
 // at the rigid wire's contact, on the outer wall at the apex. (At 10^6 the potential's Newton
 // stalls at a residual of 3e-8 N, 4e-5 of the force scale.)
 TEST(GuidewireContact, TheArchOnAWallTenThousandTimesStifferIsTheQuarterWaveElastica) {
-  const Scene scene = stiff_scene("guidewire_arch.toml", 1e4, {});
+  const Scene scene = shipped_scene("guidewire_arch.toml", {}, 1e4);
   contact::ContactModelsOptions o;
   o.bending_stiffness = {4e-7};
   o.reference_degree = 1;
@@ -109,7 +110,7 @@ TEST(GuidewireContact, TheArchOnAWallTenThousandTimesStifferIsTheQuarterWaveElas
 // force. The solve kept in the outcome cache is read back (the same forces, marked cached), and
 // results.json's object conforms to the schema.
 TEST(GuidewireContactSlow, TheStraightSceneOnAStiffWallScalesWithEiAndIsReadBackFromTheCache) {
-  Scene scene = stiff_scene("guidewire_straight.toml", 1e6, {"fem_p1"});
+  Scene scene = shipped_scene("guidewire_straight.toml", {"fem_p1"}, 1e6);
   scene.load.guidewire->coupling = GuidewireCoupling::contact;
   scene.load.guidewire->stiffness_sweep = {4e-7, 4e-6};
   CachedContactOptions cached;
@@ -175,7 +176,7 @@ TEST(GuidewireContactSlow, TheStraightSceneOnAStiffWallScalesWithEiAndIsReadBack
 // 0.032 / 0.015 / 0.011 mm, tips 0.013 / 0.015 / 0.006 / 0.005 mm. So at 0.08 mm: forces within
 // 0.5 %, centroids within h / 2, tips within h / 4.
 TEST(GuidewireContactSlow, ThePotentialAndTheActiveSetAgreeOnTheScenesWall) {
-  const Scene scene = stiff_scene("guidewire_straight.toml", 1.0, {});
+  const Scene scene = shipped_scene("guidewire_straight.toml", {});
   contact::ContactModelsOptions o;
   o.bending_stiffness = {4e-7};
   o.reference_degree = 1;
@@ -258,7 +259,7 @@ TEST(GuidewireContact, AnEiWhoseSeriesSpringsDentTheWallDeeperThanItIsThickIsNot
 // 1 %, and the run is judged (valid at any strain), its results.json object naming the wall and
 // meeting the schema.
 TEST(GuidewireContactSlow, ANeoHookeanContactWallSolvesTheEiALinearWallCannotHold) {
-  Scene scene = stiff_scene("guidewire_straight.toml", 1e4, {"surface_seed000"});
+  Scene scene = shipped_scene("guidewire_straight.toml", {"surface_seed000"}, 1e4);
   scene.load.guidewire->coupling = GuidewireCoupling::contact;
   scene.load.guidewire->contact_wall = ContactWall::neo_hookean;
   *scene.load.guidewire = with_stiffness(*scene.load.guidewire, 4e-6);  // its one EI
@@ -317,7 +318,7 @@ TEST(GuidewireContactSlow, ANeoHookeanContactWallSolvesTheEiALinearWallCannotHol
 // 4e-6 did (zone centroids 0.09 mm and 0.11 mm off it), its forces 0.2 % apart; across the plane
 // the forces agree within 0.5 %.
 TEST(GuidewireContactSlow, AStifferWireFromTheSofterWiresEquilibriumReachesItsOwnFromRest) {
-  const Scene scene = stiff_scene("guidewire_straight.toml", 1.0, {"volume_hybrid"});
+  const Scene scene = shipped_scene("guidewire_straight.toml", {"volume_hybrid"});
   contact::ContactModelsOptions o;
   o.bending_stiffness = {4e-7, 4e-6};
   o.reference_degree = 1;
