@@ -112,7 +112,8 @@ def main():
                                                             "vesselverify"))
     ap.add_argument("--out", help="the page (default: docs/measurements/contact_models.md, or "
                     "contact_models_own_equilibrium.md with --own-equilibrium, "
-                    "contact_models_active_set.md with --active-set)")
+                    "contact_models_active_set.md with --active-set; _SCENE after a scene other "
+                    "than the straight one, _p1 after a P1 reference)")
     args = ap.parse_args()
     if not args.out:
         name = "contact_models"
@@ -122,6 +123,8 @@ def main():
             name += "_active_set"
         if args.scene != STRAIGHT:
             name += "_" + args.scene
+        if args.reference_degree != 2:
+            name += f"_p{args.reference_degree}"
         args.out = os.path.join(ROOT, "docs", "measurements", name + ".md")
     cmd = [args.vesselverify, "contact-models", f"verification/scenes/{args.scene}.toml"]
     if args.own_equilibrium:
