@@ -292,8 +292,9 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
     const std::vector<int> candidates =
         p.mesh->group_nodes(p.mesh->require_group("inner_wall", 2, "contact mesh"));
     o.log = options.log;  // an own-equilibrium solve takes minutes (the reference's, an hour)
-    // Undamped, Newton on a soft wall dented by millimetres oscillates (the contact reference's
-    // solve_neo_hookean_wall): the P2 reference at EI 4e-5 hovered at a residual of 3e-3 N.
+    // Levenberg–Marquardt damping, as the contact reference's solve_neo_hookean_wall: undamped,
+    // Newton on a soft wall dented by millimetres oscillated there (175 steps against 45). (The
+    // P2 reference at EI 4e-5 stalls near a residual of 3e-3 N either way; contact.md.)
     o.damped_newton = true;
     s = solve_own_equilibrium(rod, w, EI, *potential, *p.mesh, candidates, rigid, o, start,
                               out.from_softer_wire);
