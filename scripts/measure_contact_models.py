@@ -42,7 +42,8 @@ rest with the scene's supports held (`model_walls.hpp`), condensed on the contac
 pressed by the wire's capsule with Signorini's conditions ({formulation}), the candidates grown
 until the contact stays inside them. Every wall is on the same tet mesh (gmsh, refined to 0.08 mm
 within 1 mm of the rigid wire's contact and to 0.16 mm along the band the wire may bear on) with
-the same candidates and the same contact law; the reference is FEM P{degree} (deal.II) on that mesh.
+the same candidates and the same contact law; the reference is FEM P{degree} (deal.II) on that
+mesh.
 Column *wall*: `own (linear)` is the model's own equilibrium,
 `small-dent` its linearisation at rest (the nonlinear models). Surface models: the contact acts
 on the inner wall, a mid-surface node's contact point being its inner-wall node carried with the

@@ -295,8 +295,9 @@ TEST(ContactModels, TheFoldedWallsAreTheSolvedOnesWithInvertedTets) {
   EXPECT_EQ(contact::folded_walls(run), "");
 }
 
-// The linear walls dented through a 1 mm wall, by hand: solved, linearised at rest, dent above the
-// thickness (the reference's row included; a failed row and a wall at its own equilibrium not).
+// The linear walls dented through a 1 mm wall, by hand: solved, linear (linearised at rest, or
+// a linear FEM model at its own equilibrium), dent above the thickness (the reference's row
+// included; a failed row and a nonlinear wall at its own equilibrium not).
 TEST(ContactModels, TheLinearWallsDentedThroughAreTheSolvedLinearOnesDeeperThanTheWall) {
   const auto model = [](const std::string& name, double dent, bool linear,
                         const std::string& failure) {

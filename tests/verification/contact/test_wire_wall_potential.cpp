@@ -696,12 +696,6 @@ TEST(WireWallPotential, AModelWallCountsItsInvertedTets) {
   EXPECT_FALSE(none.inverted_tets(mesh, Eigen::VectorXd()).has_value());
 }
 
-// The wall's start (a stiffness continuation's rung): the wire at a tenth of its EI solved first,
-// then the wire at its EI from that equilibrium (the softer wire's centreline, the wall's dented
-// displacement) reaches the equilibrium the solve from the rigid-lumen state with the wall at rest
-// reaches (the same minimiser of Π: the same pressed nodes, the force to 1e-7). The rigid-lumen
-// shape a continuation starts every rung from does not depend on EI (the rod's energy scales
-// with E): the softer wire's rigid-wall solve gives the same centreline to 1e-9 of the radius.
 // By hand: from 4e-7 towards 4e-5 in steps of 10 are 4e-7, 4e-6 and the target; in steps of √10,
 // five rungs; a target at or below the first is solved alone; with a ratio that does not divide
 // the span evenly the steps are still the ratio, ending on the target, the first at or below
@@ -719,6 +713,12 @@ TEST(ContinuationRungs, StepsOfTheRatioEndingOnTheTarget) {
   near(contact::continuation_rungs(1e-6, 3.0, 4e-6), {4e-6 / 9.0, 4e-6 / 3.0, 4e-6});
 }
 
+// The wall's start (a stiffness continuation's rung): the wire at a tenth of its EI solved first,
+// then the wire at its EI from that equilibrium (the softer wire's centreline, the wall's dented
+// displacement) reaches the equilibrium the solve from the rigid-lumen state with the wall at rest
+// reaches (the same minimiser of Π: the same pressed nodes, the force to 1e-7). The rigid-lumen
+// shape a continuation starts every rung from does not depend on EI (the rod's energy scales
+// with E): the softer wire's rigid-wall solve gives the same centreline to 1e-9 of the radius.
 TEST(WireWallPotentialSlow, ContinuationFromASofterWireReachesTheDirectSolve) {
   const TetMesh mesh = line_of_contact_mesh();
   const std::vector<int> nodes = nodes_within(mesh, kAimPoint, 1.6e-3);
