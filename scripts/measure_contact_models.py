@@ -21,7 +21,6 @@ Usage: /usr/bin/python3 scripts/measure_contact_models.py [--ei 4e-7,4e-6] [--ow
            [--out PAGE]
 """
 import argparse
-import datetime
 import os
 import subprocess
 import sys
@@ -154,8 +153,8 @@ def main():
         wire=wire_sentence(args.scene), formulation=ACTIVE_SET if args.active_set else POTENTIAL,
         degree=args.reference_degree))
     page = intro + f"""
-Measured {datetime.date.today().isoformat()} on the 2-core machine, load average {load_before}
-before and {load_after} after{shared}, {time.time() - start:.0f} s in all:
+Measured on the 2-core machine, load average {load_before} before and {load_after}
+after{shared}, {time.time() - start:.0f} s in all:
 
 ```sh
 {' '.join(shown)}
