@@ -35,7 +35,10 @@ std::string along(const VesselParams& vessel, const Vec3& centroid) {
   return fmt("%.3f", centreline_coordinates(vessel, centroid).s * 1e3);
 }
 
-void print_run(const contact::ContactModelsRun& run, const VesselParams& vessel) {
+/// `own_equilibrium`: the run solved every wall at its own equilibrium (the finite-strain
+/// reference among them), so a dented-through linear wall is judged by the table's own reference.
+void print_run(const contact::ContactModelsRun& run, const VesselParams& vessel,
+               bool own_equilibrium) {
   const contact::ModelContact& ref = run.reference;
   std::cout << "\n### EI = " << fmt("%.3g", run.bending_stiffness) << " N·m²\n\n"
             << "Rigid lumen: " << fmt("%.4f", run.rigid_force * 1e3) << " mN. Reference ("
@@ -86,7 +89,8 @@ void print_run(const contact::ContactModelsRun& run, const VesselParams& vessel)
     std::cout << "\nLinear walls dented deeper than the wall is thick ("
               << fmt("%.3g", vessel.wall_thickness * 1e3) << " mm): " << through
               << ". A linear wall there is far beyond its validity: judge this EI by the "
-                 "finite-strain walls (--own-equilibrium).\n";
+              << (own_equilibrium ? "finite-strain walls above.\n"
+                                  : "finite-strain walls (--own-equilibrium).\n");
   }
 }
 
@@ -176,7 +180,8 @@ void add_contact_models_command(CLI::App& app) {
                 << " mm along the band the wire may bear on";
     }
     std::cout << ").\n";
-    for (const contact::ContactModelsRun& run : result.runs) print_run(run, scene.vessel);
+    for (const contact::ContactModelsRun& run : result.runs)
+      print_run(run, scene.vessel, o->options.own_equilibrium);
   });
 }
 
