@@ -6,8 +6,11 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "meshes/foundation/errors.hpp"
 #include "msm/linalg/linear_solver.hpp"
@@ -46,10 +49,65 @@ double LinearWall::largest_strain(const TetMesh& mesh, const VectorXd& u) const 
 }
 
 NeoHookeanWall::NeoHookeanWall(const TetMesh& mesh, fem::ElasticityProblem problem)
-    : solver_(std::make_unique<fem::HyperelasticSolver>(mesh, std::move(problem))),
+    : degree_(problem.options.degree),
+      solver_(std::make_unique<fem::HyperelasticSolver>(mesh, std::move(problem))),
       dofs_(solver_->free_dofs()) {
   n_ = static_cast<int>(std::count_if(dofs_.free_index.begin(), dofs_.free_index.end(),
                                       [](int r) { return r >= 0; }));
+}
+
+std::vector<EdgeNode> NeoHookeanWall::edge_nodes(
+    const TetMesh& mesh, const std::vector<std::array<int, 2>>& edges) const {
+  if (degree_ < 2) return {};
+  return mid_edge_nodes(dofs_, mesh, edges);
+}
+
+std::vector<EdgeNode> mid_edge_nodes(const fem::FreeDisplacementSystem& system, const TetMesh& mesh,
+                                     const std::vector<std::array<int, 2>>& edges) {
+  if (system.row_points.size() != system.row_components.size()) {
+    throw std::logic_error("mid_edge_nodes: the system's row points are not filled");
+  }
+  // The support points, each with its rows, sorted by x for a slab search.
+  std::vector<int> order(system.row_points.size());
+  std::iota(order.begin(), order.end(), 0);
+  const auto lexicographic = [&](int i, int j) {
+    const Vec3& p = system.row_points[static_cast<std::size_t>(i)];
+    const Vec3& q = system.row_points[static_cast<std::size_t>(j)];
+    return std::tie(p[0], p[1], p[2]) < std::tie(q[0], q[1], q[2]);
+  };
+  std::sort(order.begin(), order.end(), lexicographic);
+  std::vector<Vec3> points;
+  std::vector<std::array<int, 3>> rows;
+  for (const int r : order) {
+    const Vec3& p = system.row_points[static_cast<std::size_t>(r)];
+    if (points.empty() || points.back() != p) {
+      points.push_back(p);
+      rows.push_back({-1, -1, -1});
+    }
+    rows.back()[static_cast<std::size_t>(system.row_components[static_cast<std::size_t>(r)])] = r;
+  }
+  std::vector<EdgeNode> out;
+  for (const auto& [a, b] : edges) {
+    const Vec3& pa = mesh.nodes[static_cast<std::size_t>(a)];
+    const Vec3& pb = mesh.nodes[static_cast<std::size_t>(b)];
+    const Vec3 middle = 0.5 * (pa + pb);
+    const double reach = 0.25 * (pb - pa).norm();
+    auto it = std::lower_bound(points.begin(), points.end(), middle[0] - reach,
+                               [](const Vec3& p, double x) { return p[0] < x; });
+    double best = reach;
+    std::ptrdiff_t found = -1;
+    for (; it != points.end() && (*it)[0] <= middle[0] + reach; ++it) {
+      const double d = (*it - middle).norm();
+      if (d < best) {
+        best = d;
+        found = it - points.begin();
+      }
+    }
+    if (found < 0) continue;
+    out.push_back(
+        {a, b, points[static_cast<std::size_t>(found)], rows[static_cast<std::size_t>(found)]});
+  }
+  return out;
 }
 
 double NeoHookeanWall::evaluate(const VectorXd& u, VectorXd* gradient,
@@ -273,22 +331,64 @@ void add_pair(const Linearisation& lin, std::size_t j, double s, VectorXd& v) {
   }
 }
 
-/// The inner wall's triangles whose three nodes are all candidates, as candidate indices (none
-/// for a mesh without the group).
-std::vector<std::array<int, 3>> candidate_faces(const TetMesh& mesh,
-                                                const std::vector<int>& candidates) {
-  std::vector<std::array<int, 3>> faces;
+/// The inner wall's triangles whose three nodes are all candidates (none for a mesh without the
+/// group).
+std::vector<Triangle> candidate_triangles(const TetMesh& mesh, const std::vector<int>& candidates) {
+  std::vector<Triangle> out;
   const PhysicalGroup* inner = mesh.find_group(group_names::inner_wall, 2);
-  if (inner == nullptr) return faces;
-  std::vector<int> index(mesh.nodes.size(), -1);
-  for (std::size_t j = 0; j < candidates.size(); ++j) {
-    index[static_cast<std::size_t>(candidates[j])] = static_cast<int>(j);
-  }
+  if (inner == nullptr) return out;
+  std::vector<char> is_candidate(mesh.nodes.size(), 0);
+  for (const int c : candidates) is_candidate[static_cast<std::size_t>(c)] = 1;
   for (const Triangle& t : mesh.group_triangles(*inner)) {
-    const std::array<int, 3> f{index[static_cast<std::size_t>(t[0])],
-                               index[static_cast<std::size_t>(t[1])],
-                               index[static_cast<std::size_t>(t[2])]};
-    if (f[0] >= 0 && f[1] >= 0 && f[2] >= 0) faces.push_back(f);
+    if (is_candidate[static_cast<std::size_t>(t[0])] &&
+        is_candidate[static_cast<std::size_t>(t[1])] &&
+        is_candidate[static_cast<std::size_t>(t[2])]) {
+      out.push_back(t);
+    }
+  }
+  return out;
+}
+
+/// The edges of `triangles`, each once (a < b).
+std::vector<std::array<int, 2>> triangle_edges(const std::vector<Triangle>& triangles) {
+  std::vector<std::array<int, 2>> edges;
+  for (const Triangle& t : triangles) {
+    for (int e = 0; e < 3; ++e) {
+      const int a = t[static_cast<std::size_t>(e)], b = t[static_cast<std::size_t>((e + 1) % 3)];
+      edges.push_back({std::min(a, b), std::max(a, b)});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+/// The tip's faces as candidate indices: each of `triangles` (mesh nodes; `index` maps a mesh
+/// node to its candidate) whole, or split into four at its edges' middle nodes where it has all
+/// three (`middle`: per edge (a < b) its middle node's candidate).
+std::vector<std::array<int, 3>> candidate_faces(const std::vector<Triangle>& triangles,
+                                                const std::vector<int>& index,
+                                                const std::map<std::array<int, 2>, int>& middle) {
+  std::vector<std::array<int, 3>> faces;
+  for (const Triangle& t : triangles) {
+    std::array<int, 3> v{}, m{};
+    bool split = true;
+    for (int e = 0; e < 3; ++e) {
+      const int a = t[static_cast<std::size_t>(e)], b = t[static_cast<std::size_t>((e + 1) % 3)];
+      v[static_cast<std::size_t>(e)] = index[static_cast<std::size_t>(a)];
+      const auto it = middle.find({std::min(a, b), std::max(a, b)});
+      split = split && it != middle.end();
+      if (it != middle.end()) m[static_cast<std::size_t>(e)] = it->second;
+    }
+    if (!split) {
+      faces.push_back(v);
+      continue;
+    }
+    // m[e] is the middle of edge (v[e], v[e+1]).
+    faces.push_back({v[0], m[0], m[2]});
+    faces.push_back({m[0], v[1], m[1]});
+    faces.push_back({m[2], m[1], v[2]});
+    faces.push_back({m[0], m[1], m[2]});
   }
   return faces;
 }
@@ -296,9 +396,11 @@ std::vector<std::array<int, 3>> candidate_faces(const TetMesh& mesh,
 /// The coupled problem Π(z) and the bookkeeping between z, the rod's dofs and the wall's rows.
 class Coupled {
  public:
+  /// `mid_edges`: also the wall's nodes at the middles of the candidate faces' edges (P2). The
+  /// contact stiffness k is set before the solve (set_stiffness).
   Coupled(msm::rods::Rod& rod, double radius, const WallPotential& wall, const TetMesh& mesh,
-          const std::vector<int>& candidates, const VectorXd& start, double k)
-      : rod_(rod), r_(radius), wall_(wall), mesh_(mesh), k_(k), x0_(start) {
+          const std::vector<int>& candidates, const VectorXd& start, bool mid_edges)
+      : rod_(rod), r_(radius), wall_(wall), mesh_(mesh), x0_(start) {
     fixed_ = rod.clamp_fixed();
     rod_row_.assign(fixed_.size(), -1);
     for (std::size_t i = 0; i < fixed_.size(); ++i) {
@@ -306,21 +408,36 @@ class Coupled {
     }
     first_ = rod.layout().first_node;
     last_ = rod.layout().tip_node;
+    std::vector<int> index(mesh.nodes.size(), -1);
     for (const int c : candidates) {
       if (c < 0 || c >= static_cast<int>(mesh.nodes.size())) {
         throw InputError("the contact candidate " + std::to_string(c) + " is not a mesh node");
       }
+      index[static_cast<std::size_t>(c)] = static_cast<int>(rest_.size());
       rest_.push_back(mesh.nodes[static_cast<std::size_t>(c)]);
       rows_.push_back(wall.node_rows()[static_cast<std::size_t>(c)]);
+      ends_.push_back({c, -1});
     }
-    nodes_ = candidates;
-    faces_ = candidate_faces(mesh, candidates);
-    multiplier_.assign(candidates.size() + faces_.size(), 0.0);
+    const std::vector<Triangle> triangles = candidate_triangles(mesh, candidates);
+    std::map<std::array<int, 2>, int> middle;
+    if (mid_edges) {
+      for (const EdgeNode& e : wall.edge_nodes(mesh, triangle_edges(triangles))) {
+        middle[{e.a, e.b}] = static_cast<int>(rest_.size());
+        rest_.push_back(e.rest);
+        rows_.push_back(e.rows);
+        ends_.push_back({e.a, e.b});
+      }
+    }
+    faces_ = candidate_faces(triangles, index, middle);
+    multiplier_.assign(rest_.size() + faces_.size(), 0.0);
   }
 
   [[nodiscard]] int size() const { return n_rod_ + wall_.num_dofs(); }
   [[nodiscard]] double radius() const { return r_; }
   [[nodiscard]] double stiffness() const { return k_; }
+  void set_stiffness(double k) { k_ = k; }
+  /// Per candidate (mesh nodes, then mid-edge nodes) its x, y, z rows in the wall.
+  [[nodiscard]] const std::vector<std::array<int, 3>>& candidate_rows() const { return rows_; }
 
   [[nodiscard]] VectorXd rod_dofs(const VectorXd& z) const {
     VectorXd x = x0_;
@@ -556,15 +673,30 @@ class Coupled {
         (point.wall ? on_wall : out.force_on_wire)[static_cast<std::size_t>(point.index)] += f;
       }
     }
+    // Per mesh node: a vertex candidate's force, and half of each mid-edge node's on its edges.
+    std::map<int, Vec3> on_node;
+    const auto add = [&on_node](int node, const Vec3& f) {
+      on_node.try_emplace(node, Vec3::Zero()).first->second += f;
+    };
+    for (std::size_t j = 0; j < on_wall.size(); ++j) {
+      if (!(on_wall[j].norm() > 0.0)) continue;
+      const auto [a, b] = ends_[j];
+      if (b < 0) {
+        add(a, on_wall[j]);
+      } else {
+        add(a, 0.5 * on_wall[j]);
+        add(b, 0.5 * on_wall[j]);
+      }
+    }
     out.pressed.clear();
     out.force.clear();
     out.direction.clear();
-    for (std::size_t j = 0; j < on_wall.size(); ++j) {
-      const double f = on_wall[j].norm();
+    for (const auto& [node, force] : on_node) {
+      const double f = force.norm();
       if (!(f > 0.0)) continue;
-      out.pressed.push_back(nodes_[j]);
+      out.pressed.push_back(node);
       out.force.push_back(f);
-      out.direction.push_back(on_wall[j] / f);
+      out.direction.push_back(force / f);
     }
   }
 
@@ -679,13 +811,14 @@ class Coupled {
   double r_;
   const WallPotential& wall_;
   const TetMesh& mesh_;
-  double k_;
+  double k_ = 0.0;
   VectorXd x0_;
   std::vector<char> fixed_;
   std::vector<int> rod_row_;
   int n_rod_ = 0;
   int first_ = 0, last_ = 0;
-  std::vector<int> nodes_;
+  /// Per candidate its mesh node {n, −1}, or a mid-edge node's edge {a, b}.
+  std::vector<std::array<int, 2>> ends_;
   std::vector<Eigen::Vector3d> rest_;
   std::vector<std::array<int, 3>> rows_;
   std::vector<std::array<int, 3>> faces_;  ///< the wall's faces, as candidate indices
@@ -693,17 +826,17 @@ class Coupled {
   bool multipliers_lead_ = false;
 };
 
-/// k from the wall's stiffness at rest: penalty_factor × its largest diagonal entry on the
-/// candidates' rows.
-double default_penalty(const WallPotential& wall, const std::vector<int>& candidates,
+/// k from the wall's stiffness at rest: `factor` × its largest diagonal entry on the candidates'
+/// rows (`rows`).
+double default_penalty(const WallPotential& wall, const std::vector<std::array<int, 3>>& rows,
                        double factor) {
   Eigen::SparseMatrix<double> h;
   VectorXd g;
   (void)wall.evaluate(VectorXd::Zero(wall.num_dofs()), &g, &h);
   const VectorXd diag = h.diagonal();
   double largest = 0.0;
-  for (const int c : candidates) {
-    for (const int row : wall.node_rows()[static_cast<std::size_t>(c)]) {
+  for (const auto& candidate : rows) {
+    for (const int row : candidate) {
       if (row >= 0) largest = std::max(largest, diag[row]);
     }
   }
@@ -1201,10 +1334,11 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
     throw InputError("the wall's start has " + std::to_string(wall_start.size()) +
                      " rows; expected " + std::to_string(wall.num_dofs()) + " (or none: at rest)");
   }
+  Coupled problem(rod, radius, wall, mesh, candidates, start, options.mid_edge_candidates);
   const double k = options.penalty_stiffness > 0.0
                        ? options.penalty_stiffness
-                       : default_penalty(wall, candidates, options.penalty_factor);
-  Coupled problem(rod, radius, wall, mesh, candidates, start, k);
+                       : default_penalty(wall, problem.candidate_rows(), options.penalty_factor);
+  problem.set_stiffness(k);
   rod.prepare(start);
   VectorXd z =
       problem.pack(start, wall_start.size() != 0 ? wall_start : VectorXd::Zero(wall.num_dofs()));

@@ -53,6 +53,13 @@
 
 namespace vessel::contact {
 
+/// A wall's displacement node at the middle of the mesh edge (a, b): a P2 wall's mid-edge node.
+struct EdgeNode {
+  int a = -1, b = -1;         ///< the edge's mesh nodes
+  Vec3 rest = Vec3::Zero();   ///< its support point at rest (on a curved wall, on the curve), m
+  std::array<int, 3> rows{};  ///< its x, y, z displacement rows (−1 where held)
+};
+
 /// A wall as the energy of its free displacement rows (m).
 class WallPotential {
  public:
@@ -60,6 +67,13 @@ class WallPotential {
   [[nodiscard]] virtual int num_dofs() const = 0;
   /// Per mesh node, the rows of its x, y, z displacement (−1 where held).
   [[nodiscard]] virtual const std::vector<std::array<int, 3>>& node_rows() const = 0;
+  /// The wall's nodes at the middles of `edges` (mesh node pairs) where its displacement is
+  /// quadratic along them (P2), an edge whose middle node is wholly held left out; none for a
+  /// wall linear on every edge.
+  [[nodiscard]] virtual std::vector<EdgeNode> edge_nodes(
+      const TetMesh& /*mesh*/, const std::vector<std::array<int, 2>>& /*edges*/) const {
+    return {};
+  }
   /// The energy at u (J; +∞ where an element is inverted), its gradient (N) and Hessian (N/m)
   /// when asked; with project_psd the Hessian's element blocks projected onto the positive
   /// semidefinite cone (a linear wall's already are).
@@ -103,6 +117,9 @@ class NeoHookeanWall final : public WallPotential {
   [[nodiscard]] const std::vector<std::array<int, 3>>& node_rows() const override {
     return dofs_.node_rows;
   }
+  /// P2: the mid-edge nodes, found by their support points (mid_edge_nodes).
+  [[nodiscard]] std::vector<EdgeNode> edge_nodes(
+      const TetMesh& mesh, const std::vector<std::array<int, 2>>& edges) const override;
   double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
                   Eigen::SparseMatrix<double>* hessian, bool project_psd = false) const override;
   [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
@@ -136,10 +153,17 @@ class NeoHookeanWall final : public WallPotential {
   }
 
  private:
+  int degree_ = 1;  ///< read before the problem moves into the solver
   std::unique_ptr<fem::HyperelasticSolver> solver_;
   fem::FreeDisplacementSystem dofs_;
   int n_ = 0;
 };
+
+/// The nodes of `system` at the middles of `edges` (mesh node pairs): per edge the support point
+/// (system.row_points) nearest its chord's midpoint, within a quarter of its length (a P2 node
+/// on a curved wall sits off the chord by about h²/(8R)); an edge with none there left out.
+std::vector<EdgeNode> mid_edge_nodes(const fem::FreeDisplacementSystem& system, const TetMesh& mesh,
+                                     const std::vector<std::array<int, 2>>& edges);
 
 /// A msm model's own energy as the wall: E(X + u) − E(X) over its free dofs with its exact
 /// gradient and Hessian, so the contact solve finds the model's own (nonlinear) equilibrium.
@@ -193,6 +217,11 @@ struct PotentialContactOptions {
   double force_scale = 1e-3;    ///< N
   double max_move = 0.5;        ///< × r_w: the largest node move of one Newton step
   int max_newton = 300;         ///< Newton steps per round
+  /// A P2 wall's mid-edge nodes on the inner wall are candidates too, and the tip meets its faces
+  /// split at them (four flat triangles each): a quadratic wall pressed at its vertices alone
+  /// takes point loads where a pressure puts none of its consistent load, and its surface
+  /// between them can wrap round the wire. Off: its vertices alone, as a P1 wall's.
+  bool mid_edge_candidates = true;
   /// Levenberg–Marquardt: the Newton model's matrix B + μ diag(|B|), μ raised tenfold (from 1e-4)
   /// after a step the line search cut and lowered tenfold after a full one.
   bool damped_newton = false;
@@ -206,7 +235,7 @@ struct PotentialContactSolution {
   Eigen::VectorXd u;  ///< the wall's free displacement rows, m
   /// The pressed wall nodes (mesh indices, ascending), the magnitude of the wire's force on each
   /// (N) and its unit direction: its own contact with the capsule plus its shares of the tip's
-  /// contacts with its faces.
+  /// contacts with its faces and half of each mid-edge node's force on its edges.
   std::vector<int> pressed;
   std::vector<double> force;
   std::vector<Vec3> direction;
@@ -239,8 +268,10 @@ struct WireThroughWall : std::runtime_error {
 
 /// Minimises Π from the wire at `start` (e.g. its rigid-lumen state) and the wall at
 /// `wall_start` (its free rows, m; empty: at rest), e.g. the equilibrium of a softer wire on the
-/// same wall. The contact candidates are `candidates` (mesh nodes; e.g. the whole inner wall):
-/// each one's gap to the capsule enters Π. `rod`: without equality constraints (DER); its clamps
+/// same wall. The contact candidates are `candidates` (mesh nodes; e.g. the whole inner wall)
+/// and, on a P2 wall, the mid-edge nodes of the inner wall's edges between two of them
+/// (options.mid_edge_candidates): each one's gap to the capsule enters Π, a mid-edge node's force
+/// reported half on each end of its edge. `rod`: without equality constraints (DER); its clamps
 /// are held; it is left prepared at the solution. Throws WireThroughWall where the centreline
 /// crosses the wall; std::runtime_error naming the round, the residual and the penetration
 /// without convergence; InputError for a rod with constraints,

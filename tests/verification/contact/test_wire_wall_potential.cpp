@@ -8,6 +8,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -299,6 +300,64 @@ TEST(NeoHookeanWall, StateMatchesLinearLimitAndFiniteDifferences) {
   EXPECT_LT((hd - fd).norm(), 1e-6 * hd.norm());
 }
 
+// A P2 wall's mid-edge nodes (NeoHookeanWall::edge_nodes): one per inner-wall edge whose middle
+// is not held (the clamped ends hold the edges lying in them), at the chord's midpoint on
+// straight-sided tets and on the cylinder r = a, off the chord, with the tube's curved mapping;
+// their rows are their own (no vertex's, no other edge's). A P1 wall has none.
+TEST(NeoHookeanWall, P2MidEdgeNodesSitAtTheInnerWallsEdgeMiddles) {
+  const TetMesh& mesh = tube_mesh();
+  std::vector<std::array<int, 2>> edges;
+  for (const Triangle& t : mesh.group_triangles(mesh.require_group("inner_wall", 2, "tube"))) {
+    for (int e = 0; e < 3; ++e) {
+      const int a = t[e], b = t[(e + 1) % 3];
+      edges.push_back({std::min(a, b), std::max(a, b)});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  fem::ElasticityProblem problem = wall_problem(kWallE);
+  EXPECT_TRUE(contact::NeoHookeanWall(mesh, problem).edge_nodes(mesh, edges).empty());
+  problem.options.degree = 2;
+  for (const bool curved : {false, true}) {
+    if (curved) problem.curved_surfaces = fem::tube_curved_walls(kA, kA + 1e-3);
+    const contact::NeoHookeanWall wall(mesh, problem);
+    const std::vector<contact::EdgeNode> middles = wall.edge_nodes(mesh, edges);
+    std::size_t held_edges = 0;
+    for (const auto& [a, b] : edges) {
+      held_edges += wall.node_rows()[a][0] < 0 && wall.node_rows()[b][0] < 0;
+    }
+    EXPECT_EQ(middles.size(), edges.size() - held_edges) << (curved ? "curved" : "flat");
+    std::set<int> rows;
+    for (const auto& node_rows : wall.node_rows()) {
+      for (const int r : node_rows) {
+        if (r >= 0) rows.insert(r);
+      }
+    }
+    const std::size_t vertex_rows = rows.size();
+    double off_chord = 0.0, off_cylinder = 0.0;
+    for (const contact::EdgeNode& m : middles) {
+      for (const int r : m.rows) {
+        EXPECT_GE(r, 0);
+        rows.insert(r);
+      }
+      off_chord = std::max(off_chord, (m.rest - 0.5 * (mesh.nodes[m.a] + mesh.nodes[m.b])).norm());
+      off_cylinder = std::max(off_cylinder, std::abs(std::hypot(m.rest.x(), m.rest.y()) - kA));
+    }
+    std::printf(
+        "WIRE-WALL-POTENTIAL P2 mid-edge nodes (%s): %zu of %zu inner-wall edges (%zu held), "
+        "largest distance from the chord's midpoint %.2e m, from the cylinder r = a %.2e m\n",
+        curved ? "curved" : "flat", middles.size(), edges.size(), held_edges, off_chord,
+        off_cylinder);
+    EXPECT_EQ(rows.size(), vertex_rows + 3 * middles.size());
+    if (curved) {
+      EXPECT_LT(off_cylinder, 1e-12);
+      EXPECT_GT(off_chord, 1e-5);  // a 0.78 mm chord's sagitta on r = 3 mm: 2.6e-5 m
+    } else {
+      EXPECT_LT(off_chord, 1e-12);
+    }
+  }
+}
+
 // A field carried from another mesh may fold a few cells (the solve's start is then refused):
 // fem::HyperelasticSolver::inverted_cells finds them (for P1, the tets whose deformed signed
 // volume, computed here by hand, is not positive), and NeoHookeanWall::untangled smooths their
@@ -535,6 +594,34 @@ TEST(WireWallPotentialSlow, RigidLimitApproachesTheRigidWallSolve) {
       forces.push_back(F);
     }
     EXPECT_NEAR(forces[0], forces[1], 1e-6 * forces[0]) << c.name;
+  }
+}
+
+// A P2 wall pressed at its mid-edge nodes too (PotentialContactOptions::mid_edge_candidates, the
+// default), on the structured tube: made 10⁶ times stiffer, its force is the rigid-wall solve's
+// against the faceted wall where the tip rests (the split faces lie in the same flat triangles),
+// as in the rigid-limit test above; at 30 times the scenes' wall (a dent of about r_w) the
+// wire's clamp and the wall's supports (its own internal forces on the held rows) balance to
+// 1e-9 of the force, so the mid-edge nodes' forces reach the wall whole.
+TEST(WireWallPotentialSlow, AP2WallPressedAtItsMidEdgeNodesMeetsTheRigidLimitAndBalances) {
+  const TetMesh& mesh = tube_mesh();
+  const std::vector<int> nodes = nodes_within(mesh, kAimPoint, 3e-3);
+  for (const double stiffer : {1e6, 30.0}) {
+    fem::ElasticityProblem problem = wall_problem(kWallE * stiffer);
+    problem.options.degree = 2;
+    const contact::NeoHookeanWall wall(mesh, problem);
+    const PotentialRun run = potential_run(mesh, kAimPoint, wall, nodes);
+    const contact::PotentialContactSolution& s = run.solution;
+    const double F = s.total_force_on_wall().norm();
+    const Vec3 supports = wall.support_reaction(s.u);
+    std::printf(
+        "WIRE-WALL-POTENTIAL P2 wall x%g, mid-edge candidates: F %.6e N, against the rigid-wall "
+        "solve where the tip rests on the faceted wall %+.2e, clamp + supports |%.2e| N (%.1e of "
+        "F), %zu pressed, %d Newton, %.1f s\n",
+        stiffer, F, F / run.faceted_force - 1, (run.clamp + supports).norm(),
+        (run.clamp + supports).norm() / F, s.pressed.size(), s.newton_iterations, s.seconds);
+    EXPECT_LT((run.clamp + supports).norm(), 1e-9 * F);
+    if (stiffer > 1e3) EXPECT_NEAR(F / run.faceted_force, 1.0, 1e-4);
   }
 }
 
