@@ -294,7 +294,7 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
     o.log = options.log;  // an own-equilibrium solve takes minutes (the reference's, an hour)
     // Levenberg–Marquardt damping, as the contact reference's solve_neo_hookean_wall: undamped,
     // Newton on a soft wall dented by millimetres oscillated there (175 steps against 45). (The
-    // P2 reference at EI 4e-5 stalls near a residual of 3e-3 N either way; contact.md.)
+    // P2 reference pressed at its vertices alone stalled at EI 4e-5 either way; contact.md.)
     o.damped_newton = true;
     s = solve_own_equilibrium(rod, w, EI, *potential, *p.mesh, candidates, rigid, o, start,
                               out.from_softer_wire);
