@@ -269,7 +269,7 @@ struct WireThroughWall : std::runtime_error {
 /// Minimises Π from the wire at `start` (e.g. its rigid-lumen state) and the wall at
 /// `wall_start` (its free rows, m; empty: at rest), e.g. the equilibrium of a softer wire on the
 /// same wall. The contact candidates are `candidates` (mesh nodes; e.g. the whole inner wall)
-/// and, on a P2 wall, the mid-edge nodes of the inner wall's edges between two of them
+/// and, on a P2 wall, the mid-edge nodes of the inner-wall faces whose three nodes are candidates
 /// (options.mid_edge_candidates): each one's gap to the capsule enters Π, a mid-edge node's force
 /// reported half on each end of its edge. `rod`: without equality constraints (DER); its clamps
 /// are held; it is left prepared at the solution. Throws WireThroughWall where the centreline
