@@ -678,6 +678,7 @@ class Coupled {
     const auto add = [&on_node](int node, const Vec3& f) {
       on_node.try_emplace(node, Vec3::Zero()).first->second += f;
     };
+    out.pressed_edge_nodes = 0;
     for (std::size_t j = 0; j < on_wall.size(); ++j) {
       if (!(on_wall[j].norm() > 0.0)) continue;
       const auto [a, b] = ends_[j];
@@ -686,6 +687,7 @@ class Coupled {
       } else {
         add(a, 0.5 * on_wall[j]);
         add(b, 0.5 * on_wall[j]);
+        ++out.pressed_edge_nodes;
       }
     }
     out.pressed.clear();

@@ -239,6 +239,9 @@ struct PotentialContactSolution {
   std::vector<int> pressed;
   std::vector<double> force;
   std::vector<Vec3> direction;
+  /// How many of the pressed candidates are a P2 wall's mid-edge nodes (their forces are in
+  /// `force`, half on each end of the edge).
+  int pressed_edge_nodes = 0;
   /// Per centreline node, the wall's contact force on it (N).
   std::vector<Vec3> force_on_wire;
   double max_penetration = 0.0;  ///< m, over every candidate
