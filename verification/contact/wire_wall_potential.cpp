@@ -44,6 +44,12 @@ double LinearWall::evaluate(const VectorXd& u, VectorXd* gradient,
   return 0.5 * u.dot(Ku) - s_.f.dot(u);
 }
 
+std::vector<EdgeNode> LinearWall::edge_nodes(const TetMesh& mesh,
+                                             const std::vector<std::array<int, 2>>& edges) const {
+  if (s_.free_index.size() == 3 * s_.node_rows.size()) return {};  // a DoF per vertex: P1
+  return mid_edge_nodes(s_, mesh, edges);
+}
+
 double LinearWall::largest_strain(const TetMesh& mesh, const VectorXd& u) const {
   return contact::largest_strain(mesh, nodal(u)).small;
 }
@@ -64,7 +70,9 @@ std::vector<EdgeNode> NeoHookeanWall::edge_nodes(
 
 std::vector<EdgeNode> mid_edge_nodes(const fem::FreeDisplacementSystem& system, const TetMesh& mesh,
                                      const std::vector<std::array<int, 2>>& edges) {
-  if (system.row_points.size() != system.row_components.size()) {
+  const auto free_rows = static_cast<std::size_t>(std::count_if(
+      system.free_index.begin(), system.free_index.end(), [](int r) { return r >= 0; }));
+  if (system.row_points.size() != free_rows || system.row_components.size() != free_rows) {
     throw std::logic_error("mid_edge_nodes: the system's row points are not filled");
   }
   // The support points, each with its rows, sorted by x for a slab search.

@@ -100,6 +100,10 @@ class LinearWall final : public WallPotential {
   [[nodiscard]] const std::vector<std::array<int, 3>>& node_rows() const override {
     return s_.node_rows;
   }
+  /// P2: the mid-edge nodes (mid_edge_nodes; std::logic_error if the system's row points are not
+  /// filled: ElasticitySolver::set_row_points). None for a system with only the vertices' rows.
+  [[nodiscard]] std::vector<EdgeNode> edge_nodes(
+      const TetMesh& mesh, const std::vector<std::array<int, 2>>& edges) const override;
   double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
                   Eigen::SparseMatrix<double>* hessian, bool project_psd = false) const override;
   [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;

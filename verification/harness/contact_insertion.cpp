@@ -137,7 +137,9 @@ InsertionWall make_wall(const Scene& scene, const TetMesh& mesh, const ContactIn
       w.potential = std::make_unique<contact::NeoHookeanWall>(mesh, problem);
     } else {
       const fem::ElasticitySolver solver(mesh, problem);
-      w.potential = std::make_unique<contact::LinearWall>(solver.free_displacement_system());
+      fem::FreeDisplacementSystem system = solver.free_displacement_system();
+      solver.set_row_points(system);  // where a P2 wall's mid-edge contact candidates are
+      w.potential = std::make_unique<contact::LinearWall>(std::move(system));
     }
     return w;
   }

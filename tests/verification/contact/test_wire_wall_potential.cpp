@@ -300,12 +300,11 @@ TEST(NeoHookeanWall, StateMatchesLinearLimitAndFiniteDifferences) {
   EXPECT_LT((hd - fd).norm(), 1e-6 * hd.norm());
 }
 
-// A P2 wall's mid-edge nodes (NeoHookeanWall::edge_nodes): one per inner-wall edge whose middle
-// is not held (the clamped ends hold the edges lying in them), at the chord's midpoint on
-// straight-sided tets and on the cylinder r = a, off the chord, with the tube's curved mapping;
-// their rows are their own (no vertex's, no other edge's). A P1 wall has none.
-TEST(NeoHookeanWall, P2MidEdgeNodesSitAtTheInnerWallsEdgeMiddles) {
-  const TetMesh& mesh = tube_mesh();
+namespace {
+
+// The inner wall's edges (mesh node pairs, each once): derived here from its triangles, apart
+// from the solve's own list.
+std::vector<std::array<int, 2>> inner_wall_edges(const TetMesh& mesh) {
   std::vector<std::array<int, 2>> edges;
   for (const Triangle& t : mesh.group_triangles(mesh.require_group("inner_wall", 2, "tube"))) {
     for (int e = 0; e < 3; ++e) {
@@ -315,6 +314,18 @@ TEST(NeoHookeanWall, P2MidEdgeNodesSitAtTheInnerWallsEdgeMiddles) {
   }
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+}  // namespace
+
+// A P2 wall's mid-edge nodes (NeoHookeanWall::edge_nodes): one per inner-wall edge whose middle
+// is not held (the clamped ends hold the edges lying in them), at the chord's midpoint on
+// straight-sided tets and on the cylinder r = a, off the chord, with the tube's curved mapping;
+// their rows are their own (no vertex's, no other edge's). A P1 wall has none.
+TEST(NeoHookeanWall, P2MidEdgeNodesSitAtTheInnerWallsEdgeMiddles) {
+  const TetMesh& mesh = tube_mesh();
+  const std::vector<std::array<int, 2>> edges = inner_wall_edges(mesh);
   fem::ElasticityProblem problem = wall_problem(kWallE);
   EXPECT_TRUE(contact::NeoHookeanWall(mesh, problem).edge_nodes(mesh, edges).empty());
   problem.options.degree = 2;
@@ -356,6 +367,36 @@ TEST(NeoHookeanWall, P2MidEdgeNodesSitAtTheInnerWallsEdgeMiddles) {
       EXPECT_LT(off_chord, 1e-12);
     }
   }
+}
+
+// The linear wall's mid-edge nodes (LinearWall::edge_nodes) from deal.II's linear system: at P2
+// the same points as the neo-Hookean wall's (its own rows), with the system's row points filled;
+// without them a P2 system's candidates cannot be found and it says so; at P1 none.
+TEST(LinearWall, P2MidEdgeNodesAreTheNeoHookeanWallsPoints) {
+  const TetMesh& mesh = tube_mesh();
+  const std::vector<std::array<int, 2>> edges = inner_wall_edges(mesh);
+  fem::ElasticityProblem problem = wall_problem(kWallE);
+  EXPECT_TRUE(contact::LinearWall(fem::ElasticitySolver(mesh, problem).free_displacement_system())
+                  .edge_nodes(mesh, edges)
+                  .empty());
+  problem.options.degree = 2;
+  problem.curved_surfaces = fem::tube_curved_walls(kA, kA + 1e-3);
+  const fem::ElasticitySolver solver(mesh, problem);
+  fem::FreeDisplacementSystem system = solver.free_displacement_system();
+  EXPECT_THROW((void)contact::LinearWall(system).edge_nodes(mesh, edges), std::logic_error);
+  solver.set_row_points(system);
+  const std::vector<contact::EdgeNode> linear =
+      contact::LinearWall(std::move(system)).edge_nodes(mesh, edges);
+  const std::vector<contact::EdgeNode> neo_hookean =
+      contact::NeoHookeanWall(mesh, problem).edge_nodes(mesh, edges);
+  ASSERT_EQ(linear.size(), neo_hookean.size());
+  ASSERT_GT(linear.size(), 1000u);
+  double apart = 0.0;
+  for (std::size_t i = 0; i < linear.size(); ++i) {
+    EXPECT_EQ(std::tie(linear[i].a, linear[i].b), std::tie(neo_hookean[i].a, neo_hookean[i].b));
+    apart = std::max(apart, (linear[i].rest - neo_hookean[i].rest).norm());
+  }
+  EXPECT_LT(apart, 1e-15);
 }
 
 // A field carried from another mesh may fold a few cells (the solve's start is then refused):
@@ -600,9 +641,11 @@ TEST(WireWallPotentialSlow, RigidLimitApproachesTheRigidWallSolve) {
 // A P2 wall pressed at its mid-edge nodes too (PotentialContactOptions::mid_edge_candidates, the
 // default), on the structured tube: made 10⁶ times stiffer, its force is the rigid-wall solve's
 // against the faceted wall where the tip rests (the split faces lie in the same flat triangles),
-// as in the rigid-limit test above; at 30 times the scenes' wall (a dent of about r_w) the
-// wire's clamp and the wall's supports (its own internal forces on the held rows) balance to
-// 1e-9 of the force with mid-edge nodes among the pressed (their forces reach the wall whole).
+// as in the rigid-limit test above, and deal.II's linear P2 wall (LinearWall::edge_nodes) gives
+// the same force (1e-6) with its mid-edge nodes pressed; at 30 times the scenes' wall (a dent of
+// about r_w) the wire's clamp and the wall's supports (its own internal forces on the held rows)
+// balance to 1e-9 of the force with mid-edge nodes among the pressed (their forces reach the wall
+// whole).
 TEST(WireWallPotentialSlow, AP2WallPressedAtItsMidEdgeNodesMeetsTheRigidLimitAndBalances) {
   const TetMesh& mesh = tube_mesh();
   const std::vector<int> nodes = nodes_within(mesh, kAimPoint, 3e-3);
@@ -623,7 +666,20 @@ TEST(WireWallPotentialSlow, AP2WallPressedAtItsMidEdgeNodesMeetsTheRigidLimitAnd
         s.newton_iterations, s.seconds);
     EXPECT_GT(s.pressed_edge_nodes, 0);  // the balance holds with mid-edge nodes bearing
     EXPECT_LT((run.clamp + supports).norm(), 1e-9 * F);
-    if (stiffer > 1e3) EXPECT_NEAR(F / run.faceted_force, 1.0, 1e-4);
+    if (stiffer < 1e3) continue;
+    EXPECT_NEAR(F / run.faceted_force, 1.0, 1e-4);
+    // deal.II's linear P2 wall (LinearWall, its own assembly) at the same strain: the same force.
+    const fem::ElasticitySolver linear(mesh, problem);
+    fem::FreeDisplacementSystem system = linear.free_displacement_system();
+    linear.set_row_points(system);
+    const contact::LinearWall linear_wall(std::move(system));
+    const contact::PotentialContactSolution l =
+        potential_run(mesh, kAimPoint, linear_wall, nodes).solution;
+    std::printf("WIRE-WALL-POTENTIAL linear P2 wall x%g: F %.6e N (%+.2e), %d mid-edge nodes\n",
+                stiffer, l.total_force_on_wall().norm(), l.total_force_on_wall().norm() / F - 1,
+                l.pressed_edge_nodes);
+    EXPECT_GT(l.pressed_edge_nodes, 0);
+    EXPECT_NEAR(l.total_force_on_wall().norm(), F, 1e-6 * F);
   }
 }
 
