@@ -1373,8 +1373,11 @@ PotentialContactSolution solve_wire_wall_potential(msm::rods::Rod& rod, double r
     problem.forces(z, out);
     if (options.log) {
       *options.log << "potential contact: round " << round << ", " << n.iterations
-                   << " Newton steps, " << n.factorisations << " factorisations, residual "
-                   << n.residual << " N, " << out.pressed.size() << " pressed, force "
+                   << " Newton steps, " << n.factorisations << " factorisations ("
+                   << factor.solver().numeric_factorisations() << " by CHOLMOD so far, "
+                   << factor.solver().symbolic_analyses() << " analyses, "
+                   << factor.solver().factorisation_seconds() << " s), residual " << n.residual
+                   << " N, " << out.pressed.size() << " pressed, force "
                    << out.total_force_on_wall().norm() * 1e3 << " mN, penetration "
                    << out.max_penetration << " m" << std::endl;
     }
