@@ -15,12 +15,26 @@ double dot(const SparseColumn& u, const VectorXd& v) {
 
 }  // namespace
 
-const VectorXd& LowRankUpdatedSolve::solved_column(int id, const SparseColumn& u) {
-  const auto it = solved_.find(id);
-  if (it != solved_.end()) return it->second;
-  VectorXd dense = VectorXd::Zero(a_.rows());
-  for (std::size_t i = 0; i < u.rows.size(); ++i) dense[u.rows[i]] += u.values[i];
-  return solved_.emplace(id, a_.solve(dense)).first->second;
+void LowRankUpdatedSolve::solve_new_columns(const std::vector<int>& ids,
+                                            const std::vector<SparseColumn>& u) {
+  std::vector<std::size_t> fresh;
+  for (std::size_t j = 0; j < ids.size(); ++j) {
+    if (!solved_.contains(ids[j])) fresh.push_back(j);
+  }
+  if (fresh.empty()) return;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(a_.rows(), static_cast<Eigen::Index>(fresh.size()));
+  for (std::size_t k = 0; k < fresh.size(); ++k) {
+    const SparseColumn& column = u[fresh[k]];
+    for (std::size_t i = 0; i < column.rows.size(); ++i) {
+      dense(column.rows[i], static_cast<Eigen::Index>(k)) += column.values[i];
+    }
+  }
+  // One solve for every new column: the factor is read once for all of them, where a solve per
+  // column reads it per column (a large factor's solve is bound by reading it).
+  const Eigen::MatrixXd z = a_.solve_columns(dense);
+  for (std::size_t k = 0; k < fresh.size(); ++k) {
+    solved_.emplace(ids[fresh[k]], z.col(static_cast<Eigen::Index>(k)));
+  }
 }
 
 VectorXd LowRankUpdatedSolve::solve(const VectorXd& b, const std::vector<int>& ids,
@@ -29,8 +43,9 @@ VectorXd LowRankUpdatedSolve::solve(const VectorXd& b, const std::vector<int>& i
   VectorXd x = a_.solve(b);
   const auto r = static_cast<Eigen::Index>(ids.size());
   if (r == 0) return x;
+  solve_new_columns(ids, u);
   std::vector<const VectorXd*> z(ids.size());
-  for (std::size_t j = 0; j < ids.size(); ++j) z[j] = &solved_column(ids[j], u[j]);
+  for (std::size_t j = 0; j < ids.size(); ++j) z[j] = &solved_.at(ids[j]);
   Eigen::MatrixXd capacitance(r, r);
   VectorXd t(r);
   for (Eigen::Index i = 0; i < r; ++i) {

@@ -5,7 +5,8 @@
 ///   (A + U W Uᵀ)⁻¹ b = y − Z (W⁻¹ + UᵀZ)⁻¹ Uᵀ y,   y = A⁻¹ b,  Z = A⁻¹ U,  W = diag(w_j).
 /// Each column u_j is sparse (a few rows) and named by an id; A⁻¹u_j is solved once per id and
 /// kept, so the passes of an active-set iteration, whose changes from A are drawn from one set of
-/// columns, cost one solve with the factor per new column and a dense r × r system each.
+/// columns, cost one solve with the factor for a pass's new columns together (one sweep of the
+/// factor for all of them) and a dense r × r system each.
 #include <map>
 #include <vector>
 
@@ -30,7 +31,8 @@ class LowRankUpdatedSolve {
                                const std::vector<SparseColumn>& u, const std::vector<double>& w);
 
  private:
-  const VectorXd& solved_column(int id, const SparseColumn& u);
+  /// A⁻¹u_j for each column not solved yet, in one solve with several right-hand sides.
+  void solve_new_columns(const std::vector<int>& ids, const std::vector<SparseColumn>& u);
   const CholmodSolver& a_;
   std::map<int, VectorXd> solved_;
 };
