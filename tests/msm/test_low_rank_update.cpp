@@ -64,13 +64,14 @@ TEST(LowRankUpdatedSolve, EqualsTheUpdatedMatrixFactorisedDirectly) {
   LowRankUpdatedSolve update(factor);
   const VectorXd rhs = VectorXd::LinSpaced(n, -1.0, 2.0).array().sin();
 
-  // Every change, then (the kept solves reused) only the entering ones.
+  // The entering changes, then every change: the kept solves of the entering columns reused and
+  // the leaving ones solved beside them in one block.
   std::vector<int> ids;
   std::vector<SparseColumn> u;
   std::vector<double> w;
   for (int j = 0; j < 6; ++j) ids.push_back(j), u.push_back(leaving[j]), w.push_back(-k);
   for (int j = 0; j < 6; ++j) ids.push_back(6 + j), u.push_back(entering[j]), w.push_back(k);
-  for (const bool with_leaving : {true, false}) {
+  for (const bool with_leaving : {false, true}) {
     const std::size_t first = with_leaving ? 0 : 6;
     const std::vector<int> i(ids.begin() + first, ids.end());
     const std::vector<SparseColumn> c(u.begin() + first, u.end());
