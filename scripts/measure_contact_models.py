@@ -63,9 +63,9 @@ at finite strain (compressible neo-Hookean), each wall and the wire solved as on
 (`solve_wire_wall_potential`: the wire's capsule and its tip against the inner wall, frictionless,
 an augmented Lagrangian), every inner-wall node a candidate (a P2 wall's nodes at the middles of
 the inner wall's edges too); each EI after the first reached from the wall's equilibrium under the
-softer wire, in EI rungs a factor √10 apart. Every wall is on the
-same tet mesh (gmsh, refined to 0.08 mm within 1 mm of the rigid wire's contact and to 0.16 mm
-along the band the wire may bear on). Surface models: the contact acts on the inner wall, a
+softer wire, in EI rungs a factor √10 apart. Every wall is on the same tet mesh (gmsh, refined to
+0.08 mm within 1 mm of the rigid wire's contact and to 0.16 mm along the band the wire may bear
+on). Surface models: the contact acts on the inner wall, a
 mid-surface node's contact point being its inner-wall node carried with the mid-surface node's
 displacement. The zone is the pressed nodes' span along the axis and around it (arc length at the
 lumen); the dent the largest displacement of a pressed node; the tip error the distance between the
