@@ -192,15 +192,11 @@ struct PotentialState {
   Eigen::VectorXd x, u;
 };
 
-/// The EI ratio between the rungs from a softer wire's equilibrium to a stiffer one's (√10, the
-/// contact reference's default ContactReferenceOptions::continuation_ratio).
-constexpr double kStiffnessStep = 3.1622776601683795;
-
 /// The own-equilibrium solve of the wall under `w` (at bending stiffness EI, its rod `rod`).
 /// From `start` (the softer wire's equilibrium) if given: in rungs of EI (continuation_rungs,
-/// steps of kStiffnessStep), each solved from the last. Without a start, or if a rung fails (the
-/// log says which and why), from the rigid-lumen state with the wall at rest. The solution's time
-/// and Newton steps are the whole climb's (a failed rung's steps are not counted, its time is).
+/// steps of kContinuationRatio), each solved from the last. Without a start, or if a rung fails
+/// (the log says which and why), from the rigid-lumen state with the wall at rest. The solution's
+/// time and Newton steps are the whole climb's (a failed rung's time counts, its steps do not).
 PotentialContactSolution solve_own_equilibrium(
     msm::rods::DerRod& rod, const SceneWire& w, double EI, const WallPotential& wall,
     const TetMesh& mesh, const std::vector<int>& candidates, const RigidContact& rigid,
@@ -215,8 +211,8 @@ PotentialContactSolution solve_own_equilibrium(
   };
   if (start != nullptr) {
     Eigen::VectorXd x = start->x, u = start->u;
-    for (const double rung :
-         continuation_rungs(start->bending_stiffness * kStiffnessStep, kStiffnessStep, EI)) {
+    for (const double rung : continuation_rungs(start->bending_stiffness * kContinuationRatio,
+                                                kContinuationRatio, EI)) {
       PotentialContactOptions ro = o;
       ro.force_scale = o.force_scale * rung / EI;
       try {

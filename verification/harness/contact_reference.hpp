@@ -20,6 +20,7 @@
 #include "fem_reference/convergence.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "meshes/tet_mesh.hpp"
+#include "verification/contact/wire_wall_potential.hpp"
 #include "verification/scene.hpp"
 
 namespace vessel {
@@ -43,11 +44,9 @@ struct ContactReferenceOptions {
   int max_steps = 300;  ///< linearised contact steps per solve
   /// The neo-Hookean wall: a stiffer wire is reached by raising EI from this (N·m²) in steps of
   /// continuation_ratio, each solved from the last one's equilibrium (4e-7: the floppy wire of
-  /// the shipped scenes, which Newton reaches from the rigid-lumen state on their 14.24 kPa wall;
-  /// √10: on the straight scene 4e-6 → 1.26e-5 converges in 41 steps; 4e-6 → 4e-5 did not in
-  /// 300, measured with the wall's tangent left unprojected)
+  /// the shipped scenes, which Newton reaches from the rigid-lumen state on their 14.24 kPa wall)
   double continuation_from = 4e-7;
-  double continuation_ratio = 3.1622776601683795;
+  double continuation_ratio = contact::kContinuationRatio;
   /// The neo-Hookean wall: each solve after the first starts at the target EI from the solve
   /// before's equilibrium (its wall interpolated onto the new mesh), the rungs only if that
   /// fails; false: every solve climbs the rungs from the wall at rest.
