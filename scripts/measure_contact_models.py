@@ -107,6 +107,9 @@ def main():
                     "formulation) instead of the potential")
     ap.add_argument("--reference-degree", type=int, choices=(1, 2), default=2,
                     help="the degree of the reference FEM wall")
+    ap.add_argument("--threads", type=int, default=1,
+                    help="threads of the reference wall's factorisations (the models' walls are "
+                    "solved on one thread)")
     ap.add_argument("--scene", default=STRAIGHT,
                     help="the guidewire scene (verification/scenes/SCENE.toml)")
     ap.add_argument("--vesselverify", default=os.path.join(ROOT, "build", "verification",
@@ -134,6 +137,8 @@ def main():
         cmd.append("--active-set")
     if args.reference_degree != 2:
         cmd += ["--reference-degree", str(args.reference_degree)]
+    if args.threads != 1:
+        cmd += ["--threads", str(args.threads)]
     for ei in args.ei.split(","):
         cmd += ["--ei", ei]
     with open("/proc/loadavg") as f:
@@ -146,8 +151,9 @@ def main():
         sys.exit(f"measure_contact_models: {' '.join(cmd)} failed (exit {run.returncode})")
     with open("/proc/loadavg") as f:
         load_after = " ".join(f.read().split()[:3])
-    # a run uses one core: a 1-minute load above 1.5 means other work shared the machine
-    busy = max(float(load_before.split()[0]), float(load_after.split()[0])) > 1.5
+    # a run uses one core (the reference --threads): a 1-minute load half a core above that
+    # means other work shared the machine
+    busy = max(float(load_before.split()[0]), float(load_after.split()[0])) > args.threads + 0.5
     shared = " (other work sharing it: the times are upper bounds)" if busy else ""
     shown = ["vesselverify"] + cmd[1:]
     intro = wrapped((OWN_EQUILIBRIUM if args.own_equilibrium else INTRO).format(

@@ -17,6 +17,7 @@
 #include <tuple>
 
 #include "meshes/foundation/errors.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 #include "meshes/vessel_geometry.hpp"
 #include "schema_check.hpp"
 #include "test_helpers.hpp"
@@ -70,7 +71,8 @@ double continuum_force(const Scene& s, double EI) {
 // rigid lumen within 0.5 % (the wall's faceting and the capsule's sink between its nodes), the
 // continuum quarter-wave elastica's within the rod's own error (N = 32) plus that, and the zone is
 // at the rigid wire's contact, on the outer wall at the apex. (At 10^6 the potential's Newton
-// stalls at a residual of 3e-8 N, 4e-5 of the force scale.)
+// stalls at a residual of 3e-8 N, 4e-5 of the force scale.) The reference is factorised on two
+// threads; the solver threads are one again after the call.
 TEST(GuidewireContact, TheArchOnAWallTenThousandTimesStifferIsTheQuarterWaveElastica) {
   const Scene scene = shipped_scene("guidewire_arch.toml", {}, 1e4);
   contact::ContactModelsOptions o;
@@ -78,8 +80,11 @@ TEST(GuidewireContact, TheArchOnAWallTenThousandTimesStifferIsTheQuarterWaveElas
   o.reference_degree = 1;
   o.fine_size = 0.1e-3;
   o.fine_radius = 0.6e-3;
+  o.reference_threads = 2;
   o.log = &std::cerr;
+  set_solver_threads(1);
   const contact::ContactModels c = contact::solve_contact_models(scene, {}, o);
+  EXPECT_EQ(solver_threads(), 1);
   ASSERT_EQ(c.runs.size(), 1u);
   const contact::ContactModelsRun& run = c.runs.front();
   ASSERT_EQ(run.reference.failure, "") << run.reference.failure;
@@ -210,6 +215,21 @@ TEST(GuidewireContact, AVesselThatIsNeitherTheTubeNorTheArchIsRefused) {
     const std::string what = e.what();
     EXPECT_NE(what.find("guidewire_straight.toml"), std::string::npos) << what;
     EXPECT_NE(what.find("\"arch\""), std::string::npos) << what;
+  }
+}
+
+// The reference's thread count is refused below one, naming the option and what is expected.
+TEST(GuidewireContact, FewerThanOneReferenceThreadIsRefused) {
+  const Scene scene = read_scene(VESSEL_SCENES_DIR + "/guidewire_straight.toml");
+  contact::ContactModelsOptions o;
+  o.reference_threads = 0;
+  try {
+    (void)contact::solve_contact_models(scene, {}, o);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("reference_threads"), std::string::npos) << what;
+    EXPECT_NE(what.find("at least 1"), std::string::npos) << what;
   }
 }
 

@@ -49,6 +49,10 @@ struct ContactModelsOptions {
   /// holds (the arch's buckled wire, whose force hardly changes with its shape; most walls at
   /// EI 4e-6 on the straight tube's band-refined mesh).
   bool active_set = false;
+  /// Threads of the reference wall's sparse factorisations and solves (CHOLMOD's BLAS,
+  /// set_solver_threads). The models' walls are solved on one thread whatever this is, so their
+  /// times are comparable with each other and with a run's.
+  int reference_threads = 1;
   /// One line per wall and EI as it is solved, and an own-equilibrium solve's progress (per
   /// round and per 25 Newton steps), if set
   std::ostream* log = nullptr;
