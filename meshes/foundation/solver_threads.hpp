@@ -22,4 +22,17 @@ void set_solver_threads(int n);
 /// Applies the setting on the calling thread; every factorisation and solve calls it first.
 void apply_solver_threads();
 
+/// set_solver_threads(n) while it lives; the setting before it restored when it ends, also when
+/// the scope is left by an exception.
+class ScopedSolverThreads {
+ public:
+  explicit ScopedSolverThreads(int n) : saved_(solver_threads()) { set_solver_threads(n); }
+  ~ScopedSolverThreads() { set_solver_threads(saved_); }
+  ScopedSolverThreads(const ScopedSolverThreads&) = delete;
+  ScopedSolverThreads& operator=(const ScopedSolverThreads&) = delete;
+
+ private:
+  int saved_;
+};
+
 }  // namespace vessel

@@ -112,15 +112,13 @@ TEST_P(MatrixFree, ThreadedProductEqualsAssembledMatrixOnFreeRows) {
   // is cut into as many parts as threads.
   ASSERT_GE(test::short_tube_mesh(1).tets.size(), 3U * 32U * 8U);
   const ElasticitySolver s(test::short_tube_mesh(1), pressurised_tube(GetParam(), 0.3));
-  const int saved = solver_threads();
   for (const int threads : {2, 3}) {
-    set_solver_threads(threads);
+    const ScopedSolverThreads on(threads);
     EXPECT_LT(
         relative_product_difference(s, 13, [&](const auto& u) { return s.matrix_free_product(u); }),
         1e-12)
         << "P" << GetParam() << " on " << threads << " threads";
   }
-  set_solver_threads(saved);
 }
 
 // The sparse matrix MatrixFreeTools::compute_matrix builds from the same cell kernel (the P1

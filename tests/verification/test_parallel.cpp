@@ -91,3 +91,12 @@ TEST(ParallelSolves, OneTaskAtATimeGetsEveryCore) {
   EXPECT_EQ(solver_threads_per_task(2, 3), 1);  // never below one thread
   EXPECT_EQ(solver_threads(), 1);
 }
+
+// A task that throws: the error reaches the caller and the process's setting is restored.
+TEST(ParallelSolves, TheSettingIsRestoredWhenATaskThrows) {
+  set_solver_threads(1);
+  EXPECT_THROW(parallel_solves(
+                   2, 1, [](std::size_t) { throw std::runtime_error("a failed solve"); }, 4),
+               std::runtime_error);
+  EXPECT_EQ(solver_threads(), 1);
+}

@@ -430,18 +430,6 @@ bool same_contact_wall(const ModelSpec& a, const ModelSpec& b) {
 
 namespace {
 
-/// set_solver_threads(n) while it lives; the setting before restored when it ends.
-class SolverThreads {
- public:
-  explicit SolverThreads(int n) : saved_(solver_threads()) { set_solver_threads(n); }
-  ~SolverThreads() { set_solver_threads(saved_); }
-  SolverThreads(const SolverThreads&) = delete;
-  SolverThreads& operator=(const SolverThreads&) = delete;
-
- private:
-  int saved_;
-};
-
 /// The progress line of one wall's contact at one EI (a failed one: the seconds it took to fail).
 void log_contact(std::ostream& log, const ModelSpec& wall, std::size_t index, std::size_t walls,
                  double EI, const ModelContact& c, double failed_after) {
@@ -526,7 +514,7 @@ void solve_every_wall(const Scene& scene, const std::vector<ModelSpec>& models,
           return same_contact_wall(*w, *walls[k]);
         });
     if (twin == here) {
-      const SolverThreads threads(k == 0 ? options.reference_threads : 1);
+      const ScopedSolverThreads threads(k == 0 ? options.reference_threads : 1);
       solve_wall_at_every_stiffness(scene, *walls[k], k, walls.size(), wires, rigid, p, options,
                                     out);
       continue;

@@ -41,7 +41,7 @@ void parallel_solves(std::size_t n, int jobs, const std::function<void(std::size
                      int cores) {
   if (cores <= 0) cores = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
   const auto width = static_cast<std::size_t>(std::max(1, jobs));
-  const int saved = solver_threads();
+  const ScopedSolverThreads restore_at_end(solver_threads());
   std::mutex share_mutex;
   std::size_t unfinished = n;
   // The tasks running or waiting share the cores: set before the first and as each one ends.
@@ -49,23 +49,17 @@ void parallel_solves(std::size_t n, int jobs, const std::function<void(std::size
     set_solver_threads(solver_threads_per_task(cores, std::min(width, unfinished)));
   };
   share();
-  try {
-    parallel_for(n, jobs, [&](std::size_t i) {
-      struct AtEnd {  // counts the task out, also when it throws
-        std::function<void()> run;
-        ~AtEnd() { run(); }
-      } const count_out{[&] {
-        const std::lock_guard lock(share_mutex);
-        --unfinished;
-        share();
-      }};
-      task(i);
-    });
-  } catch (...) {
-    set_solver_threads(saved);
-    throw;
-  }
-  set_solver_threads(saved);
+  parallel_for(n, jobs, [&](std::size_t i) {
+    struct AtEnd {  // counts the task out, also when it throws
+      std::function<void()> run;
+      ~AtEnd() { run(); }
+    } const count_out{[&] {
+      const std::lock_guard lock(share_mutex);
+      --unfinished;
+      share();
+    }};
+    task(i);
+  });
 }
 
 }  // namespace vessel
