@@ -137,8 +137,7 @@ def main():
         cmd.append("--active-set")
     if args.reference_degree != 2:
         cmd += ["--reference-degree", str(args.reference_degree)]
-    if args.threads != 1:
-        cmd += ["--threads", str(args.threads)]
+    cmd += ["--threads", str(args.threads)]
     for ei in args.ei.split(","):
         cmd += ["--ei", ei]
     with open("/proc/loadavg") as f:

@@ -75,7 +75,9 @@ def main():
     runs = []
     for scene in args.scenes.split(","):
         path = os.path.join("verification/scenes", scene + ".toml")
-        cmd = [args.program, "contact", path] + args.extra
+        # the scenes run side by side: one core each unless the extra flags say otherwise
+        threads = [] if any(a.startswith("--threads") for a in args.extra) else ["--threads", "1"]
+        cmd = [args.program, "contact", path] + threads + args.extra
         runs.append((scene, cmd, load_average(), time.monotonic(),
                      subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE,
                                       stderr=subprocess.PIPE, text=True)))

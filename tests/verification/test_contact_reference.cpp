@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "meshes/foundation/errors.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/rods/rod_layout.hpp"
 #include "reports/insertion_section.hpp"
@@ -72,6 +73,10 @@ TEST(ContactReference, RefusesASceneWithoutAGuidewireAndABadStiffness) {
   bad_rungs.continuation_ratio = 1.0;
   expect_input_error([&] { (void)solve_contact_reference(wire, 4e-7, bad_rungs); },
                      {"continuation ratio > 1"});
+  ContactReferenceOptions no_threads;
+  no_threads.threads = 0;
+  expect_input_error([&] { (void)solve_contact_reference(wire, 4e-7, no_threads); },
+                     {"threads ≥ 1"});
   expect_input_error([] { (void)parse_contact_wall("hyperelastic"); },
                      {"linear", "neo-hookean", "hyperelastic"});
   EXPECT_EQ(parse_contact_wall("neo-hookean"), ContactWall::neo_hookean);
@@ -399,7 +404,10 @@ TEST(ContactReferenceSlow, StraightSceneFloppyWireOnTheNeoHookeanWall) {
   o.levels = 2;
   o.coarsest_size = 0.1e-3;
   o.ratio = 1.25;
+  o.threads = 2;  // the wall's factorisations on two threads, the process's one restored after
+  set_solver_threads(1);
   const ContactReference r = solve_contact_reference(scene, 4e-7, o);
+  EXPECT_EQ(solver_threads(), 1);
   print_contact_reference(r, std::cout);
   ASSERT_EQ(r.levels.size(), 2u);
   for (const ContactLevel& l : r.levels) {
@@ -435,6 +443,10 @@ TEST(ContactInsertion, RefusesASceneWithoutAGuidewireAnEmptyRangeAndAModelItDoes
   no_steps.steps = 0;
   expect_input_error([&] { (void)solve_contact_insertion(wire, 4e-7, no_steps); },
                      {"guidewire_straight.toml", "steps ≥ 1"});
+  ContactInsertionOptions no_threads;
+  no_threads.reference_threads = 0;
+  expect_input_error([&] { (void)solve_contact_insertion(wire, 4e-7, no_threads); },
+                     {"guidewire_straight.toml", "reference threads ≥ 1"});
   expect_input_error([&] { (void)solve_contact_insertion(wire, 0.0); },
                      {"guidewire_straight.toml", "EI"});
   ContactInsertionOptions unknown;
@@ -653,7 +665,10 @@ TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes
   o.steps = 4;
   o.view_at = 19.6e-3;  // the 3D view's step: the converged one nearest, 19.5 mm
   o.log = &std::cerr;
+  o.reference_threads = 2;  // the process's one thread restored after the insertion
+  set_solver_threads(1);
   const ContactInsertion r = solve_contact_insertion(scene, EI, o);
+  EXPECT_EQ(solver_threads(), 1);
   EXPECT_EQ(r.view.step, 1);
   EXPECT_FALSE(r.view.triangles.empty());
   std::cout << reports::insertion_markdown(

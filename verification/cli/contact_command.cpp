@@ -13,6 +13,7 @@
 #include "reports/svg_plot.hpp"
 #include "verification/cli/cache_options.hpp"
 #include "verification/cli/commands.hpp"
+#include "verification/cli/jobs_option.hpp"
 #include "verification/harness/contact_insertion.hpp"
 #include "verification/harness/contact_reference.hpp"
 #include "verification/scene.hpp"
@@ -142,6 +143,9 @@ void add_contact_command(CLI::App& app) {
   cmd->add_flag("--from-rest", o->from_rest,
                 "Neo-Hookean wall: every level climbs the EI rungs from the wall at rest, instead "
                 "of starting from the level before's equilibrium");
+  add_threads_option(*cmd, o->options.threads,
+                     "Threads of the wall's factorisations (CHOLMOD's BLAS; default: the core "
+                     "count)");
   cmd->callback([o] {
     o->options.log = &std::cerr;  // progress; the table goes to stdout
     o->options.wall = parse_contact_wall(o->wall);
@@ -210,6 +214,10 @@ void add_insertion_command(CLI::App& app, const std::string& command_line) {
                   "at its own equilibrium)")
       ->delimiter(',')
       ->capture_default_str();
+  add_threads_option(*cmd, o->options.reference_threads,
+                     "Threads of the reference wall's factorisations (CHOLMOD's BLAS; default: "
+                     "the core count); a model's wall is solved on one thread, its times a "
+                     "simulator's on one core");
   add_cache_options(*cmd, o->cache);
   cmd->add_flag("--retime", o->cache.retime,
                 "Solve every insertion again (and replace its entry in the outcome cache) instead "

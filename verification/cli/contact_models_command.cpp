@@ -10,6 +10,7 @@
 #include "meshes/vessel_geometry.hpp"
 #include "reports/document.hpp"
 #include "verification/cli/commands.hpp"
+#include "verification/cli/jobs_option.hpp"
 #include "verification/contact_models/contact_models.hpp"
 
 namespace vessel::cli {
@@ -147,11 +148,10 @@ void add_contact_models_command(CLI::App& app) {
                 "Each model at its own nonlinear equilibrium (its own energy) and the reference at "
                 "finite strain (neo-Hookean FEM), the wire and each wall solved as one potential; "
                 "default: every wall linearised at rest");
-  cmd->add_option("--threads", o->options.reference_threads,
-                  "Threads of the reference wall's factorisations (CHOLMOD's BLAS); the models' "
-                  "walls are solved on one thread, their times comparable")
-      ->check(CLI::Range(1, 1024))
-      ->capture_default_str();
+  add_threads_option(*cmd, o->options.reference_threads,
+                     "Threads of the reference wall's factorisations (CHOLMOD's BLAS; default: "
+                     "the core count); the models' walls are solved on one thread, their times "
+                     "comparable");
   cmd->add_flag(
       "--from-rest", [o](std::int64_t) { o->options.from_softer_wire = false; },
       "With --own-equilibrium: every EI solved from the wall at rest, instead of from the wall's "

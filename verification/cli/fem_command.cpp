@@ -51,7 +51,7 @@ struct FemCommandOptions {
   double tolerance = fem::SolverOptions{}.cg_relative_tolerance;
   unsigned max_iterations = fem::SolverOptions{}.max_iterations;
   unsigned gmres_restart = fem::SolverOptions{}.gmres_restart;
-  int threads = default_jobs();
+  int threads = 1;  // --threads: the core count (add_threads_option)
   int modes = 0;
   bool curved = false;
   bool distributed = false;
@@ -703,11 +703,9 @@ void add_solver_options(CLI::App* cmd, FemCommandOptions& o) {
                   "gmres-block: Krylov basis size before FGMRES restarts (2 vectors each)")
       ->check(CLI::Range(2u, 2000u))
       ->capture_default_str();
-  cmd->add_option("--threads", o.threads,
-                  "Threads of the serial solve (CHOLMOD's BLAS, the matrix-free operator's "
-                  "cells; default: the core count)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
+  add_threads_option(*cmd, o.threads,
+                     "Threads of the serial solve (CHOLMOD's BLAS, the matrix-free operator's "
+                     "cells; default: the core count)");
 }
 
 /// Curved geometry, modes, Richardson, MPI, transient and output files.

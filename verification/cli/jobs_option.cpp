@@ -14,6 +14,11 @@ void add_jobs_option(CLI::App& cmd, int& jobs, const std::string& what) {
   cmd.add_option("--jobs,-j", jobs, what)->check(CLI::Range(1, 1024));
 }
 
+void add_threads_option(CLI::App& cmd, int& threads, const std::string& what) {
+  threads = default_jobs();  // stated in words in `what`, as --jobs
+  cmd.add_option("--threads", threads, what)->check(CLI::Range(1, 1024));
+}
+
 void add_timing_options(CLI::App& cmd, int& repeats, int& updates) {
   cmd.add_option("--repeats", repeats, "Timed repeats per model solve (median reported)")
       ->check(CLI::Range(1, 100))

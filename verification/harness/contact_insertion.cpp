@@ -11,6 +11,7 @@
 #include "fem_reference/elasticity.hpp"
 #include "meshes/foundation/content_hash.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
@@ -332,11 +333,12 @@ void log_step(std::ostream& log, const InsertionStep& step) {
 void require_options(const std::string& file, const ContactInsertionOptions& o) {
   if (o.steps < 1 || !(o.first >= 0.0) || !(o.last >= 0.0) || !(o.fine_size > 0.0) ||
       !(o.refine_radius > 0.0) || (o.degree != 1 && o.degree != 2) || o.max_steps < 1 ||
-      !(o.view_at >= 0.0)) {
+      !(o.view_at >= 0.0) || o.reference_threads < 1) {
     throw InputError(file +
                      ": insertion options: expected steps ≥ 1, first and last ≥ 0 (0: the "
                      "defaults), a positive fine size and refined radius, degree 1 or 2, "
-                     "Newton steps ≥ 1 and a view length ≥ 0 (0: the last step)");
+                     "Newton steps ≥ 1, a view length ≥ 0 (0: the last step) and reference "
+                     "threads ≥ 1");
   }
 }
 
@@ -376,6 +378,7 @@ std::string insertion_key(const Scene& scene, double EI, const ContactInsertionO
   h.text(file_contents(scene.source)).real(EI).integer(static_cast<int>(o.wall));
   h.real(o.first).real(o.last).integer(o.steps).real(o.fine_size).real(o.refine_radius);
   h.integer(o.degree).integer(o.max_steps).text(o.model).real(o.view_at);
+  h.integer(o.model.empty() ? o.reference_threads : 1);  // the times depend on it
   return "contact-insertion " + h.hex();
 }
 
@@ -386,6 +389,7 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
   const std::string file = scene.source.string();
   double first = 0.0, last = 0.0;
   const GuidewireSpec spec = insertion_spec(scene, EI, o, first, last);
+  const ScopedSolverThreads threads(o.model.empty() ? o.reference_threads : 1);
   ContactInsertion out;
   out.scene = scene.name;
   out.bending_stiffness = EI;

@@ -47,6 +47,10 @@ struct ContactInsertionOptions {
   /// so its own nonlinear equilibrium; a linear FEM model's linear wall; contact_models/
   /// model_walls.hpp says how a surface model's thickness enters)
   std::string model;
+  /// Threads of the reference wall's factorisations (CHOLMOD's BLAS; set_solver_threads). A
+  /// model's wall is solved on one thread whatever this is, so its per-step times are a
+  /// simulator's on one core. The process's setting is restored after the insertion.
+  int reference_threads = 1;
   std::ostream* log = nullptr;  ///< per step a line, and the contact solve's progress, if set
 };
 

@@ -11,6 +11,7 @@
 
 #include "fem_reference/elasticity.hpp"
 #include "meshes/foundation/errors.hpp"
+#include "meshes/foundation/solver_threads.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/rods/der_rod.hpp"
 #include "verification/contact/wall_crossing.hpp"
@@ -683,12 +684,13 @@ ContactReference solve_contact_reference(const Scene& scene, double EI,
   if (o.levels < 1 || !(o.coarsest_size > 0.0) || !(o.ratio > 1.0) ||
       (o.degree != 1 && o.degree != 2) || !(o.margin >= 0.0) || !(o.band > 0.0) ||
       !(o.strain_limit > 0.0) || !(o.gci_limit > 0.0) || o.max_steps < 1 ||
-      !(o.continuation_from > 0.0) || !(o.continuation_ratio > 1.0)) {
+      !(o.continuation_from > 0.0) || !(o.continuation_ratio > 1.0) || o.threads < 1) {
     throw InputError(
         "contact reference options: expected levels ≥ 1, a positive coarsest size, "
         "ratio > 1, degree 1 or 2, margin ≥ 0, band > 0, strain limit > 0, GCI limit > 0, "
-        "steps ≥ 1, a positive continuation start and a continuation ratio > 1");
+        "steps ≥ 1, a positive continuation start, a continuation ratio > 1 and threads ≥ 1");
   }
+  const ScopedSolverThreads threads(o.threads);
   GuidewireSpec spec;
   try {
     spec = with_stiffness(*scene.load.guidewire, EI);

@@ -51,6 +51,9 @@ struct ContactReferenceOptions {
   /// before's equilibrium (its wall interpolated onto the new mesh), the rungs only if that
   /// fails; false: every solve climbs the rungs from the wall at rest.
   bool from_previous_solve = true;
+  /// Threads of the wall's factorisations (CHOLMOD's BLAS; set_solver_threads) over the solve,
+  /// the process's setting restored after it
+  int threads = 1;
   std::ostream* log = nullptr;  ///< one line per solve (mesh, candidates, result), if set
 };
 
