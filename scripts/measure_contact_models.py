@@ -107,6 +107,9 @@ def main():
                     "formulation) instead of the potential")
     ap.add_argument("--reference-degree", type=int, choices=(1, 2), default=2,
                     help="the degree of the reference FEM wall")
+    ap.add_argument("--p1-start", action="store_true",
+                    help="with --own-equilibrium: the P2 reference solved from P1's equilibrium "
+                    "on the same mesh (it pays in the arch)")
     ap.add_argument("--threads", type=int, default=1,
                     help="threads of the reference wall's factorisations (the models' walls are "
                     "solved on one thread)")
@@ -138,6 +141,8 @@ def main():
     if args.reference_degree != 2:
         cmd += ["--reference-degree", str(args.reference_degree)]
     cmd += ["--threads", str(args.threads)]
+    if args.p1_start:
+        cmd.append("--p1-start")
     for ei in args.ei.split(","):
         cmd += ["--ei", ei]
     with open("/proc/loadavg") as f:

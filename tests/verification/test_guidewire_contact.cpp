@@ -386,5 +386,40 @@ TEST(GuidewireContactSlow, AStifferWireFromTheSofterWiresEquilibriumReachesItsOw
   }
 }
 
+// The P2 reference's own equilibrium started from P1's on the same mesh (ContactModelsOptions::
+// p2_from_p1) is the one P2 reaches alone from the rigid-lumen state: the straight scene's wire
+// at EI 4e-7 on its wall (0.16 mm mesh), the same force (1e-6) and pressed nodes, the P1 start
+// logged and not fallen back from.
+TEST(GuidewireContactSlow, TheP2ReferenceFromP1sEquilibriumReachesTheOneP2ReachesAlone) {
+  const Scene scene = shipped_scene("guidewire_straight.toml", {});
+  contact::ContactModelsOptions o;
+  o.bending_stiffness = {4e-7};
+  o.fine_size = 0.16e-3;
+  o.own_equilibrium = true;
+  o.p2_from_p1 = true;
+  ASSERT_EQ(o.reference_degree, 2);
+  std::ostringstream log;
+  o.log = &log;
+  const contact::ContactModels from_p1 = contact::solve_contact_models(scene, {}, o);
+  std::cerr << log.str();
+  EXPECT_NE(log.str().find("P1's equilibrium: F"), std::string::npos);
+  EXPECT_EQ(log.str().find("P2 from P1's equilibrium failed"), std::string::npos);
+  o.p2_from_p1 = false;
+  o.log = &std::cerr;
+  const contact::ContactModels alone = contact::solve_contact_models(scene, {}, o);
+  const contact::ModelContact& a = from_p1.runs.at(0).reference;
+  const contact::ModelContact& b = alone.runs.at(0).reference;
+  ASSERT_EQ(a.failure, "");
+  ASSERT_EQ(b.failure, "");
+  std::printf(
+      "GUIDEWIRE-CONTACT P2 reference at EI 4e-7 from P1's equilibrium: F %.6f mN, %d pressed, %d "
+      "steps (P1's included), %.1f s; alone: F %.6f mN, %d pressed, %d steps, %.1f s\n",
+      a.force * 1e3, a.pressed, a.steps, a.solve_seconds, b.force * 1e3, b.pressed, b.steps,
+      b.solve_seconds);
+  EXPECT_NEAR(a.force, b.force, 1e-6 * b.force);
+  EXPECT_EQ(a.pressed, b.pressed);
+  EXPECT_NE(a.detail.find("from P1's equilibrium"), std::string::npos) << a.detail;
+}
+
 }  // namespace
 }  // namespace vessel

@@ -68,6 +68,40 @@ std::vector<EdgeNode> NeoHookeanWall::edge_nodes(
   return mid_edge_nodes(dofs_, mesh, edges);
 }
 
+Eigen::VectorXd linear_field_rows(const WallPotential& wall, const TetMesh& mesh,
+                                  const std::vector<Vec3>& nodal) {
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(wall.num_dofs());
+  std::vector<char> set(static_cast<std::size_t>(wall.num_dofs()), 0);
+  const auto put = [&](int row, double value) {
+    if (row < 0) return;
+    u[row] = value;
+    set[static_cast<std::size_t>(row)] = 1;
+  };
+  for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
+    for (int c = 0; c < 3; ++c) put(wall.node_rows()[n][static_cast<std::size_t>(c)], nodal[n][c]);
+  }
+  std::vector<std::array<int, 2>> edges;
+  edges.reserve(6 * mesh.tets.size());
+  for (const Tet& t : mesh.tets) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      for (std::size_t j = i + 1; j < 4; ++j)
+        edges.push_back({std::min(t[i], t[j]), std::max(t[i], t[j])});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const EdgeNode& e : wall.edge_nodes(mesh, edges)) {
+    const Vec3 middle =
+        0.5 * (nodal[static_cast<std::size_t>(e.a)] + nodal[static_cast<std::size_t>(e.b)]);
+    for (int c = 0; c < 3; ++c) put(e.rows[static_cast<std::size_t>(c)], middle[c]);
+  }
+  if (std::find(set.begin(), set.end(), 0) != set.end()) {
+    throw std::logic_error(
+        "linear_field_rows: a row of the wall is at no vertex and no edge middle");
+  }
+  return u;
+}
+
 std::vector<EdgeNode> mid_edge_nodes(const fem::FreeDisplacementSystem& system, const TetMesh& mesh,
                                      const std::vector<std::array<int, 2>>& edges) {
   const auto free_rows = static_cast<std::size_t>(std::count_if(

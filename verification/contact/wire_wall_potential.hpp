@@ -169,6 +169,13 @@ class NeoHookeanWall final : public WallPotential {
 std::vector<EdgeNode> mid_edge_nodes(const fem::FreeDisplacementSystem& system, const TetMesh& mesh,
                                      const std::vector<std::array<int, 2>>& edges);
 
+/// The rows of `wall` (P1 or P2 on `mesh`) of the field linear in each tet with the values
+/// `nodal` at the mesh's nodes: a vertex's rows take its value, a mid-edge node's the mean of its
+/// edge's two (edge_nodes). A P2 wall's start from a P1 equilibrium on the same mesh.
+/// std::logic_error if a row is at no vertex and no edge's middle.
+Eigen::VectorXd linear_field_rows(const WallPotential& wall, const TetMesh& mesh,
+                                  const std::vector<Vec3>& nodal);
+
 /// A msm model's own energy as the wall: E(X + u) − E(X) over its free dofs with its exact
 /// gradient and Hessian, so the contact solve finds the model's own (nonlinear) equilibrium.
 /// `free_index` and `node_rows` as form_wall_system (contact_models/model_walls.hpp) gives them.

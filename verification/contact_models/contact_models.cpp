@@ -191,6 +191,8 @@ std::string wall_label(const ModelWall& wall, const ContactModelsOptions& option
 struct PotentialState {
   double bending_stiffness = 0.0;  ///< the wire's EI, N·m²
   Eigen::VectorXd x, u;
+  /// A P2 reference's P1 start at the same EI (solve_p2_from_p1): its wire and wall; empty if none
+  Eigen::VectorXd x_p1, u_p1;
 };
 
 /// The own-equilibrium solve of the wall under `w` (at bending stiffness EI, its rod `rod`).
@@ -246,6 +248,54 @@ PotentialContactSolution solve_own_equilibrium(
   return whole_climb(solve_wire_wall_potential(rod, w.radius, wall, mesh, candidates, rigid.x, o));
 }
 
+/// A P2 reference's own equilibrium from P1's on the same mesh: P1's (solve_own_equilibrium,
+/// from `start`'s P1 equilibrium where it has one), then P2's from P1's wire and P1's field at
+/// P2's rows (linear_field_rows). P1 climbs the EI rungs at a tenth of P2's cost per
+/// factorisation; P2's Newton then starts where P1's locked tets stopped (measured in contact.md:
+/// it pays in the arch, not on the straight tube's stiffer wires). If P2 fails from there, P2 as
+/// without the start (solve_own_equilibrium). The solution's time and Newton steps include P1's.
+/// P1's equilibrium is left in `reached`'s x_p1 and u_p1.
+PotentialContactSolution solve_p2_from_p1(msm::rods::DerRod& rod, const SceneWire& w, double EI,
+                                          const NeoHookeanWall& p2, const NeoHookeanWall& p1,
+                                          const TetMesh& mesh, const std::vector<int>& candidates,
+                                          const RigidContact& rigid,
+                                          const PotentialContactOptions& o,
+                                          const PotentialState* start, bool& from_start,
+                                          PotentialState& reached) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::optional<PotentialState> p1_start;
+  if (start != nullptr && start->x_p1.size() > 0) {
+    p1_start = PotentialState{start->bending_stiffness, start->x_p1, start->u_p1, {}, {}};
+  }
+  msm::rods::DerRod p1_rod = rod;
+  bool p1_from_start = false;
+  const PotentialContactSolution s1 =
+      solve_own_equilibrium(p1_rod, w, EI, p1, mesh, candidates, rigid, o,
+                            p1_start ? &*p1_start : nullptr, p1_from_start);
+  reached.x_p1 = s1.x;
+  reached.u_p1 = s1.u;
+  if (o.log) {
+    *o.log << "contact-models:   P1's equilibrium: F " << s1.total_force_on_wall().norm() * 1e3
+           << " mN, " << s1.newton_iterations << " steps, " << s1.seconds << " s; P2 from there"
+           << std::endl;
+  }
+  const Eigen::VectorXd u = linear_field_rows(p2, mesh, p1.nodal(s1.u));
+  PotentialContactSolution s;
+  try {
+    s = solve_wire_wall_potential(rod, w.radius, p2, mesh, candidates, s1.x, o, u);
+    from_start = p1_from_start;
+  } catch (const std::runtime_error& e) {
+    if (o.log) {
+      *o.log << "contact-models:   P2 from P1's equilibrium failed (" << e.what()
+             << "); P2 without it" << std::endl;
+    }
+    s = solve_own_equilibrium(rod, w, EI, p2, mesh, candidates, rigid, o, start, from_start);
+  }
+  s.newton_iterations += s1.newton_iterations;
+  s.seconds = seconds_since(t0);
+  return s;
+}
+
 /// The wall and the wire as one potential: the wall linearised at rest (condensed on a band
 /// grown from the first candidates, CondensedLinearWall) or, with options.own_equilibrium, at its
 /// own equilibrium (a msm model's own energy, FormWall; deal.II's FEM as the neo-Hookean wall for
@@ -279,12 +329,17 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
     out.rounds = grown.rounds;
     potential = std::move(grown.wall);
   } else {
+    std::unique_ptr<NeoHookeanWall> p1;  // the P2 reference's start (solve_p2_from_p1)
     if (wall.energy.form) {
       potential = std::make_unique<FormWall>(*wall.energy.form, wall.energy.rest,
                                              wall.system.free_index, wall.system.node_rows);
     } else {
       potential = std::make_unique<NeoHookeanWall>(*p.mesh, wall_problem(scene, nu, spec.degree));
       out.detail += ", compressible neo-Hookean";
+      if (reference && spec.degree == 2 && options.p2_from_p1) {
+        p1 = std::make_unique<NeoHookeanWall>(*p.mesh, wall_problem(scene, nu, 1));
+        out.detail += ", from P1's equilibrium";
+      }
     }
     const std::vector<int> candidates =
         p.mesh->group_nodes(p.mesh->require_group("inner_wall", 2, "contact mesh"));
@@ -293,11 +348,17 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
     // Newton on a soft wall dented by millimetres oscillated there (175 steps against 45). (The
     // P2 reference pressed at its vertices alone stalled at EI 4e-5 either way; contact.md.)
     o.damped_newton = true;
-    s = solve_own_equilibrium(rod, w, EI, *potential, *p.mesh, candidates, rigid, o, start,
-                              out.from_softer_wire);
+    PotentialState state;
+    s = p1 ? solve_p2_from_p1(rod, w, EI, static_cast<const NeoHookeanWall&>(*potential), *p1,
+                              *p.mesh, candidates, rigid, o, start, out.from_softer_wire, state)
+           : solve_own_equilibrium(rod, w, EI, *potential, *p.mesh, candidates, rigid, o, start,
+                                   out.from_softer_wire);
     out.candidates = static_cast<int>(candidates.size());
     out.inverted_tets = potential->inverted_tets(*p.mesh, s.u);
-    reached = PotentialState{EI, s.x, s.u};
+    state.bending_stiffness = EI;
+    state.x = s.x;
+    state.u = s.u;
+    reached = std::move(state);
   }
   out.solve_seconds = s.seconds;
   out.setup_seconds = wall.setup_seconds + seconds_since(t0) - s.seconds;

@@ -42,6 +42,13 @@ struct ContactModelsOptions {
   /// a stiffer wire dents a soft wall by millimetres, which Newton from the wall at rest may not
   /// reach. false: every EI from rest.
   bool from_softer_wire = true;
+  /// At own equilibrium with a P2 reference: its equilibrium is first solved on P1 (the same mesh,
+  /// from P1's own equilibrium at the EI before where there is one), and P2 from there (P1's
+  /// wire, P1's field at P2's nodes); P2 as without it only if that fails. P1's factorisations
+  /// cost a tenth of P2's. It pays in the arch (EI 4e-7: P2 from P1's state at residual 9e-6 N
+  /// after 25 steps, from rest 5.5e-4 N) and not on the straight tube's stiffer wires (EI 4e-6:
+  /// 1.5e-3 N after 25 steps, where P2 alone converges through its rung in 55), so it is asked for.
+  bool p2_from_p1 = false;
   /// For walls linearised at rest. false: each wall with the wire as one potential on the wall
   /// condensed on a band of candidates grown from the first (condensed_wall_potential.hpp): an
   /// energy line search, a wire through the wall refused. true: the active set on the condensed

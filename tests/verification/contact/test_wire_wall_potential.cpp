@@ -369,6 +369,35 @@ TEST(NeoHookeanWall, P2MidEdgeNodesSitAtTheInnerWallsEdgeMiddles) {
   }
 }
 
+// A field linear in space, given at the mesh's nodes, onto a wall's rows (linear_field_rows): on
+// P1 and on straight-sided P2 every row takes the field's value at its own support point (the
+// rows' points deal.II reports), vertices and edge middles alike, to round-off.
+TEST(NeoHookeanWall, ALinearFieldAtTheNodesIsItselfOnP1AndP2Rows) {
+  const TetMesh& mesh = tube_mesh();
+  Eigen::Matrix3d A;
+  A << 0.01, -0.02, 0.03, 0.005, 0.015, -0.01, -0.02, 0.01, 0.025;
+  const Vec3 b(1e-4, -2e-4, 3e-4);
+  const auto field = [&](const Vec3& x) -> Vec3 { return A * x + b; };
+  std::vector<Vec3> nodal;
+  for (const Vec3& x : mesh.nodes) nodal.push_back(field(x));
+  fem::ElasticityProblem problem = wall_problem(kWallE);
+  for (const int degree : {1, 2}) {
+    problem.options.degree = degree;
+    const contact::NeoHookeanWall wall(mesh, problem);
+    const VectorXd u = contact::linear_field_rows(wall, mesh, nodal);
+    const fem::FreeDisplacementSystem& rows = wall.dofs();
+    ASSERT_EQ(u.size(), static_cast<Eigen::Index>(rows.row_points.size()));
+    double worst = 0.0;
+    for (std::size_t r = 0; r < rows.row_points.size(); ++r) {
+      const double exact = field(rows.row_points[r])[rows.row_components[r]];
+      worst = std::max(worst, std::abs(u[static_cast<Eigen::Index>(r)] - exact));
+    }
+    std::printf("WIRE-WALL-POTENTIAL linear field on P%d rows: %zu rows, largest error %.2e m\n",
+                degree, rows.row_points.size(), worst);
+    EXPECT_LT(worst, 1e-15);
+  }
+}
+
 // The linear wall's mid-edge nodes (LinearWall::edge_nodes) from deal.II's linear system: at P2
 // the same points as the neo-Hookean wall's (its own rows), with the system's row points filled;
 // without them a P2 system's candidates cannot be found and it says so; at P1 none.
