@@ -155,7 +155,8 @@ void add_contact_models_command(CLI::App& app) {
   cmd->add_flag(
       "--p1-start", [o](std::int64_t) { o->options.p2_from_p1 = true; },
       "With --own-equilibrium and the P2 reference: P2 solved from P1's equilibrium on the same "
-      "mesh (P1's factorisations cost a tenth of P2's; it pays in the arch) instead of alone");
+      "mesh (a P1 factorisation takes a fortieth of P2's time; it pays in the arch) instead of "
+      "alone");
   cmd->add_flag(
       "--from-rest", [o](std::int64_t) { o->options.from_softer_wire = false; },
       "With --own-equilibrium: every EI solved from the wall at rest, instead of from the wall's "

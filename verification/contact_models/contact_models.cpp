@@ -250,8 +250,8 @@ PotentialContactSolution solve_own_equilibrium(
 
 /// A P2 reference's own equilibrium from P1's on the same mesh: P1's (solve_own_equilibrium,
 /// from `start`'s P1 equilibrium where it has one), then P2's from P1's wire and P1's field at
-/// P2's rows (linear_field_rows). P1 climbs the EI rungs at a tenth of P2's cost per
-/// factorisation; P2's Newton then starts where P1's locked tets stopped (measured in contact.md:
+/// P2's rows (linear_field_rows). P1 climbs the EI rungs at ~0.3 s per factorisation against
+/// P2's 10–13 s; P2's Newton then starts where P1's locked tets stopped (measured in contact.md:
 /// it pays in the arch, not on the straight tube's stiffer wires). If P2 fails from there, P2 as
 /// without the start (solve_own_equilibrium). The solution's time and Newton steps include P1's.
 /// P1's equilibrium is left in `reached`'s x_p1 and u_p1.

@@ -44,10 +44,11 @@ struct ContactModelsOptions {
   bool from_softer_wire = true;
   /// At own equilibrium with a P2 reference: its equilibrium is first solved on P1 (the same mesh,
   /// from P1's own equilibrium at the EI before where there is one), and P2 from there (P1's
-  /// wire, P1's field at P2's nodes); P2 as without it only if that fails. P1's factorisations
-  /// cost a tenth of P2's. It pays in the arch (EI 4e-7: P2 from P1's state at residual 9e-6 N
-  /// after 25 steps, from rest 5.5e-4 N) and not on the straight tube's stiffer wires (EI 4e-6:
-  /// 1.5e-3 N after 25 steps, where P2 alone converges through its rung in 55), so it is asked for.
+  /// wire, P1's field at P2's nodes); P2 as without it only if that fails. A P1 factorisation
+  /// takes ~0.3 s against P2's 10–13 s on the contact meshes. It pays in the arch (EI 4e-7: P2
+  /// from P1's state converges in 46 steps, from rest it had not in 50) and not on the straight
+  /// tube's stiffer wires (EI 4e-6: 1.5e-3 N after 25 steps, where P2 alone converges through
+  /// its rung in 55), so it is asked for.
   bool p2_from_p1 = false;
   /// For walls linearised at rest. false: each wall with the wire as one potential on the wall
   /// condensed on a band of candidates grown from the first (condensed_wall_potential.hpp): an
