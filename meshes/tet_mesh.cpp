@@ -134,6 +134,20 @@ Vec3 closest_point_on_triangle(const Vec3& a, const Vec3& b, const Vec3& c, cons
   return best;
 }
 
+std::vector<std::array<int, 2>> unique_edges(const TetMesh& mesh) {
+  std::vector<std::array<int, 2>> edges;
+  edges.reserve(6 * mesh.tets.size());
+  for (const Tet& t : mesh.tets) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      for (std::size_t j = i + 1; j < 4; ++j)
+        edges.push_back({std::min(t[i], t[j]), std::max(t[i], t[j])});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
 double mesh_volume(const TetMesh& mesh) {
   double v = 0.0;
   for (const auto& t : mesh.tets) {

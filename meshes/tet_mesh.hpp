@@ -88,6 +88,9 @@ Vec3 nearest_point_on_group(const TetMesh& mesh, std::string_view group, const V
 /// mesh file whose scene gives no thickness (the surface models' shell thickness).
 double estimate_wall_thickness(const TetMesh& mesh, std::string_view source);
 
+/// The tetrahedra's edges, each once as (smaller, larger) node index, in ascending order.
+std::vector<std::array<int, 2>> unique_edges(const TetMesh& mesh);
+
 /// Total volume of the tetrahedra, m³.
 double mesh_volume(const TetMesh& mesh);
 /// Total area of the group's triangles, m².

@@ -54,14 +54,9 @@ SpringNetwork build_volume_network(const TetMesh& mesh) {
   net.source_node.resize(mesh.nodes.size());
   for (std::size_t i = 0; i < mesh.nodes.size(); ++i) net.source_node[i] = static_cast<int>(i);
   net.tets = mesh.tets;
-  std::set<Edge> edges;
   // seed 001 §1 (Mollemans): "each vertex corresponds to each particle and each edge
   // corresponds to each spring".
-  for (const Tet& t : mesh.tets) {
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i + 1; j < 4; ++j) edges.insert(make_edge(t[i], t[j]));
-    }
-  }
+  const std::vector<std::array<int, 2>> edges = unique_edges(mesh);
   net.springs.reserve(edges.size());
   for (const auto& [a, b] : edges) {
     net.springs.push_back(make_spring(net.nodes, a, b, SpringFamily::volume));

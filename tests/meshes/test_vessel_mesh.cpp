@@ -103,6 +103,28 @@ TEST_P(VesselMesh, Level0HasEveryGroupAClosedOrientedBoundaryAndValidTets) {
   EXPECT_GT(q.radius_ratio.min, 0.05);
 }
 
+// A tube's wall (straight or bent, open at both ends) has Euler characteristic 0: V − E + F − T
+// = 0, every interior face shared by two tets, so F = (4T + F_boundary)/2.
+TEST_P(VesselMesh, TetEdgesAreListedOnceEachAndSatisfyEulersFormulaForATube) {
+  const TetMesh mesh = generate_vessel_mesh(params_for(GetParam(), 0));
+  const std::vector<std::array<int, 2>> edges = unique_edges(mesh);
+  EXPECT_TRUE(std::is_sorted(edges.begin(), edges.end()));
+  EXPECT_EQ(std::adjacent_find(edges.begin(), edges.end()), edges.end());
+  for (const auto& [a, b] : edges) ASSERT_LT(a, b);
+  const auto V = static_cast<long>(mesh.nodes.size()), T = static_cast<long>(mesh.tets.size());
+  const long F = (4 * T + static_cast<long>(boundary_faces(mesh).size())) / 2;
+  EXPECT_EQ(V - static_cast<long>(edges.size()) + F - T, 0);
+}
+
+TEST(UniqueEdges, TwoTetsSharingAFaceHaveNineEdges) {
+  TetMesh mesh;
+  mesh.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 1)};
+  mesh.tets = {{0, 1, 2, 3}, {3, 2, 1, 4}};
+  const std::vector<std::array<int, 2>> expected = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3},
+                                                    {1, 4}, {2, 3}, {2, 4}, {3, 4}};
+  EXPECT_EQ(unique_edges(mesh), expected);
+}
+
 TEST_P(VesselMesh, WallNodesLieOnTheirSurfaces) {
   const VesselParams p = params_for(GetParam(), 0);
   const TetMesh mesh = generate_vessel_mesh(p);

@@ -80,17 +80,7 @@ Eigen::VectorXd linear_field_rows(const WallPotential& wall, const TetMesh& mesh
   for (std::size_t n = 0; n < mesh.nodes.size(); ++n) {
     for (int c = 0; c < 3; ++c) put(wall.node_rows()[n][static_cast<std::size_t>(c)], nodal[n][c]);
   }
-  std::vector<std::array<int, 2>> edges;
-  edges.reserve(6 * mesh.tets.size());
-  for (const Tet& t : mesh.tets) {
-    for (std::size_t i = 0; i < 4; ++i) {
-      for (std::size_t j = i + 1; j < 4; ++j)
-        edges.push_back({std::min(t[i], t[j]), std::max(t[i], t[j])});
-    }
-  }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  for (const EdgeNode& e : wall.edge_nodes(mesh, edges)) {
+  for (const EdgeNode& e : wall.edge_nodes(mesh, unique_edges(mesh))) {
     const Vec3 middle =
         0.5 * (nodal[static_cast<std::size_t>(e.a)] + nodal[static_cast<std::size_t>(e.b)]);
     for (int c = 0; c < 3; ++c) put(e.rows[static_cast<std::size_t>(c)], middle[c]);
