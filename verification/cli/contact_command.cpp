@@ -52,8 +52,10 @@ void add_scene_stiffness_wall(CLI::App* cmd, std::filesystem::path& scene, std::
                   "stiffness_sweep, or its wire's own EI)")
       ->delimiter(',');
   cmd->add_option("--wall", wall,
-                  "The wall: linear (condensed, active set in the contact reference) or "
-                  "neo-hookean (finite strain, the wire and the wall as one potential)")
+                  "The wall: linear (`contact`: condensed on the contact candidates, the "
+                  "contact by the active set; `insertion`: the whole wall, factorised at every "
+                  "Newton step, with the wire as one potential) or neo-hookean (finite strain, "
+                  "the wire and the wall as one potential)")
       ->check(CLI::IsMember({"linear", "neo-hookean"}))
       ->capture_default_str();
 }
