@@ -36,6 +36,18 @@ std::optional<std::size_t> WallPotential::inverted_tets(const TetMesh& mesh,
   return vessel::inverted_tets(mesh, x);
 }
 
+WireThroughWall with_inverted_tets(const WireThroughWall& crossing, const WallPotential& wall,
+                                   const TetMesh& mesh) {
+  std::string what = crossing.what();
+  const std::optional<std::size_t> inverted = crossing.wall_rows.size() == wall.num_dofs()
+                                                  ? wall.inverted_tets(mesh, crossing.wall_rows)
+                                                  : std::nullopt;
+  if (inverted && *inverted > 0) {
+    what += " (" + std::to_string(*inverted) + " of the wall's tets inverted: it had folded)";
+  }
+  return {what, crossing.centreline, crossing.point, crossing.triangle, crossing.wall_rows};
+}
+
 double LinearWall::evaluate(const VectorXd& u, VectorXd* gradient,
                             Eigen::SparseMatrix<double>* hessian, bool /*project_psd*/) const {
   const VectorXd Ku = s_.K * u;
@@ -830,7 +842,7 @@ class Coupled {
             first_wall_crossing(mesh_, triangles, wall_.nodal(wall_rows(z)), centreline)) {
       throw WireThroughWall("the wire-wall potential " + when + ": " + describe(*crossing) + why,
                             std::move(centreline), crossing->point,
-                            triangles[static_cast<std::size_t>(crossing->triangle)]);
+                            triangles[static_cast<std::size_t>(crossing->triangle)], wall_rows(z));
     }
   }
 

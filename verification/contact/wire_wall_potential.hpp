@@ -269,16 +269,28 @@ struct PotentialContactSolution {
 /// The wire's centreline crossed the wall's inner surface (describe_wall_crossing) at the solve's
 /// start or after a Newton step: the capsule passed between the wall's nodes, whose gaps are open
 /// again on the far side, and a solve from there would converge outside the lumen. Holds that
-/// iterate's centreline nodes (m), where it crossed (m) and the crossed inner-wall triangle's
-/// mesh nodes, for a caller that refines the wall or widens its candidates where the wire bears.
+/// iterate's centreline nodes (m), where it crossed (m), the crossed inner-wall triangle's
+/// mesh nodes and the wall's rows (m), for a caller that refines the wall or widens its
+/// candidates where the wire bears, or asks whether the wall had folded there.
 struct WireThroughWall : std::runtime_error {
   WireThroughWall(const std::string& what, std::vector<Vec3> at, const Vec3& where,
-                  const Triangle& crossed)
-      : std::runtime_error(what), centreline(std::move(at)), point(where), triangle(crossed) {}
+                  const Triangle& crossed, Eigen::VectorXd rows)
+      : std::runtime_error(what),
+        centreline(std::move(at)),
+        point(where),
+        triangle(crossed),
+        wall_rows(std::move(rows)) {}
   std::vector<Vec3> centreline;
   Vec3 point;
   Triangle triangle;
+  Eigen::VectorXd wall_rows;
 };
+
+/// `crossing` with, where `wall` (whose rows the crossing holds) then had inverted tets, how many
+/// appended to its message: a folded wall, not only a coarse one, lets the wire through between
+/// its nodes.
+WireThroughWall with_inverted_tets(const WireThroughWall& crossing, const WallPotential& wall,
+                                   const TetMesh& mesh);
 
 /// Minimises Π from the wire at `start` (e.g. its rigid-lumen state) and the wall at
 /// `wall_start` (its free rows, m; empty: at rest), e.g. the equilibrium of a softer wire on the

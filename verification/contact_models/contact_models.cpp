@@ -349,10 +349,14 @@ ModelContact solve_wall_potential(const Scene& scene, const ModelSpec& spec, con
     // P2 reference pressed at its vertices alone stalled at EI 4e-5 either way; contact.md.)
     o.damped_newton = true;
     PotentialState state;
-    s = p1 ? solve_p2_from_p1(rod, w, EI, static_cast<const NeoHookeanWall&>(*potential), *p1,
-                              *p.mesh, candidates, rigid, o, start, out.from_softer_wire, state)
-           : solve_own_equilibrium(rod, w, EI, *potential, *p.mesh, candidates, rigid, o, start,
-                                   out.from_softer_wire);
+    try {
+      s = p1 ? solve_p2_from_p1(rod, w, EI, static_cast<const NeoHookeanWall&>(*potential), *p1,
+                                *p.mesh, candidates, rigid, o, start, out.from_softer_wire, state)
+             : solve_own_equilibrium(rod, w, EI, *potential, *p.mesh, candidates, rigid, o, start,
+                                     out.from_softer_wire);
+    } catch (const WireThroughWall& e) {
+      throw with_inverted_tets(e, *potential, *p.mesh);
+    }
     out.candidates = static_cast<int>(candidates.size());
     out.inverted_tets = potential->inverted_tets(*p.mesh, s.u);
     state.bending_stiffness = EI;

@@ -210,11 +210,13 @@ TEST(WireWallPotential, ACentrelineThroughTheWallIsRefusedNotSolved) {
   contact::PotentialContactOptions o;
   o.force_scale = w.EI / (kZc * kZc);
   const contact::NeoHookeanWall wall(mesh, wall_problem(kWallE));
+  std::optional<contact::WireThroughWall> last;
   const auto message = [&](const VectorXd& start, const std::vector<int>& candidates) {
     try {
       (void)contact::solve_wire_wall_potential(w.rod, w.radius, wall, mesh, candidates, start, o);
     } catch (const contact::WireThroughWall& e) {
       EXPECT_EQ(static_cast<int>(e.centreline.size()), w.layout.tip_node - w.layout.first_node + 1);
+      last = e;
       return std::string(e.what());
     } catch (const std::runtime_error& e) {
       return std::string("another error: ") + e.what();
@@ -240,6 +242,22 @@ TEST(WireWallPotential, ACentrelineThroughTheWallIsRefusedNotSolved) {
   const Vec3 middle(0, 0, 0.5 * kTubeLength);
   const VectorXd inverted =
       fem::interpolate_rows(wall.dofs(), [&](const Vec3& x) -> Vec3 { return 2.0 * (middle - x); });
+  // The crossing holds the wall's rows where it crossed: a whole wall adds nothing to its message;
+  // the same crossing on the wall turned inside out names its inverted tets, every tet but those
+  // at the clamped ends.
+  ASSERT_TRUE(last.has_value());
+  ASSERT_EQ(last->wall_rows.size(), wall.num_dofs());
+  EXPECT_EQ(std::string(contact::with_inverted_tets(*last, wall, mesh).what()), through);
+  contact::WireThroughWall folded = *last;
+  folded.wall_rows = inverted;
+  const std::string named = contact::with_inverted_tets(folded, wall, mesh).what();
+  const std::size_t at = named.rfind(" (");
+  ASSERT_NE(at, std::string::npos) << named;
+  EXPECT_EQ(named.substr(0, at), through);
+  const double count = std::stod(named.substr(at + 2));
+  EXPECT_GT(count, 0.8 * static_cast<double>(mesh.tets.size())) << named;
+  EXPECT_LE(count, static_cast<double>(mesh.tets.size())) << named;
+  EXPECT_NE(named.find("of the wall's tets inverted: it had folded)"), std::string::npos) << named;
   try {
     (void)contact::solve_wire_wall_potential(w.rod, w.radius, wall, mesh, nodes, rigid.x, o,
                                              inverted);
