@@ -300,3 +300,15 @@ TEST(Cli, RunPrintsTheGuidewiresSolvedForceAndWallPoint) {
   EXPECT_NEAR(std::hypot(x, y), 3.0, 1e-3);  // on the inner wall (radius 3 mm)
   EXPECT_NEAR(z, 20.0, 0.05);
 }
+
+// `contact --p1-start` starts a P2 finite-strain wall from P1's equilibrium: with a linear or a
+// P1 wall there is nothing to start, and the flag is refused rather than ignored.
+TEST(Cli, ContactRefusesAP1StartWithoutAP2FiniteStrainWall) {
+  const std::string scene = std::string(VESSEL_SCENES_DIR) + "/guidewire_straight.toml";
+  for (const std::string wall : {"--wall linear --degree 2", "--wall neo-hookean --degree 1"}) {
+    const auto r = vv("contact " + scene + " --p1-start " + wall);
+    EXPECT_NE(r.exit_code, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "--p1-start: expected --wall neo-hookean and --degree 2"))
+        << r.output;
+  }
+}

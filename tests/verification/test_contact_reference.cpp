@@ -421,6 +421,36 @@ TEST(ContactReferenceSlow, StraightSceneFloppyWireOnTheNeoHookeanWall) {
   EXPECT_EQ(r.verdict, "reference");
 }
 
+// A P2 finite-strain level solved from P1's equilibrium on its mesh (p1_start) reaches the
+// equilibrium P2 reaches on its own (the same force, zone and dent to the solve's tolerance),
+// and says it started there; without the option, it does not.
+TEST(ContactReferenceSlow, AP2LevelFromP1sEquilibriumReachesTheOneP2ReachesAlone) {
+  const Scene scene = shipped("guidewire_straight.toml");
+  ContactReferenceOptions o;
+  o.wall = ContactWall::neo_hookean;
+  o.degree = 2;
+  o.levels = 1;
+  o.coarsest_size = 0.12e-3;
+  const ContactReference alone = solve_contact_reference(scene, 4e-7, o);
+  o.p1_start = true;
+  const ContactReference from_p1 = solve_contact_reference(scene, 4e-7, o);
+  print_contact_reference(from_p1, std::cout);
+  ASSERT_EQ(alone.levels.size(), 1u);
+  ASSERT_EQ(from_p1.levels.size(), 1u);
+  const ContactLevel& a = alone.levels.front();
+  const ContactLevel& b = from_p1.levels.front();
+  ASSERT_TRUE(a.converged) << a.failure;
+  ASSERT_TRUE(b.converged) << b.failure;
+  EXPECT_FALSE(a.from_p1);
+  EXPECT_TRUE(b.from_p1);
+  std::printf(
+      "CONTACT-REFERENCE P2 alone %.7f mN (%d steps), from P1 %.7f mN (%d steps, P1's too)\n",
+      a.force * 1e3, a.steps, b.force * 1e3, b.steps);
+  EXPECT_NEAR(b.force, a.force, 1e-6 * a.force);
+  EXPECT_EQ(b.pressed, a.pressed);
+  EXPECT_NEAR(b.dent, a.dent, 1e-6 * a.dent);
+}
+
 // The insertion (verification/harness/contact_insertion.hpp): bad input refused with the file
 // named; on the straight scene the push computed from the clamp's force and moment (R·t − M²/2EI,
 // the Eshelby-like force of a rod leaving a sleeve) equals the derivative of the stored energy

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "meshes/foundation/atomic_file.hpp"
+#include "meshes/foundation/errors.hpp"
 #include "reports/insertion_section.hpp"
 #include "reports/study_files.hpp"
 #include "reports/svg_plot.hpp"
@@ -145,6 +146,10 @@ void add_contact_command(CLI::App& app) {
   cmd->add_flag("--from-rest", o->from_rest,
                 "Neo-Hookean wall: every level climbs the EI rungs from the wall at rest, instead "
                 "of starting from the level before's equilibrium");
+  cmd->add_flag("--p1-start", o->options.p1_start,
+                "With --wall neo-hookean and --degree 2: each level's P2 wall solved from P1's "
+                "equilibrium on the same mesh (P1 climbs the EI rungs; a P1 factorisation takes a "
+                "fortieth of P2's time), P2's own path where that fails");
   add_threads_option(*cmd, o->options.threads,
                      "Threads of the wall's factorisations (CHOLMOD's BLAS; default: the core "
                      "count)");
@@ -152,6 +157,12 @@ void add_contact_command(CLI::App& app) {
     o->options.log = &std::cerr;  // progress; the table goes to stdout
     o->options.wall = parse_contact_wall(o->wall);
     o->options.from_previous_solve = !o->from_rest;
+    if (o->options.p1_start &&
+        (o->options.wall != ContactWall::neo_hookean || o->options.degree != 2)) {
+      throw InputError(
+          "--p1-start: expected --wall neo-hookean and --degree 2 (a P2 "
+          "finite-strain wall solved from P1's equilibrium)");
+    }
     const Scene scene = read_scene(o->scene);
     for (const double EI : stiffnesses(scene, o->ei)) {
       print_contact_reference(solve_contact_reference(scene, EI, o->options), std::cout);

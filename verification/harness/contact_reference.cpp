@@ -323,11 +323,58 @@ std::optional<contact::PotentialContactSolution> climb_rungs(
   return s;
 }
 
+/// The P2 wall's equilibrium from P1's on the same mesh (ContactReferenceOptions::p1_start): P1
+/// reached as climb_rungs reaches it, its field interpolated onto P2's rows (linear_field_rows),
+/// then P2 at the wire's EI from there. Counts both solves' steps and P1's rungs in `out`;
+/// nothing if either fails or P1's wall gives way (the log says which).
+std::optional<contact::PotentialContactSolution> solve_from_p1(
+    const Scene& scene, const ReferenceWire& wire, double nu, const contact::NeoHookeanWall& p2,
+    const TetMesh& mesh, const std::vector<int>& nodes, contact::PotentialContactOptions po,
+    double force_scale, const ContactReferenceOptions& o, ContactLevel& out) {
+  const contact::NeoHookeanWall p1(mesh, wall_problem(scene, nu, 1));
+  ContactLevel p1_level;
+  std::optional<contact::PotentialContactSolution> s1;
+  try {
+    s1 =
+        climb_rungs(wire, p1, mesh, nodes, po, force_scale, scene.vessel.inner_radius, o, p1_level);
+  } catch (const std::runtime_error& e) {
+    if (o.log) *o.log << "contact:   P1 failed (" << e.what() << "); P2 alone" << std::endl;
+    return std::nullopt;
+  }
+  if (!s1) {
+    if (o.log) *o.log << "contact:   P1's wall gave way; P2 alone" << std::endl;
+    return std::nullopt;
+  }
+  if (o.log) {
+    *o.log << "contact:   P1's equilibrium: F " << s1->total_force_on_wall().norm() * 1e3 << " mN, "
+           << p1_level.steps << " steps; P2 from there" << std::endl;
+  }
+  ReferenceWire at_target = wire.with_bending_stiffness(wire.bending_stiffness);
+  po.force_scale = force_scale;
+  try {
+    contact::PotentialContactSolution s =
+        contact::solve_wire_wall_potential(at_target.rod, wire.radius, p2, mesh, nodes, s1->x, po,
+                                           contact::linear_field_rows(p2, mesh, p1.nodal(s1->u)));
+    out.steps = p1_level.steps + s.newton_iterations;
+    out.rungs = p1_level.rungs;
+    out.from_p1 = true;
+    return s;
+  } catch (const std::runtime_error& e) {
+    if (o.log) {
+      *o.log << "contact:   P2 from P1's equilibrium failed (" << e.what() << "); P2 alone"
+             << std::endl;
+    }
+    return std::nullopt;
+  }
+}
+
 /// The finite-strain wall: the wire and the neo-Hookean wall as one potential
 /// (solve_wire_wall_potential), every inner-wall node a candidate. A stiff wire dents the wall
 /// by millimetres, and Newton's method from the rigid-lumen state (the wall at rest) does not
-/// reach that equilibrium: with `from` (the solve before's equilibrium) the wire's EI is solved
-/// from there (solve_from_previous), else, or if that fails, reached in rungs (climb_rungs).
+/// reach that equilibrium: with options.p1_start on a P2 wall it is solved from P1's
+/// (solve_from_p1); else, or if that fails, with `from` (the solve before's equilibrium) the
+/// wire's EI is solved from there (solve_from_previous); else, or if that fails, reached in rungs
+/// (climb_rungs).
 /// The equilibrium reached is left in `reached`; false if a softer rung's wall gave way (`out`
 /// says where) and none was reached.
 bool solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, double nu,
@@ -349,13 +396,18 @@ bool solve_neo_hookean_wall(const Scene& scene, const ReferenceWire& wire, doubl
   // rung converged in 45 damped steps; undamped it oscillated for 175 (residual 5e-4-2.6e-3 N).
   po.damped_newton = true;
   std::optional<contact::PotentialContactSolution> s;
-  if (from != nullptr)
+  if (o.p1_start && o.degree == 2) {
+    s = solve_from_p1(scene, wire, nu, wall, mesh, nodes, po, force_scale, o, out);
+  }
+  if (!s && from != nullptr) {
     s = solve_from_previous(wire, wall, mesh, nodes, *from, po, force_scale, o.log);
-  if (s) {
-    out.steps = s->newton_iterations;
-    out.rungs = 1;
-    out.from_previous_solve = true;
-  } else {
+    if (s) {
+      out.steps = s->newton_iterations;
+      out.rungs = 1;
+      out.from_previous_solve = true;
+    }
+  }
+  if (!s) {
     s = climb_rungs(wire, wall, mesh, nodes, po, force_scale, scene.vessel.inner_radius, o, out);
     if (!s) return false;
   }
@@ -519,8 +571,8 @@ void print_level_row(const ContactLevel& l, std::ostream& out) {
       << fixed(l.extent * 1e3, 3) << (l.zone_inside_patch ? "" : " (leaves the patch)") << " | "
       << fixed(l.dent * 1e3, 3) << " | " << fixed(l.strain, 3) << " | " << l.steps
       << (l.rungs > 1 ? " in " + std::to_string(l.rungs) + " EI rungs" : std::string())
-      << (l.from_previous_solve ? " from the solve before" : "") << " | " << fixed(l.seconds, 1)
-      << " |\n";
+      << (l.from_previous_solve ? " from the solve before" : "")
+      << (l.from_p1 ? " (P1's, then P2's from it)" : "") << " | " << fixed(l.seconds, 1) << " |\n";
 }
 
 }  // namespace

@@ -51,6 +51,10 @@ struct ContactReferenceOptions {
   /// before's equilibrium (its wall interpolated onto the new mesh), the rungs only if that
   /// fails; false: every solve climbs the rungs from the wall at rest.
   bool from_previous_solve = true;
+  /// The neo-Hookean P2 wall: each level solved from P1's equilibrium on its mesh (P1 climbing
+  /// the EI rungs from the wall at rest, a P1 factorisation a fortieth of P2's time), P2's own
+  /// path (from the solve before, else the rungs) where that fails.
+  bool p1_start = false;
   /// Threads of the wall's factorisations (CHOLMOD's BLAS; set_solver_threads) over the solve,
   /// the process's setting restored after it
   int threads = 1;
@@ -84,6 +88,9 @@ struct ContactLevel {
   /// the neo-Hookean wall solved at the EI from the solve before (a coarser level's or the
   /// ungrown patch's equilibrium, interpolated onto this mesh), not from the wall at rest
   bool from_previous_solve = false;
+  /// the P2 wall solved at the EI from P1's equilibrium on this mesh (ContactReferenceOptions::
+  /// p1_start); `steps` and `rungs` count P1's too
+  bool from_p1 = false;
   double seconds = 0.0;  ///< meshing, condensing and solving this level
 };
 
