@@ -319,6 +319,7 @@ bool CholmodSolver::try_factorize(const SparseMatrix& A) {
     // Debian's reference BLAS the crossing was near 10k). Simplicial for the tiny test problems.
     llt_.setMode(A.rows() < 1000 ? Eigen::CholmodSimplicialLLt : Eigen::CholmodSupernodalLLt);
     llt_.analyzePattern(A);
+    flops_ = llt_.cholmod().fl;
     tree_.reset();  // planned for the old symbolic factor
     pattern_rows_ = A.rows();
     keep_pattern(A);

@@ -62,6 +62,9 @@ class CholmodSolver {
   /// Numbers stored in the factor L (supernodal: with the zeros of supernode amalgamation), what
   /// each triangular sweep of a solve reads; 0 before the first analysis.
   [[nodiscard]] double factor_entries() const;
+  /// Floating-point operations of one numeric factorisation (CHOLMOD's count at the symbolic
+  /// analysis); 0 before the first analysis.
+  [[nodiscard]] double factor_flops() const { return flops_; }
   [[nodiscard]] int symbolic_analyses() const { return analyses_; }
   [[nodiscard]] int numeric_factorisations() const { return factorisations_; }
   [[nodiscard]] double last_regularisation() const { return mu_; }
@@ -86,6 +89,7 @@ class CholmodSolver {
   std::vector<SparseMatrix::StorageIndex> pattern_inner_;
   int analyses_ = 0;
   int factorisations_ = 0;
+  double flops_ = 0.0;
   double mu_ = 0.0;
   double seconds_ = 0.0;
 };

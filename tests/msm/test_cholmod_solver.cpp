@@ -41,5 +41,21 @@ TEST(CholmodSolver, AnalysesAgainAMatrixWithTheSameCountButNotTheSamePattern) {
   EXPECT_LT((solver.solve(b) - 0.5 * expected).norm(), 1e-12 * expected.norm());
 }
 
+TEST(CholmodSolver, CountsAFactorisationsFlopsAsTheSumOfItsSquaredColumnCounts) {
+  // CHOLMOD's count (cholmod_rowcolcounts): Σ_j c_j² over L's column counts c_j. A dense matrix
+  // fills completely under any ordering: column counts n, n − 1, …, 1. A path has a fill-free
+  // ordering (from its ends, the one AMD finds): counts 2, …, 2, 1.
+  const int n = 40;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Constant(n, n, -0.1);
+  dense.diagonal().setConstant(10.0);
+  CholmodSolver full;
+  EXPECT_EQ(full.factor_flops(), 0.0);
+  full.factorize(dense.sparseView());
+  EXPECT_DOUBLE_EQ(full.factor_flops(), n * (n + 1) * (2 * n + 1) / 6.0);
+  CholmodSolver path;
+  path.factorize(path_with_link(n, 0, 1));
+  EXPECT_DOUBLE_EQ(path.factor_flops(), 4.0 * (n - 1) + 1.0);
+}
+
 }  // namespace
 }  // namespace vessel::msm

@@ -926,10 +926,11 @@ class NewtonFactor {
 /// The Newton model's matrix H(A) = B + Σ_{j∈A} k a_j a_jᵀ for the active sets A of one step's
 /// passes: H(A₀) factorised once, a later set's pairs that differ from A₀ applied as rank-one
 /// terms (+k entering, −k leaving; msm::LowRankUpdatedSolve), so a pass costs solves with the
-/// factor, not a factorisation. Past kMaxChanged such pairs H(A) is factorised afresh.
+/// factor, not a factorisation. Past most_changed() such pairs H(A) is factorised afresh.
 class ModelMatrix {
  public:
-  static constexpr std::size_t kMaxChanged = 64;
+  static constexpr std::size_t kFewestChanged = 64;
+  static constexpr double kColumnBytes = 256e6;  ///< the kept columns A⁻¹u_j, dense
 
   /// `shift` μ ≥ 0: Levenberg–Marquardt's damping, B + μ diag(|B|) in place of B. `regularise`
   /// as NewtonFactor::factorize.
@@ -967,7 +968,7 @@ class ModelMatrix {
       columns.push_back(column(j));
       weights.push_back(active[j] ? p_.stiffness() : -p_.stiffness());
     }
-    if (!update_ || ids.size() > kMaxChanged) {
+    if (!update_ || ids.size() > most_changed()) {
       if (!factorize(active)) return false;
       ids.clear();
       columns.clear();
@@ -1004,6 +1005,18 @@ class ModelMatrix {
     factored_ = active;
     update_ = std::make_unique<msm::LowRankUpdatedSolve>(factor_.solver());
     return true;
+  }
+
+  /// The changed pairs past which H(A) is factorised afresh: where their columns' solves with the
+  /// kept factor (two sweeps of L, 4 flops per entry of L and column) would cost more than a
+  /// factorisation (CHOLMOD's flop count), and at most as many columns as kColumnBytes hold;
+  /// never fewer than kFewestChanged. (The arch's P1 wall, 33 k rows: ~126 columns; a P2 wall of
+  /// 240 k rows is held to 133 by the memory.)
+  [[nodiscard]] std::size_t most_changed() const {
+    const msm::CholmodSolver& s = factor_.solver();
+    const double by_cost = s.factor_flops() / (4.0 * std::max(s.factor_entries(), 1.0));
+    const double by_memory = kColumnBytes / (8.0 * static_cast<double>(p_.size()));
+    return std::max(kFewestChanged, static_cast<std::size_t>(std::min(by_cost, by_memory)));
   }
 
   /// Pair j's gap gradient a_j on its free rows.
