@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "fem_reference/detail/matrix_free_elasticity.hpp"
@@ -88,7 +89,80 @@ struct PassStats {
   double min_jacobian = std::numeric_limits<double>::infinity();
   double energy = 0.0;     ///< ∫Ψ dV, J
   double dead_work = 0.0;  ///< f_dead · w at unit load (all DoFs), J
-  double max_abs_strain = 0.0;
+  double max_abs_strain = 0.0;  ///< with PassExtras::strain
+};
+
+/// What a pass computes besides the energy, the internal forces and its share of the tangent.
+struct PassExtras {
+  /// The dead loads f_dead and dead_work: left out (zero) where the load factor is 0 anyway.
+  bool dead_loads = true;
+  /// PassStats::max_abs_strain: a 3 × 3 eigenvalue problem per quadrature point.
+  bool strain = false;
+};
+
+/// The free rows' block of a cell-by-cell assembled matrix, assembled straight into its
+/// compressed columns: the pattern of every coupling of two free DoFs in a cell and, per cell in
+/// deal.II's active cell order, where each entry (i, j) of its local matrix goes (−1 where row
+/// or column is constrained). Entries are summed in cell order, as deal.II's SparseMatrix::add
+/// sums them.
+struct FreeBlockAssembly {
+  Eigen::SparseMatrix<double> pattern;  ///< n_free × n_free, compressed, values zero
+  std::vector<int> position;            ///< n_cells × n × n, row-major per cell
+  unsigned n = 0;                       ///< DoFs per cell
+
+  FreeBlockAssembly(const dl::DoFHandler<kDim>& dof, const std::vector<int>& free_index, int n_free)
+      : n(dof.get_fe().n_dofs_per_cell()) {
+    std::vector<Index> dofs(n);
+    std::vector<Eigen::Triplet<double>> t;
+    for (const auto& cell : dof.active_cell_iterators()) {
+      cell->get_dof_indices(dofs);
+      for (const Index a : dofs) {
+        for (const Index b : dofs) {
+          if (free_index[a] >= 0 && free_index[b] >= 0) {
+            t.emplace_back(free_index[a], free_index[b], 0.0);
+          }
+        }
+      }
+    }
+    pattern.resize(n_free, n_free);
+    pattern.setFromTriplets(t.begin(), t.end());
+    pattern.makeCompressed();
+    const int* outer = pattern.outerIndexPtr();
+    const int* inner = pattern.innerIndexPtr();
+    for (const auto& cell : dof.active_cell_iterators()) {
+      cell->get_dof_indices(dofs);
+      for (const Index a : dofs) {
+        for (const Index b : dofs) {
+          const int r = free_index[a], c = free_index[b];
+          if (r < 0 || c < 0) {
+            position.push_back(-1);
+            continue;
+          }
+          const int* at = std::lower_bound(inner + outer[c], inner + outer[c + 1], r);
+          position.push_back(static_cast<int>(at - inner));
+        }
+      }
+    }
+  }
+
+  /// values (the pattern's size) with the cell's local matrix k added at its positions.
+  void add(std::size_t cell, const dl::FullMatrix<double>& k, std::vector<double>& values) const {
+    const int* at = position.data() + cell * n * n;
+    for (unsigned i = 0; i < n; ++i) {
+      for (unsigned j = 0; j < n; ++j, ++at) {
+        if (*at >= 0) values[static_cast<std::size_t>(*at)] += k(i, j);
+      }
+    }
+  }
+
+  /// The pattern with `values`, its zero entries left out (as a matrix from triplets of the
+  /// non-zero values has them).
+  [[nodiscard]] Eigen::SparseMatrix<double> matrix(const std::vector<double>& values) const {
+    Eigen::SparseMatrix<double> m = pattern;
+    std::copy(values.begin(), values.end(), m.valuePtr());
+    m.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
+    return m;
+  }
 };
 
 }  // namespace
@@ -113,6 +187,7 @@ struct HyperelasticSolver::Impl {
   std::vector<double> prescribed;   // their values at load factor 1
   std::vector<int> free_index;      // per DoF its row among the unconstrained ones, −1 if constrained
   int n_free = 0;
+  std::optional<FreeBlockAssembly> free_block;  // free_state's Hessians' (built on first use)
   dl::Vector<double> pressure_volume;  // per pressure DoF: ∫ψ dV (scale of its residual)
   dl::Vector<double> u, internal;
   HyperelasticResult result;
@@ -181,11 +256,13 @@ struct HyperelasticSolver::Impl {
   /// r = f_int − f_follower − s f_dead and the share `tangent` of its tangent k = ∂r/∂u, handed
   /// to sink(dofs, k, r, r_int) with r_int = f_int alone.
   template <class Sink>
-  PassStats pass(const dl::Vector<double>& w, double s, bool with_matrix, Sink&& sink) const {
-    return pass(w, s, with_matrix ? Tangent::all : Tangent::none, sink);
+  PassStats pass(const dl::Vector<double>& w, double s, bool with_matrix, Sink&& sink,
+                 PassExtras extras = {}) const {
+    return pass(w, s, with_matrix ? Tangent::all : Tangent::none, sink, extras);
   }
   template <class Sink>
-  PassStats pass(const dl::Vector<double>& w, double s, Tangent tangent, Sink&& sink) const {
+  PassStats pass(const dl::Vector<double>& w, double s, Tangent tangent, Sink&& sink,
+                 PassExtras extras = {}) const {
     const bool with_matrix = tangent == Tangent::all;
     const unsigned n = d.fe->n_dofs_per_cell();
     detail::CellValues values(*d.mapping, *d.fe, d.degree);
@@ -209,12 +286,19 @@ struct HyperelasticSolver::Impl {
     PassStats stats;
 
     for (const auto& cell : d.dof.active_cell_iterators()) {
-      d.form->local_load(cell, values, f_dead, nullptr, dead_pressure);  // reinits values.cell
+      if (extras.dead_loads) {
+        d.form->local_load(cell, values, f_dead, nullptr, dead_pressure);  // reinits values.cell
+      } else {
+        values.cell.reinit(cell);
+        f_dead = 0.0;
+      }
       const auto& fev = values.cell;
       fev[disp].get_function_gradients(w, grad_u);
       if (mixed) fev[pres].get_function_values(w, p_h);
       cell->get_dof_indices(dofs);
-      for (unsigned i = 0; i < n; ++i) stats.dead_work += f_dead(i) * w(dofs[i]);
+      if (extras.dead_loads) {
+        for (unsigned i = 0; i < n; ++i) stats.dead_work += f_dead(i) * w(dofs[i]);
+      }
       k = 0.0;
       r_int = 0.0;
       for (unsigned q = 0; q < nq; ++q) {
@@ -234,10 +318,13 @@ struct HyperelasticSolver::Impl {
             0.5 * material.mu * (F.squaredNorm() - 3.0) - material.mu * ln_j +
             (mixed ? -p * ln_j - 0.5 * p * p * inv_lambda : 0.5 * material.lambda * ln_j * ln_j);
         stats.energy += psi * jxw;
-        const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
-        const Eigen::Vector3d ev =
-            Eigen::SelfAdjointEigenSolver<Mat3>().computeDirect(E, Eigen::EigenvaluesOnly).eigenvalues();
-        stats.max_abs_strain = std::max(stats.max_abs_strain, ev.cwiseAbs().maxCoeff());
+        if (extras.strain) {
+          const Mat3 E = 0.5 * (F.transpose() * F - Mat3::Identity());
+          const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Mat3>()
+                                         .computeDirect(E, Eigen::EigenvaluesOnly)
+                                         .eigenvalues();
+          stats.max_abs_strain = std::max(stats.max_abs_strain, ev.cwiseAbs().maxCoeff());
+        }
         // R_p = ∫ (−ln J − p/λ) ψ: stationarity of ∫ −p ln J − p²/(2λ) in p (p = −λ ln J).
         const double r_p = -ln_j - p * inv_lambda;
         for (unsigned i = 0; i < n; ++i) {
@@ -720,7 +807,7 @@ struct HyperelasticSolver::Impl {
     result.load_factor = s;
     set_prescribed_increment(0.0);
     const auto t0 = Clock::now();
-    const PassStats st = pass(u, s, false, [](auto&&...) {});
+    const PassStats st = pass(u, s, false, [](auto&&...) {}, {.strain = true});
     result.strain_energy = st.energy;
     result.max_abs_principal_strain = st.max_abs_strain;
     result.min_jacobian = st.min_jacobian;
@@ -901,8 +988,8 @@ void project_onto_psd_cone(dl::FullMatrix<double>& k) {
 }  // namespace
 
 FreeHyperelasticState HyperelasticSolver::free_state(const Eigen::VectorXd& u_free,
-                                                     bool with_tangent,
-                                                     bool project_tangent) const {
+                                                     FreeTangents tangents,
+                                                     bool with_strain) const {
   auto& im = *impl_;
   if (im.mixed) {
     throw InputError("the free DoFs' state is for the displacement formulation, not the mixed one");
@@ -914,40 +1001,33 @@ FreeHyperelasticState HyperelasticSolver::free_state(const Eigen::VectorXd& u_fr
   for (Index i = 0; i < w.size(); ++i) {
     if (im.free_index[i] >= 0) w(i) = u_free[im.free_index[i]];
   }
+  const bool exact = tangents == FreeTangents::exact || tangents == FreeTangents::both;
+  const bool projected = tangents == FreeTangents::projected || tangents == FreeTangents::both;
+  if ((exact || projected) && !im.free_block)
+    im.free_block.emplace(im.d.dof, im.free_index, im.n_free);
+  const auto nnz = static_cast<std::size_t>(im.free_block ? im.free_block->pattern.nonZeros() : 0);
+  std::vector<double> exact_values(exact ? nnz : 0), projected_values(projected ? nnz : 0);
   FreeHyperelasticState out;
   out.gradient = Eigen::VectorXd::Zero(im.n_free);
-  if (with_tangent) {
-    im.d.ensure_matrix();
-    im.d.matrix = 0.0;  // scratch: the assembled path's matrix
-  }
-  std::vector<Index> cols;
-  std::vector<double> vals;
-  dl::FullMatrix<double> projected;
+  dl::FullMatrix<double> k_projected;
+  std::size_t cell = 0;
   // Load factor 0: the strain energy alone (loads and prescribed values are not applied).
-  const PassStats st = im.pass(
-      w, 0.0, with_tangent,
-      [&](const std::vector<Index>& dofs, const dl::FullMatrix<double>& exact, const auto&,
-          const dl::Vector<double>& r_int) {
-        if (with_tangent && project_tangent) {
-          projected = exact;
-          project_onto_psd_cone(projected);
-        }
-        const dl::FullMatrix<double>& k = with_tangent && project_tangent ? projected : exact;
-        for (unsigned i = 0; i < dofs.size(); ++i) {
-          const int fi = im.free_index[dofs[i]];
-          if (fi < 0) continue;
-          out.gradient[fi] += r_int(i);
-          if (!with_tangent) continue;
-          cols.clear();
-          vals.clear();
-          for (unsigned j = 0; j < dofs.size(); ++j) {
-            if (im.free_index[dofs[j]] < 0) continue;
-            cols.push_back(dofs[j]);
-            vals.push_back(k(i, j));
-          }
-          im.d.matrix.add(dofs[i], static_cast<unsigned>(cols.size()), cols.data(), vals.data());
-        }
-      });
+  const PassStats st = im.pass(w, 0.0, exact || projected,
+                               [&](const std::vector<Index>& dofs, const dl::FullMatrix<double>& k,
+                                   const auto&, const dl::Vector<double>& r_int) {
+                                 for (unsigned i = 0; i < dofs.size(); ++i) {
+                                   const int fi = im.free_index[dofs[i]];
+                                   if (fi >= 0) out.gradient[fi] += r_int(i);
+                                 }
+                                 if (exact) im.free_block->add(cell, k, exact_values);
+                                 if (projected) {
+                                   k_projected = k;
+                                   project_onto_psd_cone(k_projected);
+                                   im.free_block->add(cell, k_projected, projected_values);
+                                 }
+                                 ++cell;
+                               },
+                               {.dead_loads = false, .strain = with_strain});
   out.admissible = st.valid;
   out.min_jacobian = st.min_jacobian;
   if (!st.valid) {
@@ -956,7 +1036,8 @@ FreeHyperelasticState HyperelasticSolver::free_state(const Eigen::VectorXd& u_fr
   }
   out.energy = st.energy;
   out.max_abs_principal_strain = st.max_abs_strain;
-  if (with_tangent) out.tangent = ElasticitySolver::Impl::free_block(im.d.matrix, im.free_index, im.n_free);
+  if (exact) out.tangent = im.free_block->matrix(exact_values);
+  if (projected) out.projected_tangent = im.free_block->matrix(projected_values);
   return out;
 }
 

@@ -122,9 +122,22 @@ struct FreeHyperelasticState {
   bool admissible = true;  ///< false when an element is inverted (J ≤ 0): energy +∞
   double energy = 0.0;     ///< ∫Ψ dV, J
   Eigen::VectorXd gradient;             ///< ∂/∂u of the energy on the free DoFs (internal forces), N
-  Eigen::SparseMatrix<double> tangent;  ///< its Hessian on the free DoFs, N/m (when asked)
-  double max_abs_principal_strain = 0.0;  ///< Green–Lagrange, at quadrature points
+  Eigen::SparseMatrix<double>
+      tangent;  ///< its Hessian on the free DoFs, N/m (FreeTangents exact, both)
+  /// The Hessian with each cell's tangent projected onto the positive semidefinite cone before
+  /// assembly, N/m (FreeTangents projected, both)
+  Eigen::SparseMatrix<double> projected_tangent;
+  /// Green–Lagrange, at quadrature points (free_state's with_strain; 0 otherwise)
+  double max_abs_principal_strain = 0.0;
   double min_jacobian = 1.0;
+};
+
+/// The Hessians free_state assembles.
+enum class FreeTangents {
+  none,
+  exact,      ///< FreeHyperelasticState::tangent
+  projected,  ///< FreeHyperelasticState::projected_tangent
+  both,       ///< both, from one pass over the cells
 };
 
 /// Solves a hyperelastic problem on one mesh (the ElasticityProblem's supports, loads, elements
@@ -172,15 +185,18 @@ class HyperelasticSolver {
   /// The cells (as free_rows_per_cell numbers them) inverted at u_free: J = det F ≤ 0 at one of
   /// their quadrature points, where free_state's energy is +∞.
   [[nodiscard]] std::vector<int> inverted_cells(const Eigen::VectorXd& u_free) const;
-  /// The strain energy, its gradient and (with_tangent) its Hessian at the displacement u_free
-  /// (m, one value per free row; the constrained DoFs at zero). An inverted element gives
-  /// admissible = false. Requires what free_dofs() requires. With project_tangent each cell's
-  /// tangent is projected onto the positive semidefinite cone before assembly (its negative
-  /// eigenvalues set to zero), so the Hessian is positive semidefinite where a compressed or
-  /// buckling wall's exact one is not: the projected Newton of minimisers (Teran et al. 2005,
-  /// "Robust quasistatic finite elements and flesh simulation").
-  [[nodiscard]] FreeHyperelasticState free_state(const Eigen::VectorXd& u_free, bool with_tangent,
-                                                 bool project_tangent = false) const;
+  /// The strain energy, its gradient and the Hessians `tangents` asks for at the displacement
+  /// u_free (m, one value per free row; the constrained DoFs at zero), and with_strain the
+  /// largest principal strain. An inverted element gives admissible = false. Requires what
+  /// free_dofs() requires. The projected Hessian has each cell's tangent projected onto the
+  /// positive semidefinite cone before assembly (its negative eigenvalues set to zero), so it is
+  /// positive semidefinite where a compressed or buckling wall's exact one is not: the projected
+  /// Newton of minimisers (Teran et al. 2005, "Robust quasistatic finite elements and flesh
+  /// simulation"). The Hessians are assembled straight into the free rows' compressed columns
+  /// (their pattern and each cell's positions in it built on first use).
+  [[nodiscard]] FreeHyperelasticState free_state(const Eigen::VectorXd& u_free,
+                                                 FreeTangents tangents = FreeTangents::none,
+                                                 bool with_strain = false) const;
 
   [[nodiscard]] std::size_t n_dofs() const;
   /// Per DoF: its component (0–2 displacement, 3 the mixed form's pressure).

@@ -48,6 +48,13 @@ WireThroughWall with_inverted_tets(const WireThroughWall& crossing, const WallPo
   return {what, crossing.centreline, crossing.point, crossing.triangle, crossing.wall_rows};
 }
 
+double WallPotential::evaluate_both(const VectorXd& u, VectorXd* gradient,
+                                    Eigen::SparseMatrix<double>& exact,
+                                    Eigen::SparseMatrix<double>& projected) const {
+  (void)evaluate(u, nullptr, &exact, false);
+  return evaluate(u, gradient, &projected, true);
+}
+
 double LinearWall::evaluate(const VectorXd& u, VectorXd* gradient,
                             Eigen::SparseMatrix<double>* hessian, bool /*project_psd*/) const {
   const VectorXd Ku = s_.K * u;
@@ -156,14 +163,27 @@ std::vector<EdgeNode> mid_edge_nodes(const fem::FreeDisplacementSystem& system, 
 
 double NeoHookeanWall::evaluate(const VectorXd& u, VectorXd* gradient,
                                 Eigen::SparseMatrix<double>* hessian, bool project_psd) const {
-  fem::FreeHyperelasticState s = solver_->free_state(u, hessian != nullptr, project_psd);
+  using fem::FreeTangents;
+  fem::FreeHyperelasticState s = solver_->free_state(u, !hessian      ? FreeTangents::none
+                                                        : project_psd ? FreeTangents::projected
+                                                                      : FreeTangents::exact);
   if (gradient) *gradient = std::move(s.gradient);
-  if (hessian) *hessian = std::move(s.tangent);
+  if (hessian) *hessian = std::move(project_psd ? s.projected_tangent : s.tangent);
+  return s.admissible ? s.energy : std::numeric_limits<double>::infinity();
+}
+
+double NeoHookeanWall::evaluate_both(const VectorXd& u, VectorXd* gradient,
+                                     Eigen::SparseMatrix<double>& exact,
+                                     Eigen::SparseMatrix<double>& projected) const {
+  fem::FreeHyperelasticState s = solver_->free_state(u, fem::FreeTangents::both);
+  if (gradient) *gradient = std::move(s.gradient);
+  exact = std::move(s.tangent);
+  projected = std::move(s.projected_tangent);
   return s.admissible ? s.energy : std::numeric_limits<double>::infinity();
 }
 
 double NeoHookeanWall::largest_strain(const TetMesh& /*mesh*/, const VectorXd& u) const {
-  return solver_->free_state(u, false).max_abs_principal_strain;
+  return solver_->free_state(u, fem::FreeTangents::none, true).max_abs_principal_strain;
 }
 
 namespace {
@@ -629,13 +649,16 @@ class Coupled {
   /// each bearing pair's curvature −w∇²d (w its curvature_weight; with `project`, the rod's and
   /// the wall's element blocks and those 12 × 12 blocks projected onto the PSD cone), and every
   /// pair within `band` of pressing with its gap's gradient, c = λ̂/k − g (pressed while
-  /// c − ∇g·dz > 0 in the model) and its multiplier.
+  /// c − ∇g·dz > 0 in the model) and its multiplier. With `project` and `exact_lin`, the exact
+  /// model's pieces too, from the same pass over the wall's elements and the pairs.
   double evaluate(const VectorXd& z, VectorXd& gradient, Linearisation* lin, bool project,
-                  double band = 0.0) const {
+                  double band = 0.0, Linearisation* exact_lin = nullptr) const {
     const VectorXd x = rod_dofs(z), u = wall_rows(z);
     VectorXd gw;
-    Eigen::SparseMatrix<double> hw;
-    const double w = wall_.evaluate(u, &gw, lin ? &hw : nullptr, project);
+    Eigen::SparseMatrix<double> hw, hw_exact;
+    const bool both = lin && project && exact_lin;
+    const double w = both ? wall_.evaluate_both(u, &gw, hw_exact, hw)
+                          : wall_.evaluate(u, &gw, lin ? &hw : nullptr, project);
     VectorXd gr;
     rod_.gradient(x, gr);
     gradient.setZero(size());
@@ -643,25 +666,8 @@ class Coupled {
       if (rod_row_[i] >= 0) gradient[rod_row_[i]] = gr[static_cast<Eigen::Index>(i)];
     }
     gradient.tail(wall_.num_dofs()) = gw;
-    if (lin) {
-      *lin = {};
-      Triplets& t = lin->base;
-      Eigen::SparseMatrix<double> hr;
-      rod_.hessian(x, hr, project);
-      t.reserve(static_cast<std::size_t>(hr.nonZeros() + hw.nonZeros()));
-      for (int c = 0; c < hr.outerSize(); ++c) {
-        for (Eigen::SparseMatrix<double>::InnerIterator it(hr, c); it; ++it) {
-          const int a = rod_row_[static_cast<std::size_t>(it.row())];
-          const int b = rod_row_[static_cast<std::size_t>(it.col())];
-          if (a >= 0 && b >= 0) t.emplace_back(a, b, it.value());
-        }
-      }
-      for (int c = 0; c < hw.outerSize(); ++c) {
-        for (Eigen::SparseMatrix<double>::InnerIterator it(hw, c); it; ++it) {
-          t.emplace_back(n_rod_ + it.row(), n_rod_ + it.col(), it.value());
-        }
-      }
-    }
+    if (lin) base_hessians(x, hw, project, *lin);
+    if (both) base_hessians(x, hw_exact, false, *exact_lin);
     double pi = rod_.energy(x) + w;
     for (const Pair& p : pairs(x, u, lin != nullptr, lin ? band : 0.0)) {
       const double g = p.distance - r_;
@@ -683,11 +689,38 @@ class Coupled {
       }
       const double weight = curvature_weight(p.multiplier, lambda);
       if (!lin || weight <= 0.0) continue;
-      Mat12 h = -weight * p.hessian;
-      if (project) h = projected(h);
-      add_block(lin->base, rows, h);
+      const Mat12 h = -weight * p.hessian;
+      add_block(lin->base, rows, project ? projected(h) : h);
+      if (both) add_block(exact_lin->base, rows, h);
+    }
+    if (both) {
+      const Triplets base = std::move(exact_lin->base);
+      *exact_lin = *lin;
+      exact_lin->base = std::move(base);
     }
     return pi;
+  }
+
+  /// lin emptied, its base the rod's Hessian at x (projected with `project`) and the wall's hw.
+  void base_hessians(const VectorXd& x, const Eigen::SparseMatrix<double>& hw, bool project,
+                     Linearisation& lin) const {
+    lin = {};
+    Triplets& t = lin.base;
+    Eigen::SparseMatrix<double> hr;
+    rod_.hessian(x, hr, project);
+    t.reserve(static_cast<std::size_t>(hr.nonZeros() + hw.nonZeros()));
+    for (int c = 0; c < hr.outerSize(); ++c) {
+      for (Eigen::SparseMatrix<double>::InnerIterator it(hr, c); it; ++it) {
+        const int a = rod_row_[static_cast<std::size_t>(it.row())];
+        const int b = rod_row_[static_cast<std::size_t>(it.col())];
+        if (a >= 0 && b >= 0) t.emplace_back(a, b, it.value());
+      }
+    }
+    for (int c = 0; c < hw.outerSize(); ++c) {
+      for (Eigen::SparseMatrix<double>::InnerIterator it(hw, c); it; ++it) {
+        t.emplace_back(n_rod_ + it.row(), n_rod_ + it.col(), it.value());
+      }
+    }
   }
 
   static void add_block(Triplets& t, const PairRows& rows, const Mat12& h) {
@@ -1142,11 +1175,12 @@ void extend_by_exact_curvature(const Coupled& p, const Linearisation& exact_lin,
 /// PSD-projected one extended along the exact model's curvature (extend_by_exact_curvature; the
 /// projected model shifted if need be: a shift of the exact, indefinite model costs a
 /// factorisation per try and gives no better a step), else steepest descent of length r_w. `lin`
-/// holds the linearisation at z (projected when `exact` is false). `radius`: the trust region
-/// of the extension (0: none yet).
+/// holds the linearisation at z: the exact one when `exact`, else the projected one with the
+/// exact one in `exact_lin`. `radius`: the trust region of the extension (0: none yet).
 Direction search_direction(const Coupled& p, const VectorXd& z, const VectorXd& g,
-                           Linearisation& lin, bool exact, double band, double shift, double radius,
-                           NewtonFactor& factor, msm::ExactBackoff& backoff, RecentSteps& recent) {
+                           Linearisation& lin, Linearisation& exact_lin, bool exact, double band,
+                           double shift, double radius, NewtonFactor& factor,
+                           msm::ExactBackoff& backoff, RecentSteps& recent) {
   Direction d;
   std::vector<char> active;
   if (exact) {
@@ -1156,13 +1190,10 @@ Direction search_direction(const Coupled& p, const VectorXd& z, const VectorXd& 
     if (d.exact) return d;
   }
   ++recent.projected;
-  Linearisation exact_lin;
-  VectorXd same;
   if (exact) {
     exact_lin = std::move(lin);
+    VectorXd same;
     (void)p.evaluate(z, same, &lin, true, band);
-  } else {
-    (void)p.evaluate(z, same, &exact_lin, false, band);
   }
   ModelMatrix Hp(p, lin, factor, shift, true);
   if (newton_step(p, lin, g, Hp, d.dz, active) && g.dot(d.dz) < 0.0) {
@@ -1290,7 +1321,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
   NewtonOutcome out;
   const int factorisations_before = factor.factorisations();
   VectorXd g, dz, trial;
-  Linearisation lin;
+  Linearisation lin, exact_lin;
   const double target = o.tolerance * o.force_scale;
   const double band = o.max_move * p.radius();
   RecentSteps recent;
@@ -1305,7 +1336,8 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
   for (int it = 0; it <= o.max_newton; ++it) {
     const bool exact = backoff.try_exact();
     double pi = 0.0;
-    const auto evaluate = [&] { pi = p.evaluate(z, g, &lin, !exact, band); };
+    // A projected step also needs the exact model (extend_by_exact_curvature): one pass.
+    const auto evaluate = [&] { pi = p.evaluate(z, g, &lin, !exact, band, &exact_lin); };
     evaluate();
     const Balance b = multipliers.at(z, g, it, evaluate);
     out.residual = b.residual;
@@ -1317,8 +1349,8 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     const bool at_floor = b.residual <= floor && b.complementarity <= o.gap_tolerance;
     if (it == o.max_newton) break;
     if (o.log && it > 0 && it % RecentSteps::kEvery == 0) recent.report(*o.log, it, out, shift);
-    const Direction d =
-        search_direction(p, z, g, lin, exact, band, shift, radius, factor, backoff, recent);
+    const Direction d = search_direction(p, z, g, lin, exact_lin, exact, band, shift, radius,
+                                         factor, backoff, recent);
     dz = d.dz;
     out.factorisations = factor.factorisations() - factorisations_before;
     const double move = p.largest_move(dz);

@@ -79,6 +79,12 @@ class WallPotential {
   /// semidefinite cone (a linear wall's already are).
   virtual double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
                           Eigen::SparseMatrix<double>* hessian, bool project_psd = false) const = 0;
+  /// evaluate's energy and gradient with both Hessians, the exact one and the projected one (as
+  /// evaluate gives each). By default two evaluations; a wall assembled from element blocks
+  /// projects each block as it assembles it and gives both from one pass.
+  virtual double evaluate_both(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
+                               Eigen::SparseMatrix<double>& exact,
+                               Eigen::SparseMatrix<double>& projected) const;
   /// The largest principal strain at u: small strain for a linear wall, Green–Lagrange for a
   /// finite-strain one.
   [[nodiscard]] virtual double largest_strain(const TetMesh& mesh,
@@ -126,6 +132,10 @@ class NeoHookeanWall final : public WallPotential {
       const TetMesh& mesh, const std::vector<std::array<int, 2>>& edges) const override;
   double evaluate(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
                   Eigen::SparseMatrix<double>* hessian, bool project_psd = false) const override;
+  /// The exact and the projected Hessian from one pass over the cells.
+  double evaluate_both(const Eigen::VectorXd& u, Eigen::VectorXd* gradient,
+                       Eigen::SparseMatrix<double>& exact,
+                       Eigen::SparseMatrix<double>& projected) const override;
   [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
   /// The cells with J ≤ 0 at a quadrature point (none where the energy is finite).
   [[nodiscard]] std::optional<std::size_t> inverted_tets(const TetMesh& mesh,

@@ -577,6 +577,17 @@ TEST(NeoHookeanWall, ProjectedTangentIsPositiveSemidefiniteAndExactWhereTheCells
   EXPECT_GT(negative, 0);
   EXPECT_EQ(negative_eigenvalues(projected), 0);
   EXPECT_TRUE(positive_definite_after_shift(projected - exact, 1e-9 * scale));
+  // Both from one pass over the cells: each the one its own evaluation gives, to the bit.
+  VectorXd g_both;
+  Eigen::SparseMatrix<double> exact_both, projected_both;
+  const double e_both = wall.evaluate_both(u, &g_both, exact_both, projected_both);
+  EXPECT_EQ(e_both, wall.evaluate(u, nullptr, nullptr));
+  EXPECT_EQ((g_both - g).cwiseAbs().maxCoeff(), 0.0);
+  for (const auto& [one_pass, own] :
+       {std::pair{&exact_both, &exact}, {&projected_both, &projected}}) {
+    ASSERT_EQ(one_pass->nonZeros(), own->nonZeros());
+    EXPECT_EQ(Eigen::MatrixXd(*one_pass - *own).cwiseAbs().maxCoeff(), 0.0);
+  }
 }
 
 namespace {
