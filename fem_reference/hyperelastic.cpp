@@ -145,23 +145,22 @@ struct FreeBlockAssembly {
     }
   }
 
-  /// values (the pattern's size) with the cell's local matrix k added at its positions.
-  void add(std::size_t cell, const dl::FullMatrix<double>& k, std::vector<double>& values) const {
+  /// m (a copy of the pattern) with the cell's local matrix k added at its positions.
+  void add(std::size_t cell, const dl::FullMatrix<double>& k,
+           Eigen::SparseMatrix<double>& m) const {
+    double* values = m.valuePtr();
     const int* at = position.data() + cell * n * n;
     for (unsigned i = 0; i < n; ++i) {
       for (unsigned j = 0; j < n; ++j, ++at) {
-        if (*at >= 0) values[static_cast<std::size_t>(*at)] += k(i, j);
+        if (*at >= 0) values[*at] += k(i, j);
       }
     }
   }
 
-  /// The pattern with `values`, its zero entries left out (as a matrix from triplets of the
-  /// non-zero values has them).
-  [[nodiscard]] Eigen::SparseMatrix<double> matrix(const std::vector<double>& values) const {
-    Eigen::SparseMatrix<double> m = pattern;
-    std::copy(values.begin(), values.end(), m.valuePtr());
+  /// m assembled: its zero entries left out (as a matrix from triplets of the non-zero values
+  /// has them).
+  static void finish(Eigen::SparseMatrix<double>& m) {
     m.prune([](Eigen::Index, Eigen::Index, double v) { return v != 0.0; });
-    return m;
   }
 };
 
@@ -1005,9 +1004,9 @@ FreeHyperelasticState HyperelasticSolver::free_state(const Eigen::VectorXd& u_fr
   const bool projected = tangents == FreeTangents::projected || tangents == FreeTangents::both;
   if ((exact || projected) && !im.free_block)
     im.free_block.emplace(im.d.dof, im.free_index, im.n_free);
-  const auto nnz = static_cast<std::size_t>(im.free_block ? im.free_block->pattern.nonZeros() : 0);
-  std::vector<double> exact_values(exact ? nnz : 0), projected_values(projected ? nnz : 0);
   FreeHyperelasticState out;
+  if (exact) out.tangent = im.free_block->pattern;
+  if (projected) out.projected_tangent = im.free_block->pattern;
   out.gradient = Eigen::VectorXd::Zero(im.n_free);
   dl::FullMatrix<double> k_projected;
   std::size_t cell = 0;
@@ -1019,11 +1018,11 @@ FreeHyperelasticState HyperelasticSolver::free_state(const Eigen::VectorXd& u_fr
                                    const int fi = im.free_index[dofs[i]];
                                    if (fi >= 0) out.gradient[fi] += r_int(i);
                                  }
-                                 if (exact) im.free_block->add(cell, k, exact_values);
+                                 if (exact) im.free_block->add(cell, k, out.tangent);
                                  if (projected) {
                                    k_projected = k;
                                    project_onto_psd_cone(k_projected);
-                                   im.free_block->add(cell, k_projected, projected_values);
+                                   im.free_block->add(cell, k_projected, out.projected_tangent);
                                  }
                                  ++cell;
                                },
@@ -1032,12 +1031,14 @@ FreeHyperelasticState HyperelasticSolver::free_state(const Eigen::VectorXd& u_fr
   out.min_jacobian = st.min_jacobian;
   if (!st.valid) {
     out.energy = std::numeric_limits<double>::infinity();
+    out.tangent = {};
+    out.projected_tangent = {};
     return out;
   }
   out.energy = st.energy;
   out.max_abs_principal_strain = st.max_abs_strain;
-  if (exact) out.tangent = im.free_block->matrix(exact_values);
-  if (projected) out.projected_tangent = im.free_block->matrix(projected_values);
+  if (exact) FreeBlockAssembly::finish(out.tangent);
+  if (projected) FreeBlockAssembly::finish(out.projected_tangent);
   return out;
 }
 
