@@ -693,10 +693,11 @@ class Coupled {
       add_block(lin->base, rows, project ? projected(h) : h);
       if (both) add_block(exact_lin->base, rows, h);
     }
-    if (both) {
-      const Triplets base = std::move(exact_lin->base);
+    if (both) {  // the pairs' pieces are the same in both; the bases (the Hessians) are not
+      Triplets exact_base = std::move(exact_lin->base), projected_base = std::move(lin->base);
       *exact_lin = *lin;
-      exact_lin->base = std::move(base);
+      exact_lin->base = std::move(exact_base);
+      lin->base = std::move(projected_base);
     }
     return pi;
   }
