@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
+#include <thread>
 #include <tuple>
 
 #include "meshes/foundation/errors.hpp"
@@ -269,6 +270,9 @@ TEST(GuidewireContact, AnEiWhoseSeriesSpringsDentTheWallDeeperThanItIsThickIsNot
     EXPECT_TRUE(c.solve.runs[k].models.empty());
   }
   EXPECT_EQ(c.shortcuts.size(), 2u);
+  // The run's solve gives the reference wall's factorisations every core of the machine.
+  EXPECT_EQ(c.options.reference_threads,
+            static_cast<int>(std::max(1U, std::thread::hardware_concurrency())));
 }
 
 // contact_wall = "neo-hookean": the EI the linear wall refuses (series springs 1.4 mm into the

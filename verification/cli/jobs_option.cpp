@@ -1,11 +1,10 @@
 #include "verification/cli/jobs_option.hpp"
 
-#include <algorithm>
-#include <thread>
+#include "verification/harness/parallel.hpp"
 
 namespace vessel::cli {
 
-int default_jobs() { return static_cast<int>(std::max(1U, std::thread::hardware_concurrency())); }
+int default_jobs() { return machine_cores(); }
 
 void add_jobs_option(CLI::App& cmd, int& jobs, const std::string& what) {
   jobs = default_jobs();

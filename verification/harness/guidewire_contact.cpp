@@ -11,6 +11,7 @@
 #include "reports/document.hpp"
 #include "verification/harness/guidewire_coupling.hpp"
 #include "verification/harness/outcome_cache.hpp"
+#include "verification/harness/parallel.hpp"
 
 namespace vessel {
 
@@ -252,6 +253,9 @@ contact::ContactModelsOptions contact_options(const Scene& scene, const Guidewir
       options.contact_fine_size > 0.0 ? options.contact_fine_size : spec.contact_fine_size;
   o.fine_radius = spec.contact_fine_radius;
   o.own_equilibrium = spec.contact_wall == ContactWall::neo_hookean;
+  // The solve runs alone, after the models' runs: the reference wall's factorisations get every
+  // core (the models' stay on one, their times a simulator's).
+  o.reference_threads = machine_cores();
   // A linear wall's run solves only the EIs whose dent stays within the wall's thickness, where
   // the wire bears near its rigid contact: the band along its body is refined at finite strain
   // alone (on the straight scene at EI 4e-7 it more than doubles the solve and moves no force).

@@ -33,13 +33,15 @@ void parallel_for(std::size_t n, int jobs, const std::function<void(std::size_t)
   if (failure) std::rethrow_exception(failure);
 }
 
+int machine_cores() { return static_cast<int>(std::max(1U, std::thread::hardware_concurrency())); }
+
 int solver_threads_per_task(int cores, std::size_t running) {
   return std::max(1, cores / static_cast<int>(std::max<std::size_t>(1, running)));
 }
 
 void parallel_solves(std::size_t n, int jobs, const std::function<void(std::size_t)>& task,
                      int cores) {
-  if (cores <= 0) cores = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  if (cores <= 0) cores = machine_cores();
   const auto width = static_cast<std::size_t>(std::max(1, jobs));
   const ScopedSolverThreads restore_at_end(solver_threads());
   std::mutex share_mutex;

@@ -18,6 +18,9 @@ void parallel_for(std::size_t n, int jobs, const std::function<void(std::size_t)
 void parallel_solves(std::size_t n, int jobs, const std::function<void(std::size_t)>& task,
                      int cores = 0);
 
+/// The machine's cores (std::thread::hardware_concurrency, at least 1).
+[[nodiscard]] int machine_cores();
+
 /// The threads each of `running` concurrent solves gets on `cores` cores (at least 1).
 [[nodiscard]] int solver_threads_per_task(int cores, std::size_t running);
 
