@@ -122,8 +122,8 @@ struct FreeHyperelasticState {
   bool admissible = true;  ///< false when an element is inverted (J ≤ 0): energy +∞
   double energy = 0.0;     ///< ∫Ψ dV, J
   Eigen::VectorXd gradient;             ///< ∂/∂u of the energy on the free DoFs (internal forces), N
-  Eigen::SparseMatrix<double>
-      tangent;  ///< its Hessian on the free DoFs, N/m (FreeTangents exact, both)
+  /// Its Hessian on the free DoFs, N/m (FreeTangents exact, both)
+  Eigen::SparseMatrix<double> tangent;
   /// The Hessian with each cell's tangent projected onto the positive semidefinite cone before
   /// assembly, N/m (FreeTangents projected, both)
   Eigen::SparseMatrix<double> projected_tangent;
