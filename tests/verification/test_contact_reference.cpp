@@ -684,6 +684,51 @@ TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
                      {"bad.json: insertions[1].view", "triangles of 3 indices into nodes"});
 }
 
+// guidewire_straight's floppy wire (EI 4e-7 N·m²) on the linear P1 wall from 19.75 to 20.25 mm
+// in two steps: the wall condensed on a band of contact candidates (grown as the contact slides,
+// kept from step to step) against the whole wall factorised at every Newton step, a second solve
+// of the same equilibrium: the same forces, pressed nodes, push, dent, energy and tip at every
+// step; a linear FEM model's wall is condensed too, and says so.
+TEST(ContactInsertion, ALinearWallCondensedOnItsBandEndsWhereTheWholeWallDoes) {
+  const Scene scene = shipped("guidewire_straight.toml");
+  ContactInsertionOptions o;
+  o.wall = ContactWall::linear;
+  o.first = 19.75e-3;
+  o.last = 20.25e-3;
+  o.steps = 2;
+  ContactInsertionOptions whole = o;
+  whole.condense_linear_walls = false;
+  const ContactInsertion condensed = solve_contact_insertion(scene, 4e-7, o);
+  const ContactInsertion reference = solve_contact_insertion(scene, 4e-7, whole);
+  EXPECT_NE(condensed.model_detail.find("condensed"), std::string::npos) << condensed.model_detail;
+  EXPECT_EQ(reference.model_detail.find("condensed"), std::string::npos) << reference.model_detail;
+  ASSERT_EQ(condensed.steps.size(), 3u);
+  ASSERT_EQ(reference.steps.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    const InsertionStep &c = condensed.steps[k], &w = reference.steps[k];
+    ASSERT_TRUE(c.converged) << c.failure;
+    ASSERT_TRUE(w.converged) << w.failure;
+    std::printf(
+        "CONTACT-INSERTION condensed against whole at %.3f mm: force %+.2e, tip %.2e m "
+        "apart, %d / %d Newton steps, %.2f / %.2f s\n",
+        c.insertion * 1e3, c.force / w.force - 1.0, (c.tip - w.tip).norm(), c.newton_steps,
+        w.newton_steps, c.seconds, w.seconds);
+    EXPECT_NEAR(c.force, w.force, 1e-6 * w.force);
+    EXPECT_EQ(c.pressed, w.pressed);
+    EXPECT_NEAR(c.push, w.push, 1e-5 * w.force);
+    EXPECT_NEAR(c.dent, w.dent, 1e-6 * w.dent);
+    EXPECT_NEAR(c.energy, w.energy, 1e-6 * w.energy);
+    EXPECT_LT((c.tip - w.tip).norm(), 1e-5 * 0.178e-3);  // r_w = 0.178 mm
+  }
+  ContactInsertionOptions model = o;
+  model.model = "fem_p1";
+  model.steps = 1;
+  model.first = 20.0e-3;
+  const ContactInsertion fem_p1 = solve_contact_insertion(scene, 4e-7, model);
+  EXPECT_NE(fem_p1.model_detail.find("condensed"), std::string::npos) << fem_p1.model_detail;
+  ASSERT_TRUE(fem_p1.steps.back().converged) << fem_p1.steps.back().failure;
+}
+
 // guidewire_straight's floppy wire (EI 4e-7 N·m²) on its neo-Hookean wall, pushed from 19.25 to
 // 20.25 mm in four steps of 0.25 mm.
 TEST(ContactInsertionSlow, PushIsTheEnergysDerivativeAndFourStepsEndWhereOneDoes) {

@@ -54,9 +54,10 @@ void add_scene_stiffness_wall(CLI::App* cmd, std::filesystem::path& scene, std::
       ->delimiter(',');
   cmd->add_option("--wall", wall,
                   "The wall: linear (`contact`: condensed on the contact candidates, the "
-                  "contact by the active set; `insertion`: the whole wall, factorised at every "
-                  "Newton step, with the wire as one potential) or neo-hookean (finite strain, "
-                  "the wire and the wall as one potential)")
+                  "contact by the active set; `insertion`: with the wire as one potential, P1 "
+                  "condensed on a band of contact candidates grown as the contact slides, P2 "
+                  "whole with its mid-edge candidates) or neo-hookean (finite strain, the wire "
+                  "and the wall as one potential)")
       ->check(CLI::IsMember({"linear", "neo-hookean"}))
       ->capture_default_str();
 }

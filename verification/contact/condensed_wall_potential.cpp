@@ -140,57 +140,66 @@ std::vector<int> near_crossing(const TetMesh& mesh, const std::vector<int>& surf
 
 }  // namespace
 
-GrownPotentialContact solve_wire_wall_potential_growing(msm::rods::Rod& rod, double radius,
-                                                        const fem::FreeDisplacementSystem& system,
-                                                        const TetMesh& mesh, std::vector<int> band,
-                                                        const VectorXd& start,
-                                                        const PotentialContactOptions& options,
-                                                        const BandGrowth& growth) {
+PotentialContactSolution solve_on_growing_band(msm::rods::Rod& rod, double radius,
+                                               CondensedLinearWall& wall, const TetMesh& mesh,
+                                               const VectorXd& start, std::vector<Vec3> field,
+                                               const PotentialContactOptions& options,
+                                               const BandGrowth& growth, int& rounds) {
   const PhysicalGroup& group = mesh.require_group(growth.surface_group, 2, "wall mesh");
   const std::vector<Triangle> triangles = mesh.group_triangles(group);
   const std::vector<int> surface = mesh.group_nodes(group);
   const ContactWire wire = contact_wire(rod, radius);
-  GrownPotentialContact out;
-  // The last equilibrium (the wire's start and the wall at rest before the first): every band's
+  // The last equilibrium (the wire's start and the given field before the first): every band's
   // solve starts from it.
   VectorXd x = start;
-  std::vector<Vec3> field(mesh.nodes.size(), Vec3::Zero());
+  PotentialContactSolution solution;
   int newton = 0, factorisations = 0;
   double seconds = 0.0;
-  out.wall = std::make_unique<CondensedLinearWall>(system, band);
-  for (;; ++out.rounds) {
+  for (rounds = 0;; ++rounds) {
+    const std::vector<int>& band = wall.band();
     std::vector<int> added;
     try {
       std::vector<int> candidates = band;  // ascending: so are the pressed nodes
       std::sort(candidates.begin(), candidates.end());
-      out.solution = solve_wire_wall_potential(rod, radius, *out.wall, mesh, candidates, x, options,
-                                               out.wall->band_rows(field));
-      newton += out.solution.newton_iterations;
-      factorisations += out.solution.factorisations;
-      seconds += out.solution.seconds;
-      x = out.solution.x;
-      field = out.wall->nodal(out.solution.u);
-      added = joining_the_band(mesh, triangles, surface, band, out.solution.pressed, wire, x, field,
+      solution = solve_wire_wall_potential(rod, radius, wall, mesh, candidates, x, options,
+                                           wall.band_rows(field));
+      newton += solution.newton_iterations;
+      factorisations += solution.factorisations;
+      seconds += solution.seconds;
+      x = solution.x;
+      field = wall.nodal(solution.u);
+      added = joining_the_band(mesh, triangles, surface, band, solution.pressed, wire, x, field,
                                growth.margin);
     } catch (const WireThroughWall& e) {
       // The wire left the band through the wall, between nodes that were not candidates.
       added = near_crossing(mesh, surface, band, e, growth.crossing_reach);
-      if (added.empty() || out.rounds == growth.max_rounds) throw;
+      if (added.empty() || rounds == growth.max_rounds) throw;
     }
     if (added.empty()) break;
-    if (out.rounds == growth.max_rounds) {
+    if (rounds == growth.max_rounds) {
       throw std::runtime_error(
           "the wire-wall potential's contact still reaches the band's edge "
           "after " +
           std::to_string(growth.max_rounds) + " growths (" + std::to_string(band.size()) +
           " band nodes)");
     }
-    out.wall->grow(added);
-    band = out.wall->band();
+    wall.grow(added);
   }
-  out.solution.newton_iterations = newton;
-  out.solution.factorisations = factorisations;
-  out.solution.seconds = seconds;
+  solution.newton_iterations = newton;
+  solution.factorisations = factorisations;
+  solution.seconds = seconds;
+  return solution;
+}
+
+GrownPotentialContact solve_wire_wall_potential_growing(
+    msm::rods::Rod& rod, double radius, const fem::FreeDisplacementSystem& system,
+    const TetMesh& mesh, const std::vector<int>& band, const VectorXd& start,
+    const PotentialContactOptions& options, const BandGrowth& growth) {
+  GrownPotentialContact out;
+  out.wall = std::make_unique<CondensedLinearWall>(system, band);
+  out.solution = solve_on_growing_band(rod, radius, *out.wall, mesh, start,
+                                       std::vector<Vec3>(mesh.nodes.size(), Vec3::Zero()), options,
+                                       growth, out.rounds);
   return out;
 }
 

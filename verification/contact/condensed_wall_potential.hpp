@@ -69,6 +69,18 @@ struct GrownPotentialContact {
   int rounds = 0;                             ///< growths
 };
 
+/// solve_wire_wall_potential on `wall` (every band node a candidate), the band grown in place as
+/// BandGrowth says (solve_wire_wall_potential_growing), from the wire's `start` and the wall's
+/// whole field `field` (per mesh node, m; the solve starts from its band rows): the last solve,
+/// its u on the wall's final band, its Newton steps, factorisations and seconds summed over every
+/// growth; `rounds` the growths. An insertion keeps its wall (and its band) from step to step.
+PotentialContactSolution solve_on_growing_band(msm::rods::Rod& rod, double radius,
+                                               CondensedLinearWall& wall, const TetMesh& mesh,
+                                               const Eigen::VectorXd& start,
+                                               std::vector<Vec3> field,
+                                               const PotentialContactOptions& options,
+                                               const BandGrowth& growth, int& rounds);
+
 /// solve_wire_wall_potential on the wall condensed on `band` (every band node a candidate), the
 /// band grown as BandGrowth says (a pressed node on its edge brings its surface neighbours, a
 /// surface node outside it within `margin` of the wire's surface joins; a solve that stops with
@@ -77,11 +89,9 @@ struct GrownPotentialContact {
 /// contact re-solved from the last equilibrium (the wire's state, the band's displacements from
 /// the whole field) until nothing joins. std::runtime_error after growth.max_rounds growths that
 /// still add nodes; solve_wire_wall_potential's errors.
-GrownPotentialContact solve_wire_wall_potential_growing(msm::rods::Rod& rod, double radius,
-                                                        const fem::FreeDisplacementSystem& system,
-                                                        const TetMesh& mesh, std::vector<int> band,
-                                                        const Eigen::VectorXd& start,
-                                                        const PotentialContactOptions& options = {},
-                                                        const BandGrowth& growth = {});
+GrownPotentialContact solve_wire_wall_potential_growing(
+    msm::rods::Rod& rod, double radius, const fem::FreeDisplacementSystem& system,
+    const TetMesh& mesh, const std::vector<int>& band, const Eigen::VectorXd& start,
+    const PotentialContactOptions& options = {}, const BandGrowth& growth = {});
 
 }  // namespace vessel::contact

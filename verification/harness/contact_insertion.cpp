@@ -14,6 +14,7 @@
 #include "meshes/foundation/solver_threads.hpp"
 #include "meshes/gmsh_vessel.hpp"
 #include "msm/rods/der_rod.hpp"
+#include "verification/contact/condensed_wall_potential.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
 #include "verification/contact_models/model_walls.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
@@ -124,11 +125,40 @@ namespace {
 /// with what keeps the model alive.
 struct InsertionWall {
   std::unique_ptr<contact::WallPotential> potential;
+  /// The potential when it is a linear wall condensed on a band (grown along the insertion).
+  contact::CondensedLinearWall* condensed = nullptr;
   std::optional<contact::ModelWall> model;  ///< owns the form a FormWall refers to
   std::string detail;
 };
 
-InsertionWall make_wall(const Scene& scene, const TetMesh& mesh, const ContactInsertionOptions& o) {
+/// m: a condensed wall's first band, the inner-wall nodes this near the first rigid-lumen wall
+/// point (contact-models' first candidates, ContactModelsOptions::band_radius).
+constexpr double kFirstBandRadius = 0.5e-3;
+
+/// A linear wall: condensed on a band of inner-wall nodes around `first_contact` (grown by the
+/// solves), or, for a P2 wall (whose contact candidates include its mid-edge nodes, which a band
+/// of mesh nodes does not hold) or with options.condense_linear_walls off, the whole wall.
+void set_linear_wall(InsertionWall& w, fem::FreeDisplacementSystem system, const TetMesh& mesh,
+                     const Vec3& first_contact, bool condense) {
+  const bool vertices_only = system.free_index.size() == 3 * system.node_rows.size();  // P1
+  if (!condense || !vertices_only) {
+    w.potential = std::make_unique<contact::LinearWall>(std::move(system));
+    return;
+  }
+  std::vector<int> band;
+  for (const int n : mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"))) {
+    if ((mesh.nodes[static_cast<std::size_t>(n)] - first_contact).norm() < kFirstBandRadius) {
+      band.push_back(n);
+    }
+  }
+  auto condensed = std::make_unique<contact::CondensedLinearWall>(std::move(system), band);
+  w.condensed = condensed.get();
+  w.potential = std::move(condensed);
+  w.detail += ", condensed on the contact's band";
+}
+
+InsertionWall make_wall(const Scene& scene, const TetMesh& mesh, const Vec3& first_contact,
+                        const ContactInsertionOptions& o) {
   const double nu = scene.poisson_ratios.front();
   InsertionWall w;
   if (o.model.empty()) {
@@ -139,8 +169,8 @@ InsertionWall make_wall(const Scene& scene, const TetMesh& mesh, const ContactIn
     } else {
       const fem::ElasticitySolver solver(mesh, problem);
       fem::FreeDisplacementSystem system = solver.free_displacement_system();
-      solver.set_row_points(system);  // where a P2 wall's mid-edge contact candidates are
-      w.potential = std::make_unique<contact::LinearWall>(std::move(system));
+      if (o.degree > 1) solver.set_row_points(system);  // its mid-edge contact candidates
+      set_linear_wall(w, std::move(system), mesh, first_contact, o.condense_linear_walls);
     }
     return w;
   }
@@ -165,7 +195,8 @@ InsertionWall make_wall(const Scene& scene, const TetMesh& mesh, const ContactIn
     w.potential = std::make_unique<contact::FormWall>(*m.energy.form, m.energy.rest,
                                                       m.system.free_index, m.system.node_rows);
   } else {  // deal.II's FEM as a model: linear
-    w.potential = std::make_unique<contact::LinearWall>(m.system);
+    // (model_wall fills a P2 model's row points: its mid-edge candidates)
+    set_linear_wall(w, m.system, mesh, first_contact, o.condense_linear_walls);
   }
   return w;
 }
@@ -175,19 +206,23 @@ InsertionWall make_wall(const Scene& scene, const TetMesh& mesh, const ContactIn
 constexpr int kMaxSplits = 3;
 
 /// The equilibrium in hand along the insertion: the wire's dofs x at length x_length and the
-/// wall's free rows u.
+/// wall's free rows u (a condensed wall's on its band, which a solve may grow: its whole field
+/// kept beside them).
 struct InsertionPath {
   const GuidewireSpec& spec;
   double EI;
   const contact::WallPotential& wall;
+  contact::CondensedLinearWall* condensed;  ///< `wall`, when it is a condensed linear wall
   const TetMesh& mesh;
-  const std::vector<int>& candidates;
-  contact::PotentialContactOptions options;
-  Eigen::VectorXd x, u;
+  const std::vector<int>& candidates;  ///< a whole wall's
+  contact::PotentialContactOptions options{};
+  Eigen::VectorXd x;
+  Eigen::VectorXd u{};
+  std::vector<Vec3> field;  ///< a condensed wall's displacement per mesh node, m
   double x_length = 0.0;
   int newton_steps = 0;                    ///< since the caller last reset it
-  std::unique_ptr<msm::rods::DerRod> rod;  ///< at x_length, prepared at x
-  contact::PotentialContactSolution solution;
+  std::unique_ptr<msm::rods::DerRod> rod{};  ///< at x_length, prepared at x
+  contact::PotentialContactSolution solution{};
 
   /// The wall's contact force on the tip's edge at the equilibrium in hand (N; zero before the
   /// first solve).
@@ -206,11 +241,17 @@ struct InsertionPath {
     options.force_scale = EI / (L * L);
     try {
       const Eigen::VectorXd from = fed_through_clamp(x, next->layout(), x_length, tip_push());
-      contact::PotentialContactSolution s = contact::solve_wire_wall_potential(
-          *next, 0.5 * spec.diameter, wall, mesh, candidates, from, options, u);
+      const double radius = 0.5 * spec.diameter;
+      int growths = 0;
+      contact::PotentialContactSolution s =
+          condensed ? contact::solve_on_growing_band(*next, radius, *condensed, mesh, from, field,
+                                                     options, {}, growths)
+                    : contact::solve_wire_wall_potential(*next, radius, wall, mesh, candidates,
+                                                         from, options, u);
       newton_steps += s.newton_iterations;
       x = s.x;
       u = s.u;
+      if (condensed) field = condensed->nodal(u);
       x_length = L;
       rod = std::move(next);
       solution = std::move(s);
@@ -378,6 +419,7 @@ std::string insertion_key(const Scene& scene, double EI, const ContactInsertionO
   h.text(file_contents(scene.source)).real(EI).integer(static_cast<int>(o.wall));
   h.real(o.first).real(o.last).integer(o.steps).real(o.fine_size).real(o.refine_radius);
   h.integer(o.degree).integer(o.max_steps).text(o.model).real(o.view_at);
+  h.integer(o.condense_linear_walls ? 1 : 0);
   h.integer(o.model.empty() ? o.reference_threads : 1);  // the times depend on it
   return "contact-insertion " + h.hex();
 }
@@ -410,7 +452,7 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
                      std::to_string(first * 1e3) + " to " + std::to_string(last * 1e3) + " mm");
   }
   const TetMesh mesh = refined_balls_mesh(scene.vessel, balls, o.fine_size);
-  const InsertionWall made = make_wall(scene, mesh, o);
+  const InsertionWall made = make_wall(scene, mesh, balls.front().centre, o);
   const contact::WallPotential* wall = made.potential.get();
   if (!o.model.empty()) out.model = o.model;
   out.model_detail = made.detail;
@@ -429,7 +471,15 @@ ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
 
   std::vector<double> lengths;
   for (int k = 0; k <= o.steps; ++k) lengths.push_back(first + (last - first) * k / o.steps);
-  InsertionPath path{spec, EI, *wall, mesh, candidates, {}, start, {}, first, 0, nullptr, {}};
+  InsertionPath path{.spec = spec,
+                     .EI = EI,
+                     .wall = *wall,
+                     .condensed = made.condensed,
+                     .mesh = mesh,
+                     .candidates = candidates,
+                     .x = start,
+                     .field = std::vector<Vec3>(mesh.nodes.size(), Vec3::Zero()),
+                     .x_length = first};
   path.options.tolerance = 1e-8;
   path.options.max_newton = o.max_steps;
   path.options.log = o.log;  // a round's line and one per 25 Newton steps: a step can take minutes

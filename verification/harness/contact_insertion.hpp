@@ -51,6 +51,12 @@ struct ContactInsertionOptions {
   /// model's wall is solved on one thread whatever this is, so its per-step times are a
   /// simulator's on one core. The process's setting is restored after the insertion.
   int reference_threads = 1;
+  /// A linear P1 wall (the reference's with `wall` linear, a linear FEM model's) condensed on a
+  /// band of contact candidates around the first contact, grown as the contact slides and kept
+  /// from step to step (condensed_wall_potential.hpp: the same equilibrium, the Newton matrix 3
+  /// rows per band node); false: the whole wall, factorised at every Newton step. A P2 wall is
+  /// always whole (its mid-edge nodes are contact candidates too).
+  bool condense_linear_walls = true;
   std::ostream* log = nullptr;  ///< per step a line, and the contact solve's progress, if set
 };
 
