@@ -298,6 +298,9 @@ Plot insertion_plot(const InsertionFile& f) {
     using Step = InsertionStepEntry;
     series(
         "contact force", [](const Step& s) { return std::optional(s.force); }, false);
+    // A model's hub forces follow its contact force (its table gives them): the figure keeps the
+    // reference's alone, readable beside every model's force.
+    if (e.model != "reference") continue;
     series(
         "clamp axial R·t", [](const Step& s) { return std::optional(s.clamp_axial); }, false);
     series(
@@ -311,8 +314,8 @@ Plot insertion_plot(const InsertionFile& f) {
 void insertion_section(Document& doc, const InsertionFile& f) {
   insertion_text(doc, f);
   doc.figure("insertion.svg", insertion_plot(f),
-             "The contact force and the hub's forces against the insertion length, per wall and wire "
-             "stiffness (converged steps).");
+             "The contact force against the insertion length per wall and wire stiffness, and the "
+             "reference's hub forces (converged steps).");
   std::set<std::string> viewed;
   for (const InsertionEntry& e : f.insertions) {
     if (e.view && viewed.insert(e.scene).second) doc.slot("view:" + view_scene(e.scene));

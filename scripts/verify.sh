@@ -16,7 +16,8 @@
 #   5. `vesselverify recommend` on the two contact scenes at 30 Hz (visual) and 1 kHz (haptic):
 #      the cheapest model meeting each scene's [budget] → recommend/<scene>/<rate>hz/;
 #   6. `vesselverify insertion` (not in --quick): the straight scene's floppy guidewire pushed in
-#      against the finite-strain wall in steps → insertion.json, insertion.md;
+#      in steps against the finite-strain wall and each of the scene's models' walls →
+#      insertion.json, insertion.md;
 #   7. `vesselverify report` → report.md, report.html (self-contained) and figures/, with the
 #      stability, recommendation, validity and insertion sections drawn from stability.json, each
 #      recommend.json, validity.json and insertion.json.
@@ -112,11 +113,11 @@ done
 insertion=()
 if [ ${#mode[@]} -eq 0 ]; then
   phase "insertion: the floppy wire pushed into the straight tube"
-  # guidewire_straight's wire (EI 4e-7 N·m²) on its neo-Hookean wall, pushed its last 0.5 mm in
-  # two steps (a longer insertion, or the stiffer wires: `vesselverify insertion`, minutes a
-  # millimetre); not in --quick.
+  # guidewire_straight's wire (EI 4e-7 N·m²) on its neo-Hookean wall and on each model's own,
+  # pushed its last 0.5 mm in two steps (a longer insertion, or the stiffer wires: `vesselverify
+  # insertion`, minutes a millimetre); not in --quick.
   "$vv" insertion "$scenes/guidewire_straight.toml" --ei 4e-7 --from 19.75e-3 --to 20.25e-3 \
-    --steps 2 --json "$out/insertion.json" > "$out/insertion.md"
+    --steps 2 --models all --json "$out/insertion.json" > "$out/insertion.md"
   insertion=(--insertion "$out/insertion.json")
 fi
 phase "report"

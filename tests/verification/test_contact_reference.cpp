@@ -522,6 +522,20 @@ TEST(ContactInsertion, AStepFeedsTheWireAlongItsOwnPathAndItsTipAlongItsLastEdge
   EXPECT_LT((fed_through_clamp(fed, layout, 5e-3) - fed).norm(), 1e-15);
 }
 
+// `--models`' names as the insertion's walls: "reference" the FEM wall (""), "all" the reference
+// and each of guidewire_straight's four models (every one has a wall in the contact), in the
+// scene's order, each wall once; another name passes through (solve_contact_insertion refuses
+// one the scene does not have, above).
+TEST(ContactInsertion, AllNamesTheReferenceAndEveryModelWithAWall) {
+  const Scene scene = shipped("guidewire_straight.toml");
+  EXPECT_EQ(insertion_walls(scene, {"reference", "volume_hybrid"}),
+            (std::vector<std::string>{"", "volume_hybrid"}));
+  EXPECT_EQ(insertion_walls(scene, {"volume_hybrid", "all", "reference"}),
+            (std::vector<std::string>{"volume_hybrid", "", "fem_p1", "surface_seed000",
+                                      "volume_mollemans"}));
+  EXPECT_EQ(insertion_walls(scene, {"nonexistent"}), (std::vector<std::string>{"nonexistent"}));
+}
+
 // The insertion's document (a hand-made insertion: the mapping, not a solve): it conforms to its
 // schema; read back, the figure's curves carry each force of each converged step in mN at its
 // length in mm, a failed step left out of every curve and dΠ/dL's undefined end left out of its
@@ -635,6 +649,11 @@ TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
   EXPECT_TRUE(problems.empty()) << test::joined(problems);
 
   const reports::InsertionFile file = reports::parse_insertion(j.dump(), "ins.json");
+  // The figure: the reference's contact force and hub forces, the model's contact force alone.
+  const reports::Plot plot = reports::insertion_plot(file);
+  ASSERT_EQ(plot.series.size(), 5U);
+  EXPECT_EQ(plot.series[4].label, "contact force (model, EI 4e-07 N·m²)");
+  EXPECT_NEAR(plot.series[4].y[0], 0.44, 1e-12);
   const std::vector<reports::SceneViews> views = reports::insertion_views(file);
   ASSERT_EQ(views.size(), 1U);
   const reports::SceneViews& v = views[0];

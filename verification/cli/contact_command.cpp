@@ -74,10 +74,9 @@ void run_insertion(InsertionCli& o, const std::string& command_line) {
   o.options.wall = parse_contact_wall(o.wall);
   const Scene scene = read_scene(o.scene);
   const auto cache = o.cache.outcome_cache(std::cerr);
-  std::vector<std::string> walls;  // "" is the reference
-  for (const std::string& m : o.models) walls.push_back(m == "reference" ? "" : m);
-  const std::string json = contact_insertion_document(scene, stiffnesses(scene, o.ei), o.options,
-                                                      command_line, cache.get(), walls);
+  const std::string json =
+      contact_insertion_document(scene, stiffnesses(scene, o.ei), o.options, command_line,
+                                 cache.get(), insertion_walls(scene, o.models));
   // The tables and the figure from the document, as the report reads it.
   const reports::InsertionFile file = reports::parse_insertion(json, "insertion");
   std::cout << reports::insertion_markdown(file) << std::flush;
@@ -225,7 +224,8 @@ void add_insertion_command(CLI::App& app, const std::string& command_line) {
   cmd->add_option("--models", o->models,
                   "The walls pushed against, comma separated: reference (deal.II's FEM, as --wall "
                   "says) and any of the scene's models by name (its own wall on the same mesh, "
-                  "at its own equilibrium)")
+                  "at its own equilibrium); all: the reference and every scene model with a wall "
+                  "in the contact")
       ->delimiter(',')
       ->capture_default_str();
   add_threads_option(*cmd, o->options.reference_threads,

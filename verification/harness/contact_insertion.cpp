@@ -16,6 +16,7 @@
 #include "msm/rods/der_rod.hpp"
 #include "verification/contact/condensed_wall_potential.hpp"
 #include "verification/contact/wire_wall_potential.hpp"
+#include "verification/contact_models/contact_models.hpp"
 #include "verification/contact_models/model_walls.hpp"
 #include "verification/guidewire/guidewire_load.hpp"
 #include "verification/harness/outcome_cache.hpp"
@@ -563,6 +564,27 @@ std::string contact_insertion_entry(const ContactInsertion& r) {
         {"force_N", r.view.force},       {"triangles", triangles}};
   }
   return entry.dump();
+}
+
+std::vector<std::string> insertion_walls(const Scene& scene,
+                                         const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  const auto add = [&](const std::string& wall) {
+    if (std::find(out.begin(), out.end(), wall) == out.end()) out.push_back(wall);
+  };
+  for (const std::string& name : names) {
+    if (name == "reference") {
+      add("");
+    } else if (name == "all") {
+      add("");
+      for (const ModelSpec& m : scene.models) {
+        if (contact::has_contact_wall(m)) add(m.name);
+      }
+    } else {
+      add(name);
+    }
+  }
+  return out;
 }
 
 std::string contact_insertion_document(const Scene& scene, const std::vector<double>& stiffnesses,

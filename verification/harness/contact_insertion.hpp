@@ -136,6 +136,11 @@ Eigen::VectorXd fed_through_clamp(const Eigen::VectorXd& x, const msm::rods::Rod
 ContactInsertion solve_contact_insertion(const Scene& scene, double EI,
                                          const ContactInsertionOptions& options = {});
 
+/// The walls `names` asks for, as contact_insertion_document takes them: "reference" is "" (the
+/// FEM wall), "all" is "" and each of the scene's models with a wall in the contact
+/// (contact::has_contact_wall) in the scene's order, another name itself; each wall once.
+std::vector<std::string> insertion_walls(const Scene& scene, const std::vector<std::string>& names);
+
 class OutcomeCache;  // verification/harness/outcome_cache.hpp
 
 /// The insertions of `scene`'s wire at each bending stiffness in `stiffnesses` (N·m²), against each
