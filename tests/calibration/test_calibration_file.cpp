@@ -8,11 +8,12 @@
 #include <fstream>
 #include <sstream>
 
+#include "../test_helpers.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "msm/model/build_network.hpp"
+#include "tests/fixtures/kuhn_block.hpp"
 #include "verification/calibration_file.hpp"
 #include "verification/scene.hpp"
-#include "tests/fixtures/kuhn_block.hpp"
 
 using namespace vessel;
 
@@ -70,10 +71,10 @@ Calibration make_calibration(const TetMesh& mesh, const msm::BuiltNetwork& built
   return c;
 }
 
+/// A file in this test program's own temporary folder (removed when the program exits).
 std::filesystem::path temp_file(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "vessel_calibration_tests";
-  std::filesystem::create_directories(dir);
-  return dir / name;
+  static const test::TempDir dir;
+  return dir.path() / name;
 }
 
 void expect_input_error(const std::function<void()>& f, const std::string& needle) {

@@ -8,13 +8,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <iterator>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
-#include <nlohmann/json.hpp>
-
-#include "reports/report.hpp"
 #include "../test_helpers.hpp"
+#include "reports/report.hpp"
 
 using namespace vessel;
 using namespace vessel::reports;
@@ -119,8 +119,9 @@ struct Probed {
 };
 
 Probed& probed() {
-  static Probed* p = [] {
-    auto* p = new Probed();
+  // Owned by a static (not leaked): its directory is removed when the test program exits.
+  static const std::unique_ptr<Probed> p = [] {
+    auto p = std::make_unique<Probed>();
     std::filesystem::copy(kFixture, p->dir / "results", std::filesystem::copy_options::recursive);
     add_arch_scene(p->dir / "results");
     ReportOptions o;

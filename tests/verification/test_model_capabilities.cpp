@@ -7,16 +7,17 @@
 #include <fstream>
 #include <string>
 
+#include "../test_helpers.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "msm/model/mass_spring_model.hpp"
 #include "msm/stiffness/hybrid_moduli.hpp"
 #include "msm/terms/edge_pair_term.hpp"
 #include "msm/terms/volume_term_homogenised.hpp"
+#include "test_paths.hpp"
+#include "tests/fixtures/lame_tube_scene.hpp"
 #include "verification/harness/harness.hpp"
 #include "verification/model_capabilities.hpp"
 #include "verification/scene.hpp"
-#include "tests/fixtures/lame_tube_scene.hpp"
-#include "test_paths.hpp"
 
 using namespace vessel;
 
@@ -33,13 +34,6 @@ std::string thrown(F f) {
     return e.what();
   }
   return {};
-}
-
-std::filesystem::path fresh_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("vv-capabilities-" + name);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
 }
 
 }  // namespace
@@ -94,7 +88,8 @@ TEST(ModelCapabilities, RequiredFilesNameTheSceneKeys) {
 TEST(ModelCapabilities, ASceneCopiedWithoutItsCalibrationFileFailsTheSceneCheck) {
   // contact_arch.toml copied to another folder, its calibrations/ left behind: read_scene (what
   // `vesselverify scene` and `run` call first) names the copy, the model, the key and the file.
-  const auto dir = fresh_dir("copied-scene");
+  const test::TempDir scratch;
+  const std::filesystem::path& dir = scratch.path();
   const auto copy = dir / "contact_arch.toml";
   std::filesystem::copy_file(std::filesystem::path(VESSEL_SCENES_DIR) / "contact_arch.toml", copy);
   const std::string why = thrown([&] { (void)read_scene(copy); });
@@ -107,7 +102,8 @@ TEST(ModelCapabilities, ASceneCopiedWithoutItsCalibrationFileFailsTheSceneCheck)
 }
 
 TEST(ModelCapabilities, AModelWhoseCalibrationFileTurnsBadDuringARunFailsAlone) {
-  const auto dir = fresh_dir("bad-calibration");
+  const test::TempDir scratch;
+  const std::filesystem::path& dir = scratch.path();
   std::ofstream(dir / "bad.json") << "{ not json";
   const std::string text = vessel::test::lame_tube_scene("bad_calibration") + R"(
 [[models]]

@@ -10,12 +10,13 @@
 #include <nlohmann/json.hpp>
 
 #include "../../schema_check.hpp"
+#include "../../test_helpers.hpp"
 #include "meshes/foundation/errors.hpp"
 #include "meshes/vtu_io.hpp"
 #include "reports/study_files.hpp"
 #include "reports/study_sections.hpp"
-#include "verification/studies/validity/validity.hpp"
 #include "test_paths.hpp"
+#include "verification/studies/validity/validity.hpp"
 
 using namespace vessel;
 
@@ -55,13 +56,6 @@ ValidityOptions small_options() {
   o.reference_level = 0;
   o.ladder = {1e-6, 2e-6, 3e-4, 1e-3, 2e-3, 4e-3};
   return o;
-}
-
-std::filesystem::path temp_dir(const std::string& name) {
-  const auto d = std::filesystem::temp_directory_path() / ("vesselverify_" + name);
-  std::filesystem::remove_all(d);
-  std::filesystem::create_directories(d);
-  return d;
 }
 
 }  // namespace
@@ -144,7 +138,8 @@ TEST(ValidityStudy, TheModelsFieldsAtTheLargestLoadAreItsErrorsAgainstTheFiniteS
   const Scene s = parse_scene(kScene, "validity_test.toml");
   ValidityOptions o = small_options();
   o.ladder = {1e-4, 1e-3};
-  const std::filesystem::path dir = temp_dir("validity_fields");
+  const test::TempDir scratch;
+  const std::filesystem::path& dir = scratch.path();
   o.fields_dir = dir / "validity_fields";
   ValidityStudy study;
   study.scenes = {run_validity_scene(s, o)};
@@ -207,7 +202,8 @@ TEST(ValidityStudy, ANewtonFailureEndsTheRowsAtTheLargestLoadReached) {
 
 TEST(ValidityStudy, TheCacheGivesTheSameRowsOnASecondRun) {
   const Scene s = parse_scene(kScene, "validity_test.toml");
-  const auto dir = temp_dir("validity_cache");
+  const test::TempDir scratch;
+  const std::filesystem::path& dir = scratch.path();
   std::ostringstream log;
   fem::SolutionCache cache(dir, &log);
   ValidityOptions o = small_options();
@@ -253,7 +249,8 @@ TEST(ValidityFile, WrittenThenReadBackByTheReportWithBadFieldsNamed) {
                   threshold_crossing({1e-3}, {0.02}, 0.05)};
   v.l2_limits = v.qoi_limits;
   study.scenes = {v};
-  const auto dir = temp_dir("validity_file");
+  const test::TempDir scratch;
+  const std::filesystem::path& dir = scratch.path();
   write_validity_json(study, dir / "validity.json");
   const reports::ValidityFile f = reports::read_validity(dir / "validity.json");
   ASSERT_EQ(f.scenes.size(), 1u);
@@ -434,7 +431,8 @@ kind = "xpbd_fem"
   // validity.json carries the timings (what scripts/measure_fem_models_vs_springs.py reads).
   ValidityStudy study;
   study.scenes = {v};
-  const auto dir = temp_dir("validity_timing");
+  const test::TempDir scratch;
+  const std::filesystem::path& dir = scratch.path();
   write_validity_json(study, dir / "validity.json");
   std::ifstream in(dir / "validity.json");
   const nlohmann::json j = nlohmann::json::parse(in);
