@@ -61,9 +61,19 @@ Table insertion_table(const InsertionEntry& e) {
 /// the reference's. Empty when there is no such pair.
 Table models_against_reference(const InsertionFile& f) {
   Table t;
-  t.header = {"scene",          "EI (N·m²)",      "model",     "insertion (mm)",
-              "force (mN)",     "reference (mN)", "error (mN)", "error (%)",
-              "dent (mm)",      "reference dent (mm)", "tip from the reference's (mm)"};
+  t.header = {"scene",
+              "EI (N·m²)",
+              "model",
+              "insertion (mm)",
+              "force (mN)",
+              "reference (mN)",
+              "error (mN)",
+              "error (%)",
+              "dent (mm)",
+              "reference dent (mm)",
+              "tip from the reference's (mm)",
+              "clamp axial R·t (mN)",
+              "reference R·t (mN)"};
   for (const InsertionEntry& r : f.insertions) {
     if (r.model != "reference") continue;
     for (const InsertionEntry& m : f.insertions) {
@@ -92,7 +102,8 @@ Table models_against_reference(const InsertionFile& f) {
                    {decimals(s.force * 1e3, 5), decimals(ref->force * 1e3, 5),
                     decimals((s.force - ref->force) * 1e3, 5),
                     decimals(100.0 * (s.force / ref->force - 1.0), 2), decimals(s.dent * 1e3, 3),
-                    decimals(ref->dent * 1e3, 3), decimals(tip_error * 1e3, 3)});
+                    decimals(ref->dent * 1e3, 3), decimals(tip_error * 1e3, 3),
+                    decimals(s.clamp_axial * 1e3, 5), decimals(ref->clamp_axial * 1e3, 5)});
         t.rows.push_back(row);
       }
     }
@@ -134,8 +145,9 @@ void insertion_text(Document& doc, const InsertionFile& f) {
     doc.paragraph(
         "Each model's wall in the same insertion (the same mesh, wire and contact law, its own "
         "equilibrium) against the reference's at the lengths both solved: the wire's net contact "
-        "force and its error, the dent, and how far the wire's tip is from where it is on the "
-        "reference's wall.");
+        "force and its error, the dent, how far the wire's tip is from where it is on the "
+        "reference's wall, and the force the clamp holding the wire bears along it (R·t, what the "
+        "hand at the hub feels) beside the reference's.");
     doc.table(against);
   }
 }

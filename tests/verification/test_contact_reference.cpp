@@ -628,6 +628,7 @@ TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
     s.insertion = 20e-3;
     s.converged = true;
     s.force = force;
+    s.clamp_axial = 0.3 * force;
     s.dent = 2 * push;
     s.centreline = {Vec3(0, 0, 0), Vec3(2.5e-3, 0, 19e-3), Vec3(2.8e-3, 0, 20e-3 + push)};
     s.tip = s.centreline.back();
@@ -690,10 +691,10 @@ TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
   }));
 
   // The model against the reference at 20 mm: +0.04 mN (+10 %), dents 0.4 and 0.2 mm, the tip
-  // 0.1 mm further along.
+  // 0.1 mm further along, the clamps' axial forces 0.132 and 0.12 mN.
   const std::string md = reports::insertion_markdown(file);
   EXPECT_NE(md.find("| hand | 4e-07 | model | 20.000 | 0.44000 | 0.40000 | 0.04000 | 10.00 | "
-                    "0.400 | 0.200 | 0.100 |"),
+                    "0.400 | 0.200 | 0.100 | 0.13200 | 0.12000 |"),
             std::string::npos)
       << md;
 
