@@ -196,6 +196,28 @@ std::optional<std::vector<double>> contact_centroid_mm(const InsertionViewEntry&
   return c;
 }
 
+/// Per drawn node the contact pressure (kPa): its force over its share of the inner wall's area at
+/// rest, a third of each drawn triangle it is a corner of (the lumped pressure, independent of the
+/// mesh's size where a node's force is not). A pressed node lies 2 mm inside the drawn wall's
+/// edge, so every triangle it touches is drawn.
+std::vector<double> pressure_kPa(const InsertionViewEntry& v) {
+  std::vector<double> area(v.nodes.size(), 0.0);
+  const auto at = [&](int k) {
+    const auto i = 3 * static_cast<std::size_t>(k);
+    return Vec3(v.rest[i], v.rest[i + 1], v.rest[i + 2]);
+  };
+  for (std::size_t t = 0; t + 2 < v.triangles.size(); t += 3) {
+    const int a = v.triangles[t], b = v.triangles[t + 1], c = v.triangles[t + 2];
+    const double third = (at(b) - at(a)).cross(at(c) - at(a)).norm() / 6.0;
+    for (const int k : {a, b, c}) area[static_cast<std::size_t>(k)] += third;
+  }
+  std::vector<double> out(v.nodes.size(), 0.0);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    if (area[k] > 0.0) out[k] = v.force[k] / area[k] * 1e-3;
+  }
+  return out;
+}
+
 WallView insertion_wall(const InsertionFile& f, const InsertionEntry& e) {
   const InsertionViewEntry& v = *e.view;
   WallView w;
@@ -208,7 +230,6 @@ WallView insertion_wall(const InsertionFile& f, const InsertionEntry& e) {
   if (r) {
     for (std::size_t k = 0; k < r->view->nodes.size(); ++k) reference_node[r->view->nodes[k]] = k;
   }
-  std::vector<double> force_mN;
   for (std::size_t k = 0; k < v.nodes.size(); ++k) {
     const auto at = reference_node.find(v.nodes[k]);
     for (std::size_t c = 0; c < 3; ++c) {
@@ -219,10 +240,9 @@ WallView insertion_wall(const InsertionFile& f, const InsertionEntry& e) {
               ? 0.0F
               : static_cast<float>(r->view->displacement[3 * at->second + c] * 1e3));
     }
-    force_mN.push_back(v.force[k] * 1e3);
   }
   w.indices.assign(v.triangles.begin(), v.triangles.end());
-  set_colour(w, force_mN);
+  set_colour(w, pressure_kPa(v));
   return w;
 }
 
@@ -257,8 +277,8 @@ std::vector<SceneViews> insertion_views(const InsertionFile& f) {
     SceneViews s;
     s.scene = view_scene(first.scene);
     s.tolerance_mm.reset();
-    s.colour_name = "contact force";
-    s.colour_unit = "mN";
+    s.colour_name = "contact pressure";
+    s.colour_unit = "kPa";
     s.true_scale = true;
     s.load_text = "the step each names";
     const InsertionEntry* drawn = nullptr;  // whose wire is drawn: the reference's, else the first
@@ -273,14 +293,15 @@ std::vector<SceneViews> insertion_views(const InsertionFile& f) {
     s.caption =
         "Each wall within 2 mm of where the wire bears at the insertion length in its name (its "
         "last converged step, or the one nearest vesselverify insertion --view-at), at true "
-        "scale, coloured by the wire's contact force on each node (mN, "
-        "viridis, one scale for every wall). Grey ghost: the reference's wall at the same step "
+        "scale, coloured by the contact pressure (kPa: each node's force over its share of the "
+        "wall's area at rest; viridis, one scale for every wall). Grey ghost: the reference's wall "
+        "at the same step "
         "(at rest where the file has none). Red sphere: the force-weighted centroid of the "
         "contact on the wire's wall. Orange tube: the wire on " +
         drawn->model + "'s wall (" + stiffness_label(drawn->bending_stiffness) +
         "; its part near the drawn wall, in place and half transparent). The camera starts "
         "outside the lumen, looking onto the dent. Drag to turn, wheel to zoom; both panes share "
-        "the camera; hover a node for its force and both displacements.";
+        "the camera; hover a node for its pressure and both displacements.";
     out.push_back(std::move(s));
   }
   return out;

@@ -610,13 +610,14 @@ TEST(ContactInsertion,
 // The insertion's 3D view (a hand-made pair of insertions, the reference and a model, each with
 // the wall near the wire at its last converged step): the document with views conforms to its
 // schema; read back, report.html gets one view of the scene at true scale, one wall per
-// insertion coloured by its contact force in mN, the ghost the reference's displacement at the
+// insertion coloured by its contact pressure in kPa (each node's force over a third of the
+// triangle's area at rest, by hand), the ghost the reference's displacement at the
 // same mesh node (at rest where the reference's view lacks it), the wire the reference's at that
 // step in mm where it is near the drawn wall, the contact's centroid, no tolerance mark; the
-// section's table of the model against the reference gives the force's, dent's and tip's errors; the
-// section has the view's slot; a view whose triangle names a node it does not have is refused
+// section's table of the model against the reference gives the force's, dent's and tip's errors;
+// the section has the view's slot; a view whose triangle names a node it does not have is refused
 // naming it.
-TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
+TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactPressure) {
   const auto insertion = [](const std::string& model, double push, double force) {
     ContactInsertion r;
     r.scene = "hand";
@@ -660,12 +661,16 @@ TEST(ContactInsertion, ViewDrawsEachWallNearTheWireColouredByItsContactForce) {
   const reports::SceneViews& v = views[0];
   EXPECT_EQ(v.scene, "insertion-hand");
   EXPECT_FALSE(v.tolerance_mm.has_value());
-  EXPECT_EQ(v.colour_unit, "mN");
+  EXPECT_EQ(v.colour_unit, "kPa");
   EXPECT_TRUE(v.true_scale);
   ASSERT_EQ(v.views.size(), 2U);
   for (const reports::WallView& w : v.views) {
-    EXPECT_NEAR(w.colour_max, 0.25, 1e-12) << w.model;
-    EXPECT_NEAR(w.colour_code[1] * w.colour_step, 0.15, 0.5 * w.colour_step) << w.model;
+    // The triangle (3, 0, 19), (3, 0, 20), (2.9, 0.5, 19.5) mm: edges (0, 0, 1) and (−0.1, 0.5,
+    // 0.5) mm, their cross product (−0.5, −0.1, 0) mm², area √0.26 / 2 mm², a third each node's.
+    const double share = std::sqrt(0.26) / 6.0 * 1e-6;                  // m²
+    EXPECT_NEAR(w.colour_max, 2.5e-4 / share * 1e-3, 1e-9) << w.model;  // 2.94 kPa
+    EXPECT_NEAR(w.colour_code[1] * w.colour_step, 1.5e-4 / share * 1e-3, 0.5 * w.colour_step)
+        << w.model;
     EXPECT_EQ(w.indices, (std::vector<std::uint32_t>{0, 1, 2}));
     EXPECT_NEAR(w.rest_mm[3], 3.0, 1e-6);
   }
