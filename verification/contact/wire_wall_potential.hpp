@@ -138,7 +138,7 @@ class NeoHookeanWall final : public WallPotential {
                        Eigen::SparseMatrix<double>& projected) const override;
   [[nodiscard]] double largest_strain(const TetMesh& mesh, const Eigen::VectorXd& u) const override;
   /// The cells with J ≤ 0 at a quadrature point (none where the energy is finite).
-  [[nodiscard]] std::optional<std::size_t> inverted_tets(const TetMesh& mesh,
+  [[nodiscard]] std::optional<std::size_t> inverted_tets(const TetMesh& /*mesh*/,
                                                          const Eigen::VectorXd& u) const override {
     return inverted_cells(u).size();
   }

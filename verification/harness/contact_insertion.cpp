@@ -132,10 +132,6 @@ struct InsertionWall {
   std::string detail;
 };
 
-/// m: a condensed wall's first band, the inner-wall nodes this near the first rigid-lumen wall
-/// point (contact-models' first candidates, ContactModelsOptions::band_radius).
-constexpr double kFirstBandRadius = 0.5e-3;
-
 /// A linear wall: condensed on a band of inner-wall nodes around `first_contact` (grown by the
 /// solves), or, for a P2 wall (whose contact candidates include its mid-edge nodes, which a band
 /// of mesh nodes does not hold) or with options.condense_linear_walls off, the whole wall.
@@ -146,9 +142,11 @@ void set_linear_wall(InsertionWall& w, fem::FreeDisplacementSystem system, const
     w.potential = std::make_unique<contact::LinearWall>(std::move(system));
     return;
   }
+  // The first band: contact-models' first candidates, the inner-wall nodes this near the contact.
+  const double radius = contact::ContactModelsOptions{}.band_radius;
   std::vector<int> band;
   for (const int n : mesh.group_nodes(mesh.require_group("inner_wall", 2, "vessel"))) {
-    if ((mesh.nodes[static_cast<std::size_t>(n)] - first_contact).norm() < kFirstBandRadius) {
+    if ((mesh.nodes[static_cast<std::size_t>(n)] - first_contact).norm() < radius) {
       band.push_back(n);
     }
   }
