@@ -20,6 +20,7 @@ constexpr int kMarginRight = 16;
 constexpr int kMarginTop = 30;
 constexpr int kMarginBottom = 46;
 constexpr int kLegendRow = 18;
+constexpr double kLegendText = 38.0;  ///< a legend label's start from its column's edge, px
 
 /// Tick label: plain for moderate values, 1e-5 style for the rest.
 std::string tick_label(double v) {
@@ -97,6 +98,23 @@ void marker(std::ostream& out, int shape, double x, double y, double r, const st
       break;
   }
   out << " fill=\"" << colour << "\" fill-opacity=\"0.85\" stroke=\"#fff\" stroke-width=\"0.6\"/>\n";
+}
+
+/// A legend label's width in pixels at the 12 px font, for laying out the legend: 7 px per code
+/// point, a little over sans-serif's mean glyph (digits and lower case are ~6.7 px).
+double label_width(const std::string& label) {
+  const auto code_points = std::count_if(label.begin(), label.end(), [](char c) {
+    return (static_cast<unsigned char>(c) & 0xC0U) != 0x80U;  // not a UTF-8 continuation byte
+  });
+  return 7.0 * static_cast<double>(code_points);
+}
+
+/// Two legend columns under the plot, or one where a label would not fit in half the width.
+int legend_columns(const Plot& plot, int width) {
+  for (const Series& s : plot.series) {
+    if (kLegendText + label_width(s.label) > width / 2.0) return 1;
+  }
+  return 2;
 }
 
 }  // namespace
@@ -188,7 +206,8 @@ std::string render_svg(const Plot& plot, int width, int height) {
       }
     }
   }
-  const int legend_rows = static_cast<int>((plot.series.size() + 1) / 2);
+  const int columns = legend_columns(plot, width);
+  const int legend_rows = static_cast<int>((plot.series.size() + columns - 1) / columns);
   const int total_height = height + legend_rows * kLegendRow + (left_out ? kLegendRow : 0);
   std::ostringstream out;
   out << std::fixed << std::setprecision(1);  // pixel coordinates; labels are formatted as text
@@ -251,16 +270,19 @@ std::string render_svg(const Plot& plot, int width, int height) {
         marker(out, static_cast<int>(k), px, py, s.emphasis ? 5.0 : 3.6, colour);
       }
     }
-    // Legend entry: two columns under the plot.
-    const double lx = 10.0 + static_cast<double>(k % 2) * (width / 2.0);
-    const double ly = height + kLegendRow * static_cast<double>(k / 2) + 4.0;
+    // Legend entry, in `columns` columns under the plot.
+    const auto column = k % static_cast<std::size_t>(columns);
+    const auto row = k / static_cast<std::size_t>(columns);
+    const double edge = static_cast<double>(column) * (width / 2.0);
+    const double lx = edge + 10.0;
+    const double ly = height + kLegendRow * static_cast<double>(row) + 4.0;
     if (s.lines) {
       out << "<line x1=\"" << lx << "\" y1=\"" << ly << "\" x2=\"" << lx + 22 << "\" y2=\"" << ly
           << "\" stroke=\"" << colour << "\" stroke-width=\"2\""
           << (s.dashed ? " stroke-dasharray=\"5,3\"" : "") << "/>\n";
     }
     if (s.markers) marker(out, static_cast<int>(k), lx + 11, ly, 4.0, colour);
-    out << "<text x=\"" << lx + 28 << "\" y=\"" << ly + 4 << "\">" << escape_xml(s.label)
+    out << "<text x=\"" << edge + kLegendText << "\" y=\"" << ly + 4 << "\">" << escape_xml(s.label)
         << "</text>\n";
   }
   if (left_out) {

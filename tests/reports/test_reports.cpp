@@ -175,6 +175,33 @@ TEST(SvgPlot, RendersSeriesEscapesTextAndCountsPointsALogAxisCannotShow) {
   EXPECT_NE(render_svg(empty).find("no data to plot"), std::string::npos);
 }
 
+// The legend has two columns while every label fits in half the width (7 px a character at the
+// 12 px font, from 38 px past the column's edge), else one: a long label ran off the figure.
+TEST(SvgPlot, ALegendLabelTooLongForHalfTheWidthPutsTheLegendInOneColumn) {
+  const auto plot_with = [](const std::string& second_label) {
+    Plot p;
+    p.title = "legend";
+    for (const std::string& label : {std::string("short"), second_label}) {
+      Series s;
+      s.label = label;
+      s.x = {1.0, 2.0};
+      s.y = {1.0, 2.0};
+      p.series.push_back(s);
+    }
+    return render_svg(p, 640, 360);
+  };
+  // 40 characters (41 bytes: a character of two counts once): 38 + 280 = 318 px ≤ 320, the
+  // second column's label starts at 320 + 38.
+  const std::string fits = plot_with(std::string(39, 'a') + "·");
+  EXPECT_NE(fits.find("height=\"378\""), std::string::npos) << fits;  // 360 + one row of 18
+  EXPECT_NE(fits.find("<text x=\"358.0\""), std::string::npos) << fits;
+  // 41 characters: 325 px, one column, two rows.
+  const std::string wide = plot_with(std::string(41, 'a'));
+  EXPECT_NE(wide.find("height=\"396\""), std::string::npos) << wide;
+  EXPECT_EQ(wide.find("<text x=\"358.0\""), std::string::npos) << wide;
+  EXPECT_EQ(count(wide, "<text x=\"38.0\""), 2u) << wide;
+}
+
 // A series without its own colour is drawn alike in the SVG and in report.html's interactive plot:
 // the palette's colour and marker shape for its index (report.html drew such series grey).
 TEST(Document, AnUnstyledSeriesHasTheSameColourAndShapeInTheSvgAndTheInteractivePlot) {
