@@ -1116,21 +1116,30 @@ struct NewtonOutcome {
   std::string reason;
 };
 
-/// What the last Newton steps needed, for a progress line on long solves.
+/// What the last Newton steps needed, for a progress line on long solves: every kEvery steps, or
+/// sooner once kSeconds have passed (a P2 wall's step takes ~20 s: 25 steps would be minutes of
+/// silence).
 struct RecentSteps {
   static constexpr int kEvery = 25;
+  static constexpr double kSeconds = 60.0;
+  int steps = 0;      ///< since the last line
   int projected = 0;  ///< steps on the PSD-projected model (the exact one not factorisable)
   int curvature = 0;  ///< of those, extended to the trust region's boundary by the exact model
   int steepest = 0;   ///< steps that fell back to steepest descent
   int capped = 0;     ///< steps cut to the largest move
   double move = 0.0;  ///< the steps' node moves summed, r_w
+  Clock::time_point since = Clock::now();  ///< the last line
+  [[nodiscard]] bool due() const {
+    return steps >= kEvery ||
+           (steps > 0 && std::chrono::duration<double>(Clock::now() - since).count() >= kSeconds);
+  }
   void report(std::ostream& log, int step, const NewtonOutcome& out, double shift) {
     log << "potential contact:   step " << step << ", residual " << out.residual << " N, "
-        << out.factorisations << " factorisations; the last " << kEvery << " steps: " << projected
+        << out.factorisations << " factorisations; the last " << steps << " steps: " << projected
         << " on the PSD-projected Hessian (" << curvature
         << " extended to the boundary by the exact curvature), " << steepest
         << " steepest descent, " << capped << " capped at the largest move, mean move "
-        << move / kEvery << " r_w"
+        << move / steps << " r_w"
         << (shift > 0.0 ? ", Levenberg–Marquardt μ " + std::to_string(shift) : std::string())
         << std::endl;
     *this = {};
@@ -1349,7 +1358,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     }
     const bool at_floor = b.residual <= floor && b.complementarity <= o.gap_tolerance;
     if (it == o.max_newton) break;
-    if (o.log && it > 0 && it % RecentSteps::kEvery == 0) recent.report(*o.log, it, out, shift);
+    if (o.log && recent.due()) recent.report(*o.log, it, out, shift);
     const Direction d = search_direction(p, z, g, lin, exact_lin, exact, band, shift, radius,
                                          factor, backoff, recent);
     dz = d.dz;
@@ -1384,6 +1393,7 @@ NewtonOutcome minimise(Coupled& p, VectorXd& z, const PotentialContactOptions& o
     // open again on the far side. Stop there rather than converge outside the lumen.
     p.require_inside_lumen(z, "stopped after Newton step " + std::to_string(it + 1),
                            std::string(": ") + kPassedBetweenNodes);
+    ++recent.steps;
     recent.capped += alpha0 < 1.0 && alpha == alpha0;
     recent.move += alpha * move / p.radius();
     // A stiff wall's forces (K u with K up to ~1e6 N/m) floor ‖∇Π‖ above the target by round-off:
