@@ -71,3 +71,15 @@ TEST(Progress, CountsCasesAndPrintsWhatIsLeft) {
   p.end();
   EXPECT_EQ(p.estimated_remaining_s(), 0.0);  // all done
 }
+
+// A progress line leaves the log's number format as it found it: the lines after it (a contact
+// solve's forces in mN) printed one significant digit ("force 2 mN", "3e+02 s").
+TEST(Progress, LeavesTheLogsNumberFormatAsItFoundIt) {
+  std::ostringstream out;
+  Progress p(out, 1);
+  p.begin("case");
+  p.end();
+  EXPECT_NE(out.str().find("s left"), std::string::npos);
+  out << 1.7841 << " mN";
+  EXPECT_NE(out.str().find("1.7841 mN"), std::string::npos) << out.str();
+}

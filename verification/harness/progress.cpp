@@ -1,6 +1,7 @@
 #include "verification/harness/progress.hpp"
 
 #include <iomanip>
+#include <sstream>
 
 namespace vessel {
 
@@ -15,9 +16,12 @@ double Progress::estimated_remaining_s() const {
 
 void Progress::end() {
   ++done_;
-  out_ << "      done " << done_ << "/" << total_ << ", elapsed " << std::fixed
+  // Formatted apart: the log's own precision and flags stay as its other writers set them.
+  std::ostringstream line;
+  line << "      done " << done_ << "/" << total_ << ", elapsed " << std::fixed
        << std::setprecision(1) << clock_.seconds() << " s, about " << estimated_remaining_s()
-       << " s left" << std::defaultfloat << std::endl;
+       << " s left";
+  out_ << line.str() << std::endl;
 }
 
 }  // namespace vessel
