@@ -469,6 +469,14 @@ GuidewireSpec read_guidewire(const TableReader& r, const VesselParams& vessel) {
   if (contact_key("contact_wall")) {
     w.contact_wall = parse_contact_wall(r.string_or("contact_wall", "linear"));
   }
+  if (const toml::node* start = contact_key("contact_p1_start")) {
+    w.contact_p1_start = r.boolean_or("contact_p1_start");
+    if (w.contact_p1_start && w.contact_wall != ContactWall::neo_hookean) {
+      r.fail(start, "contact_p1_start",
+             "found with a linear contact wall; expected contact_wall = \"neo-hookean\" (the P1 "
+             "start is the finite-strain P2 reference's)");
+    }
+  }
   return w;
 }
 

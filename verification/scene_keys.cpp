@@ -171,6 +171,11 @@ std::vector<Row> guidewire_rows() {
           "reference the finite-strain neo-Hookean FEM wall and each model at its own nonlinear "
           "equilibrium, at every EI (minutes per EI)")
           .dflt("\"linear\"").one_of({"linear", "neo-hookean"}).in(g),
+      Row("load", "contact_p1_start", KeyType::boolean,
+          "Contact coupling with contact_wall = \"neo-hookean\": the P2 reference solved first "
+          "with P1 on the same mesh and P2 from P1's equilibrium (needed in the arch, where P2 "
+          "from rest stalls; it does not pay on the straight tube)")
+          .dflt("false").in(g),
   };
 }
 

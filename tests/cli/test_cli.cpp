@@ -261,6 +261,25 @@ TEST(Cli, SceneSaysWhatAContactCouplingWouldSolveAndRefusesAnUnknownCoupling) {
   const auto neo = vv("scene " + (dir / "neo.toml").string());
   EXPECT_EQ(neo.exit_code, 0) << neo.output;
   EXPECT_TRUE(contains(neo.output, "at finite strain: the neo-Hookean reference")) << neo.output;
+  EXPECT_FALSE(contains(neo.output, "from P1's equilibrium")) << neo.output;
+  // The finite-strain reference's P1 start: said by `scene`, refused beside a linear wall.
+  const std::string neo_text = text;
+  text.replace(text.find("contact_wall = \"neo-hookean\""),
+               std::string("contact_wall = \"neo-hookean\"").size(),
+               "contact_wall = \"neo-hookean\"\ncontact_p1_start = true");
+  write_text(dir / "started.toml", text);
+  const auto started = vv("scene " + (dir / "started.toml").string());
+  EXPECT_EQ(started.exit_code, 0) << started.output;
+  EXPECT_TRUE(contains(started.output, "the neo-Hookean reference from P1's equilibrium"))
+      << started.output;
+  text.replace(text.find("\"neo-hookean\""), std::string("\"neo-hookean\"").size(), "\"linear\"");
+  write_text(dir / "linear_started.toml", text);
+  const auto linear_started = vv("scene " + (dir / "linear_started.toml").string());
+  EXPECT_EQ(linear_started.exit_code, 1) << linear_started.output;
+  EXPECT_TRUE(contains(linear_started.output, "contact_p1_start")) << linear_started.output;
+  EXPECT_TRUE(contains(linear_started.output, "expected contact_wall = \"neo-hookean\""))
+      << linear_started.output;
+  text = neo_text;
   text.replace(text.find("\"neo-hookean\""), std::string("\"neo-hookean\"").size(),
                "\"hyperelastic\"");
   write_text(dir / "unknown.toml", text);

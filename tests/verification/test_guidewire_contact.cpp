@@ -273,6 +273,23 @@ TEST(GuidewireContact, AnEiWhoseSeriesSpringsDentTheWallDeeperThanItIsThickIsNot
   // The run's solve gives the reference wall's factorisations every core of the machine.
   EXPECT_EQ(c.options.reference_threads,
             static_cast<int>(std::max(1U, std::thread::hardware_concurrency())));
+  EXPECT_FALSE(c.options.p2_from_p1);
+}
+
+// The scene's contact_p1_start reaches the solve's options (the P2 reference from P1's
+// equilibrium); nothing is solved, no EI having a hand-written rigid force to start from.
+TEST(GuidewireContact, AScenesP1StartReachesTheFiniteStrainReferencesOptions) {
+  Scene scene = read_scene(VESSEL_SCENES_DIR + "/guidewire_straight.toml");
+  scene.load.guidewire->contact_wall = ContactWall::neo_hookean;
+  scene.load.guidewire->contact_p1_start = true;
+  scene.load.guidewire->stiffness_sweep.clear();
+  scene.load.guidewire->contact_at_own_stiffness_only = true;
+  const contact::ContactModelsOptions o =
+      guidewire_contact_options(scene, GuidewireOutcome{}, HarnessOptions{});
+  EXPECT_TRUE(o.own_equilibrium);
+  EXPECT_TRUE(o.p2_from_p1);
+  scene.load.guidewire->contact_p1_start = false;
+  EXPECT_FALSE(guidewire_contact_options(scene, GuidewireOutcome{}, HarnessOptions{}).p2_from_p1);
 }
 
 // contact_wall = "neo-hookean": the EI the linear wall refuses (series springs 1.4 mm into the

@@ -495,8 +495,10 @@ std::string describe_guidewire_solve(const GuidewireSpec& spec) {
     s << "; coupling contact: `vesselverify run` would then press each model's wall and the FEM "
          "P2 wall"
       << (spec.contact_wall == ContactWall::neo_hookean
-              ? " (at finite strain: the neo-Hookean reference, each model at its own equilibrium)"
-              : " (linearised at rest)")
+              ? std::string(" (at finite strain: the neo-Hookean reference") +
+                    (spec.contact_p1_start ? " from P1's equilibrium" : "") +
+                    ", each model at its own equilibrium)"
+              : std::string(" (linearised at rest)"))
       << " with the wire in a contact solve at the wire's EI and each of stiffness_sweep on a "
          "mesh refined to "
       << spec.contact_fine_size * 1e3 << " mm within " << spec.contact_fine_radius * 1e3

@@ -114,6 +114,10 @@ struct GuidewireSpec {
   /// dent the reference's wall deeper than it is thick is not solved (a linear wall cannot hold
   /// the wire there); neo_hookean: every EI.
   ContactWall contact_wall = ContactWall::linear;
+  /// Contact coupling at finite strain: the P2 reference solved first with P1 on the same mesh
+  /// and P2 from P1's equilibrium (in the arch P2 from rest stalls; on the straight tube the
+  /// start does not pay: contact.md).
+  bool contact_p1_start = false;
   /// Contact coupling: the contact solved at the wire's own EI alone, not at stiffness_sweep's
   /// (the series springs still are). Not a scene key: set by the quick variant.
   bool contact_at_own_stiffness_only = false;

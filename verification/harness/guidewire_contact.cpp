@@ -239,11 +239,11 @@ std::string not_solved(const Scene& scene, const GuidewireOutcome& coupled, doub
   return beyond_the_linear_wall(scene, coupled, EI);
 }
 
-/// The scene's solve options: the EIs its walls can hold (the wire's own alone in the quick
-/// variant), the contact mesh's size and refined radius, the wire and each wall as one potential
-/// (linear walls condensed on the band; at finite strain each at its own equilibrium).
-contact::ContactModelsOptions contact_options(const Scene& scene, const GuidewireOutcome& coupled,
-                                              const HarnessOptions& options) {
+}  // namespace
+
+contact::ContactModelsOptions guidewire_contact_options(const Scene& scene,
+                                                        const GuidewireOutcome& coupled,
+                                                        const HarnessOptions& options) {
   const GuidewireSpec& spec = *scene.load.guidewire;
   contact::ContactModelsOptions o;
   for (const double EI : contact_stiffnesses(spec)) {
@@ -253,6 +253,7 @@ contact::ContactModelsOptions contact_options(const Scene& scene, const Guidewir
       options.contact_fine_size > 0.0 ? options.contact_fine_size : spec.contact_fine_size;
   o.fine_radius = spec.contact_fine_radius;
   o.own_equilibrium = spec.contact_wall == ContactWall::neo_hookean;
+  o.p2_from_p1 = spec.contact_p1_start;
   // The solve runs alone, after the models' runs: the reference wall's factorisations get every
   // core (the models' stay on one, their times a simulator's).
   o.reference_threads = machine_cores();
@@ -262,8 +263,6 @@ contact::ContactModelsOptions contact_options(const Scene& scene, const Guidewir
   if (!o.own_equilibrium) o.bearing_band_size = 0.0;
   return o;
 }
-
-}  // namespace
 
 std::optional<double> worst_contact_force_error_mN(const GuidewireContact& contact,
                                                    const std::string& model, std::string& why) {
@@ -300,7 +299,7 @@ GuidewireContact solve_guidewire_contact(const Scene& scene, const GuidewireOutc
                                          const HarnessOptions& options) {
   GuidewireContact c;
   c.wall = scene.load.guidewire->contact_wall;
-  c.options = contact_options(scene, coupled, options);
+  c.options = guidewire_contact_options(scene, coupled, options);
   std::vector<ModelSpec> walls;
   std::vector<std::string> names;
   for (const ModelSpec& m : scene.models) {

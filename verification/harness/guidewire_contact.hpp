@@ -54,6 +54,14 @@ struct GuidewireContact {
 std::optional<double> worst_contact_force_error_mN(const GuidewireContact& contact,
                                                    const std::string& model, std::string& why);
 
+/// The options of `scene`'s contact solve: the EIs its walls can hold (the wire's own alone in the
+/// quick variant), the contact mesh's size and refined radius, the wire and each wall as one
+/// potential (linear walls condensed on the band; at finite strain each at its own equilibrium,
+/// the P2 reference from P1's where the scene asks, contact_p1_start).
+contact::ContactModelsOptions guidewire_contact_options(const Scene& scene,
+                                                        const GuidewireOutcome& coupled,
+                                                        const HarnessOptions& options);
+
 /// The contact of `scene` (coupling = "contact") at guidewire_stiffnesses, its solve read from
 /// options.outcome_cache when a run of the same executable on this machine kept it (keyed by the
 /// scene file's text and the solve's options); the shortcuts from `coupled` (its rigid forces and
