@@ -276,8 +276,8 @@ TEST(GuidewireContact, AnEiWhoseSeriesSpringsDentTheWallDeeperThanItIsThickIsNot
   EXPECT_FALSE(c.options.p2_from_p1);
 }
 
-// The scene's contact_p1_start reaches the solve's options (the P2 reference from P1's
-// equilibrium); nothing is solved, no EI having a hand-written rigid force to start from.
+// The scene's contact_p1_start reaches the run's contact-solve options (the P2 reference from
+// P1's equilibrium); the options alone are built, nothing is solved.
 TEST(GuidewireContact, AScenesP1StartReachesTheFiniteStrainReferencesOptions) {
   Scene scene = read_scene(VESSEL_SCENES_DIR + "/guidewire_straight.toml");
   scene.load.guidewire->contact_wall = ContactWall::neo_hookean;
