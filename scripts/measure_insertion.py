@@ -61,9 +61,11 @@ def run_here(args, svg):
     if proc.returncode != 0:
         sys.exit(f"measure_insertion.py: `{' '.join(cmd)}` exited {proc.returncode}:\n"
                  f"{proc.stderr}")
-    head = (f"`{shown(' '.join(cmd), args.program)}`: {seconds:.0f} s, load average {before} "
-            f"before, {load_average()} after.")
-    return head, shown(proc.stdout, args.program)
+    # The figure's temporary folder is no part of what a reader would type.
+    here = os.path.dirname(svg) + "/"
+    head = (f"`{shown(' '.join(cmd), args.program).replace(here, '')}`: {seconds:.0f} s, load "
+            f"average {before} before, {load_average()} after.")
+    return head, shown(proc.stdout, args.program).replace(here, "")
 
 
 def saved_run(args, svg):
