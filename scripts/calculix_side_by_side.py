@@ -21,6 +21,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from measurement_host import load_average
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # C3D10's midside nodes 5..10 sit on the corner pairs (1,2), (2,3), (3,1), (1,4), (2,4), (3,4);
@@ -134,10 +135,6 @@ def timed(cmd, cwd, env):
         sys.exit(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}")
     wall, rss = re.findall(r"TIMED ([\d.]+) (\d+)", p.stderr)[-1]
     return float(wall), int(rss) / 1024, p.stdout
-
-
-def load_average():
-    return open("/proc/loadavg").read().split()[0]
 
 
 def main():

@@ -31,14 +31,10 @@ import subprocess
 import sys
 import tempfile
 import time
+from measurement_host import load_average
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT_HEADERS = ["verification/harness/harness.hpp", "msm/form/form.hpp", "meshes/tet_mesh.hpp"]
-
-
-def load_average():
-    with open("/proc/loadavg") as f:
-        return f.read().split()[0]
 
 
 def configure(build, ccache, extra):

@@ -20,6 +20,7 @@ import re
 import subprocess
 import sys
 import tempfile
+from measurement_host import load_average
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MPIRUN = ["mpirun", "--allow-run-as-root", "--oversubscribe", "--mca", "mpi_yield_when_idle", "1"]
@@ -27,11 +28,6 @@ CASES = {"p2": ["--degree", "2", "--nu", "0.45"], "th": ["--nu", "0.5"]}
 SERIAL = {"p2": [("CHOLMOD", "direct"), ("AMG-CG", "cg-amg")],
           "th": [("UMFPACK", "direct"), ("FGMRES", "gmres-block")]}
 DISTRIBUTED = {"p2": ["cg-amg", "matrix-free"], "th": ["gmres-block"]}
-
-
-def load_average():
-    with open("/proc/loadavg") as f:
-        return f.read().split()[0]
 
 
 def run(command, json_path, peak_base, log):

@@ -26,6 +26,7 @@ import re
 import subprocess
 import sys
 import time
+from measurement_host import load_average, machine
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -39,23 +40,6 @@ PATCH_FORCES = {
         4e-5: (5.859, 5.381, 5.037),
     },
 }
-
-
-def load_average():
-    with open("/proc/loadavg") as f:
-        return f.read().split()[0]
-
-
-def machine():
-    cpu = "unknown CPU"
-    with open("/proc/cpuinfo") as f:
-        for line in f:
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    with open("/proc/meminfo") as f:
-        mem_kib = int(f.readline().split()[1])
-    return f"{cpu}, {os.cpu_count()} cores, {mem_kib / 2**20:.0f} GiB"
 
 
 def main():

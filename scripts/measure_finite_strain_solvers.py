@@ -21,13 +21,9 @@ import re
 import subprocess
 import sys
 import tempfile
+from measurement_host import load_average
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-def load_average():
-    with open("/proc/loadavg") as f:
-        return f.read().split()[0]
 
 
 def run(vv, level, solver, threads, env):

@@ -20,15 +20,11 @@ import re
 import subprocess
 import sys
 import tempfile
+import measurement_host
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # (structured level, tube length m): P2 DoFs from about 4 thousand to 230 thousand
 CASES = [(0, 0.005), (0, 0.01), (0, 0.015), (0, 0.02), (0, 0.04), (1, 0.01), (1, 0.04)]
-
-
-def load_average():
-    with open("/proc/loadavg") as f:
-        return float(f.read().split()[0])
 
 
 def run(vv, level, length, solver, env):
@@ -75,7 +71,7 @@ def main():
         for k in range(args.repeats):
             order = ("direct", "matrix-free") if k % 2 == 0 else ("matrix-free", "direct")
             for solver in order:
-                loads.append(load_average())
+                loads.append(float(measurement_host.load_average()))
                 r = run(args.vesselverify, level, length, solver, env)
                 if solver not in best or r["paid"] < best[solver]["paid"]:
                     best[solver] = r

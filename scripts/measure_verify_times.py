@@ -18,27 +18,10 @@ import shutil
 import subprocess
 import sys
 import tempfile
+from measurement_host import load_average, machine
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MODES = {"default": [], "quick": ["--quick"]}
-
-
-def load_average():
-    with open("/proc/loadavg") as f:
-        return f.read().split()[0]
-
-
-def machine():
-    """CPU model, cores and memory, as the page names the machine."""
-    cpu = "unknown CPU"
-    with open("/proc/cpuinfo") as f:
-        for line in f:
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    with open("/proc/meminfo") as f:
-        mem_kib = int(f.readline().split()[1])
-    return f"{cpu}, {os.cpu_count()} cores, {mem_kib / 2**20:.0f} GiB"
 
 
 def run_verify(mode, cache, out):
