@@ -96,7 +96,7 @@ void coupled_table(Document& doc, const GuidewireRows& g) {
           row.end(),
           {significant(r.force_mN), significant(r.reference_force_mN),
            significant(r.force_mN - r.reference_force_mN), significant(r.displacement_mm),
-           significant(r.reference_displacement_mm),
+           significant(r.reference_displacement_mm) + (r.reference_within_wall ? "" : " ✗"),
            significant(r.slide_mm) + (r.within_patch ? "" : " ⚠"),
            optional_number(r.field_relative_l2_rigid), optional_number(r.field_relative_l2)});
     }
@@ -124,7 +124,9 @@ void guidewire_section(Document& doc, const SceneRows& s) {
                 "each model gets its own force (docs/rods.md), and its field error is given at the "
                 "rigid wire's force (both walls under the same load) and with each wall under its "
                 "own coupled force. ⚠: the wire's contact slid out of the load's patch, outside "
-                "the coupling's validity.");
+                "the coupling's validity. ✗: the series springs dent the reference's wall deeper "
+                "than it is thick: no linear wall holds the wire there, and the row's figures are "
+                "the springs' arithmetic, not a state of the vessel.");
   doc.table(rigid);
   if (!g.coupled.empty()) coupled_table(doc, g);
   if (g.contact) contact_tables(doc, *g.contact);

@@ -184,6 +184,7 @@ GuidewireRows read_guidewire(const json& g, const std::string& where) {
       c.reference_displacement_mm = field<double>(r, "reference_contact_displacement_mm", rw);
       c.slide_mm = field<double>(r, "slide_mm", rw);
       c.within_patch = field<bool>(r, "within_patch", rw);
+      c.reference_within_wall = field_or<bool>(r, "reference_within_wall", true, rw);
       c.field_relative_l2_rigid = json_fields::optional_field<double>(r, "field_relative_l2_rigid", rw);
       c.field_relative_l2 = json_fields::optional_field<double>(r, "field_relative_l2", rw);
     }

@@ -122,6 +122,9 @@ struct GuidewireCoupledRow {
   double poisson_ratio = 0.0, bending_stiffness = 0.0;
   int level = 0;
   bool ok = false, within_patch = true;
+  /// The series springs dent the reference's wall no deeper than it is thick (true in results
+  /// files from before the field).
+  bool reference_within_wall = true;
   double force_mN = 0.0, reference_force_mN = 0.0;
   double displacement_mm = 0.0, reference_displacement_mm = 0.0, slide_mm = 0.0;
   /// The field's relative L2 error at the rigid wire's force and at each wall's coupled force.

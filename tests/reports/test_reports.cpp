@@ -574,7 +574,8 @@ TEST(Gate, TimingsAreComparedNormalisedByTheReferenceKernel) {
 
 TEST(GuidewireSection, TheWiresForcesAndEachModelsCoupledForceAsResultsJsonGivesThem) {
   // The fixture's results with a guidewire block written by hand: two stiffnesses against the
-  // rigid lumen, a coupled row inside the patch, one that slid out of it, and a failed one.
+  // rigid lumen, a coupled row inside the patch, one that slid out of it and whose reference wall
+  // is dented deeper than it is thick, and a failed one.
   auto j = nlohmann::json::parse(test::read_text(
       std::filesystem::path(VESSEL_REPORT_FIXTURE) / "results.json"));
   const auto row = [](const std::string& model, double ei, bool within) {
@@ -597,6 +598,7 @@ TEST(GuidewireSection, TheWiresForcesAndEachModelsCoupledForceAsResultsJsonGives
         {{"bending_stiffness_Nm2", 4e-5}, {"contact_force_N", 4.707e-2},
          {"wire_compliance_m_per_N", 0.0695}}}},
       {"coupling_rows", {row("fem_p1", 4e-7, true), row("other_springs", 4e-5, false), failed}}};
+  j["scenes"][0]["guidewire"]["coupling_rows"][1]["reference_within_wall"] = false;
   const ResultsFile r = parse_results(j.dump(), "results.json");
   ASSERT_TRUE(r.scenes[0].guidewire.has_value());
   const GuidewireRows& g = *r.scenes[0].guidewire;
@@ -610,6 +612,9 @@ TEST(GuidewireSection, TheWiresForcesAndEachModelsCoupledForceAsResultsJsonGives
   EXPECT_EQ(count(md, "| fem_p1 | 0.45 | 0 | 4e-07 | 0.45 | 0.44 | 0.01 | 0.15 | 0.21 | 0.02 |"), 1u)
       << md;
   EXPECT_EQ(count(md, "| 1.5 ⚠ |"), 1u) << md;
+  // The row without the field (results from before it) is not marked.
+  EXPECT_TRUE(g.coupled[0].reference_within_wall);
+  EXPECT_EQ(count(md, "| 0.21 ✗ |"), 1u) << md;
   EXPECT_EQ(count(md, "failed: secant did not converge"), 1u) << md;
   // A scene without a wire has no such section.
   j["scenes"][0].erase("guidewire");

@@ -7,10 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <numbers>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+#include <string>
 
 #include "../schema_check.hpp"
 #include "../test_helpers.hpp"
@@ -238,6 +238,24 @@ TEST(GuidewireCoupling, RowsPerModelAndStiffnessFromTheOutcomesIndentation) {
   // A stiffer wire is closer to displacement control: its force falls further below the rigid one.
   EXPECT_LT(g.rows[2].force_mN / (g.rigid[2].solution.force * 1e3),
             g.rows[1].force_mN / (g.rigid[1].solution.force * 1e3));
+  // The reference's dent C_ref·F_ref against the wall's 1 mm. The springs keep
+  // F_ref = F_rigid·C_r/(C_r + C_ref), C_r the wire's compliance (6.95 m/N at EI 4e-7, a tenth
+  // per decade of EI) and F_rigid 0.471 mN × EI/4e-7: by hand 0.439 / 2.74 / 5.75 mN, dents 0.22 /
+  // 1.37 / 2.87 mm. The stiff wires' rows dent the wall deeper than it is thick and are marked.
+  ASSERT_DOUBLE_EQ(s.vessel.wall_thickness, 1e-3);
+  const nlohmann::json rows = guidewire_json(g)["coupling_rows"];
+  const std::vector<bool> within{true, false, false};
+  std::ostringstream md;
+  write_guidewire_markdown(md, g);
+  for (std::size_t k = 0; k < g.rows.size(); ++k) {
+    EXPECT_EQ(rows[k]["reference_within_wall"].get<bool>(), within[k])
+        << "EI " << g.rows[k].bending_stiffness;
+  }
+  const std::string text = md.str();
+  std::size_t marked = 0;
+  for (auto at = text.find(" ✗ |"); at != std::string::npos; at = text.find(" ✗ |", at + 1))
+    ++marked;
+  EXPECT_EQ(marked, 2u) << text;
 }
 
 TEST(GuidewireResults, CentrelineRunsFromTheScenesClampToTheContactPointOnTheWall) {

@@ -55,6 +55,9 @@ struct GuidewireCouplingRow {
 struct GuidewireOutcome {
   GuidewireSpec spec;
   double patch_radius = 0.0;  ///< m: a coupled contact that slid farther has left the patch
+  /// m: the vessel's wall thickness; a row whose reference wall the series springs dent deeper
+  /// (C_ref·F_ref) is beyond every linear wall (reference_within_wall)
+  double wall_thickness = 0.0;
   std::vector<GuidewireRigid> rigid;       ///< the scene's EI first, then the stiffness sweep's
   std::vector<GuidewireCouplingRow> rows;  ///< compliant coupling: per EI, per model outcome
 };

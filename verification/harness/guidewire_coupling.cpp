@@ -111,6 +111,14 @@ double slide_mm(const GuidewireOutcome& g, const GuidewireCouplingRow& r) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
+/// Whether the series springs leave the reference's wall dented (C_ref·F_ref) no deeper than it
+/// is thick: deeper, no linear wall holds the wire (the contact coupling does not solve such an EI,
+/// guidewire_contact.cpp), and the row's figures are the springs' arithmetic, not a state of the
+/// vessel.
+bool reference_within_wall(const GuidewireOutcome& g, const GuidewireCouplingRow& r) {
+  return !(r.reference_displacement_mm > g.wall_thickness * 1e3);
+}
+
 nlohmann::json finite_or_null(double x) {
   return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
 }
@@ -138,6 +146,7 @@ GuidewireOutcome couple_guidewire(const Scene& s, const std::vector<ModelOutcome
   GuidewireOutcome g;
   g.spec = *s.load.guidewire;
   g.patch_radius = s.load.contact.radius;
+  g.wall_thickness = s.vessel.wall_thickness;
   for (const double EI : guidewire_stiffnesses(g.spec)) couple_at(s, EI, outcomes, g);
   return g;
 }
@@ -174,7 +183,13 @@ void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g) {
   if (g.rows.empty()) return;
   out << "The lumen gives way as a whole, so the wire's contact node slides along the wall (slide); "
          "⚠: it left the load's patch (radius "
-      << g.patch_radius * 1e3 << " mm), and the row is outside the coupling's validity.\n\n";
+      << g.patch_radius * 1e3
+      << " mm), and the row is outside the coupling's validity. ✗: the series springs dent the "
+         "reference's wall deeper than it is thick ("
+      << g.wall_thickness * 1e3
+      << " mm): no linear wall holds the wire there, so the row's figures are the springs' "
+         "arithmetic, not a state of the vessel (the finite-strain contact: contact_wall = "
+         "\"neo-hookean\" in the scene, or vesselverify contact-models --own-equilibrium).\n\n";
   out << "| model | ν | level | EI N·m² | C m/N | C_ref m/N | force mN | reference mN | error mN | "
          "contact displ. mm | reference mm | error mm | slide mm | field rel. L2 rigid | "
          "field rel. L2 coupled |\n"
@@ -188,10 +203,11 @@ void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g) {
     }
     out << r.wall_compliance << " | " << r.reference_compliance << " | " << r.force_mN << " | "
         << r.reference_force_mN << " | " << r.force_mN - r.reference_force_mN << " | "
-        << r.displacement_mm << " | " << r.reference_displacement_mm << " | "
-        << r.displacement_mm - r.reference_displacement_mm << " | "
-        << slide_mm(g, r) << (slide_mm(g, r) > g.patch_radius * 1e3 ? " ⚠" : "") << " | "
-        << r.field_relative_l2_rigid << " | " << r.field_relative_l2 << " |\n";
+        << r.displacement_mm << " | " << r.reference_displacement_mm
+        << (reference_within_wall(g, r) ? "" : " ✗") << " | "
+        << r.displacement_mm - r.reference_displacement_mm << " | " << slide_mm(g, r)
+        << (slide_mm(g, r) > g.patch_radius * 1e3 ? " ⚠" : "") << " | " << r.field_relative_l2_rigid
+        << " | " << r.field_relative_l2 << " |\n";
   }
   out << "\n";
 }
@@ -231,6 +247,7 @@ nlohmann::json guidewire_json(const GuidewireOutcome& g) {
                     {"contact_point_mm", vec_mm(r.contact_point)},
                     {"slide_mm", slide_mm(g, r)},
                     {"within_patch", slide_mm(g, r) <= g.patch_radius * 1e3},
+                    {"reference_within_wall", reference_within_wall(g, r)},
                     {"contact_displacement_error_mm", r.displacement_mm - r.reference_displacement_mm},
                     {"field_relative_l2_rigid", finite_or_null(r.field_relative_l2_rigid)},
                     {"field_relative_l2", finite_or_null(r.field_relative_l2)},
