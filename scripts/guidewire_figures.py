@@ -5,7 +5,9 @@
   plane of its contact (mm);
 - <scene>_guidewire_forces.png: each model's coupled contact force over the reference's and over
   the rigid wire's, against EI (compliant coupling). F/F_rigid near 1 is force control (the wire
-  is the soft spring), falling with EI is displacement control (the wall is).
+  is the soft spring), falling with EI is displacement control (the wall is). A hollow marker is a
+  row whose springs dent the reference's wall deeper than it is thick (reference_within_wall
+  false): the springs' arithmetic, not a state of the vessel.
 
 Usage: /usr/bin/python3 scripts/guidewire_figures.py results.json output-dir
 """
@@ -60,8 +62,12 @@ def force_figure(scene, out):
     for m in models:
         mine = sorted((r for r in rows if r["model"] == m), key=lambda r: r["bending_stiffness_Nm2"])
         ei = [r["bending_stiffness_Nm2"] for r in mine]
-        a1.plot(ei, [r["force_mN"] / rigid[r["bending_stiffness_Nm2"]] for r in mine], "o-", label=m)
-        a2.plot(ei, [r["force_mN"] / r["reference_force_mN"] for r in mine], "o-", label=m)
+        held = [r.get("reference_within_wall", True) for r in mine]
+        for a, y in ((a1, [r["force_mN"] / rigid[r["bending_stiffness_Nm2"]] for r in mine]),
+                     (a2, [r["force_mN"] / r["reference_force_mN"] for r in mine])):
+            (line,) = a.plot(ei, y, "-", label=m)
+            for x, v, h in zip(ei, y, held):
+                a.plot([x], [v], "o", color=line.get_color(), mfc=line.get_color() if h else "none")
     ref = sorted((r for r in rows if r["model"] == models[0]), key=lambda r: r["bending_stiffness_Nm2"])
     a1.plot([r["bending_stiffness_Nm2"] for r in ref],
             [r["reference_force_mN"] / rigid[r["bending_stiffness_Nm2"]] for r in ref], "k--",
@@ -75,7 +81,9 @@ def force_figure(scene, out):
     a2.set_ylabel("F_model / F_reference")
     a2.set_title("contact-force error")
     a1.legend(fontsize=7)
-    fig.suptitle(scene["name"] + ": coupled contact force (linear walls)")
+    beyond = any(not r.get("reference_within_wall", True) for r in rows)
+    fig.suptitle(scene["name"] + ": coupled contact force (linear walls)"
+                 + ("; hollow: the wall dented deeper than it is thick" if beyond else ""))
     fig.tight_layout()
     fig.savefig(out / (scene["name"] + "_guidewire_forces.png"), dpi=120)
     plt.close(fig)
