@@ -74,7 +74,8 @@ def saved_run(args, svg):
     head = (f"`{value['command'] or 'vesselverify insertion'}`: {seconds:.0f} s (a run by hand, "
             f"beside other work), load average {value['before'] or 'not recorded'} before, "
             f"{value['after'] or 'not recorded'} after.")
-    return head, shown(stdout, args.program)
+    # The run's own figure path is no part of what a reader would type either.
+    return head, shown(stdout, args.program).replace(os.path.abspath(folder) + "/", "")
 
 
 def main():
