@@ -205,8 +205,8 @@ std::vector<double> contact_stiffnesses(const GuidewireSpec& spec) {
 std::string beyond_the_linear_wall(const Scene& scene, const GuidewireOutcome& coupled, double EI) {
   for (const GuidewireRigid& r : coupled.rigid) {
     if (!same_stiffness(r.bending_stiffness, EI)) continue;
+    if (reference_within_wall(r, scene.vessel.wall_thickness)) return {};
     const double dent = r.reference_compliance * r.reference_force;
-    if (!(dent > scene.vessel.wall_thickness)) return {};
     return "not solved: the series springs put the reference's wall " + fmt("%.2f", dent * 1e3) +
            " mm in under " + fmt("%.3f", r.reference_force * 1e3) +
            " mN, deeper than the wall is thick (" + fmt("%.2f", scene.vessel.wall_thickness * 1e3) +

@@ -22,6 +22,12 @@ GuidewireOutcome couple_guidewire(const Scene& scene, const std::vector<ModelOut
 /// stiffness_sweep that differs from it by more than 1e-3 (relative).
 std::vector<double> guidewire_stiffnesses(const GuidewireSpec& spec);
 
+/// Whether the series springs leave the reference's wall at `rigid`'s EI dented (C_ref·F_ref) no
+/// deeper than `wall_thickness` (m). Deeper, no linear wall holds the wire: the contact coupling
+/// does not solve that EI, and the compliant rows at it are the springs' arithmetic, not a state
+/// of the vessel (marked in summary.md, results.json's reference_within_wall and the report).
+bool reference_within_wall(const GuidewireRigid& rigid, double wall_thickness);
+
 /// summary.md's guidewire section: the wire against the rigid lumen per EI, and the coupled
 /// contact force of each model beside the reference's (mN), with the contact displacements (mm).
 void write_guidewire_markdown(std::ostream& out, const GuidewireOutcome& g);
